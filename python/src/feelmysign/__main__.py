@@ -1,0 +1,5 @@
+import sys
+
+from feelmysign.cli import main
+
+sys.exit(main())
