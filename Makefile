@@ -35,8 +35,7 @@ system:
 	fi
 
 lint: $(STAMP)
-	cd python && ../$(BIN)/ruff check . && ../$(BIN)/ruff format --check .
-	$(BIN)/ruff check testdata && $(BIN)/ruff format --check testdata
+	cd python && ../$(BIN)/ruff check . ../testdata && ../$(BIN)/ruff format --check . ../testdata
 
 typecheck: $(STAMP)
 	cd python && ../$(BIN)/mypy

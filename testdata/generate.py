@@ -3,6 +3,7 @@
 
     python testdata/generate.py          # (re)write the vectors
     python testdata/generate.py --check  # exit 1 if any file differs or is stale
+    python testdata/generate.py planner  # only some parts
 
 One module per part (``gen_<part>.py`` beside this file) returns its cases as
 ``{relative path: JSON-able dict}``; this script writes them with a stable
@@ -27,10 +28,10 @@ def render(case: dict[str, object]) -> str:
     return json.dumps({"_generated": HEADER, **case}, indent=1, sort_keys=False) + "\n"
 
 
-def collect() -> dict[Path, str]:
+def collect(parts: list[str]) -> dict[Path, str]:
     sys.path.insert(0, str(HERE))
     files: dict[Path, str] = {}
-    for part in PARTS:
+    for part in parts:
         module = importlib.import_module(f"gen_{part}")
         for relative, case in module.cases().items():
             files[HERE / part / relative] = render(case)
@@ -40,9 +41,11 @@ def collect() -> dict[Path, str]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--check", action="store_true", help="compare instead of writing")
+    parser.add_argument("parts", nargs="*", choices=[[], *PARTS], help="parts (default: all)")
     args = parser.parse_args()
-    files = collect()
-    existing = {p for part in PARTS for p in (HERE / part).glob("**/*.json")}
+    parts = args.parts or list(PARTS)
+    files = collect(parts)
+    existing = {p for part in parts for p in (HERE / part).glob("**/*.json")}
     stale = sorted(existing - set(files))
     changed = sorted(p for p, text in files.items() if not p.exists() or p.read_text() != text)
     if args.check:

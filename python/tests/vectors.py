@@ -14,4 +14,7 @@ def load(part: str) -> list[tuple[str, dict[str, Any]]]:
     paths = sorted((TESTDATA / part).glob("**/*.json"))
     if not paths:
         raise FileNotFoundError(f"no vectors in {TESTDATA / part}; run `make vectors`")
-    return [(str(p.relative_to(TESTDATA / part).with_suffix("")), json.loads(p.read_text())) for p in paths]
+    return [
+        (str(p.relative_to(TESTDATA / part).with_suffix("")), json.loads(p.read_text()))
+        for p in paths
+    ]

@@ -25,14 +25,26 @@ class StrokeError(FeelMySignError):
 
 
 class LayoutError(FeelMySignError):
-    """A sleeve layout file that is wrong; ``problems`` lists every problem found, not only the first."""
+    """A sleeve layout that is wrong; ``problems`` lists every problem found, not only the first."""
 
     def __init__(self, source: str, problems: list[str]) -> None:
         self.source = source
         self.problems = list(problems)
         lines = "\n".join(f"  - {p}" for p in self.problems)
-        super().__init__(f"{source}: {len(self.problems)} problem(s) in the sleeve layout:\n{lines}")
+        super().__init__(
+            f"{source}: {len(self.problems)} problem(s) in the sleeve layout:\n{lines}"
+        )
 
 
 class HardwareError(FeelMySignError):
     """Hardware that did not answer or answered wrongly (an I2C chip, a multiplexer channel)."""
+
+
+class ParameterError(FeelMySignError, ValueError):
+    """A parameter outside its allowed range; carries the name, the value and the range."""
+
+    def __init__(self, name: str, value: object, allowed: str) -> None:
+        self.name = name
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"{name} = {value!r} is not allowed; it must be {allowed}")

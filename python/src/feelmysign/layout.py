@@ -1,14 +1,62 @@
 """The sleeve's geometry, safety caps and wiring, from one validated TOML file.
 
-(Skeleton: the dataclasses are final; loading and validation are being written.)
+A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
+
+    name = "paper-sleeve"
+    rows = 3                      # actuators along y (row index 0..rows-1)
+    columns = 4                   # actuators along x (column index 0..columns-1)
+    spacing_cm = 3.0              # centre-to-centre distance between neighbours
+    actuator_type = "ERM"         # ERM or LRA
+    default_intensity = 0.8       # for strokes that do not say, 0..1
+
+    [safety]
+    max_intensity = 1.0           # no actuator is driven above this, 0..1
+    max_stroke_duration_ms = 10000
+    max_on_time_ms = 5000         # longest continuous on-time of one actuator
+
+    [i2c]
+    bus = 1                       # /dev/i2c-1
+    multiplexers = [0x70, 0x71]   # TCA9548A addresses
+    wiring = [
+      { row = 0, column = 0, multiplexer = 0x70, channel = 0 },
+      ...
+    ]
+
+The whole file is checked before anything drives a motor, and every problem is
+reported at once (a ``LayoutError`` with ``problems``), each naming the key, the
+bad value and the allowed range.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal
+import difflib
+import json
+import math
+import sys
+from dataclasses import dataclass, fields
+from os import PathLike
+from pathlib import Path
+from typing import Any, Literal
+
+from feelmysign.errors import LayoutError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 ActuatorType = Literal["ERM", "LRA"]
+ACTUATOR_TYPES: tuple[ActuatorType, ...] = ("ERM", "LRA")
+
+MAX_GRID_SIDE = 64  # rows or columns; 8 multiplexers x 8 channels drive 64 actuators at most
+MIN_ACTUATORS = 2  # a stroke moves between actuators; one cannot draw anything
+MAX_SPACING_CM = 20.0  # wider than any forearm or back grid; catches millimetres typed as cm
+MAX_DURATION_MS = 600_000.0  # 10 minutes; catches microseconds typed as milliseconds
+MUX_ADDRESSES = range(0x70, 0x78)  # TCA9548A: pins A0..A2 select 0x70..0x77
+MUX_CHANNELS = 8  # TCA9548A channels 0..7; one DRV2605L (fixed address 0x5A) per channel
+MAX_I2C_BUS = 255  # the N of /dev/i2c-N
+MAX_NAME_CHARS = 64
+NAME_FORBIDDEN = "/+#"  # the name may appear in MQTT topics, where these are special
 
 
 @dataclass(frozen=True)
@@ -41,3 +89,412 @@ class Layout:
     i2c_bus: int = 1
     multiplexers: tuple[int, ...] = ()
     wiring: tuple[Wire, ...] = ()
+
+
+_DEFAULTS = Layout(rows=1, columns=MIN_ACTUATORS, spacing_cm=1.0)
+_TOP_KEYS = ("name", "rows", "columns", "spacing_cm", "actuator_type", "default_intensity")
+_SAFETY_KEYS = ("max_intensity", "max_stroke_duration_ms", "max_on_time_ms")
+_I2C_KEYS = ("bus", "multiplexers", "wiring")
+_WIRE_KEYS = ("row", "column", "multiplexer", "channel")
+_MEANINGS = {
+    "rows": "the number of actuator rows",
+    "columns": "the number of actuator columns",
+    "spacing_cm": "the distance between neighbouring actuators in cm",
+    "row": "the actuator's row",
+    "column": "the actuator's column",
+    "multiplexer": "the address of the actuator's multiplexer",
+    "channel": "the multiplexer channel of the actuator's DRV2605L",
+}
+_MISSING: Any = object()  # a key that is not in the file (None is not a TOML value either)
+
+
+def load_layout(path: str | PathLike[str]) -> Layout:
+    """Read and validate a layout file; LayoutError names the path and every problem."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise LayoutError(
+            source,
+            ["file not found; check the path, or see deploy/layouts/ for example layouts"],
+        ) from None
+    except UnicodeDecodeError as error:
+        raise LayoutError(
+            source, [f"not UTF-8 text (byte {error.start}); save the file as UTF-8"]
+        ) from None
+    except OSError as error:
+        raise LayoutError(source, [f"cannot read the file: {error.strerror}"]) from None
+    return parse_layout(text, source)
+
+
+def parse_layout(text: str, source: str = "<string>") -> Layout:
+    """Validate a layout given as TOML text; ``source`` names it in error messages."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise LayoutError(source, [f"not valid TOML: {error}"]) from None
+    return _build(data, source)
+
+
+def grid_layout(
+    rows: int,
+    columns: int,
+    spacing_cm: float,
+    *,
+    name: str = "grid",
+    default_intensity: float = _DEFAULTS.default_intensity,
+    max_intensity: float = _DEFAULTS.max_intensity,
+    max_stroke_duration_ms: float = _DEFAULTS.max_stroke_duration_ms,
+    max_on_time_ms: float = _DEFAULTS.max_on_time_ms,
+    actuator_type: ActuatorType = _DEFAULTS.actuator_type,
+) -> Layout:
+    """A validated layout without wiring: for the simulator, the planner and the CLI."""
+    layout = Layout(
+        rows=rows,
+        columns=columns,
+        spacing_cm=spacing_cm,
+        name=name,
+        default_intensity=default_intensity,
+        max_intensity=max_intensity,
+        max_stroke_duration_ms=max_stroke_duration_ms,
+        max_on_time_ms=max_on_time_ms,
+        actuator_type=actuator_type,
+    )
+    return check_layout(layout, f"grid {rows} x {columns}")
+
+
+def check_layout(layout: Layout, source: str = "<layout>") -> Layout:
+    """Validate a layout built in code by the rules of a layout file; return it unchanged."""
+    _build(_to_data(layout), source)
+    return layout
+
+
+def default_layout() -> Layout:
+    """The paper's sleeve: 3 rows x 4 columns, 3.0 cm apart (geometry and caps, no wiring)."""
+    return PAPER_SLEEVE
+
+
+# --- building -----------------------------------------------------------------------------
+
+
+def _build(data: dict[str, Any], source: str) -> Layout:
+    problems = _Problems()
+    problems.unknown_keys("", data, (*_TOP_KEYS, "safety", "i2c"))
+    geometry = _read_geometry(problems, data)
+    caps = _read_caps(problems, data)
+    hardware = _read_i2c(problems, data.get("i2c", {}), geometry["rows"], geometry["columns"])
+    if problems.items:
+        raise LayoutError(source, problems.items)
+    return Layout(**geometry, **caps, **hardware)
+
+
+def _read_geometry(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
+    rows = problems.integer("rows", data.get("rows", _MISSING), 1, MAX_GRID_SIDE)
+    columns = problems.integer("columns", data.get("columns", _MISSING), 1, MAX_GRID_SIDE)
+    if rows and columns and rows * columns < MIN_ACTUATORS:
+        problems.add(
+            "rows x columns",
+            f"a sleeve needs at least {MIN_ACTUATORS} actuators for a stroke to move; "
+            f"got {rows} x {columns}",
+        )
+    return {
+        "name": problems.name("name", data.get("name", _DEFAULTS.name)),
+        "rows": rows,
+        "columns": columns,
+        "spacing_cm": problems.number(
+            "spacing_cm", data.get("spacing_cm", _MISSING), MAX_SPACING_CM
+        ),
+        "actuator_type": problems.actuator_type(data.get("actuator_type", _DEFAULTS.actuator_type)),
+    }
+
+
+def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
+    """The default intensity and the [safety] caps; the default may not exceed the cap."""
+    safety = problems.table("safety", data.get("safety", {}), _SAFETY_KEYS)
+    caps = {
+        "default_intensity": problems.number(
+            "default_intensity", data.get("default_intensity", _DEFAULTS.default_intensity), 1.0
+        ),
+        "max_intensity": problems.number(
+            "safety.max_intensity", safety.get("max_intensity", _DEFAULTS.max_intensity), 1.0
+        ),
+    }
+    for key in ("max_stroke_duration_ms", "max_on_time_ms"):
+        value = safety.get(key, getattr(_DEFAULTS, key))
+        caps[key] = problems.number(f"safety.{key}", value, MAX_DURATION_MS)
+    default, cap = caps["default_intensity"], caps["max_intensity"]
+    if default is not None and cap is not None and default > cap:
+        problems.add(
+            "default_intensity",
+            f"{default:g} is above safety.max_intensity {cap:g}; lower it or raise the cap",
+        )
+    return caps
+
+
+def _read_i2c(
+    problems: _Problems, value: Any, rows: int | None, columns: int | None
+) -> dict[str, Any]:
+    i2c = problems.table("i2c", value, _I2C_KEYS)
+    bus = problems.integer("i2c.bus", i2c.get("bus", _DEFAULTS.i2c_bus), 0, MAX_I2C_BUS)
+    multiplexers = _read_multiplexers(problems, i2c.get("multiplexers", []))
+    wiring = _read_wiring(problems, i2c.get("wiring", []), rows, columns, multiplexers)
+    return {"i2c_bus": bus, "multiplexers": multiplexers, "wiring": wiring}
+
+
+def _read_multiplexers(problems: _Problems, value: Any) -> tuple[int, ...]:
+    if not isinstance(value, list):
+        problems.add(
+            "i2c.multiplexers",
+            f"must be an array of addresses such as [0x70, 0x71]; got {_show(value)}",
+        )
+        return ()
+    addresses: list[int] = []
+    for index, item in enumerate(value):
+        address = problems.address(f"i2c.multiplexers[{index}]", item)
+        if address is None:
+            continue
+        if address in addresses:
+            problems.add(
+                f"i2c.multiplexers[{index}]",
+                f"{_hex(address)} is listed twice; list each multiplexer once",
+            )
+            continue
+        addresses.append(address)
+    return tuple(addresses)
+
+
+def _read_wiring(
+    problems: _Problems,
+    value: Any,
+    rows: int | None,
+    columns: int | None,
+    declared: tuple[int, ...],
+) -> tuple[Wire, ...]:
+    if not isinstance(value, list):
+        problems.add(
+            "i2c.wiring",
+            f"must be an array of tables {{row, column, multiplexer, channel}}; got {_show(value)}",
+        )
+        return ()
+    by_channel: dict[tuple[int, int], str] = {}
+    by_actuator: dict[tuple[int, int], str] = {}
+    wires: list[Wire] = []
+    for index, entry in enumerate(value):
+        key = f"i2c.wiring[{index}]"
+        wire = _read_wire(problems, key, entry, rows, columns, declared)
+        if wire is None:
+            continue
+        channel, actuator = (wire.multiplexer, wire.channel), (wire.row, wire.column)
+        if channel in by_channel:
+            problems.add(
+                key,
+                f"multiplexer {_hex(wire.multiplexer)} channel {wire.channel} is already used by "
+                f"{by_channel[channel]}; each channel drives one actuator",
+            )
+        elif actuator in by_actuator:
+            problems.add(
+                key,
+                f"actuator (row {wire.row}, column {wire.column}) is already wired in "
+                f"{by_actuator[actuator]}; wire each actuator once",
+            )
+        else:
+            by_channel[channel] = f"{key} (row {wire.row}, column {wire.column})"
+            by_actuator[actuator] = key
+            wires.append(wire)
+    if value and rows and columns:
+        _check_all_wired(problems, rows, columns, set(by_actuator))
+    return tuple(sorted(wires, key=lambda w: (w.row, w.column)))
+
+
+def _read_wire(
+    problems: _Problems,
+    key: str,
+    entry: Any,
+    rows: int | None,
+    columns: int | None,
+    declared: tuple[int, ...],
+) -> Wire | None:
+    table = problems.table(key, entry, _WIRE_KEYS)
+    if not table:
+        return None
+    # Without a valid grid size only the type and the lower bound can be checked.
+    row = problems.integer(f"{key}.row", table.get("row", _MISSING), 0, rows - 1 if rows else None)
+    column = problems.integer(
+        f"{key}.column", table.get("column", _MISSING), 0, columns - 1 if columns else None
+    )
+    multiplexer = problems.address(f"{key}.multiplexer", table.get("multiplexer", _MISSING))
+    channel = problems.integer(
+        f"{key}.channel", table.get("channel", _MISSING), 0, MUX_CHANNELS - 1
+    )
+    if multiplexer is not None and multiplexer not in declared:
+        listed = ", ".join(_hex(a) for a in declared) or "none"
+        problems.add(
+            f"{key}.multiplexer",
+            f"{_hex(multiplexer)} is not declared in i2c.multiplexers (declared: {listed}); "
+            "add it there or fix the address",
+        )
+    if row is None or column is None or multiplexer is None or channel is None:
+        return None
+    return Wire(row=row, column=column, multiplexer=multiplexer, channel=channel)
+
+
+def _check_all_wired(
+    problems: _Problems, rows: int, columns: int, wired: set[tuple[int, int]]
+) -> None:
+    missing = [(r, c) for r in range(rows) for c in range(columns) if (r, c) not in wired]
+    if not missing:
+        return
+    shown = ", ".join(f"(row {r}, column {c})" for r, c in missing[:8])
+    more = f" and {len(missing) - 8} more" if len(missing) > 8 else ""
+    problems.add(
+        "i2c.wiring",
+        f"{len(missing)} of {rows * columns} actuators are not wired: {shown}{more}; "
+        "add an entry for each, or remove i2c.wiring to use the simulator only",
+    )
+
+
+def _to_data(layout: Layout) -> dict[str, Any]:
+    """A layout as the dictionary its TOML file would give, so one validator checks both."""
+    wires = [{f.name: getattr(w, f.name) for f in fields(w)} for w in layout.wiring]
+    return {
+        **{key: getattr(layout, key) for key in _TOP_KEYS},
+        "safety": {key: getattr(layout, key) for key in _SAFETY_KEYS},
+        "i2c": {"bus": layout.i2c_bus, "multiplexers": list(layout.multiplexers), "wiring": wires},
+    }
+
+
+# --- checking one value -------------------------------------------------------------------
+
+
+class _Problems:
+    """Collects every problem as 'key: what is wrong; got value'. Readers return None when bad."""
+
+    def __init__(self) -> None:
+        self.items: list[str] = []
+
+    def add(self, key: str, text: str) -> None:
+        self.items.append(f"{key}: {text}")
+
+    def missing(self, key: str, value: Any, allowed: str) -> bool:
+        if value is _MISSING:
+            meaning = _MEANINGS.get(key.rsplit(".", 1)[-1], "a value")
+            self.add(key, f"missing; {meaning} ({allowed}) is required")
+            return True
+        return False
+
+    def integer(self, key: str, value: Any, low: int, high: int | None) -> int | None:
+        allowed = (
+            f"a whole number from {low} to {high}"
+            if high is not None
+            else f"a whole number from {low}"
+        )
+        if self.missing(key, value, allowed):
+            return None
+        if not isinstance(value, int) or isinstance(value, bool):
+            self.add(key, f"must be {allowed}; got {_show(value)}")
+            return None
+        if value < low or (high is not None and value > high):
+            self.add(key, f"must be {allowed}; got {value}")
+            return None
+        return value
+
+    def number(self, key: str, value: Any, high: float) -> float | None:
+        """A finite number above 0 and at most ``high``: sizes, caps and durations."""
+        allowed = f"a number above 0 and at most {high:g}"
+        if self.missing(key, value, allowed):
+            return None
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            self.add(key, f"must be {allowed}; got {_show(value)}")
+            return None
+        if not (math.isfinite(value) and 0 < value <= high):
+            self.add(key, f"must be {allowed}; got {value}")
+            return None
+        return float(value)
+
+    def address(self, key: str, value: Any) -> int | None:
+        allowed = f"a TCA9548A address from {_hex(MUX_ADDRESSES[0])} to {_hex(MUX_ADDRESSES[-1])}"
+        if self.missing(key, value, allowed):
+            return None
+        if not isinstance(value, int) or isinstance(value, bool) or value not in MUX_ADDRESSES:
+            shown = (
+                f"{_hex(value)} ({value})"
+                if isinstance(value, int) and not isinstance(value, bool)
+                else _show(value)
+            )
+            self.add(key, f"must be {allowed}; got {shown}")
+            return None
+        return value
+
+    def name(self, key: str, value: Any) -> str:
+        fits = isinstance(value, str) and 0 < len(value) <= MAX_NAME_CHARS
+        if fits and not any(c in NAME_FORBIDDEN or not c.isprintable() for c in value):
+            return str(value)
+        self.add(
+            key,
+            f"must be 1 to {MAX_NAME_CHARS} printable characters without "
+            f"{' '.join(NAME_FORBIDDEN)} (it may appear in MQTT topics); got {_show(value)}",
+        )
+        return _DEFAULTS.name
+
+    def actuator_type(self, value: Any) -> ActuatorType:
+        for choice in ACTUATOR_TYPES:
+            if value == choice:
+                return choice
+        hint = (
+            f'; write it in capitals: "{value.upper()}"'
+            if isinstance(value, str) and value.upper() in ACTUATOR_TYPES
+            else ""
+        )
+        self.add("actuator_type", f'must be "ERM" or "LRA"; got {_show(value)}{hint}')
+        return _DEFAULTS.actuator_type
+
+    def table(self, key: str, value: Any, allowed: tuple[str, ...]) -> dict[str, Any]:
+        if not isinstance(value, dict):
+            self.add(key, f"must be a table of {', '.join(allowed)}; got {_show(value)}")
+            return {}
+        self.unknown_keys(f"{key}.", value, allowed)
+        return value
+
+    def unknown_keys(self, prefix: str, table: dict[str, Any], allowed: tuple[str, ...]) -> None:
+        for key in table:
+            if key in allowed:
+                continue
+            self.add(
+                f"{prefix}{key}",
+                f"unknown key{_suggestion(key, allowed)}; allowed here: {', '.join(allowed)}",
+            )
+
+
+def _suggestion(key: str, allowed: tuple[str, ...]) -> str:
+    """A hint for a typo ('colums') or a key put in the wrong table ('max_intensity' at the top)."""
+    for table, keys in (("[safety]", _SAFETY_KEYS), ("[i2c]", _I2C_KEYS)):
+        if key in keys and key not in allowed:
+            return f" here (it belongs in the {table} table)"
+    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
+    return f' (did you mean "{close[0]}"?)' if close else ""
+
+
+def _hex(address: int) -> str:
+    return f"0x{address:02x}"
+
+
+def _show(value: Any) -> str:
+    """A TOML value as the person wrote it, with its kind when the kind is the problem."""
+    if isinstance(value, bool):
+        return f"{str(value).lower()} (a boolean)"
+    if isinstance(value, str):
+        shown = json.dumps(value if len(value) <= 40 else value[:40] + "...")
+        return f"{shown} (a string)"
+    if isinstance(value, float):
+        return f"{value} (a decimal number)"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, dict):
+        return "a table"
+    return f"{value} ({type(value).__name__})"
+
+
+PAPER_SLEEVE = grid_layout(3, 4, 3.0, name="paper-sleeve", default_intensity=0.8)
+"""The sleeve of "Can You Feel My Sign?" (appendix A.1: ``TactileBrush(3, 4, 3.0)``)."""

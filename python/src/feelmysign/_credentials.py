@@ -1,0 +1,193 @@
+"""The broker's accounts as written to ``credentials.json``, the one file clients read.
+
+Shape of the file (mode 0600)::
+
+    {"mqtt_url": "mqtt://127.0.0.1:1883", "ws_url": "ws://127.0.0.1:9001",
+     "sleeve": {"id": "sleeve1", "username": "sleeve-sleeve1", "password": "..."},
+     "sender": {"username": "sender", "password": "..."}}
+
+Passwords are kept across restarts (a running sleeve keeps working); a new
+sleeve id gets a new sleeve account, the sender's account is kept.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import secrets
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+from feelmysign._broker_error import BrokerError
+
+SENDER_USERNAME = "sender"
+SLEEVE_USERNAME_PREFIX = "sleeve-"
+# A sleeve id becomes one level of a topic: no '/', and no MQTT wildcards '+' '#'.
+SLEEVE_ID_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,64}")
+# 24 random bytes (192 bits), URL-safe so a password needs no quoting anywhere.
+PASSWORD_BYTES = 24
+# What a password file line and a URL can hold without escaping.
+_PASSWORD_PATTERN = re.compile(r"[!-~]{8,256}")
+CREDENTIALS_FILE_MODE = 0o600
+
+
+@dataclass(frozen=True)
+class Account:
+    """One MQTT login. The password is left out of ``repr`` so it never lands in a log."""
+
+    username: str
+    password: str = field(repr=False)
+
+
+@dataclass(frozen=True)
+class Credentials:
+    """Where the broker listens and the two accounts on it (a sleeve's and the sender's)."""
+
+    mqtt_url: str
+    ws_url: str
+    sleeve_id: str
+    sleeve: Account
+    sender: Account
+
+    @property
+    def mqtt_host(self) -> str:
+        return urlsplit(self.mqtt_url).hostname or "127.0.0.1"
+
+    @property
+    def mqtt_port(self) -> int:
+        return urlsplit(self.mqtt_url).port or 1883
+
+    @property
+    def ws_port(self) -> int:
+        return urlsplit(self.ws_url).port or 80
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "mqtt_url": self.mqtt_url,
+            "ws_url": self.ws_url,
+            "sleeve": {
+                "id": self.sleeve_id,
+                "username": self.sleeve.username,
+                "password": self.sleeve.password,
+            },
+            "sender": {"username": self.sender.username, "password": self.sender.password},
+        }
+
+
+def check_sleeve_id(sleeve_id: str) -> str:
+    """Return ``sleeve_id`` if it can be one topic level, else raise a BrokerError saying why."""
+    if not SLEEVE_ID_PATTERN.fullmatch(sleeve_id):
+        raise BrokerError(
+            "bad-option",
+            f"Sleeve id {sleeve_id!r} cannot be used: use 1 to 64 letters, digits, '_' or '-' "
+            "(no '/', '+' or '#': they are MQTT topic separators and wildcards).",
+        )
+    return sleeve_id
+
+
+def sleeve_username(sleeve_id: str) -> str:
+    return SLEEVE_USERNAME_PREFIX + sleeve_id
+
+
+def new_password() -> str:
+    return secrets.token_urlsafe(PASSWORD_BYTES)
+
+
+def load_credentials(path: str | Path) -> Credentials:
+    """Read a ``credentials.json`` the broker wrote; a BrokerError names the file and problem."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise BrokerError(
+            "credentials-file",
+            f"No credentials file at {path}; start the broker first ('feelmysign broker') "
+            "or pass the file it wrote (STATE_DIR/credentials.json).",
+        ) from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
+    return _credentials_from_json(data, path)
+
+
+def _credentials_from_json(data: object, path: Path) -> Credentials:
+    try:
+        if not isinstance(data, dict):
+            raise TypeError(f"expected a JSON object, got {data!r}")
+        sleeve, sender = data["sleeve"], data["sender"]
+        credentials = Credentials(
+            mqtt_url=_text(data["mqtt_url"]),
+            ws_url=_text(data["ws_url"]),
+            sleeve_id=_text(sleeve["id"]),
+            sleeve=Account(_text(sleeve["username"]), _text(sleeve["password"])),
+            sender=Account(_text(sender["username"]), _text(sender["password"])),
+        )
+    except (KeyError, TypeError):
+        raise _bad_file(
+            path, "it lacks mqtt_url, ws_url, sleeve{id, username, password} or sender{...}"
+        ) from None
+    check_sleeve_id(credentials.sleeve_id)
+    for account in (credentials.sleeve, credentials.sender):
+        if ":" in account.username or not _PASSWORD_PATTERN.fullmatch(account.password):
+            raise _bad_file(
+                path, f"the account {account.username!r} has an unusable name or password"
+            )
+    return credentials
+
+
+def _text(value: object) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"expected a string, got {value!r}")
+    return value
+
+
+def _bad_file(path: Path, problem: str) -> BrokerError:
+    return BrokerError(
+        "credentials-file",
+        f"The credentials file {path} is not usable: {problem}. Fix it, or delete it to have "
+        "the broker generate new passwords (every sleeve and sender must then use the new file).",
+    )
+
+
+def reuse_or_create(path: Path, *, sleeve_id: str, mqtt_url: str, ws_url: str) -> Credentials:
+    """The credentials to run with: the passwords in ``path`` when it exists, fresh ones otherwise.
+
+    The URLs always follow the ports of this run. A different sleeve id gets a new sleeve
+    account (the old sleeve must not read the new one's strokes); the sender keeps its own.
+    """
+    if path.exists():
+        previous = load_credentials(path)
+        sleeve = previous.sleeve
+        if previous.sleeve_id != sleeve_id:
+            sleeve = Account(sleeve_username(sleeve_id), new_password())
+        return replace(
+            previous, mqtt_url=mqtt_url, ws_url=ws_url, sleeve_id=sleeve_id, sleeve=sleeve
+        )
+    return Credentials(
+        mqtt_url=mqtt_url,
+        ws_url=ws_url,
+        sleeve_id=sleeve_id,
+        sleeve=Account(sleeve_username(sleeve_id), new_password()),
+        sender=Account(SENDER_USERNAME, new_password()),
+    )
+
+
+def write_private_file(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` with mode 0600, atomically (a reader never sees half a file)."""
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, CREDENTIALS_FILE_MODE)
+    try:
+        # The mode given to open() is filtered by the umask; set it explicitly.
+        os.fchmod(descriptor, CREDENTIALS_FILE_MODE)
+        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+
+
+def write_credentials(path: Path, credentials: Credentials) -> None:
+    write_private_file(path, json.dumps(credentials.to_json(), indent=2) + "\n")

@@ -1,0 +1,391 @@
+"""An emulated I2C bus with TCA9548A multiplexers and DRV2605L chips, register by register.
+
+It has the ``smbus2.SMBus`` methods the drivers use, so the hardware backend
+runs on it unchanged: in tests, and behind ``--emulate`` without a sleeve.
+It is written from the datasheets, independently of the driver (constants are
+repeated on purpose), so that a misreading in the driver shows up as a
+difference instead of being shared.
+
+What it models:
+
+- a TCA9548A answers at its address; its control register is the channel
+  mask (bit n enables channel n) and reading returns it. Like the chip, it
+  keeps the last byte of a write, so ``write_byte_data(0x70, r, v)`` stores v.
+- a DRV2605L (address 0x5A) hangs on one multiplexer channel and answers only
+  while that channel is enabled. Its register file starts at the datasheet's
+  reset values (MODE 0x40: standby); STATUS, VBAT and LRA_RESONANCE_PERIOD are
+  read-only; MODE bit 7 (DEV_RESET) restores the reset values.
+- nobody answering an address raises ``OSError(121, 'Remote I/O error')`` as
+  Linux's i2c-dev does; two devices answering one address (two enabled
+  channels with a chip each) is a bus conflict: counted, logged and raised as
+  :class:`BusConflictError`.
+
+Faults to inject: ``detach_chip`` (a missing chip), ``connected = False`` (a
+broken wire, registers kept), ``device_id`` (a wrong chip, e.g. 4 = DRV2604).
+"""
+
+from __future__ import annotations
+
+import errno
+import threading
+from collections import Counter, deque
+from dataclasses import dataclass
+from typing import Literal
+
+from feelmysign.layout import Layout
+
+DRV2605L_ADDRESS = 0x5A
+DRV2605L_DEVICE_ID = 7
+DRV2604_DEVICE_ID = 4
+
+# DRV2605L register file: reset values from the datasheet's register map.
+_DRV2605L_RESET_VALUES = (
+    0xE0,  # 0x00 STATUS: DEVICE_ID = 7 in bits 7:5 (set from device_id)
+    0x40,  # 0x01 MODE: STANDBY, internal trigger
+    0x00,  # 0x02 RTP_INPUT
+    0x01,  # 0x03 LIBRARY_SEL
+    0x01,  # 0x04 WAVEFORM_SEQUENCER_1
+    0x00,  # 0x05 WAVEFORM_SEQUENCER_2
+    0x00,  # 0x06 WAVEFORM_SEQUENCER_3
+    0x00,  # 0x07 WAVEFORM_SEQUENCER_4
+    0x00,  # 0x08 WAVEFORM_SEQUENCER_5
+    0x00,  # 0x09 WAVEFORM_SEQUENCER_6
+    0x00,  # 0x0A WAVEFORM_SEQUENCER_7
+    0x00,  # 0x0B WAVEFORM_SEQUENCER_8
+    0x00,  # 0x0C GO
+    0x00,  # 0x0D OVERDRIVE_TIME_OFFSET
+    0x00,  # 0x0E SUSTAIN_TIME_OFFSET_POSITIVE
+    0x00,  # 0x0F SUSTAIN_TIME_OFFSET_NEGATIVE
+    0x00,  # 0x10 BRAKE_TIME_OFFSET
+    0x05,  # 0x11 AUDIO_TO_VIBE_CONTROL
+    0x19,  # 0x12 AUDIO_TO_VIBE_MIN_INPUT_LEVEL
+    0xFF,  # 0x13 AUDIO_TO_VIBE_MAX_INPUT_LEVEL
+    0x19,  # 0x14 AUDIO_TO_VIBE_MIN_OUTPUT_DRIVE
+    0xFF,  # 0x15 AUDIO_TO_VIBE_MAX_OUTPUT_DRIVE
+    0x3E,  # 0x16 RATED_VOLTAGE
+    0x8C,  # 0x17 OVERDRIVE_CLAMP_VOLTAGE
+    0x0C,  # 0x18 AUTO_CALIBRATION_COMPENSATION_RESULT
+    0x6C,  # 0x19 AUTO_CALIBRATION_BACK_EMF_RESULT
+    0x36,  # 0x1A FEEDBACK_CONTROL: N_ERM_LRA = 0 (ERM), FB_BRAKE_FACTOR 3, LOOP_GAIN 1, BEMF_GAIN 2
+    0x93,  # 0x1B CONTROL1
+    0xF5,  # 0x1C CONTROL2
+    0xA0,  # 0x1D CONTROL3: NG_THRESH 2, ERM_OPEN_LOOP 1, DATA_FORMAT_RTP 0 (signed)
+    0x20,  # 0x1E CONTROL4
+    0x80,  # 0x1F CONTROL5
+    0x33,  # 0x20 LRA_OPEN_LOOP_PERIOD
+    0x00,  # 0x21 VBAT
+    0x00,  # 0x22 LRA_RESONANCE_PERIOD
+)
+STATUS, MODE, RTP_INPUT, FEEDBACK_CONTROL, CONTROL3 = 0x00, 0x01, 0x02, 0x1A, 0x1D
+_READ_ONLY = frozenset({STATUS, 0x21, 0x22})
+_MODE_DEV_RESET = 0x80
+_MODE_STANDBY = 0x40
+_MODE_FIELD = 0x07
+_MODE_REAL_TIME_PLAYBACK = 0x05
+_FEEDBACK_N_ERM_LRA = 0x80
+_CONTROL3_DATA_FORMAT_RTP = 0x08
+
+
+class BusConflictError(OSError):
+    """Two or more devices answered one address at once (e.g. two enabled DRV2605L channels)."""
+
+    def __init__(self, address: int, devices: list[str]) -> None:
+        super().__init__(
+            errno.EIO,
+            f"bus conflict: {len(devices)} devices answer at 0x{address:02X} "
+            f"({', '.join(devices)})",
+        )
+        self.address = address
+        self.devices = devices
+
+
+@dataclass(frozen=True)
+class Transaction:
+    """One bus transaction: ``device`` that answered (None: nobody), ``error`` when it failed."""
+
+    op: Literal["read_byte", "write_byte", "read_byte_data", "write_byte_data"]
+    address: int
+    register: int | None
+    value: int | None
+    device: str | None
+    error: str | None = None
+
+
+class EmulatedDRV2605L:
+    """A DRV2605L's register file, with what a test wants to know about it."""
+
+    def __init__(self, name: str, *, device_id: int = DRV2605L_DEVICE_ID) -> None:
+        self.name = name
+        self.address = DRV2605L_ADDRESS
+        self.connected = True
+        self.registers = bytearray(_DRV2605L_RESET_VALUES)
+        self.writes: Counter[int] = Counter()  # register -> writes received
+        self.reads: Counter[int] = Counter()
+        self._pointer = 0
+        self.device_id = device_id
+
+    @property
+    def device_id(self) -> int:
+        return self.registers[STATUS] >> 5
+
+    @device_id.setter
+    def device_id(self, device_id: int) -> None:
+        self.registers[STATUS] = (self.registers[STATUS] & 0x1F) | ((device_id & 0b111) << 5)
+
+    @property
+    def standby(self) -> bool:
+        return bool(self.registers[MODE] & _MODE_STANDBY)
+
+    @property
+    def rtp_mode(self) -> bool:
+        return (self.registers[MODE] & _MODE_FIELD) == _MODE_REAL_TIME_PLAYBACK
+
+    @property
+    def lra(self) -> bool:
+        return bool(self.registers[FEEDBACK_CONTROL] & _FEEDBACK_N_ERM_LRA)
+
+    @property
+    def rtp_unsigned(self) -> bool:
+        return bool(self.registers[CONTROL3] & _CONTROL3_DATA_FORMAT_RTP)
+
+    @property
+    def output(self) -> float:
+        """The drive the motor gets, 0..1 (only RTP mode is modelled; other modes give 0)."""
+        if self.standby or not self.rtp_mode:
+            return 0.0
+        rtp = self.registers[RTP_INPUT]
+        if self.rtp_unsigned:
+            return rtp / 255
+        signed = rtp - 256 if rtp >= 128 else rtp
+        return max(0, signed) / 127  # negative values brake: nothing felt
+
+    @property
+    def write_count(self) -> int:
+        return sum(self.writes.values())
+
+    def reset(self) -> None:
+        device_id = self.device_id
+        self.registers[:] = bytes(_DRV2605L_RESET_VALUES)
+        self.device_id = device_id
+
+    def read(self, register: int) -> int:
+        self._check(register)
+        self.reads[register] += 1
+        self._pointer = register
+        return self.registers[register]
+
+    def write(self, register: int, value: int) -> None:
+        self._check(register)
+        self.writes[register] += 1
+        self._pointer = register
+        if register == MODE and value & _MODE_DEV_RESET:
+            self.reset()  # DEV_RESET clears itself once the reset is done
+        elif register not in _READ_ONLY:
+            self.registers[register] = value
+
+    def set_pointer(self, register: int) -> None:
+        self._check(register)
+        self._pointer = register
+
+    def read_current(self) -> int:
+        return self.read(self._pointer)
+
+    def _check(self, register: int) -> None:
+        if not 0 <= register < len(self.registers):
+            raise ValueError(
+                f"register 0x{register:02X} does not exist on the DRV2605L "
+                f"(0x00..0x{len(self.registers) - 1:02X})"
+            )
+
+
+class EmulatedTCA9548A:
+    def __init__(self, address: int) -> None:
+        self.address = address
+        self.name = f"TCA9548A 0x{address:02X}"
+        self.connected = True
+        self.control = 0x00  # power-on: every channel disabled
+        self.writes = 0
+
+    @property
+    def enabled_channels(self) -> tuple[int, ...]:
+        return tuple(channel for channel in range(8) if self.control >> channel & 1)
+
+
+_Device = EmulatedTCA9548A | EmulatedDRV2605L
+
+
+class EmulatedI2CBus:
+    """Multiplexers and DRV2605L chips on one emulated bus; smbus2-compatible byte transactions.
+
+    ``log`` keeps the last ``log_size`` transactions (None: all).
+    """
+
+    def __init__(self, *, log_size: int | None = 10_000) -> None:
+        self._lock = threading.RLock()
+        self._multiplexers: dict[int, EmulatedTCA9548A] = {}
+        self._chips: dict[tuple[int, int], EmulatedDRV2605L] = {}
+        self._main_bus_chips: list[EmulatedDRV2605L] = []
+        self.log: deque[Transaction] = deque(maxlen=log_size)
+        self.conflicts = 0
+        self.write_count = 0
+        self.read_count = 0
+        self.max_enabled_channels = 0  # the most channels ever enabled at once, all multiplexers
+        self.closed = False
+
+    @classmethod
+    def for_layout(
+        cls, layout: Layout, *, device_id: int = DRV2605L_DEVICE_ID, log_size: int | None = 10_000
+    ) -> EmulatedI2CBus:
+        """A bus wired as ``layout`` says: its multiplexers, one chip per wired actuator."""
+        bus = cls(log_size=log_size)
+        for address in layout.multiplexers:
+            bus.add_multiplexer(address)
+        for wire in layout.wiring:
+            bus.attach_chip(wire.multiplexer, wire.channel, device_id=device_id)
+        return bus
+
+    # -- building and inspecting ------------------------------------------------------------
+
+    def add_multiplexer(self, address: int) -> EmulatedTCA9548A:
+        if address not in range(0x70, 0x78):
+            raise ValueError(f"a TCA9548A address is 0x70..0x77, not 0x{address:02X}")
+        with self._lock:
+            multiplexer = self._multiplexers.setdefault(address, EmulatedTCA9548A(address))
+        return multiplexer
+
+    def attach_chip(
+        self, multiplexer: int, channel: int, *, device_id: int = DRV2605L_DEVICE_ID
+    ) -> EmulatedDRV2605L:
+        if multiplexer not in self._multiplexers or channel not in range(8):
+            raise ValueError(
+                f"no multiplexer 0x{multiplexer:02X} with a channel {channel} on this bus"
+            )
+        chip = EmulatedDRV2605L(f"DRV2605L 0x{multiplexer:02X}/{channel}", device_id=device_id)
+        with self._lock:
+            self._chips[(multiplexer, channel)] = chip
+        return chip
+
+    def attach_main_bus_chip(self, *, device_id: int = DRV2605L_DEVICE_ID) -> EmulatedDRV2605L:
+        """A DRV2605L wired straight to the bus: it answers whatever channel is enabled."""
+        chip = EmulatedDRV2605L("DRV2605L on the main bus", device_id=device_id)
+        with self._lock:
+            self._main_bus_chips.append(chip)
+        return chip
+
+    def detach_chip(self, multiplexer: int, channel: int) -> EmulatedDRV2605L:
+        with self._lock:
+            return self._chips.pop((multiplexer, channel))
+
+    def chip(self, *, mux: int, channel: int) -> EmulatedDRV2605L:
+        return self._chips[(mux, channel)]
+
+    def multiplexer(self, address: int) -> EmulatedTCA9548A:
+        return self._multiplexers[address]
+
+    @property
+    def chips(self) -> dict[tuple[int, int], EmulatedDRV2605L]:
+        """(multiplexer, channel) -> chip."""
+        return dict(self._chips)
+
+    def enabled_channels(self) -> list[tuple[int, int]]:
+        return [
+            (address, channel)
+            for address, multiplexer in sorted(self._multiplexers.items())
+            for channel in multiplexer.enabled_channels
+        ]
+
+    # -- smbus2-compatible transactions ----------------------------------------------------
+
+    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
+        return self._transact("read_byte", i2c_addr, None, None)
+
+    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
+        self._transact("write_byte", i2c_addr, None, value)
+
+    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._transact("read_byte_data", i2c_addr, register, None)
+
+    def write_byte_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._transact("write_byte_data", i2c_addr, register, value)
+
+    def close(self) -> None:
+        self.closed = True
+
+    # -- the bus itself ----------------------------------------------------------------------
+
+    def _transact(
+        self,
+        op: Literal["read_byte", "write_byte", "read_byte_data", "write_byte_data"],
+        address: int,
+        register: int | None,
+        value: int | None,
+    ) -> int:
+        if self.closed:
+            raise ValueError("I/O on a closed I2C bus")
+        for name, byte in (("address", address), ("register", register), ("value", value)):
+            limit = 0x7F if name == "address" else 0xFF
+            if byte is not None and not 0 <= byte <= limit:
+                raise ValueError(f"{name} {byte} is outside the allowed range 0..{limit}")
+        with self._lock:
+            devices = self._answering(address)
+            if len(devices) != 1:
+                error = self._no_answer(address, devices)
+                self.log.append(Transaction(op, address, register, value, None, str(error)))
+                raise error
+            device = devices[0]
+            result = self._apply(device, op, register, value)
+            self.log.append(Transaction(op, address, register, value, device.name))
+            return result
+
+    def _answering(self, address: int) -> list[_Device]:
+        devices: list[_Device] = []
+        multiplexer = self._multiplexers.get(address)
+        if multiplexer is not None and multiplexer.connected:
+            devices.append(multiplexer)
+        reachable = list(self._main_bus_chips)
+        for (mux_address, channel), chip in self._chips.items():
+            mux = self._multiplexers[mux_address]
+            if mux.connected and mux.control >> channel & 1:
+                reachable.append(chip)
+        devices.extend(c for c in reachable if c.connected and c.address == address)
+        return devices
+
+    def _no_answer(self, address: int, devices: list[_Device]) -> OSError:
+        if not devices:
+            return OSError(errno.EREMOTEIO, "Remote I/O error")
+        self.conflicts += 1
+        return BusConflictError(address, [d.name for d in devices])
+
+    def _apply(self, device: _Device, op: str, register: int | None, value: int | None) -> int:
+        if op.startswith("write"):
+            self.write_count += 1
+        else:
+            self.read_count += 1
+        if isinstance(device, EmulatedTCA9548A):
+            return self._apply_multiplexer(device, op, register, value)
+        if op == "write_byte":  # sets the register pointer, as an SMBus "send byte" does
+            assert value is not None
+            device.set_pointer(value)
+            return 0
+        if op == "read_byte":
+            return device.read_current()
+        assert register is not None
+        if op == "read_byte_data":
+            return device.read(register)
+        assert value is not None
+        device.write(register, value)
+        return 0
+
+    def _apply_multiplexer(
+        self, multiplexer: EmulatedTCA9548A, op: str, register: int | None, value: int | None
+    ) -> int:
+        # The TCA9548A has one register and keeps the last byte written to it; the
+        # "register" byte of an SMBus data transaction is such a byte too.
+        written = value if value is not None else register
+        if written is not None:
+            multiplexer.control = written
+            multiplexer.writes += 1
+            self.max_enabled_channels = max(self.max_enabled_channels, len(self.enabled_channels()))
+        return multiplexer.control

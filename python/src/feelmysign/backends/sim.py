@@ -1,0 +1,109 @@
+"""The simulator backend: records what the sleeve would have felt, change by change.
+
+It has the hardware backend's interface (``--backend sim``), so the player
+never knows which one it drives. Every change is kept with its time on an
+injected clock, relative to when the backend was opened; with ``record`` it is
+also appended to a JSON-lines file, one line per change and flushed line by
+line, so that a crash loses at most the line being written:
+
+    {"t_ms": 12.5, "row": 0, "column": 3, "intensity": 0.8}
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import threading
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TextIO
+
+from feelmysign.backends.base import GridBackend
+from feelmysign.backends.telemetry import ActuatorTelemetry, monotonic_ms
+from feelmysign.errors import ParameterError
+from feelmysign.layout import Layout
+
+DEFAULT_KEEP_CHANGES = 100_000  # about an hour of dense drawing; the record file keeps everything
+_T_DECIMALS = 3  # microseconds: finer than any clock the player is measured against
+
+
+@dataclass(frozen=True)
+class Change:
+    """One actuator's intensity changed at ``t_ms`` after the backend was opened."""
+
+    t_ms: float
+    row: int
+    column: int
+    intensity: float
+
+    def as_dict(self) -> dict[str, float | int]:
+        return {
+            "t_ms": self.t_ms,
+            "row": self.row,
+            "column": self.column,
+            "intensity": self.intensity,
+        }
+
+
+class SimBackend(GridBackend):
+    """Keeps the intensity grid, the recent changes, and optionally a JSON-lines record.
+
+    ``clock`` returns milliseconds; ``keep_changes`` bounds the changes held in
+    memory (None = unbounded), so a sleeve that runs for days does not grow.
+    """
+
+    def __init__(
+        self,
+        layout: Layout,
+        *,
+        clock: Callable[[], float] = monotonic_ms,
+        record: str | os.PathLike[str] | None = None,
+        telemetry: ActuatorTelemetry | None = None,
+        keep_changes: int | None = DEFAULT_KEEP_CHANGES,
+    ) -> None:
+        super().__init__(layout, telemetry=telemetry)
+        if keep_changes is not None and keep_changes < 0:
+            raise ParameterError("keep_changes", keep_changes, "0 or more, or None to keep all")
+        self._clock = clock
+        self._record_path = Path(record) if record is not None else None
+        self._record: TextIO | None = None
+        self._changes: deque[Change] = deque(maxlen=keep_changes)
+        self._changes_lock = threading.Lock()
+        self._start_ms = 0.0
+
+    @property
+    def record_path(self) -> Path | None:
+        return self._record_path
+
+    @property
+    def changes(self) -> list[Change]:
+        """The recorded changes, oldest first (at most ``keep_changes``)."""
+        with self._changes_lock:
+            return list(self._changes)
+
+    def _open(self) -> None:
+        if self._record_path is not None:
+            # Line buffering: every change reaches the file when its line ends.
+            self._record = self._record_path.open("w", encoding="utf-8", buffering=1)
+        self._start_ms = self._clock()
+
+    def _write(self, row: int, column: int, intensity: float) -> None:
+        t_ms = round(self._clock() - self._start_ms, _T_DECIMALS)
+        change = Change(t_ms, row, column, intensity)
+        with self._changes_lock:
+            self._changes.append(change)
+        if self._record is not None:
+            self._record.write(json.dumps(change.as_dict()) + "\n")
+
+    def _all_off(self) -> None:
+        for row, intensities in enumerate(self.snapshot()):
+            for column, intensity in enumerate(intensities):
+                if intensity != 0.0:
+                    self._write(row, column, 0.0)
+
+    def _release(self) -> None:
+        if self._record is not None:
+            self._record.close()
+            self._record = None

@@ -1,0 +1,24 @@
+"""``python -m feelmysign.bench``: print every benchmark's figures."""
+
+from __future__ import annotations
+
+import platform
+
+from feelmysign.bench import algorithms
+
+
+def main() -> None:
+    print(
+        f"feelmysign benchmarks on {platform.python_implementation()} {platform.python_version()}, "
+        f"{platform.machine()}"
+    )
+    print(
+        "Each figure is the best of 5 runs; ratios compare with the baseline of its group,"
+        " measured in the same run.\n"
+    )
+    for line in algorithms.report():
+        print(line)
+
+
+if __name__ == "__main__":
+    main()

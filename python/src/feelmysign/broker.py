@@ -1,0 +1,393 @@
+"""A local Mosquitto for feelmysign: generated config, accounts and ACL, run as a child process.
+
+::
+
+    with Broker(state_dir=Path("state"), port=0, ws_port=0) as broker:   # 0: a free port
+        broker.credentials.mqtt_url          # "mqtt://127.0.0.1:40123"
+        broker.credentials.sleeve.username   # "sleeve-sleeve1"
+
+Everything lives in the state directory (default ``$XDG_STATE_HOME/feelmysign/broker``):
+``mosquitto.conf``, ``acl``, ``passwd``, ``credentials.json`` (what clients read),
+``mosquitto.log`` and ``data/`` (retained messages and sessions). Passwords are kept
+across restarts, so a running sleeve keeps working. Listeners are on 127.0.0.1 only.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import pwd
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+from types import TracebackType
+
+from feelmysign import _mosquitto_process as process_
+from feelmysign._broker_error import BrokerError
+from feelmysign._credentials import (
+    Account,
+    Credentials,
+    check_sleeve_id,
+    load_credentials,
+    reuse_or_create,
+    write_credentials,
+    write_private_file,
+)
+from feelmysign._mosquitto_config import (
+    LEGACY_TOPIC,
+    LOOPBACK_ADDRESS,
+    StateFiles,
+    render_acl,
+    render_config,
+    write_password_file,
+)
+
+__all__ = [
+    "DEFAULT_MQTT_PORT",
+    "DEFAULT_SLEEVE_ID",
+    "DEFAULT_WS_PORT",
+    "Account",
+    "Broker",
+    "BrokerError",
+    "Credentials",
+    "default_state_dir",
+    "load_credentials",
+]
+
+DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
+DEFAULT_WS_PORT = 9001  # the WebSocket port of Mosquitto's documentation and examples
+DEFAULT_SLEEVE_ID = "sleeve1"
+DEFAULT_READY_TIMEOUT_S = 10.0
+DEFAULT_STOP_TIMEOUT_S = 5.0
+# Ports chosen by us (port=0) can be taken by someone else before Mosquitto binds them.
+AUTO_PORT_ATTEMPTS = 3
+READY_POLL_S = 0.02
+READY_PROBE_TIMEOUT_S = 1.0
+# Mosquitto 2.0.11 and older bind a WebSocket listener to every address whatever the
+# config says (eclipse-mosquitto/mosquitto#2085); naming the loopback interface works.
+FIRST_VERSION_BINDING_WS_ADDRESS = (2, 0, 12)
+LOOPBACK_INTERFACE = "lo"
+LOG_ROTATE_BYTES = 10_000_000  # checked at each start
+_TOPIC_PATTERN = re.compile(r"[^\s+#\x00]{1,256}")
+
+
+def default_state_dir() -> Path:
+    """``$XDG_STATE_HOME/feelmysign/broker``, ``~/.local/state/feelmysign/broker`` by default."""
+    state_home = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
+    return Path(state_home) / "feelmysign" / "broker"
+
+
+class Broker:
+    """Mosquitto on 127.0.0.1 with one sleeve account, one sender account and their ACL.
+
+    Options are checked when the object is made; ``start()`` (or ``with``) writes the
+    files, starts Mosquitto and returns once it accepts the sender's login. ``port`` or
+    ``ws_port`` 0 picks a free port. ``mosquitto`` is the executable (default: found on
+    PATH, then in /usr/sbin). Mosquitto is stopped by ``stop()``, at exit, and, when
+    started from the main thread on Linux, by the kernel if this process dies.
+    """
+
+    def __init__(
+        self,
+        *,
+        state_dir: str | Path | None = None,
+        port: int = DEFAULT_MQTT_PORT,
+        ws_port: int = DEFAULT_WS_PORT,
+        sleeve_id: str = DEFAULT_SLEEVE_ID,
+        legacy_topic: str = LEGACY_TOPIC,
+        mosquitto: str | Path | None = None,
+        ready_timeout_s: float = DEFAULT_READY_TIMEOUT_S,
+        stop_timeout_s: float = DEFAULT_STOP_TIMEOUT_S,
+    ) -> None:
+        _check_port(port, "--port")
+        _check_port(ws_port, "--ws-port")
+        if port == ws_port != 0:
+            raise BrokerError(
+                "bad-option",
+                f"The MQTT and WebSocket ports are both {port}; give them different ports.",
+            )
+        _check_topic(legacy_topic)
+        state_dir = Path(state_dir) if state_dir is not None else default_state_dir()
+        if "\n" in str(state_dir) or "\r" in str(state_dir):
+            # Mosquitto's config is line based: such a path cannot be written into it.
+            raise BrokerError("bad-option", f"State directory {state_dir!r} contains a line break.")
+        self._files = StateFiles(state_dir.absolute())
+        self._requested_port = port
+        self._requested_ws_port = ws_port
+        self._sleeve_id = check_sleeve_id(sleeve_id)
+        self._legacy_topic = legacy_topic
+        self._mosquitto = mosquitto
+        self._ready_timeout_s = ready_timeout_s
+        self._stop_timeout_s = stop_timeout_s
+        self._process: subprocess.Popen[bytes] | None = None
+        self._credentials: Credentials | None = None
+        self.version: tuple[int, int, int] | None = None
+        """Mosquitto's version, known once started (None if it did not say)."""
+
+    @property
+    def state_dir(self) -> Path:
+        return self._files.state_dir
+
+    @property
+    def credentials_path(self) -> Path:
+        return self._files.credentials
+
+    @property
+    def log_path(self) -> Path:
+        return self._files.log
+
+    @property
+    def config_path(self) -> Path:
+        return self._files.config
+
+    @property
+    def pid(self) -> int | None:
+        return self._process.pid if self._process is not None else None
+
+    @property
+    def running(self) -> bool:
+        return self._process is not None and self._process.poll() is None
+
+    @property
+    def credentials(self) -> Credentials:
+        """URLs and accounts of the running broker (also in ``credentials_path``)."""
+        if self._credentials is None or self._process is None:
+            raise BrokerError(
+                "not-running", "The broker is not running: call start() or use 'with Broker(...)'."
+            )
+        return self._credentials
+
+    def __enter__(self) -> Broker:
+        self.start()
+        return self
+
+    def __exit__(
+        self,
+        _type: type[BaseException] | None,
+        _value: BaseException | None,
+        _traceback: TracebackType | None,
+    ) -> None:
+        self.stop()
+
+    def start(self) -> Credentials:
+        """Write the files, start Mosquitto, wait until it accepts a login; return credentials."""
+        if self._process is not None:
+            raise BrokerError("start-failed", f"This broker already runs (pid {self.pid}).")
+        executable = process_.find_mosquitto(self._mosquitto, process_.search_dirs())
+        self.version = process_.mosquitto_version(executable)
+        self._make_state_dir()
+        attempts_left = AUTO_PORT_ATTEMPTS
+        while True:
+            port, ws_port = self._choose_ports()
+            try:
+                return self._start_on(executable, port, ws_port)
+            except BrokerError as error:
+                attempts_left -= 1
+                if attempts_left == 0 or not self._took_a_port_we_chose(error):
+                    raise
+
+    def _took_a_port_we_chose(self, error: BrokerError) -> bool:
+        """Someone else bound a port we picked before Mosquitto could: worth another pick."""
+        requested = (self._requested_port, self._requested_ws_port)
+        return error.reason == "port-in-use" and error.port not in (None, *requested)
+
+    def stop(self) -> None:
+        """Stop Mosquitto (SIGTERM, so it saves retained messages; SIGKILL after the timeout)."""
+        process, self._process = self._process, None
+        self._credentials = None
+        atexit.unregister(self.stop)
+        if process is not None:
+            process_.stop(process, timeout_s=self._stop_timeout_s)
+
+    def check_running(self, *, wait_s: float = 0.0) -> None:
+        """Wait up to ``wait_s`` for Mosquitto to exit; BrokerError ``exited`` if it did."""
+        process = self._process
+        if process is None:
+            raise BrokerError("not-running", "The broker is not running.")
+        try:
+            code = process.wait(timeout=wait_s) if wait_s > 0 else process.poll()
+        except subprocess.TimeoutExpired:
+            return
+        if code is not None:
+            self.stop()
+            tail = process_.log_tail(self.log_path)
+            raise BrokerError(
+                "exited",
+                f"Mosquitto stopped unexpectedly (exit code {code}). "
+                f"Last lines of {self.log_path}:\n{_indent(tail)}",
+                log_path=self.log_path,
+            )
+
+    def _make_state_dir(self) -> None:
+        try:
+            self._files.state_dir.mkdir(mode=0o700, parents=True, exist_ok=True)
+            self._files.persistence_dir.mkdir(mode=0o700, exist_ok=True)
+        except OSError as error:
+            raise BrokerError(
+                "bad-option",
+                f"Cannot create the state directory {self._files.state_dir}: {error.strerror}. "
+                "Choose another one with --state-dir.",
+            ) from None
+
+    def _choose_ports(self) -> tuple[int, int]:
+        port = self._requested_port or process_.free_port(LOOPBACK_ADDRESS)
+        ws_port = self._requested_ws_port
+        while ws_port in (0, port):
+            ws_port = process_.free_port(LOOPBACK_ADDRESS)
+        process_.check_port_free(LOOPBACK_ADDRESS, port, what="MQTT", option="--port")
+        process_.check_port_free(LOOPBACK_ADDRESS, ws_port, what="WebSocket", option="--ws-port")
+        return port, ws_port
+
+    def _start_on(self, executable: str, port: int, ws_port: int) -> Credentials:
+        credentials = reuse_or_create(
+            self._files.credentials,
+            sleeve_id=self._sleeve_id,
+            mqtt_url=f"mqtt://{LOOPBACK_ADDRESS}:{port}",
+            ws_url=f"ws://{LOOPBACK_ADDRESS}:{ws_port}",
+        )
+        self._write_files(credentials, executable, port, ws_port)
+        _rotate(self._files.log)
+        log_offset_bytes = self._files.log.stat().st_size if self._files.log.exists() else 0
+        # The log names clients and accounts: private like the rest of the state directory.
+        log_fd = os.open(self._files.log, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+        with os.fdopen(log_fd, "ab") as log:
+            self._process = process_.spawn(executable, self._files.config, log)
+        atexit.register(self.stop)
+        try:
+            self._wait_until_ready(credentials.sender, port, ws_port, log_offset_bytes)
+        except BaseException:
+            self.stop()
+            raise
+        self._credentials = credentials
+        return credentials
+
+    def _write_files(
+        self, credentials: Credentials, executable: str, port: int, ws_port: int
+    ) -> None:
+        files = self._files
+        write_credentials(files.credentials, credentials)
+        passwd_tool = process_.find_executable(
+            "mosquitto_passwd", [str(Path(executable).parent), *process_.search_dirs()]
+        )
+        write_password_file(
+            files.passwords, [credentials.sleeve, credentials.sender], mosquitto_passwd=passwd_tool
+        )
+        acl = render_acl(
+            sleeve_id=credentials.sleeve_id,
+            sleeve_username=credentials.sleeve.username,
+            sender_username=credentials.sender.username,
+            legacy_topic=self._legacy_topic,
+        )
+        write_private_file(files.acl, acl)
+        config = render_config(
+            files,
+            port=port,
+            ws_port=ws_port,
+            ws_bind=_ws_bind(self.version),
+            run_as_user=_user_name(),
+        )
+        write_private_file(files.config, config)
+
+    def _wait_until_ready(
+        self, sender: Account, port: int, ws_port: int, log_offset_bytes: int
+    ) -> None:
+        """Return once Mosquitto accepts the sender's login on ``port`` and TCP on ``ws_port``."""
+        assert self._process is not None
+        deadline = time.monotonic() + self._ready_timeout_s
+        while True:
+            code = self._process.poll()
+            if code is not None:
+                raise self._start_error(code, port, ws_port, log_offset_bytes)
+            remaining_s = deadline - time.monotonic()
+            if remaining_s <= 0:
+                raise self._not_ready_error(port, log_offset_bytes)
+            probe_s = min(remaining_s, READY_PROBE_TIMEOUT_S)
+            accepted = process_.accepts_login(LOOPBACK_ADDRESS, port, sender, timeout_s=probe_s)
+            if accepted is False:
+                raise self._login_refused_error(port, log_offset_bytes)
+            if accepted and process_.accepts_tcp(LOOPBACK_ADDRESS, ws_port, timeout_s=probe_s):
+                return
+            # No event to wait on: the listener does not exist yet, so poll.
+            time.sleep(READY_POLL_S)
+
+    def _start_error(
+        self, code: int, port: int, ws_port: int, log_offset_bytes: int
+    ) -> BrokerError:
+        tail = process_.log_tail(self.log_path, start_offset_bytes=log_offset_bytes)
+        if "Unable to create websockets listener" in tail:
+            return process_.port_in_use_error(
+                ws_port, what="WebSocket", option="--ws-port", log_path=self.log_path
+            )
+        if "Address already in use" in tail:
+            return process_.port_in_use_error(
+                port, what="MQTT", option="--port", log_path=self.log_path
+            )
+        return BrokerError(
+            "start-failed",
+            f"Mosquitto exited at start-up (exit code {code}). "
+            f"Last lines of {self.log_path}:\n{_indent(tail)}",
+            log_path=self.log_path,
+        )
+
+    def _not_ready_error(self, port: int, log_offset_bytes: int) -> BrokerError:
+        tail = process_.log_tail(self.log_path, start_offset_bytes=log_offset_bytes)
+        return BrokerError(
+            "start-failed",
+            f"Mosquitto (pid {self.pid}) did not accept connections on {LOOPBACK_ADDRESS}:{port} "
+            f"within {self._ready_timeout_s:g} s. Last lines of {self.log_path}:\n{_indent(tail)}",
+            port=port,
+            log_path=self.log_path,
+        )
+
+    def _login_refused_error(self, port: int, log_offset_bytes: int) -> BrokerError:
+        tail = process_.log_tail(self.log_path, start_offset_bytes=log_offset_bytes)
+        return BrokerError(
+            "start-failed",
+            f"The broker on {LOOPBACK_ADDRESS}:{port} refused the generated sender login: "
+            f"either another broker answered there, or {self._files.passwords} is wrong "
+            f"(delete it to have it rewritten). Last lines of {self.log_path}:\n{_indent(tail)}",
+            port=port,
+            log_path=self.log_path,
+        )
+
+
+def _rotate(log: Path) -> None:
+    """Keep one previous log, so a broker that runs for months cannot fill a Pi's SD card."""
+    if log.exists() and log.stat().st_size > LOG_ROTATE_BYTES:
+        log.replace(log.with_name(log.name + ".1"))
+
+
+def _check_port(port: int, option: str) -> None:
+    if not 0 <= port <= 65535:
+        raise BrokerError(
+            "bad-option",
+            f"Port {port} ({option}) is out of range: use 1 to 65535, or 0 for a free one.",
+        )
+
+
+def _check_topic(topic: str) -> None:
+    if not _TOPIC_PATTERN.fullmatch(topic) or topic.startswith("$"):
+        raise BrokerError(
+            "bad-option",
+            f"Legacy topic {topic!r} cannot be used: give a topic name without spaces, "
+            "'+' or '#', not starting with '$' (the default is 'deviceOne/line').",
+        )
+
+
+def _ws_bind(version: tuple[int, int, int] | None) -> str:
+    old = version is not None and version < FIRST_VERSION_BINDING_WS_ADDRESS
+    return LOOPBACK_INTERFACE if old and sys.platform.startswith("linux") else LOOPBACK_ADDRESS
+
+
+def _user_name() -> str | None:
+    """Who we run as, for Mosquitto's ``user`` option (None: a uid without a name)."""
+    try:
+        return pwd.getpwuid(os.geteuid()).pw_name
+    except KeyError:
+        return None
+
+
+def _indent(text: str) -> str:
+    return "\n".join(f"  {line}" for line in text.splitlines()) or "  (the log is empty)"

@@ -1,0 +1,105 @@
+"""Options shared by the subcommands that need a sleeve layout (validate, plan, simplify, sleeve).
+
+Either ``--layout FILE`` (or the ``FEELMYSIGN_LAYOUT`` environment variable) or
+a bare grid ``--rows R --columns C --spacing-cm S``; any grid option left out
+takes the paper's sleeve value. Giving both ``--layout`` and a grid option is a
+usage error (exit 2), found while parsing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from collections.abc import Sequence
+from typing import Any
+
+from feelmysign.layout import PAPER_SLEEVE, Layout, grid_layout, load_layout
+
+LAYOUT_ENV = "FEELMYSIGN_LAYOUT"
+_GRID_DESTS = ("rows", "columns", "spacing_cm")
+
+
+class _Exclusive(argparse.Action):
+    """Stores the value, refusing --layout together with a grid option in either order.
+
+    argparse's mutually exclusive groups cannot say "A, or any of B, C, D".
+    """
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
+        others = _GRID_DESTS if self.dest == "layout" else ("layout",)
+        given = [d for d in others if getattr(namespace, d, None) is not None]
+        if given:
+            flags = ", ".join("--" + d.replace("_", "-") for d in given)
+            parser.error(
+                f"{option_string} cannot be combined with {flags}: the layout file already "
+                "sets the grid; edit the file or leave --layout out"
+            )
+        setattr(namespace, self.dest, values)
+
+
+def add_layout_options(parser: argparse.ArgumentParser) -> None:
+    """Add --layout and --rows/--columns/--spacing-cm (defaults: the paper's 3 x 4 sleeve)."""
+    group = parser.add_argument_group(
+        "sleeve layout",
+        f"Give a layout file, or a bare grid; default: ${LAYOUT_ENV} if set,\nelse the "
+        f"paper's sleeve ({PAPER_SLEEVE.rows} rows x {PAPER_SLEEVE.columns} columns, "
+        f"{PAPER_SLEEVE.spacing_cm:g} cm apart).",
+    )
+    group.add_argument(
+        "--layout",
+        metavar="FILE",
+        action=_Exclusive,
+        help=f"sleeve layout TOML file, e.g. deploy/layouts/paper-sleeve.toml "
+        f"(default: ${LAYOUT_ENV}, if set)",
+    )
+    group.add_argument(
+        "--rows",
+        metavar="R",
+        type=int,
+        action=_Exclusive,
+        help=f"number of actuator rows, 1 to 64 (default: {PAPER_SLEEVE.rows})",
+    )
+    group.add_argument(
+        "--columns",
+        metavar="C",
+        type=int,
+        action=_Exclusive,
+        help=f"number of actuator columns, 1 to 64 (default: {PAPER_SLEEVE.columns})",
+    )
+    group.add_argument(
+        "--spacing-cm",
+        metavar="S",
+        type=float,
+        action=_Exclusive,
+        help=f"distance between neighbouring actuators in cm, above 0 and at most 20 "
+        f"(default: {PAPER_SLEEVE.spacing_cm:g})",
+    )
+
+
+def layout_from_args(args: argparse.Namespace) -> Layout:
+    """The layout the options ask for; raises LayoutError (exit 1) for a bad file or grid."""
+    if args.layout is not None:
+        return load_layout(args.layout)
+    grid = {dest: getattr(args, dest) for dest in _GRID_DESTS}
+    if any(value is not None for value in grid.values()):
+        # Same caps as the paper's sleeve: only the geometry was asked to change.
+        return grid_layout(
+            grid["rows"] if grid["rows"] is not None else PAPER_SLEEVE.rows,
+            grid["columns"] if grid["columns"] is not None else PAPER_SLEEVE.columns,
+            grid["spacing_cm"] if grid["spacing_cm"] is not None else PAPER_SLEEVE.spacing_cm,
+            name="grid",
+            default_intensity=PAPER_SLEEVE.default_intensity,
+            max_intensity=PAPER_SLEEVE.max_intensity,
+            max_stroke_duration_ms=PAPER_SLEEVE.max_stroke_duration_ms,
+            max_on_time_ms=PAPER_SLEEVE.max_on_time_ms,
+        )
+    from_env = os.environ.get(LAYOUT_ENV, "")
+    if from_env:
+        return load_layout(from_env)
+    return PAPER_SLEEVE

@@ -1,0 +1,130 @@
+"""feelmysign broker: run a local Mosquitto for a sleeve and a sender until interrupted.
+
+    feelmysign broker [--state-dir DIR] [--port P] [--ws-port W] [--sleeve-id ID]
+
+Prints the URLs, the credentials file and the log file, then "Ready." once the broker
+accepts connections. Ctrl-C (SIGINT), SIGTERM or SIGHUP stop Mosquitto and exit 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
+from types import FrameType
+
+from feelmysign.broker import (
+    DEFAULT_MQTT_PORT,
+    DEFAULT_SLEEVE_ID,
+    DEFAULT_WS_PORT,
+    Broker,
+    default_state_dir,
+)
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+# How often the CLI notices a stop request or a Mosquitto that died.
+WATCH_INTERVAL_S = 0.1
+
+
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    parser = subparsers.add_parser(
+        "broker",
+        help="run a local Mosquitto (MQTT and WebSockets on 127.0.0.1) until interrupted",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--state-dir",
+        metavar="DIR",
+        help="where the config, passwords, credentials.json, log and retained messages live "
+        f"(default: {default_state_dir()})",
+    )
+    parser.add_argument(
+        "--port",
+        type=_port,
+        default=DEFAULT_MQTT_PORT,
+        metavar="P",
+        help=f"MQTT TCP port on 127.0.0.1; 0 picks a free one (default: {DEFAULT_MQTT_PORT})",
+    )
+    parser.add_argument(
+        "--ws-port",
+        type=_port,
+        default=DEFAULT_WS_PORT,
+        metavar="W",
+        help=f"MQTT-over-WebSockets port on 127.0.0.1, for browsers; 0 picks a free one "
+        f"(default: {DEFAULT_WS_PORT})",
+    )
+    parser.add_argument(
+        "--sleeve-id",
+        default=DEFAULT_SLEEVE_ID,
+        metavar="ID",
+        help="the sleeve allowed on this broker: 1-64 letters, digits, '_' or '-' "
+        f"(default: {DEFAULT_SLEEVE_ID})",
+    )
+    parser.add_argument(
+        "--mosquitto",
+        metavar="PATH",
+        help="the mosquitto executable (default: found on PATH, then in /usr/sbin)",
+    )
+    parser.set_defaults(handler=run)
+
+
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a port number") from None
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{port} is out of range: use 1 to 65535, or 0")
+    return port
+
+
+def run(args: argparse.Namespace) -> int:
+    broker = Broker(
+        state_dir=args.state_dir,
+        port=args.port,
+        ws_port=args.ws_port,
+        sleeve_id=args.sleeve_id,
+        mosquitto=args.mosquitto,
+    )
+    with _stop_requests() as stop_requested, broker:
+        _announce(broker)
+        while not stop_requested:
+            broker.check_running(wait_s=WATCH_INTERVAL_S)
+    print("Mosquitto stopped.", flush=True)
+    return 0
+
+
+@contextmanager
+def _stop_requests() -> Iterator[list[int]]:
+    """Turn the stop signals into an entry in the yielded list while the broker runs.
+
+    A flag, not an exception: a second Ctrl-C during shutdown must not cut the shutdown short.
+    """
+    received: list[int] = []
+
+    def handler(signum: int, _frame: FrameType | None) -> None:
+        received.append(signum)
+
+    previous = {signum: signal.signal(signum, handler) for signum in STOP_SIGNALS}
+    try:
+        yield received
+    finally:
+        for signum, action in previous.items():
+            signal.signal(signum, action)
+
+
+def _announce(broker: Broker) -> None:
+    credentials = broker.credentials
+    version = ".".join(map(str, broker.version)) if broker.version else "(version unknown)"
+    lines = [
+        f"Mosquitto {version} running (pid {broker.pid}) with state in {broker.state_dir}",
+        f"  MQTT:        {credentials.mqtt_url}",
+        f"  WebSockets:  {credentials.ws_url}",
+        f"  Credentials: {broker.credentials_path} "
+        f"(sleeve user {credentials.sleeve.username}, sender user {credentials.sender.username})",
+        f"  Log:         {broker.log_path}",
+        "Ready. Press Ctrl-C to stop.",
+    ]
+    print("\n".join(lines), flush=True)

@@ -1,0 +1,143 @@
+"""``feelmysign plan``: what the sleeve would do with a stroke: a table and a picture, or JSON."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Iterator
+from typing import Any
+
+from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli._picture import grid_picture
+from feelmysign.errors import ParameterError, StrokeError
+from feelmysign.layout import Layout
+from feelmysign.planner import MERGE_DISTANCE, MIN_COMMAND_MS, plan
+from feelmysign.protocol import Accepted, parse
+from feelmysign.schedule import Schedule, schedule_to_json
+from feelmysign.stroke import Stroke
+
+MAX_MIN_COMMAND_MS = 1000.0  # a burst floor of a second already forbids any drawing
+MAX_MERGE_DISTANCE = 0.5  # beyond half a cell, merging would move crossings off their lines
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "plan",
+        help="show the actuator commands the sleeve would play for strokes",
+        description=(
+            "Plan strokes with Tactile Brush and show the actuator commands. STROKE is the "
+            "legacy text startX,startY,endX,endY,duration (grid units, ms), e.g. 0,0,2,0,1000; "
+            "'-' reads one stroke per line from standard input."
+        ),
+    )
+    parser.add_argument("strokes", nargs="+", metavar="STROKE", help="a stroke, or - for stdin")
+    add_layout_options(parser)
+    parser.add_argument(
+        "--intensity",
+        type=float,
+        metavar="A",
+        help="stroke intensity in [0, 1] (default: the layout's default intensity)",
+    )
+    parser.add_argument(
+        "--min-command-ms",
+        type=float,
+        default=MIN_COMMAND_MS,
+        metavar="D",
+        help=f"shortest burst an actuator may play, in ms (default: {MIN_COMMAND_MS:g})",
+    )
+    parser.add_argument(
+        "--merge-distance",
+        type=float,
+        default=MERGE_DISTANCE,
+        metavar="G",
+        help=f"merge virtual actuators closer than this, grid units (default: {MERGE_DISTANCE:g})",
+    )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="reject a stroke too fast to render instead of slowing it (default: slow it)",
+    )
+    parser.add_argument("--json", action="store_true", help="one JSON object per stroke per line")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    layout = layout_from_args(args)
+    _check_options(args)
+    for text in _stroke_texts(args.strokes):
+        stroke = _parsed(text, layout, args.intensity)
+        schedule = plan(
+            stroke,
+            layout,
+            min_command_ms=args.min_command_ms,
+            merge_distance=args.merge_distance,
+            strict=args.strict,
+        )
+        if args.json:
+            print(json.dumps(schedule_to_json(schedule)), flush=True)
+        else:
+            print(describe(schedule, layout), flush=True)
+    return 0
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    if args.intensity is not None and not 0.0 <= args.intensity <= 1.0:
+        raise ParameterError("--intensity", args.intensity, "in [0, 1]")
+    if not 0.0 <= args.min_command_ms <= MAX_MIN_COMMAND_MS:
+        raise ParameterError("--min-command-ms", args.min_command_ms, "in [0, 1000] ms")
+    if not 0.0 <= args.merge_distance <= MAX_MERGE_DISTANCE:
+        raise ParameterError("--merge-distance", args.merge_distance, "in [0, 0.5] grid units")
+
+
+def _stroke_texts(arguments: list[str]) -> Iterator[str]:
+    for argument in arguments:
+        if argument == "-":
+            yield from (line.strip() for line in sys.stdin if line.strip())
+        else:
+            yield argument
+
+
+def _parsed(text: str, layout: Layout, intensity: float | None) -> Stroke:
+    result = parse(text, layout, format="legacy")
+    if not isinstance(result, Accepted):
+        raise StrokeError(result.reason, f"stroke {text!r}: {result.message}")
+    stroke = result.stroke
+    if intensity is not None:
+        stroke = Stroke(stroke.start, stroke.end, stroke.duration_ms, intensity)
+    return stroke
+
+
+def describe(schedule: Schedule, layout: Layout) -> str:
+    """A readable table of the commands and a picture of the grid."""
+    stroke = schedule.stroke
+    length_cm = stroke.length * layout.spacing_cm
+    speed = length_cm / schedule.duration_ms * 1000.0
+    intensity = layout.default_intensity if stroke.intensity is None else stroke.intensity
+    lines = [
+        f"Stroke ({_p(stroke.start)}) -> ({_p(stroke.end)}): {length_cm:.2f} cm in "
+        f"{schedule.duration_ms:.3f} ms ({speed:.1f} cm/s), intensity {intensity:g}, "
+        f"on a {layout.rows} x {layout.columns} grid, {layout.spacing_cm:g} cm apart",
+    ]
+    if schedule.adjusted is not None:
+        lines.append(
+            f"Adjusted: too fast to render at {schedule.adjusted.requested_duration_ms:g} ms; "
+            f"slowed to {schedule.adjusted.duration_ms:.3f} ms (--strict would reject it)"
+        )
+    lines.append("")
+    lines.append(
+        f"{'#':>3} {'row':>3} {'column':>6} {'start ms':>10} {'duration ms':>12} "
+        f"{'end ms':>10} {'intensity':>9}"
+    )
+    for i, c in enumerate(schedule.commands, start=1):
+        lines.append(
+            f"{i:>3} {c.row:>3} {c.column:>6} {c.start_ms:>10.3f} {c.duration_ms:>12.3f} "
+            f"{c.end_ms:>10.3f} {c.intensity:>9.3f}"
+        )
+    lines.append("")
+    lines.append(grid_picture(schedule, layout))
+    return "\n".join(lines) + "\n"
+
+
+def _p(point: tuple[float, float]) -> str:
+    return f"{point[0]:g}, {point[1]:g}"

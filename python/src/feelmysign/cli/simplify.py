@@ -1,0 +1,181 @@
+"""``feelmysign simplify``: run a recorded drawing through a simplifier and show the strokes."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import asdict, replace
+from typing import Any
+
+from feelmysign.simplify import AngleParams, PathSegment, load_recording, simplify_paths
+from feelmysign.simplify.recording import Recording
+
+DEFAULTS = AngleParams()
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "simplify",
+        help="cut a recorded drawing into the strokes a sender would send",
+        description=(
+            "Run a recording (JSON: canvas size and pointer samples per path; see "
+            "docs/research.md) through a simplifier, exactly as the drawing client would, "
+            "and show the strokes it sends and the ones it drops."
+        ),
+    )
+    parser.add_argument("recording", metavar="RECORDING", help="a recording JSON file")
+    parser.add_argument(
+        "--algorithm",
+        choices=["angle"],
+        default="angle",
+        help="the simplifier (default: angle, the paper's)",
+    )
+    _option(parser, "--check-frames", int, "N", "frames between checks", DEFAULTS.check_frames)
+    _option(
+        parser,
+        "--max-angle-deg",
+        float,
+        "A",
+        "largest turn that continues a line, degrees",
+        DEFAULTS.max_angle_deg,
+    )
+    _option(
+        parser, "--frame-max", int, "N", "longest line in frames, 0 = no limit", DEFAULTS.frame_max
+    )
+    _option(parser, "--fps", float, "F", "frames per second of the drawing loop", DEFAULTS.fps)
+    parser.add_argument(
+        "--no-recover",
+        dest="recover",
+        action="store_false",
+        default=None,
+        help="start a new line at the pointer after a failed check, leaving gaps "
+        "(default: recover, start it at the last check)",
+    )
+    _option(
+        parser,
+        "--min-duration-ms",
+        float,
+        "D",
+        "shortest stroke sent, ms",
+        DEFAULTS.min_duration_ms,
+    )
+    _option(
+        parser, "--min-length", float, "L", "shortest stroke sent, grid units", DEFAULTS.min_length
+    )
+    _option(
+        parser,
+        "--rows",
+        int,
+        "R",
+        "actuator rows (default: the recording's sleeve, else",
+        DEFAULTS.rows,
+    )
+    _option(
+        parser,
+        "--columns",
+        int,
+        "C",
+        "actuator columns (default: the recording's sleeve, else",
+        DEFAULTS.columns,
+    )
+    parser.add_argument(
+        "--stretch",
+        action="store_true",
+        default=None,
+        help="stretch the canvas onto the grid as the paper did (default: keep the aspect ratio)",
+    )
+    parser.add_argument("--json", action="store_true", help="print the strokes as JSON")
+    parser.set_defaults(handler=run)
+
+
+def _option(
+    parser: argparse.ArgumentParser, flag: str, kind: type, metavar: str, text: str, default: object
+) -> None:
+    suffix = f" {default})" if text.endswith("else") else f" (default: {default})"
+    parser.add_argument(flag, type=kind, metavar=metavar, default=None, help=text + suffix)
+
+
+def params_from_args(args: argparse.Namespace, recording: Recording) -> AngleParams:
+    """The recording's own settings, then the command line's, over the paper's defaults."""
+    recorded = (
+        recording.simplifier.get("params", {})
+        if recording.simplifier.get("algorithm", "angle") == "angle"
+        else {}
+    )
+    known = {k: v for k, v in recorded.items() if k in asdict(DEFAULTS)}
+    base = replace(DEFAULTS, **known)
+    overrides: dict[str, Any] = {
+        "canvas_width_px": recording.width_px,
+        "canvas_height_px": recording.height_px,
+        "rows": recording.rows or base.rows,
+        "columns": recording.columns or base.columns,
+    }
+    for name in (
+        "check_frames",
+        "max_angle_deg",
+        "frame_max",
+        "fps",
+        "recover",
+        "min_duration_ms",
+        "min_length",
+        "rows",
+        "columns",
+        "stretch",
+    ):
+        value = getattr(args, name)
+        if value is not None:
+            overrides[name] = value
+    return replace(base, **overrides)
+
+
+def run(args: argparse.Namespace) -> int:
+    recording = load_recording(args.recording)
+    params = params_from_args(args, recording)
+    result = simplify_paths(params, recording.paths)
+    if args.json:
+        print(json.dumps(to_json(result, params)))
+    else:
+        print(describe(result, params, args.recording))
+    return 0
+
+
+def to_json(result: list[PathSegment], params: AngleParams) -> dict[str, Any]:
+    strokes, dropped = [], []
+    for item in result:
+        s = item.segment
+        entry = {
+            "start": list(s.start),
+            "end": list(s.end),
+            "duration_ms": s.duration_ms,
+            "path": item.path,
+            "emitted_at_ms": s.emitted_at_ms,
+        }
+        if s.dropped is None:
+            strokes.append(entry)
+        else:
+            dropped.append({"reason": s.dropped, **entry})
+    return {"algorithm": "angle", "params": asdict(params), "strokes": strokes, "dropped": dropped}
+
+
+def describe(result: list[PathSegment], params: AngleParams, source: str) -> str:
+    sent = [r for r in result if r.segment.dropped is None]
+    lines = [
+        f"{source}: {len({r.path for r in result})} path(s) -> {len(sent)} stroke(s) sent, "
+        f"{len(result) - len(sent)} dropped (angle: check every {params.check_frames} frames, "
+        f"max {params.max_angle_deg:g} deg, {params.fps:g} fps; "
+        f"{params.rows} x {params.columns} grid)",
+        "",
+        f"{'path':>4}  {'start':>15}  {'end':>15}  {'ms':>8}  {'emitted at':>10}  note",
+    ]
+    for r in result:
+        s = r.segment
+        note = f"dropped: {s.dropped}" if s.dropped else ""
+        lines.append(
+            f"{r.path:>4}  {_p(s.start):>15}  {_p(s.end):>15}  {s.duration_ms:>8.1f}  "
+            f"{s.emitted_at_ms:>10.1f}  {note}"
+        )
+    return "\n".join(lines)
+
+
+def _p(point: tuple[float, float]) -> str:
+    return f"({point[0]:.3f}, {point[1]:.3f})"

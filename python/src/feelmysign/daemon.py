@@ -1,0 +1,301 @@
+"""The sleeve daemon: strokes in over MQTT, the player out, telemetry back.
+
+Unlike the paper's sleeve, it never disconnects to play: it stays subscribed
+(QoS 1, a persistent session under a stable client id, subscriptions made in
+the on-connect handler so they come back after every reconnect) and hands
+each stroke to the player, which plays it while the next ones arrive.
+
+Topics (all but the legacy one under ``feelmysign/<id>/``): ``strokes`` (JSON
+v1 in), the legacy topic (``deviceOne/line``, text in), ``status`` (retained,
+with a last will that marks the sleeve offline), ``actuators`` (telemetry for
+previews, rate-limited) and ``events`` (one JSON message per stroke: played,
+adjusted or rejected, with the reason and the latency figures).
+
+The message handler cannot raise: every failure becomes a counted, reported
+``rejected`` event, and the strokes around it play on.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import queue
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign import __version__
+from feelmysign.backends.base import Backend
+from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.errors import FeelMySignError, StrokeError
+from feelmysign.layout import Layout
+from feelmysign.planner import plan
+from feelmysign.player import PlannedStroke, Player, monotonic_ms, wall_ms
+from feelmysign.protocol import Accepted, parse
+
+log = logging.getLogger(__name__)
+
+LEGACY_TOPIC = "deviceOne/line"  # the paper's sleeve (appendix A.2)
+RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
+BURST = 60  # strokes accepted at once (a drawing queued offline and sent on reconnect)
+KEEPALIVE_S = 15
+RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
+
+
+def topic(sleeve_id: str, name: str) -> str:
+    return f"feelmysign/{sleeve_id}/{name}"
+
+
+class TokenBucket:
+    """At most ``rate_per_s`` on average, ``burst`` at once."""
+
+    def __init__(self, rate_per_s: float, burst: float, clock: Callable[[], float]) -> None:
+        self._rate_per_ms = rate_per_s / 1000.0
+        self._burst = burst
+        self._tokens = burst
+        self._clock = clock
+        self._last_ms = clock()
+
+    def take(self) -> bool:
+        now = self._clock()
+        self._tokens = min(self._burst, self._tokens + (now - self._last_ms) * self._rate_per_ms)
+        self._last_ms = now
+        if self._tokens >= 1.0:
+            self._tokens -= 1.0
+            return True
+        return False
+
+
+@dataclass(frozen=True)
+class SleeveOptions:
+    sleeve_id: str
+    legacy_topic: str | None = LEGACY_TOPIC
+    rate_per_s: float = RATE_PER_S
+    burst: int = BURST
+    strict: bool = False
+    backend_name: str = "sim"
+
+
+class Sleeve:
+    """Run with ``run()`` (blocks until ``stop()``); every motor is off when it returns."""
+
+    def __init__(
+        self,
+        settings: BrokerSettings,
+        layout: Layout,
+        backend: Backend,
+        options: SleeveOptions,
+        *,
+        player: Player | None = None,
+    ) -> None:
+        self._settings = settings
+        self._layout = layout
+        self._options = options
+        self._id = options.sleeve_id
+        self._outbox: queue.SimpleQueue[tuple[str, str, int, bool] | None] = queue.SimpleQueue()
+        self._player = player or Player(backend, layout, on_event=self._event)
+        self._bucket = TokenBucket(options.rate_per_s, options.burst, monotonic_ms)
+        self._stopped = threading.Event()
+        self._connected = threading.Event()
+        self._fatal: FeelMySignError | None = None
+        self.counts: Counter[str] = Counter()
+        self._client = self._make_client()
+
+    @property
+    def player(self) -> Player:
+        return self._player
+
+    @property
+    def connected(self) -> threading.Event:
+        return self._connected
+
+    # --- life cycle --------------------------------------------------------------
+
+    def run(self) -> None:
+        """Connect, play, and keep going through broker restarts until ``stop()``."""
+        publisher = threading.Thread(
+            target=self._publish_loop, name="feelmysign-events", daemon=True
+        )
+        publisher.start()
+        self._player.start()
+        try:
+            self._client.connect_async(self._settings.host, self._settings.port, KEEPALIVE_S)
+            self._client.loop_start()
+            log.info("sleeve %s: connecting to %s", self._id, self._settings.url)
+            self._stopped.wait()
+            if self._fatal is not None:
+                raise self._fatal
+        finally:
+            self._shutdown()
+            self._outbox.put(None)
+            publisher.join(timeout=2.0)
+
+    def stop(self) -> None:
+        self._stopped.set()
+
+    def _shutdown(self) -> None:
+        self._player.stop()  # motors off first, whatever happens to the network
+        try:
+            if self._client.is_connected():
+                info = self._client.publish(
+                    topic(self._id, "status"), self._status(online=False), qos=1, retain=True
+                )
+                info.wait_for_publish(timeout=2.0)
+            self._client.disconnect()
+        except (RuntimeError, ValueError, OSError) as error:
+            log.warning("sleeve %s: could not say goodbye to the broker: %s", self._id, error)
+        finally:
+            self._client.loop_stop()
+
+    # --- MQTT ----------------------------------------------------------------------
+
+    def _make_client(self) -> mqtt.Client:
+        client = new_client(
+            self._settings, client_id=f"feelmysign-sleeve-{self._id}", persistent_session=True
+        )
+        client.will_set(topic(self._id, "status"), self._status(online=False), qos=1, retain=True)
+        client.reconnect_delay_set(RECONNECT_MIN_S, RECONNECT_MAX_S)
+        client.on_connect = self._on_connect
+        client.on_disconnect = self._on_disconnect
+        client.on_message = self._on_message
+        return client
+
+    def _on_connect(
+        self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
+    ) -> None:
+        if reason.is_failure:
+            message = (
+                f"the broker at {self._settings.url} refused the sleeve: {reason}; check the "
+                "username and password (or --credentials) and that this user may use the "
+                f"topics of sleeve {self._id}"
+            )
+            if str(reason) in ("Not authorized", "Bad user name or password"):
+                self._fatal = FeelMySignError(message)
+                self._stopped.set()
+            log.error(message)
+            return
+        subscriptions = [(topic(self._id, "strokes"), 1)]
+        if self._options.legacy_topic:
+            subscriptions.append((self._options.legacy_topic, 1))
+        client.subscribe(subscriptions)
+        client.publish(topic(self._id, "status"), self._status(online=True), qos=1, retain=True)
+        self._connected.set()
+        session = "resumed" if getattr(flags, "session_present", False) else "new"
+        log.info("sleeve %s: connected to %s (%s session)", self._id, self._settings.url, session)
+
+    def _on_disconnect(
+        self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
+    ) -> None:
+        self._connected.clear()
+        if not self._stopped.is_set():
+            log.warning("sleeve %s: lost the broker (%s); reconnecting", self._id, reason)
+
+    def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
+        received_at_ms, received_wall_ms = monotonic_ms(), wall_ms()
+        try:
+            self._handle(message.topic, message.payload, received_at_ms, received_wall_ms)
+        except Exception as error:  # the handler must never take the sleeve down
+            log.exception("sleeve %s: unexpected error handling a message", self._id)
+            self._reject(
+                "internal_error",
+                f"unexpected error: {error}",
+                {"topic": message.topic},
+                received_wall_ms,
+            )
+
+    def _handle(
+        self, name: str, payload: bytes | bytearray, received_at_ms: float, received_wall_ms: float
+    ) -> None:
+        self.counts["received"] += 1
+        legacy = name == self._options.legacy_topic
+        info: dict[str, Any] = {"topic": name}
+        result = parse(payload, self._layout, format="legacy" if legacy else "json")
+        if not isinstance(result, Accepted):
+            self._reject(result.reason, result.message, info, received_wall_ms)
+            return
+        stroke = result.stroke
+        info.update(
+            {k: v for k, v in (("drawing", stroke.drawing), ("seq", stroke.seq)) if v is not None}
+        )
+        if not self._bucket.take():
+            self._reject(
+                "rate_limited",
+                f"more than {self._options.rate_per_s:g} strokes per second "
+                f"(bursts of {self._options.burst}); send more slowly",
+                info,
+                received_wall_ms,
+            )
+            return
+        try:
+            schedule = plan(stroke, self._layout, strict=self._options.strict)
+        except StrokeError as error:
+            self._reject(error.reason, error.message, info, received_wall_ms)
+            return
+        planned = PlannedStroke(schedule, received_at_ms, received_wall_ms, info)
+        refusal = self._player.submit(planned)
+        if refusal is not None:
+            self._reject(refusal.reason, refusal.message, info, received_wall_ms)
+
+    # --- what the sleeve tells the world -----------------------------------------------
+
+    def _reject(
+        self, reason: str, message: str, info: dict[str, Any], received_wall_ms: float
+    ) -> None:
+        self.counts["rejected"] += 1
+        self.counts[f"rejected:{reason}"] += 1
+        log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
+        self._event(
+            {
+                "type": "rejected",
+                "reason": reason,
+                "message": message,
+                **info,
+                "received_at_ms": received_wall_ms,
+            }
+        )
+
+    def _event(self, event: dict[str, Any]) -> None:
+        """Called from the player thread too: only queues, never touches the network."""
+        if event.get("type") in ("played", "adjusted"):
+            self.counts["played"] += 1
+        self._outbox.put((topic(self._id, "events"), json.dumps(event), 1, False))
+
+    def publish_actuators(self, frame: dict[str, Any]) -> None:
+        """Telemetry for previews: best effort (QoS 0), never retained."""
+        self._outbox.put((topic(self._id, "actuators"), json.dumps(frame), 0, False))
+
+    def _publish_loop(self) -> None:
+        while (item := self._outbox.get()) is not None:
+            name, payload, qos, retain = item
+            try:
+                self._client.publish(name, payload, qos=qos, retain=retain)
+            except (RuntimeError, ValueError, OSError) as error:
+                log.warning("sleeve %s: could not publish on %s: %s", self._id, name, error)
+
+    def _status(self, *, online: bool) -> str:
+        layout = self._layout
+        return json.dumps(
+            {
+                "online": online,
+                "sleeve_id": self._id,
+                "version": __version__,
+                "backend": self._options.backend_name,
+                "legacy_topic": self._options.legacy_topic,
+                "layout": {
+                    "name": layout.name,
+                    "rows": layout.rows,
+                    "columns": layout.columns,
+                    "spacing_cm": layout.spacing_cm,
+                    "actuator_type": layout.actuator_type,
+                    "default_intensity": layout.default_intensity,
+                    "max_intensity": layout.max_intensity,
+                    "max_stroke_duration_ms": layout.max_stroke_duration_ms,
+                },
+                "at_ms": round(time.time() * 1000),
+            }
+        )

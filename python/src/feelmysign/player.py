@@ -1,0 +1,248 @@
+"""The player: plays planned strokes on a backend at their planned times, in one real-time thread.
+
+Strokes play back to back: a stroke that arrives while another is playing
+starts the moment the one before it ends (its duration T), so the strokes of
+a drawing feel like one continuous touch; a stroke that arrives to an idle
+sleeve starts at once. Within a drawing, strokes play in ``seq`` order: a
+repeated or older ``seq`` (a redelivery) is dropped, and a gap (the sender
+drops strokes too short to feel) never waits for the missing one.
+
+The queue is bounded: a stroke that would start more than ``max_backlog_ms``
+from now, or beyond ``max_pending`` strokes not yet started, is refused
+(``queue_full``) rather than played late: a touch felt half a minute after it
+was drawn is no longer the sender's.
+
+Timing: the thread sleeps until just before the next change and spins the last
+``spin_ms``, so writes land within a fraction of a millisecond of the plan;
+each write's lateness is kept for ``timing_errors_ms``.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import OrderedDict, deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from feelmysign.backends.base import Backend
+from feelmysign.layout import Layout
+from feelmysign.schedule import Schedule
+from feelmysign.timeline import Change, Timeline
+
+log = logging.getLogger(__name__)
+
+SPIN_MS = 0.5  # spin, not sleep, for the last half millisecond: sleep wakes up late
+IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
+MAX_PENDING = 256
+MAX_BACKLOG_MS = 30_000.0
+REMEMBERED_DRAWINGS = 64  # drawings whose last seq is kept, for dropping redeliveries
+TIMING_SAMPLES = 100_000
+
+
+def monotonic_ms() -> float:
+    return time.monotonic_ns() / 1e6
+
+
+def wall_ms() -> float:
+    return time.time_ns() / 1e6
+
+
+@dataclass
+class PlannedStroke:
+    """A stroke ready to play, with what the events report about it."""
+
+    schedule: Schedule
+    received_at_ms: float  # player clock (monotonic)
+    received_wall_ms: float
+    info: dict[str, Any] = field(
+        default_factory=dict
+    )  # e.g. drawing, seq, topic: copied into events
+    start_ms: float = 0.0
+
+
+@dataclass(frozen=True)
+class Refusal:
+    reason: str
+    message: str
+
+
+class Player:
+    """Call ``start`` once, ``submit`` from any thread, ``stop`` to end with every motor off."""
+
+    def __init__(
+        self,
+        backend: Backend,
+        layout: Layout,
+        *,
+        on_event: Callable[[dict[str, Any]], None] = lambda event: None,
+        clock: Callable[[], float] = monotonic_ms,
+        max_pending: int = MAX_PENDING,
+        max_backlog_ms: float = MAX_BACKLOG_MS,
+        spin_ms: float = SPIN_MS,
+    ) -> None:
+        self._backend = backend
+        self._timeline = Timeline(layout)
+        self._on_event = on_event
+        self._clock = clock
+        self._max_pending = max_pending
+        self._max_backlog_ms = max_backlog_ms
+        self._spin_ms = spin_ms
+        self._lock = threading.Lock()
+        self._wake = threading.Event()
+        self._inbox: deque[PlannedStroke] = deque()
+        self._pending = 0
+        self._tail_ms = float("-inf")
+        self._last_seq: OrderedDict[str, int] = OrderedDict()
+        self._running = False
+        self._thread: threading.Thread | None = None
+        self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
+        self.played = 0
+
+    # --- any thread ------------------------------------------------------------
+
+    def submit(self, stroke: PlannedStroke) -> Refusal | None:
+        """Queue a stroke; None when accepted, else why not (nothing is queued then)."""
+        drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        with self._lock:
+            refusal = self._check_order(drawing, seq) or self._check_room(stroke)
+            if refusal:
+                return refusal
+            if isinstance(drawing, str) and isinstance(seq, int):
+                self._last_seq[drawing] = seq
+                self._last_seq.move_to_end(drawing)
+                while len(self._last_seq) > REMEMBERED_DRAWINGS:
+                    self._last_seq.popitem(last=False)
+            stroke.start_ms = max(stroke.received_at_ms, self._tail_ms)
+            self._tail_ms = stroke.start_ms + stroke.schedule.duration_ms
+            self._pending += 1
+            self._inbox.append(stroke)
+        self._wake.set()
+        return None
+
+    def _check_order(self, drawing: object, seq: object) -> Refusal | None:
+        if not isinstance(drawing, str) or not isinstance(seq, int):
+            return None
+        last = self._last_seq.get(drawing)
+        if last is None or seq > last:
+            return None
+        if seq == last:
+            return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already played")
+        return Refusal(
+            "out_of_order",
+            f"stroke {seq} of drawing {drawing} arrived after stroke {last}; strokes play in order",
+        )
+
+    def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
+        backlog_ms = max(0.0, self._tail_ms - stroke.received_at_ms)
+        if self._pending >= self._max_pending or backlog_ms > self._max_backlog_ms:
+            return Refusal(
+                "queue_full",
+                f"{self._pending} strokes ({backlog_ms / 1000:.1f} s) are waiting to play; the "
+                f"sleeve keeps at most {self._max_pending} strokes or "
+                f"{self._max_backlog_ms / 1000:g} s: send more slowly",
+            )
+        return None
+
+    def start(self) -> None:
+        self._backend.open()
+        self._running = True
+        self._thread = threading.Thread(target=self._run, name="feelmysign-player", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop playing and switch every motor off (also when the thread died)."""
+        self._running = False
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+        self._backend.all_off()
+
+    @property
+    def idle(self) -> bool:
+        with self._lock:
+            return not self._inbox and not self._timeline.busy
+
+    # --- the player thread --------------------------------------------------------
+
+    def _run(self) -> None:
+        try:
+            while self._running:
+                self._wake.clear()
+                self._take_inbox()
+                self._step()
+        except Exception:  # the thread must never die with motors on
+            log.exception("player stopped by an unexpected error; all motors off")
+            self._on_event({"type": "error", "reason": "player_crashed"})
+        finally:
+            self._running = False
+            self._backend.all_off()
+
+    def _take_inbox(self) -> None:
+        with self._lock:
+            while self._inbox:
+                stroke = self._inbox.popleft()
+                self._timeline.add(stroke.schedule, stroke.start_ms, stroke)
+
+    def _step(self) -> None:
+        next_ms = self._timeline.next_ms()
+        if next_ms is None:
+            self._wake.wait(IDLE_WAIT_S)
+            return
+        wait_ms = next_ms - self._clock() - self._spin_ms
+        if wait_ms > 0:
+            self._wake.wait(wait_ms / 1000.0)
+            return  # new strokes may have come in: look again
+        while self._clock() < next_ms:
+            time.sleep(0)  # let the network thread take the interpreter meanwhile
+        due = self._timeline.pop_due(self._clock())
+        self._write(due.changes)
+        for tag in due.started:
+            if isinstance(tag, PlannedStroke):
+                self._started(tag)
+        for row, column in due.tripped:
+            self._on_event(
+                {"type": "safety", "reason": "max_on_time", "row": row, "column": column}
+            )
+
+    def _write(self, changes: list[Change]) -> None:
+        for change in changes:
+            self.timing_errors_ms.append(self._clock() - change.t_ms)
+            try:
+                self._backend.set_intensity(change.row, change.column, change.intensity)
+            except Exception as error:  # a motor that fails must not stop the others
+                log.warning("actuator (%d, %d): %s", change.row, change.column, error)
+                self._on_event(
+                    {
+                        "type": "error",
+                        "reason": "backend",
+                        "message": str(error),
+                        "row": change.row,
+                        "column": change.column,
+                    }
+                )
+
+    def _started(self, stroke: PlannedStroke) -> None:
+        now = self._clock()
+        with self._lock:
+            self._pending -= 1
+        self.played += 1
+        schedule = stroke.schedule
+        event: dict[str, Any] = {
+            "type": "adjusted" if schedule.adjusted else "played",
+            **stroke.info,
+            "received_at_ms": stroke.received_wall_ms,
+            "start_at_ms": stroke.received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
+            "first_command_at_ms": stroke.received_wall_ms + (now - stroke.received_at_ms),
+            "latency_ms": now - stroke.received_at_ms,
+            "start_error_ms": now - stroke.start_ms,
+            "queued_ms": stroke.start_ms - stroke.received_at_ms,
+            "duration_ms": schedule.duration_ms,
+            "commands": len(schedule.commands),
+        }
+        if schedule.adjusted:
+            event["reason"] = schedule.adjusted.reason
+            event["requested_duration_ms"] = schedule.adjusted.requested_duration_ms
+        self._on_event(event)

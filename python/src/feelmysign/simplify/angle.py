@@ -1,0 +1,181 @@
+"""The angle simplifier: the online algorithm of "Can You Feel My Sign?" (section 4.4, B.4).
+
+Every ``check_frames`` frames it compares the direction of the line drawn so
+far (start -> pointer) with the direction of the latest movement (pointer at
+the last check -> pointer). When they differ by more than ``max_angle_deg`` the
+line up to the last check is finished and a new one begins there. Pure and
+streaming: ``push`` one animation frame at a time (canvas pixels, with its real
+time), ``end`` on release; both return the segments finished by that call.
+
+Where the paper's pseudo-code is ambiguous the reading taken keeps consecutive
+strokes joined end to start; each choice is written down in docs/research.md:
+
+1. Counters start at zero on press, so the first check comes ``check_frames``
+   frames after it (and passes: start and last check are the same point).
+2. A failed check (``recover`` on) finishes start -> last check, and the new
+   line begins at the last check with the movement since then as its first
+   checked leg. With ``recover`` off the new line begins at the pointer and the
+   movement since the last check is not sent (the paper's gaps).
+3. ``frame_max`` cuts the line at the pointer and restarts checking there.
+4. On release, a last check decides whether the rest is one line or two.
+5. A finished line too short (grid units) or too brief (ms) is dropped with
+   its reason; it still ends where the next one starts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from feelmysign.simplify.mapping import CanvasMapping
+from feelmysign.simplify.params import ParamSpec, check_all
+from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION, Sample, Segment
+
+# Movements shorter than this (pixels) have no direction: the check passes.
+STILL_PX = 1e-9
+
+ANGLE_PARAMS: dict[str, ParamSpec] = {
+    s.name: s
+    for s in (
+        ParamSpec(
+            "check_frames", int, 2, 600, "frames between two checks (the paper's checkFrame)"
+        ),
+        ParamSpec(
+            "max_angle_deg", float, 1, 179, "largest turn, in degrees, that continues a line"
+        ),
+        ParamSpec("frame_max", int, 0, 36_000, "longest line in frames; 0 = no limit"),
+        ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
+        ParamSpec("recover", bool, None, None, "start a new line at the last check (no gaps)"),
+        ParamSpec("clear_on_press", bool, None, None, "a new press clears the drawing"),
+        ParamSpec("min_duration_ms", float, 0, 10_000, "shortest stroke to send, in ms"),
+        ParamSpec("min_length", float, 0, 100, "shortest stroke to send, in grid units"),
+        ParamSpec("rows", int, 1, 64, "actuator rows of the sleeve"),
+        ParamSpec("columns", int, 1, 64, "actuator columns of the sleeve"),
+        ParamSpec("canvas_width_px", float, 1, 100_000, "drawing area width in pixels"),
+        ParamSpec("canvas_height_px", float, 1, 100_000, "drawing area height in pixels"),
+        ParamSpec("stretch", bool, None, None, "stretch the canvas onto the grid (the paper's)"),
+    )
+}
+
+
+@dataclass(frozen=True)
+class AngleParams:
+    """The paper's parameters (appendix B.1) with its defaults, named with their units."""
+
+    check_frames: int = 5
+    max_angle_deg: float = 20.0
+    frame_max: int = 0
+    fps: float = 60.0
+    recover: bool = True
+    clear_on_press: bool = True
+    min_duration_ms: float = 6.1
+    min_length: float = 0.1
+    rows: int = 3
+    columns: int = 4
+    canvas_width_px: float = 1920.0
+    canvas_height_px: float = 1080.0
+    stretch: bool = False
+
+    def __post_init__(self) -> None:
+        check_all(self, ANGLE_PARAMS)
+
+    @property
+    def mapping(self) -> CanvasMapping:
+        return CanvasMapping(
+            self.canvas_width_px, self.canvas_height_px, self.columns, self.rows, self.stretch
+        )
+
+
+@dataclass
+class _Line:
+    """The line being drawn: where it starts and where its last passed check was."""
+
+    start: Sample
+    last: Sample
+    frames_since_check: int = 0
+    frames_in_line: int = 0
+
+
+@dataclass
+class AngleSimplifier:
+    params: AngleParams = field(default_factory=AngleParams)
+    _line: _Line | None = None
+    _pointer: Sample | None = None
+    _cos_max: float = field(init=False)
+    _mapping: CanvasMapping = field(init=False)
+
+    def __post_init__(self) -> None:
+        self._cos_max = math.cos(math.radians(self.params.max_angle_deg))
+        self._mapping = self.params.mapping
+
+    @property
+    def drawing(self) -> bool:
+        """True between the first frame of a path and ``end``."""
+        return self._line is not None
+
+    def push(self, frame: Sample) -> list[Segment]:
+        """One animation frame while the pointer is down; the first frame of a path is the press."""
+        self._pointer = frame
+        line = self._line
+        if line is None:
+            self._line = _Line(start=frame, last=frame)
+            return []
+        out: list[Segment] = []
+        line.frames_since_check += 1
+        line.frames_in_line += 1
+        if line.frames_since_check >= self.params.check_frames:
+            self._check(line, frame, out)
+        if self.params.frame_max and line.frames_in_line > self.params.frame_max:
+            out.append(self._finish(line.start, frame))
+            self._line = _Line(start=frame, last=frame)
+        return out
+
+    def end(self) -> list[Segment]:
+        """Release: the rest of the path as one line, or two if it turned since the last check."""
+        line, pointer = self._line, self._pointer
+        self._line = None
+        if line is None or pointer is None:
+            return []
+        if line.last is not line.start and self._turned(line, pointer):
+            return [self._finish(line.start, line.last), self._finish(line.last, pointer)]
+        return [self._finish(line.start, pointer)]
+
+    def _check(self, line: _Line, frame: Sample, out: list[Segment]) -> None:
+        if self._turned(line, frame):
+            out.append(self._finish(line.start, line.last))
+            if self.params.recover:
+                line.start, line.frames_in_line = line.last, line.frames_since_check
+            else:
+                line.start, line.frames_in_line = frame, 0
+        line.last = frame
+        line.frames_since_check = 0
+
+    def _turned(self, line: _Line, frame: Sample) -> bool:
+        """Whether start -> frame and last check -> frame differ by more than the maximum angle."""
+        ux, uy = frame.x - line.start.x, frame.y - line.start.y
+        vx, vy = frame.x - line.last.x, frame.y - line.last.y
+        norms = math.sqrt(ux * ux + uy * uy) * math.sqrt(vx * vx + vy * vy)
+        if norms <= STILL_PX:
+            return False
+        return (ux * vx + uy * vy) / norms < self._cos_max
+
+    def _finish(self, start: Sample, end: Sample) -> Segment:
+        emitted_at_ms = self._pointer.t_ms if self._pointer else end.t_ms
+        segment = Segment(
+            start=self._mapping.to_grid(start.x, start.y),
+            end=self._mapping.to_grid(end.x, end.y),
+            start_ms=start.t_ms,
+            end_ms=end.t_ms,
+            emitted_at_ms=emitted_at_ms,
+        )
+        if segment.length < self.params.min_length:
+            return _dropped(segment, NOT_ENOUGH_DISTANCE)
+        if segment.duration_ms < self.params.min_duration_ms:
+            return _dropped(segment, NOT_ENOUGH_DURATION)
+        return segment
+
+
+def _dropped(segment: Segment, reason: str) -> Segment:
+    return Segment(
+        segment.start, segment.end, segment.start_ms, segment.end_ms, segment.emitted_at_ms, reason
+    )

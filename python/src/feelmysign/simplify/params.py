@@ -1,0 +1,62 @@
+"""Parameters of the simplifiers: defaults, allowed ranges, units, help — one table.
+
+The same table is written to ``testdata/angle/params.json`` so that the
+browser's settings panel validates with exactly these ranges.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any
+
+from feelmysign.errors import ParameterError
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    name: str
+    kind: type
+    minimum: float | None
+    maximum: float | None
+    help: str
+
+    def check(self, value: Any) -> None:
+        if self.kind is bool:
+            if not isinstance(value, bool):
+                raise ParameterError(self.name, value, "true or false")
+            return
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParameterError(self.name, value, f"a number in {self.range_text()}")
+        if self.kind is int and not float(value).is_integer():
+            raise ParameterError(self.name, value, f"a whole number in {self.range_text()}")
+        if not math.isfinite(value) or not self._in_range(float(value)):
+            raise ParameterError(self.name, value, f"in {self.range_text()}")
+
+    def _in_range(self, value: float) -> bool:
+        low_ok = self.minimum is None or value >= self.minimum
+        high_ok = self.maximum is None or value <= self.maximum
+        return low_ok and high_ok
+
+    def range_text(self) -> str:
+        return f"[{_fmt(self.minimum)}, {_fmt(self.maximum)}]"
+
+    def to_json(self, default: Any) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "type": {bool: "boolean", int: "integer", float: "number"}[self.kind],
+            "default": default,
+            "minimum": self.minimum,
+            "maximum": self.maximum,
+            "help": self.help,
+        }
+
+
+def _fmt(bound: float | None) -> str:
+    return "unbounded" if bound is None else f"{bound:g}"
+
+
+def check_all(params: object, specs: dict[str, ParamSpec]) -> None:
+    """Raise ParameterError for the first field of a params dataclass outside its range."""
+    for field in fields(params):  # type: ignore[arg-type]
+        specs[field.name].check(getattr(params, field.name))

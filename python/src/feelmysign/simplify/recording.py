@@ -1,0 +1,115 @@
+"""Recordings: the pointer samples of a drawing, as JSON, for exact replay.
+
+Format (also in docs/research.md)::
+
+    {"canvas": {"width_px": W, "height_px": H},
+     "paths": [[{"t_ms": t, "x": x, "y": y, "pressure": p}, ...], ...],
+     "sleeve": {"rows": R, "columns": C},                # optional
+     "simplifier": {"algorithm": "angle", "params": {}}} # optional: what the sender used
+
+Times in ms (any origin, non-decreasing within a path), canvas pixels with the
+origin top-left and y down, pressure 0..1 (optional, 0.5 when absent).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeGuard
+
+from feelmysign.errors import FeelMySignError
+from feelmysign.simplify.segment import Sample
+
+
+class RecordingError(FeelMySignError):
+    """A recording file that cannot be read; says where and what is wrong."""
+
+
+@dataclass(frozen=True)
+class Recording:
+    width_px: float
+    height_px: float
+    paths: tuple[tuple[Sample, ...], ...]
+    rows: int | None = None
+    columns: int | None = None
+    simplifier: dict[str, Any] = field(default_factory=dict)
+
+
+def load_recording(path: str | Path) -> Recording:
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as error:
+        raise RecordingError(f"cannot read recording {path}: {error.strerror or error}") from error
+    return parse_recording(text, source=str(path))
+
+
+def parse_recording(text: str, *, source: str = "<recording>") -> Recording:
+    try:
+        data = json.loads(text, parse_constant=_reject_constant)
+    except (ValueError, RecursionError) as error:
+        raise RecordingError(f"{source}: not valid JSON ({error})") from error
+    if not isinstance(data, dict):
+        raise RecordingError(f"{source}: the recording must be a JSON object with canvas and paths")
+    canvas = _field(data, "canvas", dict, source)
+    width = _positive(canvas, "width_px", source)
+    height = _positive(canvas, "height_px", source)
+    raw_paths = _field(data, "paths", list, source)
+    paths = tuple(_path(raw, i, source) for i, raw in enumerate(raw_paths))
+    sleeve = data.get("sleeve") or {}
+    simplifier = data.get("simplifier") or {}
+    if not isinstance(sleeve, dict) or not isinstance(simplifier, dict):
+        raise RecordingError(f"{source}: sleeve and simplifier, when given, must be objects")
+    rows, columns = sleeve.get("rows"), sleeve.get("columns")
+    return Recording(width, height, paths, _opt_int(rows), _opt_int(columns), simplifier)
+
+
+def _reject_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a number")
+
+
+def _field(data: dict[str, Any], key: str, kind: type, source: str) -> Any:
+    value = data.get(key)
+    if not isinstance(value, kind):
+        wanted = "an object" if kind is dict else "a list"
+        raise RecordingError(f"{source}: '{key}' must be {wanted}, got {type(value).__name__}")
+    return value
+
+
+def _positive(data: dict[str, Any], key: str, source: str) -> float:
+    value = data.get(key)
+    if not _is_number(value) or value <= 0:
+        raise RecordingError(f"{source}: canvas.{key} must be a number > 0, got {value!r}")
+    return float(value)
+
+
+def _path(raw: object, index: int, source: str) -> tuple[Sample, ...]:
+    if not isinstance(raw, list) or not raw:
+        raise RecordingError(f"{source}: paths[{index}] must be a non-empty list of samples")
+    samples: list[Sample] = []
+    for k, item in enumerate(raw):
+        where = f"{source}: paths[{index}][{k}]"
+        if not isinstance(item, dict):
+            raise RecordingError(f"{where} must be an object with t_ms, x, y")
+        values = [item.get(key) for key in ("t_ms", "x", "y")]
+        if not all(_is_number(v) for v in values):
+            raise RecordingError(f"{where} needs finite numbers t_ms, x, y; got {item!r}")
+        pressure = item.get("pressure", 0.5)
+        if not _is_number(pressure) or not 0 <= pressure <= 1:
+            raise RecordingError(f"{where}: pressure must be in [0, 1], got {pressure!r}")
+        t_ms, x, y = (float(v) for v in values)  # type: ignore[arg-type]
+        if samples and t_ms < samples[-1].t_ms:
+            raise RecordingError(
+                f"{where}: t_ms {t_ms:g} goes back in time (samples must be in order)"
+            )
+        samples.append(Sample(t_ms, x, y, float(pressure)))
+    return tuple(samples)
+
+
+def _is_number(value: object) -> TypeGuard[int | float]:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _opt_int(value: object) -> int | None:
+    return value if isinstance(value, int) and not isinstance(value, bool) else None

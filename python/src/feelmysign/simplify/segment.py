@@ -1,0 +1,47 @@
+"""What simplifiers take (samples) and give (segments)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from feelmysign.stroke import Point
+
+NOT_ENOUGH_DISTANCE = "not_enough_distance"  # the paper's NotEnoughDistanceException
+NOT_ENOUGH_DURATION = "not_enough_duration"  # the paper's NotEnoughDurationException
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One pointer reading: canvas pixels (origin top-left, y down), ms, pressure 0..1."""
+
+    t_ms: float
+    x: float
+    y: float
+    pressure: float = 0.5
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A straight piece of a path, in grid units, and when the simplifier let it go.
+
+    ``dropped`` is None for a stroke to send, else the reason it is too short
+    or too brief to feel. Sent and dropped segments of a path together join
+    end to start, so a dropped one leaves a gap no longer than itself.
+    """
+
+    start: Point
+    end: Point
+    start_ms: float
+    end_ms: float
+    emitted_at_ms: float
+    dropped: str | None = None
+
+    @property
+    def duration_ms(self) -> float:
+        return self.end_ms - self.start_ms
+
+    @property
+    def length(self) -> float:
+        dx, dy = self.end[0] - self.start[0], self.end[1] - self.start[1]
+        return math.sqrt(dx * dx + dy * dy)

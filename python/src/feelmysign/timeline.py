@@ -1,0 +1,149 @@
+"""The timeline: planned strokes at absolute times, turned into intensity changes per actuator.
+
+Pure (no clock, no thread): the player asks it what is due at a time and
+writes what it answers. Commands of consecutive strokes may overlap on one
+actuator (a burst that ends after its stroke, under the next stroke's first
+burst); energies add, as within a stroke, capped at 1 and then at the layout's
+maximum intensity. An actuator on for longer than the layout's maximum
+continuous on-time is switched off and kept off until its commands stop.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+from feelmysign.layout import Layout
+from feelmysign.schedule import Schedule
+
+Actuator = tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Change:
+    """Set an actuator's intensity at a planned time (ms on the player's clock)."""
+
+    t_ms: float
+    row: int
+    column: int
+    intensity: float
+
+
+@dataclass(frozen=True)
+class Due:
+    """What became due: intensity changes, strokes that started, actuators cut by the cap."""
+
+    changes: list[Change] = field(default_factory=list)
+    started: list[object] = field(default_factory=list)
+    tripped: list[Actuator] = field(default_factory=list)
+
+
+_Kind = Literal["on", "off", "start", "cap"]
+
+
+@dataclass(order=True)
+class _Event:
+    t_ms: float
+    order: int
+    kind: _Kind = field(compare=False)
+    actuator: Actuator = field(compare=False, default=(0, 0))
+    command: int = field(compare=False, default=0)
+    energy: float = field(compare=False, default=0.0)
+    since_ms: float = field(compare=False, default=0.0)
+    tag: object = field(compare=False, default=None)
+
+
+class Timeline:
+    def __init__(self, layout: Layout) -> None:
+        self._layout = layout
+        self._events: list[_Event] = []
+        self._order = itertools.count()
+        self._commands = itertools.count()
+        self._active: dict[Actuator, dict[int, float]] = {}
+        self._output: dict[Actuator, float] = {}
+        self._on_since: dict[Actuator, float] = {}
+        self._tripped: set[Actuator] = set()
+
+    def add(self, schedule: Schedule, start_ms: float, tag: object = None) -> None:
+        """Play ``schedule`` from ``start_ms``; ``tag`` comes back in ``Due.started`` then."""
+        self._push(_Event(start_ms, 0, "start", tag=tag))
+        for command in schedule.commands:
+            ident = next(self._commands)
+            actuator = (command.row, command.column)
+            energy = command.intensity**2
+            self._push(_Event(start_ms + command.start_ms, 0, "on", actuator, ident, energy))
+            self._push(_Event(start_ms + command.end_ms, 0, "off", actuator, ident))
+
+    def next_ms(self) -> float | None:
+        """When the next thing is due, or None when nothing is planned."""
+        return self._events[0].t_ms if self._events else None
+
+    @property
+    def busy(self) -> bool:
+        return bool(self._events) or any(self._output.values())
+
+    def pop_due(self, now_ms: float) -> Due:
+        """Everything due at or before ``now_ms``, in time order; only real changes are listed."""
+        due = Due()
+        while self._events and self._events[0].t_ms <= now_ms:
+            t_ms = self._events[0].t_ms
+            touched: set[Actuator] = set()
+            while self._events and self._events[0].t_ms == t_ms:
+                self._apply(heapq.heappop(self._events), touched, due)
+            for actuator in sorted(touched):
+                self._settle(actuator, t_ms, due)
+        return due
+
+    def clear(self) -> list[Change]:
+        """Drop everything planned; the changes that switch every running actuator off."""
+        self._events.clear()
+        self._active.clear()
+        self._tripped.clear()
+        self._on_since.clear()
+        off = [Change(0.0, r, c, 0.0) for (r, c), value in sorted(self._output.items()) if value]
+        self._output.clear()
+        return off
+
+    def _push(self, event: _Event) -> None:
+        event.order = next(self._order)  # ties at one time keep the order they were added in
+        heapq.heappush(self._events, event)
+
+    def _apply(self, event: _Event, touched: set[Actuator], due: Due) -> None:
+        if event.kind == "start":
+            due.started.append(event.tag)
+        elif event.kind == "on":
+            self._active.setdefault(event.actuator, {})[event.command] = event.energy
+            touched.add(event.actuator)
+        elif event.kind == "off":
+            self._active.get(event.actuator, {}).pop(event.command, None)
+            touched.add(event.actuator)
+        elif self._on_since.get(event.actuator) == event.since_ms:
+            # Still the on-period this cap was set for: it has lasted the
+            # maximum continuous on-time.
+            self._tripped.add(event.actuator)
+            due.tripped.append(event.actuator)
+            touched.add(event.actuator)
+
+    def _settle(self, actuator: Actuator, t_ms: float, due: Due) -> None:
+        active = self._active.get(actuator)
+        if not active:
+            self._active.pop(actuator, None)
+            self._tripped.discard(actuator)
+        energy = sum(active.values()) if active else 0.0
+        wanted = min(1.0, math.sqrt(energy), self._layout.max_intensity)
+        if actuator in self._tripped:
+            wanted = 0.0
+        if wanted == self._output.get(actuator, 0.0):
+            return
+        was_on = bool(self._output.get(actuator))
+        self._output[actuator] = wanted
+        due.changes.append(Change(t_ms, actuator[0], actuator[1], wanted))
+        if wanted and not was_on:
+            self._on_since[actuator] = t_ms
+            cap_ms = t_ms + self._layout.max_on_time_ms
+            self._push(_Event(cap_ms, 0, "cap", actuator, since_ms=t_ms))
+        elif not wanted:
+            self._on_since.pop(actuator, None)

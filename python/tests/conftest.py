@@ -1,0 +1,72 @@
+"""Shared fixtures: a real Mosquitto, started through ``feelmysign.broker.Broker``.
+
+``broker`` (function scope)
+    A running :class:`feelmysign.broker.Broker` on free 127.0.0.1 ports, its state in a
+    fresh temporary directory, sleeve id ``sleeve1``; stopped (no process left) after the
+    test. What a test uses from it:
+
+    - ``broker.credentials``: a :class:`feelmysign.broker.Credentials` with ``mqtt_url``,
+      ``mqtt_host``, ``mqtt_port``, ``ws_url``, ``ws_port``, ``sleeve_id``,
+      ``sleeve.username`` / ``sleeve.password`` and ``sender.username`` / ``sender.password``;
+    - ``broker.credentials_path``: the ``credentials.json`` to pass as ``--credentials FILE``;
+    - ``broker.log_path``: Mosquitto's log, worth printing when a test fails.
+
+``broker_credentials`` (function scope)
+    Just ``broker.credentials``.
+
+``start_broker`` (function scope)
+    A factory ``start_broker(**options) -> Broker`` for other options (``sleeve_id=...``,
+    ``state_dir=...`` to restart on the same state); every broker it started is stopped
+    after the test.
+
+A test that uses any of them is marked ``broker`` automatically (``pytest -m "not broker"``
+skips it); a missing Mosquitto fails it with the command that installs it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from feelmysign.broker import Broker, Credentials
+
+BROKER_FIXTURES = frozenset({"broker", "broker_credentials", "start_broker"})
+
+StartBroker = Callable[..., Broker]
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        if BROKER_FIXTURES.intersection(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.broker)
+
+
+@pytest.fixture
+def start_broker(tmp_path: Path) -> Iterator[StartBroker]:
+    started: list[Broker] = []
+
+    def start(**options: Any) -> Broker:
+        options.setdefault("state_dir", tmp_path / f"broker-{len(started)}")
+        options.setdefault("port", 0)
+        options.setdefault("ws_port", 0)
+        broker = Broker(**options)
+        broker.start()
+        started.append(broker)
+        return broker
+
+    yield start
+    for broker in started:
+        broker.stop()
+
+
+@pytest.fixture
+def broker(start_broker: StartBroker) -> Broker:
+    return start_broker()
+
+
+@pytest.fixture
+def broker_credentials(broker: Broker) -> Credentials:
+    return broker.credentials

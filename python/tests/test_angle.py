@@ -1,0 +1,199 @@
+"""The paper's angle simplifier: shared vectors, then invariants over random paths."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from vectors import load
+
+from feelmysign.errors import ParameterError
+from feelmysign.simplify import (
+    AngleParams,
+    CanvasMapping,
+    Sample,
+    Segment,
+    frames_from_samples,
+    simplify_paths,
+)
+from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
+
+VECTORS = [(n, c) for n, c in load("angle") if n != "params"]
+PARAMS_TABLE = dict(load("angle"))["params"]
+
+
+def _run(params: AngleParams, paths: list[list[Sample]]) -> list[tuple[int, Segment]]:
+    return [(p.path, p.segment) for p in simplify_paths(params, paths)]
+
+
+@pytest.mark.parametrize(("name", "case"), VECTORS, ids=[n for n, _ in VECTORS])
+def test_vector(name: str, case: dict[str, Any]) -> None:
+    params = AngleParams(**case["params"])
+    paths = [[Sample(*s) for s in path] for path in case["paths"]]
+    tolerance = case["tolerance"]
+    assert [len(frames_from_samples(p, params.fps)) for p in paths] == case["expected"]["frames"]
+    actual = _run(params, paths)
+    expected = case["expected"]["segments"]
+    assert len(actual) == len(expected), name
+    for (path, segment), want in zip(actual, expected, strict=True):
+        assert path == want["path"] and segment.dropped == want["dropped"]
+        got = [
+            *segment.start,
+            *segment.end,
+            segment.start_ms,
+            segment.end_ms,
+            segment.emitted_at_ms,
+        ]
+        wanted = [
+            *want["start"],
+            *want["end"],
+            want["start_ms"],
+            want["end_ms"],
+            want["emitted_at_ms"],
+        ]
+        assert got == pytest.approx(wanted, abs=tolerance)
+
+
+def test_parameter_table_matches_the_defaults() -> None:
+    defaults = AngleParams()
+    for entry in PARAMS_TABLE["parameters"]:
+        assert getattr(defaults, entry["name"]) == entry["default"]
+
+
+def test_paper_defaults() -> None:
+    p = AngleParams()
+    assert (p.check_frames, p.max_angle_deg, p.frame_max, p.fps) == (5, 20.0, 0, 60.0)
+    assert (p.recover, p.clear_on_press, p.min_duration_ms, p.min_length) == (True, True, 6.1, 0.1)
+    assert (p.rows, p.columns) == (3, 4)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("check_frames", 1),
+        ("check_frames", 2.5),
+        ("max_angle_deg", 0),
+        ("fps", math.nan),
+        ("frame_max", -1),
+        ("min_length", -0.1),
+        ("recover", 1),
+        ("rows", True),
+    ],
+)
+def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: object) -> None:
+    with pytest.raises(ParameterError) as error:
+        AngleParams(**{field: value})  # type: ignore[arg-type]
+    assert error.value.name == field and "must be" in str(error.value)
+
+
+def test_square_is_four_strokes_with_its_corners() -> None:
+    params = AngleParams(canvas_width_px=900, canvas_height_px=600)
+    corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
+    # One sample per frame, 40 frames a side: every corner falls on a check.
+    points = [
+        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
+        for (x0, y0), (x1, y1) in itertools.pairwise(corners)
+        for k in range(40)
+    ] + [corners[-1]]
+    path = [Sample(i * 1000 / 60, x, y) for i, (x, y) in enumerate(points)]
+    segments = [s for _, s in _run(params, [path])]
+    grid = [params.mapping.to_grid(x, y) for x, y in corners]
+    assert [s.dropped for s in segments] == [None] * 4
+    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
+        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+
+
+def test_mapping_keeps_a_circle_round() -> None:
+    mapping = CanvasMapping(1000, 1000, columns=4, rows=3)
+    left, right = mapping.to_grid(0, 500), mapping.to_grid(1000, 500)
+    top, bottom = mapping.to_grid(500, 0), mapping.to_grid(500, 1000)
+    assert right[0] - left[0] == pytest.approx(bottom[1] - top[1]) == pytest.approx(2.0)
+    stretched = CanvasMapping(1000, 1000, columns=4, rows=3, stretch=True)
+    assert stretched.to_grid(1000, 1000) == (3.0, 2.0)
+
+
+# --- properties over random paths ---------------------------------------------
+
+
+@st.composite
+def paths(draw: st.DrawFn) -> tuple[AngleParams, list[Sample]]:
+    params = AngleParams(
+        check_frames=draw(st.integers(2, 12)),
+        max_angle_deg=draw(st.floats(5, 90)),
+        frame_max=draw(st.sampled_from([0, 0, 3, 20, 90])),
+        fps=draw(st.sampled_from([30.0, 60.0, 120.0])),
+        min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
+        min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
+        canvas_width_px=800,
+        canvas_height_px=600,
+    )
+    count = draw(st.integers(1, 150))
+    steps = draw(
+        st.lists(
+            st.tuples(st.floats(-40, 40), st.floats(-40, 40), st.floats(0, 30)),
+            min_size=count,
+            max_size=count,
+        )
+    )
+    x, y, t_ms = draw(st.floats(0, 800)), draw(st.floats(0, 600)), 0.0
+    samples = [Sample(t_ms, x, y)]
+    for dx, dy, dt in steps:
+        x, y, t_ms = min(max(x + dx, 0), 800), min(max(y + dy, 0), 600), t_ms + dt
+        samples.append(Sample(t_ms, x, y))
+    return params, samples
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths())
+def test_segments_join_and_keep_the_path_ends(case: tuple[AngleParams, list[Sample]]) -> None:
+    params, samples = case
+    segments = [s for _, s in _run(params, [samples])]
+    assert segments, "a path always gives at least one segment (sent or dropped)"
+    mapping = params.mapping
+    assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
+    assert segments[-1].end == mapping.to_grid(samples[-1].x, samples[-1].y)
+    assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
+    for before, after in itertools.pairwise(segments):
+        assert after.start == before.end and after.start_ms == before.end_ms
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths())
+def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
+    case: tuple[AngleParams, list[Sample]],
+) -> None:
+    params, samples = case
+    for _, segment in _run(params, [samples]):
+        if segment.dropped is None:
+            assert segment.length >= params.min_length
+            assert segment.duration_ms >= params.min_duration_ms
+        elif segment.dropped == NOT_ENOUGH_DISTANCE:
+            assert segment.length < params.min_length
+        else:
+            assert segment.dropped == NOT_ENOUGH_DURATION
+            assert segment.duration_ms < params.min_duration_ms
+        assert segment.emitted_at_ms >= segment.end_ms
+
+
+@settings(max_examples=100, deadline=None)
+@given(paths())
+def test_without_recover_strokes_still_start_and_end_on_the_path(
+    case: tuple[AngleParams, list[Sample]],
+) -> None:
+    params, samples = case
+    params = AngleParams(**{**params.__dict__, "recover": False})
+    segments = [s for _, s in _run(params, [samples])]
+    on_path = {params.mapping.to_grid(s.x, s.y) for s in samples}
+    assert all(s.start in on_path and s.end in on_path for s in segments)
+    assert all(a.end_ms <= b.start_ms for a, b in itertools.pairwise(segments))
+
+
+@settings(max_examples=100, deadline=None)
+@given(paths())
+def test_replay_is_deterministic(case: tuple[AngleParams, list[Sample]]) -> None:
+    params, samples = case
+    assert _run(params, [samples]) == _run(params, [samples])

@@ -1,0 +1,124 @@
+"""``feelmysign simplify`` on recordings built from the shared angle vectors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+from vectors import load
+
+from feelmysign.cli import main
+
+ANGLE = dict(load("angle"))
+
+
+def _recording(case: dict[str, Any], path: Path) -> Path:
+    params = case["params"]
+    document = {
+        "canvas": {"width_px": params["canvas_width_px"], "height_px": params["canvas_height_px"]},
+        "paths": [
+            [{"t_ms": t, "x": x, "y": y, "pressure": p} for t, x, y, p in p_]
+            for p_ in case["paths"]
+        ],
+        "sleeve": {"rows": params["rows"], "columns": params["columns"]},
+    }
+    path.write_text(json.dumps(document))
+    return path
+
+
+def _flags(params: dict[str, Any]) -> list[str]:
+    flags = [
+        "--check-frames",
+        str(params["check_frames"]),
+        "--max-angle-deg",
+        repr(params["max_angle_deg"]),
+        "--frame-max",
+        str(params["frame_max"]),
+        "--fps",
+        repr(params["fps"]),
+        "--min-duration-ms",
+        repr(params["min_duration_ms"]),
+        "--min-length",
+        repr(params["min_length"]),
+    ]
+    if not params["recover"]:
+        flags.append("--no-recover")
+    if params["stretch"]:
+        flags.append("--stretch")
+    return flags
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "circle/defaults",
+        "zigzag/no-recover",
+        "pause/frame-max-60",
+        "two-paths/defaults",
+        "tap/defaults",
+        "circle/stretch",
+    ],
+)
+def test_cli_reproduces_the_vectors(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = ANGLE[name]
+    recording = _recording(case, tmp_path / "drawing.json")
+    assert main(["simplify", str(recording), "--json", *_flags(case["params"])]) == 0
+    result = json.loads(capsys.readouterr().out)
+    expected = case["expected"]["segments"]
+    sent = [e for e in expected if e["dropped"] is None]
+    dropped = [e for e in expected if e["dropped"] is not None]
+    assert len(result["strokes"]) == len(sent) and len(result["dropped"]) == len(dropped)
+    for got, want in zip(result["strokes"] + result["dropped"], sent + dropped, strict=True):
+        assert got["path"] == want["path"]
+        assert got["start"] == pytest.approx(want["start"]) and got["end"] == pytest.approx(
+            want["end"]
+        )
+        assert got["duration_ms"] == pytest.approx(want["end_ms"] - want["start_ms"])
+        assert got["emitted_at_ms"] == pytest.approx(want["emitted_at_ms"])
+        assert got.get("reason") == want["dropped"]
+
+
+def test_readable_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    recording = _recording(ANGLE["right-angle/defaults"], tmp_path / "r.json")
+    assert main(["simplify", str(recording)]) == 0
+    out = capsys.readouterr().out
+    assert "stroke(s) sent" in out and "path" in out
+
+
+@pytest.mark.parametrize(
+    ("content", "words"),
+    [
+        ("not json", ["not valid JSON"]),
+        ('{"paths": []}', ["canvas"]),
+        ('{"canvas": {"width_px": 0, "height_px": 10}, "paths": []}', ["width_px", "> 0"]),
+        (
+            '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [[{"t_ms": 0, "x": 1}]]}',
+            ["paths[0][0]"],
+        ),
+        (
+            '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [[{"t_ms": 5, "x": 1, "y": 1},'
+            ' {"t_ms": 1, "x": 1, "y": 1}]]}',
+            ["back in time"],
+        ),
+    ],
+)
+def test_bad_recordings_say_what_is_wrong(
+    content: str, words: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text(content)
+    assert main(["simplify", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("Error: ") and all(w in err for w in words), err
+
+
+def test_missing_file_and_bad_parameter(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simplify", str(tmp_path / "absent.json")]) == 1
+    assert "cannot read recording" in capsys.readouterr().err
+    recording = _recording(ANGLE["circle/defaults"], tmp_path / "c.json")
+    assert main(["simplify", str(recording), "--check-frames", "1"]) == 1
+    assert "check_frames" in capsys.readouterr().err

@@ -1,0 +1,241 @@
+"""The Tactile Brush planner: shared vectors, then invariants over random strokes."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from vectors import load
+
+from feelmysign.errors import StrokeError
+from feelmysign.layout import Layout
+from feelmysign.planner import MIN_COMMAND_MS, merge_commands, plan, render_point
+from feelmysign.schedule import Burst, Command, Schedule, schedule_to_json
+from feelmysign.stroke import Stroke
+
+PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
+VECTORS = load("planner")
+
+
+def _stroke(data: dict[str, Any]) -> Stroke:
+    return Stroke(
+        tuple(data["start"]), tuple(data["end"]), data["duration_ms"], data.get("intensity")
+    )
+
+
+def _assert_close(actual: object, expected: object, tolerance: float, where: str = "") -> None:
+    if isinstance(expected, dict):
+        assert isinstance(actual, dict) and actual.keys() == expected.keys(), where
+        for key in expected:
+            _assert_close(actual[key], expected[key], tolerance, f"{where}.{key}")
+    elif isinstance(expected, list):
+        assert isinstance(actual, list) and len(actual) == len(expected), where
+        for i, (a, e) in enumerate(zip(actual, expected, strict=True)):
+            _assert_close(a, e, tolerance, f"{where}[{i}]")
+    elif isinstance(expected, float):
+        assert isinstance(actual, (int, float)), where
+        assert math.isclose(actual, expected, rel_tol=0, abs_tol=tolerance), (
+            f"{where}: {actual} != {expected}"
+        )
+    else:
+        assert actual == expected, f"{where}: {actual!r} != {expected!r}"
+
+
+@pytest.mark.parametrize(("name", "case"), VECTORS, ids=[n for n, _ in VECTORS])
+def test_vector(name: str, case: dict[str, Any]) -> None:
+    layout = Layout(**case["layout"])
+    stroke = _stroke(case["stroke"])
+    if "expected_error" in case:
+        with pytest.raises(StrokeError) as error:
+            plan(stroke, layout, **case["options"])
+        assert error.value.reason == case["expected_error"]["reason"]
+        return
+    schedule = plan(stroke, layout, **case["options"])
+    _assert_close(
+        schedule_to_json(schedule, bursts=True), case["expected"], case["tolerance"], name
+    )
+
+
+def test_worked_values_of_the_reference() -> None:
+    """tactile-brush.md: (0,0)->(2,0), T = 1000 (the values the issue quotes)."""
+    schedule = plan(Stroke((0, 0), (2, 0), 1000), PAPER)
+    onsets = [round(c.start_ms, 3) for c in schedule.commands]
+    durations = [round(c.duration_ms, 3) for c in schedule.commands]
+    assert onsets == [0.0, 157.045, 480.372]
+    assert durations == [342.955, 862.583, 519.628]
+
+
+def test_diagonal_phantom_intensities() -> None:
+    schedule = plan(Stroke((0, 0), (3, 2), 1500), PAPER)
+    first = {
+        (c.row, c.column): c.intensity
+        for c in schedule.commands
+        if abs(c.start_ms - 157.045) < 1e-3
+    }
+    assert first[(0, 1)] == pytest.approx(0.57735, abs=1e-5)
+    assert first[(1, 1)] == pytest.approx(0.81650, abs=1e-5)
+
+
+def test_strict_rejects_what_default_slows() -> None:
+    fast = Stroke((0, 0), (3, 2), 100)
+    schedule = plan(fast, PAPER)
+    assert schedule.adjusted is not None and schedule.adjusted.duration_ms > 100
+    with pytest.raises(StrokeError, match="too fast") as error:
+        plan(fast, PAPER, strict=True)
+    assert error.value.reason == "too_fast"
+
+
+def test_out_of_grid_message_names_the_range() -> None:
+    with pytest.raises(StrokeError) as error:
+        plan(Stroke((0, 0), (5, 5), 1000), PAPER)
+    assert error.value.reason == "outside_grid"
+    assert "[0, 3]" in error.value.message and "[0, 2]" in error.value.message
+
+
+def test_slowed_stroke_longer_than_the_cap_is_refused() -> None:
+    capped = Layout(rows=3, columns=4, spacing_cm=3.0, max_stroke_duration_ms=150)
+    with pytest.raises(StrokeError) as error:
+        plan(Stroke((0, 0), (3, 2), 100), capped)
+    assert error.value.reason == "duration_too_long"
+
+
+def test_overlap_merge_sums_energy_and_caps_at_one() -> None:
+    merged = merge_commands(
+        [Command(0, 0, 0, 100, 0.6), Command(0, 0, 50, 100, 0.8), Command(0, 0, 120, 100, 0.9)],
+        min_command_ms=0,
+    )
+    pieces = [(c.start_ms, c.end_ms, round(c.intensity, 6)) for c in merged]
+    assert pieces == [
+        (0, 50, 0.6),
+        (50, 100, 1.0),
+        (100, 120, 0.8),
+        (120, 150, 1.0),
+        (150, 220, 0.9),
+    ]
+
+
+def test_short_overlap_piece_joins_its_neighbour_keeping_energy() -> None:
+    inputs = [Command(0, 0, 0, 100, 0.6), Command(0, 0, 95, 100, 0.6)]
+    merged = merge_commands(inputs, min_command_ms=20)
+    assert len(merged) == 2  # the 5 ms overlap did not survive as a piece of its own
+    assert all(c.duration_ms >= 20 for c in merged)
+    assert merged[0].start_ms == 0 and merged[-1].end_ms == 195
+    energy = sum(c.intensity**2 * c.duration_ms for c in merged)
+    assert energy == pytest.approx(sum(c.intensity**2 * c.duration_ms for c in inputs))
+
+
+# --- properties over random strokes and grids --------------------------------
+
+grids = st.tuples(st.integers(1, 6), st.integers(2, 7)).map(
+    lambda rc: Layout(rows=rc[0], columns=rc[1], spacing_cm=3.0, max_stroke_duration_ms=1e9)
+)
+
+
+@st.composite
+def strokes(draw: st.DrawFn) -> tuple[Layout, Stroke, float]:
+    layout = draw(grids)
+    coordinate_x = st.floats(0, layout.columns - 1)
+    coordinate_y = st.floats(0, layout.rows - 1)
+    # Grid points and lines are the interesting places: draw them often.
+    x = st.one_of(coordinate_x, st.integers(0, layout.columns - 1).map(float))
+    y = st.one_of(coordinate_y, st.integers(0, layout.rows - 1).map(float))
+    start, end = (draw(x), draw(y)), (draw(x), draw(y))
+    duration_ms = draw(st.floats(1, 5000))
+    intensity = draw(st.floats(0.05, 1))
+    min_command_ms = draw(st.sampled_from([0.0, MIN_COMMAND_MS, 45.0]))
+    return layout, Stroke(start, end, duration_ms, intensity), min_command_ms
+
+
+def _planned(case: tuple[Layout, Stroke, float]) -> Schedule:
+    layout, stroke, min_command_ms = case
+    return plan(stroke, layout, min_command_ms=min_command_ms)
+
+
+@settings(max_examples=300, deadline=None)
+@given(strokes())
+def test_commands_are_well_formed(case: tuple[Layout, Stroke, float]) -> None:
+    layout, _, min_command_ms = case
+    schedule = _planned(case)
+    assert schedule.commands
+    for c in schedule.commands:
+        assert c.start_ms >= 0
+        assert c.duration_ms >= min_command_ms - 1e-6
+        assert 0 < c.intensity <= 1
+        assert 0 <= c.row < layout.rows and 0 <= c.column < layout.columns
+
+
+@settings(max_examples=300, deadline=None)
+@given(strokes())
+def test_one_command_per_actuator_at_a_time(case: tuple[Layout, Stroke, float]) -> None:
+    by_actuator: dict[tuple[int, int], list[Command]] = {}
+    for c in _planned(case).commands:
+        by_actuator.setdefault((c.row, c.column), []).append(c)
+    for commands in by_actuator.values():
+        commands.sort(key=lambda c: c.start_ms)
+        for before, after in itertools.pairwise(commands):
+            assert after.start_ms >= before.end_ms - 1e-9
+
+
+@settings(max_examples=300, deadline=None)
+@given(strokes())
+def test_bursts_end_at_the_stroke_duration_and_move_forward(
+    case: tuple[Layout, Stroke, float],
+) -> None:
+    schedule = _planned(case)
+    bursts = schedule.bursts
+    last = bursts[-1]
+    assert last.start_ms + last.duration_ms == pytest.approx(schedule.duration_ms, abs=1e-9)
+    assert max(c.end_ms for c in schedule.commands) >= schedule.duration_ms - 1e-6
+    assert all(a.start_ms < b.start_ms for a, b in itertools.pairwise(bursts))
+    assert all(a.peak_ms < b.peak_ms for a, b in itertools.pairwise(bursts))
+    if schedule.adjusted is None:
+        assert schedule.duration_ms == case[1].duration_ms
+    else:
+        assert schedule.duration_ms > case[1].duration_ms
+
+
+@settings(max_examples=300, deadline=None)
+@given(strokes())
+def test_funneling_preserves_energy(case: tuple[Layout, Stroke, float]) -> None:
+    layout = case[0]
+    for burst in _planned(case).bursts:
+        rendered = render_point(burst, layout)
+        assert sum(c.intensity**2 for c in rendered) == pytest.approx(burst.intensity**2, rel=1e-9)
+        assert len(rendered) in (1, 2, 4)
+
+
+@settings(max_examples=300, deadline=None)
+@given(strokes())
+def test_reverse_visits_the_same_places_in_opposite_order(
+    case: tuple[Layout, Stroke, float],
+) -> None:
+    layout, stroke, min_command_ms = case
+    forward = plan(stroke, layout, min_command_ms=min_command_ms)
+    backward = plan(stroke.reversed(), layout, min_command_ms=min_command_ms)
+
+    def places(bursts: tuple[Burst, ...]) -> list[tuple[float, float]]:
+        return [(round(b.x, 6), round(b.y, 6)) for b in bursts]
+
+    def actuators(bursts: tuple[Burst, ...]) -> list[set[tuple[int, int]]]:
+        return [{(c.row, c.column) for c in render_point(b, layout)} for b in bursts]
+
+    assert places(backward.bursts) == places(forward.bursts)[::-1]
+    assert actuators(backward.bursts) == actuators(forward.bursts)[::-1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(strokes())
+def test_strict_agrees_with_the_adjustment(case: tuple[Layout, Stroke, float]) -> None:
+    layout, stroke, min_command_ms = case
+    schedule = plan(stroke, layout, min_command_ms=min_command_ms)
+    if schedule.adjusted is None:
+        assert plan(stroke, layout, min_command_ms=min_command_ms, strict=True) == schedule
+    else:
+        with pytest.raises(StrokeError):
+            plan(stroke, layout, min_command_ms=min_command_ms, strict=True)
+        slowed = Stroke(stroke.start, stroke.end, schedule.duration_ms, stroke.intensity)
+        assert plan(slowed, layout, min_command_ms=min_command_ms, strict=True).adjusted is None

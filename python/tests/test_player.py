@@ -1,0 +1,116 @@
+"""The player, in its real thread, on the simulator: order, continuity, refusals, all off."""
+
+from __future__ import annotations
+
+import itertools
+import threading
+from typing import Any
+
+import pytest
+
+from feelmysign.backends.sim import SimBackend
+from feelmysign.layout import Layout
+from feelmysign.planner import plan
+from feelmysign.player import PlannedStroke, Player, monotonic_ms, wall_ms
+from feelmysign.stroke import Stroke
+
+PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
+
+
+class Events:
+    def __init__(self) -> None:
+        self.items: list[dict[str, Any]] = []
+        self.changed = threading.Condition()
+
+    def __call__(self, event: dict[str, Any]) -> None:
+        with self.changed:
+            self.items.append(event)
+            self.changed.notify_all()
+
+    def wait_for(self, count: int, timeout_s: float = 10.0) -> list[dict[str, Any]]:
+        with self.changed:
+            assert self.changed.wait_for(lambda: len(self.items) >= count, timeout_s), self.items
+            return list(self.items)
+
+
+def _planned(
+    x0: float, y0: float, x1: float, y1: float, duration_ms: float, **info: Any
+) -> PlannedStroke:
+    schedule = plan(Stroke((x0, y0), (x1, y1), duration_ms), PAPER)
+    return PlannedStroke(schedule, monotonic_ms(), wall_ms(), dict(info))
+
+
+@pytest.fixture
+def running() -> Any:
+    backend = SimBackend(PAPER)
+    events = Events()
+    player = Player(backend, PAPER, on_event=events)
+    player.start()
+    yield player, backend, events
+    player.stop()
+    backend.close()
+
+
+def test_strokes_of_a_drawing_play_back_to_back(running: Any) -> None:
+    player, backend, events = running
+    square = [(0, 0, 3, 0), (3, 0, 3, 2), (3, 2, 0, 2), (0, 2, 0, 0)]
+    for seq, (x0, y0, x1, y1) in enumerate(square):
+        assert player.submit(_planned(x0, y0, x1, y1, 150, drawing="d", seq=seq)) is None
+    played = events.wait_for(4)
+    assert [e["seq"] for e in played] == [0, 1, 2, 3]
+    for before, after in itertools.pairwise(played):
+        start_gap_ms = after["first_command_at_ms"] - before["first_command_at_ms"]
+        assert start_gap_ms == pytest.approx(before["duration_ms"], abs=50)  # loose: a busy CI
+    _wait_idle(player)
+    assert backend.snapshot() == [[0.0] * 4 for _ in range(3)]
+    assert {(c.row, c.column) for c in backend.changes} >= {(0, 0), (0, 3), (2, 3), (2, 0)}
+
+
+def test_duplicates_and_late_strokes_are_refused_gaps_are_not(running: Any) -> None:
+    player, _, events = running
+    assert player.submit(_planned(0, 0, 1, 0, 100, drawing="d", seq=0)) is None
+    assert player.submit(_planned(1, 0, 2, 0, 100, drawing="d", seq=2)) is None  # 1 never came
+    duplicate = player.submit(_planned(1, 0, 2, 0, 100, drawing="d", seq=2))
+    late = player.submit(_planned(0, 0, 1, 0, 100, drawing="d", seq=1))
+    assert duplicate is not None and duplicate.reason == "duplicate"
+    assert late is not None and late.reason == "out_of_order"
+    assert [e["seq"] for e in events.wait_for(2)] == [0, 2]
+
+
+def test_a_full_queue_refuses_with_the_limits_in_the_message() -> None:
+    backend = SimBackend(PAPER)
+    player = Player(backend, PAPER, max_pending=2, max_backlog_ms=60_000)
+    player.start()
+    try:
+        results = [player.submit(_planned(0, 0, 3, 0, 2000)) for _ in range(4)]
+        assert results[0] is None and results[1] is None
+        refusals = [r for r in results if r is not None]
+        assert refusals and all(r.reason == "queue_full" for r in refusals)
+        assert "at most 2 strokes" in refusals[0].message
+    finally:
+        player.stop()
+        backend.close()
+
+
+def test_stop_mid_stroke_leaves_every_motor_off(running: Any) -> None:
+    player, backend, events = running
+    player.submit(_planned(0, 0, 3, 2, 5000))
+    events.wait_for(1)
+    assert any(any(row) for row in backend.snapshot())
+    player.stop()
+    assert backend.snapshot() == [[0.0] * 4 for _ in range(3)]
+
+
+def test_adjusted_strokes_say_so(running: Any) -> None:
+    player, _, events = running
+    player.submit(_planned(0, 0, 3, 2, 100))
+    (event,) = events.wait_for(1)
+    assert event["type"] == "adjusted" and event["reason"] == "too_fast"
+    assert event["duration_ms"] > event["requested_duration_ms"] == 100
+
+
+def _wait_idle(player: Player, timeout_s: float = 10.0) -> None:
+    deadline = monotonic_ms() + timeout_s * 1000
+    while not player.idle:
+        assert monotonic_ms() < deadline, "player never went idle"
+        threading.Event().wait(0.01)

@@ -1,0 +1,124 @@
+"""The timeline: planned strokes at absolute times -> intensity changes, safety caps."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from feelmysign.layout import Layout
+from feelmysign.planner import plan
+from feelmysign.schedule import Command, Schedule
+from feelmysign.stroke import Stroke
+from feelmysign.timeline import Change, Timeline
+
+PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
+
+
+def _schedule(*commands: Command, duration_ms: float = 100.0) -> Schedule:
+    return Schedule(Stroke((0, 0), (1, 0), duration_ms), tuple(commands), duration_ms)
+
+
+def _drain(timeline: Timeline) -> list[Change]:
+    changes: list[Change] = []
+    while (t := timeline.next_ms()) is not None:
+        changes += timeline.pop_due(t).changes
+    return changes
+
+
+def test_a_planned_stroke_becomes_its_commands_at_absolute_times() -> None:
+    schedule = plan(Stroke((0, 0), (2, 0), 1000), PAPER)
+    timeline = Timeline(PAPER)
+    timeline.add(schedule, 5000.0, tag="first")
+    first = timeline.pop_due(5000.0)
+    assert first.started == ["first"]
+    assert first.changes == [Change(5000.0, 0, 0, 1.0)]
+    rest = _drain(timeline)
+    ons = [(c.t_ms - 5000.0, c.column) for c in rest if c.intensity > 0]
+    assert [(round(t, 3), col) for t, col in ons] == [(157.045, 1), (480.372, 2)]
+    final = {(c.row, c.column): c.intensity for c in rest}
+    assert final == {(0, 0): 0.0, (0, 1): 0.0, (0, 2): 0.0} and not timeline.busy
+
+
+def test_overlapping_strokes_add_energy_capped_by_the_layout() -> None:
+    capped = Layout(rows=3, columns=4, spacing_cm=3.0, max_intensity=0.9)
+    timeline = Timeline(capped)
+    timeline.add(_schedule(Command(0, 0, 0, 100, 0.6)), 0.0)
+    timeline.add(_schedule(Command(0, 0, 0, 100, 0.6)), 50.0)
+    levels = [(c.t_ms, round(c.intensity, 6)) for c in _drain(timeline)]
+    assert levels == [(0.0, 0.6), (50.0, 0.848528), (100.0, 0.6), (150.0, 0.0)]
+    timeline.add(_schedule(Command(0, 0, 0, 100, 1.0)), 200.0)
+    assert [c.intensity for c in _drain(timeline)] == [0.9, 0.0]
+
+
+def test_writes_only_on_change() -> None:
+    timeline = Timeline(PAPER)
+    timeline.add(_schedule(Command(1, 1, 0, 100, 0.5), Command(1, 1, 100, 100, 0.5)), 0.0)
+    assert [(c.t_ms, c.intensity) for c in _drain(timeline)] == [(0.0, 0.5), (200.0, 0.0)]
+
+
+def test_continuous_on_time_is_capped_until_the_commands_stop() -> None:
+    short = Layout(rows=3, columns=4, spacing_cm=3.0, max_on_time_ms=1000)
+    timeline = Timeline(short)
+    for k in range(4):  # back-to-back strokes keeping one actuator on for 2 s
+        timeline.add(_schedule(Command(2, 3, 0, 500, 0.7), duration_ms=500), k * 500.0)
+    tripped: list[tuple[int, int]] = []
+    changes: list[Change] = []
+    while (t := timeline.next_ms()) is not None:
+        due = timeline.pop_due(t)
+        changes += due.changes
+        tripped += due.tripped
+    assert tripped == [(2, 3)]
+    assert [(c.t_ms, c.intensity) for c in changes] == [(0.0, 0.7), (1000.0, 0.0)]
+    timeline.add(_schedule(Command(2, 3, 0, 100, 0.7)), 3000.0)  # after a rest it plays again
+    assert [(c.t_ms, c.intensity) for c in _drain(timeline)] == [(3000.0, 0.7), (3100.0, 0.0)]
+
+
+def test_clear_switches_running_actuators_off() -> None:
+    timeline = Timeline(PAPER)
+    timeline.add(_schedule(Command(0, 2, 0, 100, 0.4)), 0.0)
+    timeline.pop_due(0.0)
+    assert timeline.clear() == [Change(0.0, 0, 2, 0.0)]
+    assert timeline.next_ms() is None
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0, 3),
+            st.floats(0, 2),
+            st.floats(0, 3),
+            st.floats(0, 2),
+            st.floats(50, 2000),
+            st.floats(0, 1500),
+        ),
+        min_size=1,
+        max_size=6,
+    )
+)
+def test_any_strokes_end_with_every_actuator_off(
+    strokes: list[tuple[float, float, float, float, float, float]],
+) -> None:
+    timeline = Timeline(PAPER)
+    for x0, y0, x1, y1, duration_ms, start_ms in strokes:
+        timeline.add(plan(Stroke((x0, y0), (x1, y1), duration_ms), PAPER), start_ms)
+    last: dict[tuple[int, int], float] = {}
+    previous_t = -math.inf
+    for change in _drain(timeline):
+        assert change.t_ms >= previous_t
+        assert 0 <= change.intensity <= PAPER.max_intensity
+        assert last.get((change.row, change.column), 0.0) != change.intensity  # only changes
+        last[(change.row, change.column)] = change.intensity
+        previous_t = change.t_ms
+    assert all(v == 0 for v in last.values())
+    assert not timeline.busy
+
+
+def test_pop_due_is_lazy_about_the_future() -> None:
+    timeline = Timeline(PAPER)
+    timeline.add(_schedule(Command(0, 0, 10, 100, 0.5)), 0.0)
+    assert timeline.pop_due(5.0).changes == []
+    assert timeline.next_ms() == pytest.approx(10.0)

@@ -1,0 +1,177 @@
+"""Planner vectors: Tactile Brush schedules from the Python reference (feelmysign.planner).
+
+Each case gives the grid, the options and one stroke, and either the expected
+schedule (virtual actuators as ``bursts`` and merged physical ``commands``) or
+the expected error reason. Times in ms, points in grid units.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from feelmysign.errors import StrokeError
+from feelmysign.layout import Layout
+from feelmysign.planner import MERGE_DISTANCE, MIN_COMMAND_MS, plan
+from feelmysign.schedule import schedule_to_json
+from feelmysign.stroke import Stroke
+
+PAPER = {"rows": 3, "columns": 4, "spacing_cm": 3.0, "default_intensity": 1.0}
+WIDE = {"rows": 4, "columns": 6, "spacing_cm": 2.5, "default_intensity": 0.7}
+
+# name -> (description, layout, stroke (x0, y0, x1, y1, T[, intensity]), options)
+CASES: dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]] = {
+    "worked/two-actuators": (
+        "tactile-brush.md: two points, T = 1000",
+        PAPER,
+        (0, 0, 1, 0, 1000),
+        {},
+    ),
+    "worked/three-actuators": (
+        "tactile-brush.md: (0,0)->(2,0), T = 1000",
+        PAPER,
+        (0, 0, 2, 0, 1000),
+        {},
+    ),
+    "worked/diagonal": (
+        "tactile-brush.md: (0,0)->(3,2), T = 1500, overlaps merged",
+        PAPER,
+        (0, 0, 3, 2, 1500),
+        {},
+    ),
+    "interior/both-ends": (
+        "both endpoints inside cells: four-actuator rendering",
+        PAPER,
+        (0.5, 0.5, 2.5, 1.5, 800),
+        {},
+    ),
+    "interior/crossing-cells": (
+        "interior endpoints, up and to the right",
+        PAPER,
+        (0.3, 1.7, 2.2, 0.4, 1200),
+        {},
+    ),
+    "interior/point": (
+        "a stroke of zero length: one point held",
+        PAPER,
+        (1.5, 0.5, 1.5, 0.5, 300),
+        {},
+    ),
+    "interior/on-row-line": (
+        "endpoints on a row line between actuators",
+        PAPER,
+        (0.25, 1, 2.75, 1, 900),
+        {},
+    ),
+    "merge/through-actuator": (
+        "crosses a row and a column at the same actuator",
+        PAPER,
+        (0, 0, 2, 2, 1000),
+        {},
+    ),
+    "merge/near-corner": (
+        "a row and a column crossing 0.014 apart become one",
+        PAPER,
+        (0, 0, 2.02, 2, 1000),
+        {},
+    ),
+    "merge/no-merge": (
+        "the same stroke with merging off keeps both crossings",
+        PAPER,
+        (0, 0, 2.02, 2, 4000),
+        {"merge_distance": 0.0},
+    ),
+    "feasible/too-fast": (
+        "9 cm at 100 ms: slowed to the fastest feasible duration",
+        PAPER,
+        (0, 0, 3, 0, 100),
+        {},
+    ),
+    "feasible/too-fast-diagonal": ("the diagonal at 100 ms: slowed", PAPER, (0, 0, 3, 2, 100), {}),
+    "feasible/strict": (
+        "too fast with strict: rejected",
+        PAPER,
+        (0, 0, 3, 2, 100),
+        {"strict": True},
+    ),
+    "feasible/min-40": (
+        "a longer minimum burst slows a stroke that was fine",
+        PAPER,
+        (0, 0, 3, 0, 300),
+        {"min_command_ms": 40.0},
+    ),
+    "feasible/min-0": (
+        "minimum 0: only negative bursts are infeasible",
+        PAPER,
+        (0, 0, 3, 0, 100),
+        {"min_command_ms": 0.0},
+    ),
+    "grid/outside": ("(0,0)->(5,5) on 3 x 4: outside the grid", PAPER, (0, 0, 5, 5, 1000), {}),
+    "grid/negative": ("a negative coordinate", PAPER, (-0.5, 0, 1, 0, 1000), {}),
+    "grid/zero-duration": ("duration 0", PAPER, (0, 0, 1, 0, 0), {}),
+    "grid/wide-sleeve": (
+        "a 4 x 6 sleeve with default intensity 0.7",
+        WIDE,
+        (0.5, 3, 5, 0.25, 2000),
+        {},
+    ),
+    "grid/intensity": ("an explicit intensity", PAPER, (0, 2, 3, 0.5, 1500, 0.4), {}),
+}
+
+DIRECTIONS = {
+    "east": (3, 1),
+    "west": (0, 1),
+    "north": (1, 0),
+    "south": (1, 2),
+    "north-east": (2, 0),
+    "north-west": (0, 0),
+    "south-east": (2, 2),
+    "south-west": (0, 2),
+}
+
+
+def _all_cases() -> dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]]:
+    cases = dict(CASES)
+    for name, (x, y) in DIRECTIONS.items():
+        cases[f"direction/{name}"] = (
+            f"from the actuator (1, 1) to the {name}",
+            PAPER,
+            (1, 1, x, y, 600),
+            {},
+        )
+    return cases
+
+
+def _run(
+    layout_args: dict[str, Any], values: tuple[float, ...], options: dict[str, Any]
+) -> dict[str, Any]:
+    layout = Layout(**layout_args)
+    x0, y0, x1, y1, duration_ms, *rest = values
+    stroke = Stroke((x0, y0), (x1, y1), duration_ms, rest[0] if rest else None)
+    try:
+        return {"expected": schedule_to_json(plan(stroke, layout, **options), bursts=True)}
+    except StrokeError as error:
+        return {"expected_error": {"reason": error.reason}}
+
+
+def cases() -> dict[str, dict[str, Any]]:
+    result = {}
+    for name, (description, layout_args, values, options) in _all_cases().items():
+        x0, y0, x1, y1, duration_ms, *rest = values
+        full_options = {
+            "min_command_ms": MIN_COMMAND_MS,
+            "merge_distance": MERGE_DISTANCE,
+            "strict": False,
+        }
+        full_options.update(options)
+        stroke: dict[str, Any] = {"start": [x0, y0], "end": [x1, y1], "duration_ms": duration_ms}
+        if rest:
+            stroke["intensity"] = rest[0]
+        result[f"{name}.json"] = {
+            "description": description,
+            "tolerance": 1e-6,
+            "layout": layout_args,
+            "options": full_options,
+            "stroke": stroke,
+            **_run(layout_args, values, full_options),
+        }
+    return result
