@@ -59,3 +59,53 @@ up: $(STAMP) system
 
 clean:
 	rm -rf $(VENV) python/src/*.egg-info
+
+# ==== web: the drawing client (web/) ====================================================
+# TypeScript + Vite; every npm package pinned by web/package-lock.json and installed by
+# `npm ci`. Node.js >= 20.19 and npm come from the machine. The browser tests drive
+# Debian's chromium (installed by `system`) against a real Mosquitto (`feelmysign broker`
+# from the venv). Output of the browser tests (screenshots) lands in web/test-results/.
+
+WEB := web
+WEB_STAMP := $(WEB)/node_modules/.installed-stamp
+# The tools straight from node_modules: no npm start-up, no npm notices in the output.
+WEB_BIN := node_modules/.bin
+NPM_QUIET := --no-audit --no-fund --loglevel=error
+SYSTEM_PACKAGES += chromium
+
+.PHONY: web-build web-test web-typecheck web-format-check web-unit web-browser-test web-bench web-clean
+
+$(WEB_STAMP): $(WEB)/package.json $(WEB)/package-lock.json
+	@command -v npm >/dev/null || { echo "Error: npm not found; install Node.js 20.19 or newer with npm, then run make again." >&2; exit 1; }
+	cd $(WEB) && npm ci $(NPM_QUIET)
+	touch $@
+
+web-build: $(WEB_STAMP)
+	cd $(WEB) && $(WEB_BIN)/vite build --logLevel warn
+
+web-typecheck: $(WEB_STAMP)
+	cd $(WEB) && $(WEB_BIN)/tsc --noEmit
+
+web-format-check: $(WEB_STAMP)
+	cd $(WEB) && $(WEB_BIN)/prettier --check --log-level warn .
+
+web-unit: $(WEB_STAMP)
+	cd $(WEB) && $(WEB_BIN)/vitest run
+
+web-browser-test: web-build $(STAMP) system
+	cd $(WEB) && $(WEB_BIN)/vitest run --config vitest.browser.config.ts
+
+web-test: web-typecheck web-format-check web-unit web-browser-test
+
+web-bench: web-build system
+	cd $(WEB) && $(WEB_BIN)/tsx bench/run.ts
+
+web-clean:
+	rm -rf $(WEB)/node_modules $(WEB)/dist $(WEB)/test-results
+
+# The web client joins the project-wide targets (extra prerequisites; their recipes stay above).
+test: web-test
+bench: web-bench
+up: web-build
+clean: web-clean
+# ==== end of web ===========================================================================

@@ -122,3 +122,11 @@ def test_pop_due_is_lazy_about_the_future() -> None:
     timeline.add(_schedule(Command(0, 0, 10, 100, 0.5)), 0.0)
     assert timeline.pop_due(5.0).changes == []
     assert timeline.next_ms() == pytest.approx(10.0)
+
+
+def test_an_ended_stroke_leaves_nothing_planned() -> None:
+    """The on-time cap of a finished on-period must not keep the sleeve busy."""
+    timeline = Timeline(PAPER)
+    timeline.add(_schedule(Command(0, 0, 0, 100, 0.5)), 0.0)
+    _drain(timeline)
+    assert timeline.next_ms() is None and not timeline.busy

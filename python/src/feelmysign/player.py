@@ -198,10 +198,11 @@ class Player:
         while self._clock() < next_ms:
             time.sleep(0)  # let the network thread take the interpreter meanwhile
         due = self._timeline.pop_due(self._clock())
+        written_at_ms = self._clock()  # the first command of a stroke goes out now
         self._write(due.changes)
         for tag in due.started:
             if isinstance(tag, PlannedStroke):
-                self._started(tag)
+                self._started(tag, written_at_ms)
         for row, column in due.tripped:
             self._on_event(
                 {"type": "safety", "reason": "max_on_time", "row": row, "column": column}
@@ -224,8 +225,7 @@ class Player:
                     }
                 )
 
-    def _started(self, stroke: PlannedStroke) -> None:
-        now = self._clock()
+    def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:
             self._pending -= 1
         self.played += 1

@@ -79,11 +79,26 @@ class Timeline:
 
     def next_ms(self) -> float | None:
         """When the next thing is due, or None when nothing is planned."""
+        self._drop_stale_caps()
         return self._events[0].t_ms if self._events else None
 
     @property
     def busy(self) -> bool:
+        """Whether anything is planned or any actuator is on."""
+        self._drop_stale_caps()
         return bool(self._events) or any(self._output.values())
+
+    def _drop_stale_caps(self) -> None:
+        """Forget on-time caps of on-periods that have ended (they would only wake us up)."""
+        while (
+            self._events
+            and self._events[0].kind == "cap"
+            and not self._is_live_cap(self._events[0])
+        ):
+            heapq.heappop(self._events)
+
+    def _is_live_cap(self, event: _Event) -> bool:
+        return self._on_since.get(event.actuator) == event.since_ms
 
     def pop_due(self, now_ms: float) -> Due:
         """Everything due at or before ``now_ms``, in time order; only real changes are listed."""
@@ -120,7 +135,7 @@ class Timeline:
         elif event.kind == "off":
             self._active.get(event.actuator, {}).pop(event.command, None)
             touched.add(event.actuator)
-        elif self._on_since.get(event.actuator) == event.since_ms:
+        elif self._is_live_cap(event):
             # Still the on-period this cap was set for: it has lasted the
             # maximum continuous on-time.
             self._tripped.add(event.actuator)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import platform
 
-from feelmysign.bench import algorithms
+from feelmysign.bench import algorithms, sleeve
 
 
 def main() -> None:
@@ -16,8 +16,10 @@ def main() -> None:
         "Each figure is the best of 5 runs; ratios compare with the baseline of its group,"
         " measured in the same run.\n"
     )
-    for line in algorithms.report():
-        print(line)
+    for report in (algorithms.report, sleeve.report):
+        for line in report():
+            print(line, flush=True)
+        print()
 
 
 if __name__ == "__main__":

@@ -16,7 +16,7 @@ from feelmysign import __version__
 from feelmysign.errors import FeelMySignError
 
 # Subcommand modules, in the order `feelmysign --help` lists them.
-SUBCOMMANDS = ("plan", "simplify", "validate", "broker")
+SUBCOMMANDS = ("up", "plan", "simplify", "validate", "sleeve", "broker", "send", "scan", "buzz")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,97 @@
+"""One place that turns ``--backend sim|drv2605 [--emulate]`` into an open backend.
+
+Used by the sleeve daemon and by ``feelmysign buzz``, so both refuse the same
+mistakes with the same words, before any I2C traffic: an unknown backend, a
+layout without wiring for the hardware, options that only one backend has.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Literal
+
+from feelmysign.backends.base import Backend
+from feelmysign.backends.drv2605 import Drv2605Backend
+from feelmysign.backends.emulated_i2c import EmulatedI2CBus
+from feelmysign.backends.sim import SimBackend
+from feelmysign.backends.telemetry import ActuatorTelemetry
+from feelmysign.errors import LayoutError, ParameterError
+from feelmysign.layout import Layout
+
+BackendName = Literal["sim", "drv2605"]
+BACKEND_NAMES: tuple[BackendName, ...] = ("sim", "drv2605")
+
+
+def open_backend(
+    name: BackendName,
+    layout: Layout,
+    *,
+    record: str | os.PathLike[str] | None = None,
+    telemetry: ActuatorTelemetry | None = None,
+    emulate: bool = False,
+) -> Backend:
+    """An open backend for ``layout``, every actuator silent; close it (or use ``with``).
+
+    ``sim`` records what would be felt (``record``: a JSON-lines file of every
+    change). ``drv2605`` drives the chips on ``/dev/i2c-<layout.i2c_bus>``, or,
+    with ``emulate``, on an emulated bus wired as the layout says (to try the
+    hardware path without hardware). Raises ParameterError for a bad choice,
+    LayoutError for a layout without wiring, HardwareError when the chips do not
+    answer (see :meth:`Drv2605Backend.open`).
+    """
+    if name not in BACKEND_NAMES:
+        raise ParameterError(
+            "backend", name, "'sim' (the simulator) or 'drv2605' (DRV2605L chips over I2C)"
+        )
+    if name == "sim":
+        return _open_sim(layout, record=record, telemetry=telemetry, emulate=emulate)
+    if record is not None:
+        raise ParameterError(
+            "record",
+            os.fspath(record),
+            "left out with the drv2605 backend: only the simulator records (--backend sim)",
+        )
+    check_wired(layout)
+    bus = EmulatedI2CBus.for_layout(layout) if emulate else None
+    backend = Drv2605Backend(layout, bus=bus, telemetry=telemetry)
+    backend.open()
+    return backend
+
+
+def _open_sim(
+    layout: Layout,
+    *,
+    record: str | os.PathLike[str] | None,
+    telemetry: ActuatorTelemetry | None,
+    emulate: bool,
+) -> SimBackend:
+    if emulate:
+        raise ParameterError(
+            "emulate",
+            emulate,
+            "False with the sim backend: --emulate stands in for the drv2605 hardware; "
+            "use it with --backend drv2605",
+        )
+    backend = SimBackend(layout, record=record, telemetry=telemetry)
+    try:
+        backend.open()
+    except OSError as error:  # only the record file can fail here
+        raise ParameterError(
+            "record", os.fspath(record or ""), f"a file that can be written ({error.strerror})"
+        ) from error
+    return backend
+
+
+def check_wired(layout: Layout) -> None:
+    """LayoutError unless ``layout`` says which chip drives each actuator (its [i2c] table)."""
+    if layout.wiring:
+        return  # the rest (every actuator once, channels unique) is checked on open
+    raise LayoutError(
+        layout.name,
+        [
+            "i2c.wiring: missing, so the drv2605 backend cannot know which DRV2605L drives "
+            "which motor; give --layout FILE with an [i2c] table (start from "
+            "deploy/layouts/paper-sleeve.toml, see docs/sleeve-hardware.md), or use "
+            "--backend sim to run without hardware"
+        ],
+    )

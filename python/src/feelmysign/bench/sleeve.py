@@ -1,0 +1,210 @@
+"""Sleeve latency, timing and continuity, against a real Mosquitto on loopback, in one run.
+
+Baseline: a bare MQTT publish -> receive on the same broker (QoS 1, the same
+two accounts). Measured: publish -> the sleeve's first actuator command (from
+its ``played`` events), the sleeve's own share (receive -> first command), the
+lateness of every actuator write against the plan, and the gap between
+consecutive strokes of a drawing, for short (1 cm) and long (10 cm) strokes.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import statistics
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign.backends.sim import SimBackend
+from feelmysign.broker import Broker, Credentials
+from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.daemon import Sleeve, SleeveOptions, topic
+from feelmysign.layout import Layout
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+
+PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
+# 1 cm and 10 cm on the paper's 3 cm grid.
+SHORT = ((1.0, 1.0), (1.0 + 1 / 3, 1.0), 120.0)
+LONG = ((0.0, 0.0), (3.0, math.sqrt((10 / 3) ** 2 - 9.0)), 900.0)
+
+
+def percentile(values: list[float], q: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, round(q / 100 * (len(ordered) - 1)))]
+
+
+def _settings(c: Credentials, role: str) -> BrokerSettings:
+    account = c.sleeve if role == "sleeve" else c.sender
+    return BrokerSettings(
+        c.mqtt_host, c.mqtt_port, username=account.username, password=account.password
+    )
+
+
+class _Inbox:
+    """Messages of a subscription, waited for one at a time."""
+
+    def __init__(self) -> None:
+        self.items: list[tuple[float, bytes]] = []
+        self.cond = threading.Condition()
+
+    def __call__(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
+        with self.cond:
+            self.items.append((time.time_ns() / 1e6, bytes(message.payload)))
+            self.cond.notify_all()
+
+    def wait(self, count: int, timeout_s: float = 30.0) -> list[tuple[float, bytes]]:
+        with self.cond:
+            if not self.cond.wait_for(lambda: len(self.items) >= count, timeout_s):
+                raise TimeoutError(f"{len(self.items)} of {count} messages arrived")
+            return list(self.items)
+
+
+def _client(
+    c: Credentials, role: str, inbox: _Inbox | None = None, subscribe: str = ""
+) -> mqtt.Client:
+    client = new_client(_settings(c, role), client_id=f"bench-{role}-{uuid.uuid4()}")
+    connected = threading.Event()
+    client.on_connect = lambda *a: connected.set()
+    if inbox is not None:
+        client.on_message = inbox
+    client.connect(c.mqtt_host, c.mqtt_port)
+    client.loop_start()
+    connected.wait(10)
+    if subscribe:
+        client.subscribe(subscribe, qos=1)[1]
+        time.sleep(0.2)  # SUBACK has no waiter in paho's API; a moment is plenty on loopback
+    return client
+
+
+def bare_latency_ms(c: Credentials, count: int = 300) -> list[float]:
+    """Publish -> receive on the same broker, sender to sleeve account, QoS 1."""
+    inbox = _Inbox()
+    receiver = _client(c, "sleeve", inbox, topic(c.sleeve_id, "strokes"))
+    sender = _client(c, "sender")
+    sent: list[float] = []
+    for k in range(count):
+        sent.append(time.time_ns() / 1e6)
+        sender.publish(topic(c.sleeve_id, "strokes"), b"bench", qos=1)
+        inbox.wait(k + 1)
+    received = inbox.wait(count)
+    for client in (receiver, sender):
+        client.loop_stop()
+        client.disconnect()
+    return [r - s for (r, _), s in zip(received, sent, strict=True)]
+
+
+@contextmanager
+def _sleeve(c: Credentials) -> Iterator[Sleeve]:
+    backend = SimBackend(PAPER)
+    options = SleeveOptions(sleeve_id=c.sleeve_id, rate_per_s=1e6, burst=10**6)
+    sleeve = Sleeve(_settings(c, "sleeve"), PAPER, backend, options)
+    thread = threading.Thread(target=sleeve.run, daemon=True)
+    thread.start()
+    sleeve.connected.wait(10)
+    try:
+        yield sleeve
+    finally:
+        sleeve.stop()
+        thread.join(10)
+        backend.close()
+
+
+def stroke_latencies(
+    c: Credentials, sleeve: Sleeve, shape: Any, count: int
+) -> list[dict[str, Any]]:
+    """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event."""
+    inbox = _Inbox()
+    watcher = _client(c, "sender", inbox, topic(c.sleeve_id, "events"))
+    sender = _client(c, "sender")
+    (start, end, duration_ms) = shape
+    results = []
+    for k in range(count):
+        stroke = Stroke(start, end, duration_ms, None, f"lat-{uuid.uuid4()}", 0)
+        published_ms = time.time_ns() / 1e6
+        sender.publish(topic(c.sleeve_id, "strokes"), format_json(stroke), qos=1)
+        _, payload = inbox.wait(k + 1)[-1]
+        event = json.loads(payload)
+        event["published_at_ms"] = published_ms
+        results.append(event)
+        while not sleeve.player.idle:
+            time.sleep(0.005)
+    for client in (watcher, sender):
+        client.loop_stop()
+        client.disconnect()
+    return results
+
+
+def drawing_gaps(c: Credentials, shape: Any, strokes: int = 20) -> list[float]:
+    """A drawing sent at once: each stroke should start as the one before it ends."""
+    inbox = _Inbox()
+    watcher = _client(c, "sender", inbox, topic(c.sleeve_id, "events"))
+    sender = _client(c, "sender")
+    (start, end, duration_ms) = shape
+    drawing = f"gap-{uuid.uuid4()}"
+    for seq in range(strokes):
+        a, b = (start, end) if seq % 2 == 0 else (end, start)
+        sender.publish(
+            topic(c.sleeve_id, "strokes"),
+            format_json(Stroke(a, b, duration_ms, None, drawing, seq)),
+            qos=1,
+        )
+    events = [json.loads(p) for _, p in inbox.wait(strokes, timeout_s=60)]
+    for client in (watcher, sender):
+        client.loop_stop()
+        client.disconnect()
+    return [
+        after["first_command_at_ms"] - (before["first_command_at_ms"] + before["duration_ms"])
+        for before, after in itertools.pairwise(events)
+        if after["queued_ms"] > 0
+    ]
+
+
+def _figures(name: str, values: list[float]) -> str:
+    return (
+        f"  {name:<48} p50 {statistics.median(values):7.3f} ms"
+        f"   p99 {percentile(values, 99):7.3f} ms"
+        f"   (n={len(values)})"
+    )
+
+
+def report() -> list[str]:
+    lines = ["Sleeve (real Mosquitto on loopback, simulator backend)"]
+    with (
+        tempfile.TemporaryDirectory() as state,
+        Broker(state_dir=Path(state), port=0, ws_port=0) as broker,
+    ):
+        c = broker.credentials
+        bare = bare_latency_ms(c)
+        lines.append(_figures("baseline: bare MQTT publish -> receive", bare))
+        with _sleeve(c) as sleeve:
+            stroke_latencies(c, sleeve, SHORT, 5)  # warm-up: first-use costs are not latency
+            for label, shape, count in (("1 cm", SHORT, 100), ("10 cm", LONG, 30)):
+                sleeve.player.timing_errors_ms.clear()
+                events = stroke_latencies(c, sleeve, shape, count)
+                end_to_end = [e["first_command_at_ms"] - e["published_at_ms"] for e in events]
+                own = [e["latency_ms"] for e in events]
+                ratio = percentile(end_to_end, 99) / percentile(bare, 99)
+                lines.append(
+                    _figures(f"{label}: publish -> first actuator command", end_to_end)
+                    + f"   {ratio:.2f}x baseline p99"
+                )
+                lines.append(_figures(f"{label}: sleeve's share (receive -> first command)", own))
+                lines.append(
+                    _figures(
+                        f"{label}: actuator write vs plan (lateness)",
+                        list(sleeve.player.timing_errors_ms),
+                    )
+                )
+                gaps = drawing_gaps(c, shape)
+                lines.append(_figures(f"{label}: gap between strokes of a drawing", gaps))
+    return lines

@@ -1,0 +1,133 @@
+"""``feelmysign buzz``: switch one motor on for a moment, to check its wiring.
+
+    feelmysign buzz 0 0 --layout /etc/feelmysign/layout.toml          # row 0, column 0
+    feelmysign buzz 1 2 --intensity 0.5 --duration-ms 300 --layout deploy/layouts/paper-sleeve.toml
+    feelmysign buzz 1 2 --backend sim                                   # no hardware needed
+
+Row and column are grid indices (row 0 = y 0, column 0 = x 0; see the layout
+file's drawing). The intensity is capped at the layout's safety.max_intensity
+and the duration at its safety.max_on_time_ms. Every motor is switched off
+afterwards, also on Ctrl-C or an error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+from feelmysign.backends.base import check_actuator
+from feelmysign.backends.factory import BACKEND_NAMES, open_backend
+from feelmysign.backends.sim import SimBackend
+from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.errors import ParameterError
+from feelmysign.layout import Layout
+
+DEFAULT_DURATION_MS = 1000.0  # long enough to feel and to find by touch which motor it is
+
+
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    parser = subparsers.add_parser(
+        "buzz",
+        help="switch one motor on for a moment, to check its wiring",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("row", type=int, metavar="ROW", help="the motor's row, from 0")
+    parser.add_argument("column", type=int, metavar="COLUMN", help="the motor's column, from 0")
+    parser.add_argument(
+        "--intensity",
+        type=float,
+        metavar="A",
+        help="drive level in [0, 1], capped at the layout's safety.max_intensity "
+        "(default: the layout's default_intensity)",
+    )
+    parser.add_argument(
+        "--duration-ms",
+        type=float,
+        default=DEFAULT_DURATION_MS,
+        metavar="D",
+        help=f"how long the motor stays on, in ms, capped at the layout's safety.max_on_time_ms "
+        f"(default: {DEFAULT_DURATION_MS:g})",
+    )
+    parser.add_argument(
+        "--backend",
+        choices=BACKEND_NAMES,
+        default="drv2605",
+        help="drv2605: the sleeve's chips over I2C; sim: the simulator (default: drv2605)",
+    )
+    parser.add_argument(
+        "--emulate",
+        action="store_true",
+        help="with drv2605: an emulated I2C bus wired as the layout says, instead of the hardware",
+    )
+    add_layout_options(parser)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    layout = layout_from_args(args)
+    check_actuator(layout, args.row, args.column)
+    intensity, intensity_note = _intensity(args.intensity, layout)
+    duration_ms, duration_note = _duration_ms(args.duration_ms, layout)
+    backend = open_backend(args.backend, layout, emulate=args.emulate)
+    where = _where(args, layout)
+    for note in (intensity_note, duration_note):
+        if note:
+            print(note, flush=True)
+    print(
+        f"Buzzing row {args.row}, column {args.column}{where} at intensity {intensity:g} "
+        f"for {duration_ms:g} ms...",
+        flush=True,
+    )
+    started_s = time.monotonic()
+    try:
+        backend.set_intensity(args.row, args.column, intensity)
+        # The motor is meant to run this long: a timed wait, not a wait for an event.
+        time.sleep(duration_ms / 1000)
+    except KeyboardInterrupt:
+        elapsed_ms = (time.monotonic() - started_s) * 1000
+        print(f"Interrupted after {elapsed_ms:.0f} ms.", flush=True)
+        raise
+    finally:
+        backend.close()  # all off first, then release the bus
+        print("Every motor is off.", flush=True)
+    if isinstance(backend, SimBackend):
+        for change in backend.changes:
+            print(
+                f"  t = {change.t_ms:8.1f} ms  row {change.row}, column {change.column}: "
+                f"intensity {change.intensity:g}"
+            )
+    return 0
+
+
+def _intensity(requested: float | None, layout: Layout) -> tuple[float, str]:
+    if requested is None:
+        requested = layout.default_intensity
+    if not (math.isfinite(requested) and 0.0 <= requested <= 1.0):
+        raise ParameterError("--intensity", requested, "a number in [0, 1]")
+    if requested > layout.max_intensity:
+        return layout.max_intensity, (
+            f"Intensity {requested:g} capped at the layout's safety.max_intensity "
+            f"{layout.max_intensity:g}."
+        )
+    return requested, ""
+
+
+def _duration_ms(requested: float, layout: Layout) -> tuple[float, str]:
+    if not (math.isfinite(requested) and requested > 0):
+        raise ParameterError("--duration-ms", requested, "a number of milliseconds above 0")
+    if requested > layout.max_on_time_ms:
+        return layout.max_on_time_ms, (
+            f"Duration {requested:g} ms capped at the layout's safety.max_on_time_ms "
+            f"{layout.max_on_time_ms:g} ms."
+        )
+    return requested, ""
+
+
+def _where(args: argparse.Namespace, layout: Layout) -> str:
+    if args.backend == "sim":
+        return " on the simulator"
+    wire = next(w for w in layout.wiring if (w.row, w.column) == (args.row, args.column))
+    bus = "an emulated I2C bus" if args.emulate else f"/dev/i2c-{layout.i2c_bus}"
+    return f" (DRV2605L on multiplexer 0x{wire.multiplexer:02X} channel {wire.channel}, {bus})"

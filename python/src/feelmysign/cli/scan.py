@@ -1,0 +1,261 @@
+"""``feelmysign scan``: what answers on every multiplexer channel, against the sleeve layout.
+
+    feelmysign scan --layout /etc/feelmysign/layout.toml
+    feelmysign scan --layout deploy/layouts/paper-sleeve.toml --emulate   # no hardware needed
+
+One line per channel of every multiplexer the layout lists: the actuator the
+layout expects there, what answered, and the verdict. Exit 0 when every wired
+actuator's DRV2605L answers and nothing answers where none is wired, 1
+otherwise (also when the layout wires nothing, as then nothing was checked).
+Only reads: no motor is switched on, and every channel is disabled afterwards.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from dataclasses import dataclass
+from typing import Any
+
+from feelmysign.backends.drv2605 import DRV2605_ADDRESS, SUPPORTED_DEVICE_IDS, device_name
+from feelmysign.backends.emulated_i2c import EmulatedI2CBus
+from feelmysign.backends.i2c import I2CBus, open_smbus
+from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
+from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
+from feelmysign.cli._options import LAYOUT_ENV
+from feelmysign.errors import HardwareError, ParameterError
+from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
+
+EMULATED_NOTE = (
+    "Emulated bus: nothing real was probed. Every chip the layout wires is simulated as "
+    "present, so this shows the output format, not your sleeve."
+)
+_TABLE_HEADER = ("multiplexer", "channel", "expected", "found", "status")
+
+
+@dataclass(frozen=True)
+class ChannelRow:
+    """One line of the table: a multiplexer channel, expected against found."""
+
+    multiplexer: int
+    channel: int
+    expected: Wire | None
+    found: str
+    status: str
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "multiplexer": f"0x{self.multiplexer:02X}",
+            "channel": self.channel,
+            "expected": None
+            if self.expected is None
+            else {"row": self.expected.row, "column": self.expected.column},
+            "found": self.found,
+            "status": self.status,
+        }
+
+
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    parser = subparsers.add_parser(
+        "scan",
+        help="check which DRV2605L answers on each multiplexer channel, against the layout",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--layout",
+        metavar="FILE",
+        help=f"sleeve layout TOML file with an [i2c] table, e.g. deploy/layouts/paper-sleeve.toml "
+        f"(default: ${LAYOUT_ENV}; without a wired layout every address 0x70..0x77 is probed "
+        "and nothing is compared)",
+    )
+    parser.add_argument(
+        "--bus",
+        type=int,
+        metavar="N",
+        help="I2C bus number, /dev/i2c-N (default: the layout's i2c.bus, 1 on a Raspberry Pi)",
+    )
+    parser.add_argument(
+        "--emulate",
+        action="store_true",
+        help="scan an emulated bus wired as the layout says, instead of /dev/i2c-N",
+    )
+    parser.add_argument("--json", action="store_true", help="print one JSON object, for programs")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    layout = _layout(args.layout)
+    bus_number = layout.i2c_bus if args.bus is None else args.bus
+    if not 0 <= bus_number <= MAX_I2C_BUS:
+        raise ParameterError("--bus", bus_number, f"a bus number from 0 to {MAX_I2C_BUS}")
+    # Without wiring there is nothing to expect: probe every address a TCA9548A can have.
+    addresses = layout.multiplexers or tuple(MULTIPLEXER_ADDRESSES)
+    bus = EmulatedI2CBus.for_layout(layout) if args.emulate else _open_bus(bus_number)
+    try:
+        result = scan(bus, addresses)
+    finally:
+        bus.close()
+    report = compare_with_layout(result, layout)
+    rows = channel_rows(result, layout)
+    ok = report.ok and bool(layout.wiring)
+    if args.json:
+        print(json.dumps(_as_json(args, layout, bus_number, result, report, rows, ok)))
+    else:
+        print(_describe(args, layout, bus_number, result, report, rows), flush=True)
+    return 0 if ok else 1
+
+
+def _open_bus(bus_number: int) -> I2CBus:
+    try:
+        return open_smbus(bus_number)
+    except HardwareError as error:
+        raise HardwareError(
+            f"{error} To see what scan prints without hardware, add --emulate."
+        ) from error
+
+
+def _layout(path: str | None) -> Layout:
+    chosen = path or os.environ.get(LAYOUT_ENV, "")
+    return load_layout(chosen) if chosen else PAPER_SLEEVE
+
+
+def channel_rows(result: ScanResult, layout: Layout) -> list[ChannelRow]:
+    """Every channel of every multiplexer scanned or expected, in address and channel order."""
+    wires = {(w.multiplexer, w.channel): w for w in layout.wiring}
+    present = {c.multiplexer for c in result.channels}
+    rows = []
+    for multiplexer in sorted(present | set(layout.multiplexers)):
+        for channel in CHANNELS:
+            expected = wires.get((multiplexer, channel))
+            if multiplexer in result.missing_multiplexers:
+                if expected is not None:
+                    rows.append(
+                        ChannelRow(multiplexer, channel, expected, "-", "multiplexer missing")
+                    )
+                continue
+            found, status = _found_and_status(result, multiplexer, channel, expected)
+            rows.append(ChannelRow(multiplexer, channel, expected, found, status))
+    return rows
+
+
+def _found_and_status(
+    result: ScanResult, multiplexer: int, channel: int, expected: Wire | None
+) -> tuple[str, str]:
+    scanned = result.channel(multiplexer, channel)
+    addresses = scanned.addresses if scanned is not None else ()
+    names = []
+    for address in addresses:
+        if address == DRV2605_ADDRESS and scanned is not None and scanned.device_id is not None:
+            names.append(f"0x{address:02X} {device_name(scanned.device_id)}")
+        else:
+            names.append(f"0x{address:02X}")
+    found = ", ".join(names) or "nothing"
+    has_driver = DRV2605_ADDRESS in addresses
+    right_chip = scanned is not None and scanned.device_id in SUPPORTED_DEVICE_IDS
+    if expected is None:
+        return found, "UNEXPECTED" if has_driver else "free"
+    if not has_driver:
+        return found, "MISSING"
+    return found, "ok" if right_chip else "WRONG CHIP"
+
+
+def _describe(
+    args: argparse.Namespace,
+    layout: Layout,
+    bus_number: int,
+    result: ScanResult,
+    report: LayoutReport,
+    rows: list[ChannelRow],
+) -> str:
+    where = "an emulated bus" if args.emulate else f"/dev/i2c-{bus_number}"
+    lines = [f"Scanning {where} against layout {layout.name!r}."]
+    if args.emulate:
+        lines.append(EMULATED_NOTE)
+    if rows:
+        lines += ["", *_table(rows), ""]
+    else:
+        listed = ", ".join(f"0x{m:02X}" for m in result.missing_multiplexers)
+        lines += [
+            "",
+            f"No multiplexer answered (probed {listed}): check the TCA9548A's power (VIN, GND), "
+            "its SDA/SCL wires to the Pi (pins 3 and 5) and its address pins A0-A2.",
+            "",
+        ]
+    lines.append(_main_bus_line(result, layout))
+    if not layout.wiring:
+        lines.append(
+            f"The layout {layout.name!r} wires no actuator, so nothing was checked: give "
+            "--layout FILE with an [i2c] table (e.g. deploy/layouts/paper-sleeve.toml)."
+        )
+        return "\n".join(lines)
+    wired = len(report.wires)
+    answering = sum(1 for check in report.wires if check.status == "ok")
+    if report.ok:
+        lines.append(f"All {wired} actuators answer as the layout says.")
+    else:
+        lines.append(f"{answering} of {wired} actuators answer as the layout says. Problems:")
+        lines += [f"  - {problem}" for problem in report.problems()]
+        lines.append("See 'Troubleshooting' in docs/sleeve-hardware.md.")
+    return "\n".join(lines)
+
+
+def _table(rows: list[ChannelRow]) -> list[str]:
+    cells = [_TABLE_HEADER] + [
+        (
+            f"0x{row.multiplexer:02X}",
+            str(row.channel),
+            "-"
+            if row.expected is None
+            else f"row {row.expected.row}, column {row.expected.column}",
+            row.found,
+            row.status,
+        )
+        for row in rows
+    ]
+    widths = [max(len(line[i]) for line in cells) for i in range(len(_TABLE_HEADER))]
+    return [
+        "  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in cells
+    ]
+
+
+def _main_bus_line(result: ScanResult, layout: Layout) -> str:
+    answering = (
+        ", ".join(
+            f"0x{a:02X}" + (" (TCA9548A)" if a in layout.multiplexers else "")
+            for a in result.main_bus
+        )
+        or "nothing"
+    )
+    line = f"On the main bus (every channel disabled): {answering}."
+    strangers = [
+        a for a in result.main_bus if a in MULTIPLEXER_ADDRESSES and a not in layout.multiplexers
+    ]
+    if strangers and layout.wiring:
+        line += (
+            f" Also answering where the layout lists no multiplexer: "
+            f"{', '.join(f'0x{a:02X}' for a in strangers)}."
+        )
+    return line
+
+
+def _as_json(
+    args: argparse.Namespace,
+    layout: Layout,
+    bus_number: int,
+    result: ScanResult,
+    report: LayoutReport,
+    rows: list[ChannelRow],
+    ok: bool,
+) -> dict[str, Any]:
+    return {
+        "ok": ok,
+        "emulated": bool(args.emulate),
+        "bus": None if args.emulate else bus_number,
+        "layout": layout.name,
+        "main_bus": [f"0x{a:02X}" for a in result.main_bus],
+        "missing_multiplexers": [f"0x{a:02X}" for a in result.missing_multiplexers],
+        "channels": [row.as_dict() for row in rows],
+        "problems": report.problems() if layout.wiring else ["the layout wires no actuator"],
+    }

@@ -1,0 +1,160 @@
+"""``feelmysign sleeve``: the daemon that plays strokes on the sleeve (or its simulator)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+from collections import Counter
+from collections.abc import Callable
+from types import FrameType
+from typing import Any
+
+from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
+from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
+from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.connection import BrokerSettings
+from feelmysign.daemon import BURST, LEGACY_TOPIC, RATE_PER_S, Sleeve, SleeveOptions
+from feelmysign.errors import ParameterError
+from feelmysign.layout import Layout
+
+TELEMETRY_RATE_HZ = 20.0  # previews look smooth at 20 frames a second; more only costs traffic
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "sleeve",
+        help="run the sleeve: play every stroke sent to it",
+        description=(
+            "Run the sleeve daemon: subscribe to this sleeve's strokes (JSON v1) and to the "
+            "legacy topic, plan each stroke with Tactile Brush and play it on the motors "
+            "(--backend drv2605) or the simulator (--backend sim), publishing status, "
+            "actuator telemetry and one event per stroke. Ctrl-C or SIGTERM stops it with "
+            "every motor off."
+        ),
+    )
+    add_broker_options(parser, role="sleeve")
+    add_layout_options(parser)
+    parser.add_argument(
+        "--backend",
+        choices=BACKEND_NAMES,
+        default="sim",
+        help="sim: the simulator; drv2605: DRV2605L chips over I2C (default: sim)",
+    )
+    parser.add_argument(
+        "--emulate",
+        action="store_true",
+        help="with --backend drv2605: an emulated I2C bus wired as the layout says",
+    )
+    parser.add_argument(
+        "--legacy-topic",
+        default=LEGACY_TOPIC,
+        metavar="TOPIC",
+        help=f"also play legacy text strokes from this topic (default: {LEGACY_TOPIC})",
+    )
+    parser.add_argument(
+        "--no-legacy", action="store_true", help="do not listen on the legacy topic"
+    )
+    parser.add_argument(
+        "--record",
+        metavar="FILE",
+        help="with --backend sim: write every actuator change as JSON lines",
+    )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="reject strokes too fast to render instead of slowing them",
+    )
+    parser.add_argument(
+        "--rate-per-s",
+        type=float,
+        default=RATE_PER_S,
+        metavar="R",
+        help=f"strokes accepted per second on average (default: {RATE_PER_S:g}; bursts of {BURST})",
+    )
+    parser.add_argument(
+        "--log-level",
+        default="info",
+        choices=["debug", "info", "warning", "error"],
+        help="how much to log on stderr (default: info)",
+    )
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    logging.basicConfig(
+        level=args.log_level.upper(),
+        stream=sys.stderr,
+        format="%(asctime)s %(levelname)s %(message)s",
+    )
+    if not 0.1 <= args.rate_per_s <= 10_000:
+        raise ParameterError("--rate-per-s", args.rate_per_s, "in [0.1, 10000] strokes per second")
+    layout = layout_from_args(args)
+    settings = broker_settings_from_args(args, "sleeve")
+    options = SleeveOptions(
+        sleeve_id=settings.sleeve_id,
+        legacy_topic=None if args.no_legacy else args.legacy_topic,
+        rate_per_s=args.rate_per_s,
+        strict=args.strict,
+        backend_name=args.backend + (" (emulated bus)" if args.emulate else ""),
+    )
+    print(
+        f"Sleeve {options.sleeve_id}: {layout.rows} x {layout.columns} actuators, "
+        f"{options.backend_name} backend, broker {settings.url}; Ctrl-C to stop",
+        flush=True,
+    )
+    counts = run_sleeve(
+        settings,
+        layout,
+        options,
+        backend=args.backend,
+        record=args.record,
+        emulate=args.emulate,
+        on_start=_stop_on_signals,
+    )
+    print(
+        f"Sleeve {options.sleeve_id} stopped, every motor off "
+        f"({counts['played']} played, {counts['rejected']} rejected)",
+        flush=True,
+    )
+    return 0
+
+
+def run_sleeve(
+    settings: BrokerSettings,
+    layout: Layout,
+    options: SleeveOptions,
+    *,
+    backend: BackendName = "sim",
+    record: str | None = None,
+    emulate: bool = False,
+    on_start: Callable[[Sleeve], None] = lambda sleeve: None,
+) -> Counter[str]:
+    """Open the backend with its telemetry, run the sleeve until it stops; every motor off after."""
+    sleeves: list[Sleeve] = []
+
+    def publish(frame: ActuatorFrame) -> None:
+        if sleeves:
+            sleeves[0].publish_actuators(frame.as_dict())
+
+    with (
+        ActuatorTelemetry(publish, rate_hz=TELEMETRY_RATE_HZ) as telemetry,
+        open_backend(
+            backend, layout, record=record, telemetry=telemetry, emulate=emulate
+        ) as opened,
+    ):
+        sleeve = Sleeve(settings, layout, opened, options)
+        sleeves.append(sleeve)
+        on_start(sleeve)
+        sleeve.run()
+    return sleeve.counts
+
+
+def _stop_on_signals(sleeve: Sleeve) -> None:
+    def stop(signum: int, frame: FrameType | None) -> None:
+        sleeve.stop()
+
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)

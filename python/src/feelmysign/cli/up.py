@@ -1,0 +1,147 @@
+"""``feelmysign up``: everything on one machine: broker, sleeve, and the drawing client."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import threading
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+from feelmysign.backends.factory import BACKEND_NAMES
+from feelmysign.broker import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID, DEFAULT_WS_PORT, Broker
+from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli.sleeve import run_sleeve
+from feelmysign.connection import BrokerSettings
+from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.webserver import WEB_DIST, WebServer
+
+DEFAULT_HTTP_PORT = 8000
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "up",
+        help="start the broker, a sleeve and the drawing client, all on this machine",
+        description=(
+            "Start Mosquitto with generated credentials, a sleeve (simulated, or the real one "
+            "on a Raspberry Pi), and serve the drawing client on http://127.0.0.1:PORT with the "
+            "broker's address and the sender's login built in. Ctrl-C stops everything."
+        ),
+    )
+    parser.add_argument(
+        "--state-dir",
+        type=Path,
+        metavar="DIR",
+        help="where the broker keeps credentials.json and its data "
+        "(default: the same as 'feelmysign broker')",
+    )
+    parser.add_argument(
+        "--http-port",
+        type=int,
+        default=DEFAULT_HTTP_PORT,
+        metavar="P",
+        help=f"drawing client port (default: {DEFAULT_HTTP_PORT}; 0 = any free)",
+    )
+    parser.add_argument(
+        "--port",
+        type=int,
+        default=DEFAULT_MQTT_PORT,
+        metavar="P",
+        help=f"MQTT port (default: {DEFAULT_MQTT_PORT}; 0 = any free)",
+    )
+    parser.add_argument(
+        "--ws-port",
+        type=int,
+        default=DEFAULT_WS_PORT,
+        metavar="W",
+        help=f"MQTT over WebSockets port, for browsers (default: {DEFAULT_WS_PORT})",
+    )
+    parser.add_argument(
+        "--sleeve-id",
+        default=DEFAULT_SLEEVE_ID,
+        metavar="ID",
+        help=f"the sleeve's id (default: {DEFAULT_SLEEVE_ID})",
+    )
+    parser.add_argument(
+        "--sleeve-backend",
+        choices=BACKEND_NAMES,
+        default="sim",
+        help="sim: the simulator; drv2605: the motors over I2C (default: sim)",
+    )
+    parser.add_argument(
+        "--record",
+        metavar="FILE",
+        help="with the sim backend: write every actuator change as JSON lines",
+    )
+    parser.add_argument(
+        "--web-dir",
+        type=Path,
+        default=WEB_DIST,
+        metavar="DIR",
+        help="the built drawing client (default: web/dist of this checkout)",
+    )
+    add_layout_options(parser)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    layout = layout_from_args(args)
+    broker = Broker(
+        state_dir=args.state_dir, port=args.port, ws_port=args.ws_port, sleeve_id=args.sleeve_id
+    )
+    with broker:
+        c = broker.credentials
+        config = {
+            "ws_url": c.ws_url,
+            "sleeve_id": c.sleeve_id,
+            "username": c.sender.username,
+            "password": c.sender.password,
+        }
+        with WebServer(port=args.http_port, config=config, directory=args.web_dir) as web:
+            settings = BrokerSettings(
+                c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
+            )
+            options = SleeveOptions(sleeve_id=c.sleeve_id, backend_name=args.sleeve_backend)
+
+            def started(sleeve: Sleeve) -> None:
+                _stop_on_signals(sleeve)
+                threading.Thread(
+                    target=_announce, args=(sleeve, web.url, broker), daemon=True
+                ).start()
+
+            run_sleeve(
+                settings,
+                layout,
+                options,
+                backend=args.sleeve_backend,
+                record=args.record,
+                on_start=started,
+            )
+    print("Stopped: sleeve (every motor off), drawing client and broker.", flush=True)
+    return 0
+
+
+def _announce(sleeve: Sleeve, url: str, broker: Broker) -> None:
+    if not sleeve.connected.wait(15):
+        print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
+        return
+    c = broker.credentials
+    print(
+        f"feelmysign is up.\n"
+        f"  Draw here:   {url}\n"
+        f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
+        f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
+        f"  Credentials: {broker.credentials_path}\n"
+        f"Press Ctrl-C to stop.",
+        flush=True,
+    )
+
+
+def _stop_on_signals(sleeve: Sleeve) -> None:
+    def stop(signum: int, frame: FrameType | None) -> None:
+        sleeve.stop()
+
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)

@@ -1,0 +1,102 @@
+/**
+ * Scripting time per animation frame while drawing, in real Chromium, after
+ * 10 and after 10,000 drawn strokes. The paper's sketch redrew every stroke on
+ * every frame, so its frames grew with the drawing; ours should not (the ratio
+ * should stay near 1). Scripting time is Chromium's own ScriptDuration (CDP
+ * Performance metrics) over a mouse drawing of a fixed number of frames.
+ */
+import { createServer } from "node:net";
+import type { CDPSession, Page } from "playwright-core";
+import { checkPrerequisites, launchBrowser, serveDist } from "../e2e/harness";
+import { drawingArea, nextFrame } from "../e2e/page";
+
+/** Pointer steps (one per frame) of each measured drawing. */
+const MEASURED_FRAMES = 240;
+
+export interface FramePhase {
+  strokes: number;
+  scriptMsPerFrame: number;
+  pageWorkMeanMs: number;
+  pageWorkP95Ms: number;
+  frames: number;
+}
+
+export interface FrameCostFigures {
+  browser: string;
+  few: FramePhase;
+  many: FramePhase;
+}
+
+async function unusedPort(): Promise<number> {
+  const server = createServer();
+  await new Promise<void>((listening) => server.listen(0, "127.0.0.1", listening));
+  const { port } = server.address() as { port: number };
+  await new Promise<void>((closed) => server.close(() => closed()));
+  return port;
+}
+
+async function measure(page: Page, cdp: CDPSession): Promise<Omit<FramePhase, "strokes">> {
+  const area = await drawingArea(page);
+  const scriptSeconds = async () => {
+    const { metrics } = await cdp.send("Performance.getMetrics");
+    return metrics.find((metric) => metric.name === "ScriptDuration")?.value ?? Number.NaN;
+  };
+  await page.evaluate(() => window.feelmysign!.resetFrameStats());
+  const before = await scriptSeconds();
+  // A circle, one pointer step per frame: the same work in both phases.
+  const cx = area.left + area.width / 2;
+  const cy = area.top + area.height / 2;
+  const radius = area.height * 0.3;
+  await page.mouse.move(cx + radius, cy);
+  await page.mouse.down();
+  for (let k = 1; k <= MEASURED_FRAMES; k++) {
+    const angle = (2 * Math.PI * k) / MEASURED_FRAMES;
+    await page.mouse.move(cx + radius * Math.cos(angle), cy + radius * Math.sin(angle));
+    await nextFrame(page);
+  }
+  await page.mouse.up();
+  const after = await scriptSeconds();
+  const work = await page.evaluate(() => window.feelmysign!.frameWorkMs());
+  const sorted = [...work].sort((a, b) => a - b);
+  return {
+    frames: work.length,
+    scriptMsPerFrame: ((after - before) * 1000) / work.length,
+    pageWorkMeanMs: work.reduce((sum, ms) => sum + ms, 0) / work.length,
+    pageWorkP95Ms: sorted[Math.floor(sorted.length * 0.95)] ?? Number.NaN,
+  };
+}
+
+export async function benchFrameCost(): Promise<FrameCostFigures> {
+  checkPrerequisites();
+  // A broker address where nothing listens: the page stays offline and keeps every stroke
+  // in its outbox, the heaviest case for memory.
+  const server = await serveDist({
+    ws_url: `ws://127.0.0.1:${await unusedPort()}`,
+    sleeve_id: "bench",
+    username: "sender",
+    password: "unused",
+  });
+  const browser = await launchBrowser({ viewport: { width: 1280, height: 800 }, deviceScaleFactor: 1 });
+  try {
+    const context = browser.context;
+    // Strokes must accumulate in one drawing: clear on press off.
+    await context.addInitScript(() => {
+      localStorage.setItem("feelmysign.settings.v1", JSON.stringify({ clear_on_press: false }));
+    });
+    const page = await context.newPage();
+    const cdp = await context.newCDPSession(page);
+    await cdp.send("Performance.enable");
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.feelmysign !== undefined);
+    const version = await cdp.send("Browser.getVersion");
+    const strokes = () => page.evaluate(() => window.feelmysign!.drawSynthetic(0));
+    await page.evaluate(() => window.feelmysign!.drawSynthetic(10));
+    const few = { strokes: await strokes(), ...(await measure(page, cdp)) };
+    await page.evaluate((n) => window.feelmysign!.drawSynthetic(n), 10_000 - (await strokes()));
+    const many = { strokes: await strokes(), ...(await measure(page, cdp)) };
+    return { browser: version.product, few, many };
+  } finally {
+    await browser.close();
+    await server.stop();
+  }
+}

@@ -1,0 +1,39 @@
+/**
+ * `npm run bench`: the web client's figures, printed (never asserted).
+ *   - the TypeScript angle simplifier's throughput (frames/s) beside a baseline;
+ *   - scripting time per frame while drawing in Chromium, after 10 and after
+ *     10,000 drawn strokes, and their ratio (incremental rendering keeps it ~1).
+ * Needs `vite build` (dist/) and Debian's chromium.
+ */
+import { benchFrameCost, type FramePhase } from "./frame-cost";
+import { benchSimplifier } from "./simplifier";
+
+function millions(value: number): string {
+  return `${(value / 1e6).toFixed(2)} M`;
+}
+
+function phase(label: string, figures: FramePhase): string {
+  return (
+    `  ${label.padEnd(22)} ${figures.scriptMsPerFrame.toFixed(3)} ms/frame scripting` +
+    ` (the page's own frame work: mean ${figures.pageWorkMeanMs.toFixed(3)} ms, p95 ${figures.pageWorkP95Ms.toFixed(3)} ms;` +
+    ` ${figures.frames} frames, ${figures.strokes} strokes on the canvas)`
+  );
+}
+
+const simplifier = benchSimplifier();
+console.log("web: angle simplifier (TypeScript, Node " + process.versions.node + ")");
+console.log(
+  `  ${millions(simplifier.framesPerSecond)} frames/s` +
+    ` (baseline, one distance per frame: ${millions(simplifier.baselineFramesPerSecond)} frames/s;` +
+    ` ratio ${(simplifier.baselineFramesPerSecond / simplifier.framesPerSecond).toFixed(1)}x;` +
+    ` ${simplifier.strokes} strokes from 200000 frames)`,
+);
+
+const frames = await benchFrameCost();
+console.log(`web: scripting time per frame while drawing (${frames.browser}, headless)`);
+console.log(phase("after 10 strokes:", frames.few));
+console.log(phase(`after ${frames.many.strokes} strokes:`, frames.many));
+console.log(
+  `  ratio (10,000 / 10): ${(frames.many.scriptMsPerFrame / frames.few.scriptMsPerFrame).toFixed(2)}` +
+    ` (scripting), ${(frames.many.pageWorkMeanMs / frames.few.pageWorkMeanMs).toFixed(2)} (page frame work)`,
+);

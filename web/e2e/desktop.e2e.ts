@@ -1,0 +1,360 @@
+/**
+ * The sender's page in real Chromium against a real Mosquitto: draw a square
+ * with the mouse and receive its four strokes as the sleeve; see the sleeve's
+ * status, preview and events; settings with inline errors that persist; a
+ * recording that `feelmysign simplify` reads; strokes drawn while the broker is
+ * down, kept and sent when it is back.
+ */
+import { execFileSync } from "node:child_process";
+import { readFileSync, rmSync } from "node:fs";
+import { createServer } from "node:net";
+import { join } from "node:path";
+import type { Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import {
+  Broker,
+  checkPrerequisites,
+  FakeSleeve,
+  FEELMYSIGN,
+  launchBrowser,
+  pageConfig,
+  portOf,
+  RESULTS_DIR,
+  serveDist,
+  tempDir,
+} from "./harness";
+import { CANVAS, drawingArea, drawWithMouse, nextFrame, screenshot, toGrid, waitForData, walk } from "./page";
+
+/** Grid units: the live frames see a corner up to check_frames frames late or early (~20 px here). */
+const CORNER_TOLERANCE = 0.15;
+/** The default min_length, grid units: the longest gap a dropped segment leaves. */
+const MIN_LENGTH = 0.1;
+const UUID = /^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}$/;
+const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3.0 }, version: "test" };
+
+type Point = readonly [number, number];
+
+function near(actual: unknown, expected: readonly [number, number], what: string): void {
+  const [x, y] = actual as [number, number];
+  const distance = Math.hypot(x - expected[0], y - expected[1]);
+  if (!(distance <= CORNER_TOLERANCE)) {
+    throw new Error(
+      `${what}: got (${x}, ${y}), expected (${expected[0].toFixed(3)}, ${expected[1].toFixed(3)}) ± ${CORNER_TOLERANCE}`,
+    );
+  }
+}
+
+describe("drawing with a mouse on a desktop", () => {
+  const cleanups: (() => Promise<void>)[] = [];
+  let broker: Broker;
+  let sleeve: FakeSleeve;
+  let page: Page;
+  let pageUrl: string;
+  const pageErrors: string[] = [];
+
+  beforeAll(async () => {
+    checkPrerequisites();
+    const stateDir = tempDir("broker");
+    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
+    broker = await Broker.start(stateDir);
+    cleanups.push(() => broker.stop());
+    const server = await serveDist(pageConfig(broker.credentials));
+    cleanups.push(server.stop);
+    pageUrl = server.url;
+    sleeve = await FakeSleeve.connect(broker.credentials);
+    cleanups.push(() => sleeve.close());
+    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 }, deviceScaleFactor: 1 });
+    cleanups.push(browser.close);
+    page = await browser.context.newPage();
+    page.on("pageerror", (error) => pageErrors.push(String(error)));
+    page.on("console", (message) => {
+      if (message.type() === "error") pageErrors.push(message.text());
+    });
+    await page.goto(pageUrl);
+  });
+
+  afterAll(async () => {
+    for (const cleanup of cleanups.reverse()) await cleanup();
+  });
+
+  it("connects with the server's config and shows the sleeve online from its retained status", async () => {
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
+    expect(await page.locator('[data-testid="sleeve-status"]').getAttribute("data-state")).toBe("unknown");
+    await sleeve.publish("status", STATUS_ONLINE, true);
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
+    await expect(page.locator('[data-testid="sleeve-status"]').innerText()).resolves.toContain("online");
+    // The drawing area has the sleeve's aspect ratio: (4 - 1) : (3 - 1).
+    const area = await drawingArea(page);
+    expect(area.width / area.height).toBeCloseTo(1.5, 2);
+    await screenshot(page, "desktop-idle");
+  });
+
+  it("sends a square drawn with the mouse as four strokes with the square's corners", async () => {
+    const area = await drawingArea(page);
+    const side = area.height * 0.6;
+    const left = area.left + (area.width - side) / 2;
+    const top = area.top + (area.height - side) / 2;
+    const corners: Point[] = [
+      [left, top],
+      [left + side, top],
+      [left + side, top + side],
+      [left, top + side],
+    ];
+    await drawWithMouse(page, [...corners, corners[0]!], {
+      beforeRelease: async () => {
+        await screenshot(page, "desktop-drawing");
+      },
+    });
+    const strokes = await sleeve.waitForStrokes(4);
+    await waitForData(page, '[data-testid="played-summary"]', "sent", "4");
+    expect(strokes).toHaveLength(4);
+    const grid = corners.map(([x, y]) => toGrid(area, x, y));
+    strokes.forEach((stroke, i) => {
+      near(stroke["start"], grid[i]!, `stroke ${i} start`);
+      near(stroke["end"], grid[(i + 1) % 4]!, `stroke ${i} end`);
+      expect(stroke).toMatchObject({ v: 1, seq: i, intensity: 0.8 });
+      expect(stroke["duration_ms"] as number).toBeGreaterThan(0);
+      expect(Math.abs((stroke["sent_at_ms"] as number) - Date.now())).toBeLessThan(60_000);
+      if (i > 0) {
+        // Sent strokes join end to start, or leave the gap of a dropped one (< min_length).
+        const [x, y] = stroke["start"] as [number, number];
+        const [px, py] = strokes[i - 1]!["end"] as [number, number];
+        expect(Math.hypot(x - px, y - py)).toBeLessThan(MIN_LENGTH);
+      }
+    });
+    expect(stroke0Drawing(strokes)).toMatch(UUID);
+    expect(new Set(strokes.map((stroke) => stroke["drawing"])).size).toBe(1);
+  });
+
+  it("lights the preview from the sleeve's actuator telemetry", async () => {
+    const preview = '[data-testid="sleeve-preview"]';
+    expect(await page.locator(preview).getAttribute("data-lit")).toBe("0");
+    await sleeve.publish("actuators", {
+      t_ms: 1200,
+      rows: 3,
+      columns: 4,
+      intensities: [
+        [0, 0.9, 0.4, 0],
+        [0, 0.2, 0, 0],
+        [0, 0, 0, 0],
+      ],
+    });
+    await waitForData(page, preview, "lit", "3");
+    expect(await page.locator(preview).getAttribute("data-max-intensity")).toBe("0.900");
+  });
+
+  it("reports what the sleeve said: played strokes counted, a refused one marked", async () => {
+    const drawing = stroke0Drawing(sleeve.strokes());
+    for (const seq of [0, 1, 3]) await sleeve.publish("events", { type: "played", drawing, seq });
+    await sleeve.publish("events", {
+      type: "rejected",
+      drawing,
+      seq: 2,
+      reason: "duration_too_long",
+      message: "duration_ms is 12000; this sleeve plays strokes of at most 10000 ms.",
+    });
+    await waitForData(page, '[data-testid="played-summary"]', "played", "3");
+    const log = page.locator('[data-testid="event-log"] li').first();
+    await expect(log.innerText()).resolves.toContain("Stroke 2 refused: duration_ms is 12000");
+    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toBe(
+      "3 of 4 strokes played, 1 refused.",
+    );
+    await screenshot(page, "desktop-after");
+  });
+
+  it("downloads a recording that feelmysign simplify reads, with the same ends", async () => {
+    const [download] = await Promise.all([
+      page.waitForEvent("download"),
+      page.locator('[data-testid="record-button"]').click(),
+    ]);
+    expect(download.suggestedFilename()).toMatch(/^feelmysign-drawing-.*\.json$/);
+    const file = join(RESULTS_DIR, "recording.json");
+    await download.saveAs(file);
+    const recording = JSON.parse(readFileSync(file, "utf8"));
+    expect(recording.sleeve).toEqual({ rows: 3, columns: 4 });
+    expect(recording.strokes).toHaveLength(4);
+    const replay = JSON.parse(execFileSync(FEELMYSIGN, ["simplify", file, "--json"], { encoding: "utf8" }));
+    // Replay resamples pointer events into frames; the press and the release are frames in both.
+    const sent = sleeve.strokes();
+    expect(replay.strokes.length).toBeGreaterThanOrEqual(3);
+    expect(replay.strokes[0].start).toEqual(sent[0]!["start"]);
+    expect(replay.strokes.at(-1).end).toEqual(sent.at(-1)!["end"]);
+  });
+
+  it("keeps pen pressure and lets it set the intensity", async () => {
+    const area = await drawingArea(page);
+    const cdp = await page.context().newCDPSession(page);
+    const before = sleeve.strokes().length;
+    const pen = async (type: string, x: number, y: number, force: number) =>
+      cdp.send("Input.dispatchMouseEvent", {
+        type: type as "mousePressed" | "mouseMoved" | "mouseReleased",
+        x,
+        y,
+        button: "left",
+        buttons: type === "mouseReleased" ? 0 : 1,
+        clickCount: 1,
+        pointerType: "pen",
+        force,
+      });
+    const y = area.top + area.height / 2;
+    await pen("mousePressed", area.left + area.width * 0.2, y, 0.5);
+    for (const [x] of walk(
+      [
+        [area.left + area.width * 0.2, y],
+        [area.left + area.width * 0.8, y],
+      ],
+      5,
+    )) {
+      await pen("mouseMoved", x, y, 0.5);
+      await nextFrame(page);
+    }
+    await pen("mouseReleased", area.left + area.width * 0.8, y, 0);
+    const strokes = await sleeve.waitForStrokes(before + 1);
+    // The intensity setting (0.8) scaled by the pen's pressure (0.5).
+    expect(strokes[before]!["intensity"]).toBe(0.4);
+    expect(strokes[before]!["seq"]).toBe(0);
+    await cdp.detach();
+  });
+
+  it("validates settings inline with the shared ranges and keeps them across a reload", async () => {
+    await page.locator('[data-testid="settings-button"]').click();
+    const panel = page.locator('[data-testid="settings-panel"]');
+    await panel.waitFor({ state: "visible" });
+    await screenshot(page, "desktop-settings");
+    const checkFrames = page.locator('[data-testid="setting-check_frames"]');
+    await checkFrames.fill("1");
+    await expect(page.locator("#setting-check_frames-error").innerText()).resolves.toBe(
+      "Check frames must be a whole number from 2 to 600.",
+    );
+    expect(await page.locator('[data-testid="settings-save"]').isDisabled()).toBe(true);
+    await screenshot(page, "desktop-settings-error");
+    await checkFrames.fill("6");
+    await page.locator('[data-testid="setting-intensity"]').fill("0.5");
+    expect(await page.locator('[data-testid="settings-save"]').isDisabled()).toBe(false);
+    await page.locator('[data-testid="settings-save"]').click();
+    await panel.waitFor({ state: "hidden" });
+    await page.reload();
+    await page.locator('[data-testid="settings-button"]').click();
+    await expect(page.locator('[data-testid="setting-check_frames"]').inputValue()).resolves.toBe("6");
+    await expect(page.locator('[data-testid="setting-intensity"]').inputValue()).resolves.toBe("0.5");
+    await page.locator("#settings-reset").click();
+    await expect(page.locator('[data-testid="setting-check_frames"]').inputValue()).resolves.toBe("5");
+    await page.locator('[data-testid="settings-save"]').click();
+    await panel.waitFor({ state: "hidden" });
+  });
+
+  it("sends legacy text to the legacy topic when chosen", async () => {
+    await sleeve.client.subscribeAsync("deviceOne/line", { qos: 1 });
+    await page.locator('[data-testid="settings-button"]').click();
+    await page.locator('label:has([data-testid="setting-protocol"][value="legacy"])').click();
+    await page.locator('[data-testid="settings-save"]').click();
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
+    const area = await drawingArea(page);
+    const y = area.top + area.height * 0.3;
+    await drawWithMouse(page, [
+      [area.left + area.width * 0.1, y],
+      [area.left + area.width * 0.9, y],
+    ]);
+    const deadline = Date.now() + 15_000;
+    let legacy = sleeve.received.filter((message) => message.topic === "deviceOne/line");
+    while (legacy.length === 0 && Date.now() < deadline) {
+      await nextFrame(page);
+      legacy = sleeve.received.filter((message) => message.topic === "deviceOne/line");
+    }
+    expect(legacy).toHaveLength(1);
+    // startX,startY,endX,endY,duration: grid units with at most 4 decimals, then milliseconds.
+    const fields = legacy[0]!.payload.split(",");
+    expect(fields).toHaveLength(5);
+    for (const field of fields) expect(field).toMatch(/^-?\d+(\.\d{1,4})?$/);
+    const [sx, sy] = toGrid(area, area.left + area.width * 0.1, y);
+    expect(Number(fields[0])).toBeCloseTo(sx, 3);
+    expect(Number(fields[1])).toBeCloseTo(sy, 3);
+  });
+
+  it("raised no error in the page", () => {
+    expect(pageErrors).toEqual([]);
+  });
+});
+
+describe("a broker that goes away", () => {
+  const cleanups: (() => Promise<void>)[] = [];
+
+  afterAll(async () => {
+    for (const cleanup of cleanups.reverse()) await cleanup();
+  });
+
+  it("keeps the strokes drawn meanwhile, shows them as unsent, and sends them when it is back", async () => {
+    checkPrerequisites();
+    const stateDir = tempDir("broker");
+    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
+    let broker = await Broker.start(stateDir, { port: await freePort(), wsPort: await freePort() });
+    cleanups.push(() => broker.stop());
+    const ports = { port: portOf(broker.credentials.mqtt_url), wsPort: portOf(broker.credentials.ws_url) };
+    const server = await serveDist(pageConfig(broker.credentials));
+    cleanups.push(server.stop);
+    // A persistent session: strokes that reach the broker before this client is back are kept for it.
+    const sleeve = await FakeSleeve.connect(broker.credentials, {
+      clientId: `test-sleeve-offline-${process.pid}`,
+      clean: false,
+    });
+    cleanups.push(() => sleeve.close());
+    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 } });
+    cleanups.push(browser.close);
+    const page = await browser.context.newPage();
+    await page.goto(server.url);
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
+
+    await broker.stop();
+    await waitForData(page, '[data-testid="broker-status"]', "state", "offline");
+    const area = await drawingArea(page);
+    const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
+    await drawWithMouse(page, [at(0.2, 0.2), at(0.2, 0.8), at(0.8, 0.8)]);
+    await waitForData(page, '[data-testid="unsent-count"]', "count", "2");
+    await expect(page.locator('[data-testid="unsent-count"]').innerText()).resolves.toBe("2 strokes unsent");
+    await expect(page.locator("#notice").innerText()).resolves.toContain("No connection to");
+    await screenshot(page, "desktop-offline");
+    expect(sleeve.strokes()).toHaveLength(0);
+
+    broker = await Broker.start(stateDir, ports);
+    const strokes = await sleeve.waitForStrokes(2, 20_000);
+    expect(strokes.map((stroke) => stroke["seq"])).toEqual([0, 1]);
+    await waitForData(page, '[data-testid="unsent-count"]', "count", "0");
+    expect(await page.locator(CANVAS).isVisible()).toBe(true);
+  });
+});
+
+describe("a wrong password", () => {
+  it("stops retrying and says what to fix", async () => {
+    checkPrerequisites();
+    const stateDir = tempDir("broker");
+    const broker = await Broker.start(stateDir);
+    const server = await serveDist({ ...pageConfig(broker.credentials), password: "not-the-password" });
+    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 } });
+    try {
+      const page = await browser.context.newPage();
+      await page.goto(server.url);
+      await waitForData(page, '[data-testid="broker-status"]', "state", "offline");
+      await expect(page.locator("#notice").innerText()).resolves.toMatch(
+        /refused the login of 'sender'.*Fix the username or password in Settings/,
+      );
+    } finally {
+      await browser.close();
+      await server.stop();
+      await broker.stop();
+      rmSync(stateDir, { recursive: true, force: true });
+    }
+  });
+});
+
+function stroke0Drawing(strokes: Record<string, unknown>[]): string {
+  return strokes[0]!["drawing"] as string;
+}
+
+/** A port free on 127.0.0.1 now (the broker must come back on the same one). */
+async function freePort(): Promise<number> {
+  const server = createServer();
+  await new Promise<void>((listening) => server.listen(0, "127.0.0.1", listening));
+  const { port } = server.address() as { port: number };
+  await new Promise<void>((closed) => server.close(() => closed()));
+  return port;
+}

@@ -1,0 +1,288 @@
+/**
+ * What the browser tests run against, all on 127.0.0.1 and all stopped by the
+ * tests: a real Mosquitto started by `feelmysign broker`, a tiny static server
+ * for the built page and its /config.json, Debian's Chromium driven by
+ * playwright-core with a fresh profile, and an MQTT client playing the sleeve.
+ */
+import { spawn, type ChildProcess } from "node:child_process";
+import { existsSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
+import { createServer, type Server } from "node:http";
+import type { AddressInfo } from "node:net";
+import { tmpdir } from "node:os";
+import { extname, join, normalize, resolve, sep } from "node:path";
+import { fileURLToPath } from "node:url";
+import mqtt, { type MqttClient } from "mqtt";
+import { chromium, type BrowserContext } from "playwright-core";
+
+export const WEB_DIR = fileURLToPath(new URL("..", import.meta.url));
+export const REPO_DIR = resolve(WEB_DIR, "..");
+export const DIST_DIR = join(WEB_DIR, "dist");
+export const RESULTS_DIR = join(WEB_DIR, "test-results");
+export const FEELMYSIGN = process.env["FEELMYSIGN_BIN"] ?? join(REPO_DIR, ".venv", "bin", "feelmysign");
+export const CHROMIUM = process.env["CHROMIUM_BIN"] ?? "/usr/bin/chromium";
+export const SLEEVE_ID = "sleeve1";
+
+const BROKER_READY_TIMEOUT_MS = 20_000;
+const STOP_TIMEOUT_MS = 5_000;
+
+export interface Credentials {
+  mqtt_url: string;
+  ws_url: string;
+  sleeve: { id: string; username: string; password: string };
+  sender: { username: string; password: string };
+}
+
+export function tempDir(prefix: string): string {
+  return mkdtempSync(join(tmpdir(), `feelmysign-${prefix}-`));
+}
+
+export function checkPrerequisites(): void {
+  const missing: string[] = [];
+  if (!existsSync(join(DIST_DIR, "index.html")))
+    missing.push(`${DIST_DIR}/index.html (run 'make web-build')`);
+  if (!existsSync(FEELMYSIGN)) missing.push(`${FEELMYSIGN} (run 'make' to set up the Python venv)`);
+  if (!existsSync(CHROMIUM)) missing.push(`${CHROMIUM} (run 'make system' to install Debian's chromium)`);
+  if (missing.length > 0) throw new Error(`The browser tests need: ${missing.join("; ")}`);
+}
+
+// ---- the broker ----------------------------------------------------------------------------
+
+export class Broker {
+  readonly stateDir: string;
+  readonly #process: ChildProcess;
+  readonly #exited: Promise<number | null>;
+  credentials!: Credentials;
+
+  private constructor(stateDir: string, child: ChildProcess) {
+    this.stateDir = stateDir;
+    this.#process = child;
+    this.#exited = new Promise((done) => child.once("exit", (code) => done(code)));
+  }
+
+  /** Starts `feelmysign broker` and waits for its "Ready." line. Ports 0 pick free ones. */
+  static async start(
+    stateDir: string,
+    ports: { port: number; wsPort: number } = { port: 0, wsPort: 0 },
+  ): Promise<Broker> {
+    const child = spawn(
+      FEELMYSIGN,
+      [
+        "broker",
+        "--state-dir",
+        stateDir,
+        "--port",
+        String(ports.port),
+        "--ws-port",
+        String(ports.wsPort),
+        "--sleeve-id",
+        SLEEVE_ID,
+      ],
+      { stdio: ["ignore", "pipe", "pipe"] },
+    );
+    const broker = new Broker(stateDir, child);
+    let output = "";
+    await new Promise<void>((ready, fail) => {
+      const timer = setTimeout(
+        () =>
+          fail(new Error(`feelmysign broker was not ready after ${BROKER_READY_TIMEOUT_MS} ms:\n${output}`)),
+        BROKER_READY_TIMEOUT_MS,
+      );
+      const collect = (chunk: Buffer) => {
+        output += chunk.toString();
+        if (/^Ready\./m.test(output)) {
+          clearTimeout(timer);
+          ready();
+        }
+      };
+      child.stdout!.on("data", collect);
+      child.stderr!.on("data", collect);
+      child.once("exit", (code) => {
+        clearTimeout(timer);
+        fail(new Error(`feelmysign broker exited with ${code} before it was ready:\n${output}`));
+      });
+    });
+    broker.credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
+    return broker;
+  }
+
+  /** SIGINT, as Ctrl-C: the broker stops Mosquitto and exits. */
+  async stop(): Promise<void> {
+    if (this.#process.exitCode !== null || this.#process.signalCode !== null) return;
+    this.#process.kill("SIGINT");
+    const timeout = new Promise<"timeout">((done) => setTimeout(() => done("timeout"), STOP_TIMEOUT_MS));
+    if ((await Promise.race([this.#exited, timeout])) === "timeout") {
+      this.#process.kill("SIGKILL");
+      await this.#exited;
+    }
+  }
+}
+
+export function portOf(url: string): number {
+  return Number(new URL(url).port);
+}
+
+// ---- the page's server ---------------------------------------------------------------------
+
+const CONTENT_TYPES: Record<string, string> = {
+  ".html": "text/html; charset=utf-8",
+  ".js": "text/javascript; charset=utf-8",
+  ".css": "text/css; charset=utf-8",
+  ".json": "application/json",
+  ".svg": "image/svg+xml",
+};
+
+/** Serves dist/ and a /config.json (or none, when `config` is null) on 127.0.0.1. */
+export async function serveDist(config: object | null): Promise<{ url: string; stop: () => Promise<void> }> {
+  const server: Server = createServer((request, response) => {
+    const path = decodeURIComponent(new URL(request.url ?? "/", "http://127.0.0.1").pathname);
+    if (path === "/config.json" && config !== null) {
+      response.writeHead(200, { "content-type": "application/json", "cache-control": "no-store" });
+      response.end(JSON.stringify(config));
+      return;
+    }
+    const file = normalize(join(DIST_DIR, path === "/" ? "index.html" : path));
+    if (!file.startsWith(DIST_DIR + sep) || !existsSync(file)) {
+      response.writeHead(404, { "content-type": "text/plain" });
+      response.end("not found");
+      return;
+    }
+    response.writeHead(200, { "content-type": CONTENT_TYPES[extname(file)] ?? "application/octet-stream" });
+    response.end(readFileSync(file));
+  });
+  await new Promise<void>((listening) => server.listen(0, "127.0.0.1", listening));
+  const { port } = server.address() as AddressInfo;
+  return {
+    url: `http://127.0.0.1:${port}/`,
+    stop: () =>
+      new Promise<void>((closed) => {
+        server.closeAllConnections();
+        server.close(() => closed());
+      }),
+  };
+}
+
+export function pageConfig(credentials: Credentials): object {
+  return {
+    ws_url: credentials.ws_url,
+    sleeve_id: SLEEVE_ID,
+    username: credentials.sender.username,
+    password: credentials.sender.password,
+  };
+}
+
+// ---- the browser ---------------------------------------------------------------------------
+
+export const CHROMIUM_ARGS = [
+  "--headless",
+  "--no-sandbox",
+  "--disable-gpu",
+  "--disable-background-networking",
+  "--disable-quic",
+  "--no-first-run",
+  "--disable-component-update",
+  "--disable-sync",
+];
+
+export interface BrowserOptions {
+  viewport: { width: number; height: number };
+  deviceScaleFactor?: number;
+  hasTouch?: boolean;
+  isMobile?: boolean;
+}
+
+/** Chromium with a fresh profile; `close` also removes the profile. */
+export async function launchBrowser(
+  options: BrowserOptions,
+): Promise<{ context: BrowserContext; close: () => Promise<void> }> {
+  const profile = tempDir("chromium");
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: CHROMIUM,
+    headless: true,
+    args: CHROMIUM_ARGS,
+    acceptDownloads: true,
+    ...options,
+  });
+  return {
+    context,
+    close: async () => {
+      await context.close();
+      rmSync(profile, { recursive: true, force: true });
+    },
+  };
+}
+
+// ---- the sleeve, played by the test ----------------------------------------------------------
+
+export interface Received {
+  topic: string;
+  payload: string;
+}
+
+export class FakeSleeve {
+  readonly client: MqttClient;
+  readonly received: Received[] = [];
+  #waiters: (() => void)[] = [];
+
+  private constructor(client: MqttClient) {
+    this.client = client;
+    client.on("message", (topic, payload) => {
+      this.received.push({ topic, payload: payload.toString("utf8") });
+      for (const wake of this.#waiters.splice(0)) wake();
+    });
+  }
+
+  /** Logs in as the sleeve user and subscribes to its strokes (QoS 1). */
+  static async connect(
+    credentials: Credentials,
+    options: { clientId?: string; clean?: boolean } = {},
+  ): Promise<FakeSleeve> {
+    const client = await mqtt.connectAsync(credentials.mqtt_url, {
+      username: credentials.sleeve.username,
+      password: credentials.sleeve.password,
+      clientId: options.clientId ?? `test-sleeve-${process.pid}-${Date.now()}`,
+      clean: options.clean ?? true,
+      reconnectPeriod: 200,
+    });
+    const sleeve = new FakeSleeve(client);
+    await client.subscribeAsync(`feelmysign/${SLEEVE_ID}/strokes`, { qos: 1 });
+    return sleeve;
+  }
+
+  strokes(): Record<string, unknown>[] {
+    return this.received
+      .filter((message) => message.topic.endsWith("/strokes"))
+      .map((message) => JSON.parse(message.payload) as Record<string, unknown>);
+  }
+
+  /** Resolves when `count` strokes have arrived; fails after `timeoutMs` saying how many did. */
+  async waitForStrokes(count: number, timeoutMs = 15_000): Promise<Record<string, unknown>[]> {
+    const deadline = Date.now() + timeoutMs;
+    while (this.strokes().length < count) {
+      const left = deadline - Date.now();
+      if (left <= 0) {
+        throw new Error(
+          `expected ${count} strokes, got ${this.strokes().length}: ${JSON.stringify(this.strokes())}`,
+        );
+      }
+      await new Promise<void>((wake) => {
+        const timer = setTimeout(wake, left);
+        this.#waiters.push(() => {
+          clearTimeout(timer);
+          wake();
+        });
+      });
+    }
+    return this.strokes();
+  }
+
+  async publish(subtopic: "status" | "actuators" | "events", payload: object, retain = false): Promise<void> {
+    await this.client.publishAsync(`feelmysign/${SLEEVE_ID}/${subtopic}`, JSON.stringify(payload), {
+      qos: 1,
+      retain,
+    });
+  }
+
+  async close(): Promise<void> {
+    await this.client.endAsync(true);
+  }
+}

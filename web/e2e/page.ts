@@ -1,0 +1,138 @@
+/** Helpers that drive the page as a person would: find the drawing area, draw, look at the status. */
+import { mkdirSync } from "node:fs";
+import { join } from "node:path";
+import type { CDPSession, Page } from "playwright-core";
+import { CanvasMapping } from "../src/simplify/mapping";
+import { RESULTS_DIR } from "./harness";
+
+export interface Area {
+  /** The drawing area's top-left corner in viewport CSS pixels. */
+  left: number;
+  top: number;
+  width: number;
+  height: number;
+}
+
+export const CANVAS = '[data-testid="drawing-canvas"]';
+
+/** The drawing area (inside the canvas's margin), read from the canvas the page laid out. */
+export async function drawingArea(page: Page): Promise<Area> {
+  const canvas = page.locator(CANVAS);
+  const box = await canvas.boundingBox();
+  if (box === null) throw new Error("the drawing canvas is not visible");
+  const data = await canvas.evaluate((element) => ({ ...(element as HTMLElement).dataset }));
+  return {
+    left: box.x + Number(data["areaLeftPx"]),
+    top: box.y + Number(data["areaTopPx"]),
+    width: Number(data["areaWidthPx"]),
+    height: Number(data["areaHeightPx"]),
+  };
+}
+
+/** Grid units of a viewport point, as the page's simplifier maps it (3 x 4 sleeve unless told). */
+export function toGrid(
+  area: Area,
+  x: number,
+  y: number,
+  grid = { rows: 3, columns: 4 },
+): readonly [number, number] {
+  const mapping = new CanvasMapping({
+    width_px: area.width,
+    height_px: area.height,
+    ...grid,
+    stretch: false,
+  });
+  return mapping.toGrid(x - area.left, y - area.top);
+}
+
+/** Waits for the page's next animation frame: one pointer step per frame, as a hand moves. */
+export async function nextFrame(page: Page): Promise<void> {
+  await page.evaluate(() => new Promise<void>((done) => requestAnimationFrame(() => done())));
+}
+
+/** Points every `stepPx` along the polyline, the first point excluded. */
+export function walk(points: readonly (readonly [number, number])[], stepPx: number): [number, number][] {
+  const out: [number, number][] = [];
+  for (let i = 1; i < points.length; i++) {
+    const [ax, ay] = points[i - 1]!;
+    const [bx, by] = points[i]!;
+    const steps = Math.max(1, Math.round(Math.hypot(bx - ax, by - ay) / stepPx));
+    for (let k = 1; k <= steps; k++) out.push([ax + ((bx - ax) * k) / steps, ay + ((by - ay) * k) / steps]);
+  }
+  return out;
+}
+
+/** Mouse: press at the first point, move along the polyline one step per frame, release. */
+export async function drawWithMouse(
+  page: Page,
+  points: readonly (readonly [number, number])[],
+  options: { stepPx?: number; beforeRelease?: () => Promise<void> } = {},
+): Promise<void> {
+  const [x0, y0] = points[0]!;
+  await page.mouse.move(x0, y0);
+  await page.mouse.down();
+  await nextFrame(page);
+  for (const [x, y] of walk(points, options.stepPx ?? 5)) {
+    await page.mouse.move(x, y);
+    await nextFrame(page);
+  }
+  await options.beforeRelease?.();
+  await page.mouse.up();
+}
+
+/** Touch through the DevTools protocol: a real touchstart/touchmove/touchend sequence. */
+export async function drawWithTouch(
+  page: Page,
+  cdp: CDPSession,
+  points: readonly (readonly [number, number])[],
+  stepPx = 5,
+): Promise<void> {
+  const [x0, y0] = points[0]!;
+  await cdp.send("Input.dispatchTouchEvent", { type: "touchStart", touchPoints: [{ x: x0, y: y0, id: 1 }] });
+  await nextFrame(page);
+  for (const [x, y] of walk(points, stepPx)) {
+    await cdp.send("Input.dispatchTouchEvent", { type: "touchMove", touchPoints: [{ x, y, id: 1 }] });
+    await nextFrame(page);
+  }
+  await cdp.send("Input.dispatchTouchEvent", { type: "touchEnd", touchPoints: [] });
+}
+
+export async function screenshot(page: Page, name: string): Promise<string> {
+  mkdirSync(RESULTS_DIR, { recursive: true });
+  // A sheet sliding in would be caught half transparent: wait for running animations to end.
+  await page.evaluate(() =>
+    Promise.all(
+      document
+        .getAnimations()
+        .filter((animation) => animation.effect?.getComputedTiming().iterations !== Infinity)
+        .map((animation) => animation.finished),
+    ),
+  );
+  const path = join(RESULTS_DIR, `${name}.png`);
+  await page.screenshot({ path });
+  return path;
+}
+
+/** Waits until `selector` has data-`key` equal to `value`, or fails saying what it had. */
+export async function waitForData(
+  page: Page,
+  selector: string,
+  key: string,
+  value: string,
+  timeoutMs = 15_000,
+): Promise<void> {
+  try {
+    await page.waitForFunction(
+      ({ selector, key, value }) =>
+        (document.querySelector(selector) as HTMLElement | null)?.dataset[key] === value,
+      { selector, key, value },
+      { timeout: timeoutMs },
+    );
+  } catch {
+    const actual = await page.evaluate(
+      ({ selector, key }) => (document.querySelector(selector) as HTMLElement | null)?.dataset[key],
+      { selector, key },
+    );
+    throw new Error(`${selector} data-${key}: expected ${value}, still ${actual} after ${timeoutMs} ms`);
+  }
+}

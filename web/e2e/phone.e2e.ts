@@ -1,0 +1,146 @@
+/**
+ * The page on a phone-sized viewport with a touch screen: drawing with a
+ * finger (real touch events through the DevTools protocol) sends strokes, and
+ * the layout and the settings sheet fit the small screen.
+ */
+import { rmSync } from "node:fs";
+import type { CDPSession, Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import {
+  Broker,
+  checkPrerequisites,
+  FakeSleeve,
+  launchBrowser,
+  pageConfig,
+  serveDist,
+  tempDir,
+} from "./harness";
+import { CANVAS, drawingArea, drawWithTouch, screenshot, toGrid, waitForData } from "./page";
+
+/** Grid units: see desktop.e2e.ts; finger steps are the same 5 px per frame. */
+const CORNER_TOLERANCE = 0.15;
+
+describe("drawing with a finger on a phone", () => {
+  const cleanups: (() => Promise<void>)[] = [];
+  let sleeve: FakeSleeve;
+  let page: Page;
+  let cdp: CDPSession;
+
+  beforeAll(async () => {
+    checkPrerequisites();
+    const stateDir = tempDir("broker");
+    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
+    const broker = await Broker.start(stateDir);
+    cleanups.push(() => broker.stop());
+    const server = await serveDist(pageConfig(broker.credentials));
+    cleanups.push(server.stop);
+    sleeve = await FakeSleeve.connect(broker.credentials);
+    cleanups.push(() => sleeve.close());
+    await sleeve.publish("status", { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3 } }, true);
+    const browser = await launchBrowser({
+      viewport: { width: 390, height: 844 },
+      deviceScaleFactor: 3,
+      hasTouch: true,
+      isMobile: true,
+    });
+    cleanups.push(browser.close);
+    page = await browser.context.newPage();
+    cdp = await browser.context.newCDPSession(page);
+    await page.goto(server.url);
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
+  });
+
+  afterAll(async () => {
+    for (const cleanup of cleanups.reverse()) await cleanup();
+  });
+
+  it("fits the screen: the whole drawing area and the status are visible without scrolling", async () => {
+    const area = await drawingArea(page);
+    expect(area.left).toBeGreaterThanOrEqual(0);
+    expect(area.left + area.width).toBeLessThanOrEqual(390);
+    expect(area.top + area.height).toBeLessThanOrEqual(844);
+    expect(area.width).toBeGreaterThan(250);
+    expect(area.width / area.height).toBeCloseTo(1.5, 1);
+    expect(await page.evaluate(() => document.documentElement.scrollWidth)).toBeLessThanOrEqual(390);
+    expect(await page.locator('[data-testid="broker-status"]').isVisible()).toBe(true);
+  });
+
+  it("sends an L drawn with touch as two strokes from the touch-down to the lift", async () => {
+    const area = await drawingArea(page);
+    const points = [
+      [area.left + area.width * 0.15, area.top + area.height * 0.15],
+      [area.left + area.width * 0.15, area.top + area.height * 0.85],
+      [area.left + area.width * 0.85, area.top + area.height * 0.85],
+    ] as const;
+    await drawWithTouch(page, cdp, points, 4);
+    const strokes = await sleeve.waitForStrokes(2);
+    await waitForData(page, '[data-testid="played-summary"]', "sent", "2");
+    const [first, second] = strokes;
+    const [sx, sy] = first!["start"] as [number, number];
+    const [ex, ey] = second!["end"] as [number, number];
+    const [wantSx, wantSy] = toGrid(area, ...points[0]);
+    const [wantEx, wantEy] = toGrid(area, ...points[2]);
+    expect(Math.hypot(sx - wantSx, sy - wantSy)).toBeLessThan(CORNER_TOLERANCE);
+    expect(Math.hypot(ex - wantEx, ey - wantEy)).toBeLessThan(CORNER_TOLERANCE);
+    const [cx, cy] = first!["end"] as [number, number];
+    const [wantCx, wantCy] = toGrid(area, ...points[1]);
+    expect(Math.hypot(cx - wantCx, cy - wantCy)).toBeLessThan(CORNER_TOLERANCE);
+    await sleeve.publish("actuators", {
+      t_ms: 10,
+      rows: 3,
+      columns: 4,
+      intensities: [
+        [0, 0, 0, 0],
+        [0.7, 0, 0, 0],
+        [1, 0.5, 0, 0],
+      ],
+    });
+    await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "3");
+    await screenshot(page, "phone");
+  });
+
+  it("opens the settings as a full-screen sheet that scrolls to its last field", async () => {
+    await page.locator('[data-testid="settings-button"]').tap();
+    const panel = page.locator('[data-testid="settings-panel"]');
+    await panel.waitFor({ state: "visible" });
+    const box = await panel.boundingBox();
+    expect(box?.width).toBeCloseTo(390, 0);
+    await screenshot(page, "phone-settings");
+    const password = page.locator('[data-testid="setting-password"]');
+    await password.scrollIntoViewIfNeeded();
+    expect(await password.isVisible()).toBe(true);
+    expect(await page.locator('[data-testid="settings-save"]').isVisible()).toBe(true);
+    await page.locator("#settings-cancel").tap();
+    await panel.waitFor({ state: "hidden" });
+    expect(await page.locator(CANVAS).isVisible()).toBe(true);
+  });
+});
+
+describe("a page served without /config.json (vite dev)", () => {
+  it("says so, and lets the broker be entered in the settings", async () => {
+    checkPrerequisites();
+    const server = await serveDist(null);
+    const browser = await launchBrowser({
+      viewport: { width: 390, height: 844 },
+      hasTouch: true,
+      isMobile: true,
+    });
+    try {
+      const page = await browser.context.newPage();
+      await page.goto(server.url);
+      await page.locator("#notice").waitFor({ state: "visible" });
+      await expect(page.locator("#notice").innerText()).resolves.toContain(
+        "No server config (/config.json: HTTP 404)",
+      );
+      await page.locator('[data-testid="settings-button"]').tap();
+      const url = page.locator('[data-testid="setting-ws_url"]');
+      expect(await url.isEnabled()).toBe(true);
+      expect(await page.locator('[data-field="broker_custom"]').isHidden()).toBe(true);
+      await url.fill("http://127.0.0.1:9001");
+      await expect(page.locator("#setting-ws_url-error").innerText()).resolves.toContain("ws:// or wss://");
+    } finally {
+      await browser.close();
+      await server.stop();
+    }
+  });
+});

@@ -1,0 +1,73 @@
+/**
+ * The server's `/config.json`: the broker address and the sender's login, so
+ * nothing has to be typed (`feelmysign up` writes it from the broker's
+ * credentials.json). Absent under `vite dev`: the page then uses the settings.
+ */
+
+export interface ServerConfig {
+  readonly ws_url: string;
+  readonly sleeve_id: string;
+  readonly username: string;
+  readonly password: string;
+}
+
+export type ConfigResult =
+  { readonly config: ServerConfig; readonly note: null } | { readonly config: null; readonly note: string };
+
+const CONFIG_PATH = "/config.json";
+
+export function readConfig(value: unknown): ServerConfig | string {
+  if (typeof value !== "object" || value === null || Array.isArray(value)) {
+    return "is not a JSON object";
+  }
+  const data = value as Record<string, unknown>;
+  for (const key of ["ws_url", "sleeve_id", "username", "password"]) {
+    if (typeof data[key] !== "string") return `has no string "${key}"`;
+  }
+  return {
+    ws_url: data["ws_url"] as string,
+    sleeve_id: data["sleeve_id"] as string,
+    username: data["username"] as string,
+    password: data["password"] as string,
+  };
+}
+
+/** Fetches and checks the config; never throws: a missing config is a normal case. */
+export async function fetchConfig(fetcher: typeof fetch = fetch): Promise<ConfigResult> {
+  let response: Response;
+  try {
+    response = await fetcher(CONFIG_PATH, { cache: "no-store" });
+  } catch {
+    return {
+      config: null,
+      note: "No server config (could not fetch /config.json): using Settings → Connection.",
+    };
+  }
+  if (!response.ok) {
+    return {
+      config: null,
+      note: `No server config (/config.json: HTTP ${response.status}); set the broker in Settings → Connection, or start the page with 'feelmysign up'.`,
+    };
+  }
+  // A dev server answers every path with index.html: that is no config either.
+  if (!(response.headers.get("content-type") ?? "").includes("json")) {
+    return {
+      config: null,
+      note: "No server config (this server has no /config.json, e.g. under 'vite dev'); set the broker in Settings → Connection, or start the page with 'feelmysign up'.",
+    };
+  }
+  let body: unknown;
+  try {
+    body = await response.json();
+  } catch {
+    return {
+      config: null,
+      note: "The server's /config.json is not valid JSON; using Settings → Connection.",
+    };
+  }
+  const config = readConfig(body);
+  if (typeof config === "string") {
+    return { config: null, note: `The server's /config.json ${config}; using Settings → Connection.` };
+  }
+  return { config, note: null };
+}

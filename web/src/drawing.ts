@@ -1,0 +1,124 @@
+/**
+ * A drawing: the paths drawn until the canvas is cleared, what the simplifier
+ * made of them, and the strokes sent. Pure data; the page and the recording
+ * read it. `seq` counts the sent strokes of one drawing from 0, so the sleeve
+ * can order, deduplicate and chain them.
+ */
+import type { Stroke } from "./protocol";
+import type { AngleParams } from "./simplify/params";
+import type { Sample, Segment } from "./simplify/segment";
+
+export type PointerKind = "mouse" | "pen" | "touch";
+
+/** A segment of path `path`, and the stroke sent for it (null when dropped). */
+export interface DrawnSegment {
+  /** Position in `Drawing.segments`. */
+  readonly index: number;
+  readonly path: number;
+  readonly segment: Segment;
+  readonly stroke: Stroke | null;
+}
+
+export class Drawing {
+  readonly id: string;
+  /** The parameters every path of this drawing is simplified with (canvas size included). */
+  readonly params: AngleParams;
+  /** Pointer samples per path, as the pointer events reported them (the recording). */
+  readonly paths: Sample[][] = [];
+  /** The animation frames fed to the simplifier, per path. */
+  readonly frames: Sample[][] = [];
+  readonly pointerKinds: PointerKind[] = [];
+  readonly segments: DrawnSegment[] = [];
+  readonly #bySeq = new Map<number, DrawnSegment>();
+  readonly #acked = new Set<number>();
+  #nextSeq = 0;
+
+  constructor(id: string, params: AngleParams) {
+    this.id = id;
+    this.params = params;
+  }
+
+  /** Starts a path; returns its index. */
+  beginPath(kind: PointerKind): number {
+    this.paths.push([]);
+    this.frames.push([]);
+    this.pointerKinds.push(kind);
+    return this.paths.length - 1;
+  }
+
+  get currentPath(): number {
+    return this.paths.length - 1;
+  }
+
+  addSample(sample: Sample): void {
+    const path = this.paths[this.currentPath];
+    if (path === undefined) throw new Error("addSample before beginPath");
+    // Recordings need non-decreasing times; event clocks can tie or, rarely, step back.
+    const previous = path[path.length - 1];
+    path.push(previous && sample.t_ms < previous.t_ms ? { ...sample, t_ms: previous.t_ms } : sample);
+  }
+
+  addFrame(frame: Sample): void {
+    const frames = this.frames[this.currentPath];
+    if (frames === undefined) throw new Error("addFrame before beginPath");
+    frames.push(frame);
+  }
+
+  /** Records a finished segment; a kept one becomes the next stroke (seq, drawing id). */
+  addSegment(segment: Segment, intensity: number): DrawnSegment {
+    let stroke: Stroke | null = null;
+    if (segment.dropped === null) {
+      stroke = {
+        start: segment.start,
+        end: segment.end,
+        duration_ms: segment.end_ms - segment.start_ms,
+        intensity,
+        drawing: this.id,
+        seq: this.#nextSeq++,
+      };
+    }
+    const drawn: DrawnSegment = { index: this.segments.length, path: this.currentPath, segment, stroke };
+    this.segments.push(drawn);
+    if (stroke?.seq != null) this.#bySeq.set(stroke.seq, drawn);
+    return drawn;
+  }
+
+  /** The segment sent as stroke `seq`, if this drawing sent it. */
+  bySeq(seq: number): DrawnSegment | undefined {
+    return this.#bySeq.get(seq);
+  }
+
+  /** The broker has acknowledged stroke `seq` (QoS 1 PUBACK): it is sent. */
+  markAcked(seq: number): DrawnSegment | undefined {
+    this.#acked.add(seq);
+    return this.#bySeq.get(seq);
+  }
+
+  isAcked(drawn: DrawnSegment): boolean {
+    return drawn.stroke?.seq != null && this.#acked.has(drawn.stroke.seq);
+  }
+
+  get strokeCount(): number {
+    return this.#nextSeq;
+  }
+
+  /**
+   * The mean pressure of the current path's frames from `startMs` to `endMs`:
+   * what "pen pressure sets intensity" uses. Walks back from the newest frame,
+   * so the cost is the segment's own length, not the path's.
+   */
+  meanPressure(startMs: number, endMs: number): number {
+    const frames = this.frames[this.currentPath] ?? [];
+    let sum = 0;
+    let count = 0;
+    for (let i = frames.length - 1; i >= 0; i--) {
+      const frame = frames[i]!;
+      if (frame.t_ms < startMs) break;
+      if (frame.t_ms <= endMs) {
+        sum += frame.pressure;
+        count++;
+      }
+    }
+    return count > 0 ? sum / count : 0.5;
+  }
+}

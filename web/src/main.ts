@@ -1,0 +1,36 @@
+/** Entry point: read the server's config, then start the client. */
+import "./styles.css";
+import { App } from "./app";
+import { fetchConfig } from "./config";
+
+declare global {
+  interface Window {
+    /** The running client, for the browser tests and the benchmark. */
+    feelmysign?: App;
+  }
+}
+
+/** Settings survive a reload in localStorage; where it is blocked they last for the visit. */
+function settingsStorage(): Storage {
+  try {
+    const probe = "feelmysign.probe";
+    localStorage.setItem(probe, probe);
+    localStorage.removeItem(probe);
+    return localStorage;
+  } catch {
+    const data = new Map<string, string>();
+    return {
+      get length() {
+        return data.size;
+      },
+      clear: () => data.clear(),
+      getItem: (key) => data.get(key) ?? null,
+      key: (index) => [...data.keys()][index] ?? null,
+      removeItem: (key) => void data.delete(key),
+      setItem: (key, value) => void data.set(key, value),
+    };
+  }
+}
+
+const { config, note } = await fetchConfig();
+window.feelmysign = new App(document, { config, configNote: note, storage: settingsStorage() });

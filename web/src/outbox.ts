@@ -1,0 +1,56 @@
+/**
+ * Strokes not yet acknowledged by the broker. A stroke drawn while offline
+ * waits here and goes out, in order, on reconnect; one published but not yet
+ * acknowledged (QoS 1) stays counted until its PUBACK. Nothing is dropped
+ * silently: `size` is what the page shows as "unsent".
+ */
+export interface OutboxEntry<T> {
+  readonly id: number;
+  readonly item: T;
+}
+
+export class Outbox<T> {
+  #queued: OutboxEntry<T>[] = [];
+  readonly #inFlight = new Map<number, OutboxEntry<T>>();
+  #nextId = 0;
+
+  add(item: T): void {
+    this.#queued.push({ id: this.#nextId++, item });
+  }
+
+  /** Queued plus in flight: every stroke the sleeve may not have yet. */
+  get size(): number {
+    return this.#queued.length + this.#inFlight.size;
+  }
+
+  get queuedCount(): number {
+    return this.#queued.length;
+  }
+
+  /** Every queued entry, oldest first, now counted as in flight. */
+  takeQueued(): OutboxEntry<T>[] {
+    const taken = this.#queued;
+    this.#queued = [];
+    for (const entry of taken) this.#inFlight.set(entry.id, entry);
+    return taken;
+  }
+
+  /** The broker acknowledged it: gone for good. */
+  ack(id: number): void {
+    this.#inFlight.delete(id);
+  }
+
+  /** Publishing failed: back in the queue, in its original order. */
+  fail(id: number): void {
+    const entry = this.#inFlight.get(id);
+    if (entry === undefined) return;
+    this.#inFlight.delete(id);
+    this.#queued.push(entry);
+    this.#queued.sort((a, b) => a.id - b.id);
+  }
+
+  /** A new connection replaces the old one: everything in flight is sent again. */
+  requeueInFlight(): void {
+    for (const id of [...this.#inFlight.keys()]) this.fail(id);
+  }
+}

@@ -1,0 +1,355 @@
+/**
+ * The sender's settings: every parameter of the paper's appendix B.1, the
+ * sleeve, the intensity, the wire format and the broker. One table of fields
+ * drives validation and the settings panel; the simplifier's fields take their
+ * defaults and ranges from `testdata/angle/params.json` (the Python table),
+ * so both sides accept exactly the same values. Pure: storage is passed in.
+ */
+import type { ServerConfig } from "./config";
+import { paramProblem, paramSpec, type AngleParamName, type AngleParams } from "./simplify/params";
+
+export type WireProtocol = "json" | "legacy";
+export type GridSource = "status" | "manual";
+
+export interface Settings {
+  readonly check_frames: number;
+  readonly max_angle_deg: number;
+  readonly frame_max: number;
+  readonly fps: number;
+  readonly recover: boolean;
+  readonly min_duration_ms: number;
+  readonly min_length: number;
+  readonly stretch: boolean;
+  readonly clear_on_press: boolean;
+  /** Where the grid comes from: the sleeve's retained status, or rows/columns below. */
+  readonly grid_source: GridSource;
+  readonly rows: number;
+  readonly columns: number;
+  readonly intensity: number;
+  readonly pressure_sets_intensity: boolean;
+  readonly protocol: WireProtocol;
+  readonly legacy_topic: string;
+  readonly sleeve_id: string;
+  /** Use the broker below instead of the one the server's /config.json names. */
+  readonly broker_custom: boolean;
+  readonly ws_url: string;
+  readonly username: string;
+  readonly password: string;
+}
+
+export type SettingKey = keyof Settings;
+export type FieldKind = "integer" | "number" | "boolean" | "text" | "password" | "choice";
+
+export interface FieldSpec {
+  readonly key: SettingKey;
+  readonly section: "drawing" | "simplifier" | "sleeve" | "connection";
+  readonly label: string;
+  readonly help: string;
+  readonly kind: FieldKind;
+  readonly minimum?: number;
+  readonly maximum?: number;
+  readonly unit?: string;
+  readonly choices?: readonly { readonly value: string; readonly label: string }[];
+  /** Why the value is not allowed (a sentence fragment after the label), or null. */
+  problem(value: unknown): string | null;
+}
+
+export const STORAGE_KEY = "feelmysign.settings.v1";
+const SLEEVE_ID = /^[A-Za-z0-9_-]{1,64}$/;
+/** MQTT allows 65535 bytes; a topic a person types is far shorter, and a log line stays readable. */
+const MAX_TOPIC_CHARS = 256;
+
+function paramField(
+  name: AngleParamName,
+  section: FieldSpec["section"],
+  label: string,
+  unit?: string,
+): FieldSpec {
+  const spec = paramSpec(name);
+  const kind: FieldKind = spec.type === "boolean" ? "boolean" : spec.type;
+  return {
+    key: name as SettingKey,
+    section,
+    label,
+    help: spec.help,
+    kind,
+    ...(spec.minimum !== null ? { minimum: spec.minimum } : {}),
+    ...(spec.maximum !== null ? { maximum: spec.maximum } : {}),
+    ...(unit !== undefined ? { unit } : {}),
+    problem: (value) => paramProblem(spec, value),
+  };
+}
+
+function boolField(key: SettingKey, section: FieldSpec["section"], label: string, help: string): FieldSpec {
+  return {
+    key,
+    section,
+    label,
+    help,
+    kind: "boolean",
+    problem: (value) => (typeof value === "boolean" ? null : "must be on or off"),
+  };
+}
+
+function textProblem(value: unknown, check: (text: string) => string | null): string | null {
+  return typeof value === "string" ? check(value) : "must be text";
+}
+
+export const FIELDS: readonly FieldSpec[] = [
+  paramField("clear_on_press", "drawing", "Clear on press"),
+  {
+    key: "intensity",
+    section: "drawing",
+    label: "Intensity",
+    help: "how strongly the sleeve vibrates (0 = off, 1 = strongest)",
+    kind: "number",
+    minimum: 0,
+    maximum: 1,
+    problem: (value) =>
+      typeof value === "number" && value >= 0 && value <= 1 ? null : "must be a number from 0 to 1",
+  },
+  boolField(
+    "pressure_sets_intensity",
+    "drawing",
+    "Pen pressure sets intensity",
+    "with a pen, pressing fully gives the intensity above and lighter presses less (mouse and touch report no real pressure)",
+  ),
+  paramField("check_frames", "simplifier", "Check frames", "frames"),
+  paramField("max_angle_deg", "simplifier", "Max angle", "°"),
+  paramField("frame_max", "simplifier", "Frame max", "frames"),
+  paramField("fps", "simplifier", "Frames per second", "fps"),
+  paramField("recover", "simplifier", "Recover"),
+  paramField("min_duration_ms", "simplifier", "Min duration", "ms"),
+  paramField("min_length", "simplifier", "Min length", "grid units"),
+  paramField("stretch", "simplifier", "Stretch to the grid"),
+  {
+    key: "sleeve_id",
+    section: "sleeve",
+    label: "Sleeve id",
+    help: "the sleeve to draw on: strokes go to feelmysign/<id>/strokes",
+    kind: "text",
+    problem: (value) =>
+      textProblem(value, (text) =>
+        SLEEVE_ID.test(text) ? null : "must be 1 to 64 letters, digits, '_' or '-' (e.g. sleeve1)",
+      ),
+  },
+  {
+    key: "grid_source",
+    section: "sleeve",
+    label: "Grid",
+    help: "the actuator grid the drawing area is shaped after",
+    kind: "choice",
+    choices: [
+      { value: "status", label: "From the sleeve" },
+      { value: "manual", label: "Set here" },
+    ],
+    problem: (value) => (value === "status" || value === "manual" ? null : "must be a listed choice"),
+  },
+  paramField("rows", "sleeve", "Rows"),
+  paramField("columns", "sleeve", "Columns"),
+  {
+    key: "protocol",
+    section: "connection",
+    label: "Message format",
+    help: "JSON v1 carries intensity and order; legacy text drives the paper's original sleeve",
+    kind: "choice",
+    choices: [
+      { value: "json", label: "JSON v1" },
+      { value: "legacy", label: "Legacy text" },
+    ],
+    problem: (value) => (value === "json" || value === "legacy" ? null : "must be a listed choice"),
+  },
+  {
+    key: "legacy_topic",
+    section: "connection",
+    label: "Legacy topic",
+    help: "where legacy text strokes are published",
+    kind: "text",
+    problem: (value) =>
+      textProblem(value, (text) => {
+        if (text.length === 0 || text.length > MAX_TOPIC_CHARS) {
+          return `must be 1 to ${MAX_TOPIC_CHARS} characters (e.g. deviceOne/line)`;
+        }
+        return /[+#\u0000]/.test(text) ? "cannot contain '+', '#' (MQTT wildcards) or NUL" : null;
+      }),
+  },
+  boolField(
+    "broker_custom",
+    "connection",
+    "Use my own broker",
+    "instead of the broker the server hands the page",
+  ),
+  {
+    key: "ws_url",
+    section: "connection",
+    label: "Broker URL",
+    help: "MQTT over WebSockets",
+    kind: "text",
+    problem: (value) => textProblem(value, wsUrlProblem),
+  },
+  {
+    key: "username",
+    section: "connection",
+    label: "Username",
+    help: "the broker's sender account",
+    kind: "text",
+    problem: (value) =>
+      textProblem(value, (text) => (text.length <= 256 ? null : "must be at most 256 characters")),
+  },
+  {
+    key: "password",
+    section: "connection",
+    label: "Password",
+    help: "kept in this browser only when you use your own broker",
+    kind: "password",
+    problem: (value) =>
+      textProblem(value, (text) => (text.length <= 256 ? null : "must be at most 256 characters")),
+  },
+];
+
+function wsUrlProblem(text: string): string | null {
+  let url: URL;
+  try {
+    url = new URL(text);
+  } catch {
+    return "must be a WebSocket URL such as ws://127.0.0.1:9001";
+  }
+  return url.protocol === "ws:" || url.protocol === "wss:"
+    ? null
+    : `must start with ws:// or wss:// (got ${url.protocol}//)`;
+}
+
+const FIELDS_BY_KEY = new Map(FIELDS.map((field) => [field.key, field]));
+
+export function fieldSpec(key: SettingKey): FieldSpec {
+  const field = FIELDS_BY_KEY.get(key);
+  if (field === undefined) throw new Error(`no settings field '${key}'`);
+  return field;
+}
+
+function paramDefault<T extends number | boolean>(name: AngleParamName): T {
+  return paramSpec(name).default as T;
+}
+
+export const DEFAULT_SETTINGS: Settings = Object.freeze({
+  check_frames: paramDefault<number>("check_frames"),
+  max_angle_deg: paramDefault<number>("max_angle_deg"),
+  frame_max: paramDefault<number>("frame_max"),
+  fps: paramDefault<number>("fps"),
+  recover: paramDefault<boolean>("recover"),
+  min_duration_ms: paramDefault<number>("min_duration_ms"),
+  min_length: paramDefault<number>("min_length"),
+  stretch: paramDefault<boolean>("stretch"),
+  clear_on_press: paramDefault<boolean>("clear_on_press"),
+  grid_source: "status",
+  rows: paramDefault<number>("rows"),
+  columns: paramDefault<number>("columns"),
+  intensity: 0.8,
+  pressure_sets_intensity: true,
+  protocol: "json",
+  legacy_topic: "deviceOne/line",
+  sleeve_id: "sleeve1",
+  broker_custom: false,
+  ws_url: "ws://127.0.0.1:9001",
+  username: "sender",
+  password: "",
+});
+
+export type SettingsErrors = Partial<Record<SettingKey, string>>;
+
+/** Every field's problem, keyed by field; empty when all are valid. */
+export function validateSettings(candidate: Record<SettingKey, unknown>): SettingsErrors {
+  const errors: SettingsErrors = {};
+  for (const field of FIELDS) {
+    const problem = field.problem(candidate[field.key]);
+    if (problem !== null) errors[field.key] = `${field.label} ${problem}.`;
+  }
+  return errors;
+}
+
+/** The defaults, with the server's broker and sleeve when it gave them. */
+export function defaultSettings(config: ServerConfig | null): Settings {
+  if (config === null) return DEFAULT_SETTINGS;
+  return {
+    ...DEFAULT_SETTINGS,
+    sleeve_id: config.sleeve_id,
+    ws_url: config.ws_url,
+    username: config.username,
+    password: config.password,
+  };
+}
+
+/** The broker settings in force: the server's unless the person chose their own. */
+export function withServerBroker(settings: Settings, config: ServerConfig | null): Settings {
+  if (config === null || settings.broker_custom) return settings;
+  return { ...settings, ws_url: config.ws_url, username: config.username, password: config.password };
+}
+
+export interface LoadedSettings {
+  readonly settings: Settings;
+  /** Stored values that were not valid any more and were replaced by defaults. */
+  readonly replaced: readonly string[];
+}
+
+/** Stored settings over the defaults; a stored value that fails validation falls back. */
+export function loadSettings(storage: Pick<Storage, "getItem">, config: ServerConfig | null): LoadedSettings {
+  const defaults = defaultSettings(config);
+  let stored: unknown = null;
+  try {
+    stored = JSON.parse(storage.getItem(STORAGE_KEY) ?? "null");
+  } catch {
+    stored = null;
+  }
+  const merged: Record<string, unknown> = { ...defaults };
+  const replaced: string[] = [];
+  if (typeof stored === "object" && stored !== null) {
+    for (const field of FIELDS) {
+      const value = (stored as Record<string, unknown>)[field.key];
+      if (value === undefined) continue;
+      if (field.problem(value) === null) merged[field.key] = value;
+      else replaced.push(field.label);
+    }
+  }
+  return { settings: withServerBroker(merged as unknown as Settings, config), replaced };
+}
+
+/**
+ * Persists the settings. The broker and password are kept only when they are
+ * the person's own: the server's login changes with its state directory, and
+ * a stale copy here would lock the page out.
+ */
+export function saveSettings(
+  storage: Pick<Storage, "setItem">,
+  settings: Settings,
+  config: ServerConfig | null,
+): void {
+  if (config !== null && !settings.broker_custom) {
+    const { ws_url: _url, username: _user, password: _password, ...rest } = settings;
+    storage.setItem(STORAGE_KEY, JSON.stringify(rest));
+  } else {
+    storage.setItem(STORAGE_KEY, JSON.stringify(settings));
+  }
+}
+
+/** The simplifier's parameters for a drawing area of this size on this grid. */
+export function angleParams(
+  settings: Settings,
+  grid: { readonly rows: number; readonly columns: number },
+  canvas: { readonly width_px: number; readonly height_px: number },
+): AngleParams {
+  return {
+    check_frames: settings.check_frames,
+    max_angle_deg: settings.max_angle_deg,
+    frame_max: settings.frame_max,
+    fps: settings.fps,
+    recover: settings.recover,
+    clear_on_press: settings.clear_on_press,
+    min_duration_ms: settings.min_duration_ms,
+    min_length: settings.min_length,
+    rows: grid.rows,
+    columns: grid.columns,
+    canvas_width_px: canvas.width_px,
+    canvas_height_px: canvas.height_px,
+    stretch: settings.stretch,
+  };
+}

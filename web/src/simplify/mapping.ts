@@ -1,0 +1,48 @@
+/**
+ * From canvas pixels to the sleeve's grid units (port of `simplify/mapping.py`).
+ *
+ * By default the aspect ratio is kept (a circle drawn stays a circle on the
+ * skin): one scale for both axes, the canvas centred on the grid. The paper
+ * stretched each axis to fill the grid; `stretch` does the same.
+ */
+import type { Point } from "./segment";
+
+export interface CanvasMappingOptions {
+  readonly width_px: number;
+  readonly height_px: number;
+  readonly columns: number;
+  readonly rows: number;
+  readonly stretch: boolean;
+}
+
+export class CanvasMapping {
+  readonly #options: CanvasMappingOptions;
+  /** Grid units per pixel when the aspect ratio is kept (the tighter axis decides). */
+  readonly scale: number;
+
+  constructor(options: CanvasMappingOptions) {
+    this.#options = options;
+    const scales: number[] = [];
+    if (options.columns - 1 > 0) scales.push((options.columns - 1) / options.width_px);
+    if (options.rows - 1 > 0) scales.push((options.rows - 1) / options.height_px);
+    this.scale = scales.length > 0 ? Math.min(...scales) : 0;
+  }
+
+  /** Grid point (x = column, y = row) of a canvas pixel, clamped onto the grid. */
+  toGrid(xPx: number, yPx: number): Point {
+    const { width_px, height_px, columns, rows, stretch } = this.#options;
+    const xExtent = columns - 1;
+    const yExtent = rows - 1;
+    let x: number;
+    let y: number;
+    if (stretch) {
+      x = (xPx * xExtent) / width_px;
+      y = (yPx * yExtent) / height_px;
+    } else {
+      // Same operation order as the reference, so results agree to the last bit.
+      x = (xExtent - width_px * this.scale) / 2 + xPx * this.scale;
+      y = (yExtent - height_px * this.scale) / 2 + yPx * this.scale;
+    }
+    return [Math.min(Math.max(x, 0), xExtent), Math.min(Math.max(y, 0), yExtent)];
+  }
+}

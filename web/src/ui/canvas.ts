@@ -1,0 +1,392 @@
+/**
+ * The drawing surface, rendered incrementally so that the cost of a frame
+ * does not grow with the drawing (the paper's sketch redrew every stroke on
+ * every frame). Three stacked canvases:
+ *
+ *   grid  the sleeve's actuators, faint; redrawn only when the size or grid changes
+ *   ink   finished content: the raw path (faint), strokes waiting for the broker
+ *         (dim) and sent ones (solid, drawn over the dim line on PUBACK), dropped
+ *         ones (dashed red), strokes the sleeve refused; only the new bits are
+ *         drawn each frame, and everything only on a resize or a new drawing
+ *   live  the stroke being drawn, highlighted; cleared and redrawn alone each frame
+ *
+ * Coordinates: the simplifier sees the drawing's own canvas pixels (fixed when
+ * the drawing starts); the screen may be resized since, so they are scaled.
+ */
+import type { Drawing, DrawnSegment } from "../drawing";
+import type { Sample } from "../simplify/segment";
+import { AREA_MARGIN_PX, fitArea, gridToCanvas, type GridSize, type MappingShape } from "./geometry";
+
+const COLORS = {
+  grid: "rgba(143, 160, 178, 0.13)",
+  actuatorFill: "rgba(143, 160, 178, 0.10)",
+  actuatorRing: "rgba(143, 160, 178, 0.38)",
+  raw: "rgba(231, 237, 243, 0.24)",
+  sent: "#ff8a5b",
+  waiting: "rgba(255, 138, 91, 0.35)",
+  live: "#ffd166",
+  dropped: "#ff6b6b",
+  rejected: "#ff6b6b",
+  /** The stage's own colour (--surface): a refused stroke is first wiped out with it. */
+  erase: "#151d26",
+} as const;
+
+const ACTUATOR_RADIUS_PX = 7;
+const SENT_WIDTH_PX = 4;
+const LIVE_WIDTH_PX = 5;
+
+export interface AreaSize {
+  readonly width_px: number;
+  readonly height_px: number;
+}
+
+export class DrawingView {
+  readonly stage: HTMLElement;
+  /** The surface that takes the pointer; carries data-testid="drawing-canvas". */
+  readonly surface: HTMLCanvasElement;
+  readonly #gridCanvas: HTMLCanvasElement;
+  readonly #inkCanvas: HTMLCanvasElement;
+  readonly #grid2d: CanvasRenderingContext2D;
+  readonly #ink2d: CanvasRenderingContext2D;
+  readonly #live2d: CanvasRenderingContext2D;
+  #grid: GridSize = { rows: 3, columns: 4 };
+  #stretch = false;
+  #area: AreaSize = { width_px: 300, height_px: 200 };
+  #dpr = 1;
+  #drawing: Drawing | null = null;
+  /** Per path, how many samples are already on the ink canvas. */
+  #rawDrawn: number[] = [];
+  #rawPathFrom = 0;
+  #segmentsDrawn = 0;
+  #rejected: DrawnSegment[] = [];
+  #rejectedDrawn = 0;
+  /** Strokes acknowledged since the last flush, to draw solid over their dim line. */
+  #acked: DrawnSegment[] = [];
+  #liveShown = false;
+  /** Canvas rectangle at the press: pointer moves are converted without a layout read each. */
+  #pointerRect: DOMRect | null = null;
+
+  constructor(stage: HTMLElement) {
+    this.stage = stage;
+    this.#gridCanvas = this.#addCanvas("grid");
+    this.#inkCanvas = this.#addCanvas("ink");
+    this.surface = this.#addCanvas("live");
+    this.surface.dataset["testid"] = "drawing-canvas";
+    this.surface.setAttribute("role", "img");
+    this.surface.setAttribute("aria-label", "Drawing area: draw with a finger, pen or mouse");
+    this.#grid2d = context(this.#gridCanvas);
+    this.#ink2d = context(this.#inkCanvas);
+    this.#live2d = context(this.surface);
+  }
+
+  #addCanvas(name: string): HTMLCanvasElement {
+    const canvas = document.createElement("canvas");
+    canvas.className = name;
+    this.stage.append(canvas);
+    return canvas;
+  }
+
+  /** The drawing area's size in CSS pixels now: a new drawing's canvas. */
+  get area(): AreaSize {
+    return this.#area;
+  }
+
+  get grid(): GridSize {
+    return this.#grid;
+  }
+
+  /** Sizes the stage to the largest area of the grid's aspect ratio that fits. */
+  fit(grid: GridSize, stretch: boolean, availableWidthPx: number, availableHeightPx: number): void {
+    const area = fitArea(grid, availableWidthPx, availableHeightPx);
+    const dpr = window.devicePixelRatio || 1;
+    const same =
+      area.width_px === this.#area.width_px &&
+      area.height_px === this.#area.height_px &&
+      grid.rows === this.#grid.rows &&
+      grid.columns === this.#grid.columns &&
+      stretch === this.#stretch &&
+      dpr === this.#dpr;
+    if (same) return;
+    this.#grid = grid;
+    this.#stretch = stretch;
+    this.#area = area;
+    this.#dpr = dpr;
+    const widthPx = area.width_px + 2 * AREA_MARGIN_PX;
+    const heightPx = area.height_px + 2 * AREA_MARGIN_PX;
+    this.stage.style.width = `${widthPx}px`;
+    this.stage.style.height = `${heightPx}px`;
+    for (const canvas of [this.#gridCanvas, this.#inkCanvas, this.surface]) {
+      // Backing store in device pixels: sharp lines on HiDPI screens.
+      canvas.width = Math.round(widthPx * dpr);
+      canvas.height = Math.round(heightPx * dpr);
+    }
+    for (const ctx of [this.#grid2d, this.#ink2d, this.#live2d]) {
+      ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+      ctx.lineCap = "round";
+      ctx.lineJoin = "round";
+    }
+    this.surface.dataset["areaLeftPx"] = String(AREA_MARGIN_PX);
+    this.surface.dataset["areaTopPx"] = String(AREA_MARGIN_PX);
+    this.surface.dataset["areaWidthPx"] = String(area.width_px);
+    this.surface.dataset["areaHeightPx"] = String(area.height_px);
+    this.#drawGrid();
+    this.#redrawInk();
+    this.#liveShown = true;
+    this.clearLive();
+  }
+
+  /** Shows `drawing` from scratch (a new or cleared drawing, or null for an empty canvas). */
+  setDrawing(drawing: Drawing | null): void {
+    this.#drawing = drawing;
+    this.#rejected = [];
+    this.#acked = [];
+    this.#redrawInk();
+  }
+
+  /** A stroke the broker acknowledged: drawn solid on the next flush. */
+  markSent(drawn: DrawnSegment): void {
+    this.#acked.push(drawn);
+  }
+
+  /** A stroke the sleeve refused: marked on the next flush. */
+  markRejected(drawn: DrawnSegment): void {
+    this.#rejected.push(drawn);
+  }
+
+  /** Draws what is new since the last flush: the cost is that of the new bits alone. */
+  flush(): void {
+    const drawing = this.#drawing;
+    if (drawing === null) return;
+    const ctx = this.#ink2d;
+    // Only paths from the one drawn last can have new samples: earlier ones are finished.
+    for (let path = this.#rawPathFrom; path < drawing.paths.length; path++) {
+      const samples = drawing.paths[path]!;
+      const drawn = this.#rawDrawn[path] ?? 0;
+      if (samples.length > drawn) {
+        this.#drawRaw(ctx, samples, Math.max(0, drawn - 1));
+        this.#rawDrawn[path] = samples.length;
+      }
+    }
+    this.#rawPathFrom = Math.max(0, drawing.paths.length - 1);
+    const segments = drawing.segments;
+    for (; this.#segmentsDrawn < segments.length; this.#segmentsDrawn++) {
+      const drawn = segments[this.#segmentsDrawn]!;
+      this.#drawSegment(ctx, drawn, drawing.isAcked(drawn));
+    }
+    for (const drawn of this.#acked.splice(0)) {
+      // Not yet on the canvas: it will be drawn solid with the other new segments.
+      if (drawn.index < this.#segmentsDrawn) this.#drawSegment(ctx, drawn, true);
+    }
+    for (; this.#rejectedDrawn < this.#rejected.length; this.#rejectedDrawn++) {
+      this.#drawRejected(ctx, this.#rejected[this.#rejectedDrawn]!);
+    }
+  }
+
+  /** The line being drawn, from its start to the pointer, highlighted. */
+  drawLive(lineStart: Sample | null, pointer: Sample | null): void {
+    const ctx = this.#live2d;
+    this.clearLive();
+    if (pointer === null) return;
+    const [px, py] = this.#toCss(pointer.x, pointer.y);
+    ctx.save();
+    if (lineStart !== null) {
+      const [sx, sy] = this.#toCss(lineStart.x, lineStart.y);
+      ctx.shadowColor = COLORS.live;
+      ctx.shadowBlur = 14;
+      ctx.strokeStyle = COLORS.live;
+      ctx.lineWidth = LIVE_WIDTH_PX;
+      ctx.beginPath();
+      ctx.moveTo(sx, sy);
+      ctx.lineTo(px, py);
+      ctx.stroke();
+    }
+    ctx.fillStyle = COLORS.live;
+    ctx.beginPath();
+    ctx.arc(px, py, 6, 0, 2 * Math.PI);
+    ctx.fill();
+    ctx.restore();
+    this.#liveShown = true;
+  }
+
+  clearLive(): void {
+    if (!this.#liveShown) return;
+    this.#live2d.clearRect(0, 0, this.surface.width, this.surface.height);
+    this.#liveShown = false;
+  }
+
+  /** Remembers the surface's position for the pointer conversions of one path. */
+  beginPointer(): void {
+    this.#pointerRect = this.surface.getBoundingClientRect();
+  }
+
+  /** A pointer position (client pixels) in the drawing's canvas pixels. */
+  toDrawing(clientX: number, clientY: number): [number, number] {
+    const rect = this.#pointerRect ?? this.surface.getBoundingClientRect();
+    const k = this.#drawingScale();
+    return [(clientX - rect.left - AREA_MARGIN_PX) / k, (clientY - rect.top - AREA_MARGIN_PX) / k];
+  }
+
+  /** CSS pixels per drawing pixel: 1 unless the screen was resized since the drawing began. */
+  #drawingScale(): number {
+    const width = this.#drawing?.params.canvas_width_px;
+    return width === undefined ? 1 : this.#area.width_px / width;
+  }
+
+  #toCss(x: number, y: number): [number, number] {
+    const k = this.#drawingScale();
+    return [AREA_MARGIN_PX + x * k, AREA_MARGIN_PX + y * k];
+  }
+
+  #gridToCss(gx: number, gy: number, shape: MappingShape): [number, number] {
+    const [x, y] = gridToCanvas(gx, gy, shape);
+    const k = this.#area.width_px / shape.width_px;
+    return [AREA_MARGIN_PX + x * k, AREA_MARGIN_PX + y * k];
+  }
+
+  #drawGrid(): void {
+    const ctx = this.#grid2d;
+    const { rows, columns } = this.#grid;
+    ctx.clearRect(0, 0, this.#gridCanvas.width, this.#gridCanvas.height);
+    const shape: MappingShape = { ...this.#area, rows, columns, stretch: this.#stretch };
+    const at = (column: number, row: number) => this.#gridToCss(column, row, shape);
+    ctx.strokeStyle = COLORS.grid;
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    for (let row = 0; row < rows; row++) {
+      ctx.moveTo(...at(0, row));
+      ctx.lineTo(...at(columns - 1, row));
+    }
+    for (let column = 0; column < columns; column++) {
+      ctx.moveTo(...at(column, 0));
+      ctx.lineTo(...at(column, rows - 1));
+    }
+    ctx.stroke();
+    for (let row = 0; row < rows; row++) {
+      for (let column = 0; column < columns; column++) {
+        const [x, y] = at(column, row);
+        ctx.beginPath();
+        ctx.arc(x, y, ACTUATOR_RADIUS_PX, 0, 2 * Math.PI);
+        ctx.fillStyle = COLORS.actuatorFill;
+        ctx.fill();
+        ctx.strokeStyle = COLORS.actuatorRing;
+        ctx.lineWidth = 1.5;
+        ctx.stroke();
+      }
+    }
+  }
+
+  #redrawInk(): void {
+    this.#ink2d.clearRect(0, 0, this.#inkCanvas.width, this.#inkCanvas.height);
+    this.#rawDrawn = [];
+    this.#rawPathFrom = 0;
+    this.#segmentsDrawn = 0;
+    this.#rejectedDrawn = 0;
+    this.flush();
+  }
+
+  #drawRaw(ctx: CanvasRenderingContext2D, samples: readonly Sample[], from: number): void {
+    const first = samples[from]!;
+    ctx.strokeStyle = COLORS.raw;
+    ctx.lineWidth = 1.5;
+    ctx.setLineDash([]);
+    ctx.beginPath();
+    ctx.moveTo(...this.#toCss(first.x, first.y));
+    if (samples.length - from === 1) {
+      ctx.lineTo(...this.#toCss(first.x + 0.01, first.y)); // a dot for a single sample
+    }
+    for (let i = from + 1; i < samples.length; i++) {
+      const sample = samples[i]!;
+      ctx.lineTo(...this.#toCss(sample.x, sample.y));
+    }
+    ctx.stroke();
+  }
+
+  #segmentShape(): MappingShape | null {
+    const params = this.#drawing?.params;
+    if (params === undefined) return null;
+    return {
+      width_px: params.canvas_width_px,
+      height_px: params.canvas_height_px,
+      rows: params.rows,
+      columns: params.columns,
+      stretch: params.stretch,
+    };
+  }
+
+  #segmentEnds({ segment }: DrawnSegment): [[number, number], [number, number]] | null {
+    const shape = this.#segmentShape();
+    if (shape === null) return null;
+    return [
+      this.#gridToCss(segment.start[0], segment.start[1], shape),
+      this.#gridToCss(segment.end[0], segment.end[1], shape),
+    ];
+  }
+
+  #drawSegment(ctx: CanvasRenderingContext2D, drawn: DrawnSegment, sent: boolean): void {
+    const ends = this.#segmentEnds(drawn);
+    if (ends === null) return;
+    const [[x0, y0], [x1, y1]] = ends;
+    const color = sent ? COLORS.sent : COLORS.waiting;
+    ctx.save();
+    if (drawn.segment.dropped === null) {
+      ctx.strokeStyle = color;
+      ctx.lineWidth = SENT_WIDTH_PX;
+    } else {
+      ctx.strokeStyle = COLORS.dropped;
+      ctx.lineWidth = 2;
+      ctx.setLineDash([5, 5]);
+    }
+    ctx.beginPath();
+    ctx.moveTo(x0, y0);
+    ctx.lineTo(x1, y1);
+    ctx.stroke();
+    if (drawn.segment.dropped === null) {
+      // The joints: where one stroke hands over to the next.
+      ctx.fillStyle = color;
+      for (const [x, y] of ends) {
+        ctx.beginPath();
+        ctx.arc(x, y, SENT_WIDTH_PX * 0.9, 0, 2 * Math.PI);
+        ctx.fill();
+      }
+    }
+    ctx.restore();
+  }
+
+  #drawRejected(ctx: CanvasRenderingContext2D, drawn: DrawnSegment): void {
+    const ends = this.#segmentEnds(drawn);
+    if (ends === null) return;
+    const [[x0, y0], [x1, y1]] = ends;
+    ctx.save();
+    ctx.strokeStyle = COLORS.erase;
+    ctx.lineWidth = SENT_WIDTH_PX + 2;
+    ctx.beginPath();
+    ctx.moveTo(x0, y0);
+    ctx.lineTo(x1, y1);
+    ctx.stroke();
+    ctx.strokeStyle = COLORS.rejected;
+    ctx.lineWidth = SENT_WIDTH_PX;
+    ctx.setLineDash([2, 7]);
+    ctx.beginPath();
+    ctx.moveTo(x0, y0);
+    ctx.lineTo(x1, y1);
+    ctx.stroke();
+    // A cross at the middle: refused, not merely thin.
+    const mx = (x0 + x1) / 2;
+    const my = (y0 + y1) / 2;
+    ctx.setLineDash([]);
+    ctx.lineWidth = 2.5;
+    ctx.beginPath();
+    ctx.moveTo(mx - 6, my - 6);
+    ctx.lineTo(mx + 6, my + 6);
+    ctx.moveTo(mx + 6, my - 6);
+    ctx.lineTo(mx - 6, my + 6);
+    ctx.stroke();
+    ctx.restore();
+  }
+}
+
+function context(canvas: HTMLCanvasElement): CanvasRenderingContext2D {
+  const ctx = canvas.getContext("2d");
+  if (ctx === null) throw new Error("This browser cannot draw on a canvas (no 2D context).");
+  return ctx;
+}

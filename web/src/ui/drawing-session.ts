@@ -1,0 +1,232 @@
+/**
+ * One drawing in progress: pointer samples in, animation frames to the angle
+ * simplifier, finished segments to the drawing and its strokes to the sender,
+ * ink to the canvas. The animation loop runs only while a pointer is down, and
+ * each frame costs the same however much has been drawn.
+ */
+import { Drawing, type DrawnSegment, type PointerKind } from "../drawing";
+import { newDrawingId } from "../drawing-id";
+import { FrameSampler } from "../frame-sampler";
+import type { Stroke } from "../protocol";
+import { angleParams, type Settings } from "../settings";
+import { AngleSimplifier } from "../simplify/angle";
+import type { Sample, Segment } from "../simplify/segment";
+import type { DrawingView } from "./canvas";
+import type { GridSize } from "./geometry";
+
+/** Frame work times kept for the benchmark (about ten seconds at 60 fps). */
+const FRAME_STATS_SIZE = 600;
+/** Intensities are sent with this many decimals: finer steps cannot be felt. */
+const INTENSITY_DECIMALS = 3;
+
+/** What the session needs from the page around it. */
+export interface SessionHost {
+  settings(): Settings;
+  grid(): GridSize;
+  send(stroke: Stroke): void;
+  /** A drawing started, gained a stroke, or was cleared (null). */
+  changed(drawing: Drawing | null): void;
+  /** A path ended: what waited for the pointer to lift can run. */
+  released(): void;
+}
+
+export class DrawingSession {
+  readonly #view: DrawingView;
+  readonly #host: SessionHost;
+  #drawing: Drawing | null = null;
+  #simplifier: AngleSimplifier | null = null;
+  #sampler = new FrameSampler(60);
+  #pointerKind: PointerKind = "mouse";
+  #pointer: Sample | null = null;
+  #loopRunning = false;
+  #flushScheduled = false;
+  readonly #frameWorkMs: number[] = [];
+
+  constructor(view: DrawingView, host: SessionHost) {
+    this.#view = view;
+    this.#host = host;
+  }
+
+  get drawing(): Drawing | null {
+    return this.#drawing;
+  }
+
+  /** True while a pointer is down. */
+  get pressed(): boolean {
+    return this.#sampler.pressed;
+  }
+
+  /** `readSample` is called once the drawing is chosen: its canvas converts the position. */
+  press(readSample: () => Sample, kind: PointerKind): void {
+    const settings = this.#host.settings();
+    if (this.#drawing === null || settings.clear_on_press) this.#newDrawing(settings);
+    const drawing = this.#drawing!;
+    const sample = readSample();
+    this.#pointerKind = kind;
+    this.#sampler = new FrameSampler(settings.fps);
+    drawing.beginPath(kind);
+    drawing.addSample(sample);
+    this.#pointer = sample;
+    this.#pushFrame(this.#sampler.press(sample));
+    this.#startLoop();
+  }
+
+  move(samples: readonly Sample[]): void {
+    const drawing = this.#drawing;
+    if (drawing === null || !this.#sampler.pressed) return;
+    for (const sample of samples) {
+      drawing.addSample(sample);
+      this.#sampler.hold(sample);
+    }
+    this.#pointer = samples[samples.length - 1] ?? this.#pointer;
+  }
+
+  release(sample: Sample): void {
+    const drawing = this.#drawing;
+    const simplifier = this.#simplifier;
+    if (drawing === null || simplifier === null || !this.#sampler.pressed) return;
+    drawing.addSample(sample);
+    this.#pushFrame(this.#sampler.release(sample));
+    for (const segment of simplifier.end()) this.#handleSegment(segment);
+    this.#pointer = null;
+    this.#view.flush();
+    this.#view.clearLive();
+    this.#host.released();
+  }
+
+  /** Empties the canvas; the next press starts a new drawing. Not while drawing. */
+  clear(): void {
+    if (this.#sampler.pressed) return;
+    this.#drawing = null;
+    this.#simplifier = null;
+    this.#view.setDrawing(null);
+    this.#host.changed(null);
+  }
+
+  /** The broker acknowledged `stroke`: drawn solid. */
+  acked(stroke: Stroke): void {
+    const drawing = this.#drawing;
+    if (drawing === null || stroke.drawing !== drawing.id || stroke.seq == null) return;
+    const drawn = drawing.markAcked(stroke.seq);
+    if (drawn === undefined) return;
+    this.#view.markSent(drawn);
+    this.#scheduleFlush();
+  }
+
+  /** The sleeve refused a stroke of this drawing: marked on the canvas. */
+  rejected(drawn: DrawnSegment): void {
+    this.#view.markRejected(drawn);
+    this.#scheduleFlush();
+  }
+
+  #pushFrame(frame: Sample): void {
+    this.#drawing!.addFrame(frame);
+    for (const segment of this.#simplifier!.push(frame)) this.#handleSegment(segment);
+  }
+
+  #handleSegment(segment: Segment): void {
+    const drawing = this.#drawing!;
+    const drawn = drawing.addSegment(segment, this.#intensity(segment));
+    if (drawn.stroke !== null) {
+      this.#host.send(drawn.stroke);
+      this.#host.changed(drawing);
+    }
+  }
+
+  #intensity(segment: Segment): number {
+    const { intensity, pressure_sets_intensity } = this.#host.settings();
+    if (!pressure_sets_intensity || this.#pointerKind !== "pen") return intensity;
+    const pressure = this.#drawing!.meanPressure(segment.start_ms, segment.end_ms);
+    const scale = 10 ** INTENSITY_DECIMALS;
+    return Math.round(intensity * pressure * scale) / scale;
+  }
+
+  #newDrawing(settings: Settings): void {
+    const params = angleParams(settings, this.#host.grid(), this.#view.area);
+    this.#simplifier = new AngleSimplifier(params);
+    this.#drawing = new Drawing(newDrawingId(), params);
+    this.#view.setDrawing(this.#drawing);
+    this.#host.changed(this.#drawing);
+  }
+
+  /** The animation loop runs only while a pointer is down: an idle page costs nothing. */
+  #startLoop(): void {
+    if (this.#loopRunning) return;
+    this.#loopRunning = true;
+    const step = (tMs: number): void => {
+      const started = performance.now();
+      const frame = this.#sampler.tick(tMs);
+      if (frame !== null) this.#pushFrame(frame);
+      this.#view.flush();
+      this.#view.drawLive(this.#simplifier?.lineStart ?? null, this.#pointer);
+      this.#frameWorkMs.push(performance.now() - started);
+      if (this.#frameWorkMs.length > FRAME_STATS_SIZE) this.#frameWorkMs.shift();
+      if (this.#sampler.pressed) requestAnimationFrame(step);
+      else this.#loopRunning = false;
+    };
+    requestAnimationFrame(step);
+  }
+
+  /** Ink outside a path (acknowledgements, refusals): drawn at the next frame, once. */
+  #scheduleFlush(): void {
+    if (this.#loopRunning || this.#flushScheduled) return;
+    this.#flushScheduled = true;
+    requestAnimationFrame(() => {
+      this.#flushScheduled = false;
+      this.#view.flush();
+    });
+  }
+
+  // ---- for the benchmark -------------------------------------------------------------------
+
+  /** Work done in each recent animation frame, in ms. */
+  frameWorkMs(): number[] {
+    return [...this.#frameWorkMs];
+  }
+
+  resetFrameStats(): void {
+    this.#frameWorkMs.length = 0;
+  }
+
+  /**
+   * Draws `strokes` strokes at once through the same pipeline as a pointer (a
+   * zigzag, fed frame by frame with synthetic times), into the current drawing.
+   * For the benchmark: a drawing of 10,000 strokes without drawing for minutes.
+   */
+  drawSynthetic(strokes: number): number {
+    if (this.#sampler.pressed || strokes <= 0) return this.#drawing?.strokeCount ?? 0;
+    const settings = this.#host.settings();
+    const { width_px: width, height_px: height } = this.#view.area;
+    // A zigzag between the top and bottom of the area: every corner turns far more than
+    // max_angle_deg, so every leg becomes one stroke.
+    const vertex = (i: number): [number, number] => [
+      width * (0.05 + 0.9 * ((i * 0.1373) % 1)),
+      height * (i % 2 === 0 ? 0.1 : 0.9),
+    ];
+    const legFrames = Math.max(2, settings.check_frames) * 3;
+    const periodMs = 1000 / settings.fps;
+    let t = performance.now();
+    const [x0, y0] = vertex(0);
+    this.press(() => ({ t_ms: t, x: x0, y: y0, pressure: 0.5 }), "mouse");
+    const drawing = this.#drawing!;
+    const target = drawing.strokeCount + strokes;
+    let last: Sample = { t_ms: t, x: x0, y: y0, pressure: 0.5 };
+    for (let leg = 0; drawing.strokeCount < target - 1; leg++) {
+      const [ax, ay] = vertex(leg);
+      const [bx, by] = vertex(leg + 1);
+      for (let k = 1; k <= legFrames; k++) {
+        t += periodMs;
+        last = {
+          t_ms: t,
+          x: ax + ((bx - ax) * k) / legFrames,
+          y: ay + ((by - ay) * k) / legFrames,
+          pressure: 0.5,
+        };
+        drawing.addSample(last);
+        this.#pushFrame(last);
+      }
+    }
+    this.release({ ...last, t_ms: t + periodMs });
+    return drawing.strokeCount;
+  }
+}

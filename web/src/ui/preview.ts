@@ -1,0 +1,128 @@
+/**
+ * The sleeve, live: one circle per actuator that glows with the intensity the
+ * sleeve's `actuators` telemetry reports, so the sender sees what the wearer
+ * feels, when they feel it. Redrawn at most once per animation frame.
+ */
+import type { ActuatorFrame } from "../telemetry";
+import type { GridSize } from "./geometry";
+
+/** Below this an actuator counts as off (telemetry rounding, a motor spinning down). */
+const LIT_THRESHOLD = 0.02;
+const GLOW = "255, 138, 91";
+
+export class SleevePreview {
+  readonly #canvas: HTMLCanvasElement;
+  readonly #caption: HTMLElement;
+  readonly #ctx: CanvasRenderingContext2D;
+  #grid: GridSize = { rows: 3, columns: 4 };
+  #frame: ActuatorFrame | null = null;
+  #scheduled = false;
+  #framesSeen = 0;
+
+  constructor(canvas: HTMLCanvasElement, caption: HTMLElement) {
+    this.#canvas = canvas;
+    this.#caption = caption;
+    const ctx = canvas.getContext("2d");
+    if (ctx === null) throw new Error("This browser cannot draw on a canvas (no 2D context).");
+    this.#ctx = ctx;
+    new ResizeObserver(() => this.#schedule()).observe(canvas);
+    this.#schedule();
+  }
+
+  /** The grid to show while no telemetry has arrived (the sleeve's status, or the settings). */
+  setGrid(grid: GridSize): void {
+    if (grid.rows === this.#grid.rows && grid.columns === this.#grid.columns) return;
+    this.#grid = grid;
+    this.#canvas.style.aspectRatio = `${Math.max(grid.columns, 1)} / ${Math.max(grid.rows, 1)}`;
+    this.#schedule();
+  }
+
+  show(frame: ActuatorFrame): void {
+    this.#frame = frame;
+    this.#framesSeen++;
+    this.setGrid({ rows: frame.rows, columns: frame.columns });
+    this.#schedule();
+  }
+
+  /** The sleeve went away: nothing is felt any more. */
+  reset(message: string): void {
+    this.#frame = null;
+    this.#caption.textContent = message;
+    this.#schedule();
+  }
+
+  #schedule(): void {
+    if (this.#scheduled) return;
+    this.#scheduled = true;
+    requestAnimationFrame(() => {
+      this.#scheduled = false;
+      this.#draw();
+    });
+  }
+
+  #draw(): void {
+    const canvas = this.#canvas;
+    const dpr = window.devicePixelRatio || 1;
+    const width = canvas.clientWidth;
+    const height = canvas.clientHeight;
+    if (width === 0 || height === 0) return;
+    if (canvas.width !== Math.round(width * dpr) || canvas.height !== Math.round(height * dpr)) {
+      canvas.width = Math.round(width * dpr);
+      canvas.height = Math.round(height * dpr);
+    }
+    const ctx = this.#ctx;
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.clearRect(0, 0, width, height);
+    const { rows, columns } = this.#grid;
+    const cell = Math.min(width / columns, height / rows);
+    const radius = cell * 0.26;
+    const left = (width - cell * columns) / 2 + cell / 2;
+    const top = (height - cell * rows) / 2 + cell / 2;
+    let lit = 0;
+    let strongest = 0;
+    for (let row = 0; row < rows; row++) {
+      for (let column = 0; column < columns; column++) {
+        const value = this.#frame?.intensities[row]?.[column] ?? 0;
+        const x = left + column * cell;
+        const y = top + row * cell;
+        if (value > LIT_THRESHOLD) {
+          lit++;
+          const glow = ctx.createRadialGradient(x, y, radius * 0.4, x, y, radius * (1.2 + 1.3 * value));
+          glow.addColorStop(0, `rgba(${GLOW}, ${0.55 * value})`);
+          glow.addColorStop(1, `rgba(${GLOW}, 0)`);
+          ctx.fillStyle = glow;
+          ctx.fillRect(x - cell / 2, y - cell / 2, cell, cell);
+        }
+        strongest = Math.max(strongest, value);
+        ctx.beginPath();
+        ctx.arc(x, y, radius, 0, 2 * Math.PI);
+        ctx.fillStyle =
+          value > LIT_THRESHOLD ? `rgba(${GLOW}, ${0.25 + 0.75 * value})` : "rgba(143, 160, 178, 0.10)";
+        ctx.fill();
+        ctx.lineWidth = 1.5;
+        ctx.strokeStyle =
+          value > LIT_THRESHOLD ? `rgba(255, 200, 170, ${0.5 + 0.5 * value})` : "rgba(143, 160, 178, 0.35)";
+        ctx.stroke();
+      }
+    }
+    // For tests and assistive tech: how many actuators are on, and the strongest intensity.
+    canvas.dataset["lit"] = String(lit);
+    canvas.dataset["maxIntensity"] = strongest.toFixed(3);
+    canvas.setAttribute(
+      "aria-label",
+      lit === 0
+        ? "Sleeve preview: all actuators off"
+        : `Sleeve preview: ${lit} actuator(s) on, strongest ${Math.round(strongest * 100)}%`,
+    );
+    if (this.#frame !== null) {
+      this.#caption.textContent =
+        lit === 0
+          ? `${rows} × ${columns} actuators · all still`
+          : `${rows} × ${columns} actuators · ${lit} vibrating`;
+    }
+  }
+
+  get framesSeen(): number {
+    return this.#framesSeen;
+  }
+}

@@ -1,0 +1,303 @@
+/**
+ * The settings panel: a slide-over sheet (a full screen on phones) built from
+ * the settings' field table, so every field shows its help, unit and allowed
+ * range, and an inline error naming that range as soon as a value is wrong.
+ * Save is possible only when every field is valid; Reset fills in the defaults.
+ */
+import type { ServerConfig } from "../config";
+import {
+  FIELDS,
+  defaultSettings,
+  validateSettings,
+  type FieldSpec,
+  type SettingKey,
+  type Settings,
+} from "../settings";
+import type { GridSize } from "./geometry";
+import { byId } from "./status";
+
+const SECTIONS: readonly { id: FieldSpec["section"]; title: string; note?: string }[] = [
+  { id: "drawing", title: "Drawing" },
+  {
+    id: "simplifier",
+    title: "Simplifier",
+    note: "How a drawing is cut into straight strokes: the parameters of the paper's appendix B.1.",
+  },
+  { id: "sleeve", title: "Sleeve" },
+  { id: "connection", title: "Connection" },
+];
+
+type Candidate = Record<SettingKey, unknown>;
+
+export interface SettingsPanelContext {
+  readonly config: ServerConfig | null;
+  /** The grid the sleeve reports, for the "From the sleeve" choice. */
+  readonly sleeveGrid: GridSize | null;
+}
+
+export class SettingsPanel {
+  readonly #dialog: HTMLDialogElement;
+  readonly #body: HTMLElement;
+  readonly #summary: HTMLElement;
+  readonly #save: HTMLButtonElement;
+  readonly #onSave: (settings: Settings) => void;
+  readonly #inputs = new Map<SettingKey, HTMLInputElement[]>();
+  readonly #errors = new Map<SettingKey, HTMLElement>();
+  readonly #rows = new Map<SettingKey, HTMLElement>();
+  #context: SettingsPanelContext = { config: null, sleeveGrid: null };
+  /** The settings in force when the panel opened. */
+  #current: Settings = defaultSettings(null);
+  #gridNote: HTMLElement | null = null;
+  #brokerNote: HTMLElement | null = null;
+
+  constructor(root: Document, onSave: (settings: Settings) => void) {
+    this.#dialog = byId<HTMLDialogElement>(root, "settings");
+    this.#body = byId(root, "settings-body");
+    this.#summary = byId(root, "settings-summary");
+    this.#save = byId<HTMLButtonElement>(root, "settings-save");
+    this.#onSave = onSave;
+    this.#build();
+    byId(root, "settings-form").addEventListener("submit", (event) => {
+      event.preventDefault();
+      this.#submit();
+    });
+    byId(root, "settings-close").addEventListener("click", () => this.#dialog.close());
+    byId(root, "settings-cancel").addEventListener("click", () => this.#dialog.close());
+    byId(root, "settings-reset").addEventListener("click", () => {
+      this.#fill(defaultSettings(this.#context.config));
+      this.#validate();
+    });
+    // A click on the backdrop (outside the sheet) closes it, as on any slide-over.
+    this.#dialog.addEventListener("click", (event) => {
+      if (event.target === this.#dialog) this.#dialog.close();
+    });
+  }
+
+  get isOpen(): boolean {
+    return this.#dialog.open;
+  }
+
+  open(settings: Settings, context: SettingsPanelContext): void {
+    this.#context = context;
+    this.#current = settings;
+    this.#fill(settings);
+    this.#validate();
+    this.#dialog.showModal();
+  }
+
+  #build(): void {
+    for (const section of SECTIONS) {
+      const fieldset = document.createElement("fieldset");
+      const legend = document.createElement("legend");
+      legend.textContent = section.title;
+      fieldset.append(legend);
+      if (section.note !== undefined) fieldset.append(paragraph("section-note", section.note));
+      if (section.id === "sleeve") {
+        this.#gridNote = paragraph("section-note", "");
+        fieldset.append(this.#gridNote);
+      }
+      if (section.id === "connection") {
+        this.#brokerNote = paragraph("section-note", "");
+        fieldset.append(this.#brokerNote);
+      }
+      for (const field of FIELDS.filter((f) => f.section === section.id))
+        fieldset.append(this.#fieldRow(field));
+      this.#body.append(fieldset);
+    }
+  }
+
+  #fieldRow(field: FieldSpec): HTMLElement {
+    const row = document.createElement("div");
+    row.className = "field";
+    row.dataset["kind"] = field.kind;
+    row.dataset["field"] = field.key;
+    const id = `setting-${field.key}`;
+    const label = document.createElement("label");
+    label.className = "field-label";
+    label.htmlFor = field.kind === "choice" ? `${id}-0` : id;
+    label.textContent = field.label;
+    const control = document.createElement("div");
+    control.className = "field-control";
+    const inputs: HTMLInputElement[] = [];
+    if (field.kind === "boolean") {
+      const wrap = document.createElement("span");
+      wrap.className = "switch";
+      const input = document.createElement("input");
+      input.type = "checkbox";
+      input.id = id;
+      input.setAttribute("role", "switch");
+      const track = document.createElement("span");
+      track.className = "track";
+      wrap.append(input, track);
+      control.append(wrap);
+      inputs.push(input);
+    } else if (field.kind === "choice") {
+      const group = document.createElement("span");
+      group.className = "segmented";
+      group.setAttribute("role", "radiogroup");
+      group.setAttribute("aria-label", field.label);
+      (field.choices ?? []).forEach((choice, index) => {
+        const option = document.createElement("label");
+        const input = document.createElement("input");
+        input.type = "radio";
+        input.name = id;
+        input.id = `${id}-${index}`;
+        input.value = choice.value;
+        option.append(input, choice.label);
+        group.append(option);
+        inputs.push(input);
+      });
+      control.append(group);
+    } else {
+      const input = document.createElement("input");
+      input.id = id;
+      input.name = field.key;
+      input.type = field.kind === "password" ? "password" : "text";
+      input.autocomplete = "off";
+      input.spellcheck = false;
+      if (field.kind === "integer") input.inputMode = "numeric";
+      if (field.kind === "number") input.inputMode = "decimal";
+      control.append(input);
+      // Every number gets a unit column, empty or not, so the inputs line up.
+      if (field.kind === "integer" || field.kind === "number")
+        control.append(paragraph("unit", field.unit ?? "", "span"));
+      inputs.push(input);
+    }
+    const help = paragraph("field-help", helpText(field), "span");
+    help.id = `${id}-help`;
+    const error = paragraph("field-error", "", "span");
+    error.id = `${id}-error`;
+    error.setAttribute("role", "alert");
+    for (const input of inputs) {
+      input.dataset["testid"] = `setting-${field.key}`;
+      input.setAttribute("aria-describedby", `${help.id} ${error.id}`);
+      input.addEventListener("input", () => this.#validate());
+      input.addEventListener("change", () => this.#validate());
+    }
+    row.append(label, control, help, error);
+    this.#inputs.set(field.key, inputs);
+    this.#errors.set(field.key, error);
+    this.#rows.set(field.key, row);
+    return row;
+  }
+
+  #fill(settings: Settings): void {
+    for (const field of FIELDS) {
+      const inputs = this.#inputs.get(field.key) ?? [];
+      const value = settings[field.key];
+      for (const input of inputs) {
+        if (field.kind === "boolean") input.checked = value === true;
+        else if (field.kind === "choice") input.checked = input.value === value;
+        else input.value = String(value);
+      }
+    }
+  }
+
+  /** The form's values, typed as the settings expect (numbers stay NaN when unreadable). */
+  #read(): Candidate {
+    const candidate: Partial<Candidate> = {};
+    for (const field of FIELDS) {
+      const inputs = this.#inputs.get(field.key) ?? [];
+      const first = inputs[0];
+      let value: unknown;
+      if (field.kind === "boolean") value = first?.checked ?? false;
+      else if (field.kind === "choice") value = inputs.find((input) => input.checked)?.value ?? null;
+      else if (field.kind === "integer" || field.kind === "number") value = parseNumber(first?.value ?? "");
+      else value = first?.value ?? "";
+      candidate[field.key] = value;
+    }
+    return candidate as Candidate;
+  }
+
+  #validate(): { candidate: Candidate; valid: boolean } {
+    const candidate = this.#read();
+    const errors = validateSettings(candidate);
+    this.#applyDependencies(candidate);
+    let count = 0;
+    for (const field of FIELDS) {
+      const message = this.#isDisabled(field.key, candidate) ? undefined : errors[field.key];
+      const error = this.#errors.get(field.key);
+      if (error) error.textContent = message ?? "";
+      for (const input of this.#inputs.get(field.key) ?? []) {
+        input.setAttribute("aria-invalid", message ? "true" : "false");
+      }
+      if (message) count++;
+    }
+    this.#summary.textContent = count === 0 ? "" : `Fix ${count} field${count === 1 ? "" : "s"} to save.`;
+    this.#save.disabled = count > 0;
+    return { candidate, valid: count === 0 };
+  }
+
+  /** Fields that do not apply (grid from the sleeve, the server's broker) are shown but locked. */
+  #isDisabled(key: SettingKey, candidate: Candidate): boolean {
+    if (key === "rows" || key === "columns") return candidate.grid_source === "status";
+    if (key === "ws_url" || key === "username" || key === "password") {
+      return this.#context.config !== null && candidate.broker_custom !== true;
+    }
+    if (key === "legacy_topic") return candidate.protocol !== "legacy";
+    return false;
+  }
+
+  #applyDependencies(candidate: Candidate): void {
+    for (const key of ["rows", "columns", "ws_url", "username", "password", "legacy_topic"] as const) {
+      const disabled = this.#isDisabled(key, candidate);
+      this.#rows.get(key)!.dataset["disabled"] = String(disabled);
+      for (const input of this.#inputs.get(key) ?? []) input.disabled = disabled;
+    }
+    const { config, sleeveGrid } = this.#context;
+    const customRow = this.#rows.get("broker_custom");
+    if (customRow) customRow.hidden = config === null;
+    if (this.#brokerNote) {
+      this.#brokerNote.textContent =
+        config === null
+          ? "This page was not given a broker by its server (no /config.json, e.g. under 'vite dev'): enter one here."
+          : candidate.broker_custom === true
+            ? "Using the broker below instead of the server's."
+            : `Using the server's broker, ${config.ws_url}, as ${config.username}.`;
+    }
+    if (this.#gridNote) {
+      this.#gridNote.textContent =
+        sleeveGrid === null
+          ? "The sleeve has not reported its grid yet; until it does, rows and columns below are used."
+          : `The sleeve reports ${sleeveGrid.rows} rows × ${sleeveGrid.columns} columns.`;
+    }
+  }
+
+  #submit(): void {
+    const { candidate, valid } = this.#validate();
+    if (!valid) return;
+    // A locked field may hold a value left half typed; it keeps its last valid value instead.
+    const errors = validateSettings(candidate);
+    const saved: Record<string, unknown> = { ...this.#current };
+    for (const field of FIELDS) {
+      if (errors[field.key] === undefined) saved[field.key] = candidate[field.key];
+    }
+    this.#onSave(saved as unknown as Settings);
+    this.#dialog.close();
+  }
+}
+
+function helpText(field: FieldSpec): string {
+  if (field.minimum !== undefined && field.maximum !== undefined) {
+    const unit = field.unit !== undefined && field.unit !== "°" ? ` ${field.unit}` : (field.unit ?? "");
+    return `${capitalize(field.help)} · ${field.minimum} to ${field.maximum}${unit}`;
+  }
+  return capitalize(field.help);
+}
+
+function capitalize(text: string): string {
+  return text.charAt(0).toUpperCase() + text.slice(1);
+}
+
+/** A number as typed: "" and anything unreadable give NaN, which the field reports. */
+function parseNumber(text: string): number {
+  const trimmed = text.trim().replace(",", ".");
+  return trimmed === "" ? Number.NaN : Number(trimmed);
+}
+
+function paragraph(className: string, text: string, tag: "p" | "span" = "p"): HTMLElement {
+  const element = document.createElement(tag);
+  element.className = className;
+  element.textContent = text;
+  return element;
+}
