@@ -220,7 +220,7 @@ def test_buzz_caps_intensity_and_on_time_at_the_layout_s(
     layout = tmp_path / "gentle.toml"
     layout.write_text(
         'name = "gentle"\nrows = 2\ncolumns = 2\nspacing_cm = 3.0\ndefault_intensity = 0.3\n'
-        "[safety]\nmax_intensity = 0.5\nmax_on_time_ms = 15\n"
+        "[safety]\nmax_intensity = 0.5\nmax_stroke_duration_ms = 15\nmax_on_time_ms = 15\n"
     )
     argv = ["buzz", "0", "1", "--backend", "sim", "--layout", str(layout)]
     assert main([*argv, "--intensity", "0.9", "--duration-ms", "60000"]) == 0

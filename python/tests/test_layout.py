@@ -348,3 +348,13 @@ def test_a_repeated_channel_is_named(
     assert any(
         "is already used by" in p and f"i2c.wiring[{max(first, second)}]" in p for p in problems
     )
+
+
+def test_on_time_cap_below_the_longest_stroke_is_refused() -> None:
+    text = (
+        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\n"
+        "[safety]\nmax_stroke_duration_ms = 10000\nmax_on_time_ms = 5000\n"
+    )
+    with pytest.raises(LayoutError) as error:
+        parse_layout(text)
+    assert any("max_on_time_ms" in p and "cut off" in p for p in error.value.problems)

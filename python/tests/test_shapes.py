@@ -29,7 +29,9 @@ def cases(draw: st.DrawFn) -> tuple[str, int, Layout, float]:
     rows = draw(st.integers(1 if name == "line" else 2, 12))
     columns = draw(st.integers(2, 12))
     spacing_cm = draw(st.floats(0.5, 5.0))
-    layout = grid_layout(rows, columns, spacing_cm, max_stroke_duration_ms=60_000)
+    layout = grid_layout(
+        rows, columns, spacing_cm, max_stroke_duration_ms=60_000, max_on_time_ms=60_000
+    )
     smaller_span = min(columns - 1, rows - 1) if name != "line" else columns - 1
     margin = draw(st.floats(0.0, smaller_span / 2 * 0.9))
     return name, segments, layout, margin

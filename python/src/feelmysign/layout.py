@@ -12,7 +12,7 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     [safety]
     max_intensity = 1.0           # no actuator is driven above this, 0..1
     max_stroke_duration_ms = 10000
-    max_on_time_ms = 5000         # longest continuous on-time of one actuator
+    max_on_time_ms = 15000        # longest continuous on-time of one actuator
 
     [i2c]
     bus = 1                       # /dev/i2c-1
@@ -84,7 +84,10 @@ class Layout:
     default_intensity: float = 1.0
     max_intensity: float = 1.0
     max_stroke_duration_ms: float = 10_000.0
-    max_on_time_ms: float = 5_000.0
+    # Longer than the longest stroke: a slow legal stroke keeps its bursts on for up
+    # to about 0.76 of its duration, and the next stroke of a drawing often takes
+    # over the same motor, so only a stuck or pathological stream reaches this.
+    max_on_time_ms: float = 15_000.0
     actuator_type: ActuatorType = "ERM"
     i2c_bus: int = 1
     multiplexers: tuple[int, ...] = ()
@@ -222,6 +225,13 @@ def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
     for key in ("max_stroke_duration_ms", "max_on_time_ms"):
         value = safety.get(key, getattr(_DEFAULTS, key))
         caps[key] = problems.number(f"safety.{key}", value, MAX_DURATION_MS)
+    longest, on_time = caps["max_stroke_duration_ms"], caps["max_on_time_ms"]
+    if longest is not None and on_time is not None and on_time < longest:
+        problems.add(
+            "safety.max_on_time_ms",
+            f"{on_time:g} is below safety.max_stroke_duration_ms {longest:g}: a slow stroke the "
+            "sleeve accepts would be cut off mid-way; raise it or lower the longest stroke",
+        )
     default, cap = caps["default_intensity"], caps["max_intensity"]
     if default is not None and cap is not None and default > cap:
         problems.add(

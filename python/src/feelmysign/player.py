@@ -20,6 +20,7 @@ each write's lateness is kept for ``timing_errors_ms``.
 from __future__ import annotations
 
 import logging
+import sys
 import threading
 import time
 from collections import OrderedDict, deque
@@ -35,6 +36,10 @@ from feelmysign.timeline import Change, Timeline
 log = logging.getLogger(__name__)
 
 SPIN_MS = 0.5  # spin, not sleep, for the last half millisecond: sleep wakes up late
+# A thread woken by another waits for the interpreter lock until the running
+# thread blocks or this interval passes (5 ms by default): far too long when a
+# stroke's first command should follow its message within a millisecond.
+SWITCH_INTERVAL_S = 0.0002
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
 MAX_PENDING = 256
 MAX_BACKLOG_MS = 30_000.0
@@ -147,6 +152,7 @@ class Player:
         return None
 
     def start(self) -> None:
+        sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL_S))
         self._backend.open()
         self._running = True
         self._thread = threading.Thread(target=self._run, name="feelmysign-player", daemon=True)

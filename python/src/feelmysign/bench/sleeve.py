@@ -12,12 +12,15 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import signal
 import statistics
+import subprocess
+import sys
 import tempfile
 import threading
 import time
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -86,8 +89,13 @@ def _client(
     return client
 
 
-def bare_latency_ms(c: Credentials, count: int = 300) -> list[float]:
-    """Publish -> receive on the same broker, sender to sleeve account, QoS 1."""
+def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = 0.12) -> list[float]:
+    """Publish -> receive on the same broker, sender to sleeve account, QoS 1.
+
+    Paced like the strokes measured against it (one, then a pause as long as a
+    short stroke): back to back, every thread stays awake and the figure halves,
+    which would flatter the baseline.
+    """
     inbox = _Inbox()
     receiver = _client(c, "sleeve", inbox, topic(c.sleeve_id, "strokes"))
     sender = _client(c, "sender")
@@ -96,6 +104,7 @@ def bare_latency_ms(c: Credentials, count: int = 300) -> list[float]:
         sent.append(time.time_ns() / 1e6)
         sender.publish(topic(c.sleeve_id, "strokes"), b"bench", qos=1)
         inbox.wait(k + 1)
+        time.sleep(pause_s)
     received = inbox.wait(count)
     for client in (receiver, sender):
         client.loop_stop()
@@ -120,7 +129,7 @@ def _sleeve(c: Credentials) -> Iterator[Sleeve]:
 
 
 def stroke_latencies(
-    c: Credentials, sleeve: Sleeve, shape: Any, count: int
+    c: Credentials, is_idle: Callable[[], bool], shape: Any, count: int
 ) -> list[dict[str, Any]]:
     """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event."""
     inbox = _Inbox()
@@ -136,12 +145,47 @@ def stroke_latencies(
         event = json.loads(payload)
         event["published_at_ms"] = published_ms
         results.append(event)
-        while not sleeve.player.idle:
+        time.sleep(event["duration_ms"] / 1000)
+        while not is_idle():
             time.sleep(0.005)
     for client in (watcher, sender):
         client.loop_stop()
         client.disconnect()
     return results
+
+
+@contextmanager
+def _sleeve_process(c: Credentials, credentials_path: Path) -> Iterator[Callable[[], bool]]:
+    """``feelmysign sleeve`` in a process of its own, as on the Pi; yields an idle check."""
+    inbox = _Inbox()
+    watcher = _client(c, "sender", inbox, topic(c.sleeve_id, "status"))
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "feelmysign",
+            "sleeve",
+            "--credentials",
+            str(credentials_path),
+            "--rate-per-s",
+            "10000",
+            "--log-level",
+            "warning",
+        ],
+        stdout=subprocess.DEVNULL,
+    )
+    try:
+        deadline = time.monotonic() + 20
+        while not any(json.loads(p).get("online") for _, p in inbox.items):
+            if time.monotonic() > deadline or process.poll() is not None:
+                raise RuntimeError("the sleeve process did not come online")
+            time.sleep(0.05)
+        yield lambda: True  # strokes are paced by their duration (see stroke_latencies)
+    finally:
+        process.send_signal(signal.SIGTERM)
+        process.wait(10)
+        watcher.loop_stop()
+        watcher.disconnect()
 
 
 def drawing_gaps(c: Credentials, shape: Any, strokes: int = 20) -> list[float]:
@@ -185,26 +229,36 @@ def report() -> list[str]:
     ):
         c = broker.credentials
         bare = bare_latency_ms(c)
-        lines.append(_figures("baseline: bare MQTT publish -> receive", bare))
-        with _sleeve(c) as sleeve:
-            stroke_latencies(c, sleeve, SHORT, 5)  # warm-up: first-use costs are not latency
+        lines.append(_figures("baseline: bare MQTT publish -> receive (paced)", bare))
+        lines.append("  the sleeve in a process of its own:")
+        with _sleeve_process(c, broker.credentials_path) as is_idle:
+            stroke_latencies(c, is_idle, SHORT, 5)  # warm-up: first-use costs are not latency
             for label, shape, count in (("1 cm", SHORT, 100), ("10 cm", LONG, 30)):
-                sleeve.player.timing_errors_ms.clear()
-                events = stroke_latencies(c, sleeve, shape, count)
+                events = stroke_latencies(c, is_idle, shape, count)
                 end_to_end = [e["first_command_at_ms"] - e["published_at_ms"] for e in events]
-                own = [e["latency_ms"] for e in events]
                 ratio = percentile(end_to_end, 99) / percentile(bare, 99)
                 lines.append(
                     _figures(f"{label}: publish -> first actuator command", end_to_end)
                     + f"   {ratio:.2f}x baseline p99"
                 )
-                lines.append(_figures(f"{label}: sleeve's share (receive -> first command)", own))
+                lines.append(
+                    _figures(
+                        f"{label}: sleeve's share (receive -> first command)",
+                        [e["latency_ms"] for e in events],
+                    )
+                )
+                lines.append(
+                    _figures(f"{label}: gap between strokes of a drawing", drawing_gaps(c, shape))
+                )
+        lines.append("  the sleeve in this process (for the player's write times):")
+        with _sleeve(c) as sleeve:
+            for label, shape in (("1 cm", SHORT), ("10 cm", LONG)):
+                sleeve.player.timing_errors_ms.clear()
+                drawing_gaps(c, shape)
                 lines.append(
                     _figures(
                         f"{label}: actuator write vs plan (lateness)",
                         list(sleeve.player.timing_errors_ms),
                     )
                 )
-                gaps = drawing_gaps(c, shape)
-                lines.append(_figures(f"{label}: gap between strokes of a drawing", gaps))
     return lines
