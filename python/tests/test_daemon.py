@@ -296,3 +296,33 @@ def _wait_quiet(running: Running) -> None:
             return
         deadline.wait(0.01)
     raise AssertionError("the sleeve kept playing")
+
+
+def test_a_retained_stroke_is_not_played_again_and_again(broker: Broker) -> None:
+    sender = _sender(broker.credentials)
+    sender.publish(LEGACY, "0,0,1,0,100", qos=1, retain=True).wait_for_publish(5)
+    running = Running(broker.credentials)  # subscribes after: the broker replays the retained one
+    try:
+        (event,) = running.wait_events(1)
+        assert event["type"] == "rejected" and event["reason"] == "retained"
+    finally:
+        sender.publish(LEGACY, b"", qos=1, retain=True).wait_for_publish(5)  # clear it
+        sender.loop_stop()
+        running.stop()
+
+
+def test_strokes_still_waiting_at_stop_are_reported(broker: Broker) -> None:
+    running = Running(broker.credentials)
+    sender = _sender(broker.credentials)
+    sid = broker.credentials.sleeve_id
+    for seq in range(3):
+        stroke = Stroke((0.0, 0.0), (3.0, 0.0), 3000.0, None, "long", seq)
+        sender.publish(topic(sid, "strokes"), format_json(stroke), qos=1).wait_for_publish(5)
+    running.wait_events(1)
+    running.sleeve.stop()
+    running.thread.join(10)
+    events = running.wait_events(3)  # the watcher is still listening: nothing is lost
+    running.stop()
+    sender.loop_stop()
+    reasons = [e.get("reason") for e in events if e["type"] == "rejected"]
+    assert reasons.count("stopped") == 2

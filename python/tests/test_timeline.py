@@ -12,7 +12,7 @@ from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.schedule import Command, Schedule
 from feelmysign.stroke import Stroke
-from feelmysign.timeline import Change, Timeline
+from feelmysign.timeline import MIN_REST_MS, Change, Timeline
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 
@@ -130,3 +130,29 @@ def test_an_ended_stroke_leaves_nothing_planned() -> None:
     timeline.add(_schedule(Command(0, 0, 0, 100, 0.5)), 0.0)
     _drain(timeline)
     assert timeline.next_ms() is None and not timeline.busy
+
+
+def test_short_gaps_do_not_reset_the_on_time_cap() -> None:
+    short = Layout(rows=3, columns=4, spacing_cm=3.0, max_on_time_ms=1000)
+    timeline = Timeline(short)
+    for k in range(6):  # 400 ms on, 1 ms off: the motor never rests
+        timeline.add(_schedule(Command(1, 1, 0, 400, 0.7), duration_ms=400), k * 401.0)
+    tripped: list[tuple[int, int]] = []
+    ons: list[float] = []
+    while (t := timeline.next_ms()) is not None:
+        due = timeline.pop_due(t)
+        tripped += due.tripped
+        ons += [c.t_ms for c in due.changes if c.intensity > 0]
+    assert tripped and tripped[0] == (1, 1)
+    # Cut at its 1000 ms budget, the motor stays off until it has rested.
+    assert all(t < 1000.0 or t >= 1000.0 + MIN_REST_MS for t in ons)
+    assert ons[-1] == 5 * 401.0
+
+
+def test_a_real_rest_restores_the_budget() -> None:
+    short = Layout(rows=3, columns=4, spacing_cm=3.0, max_on_time_ms=1000)
+    timeline = Timeline(short)
+    timeline.add(_schedule(Command(1, 1, 0, 900, 0.7), duration_ms=900), 0.0)
+    timeline.add(_schedule(Command(1, 1, 0, 900, 0.7), duration_ms=900), 900.0 + MIN_REST_MS)
+    changes = _drain(timeline)
+    assert [c.intensity for c in changes] == [0.7, 0.0, 0.7, 0.0]

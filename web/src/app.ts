@@ -1,6 +1,6 @@
 /**
  * The drawing client, put together: pointer samples -> animation frames ->
- * the angle simplifier -> strokes -> MQTT, and the sleeve's telemetry back to
+ * the chosen simplifier -> strokes -> MQTT, and the sleeve's telemetry back to
  * the status bar, the canvas and the preview. The algorithms live in pure
  * modules; this class only wires them to the page.
  */
@@ -21,6 +21,9 @@ import { byId, StatusBar } from "./ui/status";
 
 /** Settings that change how a drawing is cut or mapped: changing one starts a new drawing. */
 const DRAWING_KEYS: readonly SettingKey[] = [
+  "algorithm",
+  "max_error",
+  "max_window",
   "check_frames",
   "max_angle_deg",
   "frame_max",

@@ -6,6 +6,7 @@
  */
 import type { Stroke } from "./protocol";
 import type { AngleParams } from "./simplify/params";
+import type { WindowParams } from "./simplify/window-params";
 import type { Sample, Segment } from "./simplify/segment";
 
 export type PointerKind = "mouse" | "pen" | "touch";
@@ -22,7 +23,7 @@ export interface DrawnSegment {
 export class Drawing {
   readonly id: string;
   /** The parameters every path of this drawing is simplified with (canvas size included). */
-  readonly params: AngleParams;
+  readonly params: AngleParams | WindowParams;
   /** Pointer samples per path, as the pointer events reported them (the recording). */
   readonly paths: Sample[][] = [];
   /** The animation frames fed to the simplifier, per path. */
@@ -33,7 +34,7 @@ export class Drawing {
   readonly #acked = new Set<number>();
   #nextSeq = 0;
 
-  constructor(id: string, params: AngleParams) {
+  constructor(id: string, params: AngleParams | WindowParams) {
     this.id = id;
     this.params = params;
   }

@@ -7,6 +7,7 @@
  * Times start at 0 at the drawing's first sample.
  */
 import type { Drawing } from "./drawing";
+import { algorithmOf, type Algorithm } from "./simplify/replay";
 import type { Sample } from "./simplify/segment";
 
 export interface RecordedSample {
@@ -29,7 +30,7 @@ export interface Recording {
   readonly canvas: { readonly width_px: number; readonly height_px: number };
   readonly paths: RecordedSample[][];
   readonly sleeve: { readonly rows: number; readonly columns: number };
-  readonly simplifier: { readonly algorithm: "angle"; readonly params: Record<string, number | boolean> };
+  readonly simplifier: { readonly algorithm: Algorithm; readonly params: Record<string, number | boolean> };
   readonly drawing: string;
   readonly recorded_at: string;
   readonly frames: RecordedSample[][];
@@ -38,17 +39,7 @@ export interface Recording {
 }
 
 /** The parameters a recording keeps: the sender's, without the canvas and grid (kept beside them). */
-const RECORDED_PARAMS = [
-  "check_frames",
-  "max_angle_deg",
-  "frame_max",
-  "fps",
-  "recover",
-  "clear_on_press",
-  "min_duration_ms",
-  "min_length",
-  "stretch",
-] as const;
+const NOT_RECORDED: ReadonlySet<string> = new Set(["rows", "columns", "canvas_width_px", "canvas_height_px"]);
 
 export function buildRecording(drawing: Drawing, recordedAt: Date): Recording {
   const origin = drawing.paths[0]?.[0]?.t_ms ?? 0;
@@ -82,8 +73,8 @@ export function buildRecording(drawing: Drawing, recordedAt: Date): Recording {
     paths: drawing.paths.filter((path) => path.length > 0).map((path) => path.map(shift)),
     sleeve: { rows: params.rows, columns: params.columns },
     simplifier: {
-      algorithm: "angle",
-      params: Object.fromEntries(RECORDED_PARAMS.map((name) => [name, params[name]])),
+      algorithm: algorithmOf(params),
+      params: Object.fromEntries(Object.entries(params).filter(([name]) => !NOT_RECORDED.has(name))),
     },
     drawing: drawing.id,
     recorded_at: recordedAt.toISOString(),

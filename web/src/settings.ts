@@ -1,17 +1,30 @@
 /**
  * The sender's settings: every parameter of the paper's appendix B.1, the
  * sleeve, the intensity, the wire format and the broker. One table of fields
- * drives validation and the settings panel; the simplifier's fields take their
- * defaults and ranges from `testdata/angle/params.json` (the Python table),
- * so both sides accept exactly the same values. Pure: storage is passed in.
+ * drives validation and the settings panel; the simplifiers' fields take their
+ * defaults and ranges from `testdata/angle/params.json` and
+ * `testdata/window/params.json` (the Python tables), so both sides accept
+ * exactly the same values. Pure: storage is passed in.
  */
 import type { ServerConfig } from "./config";
-import { paramProblem, paramSpec, type AngleParamName, type AngleParams } from "./simplify/params";
+import {
+  paramProblem,
+  paramSpec,
+  type AngleParamName,
+  type AngleParams,
+  type ParamSpec,
+} from "./simplify/params";
+import type { Algorithm } from "./simplify/replay";
+import { windowParamSpec, type WindowParamName, type WindowParams } from "./simplify/window-params";
 
 export type WireProtocol = "json" | "legacy";
 export type GridSource = "status" | "manual";
 
 export interface Settings {
+  /** The simplifier: the paper's angle rule, or the error-bounded window. */
+  readonly algorithm: Algorithm;
+  readonly max_error: number;
+  readonly max_window: number;
   readonly check_frames: number;
   readonly max_angle_deg: number;
   readonly frame_max: number;
@@ -65,7 +78,20 @@ function paramField(
   label: string,
   unit?: string,
 ): FieldSpec {
-  const spec = paramSpec(name);
+  return specField(paramSpec(name), section, label, unit);
+}
+
+function windowField(name: WindowParamName, label: string, unit?: string): FieldSpec {
+  return specField(windowParamSpec(name), "simplifier", label, unit);
+}
+
+function specField(
+  spec: ParamSpec<string>,
+  section: FieldSpec["section"],
+  label: string,
+  unit?: string,
+): FieldSpec {
+  const name = spec.name;
   const kind: FieldKind = spec.type === "boolean" ? "boolean" : spec.type;
   return {
     key: name as SettingKey,
@@ -114,6 +140,20 @@ export const FIELDS: readonly FieldSpec[] = [
     "Pen pressure sets intensity",
     "with a pen, pressing fully gives the intensity above and lighter presses less (mouse and touch report no real pressure)",
   ),
+  {
+    key: "algorithm",
+    section: "simplifier",
+    label: "Simplifier",
+    help: "angle: the paper's turn rule; window: every drawn point within the max error of its stroke",
+    kind: "choice",
+    choices: [
+      { value: "angle", label: "Angle (paper)" },
+      { value: "window", label: "Window (error-bounded)" },
+    ],
+    problem: (value) => (value === "angle" || value === "window" ? null : "must be a listed choice"),
+  },
+  windowField("max_error", "Max error", "grid units"),
+  windowField("max_window", "Window cap", "frames"),
   paramField("check_frames", "simplifier", "Check frames", "frames"),
   paramField("max_angle_deg", "simplifier", "Max angle", "°"),
   paramField("frame_max", "simplifier", "Frame max", "frames"),
@@ -232,6 +272,9 @@ function paramDefault<T extends number | boolean>(name: AngleParamName): T {
 }
 
 export const DEFAULT_SETTINGS: Settings = Object.freeze({
+  algorithm: "angle",
+  max_error: windowParamSpec("max_error").default as number,
+  max_window: windowParamSpec("max_window").default as number,
   check_frames: paramDefault<number>("check_frames"),
   max_angle_deg: paramDefault<number>("max_angle_deg"),
   frame_max: paramDefault<number>("frame_max"),
@@ -352,4 +395,36 @@ export function angleParams(
     canvas_height_px: canvas.height_px,
     stretch: settings.stretch,
   };
+}
+
+/** The window simplifier's parameters for a drawing area of this size on this grid. */
+export function windowParams(
+  settings: Settings,
+  grid: { readonly rows: number; readonly columns: number },
+  canvas: { readonly width_px: number; readonly height_px: number },
+): WindowParams {
+  return {
+    max_error: settings.max_error,
+    max_window: settings.max_window,
+    fps: settings.fps,
+    clear_on_press: settings.clear_on_press,
+    min_duration_ms: settings.min_duration_ms,
+    min_length: settings.min_length,
+    rows: grid.rows,
+    columns: grid.columns,
+    canvas_width_px: canvas.width_px,
+    canvas_height_px: canvas.height_px,
+    stretch: settings.stretch,
+  };
+}
+
+/** The chosen simplifier's parameters (their shape says which one: see `makeSimplifier`). */
+export function simplifierParams(
+  settings: Settings,
+  grid: { readonly rows: number; readonly columns: number },
+  canvas: { readonly width_px: number; readonly height_px: number },
+): AngleParams | WindowParams {
+  return settings.algorithm === "window"
+    ? windowParams(settings, grid, canvas)
+    : angleParams(settings, grid, canvas);
 }

@@ -35,14 +35,16 @@ from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.errors import FeelMySignError, StrokeError
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
-from feelmysign.player import PlannedStroke, Player, monotonic_ms, wall_ms
+from feelmysign.player import MAX_PENDING, PlannedStroke, Player, monotonic_ms, wall_ms
 from feelmysign.protocol import Accepted, parse
 
 log = logging.getLogger(__name__)
 
 LEGACY_TOPIC = "deviceOne/line"  # the paper's sleeve (appendix A.2)
 RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
-BURST = 60  # strokes accepted at once (a drawing queued offline and sent on reconnect)
+# Strokes accepted at once: as many as the player may hold, so that a drawing
+# the broker kept for a sleeve that was away is not rate-limited on its return.
+BURST = MAX_PENDING
 KEEPALIVE_S = 15
 RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
 
@@ -104,6 +106,7 @@ class Sleeve:
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
         self.counts: Counter[str] = Counter()
+        self._counts_lock = threading.Lock()  # counted from the network and player threads
         self._client = self._make_client()
 
     @property
@@ -131,15 +134,27 @@ class Sleeve:
             if self._fatal is not None:
                 raise self._fatal
         finally:
-            self._shutdown()
-            self._outbox.put(None)
-            publisher.join(timeout=2.0)
+            self._shutdown(publisher)
 
     def stop(self) -> None:
         self._stopped.set()
 
-    def _shutdown(self) -> None:
-        self._player.stop()  # motors off first, whatever happens to the network
+    def _shutdown(self, publisher: threading.Thread) -> None:
+        try:
+            unplayed = self._player.stop()  # motors off first, whatever happens to the network
+            for stroke in unplayed:
+                self._reject(
+                    "stopped",
+                    "the sleeve stopped before this stroke could play",
+                    stroke.info,
+                    stroke.received_wall_ms,
+                )
+        finally:
+            self._outbox.put(None)  # the events still queued go out before the goodbye
+            publisher.join(timeout=5.0)
+            self._say_goodbye()
+
+    def _say_goodbye(self) -> None:
         try:
             if self._client.is_connected():
                 info = self._client.publish(
@@ -161,7 +176,9 @@ class Sleeve:
         client.will_set(topic(self._id, "status"), self._status(online=False), qos=1, retain=True)
         client.reconnect_delay_set(RECONNECT_MIN_S, RECONNECT_MAX_S)
         client.on_connect = self._on_connect
+        client.on_connect_fail = self._on_connect_fail
         client.on_disconnect = self._on_disconnect
+        client.on_subscribe = self._on_subscribe
         client.on_message = self._on_message
         return client
 
@@ -188,6 +205,35 @@ class Sleeve:
         session = "resumed" if getattr(flags, "session_present", False) else "new"
         log.info("sleeve %s: connected to %s (%s session)", self._id, self._settings.url, session)
 
+    def _on_connect_fail(self, client: mqtt.Client, userdata: Any) -> None:
+        log.warning(
+            "sleeve %s: cannot reach the broker at %s (nothing answers, or the host is unknown); "
+            "retrying every %d s at most. Start one with 'feelmysign broker' or check --broker.",
+            self._id,
+            self._settings.url,
+            RECONNECT_MAX_S,
+        )
+
+    def _on_subscribe(
+        self, client: mqtt.Client, userdata: Any, mid: int, reasons: Any, properties: Any
+    ) -> None:
+        # Brokers that check access at subscription refuse it here. (Mosquitto 2.0 grants
+        # every subscription and filters at delivery, so there a sleeve with the wrong id
+        # simply receives nothing.)
+        if any(reason.is_failure for reason in reasons):
+            names = [topic(self._id, "strokes")]
+            if self._options.legacy_topic:
+                names.append(self._options.legacy_topic)
+            self._fatal = FeelMySignError(
+                f"the broker at {self._settings.url} refused the subscription to "
+                f"{' and '.join(names)} for user {self._settings.username!r}: the broker's access "
+                f"list does not let this user read sleeve {self._id}'s strokes; check --id, "
+                "--legacy-topic and the credentials (a 'feelmysign broker' sleeve account reads "
+                "only its own sleeve's topics and deviceOne/line)"
+            )
+            log.error("%s", self._fatal)
+            self._stopped.set()
+
     def _on_disconnect(
         self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
     ) -> None:
@@ -198,7 +244,7 @@ class Sleeve:
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
         received_at_ms, received_wall_ms = monotonic_ms(), wall_ms()
         try:
-            self._handle(message.topic, message.payload, received_at_ms, received_wall_ms)
+            self._handle(message, received_at_ms, received_wall_ms)
         except Exception as error:  # the handler must never take the sleeve down
             log.exception("sleeve %s: unexpected error handling a message", self._id)
             self._reject(
@@ -209,19 +255,34 @@ class Sleeve:
             )
 
     def _handle(
-        self, name: str, payload: bytes | bytearray, received_at_ms: float, received_wall_ms: float
+        self, message: mqtt.MQTTMessage, received_at_ms: float, received_wall_ms: float
     ) -> None:
-        self.counts["received"] += 1
+        self._count("received")
+        name = message.topic
         legacy = name == self._options.legacy_topic
         info: dict[str, Any] = {"topic": name}
+        if message.retain:
+            # A stroke kept by the broker would play again at every start.
+            self._reject(
+                "retained",
+                "a retained stroke is not played: publish strokes without "
+                "the retain flag, and clear this one with an empty retained message",
+                info,
+                received_wall_ms,
+            )
+            return
+        payload = message.payload
         result = parse(payload, self._layout, format="legacy" if legacy else "json")
         if not isinstance(result, Accepted):
             self._reject(result.reason, result.message, info, received_wall_ms)
             return
         stroke = result.stroke
-        info.update(
-            {k: v for k, v in (("drawing", stroke.drawing), ("seq", stroke.seq)) if v is not None}
+        known = (
+            ("drawing", stroke.drawing),
+            ("seq", stroke.seq),
+            ("sent_at_ms", stroke.sent_at_ms),
         )
+        info.update({k: v for k, v in known if v is not None})
         if not self._bucket.take():
             self._reject(
                 "rate_limited",
@@ -246,8 +307,7 @@ class Sleeve:
     def _reject(
         self, reason: str, message: str, info: dict[str, Any], received_wall_ms: float
     ) -> None:
-        self.counts["rejected"] += 1
-        self.counts[f"rejected:{reason}"] += 1
+        self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
         self._event(
             {
@@ -262,8 +322,18 @@ class Sleeve:
     def _event(self, event: dict[str, Any]) -> None:
         """Called from the player thread too: only queues, never touches the network."""
         if event.get("type") in ("played", "adjusted"):
-            self.counts["played"] += 1
+            self._count("played")
+        if event.get("reason") == "player_crashed":
+            self._fatal = FeelMySignError(
+                "the player stopped on an unexpected error (see the log); every motor is off"
+            )
+            self._stopped.set()
         self._outbox.put((topic(self._id, "events"), json.dumps(event), 1, False))
+
+    def _count(self, *names: str) -> None:
+        with self._counts_lock:
+            for name in names:
+                self.counts[name] += 1
 
     def publish_actuators(self, frame: dict[str, Any]) -> None:
         """Telemetry for previews: best effort (QoS 0), never retained."""

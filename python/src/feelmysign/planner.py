@@ -26,8 +26,9 @@ from __future__ import annotations
 
 import itertools
 import math
+from bisect import bisect_left
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
@@ -53,25 +54,20 @@ ON_LINE_EPSILON = 1e-9
 
 TOO_FAST = "too_fast"
 
+# Planning runs on the sleeve before a stroke's first motor command, so the code
+# below works on plain tuples and builds the public dataclasses only for its
+# result. Every float that reaches a schedule is computed with the same
+# operations in the same order as the published formulas (and the TypeScript
+# and Java ports): the shared vectors in testdata/planner are compared bit for bit.
 
-@dataclass(frozen=True)
-class _Affine:
-    """``a * T + b``: every time in the motion model is affine in the stroke duration T."""
+# (onset a, onset b, duration a, duration b) of one burst: every time in the
+# motion model is affine in the stroke duration T, onset = a T + b and so on.
+_Timing = tuple[float, float, float, float]
+_Span = tuple[float, float, float]  # start_ms, end_ms, intensity of one actuator's command
+_Piece = tuple[float, float, float]  # start_ms, end_ms, intensity after merging
+_Actuator = tuple[int, int]  # row, column
 
-    a: float
-    b: float
-
-    def at(self, duration_ms: float) -> float:
-        return self.a * duration_ms + self.b
-
-    def __add__(self, other: _Affine) -> _Affine:
-        return _Affine(self.a + other.a, self.b + other.b)
-
-    def __sub__(self, other: _Affine) -> _Affine:
-        return _Affine(self.a - other.a, self.b - other.b)
-
-    def scaled(self, k: float) -> _Affine:
-        return _Affine(self.a * k, self.b * k)
+_SOA_SCALE = 1.0 / (1.0 + SOA_SLOPE)  # solves SOA = 0.32 (d + SOA) + 47.3 for SOA
 
 
 def plan(
@@ -112,28 +108,15 @@ def plan(
             f"stroke needs {duration_ms:.3f} ms, more than the sleeve's maximum of "
             f"{layout.max_stroke_duration_ms:g} ms; send a slower, shorter stroke",
         )
-    bursts = tuple(
-        Burst(
-            x=p[0],
-            y=p[1],
-            peak_ms=f * duration_ms,
-            start_ms=on.at(duration_ms),
-            duration_ms=d.at(duration_ms),
-            intensity=intensity,
-        )
-        for p, f, (on, d) in zip(points, fractions, timings, strict=True)
-    )
-    bursts = _pin_last_end(bursts, duration_ms)
-    raw = [c for b in bursts for c in render_point(b, layout)]
-    commands = merge_commands(raw, min_command_ms=min_command_ms)
-    canonical = replace(stroke, start=start, end=end)
-    return Schedule(canonical, commands, duration_ms, adjusted, bursts)
+    bursts = _bursts(points, fractions, timings, duration_ms, intensity)
+    commands = _merged_commands(_spans_by_actuator(bursts, layout), min_command_ms)
+    return Schedule(_canonical(stroke, start, end), commands, duration_ms, adjusted, bursts)
 
 
 def _checked_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point]:
     """The stroke's endpoints clamped onto the grid, or StrokeError saying what is wrong."""
     values = (*stroke.start, *stroke.end, stroke.duration_ms)
-    if not all(math.isfinite(v) for v in values):
+    if not all(map(math.isfinite, values)):
         raise StrokeError("not_finite", f"stroke has a non-finite number: {values}")
     if stroke.duration_ms <= 0:
         raise StrokeError(
@@ -160,6 +143,16 @@ def _on_grid(point: Point, name: str, layout: Layout) -> Point:
     return (min(max(float(x), 0.0), float(x_max)), min(max(float(y), 0.0), float(y_max)))
 
 
+def _canonical(stroke: Stroke, start: Point, end: Point) -> Stroke:
+    """The stroke with its clamped float endpoints (itself when they already are)."""
+    # dataclasses.replace costs as much as a tenth of a short stroke's plan, and
+    # most strokes arrive already on the grid as floats.
+    given = (*stroke.start, *stroke.end)
+    if (*start, *end) == given and all(type(v) is float for v in given):
+        return stroke
+    return replace(stroke, start=start, end=end)
+
+
 def virtual_actuators(
     start: Point, end: Point, *, merge_distance: float = MERGE_DISTANCE
 ) -> tuple[list[Point], list[float]]:
@@ -173,7 +166,7 @@ def virtual_actuators(
     if length <= ON_LINE_EPSILON:
         return [start], [0.0]
     crossings = sorted({*_line_crossings(start[0], end[0]), *_line_crossings(start[1], end[1])})
-    fractions = _merged([0.0, *crossings, 1.0], merge_distance / length)
+    fractions = _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
     points = [_lerp(start, end, f) for f in fractions]
     return points, fractions
 
@@ -184,29 +177,31 @@ def _line_crossings(a: float, b: float) -> list[float]:
         return []
     low, high = min(a, b), max(a, b)
     first, last = math.ceil(low - ON_LINE_EPSILON), math.floor(high + ON_LINE_EPSILON)
-    fractions = ((k - a) / (b - a) for k in range(first, last + 1))
-    return [f for f in fractions if 0.0 < f < 1.0]
+    return [f for k in range(first, last + 1) if 0.0 < (f := (k - a) / (b - a)) < 1.0]
 
 
-def _merged(fractions: list[float], merge_fraction: float) -> list[float]:
+def _merged_fractions(fractions: list[float], merge_fraction: float) -> list[float]:
     """Group sorted fractions closer than ``merge_fraction``; keep 0 and 1 exactly."""
-    groups: list[list[float]] = []
-    for f in fractions:
-        if groups and f - groups[-1][0] < merge_fraction:
-            groups[-1].append(f)
+    merged: list[float] = []
+    first = last = fractions[0]  # of the group being gathered; only they decide its point
+    for f in itertools.islice(fractions, 1, None):
+        if f - first < merge_fraction:
+            last = f
         else:
-            groups.append([f])
-    if len(groups) == 1:
+            merged.append(_representative(first, last))
+            first = last = f
+    if not merged:
         return [0.0, 1.0]  # shorter than the merge distance: just its two endpoints
-    return [_representative(group) for group in groups]
+    merged.append(_representative(first, last))
+    return merged
 
 
-def _representative(group: list[float]) -> float:
-    if group[0] == 0.0:
+def _representative(first: float, last: float) -> float:
+    if first == 0.0:
         return 0.0
-    if group[-1] == 1.0:
+    if last == 1.0:
         return 1.0
-    return (group[0] + group[-1]) / 2
+    return (first + last) / 2
 
 
 def _lerp(start: Point, end: Point, fraction: float) -> Point:
@@ -224,33 +219,35 @@ def _snap(value: float) -> float:
     return float(nearest) if abs(value - nearest) <= ON_LINE_EPSILON else value
 
 
-def _timings(fractions: Sequence[float]) -> list[tuple[_Affine, _Affine]]:
+def _timings(fractions: Sequence[float]) -> list[_Timing]:
     """(onset, duration) of each burst, as affine functions of the stroke duration T.
 
     The Tactile Brush recursion (``tactile-brush.md``, "Durations and onsets"):
     ``SOA_i = (0.32 (d_i- + tau_{i+1} - S) + 47.3) / 1.32``, ``S += SOA_i``,
     ``d_{i+1}- = d_i+ = tau_{i+1} - S``, and finally ``d_n- = T - S``.
+
+    Each time is carried as its two coefficients (``a`` of T, then ``b``); a
+    peak ``tau`` is ``f T + 0``. Adding that 0 could only turn a -0.0 into 0.0,
+    which never reaches an onset or a duration, so it is left out; subtracting
+    from it (``0.0 - next_b``) is kept. Every float is the formula's, bit for bit.
     """
-    taus = [_Affine(f, 0.0) for f in fractions]
-    if len(taus) == 1:
-        return [(_Affine(0.0, 0.0), _Affine(1.0, 0.0))]
-    onset = _Affine(0.0, 0.0)
-    before_peak = _Affine(0.0, 0.0)  # d_i minus
-    result: list[tuple[_Affine, _Affine]] = []
-    for tau_next in taus[1:]:
-        soa = (before_peak + tau_next - onset).scaled(SOA_SLOPE) + _Affine(0.0, SOA_INTERCEPT_MS)
-        soa = soa.scaled(1.0 / (1.0 + SOA_SLOPE))
-        next_onset = onset + soa
-        after_peak = tau_next - next_onset  # d_i plus, which is d_{i+1} minus
-        result.append((onset, before_peak + after_peak))
-        onset, before_peak = next_onset, after_peak
-    result.append((onset, _Affine(1.0, 0.0) - onset))
+    if len(fractions) == 1:
+        return [(0.0, 0.0, 1.0, 0.0)]
+    onset_a = onset_b = 0.0
+    before_a = before_b = 0.0  # d_i minus
+    result: list[_Timing] = []
+    for tau in itertools.islice(fractions, 1, None):
+        soa_a = (before_a + tau - onset_a) * SOA_SLOPE * _SOA_SCALE
+        soa_b = ((before_b - onset_b) * SOA_SLOPE + SOA_INTERCEPT_MS) * _SOA_SCALE
+        next_a, next_b = onset_a + soa_a, onset_b + soa_b
+        after_a, after_b = tau - next_a, 0.0 - next_b  # d_i plus, which is d_{i+1} minus
+        result.append((onset_a, onset_b, before_a + after_a, before_b + after_b))
+        onset_a, onset_b, before_a, before_b = next_a, next_b, after_a, after_b
+    result.append((onset_a, onset_b, 1.0 - onset_a, 0.0 - onset_b))
     return result
 
 
-def _fastest_feasible_ms(
-    timings: Iterable[tuple[_Affine, _Affine]], min_command_ms: float
-) -> float:
+def _fastest_feasible_ms(timings: Iterable[_Timing], min_command_ms: float) -> float:
     """The least T for which every burst lasts at least ``min_command_ms``.
 
     Every duration grows with T (its slope is positive: each onset is a
@@ -258,18 +255,35 @@ def _fastest_feasible_ms(
     feasible durations are one interval [T_min, inf).
     """
     needed = 0.0
-    for _, duration in timings:
-        if duration.a > 0:
-            needed = max(needed, (min_command_ms - duration.b) / duration.a)
+    for _, _, duration_a, duration_b in timings:
+        if duration_a > 0:
+            needed = max(needed, (min_command_ms - duration_b) / duration_a)
     # Rounded up to the microsecond: every burst reaches the minimum despite
     # float rounding, and the adjusted duration reads well.
     return math.ceil(needed * 1000.0 * (1 + 1e-12)) / 1000.0
 
 
-def _pin_last_end(bursts: tuple[Burst, ...], duration_ms: float) -> tuple[Burst, ...]:
-    """Make the last burst end exactly at the stroke's duration (no float residue)."""
-    last = bursts[-1]
-    return (*bursts[:-1], replace(last, duration_ms=duration_ms - last.start_ms))
+def _bursts(
+    points: Sequence[Point],
+    fractions: Sequence[float],
+    timings: Sequence[_Timing],
+    duration_ms: float,
+    intensity: float,
+) -> tuple[Burst, ...]:
+    """The bursts at stroke duration ``duration_ms``, the last ending exactly there."""
+    t = duration_ms
+    bursts = [
+        Burst(x, y, f * t, onset_a * t + onset_b, length_a * t + length_b, intensity)
+        for (x, y), f, (onset_a, onset_b, length_a, length_b) in zip(
+            points[:-1], fractions[:-1], timings[:-1], strict=True
+        )
+    ]
+    # The model's last duration is T - S too, but evaluated as a T + b it would
+    # leave a float residue after the stroke's end.
+    (x, y), onset_a, onset_b = points[-1], timings[-1][0], timings[-1][1]
+    start_ms = onset_a * t + onset_b
+    bursts.append(Burst(x, y, fractions[-1] * t, start_ms, t - start_ms, intensity))
+    return tuple(bursts)
 
 
 def render_point(burst: Burst, layout: Layout) -> list[Command]:
@@ -280,12 +294,18 @@ def render_point(burst: Burst, layout: Layout) -> list[Command]:
     a cell, the four corners with ``A sqrt(wx wy)`` (Tang et al.: funneling
     applied twice, which factorises). The squares always sum to ``A**2``.
     """
+    return [
+        Command(row, column, burst.start_ms, burst.duration_ms, intensity)
+        for row, column, intensity in _funneled(burst, layout)
+    ]
+
+
+def _funneled(burst: Burst, layout: Layout) -> list[tuple[int, int, float]]:
+    """(row, column, intensity) of each physical actuator rendering ``burst``."""
     column_weights = _axis_weights(burst.x, layout.columns)
     row_weights = _axis_weights(burst.y, layout.rows)
     return [
-        Command(
-            row, column, burst.start_ms, burst.duration_ms, burst.intensity * math.sqrt(wx * wy)
-        )
+        (row, column, burst.intensity * math.sqrt(wx * wy))
         for row, wy in row_weights
         for column, wx in column_weights
     ]
@@ -293,13 +313,35 @@ def render_point(burst: Burst, layout: Layout) -> list[Command]:
 
 def _axis_weights(coordinate: float, count: int) -> list[tuple[int, float]]:
     """(index, weight) of the one or two actuators around a coordinate; weights sum to 1."""
-    low = min(math.floor(coordinate), count - 1)
+    # The last line belongs to the cell before it (no cell starts there). As
+    # min(floor, count - 1) without a builtin call, which shows on the hot path.
+    floor = math.floor(coordinate)
+    low = floor if floor < count - 1 else count - 1
     fraction = coordinate - low
     if fraction <= ON_LINE_EPSILON:
         return [(low, 1.0)]
     if fraction >= 1 - ON_LINE_EPSILON:
         return [(low + 1, 1.0)]
     return [(low, 1.0 - fraction), (low + 1, fraction)]
+
+
+def _spans_by_actuator(bursts: Iterable[Burst], layout: Layout) -> dict[_Actuator, list[_Span]]:
+    """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
+    by_actuator: dict[_Actuator, list[_Span]] = {}
+    for burst in bursts:
+        if burst.duration_ms <= 0:
+            continue
+        span_start = burst.start_ms
+        span_end = burst.start_ms + burst.duration_ms  # as Command.end_ms computes it
+        column_weights = _axis_weights(burst.x, layout.columns)
+        # _funneled, unrolled into this loop: no list per burst on the planning path.
+        for row, wy in _axis_weights(burst.y, layout.rows):
+            for column, wx in column_weights:
+                intensity = burst.intensity * math.sqrt(wx * wy)
+                if intensity > 0:
+                    span = (span_start, span_end, intensity)
+                    by_actuator.setdefault((row, column), []).append(span)
+    return by_actuator
 
 
 def merge_commands(
@@ -312,28 +354,54 @@ def merge_commands(
     joins its neighbour with the energy-weighted intensity, so no command is
     shorter than the minimum unless the whole on-period is.
     """
-    by_actuator: dict[tuple[int, int], list[Command]] = {}
+    by_actuator: dict[_Actuator, list[_Span]] = {}
     for command in commands:
         if command.intensity > 0 and command.duration_ms > 0:
-            by_actuator.setdefault((command.row, command.column), []).append(command)
-    merged: list[Command] = []
-    for (row, column), group in by_actuator.items():
-        for piece in _join_short(_energy_pieces(group), min_command_ms):
-            start, end, intensity = piece
-            merged.append(Command(row, column, start, end - start, intensity))
-    merged.sort(key=lambda c: (c.start_ms, c.row, c.column))
-    return tuple(merged)
+            span = (command.start_ms, command.end_ms, command.intensity)
+            by_actuator.setdefault((command.row, command.column), []).append(span)
+    return _merged_commands(by_actuator, min_command_ms)
 
 
-_Piece = tuple[float, float, float]  # start_ms, end_ms, intensity
+def _merged_commands(
+    by_actuator: dict[_Actuator, list[_Span]], min_command_ms: float
+) -> tuple[Command, ...]:
+    """Each actuator's spans merged, as commands sorted by start, then row, then column."""
+    # One actuator's pieces never share a start, so sorting these tuples whole
+    # orders them exactly as that key does.
+    pieces = [
+        (start, row, column, end, intensity)
+        for (row, column), spans in by_actuator.items()
+        for start, end, intensity in _actuator_pieces(spans, min_command_ms)
+    ]
+    pieces.sort()
+    return tuple(
+        [
+            Command(row, column, start, end - start, intensity)
+            for start, row, column, end, intensity in pieces
+        ]
+    )
 
 
-def _energy_pieces(group: list[Command]) -> list[_Piece]:
+def _actuator_pieces(spans: list[_Span], min_command_ms: float) -> list[_Piece]:
+    """What one actuator does: its spans' energies summed, short pieces joined."""
+    if len(spans) == 1:
+        return _lone_piece(*spans[0])  # most actuators of a stroke render one burst
+    return _join_short(_energy_pieces(spans), min_command_ms)
+
+
+def _energy_pieces(spans: list[_Span]) -> list[_Piece]:
     """Piecewise-constant intensity of one actuator: energies summed, capped at 1."""
-    bounds = sorted({t for c in group for t in (c.start_ms, c.end_ms)})
+    bounds = sorted({t for start, end, _ in spans for t in (start, end)})
+    # The energies on each interval between bounds, in the spans' order (the
+    # order they are summed in): one pass over the spans, not one per interval.
+    energies: list[list[float]] = [[] for _ in range(len(bounds) - 1)]
+    for start, end, intensity in spans:
+        energy = intensity**2
+        for terms in energies[bisect_left(bounds, start) : bisect_left(bounds, end)]:
+            terms.append(energy)
     pieces: list[_Piece] = []
-    for start, end in itertools.pairwise(bounds):
-        energy = sum(c.intensity**2 for c in group if c.start_ms < end and c.end_ms > start)
+    for (start, end), terms in zip(itertools.pairwise(bounds), energies, strict=True):
+        energy = sum(terms)
         if energy <= 0:
             continue
         intensity = min(1.0, math.sqrt(energy))
@@ -344,8 +412,18 @@ def _energy_pieces(group: list[Command]) -> list[_Piece]:
     return pieces
 
 
+def _lone_piece(start: float, end: float, intensity: float) -> list[_Piece]:
+    """``_energy_pieces`` of a single span (which ``_join_short`` leaves alone)."""
+    energy = intensity**2
+    if energy <= 0 or not start < end:  # underflow, or a span shorter than its start's ulp
+        return []
+    return [(start, end, min(1.0, math.sqrt(energy)))]
+
+
 def _join_short(pieces: list[_Piece], min_command_ms: float) -> list[_Piece]:
     """Join pieces shorter than the minimum to an adjacent piece of the same on-period."""
+    if len(pieces) < 2:
+        return pieces  # nothing to join with
     pieces = list(pieces)
     while True:
         short = [

@@ -111,6 +111,8 @@ class Player:
     def submit(self, stroke: PlannedStroke) -> Refusal | None:
         """Queue a stroke; None when accepted, else why not (nothing is queued then)."""
         drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        if not self._running:
+            return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
         with self._lock:
             refusal = self._check_order(drawing, seq) or self._check_room(stroke)
             if refusal:
@@ -134,7 +136,7 @@ class Player:
         if last is None or seq > last:
             return None
         if seq == last:
-            return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already played")
+            return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already accepted")
         return Refusal(
             "out_of_order",
             f"stroke {seq} of drawing {drawing} arrived after stroke {last}; strokes play in order",
@@ -158,13 +160,22 @@ class Player:
         self._thread = threading.Thread(target=self._run, name="feelmysign-player", daemon=True)
         self._thread.start()
 
-    def stop(self) -> None:
-        """Stop playing and switch every motor off (also when the thread died)."""
+    def stop(self) -> list[PlannedStroke]:
+        """Stop playing and switch every motor off (also when the thread died).
+
+        Returns the strokes accepted but not started, which will never play.
+        """
         self._running = False
         self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
         self._backend.all_off()
+        with self._lock:
+            unplayed = list(self._inbox) + [
+                tag for tag in self._timeline.unstarted() if isinstance(tag, PlannedStroke)
+            ]
+            self._inbox.clear()
+        return unplayed
 
     @property
     def idle(self) -> bool:
@@ -230,6 +241,30 @@ class Player:
                         "column": change.column,
                     }
                 )
+                if change.intensity == 0.0:
+                    self._force_off(change)
+
+    def _force_off(self, change: Change) -> None:
+        """An 'off' that failed: try once more, then every motor off (a glitch must not leave
+        one running with nothing left to switch it off)."""
+        try:
+            self._backend.set_intensity(change.row, change.column, 0.0)
+            return
+        except Exception:
+            log.warning(
+                "actuator (%d, %d) still not off: all motors off", change.row, change.column
+            )
+        try:
+            self._backend.all_off()
+        finally:
+            self._on_event(
+                {
+                    "type": "safety",
+                    "reason": "off_failed",
+                    "row": change.row,
+                    "column": change.column,
+                }
+            )
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:

@@ -5,7 +5,9 @@ writes what it answers. Commands of consecutive strokes may overlap on one
 actuator (a burst that ends after its stroke, under the next stroke's first
 burst); energies add, as within a stroke, capped at 1 and then at the layout's
 maximum intensity. An actuator on for longer than the layout's maximum
-continuous on-time is switched off and kept off until its commands stop.
+continuous on-time is switched off and kept off until its commands stop; an
+off shorter than ``MIN_REST_MS`` does not end an on-period (back-to-back
+strokes a few ms apart keep a motor running just the same).
 """
 
 from __future__ import annotations
@@ -20,6 +22,11 @@ from feelmysign.layout import Layout
 from feelmysign.schedule import Schedule
 
 Actuator = tuple[int, int]
+
+# A motor must be off this long before a new on-period (and a new on-time
+# budget) starts: a stroke that reaches an idle sleeve a few ms after the last
+# one ended gives the motor no rest at all.
+MIN_REST_MS = 1000.0
 
 
 @dataclass(frozen=True)
@@ -65,6 +72,7 @@ class Timeline:
         self._active: dict[Actuator, dict[int, float]] = {}
         self._output: dict[Actuator, float] = {}
         self._on_since: dict[Actuator, float] = {}
+        self._off_at: dict[Actuator, float] = {}
         self._tripped: set[Actuator] = set()
 
     def add(self, schedule: Schedule, start_ms: float, tag: object = None) -> None:
@@ -84,9 +92,9 @@ class Timeline:
 
     @property
     def busy(self) -> bool:
-        """Whether anything is planned or any actuator is on."""
-        self._drop_stale_caps()
-        return bool(self._events) or any(self._output.values())
+        """Whether anything is planned or any actuator is on (reads only: any thread may ask)."""
+        live = (e for e in list(self._events) if e.kind != "cap" or self._is_live_cap(e))
+        return any(self._output.values()) or any(True for _ in live)
 
     def _drop_stale_caps(self) -> None:
         """Forget on-time caps of on-periods that have ended (they would only wake us up)."""
@@ -98,7 +106,9 @@ class Timeline:
             heapq.heappop(self._events)
 
     def _is_live_cap(self, event: _Event) -> bool:
-        return self._on_since.get(event.actuator) == event.since_ms
+        """A cap still matters while its on-period runs and the motor is on."""
+        actuator = event.actuator
+        return self._on_since.get(actuator) == event.since_ms and bool(self._output.get(actuator))
 
     def pop_due(self, now_ms: float) -> Due:
         """Everything due at or before ``now_ms``, in time order; only real changes are listed."""
@@ -112,12 +122,17 @@ class Timeline:
                 self._settle(actuator, t_ms, due)
         return due
 
+    def unstarted(self) -> list[object]:
+        """The tags of strokes added but not yet started."""
+        return [e.tag for e in sorted(self._events) if e.kind == "start"]
+
     def clear(self) -> list[Change]:
         """Drop everything planned; the changes that switch every running actuator off."""
         self._events.clear()
         self._active.clear()
         self._tripped.clear()
         self._on_since.clear()
+        self._off_at.clear()
         off = [Change(0.0, r, c, 0.0) for (r, c), value in sorted(self._output.items()) if value]
         self._output.clear()
         return off
@@ -135,7 +150,7 @@ class Timeline:
         elif event.kind == "off":
             self._active.get(event.actuator, {}).pop(event.command, None)
             touched.add(event.actuator)
-        elif self._is_live_cap(event):
+        elif self._is_live_cap(event) and event.actuator not in self._tripped:
             # Still the on-period this cap was set for: it has lasted the
             # maximum continuous on-time.
             self._tripped.add(event.actuator)
@@ -154,11 +169,25 @@ class Timeline:
         if wanted == self._output.get(actuator, 0.0):
             return
         was_on = bool(self._output.get(actuator))
+        if wanted and not was_on and self._over_on_time(actuator, t_ms):
+            self._tripped.add(actuator)
+            due.tripped.append(actuator)
+            wanted = 0.0
+            if not self._output.get(actuator):
+                return
         self._output[actuator] = wanted
         due.changes.append(Change(t_ms, actuator[0], actuator[1], wanted))
         if wanted and not was_on:
-            self._on_since[actuator] = t_ms
-            cap_ms = t_ms + self._layout.max_on_time_ms
-            self._push(_Event(cap_ms, 0, "cap", actuator, since_ms=t_ms))
+            since_ms = self._on_since[actuator]
+            cap_ms = since_ms + self._layout.max_on_time_ms
+            self._push(_Event(cap_ms, 0, "cap", actuator, since_ms=since_ms))
         elif not wanted:
-            self._on_since.pop(actuator, None)
+            self._off_at[actuator] = t_ms
+
+    def _over_on_time(self, actuator: Actuator, t_ms: float) -> bool:
+        """Start or continue the on-period of a motor switching on; True if it is used up."""
+        off_at = self._off_at.get(actuator)
+        if actuator not in self._on_since or off_at is None or t_ms - off_at >= MIN_REST_MS:
+            self._on_since[actuator] = t_ms  # rested: a new on-period
+            return False
+        return t_ms - self._on_since[actuator] >= self._layout.max_on_time_ms

@@ -8,8 +8,9 @@ import table from "../../../testdata/angle/params.json";
 
 export type ParamType = "integer" | "number" | "boolean";
 
-export interface ParamSpec {
-  readonly name: AngleParamName;
+/** One row of a parameter table; `N` names the parameters of one simplifier. */
+export interface ParamSpec<N extends string = AngleParamName> {
+  readonly name: N;
   readonly type: ParamType;
   readonly default: number | boolean;
   readonly minimum: number | null;
@@ -38,11 +39,12 @@ export type AngleParamName = keyof AngleParams;
 
 const PARAM_TYPES: readonly string[] = ["integer", "number", "boolean"];
 
-function readSpecs(raw: unknown): ParamSpec[] {
+/** A simplifier's parameter table (`source` names its file, for the errors). */
+export function readSpecs<N extends string>(raw: unknown, source: string): ParamSpec<N>[] {
   // Checked once at load: a reshaped params.json should fail loudly, not validate wrongly.
   const parameters = (raw as { parameters?: unknown }).parameters;
   if (!Array.isArray(parameters)) {
-    throw new Error("testdata/angle/params.json has no 'parameters' list; regenerate it");
+    throw new Error(`${source} has no 'parameters' list; regenerate it`);
   }
   return parameters.map((entry: Record<string, unknown>, index) => {
     const { name, type, minimum, maximum, help } = entry;
@@ -57,10 +59,10 @@ function readSpecs(raw: unknown): ParamSpec[] {
       !bound(maximum) ||
       typeof help !== "string"
     ) {
-      throw new Error(`testdata/angle/params.json: parameters[${index}] is malformed`);
+      throw new Error(`${source}: parameters[${index}] is malformed`);
     }
     return {
-      name: name as AngleParamName,
+      name: name as N,
       type: type as ParamType,
       default: value,
       minimum: minimum as number | null,
@@ -71,7 +73,10 @@ function readSpecs(raw: unknown): ParamSpec[] {
 }
 
 /** Every parameter, in the reference's order. */
-export const PARAM_SPECS: readonly ParamSpec[] = readSpecs(table);
+export const PARAM_SPECS: readonly ParamSpec[] = readSpecs<AngleParamName>(
+  table,
+  "testdata/angle/params.json",
+);
 
 const SPECS_BY_NAME = new Map(PARAM_SPECS.map((spec) => [spec.name, spec]));
 
@@ -89,7 +94,7 @@ export const DEFAULT_ANGLE_PARAMS: AngleParams = Object.freeze(
 ) as unknown as AngleParams;
 
 /** "[2, 600]"-style text, or "from 2 to 600" for sentences. */
-export function rangeText(spec: ParamSpec): string {
+export function rangeText(spec: ParamSpec<string>): string {
   const low = spec.minimum === null ? "unbounded" : String(spec.minimum);
   const high = spec.maximum === null ? "unbounded" : String(spec.maximum);
   return `from ${low} to ${high}`;
@@ -99,7 +104,7 @@ export function rangeText(spec: ParamSpec): string {
  * Why `value` is not allowed for `spec` (a sentence naming the allowed range),
  * or null when it is. The same checks, in the same order, as `ParamSpec.check`.
  */
-export function paramProblem(spec: ParamSpec, value: unknown): string | null {
+export function paramProblem(spec: ParamSpec<string>, value: unknown): string | null {
   if (spec.type === "boolean") {
     return typeof value === "boolean" ? null : "must be on or off";
   }
@@ -120,7 +125,15 @@ export function paramProblem(spec: ParamSpec, value: unknown): string | null {
 
 /** Throws a RangeError naming the parameter, the value and the range, for the first bad one. */
 export function checkAngleParams(params: AngleParams): void {
-  for (const spec of PARAM_SPECS) {
+  checkParams(PARAM_SPECS, params);
+}
+
+/** `checkAngleParams` for any simplifier's table. */
+export function checkParams<N extends string>(
+  specs: readonly ParamSpec<N>[],
+  params: Readonly<Record<N, number | boolean>>,
+): void {
+  for (const spec of specs) {
     const value = params[spec.name];
     const problem = paramProblem(spec, value);
     if (problem !== null) {

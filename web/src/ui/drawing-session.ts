@@ -1,6 +1,6 @@
 /**
- * One drawing in progress: pointer samples in, animation frames to the angle
- * simplifier, finished segments to the drawing and its strokes to the sender,
+ * One drawing in progress: pointer samples in, animation frames to the chosen
+ * simplifier (angle or window), finished segments to the drawing and its strokes to the sender,
  * ink to the canvas. The animation loop runs only while a pointer is down, and
  * each frame costs the same however much has been drawn.
  */
@@ -8,8 +8,8 @@ import { Drawing, type DrawnSegment, type PointerKind } from "../drawing";
 import { newDrawingId } from "../drawing-id";
 import { FrameSampler } from "../frame-sampler";
 import type { Stroke } from "../protocol";
-import { angleParams, type Settings } from "../settings";
-import { AngleSimplifier } from "../simplify/angle";
+import { simplifierParams, type Settings } from "../settings";
+import { makeSimplifier, type Simplifier } from "../simplify/replay";
 import type { Sample, Segment } from "../simplify/segment";
 import type { DrawingView } from "./canvas";
 import type { GridSize } from "./geometry";
@@ -34,7 +34,7 @@ export class DrawingSession {
   readonly #view: DrawingView;
   readonly #host: SessionHost;
   #drawing: Drawing | null = null;
-  #simplifier: AngleSimplifier | null = null;
+  #simplifier: Simplifier | null = null;
   #sampler = new FrameSampler(60);
   #pointerKind: PointerKind = "mouse";
   #pointer: Sample | null = null;
@@ -142,8 +142,8 @@ export class DrawingSession {
   }
 
   #newDrawing(settings: Settings): void {
-    const params = angleParams(settings, this.#host.grid(), this.#view.area);
-    this.#simplifier = new AngleSimplifier(params);
+    const params = simplifierParams(settings, this.#host.grid(), this.#view.area);
+    this.#simplifier = makeSimplifier(params);
     this.#drawing = new Drawing(newDrawingId(), params);
     this.#view.setDrawing(this.#drawing);
     this.#host.changed(this.#drawing);
@@ -198,7 +198,7 @@ export class DrawingSession {
     const settings = this.#host.settings();
     const { width_px: width, height_px: height } = this.#view.area;
     // A zigzag between the top and bottom of the area: every corner turns far more than
-    // max_angle_deg, so every leg becomes one stroke.
+    // max_angle_deg (and strays far beyond max_error), so every leg becomes one stroke.
     const vertex = (i: number): [number, number] => [
       width * (0.05 + 0.9 * ((i * 0.1373) % 1)),
       height * (i % 2 === 0 ? 0.1 : 0.9),

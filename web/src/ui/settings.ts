@@ -21,13 +21,25 @@ const SECTIONS: readonly { id: FieldSpec["section"]; title: string; note?: strin
   {
     id: "simplifier",
     title: "Simplifier",
-    note: "How a drawing is cut into straight strokes: the parameters of the paper's appendix B.1.",
+    note:
+      "How a drawing is cut into straight strokes: the paper's angle rule (its appendix B.1) " +
+      "or the window simplifier, which keeps every drawn point within the max error of its stroke.",
   },
   { id: "sleeve", title: "Sleeve" },
   { id: "connection", title: "Connection" },
 ];
 
 type Candidate = Record<SettingKey, unknown>;
+
+/** Fields only one simplifier has: locked while the other is chosen. */
+const ONLY_FOR: Partial<Record<SettingKey, "angle" | "window">> = {
+  check_frames: "angle",
+  max_angle_deg: "angle",
+  frame_max: "angle",
+  recover: "angle",
+  max_error: "window",
+  max_window: "window",
+};
 
 export interface SettingsPanelContext {
   readonly config: ServerConfig | null;
@@ -235,11 +247,21 @@ export class SettingsPanel {
       return this.#context.config !== null && candidate.broker_custom !== true;
     }
     if (key === "legacy_topic") return candidate.protocol !== "legacy";
-    return false;
+    const owner = ONLY_FOR[key];
+    return owner !== undefined && candidate.algorithm !== owner;
   }
 
   #applyDependencies(candidate: Candidate): void {
-    for (const key of ["rows", "columns", "ws_url", "username", "password", "legacy_topic"] as const) {
+    const keys: readonly SettingKey[] = [
+      "rows",
+      "columns",
+      "ws_url",
+      "username",
+      "password",
+      "legacy_topic",
+      ...(Object.keys(ONLY_FOR) as SettingKey[]),
+    ];
+    for (const key of keys) {
       const disabled = this.#isDisabled(key, candidate);
       this.#rows.get(key)!.dataset["disabled"] = String(disabled);
       for (const input of this.#inputs.get(key) ?? []) input.disabled = disabled;

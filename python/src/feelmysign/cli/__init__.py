@@ -16,7 +16,19 @@ from feelmysign import __version__
 from feelmysign.errors import FeelMySignError
 
 # Subcommand modules, in the order `feelmysign --help` lists them.
-SUBCOMMANDS = ("up", "plan", "simplify", "validate", "sleeve", "broker", "send", "scan", "buzz")
+SUBCOMMANDS = (
+    "up",
+    "plan",
+    "simplify",
+    "replay",
+    "evaluate",
+    "validate",
+    "sleeve",
+    "broker",
+    "send",
+    "scan",
+    "buzz",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -20,6 +20,7 @@ from feelmysign.backends.base import check_actuator
 from feelmysign.backends.factory import BACKEND_NAMES, open_backend
 from feelmysign.backends.sim import SimBackend
 from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli._signals import interrupt_on_stop_signals
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
 
@@ -81,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
         flush=True,
     )
     started_s = time.monotonic()
+    interrupt_on_stop_signals()
     try:
         backend.set_intensity(args.row, args.column, intensity)
         # The motor is meant to run this long: a timed wait, not a wait for an event.

@@ -3,14 +3,33 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import json
-from dataclasses import asdict, replace
+from dataclasses import asdict, fields, replace
 from typing import Any
 
-from feelmysign.simplify import AngleParams, PathSegment, load_recording, simplify_paths
-from feelmysign.simplify.recording import Recording
+from feelmysign.simplify import (
+    ALGORITHMS,
+    AngleParams,
+    PathSegment,
+    WindowParams,
+    load_recording,
+    simplify_paths,
+)
+from feelmysign.simplify.recording import Recording, RecordingError
+from feelmysign.simplify.replay import Params, algorithm_of
 
 DEFAULTS = AngleParams()
+WINDOW_DEFAULTS = WindowParams()
+# Options that only one algorithm has; giving one to the other is a usage error.
+ONLY_FOR = {
+    "check_frames": "angle",
+    "max_angle_deg": "angle",
+    "frame_max": "angle",
+    "recover": "angle",
+    "max_error": "window",
+    "max_window": "window",
+}
 
 
 def register(subparsers: Any) -> None:
@@ -26,21 +45,45 @@ def register(subparsers: Any) -> None:
     parser.add_argument("recording", metavar="RECORDING", help="a recording JSON file")
     parser.add_argument(
         "--algorithm",
-        choices=["angle"],
-        default="angle",
-        help="the simplifier (default: angle, the paper's)",
+        choices=list(ALGORITHMS),
+        default=None,
+        help="the simplifier: angle (the paper's) or window (error-bounded); "
+        "default: the recording's, else angle",
     )
-    _option(parser, "--check-frames", int, "N", "frames between checks", DEFAULTS.check_frames)
+    _option(
+        parser,
+        "--max-error",
+        float,
+        "E",
+        "window: farthest a drawn point may lie from its stroke, grid units",
+        WINDOW_DEFAULTS.max_error,
+    )
+    _option(
+        parser,
+        "--max-window",
+        int,
+        "N",
+        "window: longest stroke in frames after its start",
+        WINDOW_DEFAULTS.max_window,
+    )
+    _option(
+        parser, "--check-frames", int, "N", "angle: frames between checks", DEFAULTS.check_frames
+    )
     _option(
         parser,
         "--max-angle-deg",
         float,
         "A",
-        "largest turn that continues a line, degrees",
+        "angle: largest turn that continues a line, degrees",
         DEFAULTS.max_angle_deg,
     )
     _option(
-        parser, "--frame-max", int, "N", "longest line in frames, 0 = no limit", DEFAULTS.frame_max
+        parser,
+        "--frame-max",
+        int,
+        "N",
+        "angle: longest line in frames, 0 = no limit",
+        DEFAULTS.frame_max,
     )
     _option(parser, "--fps", float, "F", "frames per second of the drawing loop", DEFAULTS.fps)
     parser.add_argument(
@@ -48,7 +91,7 @@ def register(subparsers: Any) -> None:
         dest="recover",
         action="store_false",
         default=None,
-        help="start a new line at the pointer after a failed check, leaving gaps "
+        help="angle: start a new line at the pointer after a failed check, leaving gaps "
         "(default: recover, start it at the last check)",
     )
     _option(
@@ -85,7 +128,7 @@ def register(subparsers: Any) -> None:
         help="stretch the canvas onto the grid as the paper did (default: keep the aspect ratio)",
     )
     parser.add_argument("--json", action="store_true", help="print the strokes as JSON")
-    parser.set_defaults(handler=run)
+    parser.set_defaults(handler=functools.partial(run, parser=parser))
 
 
 def _option(
@@ -95,41 +138,47 @@ def _option(
     parser.add_argument(flag, type=kind, metavar=metavar, default=None, help=text + suffix)
 
 
-def params_from_args(args: argparse.Namespace, recording: Recording) -> AngleParams:
-    """The recording's own settings, then the command line's, over the paper's defaults."""
+def params_from_args(args: argparse.Namespace, recording: Recording) -> Params:
+    """The recording's own settings, then the command line's, over the algorithm's defaults."""
+    algorithm = ALGORITHMS[chosen_algorithm(args, recording)]
+    names = [f.name for f in fields(algorithm.params)]
     recorded = (
         recording.simplifier.get("params", {})
-        if recording.simplifier.get("algorithm", "angle") == "angle"
+        if recording.simplifier.get("algorithm", "angle") == algorithm.name
         else {}
     )
-    known = {k: v for k, v in recorded.items() if k in asdict(DEFAULTS)}
-    base = replace(DEFAULTS, **known)
+    base = algorithm.params(**{k: v for k, v in recorded.items() if k in names})
     overrides: dict[str, Any] = {
         "canvas_width_px": recording.width_px,
         "canvas_height_px": recording.height_px,
         "rows": recording.rows or base.rows,
         "columns": recording.columns or base.columns,
     }
-    for name in (
-        "check_frames",
-        "max_angle_deg",
-        "frame_max",
-        "fps",
-        "recover",
-        "min_duration_ms",
-        "min_length",
-        "rows",
-        "columns",
-        "stretch",
-    ):
-        value = getattr(args, name)
+    for name in names:
+        value = getattr(args, name, None)
         if value is not None:
             overrides[name] = value
-    return replace(base, **overrides)
+    params: Params = replace(base, **overrides)
+    return params
 
 
-def run(args: argparse.Namespace) -> int:
+def chosen_algorithm(args: argparse.Namespace, recording: Recording) -> str:
+    """``--algorithm``, else the one the recording's sender used, else angle."""
+    chosen = getattr(args, "algorithm", None)
+    if chosen is not None:
+        return str(chosen)
+    recorded = recording.simplifier.get("algorithm", "angle")
+    if recorded not in ALGORITHMS:
+        raise RecordingError(
+            f"{args.recording}: simplifier.algorithm {recorded!r} is unknown; "
+            f"choose one with --algorithm {'|'.join(ALGORITHMS)}"
+        )
+    return str(recorded)
+
+
+def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser | None = None) -> int:
     recording = load_recording(args.recording)
+    _check_usage(args, chosen_algorithm(args, recording), parser)
     params = params_from_args(args, recording)
     result = simplify_paths(params, recording.paths)
     if args.json:
@@ -139,7 +188,17 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def to_json(result: list[PathSegment], params: AngleParams) -> dict[str, Any]:
+def _check_usage(
+    args: argparse.Namespace, algorithm: str, parser: argparse.ArgumentParser | None
+) -> None:
+    """Usage error (exit 2): an option of the other algorithm, which would be ignored."""
+    for name, owner in ONLY_FOR.items():
+        if owner != algorithm and getattr(args, name, None) is not None and parser:
+            flag = "--no-recover" if name == "recover" else "--" + name.replace("_", "-")
+            parser.error(f"{flag} only applies to --algorithm {owner}")
+
+
+def to_json(result: list[PathSegment], params: Params) -> dict[str, Any]:
     strokes, dropped = [], []
     for item in result:
         s = item.segment
@@ -154,15 +213,19 @@ def to_json(result: list[PathSegment], params: AngleParams) -> dict[str, Any]:
             strokes.append(entry)
         else:
             dropped.append({"reason": s.dropped, **entry})
-    return {"algorithm": "angle", "params": asdict(params), "strokes": strokes, "dropped": dropped}
+    return {
+        "algorithm": algorithm_of(params).name,
+        "params": asdict(params),
+        "strokes": strokes,
+        "dropped": dropped,
+    }
 
 
-def describe(result: list[PathSegment], params: AngleParams, source: str) -> str:
+def describe(result: list[PathSegment], params: Params, source: str) -> str:
     sent = [r for r in result if r.segment.dropped is None]
     lines = [
         f"{source}: {len({r.path for r in result})} path(s) -> {len(sent)} stroke(s) sent, "
-        f"{len(result) - len(sent)} dropped (angle: check every {params.check_frames} frames, "
-        f"max {params.max_angle_deg:g} deg, {params.fps:g} fps; "
+        f"{len(result) - len(sent)} dropped ({_settings(params)}, {params.fps:g} fps; "
         f"{params.rows} x {params.columns} grid)",
         "",
         f"{'path':>4}  {'start':>15}  {'end':>15}  {'ms':>8}  {'emitted at':>10}  note",
@@ -175,6 +238,15 @@ def describe(result: list[PathSegment], params: AngleParams, source: str) -> str
             f"{s.emitted_at_ms:>10.1f}  {note}"
         )
     return "\n".join(lines)
+
+
+def _settings(params: Params) -> str:
+    if isinstance(params, WindowParams):
+        return (
+            f"window: max error {params.max_error:g} grid units, "
+            f"at most {params.max_window} frames a stroke"
+        )
+    return f"angle: check every {params.check_frames} frames, max {params.max_angle_deg:g} deg"
 
 
 def _p(point: tuple[float, float]) -> str:

@@ -4,17 +4,16 @@ from __future__ import annotations
 
 import argparse
 import logging
-import signal
 import sys
 from collections import Counter
 from collections.abc import Callable
-from types import FrameType
 from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import BURST, LEGACY_TOPIC, RATE_PER_S, Sleeve, SleeveOptions
 from feelmysign.errors import ParameterError
@@ -153,8 +152,4 @@ def run_sleeve(
 
 
 def _stop_on_signals(sleeve: Sleeve) -> None:
-    def stop(signum: int, frame: FrameType | None) -> None:
-        sleeve.stop()
-
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    call_on_stop_signals(sleeve.stop)

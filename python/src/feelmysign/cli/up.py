@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import signal
+import socket
 import threading
 from pathlib import Path
-from types import FrameType
 from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES
 from feelmysign.broker import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID, DEFAULT_WS_PORT, Broker
 from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
@@ -47,16 +47,14 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--port",
         type=int,
-        default=DEFAULT_MQTT_PORT,
         metavar="P",
-        help=f"MQTT port (default: {DEFAULT_MQTT_PORT}; 0 = any free)",
+        help=f"MQTT port (default: {DEFAULT_MQTT_PORT}, or any free one if taken; 0 = any free)",
     )
     parser.add_argument(
         "--ws-port",
         type=int,
-        default=DEFAULT_WS_PORT,
         metavar="W",
-        help=f"MQTT over WebSockets port, for browsers (default: {DEFAULT_WS_PORT})",
+        help=f"MQTT over WebSockets port (default: {DEFAULT_WS_PORT}, or any free one if taken)",
     )
     parser.add_argument(
         "--sleeve-id",
@@ -88,9 +86,9 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     layout = layout_from_args(args)
-    broker = Broker(
-        state_dir=args.state_dir, port=args.port, ws_port=args.ws_port, sleeve_id=args.sleeve_id
-    )
+    port = _port_or_free(args.port, DEFAULT_MQTT_PORT, "MQTT")
+    ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
+    broker = Broker(state_dir=args.state_dir, port=port, ws_port=ws_port, sleeve_id=args.sleeve_id)
     with broker:
         c = broker.credentials
         config = {
@@ -123,6 +121,26 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _port_or_free(asked: int | None, default: int, name: str) -> int:
+    """The port asked for; else the default, or any free port when something else has it.
+
+    Debian starts its own Mosquitto on 1883 when the package is installed: ``make up``
+    must still come up with nothing typed (the page learns the ports from /config.json).
+    """
+    if asked is not None:
+        return asked
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        try:
+            probe.bind(("127.0.0.1", default))
+        except OSError:
+            print(
+                f"Port {default} is taken (another {name} server?); using a free port instead.",
+                flush=True,
+            )
+            return 0
+    return default
+
+
 def _announce(sleeve: Sleeve, url: str, broker: Broker) -> None:
     if not sleeve.connected.wait(15):
         print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
@@ -140,8 +158,4 @@ def _announce(sleeve: Sleeve, url: str, broker: Broker) -> None:
 
 
 def _stop_on_signals(sleeve: Sleeve) -> None:
-    def stop(signum: int, frame: FrameType | None) -> None:
-        sleeve.stop()
-
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    call_on_stop_signals(sleeve.stop)

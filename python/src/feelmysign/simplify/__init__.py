@@ -4,10 +4,13 @@ from feelmysign.simplify.angle import AngleParams, AngleSimplifier
 from feelmysign.simplify.frames import frames_from_samples
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.recording import Recording, load_recording, parse_recording
-from feelmysign.simplify.replay import PathSegment, simplify_paths
+from feelmysign.simplify.replay import ALGORITHMS, Algorithm, PathSegment, simplify_paths
 from feelmysign.simplify.segment import Sample, Segment
+from feelmysign.simplify.window import WindowParams, WindowSimplifier
 
 __all__ = [
+    "ALGORITHMS",
+    "Algorithm",
     "AngleParams",
     "AngleSimplifier",
     "CanvasMapping",
@@ -15,6 +18,8 @@ __all__ = [
     "Recording",
     "Sample",
     "Segment",
+    "WindowParams",
+    "WindowSimplifier",
     "frames_from_samples",
     "load_recording",
     "parse_recording",

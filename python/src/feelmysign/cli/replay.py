@@ -1,0 +1,214 @@
+"""``feelmysign replay``: re-run a recording through a simplifier, exactly; send it at its pace.
+
+    feelmysign replay drawing.json                  # the strokes; do they match the recorded ones?
+    feelmysign replay drawing.json --algorithm window --max-error 0.05
+    feelmysign replay drawing.json --send           # to the local broker's sleeve, as drawn
+    feelmysign replay drawing.json --send --speed 4 --broker mqtt://pi.local:1883 --id sleeve2
+
+The simplifier options are those of 'feelmysign simplify' (the recording's own
+settings, then the options, over the algorithm's defaults). A recording from
+the browser carries the animation frames its simplifier was fed: they are
+replayed as they are, so the replay gives exactly the strokes the browser sent
+(when --fps is not changed), and when it carries those strokes the replay says
+whether it matches them. Otherwise the pointer samples are resampled at --fps.
+The same recording and options always give the same strokes.
+
+With --send the strokes go to the sleeve as JSON v1 (one new drawing id, seq
+0..n-1), each at the moment the simplifier let it go in the drawing (its
+emitted_at_ms from the first frame, divided by --speed; durations unchanged),
+and each is acknowledged by the broker before the next (QoS 1). Every stroke
+is checked against the sleeve's rules before connecting.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import math
+import time
+import uuid
+from typing import Any
+
+from feelmysign.cli import simplify
+from feelmysign.cli._broker_options import (
+    DEFAULT_TIMEOUT_S,
+    BrokerSettings,
+    add_broker_options,
+    broker_settings_from_args,
+    connect_client,
+)
+from feelmysign.cli.send import _Message, _Sender
+from feelmysign.errors import StrokeError
+from feelmysign.layout import PAPER_SLEEVE, grid_layout
+from feelmysign.protocol import Rejected, validate_stroke
+from feelmysign.research.rerun import Rerun, mismatch, rerun
+from feelmysign.simplify.recording import Recording, load_recording
+from feelmysign.simplify.replay import Params
+from feelmysign.stroke import Stroke
+
+BROKER_DESTS = ("broker", "sleeve_id", "username", "password", "credentials")
+
+
+def _simplify_options() -> argparse.ArgumentParser:
+    """The parser of 'feelmysign simplify', as a parent: its options, defined once, are ours."""
+    holder = argparse.ArgumentParser(add_help=False)
+    actions = holder.add_subparsers()
+    simplify.register(actions)
+    parser: argparse.ArgumentParser = actions.choices["simplify"]
+    return parser
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "replay",
+        help="re-run a recording through a simplifier, exactly, and optionally send it",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        parents=[_simplify_options()],
+        conflict_handler="resolve",  # both have -h
+    )
+    group = parser.add_argument_group("sending")
+    group.add_argument(
+        "--send",
+        action="store_true",
+        help="publish the strokes to a sleeve at the pace they were drawn (default: only show)",
+    )
+    group.add_argument(
+        "--speed",
+        type=float,
+        metavar="X",
+        help="with --send, send X times faster than drawn (default: 1, as drawn)",
+    )
+    group.add_argument(
+        "--timeout-s",
+        type=float,
+        default=DEFAULT_TIMEOUT_S,
+        metavar="S",
+        help=f"with --send, longest wait for the broker, seconds (default: {DEFAULT_TIMEOUT_S:g})",
+    )
+    add_broker_options(parser, role="sender")
+    parser.set_defaults(handler=functools.partial(run, parser=parser))
+
+
+def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
+    _check_usage(args, parser)
+    recording = load_recording(args.recording)
+    algorithm = simplify.chosen_algorithm(args, recording)
+    simplify._check_usage(args, algorithm, parser)  # another algorithm's option: exit 2
+    params = simplify.params_from_args(args, recording)
+    result = rerun(recording, params)
+    compared = recording.strokes is not None and algorithm == _recorded_algorithm(recording)
+    difference = mismatch(result.segments, recording.strokes or ()) if compared else None
+    if args.send:
+        _send(args, result, params)
+    if args.json:
+        print(json.dumps(_document(result, params, compared, difference)))
+    else:
+        print(simplify.describe(result.segments, params, args.recording))
+        verdict = _verdict(recording, algorithm, difference)
+        print(f"\nframes: {result.frames_source}; {verdict}")
+    return 0
+
+
+def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:
+    if not args.send:
+        given = [d for d in BROKER_DESTS if getattr(args, d) is not None]
+        if args.speed is not None:
+            given.append("speed")
+        if given:
+            flags = ", ".join("--" + ("id" if d == "sleeve_id" else d) for d in given)
+            verb = "applies" if len(given) == 1 else "apply"
+            parser.error(f"{flags} only {verb} with --send")
+    if args.speed is not None and not (math.isfinite(args.speed) and args.speed > 0):
+        parser.error(f"--speed must be a number above 0 (2 = twice as fast), not {args.speed:g}")
+    if not (math.isfinite(args.timeout_s) and args.timeout_s > 0):
+        parser.error(f"--timeout-s must be a number of seconds above 0, not {args.timeout_s:g}")
+
+
+def _recorded_algorithm(recording: Recording) -> str:
+    return str(recording.simplifier.get("algorithm", "angle"))
+
+
+def _verdict(recording: Recording, algorithm: str, difference: str | None) -> str:
+    if recording.strokes is None:
+        return "the recording has no strokes to compare with"
+    if algorithm != _recorded_algorithm(recording):
+        return (
+            f"the recorded strokes came from {_recorded_algorithm(recording)}, "
+            f"not {algorithm}: not compared"
+        )
+    if difference is None:
+        return f"matches the {len(recording.strokes)} strokes the recording says were sent"
+    return f"DIFFERS from the strokes the recording says were sent: {difference}"
+
+
+def _document(
+    result: Rerun, params: Params, compared: bool, difference: str | None
+) -> dict[str, Any]:
+    document = simplify.to_json(result.segments, params)
+    document["frames"] = result.frames_source
+    document["matches_recording"] = difference is None if compared else None
+    document["difference"] = difference
+    return document
+
+
+def strokes_to_send(result: Rerun, params: Params) -> tuple[list[Stroke], list[float]]:
+    """The sent segments as strokes of one new drawing, and when to send each (ms from the press).
+
+    Each is checked by the sleeve's own rules first: StrokeError, nothing sent.
+    """
+    layout = grid_layout(
+        params.rows,
+        params.columns,
+        PAPER_SLEEVE.spacing_cm,
+        max_stroke_duration_ms=PAPER_SLEEVE.max_stroke_duration_ms,
+    )
+    drawing = str(uuid.uuid4())
+    origin_ms = next((path[0].t_ms for path in result.frames if path), 0.0)
+    strokes, at_ms = [], []
+    sent = [item.segment for item in result.segments if item.segment.dropped is None]
+    for seq, segment in enumerate(sent):
+        stroke = Stroke(segment.start, segment.end, segment.duration_ms, drawing=drawing, seq=seq)
+        checked = validate_stroke(stroke, layout)
+        if isinstance(checked, Rejected):
+            raise StrokeError(
+                checked.reason,
+                f"Stroke {seq + 1} of the replay would be rejected by the sleeve "
+                f"({checked.reason}): {checked.message} Nothing was sent.",
+            )
+        strokes.append(checked)
+        at_ms.append(segment.emitted_at_ms - origin_ms)
+    if not strokes:
+        raise StrokeError(
+            "empty",
+            f"The replay gave no stroke to send ({len(result.segments)} segment(s), all "
+            "dropped as too short or too brief); try a lower --min-length or --min-duration-ms.",
+        )
+    return strokes, at_ms
+
+
+def _send(args: argparse.Namespace, result: Rerun, params: Params) -> None:
+    strokes, at_ms = strokes_to_send(result, params)
+    settings: BrokerSettings = broker_settings_from_args(args, "sender")
+    speed = args.speed or 1.0
+    messages = [
+        _Message(i, settings.strokes_topic, stroke, legacy=False)
+        for i, stroke in enumerate(strokes)
+    ]
+    client = connect_client(
+        settings, f"feelmysign-replay-{uuid.uuid4().hex[:12]}", timeout_s=args.timeout_s
+    )
+    try:
+        # send.py's sender: the same publish, acknowledgement wait and report as 'send'.
+        sender = _Sender(client, settings, timeout_s=args.timeout_s, json_lines=args.json)
+        start_s = time.monotonic()
+        for message, offset_ms in zip(messages, at_ms, strict=True):
+            # Drawing time, not a wait for an event: the pace is the point.
+            time.sleep(max(0.0, start_s + offset_ms / 1000 / speed - time.monotonic()))
+            payload, mid = sender._publish(message)
+            deadline_s = time.monotonic() + args.timeout_s
+            sender._confirm(message, payload, mid, deadline_s, len(messages))
+    finally:
+        client.disconnect()
+        client.loop_stop()

@@ -1,0 +1,135 @@
+"""``feelmysign evaluate``: the CSV files, plots and JSON summary, and its usage errors."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+from test_cli_replay import browser_recording
+
+from feelmysign.cli import main
+from feelmysign.research.sweep import SweepError, parse_sweep
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+OUTPUTS = ("results.csv", "frontier.csv", "summary.json")
+PLOTS = ("error_vs_strokes.png", "lag.png", "per_shape.png")
+
+
+def recordings(tmp_path: Path) -> list[str]:
+    """A browser recording, and a plain one (no frames, no strokes) of a tap and a line."""
+    first = browser_recording(tmp_path / "spiral.json")
+    line = [{"t_ms": 10.0 * k, "x": 100 + 8.0 * k, "y": 300 + 2.0 * k} for k in range(60)]
+    tap = [{"t_ms": 900.0, "x": 50, "y": 50}, {"t_ms": 930.0, "x": 50, "y": 50}]
+    second = tmp_path / "line-and-tap.json"
+    second.write_text(
+        json.dumps({"canvas": {"width_px": 800, "height_px": 600}, "paths": [line, tap]})
+    )
+    return [str(first), str(second)]
+
+
+def evaluate_json(capsys: pytest.CaptureFixture[str], *argv: str) -> dict[str, Any]:
+    assert main(["evaluate", *argv, "--json"]) == 0
+    document: dict[str, Any] = json.loads(capsys.readouterr().out)
+    return document
+
+
+def test_recordings_give_the_csv_plots_and_summary(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    document = evaluate_json(
+        capsys,
+        *recordings(tmp_path),
+        "--sweep",
+        "max_angle_deg=20:30:10",
+        "--sweep",
+        "max_error=0.1",
+        "--out",
+        str(out),
+    )
+    for name in OUTPUTS:
+        assert (out / name).stat().st_size > 0
+    for name in PLOTS:
+        assert (out / name).read_bytes().startswith(PNG_SIGNATURE)
+    with (out / "results.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 2 * 3  # 2 recordings x (angle 20, angle 30, window 0.1)
+    assert {(r["algorithm"], r["setting"]) for r in rows} == {
+        ("angle", "max_angle_deg=20"),
+        ("angle", "max_angle_deg=30"),
+        ("window", "max_error=0.1"),
+    }
+    assert {r["group"] for r in rows} == {"spiral", "line-and-tap"}
+    line_and_tap = [r for r in rows if r["group"] == "line-and-tap"]
+    assert all(int(r["dropped"]) >= 1 for r in line_and_tap)  # the tap
+    summary = {(s["algorithm"], s["setting"]): s for s in document["summary"]}
+    assert set(summary) == {(r["algorithm"], r["setting"]) for r in rows}
+    window = summary[("window", "max_error=0.1")]
+    assert window["max_deviation_max"] <= 0.1 + 1e-9
+    for entry in summary.values():
+        assert entry["recordings"] == 2
+        for key in ("strokes_mean", "max_deviation_mean", "frechet_mean", "lag_p95_ms"):
+            assert entry[key] >= 0
+        assert entry["dropped_total"] >= 1  # the tap
+    assert document["references"] == {"angle": "max_angle_deg=20", "window": "max_error=0.1"}
+    assert document["frontier"][0]["strokes_mean"] >= document["frontier"][-1]["strokes_mean"]
+    assert json.loads((out / "summary.json").read_text()) == document
+
+
+def test_lasa_subset_with_the_default_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    document = evaluate_json(
+        capsys, "--lasa", "--limit", "3", "--algorithm", "angle", "--sweep", "check_frames=5"
+    )
+    out = Path(document["out"])
+    assert out.parent == Path("evaluations") and out.name[:8].isdigit()
+    assert document["recordings"] == 3 and document["source"] == "lasa"
+    with (out / "results.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert [r["recording"] for r in rows] == ["lasa/Angle/1", "lasa/Angle/2", "lasa/Angle/3"]
+    assert all(int(r["strokes"]) >= 1 for r in rows)
+
+
+def test_the_table_without_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = [*recordings(tmp_path)[:1], "--algorithm", "window", "--sweep", "max_error=0.2"]
+    assert main(["evaluate", *argv, "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "window    max_error=0.2" in out and "Wrote results.csv" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--lasa", "--algorithm", "wiggle"], "the algorithms available are: angle"),
+        ([], "give RECORDING files to evaluate, or --lasa"),
+        (["--lasa", "--sweep", "max_speed=1:2:1"], "the parameters are: "),
+        (["--lasa", "--sweep", "check_frames=1:3:0.5"], "whole numbers only"),
+        (["--lasa", "--limit", "0"], "--limit must be 1 or more"),
+    ],
+)
+def test_usage_errors_list_the_choices(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main(["evaluate", *argv])
+    assert exit_info.value.code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_a_value_out_of_range_names_the_range(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["evaluate", "--lasa", "--sweep", "max_angle_deg=100:200:50"]) == 1
+    assert "max_angle_deg = 200.0 is not allowed; it must be in [1, 179]" in capsys.readouterr().err
+
+
+def test_sweep_values() -> None:
+    assert parse_sweep("max-error=0.05:0.2:0.05").values == (0.05, 0.1, 0.15, 0.2)
+    assert parse_sweep("max_angle_deg=10:45:10").values == (10, 20, 30, 40)
+    assert parse_sweep("fps=30").values == (30,)
+    for bad in ("max_error", "max_error=a:b:c", "max_error=1:0:1", "max_error=0:1:0"):
+        with pytest.raises(SweepError):
+            parse_sweep(bad)

@@ -1,0 +1,354 @@
+"""The window simplifier: shared vectors, the CLI, then invariants over random paths."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from vectors import load
+
+from feelmysign.cli import main
+from feelmysign.errors import ParameterError
+from feelmysign.simplify import (
+    Sample,
+    Segment,
+    WindowParams,
+    WindowSimplifier,
+    frames_from_samples,
+    simplify_paths,
+)
+from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
+from feelmysign.stroke import Point
+
+WINDOW = dict(load("window"))
+VECTORS = [(n, c) for n, c in WINDOW.items() if n != "params"]
+PARAMS_TABLE = WINDOW["params"]
+# The bound is tested on the reference's own float arithmetic; a different
+# formula for the same distance may differ in the last bits.
+FLOAT_TOLERANCE = 1e-12
+
+
+def _run(params: WindowParams, paths: list[list[Sample]]) -> list[tuple[int, Segment]]:
+    return [(p.path, p.segment) for p in simplify_paths(params, paths)]
+
+
+def _distance(point: Point, start: Point, end: Point) -> float:
+    """Distance from a point to the segment start -> end (not its line)."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    qx, qy = point[0] - start[0], point[1] - start[1]
+    length_sq = dx * dx + dy * dy
+    t = 0.0 if length_sq == 0 else min(max((qx * dx + qy * dy) / length_sq, 0.0), 1.0)
+    return math.hypot(qx - t * dx, qy - t * dy)
+
+
+@pytest.mark.parametrize(("name", "case"), VECTORS, ids=[n for n, _ in VECTORS])
+def test_vector(name: str, case: dict[str, Any]) -> None:
+    params = WindowParams(**case["params"])
+    paths = [[Sample(*s) for s in path] for path in case["paths"]]
+    tolerance = case["tolerance"]
+    assert [len(frames_from_samples(p, params.fps)) for p in paths] == case["expected"]["frames"]
+    actual = _run(params, paths)
+    expected = case["expected"]["segments"]
+    assert len(actual) == len(expected), name
+    for (path, segment), want in zip(actual, expected, strict=True):
+        assert path == want["path"] and segment.dropped == want["dropped"]
+        got = [*segment.start, *segment.end, segment.start_ms, segment.end_ms]
+        wanted = [*want["start"], *want["end"], want["start_ms"], want["end_ms"]]
+        assert [*got, segment.emitted_at_ms] == pytest.approx(
+            [*wanted, want["emitted_at_ms"]], abs=tolerance
+        )
+
+
+def test_parameter_table_matches_the_defaults() -> None:
+    defaults = WindowParams()
+    names = [entry["name"] for entry in PARAMS_TABLE["parameters"]]
+    assert names == list(asdict(defaults))
+    for entry in PARAMS_TABLE["parameters"]:
+        assert getattr(defaults, entry["name"]) == entry["default"]
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("max_error", 0),
+        ("max_error", math.inf),
+        ("max_window", 0),
+        ("max_window", 2.5),
+        ("fps", math.nan),
+        ("min_length", -0.1),
+        ("stretch", 1),
+    ],
+)
+def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: object) -> None:
+    with pytest.raises(ParameterError) as error:
+        WindowParams(**{field: value})  # type: ignore[arg-type]
+    assert error.value.name == field and "must be" in str(error.value)
+
+
+def test_square_is_four_strokes_with_its_corners() -> None:
+    # 10 px a frame is 0.033 grid units: above the error, so a corner shows at once.
+    params = WindowParams(
+        canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000
+    )
+    corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
+    points = [
+        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
+        for (x0, y0), (x1, y1) in itertools.pairwise(corners)
+        for k in range(40)
+    ] + [corners[-1]]
+    path = [Sample(i * 1000 / 60, x, y) for i, (x, y) in enumerate(points)]
+    segments = [s for _, s in _run(params, [path])]
+    grid = [params.mapping.to_grid(x, y) for x, y in corners]
+    assert [s.dropped for s in segments] == [None] * 4
+    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
+        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+    # Each corner is found one frame later, when the next frame leaves the line.
+    assert [s.emitted_at_ms - s.end_ms for s in segments[:3]] == pytest.approx([1000 / 60] * 3)
+
+
+def test_a_stroke_ends_at_the_frame_before_the_one_that_breaks_the_bound() -> None:
+    params = WindowParams(
+        canvas_width_px=300, canvas_height_px=200, max_error=0.05, min_duration_ms=0
+    )
+    simplifier = WindowSimplifier(params)
+    frames = [Sample(10.0 * k, 10.0 * k, 100) for k in range(5)] + [Sample(50.0, 40, 150)]
+    out = [segment for frame in frames for segment in simplifier.push(frame)]
+    assert len(out) == 1 and out[0].end_ms == 40.0 and out[0].emitted_at_ms == 50.0
+    assert simplifier.line_start == frames[4]
+    (last,) = simplifier.end()
+    assert last.start == out[0].end and last.end_ms == 50.0
+
+
+def test_window_cap_cuts_at_the_current_frame() -> None:
+    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_window=3)
+    simplifier = WindowSimplifier(params)
+    frames = [Sample(20.0 * k, 10.0 * k, 100) for k in range(7)]
+    pushed = [[s.end_ms for s in simplifier.push(frame)] for frame in frames]
+    assert pushed == [[], [], [], [60.0], [], [], [120.0]]
+    assert simplifier.end() == []  # the last frame already ends a stroke
+    assert not simplifier.drawing
+
+
+def test_a_tap_gives_one_dropped_segment() -> None:
+    simplifier = WindowSimplifier(WindowParams())
+    assert simplifier.push(Sample(0.0, 500, 500)) == []
+    (tap,) = simplifier.end()
+    assert tap.dropped == NOT_ENOUGH_DISTANCE and tap.start == tap.end
+
+
+# --- the command line ---------------------------------------------------------
+
+
+def _recording(case: dict[str, Any], path: Path) -> Path:
+    params = case["params"]
+    document = {
+        "canvas": {"width_px": params["canvas_width_px"], "height_px": params["canvas_height_px"]},
+        "paths": [
+            [{"t_ms": t, "x": x, "y": y, "pressure": p} for t, x, y, p in samples]
+            for samples in case["paths"]
+        ],
+        "sleeve": {"rows": params["rows"], "columns": params["columns"]},
+    }
+    path.write_text(json.dumps(document))
+    return path
+
+
+def _flags(params: dict[str, Any]) -> list[str]:
+    flags = ["--algorithm", "window"]
+    for name in ("max_error", "max_window", "fps", "min_duration_ms", "min_length"):
+        flags += ["--" + name.replace("_", "-"), repr(params[name])]
+    return flags + (["--stretch"] if params["stretch"] else [])
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["circle/defaults", "zigzag/max-error-0.02", "pause/max-window-8", "two-paths/defaults"],
+)
+def test_cli_reproduces_the_vectors(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = WINDOW[name]
+    recording = _recording(case, tmp_path / "drawing.json")
+    assert main(["simplify", str(recording), "--json", *_flags(case["params"])]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["algorithm"] == "window" and result["params"] == case["params"]
+    expected = case["expected"]["segments"]
+    sent = [e for e in expected if e["dropped"] is None]
+    dropped = [e for e in expected if e["dropped"] is not None]
+    assert len(result["strokes"]) == len(sent) and len(result["dropped"]) == len(dropped)
+    for got, want in zip(result["strokes"] + result["dropped"], sent + dropped, strict=True):
+        assert got["path"] == want["path"] and got.get("reason") == want["dropped"]
+        assert got["start"] == pytest.approx(want["start"])
+        assert got["end"] == pytest.approx(want["end"])
+        assert got["emitted_at_ms"] == pytest.approx(want["emitted_at_ms"])
+
+
+def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    recording = _recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
+    assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0.05"]) == 0
+    assert "window: max error 0.05 grid units" in capsys.readouterr().out
+    assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"]) == 1
+    assert "max_error" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:
+        main(["simplify", str(recording), "--algorithm", "window", "--check-frames", "5"])
+    assert exit_.value.code == 2
+    assert "--check-frames only applies to --algorithm angle" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["simplify", str(recording), "--max-error", "0.1"])
+    assert "--max-error only applies to --algorithm window" in capsys.readouterr().err
+    assert main(["simplify", str(recording), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["algorithm"] == "angle"
+
+
+def test_cli_uses_the_recordings_algorithm_and_parameters(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _recording(WINDOW["circle/max-error-0.02"], tmp_path / "w.json")
+    document = json.loads(path.read_text())
+    path.write_text(
+        json.dumps(
+            {**document, "simplifier": {"algorithm": "window", "params": {"max_error": 0.02}}}
+        )
+    )
+    assert main(["simplify", str(path), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["algorithm"] == "window" and result["params"]["max_error"] == 0.02
+    expected = WINDOW["circle/max-error-0.02"]["expected"]["segments"]
+    assert len(result["strokes"]) + len(result["dropped"]) == len(expected)
+    path.write_text(json.dumps({**document, "simplifier": {"algorithm": "dp"}}))
+    assert main(["simplify", str(path)]) == 1
+    assert "'dp' is unknown; choose one with --algorithm angle|window" in capsys.readouterr().err
+
+
+# --- properties over random paths ---------------------------------------------
+
+
+@st.composite
+def paths(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
+    params = WindowParams(
+        max_error=draw(st.sampled_from([0.001, 0.02, 0.05, 0.2, 1.0])),
+        max_window=draw(st.sampled_from([1, 2, 5, 64, 1000])),
+        fps=draw(st.sampled_from([30.0, 60.0, 120.0])),
+        min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
+        min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
+        stretch=draw(st.booleans()),
+        canvas_width_px=800,
+        canvas_height_px=600,
+    )
+    count = draw(st.integers(1, 150))
+    steps = draw(
+        st.lists(
+            st.tuples(st.floats(-40, 40), st.floats(-40, 40), st.floats(0, 30)),
+            min_size=count,
+            max_size=count,
+        )
+    )
+    # Starting and stepping past the canvas exercises the clamping onto the grid.
+    x, y, t_ms = draw(st.floats(-50, 850)), draw(st.floats(-50, 650)), 0.0
+    samples = [Sample(t_ms, x, y)]
+    for dx, dy, dt in steps:
+        x, y, t_ms = min(max(x + dx, -50), 850), min(max(y + dy, -50), 650), t_ms + dt
+        samples.append(Sample(t_ms, x, y))
+    return params, samples
+
+
+def _covered(
+    params: WindowParams, samples: list[Sample]
+) -> tuple[list[Sample], list[tuple[int, int, Segment]]]:
+    """The frames, and each segment with the indices of the first and last frame it covers.
+
+    Segments join end to start, so each starts at the frame the one before
+    ended on; it ends on the last frame (from there) with its end time and
+    point. Frame times only repeat when a whole path has a single time.
+    """
+    frames = frames_from_samples(samples, params.fps)
+    segments = [s for _, s in _run(params, [samples])]
+    mapping = params.mapping
+    covered: list[tuple[int, int, Segment]] = []
+    start = 0
+    for segment in segments:
+        ends = [
+            j
+            for j in range(start, len(frames))
+            if frames[j].t_ms == segment.end_ms
+            and mapping.to_grid(frames[j].x, frames[j].y) == segment.end
+        ]
+        assert ends, f"{segment} does not end on a frame"
+        covered.append((start, ends[-1], segment))
+        start = ends[-1]
+    assert start == len(frames) - 1, "the last segment ends on the last frame"
+    return frames, covered
+
+
+@settings(max_examples=500, deadline=None)
+@given(paths())
+def test_every_frame_lies_within_max_error_of_its_stroke(
+    case: tuple[WindowParams, list[Sample]],
+) -> None:
+    params, samples = case
+    frames, covered = _covered(params, samples)
+    mapping = params.mapping
+    for first, last, segment in covered:
+        for frame in frames[first : last + 1]:
+            distance = _distance(mapping.to_grid(frame.x, frame.y), segment.start, segment.end)
+            assert distance <= params.max_error + FLOAT_TOLERANCE, (segment, frame, distance)
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths())
+def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sample]]) -> None:
+    params, samples = case
+    segments = [s for _, s in _run(params, [samples])]
+    assert segments, "a path always gives at least one segment (sent or dropped)"
+    mapping = params.mapping
+    assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
+    assert segments[-1].end == mapping.to_grid(samples[-1].x, samples[-1].y)
+    assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
+    for before, after in itertools.pairwise(segments):
+        assert after.start == before.end and after.start_ms == before.end_ms
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths())
+def test_no_stroke_covers_more_than_the_window_and_each_is_emitted_at_most_a_frame_late(
+    case: tuple[WindowParams, list[Sample]],
+) -> None:
+    params, samples = case
+    frames, covered = _covered(params, samples)
+    for first, last, segment in covered:
+        assert last - first + 1 <= params.max_window + 1
+        assert last > first or len(frames) == 1, "only a one-frame path gives an empty stroke"
+        next_time = frames[min(last + 1, len(frames) - 1)].t_ms
+        assert segment.emitted_at_ms in (frames[last].t_ms, next_time)
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths())
+def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
+    case: tuple[WindowParams, list[Sample]],
+) -> None:
+    params, samples = case
+    for _, segment in _run(params, [samples]):
+        if segment.dropped is None:
+            assert segment.length >= params.min_length
+            assert segment.duration_ms >= params.min_duration_ms
+        elif segment.dropped == NOT_ENOUGH_DISTANCE:
+            assert segment.length < params.min_length
+        else:
+            assert segment.dropped == NOT_ENOUGH_DURATION
+            assert segment.duration_ms < params.min_duration_ms
+        assert segment.emitted_at_ms >= segment.end_ms
+
+
+@settings(max_examples=100, deadline=None)
+@given(paths())
+def test_replay_is_deterministic(case: tuple[WindowParams, list[Sample]]) -> None:
+    params, samples = case
+    assert _run(params, [samples]) == _run(params, [samples])

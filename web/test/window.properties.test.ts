@@ -1,0 +1,172 @@
+/**
+ * Invariants of the TypeScript window simplifier on random paths and
+ * parameters (fast-check): every frame lies within max_error of the stroke
+ * that covers it, no stroke covers more than max_window + 1 frames, strokes
+ * join end to start from the press to the release, and a dropped segment
+ * carries the reason that matches its size.
+ */
+import fc from "fast-check";
+import { describe, expect, it } from "vitest";
+import { framesFromSamples } from "../src/simplify/frames";
+import { CanvasMapping } from "../src/simplify/mapping";
+import {
+  NOT_ENOUGH_DISTANCE,
+  NOT_ENOUGH_DURATION,
+  segmentLength,
+  type Point,
+  type Sample,
+  type Segment,
+} from "../src/simplify/segment";
+import { WindowSimplifier } from "../src/simplify/window";
+import type { WindowParams } from "../src/simplify/window-params";
+
+const WIDTH_PX = 900;
+const HEIGHT_PX = 600;
+/** Room for a distance computed another way than the simplifier's (last bits only). */
+const FLOAT_TOLERANCE = 1e-12;
+
+/** A pointer path: a random walk inside (and a little outside) the canvas, times increasing. */
+const pathArb = fc
+  .record({
+    x0: fc.double({ min: -20, max: WIDTH_PX + 20, noNaN: true }),
+    y0: fc.double({ min: -20, max: HEIGHT_PX + 20, noNaN: true }),
+    steps: fc.array(
+      fc.record({
+        dt: fc.double({ min: 0, max: 40, noNaN: true }),
+        dx: fc.double({ min: -60, max: 60, noNaN: true }),
+        dy: fc.double({ min: -60, max: 60, noNaN: true }),
+      }),
+      { minLength: 0, maxLength: 200, size: "max" },
+    ),
+  })
+  .map(({ x0, y0, steps }) => {
+    const samples: Sample[] = [{ t_ms: 0, x: x0, y: y0, pressure: 0.5 }];
+    for (const step of steps) {
+      const last = samples[samples.length - 1]!;
+      samples.push({ t_ms: last.t_ms + step.dt, x: last.x + step.dx, y: last.y + step.dy, pressure: 0.5 });
+    }
+    return samples;
+  });
+
+const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
+  max_error: fc.oneof(
+    fc.constantFrom(0.001, 0.02, 0.05, 0.2),
+    fc.double({ min: 0.001, max: 2, noNaN: true }),
+  ),
+  max_window: fc.oneof(fc.constantFrom(1, 2, 64), fc.integer({ min: 1, max: 300 })),
+  fps: fc.double({ min: 10, max: 240, noNaN: true }),
+  clear_on_press: fc.boolean(),
+  min_duration_ms: fc.double({ min: 0, max: 100, noNaN: true }),
+  min_length: fc.double({ min: 0, max: 1, noNaN: true }),
+  rows: fc.integer({ min: 2, max: 8 }),
+  columns: fc.integer({ min: 2, max: 8 }),
+  canvas_width_px: fc.constant(WIDTH_PX),
+  canvas_height_px: fc.constant(HEIGHT_PX),
+  stretch: fc.boolean(),
+});
+
+function mapping(params: WindowParams): CanvasMapping {
+  return new CanvasMapping({
+    width_px: params.canvas_width_px,
+    height_px: params.canvas_height_px,
+    columns: params.columns,
+    rows: params.rows,
+    stretch: params.stretch,
+  });
+}
+
+/** Distance from a point to the segment start -> end (not its line). */
+function distance(point: Point, start: Point, end: Point): number {
+  const dx = end[0] - start[0];
+  const dy = end[1] - start[1];
+  const qx = point[0] - start[0];
+  const qy = point[1] - start[1];
+  const lengthSq = dx * dx + dy * dy;
+  const t = lengthSq === 0 ? 0 : Math.min(Math.max((qx * dx + qy * dy) / lengthSq, 0), 1);
+  return Math.hypot(qx - t * dx, qy - t * dy);
+}
+
+/**
+ * The frames, and each segment with the first and last frame it covers:
+ * segments join, so each starts where the one before ended, and ends on the
+ * last frame from there with its end time and point.
+ */
+function covered(params: WindowParams, samples: readonly Sample[]) {
+  const simplifier = new WindowSimplifier(params);
+  const frames = framesFromSamples(samples, params.fps);
+  const segments: Segment[] = frames.flatMap((frame) => simplifier.push(frame));
+  segments.push(...simplifier.end());
+  const map = mapping(params);
+  const spans: { first: number; last: number; segment: Segment }[] = [];
+  let start = 0;
+  for (const segment of segments) {
+    let last = -1;
+    for (let j = start; j < frames.length; j++) {
+      const [x, y] = map.toGrid(frames[j]!.x, frames[j]!.y);
+      if (frames[j]!.t_ms === segment.end_ms && x === segment.end[0] && y === segment.end[1]) last = j;
+    }
+    expect(last, "a segment ends on a frame").toBeGreaterThanOrEqual(start);
+    spans.push({ first: start, last, segment });
+    start = last;
+  }
+  expect(start, "the last segment ends on the last frame").toBe(frames.length - 1);
+  return { frames, spans, segments, map };
+}
+
+describe("window simplifier invariants", () => {
+  it("every frame lies within max_error of its stroke, and no stroke covers more than the window", () => {
+    fc.assert(
+      fc.property(paramsArb, pathArb, (params, samples) => {
+        const { frames, spans, map } = covered(params, samples);
+        for (const { first, last, segment } of spans) {
+          expect(last - first).toBeLessThanOrEqual(params.max_window);
+          for (let j = first; j <= last; j++) {
+            const point = map.toGrid(frames[j]!.x, frames[j]!.y);
+            expect(distance(point, segment.start, segment.end)).toBeLessThanOrEqual(
+              params.max_error + FLOAT_TOLERANCE,
+            );
+          }
+        }
+      }),
+      { numRuns: 400 },
+    );
+  });
+
+  it("strokes join end to start from the press to the release", () => {
+    fc.assert(
+      fc.property(paramsArb, pathArb, (params, samples) => {
+        const { segments, map } = covered(params, samples);
+        const first = samples[0]!;
+        const last = samples[samples.length - 1]!;
+        expect(segments[0]!.start).toEqual(map.toGrid(first.x, first.y));
+        expect(segments[segments.length - 1]!.end).toEqual(map.toGrid(last.x, last.y));
+        for (let i = 1; i < segments.length; i++) {
+          expect(segments[i]!.start).toEqual(segments[i - 1]!.end);
+          expect(segments[i]!.start_ms).toBe(segments[i - 1]!.end_ms);
+        }
+      }),
+      { numRuns: 200 },
+    );
+  });
+
+  it("sent strokes meet the minimums and dropped ones say why", () => {
+    fc.assert(
+      fc.property(paramsArb, pathArb, (params, samples) => {
+        for (const segment of covered(params, samples).segments) {
+          const duration = segment.end_ms - segment.start_ms;
+          if (segment.dropped === null) {
+            expect(segmentLength(segment)).toBeGreaterThanOrEqual(params.min_length);
+            expect(duration).toBeGreaterThanOrEqual(params.min_duration_ms);
+          } else if (segment.dropped === NOT_ENOUGH_DISTANCE) {
+            expect(segmentLength(segment)).toBeLessThan(params.min_length);
+          } else {
+            expect(segment.dropped).toBe(NOT_ENOUGH_DURATION);
+            expect(duration).toBeLessThan(params.min_duration_ms);
+          }
+          expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
+        }
+      }),
+      { numRuns: 200 },
+    );
+  });
+});

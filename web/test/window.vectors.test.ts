@@ -1,0 +1,73 @@
+/**
+ * The TypeScript window simplifier against every vector of testdata/window:
+ * frames per path and every segment (path, start, end, times, dropped
+ * reason), within the file's own tolerance.
+ */
+import { describe, expect, it } from "vitest";
+import { framesFromSamples } from "../src/simplify/frames";
+import { simplifyPaths } from "../src/simplify/replay";
+import type { Sample } from "../src/simplify/segment";
+import { DEFAULT_WINDOW_PARAMS, WINDOW_PARAM_SPECS, type WindowParams } from "../src/simplify/window-params";
+import { vectors } from "./testdata";
+
+interface ExpectedSegment {
+  path: number;
+  start: [number, number];
+  end: [number, number];
+  start_ms: number;
+  end_ms: number;
+  emitted_at_ms: number;
+  dropped: string | null;
+}
+
+interface WindowVector {
+  description: string;
+  tolerance: number;
+  params: WindowParams;
+  paths: [number, number, number, number][][];
+  expected: { frames: number[]; segments: ExpectedSegment[] };
+}
+
+const cases = vectors("window").filter(([name]) => !name.endsWith("params.json")) as [string, WindowVector][];
+
+function close(actual: number, expected: number, tolerance: number, what: string): void {
+  if (Math.abs(actual - expected) > tolerance) {
+    throw new Error(`${what}: got ${actual}, expected ${expected} (tolerance ${tolerance})`);
+  }
+}
+
+describe("window vectors", () => {
+  it("finds the vectors", () => {
+    expect(cases.length).toBeGreaterThanOrEqual(50);
+  });
+
+  it("reads the reference's parameter table", () => {
+    expect(WINDOW_PARAM_SPECS.map((spec) => spec.name)).toEqual(Object.keys(DEFAULT_WINDOW_PARAMS));
+    expect(DEFAULT_WINDOW_PARAMS.max_error).toBe(0.1);
+  });
+
+  it.each(cases)("%s", (_name, vector) => {
+    const paths: Sample[][] = vector.paths.map((path) =>
+      path.map(([t_ms, x, y, pressure]) => ({ t_ms, x, y, pressure })),
+    );
+    expect(paths.map((path) => framesFromSamples(path, vector.params.fps).length)).toEqual(
+      vector.expected.frames,
+    );
+    const actual = simplifyPaths(vector.params, paths);
+    expect(actual.length, "segment count").toBe(vector.expected.segments.length);
+    const tol = vector.tolerance;
+    vector.expected.segments.forEach((want, i) => {
+      const got = actual[i]!;
+      const where = `segment ${i}`;
+      expect(got.path, `${where} path`).toBe(want.path);
+      expect(got.segment.dropped, `${where} dropped`).toBe(want.dropped);
+      close(got.segment.start[0], want.start[0], tol, `${where} start x`);
+      close(got.segment.start[1], want.start[1], tol, `${where} start y`);
+      close(got.segment.end[0], want.end[0], tol, `${where} end x`);
+      close(got.segment.end[1], want.end[1], tol, `${where} end y`);
+      close(got.segment.start_ms, want.start_ms, tol, `${where} start_ms`);
+      close(got.segment.end_ms, want.end_ms, tol, `${where} end_ms`);
+      close(got.segment.emitted_at_ms, want.emitted_at_ms, tol, `${where} emitted_at_ms`);
+    });
+  });
+});
