@@ -97,7 +97,14 @@ web-browser-test: web-build $(STAMP) system
 
 web-test: web-typecheck web-format-check web-unit web-browser-test
 
-web-bench: web-build system
+# The LASA points the web bench times its simplifiers and simplify-js on: 60 fps frames,
+# written by the Python importer from the venv before the web bench reads them.
+LASA_FRAMES := $(WEB)/bench/.lasa-frames.json
+
+$(LASA_FRAMES): $(STAMP) python/src/feelmysign/bench/lasa_points.py python/src/feelmysign/research/lasa.py python/src/feelmysign/simplify/frames.py
+	$(PY) -m feelmysign.bench.lasa_points $@
+
+web-bench: web-build system $(LASA_FRAMES)
 	cd $(WEB) && $(WEB_BIN)/tsx bench/run.ts
 
 web-clean:

@@ -1,11 +1,15 @@
 /**
  * `npm run bench`: the web client's figures, printed (never asserted).
  *   - the TypeScript angle simplifier's throughput (frames/s) beside a baseline;
+ *   - the TypeScript angle and window simplifiers' throughput on the LASA points
+ *     (written by the Python bench) beside simplify-js (Douglas-Peucker) on the
+ *     same points, as ratios;
  *   - scripting time per frame while drawing in Chromium, after 10 and after
  *     10,000 drawn strokes, and their ratio (incremental rendering keeps it ~1).
  * Needs `vite build` (dist/) and Debian's chromium.
  */
 import { benchFrameCost, type FramePhase } from "./frame-cost";
+import { benchLasa, type LasaRate } from "./lasa";
 import { benchSimplifier } from "./simplifier";
 
 function millions(value: number): string {
@@ -28,6 +32,27 @@ console.log(
     ` ratio ${(simplifier.baselineFramesPerSecond / simplifier.framesPerSecond).toFixed(1)}x;` +
     ` ${simplifier.strokes} strokes from 200000 frames)`,
 );
+
+const lasa = benchLasa();
+if (lasa !== null) {
+  const { highQuality, fast } = lasa.simplifyJs;
+  console.log(
+    `web: simplifiers on LASA (TypeScript, Node ${process.versions.node}): ${lasa.demos} demonstrations,` +
+      ` ${lasa.points.toLocaleString("en")} points (frames at ${lasa.fps} fps, canvas px) from ${lasa.path}`,
+  );
+  console.log(
+    `  ratios are points/s over simplify-js's on the same points (above 1: faster); simplify-js runs` +
+      ` on each whole path, tolerance max_error ${lasa.maxError} grid units in each canvas's px`,
+  );
+  const line = (rate: LasaRate, label: string) =>
+    `  ${rate.name.padEnd(36)} ${millions(rate.pointsPerSecond).padStart(9)} points/s` +
+    `  ${(rate.pointsPerSecond / highQuality.pointsPerSecond).toFixed(2).padStart(6)}x simplify-js (hq)` +
+    `  ${(rate.pointsPerSecond / fast.pointsPerSecond).toFixed(2).padStart(6)}x simplify-js (fast)` +
+    `  ${(lasa.baseline.pointsPerSecond / rate.pointsPerSecond).toFixed(1).padStart(6)}x baseline's time` +
+    (rate.strokes === null ? "" : `  ${rate.strokes} ${label}`);
+  for (const rate of lasa.rates) console.log(line(rate, "strokes (dropped ones too)"));
+  for (const rate of [highQuality, fast]) console.log(line(rate, "segments"));
+}
 
 const frames = await benchFrameCost();
 console.log(`web: scripting time per frame while drawing (${frames.browser}, headless)`);

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections.abc import Sequence
 
 from feelmysign.bench._timing import Rate, best_rate, row
 from feelmysign.layout import Layout
@@ -45,6 +46,15 @@ def _frames(count: int, seed: int = 11) -> list[Sample]:
     return frames_from_samples(samples, 60.0)[:count]
 
 
+def one_distance_per_frame(frames: Sequence[Sample]) -> int:
+    """The simplifiers' baseline: the least per-frame work any of them does. Returns the count."""
+    total, last = 0.0, frames[0]
+    for f in frames:
+        total += math.sqrt((f.x - last.x) ** 2 + (f.y - last.y) ** 2)
+        last = f
+    return len(frames)
+
+
 def planner_rates(count: int = 2000) -> tuple[Rate, Rate]:
     strokes = _strokes(count)
     payloads = [format_legacy(s) for s in strokes]
@@ -61,13 +71,6 @@ def simplifier_rates(count: int = 20_000) -> tuple[Rate, Rate]:
     frames = _frames(count)
     params = AngleParams(canvas_width_px=1200, canvas_height_px=800)
 
-    def minimal() -> int:
-        total, last = 0.0, frames[0]
-        for f in frames:
-            total += math.sqrt((f.x - last.x) ** 2 + (f.y - last.y) ** 2)
-            last = f
-        return len(frames)
-
     def angle() -> int:
         simplifier = AngleSimplifier(params)
         for f in frames:
@@ -75,9 +78,9 @@ def simplifier_rates(count: int = 20_000) -> tuple[Rate, Rate]:
         simplifier.end()
         return len(frames)
 
-    return best_rate("baseline: one distance per frame", minimal), best_rate(
-        "angle simplifier: push one frame", angle
-    )
+    return best_rate(
+        "baseline: one distance per frame", lambda: one_distance_per_frame(frames)
+    ), best_rate("angle simplifier: push one frame", angle)
 
 
 def report() -> list[str]:

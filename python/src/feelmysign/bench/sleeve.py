@@ -65,6 +65,18 @@ class _Inbox:
             self.items.append((time.time_ns() / 1e6, bytes(message.payload)))
             self.cond.notify_all()
 
+    def wait_played(self, count: int, timeout_s: float = 30.0) -> list[dict[str, Any]]:
+        """The first ``count`` played (or adjusted) events; safety events and others skipped."""
+
+        def played() -> list[dict[str, Any]]:
+            events = (json.loads(payload) for _, payload in self.items)
+            return [e for e in events if e.get("type") in ("played", "adjusted")]
+
+        with self.cond:
+            if not self.cond.wait_for(lambda: len(played()) >= count, timeout_s):
+                raise TimeoutError(f"{len(played())} of {count} strokes were played")
+            return played()[:count]
+
     def wait(self, count: int, timeout_s: float = 30.0) -> list[tuple[float, bytes]]:
         with self.cond:
             if not self.cond.wait_for(lambda: len(self.items) >= count, timeout_s):
@@ -141,8 +153,7 @@ def stroke_latencies(
         stroke = Stroke(start, end, duration_ms, None, f"lat-{uuid.uuid4()}", 0)
         published_ms = time.time_ns() / 1e6
         sender.publish(topic(c.sleeve_id, "strokes"), format_json(stroke), qos=1)
-        _, payload = inbox.wait(k + 1)[-1]
-        event = json.loads(payload)
+        event = inbox.wait_played(k + 1)[-1]
         event["published_at_ms"] = published_ms
         results.append(event)
         time.sleep(event["duration_ms"] / 1000)
@@ -202,7 +213,7 @@ def drawing_gaps(c: Credentials, shape: Any, strokes: int = 20) -> list[float]:
             format_json(Stroke(a, b, duration_ms, None, drawing, seq)),
             qos=1,
         )
-    events = [json.loads(p) for _, p in inbox.wait(strokes, timeout_s=60)]
+    events = inbox.wait_played(strokes, timeout_s=60)
     for client in (watcher, sender):
         client.loop_stop()
         client.disconnect()
