@@ -20,6 +20,8 @@ from typing import Any
 
 from feelmysign.simplify import AngleParams, Sample, frames_from_samples, simplify_paths
 from feelmysign.simplify.angle import ANGLE_PARAMS
+from feelmysign.simplify.params import ParamSpec
+from feelmysign.simplify.replay import Params
 
 W, H = 1200.0, 800.0  # the canvas of every case: the 3 x 2 grid's aspect ratio
 
@@ -101,7 +103,7 @@ VARIATIONS: dict[str, dict[str, Any]] = {
 VARIED_SHAPES = ("circle", "zigzag", "right-angle", "pause")
 
 
-def _segments(params: AngleParams, paths: list[Path]) -> dict[str, Any]:
+def _segments(params: Params, paths: list[Path]) -> dict[str, Any]:
     segments = [
         {
             "path": p.path,
@@ -121,31 +123,47 @@ def _segments(params: AngleParams, paths: list[Path]) -> dict[str, Any]:
     }
 
 
-def _case(shape: str, variation: str) -> dict[str, Any]:
-    overrides = {"canvas_width_px": W, "canvas_height_px": H, **VARIATIONS[variation]}
-    params = AngleParams(**overrides)
-    paths = SHAPES[shape]()
-    return {
-        "description": f"{shape} path, {variation}",
-        "tolerance": 1e-9,
-        "params": asdict(params),
-        "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
-        "expected": _segments(params, paths),
+def simplifier_cases(
+    make_params: Callable[..., Params],
+    specs: dict[str, ParamSpec],
+    variations: dict[str, dict[str, Any]],
+    params_description: str,
+) -> dict[str, dict[str, Any]]:
+    """Every shape with the defaults, the richer shapes with every variation, and the table.
+
+    Shared by every simplifier's generator, so all are pinned on the same paths.
+    """
+
+    def case(shape: str, variation: str) -> dict[str, Any]:
+        overrides = {"canvas_width_px": W, "canvas_height_px": H, **variations[variation]}
+        params = make_params(**overrides)
+        paths = SHAPES[shape]()
+        return {
+            "description": f"{shape} path, {variation}",
+            "tolerance": 1e-9,
+            "params": asdict(params),
+            "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
+            "expected": _segments(params, paths),
+        }
+
+    result: dict[str, dict[str, Any]] = {}
+    for shape in SHAPES:
+        result[f"{shape}/defaults.json"] = case(shape, "defaults")
+    for shape in VARIED_SHAPES:
+        for variation in variations:
+            result[f"{shape}/{variation}.json"] = case(shape, variation)
+    defaults = make_params()
+    result["params.json"] = {
+        "description": params_description,
+        "parameters": [specs[f.name].to_json(getattr(defaults, f.name)) for f in fields(defaults)],
     }
+    return result
 
 
 def cases() -> dict[str, dict[str, Any]]:
-    result: dict[str, dict[str, Any]] = {}
-    for shape in SHAPES:
-        result[f"{shape}/defaults.json"] = _case(shape, "defaults")
-    for shape in VARIED_SHAPES:
-        for variation in VARIATIONS:
-            result[f"{shape}/{variation}.json"] = _case(shape, variation)
-    defaults = AngleParams()
-    result["params.json"] = {
-        "description": "the angle simplifier's parameters: defaults (paper, B.1), allowed ranges",
-        "parameters": [
-            ANGLE_PARAMS[f.name].to_json(getattr(defaults, f.name)) for f in fields(defaults)
-        ],
-    }
-    return result
+    return simplifier_cases(
+        AngleParams,
+        ANGLE_PARAMS,
+        VARIATIONS,
+        "the angle simplifier's parameters: defaults (paper, B.1), allowed ranges",
+    )

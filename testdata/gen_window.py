@@ -12,13 +12,11 @@ parameter table (defaults and allowed ranges).
 
 from __future__ import annotations
 
-from dataclasses import asdict, fields
 from typing import Any
 
-from feelmysign.simplify import WindowParams, frames_from_samples, simplify_paths
+from feelmysign.simplify import WindowParams
 from feelmysign.simplify.window import WINDOW_PARAMS
-from gen_angle import SHAPES, H, W
-from gen_angle import Path as SamplePath
+from gen_angle import simplifier_cases
 
 VARIATIONS: dict[str, dict[str, Any]] = {
     "defaults": {},
@@ -35,55 +33,11 @@ VARIATIONS: dict[str, dict[str, Any]] = {
     "sleeve-4x6": {"rows": 4, "columns": 6},
 }
 
-# Every shape with the defaults; the richer shapes with every variation.
-VARIED_SHAPES = ("circle", "zigzag", "right-angle", "pause")
-
-
-def _segments(params: WindowParams, paths: list[SamplePath]) -> dict[str, Any]:
-    segments = [
-        {
-            "path": p.path,
-            "start": list(s.start),
-            "end": list(s.end),
-            "start_ms": s.start_ms,
-            "end_ms": s.end_ms,
-            "emitted_at_ms": s.emitted_at_ms,
-            "dropped": s.dropped,
-        }
-        for p in simplify_paths(params, paths)
-        for s in [p.segment]
-    ]
-    return {
-        "frames": [len(frames_from_samples(path, params.fps)) for path in paths],
-        "segments": segments,
-    }
-
-
-def _case(shape: str, variation: str) -> dict[str, Any]:
-    overrides = {"canvas_width_px": W, "canvas_height_px": H, **VARIATIONS[variation]}
-    params = WindowParams(**overrides)
-    paths = SHAPES[shape]()
-    return {
-        "description": f"{shape} path, {variation}",
-        "tolerance": 1e-9,
-        "params": asdict(params),
-        "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
-        "expected": _segments(params, paths),
-    }
-
 
 def cases() -> dict[str, dict[str, Any]]:
-    result: dict[str, dict[str, Any]] = {}
-    for shape in SHAPES:
-        result[f"{shape}/defaults.json"] = _case(shape, "defaults")
-    for shape in VARIED_SHAPES:
-        for variation in VARIATIONS:
-            result[f"{shape}/{variation}.json"] = _case(shape, variation)
-    defaults = WindowParams()
-    result["params.json"] = {
-        "description": "the window simplifier's parameters: defaults and allowed ranges",
-        "parameters": [
-            WINDOW_PARAMS[f.name].to_json(getattr(defaults, f.name)) for f in fields(defaults)
-        ],
-    }
-    return result
+    return simplifier_cases(
+        WindowParams,
+        WINDOW_PARAMS,
+        VARIATIONS,
+        "the window simplifier's parameters: defaults and allowed ranges",
+    )

@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
-from feelmysign.simplify.params import ParamSpec, check_all
+from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION, Sample, Segment
 
 # Movements shorter than this (pixels) have no direction: the check passes.
@@ -44,22 +44,14 @@ ANGLE_PARAMS: dict[str, ParamSpec] = {
             "max_angle_deg", float, 1, 179, "largest turn, in degrees, that continues a line"
         ),
         ParamSpec("frame_max", int, 0, 36_000, "longest line in frames; 0 = no limit"),
-        ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
         ParamSpec("recover", bool, None, None, "start a new line at the last check (no gaps)"),
-        ParamSpec("clear_on_press", bool, None, None, "a new press clears the drawing"),
-        ParamSpec("min_duration_ms", float, 0, 10_000, "shortest stroke to send, in ms"),
-        ParamSpec("min_length", float, 0, 100, "shortest stroke to send, in grid units"),
-        ParamSpec("rows", int, 1, 64, "actuator rows of the sleeve"),
-        ParamSpec("columns", int, 1, 64, "actuator columns of the sleeve"),
-        ParamSpec("canvas_width_px", float, 1, 100_000, "drawing area width in pixels"),
-        ParamSpec("canvas_height_px", float, 1, 100_000, "drawing area height in pixels"),
-        ParamSpec("stretch", bool, None, None, "stretch the canvas onto the grid (the paper's)"),
+        *FRAME_AND_GRID_SPECS,
     )
 }
 
 
 @dataclass(frozen=True)
-class AngleParams:
+class AngleParams(FrameAndGrid):
     """The paper's parameters (appendix B.1) with its defaults, named with their units."""
 
     check_frames: int = 5
@@ -78,12 +70,6 @@ class AngleParams:
 
     def __post_init__(self) -> None:
         check_all(self, ANGLE_PARAMS)
-
-    @property
-    def mapping(self) -> CanvasMapping:
-        return CanvasMapping(
-            self.canvas_width_px, self.canvas_height_px, self.columns, self.rows, self.stretch
-        )
 
 
 @dataclass

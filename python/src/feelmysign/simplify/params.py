@@ -11,6 +11,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from feelmysign.errors import ParameterError
+from feelmysign.simplify.mapping import CanvasMapping
 
 
 @dataclass(frozen=True)
@@ -60,3 +61,33 @@ def check_all(params: object, specs: dict[str, ParamSpec]) -> None:
     """Raise ParameterError for the first field of a params dataclass outside its range."""
     for field in fields(params):  # type: ignore[arg-type]
         specs[field.name].check(getattr(params, field.name))
+
+
+# The frame, drop and grid settings every simplifier has (beside its own).
+FRAME_AND_GRID_SPECS = (
+    ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
+    ParamSpec("clear_on_press", bool, None, None, "a new press clears the drawing"),
+    ParamSpec("min_duration_ms", float, 0, 10_000, "shortest stroke to send, in ms"),
+    ParamSpec("min_length", float, 0, 100, "shortest stroke to send, in grid units"),
+    ParamSpec("rows", int, 1, 64, "actuator rows of the sleeve"),
+    ParamSpec("columns", int, 1, 64, "actuator columns of the sleeve"),
+    ParamSpec("canvas_width_px", float, 1, 100_000, "drawing area width in pixels"),
+    ParamSpec("canvas_height_px", float, 1, 100_000, "drawing area height in pixels"),
+    ParamSpec("stretch", bool, None, None, "stretch the canvas onto the grid (the paper's)"),
+)
+
+
+class FrameAndGrid:
+    """The canvas-to-grid mapping of a simplifier's parameters (their grid and canvas fields)."""
+
+    rows: int
+    columns: int
+    canvas_width_px: float
+    canvas_height_px: float
+    stretch: bool
+
+    @property
+    def mapping(self) -> CanvasMapping:
+        return CanvasMapping(
+            self.canvas_width_px, self.canvas_height_px, self.columns, self.rows, self.stretch
+        )

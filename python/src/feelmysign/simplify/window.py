@@ -31,7 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
-from feelmysign.simplify.params import ParamSpec, check_all
+from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION, Sample, Segment
 from feelmysign.stroke import Point
 
@@ -48,21 +48,13 @@ WINDOW_PARAMS: dict[str, ParamSpec] = {
         ParamSpec(
             "max_window", int, 1, 1000, "longest stroke in frames after its start (bounds the work)"
         ),
-        ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
-        ParamSpec("clear_on_press", bool, None, None, "a new press clears the drawing"),
-        ParamSpec("min_duration_ms", float, 0, 10_000, "shortest stroke to send, in ms"),
-        ParamSpec("min_length", float, 0, 100, "shortest stroke to send, in grid units"),
-        ParamSpec("rows", int, 1, 64, "actuator rows of the sleeve"),
-        ParamSpec("columns", int, 1, 64, "actuator columns of the sleeve"),
-        ParamSpec("canvas_width_px", float, 1, 100_000, "drawing area width in pixels"),
-        ParamSpec("canvas_height_px", float, 1, 100_000, "drawing area height in pixels"),
-        ParamSpec("stretch", bool, None, None, "stretch the canvas onto the grid (the paper's)"),
+        *FRAME_AND_GRID_SPECS,
     )
 }
 
 
 @dataclass(frozen=True)
-class WindowParams:
+class WindowParams(FrameAndGrid):
     """The error bound and window cap, then the same frame, drop and grid settings as angle.
 
     ``max_error`` 0.1 grid units is 3 mm on the paper's sleeve (3 cm spacing),
@@ -83,12 +75,6 @@ class WindowParams:
 
     def __post_init__(self) -> None:
         check_all(self, WINDOW_PARAMS)
-
-    @property
-    def mapping(self) -> CanvasMapping:
-        return CanvasMapping(
-            self.canvas_width_px, self.canvas_height_px, self.columns, self.rows, self.stretch
-        )
 
 
 @dataclass(frozen=True)
