@@ -384,16 +384,8 @@ export function angleParams(
     check_frames: settings.check_frames,
     max_angle_deg: settings.max_angle_deg,
     frame_max: settings.frame_max,
-    fps: settings.fps,
     recover: settings.recover,
-    clear_on_press: settings.clear_on_press,
-    min_duration_ms: settings.min_duration_ms,
-    min_length: settings.min_length,
-    rows: grid.rows,
-    columns: grid.columns,
-    canvas_width_px: canvas.width_px,
-    canvas_height_px: canvas.height_px,
-    stretch: settings.stretch,
+    ...frameAndGrid(settings, grid, canvas),
   };
 }
 
@@ -406,6 +398,17 @@ export function windowParams(
   return {
     max_error: settings.max_error,
     max_window: settings.max_window,
+    ...frameAndGrid(settings, grid, canvas),
+  };
+}
+
+/** The frame, drop and grid parameters every simplifier has. */
+function frameAndGrid(
+  settings: Settings,
+  grid: { readonly rows: number; readonly columns: number },
+  canvas: { readonly width_px: number; readonly height_px: number },
+) {
+  return {
     fps: settings.fps,
     clear_on_press: settings.clear_on_press,
     min_duration_ms: settings.min_duration_ms,
