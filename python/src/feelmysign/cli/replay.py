@@ -26,7 +26,6 @@ import argparse
 import functools
 import json
 import math
-import time
 import uuid
 from typing import Any
 
@@ -38,11 +37,11 @@ from feelmysign.cli._broker_options import (
     broker_settings_from_args,
     connect_client,
 )
-from feelmysign.cli.send import _Message, _Sender
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.research.rerun import Rerun, mismatch, rerun
+from feelmysign.sending import OutgoingStroke, StrokeSender, printer
 from feelmysign.simplify.recording import Recording, load_recording
 from feelmysign.simplify.replay import Params
 from feelmysign.stroke import Stroke
@@ -193,22 +192,17 @@ def _send(args: argparse.Namespace, result: Rerun, params: Params) -> None:
     settings: BrokerSettings = broker_settings_from_args(args, "sender")
     speed = args.speed or 1.0
     messages = [
-        _Message(i, settings.strokes_topic, stroke, legacy=False)
+        OutgoingStroke(i, settings.strokes_topic, stroke, legacy=False)
         for i, stroke in enumerate(strokes)
     ]
     client = connect_client(
         settings, f"feelmysign-replay-{uuid.uuid4().hex[:12]}", timeout_s=args.timeout_s
     )
     try:
-        # send.py's sender: the same publish, acknowledgement wait and report as 'send'.
-        sender = _Sender(client, settings, timeout_s=args.timeout_s, json_lines=args.json)
-        start_s = time.monotonic()
-        for message, offset_ms in zip(messages, at_ms, strict=True):
-            # Drawing time, not a wait for an event: the pace is the point.
-            time.sleep(max(0.0, start_s + offset_ms / 1000 / speed - time.monotonic()))
-            payload, mid = sender._publish(message)
-            deadline_s = time.monotonic() + args.timeout_s
-            sender._confirm(message, payload, mid, deadline_s, len(messages))
+        # The same publish, acknowledgement wait and report as 'send'.
+        report = printer(json_lines=args.json, total=len(messages))
+        sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
+        sender.send_at(messages, [offset_ms / speed for offset_ms in at_ms])
     finally:
         client.disconnect()
         client.loop_stop()

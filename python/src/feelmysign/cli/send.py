@@ -17,23 +17,15 @@ from __future__ import annotations
 
 import argparse
 import functools
-import json
 import math
 import sys
-import threading
-import time
 import uuid
 from collections.abc import Iterator
-from dataclasses import dataclass, replace
-from typing import Any, Literal
-
-import paho.mqtt.client as mqtt
-from paho.mqtt.reasoncodes import ReasonCode
+from dataclasses import replace
 
 from feelmysign._mosquitto_config import LEGACY_TOPIC
 from feelmysign.cli._broker_options import (
     DEFAULT_TIMEOUT_S,
-    BrokerConnectionError,
     BrokerSettings,
     add_broker_options,
     broker_settings_from_args,
@@ -42,11 +34,10 @@ from feelmysign.cli._broker_options import (
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.errors import ParameterError, StrokeError
 from feelmysign.layout import Layout
-from feelmysign.protocol import Accepted, format_json, format_legacy, parse
+from feelmysign.protocol import Accepted, parse
+from feelmysign.sending import OutgoingStroke, Pace, StrokeSender, printer
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
 from feelmysign.stroke import Stroke
-
-Pace = Literal["realtime", "burst"]
 
 
 def _epilog() -> str:
@@ -60,20 +51,6 @@ def _epilog() -> str:
         "A stroke that starts with '-' (a negative coordinate) must follow '--':\n"
         "  feelmysign send -- -0.5,0,2,0,1000\n"
     )
-
-
-@dataclass(frozen=True)
-class _Message:
-    index: int
-    topic: str
-    stroke: Stroke
-    legacy: bool
-
-    def payload(self) -> str:
-        if self.legacy:
-            return format_legacy(self.stroke)
-        # The wall clock at the moment of sending: the sleeve measures latency from it.
-        return format_json(replace(self.stroke, sent_at_ms=round(time.time() * 1000)))
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -169,12 +146,13 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     strokes = _strokes(args, layout)  # all checked before connecting: a bad one sends nothing
     settings = broker_settings_from_args(args, "sender")
     topic = args.legacy_topic if args.legacy else settings.strokes_topic
-    messages = [_Message(i, topic, stroke, args.legacy) for i, stroke in enumerate(strokes)]
+    messages = [OutgoingStroke(i, topic, stroke, args.legacy) for i, stroke in enumerate(strokes)]
     pace: Pace = args.pace or ("realtime" if args.shape else "burst")
     client_id = f"feelmysign-send-{uuid.uuid4().hex[:12]}"
     client = connect_client(settings, client_id, timeout_s=args.timeout_s)
     try:
-        _Sender(client, settings, timeout_s=args.timeout_s, json_lines=args.json).send(
+        report = printer(json_lines=args.json, total=len(messages))
+        StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report).send(
             messages, pace=pace
         )
     finally:
@@ -259,120 +237,3 @@ def _summary(args: argparse.Namespace, settings: BrokerSettings, strokes: list[S
         f"Sent {what}, {total_ms / 1000:.2f} s of drawing, to {where} via {settings.url}; "
         f"the broker acknowledged every one."
     )
-
-
-class _Acks:
-    """PUBACKs by message id, from paho's thread; waiting ends early if the connection drops.
-
-    An acknowledgement may arrive before ``publish`` has returned its id, hence a dict.
-    """
-
-    def __init__(self) -> None:
-        self._condition = threading.Condition()
-        self._codes: dict[int, ReasonCode] = {}
-        self._lost: str | None = None
-
-    def on_publish(
-        self, _client: mqtt.Client, _userdata: Any, mid: int, code: ReasonCode, _props: Any
-    ) -> None:
-        with self._condition:
-            self._codes[mid] = code
-            self._condition.notify_all()
-
-    def on_disconnect(
-        self, _client: mqtt.Client, _userdata: Any, _flags: Any, code: ReasonCode, _props: Any
-    ) -> None:
-        with self._condition:
-            self._lost = str(code)
-            self._condition.notify_all()
-
-    def wait(self, mid: int, timeout_s: float) -> ReasonCode | str:
-        """The PUBACK's reason code, or why none will come ('timeout' or the disconnect)."""
-        with self._condition:
-            arrived = self._condition.wait_for(
-                lambda: mid in self._codes or self._lost is not None, max(timeout_s, 0.0)
-            )
-            if mid in self._codes:
-                return self._codes.pop(mid)
-            return self._lost if arrived and self._lost is not None else "timeout"
-
-
-class _Sender:
-    """Publishes messages at their pace and reports each once the broker acknowledged it."""
-
-    def __init__(
-        self, client: mqtt.Client, settings: BrokerSettings, *, timeout_s: float, json_lines: bool
-    ) -> None:
-        self._client = client
-        self._settings = settings
-        self._timeout_s = timeout_s
-        self._json_lines = json_lines
-        self._acks = _Acks()
-        client.on_publish = self._acks.on_publish
-        client.on_disconnect = self._acks.on_disconnect
-
-    def send(self, messages: list[_Message], *, pace: Pace) -> None:
-        if pace == "burst":
-            sent = [(message, *self._publish(message)) for message in messages]
-            deadline_s = time.monotonic() + self._timeout_s
-            for message, payload, mid in sent:
-                self._confirm(message, payload, mid, deadline_s, len(messages))
-            return
-        start_s = time.monotonic()
-        offset_ms = 0.0
-        for message in messages:
-            # Drawing time, not a wait for an event: the pace is the point.
-            time.sleep(max(0.0, start_s + offset_ms / 1000 - time.monotonic()))
-            payload, mid = self._publish(message)
-            self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
-            offset_ms += message.stroke.duration_ms
-
-    def _publish(self, message: _Message) -> tuple[str, int]:
-        payload = message.payload()
-        info = self._client.publish(message.topic, payload, qos=1)
-        if info.rc != mqtt.MQTT_ERR_SUCCESS:
-            raise BrokerConnectionError(
-                "closed",
-                f"Lost the connection to {self._settings.url} before stroke {message.index + 1} "
-                f"could be sent ({mqtt.error_string(info.rc)}); send the drawing again.",
-                url=self._settings.url,
-            )
-        return payload, info.mid
-
-    def _confirm(
-        self, message: _Message, payload: str, mid: int, deadline_s: float, total: int
-    ) -> None:
-        answer = self._acks.wait(mid, deadline_s - time.monotonic())
-        number = f"stroke {message.index + 1} of {total}"
-        url = self._settings.url
-        if answer == "timeout":
-            raise BrokerConnectionError(
-                "timeout",
-                f"{url} did not acknowledge {number} within {self._timeout_s:g} s: the broker "
-                "may be overloaded or the network slow; try again, or raise --timeout-s.",
-                url=url,
-            )
-        if isinstance(answer, str):
-            raise BrokerConnectionError(
-                "closed",
-                f"{url} closed the connection ({answer}) before acknowledging {number}; "
-                "check the broker's log, then send the drawing again.",
-                url=url,
-            )
-        if answer.is_failure:
-            raise BrokerConnectionError(
-                "publish-refused",
-                f"{url} refused {number} on {message.topic} ({answer}): user "
-                f"{self._settings.username!r} may not publish there. Send with the sender "
-                "account (credentials.json's 'sender') and check --id.",
-                url=url,
-            )
-        self._report(message, payload, total)
-
-    def _report(self, message: _Message, payload: str, total: int) -> None:
-        if self._json_lines:
-            line = json.dumps({"index": message.index, "topic": message.topic, "payload": payload})
-        else:
-            width = len(str(total))
-            line = f"[{message.index + 1:>{width}}/{total}] {message.topic} {payload}"
-        print(line, flush=True)

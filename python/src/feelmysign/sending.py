@@ -1,0 +1,173 @@
+"""Publish strokes to a sleeve at their pace, each acknowledged by the broker before the next.
+
+Used by ``feelmysign send`` and by the study runner (``feelmysign study``),
+which both need the same guarantee: when ``StrokeSender.send`` returns, the
+broker holds every stroke (QoS 1 PUBACK), or a BrokerConnectionError says why
+not. ``on_sent`` is told of each acknowledged stroke with the exact payload.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any, Literal
+
+import paho.mqtt.client as mqtt
+from paho.mqtt.reasoncodes import ReasonCode
+
+from feelmysign.cli._broker_options import BrokerConnectionError, BrokerSettings
+from feelmysign.protocol import format_json, format_legacy
+from feelmysign.stroke import Stroke
+
+Pace = Literal["realtime", "burst"]
+
+
+@dataclass(frozen=True)
+class OutgoingStroke:
+    """One stroke to publish: its place in the drawing, its topic, and its format."""
+
+    index: int
+    topic: str
+    stroke: Stroke
+    legacy: bool = False
+
+    def payload(self) -> str:
+        if self.legacy:
+            return format_legacy(self.stroke)
+        # The wall clock at the moment of sending: the sleeve measures latency from it.
+        return format_json(replace(self.stroke, sent_at_ms=round(time.time() * 1000)))
+
+
+class _Acks:
+    """PUBACKs by message id, from paho's thread; waiting ends early if the connection drops.
+
+    An acknowledgement may arrive before ``publish`` has returned its id, hence a dict.
+    """
+
+    def __init__(self) -> None:
+        self._condition = threading.Condition()
+        self._codes: dict[int, ReasonCode] = {}
+        self._lost: str | None = None
+
+    def on_publish(
+        self, _client: mqtt.Client, _userdata: Any, mid: int, code: ReasonCode, _props: Any
+    ) -> None:
+        with self._condition:
+            self._codes[mid] = code
+            self._condition.notify_all()
+
+    def on_disconnect(
+        self, _client: mqtt.Client, _userdata: Any, _flags: Any, code: ReasonCode, _props: Any
+    ) -> None:
+        with self._condition:
+            self._lost = str(code)
+            self._condition.notify_all()
+
+    def wait(self, mid: int, timeout_s: float) -> ReasonCode | str:
+        """The PUBACK's reason code, or why none will come ('timeout' or the disconnect)."""
+        with self._condition:
+            arrived = self._condition.wait_for(
+                lambda: mid in self._codes or self._lost is not None, max(timeout_s, 0.0)
+            )
+            if mid in self._codes:
+                return self._codes.pop(mid)
+            return self._lost if arrived and self._lost is not None else "timeout"
+
+
+class StrokeSender:
+    """Publishes strokes at their pace and reports each once the broker acknowledged it."""
+
+    def __init__(
+        self,
+        client: mqtt.Client,
+        settings: BrokerSettings,
+        *,
+        timeout_s: float,
+        on_sent: Callable[[OutgoingStroke, str], None] = lambda message, payload: None,
+    ) -> None:
+        self._client = client
+        self._settings = settings
+        self._timeout_s = timeout_s
+        self._on_sent = on_sent
+        self._acks = _Acks()
+        client.on_publish = self._acks.on_publish
+        client.on_disconnect = self._acks.on_disconnect
+
+    def send(self, messages: list[OutgoingStroke], *, pace: Pace) -> None:
+        if pace == "burst":
+            sent = [(message, *self._publish(message)) for message in messages]
+            deadline_s = time.monotonic() + self._timeout_s
+            for message, payload, mid in sent:
+                self._confirm(message, payload, mid, deadline_s, len(messages))
+            return
+        offsets_ms = list(itertools.accumulate((m.stroke.duration_ms for m in messages), initial=0))
+        self.send_at(messages, offsets_ms[:-1])
+
+    def send_at(self, messages: list[OutgoingStroke], offsets_ms: list[float]) -> None:
+        """Each message published ``offsets_ms`` after the first, once the previous is acked."""
+        start_s = time.monotonic()
+        for message, offset_ms in zip(messages, offsets_ms, strict=True):
+            # Drawing time, not a wait for an event: the pace is the point.
+            time.sleep(max(0.0, start_s + offset_ms / 1000 - time.monotonic()))
+            payload, mid = self._publish(message)
+            self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
+
+    def _publish(self, message: OutgoingStroke) -> tuple[str, int]:
+        payload = message.payload()
+        info = self._client.publish(message.topic, payload, qos=1)
+        if info.rc != mqtt.MQTT_ERR_SUCCESS:
+            raise BrokerConnectionError(
+                "closed",
+                f"Lost the connection to {self._settings.url} before stroke {message.index + 1} "
+                f"could be sent ({mqtt.error_string(info.rc)}); send the drawing again.",
+                url=self._settings.url,
+            )
+        return payload, info.mid
+
+    def _confirm(
+        self, message: OutgoingStroke, payload: str, mid: int, deadline_s: float, total: int
+    ) -> None:
+        answer = self._acks.wait(mid, deadline_s - time.monotonic())
+        number = f"stroke {message.index + 1} of {total}"
+        url = self._settings.url
+        if answer == "timeout":
+            raise BrokerConnectionError(
+                "timeout",
+                f"{url} did not acknowledge {number} within {self._timeout_s:g} s: the broker "
+                "may be overloaded or the network slow; try again, or raise --timeout-s.",
+                url=url,
+            )
+        if isinstance(answer, str):
+            raise BrokerConnectionError(
+                "closed",
+                f"{url} closed the connection ({answer}) before acknowledging {number}; "
+                "check the broker's log, then send the drawing again.",
+                url=url,
+            )
+        if answer.is_failure:
+            raise BrokerConnectionError(
+                "publish-refused",
+                f"{url} refused {number} on {message.topic} ({answer}): user "
+                f"{self._settings.username!r} may not publish there. Send with the sender "
+                "account (credentials.json's 'sender') and check --id.",
+                url=url,
+            )
+        self._on_sent(message, payload)
+
+
+def printer(*, json_lines: bool, total: int) -> Callable[[OutgoingStroke, str], None]:
+    """An ``on_sent`` that prints one line per stroke: ``[i/n] topic payload``, or JSON."""
+
+    def report(message: OutgoingStroke, payload: str) -> None:
+        if json_lines:
+            line = json.dumps({"index": message.index, "topic": message.topic, "payload": payload})
+        else:
+            width = len(str(total))
+            line = f"[{message.index + 1:>{width}}/{total}] {message.topic} {payload}"
+        print(line, flush=True)
+
+    return report
