@@ -21,7 +21,7 @@ from typing import Any
 from feelmysign.simplify import AngleParams, Sample, frames_from_samples, simplify_paths
 from feelmysign.simplify.angle import ANGLE_PARAMS
 from feelmysign.simplify.params import ParamSpec
-from feelmysign.simplify.replay import Params
+from feelmysign.simplify.registry import Params
 
 W, H = 1200.0, 800.0  # the canvas of every case: the 3 x 2 grid's aspect ratio
 

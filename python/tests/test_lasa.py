@@ -9,7 +9,7 @@ from scipy.io import loadmat
 from feelmysign.research import lasa, metrics
 from feelmysign.research.evaluate import grid_points, params_for
 from feelmysign.research.rerun import rerun
-from feelmysign.simplify.replay import ALGORITHMS
+from feelmysign.simplify.registry import ALGORITHMS
 
 
 @pytest.fixture(scope="module")

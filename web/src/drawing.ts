@@ -5,8 +5,7 @@
  * can order, deduplicate and chain them.
  */
 import type { Stroke } from "./protocol";
-import type { AngleParams } from "./simplify/params";
-import type { WindowParams } from "./simplify/window-params";
+import type { SimplifierParams } from "./simplify/registry";
 import type { Sample, Segment } from "./simplify/segment";
 
 export type PointerKind = "mouse" | "pen" | "touch";
@@ -23,7 +22,7 @@ export interface DrawnSegment {
 export class Drawing {
   readonly id: string;
   /** The parameters every path of this drawing is simplified with (canvas size included). */
-  readonly params: AngleParams | WindowParams;
+  readonly params: SimplifierParams;
   /** Pointer samples per path, as the pointer events reported them (the recording). */
   readonly paths: Sample[][] = [];
   /** The animation frames fed to the simplifier, per path. */
@@ -34,7 +33,7 @@ export class Drawing {
   readonly #acked = new Set<number>();
   #nextSeq = 0;
 
-  constructor(id: string, params: AngleParams | WindowParams) {
+  constructor(id: string, params: SimplifierParams) {
     this.id = id;
     this.params = params;
   }

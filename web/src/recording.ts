@@ -7,7 +7,7 @@
  * Times start at 0 at the drawing's first sample.
  */
 import type { Drawing } from "./drawing";
-import { algorithmOf, type Algorithm } from "./simplify/replay";
+import type { Algorithm } from "./simplify/registry";
 import type { Sample } from "./simplify/segment";
 
 export interface RecordedSample {
@@ -39,7 +39,13 @@ export interface Recording {
 }
 
 /** The parameters a recording keeps: the sender's, without the canvas and grid (kept beside them). */
-const NOT_RECORDED: ReadonlySet<string> = new Set(["rows", "columns", "canvas_width_px", "canvas_height_px"]);
+const NOT_RECORDED: ReadonlySet<string> = new Set([
+  "algorithm",
+  "rows",
+  "columns",
+  "canvas_width_px",
+  "canvas_height_px",
+]);
 
 export function buildRecording(drawing: Drawing, recordedAt: Date): Recording {
   const origin = drawing.paths[0]?.[0]?.t_ms ?? 0;
@@ -73,7 +79,7 @@ export function buildRecording(drawing: Drawing, recordedAt: Date): Recording {
     paths: drawing.paths.filter((path) => path.length > 0).map((path) => path.map(shift)),
     sleeve: { rows: params.rows, columns: params.columns },
     simplifier: {
-      algorithm: algorithmOf(params),
+      algorithm: params.algorithm,
       params: Object.fromEntries(Object.entries(params).filter(([name]) => !NOT_RECORDED.has(name))),
     },
     drawing: drawing.id,

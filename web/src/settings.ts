@@ -14,7 +14,7 @@ import {
   type AngleParams,
   type ParamSpec,
 } from "./simplify/params";
-import type { Algorithm } from "./simplify/replay";
+import type { Algorithm, SimplifierParams } from "./simplify/registry";
 import { windowParamSpec, type WindowParamName, type WindowParams } from "./simplify/window-params";
 
 export type WireProtocol = "json" | "legacy";
@@ -381,6 +381,7 @@ export function angleParams(
   canvas: { readonly width_px: number; readonly height_px: number },
 ): AngleParams {
   return {
+    algorithm: "angle",
     check_frames: settings.check_frames,
     max_angle_deg: settings.max_angle_deg,
     frame_max: settings.frame_max,
@@ -396,6 +397,7 @@ export function windowParams(
   canvas: { readonly width_px: number; readonly height_px: number },
 ): WindowParams {
   return {
+    algorithm: "window",
     max_error: settings.max_error,
     max_window: settings.max_window,
     ...frameAndGrid(settings, grid, canvas),
@@ -421,12 +423,12 @@ function frameAndGrid(
   };
 }
 
-/** The chosen simplifier's parameters (their shape says which one: see `makeSimplifier`). */
+/** The chosen simplifier's parameters (their `algorithm` says which one). */
 export function simplifierParams(
   settings: Settings,
   grid: { readonly rows: number; readonly columns: number },
   canvas: { readonly width_px: number; readonly height_px: number },
-): AngleParams | WindowParams {
+): SimplifierParams {
   return settings.algorithm === "window"
     ? windowParams(settings, grid, canvas)
     : angleParams(settings, grid, canvas);

@@ -11,7 +11,7 @@ import { AngleSimplifier } from "../src/simplify/angle";
 import { framesFromSamples } from "../src/simplify/frames";
 import { CanvasMapping } from "../src/simplify/mapping";
 import { DEFAULT_ANGLE_PARAMS, type AngleParams } from "../src/simplify/params";
-import { simplifyPaths } from "../src/simplify/replay";
+import { simplifyPaths } from "../src/simplify/registry";
 import {
   NOT_ENOUGH_DISTANCE,
   NOT_ENOUGH_DURATION,
@@ -54,6 +54,7 @@ const pathArb = fc
   });
 
 const paramsArb: fc.Arbitrary<AngleParams> = fc.record({
+  algorithm: fc.constant("angle" as const),
   check_frames: fc.integer({ min: 2, max: 20 }),
   max_angle_deg: fc.double({ min: 1, max: 179, noNaN: true }),
   frame_max: fc.oneof(fc.constant(0), fc.integer({ min: 1, max: 120 })),

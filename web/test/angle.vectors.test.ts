@@ -6,7 +6,7 @@
 import { describe, expect, it } from "vitest";
 import { framesFromSamples } from "../src/simplify/frames";
 import type { AngleParams } from "../src/simplify/params";
-import { simplifyPaths } from "../src/simplify/replay";
+import { simplifyPaths } from "../src/simplify/registry";
 import type { Sample } from "../src/simplify/segment";
 import { vectors } from "./testdata";
 
@@ -23,7 +23,7 @@ interface ExpectedSegment {
 interface AngleVector {
   description: string;
   tolerance: number;
-  params: AngleParams;
+  params: Omit<AngleParams, "algorithm">;
   paths: [number, number, number, number][][];
   expected: { frames: number[]; segments: ExpectedSegment[] };
 }
@@ -48,7 +48,7 @@ describe("angle vectors", () => {
     expect(paths.map((path) => framesFromSamples(path, vector.params.fps).length)).toEqual(
       vector.expected.frames,
     );
-    const actual = simplifyPaths(vector.params, paths);
+    const actual = simplifyPaths({ ...vector.params, algorithm: "angle" }, paths);
     expect(actual.length, "segment count").toBe(vector.expected.segments.length);
     const tol = vector.tolerance;
     vector.expected.segments.forEach((want, i) => {

@@ -49,6 +49,7 @@ const pathArb = fc
   });
 
 const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
+  algorithm: fc.constant("window" as const),
   max_error: fc.oneof(
     fc.constantFrom(0.001, 0.02, 0.05, 0.2),
     fc.double({ min: 0.001, max: 2, noNaN: true }),

@@ -13,7 +13,7 @@ import {
   STORAGE_KEY,
   validateSettings,
 } from "../src/settings";
-import { makeSimplifier } from "../src/simplify/replay";
+import { makeSimplifier } from "../src/simplify/registry";
 import type { Sample } from "../src/simplify/segment";
 import { WindowSimplifier } from "../src/simplify/window";
 import { windowParamSpec, type WindowParams } from "../src/simplify/window-params";

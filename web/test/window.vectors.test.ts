@@ -5,9 +5,9 @@
  */
 import { describe, expect, it } from "vitest";
 import { framesFromSamples } from "../src/simplify/frames";
-import { simplifyPaths } from "../src/simplify/replay";
+import { simplifyPaths } from "../src/simplify/registry";
 import type { Sample } from "../src/simplify/segment";
-import { DEFAULT_WINDOW_PARAMS, WINDOW_PARAM_SPECS, type WindowParams } from "../src/simplify/window-params";
+import type { WindowParams } from "../src/simplify/window-params";
 import { vectors } from "./testdata";
 
 interface ExpectedSegment {
@@ -23,7 +23,7 @@ interface ExpectedSegment {
 interface WindowVector {
   description: string;
   tolerance: number;
-  params: WindowParams;
+  params: Omit<WindowParams, "algorithm">;
   paths: [number, number, number, number][][];
   expected: { frames: number[]; segments: ExpectedSegment[] };
 }
@@ -41,11 +41,6 @@ describe("window vectors", () => {
     expect(cases.length).toBeGreaterThanOrEqual(50);
   });
 
-  it("reads the reference's parameter table", () => {
-    expect(WINDOW_PARAM_SPECS.map((spec) => spec.name)).toEqual(Object.keys(DEFAULT_WINDOW_PARAMS));
-    expect(DEFAULT_WINDOW_PARAMS.max_error).toBe(0.1);
-  });
-
   it.each(cases)("%s", (_name, vector) => {
     const paths: Sample[][] = vector.paths.map((path) =>
       path.map(([t_ms, x, y, pressure]) => ({ t_ms, x, y, pressure })),
@@ -53,7 +48,7 @@ describe("window vectors", () => {
     expect(paths.map((path) => framesFromSamples(path, vector.params.fps).length)).toEqual(
       vector.expected.frames,
     );
-    const actual = simplifyPaths(vector.params, paths);
+    const actual = simplifyPaths({ ...vector.params, algorithm: "window" }, paths);
     expect(actual.length, "segment count").toBe(vector.expected.segments.length);
     const tol = vector.tolerance;
     vector.expected.segments.forEach((want, i) => {

@@ -15,13 +15,7 @@
  */
 import { CanvasMapping } from "./mapping";
 import { checkAngleParams, type AngleParams } from "./params";
-import {
-  NOT_ENOUGH_DISTANCE,
-  NOT_ENOUGH_DURATION,
-  segmentLength,
-  type Sample,
-  type Segment,
-} from "./segment";
+import { finishSegment, type Sample, type Segment } from "./segment";
 
 /** Movements shorter than this (pixels) have no direction: the check passes. */
 const STILL_PX = 1e-9;
@@ -124,22 +118,14 @@ export class AngleSimplifier {
   }
 
   #finish(start: Sample, end: Sample): Segment {
-    const segment: Segment = {
-      start: this.#mapping.toGrid(start.x, start.y),
-      end: this.#mapping.toGrid(end.x, end.y),
-      start_ms: start.t_ms,
-      end_ms: end.t_ms,
-      emitted_at_ms: this.#pointer ? this.#pointer.t_ms : end.t_ms,
-      dropped: null,
-    };
-    // Length first, as the reference: a tap is "not enough distance".
-    if (segmentLength(segment) < this.params.min_length) {
-      return { ...segment, dropped: NOT_ENOUGH_DISTANCE };
-    }
-    if (segment.end_ms - segment.start_ms < this.params.min_duration_ms) {
-      return { ...segment, dropped: NOT_ENOUGH_DURATION };
-    }
-    return segment;
+    return finishSegment(
+      this.#mapping.toGrid(start.x, start.y),
+      this.#mapping.toGrid(end.x, end.y),
+      start.t_ms,
+      end.t_ms,
+      this.#pointer ? this.#pointer.t_ms : end.t_ms,
+      this.params,
+    );
   }
 }
 

@@ -1,11 +1,10 @@
 /**
- * The angle simplifier's parameters: defaults (the paper's, appendix B.1) and
- * allowed ranges, read at build time from `testdata/angle/params.json`, the
- * table the Python reference writes. The browser therefore validates with
- * exactly the Python ranges and can never drift from them.
+ * Parameter tables of the simplifiers: defaults, allowed ranges, units, help,
+ * and the angle simplifier's own (defaults from the paper, appendix B.1). The
+ * tables are written here, not read from the `params.json` files in testdata/ (test data
+ * stays out of the page), and a test holds them equal to those files, which the
+ * Python reference writes: the browser validates with exactly its ranges.
  */
-import table from "../../../testdata/angle/params.json";
-
 export type ParamType = "integer" | "number" | "boolean";
 
 /** One row of a parameter table; `N` names the parameters of one simplifier. */
@@ -20,6 +19,8 @@ export interface ParamSpec<N extends string = AngleParamName> {
 
 /** The parameters of `AngleParams` in the reference, snake_case as in every file that holds them. */
 export interface AngleParams {
+  /** Which simplifier these parameters are for (see `registry.ts`). */
+  readonly algorithm: "angle";
   readonly check_frames: number;
   readonly max_angle_deg: number;
   readonly frame_max: number;
@@ -35,63 +36,148 @@ export interface AngleParams {
   readonly stretch: boolean;
 }
 
-export type AngleParamName = keyof AngleParams;
+export type AngleParamName = Exclude<keyof AngleParams, "algorithm">;
 
-const PARAM_TYPES: readonly string[] = ["integer", "number", "boolean"];
+/** The frame, drop and grid parameters every simplifier has, named as in every simplifier. */
+export type FrameAndGridName =
+  | "fps"
+  | "clear_on_press"
+  | "min_duration_ms"
+  | "min_length"
+  | "rows"
+  | "columns"
+  | "canvas_width_px"
+  | "canvas_height_px"
+  | "stretch";
 
-/** A simplifier's parameter table (`source` names its file, for the errors). */
-export function readSpecs<N extends string>(raw: unknown, source: string): ParamSpec<N>[] {
-  // Checked once at load: a reshaped params.json should fail loudly, not validate wrongly.
-  const parameters = (raw as { parameters?: unknown }).parameters;
-  if (!Array.isArray(parameters)) {
-    throw new Error(`${source} has no 'parameters' list; regenerate it`);
-  }
-  return parameters.map((entry: Record<string, unknown>, index) => {
-    const { name, type, minimum, maximum, help } = entry;
-    const value = entry["default"];
-    const bound = (b: unknown) => b === null || typeof b === "number";
-    if (
-      typeof name !== "string" ||
-      typeof type !== "string" ||
-      !PARAM_TYPES.includes(type) ||
-      !(typeof value === "number" || typeof value === "boolean") ||
-      !bound(minimum) ||
-      !bound(maximum) ||
-      typeof help !== "string"
-    ) {
-      throw new Error(`${source}: parameters[${index}] is malformed`);
-    }
-    return {
-      name: name as N,
-      type: type as ParamType,
-      default: value,
-      minimum: minimum as number | null,
-      maximum: maximum as number | null,
-      help,
-    };
-  });
+export const FPS_SPEC: ParamSpec<FrameAndGridName> = {
+  name: "fps",
+  type: "number",
+  default: 60,
+  minimum: 1,
+  maximum: 1000,
+  help: "frames per second of the drawing loop",
+};
+
+/** The drop and grid settings every simplifier has, after its own and `fps`. */
+export const DROP_AND_GRID_SPECS: readonly ParamSpec<FrameAndGridName>[] = [
+  {
+    name: "clear_on_press",
+    type: "boolean",
+    default: true,
+    minimum: null,
+    maximum: null,
+    help: "a new press clears the drawing",
+  },
+  {
+    name: "min_duration_ms",
+    type: "number",
+    default: 6.1,
+    minimum: 0,
+    maximum: 10000,
+    help: "shortest stroke to send, in ms",
+  },
+  {
+    name: "min_length",
+    type: "number",
+    default: 0.1,
+    minimum: 0,
+    maximum: 100,
+    help: "shortest stroke to send, in grid units",
+  },
+  { name: "rows", type: "integer", default: 3, minimum: 1, maximum: 64, help: "actuator rows of the sleeve" },
+  {
+    name: "columns",
+    type: "integer",
+    default: 4,
+    minimum: 1,
+    maximum: 64,
+    help: "actuator columns of the sleeve",
+  },
+  {
+    name: "canvas_width_px",
+    type: "number",
+    default: 1920,
+    minimum: 1,
+    maximum: 100000,
+    help: "drawing area width in pixels",
+  },
+  {
+    name: "canvas_height_px",
+    type: "number",
+    default: 1080,
+    minimum: 1,
+    maximum: 100000,
+    help: "drawing area height in pixels",
+  },
+  {
+    name: "stretch",
+    type: "boolean",
+    default: false,
+    minimum: null,
+    maximum: null,
+    help: "stretch the canvas onto the grid (the paper's)",
+  },
+];
+
+/** The defaults of a table, as a parameter object. */
+export function defaultsOf<P>(specs: readonly ParamSpec<string>[], algorithm: string): P {
+  return Object.freeze({
+    algorithm,
+    ...Object.fromEntries(specs.map((spec) => [spec.name, spec.default])),
+  }) as unknown as P;
 }
 
 /** Every parameter, in the reference's order. */
-export const PARAM_SPECS: readonly ParamSpec[] = readSpecs<AngleParamName>(
-  table,
-  "testdata/angle/params.json",
-);
+export const PARAM_SPECS: readonly ParamSpec[] = [
+  {
+    name: "check_frames",
+    type: "integer",
+    default: 5,
+    minimum: 2,
+    maximum: 600,
+    help: "frames between two checks (the paper's checkFrame)",
+  },
+  {
+    name: "max_angle_deg",
+    type: "number",
+    default: 20,
+    minimum: 1,
+    maximum: 179,
+    help: "largest turn, in degrees, that continues a line",
+  },
+  {
+    name: "frame_max",
+    type: "integer",
+    default: 0,
+    minimum: 0,
+    maximum: 36000,
+    help: "longest line in frames; 0 = no limit",
+  },
+  FPS_SPEC,
+  {
+    name: "recover",
+    type: "boolean",
+    default: true,
+    minimum: null,
+    maximum: null,
+    help: "start a new line at the last check (no gaps)",
+  },
+  ...DROP_AND_GRID_SPECS,
+];
 
 const SPECS_BY_NAME = new Map(PARAM_SPECS.map((spec) => [spec.name, spec]));
 
 export function paramSpec(name: AngleParamName): ParamSpec {
   const spec = SPECS_BY_NAME.get(name);
   if (spec === undefined) {
-    throw new Error(`testdata/angle/params.json has no parameter '${name}'; regenerate it`);
+    throw new Error(`the angle simplifier has no parameter '${name}'`);
   }
   return spec;
 }
 
 /** The paper's defaults, as the reference writes them. */
-export const DEFAULT_ANGLE_PARAMS: AngleParams = Object.freeze(
-  Object.fromEntries(PARAM_SPECS.map((spec) => [spec.name, spec.default])),
-) as unknown as AngleParams;
+export const DEFAULT_ANGLE_PARAMS: AngleParams = defaultsOf<AngleParams>(PARAM_SPECS, "angle");
 
 /** "[2, 600]"-style text, or "from 2 to 600" for sentences. */
 export function rangeText(spec: ParamSpec<string>): string {
@@ -129,12 +215,9 @@ export function checkAngleParams(params: AngleParams): void {
 }
 
 /** `checkAngleParams` for any simplifier's table. */
-export function checkParams<N extends string>(
-  specs: readonly ParamSpec<N>[],
-  params: Readonly<Record<N, number | boolean>>,
-): void {
+export function checkParams<N extends string>(specs: readonly ParamSpec<N>[], params: object): void {
   for (const spec of specs) {
-    const value = params[spec.name];
+    const value = (params as Record<string, unknown>)[spec.name];
     const problem = paramProblem(spec, value);
     if (problem !== null) {
       throw new RangeError(`${spec.name} = ${String(value)} is not allowed; it ${problem}`);

@@ -35,6 +35,8 @@ export interface Segment {
   readonly end: Point;
   readonly start_ms: number;
   readonly end_ms: number;
+  /** end_ms - start_ms: how long the piece took to draw. */
+  readonly duration_ms: number;
   readonly emitted_at_ms: number;
   readonly dropped: DropReason | null;
 }
@@ -44,4 +46,36 @@ export function segmentLength(segment: Segment): number {
   const dx = segment.end[0] - segment.start[0];
   const dy = segment.end[1] - segment.start[1];
   return Math.sqrt(dx * dx + dy * dy);
+}
+
+/** What decides whether a finished piece is sent: the shortest length and duration to feel. */
+export interface DropLimits {
+  readonly min_length: number;
+  readonly min_duration_ms: number;
+}
+
+/**
+ * A finished piece of a path: sent, or dropped as too short (first, as the
+ * reference: a tap is "not enough distance") or too brief to feel.
+ */
+export function finishSegment(
+  start: Point,
+  end: Point,
+  startMs: number,
+  endMs: number,
+  emittedAtMs: number,
+  limits: DropLimits,
+): Segment {
+  const segment: Segment = {
+    start,
+    end,
+    start_ms: startMs,
+    end_ms: endMs,
+    duration_ms: endMs - startMs,
+    emitted_at_ms: emittedAtMs,
+    dropped: null,
+  };
+  if (segmentLength(segment) < limits.min_length) return { ...segment, dropped: NOT_ENOUGH_DISTANCE };
+  if (segment.duration_ms < limits.min_duration_ms) return { ...segment, dropped: NOT_ENOUGH_DURATION };
+  return segment;
 }

@@ -1,13 +1,14 @@
 /**
- * The window simplifier's parameters: defaults and allowed ranges, read at
- * build time from `testdata/window/params.json`, the table the Python
- * reference writes, so the browser validates with exactly its ranges.
+ * The window simplifier's parameters: defaults and allowed ranges, the same
+ * table as the Python reference's (a test holds it equal to
+ * `testdata/window/params.json`, which the reference writes).
  */
-import table from "../../../testdata/window/params.json";
-import { checkParams, readSpecs, type ParamSpec } from "./params";
+import { checkParams, defaultsOf, DROP_AND_GRID_SPECS, FPS_SPEC, type ParamSpec } from "./params";
 
 /** The parameters of `WindowParams` in the reference, snake_case as in every file that holds them. */
 export interface WindowParams {
+  /** Which simplifier these parameters are for (see `registry.ts`). */
+  readonly algorithm: "window";
   readonly max_error: number;
   readonly max_window: number;
   readonly fps: number;
@@ -21,35 +22,44 @@ export interface WindowParams {
   readonly stretch: boolean;
 }
 
-export type WindowParamName = keyof WindowParams;
+export type WindowParamName = Exclude<keyof WindowParams, "algorithm">;
 
 /** Every parameter, in the reference's order. */
-export const WINDOW_PARAM_SPECS: readonly ParamSpec<WindowParamName>[] = readSpecs<WindowParamName>(
-  table,
-  "testdata/window/params.json",
-);
+export const WINDOW_PARAM_SPECS: readonly ParamSpec<WindowParamName>[] = [
+  {
+    name: "max_error",
+    type: "number",
+    default: 0.1,
+    minimum: 0.001,
+    maximum: 100,
+    help: "farthest a drawn point may lie from its stroke, in grid units",
+  },
+  {
+    name: "max_window",
+    type: "integer",
+    default: 64,
+    minimum: 1,
+    maximum: 1000,
+    help: "longest stroke in frames after its start (bounds the work)",
+  },
+  FPS_SPEC,
+  ...DROP_AND_GRID_SPECS,
+];
 
 const SPECS_BY_NAME = new Map(WINDOW_PARAM_SPECS.map((spec) => [spec.name, spec]));
 
 export function windowParamSpec(name: WindowParamName): ParamSpec<WindowParamName> {
   const spec = SPECS_BY_NAME.get(name);
   if (spec === undefined) {
-    throw new Error(`testdata/window/params.json has no parameter '${name}'; regenerate it`);
+    throw new Error(`the window simplifier has no parameter '${name}'`);
   }
   return spec;
 }
 
 /** The reference's defaults. */
-export const DEFAULT_WINDOW_PARAMS: WindowParams = Object.freeze(
-  Object.fromEntries(WINDOW_PARAM_SPECS.map((spec) => [spec.name, spec.default])),
-) as unknown as WindowParams;
+export const DEFAULT_WINDOW_PARAMS: WindowParams = defaultsOf<WindowParams>(WINDOW_PARAM_SPECS, "window");
 
 /** Throws a RangeError naming the parameter, the value and the range, for the first bad one. */
 export function checkWindowParams(params: WindowParams): void {
   checkParams(WINDOW_PARAM_SPECS, params);
-}
-
-/** Whether `params` are the window simplifier's (the angle simplifier has no `max_error`). */
-export function isWindowParams(params: object): params is WindowParams {
-  return "max_error" in params;
 }

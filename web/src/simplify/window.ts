@@ -13,14 +13,7 @@
  * angle simplifier. The float operations follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
-import {
-  NOT_ENOUGH_DISTANCE,
-  NOT_ENOUGH_DURATION,
-  segmentLength,
-  type Point,
-  type Sample,
-  type Segment,
-} from "./segment";
+import { finishSegment, type Point, type Sample, type Segment } from "./segment";
 import { checkWindowParams, type WindowParams } from "./window-params";
 
 interface Frame {
@@ -120,21 +113,13 @@ export class WindowSimplifier {
 
   #finish(start: Frame, end: Frame): Segment {
     this.#emittedInPath = true;
-    const segment: Segment = {
-      start: start.point,
-      end: end.point,
-      start_ms: start.sample.t_ms,
-      end_ms: end.sample.t_ms,
-      emitted_at_ms: this.#pointer ? this.#pointer.t_ms : end.sample.t_ms,
-      dropped: null,
-    };
-    // Length first, as the reference: a tap is "not enough distance".
-    if (segmentLength(segment) < this.params.min_length) {
-      return { ...segment, dropped: NOT_ENOUGH_DISTANCE };
-    }
-    if (segment.end_ms - segment.start_ms < this.params.min_duration_ms) {
-      return { ...segment, dropped: NOT_ENOUGH_DURATION };
-    }
-    return segment;
+    return finishSegment(
+      start.point,
+      end.point,
+      start.sample.t_ms,
+      end.sample.t_ms,
+      this.#pointer ? this.#pointer.t_ms : end.sample.t_ms,
+      this.params,
+    );
   }
 }

@@ -9,7 +9,7 @@ import { newDrawingId } from "../drawing-id";
 import { FrameSampler } from "../frame-sampler";
 import type { Stroke } from "../protocol";
 import { simplifierParams, type Settings } from "../settings";
-import { makeSimplifier, type Simplifier } from "../simplify/replay";
+import { makeSimplifier, type Simplifier } from "../simplify/registry";
 import type { Sample, Segment } from "../simplify/segment";
 import type { DrawingView } from "./canvas";
 import type { GridSize } from "./geometry";

@@ -15,6 +15,7 @@ import {
 } from "../settings";
 import type { GridSize } from "./geometry";
 import { byId } from "./status";
+import { ONLY_FOR } from "../simplify/registry";
 
 const SECTIONS: readonly { id: FieldSpec["section"]; title: string; note?: string }[] = [
   { id: "drawing", title: "Drawing" },
@@ -30,16 +31,6 @@ const SECTIONS: readonly { id: FieldSpec["section"]; title: string; note?: strin
 ];
 
 type Candidate = Record<SettingKey, unknown>;
-
-/** Fields only one simplifier has: locked while the other is chosen. */
-const ONLY_FOR: Partial<Record<SettingKey, "angle" | "window">> = {
-  check_frames: "angle",
-  max_angle_deg: "angle",
-  frame_max: "angle",
-  recover: "angle",
-  max_error: "window",
-  max_window: "window",
-};
 
 export interface SettingsPanelContext {
   readonly config: ServerConfig | null;
@@ -247,6 +238,7 @@ export class SettingsPanel {
       return this.#context.config !== null && candidate.broker_custom !== true;
     }
     if (key === "legacy_topic") return candidate.protocol !== "legacy";
+    // Fields only one simplifier has: locked while the other is chosen.
     const owner = ONLY_FOR[key];
     return owner !== undefined && candidate.algorithm !== owner;
   }

@@ -43,7 +43,7 @@ from feelmysign.research.sweep import (
     parse_sweep,
 )
 from feelmysign.simplify.recording import load_recording
-from feelmysign.simplify.replay import ALGORITHMS, Algorithm
+from feelmysign.simplify.registry import ALGORITHMS, Algorithm
 
 if TYPE_CHECKING:
     from feelmysign.research.evaluate import Row, Run, Source

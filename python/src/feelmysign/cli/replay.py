@@ -43,7 +43,7 @@ from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.research.rerun import Rerun, mismatch, rerun
 from feelmysign.sending import OutgoingStroke, StrokeSender, printer
 from feelmysign.simplify.recording import Recording, load_recording
-from feelmysign.simplify.replay import Params
+from feelmysign.simplify.registry import Params
 from feelmysign.stroke import Stroke
 
 BROKER_DESTS = ("broker", "sleeve_id", "username", "password", "credentials")

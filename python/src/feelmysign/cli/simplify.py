@@ -17,19 +17,10 @@ from feelmysign.simplify import (
     simplify_paths,
 )
 from feelmysign.simplify.recording import Recording, RecordingError
-from feelmysign.simplify.replay import Params, algorithm_of
+from feelmysign.simplify.registry import ONLY_FOR, Params, algorithm_of
 
 DEFAULTS = AngleParams()
 WINDOW_DEFAULTS = WindowParams()
-# Options that only one algorithm has; giving one to the other is a usage error.
-ONLY_FOR = {
-    "check_frames": "angle",
-    "max_angle_deg": "angle",
-    "frame_max": "angle",
-    "recover": "angle",
-    "max_error": "window",
-    "max_window": "window",
-}
 
 
 def register(subparsers: Any) -> None:

@@ -24,7 +24,7 @@ from feelmysign.research import metrics
 from feelmysign.research.rerun import rerun
 from feelmysign.research.sweep import label
 from feelmysign.simplify.recording import Recording
-from feelmysign.simplify.replay import Algorithm, Params
+from feelmysign.simplify.registry import Algorithm, Params
 from feelmysign.simplify.segment import Sample
 
 # Errors (grid units) at which the Douglas-Peucker frontier is drawn: from far below

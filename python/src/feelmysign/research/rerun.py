@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from feelmysign.simplify.frames import frames_from_samples
 from feelmysign.simplify.recording import RecordedStroke, Recording
-from feelmysign.simplify.replay import Params, PathSegment, algorithm_of
+from feelmysign.simplify.registry import Params, PathSegment, algorithm_of
 from feelmysign.simplify.segment import Sample
 
 DEFAULT_FPS = 60.0  # a recording that names no fps was drawn in a 60 Hz loop (AngleParams)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from feelmysign.errors import FeelMySignError
-from feelmysign.simplify.replay import Algorithm
+from feelmysign.simplify.registry import Algorithm
 
 # Around the paper's defaults (check 5 frames, 20 degrees; window 0.1 grid units),
 # which are in every grid, and small enough for all 210 LASA demonstrations in a

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
-from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION, Sample, Segment
+from feelmysign.simplify.segment import Sample, Segment, finish_segment
 
 # Movements shorter than this (pixels) have no direction: the check passes.
 STILL_PX = 1e-9
@@ -146,22 +146,12 @@ class AngleSimplifier:
         return (ux * vx + uy * vy) / norms < self._cos_max
 
     def _finish(self, start: Sample, end: Sample) -> Segment:
-        emitted_at_ms = self._pointer.t_ms if self._pointer else end.t_ms
-        segment = Segment(
-            start=self._mapping.to_grid(start.x, start.y),
-            end=self._mapping.to_grid(end.x, end.y),
-            start_ms=start.t_ms,
-            end_ms=end.t_ms,
-            emitted_at_ms=emitted_at_ms,
+        return finish_segment(
+            self._mapping.to_grid(start.x, start.y),
+            self._mapping.to_grid(end.x, end.y),
+            start.t_ms,
+            end.t_ms,
+            self._pointer.t_ms if self._pointer else end.t_ms,
+            min_length=self.params.min_length,
+            min_duration_ms=self.params.min_duration_ms,
         )
-        if segment.length < self.params.min_length:
-            return _dropped(segment, NOT_ENOUGH_DISTANCE)
-        if segment.duration_ms < self.params.min_duration_ms:
-            return _dropped(segment, NOT_ENOUGH_DURATION)
-        return segment
-
-
-def _dropped(segment: Segment, reason: str) -> Segment:
-    return Segment(
-        segment.start, segment.end, segment.start_ms, segment.end_ms, segment.emitted_at_ms, reason
-    )

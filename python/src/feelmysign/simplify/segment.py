@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from feelmysign.stroke import Point
 
@@ -45,3 +45,25 @@ class Segment:
     def length(self) -> float:
         dx, dy = self.end[0] - self.start[0], self.end[1] - self.start[1]
         return math.sqrt(dx * dx + dy * dy)
+
+
+def finish_segment(
+    start: Point,
+    end: Point,
+    start_ms: float,
+    end_ms: float,
+    emitted_at_ms: float,
+    *,
+    min_length: float,
+    min_duration_ms: float,
+) -> Segment:
+    """A finished piece of a path: sent, or dropped as too short (first) or too brief to feel.
+
+    Length is tested first, as the paper does: a tap is "not enough distance".
+    """
+    segment = Segment(start, end, start_ms, end_ms, emitted_at_ms)
+    if segment.length < min_length:
+        return replace(segment, dropped=NOT_ENOUGH_DISTANCE)
+    if segment.duration_ms < min_duration_ms:
+        return replace(segment, dropped=NOT_ENOUGH_DURATION)
+    return segment

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
-from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION, Sample, Segment
+from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.stroke import Point
 
 WINDOW_PARAMS: dict[str, ParamSpec] = {
@@ -153,21 +153,12 @@ class WindowSimplifier:
 
     def _finish(self, start: _Frame, end: _Frame) -> Segment:
         self._emitted_in_path = True
-        segment = Segment(
-            start=start.point,
-            end=end.point,
-            start_ms=start.sample.t_ms,
-            end_ms=end.sample.t_ms,
-            emitted_at_ms=self._pointer.t_ms if self._pointer else end.sample.t_ms,
+        return finish_segment(
+            start.point,
+            end.point,
+            start.sample.t_ms,
+            end.sample.t_ms,
+            self._pointer.t_ms if self._pointer else end.sample.t_ms,
+            min_length=self.params.min_length,
+            min_duration_ms=self.params.min_duration_ms,
         )
-        if segment.length < self.params.min_length:
-            return _dropped(segment, NOT_ENOUGH_DISTANCE)
-        if segment.duration_ms < self.params.min_duration_ms:
-            return _dropped(segment, NOT_ENOUGH_DURATION)
-        return segment
-
-
-def _dropped(segment: Segment, reason: str) -> Segment:
-    return Segment(
-        segment.start, segment.end, segment.start_ms, segment.end_ms, segment.emitted_at_ms, reason
-    )

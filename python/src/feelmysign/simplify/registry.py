@@ -1,8 +1,9 @@
-"""Run a whole recording through a simplifier, deterministically (same input, same strokes).
+"""The simplifiers by name, and a whole recording through one, deterministically.
 
 ``ALGORITHMS`` is the registry every caller (CLI, vectors, research tools)
 chooses from by name: each algorithm's parameter class, its streaming
-simplifier and its parameter table. Both take the same animation frames.
+simplifier and its parameter table. ``ONLY_FOR`` follows from the tables: the
+parameters that only one algorithm has (giving one to the other is an error).
 """
 
 from __future__ import annotations
@@ -45,6 +46,18 @@ ALGORITHMS: dict[str, Algorithm] = {
         "window", WindowParams, WindowSimplifier, WINDOW_PARAMS, "error-bounded opening window"
     ),
 }
+
+
+def _only_for() -> dict[str, str]:
+    owners: dict[str, list[str]] = {}
+    for algorithm in ALGORITHMS.values():
+        for name in algorithm.specs:
+            owners.setdefault(name, []).append(algorithm.name)
+    return {name: names[0] for name, names in owners.items() if len(names) == 1}
+
+
+# Parameter name -> the one algorithm that has it.
+ONLY_FOR: dict[str, str] = _only_for()
 
 
 def algorithm_of(params: Params) -> Algorithm:
