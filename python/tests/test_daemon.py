@@ -20,6 +20,7 @@ from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.daemon import Sleeve, SleeveOptions, topic
 from feelmysign.errors import FeelMySignError
+from feelmysign.events import event_from_json
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.protocol import format_json
@@ -175,6 +176,8 @@ def test_a_drawing_plays_in_order_back_to_back(running: Running, broker: Broker)
     events = running.wait_events(20)
     assert [e["seq"] for e in events] == list(range(20))
     assert {e["type"] for e in events} <= {"played", "adjusted"}
+    # What went over the wire reads back as the typed events, unchanged.
+    assert all(event_from_json(e).to_json() == e for e in events)
     for before, after in itertools.pairwise(events):
         if after["queued_ms"] > 0:  # arrived while the one before was playing: starts as it ends
             planned_gap_ms = after["start_at_ms"] - (before["start_at_ms"] + before["duration_ms"])

@@ -9,6 +9,7 @@ from typing import Any
 import pytest
 
 from feelmysign.backends.sim import SimBackend
+from feelmysign.events import Event
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.player import PlannedStroke, Player, monotonic_ms, wall_ms
@@ -22,9 +23,9 @@ class Events:
         self.items: list[dict[str, Any]] = []
         self.changed = threading.Condition()
 
-    def __call__(self, event: dict[str, Any]) -> None:
+    def __call__(self, event: Event) -> None:
         with self.changed:
-            self.items.append(event)
+            self.items.append(event.to_json())
             self.changed.notify_all()
 
     def wait_for(self, count: int, timeout_s: float = 10.0) -> list[dict[str, Any]]:

@@ -145,11 +145,15 @@ describe("drawing with a mouse on a desktop", () => {
 
   it("reports what the sleeve said: played strokes counted, a refused one marked", async () => {
     const drawing = stroke0Drawing(sleeve.strokes());
-    for (const seq of [0, 1, 3]) await sleeve.publish("events", { type: "played", drawing, seq });
+    const now = Date.now();
+    const timing = { received_at_ms: now, start_at_ms: now, first_command_at_ms: now, latency_ms: 0.3 };
+    const played = { ...timing, start_error_ms: 0, queued_ms: 0, duration_ms: 400, commands: 4 };
+    for (const seq of [0, 1, 3]) await sleeve.publish("events", { type: "played", drawing, seq, ...played });
     await sleeve.publish("events", {
       type: "rejected",
       drawing,
       seq: 2,
+      received_at_ms: now,
       reason: "duration_too_long",
       message: "duration_ms is 12000; this sleeve plays strokes of at most 10000 ms.",
     });

@@ -9,7 +9,8 @@ import type { Drawing } from "./drawing";
 import { StrokeSender, type BrokerState, type SenderTarget } from "./mqtt/sender";
 import { buildRecording, recordingFileName } from "./recording";
 import { loadSettings, saveSettings, withServerBroker, type SettingKey, type Settings } from "./settings";
-import { parseActuators, parseEvent, parseStatus, type SleeveEvent, type SleeveStatus } from "./telemetry";
+import { parseEvent, parseStatus, type AdjustedEvent, type SleeveEvent, type SleeveStatus } from "./events";
+import { parseActuators } from "./telemetry";
 import { DrawingView } from "./ui/canvas";
 import { DrawingSession } from "./ui/drawing-session";
 import { EventLog } from "./ui/event-log";
@@ -296,11 +297,12 @@ export class App {
     const event = parseEvent(payload);
     if (event === null) return;
     const drawing = this.#session.drawing;
+    const ref = "seq" in event ? event : null;
     const drawn =
-      drawing !== null && event.drawing === drawing.id && event.seq !== null
-        ? drawing.bySeq(event.seq)
+      drawing !== null && ref !== null && ref.drawing === drawing.id && ref.seq !== null
+        ? drawing.bySeq(ref.seq)
         : undefined;
-    const label = event.seq === null ? "A stroke" : `Stroke ${event.seq}`;
+    const label = ref === null || ref.seq === null ? "A stroke" : `Stroke ${ref.seq}`;
     switch (event.type) {
       case "played":
       case "adjusted":
@@ -319,11 +321,15 @@ export class App {
         }
         this.#log.add("rejected", `${label} refused: ${describe(event)}`);
         return;
-      case "safety": {
-        const where = event.row !== null && event.column !== null ? ` (${event.row}, ${event.column})` : "";
-        this.#log.add("error", `Safety: actuator${where} switched off: ${describe(event)}`);
+      case "cancelled":
+        this.#log.add("info", `${label} cancelled${event.started ? " while playing" : ""}.`);
         return;
-      }
+      case "safety":
+        this.#log.add(
+          "error",
+          `Safety: actuator (${event.row}, ${event.column}) switched off: ${describe(event)}`,
+        );
+        return;
       case "error":
         this.#log.add("error", `The sleeve reports an error: ${describe(event)}`);
         return;
@@ -348,14 +354,11 @@ export class App {
 }
 
 function describe(event: SleeveEvent): string {
-  return event.message ?? event.reason?.replaceAll("_", " ") ?? "no reason given";
+  const message = "message" in event ? event.message : null;
+  return message ?? ("reason" in event ? event.reason.replaceAll("_", " ") : "no reason given");
 }
 
-function adjustment(event: SleeveEvent): string {
+function adjustment(event: AdjustedEvent): string {
   const { requested_duration_ms: requested, duration_ms: played } = event;
-  const why = event.reason === null ? "" : ` (${event.reason.replaceAll("_", " ")})`;
-  if (requested !== null && played !== null) {
-    return `played in ${Math.round(played)} ms instead of ${Math.round(requested)} ms${why}.`;
-  }
-  return `played with changes${why}.`;
+  return `played in ${Math.round(played)} ms instead of ${Math.round(requested)} ms (${event.reason.replaceAll("_", " ")}).`;
 }

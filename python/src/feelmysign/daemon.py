@@ -33,6 +33,7 @@ from feelmysign import __version__
 from feelmysign.backends.base import Backend
 from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.errors import FeelMySignError, StrokeError
+from feelmysign.events import ErrorEvent, Event, Played, Rejected, Status, StatusLayout
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.player import MAX_PENDING, PlannedStroke, Player, monotonic_ms, wall_ms
@@ -47,6 +48,9 @@ RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
 BURST = MAX_PENDING
 KEEPALIVE_S = 15
 RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
+# CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
+# "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
+LOGIN_REFUSED_CODES = (134, 135)
 
 
 def topic(sleeve_id: str, name: str) -> str:
@@ -191,7 +195,7 @@ class Sleeve:
                 "username and password (or --credentials) and that this user may use the "
                 f"topics of sleeve {self._id}"
             )
-            if str(reason) in ("Not authorized", "Bad user name or password"):
+            if getattr(reason, "value", None) in LOGIN_REFUSED_CODES:
                 self._fatal = FeelMySignError(message)
                 self._stopped.set()
             log.error(message)
@@ -309,26 +313,19 @@ class Sleeve:
     ) -> None:
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
-        self._event(
-            {
-                "type": "rejected",
-                "reason": reason,
-                "message": message,
-                **info,
-                "received_at_ms": received_wall_ms,
-            }
-        )
+        rejected = Rejected(reason=reason, message=message, **info, received_at_ms=received_wall_ms)
+        self._event(rejected)
 
-    def _event(self, event: dict[str, Any]) -> None:
+    def _event(self, event: Event) -> None:
         """Called from the player thread too: only queues, never touches the network."""
-        if event.get("type") in ("played", "adjusted"):
+        if isinstance(event, Played):
             self._count("played")
-        if event.get("reason") == "player_crashed":
+        if isinstance(event, ErrorEvent) and event.reason == "player_crashed":
             self._fatal = FeelMySignError(
                 "the player stopped on an unexpected error (see the log); every motor is off"
             )
             self._stopped.set()
-        self._outbox.put((topic(self._id, "events"), json.dumps(event), 1, False))
+        self._outbox.put((topic(self._id, "events"), event.dumps(), 1, False))
 
     def _count(self, *names: str) -> None:
         with self._counts_lock:
@@ -349,23 +346,21 @@ class Sleeve:
 
     def _status(self, *, online: bool) -> str:
         layout = self._layout
-        return json.dumps(
-            {
-                "online": online,
-                "sleeve_id": self._id,
-                "version": __version__,
-                "backend": self._options.backend_name,
-                "legacy_topic": self._options.legacy_topic,
-                "layout": {
-                    "name": layout.name,
-                    "rows": layout.rows,
-                    "columns": layout.columns,
-                    "spacing_cm": layout.spacing_cm,
-                    "actuator_type": layout.actuator_type,
-                    "default_intensity": layout.default_intensity,
-                    "max_intensity": layout.max_intensity,
-                    "max_stroke_duration_ms": layout.max_stroke_duration_ms,
-                },
-                "at_ms": round(time.time() * 1000),
-            }
-        )
+        return Status(
+            online=online,
+            sleeve_id=self._id,
+            version=__version__,
+            backend=self._options.backend_name,
+            legacy_topic=self._options.legacy_topic,
+            layout=StatusLayout(
+                name=layout.name,
+                rows=layout.rows,
+                columns=layout.columns,
+                spacing_cm=layout.spacing_cm,
+                actuator_type=layout.actuator_type,
+                default_intensity=layout.default_intensity,
+                max_intensity=layout.max_intensity,
+                max_stroke_duration_ms=layout.max_stroke_duration_ms,
+            ),
+            at_ms=round(time.time() * 1000),
+        ).dumps()

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from feelmysign.backends.base import Backend
+from feelmysign.events import Adjusted, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
 from feelmysign.schedule import Schedule
 from feelmysign.timeline import Change, Timeline
@@ -82,7 +83,7 @@ class Player:
         backend: Backend,
         layout: Layout,
         *,
-        on_event: Callable[[dict[str, Any]], None] = lambda event: None,
+        on_event: Callable[[Event], None] = lambda event: None,
         clock: Callable[[], float] = monotonic_ms,
         max_pending: int = MAX_PENDING,
         max_backlog_ms: float = MAX_BACKLOG_MS,
@@ -192,7 +193,7 @@ class Player:
                 self._step()
         except Exception:  # the thread must never die with motors on
             log.exception("player stopped by an unexpected error; all motors off")
-            self._on_event({"type": "error", "reason": "player_crashed"})
+            self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
             self._backend.all_off()
@@ -221,9 +222,7 @@ class Player:
             if isinstance(tag, PlannedStroke):
                 self._started(tag, written_at_ms)
         for row, column in due.tripped:
-            self._on_event(
-                {"type": "safety", "reason": "max_on_time", "row": row, "column": column}
-            )
+            self._on_event(Safety(reason="max_on_time", row=row, column=column))
 
     def _write(self, changes: list[Change]) -> None:
         for change in changes:
@@ -233,13 +232,9 @@ class Player:
             except Exception as error:  # a motor that fails must not stop the others
                 log.warning("actuator (%d, %d): %s", change.row, change.column, error)
                 self._on_event(
-                    {
-                        "type": "error",
-                        "reason": "backend",
-                        "message": str(error),
-                        "row": change.row,
-                        "column": change.column,
-                    }
+                    ErrorEvent(
+                        reason="backend", message=str(error), row=change.row, column=change.column
+                    )
                 )
                 if change.intensity == 0.0:
                     self._force_off(change)
@@ -257,22 +252,14 @@ class Player:
         try:
             self._backend.all_off()
         finally:
-            self._on_event(
-                {
-                    "type": "safety",
-                    "reason": "off_failed",
-                    "row": change.row,
-                    "column": change.column,
-                }
-            )
+            self._on_event(Safety(reason="off_failed", row=change.row, column=change.column))
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:
             self._pending -= 1
         self.played += 1
         schedule = stroke.schedule
-        event: dict[str, Any] = {
-            "type": "adjusted" if schedule.adjusted else "played",
+        timing = {
             **stroke.info,
             "received_at_ms": stroke.received_wall_ms,
             "start_at_ms": stroke.received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
@@ -283,7 +270,13 @@ class Player:
             "duration_ms": schedule.duration_ms,
             "commands": len(schedule.commands),
         }
+        event: Played
         if schedule.adjusted:
-            event["reason"] = schedule.adjusted.reason
-            event["requested_duration_ms"] = schedule.adjusted.requested_duration_ms
+            event = Adjusted(
+                **timing,
+                reason=schedule.adjusted.reason,
+                requested_duration_ms=schedule.adjusted.requested_duration_ms,
+            )
+        else:
+            event = Played(**timing)
         self._on_event(event)

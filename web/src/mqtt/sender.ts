@@ -39,8 +39,11 @@ const RECONNECT_PERIOD_MS = 2000;
 const CONNECT_TIMEOUT_MS = 8000;
 /** The broker notices a vanished page after 1.5 x this. */
 const KEEPALIVE_S = 20;
-/** CONNACK return codes (MQTT 3.1.1) that retrying cannot fix. */
-const BAD_LOGIN_CODES = new Set([4, 5]);
+/**
+ * CONNACK codes that retrying cannot fix, told by code, never by the broker's wording: bad
+ * user name or password, not authorized (MQTT 3.1.1: 4, 5; MQTT 5: 134, 135).
+ */
+export const BAD_LOGIN_CODES: ReadonlySet<number> = new Set([4, 5, 134, 135]);
 
 export const strokesTopic = (sleeveId: string): string => `feelmysign/${sleeveId}/strokes`;
 export const telemetryTopic = (sleeveId: string, name: "status" | "actuators" | "events"): string =>

@@ -1,0 +1,373 @@
+"""What the sleeve publishes, as typed values: one class per event, and its status.
+
+The sleeve publishes one JSON object per event on ``feelmysign/<id>/events``
+(``played``, ``adjusted``, ``rejected``, ``cancelled``, ``safety``, ``error``)
+and a retained ``status`` (docs/protocol.md, "What the sleeve publishes").
+``to_json`` gives the object as published (optional fields left out when
+absent, keys in the order below); ``event_from_json`` and
+``Status.from_json`` read one back: unknown keys are ignored (a newer sleeve
+may add some), a missing or mistyped field raises ``EventError``. The page
+reads the same messages with ``web/src/events.ts``; ``testdata/events`` keeps
+the two equal.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from typing import Any, ClassVar, Literal, TypeVar
+
+EventType = Literal["played", "adjusted", "rejected", "cancelled", "safety", "error"]
+
+
+class EventError(ValueError):
+    """A message that is not a sleeve event (or status): ``field`` names what was wrong."""
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
+
+
+class _Reader:
+    """Typed access to a JSON object's fields; every wrong value raises EventError."""
+
+    def __init__(self, data: object, what: str) -> None:
+        if not isinstance(data, dict):
+            raise EventError(f"{what} must be a JSON object, not {type(data).__name__}")
+        self._data: dict[str, Any] = data
+
+    def _get(self, name: str, required: bool) -> Any:
+        value = self._data.get(name)
+        if value is None and required:
+            raise EventError(f"{name} is missing", name)
+        return value
+
+    def text(self, name: str, *, required: bool = True) -> Any:
+        value = self._get(name, required)
+        if value is not None and not isinstance(value, str):
+            raise EventError(f"{name} must be a string", name)
+        return value
+
+    def number(self, name: str, *, required: bool = True) -> Any:
+        value = self._get(name, required)
+        if value is None:
+            return None
+        number = isinstance(value, int | float) and not isinstance(value, bool)
+        if not number or not math.isfinite(value):
+            raise EventError(f"{name} must be a finite number", name)
+        return value
+
+    def index(self, name: str, *, required: bool = True) -> Any:
+        """A whole number 0 or more (seq, row, column, counts); 3.0 counts as 3."""
+        value = self.number(name, required=required)
+        if value is None:
+            return None
+        if value < 0 or value != int(value):
+            raise EventError(f"{name} must be a whole number 0 or more", name)
+        return int(value)
+
+    def flag(self, name: str, *, required: bool = True) -> Any:
+        value = self._get(name, required)
+        if value is not None and not isinstance(value, bool):
+            raise EventError(f"{name} must be true or false", name)
+        return value
+
+    def obj(self, name: str) -> dict[str, Any] | None:
+        value = self._data.get(name)
+        if value is not None and not isinstance(value, dict):
+            raise EventError(f"{name} must be a JSON object", name)
+        return value
+
+
+def _wire(type_name: str | None, values: dict[str, Any]) -> dict[str, Any]:
+    head = {} if type_name is None else {"type": type_name}
+    return head | {k: v for k, v in values.items() if v is not None}
+
+
+_E = TypeVar("_E", bound="_Event")
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Event:
+    kind: ClassVar[EventType]
+
+    def to_json(self) -> dict[str, Any]:
+        return _wire(self.kind, asdict(self))
+
+    def dumps(self) -> str:
+        return json.dumps(self.to_json())
+
+    @classmethod
+    def from_json(cls: type[_E], data: object) -> _E:
+        """This event from its JSON object or text; EventError if it is another type
+        (``Played.from_json`` reads an ``adjusted`` event too: it was played)."""
+        event = event_from_json(data)
+        if not isinstance(event, cls):
+            raise EventError(f"expected a {cls.kind!r} event, got {event.kind!r}", "type")
+        return event
+
+
+@dataclass(frozen=True, kw_only=True)
+class Played(_Event):
+    """The stroke's first command went out (times ``*_at_ms``: the sleeve's wall clock)."""
+
+    kind: ClassVar[EventType] = "played"
+    topic: str | None = None
+    drawing: str | None = None
+    seq: int | None = None
+    sent_at_ms: float | None = None
+    received_at_ms: float
+    start_at_ms: float  # planned start
+    first_command_at_ms: float
+    latency_ms: float  # receive -> first command
+    start_error_ms: float  # first command -> planned start
+    queued_ms: float  # waiting for the strokes before it
+    duration_ms: float
+    commands: int
+
+    @classmethod
+    def _read(cls, r: _Reader) -> dict[str, Any]:
+        return {
+            "topic": r.text("topic", required=False),
+            "drawing": r.text("drawing", required=False),
+            "seq": r.index("seq", required=False),
+            "sent_at_ms": r.number("sent_at_ms", required=False),
+            "received_at_ms": r.number("received_at_ms"),
+            "start_at_ms": r.number("start_at_ms"),
+            "first_command_at_ms": r.number("first_command_at_ms"),
+            "latency_ms": r.number("latency_ms"),
+            "start_error_ms": r.number("start_error_ms"),
+            "queued_ms": r.number("queued_ms"),
+            "duration_ms": r.number("duration_ms"),
+            "commands": r.index("commands"),
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class Adjusted(Played):
+    """Played, but changed to be felt: slowed (``reason: too_fast``) from the duration asked."""
+
+    kind: ClassVar[EventType] = "adjusted"
+    reason: str
+    requested_duration_ms: float
+
+    @classmethod
+    def _read(cls, r: _Reader) -> dict[str, Any]:
+        return Played._read(r) | {
+            "reason": r.text("reason"),
+            "requested_duration_ms": r.number("requested_duration_ms"),
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class Rejected(_Event):
+    """The stroke will not be played: ``reason`` is a code of docs/protocol.md."""
+
+    kind: ClassVar[EventType] = "rejected"
+    reason: str
+    message: str
+    topic: str | None = None
+    drawing: str | None = None
+    seq: int | None = None
+    sent_at_ms: float | None = None
+    received_at_ms: float
+
+    @classmethod
+    def _read(cls, r: _Reader) -> dict[str, Any]:
+        return {
+            "reason": r.text("reason"),
+            "message": r.text("message"),
+            "topic": r.text("topic", required=False),
+            "drawing": r.text("drawing", required=False),
+            "seq": r.index("seq", required=False),
+            "sent_at_ms": r.number("sent_at_ms", required=False),
+            "received_at_ms": r.number("received_at_ms"),
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class Cancelled(_Event):
+    """A control message cancelled the stroke: ``started`` when it was cut short while playing
+    (it had its ``played`` event), not when it was dropped before it started."""
+
+    kind: ClassVar[EventType] = "cancelled"
+    reason: str = "cancelled"
+    message: str
+    topic: str | None = None
+    drawing: str | None = None
+    seq: int | None = None
+    sent_at_ms: float | None = None
+    received_at_ms: float
+    cancelled_at_ms: float
+    started: bool
+
+    @classmethod
+    def _read(cls, r: _Reader) -> dict[str, Any]:
+        return {
+            "reason": r.text("reason"),
+            "message": r.text("message"),
+            "topic": r.text("topic", required=False),
+            "drawing": r.text("drawing", required=False),
+            "seq": r.index("seq", required=False),
+            "sent_at_ms": r.number("sent_at_ms", required=False),
+            "received_at_ms": r.number("received_at_ms"),
+            "cancelled_at_ms": r.number("cancelled_at_ms"),
+            "started": r.flag("started"),
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class Safety(_Event):
+    """A motor was switched off to protect the wearer (``max_on_time``, ``off_failed``)."""
+
+    kind: ClassVar[EventType] = "safety"
+    reason: str
+    row: int
+    column: int
+
+    @classmethod
+    def _read(cls, r: _Reader) -> dict[str, Any]:
+        return {"reason": r.text("reason"), "row": r.index("row"), "column": r.index("column")}
+
+
+@dataclass(frozen=True, kw_only=True)
+class ErrorEvent(_Event):
+    """A motor write failed (``backend``, with the actuator), or the player stopped on a bug."""
+
+    kind: ClassVar[EventType] = "error"
+    reason: str
+    message: str | None = None
+    row: int | None = None
+    column: int | None = None
+
+    @classmethod
+    def _read(cls, r: _Reader) -> dict[str, Any]:
+        return {
+            "reason": r.text("reason"),
+            "message": r.text("message", required=False),
+            "row": r.index("row", required=False),
+            "column": r.index("column", required=False),
+        }
+
+
+Event = Played | Adjusted | Rejected | Cancelled | Safety | ErrorEvent
+EVENT_CLASSES: dict[str, type[Played | Rejected | Cancelled | Safety | ErrorEvent]] = {
+    cls.kind: cls for cls in (Played, Adjusted, Rejected, Cancelled, Safety, ErrorEvent)
+}
+
+
+def event_from_json(data: object) -> Event:
+    """An event from its JSON object (or text); EventError if it is not one."""
+    if isinstance(data, str | bytes):
+        try:
+            data = json.loads(data)
+        except ValueError as error:
+            raise EventError(f"not JSON: {error}") from None
+    r = _Reader(data, "an event")
+    kind = r.text("type")
+    cls = EVENT_CLASSES.get(kind)
+    if cls is None:
+        known = ", ".join(EVENT_CLASSES)
+        raise EventError(f"unknown event type {kind!r}; known: {known}", "type")
+    event: Event = cls(**cls._read(r))
+    return event
+
+
+# The order the sleeve publishes the layout's keys in.
+_LAYOUT_ORDER = (
+    "name",
+    "rows",
+    "columns",
+    "spacing_cm",
+    "actuator_type",
+    "default_intensity",
+    "max_intensity",
+    "max_stroke_duration_ms",
+)
+
+
+@dataclass(frozen=True, kw_only=True)
+class StatusLayout:
+    """The sleeve's layout as its status tells it (the page sizes its grid from this)."""
+
+    rows: int
+    columns: int
+    name: str | None = None
+    spacing_cm: float | None = None
+    actuator_type: str | None = None
+    default_intensity: float | None = None
+    max_intensity: float | None = None
+    max_stroke_duration_ms: float | None = None
+
+    @classmethod
+    def from_json(cls, data: object) -> StatusLayout:
+        r = _Reader(data, "layout")
+        rows, columns = r.index("rows"), r.index("columns")
+        if not 1 <= rows <= 64 or not 1 <= columns <= 64:
+            raise EventError("layout rows and columns must be 1 to 64", "layout")
+        return cls(
+            rows=rows,
+            columns=columns,
+            name=r.text("name", required=False),
+            spacing_cm=r.number("spacing_cm", required=False),
+            actuator_type=r.text("actuator_type", required=False),
+            default_intensity=r.number("default_intensity", required=False),
+            max_intensity=r.number("max_intensity", required=False),
+            max_stroke_duration_ms=r.number("max_stroke_duration_ms", required=False),
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        values = asdict(self)
+        return _wire(None, {name: values[name] for name in _LAYOUT_ORDER})
+
+
+@dataclass(frozen=True, kw_only=True)
+class Status:
+    """The retained ``status``: ``online`` is all a last will must carry."""
+
+    online: bool
+    sleeve_id: str | None = None
+    version: str | None = None
+    backend: str | None = None
+    legacy_topic: str | None = None
+    layout: StatusLayout | None = None
+    at_ms: float | None = None
+
+    @classmethod
+    def from_json(cls, data: object) -> Status:
+        if isinstance(data, str | bytes):
+            try:
+                data = json.loads(data)
+            except ValueError as error:
+                raise EventError(f"not JSON: {error}") from None
+        r = _Reader(data, "a status")
+        layout = r.obj("layout")
+        return cls(
+            online=r.flag("online"),
+            sleeve_id=r.text("sleeve_id", required=False),
+            version=r.text("version", required=False),
+            backend=r.text("backend", required=False),
+            legacy_topic=r.text("legacy_topic", required=False),
+            layout=None if layout is None else StatusLayout.from_json(layout),
+            at_ms=r.number("at_ms", required=False),
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        # legacy_topic is published as null when the sleeve listens to none: kept as it is sent.
+        wire = _wire(
+            None,
+            {
+                "online": self.online,
+                "sleeve_id": self.sleeve_id,
+                "version": self.version,
+                "backend": self.backend,
+                "legacy_topic": self.legacy_topic,
+                "layout": None if self.layout is None else self.layout.to_json(),
+                "at_ms": self.at_ms,
+            },
+        )
+        return wire
+
+    def dumps(self) -> str:
+        return json.dumps(self.to_json())

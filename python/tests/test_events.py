@@ -1,0 +1,77 @@
+"""The sleeve's events and status against the shared vectors (testdata/events)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from typing import Any
+
+import pytest
+from vectors import load
+
+from feelmysign.events import (
+    Adjusted,
+    Cancelled,
+    EventError,
+    Played,
+    Rejected,
+    Status,
+    event_from_json,
+)
+
+CASES = load("events")
+EVENTS = [(name, case) for name, case in CASES if name.startswith("event/")]
+STATUSES = [(name, case) for name, case in CASES if name.startswith("status/")]
+INVALID = [(name, case) for name, case in CASES if name.startswith("invalid/")]
+
+
+def test_every_group_has_vectors() -> None:
+    assert EVENTS and STATUSES and INVALID
+
+
+@pytest.mark.parametrize(("name", "case"), EVENTS, ids=[n for n, _ in EVENTS])
+def test_event_vectors(name: str, case: dict[str, Any]) -> None:
+    event = event_from_json(case["wire"])
+    assert {"type": event.kind, **dataclasses.asdict(event)} == case["typed"]
+    assert event.to_json() == case["json"]
+    # The text form reads back as the same event, and the class reads its own type.
+    assert event_from_json(event.dumps()) == event
+    assert type(event).from_json(case["json"]) == event
+
+
+@pytest.mark.parametrize(("name", "case"), STATUSES, ids=[n for n, _ in STATUSES])
+def test_status_vectors(name: str, case: dict[str, Any]) -> None:
+    status = Status.from_json(json.dumps(case["wire"]))
+    assert dataclasses.asdict(status) == case["typed"]
+    assert status.to_json() == case["json"]
+
+
+@pytest.mark.parametrize(("name", "case"), INVALID, ids=[n for n, _ in INVALID])
+def test_invalid_vectors(name: str, case: dict[str, Any]) -> None:
+    read = event_from_json if case["kind"] == "event" else Status.from_json
+    with pytest.raises(EventError) as caught:
+        read(case["wire"])
+    assert caught.value.field == case["field"]
+
+
+def test_a_class_reads_only_its_own_type() -> None:
+    played = next(case["wire"] for name, case in EVENTS if name == "event/played")
+    assert isinstance(Played.from_json(played), Played)
+    with pytest.raises(EventError, match="expected a 'rejected' event"):
+        Rejected.from_json(played)
+    adjusted = next(case["wire"] for name, case in EVENTS if name == "event/adjusted")
+    # An adjusted stroke was played too: Played reads it, Adjusted keeps what changed.
+    assert isinstance(Played.from_json(adjusted), Adjusted)
+    assert Adjusted.from_json(adjusted).requested_duration_ms == 120
+
+
+def test_text_that_is_not_json_is_an_event_error() -> None:
+    with pytest.raises(EventError, match="not JSON"):
+        event_from_json("{")
+    with pytest.raises(EventError, match="not JSON"):
+        Status.from_json(b"\xff")
+
+
+def test_cancelled_defaults_to_its_reason() -> None:
+    event = Cancelled(message="m", received_at_ms=1, cancelled_at_ms=2, started=False)
+    assert event.to_json()["reason"] == "cancelled"

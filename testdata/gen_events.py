@@ -1,0 +1,270 @@
+"""Vectors for what the sleeve publishes: its events and its status (feelmysign.events).
+
+- ``event/<name>.json``: ``wire`` (a message as received), ``typed`` (every field of the
+  event it reads as, ``null`` when absent) and ``json`` (what ``to_json`` writes back:
+  optional fields left out, unknown keys dropped, keys in publishing order);
+- ``status/<name>.json``: the same for the retained status;
+- ``invalid/<name>.json``: ``kind`` (``event`` or ``status``) and a ``wire`` value that
+  is not one, with the ``field`` at fault (``null`` when it is the whole message).
+
+Every expected value is computed here by feelmysign.events; a case that the
+reference reads differently from what it is meant to show stops generation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from feelmysign.events import EventError, Status, event_from_json
+
+TIMING = {
+    "received_at_ms": 1795326267664.25,
+    "start_at_ms": 1795326267664.25,
+    "first_command_at_ms": 1795326267664.5,
+    "latency_ms": 0.25,
+    "start_error_ms": 0.031,
+    "queued_ms": 0,
+    "duration_ms": 417.5,
+    "commands": 5,
+}
+STROKE = {"topic": "feelmysign/sleeve1/strokes", "drawing": "d-1", "seq": 3}
+LAYOUT = {
+    "name": "paper-sleeve",
+    "rows": 3,
+    "columns": 4,
+    "spacing_cm": 3.0,
+    "actuator_type": "ERM",
+    "default_intensity": 0.8,
+    "max_intensity": 1.0,
+    "max_stroke_duration_ms": 10000.0,
+}
+
+EVENTS: dict[str, tuple[str, dict[str, Any]]] = {
+    "played": ("a stroke of a drawing played", {"type": "played", **STROKE, **TIMING}),
+    "played-legacy": (
+        "a legacy stroke: no drawing, seq or sent_at_ms",
+        {"type": "played", "topic": "deviceOne/line", **TIMING},
+    ),
+    "played-with-sent-at": (
+        "the sender stamped sent_at_ms",
+        {"type": "played", **STROKE, "sent_at_ms": 1795326267600, **TIMING},
+    ),
+    "played-unknown-keys": (
+        "keys a newer sleeve may add are ignored",
+        {"type": "played", **STROKE, **TIMING, "colour": "red", "extra": {"a": [1]}},
+    ),
+    "played-seq-as-float": (
+        "3.0 is the whole number 3 (JavaScript cannot tell them apart)",
+        {"type": "played", **STROKE, **TIMING, "seq": 3.0},
+    ),
+    "played-null-optional": (
+        "null for an optional field means absent",
+        {"type": "played", "topic": None, "drawing": None, "seq": None, **TIMING},
+    ),
+    "adjusted": (
+        "a stroke slowed to be felt",
+        {
+            "type": "adjusted",
+            **STROKE,
+            **TIMING,
+            "reason": "too_fast",
+            "requested_duration_ms": 120,
+        },
+    ),
+    "rejected": (
+        "a stroke refused, with the reason code and sentence",
+        {
+            "type": "rejected",
+            "reason": "outside_grid",
+            "message": "start (4, 0) is outside the grid",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+        },
+    ),
+    "rejected-unparsed": (
+        "a payload that could not be read: only the topic is known",
+        {
+            "type": "rejected",
+            "reason": "invalid_json",
+            "message": "not JSON",
+            "topic": "feelmysign/sleeve1/strokes",
+            "received_at_ms": 1795326267664.25,
+        },
+    ),
+    "cancelled-queued": (
+        "a stroke dropped from the queue by a cancel",
+        {
+            "type": "cancelled",
+            "reason": "cancelled",
+            "message": "cancelled by a control message",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+            "cancelled_at_ms": 1795326268000.5,
+            "started": False,
+        },
+    ),
+    "cancelled-playing": (
+        "the stroke playing when the cancel came, cut short",
+        {
+            "type": "cancelled",
+            "reason": "cancelled",
+            "message": "cancelled by a control message",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+            "cancelled_at_ms": 1795326268000.5,
+            "started": True,
+        },
+    ),
+    "safety-max-on-time": (
+        "a motor on for too long, switched off",
+        {"type": "safety", "reason": "max_on_time", "row": 1, "column": 2},
+    ),
+    "safety-off-failed": (
+        "an off that failed twice: every motor off",
+        {"type": "safety", "reason": "off_failed", "row": 0, "column": 3},
+    ),
+    "error-backend": (
+        "a motor write failed",
+        {"type": "error", "reason": "backend", "message": "I2C error", "row": 2, "column": 0},
+    ),
+    "error-player-crashed": (
+        "the player stopped on a bug",
+        {"type": "error", "reason": "player_crashed"},
+    ),
+}
+
+STATUSES: dict[str, tuple[str, dict[str, Any]]] = {
+    "online": (
+        "what the sleeve publishes on connecting",
+        {
+            "online": True,
+            "sleeve_id": "sleeve1",
+            "version": "0.1.0",
+            "backend": "sim",
+            "legacy_topic": "deviceOne/line",
+            "layout": LAYOUT,
+            "at_ms": 1795326267664,
+        },
+    ),
+    "last-will": ("the least a status carries", {"online": False}),
+    "no-legacy-topic": (
+        "a sleeve without the legacy topic publishes null for it",
+        {"online": True, "sleeve_id": "s2", "legacy_topic": None, "layout": LAYOUT},
+    ),
+    "small-layout": (
+        "a layout with only its grid",
+        {"online": True, "layout": {"rows": 4, "columns": 6}},
+    ),
+}
+
+INVALID: dict[str, tuple[str, str, Any]] = {
+    "event-not-object": ("event", "a JSON array is not an event", [1, 2]),
+    "event-no-type": ("event", "no type", {"reason": "backend"}),
+    "event-unknown-type": ("event", "a type no sleeve publishes", {"type": "exploded"}),
+    "event-type-not-string": ("event", "type must be a string", {"type": 1}),
+    "played-missing-timing": (
+        "event",
+        "played without its timing",
+        {"type": "played", **STROKE},
+    ),
+    "played-negative-seq": (
+        "event",
+        "seq below 0",
+        {"type": "played", **STROKE, **TIMING, "seq": -1},
+    ),
+    "played-fractional-seq": (
+        "event",
+        "seq 1.5",
+        {"type": "played", **STROKE, **TIMING, "seq": 1.5},
+    ),
+    "played-latency-string": (
+        "event",
+        "a number sent as text",
+        {"type": "played", **STROKE, **TIMING, "latency_ms": "0.25"},
+    ),
+    "played-duration-bool": (
+        "event",
+        "true is not a number",
+        {"type": "played", **STROKE, **TIMING, "duration_ms": True},
+    ),
+    "adjusted-no-requested": (
+        "event",
+        "adjusted without the duration asked",
+        {"type": "adjusted", **STROKE, **TIMING, "reason": "too_fast"},
+    ),
+    "rejected-no-message": (
+        "event",
+        "rejected without its sentence",
+        {"type": "rejected", "reason": "x", "received_at_ms": 1},
+    ),
+    "cancelled-started-not-bool": (
+        "event",
+        "started must be true or false",
+        {
+            "type": "cancelled",
+            "reason": "cancelled",
+            "message": "m",
+            "received_at_ms": 1,
+            "cancelled_at_ms": 2,
+            "started": 1,
+        },
+    ),
+    "safety-no-row": ("event", "safety without its actuator", {"type": "safety", "reason": "x"}),
+    "status-not-object": ("status", "a string is not a status", "online"),
+    "status-online-string": ("status", "online must be true or false", {"online": "yes"}),
+    "status-no-online": ("status", "online is required", {"sleeve_id": "s"}),
+    "status-layout-zero-rows": (
+        "status",
+        "a grid side outside 1..64",
+        {"online": True, "layout": {"rows": 0, "columns": 4}},
+    ),
+    "status-layout-not-object": (
+        "status",
+        "layout must be an object",
+        {"online": True, "layout": [3, 4]},
+    ),
+}
+
+
+def _typed(value: Any) -> dict[str, Any]:
+    return dataclasses.asdict(value)
+
+
+def cases() -> dict[str, dict[str, Any]]:
+    out: dict[str, dict[str, Any]] = {}
+    for name, (description, wire) in EVENTS.items():
+        event = event_from_json(wire)
+        assert event.kind == wire["type"], name
+        typed = {"type": event.kind, **_typed(event)}
+        out[f"event/{name}.json"] = {
+            "description": description,
+            "wire": wire,
+            "typed": typed,
+            "json": event.to_json(),
+        }
+    for name, (description, wire) in STATUSES.items():
+        status = Status.from_json(wire)
+        out[f"status/{name}.json"] = {
+            "description": description,
+            "wire": wire,
+            "typed": _typed(status),
+            "json": status.to_json(),
+        }
+    for name, (kind, description, wire) in INVALID.items():
+        try:
+            if kind == "event":
+                event_from_json(wire)
+            else:
+                Status.from_json(wire)
+        except EventError as error:
+            out[f"invalid/{name}.json"] = {
+                "description": description,
+                "kind": kind,
+                "wire": wire,
+                "field": error.field,
+                "message": str(error),
+            }
+        else:
+            raise AssertionError(f"{name}: the reference accepts it")
+    return out

@@ -1,0 +1,263 @@
+/**
+ * What the sleeve publishes, typed: its events (`feelmysign/<id>/events`) and
+ * its retained status. The mirror of `python/src/feelmysign/events.py`: the
+ * same fields, the same rules (unknown keys ignored, `null` for an optional
+ * field means absent, 3.0 is the whole number 3), kept equal by the vectors
+ * in testdata/events. A message that is not one gives null, never an
+ * exception: the page must survive whatever a broker delivers.
+ */
+
+interface StrokeRef {
+  readonly topic: string | null;
+  readonly drawing: string | null;
+  readonly seq: number | null;
+  readonly sent_at_ms: number | null;
+}
+
+interface Timing {
+  readonly received_at_ms: number;
+  /** The planned start, the sleeve's wall clock. */
+  readonly start_at_ms: number;
+  readonly first_command_at_ms: number;
+  /** Receive -> first command. */
+  readonly latency_ms: number;
+  readonly start_error_ms: number;
+  /** Time spent waiting for the strokes before it. */
+  readonly queued_ms: number;
+  readonly duration_ms: number;
+  readonly commands: number;
+}
+
+export interface PlayedEvent extends StrokeRef, Timing {
+  readonly type: "played";
+}
+
+/** Played, but changed to be felt (slowed: `reason` "too_fast"). */
+export interface AdjustedEvent extends StrokeRef, Timing {
+  readonly type: "adjusted";
+  readonly reason: string;
+  readonly requested_duration_ms: number;
+}
+
+export interface RejectedEvent extends StrokeRef {
+  readonly type: "rejected";
+  readonly reason: string;
+  readonly message: string;
+  readonly received_at_ms: number;
+}
+
+/** A control message cancelled it: `started` when it was cut short while playing. */
+export interface CancelledEvent extends StrokeRef {
+  readonly type: "cancelled";
+  readonly reason: string;
+  readonly message: string;
+  readonly received_at_ms: number;
+  readonly cancelled_at_ms: number;
+  readonly started: boolean;
+}
+
+export interface SafetyEvent {
+  readonly type: "safety";
+  readonly reason: string;
+  readonly row: number;
+  readonly column: number;
+}
+
+export interface ErrorEvent {
+  readonly type: "error";
+  readonly reason: string;
+  readonly message: string | null;
+  readonly row: number | null;
+  readonly column: number | null;
+}
+
+export type SleeveEvent =
+  PlayedEvent | AdjustedEvent | RejectedEvent | CancelledEvent | SafetyEvent | ErrorEvent;
+export type SleeveEventType = SleeveEvent["type"];
+
+export interface StatusLayout {
+  readonly name: string | null;
+  readonly rows: number;
+  readonly columns: number;
+  readonly spacing_cm: number | null;
+  readonly actuator_type: string | null;
+  readonly default_intensity: number | null;
+  readonly max_intensity: number | null;
+  readonly max_stroke_duration_ms: number | null;
+}
+
+/** The retained status: `online` is all a last will must carry. */
+export interface SleeveStatus {
+  readonly online: boolean;
+  readonly sleeve_id: string | null;
+  readonly version: string | null;
+  readonly backend: string | null;
+  readonly legacy_topic: string | null;
+  readonly layout: StatusLayout | null;
+  readonly at_ms: number | null;
+}
+
+// ---- the field tables: names in publishing order, as in events.py -----------------------------
+
+type Kind = "text" | "number" | "index" | "flag";
+type Field = readonly [name: string, kind: Kind, required: boolean];
+
+const STROKE: readonly Field[] = [
+  ["topic", "text", false],
+  ["drawing", "text", false],
+  ["seq", "index", false],
+  ["sent_at_ms", "number", false],
+];
+const TIMING: readonly Field[] = [
+  ["received_at_ms", "number", true],
+  ["start_at_ms", "number", true],
+  ["first_command_at_ms", "number", true],
+  ["latency_ms", "number", true],
+  ["start_error_ms", "number", true],
+  ["queued_ms", "number", true],
+  ["duration_ms", "number", true],
+  ["commands", "index", true],
+];
+const REASON_MESSAGE: readonly Field[] = [
+  ["reason", "text", true],
+  ["message", "text", true],
+];
+
+const EVENT_FIELDS: Record<SleeveEventType, readonly Field[]> = {
+  played: [...STROKE, ...TIMING],
+  adjusted: [...STROKE, ...TIMING, ["reason", "text", true], ["requested_duration_ms", "number", true]],
+  rejected: [...REASON_MESSAGE, ...STROKE, ["received_at_ms", "number", true]],
+  cancelled: [
+    ...REASON_MESSAGE,
+    ...STROKE,
+    ["received_at_ms", "number", true],
+    ["cancelled_at_ms", "number", true],
+    ["started", "flag", true],
+  ],
+  safety: [
+    ["reason", "text", true],
+    ["row", "index", true],
+    ["column", "index", true],
+  ],
+  error: [
+    ["reason", "text", true],
+    ["message", "text", false],
+    ["row", "index", false],
+    ["column", "index", false],
+  ],
+};
+const LAYOUT_FIELDS: readonly Field[] = [
+  ["name", "text", false],
+  ["rows", "index", true],
+  ["columns", "index", true],
+  ["spacing_cm", "number", false],
+  ["actuator_type", "text", false],
+  ["default_intensity", "number", false],
+  ["max_intensity", "number", false],
+  ["max_stroke_duration_ms", "number", false],
+];
+const STATUS_FIELDS: readonly Field[] = [
+  ["online", "flag", true],
+  ["sleeve_id", "text", false],
+  ["version", "text", false],
+  ["backend", "text", false],
+  ["legacy_topic", "text", false],
+];
+/** A grid side the page will draw: the layout file's own limit. */
+const MAX_GRID_SIDE = 64;
+
+function asObject(value: unknown): Record<string, unknown> | null {
+  return typeof value === "object" && value !== null && !Array.isArray(value)
+    ? (value as Record<string, unknown>)
+    : null;
+}
+
+/** undefined: the value does not have the kind; null: absent. */
+function readValue(value: unknown, kind: Kind): unknown {
+  if (value === null || value === undefined) return null;
+  switch (kind) {
+    case "text":
+      return typeof value === "string" ? value : undefined;
+    case "flag":
+      return typeof value === "boolean" ? value : undefined;
+    case "number":
+      return typeof value === "number" && Number.isFinite(value) ? value : undefined;
+    case "index":
+      return typeof value === "number" && Number.isInteger(value) && value >= 0 ? value : undefined;
+  }
+}
+
+function readFields(data: Record<string, unknown>, fields: readonly Field[]): Record<string, unknown> | null {
+  const out: Record<string, unknown> = {};
+  for (const [name, kind, required] of fields) {
+    const value = readValue(data[name], kind);
+    if (value === undefined || (value === null && required)) return null;
+    out[name] = value;
+  }
+  return out;
+}
+
+function writeFields(data: object, fields: readonly Field[]): Record<string, unknown> {
+  const values = data as Record<string, unknown>;
+  const out: Record<string, unknown> = {};
+  for (const [name] of fields)
+    if (values[name] !== null && values[name] !== undefined) out[name] = values[name];
+  return out;
+}
+
+function parseText(text: string): unknown {
+  try {
+    return JSON.parse(text);
+  } catch {
+    return undefined;
+  }
+}
+
+/** An event from its JSON value; null when it is not one. */
+export function readEvent(value: unknown): SleeveEvent | null {
+  const data = asObject(value);
+  const type = data?.["type"];
+  if (data === null || typeof type !== "string" || !Object.hasOwn(EVENT_FIELDS, type)) return null;
+  const fields = readFields(data, EVENT_FIELDS[type as SleeveEventType]);
+  return fields === null ? null : ({ type, ...fields } as unknown as SleeveEvent);
+}
+
+export function parseEvent(text: string): SleeveEvent | null {
+  return readEvent(parseText(text));
+}
+
+/** The event as the sleeve publishes it: optional fields left out. */
+export function eventToJson(event: SleeveEvent): Record<string, unknown> {
+  return { type: event.type, ...writeFields(event, EVENT_FIELDS[event.type]) };
+}
+
+function readLayout(value: unknown): StatusLayout | null | undefined {
+  if (value === null || value === undefined) return null;
+  const data = asObject(value);
+  const fields = data === null ? null : readFields(data, LAYOUT_FIELDS);
+  if (fields === null) return undefined;
+  const { rows, columns } = fields as { rows: number; columns: number };
+  if (rows < 1 || rows > MAX_GRID_SIDE || columns < 1 || columns > MAX_GRID_SIDE) return undefined;
+  return fields as unknown as StatusLayout;
+}
+
+export function readStatus(value: unknown): SleeveStatus | null {
+  const data = asObject(value);
+  if (data === null) return null;
+  const fields = readFields(data, STATUS_FIELDS);
+  const layout = readLayout(data["layout"]);
+  const atMs = readValue(data["at_ms"], "number");
+  if (fields === null || layout === undefined || atMs === undefined) return null;
+  return { ...fields, layout, at_ms: atMs } as unknown as SleeveStatus;
+}
+
+export function parseStatus(text: string): SleeveStatus | null {
+  return readStatus(parseText(text));
+}
+
+export function statusToJson(status: SleeveStatus): Record<string, unknown> {
+  const out = writeFields(status, STATUS_FIELDS);
+  if (status.layout !== null) out["layout"] = writeFields(status.layout, LAYOUT_FIELDS);
+  if (status.at_ms !== null) out["at_ms"] = status.at_ms;
+  return out;
+}

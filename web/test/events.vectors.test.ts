@@ -1,0 +1,54 @@
+/** The sleeve's events and status, read and written as the Python reference does (testdata/events). */
+import { describe, expect, it } from "vitest";
+import { eventToJson, parseEvent, parseStatus, readEvent, readStatus, statusToJson } from "../src/events";
+import { hasVectors, vectors } from "./testdata";
+
+interface ValidVector {
+  description: string;
+  wire: unknown;
+  typed: Record<string, unknown>;
+  json: Record<string, unknown>;
+}
+
+interface InvalidVector {
+  description: string;
+  kind: "event" | "status";
+  wire: unknown;
+}
+
+const present = hasVectors("events");
+const events = present ? (vectors("events", "event") as [string, ValidVector][]) : [];
+const statuses = present ? (vectors("events", "status") as [string, ValidVector][]) : [];
+const invalid = present ? (vectors("events", "invalid") as [string, InvalidVector][]) : [];
+
+describe.skipIf(!present)("event and status vectors", () => {
+  it("finds every group", () => {
+    expect(events.length).toBeGreaterThan(0);
+    expect(statuses.length).toBeGreaterThan(0);
+    expect(invalid.length).toBeGreaterThan(0);
+  });
+
+  it.each(events)("%s", (_name, vector) => {
+    const event = parseEvent(JSON.stringify(vector.wire));
+    expect(event).toEqual(vector.typed);
+    expect(eventToJson(event!)).toEqual(vector.json);
+  });
+
+  it.each(statuses)("%s", (_name, vector) => {
+    const status = parseStatus(JSON.stringify(vector.wire));
+    expect(status).toEqual(vector.typed);
+    expect(statusToJson(status!)).toEqual(vector.json);
+  });
+
+  it.each(invalid)("%s", (_name, vector) => {
+    const read = vector.kind === "event" ? readEvent : readStatus;
+    expect(read(vector.wire)).toBeNull();
+  });
+});
+
+describe("text that is not JSON", () => {
+  it.each(["", "{", "null", '"played"'])("gives null for %j", (text) => {
+    expect(parseEvent(text)).toBeNull();
+    expect(parseStatus(text)).toBeNull();
+  });
+});
