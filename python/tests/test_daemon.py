@@ -7,6 +7,7 @@ import itertools
 import json
 import subprocess
 import threading
+import time
 import uuid
 from collections.abc import Iterator
 from typing import Any
@@ -322,6 +323,10 @@ def test_strokes_still_waiting_at_stop_are_reported(broker: Broker) -> None:
         stroke = Stroke((0.0, 0.0), (3.0, 0.0), 3000.0, None, "long", seq)
         sender.publish(topic(sid, "strokes"), format_json(stroke), qos=1).wait_for_publish(5)
     running.wait_events(1)
+    # All three in the sleeve's hands (acknowledged by the broker is not yet received).
+    deadline = time.monotonic() + 10
+    while running.sleeve.counts["received"] < 3 and time.monotonic() < deadline:
+        time.sleep(0.01)
     running.sleeve.stop()
     running.thread.join(10)
     events = running.wait_events(3)  # the watcher is still listening: nothing is lost
