@@ -102,18 +102,53 @@ def test_erm_clears_a_leftover_lra_bit() -> None:
     assert chip.registers[FEEDBACK_CONTROL] == 0x36
 
 
-def test_a_missing_chip_is_named_by_multiplexer_and_channel_before_any_chip_is_set_up() -> None:
+def left_running(bus: EmulatedI2CBus, level: int = 0xCC) -> None:
+    """Every chip as a killed sleeve leaves it: real-time playback, unsigned, at ``level``."""
+    for chip in bus.chips.values():
+        chip.registers[CONTROL3] |= 0x08
+        chip.registers[RTP_INPUT] = level
+        chip.registers[MODE] = 0x05
+    assert all(chip.output > 0.5 for chip in bus.chips.values())
+
+
+def test_a_missing_chip_is_named_and_every_other_chip_is_switched_off_first() -> None:
     layout = paper_layout()
     bus = EmulatedI2CBus.for_layout(layout)
+    left_running(bus)
     bus.detach_chip(0x70, 3)
     with pytest.raises(HardwareError) as error:
         Drv2605Backend(layout, bus=bus).open()
     assert str(error.value) == (
         "No DRV2605L answered on multiplexer 0x70 channel 3 (actuator row 0, column 3); "
         + NOT_FOUND_HINT
+        + " (every chip that answered was switched off first)"
     )
-    assert all(chip.write_count == 0 for chip in bus.chips.values())
+    assert len(bus.chips) == 11
+    assert all(chip.output == 0.0 and chip.standby for chip in bus.chips.values())
     assert bus.enabled_channels() == []
+
+
+@pytest.mark.parametrize("fault", ["missing", "broken wire", "wrong id", "missing multiplexer"])
+def test_no_single_fault_at_start_up_leaves_a_reachable_motor_on(fault: str) -> None:
+    layout = paper_layout()
+    bus = EmulatedI2CBus.for_layout(layout)
+    left_running(bus)
+    unreachable: set[tuple[int, int]] = set()
+    if fault == "missing":
+        bus.detach_chip(0x71, 2)
+    elif fault == "broken wire":
+        bus.chip(mux=0x70, channel=5).connected = False
+        unreachable.add((0x70, 5))
+    elif fault == "wrong id":
+        bus.chip(mux=0x70, channel=0).device_id = DRV2604_DEVICE_ID
+    else:
+        bus.multiplexer(0x71).connected = False
+        unreachable.update((0x71, channel) for channel in range(4))
+    with pytest.raises(HardwareError):
+        Drv2605Backend(layout, bus=bus).open()
+    drives = {key: chip.output for key, chip in bus.chips.items()}
+    assert {key for key, drive in drives.items() if drive > 0} == unreachable
+    assert all(chip.output == 0.0 for key, chip in bus.chips.items() if key not in unreachable)
 
 
 def test_a_wrong_chip_id_is_named_with_what_was_found() -> None:
@@ -240,12 +275,12 @@ def test_set_intensity_writes_only_the_target_rtp_register_and_only_on_change() 
 
     backend.set_intensity(0, 3, 0.5)
     assert target.registers[RTP_INPUT] == 128  # round(127.5)
-    assert target.writes[RTP_INPUT] == 2  # start-up's 0, then this one
+    assert target.writes[RTP_INPUT] == 3  # start-up's off and set-up zeros, then this one
     backend.set_intensity(0, 3, 0.5)  # unchanged: nothing on the bus
     backend.set_intensity(0, 3, 0.5001)  # another intensity, the same register value
-    assert target.writes[RTP_INPUT] == 2
+    assert target.writes[RTP_INPUT] == 3
     backend.set_intensity(0, 3, 1.0)
-    assert target.registers[RTP_INPUT] == 255 and target.writes[RTP_INPUT] == 3
+    assert target.registers[RTP_INPUT] == 255 and target.writes[RTP_INPUT] == 4
     assert target.output == 1.0
 
     after = {key: chip.write_count for key, chip in bus.chips.items()}
@@ -423,7 +458,8 @@ def test_any_sequence_leaves_each_rtp_register_at_the_last_intensity_without_con
     assert bus.max_enabled_channels == 1
     rtp_writes = sum(1 for t in bus.log if t.op == "write_byte_data" and t.register == RTP_INPUT)
     distinct_changes = _count_level_changes(calls)
-    assert rtp_writes == 12 + distinct_changes  # start-up zeros, then one write per change
+    # Start-up's off and set-up zeros, then one write per change.
+    assert rtp_writes == 2 * 12 + distinct_changes
 
 
 def _count_level_changes(calls: list[tuple[tuple[int, int], float]]) -> int:

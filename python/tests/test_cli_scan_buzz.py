@@ -325,7 +325,7 @@ def test_factory_emulated_drv2605_drives_the_emulated_chip(
     [
         ("tactor", {}, ParameterError, "'sim' (the simulator) or 'drv2605'"),
         ("drv2605", {}, LayoutError, "i2c.wiring: missing"),
-        ("sim", {"emulate": True}, ParameterError, "use it with --backend drv2605"),
+        ("sim", {"emulate": True}, ParameterError, "use them with --backend drv2605"),
         ("sim", {"record": "/nonexistent/x.jsonl"}, ParameterError, "a file that can be written"),
     ],
 )

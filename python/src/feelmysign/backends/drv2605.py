@@ -186,6 +186,18 @@ class _Actuator:
 _CHECK_HINT = "check the wiring or run 'feelmysign scan'"
 
 
+# Said with every failed chip check: the off went out before the check.
+_OTHERS_OFF = "(every chip that answered was switched off first)"
+
+
+def _off_failed_message(problems: list[str]) -> str:
+    listed = "\n".join(f"  - {p}" for p in problems)
+    return (
+        "Could not switch off every actuator; if a motor keeps vibrating, cut the "
+        f"sleeve's power:\n{listed}"
+    )
+
+
 class Drv2605Backend(GridBackend):
     """Drives one DRV2605L per actuator, wired as ``layout.wiring`` says.
 
@@ -210,7 +222,25 @@ class Drv2605Backend(GridBackend):
         self._configured: set[tuple[int, int]] = set()  # chips set up for RTP by start_rtp
         self._playing: set[tuple[int, int]] = set()  # of those, the ones out of standby
 
-    def _open(self) -> None:
+    def switch_off_unchecked(self) -> list[str]:
+        """Before (or instead of) ``open``: every chip that answers off, none checked; what failed.
+
+        For the very start of a process, when a crash may have left motors on:
+        it never raises, and leaves the backend as it found it (not open).
+        """
+        with self._lock:
+            if self.is_open:
+                return []
+            try:
+                self._connect()
+                return self._off_problems()
+            except (HardwareError, LayoutError) as error:
+                return [str(error)]
+            finally:
+                self._multiplexers = None
+                self._release()
+
+    def _connect(self) -> Multiplexers:
         problems = check_wiring(self._layout)
         if problems:  # before any I2C traffic
             raise LayoutError(self._layout.name, problems)
@@ -224,9 +254,17 @@ class Drv2605Backend(GridBackend):
             )
             for w in self._layout.wiring
         }
+        return multiplexers
+
+    def _open(self) -> None:
+        multiplexers = self._connect()
         try:
-            multiplexers.deselect_all()  # a known state; a missing multiplexer shows up here
+            # Off first, before any check can raise: after a crash a chip may still drive
+            # its motor, and a missing or wrong chip elsewhere must not keep it running.
+            off_problems = self._off_problems()
             self._check_chips()
+            if off_problems:  # every chip passed the check, yet one could not be switched off
+                raise HardwareError(_off_failed_message(off_problems))
             for key, actuator in self._actuators.items():
                 self._guard(
                     actuator,
@@ -265,12 +303,13 @@ class Drv2605Backend(GridBackend):
                     f"fit a DRV2605L there or {_CHECK_HINT}"
                 )
         if len(problems) == 1:
-            raise HardwareError(problems[0])
+            raise HardwareError(f"{problems[0]} {_OTHERS_OFF}")
         if problems:
             total = len(self._actuators)
             listed = "\n".join(f"  - {p}" for p in problems)
             raise HardwareError(
-                f"{len(problems)} of {total} DRV2605L chips failed the check:\n{listed}"
+                f"{len(problems)} of {total} DRV2605L chips failed the check ({_OTHERS_OFF}):"
+                f"\n{listed}"
             )
 
     def _write(self, row: int, column: int, intensity: float) -> None:
@@ -290,40 +329,43 @@ class Drv2605Backend(GridBackend):
         self._rtp_levels[key] = level
 
     def _all_off(self) -> None:
+        problems = self._off_problems()
+        if problems:
+            raise HardwareError(_off_failed_message(problems))
+
+    def _off_problems(self) -> list[str]:
+        """Switch every chip that answers off (RTP 0, standby), then deselect every channel.
+
+        Never raises for a chip or multiplexer that fails: it tries all of them
+        and returns what failed, so that one broken part cannot keep the others on.
+        """
         multiplexers = self._multiplexers
         if multiplexers is None:  # never opened: nothing was switched on
-            return
-        problems = []
+            return []
+        problems: dict[tuple[int, int], str] = {}
         with multiplexers.best_effort():
-            for key, actuator in self._actuators.items():
-                problem = self._switch_off(key, actuator)
-                if problem is not None:
-                    problems.append(problem)
+            # RTP 0 on every chip first (the quickest way to silence them all), then
+            # standby: either alone silences a motor, so both are tried on every chip.
+            for step in (self._rtp_zero, self._standby):
+                for key, actuator in self._actuators.items():
+                    try:
+                        step(key, actuator)
+                    except HardwareError as error:
+                        problems.setdefault(key, str(error))
+        listed = list(problems.values())
         try:
             multiplexers.deselect_all()
         except HardwareError as error:
-            problems.append(str(error))
-        if problems:
-            listed = "\n".join(f"  - {p}" for p in problems)
-            raise HardwareError(
-                "Could not switch off every actuator; if a motor keeps vibrating, cut the "
-                f"sleeve's power:\n{listed}"
-            )
+            listed.append(str(error))
+        return listed
 
-    def _switch_off(self, key: tuple[int, int], actuator: _Actuator) -> str | None:
-        """RTP 0, then standby: both tried, as either alone silences the motor; the first error."""
+    def _rtp_zero(self, key: tuple[int, int], actuator: _Actuator) -> None:
+        self._guard(actuator, "", actuator.chip.set_rtp, 0)
+        self._rtp_levels[key] = 0
+
+    def _standby(self, key: tuple[int, int], actuator: _Actuator) -> None:
         self._playing.discard(key)
-        problem = None
-        try:
-            self._guard(actuator, "", actuator.chip.set_rtp, 0)
-            self._rtp_levels[key] = 0
-        except HardwareError as error:
-            problem = str(error)
-        try:
-            self._guard(actuator, "", actuator.chip.standby)
-        except HardwareError as error:
-            problem = problem or str(error)
-        return problem
+        self._guard(actuator, "", actuator.chip.standby)
 
     def _release(self) -> None:
         bus, self._owned_bus = self._owned_bus, None

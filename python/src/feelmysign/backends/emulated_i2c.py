@@ -22,6 +22,10 @@ What it models:
 
 Faults to inject: ``detach_chip`` (a missing chip), ``connected = False`` (a
 broken wire, registers kept), ``device_id`` (a wrong chip, e.g. 4 = DRV2604).
+
+``on_write``, when set, is called after every write the bus applied, while the
+bus is locked: :mod:`feelmysign.backends.emulated_state` uses it to keep the
+registers in a file, so that they outlive the process as a real chip's do.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from __future__ import annotations
 import errno
 import threading
 from collections import Counter, deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -231,6 +236,7 @@ class EmulatedI2CBus:
         self.read_count = 0
         self.max_enabled_channels = 0  # the most channels ever enabled at once, all multiplexers
         self.closed = False
+        self.on_write: Callable[[EmulatedI2CBus], None] | None = None
 
     @classmethod
     def for_layout(
@@ -281,6 +287,15 @@ class EmulatedI2CBus:
 
     def multiplexer(self, address: int) -> EmulatedTCA9548A:
         return self._multiplexers[address]
+
+    @property
+    def multiplexers(self) -> dict[int, EmulatedTCA9548A]:
+        """address -> multiplexer."""
+        return dict(self._multiplexers)
+
+    @property
+    def main_bus_chips(self) -> list[EmulatedDRV2605L]:
+        return list(self._main_bus_chips)
 
     @property
     def chips(self) -> dict[tuple[int, int], EmulatedDRV2605L]:
@@ -337,6 +352,8 @@ class EmulatedI2CBus:
             device = devices[0]
             result = self._apply(device, op, register, value)
             self.log.append(Transaction(op, address, register, value, device.name))
+            if self.on_write is not None and op.startswith("write"):
+                self.on_write(self)
             return result
 
     def _answering(self, address: int) -> list[_Device]:

@@ -1,4 +1,4 @@
-"""One place that turns ``--backend sim|drv2605 [--emulate]`` into an open backend.
+"""One place that turns ``--backend sim|drv2605 [--emulate | --emulate-state FILE]`` into a backend.
 
 Used by the sleeve daemon and by ``feelmysign buzz``, so both refuse the same
 mistakes with the same words, before any I2C traffic: an unknown backend, a
@@ -13,6 +13,8 @@ from typing import Literal
 from feelmysign.backends.base import Backend
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
+from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.sim import SimBackend
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.errors import LayoutError, ParameterError
@@ -29,13 +31,16 @@ def open_backend(
     record: str | os.PathLike[str] | None = None,
     telemetry: ActuatorTelemetry | None = None,
     emulate: bool = False,
+    emulate_state: str | os.PathLike[str] | None = None,
 ) -> Backend:
     """An open backend for ``layout``, every actuator silent; close it (or use ``with``).
 
     ``sim`` records what would be felt (``record``: a JSON-lines file of every
     change). ``drv2605`` drives the chips on ``/dev/i2c-<layout.i2c_bus>``, or,
     with ``emulate``, on an emulated bus wired as the layout says (to try the
-    hardware path without hardware). Raises ParameterError for a bad choice,
+    hardware path without hardware); ``emulate_state`` keeps that bus's registers
+    in a file across processes (see :mod:`feelmysign.backends.emulated_state`)
+    and implies ``emulate``. Raises ParameterError for a bad choice,
     LayoutError for a layout without wiring, HardwareError when the chips do not
     answer (see :meth:`Drv2605Backend.open`).
     """
@@ -44,7 +49,9 @@ def open_backend(
             "backend", name, "'sim' (the simulator) or 'drv2605' (DRV2605L chips over I2C)"
         )
     if name == "sim":
-        return _open_sim(layout, record=record, telemetry=telemetry, emulate=emulate)
+        return _open_sim(
+            layout, record=record, telemetry=telemetry, emulate=emulate or emulate_state is not None
+        )
     if record is not None:
         raise ParameterError(
             "record",
@@ -52,7 +59,11 @@ def open_backend(
             "left out with the drv2605 backend: only the simulator records (--backend sim)",
         )
     check_wired(layout)
-    bus = EmulatedI2CBus.for_layout(layout) if emulate else None
+    bus: I2CBus | None = None
+    if emulate_state is not None:
+        bus = open_state_bus(emulate_state, layout)
+    elif emulate:
+        bus = EmulatedI2CBus.for_layout(layout)
     backend = Drv2605Backend(layout, bus=bus, telemetry=telemetry)
     backend.open()
     return backend
@@ -69,8 +80,8 @@ def _open_sim(
         raise ParameterError(
             "emulate",
             emulate,
-            "False with the sim backend: --emulate stands in for the drv2605 hardware; "
-            "use it with --backend drv2605",
+            "False with the sim backend: --emulate and --emulate-state stand in for the "
+            "drv2605 hardware; use them with --backend drv2605",
         )
     backend = SimBackend(layout, record=record, telemetry=telemetry)
     try:

@@ -19,6 +19,7 @@ import time
 from feelmysign.backends.base import check_actuator
 from feelmysign.backends.factory import BACKEND_NAMES, open_backend
 from feelmysign.backends.sim import SimBackend
+from feelmysign.cli._emulation import add_emulate_state_option
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import interrupt_on_stop_signals
 from feelmysign.errors import ParameterError
@@ -62,6 +63,7 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         action="store_true",
         help="with drv2605: an emulated I2C bus wired as the layout says, instead of the hardware",
     )
+    add_emulate_state_option(parser)
     add_layout_options(parser)
     parser.set_defaults(handler=run)
 
@@ -71,7 +73,9 @@ def run(args: argparse.Namespace) -> int:
     check_actuator(layout, args.row, args.column)
     intensity, intensity_note = _intensity(args.intensity, layout)
     duration_ms, duration_note = _duration_ms(args.duration_ms, layout)
-    backend = open_backend(args.backend, layout, emulate=args.emulate)
+    backend = open_backend(
+        args.backend, layout, emulate=args.emulate, emulate_state=args.emulate_state
+    )
     where = _where(args, layout)
     for note in (intensity_note, duration_note):
         if note:
@@ -131,5 +135,9 @@ def _where(args: argparse.Namespace, layout: Layout) -> str:
     if args.backend == "sim":
         return " on the simulator"
     wire = next(w for w in layout.wiring if (w.row, w.column) == (args.row, args.column))
-    bus = "an emulated I2C bus" if args.emulate else f"/dev/i2c-{layout.i2c_bus}"
+    bus = f"/dev/i2c-{layout.i2c_bus}"
+    if args.emulate_state:
+        bus = f"the emulated I2C bus in {args.emulate_state}"
+    elif args.emulate:
+        bus = "an emulated I2C bus"
     return f" (DRV2605L on multiplexer 0x{wire.multiplexer:02X} channel {wire.channel}, {bus})"

@@ -2,6 +2,7 @@
 
     feelmysign scan --layout /etc/feelmysign/layout.toml
     feelmysign scan --layout deploy/layouts/paper-sleeve.toml --emulate   # no hardware needed
+    feelmysign scan --layout deploy/layouts/paper-sleeve.toml --emulate-state bus.json
 
 One line per channel of every multiplexer the layout lists: the actuator the
 layout expects there, what answered, and the verdict. Exit 0 when every wired
@@ -20,9 +21,11 @@ from typing import Any
 
 from feelmysign.backends.drv2605 import DRV2605_ADDRESS, SUPPORTED_DEVICE_IDS, device_name
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
+from feelmysign.backends.emulated_state import open_state_bus
 from feelmysign.backends.i2c import I2CBus, open_smbus
 from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
+from feelmysign.cli._emulation import add_emulate_state_option
 from feelmysign.cli._options import LAYOUT_ENV
 from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
@@ -30,6 +33,10 @@ from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layo
 EMULATED_NOTE = (
     "Emulated bus: nothing real was probed. Every chip the layout wires is simulated as "
     "present, so this shows the output format, not your sleeve."
+)
+STATE_NOTE = (
+    "Emulated bus kept in {path}: nothing real was probed; the chips are those the file holds, "
+    "with the faults set in it."
 )
 _TABLE_HEADER = ("multiplexer", "channel", "expected", "found", "status")
 
@@ -81,6 +88,7 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         action="store_true",
         help="scan an emulated bus wired as the layout says, instead of /dev/i2c-N",
     )
+    add_emulate_state_option(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object, for programs")
     parser.set_defaults(handler=run)
 
@@ -92,7 +100,13 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("--bus", bus_number, f"a bus number from 0 to {MAX_I2C_BUS}")
     # Without wiring there is nothing to expect: probe every address a TCA9548A can have.
     addresses = layout.multiplexers or tuple(MULTIPLEXER_ADDRESSES)
-    bus = EmulatedI2CBus.for_layout(layout) if args.emulate else _open_bus(bus_number)
+    bus: I2CBus
+    if args.emulate_state:
+        bus = open_state_bus(args.emulate_state, layout)
+    elif args.emulate:
+        bus = EmulatedI2CBus.for_layout(layout)
+    else:
+        bus = _open_bus(bus_number)
     try:
         result = scan(bus, addresses)
     finally:
@@ -169,9 +183,15 @@ def _describe(
     report: LayoutReport,
     rows: list[ChannelRow],
 ) -> str:
-    where = "an emulated bus" if args.emulate else f"/dev/i2c-{bus_number}"
+    where = f"/dev/i2c-{bus_number}"
+    if args.emulate_state:
+        where = f"the emulated bus in {args.emulate_state}"
+    elif args.emulate:
+        where = "an emulated bus"
     lines = [f"Scanning {where} against layout {layout.name!r}."]
-    if args.emulate:
+    if args.emulate_state:
+        lines.append(STATE_NOTE.format(path=args.emulate_state))
+    elif args.emulate:
         lines.append(EMULATED_NOTE)
     if rows:
         lines += ["", *_table(rows), ""]
@@ -251,8 +271,8 @@ def _as_json(
 ) -> dict[str, Any]:
     return {
         "ok": ok,
-        "emulated": bool(args.emulate),
-        "bus": None if args.emulate else bus_number,
+        "emulated": bool(args.emulate or args.emulate_state),
+        "bus": None if args.emulate or args.emulate_state else bus_number,
         "layout": layout.name,
         "main_bus": [f"0x{a:02X}" for a in result.main_bus],
         "missing_multiplexers": [f"0x{a:02X}" for a in result.missing_multiplexers],

@@ -12,6 +12,7 @@ from typing import Any
 from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli._emulation import add_emulate_state_option
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.connection import BrokerSettings
@@ -47,6 +48,7 @@ def register(subparsers: Any) -> None:
         action="store_true",
         help="with --backend drv2605: an emulated I2C bus wired as the layout says",
     )
+    add_emulate_state_option(parser)
     parser.add_argument(
         "--legacy-topic",
         default=LEGACY_TOPIC,
@@ -97,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
         legacy_topic=None if args.no_legacy else args.legacy_topic,
         rate_per_s=args.rate_per_s,
         strict=args.strict,
-        backend_name=args.backend + (" (emulated bus)" if args.emulate else ""),
+        backend_name=args.backend
+        + (" (emulated bus)" if args.emulate or args.emulate_state else ""),
     )
     print(
         f"Sleeve {options.sleeve_id}: {layout.rows} x {layout.columns} actuators, "
@@ -111,6 +114,7 @@ def run(args: argparse.Namespace) -> int:
         backend=args.backend,
         record=args.record,
         emulate=args.emulate,
+        emulate_state=args.emulate_state,
         on_start=_stop_on_signals,
     )
     print(
@@ -129,6 +133,7 @@ def run_sleeve(
     backend: BackendName = "sim",
     record: str | None = None,
     emulate: bool = False,
+    emulate_state: str | None = None,
     on_start: Callable[[Sleeve], None] = lambda sleeve: None,
 ) -> Counter[str]:
     """Open the backend with its telemetry, run the sleeve until it stops; every motor off after."""
@@ -141,7 +146,12 @@ def run_sleeve(
     with (
         ActuatorTelemetry(publish, rate_hz=TELEMETRY_RATE_HZ) as telemetry,
         open_backend(
-            backend, layout, record=record, telemetry=telemetry, emulate=emulate
+            backend,
+            layout,
+            record=record,
+            telemetry=telemetry,
+            emulate=emulate,
+            emulate_state=emulate_state,
         ) as opened,
     ):
         sleeve = Sleeve(settings, layout, opened, options)

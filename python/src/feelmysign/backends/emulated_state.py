@@ -1,0 +1,208 @@
+"""The emulated I2C bus kept in a file, so that its registers outlive the process.
+
+A real DRV2605L keeps its registers, and so keeps driving its motor, when the
+process that wrote them dies; a TCA9548A keeps its enabled channels. The
+emulated bus on its own forgets everything with its process, so it cannot
+show what a crash leaves behind. With a state file (``--emulate-state FILE`` on
+``sleeve``, ``scan`` and ``buzz``) every register write is written through to
+the file, and the next process starts from what the last one left: a test can
+``kill -9`` a sleeve mid-stroke, see the motor still on in the file, restart
+the sleeve and read back every motor's drive level.
+
+The file is JSON, written whole to a temporary file and renamed over the old
+one after every write, so a process killed at any moment leaves either the
+state before or the state after its last write, never half a file (a rename
+survives the death of the process; like the chips themselves, it is not meant
+to survive a power cut)::
+
+    {
+      "format": "feelmysign-emulated-i2c/1",
+      "multiplexers": {"0x70": {"control": 0, "connected": true}, ...},
+      "chips": {
+        "0x70/0": {"device_id": 7, "connected": true, "drive": 0.0,
+                   "registers": "e04000010100..."},
+        ...
+      },
+      "main_bus_chips": []
+    }
+
+Faults are set in the file: leave a chip out of ``chips`` (or set
+``"connected": false``, a broken wire that keeps the registers) for a missing
+chip; set ``device_id`` (e.g. 4, a DRV2604) for a wrong chip. ``drive`` is
+written for people and tests to read (0..1, what the motor gets) and ignored
+when the file is read back. One process at a time should drive a state file;
+others may read it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from feelmysign.backends.emulated_i2c import EmulatedDRV2605L, EmulatedI2CBus
+from feelmysign.errors import FeelMySignError
+from feelmysign.layout import Layout
+
+STATE_FORMAT = "feelmysign-emulated-i2c/1"
+# Far above any real state file (a few kB), far below what would hurt to read.
+MAX_STATE_BYTES = 1_000_000
+
+
+class EmulatedStateError(FeelMySignError):
+    """A state file that cannot be used; ``path`` and ``problem`` say which and why."""
+
+    def __init__(self, path: Path, problem: str) -> None:
+        super().__init__(
+            f"{path}: not a usable emulated I2C bus state file ({problem}); fix it, or delete it "
+            "to start from a fresh bus wired as the layout says"
+        )
+        self.path = path
+        self.problem = problem
+
+
+def chip_key(multiplexer: int, channel: int) -> str:
+    """How the file names the chip on ``channel`` of ``multiplexer``: ``"0x70/3"``."""
+    return f"0x{multiplexer:02X}/{channel}"
+
+
+def open_state_bus(path: str | os.PathLike[str], layout: Layout) -> EmulatedI2CBus:
+    """The bus kept in ``path``, written through on every write.
+
+    A file that does not exist yet becomes a fresh bus wired as ``layout``
+    says (every chip at its power-on reset values); an existing file is the
+    truth, whatever the layout says, as the hardware would be.
+    """
+    state_path = Path(path)
+    if state_path.exists():
+        bus = read_state(state_path)
+    else:
+        bus = EmulatedI2CBus.for_layout(layout)
+        try:
+            write_state(bus, state_path)
+        except OSError as error:
+            raise EmulatedStateError(
+                state_path, f"cannot be written: {error.strerror or error}"
+            ) from error
+    bus.on_write = _WriteThrough(state_path)
+    return bus
+
+
+class _WriteThrough:
+    """Saves the bus after each write that changed it (a write of what a register holds
+    changes nothing, and skipping it keeps a burst of writes quick)."""
+
+    def __init__(self, path: Path) -> None:
+        self._path = path
+        self._last = ""
+
+    def __call__(self, bus: EmulatedI2CBus) -> None:
+        text = _as_text(bus)
+        if text != self._last:
+            _replace(self._path, text)
+            self._last = text
+
+
+def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
+    """The bus saved in ``path`` (no write-through: for looking, or for a test to edit)."""
+    state_path = Path(path)
+    try:
+        if state_path.stat().st_size > MAX_STATE_BYTES:
+            raise EmulatedStateError(state_path, f"larger than {MAX_STATE_BYTES} bytes")
+        data = json.loads(state_path.read_text(encoding="utf-8"))
+    except OSError as error:
+        problem = f"cannot be read: {error.strerror or error}"
+        raise EmulatedStateError(state_path, problem) from error
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise EmulatedStateError(state_path, f"not JSON: {error}") from error
+    try:
+        return bus_from_state(data)
+    except (KeyError, TypeError, ValueError) as error:
+        raise EmulatedStateError(state_path, f"{type(error).__name__}: {error}") from error
+
+
+def write_state(bus: EmulatedI2CBus, path: str | os.PathLike[str]) -> None:
+    """Save ``bus`` to ``path`` atomically: a reader, or a killed writer, never sees half a file."""
+    _replace(Path(path), _as_text(bus))
+
+
+def _as_text(bus: EmulatedI2CBus) -> str:
+    return json.dumps(state_of(bus), indent=1) + "\n"
+
+
+def _replace(path: Path, text: str) -> None:
+    # A rename replaces the file in one step: readers see the old or the new one.
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    temporary.write_text(text, encoding="utf-8")
+    os.replace(temporary, path)
+
+
+def drive_levels(path: str | os.PathLike[str]) -> dict[str, float]:
+    """What each chip saved in ``path`` drives its motor with, 0..1, by :func:`chip_key`."""
+    return {
+        chip_key(multiplexer, channel): chip.output
+        for (multiplexer, channel), chip in read_state(path).chips.items()
+    }
+
+
+def state_of(bus: EmulatedI2CBus) -> dict[str, Any]:
+    """The JSON-ready state of every multiplexer and chip on ``bus``."""
+    return {
+        "format": STATE_FORMAT,
+        "multiplexers": {
+            f"0x{address:02X}": {"control": mux.control, "connected": mux.connected}
+            for address, mux in sorted(bus.multiplexers.items())
+        },
+        "chips": {
+            chip_key(multiplexer, channel): _chip_state(chip)
+            for (multiplexer, channel), chip in sorted(bus.chips.items())
+        },
+        "main_bus_chips": [_chip_state(chip) for chip in bus.main_bus_chips],
+    }
+
+
+def bus_from_state(data: Any) -> EmulatedI2CBus:
+    """The bus ``data`` (as :func:`state_of` makes it) describes; ValueError/KeyError if not one."""
+    if not isinstance(data, dict) or data.get("format") != STATE_FORMAT:
+        raise ValueError(f"format is not {STATE_FORMAT!r}")
+    bus = EmulatedI2CBus()
+    for name, saved in dict(data["multiplexers"]).items():
+        mux = bus.add_multiplexer(int(name, 16))
+        mux.control = _byte(saved["control"], f"multiplexer {name} control")
+        mux.connected = bool(saved.get("connected", True))
+    for name, saved in dict(data["chips"]).items():
+        multiplexer, _, channel = str(name).partition("/")
+        _restore(bus.attach_chip(int(multiplexer, 16), int(channel)), saved, name)
+    for index, saved in enumerate(list(data.get("main_bus_chips", []))):
+        _restore(bus.attach_main_bus_chip(), saved, f"main bus chip {index}")
+    return bus
+
+
+def _chip_state(chip: EmulatedDRV2605L) -> dict[str, Any]:
+    return {
+        "device_id": chip.device_id,
+        "connected": chip.connected,
+        "drive": round(chip.output, 4),
+        "registers": chip.registers.hex(),
+    }
+
+
+def _restore(chip: EmulatedDRV2605L, saved: Any, name: str) -> None:
+    registers = bytes.fromhex(str(saved["registers"]))
+    if len(registers) != len(chip.registers):
+        raise ValueError(f"chip {name} has {len(registers)} registers, not {len(chip.registers)}")
+    chip.registers[:] = registers
+    chip.connected = bool(saved.get("connected", True))
+    if "device_id" in saved:  # wins over STATUS, so a test can fit a wrong chip by editing one key
+        device_id = int(saved["device_id"])
+        if not 0 <= device_id <= 7:
+            raise ValueError(f"chip {name} device_id {device_id} is outside 0..7")
+        chip.device_id = device_id
+
+
+def _byte(value: Any, name: str) -> int:
+    byte = int(value)
+    if not 0 <= byte <= 0xFF:
+        raise ValueError(f"{name} {byte} is outside 0..255")
+    return byte

@@ -1,0 +1,15 @@
+"""``--emulate-state FILE``, for the commands that drive or probe chips: sleeve, scan, buzz."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_emulate_state_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--emulate-state",
+        metavar="FILE",
+        help="like --emulate, but the emulated chips keep their registers in FILE across "
+        "processes, as real chips do when a process dies (created, every chip at its reset "
+        "values, if missing; see docs/sleeve-hardware.md)",
+    )
