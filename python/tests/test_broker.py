@@ -31,9 +31,9 @@ import pytest
 from paho.mqtt.enums import CallbackAPIVersion
 from paho.mqtt.reasoncodes import ReasonCode
 
-from feelmysign._mosquitto_config import hash_password
-from feelmysign._mosquitto_process import find_mosquitto
 from feelmysign.broker import Account, Broker, BrokerError, Credentials, load_credentials
+from feelmysign.broker._config import hash_password
+from feelmysign.broker._process import find_mosquitto
 
 pytestmark = pytest.mark.broker
 

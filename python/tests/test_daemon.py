@@ -19,13 +19,14 @@ from vectors import load
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
-from feelmysign.daemon import Sleeve, SleeveOptions, topic
+from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.errors import FeelMySignError
 from feelmysign.events import event_from_json
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
+from feelmysign.topics import sleeve_topic as topic
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 LEGACY = "deviceOne/line"

@@ -27,9 +27,9 @@ import pytest
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.broker import Broker
 from feelmysign.connection import BrokerSettings, new_client
-from feelmysign.daemon import topic
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
 
 REPO = Path(__file__).resolve().parents[2]
 PAPER = str(REPO / "deploy" / "layouts" / "paper-sleeve.toml")
@@ -77,7 +77,7 @@ class Watcher:
         self._changed = threading.Condition()
         sid = c.sleeve_id
         self.client.on_connect = lambda client, *_: client.subscribe(
-            [(topic(sid, "status"), 1), (topic(sid, "events"), 1)]
+            [(telemetry_topic(sid, "status"), 1), (telemetry_topic(sid, "events"), 1)]
         )
         self.client.on_message = self._on_message
         self.client.connect(c.mqtt_host, c.mqtt_port)
@@ -103,7 +103,7 @@ class Watcher:
             return found[0]
 
     def send(self, stroke: Stroke) -> None:
-        self.client.publish(topic(self.sleeve_id, "strokes"), format_json(stroke), qos=1)
+        self.client.publish(strokes_topic(self.sleeve_id), format_json(stroke), qos=1)
 
     def close(self) -> None:
         self.client.loop_stop()

@@ -7,6 +7,7 @@
  * exactly the same values. Pure: storage is passed in.
  */
 import type { ServerConfig } from "./config";
+import { LEGACY_TOPIC } from "./mqtt/topics";
 import {
   paramProblem,
   paramSpec,
@@ -290,7 +291,7 @@ export const DEFAULT_SETTINGS: Settings = Object.freeze({
   intensity: 0.8,
   pressure_sets_intensity: true,
   protocol: "json",
-  legacy_topic: "deviceOne/line",
+  legacy_topic: LEGACY_TOPIC,
   sleeve_id: "sleeve1",
   broker_custom: false,
   ws_url: "ws://127.0.0.1:9001",

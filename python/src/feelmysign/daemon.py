@@ -38,10 +38,10 @@ from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.player import MAX_PENDING, PlannedStroke, Player, monotonic_ms, wall_ms
 from feelmysign.protocol import Accepted, parse
+from feelmysign.topics import LEGACY_TOPIC, strokes_topic, telemetry_topic
 
 log = logging.getLogger(__name__)
 
-LEGACY_TOPIC = "deviceOne/line"  # the paper's sleeve (appendix A.2)
 RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
 # Strokes accepted at once: as many as the player may hold, so that a drawing
 # the broker kept for a sleeve that was away is not rate-limited on its return.
@@ -51,10 +51,6 @@ RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
 # "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
 LOGIN_REFUSED_CODES = (134, 135)
-
-
-def topic(sleeve_id: str, name: str) -> str:
-    return f"feelmysign/{sleeve_id}/{name}"
 
 
 class TokenBucket:
@@ -162,7 +158,10 @@ class Sleeve:
         try:
             if self._client.is_connected():
                 info = self._client.publish(
-                    topic(self._id, "status"), self._status(online=False), qos=1, retain=True
+                    telemetry_topic(self._id, "status"),
+                    self._status(online=False),
+                    qos=1,
+                    retain=True,
                 )
                 info.wait_for_publish(timeout=2.0)
             self._client.disconnect()
@@ -177,7 +176,9 @@ class Sleeve:
         client = new_client(
             self._settings, client_id=f"feelmysign-sleeve-{self._id}", persistent_session=True
         )
-        client.will_set(topic(self._id, "status"), self._status(online=False), qos=1, retain=True)
+        client.will_set(
+            telemetry_topic(self._id, "status"), self._status(online=False), qos=1, retain=True
+        )
         client.reconnect_delay_set(RECONNECT_MIN_S, RECONNECT_MAX_S)
         client.on_connect = self._on_connect
         client.on_connect_fail = self._on_connect_fail
@@ -200,11 +201,13 @@ class Sleeve:
                 self._stopped.set()
             log.error(message)
             return
-        subscriptions = [(topic(self._id, "strokes"), 1)]
+        subscriptions = [(strokes_topic(self._id), 1)]
         if self._options.legacy_topic:
             subscriptions.append((self._options.legacy_topic, 1))
         client.subscribe(subscriptions)
-        client.publish(topic(self._id, "status"), self._status(online=True), qos=1, retain=True)
+        client.publish(
+            telemetry_topic(self._id, "status"), self._status(online=True), qos=1, retain=True
+        )
         self._connected.set()
         session = "resumed" if getattr(flags, "session_present", False) else "new"
         log.info("sleeve %s: connected to %s (%s session)", self._id, self._settings.url, session)
@@ -225,7 +228,7 @@ class Sleeve:
         # every subscription and filters at delivery, so there a sleeve with the wrong id
         # simply receives nothing.)
         if any(reason.is_failure for reason in reasons):
-            names = [topic(self._id, "strokes")]
+            names = [strokes_topic(self._id)]
             if self._options.legacy_topic:
                 names.append(self._options.legacy_topic)
             self._fatal = FeelMySignError(
@@ -325,7 +328,7 @@ class Sleeve:
                 "the player stopped on an unexpected error (see the log); every motor is off"
             )
             self._stopped.set()
-        self._outbox.put((topic(self._id, "events"), event.dumps(), 1, False))
+        self._outbox.put((telemetry_topic(self._id, "events"), event.dumps(), 1, False))
 
     def _count(self, *names: str) -> None:
         with self._counts_lock:
@@ -334,7 +337,7 @@ class Sleeve:
 
     def publish_actuators(self, frame: dict[str, Any]) -> None:
         """Telemetry for previews: best effort (QoS 0), never retained."""
-        self._outbox.put((topic(self._id, "actuators"), json.dumps(frame), 0, False))
+        self._outbox.put((telemetry_topic(self._id, "actuators"), json.dumps(frame), 0, False))
 
     def _publish_loop(self) -> None:
         while (item := self._outbox.get()) is not None:

@@ -6,6 +6,8 @@ values, not exceptions; these are for what a caller cannot go on from.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 class FeelMySignError(Exception):
     """Base class: every error this package raises on purpose."""
@@ -48,3 +50,47 @@ class ParameterError(FeelMySignError, ValueError):
         self.value = value
         self.allowed = allowed
         super().__init__(f"{name} = {value!r} is not allowed; it must be {allowed}")
+
+
+class BrokerError(FeelMySignError):
+    """The local Mosquitto could not be set up, started or kept running.
+
+    ``reason`` is a stable code a program can branch on:
+
+    - ``mosquitto-missing``: no ``mosquitto`` executable was found;
+    - ``port-in-use``: ``port`` is taken by another program;
+    - ``bad-option``: a sleeve id, port or topic that cannot be used;
+    - ``credentials-file``: a ``credentials.json`` that cannot be read or is wrong;
+    - ``start-failed``: Mosquitto exited or never accepted connections at start-up;
+    - ``exited``: Mosquitto stopped while it should have been running.
+
+    ``log_path`` is Mosquitto's log file when there is one to look at.
+    """
+
+    def __init__(
+        self,
+        reason: str,
+        message: str,
+        *,
+        port: int | None = None,
+        log_path: Path | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.reason = reason
+        self.message = message
+        self.port = port
+        self.log_path = log_path
+
+
+class BrokerConnectionError(BrokerError):
+    """A broker that cannot be reached, refuses the login, or refuses or drops a message.
+
+    ``reason`` (as for BrokerError) is one of ``bad-url``, ``bad-option``,
+    ``refused`` (nothing listens), ``unreachable`` (name, route, TLS),
+    ``login-refused``, ``timeout``, ``closed`` (the connection dropped) and
+    ``publish-refused``; ``url`` is the broker's URL when known.
+    """
+
+    def __init__(self, reason: str, message: str, *, url: str | None = None) -> None:
+        super().__init__(reason, message)
+        self.url = url

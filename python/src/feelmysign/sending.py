@@ -19,7 +19,8 @@ from typing import Any, Literal
 import paho.mqtt.client as mqtt
 from paho.mqtt.reasoncodes import ReasonCode
 
-from feelmysign.cli._broker_options import BrokerConnectionError, BrokerSettings
+from feelmysign.connection import BrokerSettings
+from feelmysign.errors import BrokerConnectionError
 from feelmysign.protocol import format_json, format_legacy
 from feelmysign.stroke import Stroke
 

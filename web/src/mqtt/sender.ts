@@ -8,6 +8,7 @@
 import mqtt, { type IClientOptions, type MqttClient } from "mqtt";
 import { Outbox } from "../outbox";
 import { formatJson, formatLegacy, StrokeError, type Stroke } from "../protocol";
+import { strokesTopic, telemetryTopic } from "./topics";
 
 export type BrokerState = "connecting" | "connected" | "offline";
 export type WireProtocol = "json" | "legacy";
@@ -44,10 +45,6 @@ const KEEPALIVE_S = 20;
  * user name or password, not authorized (MQTT 3.1.1: 4, 5; MQTT 5: 134, 135).
  */
 export const BAD_LOGIN_CODES: ReadonlySet<number> = new Set([4, 5, 134, 135]);
-
-export const strokesTopic = (sleeveId: string): string => `feelmysign/${sleeveId}/strokes`;
-export const telemetryTopic = (sleeveId: string, name: "status" | "actuators" | "events"): string =>
-  `feelmysign/${sleeveId}/${name}`;
 
 export class StrokeSender {
   readonly #listener: SenderListener;

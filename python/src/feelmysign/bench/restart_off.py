@@ -30,9 +30,9 @@ import paho.mqtt.client as mqtt
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
-from feelmysign.daemon import topic
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
 
 PAPER = Path(__file__).resolve().parents[3].parent / "deploy" / "layouts" / "paper-sleeve.toml"
 ROUNDS = 5
@@ -85,7 +85,7 @@ class _Online:
         self.client = new_client(settings, client_id="bench-restart-watch")
         self.client.on_message = self._on_message
         self.client.connect(c.mqtt_host, c.mqtt_port)
-        self.client.subscribe(topic(c.sleeve_id, "status"), qos=1)
+        self.client.subscribe(telemetry_topic(c.sleeve_id, "status"), qos=1)
         self.client.loop_start()
         self.sleeve_id = c.sleeve_id
 
@@ -105,7 +105,7 @@ def _kill_mid_stroke(command: list[str], state: Path, online: _Online) -> None:
     try:
         _wait(lambda: online.count > seen, "the sleeve did not come online")
         online.client.publish(
-            topic(online.sleeve_id, "strokes"), format_json(LONG_STROKE), qos=1
+            strokes_topic(online.sleeve_id), format_json(LONG_STROKE), qos=1
         ).wait_for_publish(WAIT_S)
         _wait(lambda: not _all_off(state), "no motor came on")
     finally:

@@ -30,10 +30,11 @@ import paho.mqtt.client as mqtt
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
-from feelmysign.daemon import Sleeve, SleeveOptions, topic
+from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.layout import Layout
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 # 1 cm and 10 cm on the paper's 3 cm grid.
@@ -109,12 +110,12 @@ def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = 0.12) -> 
     which would flatter the baseline.
     """
     inbox = _Inbox()
-    receiver = _client(c, "sleeve", inbox, topic(c.sleeve_id, "strokes"))
+    receiver = _client(c, "sleeve", inbox, strokes_topic(c.sleeve_id))
     sender = _client(c, "sender")
     sent: list[float] = []
     for k in range(count):
         sent.append(time.time_ns() / 1e6)
-        sender.publish(topic(c.sleeve_id, "strokes"), b"bench", qos=1)
+        sender.publish(strokes_topic(c.sleeve_id), b"bench", qos=1)
         inbox.wait(k + 1)
         time.sleep(pause_s)
     received = inbox.wait(count)
@@ -145,14 +146,14 @@ def stroke_latencies(
 ) -> list[dict[str, Any]]:
     """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event."""
     inbox = _Inbox()
-    watcher = _client(c, "sender", inbox, topic(c.sleeve_id, "events"))
+    watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "events"))
     sender = _client(c, "sender")
     (start, end, duration_ms) = shape
     results = []
     for k in range(count):
         stroke = Stroke(start, end, duration_ms, None, f"lat-{uuid.uuid4()}", 0)
         published_ms = time.time_ns() / 1e6
-        sender.publish(topic(c.sleeve_id, "strokes"), format_json(stroke), qos=1)
+        sender.publish(strokes_topic(c.sleeve_id), format_json(stroke), qos=1)
         event = inbox.wait_played(k + 1)[-1]
         event["published_at_ms"] = published_ms
         results.append(event)
@@ -169,7 +170,7 @@ def stroke_latencies(
 def _sleeve_process(c: Credentials, credentials_path: Path) -> Iterator[Callable[[], bool]]:
     """``feelmysign sleeve`` in a process of its own, as on the Pi; yields an idle check."""
     inbox = _Inbox()
-    watcher = _client(c, "sender", inbox, topic(c.sleeve_id, "status"))
+    watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "status"))
     process = subprocess.Popen(
         [
             sys.executable,
@@ -202,14 +203,14 @@ def _sleeve_process(c: Credentials, credentials_path: Path) -> Iterator[Callable
 def drawing_gaps(c: Credentials, shape: Any, strokes: int = 20) -> list[float]:
     """A drawing sent at once: each stroke should start as the one before it ends."""
     inbox = _Inbox()
-    watcher = _client(c, "sender", inbox, topic(c.sleeve_id, "events"))
+    watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "events"))
     sender = _client(c, "sender")
     (start, end, duration_ms) = shape
     drawing = f"gap-{uuid.uuid4()}"
     for seq in range(strokes):
         a, b = (start, end) if seq % 2 == 0 else (end, start)
         sender.publish(
-            topic(c.sleeve_id, "strokes"),
+            strokes_topic(c.sleeve_id),
             format_json(Stroke(a, b, duration_ms, None, drawing, seq)),
             qos=1,
         )

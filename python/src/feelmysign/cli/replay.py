@@ -30,13 +30,8 @@ import uuid
 from typing import Any
 
 from feelmysign.cli import simplify
-from feelmysign.cli._broker_options import (
-    DEFAULT_TIMEOUT_S,
-    BrokerSettings,
-    add_broker_options,
-    broker_settings_from_args,
-    connect_client,
-)
+from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke

@@ -23,21 +23,16 @@ import uuid
 from collections.abc import Iterator
 from dataclasses import replace
 
-from feelmysign._mosquitto_config import LEGACY_TOPIC
-from feelmysign.cli._broker_options import (
-    DEFAULT_TIMEOUT_S,
-    BrokerSettings,
-    add_broker_options,
-    broker_settings_from_args,
-    connect_client,
-)
+from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
 from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, parse
 from feelmysign.sending import OutgoingStroke, Pace, StrokeSender, printer
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
 from feelmysign.stroke import Stroke
+from feelmysign.topics import LEGACY_TOPIC
 
 
 def _epilog() -> str:

@@ -16,9 +16,10 @@ from feelmysign.cli._emulation import add_emulate_state_option
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.connection import BrokerSettings
-from feelmysign.daemon import BURST, LEGACY_TOPIC, RATE_PER_S, Sleeve, SleeveOptions
+from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
+from feelmysign.topics import LEGACY_TOPIC
 
 TELEMETRY_RATE_HZ = 20.0  # previews look smooth at 20 frames a second; more only costs traffic
 

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-from feelmysign._broker_error import BrokerError
+from feelmysign.errors import BrokerError
 
 SENDER_USERNAME = "sender"
 SLEEVE_USERNAME_PREFIX = "sleeve-"

@@ -27,8 +27,8 @@ from paho.mqtt.enums import CallbackAPIVersion
 from paho.mqtt.properties import Properties
 from paho.mqtt.reasoncodes import ReasonCode
 
-from feelmysign._broker_error import BrokerError
-from feelmysign._credentials import Account
+from feelmysign.broker.credentials import Account
+from feelmysign.errors import BrokerError
 
 INSTALL_HINT = (
     "Install it with 'sudo apt-get install mosquitto' (or 'make system' in the repository)."

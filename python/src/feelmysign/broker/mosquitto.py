@@ -24,37 +24,24 @@ import time
 from pathlib import Path
 from types import TracebackType
 
-from feelmysign import _mosquitto_process as process_
-from feelmysign._broker_error import BrokerError
-from feelmysign._credentials import (
-    Account,
-    Credentials,
-    check_sleeve_id,
-    load_credentials,
-    reuse_or_create,
-    write_credentials,
-    write_private_file,
-)
-from feelmysign._mosquitto_config import (
-    LEGACY_TOPIC,
+from feelmysign.broker import _process as process_
+from feelmysign.broker._config import (
     LOOPBACK_ADDRESS,
     StateFiles,
     render_acl,
     render_config,
     write_password_file,
 )
-
-__all__ = [
-    "DEFAULT_MQTT_PORT",
-    "DEFAULT_SLEEVE_ID",
-    "DEFAULT_WS_PORT",
-    "Account",
-    "Broker",
-    "BrokerError",
-    "Credentials",
-    "default_state_dir",
-    "load_credentials",
-]
+from feelmysign.broker.credentials import (
+    Account,
+    Credentials,
+    check_sleeve_id,
+    reuse_or_create,
+    write_credentials,
+    write_private_file,
+)
+from feelmysign.errors import BrokerError
+from feelmysign.topics import LEGACY_TOPIC
 
 DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
 DEFAULT_WS_PORT = 9001  # the WebSocket port of Mosquitto's documentation and examples

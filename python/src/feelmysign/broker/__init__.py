@@ -1,0 +1,28 @@
+"""The local broker: Mosquitto run as a child process from a generated config.
+
+``mosquitto``: the ``Broker`` object (start, wait, stop); ``credentials``: the
+accounts and ``credentials.json``; ``_config``: the files Mosquitto reads;
+``_process``: finding, starting and probing the executable.
+"""
+
+from feelmysign.broker.credentials import Account, Credentials, load_credentials
+from feelmysign.broker.mosquitto import (
+    DEFAULT_MQTT_PORT,
+    DEFAULT_SLEEVE_ID,
+    DEFAULT_WS_PORT,
+    Broker,
+    default_state_dir,
+)
+from feelmysign.errors import BrokerError
+
+__all__ = [
+    "DEFAULT_MQTT_PORT",
+    "DEFAULT_SLEEVE_ID",
+    "DEFAULT_WS_PORT",
+    "Account",
+    "Broker",
+    "BrokerError",
+    "Credentials",
+    "default_state_dir",
+    "load_credentials",
+]

@@ -1,0 +1,116 @@
+"""Where the broker is, how to log in and which sleeve: one settings object and its URL parser."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+from urllib.parse import urlsplit
+
+from feelmysign.broker.mosquitto import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
+from feelmysign.errors import BrokerConnectionError
+from feelmysign.topics import strokes_topic
+
+Transport = Literal["tcp", "websockets"]
+# scheme -> (transport, TLS on, default port)
+SCHEMES: dict[str, tuple[Transport, bool, int]] = {
+    "mqtt": ("tcp", False, 1883),
+    "mqtts": ("tcp", True, 8883),
+    "ws": ("websockets", False, 9001),
+    "wss": ("websockets", True, 443),
+}
+DEFAULT_BROKER_URL = f"mqtt://127.0.0.1:{DEFAULT_MQTT_PORT}"  # where 'feelmysign broker' listens
+USERNAME_ENV = "FEELMYSIGN_USERNAME"
+PASSWORD_ENV = "FEELMYSIGN_PASSWORD"
+
+
+@dataclass(frozen=True)
+class BrokerSettings:
+    """One broker endpoint, the login on it, and the sleeve the program sends to or plays as."""
+
+    host: str
+    port: int
+    transport: Transport = "tcp"
+    tls: bool = False
+    path: str = "/"
+    username: str | None = None
+    password: str | None = None
+    sleeve_id: str = DEFAULT_SLEEVE_ID
+
+    @property
+    def url(self) -> str:
+        scheme = {
+            ("tcp", False): "mqtt",
+            ("tcp", True): "mqtts",
+            ("websockets", False): "ws",
+            ("websockets", True): "wss",
+        }[(self.transport, self.tls)]
+        suffix = self.path if self.transport == "websockets" and self.path != "/" else ""
+        return f"{scheme}://{self.host}:{self.port}{suffix}"
+
+    @property
+    def strokes_topic(self) -> str:
+        return strokes_topic(self.sleeve_id)
+
+
+def parse_broker_url(
+    url: str,
+    *,
+    username: str | None = None,
+    password: str | None = None,
+    sleeve_id: str = DEFAULT_SLEEVE_ID,
+) -> BrokerSettings:
+    """Settings for ``url``; BrokerConnectionError ``bad-url`` naming what is wrong with it."""
+    text = url.strip()
+    if "://" not in text:
+        return _bad_url(url, "has no scheme", f"write it as mqtt://{text or '127.0.0.1:1883'}")
+    parts = urlsplit(text)
+    scheme = parts.scheme.lower()
+    if scheme not in SCHEMES:
+        return _bad_url(url, f"uses the scheme {parts.scheme!r}", _scheme_hint(scheme))
+    if parts.username is not None or parts.password is not None:
+        return _bad_url(
+            url,
+            "contains a user name or password",
+            f"leave them out and use --username/--password, ${USERNAME_ENV}/${PASSWORD_ENV} or "
+            "--credentials (a URL shows up in process lists and logs)",
+        )
+    if not parts.hostname:
+        return _bad_url(url, "has no host name", "e.g. mqtt://127.0.0.1:1883")
+    try:
+        port = parts.port
+    except ValueError:
+        shown = parts.netloc.rpartition(":")[2]
+        return _bad_url(url, f"has the port {shown!r}", "use a whole number from 1 to 65535")
+    if port == 0:
+        return _bad_url(url, "has the port 0", "use a whole number from 1 to 65535")
+    transport, tls, default_port = SCHEMES[scheme]
+    if parts.query or parts.fragment or (transport == "tcp" and parts.path not in ("", "/")):
+        return _bad_url(
+            url,
+            "has a path, query or fragment",
+            "an mqtt:// or mqtts:// URL is only scheme://HOST:PORT; ws:// may have a path",
+        )
+    return BrokerSettings(
+        host=parts.hostname,
+        port=port or default_port,
+        transport=transport,
+        tls=tls,
+        path=parts.path or "/",
+        username=username,
+        password=password,
+        sleeve_id=sleeve_id,
+    )
+
+
+def _scheme_hint(scheme: str) -> str:
+    instead = {"tcp": "mqtt", "ssl": "mqtts", "tls": "mqtts", "http": "ws", "https": "wss"}
+    known = "mqtt:// (TCP), mqtts:// (TLS), ws:// or wss:// (WebSockets)"
+    if scheme in instead:
+        return f"write {instead[scheme]}:// instead; the schemes are {known}"
+    return f"use {known}, e.g. {DEFAULT_BROKER_URL}"
+
+
+def _bad_url(url: str, problem: str, hint: str) -> BrokerSettings:
+    raise BrokerConnectionError(
+        "bad-url", f"The broker URL {url!r} {problem}: {hint}.", url=url or None
+    )
