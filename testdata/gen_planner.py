@@ -11,12 +11,16 @@ from typing import Any
 
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
-from feelmysign.planner import MERGE_DISTANCE, MIN_COMMAND_MS, plan
+from feelmysign.planner import MERGE_DISTANCE, plan
 from feelmysign.schedule import schedule_to_json
 from feelmysign.stroke import Stroke
 
 PAPER = {"rows": 3, "columns": 4, "spacing_cm": 3.0, "default_intensity": 1.0}
 WIDE = {"rows": 4, "columns": 6, "spacing_cm": 2.5, "default_intensity": 0.7}
+LRA = {**WIDE, "actuator_type": "LRA"}
+# A stroke whose row and column crossings fall 0.05 to 0.15 apart: once slowed
+# from 83 ms to 1,865 ms, with a burst running 603 ms past its end.
+NEAR_CROSSINGS = (2.0429, 0.1643, 0.9571, 0.8214, 83.3333)
 
 # name -> (description, layout, stroke (x0, y0, x1, y1, T[, intensity]), options)
 CASES: dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]] = {
@@ -81,20 +85,32 @@ CASES: dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]] 
         {"merge_distance": 0.0},
     ),
     "feasible/too-fast": (
-        "9 cm at 100 ms: slowed to the fastest feasible duration",
+        "9 cm at 50 ms: too fast even for two end phantoms; slowed to 73.701 ms",
         PAPER,
-        (0, 0, 3, 0, 100),
+        (0, 0, 3, 0, 50),
         {},
     ),
-    "feasible/too-fast-diagonal": ("the diagonal at 100 ms: slowed", PAPER, (0, 0, 3, 2, 100), {}),
+    "feasible/too-fast-diagonal": ("the diagonal at 50 ms: slowed", PAPER, (0, 0, 3, 2, 50), {}),
+    "feasible/too-fast-point": (
+        "a point at 30 ms: held as long as the shortest stroke",
+        PAPER,
+        (1.5, 0.5, 1.5, 0.5, 30),
+        {},
+    ),
     "feasible/strict": (
-        "too fast with strict: rejected",
+        "too fast for two end phantoms, with strict: rejected",
+        PAPER,
+        (0, 0, 3, 2, 50),
+        {"strict": True},
+    ),
+    "feasible/strict-thinned": (
+        "the diagonal at 100 ms with strict: thinned, not rejected",
         PAPER,
         (0, 0, 3, 2, 100),
         {"strict": True},
     ),
     "feasible/min-40": (
-        "a longer minimum burst slows a stroke that was fine",
+        "a longer minimum burst thins a stroke that was fine",
         PAPER,
         (0, 0, 3, 0, 300),
         {"min_command_ms": 40.0},
@@ -104,6 +120,48 @@ CASES: dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]] 
         PAPER,
         (0, 0, 3, 0, 100),
         {"min_command_ms": 0.0},
+    ),
+    "thin/straight": (
+        "9 cm at 100 ms: the two crossings left out, time kept",
+        PAPER,
+        (0, 0, 3, 0, 100),
+        {},
+    ),
+    "thin/diagonal": (
+        "the diagonal at 200 ms: the crossings closest in time left out",
+        PAPER,
+        (0, 0, 3, 2, 200),
+        {},
+    ),
+    "thin/near-crossings": (
+        "crossings 0.05 to 0.15 apart: thinned, played in its 83.3 ms",
+        PAPER,
+        NEAR_CROSSINGS,
+        {},
+    ),
+    "thin/near-crossings-moved": (
+        "the same with the start moved by 0.003: the same duration",
+        PAPER,
+        (2.04, *NEAR_CROSSINGS[1:]),
+        {},
+    ),
+    "thin/near-crossings-merged": (
+        "the same with merge distance 0.15: the same duration",
+        PAPER,
+        NEAR_CROSSINGS,
+        {"merge_distance": 0.15},
+    ),
+    "overrun/near-crossings-slow": (
+        "that stroke at 1,865 ms: the burst before the last is cut 186.5 ms after the end",
+        PAPER,
+        (*NEAR_CROSSINGS[:4], 1865.349),
+        {},
+    ),
+    "overrun/long": (
+        "9 cm in 10 s: the burst before the last is cut 1 s after the end",
+        PAPER,
+        (0, 0, 3, 0, 10000),
+        {},
     ),
     "grid/outside": ("(0,0)->(5,5) on 3 x 4: outside the grid", PAPER, (0, 0, 5, 5, 1000), {}),
     "grid/negative": ("a negative coordinate", PAPER, (-0.5, 0, 1, 0, 1000), {}),
@@ -115,6 +173,12 @@ CASES: dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]] 
         {},
     ),
     "grid/intensity": ("an explicit intensity", PAPER, (0, 2, 3, 0.5, 1500, 0.4), {}),
+    "grid/lra": (
+        "linear resonant actuators: 10 ms bursts, so 61 ms fit two end phantoms",
+        LRA,
+        (0, 0, 5, 3, 61),
+        {},
+    ),
 }
 
 DIRECTIONS = {
@@ -158,7 +222,7 @@ def cases() -> dict[str, dict[str, Any]]:
     for name, (description, layout_args, values, options) in _all_cases().items():
         x0, y0, x1, y1, duration_ms, *rest = values
         full_options = {
-            "min_command_ms": MIN_COMMAND_MS,
+            "min_command_ms": Layout(**layout_args).shortest_burst_ms,
             "merge_distance": MERGE_DISTANCE,
             "strict": False,
         }

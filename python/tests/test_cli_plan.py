@@ -67,9 +67,9 @@ def test_cli_matches_the_vectors(name: str, capsys: pytest.CaptureFixture[str]) 
 
 
 def test_too_fast_is_slowed_and_reported(capsys: pytest.CaptureFixture[str]) -> None:
-    (result,) = _json_lines(capsys, "0,0,3,2,100")
+    (result,) = _json_lines(capsys, "0,0,3,2,50")
     assert result["adjusted"]["reason"] == "too_fast"
-    assert result["adjusted"]["duration_ms"] > 100
+    assert result["adjusted"]["duration_ms"] > 50
     assert (
         max(c["start_ms"] + c["duration_ms"] for c in result["commands"])
         >= result["adjusted"]["duration_ms"]
@@ -80,7 +80,7 @@ def test_too_fast_is_slowed_and_reported(capsys: pytest.CaptureFixture[str]) -> 
     ("argv", "words"),
     [
         (["0,0,5,5,1000"], ["outside", "0..3", "0..2"]),
-        (["0,0,3,2,100", "--strict"], ["too fast", "268.317"]),
+        (["0,0,3,2,50", "--strict"], ["too fast", "73.701"]),
         (["0,0,2,0"], ["5"]),
         (["0,0,2,0,-5"], ["duration"]),
         (["0,0,2,0,1000", "--intensity", "1.5"], ["--intensity", "[0, 1]"]),
@@ -126,3 +126,21 @@ def test_invalid_stroke_has_no_traceback() -> None:
 def test_usage_error_exits_2() -> None:
     done = subprocess.run([*FEELMYSIGN, "plan"], capture_output=True, text=True, check=False)
     assert done.returncode == 2 and "usage" in done.stderr
+
+
+def test_a_thinned_stroke_says_so_and_keeps_its_time(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["plan", "2.0429,0.1643,0.9571,0.8214,83.3333"]) == 0
+    out = capsys.readouterr().out
+    assert "in 83.333 ms" in out and "Adjusted" not in out
+    assert "Thinned: 2 of 4 virtual actuators left out" in out
+
+
+def test_the_minimum_burst_comes_from_the_layout_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    layout = tmp_path / "lra.toml"
+    layout.write_text('rows = 3\ncolumns = 4\nspacing_cm = 3.0\nactuator_type = "LRA"\n')
+    (result,) = _json_lines(capsys, "0,0,3,2,65", "--layout", str(layout))
+    assert result["adjusted"] is None and result["duration_ms"] == 65
+    (result,) = _json_lines(capsys, "0,0,3,2,65")  # the paper's ERM sleeve
+    assert result["adjusted"]["duration_ms"] == 73.701

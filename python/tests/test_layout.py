@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from feelmysign.errors import LayoutError
 from feelmysign.layout import (
+    MIN_BURST_MS,
     MUX_ADDRESSES,
     MUX_CHANNELS,
     PAPER_SLEEVE,
@@ -86,6 +87,16 @@ def test_addresses_may_be_written_in_decimal_too() -> None:
     assert layout.wiring == (Wire(0, 0, 0x70, 0), Wire(0, 1, 0x70, 1))
 
 
+def test_the_shortest_burst_follows_the_actuator_type_unless_set() -> None:
+    assert parse_layout(GRID).shortest_burst_ms == MIN_BURST_MS["ERM"]
+    lra = parse_layout(GRID + 'actuator_type = "LRA"\n')
+    assert lra.min_burst_ms is None and lra.shortest_burst_ms == MIN_BURST_MS["LRA"]
+    assert MIN_BURST_MS["LRA"] < MIN_BURST_MS["ERM"]  # an LRA starts faster
+    own = parse_layout(GRID + 'actuator_type = "LRA"\nmin_burst_ms = 15\n')
+    assert own.min_burst_ms == own.shortest_burst_ms == 15.0
+    assert check_layout(grid_layout(3, 4, 3.0, min_burst_ms=12.5)).shortest_burst_ms == 12.5
+
+
 # --- problems -----------------------------------------------------------------------------
 
 
@@ -153,6 +164,14 @@ def test_addresses_may_be_written_in_decimal_too() -> None:
         (
             GRID + 'actuator_type = "lra"\n',
             'actuator_type: must be "ERM" or "LRA"; got "lra" (a string); write it in capitals',
+        ),
+        (
+            GRID + "min_burst_ms = 0\n",
+            "min_burst_ms: must be a number above 0 and at most 1000; got 0",
+        ),
+        (
+            GRID + 'min_burst_ms = "20"\n',
+            'min_burst_ms: must be a number above 0 and at most 1000; got "20" (a string)',
         ),
         (GRID + 'name = "a/b"\n', "name: must be 1 to 64 printable characters without / + #"),
         (GRID + 'name = ""\n', "name: must be 1 to 64"),
@@ -281,7 +300,16 @@ TOML_LITERALS = st.sampled_from(
         "0.5",
     ]
 )
-KEYS = ["name", "rows", "columns", "spacing_cm", "actuator_type", "default_intensity", "colour"]
+KEYS = [
+    "name",
+    "rows",
+    "columns",
+    "spacing_cm",
+    "actuator_type",
+    "min_burst_ms",
+    "default_intensity",
+    "colour",
+]
 
 
 @given(st.dictionaries(st.sampled_from(KEYS), TOML_LITERALS))

@@ -104,10 +104,10 @@ def test_stop_mid_stroke_leaves_every_motor_off(running: Any) -> None:
 
 def test_adjusted_strokes_say_so(running: Any) -> None:
     player, _, events = running
-    player.submit(_planned(0, 0, 3, 2, 100))
+    player.submit(_planned(0, 0, 3, 2, 50))
     (event,) = events.wait_for(1)
     assert event["type"] == "adjusted" and event["reason"] == "too_fast"
-    assert event["duration_ms"] > event["requested_duration_ms"] == 100
+    assert event["duration_ms"] > event["requested_duration_ms"] == 50
 
 
 def _wait_idle(player: Player, timeout_s: float = 10.0) -> None:

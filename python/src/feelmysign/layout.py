@@ -7,6 +7,7 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     columns = 4                   # actuators along x (column index 0..columns-1)
     spacing_cm = 3.0              # centre-to-centre distance between neighbours
     actuator_type = "ERM"         # ERM or LRA
+    min_burst_ms = 20             # optional; default by actuator_type (ERM 20, LRA 10)
     default_intensity = 0.8       # for strokes that do not say, 0..1
 
     [safety]
@@ -47,6 +48,15 @@ else:  # pragma: no cover - Python 3.10
 
 ActuatorType = Literal["ERM", "LRA"]
 ACTUATOR_TYPES: tuple[ActuatorType, ...] = ("ERM", "LRA")
+
+# The shortest burst the planner may give an actuator, by type, unless the layout
+# sets min_burst_ms. A burst is felt only once the actuator is up to speed: an
+# eccentric rotating mass spins up in about 20 ms even with the DRV2605L's
+# overdrive; a linear resonant actuator, driven at its resonance (about 175 to
+# 235 Hz) with closed-loop overdrive, is felt after about two periods, 10 ms.
+# Measure your motors and set min_burst_ms when they differ.
+MIN_BURST_MS: dict[ActuatorType, float] = {"ERM": 20.0, "LRA": 10.0}
+MAX_MIN_BURST_MS = 1000.0  # a burst floor of a second already forbids any drawing
 
 MAX_GRID_SIDE = 64  # rows or columns; 8 multiplexers x 8 channels drive 64 actuators at most
 MIN_ACTUATORS = 2  # a stroke moves between actuators; one cannot draw anything
@@ -89,13 +99,30 @@ class Layout:
     # over the same motor, so only a stuck or pathological stream reaches this.
     max_on_time_ms: float = 15_000.0
     actuator_type: ActuatorType = "ERM"
+    # None: the actuator type's MIN_BURST_MS; read it through ``shortest_burst_ms``.
+    min_burst_ms: float | None = None
     i2c_bus: int = 1
     multiplexers: tuple[int, ...] = ()
     wiring: tuple[Wire, ...] = ()
 
+    @property
+    def shortest_burst_ms(self) -> float:
+        """The shortest burst the planner may play: ``min_burst_ms``, else the type's default."""
+        if self.min_burst_ms is not None:
+            return self.min_burst_ms
+        return MIN_BURST_MS[self.actuator_type]
+
 
 _DEFAULTS = Layout(rows=1, columns=MIN_ACTUATORS, spacing_cm=1.0)
-_TOP_KEYS = ("name", "rows", "columns", "spacing_cm", "actuator_type", "default_intensity")
+_TOP_KEYS = (
+    "name",
+    "rows",
+    "columns",
+    "spacing_cm",
+    "actuator_type",
+    "min_burst_ms",
+    "default_intensity",
+)
 _SAFETY_KEYS = ("max_intensity", "max_stroke_duration_ms", "max_on_time_ms")
 _I2C_KEYS = ("bus", "multiplexers", "wiring")
 _WIRE_KEYS = ("row", "column", "multiplexer", "channel")
@@ -150,6 +177,7 @@ def grid_layout(
     max_stroke_duration_ms: float = _DEFAULTS.max_stroke_duration_ms,
     max_on_time_ms: float = _DEFAULTS.max_on_time_ms,
     actuator_type: ActuatorType = _DEFAULTS.actuator_type,
+    min_burst_ms: float | None = None,
 ) -> Layout:
     """A validated layout without wiring: for the simulator, the planner and the CLI."""
     layout = Layout(
@@ -162,6 +190,7 @@ def grid_layout(
         max_stroke_duration_ms=max_stroke_duration_ms,
         max_on_time_ms=max_on_time_ms,
         actuator_type=actuator_type,
+        min_burst_ms=min_burst_ms,
     )
     return check_layout(layout, f"grid {rows} x {columns}")
 
@@ -208,7 +237,15 @@ def _read_geometry(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
             "spacing_cm", data.get("spacing_cm", _MISSING), MAX_SPACING_CM
         ),
         "actuator_type": problems.actuator_type(data.get("actuator_type", _DEFAULTS.actuator_type)),
+        "min_burst_ms": _read_min_burst(problems, data.get("min_burst_ms")),
     }
+
+
+def _read_min_burst(problems: _Problems, value: Any) -> float | None:
+    """The optional floor on burst length; absent means the actuator type's default."""
+    if value is None:
+        return None
+    return problems.number("min_burst_ms", value, MAX_MIN_BURST_MS)
 
 
 def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
@@ -366,8 +403,10 @@ def _check_all_wired(
 def _to_data(layout: Layout) -> dict[str, Any]:
     """A layout as the dictionary its TOML file would give, so one validator checks both."""
     wires = [{f.name: getattr(w, f.name) for f in fields(w)} for w in layout.wiring]
+    # None is no TOML value: an unset optional key is simply absent from the file.
+    top = {key: getattr(layout, key) for key in _TOP_KEYS}
     return {
-        **{key: getattr(layout, key) for key in _TOP_KEYS},
+        **{key: value for key, value in top.items() if value is not None},
         "safety": {key: getattr(layout, key) for key in _SAFETY_KEYS},
         "i2c": {"bus": layout.i2c_bus, "multiplexers": list(layout.multiplexers), "wiring": wires},
     }

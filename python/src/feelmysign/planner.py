@@ -7,6 +7,15 @@ inside the grid, every direction, near-duplicate crossings merged, a
 feasibility rule (no negative or too-short burst), and overlapping commands on
 one actuator merged into one piecewise-constant intensity.
 
+Time is kept: a stroke plays in the time it was drawn. When the motion model
+cannot fit every virtual actuator into that time, the crossings closest in time
+are left out, one by one, until it can (``_thinned``). A stroke is slowed only
+when even its simplest rendering, apparent motion between its two end
+phantoms, cannot fit: below ``shortest_planned_ms`` (73.7 ms for 20 ms bursts),
+whatever its length or direction, so the planned duration is continuous in the
+endpoints. And no burst runs on past the stroke's end by more than
+``overrun_allowance_ms`` (``_bursts`` cuts it there): the next stroke starts then.
+
 The stroke's path is sampled at *virtual actuators* (its endpoints and every
 crossing with a row or column line). Each virtual actuator gets one burst,
 timed by the apparent-motion model (``SOA = 0.32 d + 47.3``), and is rendered
@@ -38,9 +47,12 @@ from feelmysign.stroke import Point, Stroke
 SOA_SLOPE = 0.32  # Israr & Poupyrev 2011, eq. 1: SOA = 0.32 d + 47.3 (ms)
 SOA_INTERCEPT_MS = 47.3  # ibid.; also the least time between two peaks of a moving touch
 
-# An ERM motor needs about 20 ms from rest to a felt vibration; a shorter burst
-# is not felt as part of the motion. Configurable per call.
-MIN_COMMAND_MS = 20.0
+# A burst may run on past the stroke's end (the motion model lets the last
+# bursts overlap), but the next stroke of a drawing starts at the end: by at most
+# the larger of these. 50 ms is about the least SOA of apparent motion (47.3 ms),
+# so a shorter overrun is never felt as a touch of its own.
+OVERRUN_MIN_MS = 50.0
+OVERRUN_FRACTION = 0.1
 
 # Virtual actuators closer than this (grid units; 1.5 mm on a 3 cm grid, far
 # below the forearm's two-point threshold of about 35 mm) are one point to the
@@ -74,43 +86,76 @@ def plan(
     stroke: Stroke,
     layout: Layout,
     *,
-    min_command_ms: float = MIN_COMMAND_MS,
+    min_command_ms: float | None = None,
     merge_distance: float = MERGE_DISTANCE,
     strict: bool = False,
 ) -> Schedule:
-    """Plan one stroke on ``layout``'s grid.
+    """Plan one stroke on ``layout``'s grid, in the time it was drawn.
 
-    A stroke too fast for every burst to last ``min_command_ms`` is slowed to
-    the fastest feasible duration and the schedule says so in ``adjusted``;
-    with ``strict`` it is rejected instead. Raises StrokeError for a stroke that
-    cannot be rendered at all (non-finite, outside the grid, bad duration).
+    ``min_command_ms`` (default: the layout's ``shortest_burst_ms``) is the
+    shortest burst. Virtual actuators that do not fit the stroke's duration are
+    left out (counted in ``thinned``). A stroke shorter than
+    ``shortest_planned_ms`` is slowed to it and the schedule says so in
+    ``adjusted``; with ``strict`` it is rejected instead. Raises StrokeError
+    for a stroke that cannot be rendered at all (non-finite, outside the grid,
+    bad duration).
     """
     start, end = _checked_stroke(stroke, layout)
     intensity = layout.default_intensity if stroke.intensity is None else stroke.intensity
-    points, fractions = virtual_actuators(start, end, merge_distance=merge_distance)
-    timings = _timings(fractions)
-    needed_ms = _fastest_feasible_ms(timings, min_command_ms)
-    duration_ms = stroke.duration_ms
-    adjusted = None
-    if duration_ms < needed_ms:
-        message = (
-            f"stroke too fast: {duration_ms:g} ms over {math.dist(start, end):.4g} grid units "
-            f"needs at least {needed_ms:.3f} ms so that every burst lasts {min_command_ms:g} ms "
-            f"or more; send it slower or plan without --strict to slow it automatically"
-        )
-        if strict:
-            raise StrokeError(TOO_FAST, message)
-        adjusted = Adjustment(TOO_FAST, stroke.duration_ms, needed_ms)
-        duration_ms = needed_ms
+    min_ms = layout.shortest_burst_ms if min_command_ms is None else min_command_ms
+    duration_ms, adjusted = _kept_duration(stroke, start, end, min_ms, strict=strict)
     if duration_ms > layout.max_stroke_duration_ms:
         raise StrokeError(
             "duration_too_long",
             f"stroke needs {duration_ms:.3f} ms, more than the sleeve's maximum of "
             f"{layout.max_stroke_duration_ms:g} ms; send a slower, shorter stroke",
         )
+    points, fractions = virtual_actuators(start, end, merge_distance=merge_distance)
+    timings = _timings(fractions)
+    thinned = 0
+    if not _fits(timings, duration_ms, min_ms):
+        kept = _thinned(fractions, duration_ms, min_ms)
+        thinned = len(fractions) - len(kept)
+        points, fractions = [points[i] for i in kept], [fractions[i] for i in kept]
+        timings = _timings(fractions)
     bursts = _bursts(points, fractions, timings, duration_ms, intensity)
-    commands = _merged_commands(_spans_by_actuator(bursts, layout), min_command_ms)
-    return Schedule(_canonical(stroke, start, end), commands, duration_ms, adjusted, bursts)
+    commands = _merged_commands(_spans_by_actuator(bursts, layout), min_ms)
+    stroke = _canonical(stroke, start, end)
+    return Schedule(stroke, commands, duration_ms, adjusted, bursts, thinned)
+
+
+def shortest_planned_ms(min_command_ms: float) -> float:
+    """The least duration of any stroke: two end phantoms, each burst ``min_command_ms``.
+
+    Two bursts in apparent motion last ``d = (T - 47.3) / 1.32`` each, so
+    ``T = 1.32 d + 47.3`` (73.7 ms for 20 ms bursts), rounded up to the
+    microsecond. A point is held for at least as long, so that the duration does
+    not jump as a stroke shrinks to a point.
+    """
+    return _fastest_feasible_ms(_TWO_PHANTOMS, min_command_ms)
+
+
+def overrun_allowance_ms(duration_ms: float) -> float:
+    """How long after a stroke of ``duration_ms`` its bursts may still run."""
+    return max(OVERRUN_MIN_MS, OVERRUN_FRACTION * duration_ms)
+
+
+def _kept_duration(
+    stroke: Stroke, start: Point, end: Point, min_command_ms: float, *, strict: bool
+) -> tuple[float, Adjustment | None]:
+    """The stroke's own duration, or the shortest plannable one (or StrokeError if strict)."""
+    needed_ms = shortest_planned_ms(min_command_ms)
+    if stroke.duration_ms >= needed_ms:
+        return stroke.duration_ms, None
+    if strict:
+        raise StrokeError(
+            TOO_FAST,
+            f"stroke too fast: {stroke.duration_ms:g} ms over {math.dist(start, end):.4g} grid "
+            f"units; the least a stroke can be felt in is {needed_ms:.3f} ms (apparent motion "
+            f"between its two ends, bursts of {min_command_ms:g} ms); send it slower or plan "
+            "without --strict to slow it automatically",
+        )
+    return needed_ms, Adjustment(TOO_FAST, stroke.duration_ms, needed_ms)
 
 
 def _checked_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point]:
@@ -263,6 +308,47 @@ def _fastest_feasible_ms(timings: Iterable[_Timing], min_command_ms: float) -> f
     return math.ceil(needed * 1000.0 * (1 + 1e-12)) / 1000.0
 
 
+_TWO_PHANTOMS = _timings([0.0, 1.0])
+
+
+def _fits(timings: Iterable[_Timing], duration_ms: float, min_command_ms: float) -> bool:
+    """Whether every burst lasts at least ``min_command_ms`` at ``duration_ms``."""
+    # The same floor as _fastest_feasible_ms, whose rounding up makes its result fit.
+    floor = min_command_ms * (1 - 1e-12) - 1e-9
+    return all(a * duration_ms + b >= floor for _, _, a, b in timings)
+
+
+def _thinned(fractions: Sequence[float], duration_ms: float, min_command_ms: float) -> list[int]:
+    """Indices of the virtual actuators kept so that every burst fits ``duration_ms``.
+
+    Apparent motion needs its peaks about 54 ms apart at the least (74 ms for
+    the first and last step): peaks closer than that cannot each get a burst the
+    skin feels. So, until the rest fit, the crossing that closes the shortest
+    gap between kept peaks is left out; of the gap's two ends, the one whose
+    other gap is shorter, so that the peaks left stay evenly spread. The two
+    endpoints are always kept, and they alone fit any duration of at least
+    ``shortest_planned_ms``.
+    """
+    kept = list(range(len(fractions)))
+    while len(kept) > 2 and not _fits(
+        _timings([fractions[i] for i in kept]), duration_ms, min_command_ms
+    ):
+        del kept[_closest_crossing(kept, fractions)]
+    return kept
+
+
+def _closest_crossing(kept: Sequence[int], fractions: Sequence[float]) -> int:
+    """Position in ``kept`` of the interior point to leave out (there are at least three)."""
+    gaps = [fractions[b] - fractions[a] for a, b in itertools.pairwise(kept)]
+    shortest = min(range(len(gaps)), key=gaps.__getitem__)
+    if shortest == 0:
+        return 1  # the start stays
+    if shortest == len(gaps) - 1:
+        return shortest  # the end stays
+    # Leaving out the gap's first end joins it to the gap before; its second, to the one after.
+    return shortest if gaps[shortest - 1] <= gaps[shortest + 1] else shortest + 1
+
+
 def _bursts(
     points: Sequence[Point],
     fractions: Sequence[float],
@@ -270,14 +356,23 @@ def _bursts(
     duration_ms: float,
     intensity: float,
 ) -> tuple[Burst, ...]:
-    """The bursts at stroke duration ``duration_ms``, the last ending exactly there."""
+    """The bursts at stroke duration ``duration_ms``, the last ending exactly there.
+
+    A burst that would run on past the end by more than the allowance is cut
+    there: the motion has reached the stroke's end, and its actuator still
+    buzzing would pull the felt point back, into the next stroke's time.
+    """
     t = duration_ms
-    bursts = [
-        Burst(x, y, f * t, onset_a * t + onset_b, length_a * t + length_b, intensity)
-        for (x, y), f, (onset_a, onset_b, length_a, length_b) in zip(
-            points[:-1], fractions[:-1], timings[:-1], strict=True
-        )
-    ]
+    latest_end = t + overrun_allowance_ms(t)
+    bursts = []
+    for (x, y), f, (onset_a, onset_b, length_a, length_b) in zip(
+        points[:-1], fractions[:-1], timings[:-1], strict=True
+    ):
+        start_ms = onset_a * t + onset_b
+        length_ms = length_a * t + length_b
+        if start_ms + length_ms > latest_end:
+            length_ms = latest_end - start_ms
+        bursts.append(Burst(x, y, f * t, start_ms, length_ms, intensity))
     # The model's last duration is T - S too, but evaluated as a T + b it would
     # leave a float residue after the stroke's end.
     (x, y), onset_a, onset_b = points[-1], timings[-1][0], timings[-1][1]
@@ -344,9 +439,7 @@ def _spans_by_actuator(bursts: Iterable[Burst], layout: Layout) -> dict[_Actuato
     return by_actuator
 
 
-def merge_commands(
-    commands: Iterable[Command], *, min_command_ms: float = MIN_COMMAND_MS
-) -> tuple[Command, ...]:
+def merge_commands(commands: Iterable[Command], *, min_command_ms: float) -> tuple[Command, ...]:
     """One actuator, one intensity at a time.
 
     Overlapping commands on an actuator add their energies (intensity squared),

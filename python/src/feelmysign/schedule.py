@@ -40,7 +40,7 @@ class Burst:
 
 @dataclass(frozen=True)
 class Adjustment:
-    """Why and how the planner changed a stroke (today: slowed it so every burst is long enough)."""
+    """Why and how the planner changed a stroke's duration: slowed to the least it plays in."""
 
     reason: str
     requested_duration_ms: float
@@ -53,7 +53,8 @@ class Schedule:
 
     No two commands on one actuator overlap in time. ``duration_ms`` is the
     stroke's duration after any adjustment: the last command ends there.
-    ``bursts`` are the virtual actuators the commands render, in stroke order.
+    ``bursts`` are the virtual actuators the commands render, in stroke order;
+    ``thinned`` counts those left out so that the stroke keeps its time.
     """
 
     stroke: Stroke
@@ -61,6 +62,7 @@ class Schedule:
     duration_ms: float
     adjusted: Adjustment | None = None
     bursts: tuple[Burst, ...] = ()
+    thinned: int = 0
 
 
 def stroke_to_json(stroke: Stroke) -> dict[str, object]:
@@ -91,7 +93,7 @@ def command_to_json(command: Command) -> dict[str, object]:
 
 
 def schedule_to_json(schedule: Schedule, *, bursts: bool = False) -> dict[str, object]:
-    """``{"stroke", "commands", "adjusted"}`` (and the virtual actuators when asked)."""
+    """``{"stroke", "duration_ms", "commands", "adjusted", "thinned"}`` (and ``bursts``)."""
     adjusted = schedule.adjusted
     data: dict[str, object] = {
         "stroke": stroke_to_json(schedule.stroke),
@@ -104,6 +106,7 @@ def schedule_to_json(schedule: Schedule, *, bursts: bool = False) -> dict[str, o
             "requested_duration_ms": adjusted.requested_duration_ms,
             "duration_ms": adjusted.duration_ms,
         },
+        "thinned": schedule.thinned,
     }
     if bursts:
         data["bursts"] = [

@@ -11,13 +11,12 @@ from typing import Any
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._picture import grid_picture
 from feelmysign.errors import ParameterError, StrokeError
-from feelmysign.layout import Layout
-from feelmysign.planner import MERGE_DISTANCE, MIN_COMMAND_MS, plan
+from feelmysign.layout import MAX_MIN_BURST_MS, MIN_BURST_MS, Layout
+from feelmysign.planner import MERGE_DISTANCE, plan
 from feelmysign.protocol import Accepted, parse
 from feelmysign.schedule import Schedule, schedule_to_json
 from feelmysign.stroke import Stroke
 
-MAX_MIN_COMMAND_MS = 1000.0  # a burst floor of a second already forbids any drawing
 MAX_MERGE_DISTANCE = 0.5  # beyond half a cell, merging would move crossings off their lines
 
 
@@ -42,9 +41,11 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--min-command-ms",
         type=float,
-        default=MIN_COMMAND_MS,
         metavar="D",
-        help=f"shortest burst an actuator may play, in ms (default: {MIN_COMMAND_MS:g})",
+        help="shortest burst an actuator may play, in ms (default: the layout's min_burst_ms, "
+        "else by actuator_type: "
+        + ", ".join(f"{kind} {ms:g}" for kind, ms in MIN_BURST_MS.items())
+        + ")",
     )
     parser.add_argument(
         "--merge-distance",
@@ -56,7 +57,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--strict",
         action="store_true",
-        help="reject a stroke too fast to render instead of slowing it (default: slow it)",
+        help="reject a stroke too fast to render even as two end phantoms instead of "
+        "slowing it (default: slow it)",
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per stroke per line")
     parser.set_defaults(handler=run)
@@ -84,8 +86,10 @@ def run(args: argparse.Namespace) -> int:
 def _check_options(args: argparse.Namespace) -> None:
     if args.intensity is not None and not 0.0 <= args.intensity <= 1.0:
         raise ParameterError("--intensity", args.intensity, "in [0, 1]")
-    if not 0.0 <= args.min_command_ms <= MAX_MIN_COMMAND_MS:
-        raise ParameterError("--min-command-ms", args.min_command_ms, "in [0, 1000] ms")
+    if args.min_command_ms is not None and not 0.0 <= args.min_command_ms <= MAX_MIN_BURST_MS:
+        raise ParameterError(
+            "--min-command-ms", args.min_command_ms, f"in [0, {MAX_MIN_BURST_MS:g}] ms"
+        )
     if not 0.0 <= args.merge_distance <= MAX_MERGE_DISTANCE:
         raise ParameterError("--merge-distance", args.merge_distance, "in [0, 0.5] grid units")
 
@@ -121,8 +125,16 @@ def describe(schedule: Schedule, layout: Layout) -> str:
     ]
     if schedule.adjusted is not None:
         lines.append(
-            f"Adjusted: too fast to render at {schedule.adjusted.requested_duration_ms:g} ms; "
-            f"slowed to {schedule.adjusted.duration_ms:.3f} ms (--strict would reject it)"
+            f"Adjusted: too fast to render at {schedule.adjusted.requested_duration_ms:g} ms, "
+            f"even as two end phantoms; slowed to {schedule.adjusted.duration_ms:.3f} ms "
+            "(--strict would reject it)"
+        )
+    if schedule.thinned:
+        kept = len(schedule.bursts)
+        lines.append(
+            f"Thinned: {schedule.thinned} of {kept + schedule.thinned} virtual actuators left "
+            f"out (too close in time to be felt apart) so that the stroke plays in "
+            f"{schedule.duration_ms:.3f} ms"
         )
     lines.append("")
     lines.append(
