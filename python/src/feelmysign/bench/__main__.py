@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import platform
 
-from feelmysign.bench import algorithms, lasa_points, restart_off, sleeve
+from feelmysign.bench import algorithms, lasa_points, planner_lasa, restart_off, sleeve
 
 
 def main() -> None:
@@ -16,7 +16,14 @@ def main() -> None:
         "Each figure is the best of 5 runs; ratios compare with the baseline of its group,"
         " measured in the same run.\n"
     )
-    for report in (algorithms.report, lasa_points.report, sleeve.report, restart_off.report):
+    reports = (
+        algorithms.report,
+        planner_lasa.report,
+        lasa_points.report,
+        sleeve.report,
+        restart_off.report,
+    )
+    for report in reports:
         for line in report():
             print(line, flush=True)
         print()

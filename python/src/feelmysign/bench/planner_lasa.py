@@ -1,0 +1,108 @@
+"""The planner on real strokes: the LASA drawings' strokes, timed and compared with their drawing.
+
+Every one of the 210 LASA demonstrations (``feelmysign.research.lasa``) goes
+through each simplifier at its defaults, on the paper's sleeve; every stroke it
+sends is planned as the sleeve plans it. LASA pens move slowly, so the same
+strokes are also planned as if drawn 2 and 4 times faster (durations divided).
+Printed per simplifier and speed: how much longer the strokes play than they
+were drawn (planned / drawn duration per stroke, mean and 95th percentile), how
+many are slowed and how many thinned; then the cost of planning one of them
+beside the legacy-payload parse of ``bench.algorithms``.
+
+``python -m feelmysign.bench.planner_lasa`` prints this group alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from feelmysign.bench._timing import Rate, best_rate, row
+from feelmysign.layout import PAPER_SLEEVE
+from feelmysign.planner import plan
+from feelmysign.protocol import format_legacy, parse
+from feelmysign.research.evaluate import params_for
+from feelmysign.research.lasa import load_lasa
+from feelmysign.research.rerun import rerun
+from feelmysign.simplify import ALGORITHMS
+from feelmysign.stroke import Stroke
+
+PERCENTILE = 95
+SPEEDS = (1.0, 2.0, 4.0)  # drawing speed, as a multiple of the LASA pen's
+
+
+@dataclass(frozen=True)
+class TimeKept:
+    """Planned against drawn duration over one simplifier's strokes."""
+
+    strokes: int
+    ratio_mean: float
+    ratio_p95: float
+    slowed: int
+    thinned: int
+
+
+def lasa_strokes(algorithm: str) -> list[Stroke]:
+    """The strokes one simplifier sends for all 210 drawings, at its defaults."""
+    strokes = []
+    for demo in load_lasa():
+        params = params_for(ALGORITHMS[algorithm], demo.recording, {})
+        for item in rerun(demo.recording, params).segments:
+            segment = item.segment
+            if segment.dropped is None:
+                strokes.append(Stroke(segment.start, segment.end, segment.duration_ms))
+    return strokes
+
+
+def time_kept(strokes: list[Stroke]) -> TimeKept:
+    schedules = [plan(s, PAPER_SLEEVE) for s in strokes]
+    ratios = np.array(
+        [p.duration_ms / s.duration_ms for p, s in zip(schedules, strokes, strict=True)]
+    )
+    return TimeKept(
+        strokes=len(strokes),
+        ratio_mean=float(ratios.mean()),
+        ratio_p95=float(np.percentile(ratios, PERCENTILE)),
+        slowed=sum(p.adjusted is not None for p in schedules),
+        thinned=sum(p.thinned > 0 for p in schedules),
+    )
+
+
+def report() -> list[str]:
+    lines = ["Planner on the LASA strokes (210 drawings, each simplifier at its defaults)"]
+    for name in ALGORITHMS:
+        strokes = lasa_strokes(name)
+        for speed in SPEEDS:
+            kept = time_kept([faster(s, speed) for s in strokes])
+            lines.append(
+                f"  {name} x{speed:g} speed: {kept.strokes} strokes, planned / drawn duration "
+                f"mean {kept.ratio_mean:.3f}, p{PERCENTILE} {kept.ratio_p95:.3f}; "
+                f"slowed {kept.slowed}, thinned {kept.thinned}"
+            )
+        for speed in (SPEEDS[0], SPEEDS[-1]):
+            base, planned = planner_rates(f"{name} x{speed:g}", [faster(s, speed) for s in strokes])
+            lines += [row(base, base), row(planned, base)]
+    return lines
+
+
+def faster(stroke: Stroke, speed: float) -> Stroke:
+    return Stroke(stroke.start, stroke.end, stroke.duration_ms / speed)
+
+
+def planner_rates(name: str, strokes: list[Stroke]) -> tuple[Rate, Rate]:
+    """Planning these strokes, beside parsing their legacy payloads (the sleeve's step before)."""
+    payloads = [format_legacy(s) for s in strokes]
+    baseline = best_rate(
+        f"baseline: parse legacy payload ({name})",
+        lambda: len([parse(p, PAPER_SLEEVE) for p in payloads]),
+    )
+    planned = best_rate(
+        f"planner: plan one LASA stroke ({name})",
+        lambda: len([plan(s, PAPER_SLEEVE) for s in strokes]),
+    )
+    return baseline, planned
+
+
+if __name__ == "__main__":
+    print("\n".join(report()))
