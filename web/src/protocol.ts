@@ -24,7 +24,7 @@ export const LEGACY_DECIMALS = 4;
 /** The largest integer a JavaScript sender holds exactly. */
 export const MAX_SEQ = Number.MAX_SAFE_INTEGER;
 /** Printable ASCII without spaces, 1 to 64 characters (a UUID is 36). */
-const DRAWING_ID = /^[!-~]{1,64}$/;
+export const DRAWING_ID = /^[!-~]{1,64}$/;
 /** Number.prototype.toFixed switches to exponent notation from here on. */
 const TO_FIXED_LIMIT = 1e21;
 

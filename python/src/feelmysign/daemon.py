@@ -22,7 +22,7 @@ import logging
 import queue
 import threading
 import time
-from collections import Counter
+from collections import Counter, OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -32,13 +32,21 @@ import paho.mqtt.client as mqtt
 from feelmysign import __version__
 from feelmysign.backends.base import Backend
 from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError, StrokeError
-from feelmysign.events import ErrorEvent, Event, Played, Rejected, Status, StatusLayout
+from feelmysign.events import Cancelled, ErrorEvent, Event, Played, Rejected, Status, StatusLayout
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
-from feelmysign.player import MAX_PENDING, PlannedStroke, Player, monotonic_ms, wall_ms
+from feelmysign.player import (
+    MAX_PENDING,
+    PlannedStroke,
+    Player,
+    cancelled,
+    monotonic_ms,
+    wall_ms,
+)
 from feelmysign.protocol import Accepted, parse
-from feelmysign.topics import LEGACY_TOPIC, strokes_topic, telemetry_topic
+from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +55,8 @@ RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
 # the broker kept for a sleeve that was away is not rate-limited on its return.
 BURST = MAX_PENDING
 KEEPALIVE_S = 15
+# Cancelled drawings remembered, so that their later strokes do not start them again.
+REMEMBERED_CANCELS = 64
 RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
 # "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
@@ -105,6 +115,7 @@ class Sleeve:
         self._stopped = threading.Event()
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
+        self._cancelled: OrderedDict[str, float] = OrderedDict()  # drawing -> cancelled at (wall)
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         self._client = self._make_client()
@@ -201,7 +212,7 @@ class Sleeve:
                 self._stopped.set()
             log.error(message)
             return
-        subscriptions = [(strokes_topic(self._id), 1)]
+        subscriptions = [(strokes_topic(self._id), 1), (control_topic(self._id), 1)]
         if self._options.legacy_topic:
             subscriptions.append((self._options.legacy_topic, 1))
         client.subscribe(subscriptions)
@@ -279,6 +290,9 @@ class Sleeve:
             )
             return
         payload = message.payload
+        if name == control_topic(self._id):
+            self._control(payload, info, received_wall_ms)
+            return
         result = parse(payload, self._layout, format="legacy" if legacy else "json")
         if not isinstance(result, Accepted):
             self._reject(result.reason, result.message, info, received_wall_ms)
@@ -290,6 +304,11 @@ class Sleeve:
             ("sent_at_ms", stroke.sent_at_ms),
         )
         info.update({k: v for k, v in known if v is not None})
+        if stroke.drawing is not None and stroke.drawing in self._cancelled:
+            # A stroke of a cancelled drawing (one the broker held, or sent just after the cancel).
+            cancelled_at_ms = self._cancelled[stroke.drawing]
+            self._event(cancelled(info, received_wall_ms, cancelled_at_ms, started=False))
+            return
         if not self._bucket.take():
             self._reject(
                 "rate_limited",
@@ -309,6 +328,20 @@ class Sleeve:
         if refusal is not None:
             self._reject(refusal.reason, refusal.message, info, received_wall_ms)
 
+    def _control(self, payload: object, info: dict[str, Any], received_wall_ms: float) -> None:
+        result = parse_control(payload)
+        if not isinstance(result, Cancel):
+            self._reject(result.reason, result.message, info, received_wall_ms)
+            return
+        if not result.everything:
+            self._cancelled[result.drawing] = received_wall_ms
+            self._cancelled.move_to_end(result.drawing)
+            while len(self._cancelled) > REMEMBERED_CANCELS:
+                self._cancelled.popitem(last=False)
+        what = "every drawing" if result.everything else f"drawing {result.drawing}"
+        log.info("sleeve %s: cancel %s", self._id, what)
+        self._player.cancel(result, received_wall_ms)
+
     # --- what the sleeve tells the world -----------------------------------------------
 
     def _reject(
@@ -323,6 +356,8 @@ class Sleeve:
         """Called from the player thread too: only queues, never touches the network."""
         if isinstance(event, Played):
             self._count("played")
+        elif isinstance(event, Cancelled):
+            self._count("cancelled")
         if isinstance(event, ErrorEvent) and event.reason == "player_crashed":
             self._fatal = FeelMySignError(
                 "the player stopped on an unexpected error (see the log); every motor is off"

@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from feelmysign.backends.base import Backend
-from feelmysign.events import Adjusted, ErrorEvent, Event, Played, Safety
+from feelmysign.control import Cancel
+from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
 from feelmysign.schedule import Schedule
 from feelmysign.timeline import Change, Timeline
@@ -67,6 +68,14 @@ class PlannedStroke:
         default_factory=dict
     )  # e.g. drawing, seq, topic: copied into events
     start_ms: float = 0.0
+    number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
+
+
+@dataclass(frozen=True)
+class _CancelRequest:
+    cancel: Cancel
+    accepted_before: int  # strokes numbered below this one were accepted before the cancel
+    received_wall_ms: float
 
 
 @dataclass(frozen=True)
@@ -103,6 +112,8 @@ class Player:
         self._tail_ms = float("-inf")
         self._last_seq: OrderedDict[str, int] = OrderedDict()
         self._running = False
+        self._accepted = 0
+        self._cancels: list[_CancelRequest] = []
         self._thread: threading.Thread | None = None
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
         self.played = 0
@@ -123,6 +134,8 @@ class Player:
                 self._last_seq.move_to_end(drawing)
                 while len(self._last_seq) > REMEMBERED_DRAWINGS:
                     self._last_seq.popitem(last=False)
+            stroke.number = self._accepted
+            self._accepted += 1
             stroke.start_ms = max(stroke.received_at_ms, self._tail_ms)
             self._tail_ms = stroke.start_ms + stroke.schedule.duration_ms
             self._pending += 1
@@ -153,6 +166,16 @@ class Player:
                 f"{self._max_backlog_ms / 1000:g} s: send more slowly",
             )
         return None
+
+    def cancel(self, cancel: Cancel, received_wall_ms: float) -> None:
+        """Cancel the strokes of a drawing (or all) accepted so far, from any thread.
+
+        The player thread wakes at once, switches their motors off, drops those not started,
+        and reports each one as ``cancelled``; strokes accepted later are not touched.
+        """
+        with self._lock:
+            self._cancels.append(_CancelRequest(cancel, self._accepted, received_wall_ms))
+        self._wake.set()
 
     def start(self) -> None:
         sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL_S))
@@ -190,6 +213,7 @@ class Player:
             while self._running:
                 self._wake.clear()
                 self._take_inbox()
+                self._apply_cancels()
                 self._step()
         except Exception:  # the thread must never die with motors on
             log.exception("player stopped by an unexpected error; all motors off")
@@ -203,6 +227,40 @@ class Player:
             while self._inbox:
                 stroke = self._inbox.popleft()
                 self._timeline.add(stroke.schedule, stroke.start_ms, stroke)
+
+    def _apply_cancels(self) -> None:
+        with self._lock:
+            requests, self._cancels = self._cancels, []
+        for request in requests:
+            cancel, before = request.cancel, request.accepted_before
+
+            def chosen(tag: object, cancel: Cancel = cancel, before: int = before) -> bool:
+                return (
+                    isinstance(tag, PlannedStroke)
+                    and tag.number < before
+                    and cancel.matches(tag.info.get("drawing"))
+                )
+
+            cut = self._timeline.cancel(chosen, self._clock())
+            self._write(cut.changes)
+            if cancel.everything:
+                self._backend.all_off()  # nothing may run on after "cancel everything"
+            with self._lock:
+                self._pending -= len(cut.unstarted)
+                self._tail_ms = max(
+                    (
+                        tag.start_ms + tag.schedule.duration_ms
+                        for tag in [*self._timeline.tags(), *self._inbox]
+                        if isinstance(tag, PlannedStroke)
+                    ),
+                    default=float("-inf"),
+                )
+            for tags, started in ((cut.started, True), (cut.unstarted, False)):
+                for tag in tags:
+                    if isinstance(tag, PlannedStroke):
+                        at_ms = request.received_wall_ms
+                        event = cancelled(tag.info, tag.received_wall_ms, at_ms, started=started)
+                        self._on_event(event)
 
     def _step(self) -> None:
         next_ms = self._timeline.next_ms()
@@ -280,3 +338,19 @@ class Player:
         else:
             event = Played(**timing)
         self._on_event(event)
+
+
+def cancelled(
+    info: dict[str, Any], received_wall_ms: float, cancelled_at_ms: float, *, started: bool
+) -> Cancelled:
+    """The event for a stroke (``info``: topic, drawing, seq, sent_at_ms) that a control
+    message received at ``cancelled_at_ms`` cancelled."""
+    return Cancelled(
+        message="cut short by a control message"
+        if started
+        else "dropped by a control message before it played",
+        **info,
+        received_at_ms=received_wall_ms,
+        cancelled_at_ms=cancelled_at_ms,
+        started=started,
+    )

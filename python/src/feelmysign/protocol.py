@@ -197,7 +197,18 @@ def stroke_to_dict(stroke: Stroke) -> dict[str, Any]:
 # --- payload ------------------------------------------------------------------------------
 
 
-def _payload_text(payload: object) -> str | Rejected:
+def is_drawing_id(text: str) -> bool:
+    """1 to 64 printable ASCII characters without spaces (what ``drawing`` allows)."""
+    return _DRAWING_ID.fullmatch(text) is not None
+
+
+def payload_text(payload: object, *, example: str = _LEGACY_EXAMPLE) -> str | Rejected:
+    """The payload as text, or not_text / too_long, checked as every message to the sleeve is
+    (the size in UTF-8 bytes, UTF-8, a byte-order mark dropped); ``example`` goes in messages."""
+    return _payload_text(payload, example)
+
+
+def _payload_text(payload: object, example: str = _LEGACY_EXAMPLE) -> str | Rejected:
     """The payload as text, or not_text / too_long. The size counts UTF-8 bytes."""
     if isinstance(payload, str):
         try:
@@ -206,7 +217,7 @@ def _payload_text(payload: object) -> str | Rejected:
             return Rejected(
                 NOT_TEXT,
                 f"The payload text cannot be encoded as UTF-8 (a lone surrogate at character "
-                f"{error.start}); send valid Unicode text such as {_LEGACY_EXAMPLE}.",
+                f"{error.start}); send valid Unicode text such as {example}.",
             )
     elif isinstance(payload, (bytes, bytearray, memoryview)):
         data = bytes(payload)
@@ -215,8 +226,7 @@ def _payload_text(payload: object) -> str | Rejected:
         kind = "None" if payload is None else f"of type {type(payload).__name__}"
         return Rejected(
             NOT_TEXT,
-            f"The payload is {kind}, not text; send a string or UTF-8 bytes such as "
-            f"{_LEGACY_EXAMPLE}.",
+            f"The payload is {kind}, not text; send a string or UTF-8 bytes such as {example}.",
         )
     if len(data) > MAX_PAYLOAD_BYTES:
         return Rejected(
@@ -233,7 +243,7 @@ def _payload_text(payload: object) -> str | Rejected:
             return Rejected(
                 NOT_TEXT,
                 f"The payload is not UTF-8 text (byte 0x{data[error.start]:02x} at position "
-                f"{error.start}); send ASCII such as {_LEGACY_EXAMPLE} or UTF-8 JSON.",
+                f"{error.start}); send ASCII such as {example} or UTF-8 JSON.",
             )
     # A byte-order mark is invisible in editors; TextDecoder drops it too.
     return text.removeprefix(_BOM)

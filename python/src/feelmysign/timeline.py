@@ -15,6 +15,7 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -46,6 +47,16 @@ class Due:
     changes: list[Change] = field(default_factory=list)
     started: list[object] = field(default_factory=list)
     tripped: list[Actuator] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Cut:
+    """What cancelling strokes did: the changes to write now, the strokes cut short while
+    playing and those that had not started (their tags, in planned order)."""
+
+    changes: list[Change] = field(default_factory=list)
+    started: list[object] = field(default_factory=list)
+    unstarted: list[object] = field(default_factory=list)
 
 
 _Kind = Literal["on", "off", "start", "cap"]
@@ -82,8 +93,9 @@ class Timeline:
             ident = next(self._commands)
             actuator = (command.row, command.column)
             energy = command.intensity**2
-            self._push(_Event(start_ms + command.start_ms, 0, "on", actuator, ident, energy))
-            self._push(_Event(start_ms + command.end_ms, 0, "off", actuator, ident))
+            on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
+            self._push(_Event(on_ms, 0, "on", actuator, ident, energy, tag=tag))
+            self._push(_Event(off_ms, 0, "off", actuator, ident, tag=tag))
 
     def next_ms(self) -> float | None:
         """When the next thing is due, or None when nothing is planned."""
@@ -121,6 +133,43 @@ class Timeline:
             for actuator in sorted(touched):
                 self._settle(actuator, t_ms, due)
         return due
+
+    def cancel(self, match: Callable[[object], bool], now_ms: float) -> Cut:
+        """Drop everything still planned for the strokes whose tag ``match``es; their motors go
+        off at ``now_ms`` (a motor another stroke also drives keeps that stroke's intensity)."""
+        dropped = [
+            e for e in self._events if e.kind != "cap" and e.tag is not None and match(e.tag)
+        ]
+        if not dropped:
+            return Cut()
+        gone = {id(e) for e in dropped}
+        self._events = [e for e in self._events if id(e) not in gone]
+        heapq.heapify(self._events)
+        dropped.sort()
+        unstarted = [e.tag for e in dropped if e.kind == "start"]
+        started: list[object] = []
+        for tag in (e.tag for e in dropped):
+            if all(tag is not t for t in unstarted) and all(tag is not t for t in started):
+                started.append(tag)
+        touched: set[Actuator] = set()
+        for event in dropped:
+            # An "off" still planned whose "on" has happened: that command is running now.
+            running = self._active.get(event.actuator)
+            if event.kind == "off" and running is not None and event.command in running:
+                del running[event.command]
+                touched.add(event.actuator)
+        due = Due()
+        for actuator in sorted(touched):
+            self._settle(actuator, now_ms, due)
+        return Cut(due.changes, started, unstarted)
+
+    def tags(self) -> list[object]:
+        """The tags of strokes with anything still planned, each once."""
+        seen: dict[int, object] = {}
+        for event in self._events:
+            if event.tag is not None:
+                seen.setdefault(id(event.tag), event.tag)
+        return list(seen.values())
 
     def unstarted(self) -> list[object]:
         """The tags of strokes added but not yet started."""

@@ -3,6 +3,7 @@
 ::
 
     feelmysign/<sleeve-id>/strokes     JSON v1 strokes in (QoS 1)
+    feelmysign/<sleeve-id>/control     control messages in: cancel a drawing or everything (QoS 1)
     feelmysign/<sleeve-id>/status      retained: online, layout, version (last will: offline)
     feelmysign/<sleeve-id>/actuators   actuator intensities, for previews
     feelmysign/<sleeve-id>/events      one message per stroke played, adjusted or rejected
@@ -19,6 +20,7 @@ from typing import Final, Literal
 TOPIC_ROOT: Final = "feelmysign"
 LEGACY_TOPIC: Final = "deviceOne/line"  # the paper's sleeve (appendix A.2)
 STROKES: Final = "strokes"
+CONTROL: Final = "control"
 TelemetryName = Literal["status", "actuators", "events"]
 TELEMETRY_NAMES: Final[tuple[TelemetryName, ...]] = ("status", "actuators", "events")
 # In an ACL or a subscription: every sleeve's topic of one kind.
@@ -32,6 +34,10 @@ def sleeve_topic(sleeve_id: str, name: str) -> str:
 
 def strokes_topic(sleeve_id: str) -> str:
     return sleeve_topic(sleeve_id, STROKES)
+
+
+def control_topic(sleeve_id: str) -> str:
+    return sleeve_topic(sleeve_id, CONTROL)
 
 
 def telemetry_topic(sleeve_id: str, name: TelemetryName) -> str:

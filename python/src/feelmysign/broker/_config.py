@@ -17,7 +17,13 @@ from pathlib import Path
 
 from feelmysign.broker.credentials import Account, write_private_file
 from feelmysign.errors import BrokerError
-from feelmysign.topics import ANY_SLEEVE, TELEMETRY_NAMES, strokes_topic, telemetry_topic
+from feelmysign.topics import (
+    ANY_SLEEVE,
+    TELEMETRY_NAMES,
+    control_topic,
+    strokes_topic,
+    telemetry_topic,
+)
 
 LOOPBACK_ADDRESS = "127.0.0.1"
 # Strokes are at most 512 bytes (protocol) and telemetry is small; anything far bigger
@@ -109,17 +115,20 @@ connection_messages true
 def render_acl(
     *, sleeve_id: str, sleeve_username: str, sender_username: str, legacy_topic: str
 ) -> str:
-    """The ACL: a sleeve reads only its strokes and writes only its telemetry; the
-    sender writes strokes to any sleeve and reads every sleeve's telemetry."""
+    """The ACL: a sleeve reads only its strokes and control messages and writes only its
+    telemetry; the sender writes strokes and control messages to any sleeve and reads every
+    sleeve's telemetry."""
     sleeve_lines = [
         f"user {sleeve_username}",
         f"topic read {strokes_topic(sleeve_id)}",
+        f"topic read {control_topic(sleeve_id)}",
         f"topic read {legacy_topic}",
         *(f"topic write {telemetry_topic(sleeve_id, sub)}" for sub in TELEMETRY_NAMES),
     ]
     sender_lines = [
         f"user {sender_username}",
         f"topic write {strokes_topic(ANY_SLEEVE)}",
+        f"topic write {control_topic(ANY_SLEEVE)}",
         f"topic write {legacy_topic}",
         *(f"topic read {telemetry_topic(ANY_SLEEVE, sub)}" for sub in TELEMETRY_NAMES),
     ]

@@ -27,6 +27,7 @@ SUBCOMMANDS = (
     "sleeve",
     "broker",
     "send",
+    "stop",
     "scan",
     "buzz",
 )
