@@ -105,6 +105,17 @@ def test_a_fast_stroke_is_thinned_not_slowed() -> None:
     assert [(b.x, b.y) for b in schedule.bursts] == [(0.0, 0.0), (3.0, 0.0)]
 
 
+def test_thinning_keeps_the_crossings_evenly_spread_in_time() -> None:
+    """The diagonal in 200 ms: of its crossings at 67, 100 and 133 ms, the middle one."""
+    schedule = plan(Stroke((0, 0), (3, 2), 200), PAPER)
+    assert schedule.thinned == 2
+    assert [(b.x, b.y, b.peak_ms) for b in schedule.bursts] == [
+        (0.0, 0.0, 0.0),
+        (1.5, 1.0, 100.0),
+        (3.0, 2.0, 200.0),
+    ]
+
+
 # Defect: crossings 0.05 to 0.15 apart made the stroke 22x slower (1,865 ms), while
 # moving its start by 0.003 (183 ms) or merging at 0.15 (83 ms) did not.
 NEAR_CROSSINGS = Stroke((2.0429, 0.1643), (0.9571, 0.8214), 83.3333)

@@ -8,8 +8,8 @@ feasibility rule (no negative or too-short burst), and overlapping commands on
 one actuator merged into one piecewise-constant intensity.
 
 Time is kept: a stroke plays in the time it was drawn. When the motion model
-cannot fit every virtual actuator into that time, the crossings closest in time
-are left out, one by one, until it can (``_thinned``). A stroke is slowed only
+cannot fit every virtual actuator into that time, it keeps the most crossings
+that fit, evenly spread in time (``_thinned``). A stroke is slowed only
 when even its simplest rendering, apparent motion between its two end
 phantoms, cannot fit: below ``shortest_planned_ms`` (73.7 ms for 20 ms bursts),
 whatever its length or direction, so the planned duration is continuous in the
@@ -323,30 +323,46 @@ def _thinned(fractions: Sequence[float], duration_ms: float, min_command_ms: flo
 
     Apparent motion needs its peaks about 54 ms apart at the least (74 ms for
     the first and last step): peaks closer than that cannot each get a burst the
-    skin feels. So, until the rest fit, the crossing that closes the shortest
-    gap between kept peaks is left out; of the gap's two ends, the one whose
-    other gap is shorter, so that the peaks left stay evenly spread. The two
+    skin feels, and are fused anyway. So the most crossings that fit are kept,
+    chosen evenly spread in time (a steady apparent speed): for ``count``
+    crossings, the one nearest each of ``count`` evenly spaced times. The two
     endpoints are always kept, and they alone fit any duration of at least
     ``shortest_planned_ms``.
+
+    Fewer crossings leave wider gaps, so whether ``count`` fits falls with
+    ``count``: a bisection finds the most that fit in a few tries, which
+    matters on a large grid (a stroke across 64 columns crosses 100 lines).
     """
-    kept = list(range(len(fractions)))
-    while len(kept) > 2 and not _fits(
-        _timings([fractions[i] for i in kept]), duration_ms, min_command_ms
-    ):
-        del kept[_closest_crossing(kept, fractions)]
+    last = len(fractions) - 1
+    best = [0, last]
+    fits, fails = 0, last - 1  # counts known to fit (none) and not to (all crossings)
+    while fails - fits > 1:
+        count = (fits + fails) // 2
+        kept = _evenly_spread(fractions, count)
+        if _fits(_timings([fractions[i] for i in kept]), duration_ms, min_command_ms):
+            fits, best = count, kept
+        else:
+            fails = count
+    return best
+
+
+def _evenly_spread(fractions: Sequence[float], count: int) -> list[int]:
+    """The ends and, for each of ``count`` evenly spaced times, the crossing nearest to it.
+
+    A crossing nearest to two of the times is kept once. The targets increase,
+    so one forward walk over the crossings finds every nearest one.
+    """
+    last = len(fractions) - 1
+    kept = [0]
+    j = 1
+    for k in range(1, count + 1):
+        target = k / (count + 1)
+        while j < last - 1 and abs(fractions[j + 1] - target) < abs(fractions[j] - target):
+            j += 1
+        if j != kept[-1]:
+            kept.append(j)
+    kept.append(last)
     return kept
-
-
-def _closest_crossing(kept: Sequence[int], fractions: Sequence[float]) -> int:
-    """Position in ``kept`` of the interior point to leave out (there are at least three)."""
-    gaps = [fractions[b] - fractions[a] for a, b in itertools.pairwise(kept)]
-    shortest = min(range(len(gaps)), key=gaps.__getitem__)
-    if shortest == 0:
-        return 1  # the start stays
-    if shortest == len(gaps) - 1:
-        return shortest  # the end stays
-    # Leaving out the gap's first end joins it to the gap before; its second, to the one after.
-    return shortest if gaps[shortest - 1] <= gaps[shortest + 1] else shortest + 1
 
 
 def _bursts(
