@@ -116,9 +116,20 @@ EVENTS: dict[str, tuple[str, dict[str, Any]]] = {
             "started": True,
         },
     ),
-    "safety-max-on-time": (
-        "a motor on for too long, switched off",
-        {"type": "safety", "reason": "max_on_time", "row": 1, "column": 2},
+    "safety-duty-cycle": (
+        "a stroke the duty-cycle cap kept from playing, with the motor and by how much",
+        {
+            "type": "safety",
+            "reason": "duty_cycle",
+            "row": 1,
+            "column": 2,
+            "message": "not played: the motor would have been driven 52% of the last 60 s",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+            "duty_cycle": 0.52,
+            "max_duty_cycle": 0.5,
+            "window_ms": 60000.0,
+        },
     ),
     "safety-off-failed": (
         "an off that failed twice: every motor off",

@@ -385,4 +385,25 @@ def test_on_time_cap_below_the_longest_stroke_is_refused() -> None:
     )
     with pytest.raises(LayoutError) as error:
         parse_layout(text)
-    assert any("max_on_time_ms" in p and "cut off" in p for p in error.value.problems)
+    assert any("max_on_time_ms" in p and "buzzed" in p for p in error.value.problems)
+
+
+def test_the_duty_cycle_cap_is_read_with_its_defaults_and_checked() -> None:
+    grid = "rows = 3\ncolumns = 4\nspacing_cm = 3.0\n"
+    default = parse_layout(grid)
+    assert (default.duty_cycle_window_ms, default.max_duty_cycle) == (60_000.0, 0.5)
+    tight = parse_layout(grid + "[safety]\nduty_cycle_window_ms = 30000\nmax_duty_cycle = 0.4\n")
+    assert (tight.duty_cycle_window_ms, tight.max_duty_cycle) == (30_000.0, 0.4)
+    cases = {
+        "max_duty_cycle = 1.5": "safety.max_duty_cycle: must be a number above 0 and at most 1;",
+        "max_duty_cycle = 0": "safety.max_duty_cycle: must be a number above 0 and at most 1;",
+        "duty_cycle_window_ms = 500": "safety.duty_cycle_window_ms: must be at least 1000",
+        "duty_cycle_window_ms = 15000\nmax_duty_cycle = 0.5": (
+            "safety.max_duty_cycle: 0.5 of safety.duty_cycle_window_ms 15000 is 7500 ms of full "
+            "drive, below safety.max_stroke_duration_ms 10000"
+        ),
+    }
+    for text, problem in cases.items():
+        with pytest.raises(LayoutError) as error:
+            parse_layout(grid + "[safety]\n" + text + "\n")
+        assert any(p.startswith(problem) for p in error.value.problems), error.value.problems

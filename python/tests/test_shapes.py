@@ -30,7 +30,12 @@ def cases(draw: st.DrawFn) -> tuple[str, int, Layout, float]:
     columns = draw(st.integers(2, 12))
     spacing_cm = draw(st.floats(0.5, 5.0))
     layout = grid_layout(
-        rows, columns, spacing_cm, max_stroke_duration_ms=60_000, max_on_time_ms=60_000
+        rows,
+        columns,
+        spacing_cm,
+        max_stroke_duration_ms=60_000,
+        max_on_time_ms=60_000,
+        max_duty_cycle=1.0,
     )
     smaller_span = min(columns - 1, rows - 1) if name != "line" else columns - 1
     margin = draw(st.floats(0.0, smaller_span / 2 * 0.9))

@@ -12,9 +12,19 @@ from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.schedule import Command, Schedule
 from feelmysign.stroke import Stroke
-from feelmysign.timeline import MIN_REST_MS, Change, Timeline
+from feelmysign.timeline import Change, Timeline
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
+# A 2 s window with half of it at full drive: 1000 ms of budget, quick to reach.
+TIGHT = Layout(
+    rows=3,
+    columns=4,
+    spacing_cm=3.0,
+    max_stroke_duration_ms=1000,
+    max_on_time_ms=1000,
+    duty_cycle_window_ms=2000,
+    max_duty_cycle=0.5,
+)
 
 
 def _schedule(*commands: Command, duration_ms: float = 100.0) -> Schedule:
@@ -59,21 +69,60 @@ def test_writes_only_on_change() -> None:
     assert [(c.t_ms, c.intensity) for c in _drain(timeline)] == [(0.0, 0.5), (200.0, 0.0)]
 
 
-def test_continuous_on_time_is_capped_until_the_commands_stop() -> None:
-    short = Layout(rows=3, columns=4, spacing_cm=3.0, max_on_time_ms=1000)
-    timeline = Timeline(short)
-    for k in range(4):  # back-to-back strokes keeping one actuator on for 2 s
-        timeline.add(_schedule(Command(2, 3, 0, 500, 0.7), duration_ms=500), k * 500.0)
-    tripped: list[tuple[int, int]] = []
+def _run(timeline: Timeline) -> tuple[list[Change], list[object], list[object]]:
     changes: list[Change] = []
+    started: list[object] = []
+    capped: list[object] = []
     while (t := timeline.next_ms()) is not None:
         due = timeline.pop_due(t)
         changes += due.changes
-        tripped += due.tripped
-    assert tripped == [(2, 3)]
-    assert [(c.t_ms, c.intensity) for c in changes] == [(0.0, 0.7), (1000.0, 0.0)]
-    timeline.add(_schedule(Command(2, 3, 0, 100, 0.7)), 3000.0)  # after a rest it plays again
-    assert [(c.t_ms, c.intensity) for c in _drain(timeline)] == [(3000.0, 0.7), (3100.0, 0.0)]
+        started += due.started
+        capped += [c.tag for c in due.capped]
+    return changes, started, capped
+
+
+def test_a_stroke_over_the_duty_cycle_budget_plays_not_at_all_and_a_rest_restores_it() -> None:
+    timeline = Timeline(TIGHT)
+    for k in range(4):  # back-to-back strokes keeping one motor at full drive
+        timeline.add(_schedule(Command(2, 3, 0, 500, 1.0), duration_ms=500), k * 500.0, tag=k)
+    timeline.add(_schedule(Command(2, 3, 0, 100, 1.0)), 3000.0, tag="rested")
+    changes, started, capped = _run(timeline)
+    # 0 and 1 fill the 1000 ms budget exactly; 2 and 3 would exceed it: not a single command.
+    assert started == [0, 1, "rested"] and capped == [2, 3]
+    assert [(c.t_ms, c.intensity) for c in changes] == [
+        (0.0, 1.0),
+        (1000.0, 0.0),
+        (3000.0, 1.0),
+        (3100.0, 0.0),
+    ]
+
+
+def test_a_refusal_says_which_motor_and_by_how_much() -> None:
+    timeline = Timeline(TIGHT)
+    timeline.add(_schedule(Command(1, 1, 0, 900, 1.0), duration_ms=900), 0.0)
+    timeline.add(_schedule(Command(1, 2, 0, 400, 1.0), Command(1, 1, 0, 400, 0.6)), 900.0, "x")
+    assert timeline.pop_due(0.0).started
+    (capped,) = timeline.pop_due(900.0).capped
+    assert capped.tag == "x" and capped.refusal.actuator == (1, 1)
+    # 900 ms at full drive, then 400 ms at 0.6 (0.36 of full): 1044 of 2000 ms.
+    assert capped.refusal.duty_cycle == pytest.approx(0.522)
+    assert (capped.refusal.max_duty_cycle, capped.refusal.window_ms) == (0.5, 2000.0)
+
+
+def test_short_gaps_are_rests_in_proportion_not_resets() -> None:
+    timeline = Timeline(TIGHT)
+    for k in range(6):  # 400 ms on, 1 ms off: the motor hardly rests
+        timeline.add(_schedule(Command(1, 1, 0, 400, 1.0), duration_ms=400), k * 401.0, tag=k)
+    _, started, capped = _run(timeline)
+    assert started == [0, 1] and capped == [2, 3, 4, 5]
+
+
+def test_a_motor_used_a_fifth_of_the_time_is_never_refused() -> None:
+    timeline = Timeline(PAPER)  # the defaults: a minute, half of it
+    for k in range(600):  # ten minutes of 200 ms at full drive every second
+        timeline.add(_schedule(Command(0, 1, 0, 200, 1.0), duration_ms=200), k * 1000.0, tag=k)
+    _, started, capped = _run(timeline)
+    assert capped == [] and len(started) == 600
 
 
 def test_clear_switches_running_actuators_off() -> None:
@@ -130,29 +179,3 @@ def test_an_ended_stroke_leaves_nothing_planned() -> None:
     timeline.add(_schedule(Command(0, 0, 0, 100, 0.5)), 0.0)
     _drain(timeline)
     assert timeline.next_ms() is None and not timeline.busy
-
-
-def test_short_gaps_do_not_reset_the_on_time_cap() -> None:
-    short = Layout(rows=3, columns=4, spacing_cm=3.0, max_on_time_ms=1000)
-    timeline = Timeline(short)
-    for k in range(6):  # 400 ms on, 1 ms off: the motor never rests
-        timeline.add(_schedule(Command(1, 1, 0, 400, 0.7), duration_ms=400), k * 401.0)
-    tripped: list[tuple[int, int]] = []
-    ons: list[float] = []
-    while (t := timeline.next_ms()) is not None:
-        due = timeline.pop_due(t)
-        tripped += due.tripped
-        ons += [c.t_ms for c in due.changes if c.intensity > 0]
-    assert tripped and tripped[0] == (1, 1)
-    # Cut at its 1000 ms budget, the motor stays off until it has rested.
-    assert all(t < 1000.0 or t >= 1000.0 + MIN_REST_MS for t in ons)
-    assert ons[-1] == 5 * 401.0
-
-
-def test_a_real_rest_restores_the_budget() -> None:
-    short = Layout(rows=3, columns=4, spacing_cm=3.0, max_on_time_ms=1000)
-    timeline = Timeline(short)
-    timeline.add(_schedule(Command(1, 1, 0, 900, 0.7), duration_ms=900), 0.0)
-    timeline.add(_schedule(Command(1, 1, 0, 900, 0.7), duration_ms=900), 900.0 + MIN_REST_MS)
-    changes = _drain(timeline)
-    assert [c.intensity for c in changes] == [0.7, 0.0, 0.7, 0.0]

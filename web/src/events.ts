@@ -56,11 +56,20 @@ export interface CancelledEvent extends StrokeRef {
   readonly started: boolean;
 }
 
-export interface SafetyEvent {
+/**
+ * A motor was protected: `duty_cycle`, a stroke the duty-cycle cap kept from playing (with
+ * the stroke's fields, the motor's would-be duty cycle and the limit); or `off_failed`.
+ */
+export interface SafetyEvent extends StrokeRef {
   readonly type: "safety";
   readonly reason: string;
   readonly row: number;
   readonly column: number;
+  readonly message: string | null;
+  readonly received_at_ms: number | null;
+  readonly duty_cycle: number | null;
+  readonly max_duty_cycle: number | null;
+  readonly window_ms: number | null;
 }
 
 export interface ErrorEvent {
@@ -138,6 +147,12 @@ const EVENT_FIELDS: Record<SleeveEventType, readonly Field[]> = {
     ["reason", "text", true],
     ["row", "index", true],
     ["column", "index", true],
+    ["message", "text", false],
+    ...STROKE,
+    ["received_at_ms", "number", false],
+    ["duty_cycle", "number", false],
+    ["max_duty_cycle", "number", false],
+    ["window_ms", "number", false],
   ],
   error: [
     ["reason", "text", true],

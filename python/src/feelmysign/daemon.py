@@ -34,7 +34,16 @@ from feelmysign.backends.base import Backend
 from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError, StrokeError
-from feelmysign.events import Cancelled, ErrorEvent, Event, Played, Rejected, Status, StatusLayout
+from feelmysign.events import (
+    Cancelled,
+    ErrorEvent,
+    Event,
+    Played,
+    Rejected,
+    Safety,
+    Status,
+    StatusLayout,
+)
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.player import (
@@ -358,6 +367,8 @@ class Sleeve:
             self._count("played")
         elif isinstance(event, Cancelled):
             self._count("cancelled")
+        elif isinstance(event, Safety) and event.reason == "duty_cycle":
+            self._count("capped")
         if isinstance(event, ErrorEvent) and event.reason == "player_crashed":
             self._fatal = FeelMySignError(
                 "the player stopped on an unexpected error (see the log); every motor is off"

@@ -219,16 +219,40 @@ class Cancelled(_Event):
 
 @dataclass(frozen=True, kw_only=True)
 class Safety(_Event):
-    """A motor was switched off to protect the wearer (``max_on_time``, ``off_failed``)."""
+    """A motor was protected: a stroke the duty-cycle cap kept from playing (``duty_cycle``:
+    the stroke's fields, the motor's would-be duty cycle and the limit), or an off that
+    failed twice, so every motor was switched off (``off_failed``)."""
 
     kind: ClassVar[EventType] = "safety"
     reason: str
     row: int
     column: int
+    message: str | None = None
+    topic: str | None = None
+    drawing: str | None = None
+    seq: int | None = None
+    sent_at_ms: float | None = None
+    received_at_ms: float | None = None
+    duty_cycle: float | None = None  # what the window would have held, 0..1 of full drive
+    max_duty_cycle: float | None = None
+    window_ms: float | None = None
 
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
-        return {"reason": r.text("reason"), "row": r.index("row"), "column": r.index("column")}
+        return {
+            "reason": r.text("reason"),
+            "row": r.index("row"),
+            "column": r.index("column"),
+            "message": r.text("message", required=False),
+            "topic": r.text("topic", required=False),
+            "drawing": r.text("drawing", required=False),
+            "seq": r.index("seq", required=False),
+            "sent_at_ms": r.number("sent_at_ms", required=False),
+            "received_at_ms": r.number("received_at_ms", required=False),
+            "duty_cycle": r.number("duty_cycle", required=False),
+            "max_duty_cycle": r.number("max_duty_cycle", required=False),
+            "window_ms": r.number("window_ms", required=False),
+        }
 
 
 @dataclass(frozen=True, kw_only=True)

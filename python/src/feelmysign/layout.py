@@ -13,7 +13,9 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     [safety]
     max_intensity = 1.0           # no actuator is driven above this, 0..1
     max_stroke_duration_ms = 10000
-    max_on_time_ms = 15000        # longest continuous on-time of one actuator
+    max_on_time_ms = 15000        # longest `buzz`
+    duty_cycle_window_ms = 60000  # a motor's heat: its drive over the last minute...
+    max_duty_cycle = 0.5          # ...at most this fraction of it at full drive
 
     [i2c]
     bus = 1                       # /dev/i2c-1
@@ -94,10 +96,16 @@ class Layout:
     default_intensity: float = 1.0
     max_intensity: float = 1.0
     max_stroke_duration_ms: float = 10_000.0
-    # Longer than the longest stroke: a slow legal stroke keeps its bursts on for up
-    # to about 0.76 of its duration, and the next stroke of a drawing often takes
-    # over the same motor, so only a stuck or pathological stream reaches this.
+    # The longest single buzz (feelmysign buzz); at least the longest stroke.
     max_on_time_ms: float = 15_000.0
+    # What heats a motor is its drive over time, so the player caps each motor's energy
+    # (intensity squared times time) within any window of duty_cycle_window_ms at
+    # max_duty_cycle of the window at full drive. A small ERM's case warms over tens of
+    # seconds, hence a minute; half of it at full drive leaves every drawing pace a person
+    # keeps up (a motor used 8-20% of the time) far from the cap, and still bounds a stuck
+    # stream to 30 s of full drive a minute.
+    duty_cycle_window_ms: float = 60_000.0
+    max_duty_cycle: float = 0.5
     actuator_type: ActuatorType = "ERM"
     # None: the actuator type's MIN_BURST_MS; read it through ``shortest_burst_ms``.
     min_burst_ms: float | None = None
@@ -123,7 +131,14 @@ _TOP_KEYS = (
     "min_burst_ms",
     "default_intensity",
 )
-_SAFETY_KEYS = ("max_intensity", "max_stroke_duration_ms", "max_on_time_ms")
+_SAFETY_KEYS = (
+    "max_intensity",
+    "max_stroke_duration_ms",
+    "max_on_time_ms",
+    "duty_cycle_window_ms",
+    "max_duty_cycle",
+)
+MIN_DUTY_WINDOW_MS = 1000.0  # shorter is no longer about heat but about single strokes
 _I2C_KEYS = ("bus", "multiplexers", "wiring")
 _WIRE_KEYS = ("row", "column", "multiplexer", "channel")
 _MEANINGS = {
@@ -176,6 +191,8 @@ def grid_layout(
     max_intensity: float = _DEFAULTS.max_intensity,
     max_stroke_duration_ms: float = _DEFAULTS.max_stroke_duration_ms,
     max_on_time_ms: float = _DEFAULTS.max_on_time_ms,
+    duty_cycle_window_ms: float = _DEFAULTS.duty_cycle_window_ms,
+    max_duty_cycle: float = _DEFAULTS.max_duty_cycle,
     actuator_type: ActuatorType = _DEFAULTS.actuator_type,
     min_burst_ms: float | None = None,
 ) -> Layout:
@@ -189,6 +206,8 @@ def grid_layout(
         max_intensity=max_intensity,
         max_stroke_duration_ms=max_stroke_duration_ms,
         max_on_time_ms=max_on_time_ms,
+        duty_cycle_window_ms=duty_cycle_window_ms,
+        max_duty_cycle=max_duty_cycle,
         actuator_type=actuator_type,
         min_burst_ms=min_burst_ms,
     )
@@ -259,16 +278,20 @@ def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
             "safety.max_intensity", safety.get("max_intensity", _DEFAULTS.max_intensity), 1.0
         ),
     }
-    for key in ("max_stroke_duration_ms", "max_on_time_ms"):
+    for key in ("max_stroke_duration_ms", "max_on_time_ms", "duty_cycle_window_ms"):
         value = safety.get(key, getattr(_DEFAULTS, key))
         caps[key] = problems.number(f"safety.{key}", value, MAX_DURATION_MS)
+    caps["max_duty_cycle"] = problems.number(
+        "safety.max_duty_cycle", safety.get("max_duty_cycle", _DEFAULTS.max_duty_cycle), 1.0
+    )
     longest, on_time = caps["max_stroke_duration_ms"], caps["max_on_time_ms"]
     if longest is not None and on_time is not None and on_time < longest:
         problems.add(
             "safety.max_on_time_ms",
             f"{on_time:g} is below safety.max_stroke_duration_ms {longest:g}: a slow stroke the "
-            "sleeve accepts would be cut off mid-way; raise it or lower the longest stroke",
+            "sleeve accepts could not be buzzed as long; raise it or lower the longest stroke",
         )
+    _check_duty_cycle(problems, caps)
     default, cap = caps["default_intensity"], caps["max_intensity"]
     if default is not None and cap is not None and default > cap:
         problems.add(
@@ -276,6 +299,25 @@ def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
             f"{default:g} is above safety.max_intensity {cap:g}; lower it or raise the cap",
         )
     return caps
+
+
+def _check_duty_cycle(problems: _Problems, caps: dict[str, Any]) -> None:
+    window, duty = caps["duty_cycle_window_ms"], caps["max_duty_cycle"]
+    if window is not None and window < MIN_DUTY_WINDOW_MS:
+        problems.add(
+            "safety.duty_cycle_window_ms",
+            f"must be at least {MIN_DUTY_WINDOW_MS:g} (a motor heats over seconds); got {window:g}",
+        )
+        return
+    longest = caps["max_stroke_duration_ms"]
+    if None in (window, duty, longest) or window * duty >= longest:
+        return
+    problems.add(
+        "safety.max_duty_cycle",
+        f"{duty:g} of safety.duty_cycle_window_ms {window:g} is {window * duty:g} ms of full "
+        f"drive, below safety.max_stroke_duration_ms {longest:g}: a slow stroke the sleeve "
+        "accepts could never play on a rested motor; raise either or lower the longest stroke",
+    )
 
 
 def _read_i2c(

@@ -33,7 +33,7 @@ from feelmysign.control import Cancel
 from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
 from feelmysign.schedule import Schedule
-from feelmysign.timeline import Change, Timeline
+from feelmysign.timeline import Capped, Change, Timeline
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +47,9 @@ MAX_PENDING = 256
 MAX_BACKLOG_MS = 30_000.0
 REMEMBERED_DRAWINGS = 64  # drawings whose last seq is kept, for dropping redeliveries
 TIMING_SAMPLES = 100_000
+
+
+_STROKE_FIELDS = ("topic", "drawing", "seq", "sent_at_ms")  # of PlannedStroke.info
 
 
 def monotonic_ms() -> float:
@@ -117,6 +120,7 @@ class Player:
         self._thread: threading.Thread | None = None
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
         self.played = 0
+        self.capped = 0
 
     # --- any thread ------------------------------------------------------------
 
@@ -279,8 +283,8 @@ class Player:
         for tag in due.started:
             if isinstance(tag, PlannedStroke):
                 self._started(tag, written_at_ms)
-        for row, column in due.tripped:
-            self._on_event(Safety(reason="max_on_time", row=row, column=column))
+        for capped in due.capped:
+            self._capped(capped)
 
     def _write(self, changes: list[Change]) -> None:
         for change in changes:
@@ -311,6 +315,34 @@ class Player:
             self._backend.all_off()
         finally:
             self._on_event(Safety(reason="off_failed", row=change.row, column=change.column))
+
+    def _capped(self, capped: Capped) -> None:
+        """A stroke the duty-cycle cap kept from playing: said, and never called played."""
+        with self._lock:
+            self._pending -= 1
+        self.capped += 1
+        refusal = capped.refusal
+        row, column = refusal.actuator
+        window_s = refusal.window_ms / 1000
+        info = capped.tag.info if isinstance(capped.tag, PlannedStroke) else {}
+        received = capped.tag.received_wall_ms if isinstance(capped.tag, PlannedStroke) else None
+        self._on_event(
+            Safety(
+                reason="duty_cycle",
+                row=row,
+                column=column,
+                message=(
+                    f"not played: motor row {row}, column {column} would have been driven "
+                    f"{refusal.duty_cycle:.0%} of the last {window_s:g} s at full drive, above "
+                    f"the layout's max_duty_cycle {refusal.max_duty_cycle:.0%}; it needs a rest"
+                ),
+                **{k: v for k, v in info.items() if k in _STROKE_FIELDS},
+                received_at_ms=received,
+                duty_cycle=round(refusal.duty_cycle, 4),
+                max_duty_cycle=refusal.max_duty_cycle,
+                window_ms=refusal.window_ms,
+            )
+        )
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:

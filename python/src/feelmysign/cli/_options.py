@@ -98,6 +98,8 @@ def layout_from_args(args: argparse.Namespace) -> Layout:
             max_intensity=PAPER_SLEEVE.max_intensity,
             max_stroke_duration_ms=PAPER_SLEEVE.max_stroke_duration_ms,
             max_on_time_ms=PAPER_SLEEVE.max_on_time_ms,
+            duty_cycle_window_ms=PAPER_SLEEVE.duty_cycle_window_ms,
+            max_duty_cycle=PAPER_SLEEVE.max_duty_cycle,
         )
     from_env = os.environ.get(LAYOUT_ENV, "")
     if from_env:

@@ -1,0 +1,205 @@
+"""``played`` means felt: a real sleeve process, strokes paced in real time, its record read back.
+
+Each stroke gets an intensity of its own, so the record (``--record``, every
+actuator change) shows which strokes were felt: a stroke is felt when every
+level its plan drives an actuator to (played alone) shows in the record.
+Strokes are sent one after the other at the pace they play (each once the
+previous one's last burst is over), as a person draws: the duty-cycle cap
+must leave such use alone, and a stroke it does refuse must be reported as
+``safety``/``duty_cycle``, never as ``played``.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+import uuid
+from pathlib import Path
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign.broker import Broker
+from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.daemon import topic
+from feelmysign.layout import Layout, load_layout
+from feelmysign.planner import plan
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+from feelmysign.timeline import Timeline
+
+REPO = Path(__file__).resolve().parents[2]
+PAPER = REPO / "deploy" / "layouts" / "paper-sleeve.toml"
+WAIT_S = 120.0
+MARGIN_S = 0.06  # after a stroke's last burst, before the next stroke is sent
+# A cap reached within seconds: a 2 s window, half of it at full drive.
+TIGHT_SAFETY = (
+    "[safety]\nmax_stroke_duration_ms = 1000\nmax_on_time_ms = 1000\n"
+    "duty_cycle_window_ms = 2000\nmax_duty_cycle = 0.5\n"
+)
+
+
+class Events:
+    """The sleeve's events and status, as a sender sees them."""
+
+    def __init__(self, broker: Broker) -> None:
+        c = broker.credentials
+        settings = BrokerSettings(
+            c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
+        )
+        self.client = new_client(settings, client_id=f"felt-{uuid.uuid4()}")
+        self.events: list[dict[str, Any]] = []
+        self.online = threading.Event()
+        self._changed = threading.Condition()
+        sid = c.sleeve_id
+        self.client.on_connect = lambda client, *_: client.subscribe(
+            [(topic(sid, "events"), 1), (topic(sid, "status"), 1)]
+        )
+        self.client.on_message = self._on_message
+        self.client.connect(c.mqtt_host, c.mqtt_port)
+        self.client.loop_start()
+        self.strokes_topic = topic(sid, "strokes")
+
+    def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
+        body = json.loads(message.payload)
+        if message.topic.endswith("/status"):
+            if body.get("online"):
+                self.online.set()
+            return
+        with self._changed:
+            self.events.append(body)
+            self._changed.notify_all()
+
+    def about(self, drawing: str, count: int) -> list[dict[str, Any]]:
+        """Wait for one event about each of ``count`` strokes of ``drawing``."""
+
+        def ours() -> list[dict[str, Any]]:
+            return [e for e in self.events if e.get("drawing") == drawing]
+
+        with self._changed:
+            assert self._changed.wait_for(lambda: len(ours()) >= count, WAIT_S), ours()[-3:]
+            return ours()
+
+    def close(self) -> None:
+        self.client.loop_stop()
+        self.client.disconnect()
+
+
+def _strokes(count: int, seed: int, *, spot: bool) -> list[Stroke]:
+    """Strokes with an intensity each: short and soft all over the grid (0.3, 0.303, ...), or
+    long and strong around one spot (0.85, 0.853, ...), so that one motor works hard."""
+    rng = random.Random(seed)
+    strokes = []
+    for seq in range(count):
+        if spot:
+            start = (1.0 + rng.uniform(-0.2, 0.2), 1.0)
+            end = (start[0] + 0.5, 1.0 + rng.uniform(-0.2, 0.2))
+            duration_ms, intensity = rng.uniform(400, 600), 0.85 + 0.003 * seq
+        else:
+            start = (rng.uniform(0, 3), rng.uniform(0, 2))
+            end = (rng.uniform(0, 3), rng.uniform(0, 2))
+            duration_ms, intensity = rng.uniform(80, 120), 0.3 + 0.003 * seq
+        strokes.append(Stroke(start, end, duration_ms, round(intensity, 3), "felt", seq))
+    return strokes
+
+
+def _levels(stroke: Stroke, layout: Layout) -> set[tuple[int, int, float]]:
+    """What playing ``stroke`` alone drives: (row, column, intensity) of each "on" change."""
+    timeline = Timeline(layout)
+    timeline.add(plan(stroke, layout), 0.0)
+    levels = set()
+    while (t := timeline.next_ms()) is not None:
+        for change in timeline.pop_due(t).changes:
+            if change.intensity > 0:
+                levels.add((change.row, change.column, round(change.intensity, 6)))
+    return levels
+
+
+def _felt(record: Path, strokes: list[Stroke], layout: Layout) -> set[int]:
+    """The strokes whose every planned level shows in the record (intensities are unique)."""
+    recorded = set()
+    for line in record.read_text().splitlines():
+        change = json.loads(line)
+        recorded.add((change["row"], change["column"], round(change["intensity"], 6)))
+    return {
+        stroke.seq
+        for stroke in strokes
+        if stroke.seq is not None and _levels(stroke, layout) <= recorded
+    }
+
+
+def _play_paced(
+    broker: Broker, tmp_path: Path, layout_file: Path, strokes: list[Stroke]
+) -> tuple[list[dict[str, Any]], set[int]]:
+    layout = load_layout(layout_file)
+    record = tmp_path / "record.jsonl"
+    events = Events(broker)
+    sleeve = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "feelmysign",
+            "sleeve",
+            "--credentials",
+            str(broker.credentials_path),
+            "--layout",
+            str(layout_file),
+            "--record",
+            str(record),
+            "--no-legacy",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert events.online.wait(WAIT_S), "the sleeve did not come online"
+        for stroke in strokes:
+            events.client.publish(events.strokes_topic, format_json(stroke), qos=1)
+            last_burst_ms = max(c.end_ms for c in plan(stroke, layout).commands)
+            time.sleep(last_burst_ms / 1000 + MARGIN_S)
+        told = events.about("felt", len(strokes))
+    finally:
+        sleeve.send_signal(signal.SIGTERM)
+        _, errors = sleeve.communicate(timeout=WAIT_S)
+        events.close()
+    assert sleeve.returncode == 0, errors
+    return told, _felt(record, strokes, layout)
+
+
+def test_strokes_paced_in_real_time_are_played_exactly_when_felt(
+    broker: Broker, tmp_path: Path
+) -> None:
+    strokes = _strokes(200, seed=8, spot=False)
+    told, felt = _play_paced(broker, tmp_path, PAPER, strokes)
+    played = {e["seq"] for e in told if e["type"] in ("played", "adjusted")}
+    assert played == felt
+    # A pace a person draws at: the cap leaves every stroke alone.
+    assert len(played) == len(strokes), [e for e in told if e["type"] != "played"][:3]
+
+
+def test_strokes_the_duty_cycle_cap_refuses_are_reported_and_never_called_played(
+    broker: Broker, tmp_path: Path
+) -> None:
+    layout_file = tmp_path / "tight.toml"
+    paper = PAPER.read_text()
+    safety = paper[paper.index("[safety]") : paper.index("[i2c]")]
+    layout_file.write_text(paper.replace(safety, TIGHT_SAFETY + "\n"))
+    strokes = _strokes(40, seed=9, spot=True)
+    told, felt = _play_paced(broker, tmp_path, layout_file, strokes)
+    played = {e["seq"] for e in told if e["type"] in ("played", "adjusted")}
+    capped = [e for e in told if e["type"] == "safety"]
+    assert played == felt
+    assert capped, "the spot was never hot enough: the test proves nothing"
+    assert played | {e["seq"] for e in capped} == set(range(len(strokes)))
+    for event in capped:
+        assert event["reason"] == "duty_cycle"
+        assert event["duty_cycle"] > event["max_duty_cycle"] == 0.5
+        assert event["window_ms"] == 2000
+        planned = plan(strokes[event["seq"]], load_layout(layout_file)).commands
+        assert (event["row"], event["column"]) in {(c.row, c.column) for c in planned}
