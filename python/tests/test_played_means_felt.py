@@ -26,12 +26,12 @@ import paho.mqtt.client as mqtt
 
 from feelmysign.broker import Broker
 from feelmysign.connection import BrokerSettings, new_client
-from feelmysign.daemon import topic
 from feelmysign.layout import Layout, load_layout
 from feelmysign.planner import plan
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.timeline import Timeline
+from feelmysign.topics import strokes_topic, telemetry_topic
 
 REPO = Path(__file__).resolve().parents[2]
 PAPER = REPO / "deploy" / "layouts" / "paper-sleeve.toml"
@@ -58,12 +58,12 @@ class Events:
         self._changed = threading.Condition()
         sid = c.sleeve_id
         self.client.on_connect = lambda client, *_: client.subscribe(
-            [(topic(sid, "events"), 1), (topic(sid, "status"), 1)]
+            [(telemetry_topic(sid, "events"), 1), (telemetry_topic(sid, "status"), 1)]
         )
         self.client.on_message = self._on_message
         self.client.connect(c.mqtt_host, c.mqtt_port)
         self.client.loop_start()
-        self.strokes_topic = topic(sid, "strokes")
+        self.strokes_topic = strokes_topic(sid)
 
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
         body = json.loads(message.payload)
