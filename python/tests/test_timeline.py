@@ -179,3 +179,14 @@ def test_an_ended_stroke_leaves_nothing_planned() -> None:
     timeline.add(_schedule(Command(0, 0, 0, 100, 0.5)), 0.0)
     _drain(timeline)
     assert timeline.next_ms() is None and not timeline.busy
+
+
+def test_cancelling_a_refused_stroke_does_not_call_it_cut_short() -> None:
+    timeline = Timeline(TIGHT)
+    timeline.add(_schedule(Command(2, 3, 0, 1000, 1.0), duration_ms=1000), 0.0, tag="full")
+    timeline.add(_schedule(Command(2, 3, 0, 500, 1.0), duration_ms=500), 1000.0, tag="refused")
+    assert timeline.pop_due(0.0).started == ["full"]
+    assert [c.tag for c in timeline.pop_due(1000.0).capped] == ["refused"]
+    cut = timeline.cancel(lambda tag: True, 1200.0)
+    assert (cut.started, cut.unstarted, cut.changes) == ([], [], [])
+    assert timeline.next_ms() is None and not timeline.busy
