@@ -109,7 +109,7 @@ def test_the_table_without_json(tmp_path: Path, capsys: pytest.CaptureFixture[st
         ([], "give RECORDING files to evaluate, or --lasa"),
         (["--lasa", "--sweep", "max_speed=1:2:1"], "the parameters are: "),
         (["--lasa", "--sweep", "check_frames=1:3:0.5"], "whole numbers only"),
-        (["--lasa", "--limit", "0"], "--limit must be 1 or more"),
+        (["--lasa", "--limit", "0"], "--limit: 0 is out of range"),
     ],
 )
 def test_usage_errors_list_the_choices(

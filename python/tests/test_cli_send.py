@@ -322,7 +322,8 @@ def test_good_broker_urls() -> None:
         ([], "give STROKEs"),
         (["0,0,1,0,100", "--segments", "4"], "--segments only apply to --shape"),
         (["--shape", "line", "--legacy", "--intensity", "0.5"], "legacy format has no intensity"),
-        (["--shape", "line", "--timeout-s", "0"], "--timeout-s must be"),
+        (["--shape", "line", "--timeout-s", "0"], "--timeout-s: 0 is out of range"),
+        (["--shape", "line", "--id", "a/b"], "--id: the sleeve id 'a/b' cannot be used"),
     ],
 )
 def test_usage_errors_exit_2(
@@ -416,7 +417,6 @@ def test_without_anything_the_default_is_the_local_broker_anonymously() -> None:
     [
         (["--username", "u"], "without a password"),
         (["--password", "p"], "without a user name"),
-        (["--id", "a/b"], "Sleeve id 'a/b' cannot be used"),
         (["--credentials", "/nonexistent/credentials.json"], "No credentials file at"),
     ],
 )
@@ -424,3 +424,12 @@ def test_bad_settings_say_what_to_do(argv: list[str], says: str) -> None:
     with pytest.raises(BrokerError) as caught:
         broker_settings_from_args(_settings_args(*argv), "sender")
     assert says in str(caught.value)
+
+
+def test_a_bad_sleeve_id_from_the_environment_says_what_to_do(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setenv("FEELMYSIGN_SLEEVE_ID", "a/b")
+    with pytest.raises(BrokerError) as caught:
+        broker_settings_from_args(_settings_args("--broker", "mqtt://127.0.0.1:1"), "sender")
+    assert "Sleeve id 'a/b' cannot be used" in str(caught.value)

@@ -110,8 +110,13 @@ def test_layout_and_grid_options_exclude_each_other(capsys: pytest.CaptureFixtur
 def test_bad_layouts_are_errors_not_tracebacks(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    code, _, err = run(capsys, "0,0,1,1,100", "--rows", "0")
-    assert code == 1 and "rows: must be a whole number from 1 to 64; got 0" in err
+    with pytest.raises(SystemExit) as caught:
+        run(capsys, "0,0,1,1,100", "--rows", "0")
+    err = capsys.readouterr().err
+    assert (
+        caught.value.code == 2
+        and "--rows: 0 is out of range; give a whole number from 1 to 64" in err
+    )
     code, _, err = run(capsys, "0,0,1,1,100", "--layout", str(tmp_path / "missing.toml"))
     assert (
         code == 1

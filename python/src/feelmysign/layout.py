@@ -178,6 +178,10 @@ def parse_layout(text: str, source: str = "<string>") -> Layout:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise LayoutError(source, [f"not valid TOML: {error}"]) from None
+    except RecursionError:
+        raise LayoutError(
+            source, ["nested too deeply to read; a layout nests arrays and tables 2 levels deep"]
+        ) from None
     return _build(data, source)
 
 

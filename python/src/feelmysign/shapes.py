@@ -197,7 +197,7 @@ def _check_longest(
     cap_ms = layout.max_stroke_duration_ms
     if longest_ms <= cap_ms:
         return
-    most_ms = total_ms * cap_ms / longest_ms
+    most_ms = total_ms / longest_ms * cap_ms  # this order cannot overflow to infinity
     raise ParameterError(
         f"duration_ms of this {spec.name}",
         round(total_ms, 3),

@@ -107,7 +107,7 @@ def load_credentials(path: str | Path) -> Credentials:
             f"No credentials file at {path}; start the broker first ('feelmysign broker') "
             "or pass the file it wrote (STATE_DIR/credentials.json).",
         ) from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
         raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
     return _credentials_from_json(data, path)
 

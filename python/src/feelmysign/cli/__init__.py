@@ -2,19 +2,27 @@
 
 Each subcommand module defines ``register(subparsers)``, which adds its parser
 and sets ``handler`` to a function ``(args) -> int``. Errors a person can act on
-print ``Error: ...`` on stderr and exit 1; usage errors exit 2 (argparse).
+print one ``Error: ...`` line on stderr and exit 1; usage errors exit 2 (one
+``Error:`` line too, see ``_parser``). Anything else that escapes a command is
+a bug: it still gets one ``Error:`` line, with a request to report it, and exit
+70 (EX_SOFTWARE); ``FEELMYSIGN_DEBUG=1`` shows its traceback instead.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
 from feelmysign import __version__
 from feelmysign.cli._early_off import switch_off_early
+from feelmysign.cli._parser import CliParser
 from feelmysign.errors import FeelMySignError
+
+DEBUG_ENV = "FEELMYSIGN_DEBUG"
+BUG_EXIT = 70  # EX_SOFTWARE (sysexits.h): an internal error, not the user's
 
 # Subcommand modules, in the order `feelmysign --help` lists them.
 SUBCOMMANDS = (
@@ -35,7 +43,7 @@ SUBCOMMANDS = (
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The whole command; with ``only``, just that subcommand (its module alone is imported)."""
-    parser = argparse.ArgumentParser(
+    parser = CliParser(
         prog="feelmysign",
         description="Draw a shape and have it felt, as it is drawn, on a vibrotactile sleeve.",
     )
@@ -61,9 +69,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     arguments = sys.argv[1:] if argv is None else list(argv)
     command = _named_subcommand(arguments)
     switch_off_early(command, arguments)  # before the imports of build_parser
-    parser = build_parser(command)
-    args = parser.parse_args(arguments)
     try:
+        args = build_parser(command).parse_args(arguments)
         code: int = args.handler(args)
     except FeelMySignError as error:
         print(f"Error: {error}", file=sys.stderr)
@@ -71,8 +78,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:
+        _silence_stdout()
         return 0
+    except Exception as error:  # the last resort: a bug, told in one line, not a traceback
+        if os.environ.get(DEBUG_ENV):
+            raise
+        print(_bug_message(error), file=sys.stderr)
+        return BUG_EXIT
     return code
+
+
+def _bug_message(error: Exception) -> str:
+    detail = " ".join(str(error).split())[:300] or "no detail"
+    return (
+        f"Error: unexpected {type(error).__name__} ({detail}). This is a bug in feelmysign: "
+        f"please report it with the command you ran; run it again with {DEBUG_ENV}=1 to "
+        "see where it happened."
+    )
+
+
+def _silence_stdout() -> None:
+    """The reader went away (``| head``): nothing more to say, not even at exit's flush."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":

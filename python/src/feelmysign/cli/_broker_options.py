@@ -7,10 +7,11 @@
 Each setting is taken from, in order: its option, its ``FEELMYSIGN_*`` environment
 variable, the credentials file, the default. The credentials file gives the
 account of the ``role`` (the sender's or the sleeve's), the MQTT URL and the
-sleeve id. When no broker, user or credentials file is given at all, the local
+sleeve id. When neither a broker nor a credentials file is given, the local
 broker's file (``feelmysign broker``'s default state directory) is used if it
-exists, so that ``feelmysign send --shape circle`` just works next to it; it is
-never sent to a broker named by --broker, so its passwords stay local.
+exists, so that ``feelmysign send --shape circle`` just works next to it: its
+URL and sleeve id always, its account unless --username gives another one. It
+is never used with a broker named by --broker, so its passwords stay local.
 Connecting is ``feelmysign.connection``'s part.
 """
 
@@ -23,6 +24,7 @@ from typing import Literal
 
 from feelmysign.broker import DEFAULT_SLEEVE_ID, default_state_dir
 from feelmysign.broker.credentials import Credentials, check_sleeve_id, load_credentials
+from feelmysign.cli._inputs import MAX_CREDENTIALS_BYTES, check_input_file, not_empty, sleeve_id
 from feelmysign.connection import DEFAULT_BROKER_URL, BrokerSettings, parse_broker_url
 from feelmysign.connection.settings import PASSWORD_ENV, USERNAME_ENV
 from feelmysign.errors import BrokerConnectionError
@@ -44,6 +46,7 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
     group.add_argument(
         "--broker",
         metavar="URL",
+        type=not_empty("broker URL"),
         help=f"broker URL: mqtt://HOST:PORT, mqtts:// (TLS), ws:// or wss:// (WebSockets) "
         f"(default: ${BROKER_ENV}, else the credentials file's mqtt_url, else "
         f"{DEFAULT_BROKER_URL})",
@@ -53,22 +56,30 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
         "--id",
         dest="sleeve_id",
         metavar="ID",
+        type=sleeve_id,
         help=f"{which}: 1-64 letters, digits, '_' or '-' (default: ${SLEEVE_ID_ENV}, else "
         f"the credentials file's sleeve id, else {DEFAULT_SLEEVE_ID})",
     )
-    group.add_argument("--username", metavar="U", help=f"MQTT user name (default: ${USERNAME_ENV})")
+    group.add_argument(
+        "--username",
+        metavar="U",
+        type=not_empty("user name"),
+        help=f"MQTT user name (default: ${USERNAME_ENV})",
+    )
     group.add_argument(
         "--password",
         metavar="P",
+        type=not_empty("password"),
         help=f"MQTT password (default: ${PASSWORD_ENV}; prefer it or --credentials: "
         "other users can see command lines)",
     )
     group.add_argument(
         "--credentials",
         metavar="FILE",
+        type=not_empty("credentials file"),
         help=f"the credentials.json written by 'feelmysign broker', for the {role} account, "
         f"the URL and the sleeve id (default: ${CREDENTIALS_ENV}, else "
-        f"{local_credentials_path()} when it exists and nothing else is given)",
+        f"{local_credentials_path()} when it exists and no --broker is given)",
     )
 
 
@@ -83,7 +94,7 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
     url = args.broker or env.get(BROKER_ENV) or None
     username = args.username or env.get(USERNAME_ENV) or None
     password = args.password or env.get(PASSWORD_ENV) or None
-    credentials = _credentials(args.credentials or env.get(CREDENTIALS_ENV), url, username)
+    credentials = _credentials(args.credentials or env.get(CREDENTIALS_ENV), url)
     if username is None and password is not None:
         raise BrokerConnectionError(
             "bad-option",
@@ -109,10 +120,10 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
     )
 
 
-def _credentials(path: str | None, url: str | None, username: str | None) -> Credentials | None:
-    if path:
-        return load_credentials(path)
+def _credentials(path: str | None, url: str | None) -> Credentials | None:
     local = local_credentials_path()
-    if url is None and username is None and local.is_file():
-        return load_credentials(local)
-    return None
+    if not path and (url is not None or not local.is_file()):
+        return None
+    chosen = path or local
+    check_input_file(chosen, what="credentials file", max_bytes=MAX_CREDENTIALS_BYTES)
+    return load_credentials(chosen)

@@ -13,7 +13,21 @@ import os
 from collections.abc import Sequence
 from typing import Any
 
-from feelmysign.layout import PAPER_SLEEVE, Layout, grid_layout, load_layout
+from feelmysign.cli._inputs import (
+    MAX_LAYOUT_BYTES,
+    check_input_file,
+    not_empty,
+    number,
+    whole_number,
+)
+from feelmysign.layout import (
+    MAX_GRID_SIDE,
+    MAX_SPACING_CM,
+    PAPER_SLEEVE,
+    Layout,
+    grid_layout,
+    load_layout,
+)
 
 LAYOUT_ENV = "FEELMYSIGN_LAYOUT"
 _GRID_DESTS = ("rows", "columns", "spacing_cm")
@@ -54,6 +68,7 @@ def add_layout_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--layout",
         metavar="FILE",
+        type=not_empty("layout file"),
         action=_Exclusive,
         help=f"sleeve layout TOML file, e.g. deploy/layouts/paper-sleeve.toml "
         f"(default: ${LAYOUT_ENV}, if set)",
@@ -61,21 +76,21 @@ def add_layout_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--rows",
         metavar="R",
-        type=int,
+        type=whole_number(1, MAX_GRID_SIDE),
         action=_Exclusive,
         help=f"number of actuator rows, 1 to 64 (default: {PAPER_SLEEVE.rows})",
     )
     group.add_argument(
         "--columns",
         metavar="C",
-        type=int,
+        type=whole_number(1, MAX_GRID_SIDE),
         action=_Exclusive,
         help=f"number of actuator columns, 1 to 64 (default: {PAPER_SLEEVE.columns})",
     )
     group.add_argument(
         "--spacing-cm",
         metavar="S",
-        type=float,
+        type=number(0, MAX_SPACING_CM, unit="cm", above_low=True),
         action=_Exclusive,
         help=f"distance between neighbouring actuators in cm, above 0 and at most 20 "
         f"(default: {PAPER_SLEEVE.spacing_cm:g})",
@@ -85,7 +100,7 @@ def add_layout_options(parser: argparse.ArgumentParser) -> None:
 def layout_from_args(args: argparse.Namespace) -> Layout:
     """The layout the options ask for; raises LayoutError (exit 1) for a bad file or grid."""
     if args.layout is not None:
-        return load_layout(args.layout)
+        return _load(args.layout)
     grid = {dest: getattr(args, dest) for dest in _GRID_DESTS}
     if any(value is not None for value in grid.values()):
         # Same caps as the paper's sleeve: only the geometry was asked to change.
@@ -103,5 +118,10 @@ def layout_from_args(args: argparse.Namespace) -> Layout:
         )
     from_env = os.environ.get(LAYOUT_ENV, "")
     if from_env:
-        return load_layout(from_env)
+        return _load(from_env)
     return PAPER_SLEEVE
+
+
+def _load(path: str) -> Layout:
+    check_input_file(path, what="layout file", max_bytes=MAX_LAYOUT_BYTES)
+    return load_layout(path)

@@ -7,11 +7,19 @@ from feelmysign.schedule import Schedule
 
 CELL_COLUMNS = 8  # characters per grid unit across
 CELL_ROWS = 3  # lines per grid unit down
-ORDER_MARKS = "123456789abcdefghijklmnopqrstuvwxyz"
+# Command numbers 1..35 as one character each; '+' for any later first command.
+NUMBER_MARKS = "123456789abcdefghijklmnopqrstuvwxyz"
+LATER_MARK = "+"
+LEGEND = (
+    "Each actuator shows the # of its first command in the table (1-9, then a = 10 ... "
+    "z = 35, + later; . = never on).\n"
+    "* is the stroke, S and E its start and end where no actuator is; x = column, "
+    "y = row, in grid units."
+)
 
 
 def grid_picture(schedule: Schedule, layout: Layout) -> str:
-    """Actuators by the order they first switch on (1, 2, ...; '.' = never), the stroke as '*'.
+    """Actuators by the table number of their first command ('.' = never), the stroke as '*'.
 
     'S' and 'E' mark the stroke's start and end when they are not on an actuator.
     """
@@ -27,12 +35,11 @@ def grid_picture(schedule: Schedule, layout: Layout) -> str:
         canvas[round(y * CELL_ROWS)][round(x * CELL_COLUMNS)] = "*"
     for point, mark in ((stroke.start, "S"), (stroke.end, "E")):
         canvas[round(point[1] * CELL_ROWS)][round(point[0] * CELL_COLUMNS)] = mark
-    order = _first_on_order(schedule)
+    first = _first_command_numbers(schedule)
     for row in range(layout.rows):
         for column in range(layout.columns):
-            rank = order.get((row, column))
-            mark = "." if rank is None else ORDER_MARKS[min(rank, len(ORDER_MARKS) - 1)]
-            canvas[row * CELL_ROWS][column * CELL_COLUMNS] = mark
+            number = first.get((row, column))
+            canvas[row * CELL_ROWS][column * CELL_COLUMNS] = _mark(number)
     header = "".join(f"x={c}".ljust(CELL_COLUMNS) for c in range(layout.columns)).rstrip()
     lines = ["      " + header]
     for i, chars in enumerate(canvas):
@@ -41,8 +48,15 @@ def grid_picture(schedule: Schedule, layout: Layout) -> str:
     return "\n".join(lines)
 
 
-def _first_on_order(schedule: Schedule) -> dict[tuple[int, int], int]:
-    order: dict[tuple[int, int], int] = {}
-    for command in schedule.commands:  # sorted by start time
-        order.setdefault((command.row, command.column), len(order))
-    return order
+def _mark(number: int | None) -> str:
+    if number is None:
+        return "."
+    return NUMBER_MARKS[number - 1] if number <= len(NUMBER_MARKS) else LATER_MARK
+
+
+def _first_command_numbers(schedule: Schedule) -> dict[tuple[int, int], int]:
+    """Each actuator's first command, numbered as the table numbers them (from 1)."""
+    first: dict[tuple[int, int], int] = {}
+    for number, command in enumerate(schedule.commands, start=1):  # sorted by start time
+        first.setdefault((command.row, command.column), number)
+    return first

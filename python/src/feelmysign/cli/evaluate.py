@@ -34,6 +34,11 @@ from typing import TYPE_CHECKING, Any
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+from feelmysign.cli._inputs import (
+    output_folder,
+    whole_number,
+)
+from feelmysign.cli.simplify import load
 from feelmysign.research.sweep import (
     DEFAULT_SWEEPS,
     Sweep,
@@ -42,7 +47,6 @@ from feelmysign.research.sweep import (
     parameter_sets,
     parse_sweep,
 )
-from feelmysign.simplify.recording import load_recording
 from feelmysign.simplify.registry import ALGORITHMS, Algorithm
 
 if TYPE_CHECKING:
@@ -68,7 +72,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--limit",
-        type=int,
+        type=whole_number(1, 1_000_000),
         metavar="N",
         help="only the first N recordings, in shape order (default: all)",
     )
@@ -113,8 +117,6 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         parser.error("give RECORDING files to evaluate, or --lasa for the LASA handwriting set")
     if args.lasa and args.recordings:
         parser.error("give either RECORDING files or --lasa, not both")
-    if args.limit is not None and args.limit < 1:
-        parser.error(f"--limit must be 1 or more, not {args.limit}")
     try:
         runs = _runs(algorithms, args.sweep)
     except SweepError as error:
@@ -186,15 +188,13 @@ def _sources(args: argparse.Namespace) -> list[Source]:
     if args.lasa:
         sources = [Source(d.name, d.shape, d.recording) for d in load_lasa()]
     else:
-        sources = [Source(path, Path(path).stem, load_recording(path)) for path in args.recordings]
+        sources = [Source(path, Path(path).stem, load(path)) for path in args.recordings]
     return sources[: args.limit] if args.limit is not None else sources
 
 
 def _out_folder(given: str | None) -> Path:
     if given is not None:
-        folder = Path(given)
-        folder.mkdir(parents=True, exist_ok=True)
-        return folder
+        return output_folder(given, option="--out")
     stamp = time.strftime("%Y%m%d-%H%M%S")
     for suffix in ("", *(f"-{n}" for n in range(2, 100))):
         folder = DEFAULT_OUT_ROOT / f"{stamp}{suffix}"

@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
-from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
+from feelmysign.cli._inputs import number
 from feelmysign.cli._options import add_layout_options, layout_from_args
-from feelmysign.cli._picture import grid_picture
-from feelmysign.errors import ParameterError, StrokeError
+from feelmysign.cli._picture import LEGEND, grid_picture
+from feelmysign.cli._stroke_input import strokes_from
 from feelmysign.layout import MAX_MIN_BURST_MS, MIN_BURST_MS, Layout
 from feelmysign.planner import MERGE_DISTANCE, plan
-from feelmysign.protocol import Accepted, parse
 from feelmysign.schedule import Schedule, schedule_to_json
 from feelmysign.stroke import Stroke
 
@@ -26,21 +25,25 @@ def register(subparsers: Any) -> None:
         help="show the actuator commands the sleeve would play for strokes",
         description=(
             "Plan strokes with Tactile Brush and show the actuator commands. STROKE is the "
-            "legacy text startX,startY,endX,endY,duration (grid units, ms), e.g. 0,0,2,0,1000; "
-            "'-' reads one stroke per line from standard input."
+            "legacy text startX,startY,endX,endY,duration (grid units, ms), e.g. 0,0,2,0,1000, "
+            "or a JSON v1 message. '-' reads strokes from standard input: one message per "
+            "line, or the --json output of 'simplify' or 'replay' "
+            "(feelmysign replay drawing.json --json | feelmysign plan -)."
         ),
     )
-    parser.add_argument("strokes", nargs="+", metavar="STROKE", help="a stroke, or - for stdin")
+    parser.add_argument(
+        "strokes", nargs="+", metavar="STROKE", help="a stroke, or - for standard input"
+    )
     add_layout_options(parser)
     parser.add_argument(
         "--intensity",
-        type=float,
+        type=number(0, 1),
         metavar="A",
         help="stroke intensity in [0, 1] (default: the layout's default intensity)",
     )
     parser.add_argument(
         "--min-command-ms",
-        type=float,
+        type=number(0, MAX_MIN_BURST_MS, unit="ms"),
         metavar="D",
         help="shortest burst an actuator may play, in ms (default: the layout's min_burst_ms, "
         "else by actuator_type: "
@@ -49,7 +52,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--merge-distance",
-        type=float,
+        type=number(0, MAX_MERGE_DISTANCE, unit="grid units"),
         default=MERGE_DISTANCE,
         metavar="G",
         help=f"merge virtual actuators closer than this, grid units (default: {MERGE_DISTANCE:g})",
@@ -66,9 +69,10 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     layout = layout_from_args(args)
-    _check_options(args)
-    for text in _stroke_texts(args.strokes):
-        stroke = _parsed(text, layout, args.intensity)
+    for given in strokes_from(args.strokes, layout):
+        stroke = Stroke(given.start, given.end, given.duration_ms, given.intensity)
+        if args.intensity is not None:
+            stroke = replace(stroke, intensity=args.intensity)
         schedule = plan(
             stroke,
             layout,
@@ -81,35 +85,6 @@ def run(args: argparse.Namespace) -> int:
         else:
             print(describe(schedule, layout), flush=True)
     return 0
-
-
-def _check_options(args: argparse.Namespace) -> None:
-    if args.intensity is not None and not 0.0 <= args.intensity <= 1.0:
-        raise ParameterError("--intensity", args.intensity, "in [0, 1]")
-    if args.min_command_ms is not None and not 0.0 <= args.min_command_ms <= MAX_MIN_BURST_MS:
-        raise ParameterError(
-            "--min-command-ms", args.min_command_ms, f"in [0, {MAX_MIN_BURST_MS:g}] ms"
-        )
-    if not 0.0 <= args.merge_distance <= MAX_MERGE_DISTANCE:
-        raise ParameterError("--merge-distance", args.merge_distance, "in [0, 0.5] grid units")
-
-
-def _stroke_texts(arguments: list[str]) -> Iterator[str]:
-    for argument in arguments:
-        if argument == "-":
-            yield from (line.strip() for line in sys.stdin if line.strip())
-        else:
-            yield argument
-
-
-def _parsed(text: str, layout: Layout, intensity: float | None) -> Stroke:
-    result = parse(text, layout, format="legacy")
-    if not isinstance(result, Accepted):
-        raise StrokeError(result.reason, f"stroke {text!r}: {result.message}")
-    stroke = result.stroke
-    if intensity is not None:
-        stroke = Stroke(stroke.start, stroke.end, stroke.duration_ms, intensity)
-    return stroke
 
 
 def describe(schedule: Schedule, layout: Layout) -> str:
@@ -138,16 +113,17 @@ def describe(schedule: Schedule, layout: Layout) -> str:
         )
     lines.append("")
     lines.append(
-        f"{'#':>3} {'row':>3} {'column':>6} {'start ms':>10} {'duration ms':>12} "
+        f"{'#':>3} {'row y':>5} {'column x':>8} {'start ms':>10} {'duration ms':>12} "
         f"{'end ms':>10} {'intensity':>9}"
     )
     for i, c in enumerate(schedule.commands, start=1):
         lines.append(
-            f"{i:>3} {c.row:>3} {c.column:>6} {c.start_ms:>10.3f} {c.duration_ms:>12.3f} "
+            f"{i:>3} {c.row:>5} {c.column:>8} {c.start_ms:>10.3f} {c.duration_ms:>12.3f} "
             f"{c.end_ms:>10.3f} {c.intensity:>9.3f}"
         )
     lines.append("")
     lines.append(grid_picture(schedule, layout))
+    lines.append(LEGEND)
     return "\n".join(lines) + "\n"
 
 

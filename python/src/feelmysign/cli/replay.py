@@ -25,22 +25,23 @@ from __future__ import annotations
 import argparse
 import functools
 import json
-import math
 import uuid
 from typing import Any
 
 from feelmysign.cli import simplify
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli._inputs import MAX_TIMEOUT_S, number
 from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.research.rerun import Rerun, mismatch, rerun
 from feelmysign.sending import OutgoingStroke, StrokeSender, printer
-from feelmysign.simplify.recording import Recording, load_recording
+from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import Params
 from feelmysign.stroke import Stroke
 
+MAX_SPEED = 1000.0  # a minute of drawing in 60 ms: faster is a burst, not a pace
 BROKER_DESTS = ("broker", "sleeve_id", "username", "password", "credentials")
 
 
@@ -70,13 +71,13 @@ def register(subparsers: Any) -> None:
     )
     group.add_argument(
         "--speed",
-        type=float,
+        type=number(0, MAX_SPEED, above_low=True),
         metavar="X",
         help="with --send, send X times faster than drawn (default: 1, as drawn)",
     )
     group.add_argument(
         "--timeout-s",
-        type=float,
+        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
         default=DEFAULT_TIMEOUT_S,
         metavar="S",
         help=f"with --send, longest wait for the broker, seconds (default: {DEFAULT_TIMEOUT_S:g})",
@@ -87,7 +88,7 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     _check_usage(args, parser)
-    recording = load_recording(args.recording)
+    recording = simplify.load(args.recording)
     algorithm = simplify.chosen_algorithm(args, recording)
     simplify._check_usage(args, algorithm, parser)  # another algorithm's option: exit 2
     params = simplify.params_from_args(args, recording)
@@ -114,10 +115,6 @@ def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> N
             flags = ", ".join("--" + ("id" if d == "sleeve_id" else d) for d in given)
             verb = "applies" if len(given) == 1 else "apply"
             parser.error(f"{flags} only {verb} with --send")
-    if args.speed is not None and not (math.isfinite(args.speed) and args.speed > 0):
-        parser.error(f"--speed must be a number above 0 (2 = twice as fast), not {args.speed:g}")
-    if not (math.isfinite(args.timeout_s) and args.timeout_s > 0):
-        parser.error(f"--timeout-s must be a number of seconds above 0, not {args.timeout_s:g}")
 
 
 def _recorded_algorithm(recording: Recording) -> str:

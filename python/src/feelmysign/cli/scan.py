@@ -26,6 +26,7 @@ from feelmysign.backends.i2c import I2CBus, open_smbus
 from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
 from feelmysign.cli._emulation import add_emulate_state_option
+from feelmysign.cli._inputs import MAX_LAYOUT_BYTES, check_input_file
 from feelmysign.cli._options import LAYOUT_ENV
 from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
@@ -132,7 +133,10 @@ def _open_bus(bus_number: int) -> I2CBus:
 
 def _layout(path: str | None) -> Layout:
     chosen = path or os.environ.get(LAYOUT_ENV, "")
-    return load_layout(chosen) if chosen else PAPER_SLEEVE
+    if not chosen:
+        return PAPER_SLEEVE
+    check_input_file(chosen, what="layout file", max_bytes=MAX_LAYOUT_BYTES)
+    return load_layout(chosen)
 
 
 def channel_rows(result: ScanResult, layout: Layout) -> list[ChannelRow]:

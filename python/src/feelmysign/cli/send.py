@@ -17,17 +17,16 @@ from __future__ import annotations
 
 import argparse
 import functools
-import math
-import sys
 import uuid
 from collections.abc import Iterator
 from dataclasses import replace
 
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli._inputs import MAX_TIMEOUT_S, number, stdin_lines, topic
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
-from feelmysign.layout import Layout
+from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, Layout
 from feelmysign.protocol import Accepted, parse
 from feelmysign.sending import OutgoingStroke, Pace, StrokeSender, printer
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
@@ -43,8 +42,7 @@ def _epilog() -> str:
     return (
         "Shapes and their --segments (the number of strokes: the paper's resolution question):\n"
         f"{shapes}\n\n"
-        "A stroke that starts with '-' (a negative coordinate) must follow '--':\n"
-        "  feelmysign send -- -0.5,0,2,0,1000\n"
+        "A stroke may start with '-' (a negative coordinate): feelmysign send -0.5,0,2,0,1000\n"
     )
 
 
@@ -83,14 +81,14 @@ def _add_shape_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument(
         "--duration-ms",
-        type=float,
+        type=number(0, MAX_DURATION_MS, unit="ms", above_low=True),
         metavar="D",
         help=f"duration of the whole shape in ms, shared by the strokes by length "
         f"(default: drawn at {DRAWING_SPEED_CM_S:g} cm/s)",
     )
     group.add_argument(
         "--margin",
-        type=float,
+        type=number(0, MAX_GRID_SIDE, unit="grid units"),
         metavar="M",
         help="grid units left free on every side of the shape (default: 0)",
     )
@@ -100,7 +98,7 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("sending")
     group.add_argument(
         "--intensity",
-        type=float,
+        type=number(0, 1),
         metavar="A",
         help="intensity of every stroke in [0, 1] (default: the sleeve's default intensity)",
     )
@@ -113,6 +111,7 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--legacy-topic",
         default=LEGACY_TOPIC,
+        type=topic,
         metavar="TOPIC",
         help=f"topic of --legacy (default: {LEGACY_TOPIC}, the original sleeve's)",
     )
@@ -125,7 +124,7 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument(
         "--timeout-s",
-        type=float,
+        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
         default=DEFAULT_TIMEOUT_S,
         metavar="S",
         help=f"longest wait for the broker to answer, in seconds (default: {DEFAULT_TIMEOUT_S:g})",
@@ -175,8 +174,6 @@ def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> N
             parser.error(f"{' and '.join(given)} only apply to --shape (a STROKE has its duration)")
     if args.legacy and args.intensity is not None:
         parser.error("--intensity cannot be sent with --legacy: the legacy format has no intensity")
-    if not (math.isfinite(args.timeout_s) and args.timeout_s > 0):
-        parser.error(f"--timeout-s must be a number of seconds above 0, not {args.timeout_s:g}")
 
 
 def _strokes(args: argparse.Namespace, layout: Layout) -> list[Stroke]:
@@ -209,13 +206,13 @@ def _strokes(args: argparse.Namespace, layout: Layout) -> list[Stroke]:
 
 def _stroke_texts(arguments: list[str]) -> Iterator[tuple[str, str]]:
     """(where, text) of every stroke: 'stroke 2' for an argument, 'line 3 of stdin' for '-'."""
-    for number, argument in enumerate(arguments, start=1):
+    for position, argument in enumerate(arguments, start=1):
         if argument != "-":
-            yield f"Stroke {number}", argument
+            yield f"Stroke {position}", argument
             continue
-        for line_number, line in enumerate(sys.stdin, start=1):
-            if line.strip():
-                yield f"Line {line_number} of standard input", line.strip()
+        for line_number, line in enumerate(stdin_lines(what="strokes"), start=1):
+            if line:
+                yield f"Line {line_number} of standard input", line
 
 
 def _summary(args: argparse.Namespace, settings: BrokerSettings, strokes: list[Stroke]) -> str:

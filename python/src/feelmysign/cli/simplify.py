@@ -8,6 +8,7 @@ import json
 from dataclasses import asdict, fields, replace
 from typing import Any
 
+from feelmysign.cli._inputs import MAX_RECORDING_BYTES, check_input_file
 from feelmysign.simplify import (
     ALGORITHMS,
     AngleParams,
@@ -167,8 +168,14 @@ def chosen_algorithm(args: argparse.Namespace, recording: Recording) -> str:
     return str(recorded)
 
 
+def load(path: str) -> Recording:
+    """The recording at ``path``, refused up front if it is not a regular file of sane size."""
+    check_input_file(path, what="recording", max_bytes=MAX_RECORDING_BYTES)
+    return load_recording(path)
+
+
 def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser | None = None) -> int:
-    recording = load_recording(args.recording)
+    recording = load(args.recording)
     _check_usage(args, chosen_algorithm(args, recording), parser)
     params = params_from_args(args, recording)
     result = simplify_paths(params, recording.paths)

@@ -13,15 +13,18 @@ from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.cli._emulation import add_emulate_state_option
+from feelmysign.cli._inputs import number, output_file, topic
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
-from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
 from feelmysign.topics import LEGACY_TOPIC
 
 TELEMETRY_RATE_HZ = 20.0  # previews look smooth at 20 frames a second; more only costs traffic
+
+MIN_RATE_PER_S = 0.1  # one stroke in 10 s: slower is a sleeve that refuses everything
+MAX_RATE_PER_S = 10_000.0  # far above what a person draws; the planner is the limit
 
 
 def register(subparsers: Any) -> None:
@@ -53,6 +56,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--legacy-topic",
         default=LEGACY_TOPIC,
+        type=topic,
         metavar="TOPIC",
         help=f"also play legacy text strokes from this topic (default: {LEGACY_TOPIC})",
     )
@@ -71,7 +75,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--rate-per-s",
-        type=float,
+        type=number(MIN_RATE_PER_S, MAX_RATE_PER_S, unit="strokes per second"),
         default=RATE_PER_S,
         metavar="R",
         help=f"strokes accepted per second on average (default: {RATE_PER_S:g}; bursts of {BURST})",
@@ -91,8 +95,8 @@ def run(args: argparse.Namespace) -> int:
         stream=sys.stderr,
         format="%(asctime)s %(levelname)s %(message)s",
     )
-    if not 0.1 <= args.rate_per_s <= 10_000:
-        raise ParameterError("--rate-per-s", args.rate_per_s, "in [0.1, 10000] strokes per second")
+    if args.record is not None:
+        output_file(args.record, option="--record")
     layout = layout_from_args(args)
     settings = broker_settings_from_args(args, "sleeve")
     options = SleeveOptions(

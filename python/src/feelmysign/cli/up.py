@@ -10,6 +10,7 @@ from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES
 from feelmysign.broker import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID, DEFAULT_WS_PORT, Broker
+from feelmysign.cli._inputs import output_file, port, sleeve_id
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.cli.sleeve import run_sleeve
@@ -39,26 +40,27 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--http-port",
-        type=int,
+        type=port(),
         default=DEFAULT_HTTP_PORT,
         metavar="P",
         help=f"drawing client port (default: {DEFAULT_HTTP_PORT}; 0 = any free)",
     )
     parser.add_argument(
         "--port",
-        type=int,
+        type=port(),
         metavar="P",
         help=f"MQTT port (default: {DEFAULT_MQTT_PORT}, or any free one if taken; 0 = any free)",
     )
     parser.add_argument(
         "--ws-port",
-        type=int,
+        type=port(),
         metavar="W",
         help=f"MQTT over WebSockets port (default: {DEFAULT_WS_PORT}, or any free one if taken)",
     )
     parser.add_argument(
         "--sleeve-id",
         default=DEFAULT_SLEEVE_ID,
+        type=sleeve_id,
         metavar="ID",
         help=f"the sleeve's id (default: {DEFAULT_SLEEVE_ID})",
     )
@@ -85,6 +87,8 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.record is not None:
+        output_file(args.record, option="--record")
     layout = layout_from_args(args)
     port = _port_or_free(args.port, DEFAULT_MQTT_PORT, "MQTT")
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")

@@ -14,9 +14,9 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 from typing import Any
 
+from feelmysign.cli._inputs import read_stdin
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, Rejected, parse, stroke_to_dict
@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
 def _read_payload(argument: str) -> bytes:
     """The payload's bytes: from stdin for '-', else the argument as the shell passed it."""
     if argument == "-":
-        return sys.stdin.buffer.read()
+        return read_stdin(what="a stroke message")
     # fsencode gives back the original bytes of an argument that was not UTF-8.
     return os.fsencode(argument)
 

@@ -63,7 +63,12 @@ def parse_broker_url(
     text = url.strip()
     if "://" not in text:
         return _bad_url(url, "has no scheme", f"write it as mqtt://{text or '127.0.0.1:1883'}")
-    parts = urlsplit(text)
+    try:
+        parts = urlsplit(text)
+    except ValueError as error:  # an unclosed '[' of an IPv6 address, for one
+        return _bad_url(
+            url, f"cannot be read ({error})", "e.g. mqtt://127.0.0.1:1883 or mqtt://[::1]:1883"
+        )
     scheme = parts.scheme.lower()
     if scheme not in SCHEMES:
         return _bad_url(url, f"uses the scheme {parts.scheme!r}", _scheme_hint(scheme))

@@ -92,7 +92,14 @@ def parse_recording(text: str, *, source: str = "<recording>") -> Recording:
         raw_strokes = _field(data, "strokes", list, source)
         strokes = tuple(_stroke(raw, i, source) for i, raw in enumerate(raw_strokes))
     return Recording(
-        width, height, paths, _opt_int(rows), _opt_int(columns), simplifier, frames, strokes
+        width,
+        height,
+        paths,
+        _grid_side(rows, "rows", source),
+        _grid_side(columns, "columns", source),
+        simplifier,
+        frames,
+        strokes,
     )
 
 
@@ -166,5 +173,13 @@ def _is_number(value: object) -> TypeGuard[int | float]:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _opt_int(value: object) -> int | None:
-    return value if isinstance(value, int) and not isinstance(value, bool) else None
+def _grid_side(value: object, key: str, source: str) -> int | None:
+    """sleeve.rows or sleeve.columns: absent, or a whole number from 1 to 64, as in a layout."""
+    if value is None:
+        return None
+    if not isinstance(value, int) or isinstance(value, bool) or not 1 <= value <= 64:
+        raise RecordingError(
+            f"{source}: sleeve.{key} must be a whole number from 1 to 64, got {value!r}; "
+            f"fix it or remove it (then --{key} or the default applies)"
+        )
+    return value

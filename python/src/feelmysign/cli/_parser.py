@@ -1,0 +1,37 @@
+"""The parser of every ``feelmysign`` command: one ``Error:`` line per usage error.
+
+argparse prints its usage block and ``prog: error: ...``; a person then has to
+find the one line that matters. Here a usage error is that line alone, as
+``Error: ...`` on stderr with a pointer to ``--help``, and exit status 2.
+
+A negative stroke such as ``-1,0,1,0,500`` is a positional argument, not an
+unknown option: no option of ours starts with a digit (Python 3.13 reads any
+``-<digit>`` this way too).
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from typing import NoReturn
+
+USAGE_ERROR_EXIT = 2
+# '-' then a digit, or '-.' then a digit: a number or a stroke, never one of our options.
+_NEGATIVE_NUMBER = re.compile(r"^-\.?\d")
+_ARGUMENT_PREFIX = re.compile(r"^argument (?=\S+: )")
+
+
+class CliParser(argparse.ArgumentParser):
+    """An ArgumentParser whose subparsers are CliParsers too (argparse copies the class)."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
+    def error(self, message: str) -> NoReturn:
+        text = " ".join(message.split()).rstrip(".")
+        # "argument --port: 99999 is out of range" -> "--port: 99999 is out of range"
+        text = _ARGUMENT_PREFIX.sub("", text)
+        sys.stderr.write(f"Error: {text}. See '{self.prog} --help'.\n")
+        sys.exit(USAGE_ERROR_EXIT)
