@@ -6,21 +6,33 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 BIN := $(VENV)/bin
+# What running needs (make up), then everything: research tools and development tools (make test).
+RUN_STAMP := $(VENV)/.installed-run-stamp
 STAMP := $(VENV)/.installed-stamp
+PIP_INSTALL := $(PY) -m pip install --disable-pip-version-check --progress-bar off
+# Options for `feelmysign up`, e.g. make up ARGS="--http-port 8080"
+ARGS ?=
 SYSTEM_PACKAGES := mosquitto mosquitto-clients
 
 .PHONY: help up test lint typecheck pytest vectors vectors-check bench system clean
 
 help:
-	@echo "make up      set up and start everything (broker, sleeve simulator, drawing client)"
+	@echo "make up      set up and start everything (broker, sleeve simulator, drawing client);"
+	@echo "             options for 'feelmysign up' go in ARGS, e.g. make up ARGS=\"--http-port 8080\""
 	@echo "make test    install what is needed, then lint, type-check and run every test"
 	@echo "make bench   print performance figures"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 
-$(STAMP): python/pyproject.toml
+$(RUN_STAMP): python/pyproject.toml
+	@echo "==> Python packages to run feelmysign (python/pyproject.toml: dependencies) into $(VENV):"
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e 'python[dev]'
+	$(PIP_INSTALL) --quiet --upgrade pip
+	$(PIP_INSTALL) -e python
+	touch $@
+
+$(STAMP): $(RUN_STAMP)
+	@echo "==> Research and development tools (python/pyproject.toml: [research] and [dev]) into $(VENV):"
+	$(PIP_INSTALL) -e 'python[research,dev]'
 	touch $@
 
 # System packages come from Debian's archive; installed only when missing.
@@ -30,7 +42,7 @@ system:
 	done; \
 	if [ -n "$$missing" ]; then \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
-	  echo "Installing system packages:$$missing"; \
+	  echo "==> System packages from Debian's archive (apt-get, about a minute):$$missing"; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
@@ -54,8 +66,9 @@ test: system $(STAMP) lint typecheck vectors-check pytest
 bench: $(STAMP) system
 	$(PY) -m feelmysign.bench
 
-up: $(STAMP) system
-	$(BIN)/feelmysign up
+up: $(RUN_STAMP) system
+	@echo "==> Starting feelmysign up $(ARGS)"
+	$(BIN)/feelmysign up $(ARGS)
 
 clean:
 	rm -rf $(VENV) python/src/*.egg-info
@@ -77,10 +90,12 @@ SYSTEM_PACKAGES += chromium
 
 $(WEB_STAMP): $(WEB)/package.json $(WEB)/package-lock.json
 	@command -v npm >/dev/null || { echo "Error: npm not found; install Node.js 20.19 or newer with npm, then run make again." >&2; exit 1; }
+	@echo "==> The drawing client's npm packages (web/package-lock.json, npm ci) into web/node_modules:"
 	cd $(WEB) && npm ci $(NPM_QUIET)
 	touch $@
 
 web-build: $(WEB_STAMP)
+	@echo "==> Building the drawing client into web/dist (vite)"
 	cd $(WEB) && $(WEB_BIN)/vite build --logLevel warn
 
 web-typecheck: $(WEB_STAMP)

@@ -39,6 +39,7 @@ from feelmysign.cli._inputs import (
     whole_number,
 )
 from feelmysign.cli.simplify import load
+from feelmysign.errors import FeelMySignError
 from feelmysign.research.sweep import (
     DEFAULT_SWEEPS,
     Sweep,
@@ -103,14 +104,21 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
-    # numpy, scipy and matplotlib load here, not with the parser of every command.
-    from feelmysign.research import plots
-    from feelmysign.research.evaluate import (
-        frontier,
-        summarize,
-        write_csv,
-        write_frontier_csv,
-    )
+    # numpy, scipy and matplotlib load here, not with the parser of every command; they
+    # are the [research] extra, which 'make up' leaves out.
+    try:
+        from feelmysign.research import plots
+        from feelmysign.research.evaluate import (
+            frontier,
+            summarize,
+            write_csv,
+            write_frontier_csv,
+        )
+    except ImportError as error:
+        raise FeelMySignError(
+            f"feelmysign evaluate needs the research tools ({error.name or error} is missing): "
+            "run 'make test', which installs them, or .venv/bin/pip install -e 'python[research]'"
+        ) from None
 
     algorithms = _algorithms(args.algorithm, parser)
     if not args.lasa and not args.recordings:

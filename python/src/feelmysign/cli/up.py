@@ -10,6 +10,7 @@ from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES
 from feelmysign.broker import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID, DEFAULT_WS_PORT, Broker
+from feelmysign.cli._drawing_log import DrawingLog
 from feelmysign.cli._inputs import output_file, port, sleeve_id
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import call_on_stop_signals
@@ -107,20 +108,25 @@ def run(args: argparse.Namespace) -> int:
             )
             options = SleeveOptions(sleeve_id=c.sleeve_id, backend_name=args.sleeve_backend)
 
+            sender = BrokerSettings(
+                c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
+            )
+
             def started(sleeve: Sleeve) -> None:
                 _stop_on_signals(sleeve)
                 threading.Thread(
                     target=_announce, args=(sleeve, web.url, broker), daemon=True
                 ).start()
 
-            run_sleeve(
-                settings,
-                layout,
-                options,
-                backend=args.sleeve_backend,
-                record=args.record,
-                on_start=started,
-            )
+            with DrawingLog(sender, c.sleeve_id):  # one line per drawing, from its events
+                run_sleeve(
+                    settings,
+                    layout,
+                    options,
+                    backend=args.sleeve_backend,
+                    record=args.record,
+                    on_start=started,
+                )
     print("Stopped: sleeve (every motor off), drawing client and broker.", flush=True)
     return 0
 
@@ -156,6 +162,7 @@ def _announce(sleeve: Sleeve, url: str, broker: Broker) -> None:
         f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
         f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"
+        f"One line per drawing follows here once it has been played.\n"
         f"Press Ctrl-C to stop.",
         flush=True,
     )

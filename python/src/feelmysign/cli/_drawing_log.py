@@ -1,0 +1,172 @@
+"""One line per drawing in the terminal of ``feelmysign up``, from the sleeve's own events.
+
+``up`` listens on ``feelmysign/<id>/events`` like any page does (with the
+sender's account) and, once a drawing has been quiet for ``QUIET_S``, prints::
+
+    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 rejected (outside_grid);
+    latency median 3 ms, max 9 ms        (on one line)
+
+Strokes without a drawing id (the legacy text format) count as one drawing
+per quiet spell. The summary is built by ``DrawingSummaries`` (pure: events
+and a clock in, lines out); ``DrawingLog`` is its MQTT listener.
+"""
+
+from __future__ import annotations
+
+import statistics
+import threading
+import uuid
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign.connection import BrokerSettings, connect_client
+from feelmysign.events import (
+    Adjusted,
+    Cancelled,
+    Event,
+    EventError,
+    Played,
+    Rejected,
+    event_from_json,
+)
+from feelmysign.topics import telemetry_topic
+
+QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted and put down
+CHECK_INTERVAL_S = 0.25
+LEGACY_DRAWING = "Legacy strokes"
+SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one session
+
+
+@dataclass
+class _Drawing:
+    last_event_s: float
+    played: int = 0
+    slowed: int = 0
+    cancelled: int = 0
+    rejected: Counter[str] = field(default_factory=Counter)
+    latencies_ms: list[float] = field(default_factory=list)
+
+    def line(self, name: str) -> str:
+        shown = name if name == LEGACY_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
+        parts = [f"{self.played} stroke{'s' if self.played != 1 else ''} played"]
+        if self.slowed:
+            parts[0] += f" ({self.slowed} slowed to be felt)"
+        if self.rejected:
+            reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in self.rejected.items())
+            parts.append(f"{sum(self.rejected.values())} rejected ({reasons})")
+        if self.cancelled:
+            parts.append(f"{self.cancelled} cancelled")
+        text = f"{shown}: " + ", ".join(parts)
+        if self.latencies_ms:
+            text += (
+                f"; latency median {statistics.median(self.latencies_ms):.0f} ms, "
+                f"max {max(self.latencies_ms):.0f} ms"
+            )
+        return text
+
+
+class DrawingSummaries:
+    """Events in, one summary line per drawing out once it has been quiet for ``quiet_s``."""
+
+    def __init__(self, *, quiet_s: float = QUIET_S) -> None:
+        self._quiet_s = quiet_s
+        self._drawings: dict[str, _Drawing] = {}
+
+    def add(self, event: Event, now_s: float) -> None:
+        if not isinstance(event, Played | Rejected | Cancelled):
+            return  # safety and error events are logged by the sleeve itself
+        name = event.drawing or LEGACY_DRAWING
+        drawing = self._drawings.setdefault(name, _Drawing(now_s))
+        drawing.last_event_s = now_s
+        if isinstance(event, Played):
+            drawing.played += 1
+            drawing.slowed += isinstance(event, Adjusted)
+            drawing.latencies_ms.append(event.latency_ms)
+        elif isinstance(event, Rejected):
+            drawing.rejected[event.reason] += 1
+        else:
+            drawing.cancelled += 1
+
+    def finished(self, now_s: float, *, all_of_them: bool = False) -> list[str]:
+        """The lines of the drawings quiet since ``quiet_s`` (or of every one), oldest first."""
+        done = [
+            name
+            for name, drawing in self._drawings.items()
+            if all_of_them or now_s - drawing.last_event_s >= self._quiet_s
+        ]
+        return [self._drawings.pop(name).line(name) for name in done]
+
+
+class DrawingLog:
+    """Listens to one sleeve's events and prints a line per finished drawing.
+
+    ``with DrawingLog(settings, sleeve_id): ...``; leaving it prints what is left.
+    Best effort: a log line must never stop ``up``, so a failure to listen is
+    said once and the rest of ``up`` goes on.
+    """
+
+    def __init__(
+        self,
+        settings: BrokerSettings,
+        sleeve_id: str,
+        *,
+        emit: Callable[[str], None] = lambda line: print(line, flush=True),
+        clock: Callable[[], float] | None = None,
+    ) -> None:
+        import time
+
+        self._settings = settings
+        self._topic = telemetry_topic(sleeve_id, "events")
+        self._emit = emit
+        self._clock = clock or time.monotonic
+        self._summaries = DrawingSummaries()
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._client: mqtt.Client | None = None
+        self._ticker = threading.Thread(
+            target=self._tick, name="feelmysign-drawing-log", daemon=True
+        )
+
+    def __enter__(self) -> DrawingLog:
+        from feelmysign.errors import FeelMySignError
+
+        try:
+            client = connect_client(self._settings, f"feelmysign-up-log-{uuid.uuid4().hex[:12]}")
+        except FeelMySignError as error:
+            self._emit(f"No per-drawing log: cannot listen to the sleeve's events ({error}).")
+            return self
+        client.on_message = self._on_message
+        client.subscribe(self._topic, qos=1)
+        self._client = client
+        self._ticker.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        if self._client is not None:
+            self._ticker.join(timeout=2 * CHECK_INTERVAL_S + 1)
+            self._client.disconnect()
+            self._client.loop_stop()
+        with self._lock:
+            lines = self._summaries.finished(self._clock(), all_of_them=True)
+        for line in lines:
+            self._emit(line)
+
+    def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        try:
+            event = event_from_json(message.payload)
+        except EventError:
+            return  # not ours to judge: the page shows it, the sleeve logged it
+        with self._lock:
+            self._summaries.add(event, self._clock())
+
+    def _tick(self) -> None:
+        while not self._stop.wait(CHECK_INTERVAL_S):
+            with self._lock:
+                lines = self._summaries.finished(self._clock())
+            for line in lines:
+                self._emit(line)

@@ -1,0 +1,139 @@
+"""``feelmysign up`` as a person runs it: its terminal says one line per drawing played.
+
+The whole of ``up`` runs as a real process (Mosquitto, the simulated sleeve,
+the web server); a real ``feelmysign send`` draws on it. Also the summary
+lines themselves, from real event objects, and ``make up ARGS=...``.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from feelmysign.cli._drawing_log import LEGACY_DRAWING, DrawingSummaries
+from feelmysign.events import Adjusted, Cancelled, Played, Rejected, Safety
+
+FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
+REPO = Path(__file__).resolve().parents[2]
+WAIT_S = 60.0  # start-up of Mosquitto, the sleeve and the web server on a loaded machine
+
+
+def _played(drawing: str | None, latency_ms: float, **extra: object) -> Played:
+    times = {
+        "received_at_ms": 1000.0,
+        "start_at_ms": 1001.0,
+        "first_command_at_ms": 1000.0 + latency_ms,
+        "latency_ms": latency_ms,
+        "start_error_ms": 0.0,
+        "queued_ms": 0.0,
+        "duration_ms": 500.0,
+        "commands": 3,
+    }
+    if extra:
+        return Adjusted(drawing=drawing, **times, **extra)  # type: ignore[arg-type]
+    return Played(drawing=drawing, **times)  # type: ignore[arg-type]
+
+
+def test_one_line_per_drawing_once_it_is_quiet() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5)
+    summaries.add(_played("aaaaaaaa-1111", 3.0), now_s=0.0)
+    summaries.add(_played("aaaaaaaa-1111", 9.0, reason="too_fast", requested_duration_ms=50), 0.2)
+    rejected = Rejected(
+        reason="outside_grid", message="m", drawing="aaaaaaaa-1111", received_at_ms=1
+    )
+    summaries.add(rejected, now_s=0.4)
+    summaries.add(_played(None, 1.0), now_s=0.5)
+    summaries.add(Safety(reason="max_on_time", row=0, column=1), now_s=0.5)  # not a stroke
+    assert summaries.finished(1.8) == []  # the last event was 1.4 s ago: still drawing
+    lines = summaries.finished(1.9)
+    assert lines == [
+        "Drawing aaaaaaaa: 2 strokes played (1 slowed to be felt), 1 rejected (outside_grid); "
+        "latency median 6 ms, max 9 ms"
+    ]
+    cancelled = Cancelled(message="m", received_at_ms=1.0, cancelled_at_ms=2.0, started=False)
+    summaries.add(cancelled, now_s=2.0)
+    assert summaries.finished(2.1, all_of_them=True) == [
+        f"{LEGACY_DRAWING}: 1 stroke played, 1 cancelled; latency median 1 ms, max 1 ms"
+    ]
+    assert summaries.finished(100.0, all_of_them=True) == []
+
+
+def _lines(stream: object) -> queue.Queue[str]:
+    lines: queue.Queue[str] = queue.Queue()
+
+    def read() -> None:
+        for line in stream:  # type: ignore[attr-defined]
+            lines.put(line.rstrip("\n"))
+
+    threading.Thread(target=read, daemon=True).start()
+    return lines
+
+
+def _wait_for(lines: queue.Queue[str], start: str, seen: list[str]) -> str:
+    while True:
+        line = lines.get(timeout=WAIT_S)
+        seen.append(line)
+        if line.startswith(start):
+            return line
+
+
+@pytest.mark.broker
+def test_up_prints_one_line_per_drawing_it_played(tmp_path: Path) -> None:
+    web = tmp_path / "web"
+    web.mkdir()
+    (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    argv = [FEELMYSIGN, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
+    ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
+    up = subprocess.Popen(
+        [*argv, *ports], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env
+    )
+    seen: list[str] = []
+    try:
+        out = _lines(up.stdout)
+        _wait_for(out, "Press Ctrl-C to stop.", seen)
+        credentials = str(tmp_path / "state" / "credentials.json")
+        shape = ["--shape", "square", "--segments", "4", "--duration-ms", "1200"]
+        sent = subprocess.run(
+            [FEELMYSIGN, "send", "--credentials", credentials, *shape, "--pace", "burst"],
+            capture_output=True,
+            text=True,
+            timeout=WAIT_S,
+            env=env,
+            check=True,
+        )
+        drawing = sent.stdout.rsplit("(drawing ", 1)[1].split(")")[0]
+        line = _wait_for(out, "Drawing ", seen)
+        assert line.startswith(f"Drawing {drawing[:8]}: 4 strokes played"), seen
+        assert "latency median" in line and "rejected" not in line
+    finally:
+        up.send_signal(signal.SIGINT)
+        try:
+            up.wait(timeout=WAIT_S)
+        finally:
+            if up.poll() is None:
+                up.kill()
+    assert up.returncode == 0, seen
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="needs make")
+def test_make_up_passes_args_on() -> None:
+    done = subprocess.run(
+        ["make", "-n", "-C", str(REPO), "up", "ARGS=--http-port 8080 --sleeve-id s2"],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+        check=True,
+    )
+    assert any(
+        line.endswith("/feelmysign up --http-port 8080 --sleeve-id s2")
+        for line in done.stdout.splitlines()
+    ), done.stdout
