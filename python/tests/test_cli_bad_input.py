@@ -108,6 +108,7 @@ BAD_VALUES = [
     (["send", "0,0,1,0,500", "--timeout-s", "1e308"], ["--timeout-s", "at most 3600 s"]),
     (["send", "0,0,1,0,500", "--timeout-s", "nan"], ["--timeout-s", "above 0"]),
     (["replay", "{good}", "--send", "--timeout-s", "1e308"], ["--timeout-s"]),
+    (["stop", "--timeout-s", "1e308"], ["--timeout-s", "at most 3600 s"]),
     (["send", "0,0,1,0,500", "--legacy", "--legacy-topic", "#"], ["--legacy-topic", "wildcards"]),
     (["sleeve", "--legacy-topic", "#"], ["--legacy-topic", "'#' cannot be used"]),
     (["sleeve", "--legacy-topic", "a/+/b"], ["--legacy-topic"]),

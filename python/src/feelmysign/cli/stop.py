@@ -11,6 +11,7 @@ import paho.mqtt.client as mqtt
 from paho.mqtt.reasoncodes import ReasonCode
 
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli._inputs import MAX_TIMEOUT_S, number
 from feelmysign.connection import DEFAULT_TIMEOUT_S, connect_client
 from feelmysign.control import CANCEL_ALL, Cancel, format_control
 from feelmysign.errors import BrokerConnectionError, ParameterError
@@ -38,7 +39,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--timeout-s",
-        type=float,
+        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
         default=DEFAULT_TIMEOUT_S,
         metavar="S",
         help=f"how long to wait for the broker, seconds (default: {DEFAULT_TIMEOUT_S:g})",
@@ -56,8 +57,6 @@ def run(args: argparse.Namespace) -> int:
             f"a drawing id of 1 to {MAX_DRAWING_ID_CHARS} printable ASCII characters without "
             "spaces (leave it out to stop everything)",
         )
-    if not args.timeout_s > 0:
-        raise ParameterError("--timeout-s", args.timeout_s, "more than 0 seconds")
     settings = broker_settings_from_args(args, "sender")
     topic = control_topic(settings.sleeve_id)
     client = connect_client(settings, f"feelmysign-stop-{uuid.uuid4().hex[:12]}")
