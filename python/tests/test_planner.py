@@ -11,16 +11,11 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from vectors import load
 
+from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.errors import StrokeError
 from feelmysign.layout import MIN_BURST_MS, Layout, grid_layout
-from feelmysign.planner import (
-    merge_commands,
-    overrun_allowance_ms,
-    plan,
-    render_point,
-    shortest_planned_ms,
-    virtual_actuators,
-)
+from feelmysign.overlaps import merge_commands
+from feelmysign.planner import overrun_allowance_ms, plan, render_point, virtual_actuators
 from feelmysign.schedule import Burst, Command, Schedule, schedule_to_json
 from feelmysign.stroke import Stroke
 

@@ -5,11 +5,11 @@ Grid Display" (CHI 2011), with the interior-endpoint extension of F. Tang et al.
 (IEEE VR 2015) and the fixes listed in ``tactile-brush.md``: endpoints anywhere
 inside the grid, every direction, near-duplicate crossings merged, a
 feasibility rule (no negative or too-short burst), and overlapping commands on
-one actuator merged into one piecewise-constant intensity.
+one actuator merged into one piecewise-constant intensity (``overlaps``).
 
 Time is kept: a stroke plays in the time it was drawn. When the motion model
 cannot fit every virtual actuator into that time, it keeps the most crossings
-that fit, evenly spread in time (``_thinned``). A stroke is slowed only
+that fit, evenly spread in time (``apparent_motion.thinned``). A stroke is slowed only
 when even its simplest rendering, apparent motion between its two end
 phantoms, cannot fit: below ``shortest_planned_ms`` (73.7 ms for 20 ms bursts),
 whatever its length or direction, so the planned duration is continuous in the
@@ -35,17 +35,15 @@ from __future__ import annotations
 
 import itertools
 import math
-from bisect import bisect_left
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
 
+from feelmysign.apparent_motion import Timing, fits, shortest_planned_ms, thinned, timings
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
+from feelmysign.overlaps import Actuator, Span, commands_from_spans
 from feelmysign.schedule import Adjustment, Burst, Command, Schedule
 from feelmysign.stroke import Point, Stroke
-
-SOA_SLOPE = 0.32  # Israr & Poupyrev 2011, eq. 1: SOA = 0.32 d + 47.3 (ms)
-SOA_INTERCEPT_MS = 47.3  # ibid.; also the least time between two peaks of a moving touch
 
 # A burst may run on past the stroke's end (the motion model lets the last
 # bursts overlap), but the next stroke of a drawing starts at the end: by at most
@@ -56,9 +54,8 @@ OVERRUN_FRACTION = 0.1
 
 # Virtual actuators closer than this (grid units; 1.5 mm on a 3 cm grid, far
 # below the forearm's two-point threshold of about 35 mm) are one point to the
-# skin. Merging them matters: the motion model needs more than 47.3 ms between
-# consecutive peaks, so two crossings a hair apart (a stroke passing next to an
-# actuator) would otherwise force the stroke to be slowed to many seconds.
+# skin: a stroke passing a hair beside an actuator crosses its row and its
+# column a hair apart, and is felt crossing once.
 MERGE_DISTANCE = 0.05
 
 # Coordinates within this of a grid line are on it (float noise, not geometry).
@@ -71,15 +68,6 @@ TOO_FAST = "too_fast"
 # result. Every float that reaches a schedule is computed with the same
 # operations in the same order as the published formulas (and the TypeScript
 # and Java ports): the shared vectors in testdata/planner are compared bit for bit.
-
-# (onset a, onset b, duration a, duration b) of one burst: every time in the
-# motion model is affine in the stroke duration T, onset = a T + b and so on.
-_Timing = tuple[float, float, float, float]
-_Span = tuple[float, float, float]  # start_ms, end_ms, intensity of one actuator's command
-_Piece = tuple[float, float, float]  # start_ms, end_ms, intensity after merging
-_Actuator = tuple[int, int]  # row, column
-
-_SOA_SCALE = 1.0 / (1.0 + SOA_SLOPE)  # solves SOA = 0.32 (d + SOA) + 47.3 for SOA
 
 
 def plan(
@@ -111,28 +99,17 @@ def plan(
             f"{layout.max_stroke_duration_ms:g} ms; send a slower, shorter stroke",
         )
     points, fractions = virtual_actuators(start, end, merge_distance=merge_distance)
-    timings = _timings(fractions)
-    thinned = 0
-    if not _fits(timings, duration_ms, min_ms):
-        kept = _thinned(fractions, duration_ms, min_ms)
-        thinned = len(fractions) - len(kept)
+    burst_timings = timings(fractions)
+    left_out = 0
+    if not fits(burst_timings, duration_ms, min_ms):
+        kept = thinned(fractions, duration_ms, min_ms)
+        left_out = len(fractions) - len(kept)
         points, fractions = [points[i] for i in kept], [fractions[i] for i in kept]
-        timings = _timings(fractions)
-    bursts = _bursts(points, fractions, timings, duration_ms, intensity)
-    commands = _merged_commands(_spans_by_actuator(bursts, layout), min_ms)
+        burst_timings = timings(fractions)
+    bursts = _bursts(points, fractions, burst_timings, duration_ms, intensity)
+    commands = commands_from_spans(_spans_by_actuator(bursts, layout), min_ms)
     stroke = _canonical(stroke, start, end)
-    return Schedule(stroke, commands, duration_ms, adjusted, bursts, thinned)
-
-
-def shortest_planned_ms(min_command_ms: float) -> float:
-    """The least duration of any stroke: two end phantoms, each burst ``min_command_ms``.
-
-    Two bursts in apparent motion last ``d = (T - 47.3) / 1.32`` each, so
-    ``T = 1.32 d + 47.3`` (73.7 ms for 20 ms bursts), rounded up to the
-    microsecond. A point is held for at least as long, so that the duration does
-    not jump as a stroke shrinks to a point.
-    """
-    return _fastest_feasible_ms(_TWO_PHANTOMS, min_command_ms)
+    return Schedule(stroke, commands, duration_ms, adjusted, bursts, left_out)
 
 
 def overrun_allowance_ms(duration_ms: float) -> float:
@@ -264,111 +241,10 @@ def _snap(value: float) -> float:
     return float(nearest) if abs(value - nearest) <= ON_LINE_EPSILON else value
 
 
-def _timings(fractions: Sequence[float]) -> list[_Timing]:
-    """(onset, duration) of each burst, as affine functions of the stroke duration T.
-
-    The Tactile Brush recursion (``tactile-brush.md``, "Durations and onsets"):
-    ``SOA_i = (0.32 (d_i- + tau_{i+1} - S) + 47.3) / 1.32``, ``S += SOA_i``,
-    ``d_{i+1}- = d_i+ = tau_{i+1} - S``, and finally ``d_n- = T - S``.
-
-    Each time is carried as its two coefficients (``a`` of T, then ``b``); a
-    peak ``tau`` is ``f T + 0``. Adding that 0 could only turn a -0.0 into 0.0,
-    which never reaches an onset or a duration, so it is left out; subtracting
-    from it (``0.0 - next_b``) is kept. Every float is the formula's, bit for bit.
-    """
-    if len(fractions) == 1:
-        return [(0.0, 0.0, 1.0, 0.0)]
-    onset_a = onset_b = 0.0
-    before_a = before_b = 0.0  # d_i minus
-    result: list[_Timing] = []
-    for tau in itertools.islice(fractions, 1, None):
-        soa_a = (before_a + tau - onset_a) * SOA_SLOPE * _SOA_SCALE
-        soa_b = ((before_b - onset_b) * SOA_SLOPE + SOA_INTERCEPT_MS) * _SOA_SCALE
-        next_a, next_b = onset_a + soa_a, onset_b + soa_b
-        after_a, after_b = tau - next_a, 0.0 - next_b  # d_i plus, which is d_{i+1} minus
-        result.append((onset_a, onset_b, before_a + after_a, before_b + after_b))
-        onset_a, onset_b, before_a, before_b = next_a, next_b, after_a, after_b
-    result.append((onset_a, onset_b, 1.0 - onset_a, 0.0 - onset_b))
-    return result
-
-
-def _fastest_feasible_ms(timings: Iterable[_Timing], min_command_ms: float) -> float:
-    """The least T for which every burst lasts at least ``min_command_ms``.
-
-    Every duration grows with T (its slope is positive: each onset is a
-    weighted mean of earlier peaks, so it trails its own peak), hence the
-    feasible durations are one interval [T_min, inf).
-    """
-    needed = 0.0
-    for _, _, duration_a, duration_b in timings:
-        if duration_a > 0:
-            needed = max(needed, (min_command_ms - duration_b) / duration_a)
-    # Rounded up to the microsecond: every burst reaches the minimum despite
-    # float rounding, and the adjusted duration reads well.
-    return math.ceil(needed * 1000.0 * (1 + 1e-12)) / 1000.0
-
-
-_TWO_PHANTOMS = _timings([0.0, 1.0])
-
-
-def _fits(timings: Iterable[_Timing], duration_ms: float, min_command_ms: float) -> bool:
-    """Whether every burst lasts at least ``min_command_ms`` at ``duration_ms``."""
-    # The same floor as _fastest_feasible_ms, whose rounding up makes its result fit.
-    floor = min_command_ms * (1 - 1e-12) - 1e-9
-    return all(a * duration_ms + b >= floor for _, _, a, b in timings)
-
-
-def _thinned(fractions: Sequence[float], duration_ms: float, min_command_ms: float) -> list[int]:
-    """Indices of the virtual actuators kept so that every burst fits ``duration_ms``.
-
-    Apparent motion needs its peaks about 54 ms apart at the least (74 ms for
-    the first and last step): peaks closer than that cannot each get a burst the
-    skin feels, and are fused anyway. So the most crossings that fit are kept,
-    chosen evenly spread in time (a steady apparent speed): for ``count``
-    crossings, the one nearest each of ``count`` evenly spaced times. The two
-    endpoints are always kept, and they alone fit any duration of at least
-    ``shortest_planned_ms``.
-
-    Fewer crossings leave wider gaps, so whether ``count`` fits falls with
-    ``count``: a bisection finds the most that fit in a few tries, which
-    matters on a large grid (a stroke across 64 columns crosses 100 lines).
-    """
-    last = len(fractions) - 1
-    best = [0, last]
-    fits, fails = 0, last - 1  # counts known to fit (none) and not to (all crossings)
-    while fails - fits > 1:
-        count = (fits + fails) // 2
-        kept = _evenly_spread(fractions, count)
-        if _fits(_timings([fractions[i] for i in kept]), duration_ms, min_command_ms):
-            fits, best = count, kept
-        else:
-            fails = count
-    return best
-
-
-def _evenly_spread(fractions: Sequence[float], count: int) -> list[int]:
-    """The ends and, for each of ``count`` evenly spaced times, the crossing nearest to it.
-
-    A crossing nearest to two of the times is kept once. The targets increase,
-    so one forward walk over the crossings finds every nearest one.
-    """
-    last = len(fractions) - 1
-    kept = [0]
-    j = 1
-    for k in range(1, count + 1):
-        target = k / (count + 1)
-        while j < last - 1 and abs(fractions[j + 1] - target) < abs(fractions[j] - target):
-            j += 1
-        if j != kept[-1]:
-            kept.append(j)
-    kept.append(last)
-    return kept
-
-
 def _bursts(
     points: Sequence[Point],
     fractions: Sequence[float],
-    timings: Sequence[_Timing],
+    timings: Sequence[Timing],
     duration_ms: float,
     intensity: float,
 ) -> tuple[Burst, ...]:
@@ -436,9 +312,9 @@ def _axis_weights(coordinate: float, count: int) -> list[tuple[int, float]]:
     return [(low, 1.0 - fraction), (low + 1, fraction)]
 
 
-def _spans_by_actuator(bursts: Iterable[Burst], layout: Layout) -> dict[_Actuator, list[_Span]]:
+def _spans_by_actuator(bursts: Iterable[Burst], layout: Layout) -> dict[Actuator, list[Span]]:
     """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
-    by_actuator: dict[_Actuator, list[_Span]] = {}
+    by_actuator: dict[Actuator, list[Span]] = {}
     for burst in bursts:
         if burst.duration_ms <= 0:
             continue
@@ -453,113 +329,3 @@ def _spans_by_actuator(bursts: Iterable[Burst], layout: Layout) -> dict[_Actuato
                     span = (span_start, span_end, intensity)
                     by_actuator.setdefault((row, column), []).append(span)
     return by_actuator
-
-
-def merge_commands(commands: Iterable[Command], *, min_command_ms: float) -> tuple[Command, ...]:
-    """One actuator, one intensity at a time.
-
-    Overlapping commands on an actuator add their energies (intensity squared),
-    capped at 1. A piece shorter than ``min_command_ms`` left by the overlap
-    joins its neighbour with the energy-weighted intensity, so no command is
-    shorter than the minimum unless the whole on-period is.
-    """
-    by_actuator: dict[_Actuator, list[_Span]] = {}
-    for command in commands:
-        if command.intensity > 0 and command.duration_ms > 0:
-            span = (command.start_ms, command.end_ms, command.intensity)
-            by_actuator.setdefault((command.row, command.column), []).append(span)
-    return _merged_commands(by_actuator, min_command_ms)
-
-
-def _merged_commands(
-    by_actuator: dict[_Actuator, list[_Span]], min_command_ms: float
-) -> tuple[Command, ...]:
-    """Each actuator's spans merged, as commands sorted by start, then row, then column."""
-    # One actuator's pieces never share a start, so sorting these tuples whole
-    # orders them exactly as that key does.
-    pieces = [
-        (start, row, column, end, intensity)
-        for (row, column), spans in by_actuator.items()
-        for start, end, intensity in _actuator_pieces(spans, min_command_ms)
-    ]
-    pieces.sort()
-    return tuple(
-        [
-            Command(row, column, start, end - start, intensity)
-            for start, row, column, end, intensity in pieces
-        ]
-    )
-
-
-def _actuator_pieces(spans: list[_Span], min_command_ms: float) -> list[_Piece]:
-    """What one actuator does: its spans' energies summed, short pieces joined."""
-    if len(spans) == 1:
-        return _lone_piece(*spans[0])  # most actuators of a stroke render one burst
-    return _join_short(_energy_pieces(spans), min_command_ms)
-
-
-def _energy_pieces(spans: list[_Span]) -> list[_Piece]:
-    """Piecewise-constant intensity of one actuator: energies summed, capped at 1."""
-    bounds = sorted({t for start, end, _ in spans for t in (start, end)})
-    # The energies on each interval between bounds, in the spans' order (the
-    # order they are summed in): one pass over the spans, not one per interval.
-    energies: list[list[float]] = [[] for _ in range(len(bounds) - 1)]
-    for start, end, intensity in spans:
-        energy = intensity**2
-        for terms in energies[bisect_left(bounds, start) : bisect_left(bounds, end)]:
-            terms.append(energy)
-    pieces: list[_Piece] = []
-    for (start, end), terms in zip(itertools.pairwise(bounds), energies, strict=True):
-        energy = sum(terms)
-        if energy <= 0:
-            continue
-        intensity = min(1.0, math.sqrt(energy))
-        if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
-            pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
-        else:
-            pieces.append((start, end, intensity))
-    return pieces
-
-
-def _lone_piece(start: float, end: float, intensity: float) -> list[_Piece]:
-    """``_energy_pieces`` of a single span (which ``_join_short`` leaves alone)."""
-    energy = intensity**2
-    if energy <= 0 or not start < end:  # underflow, or a span shorter than its start's ulp
-        return []
-    return [(start, end, min(1.0, math.sqrt(energy)))]
-
-
-def _join_short(pieces: list[_Piece], min_command_ms: float) -> list[_Piece]:
-    """Join pieces shorter than the minimum to an adjacent piece of the same on-period."""
-    if len(pieces) < 2:
-        return pieces  # nothing to join with
-    pieces = list(pieces)
-    while True:
-        short = [
-            i
-            for i, (s, e, _) in enumerate(pieces)
-            if e - s < min_command_ms and _neighbour(pieces, i) is not None
-        ]
-        if not short:
-            return pieces
-        i = min(short, key=lambda k: pieces[k][1] - pieces[k][0])
-        j = _neighbour(pieces, i)
-        assert j is not None
-        a, b = sorted((i, j))
-        pieces[a : b + 1] = [_joined(pieces[a], pieces[b])]
-
-
-def _neighbour(pieces: list[_Piece], i: int) -> int | None:
-    """The adjacent piece touching piece i (previous preferred), or None if it stands alone."""
-    if i > 0 and pieces[i - 1][1] == pieces[i][0]:
-        return i - 1
-    if i + 1 < len(pieces) and pieces[i + 1][0] == pieces[i][1]:
-        return i + 1
-    return None
-
-
-def _joined(first: _Piece, second: _Piece) -> _Piece:
-    """Two touching pieces as one, keeping the energy (intensity squared x time)."""
-    d1, d2 = first[1] - first[0], second[1] - second[0]
-    energy = first[2] ** 2 * d1 + second[2] ** 2 * d2
-    return (first[0], second[1], min(1.0, math.sqrt(energy / (d1 + d2))))

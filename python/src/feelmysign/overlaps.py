@@ -1,0 +1,132 @@
+"""Overlapping commands on one actuator, merged into one piecewise-constant intensity.
+
+Tactile Brush drives an actuator from several virtual actuators at once (a
+diagonal renders row 1, column 1 from two phantoms), and a burst may run on
+under the next stroke. An actuator plays one intensity at a time, so the
+commands on it are merged: energies (intensity squared) add, capped at 1, and a
+piece shorter than the minimum burst left by an overlap joins its neighbour
+with the energy-weighted intensity.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from bisect import bisect_left
+from collections.abc import Iterable
+
+from feelmysign.schedule import Command
+
+Span = tuple[float, float, float]  # start_ms, end_ms, intensity of one actuator's command
+Piece = tuple[float, float, float]  # start_ms, end_ms, intensity after merging
+Actuator = tuple[int, int]  # row, column
+
+
+def merge_commands(commands: Iterable[Command], *, min_command_ms: float) -> tuple[Command, ...]:
+    """One actuator, one intensity at a time.
+
+    Overlapping commands on an actuator add their energies (intensity squared),
+    capped at 1. A piece shorter than ``min_command_ms`` left by the overlap
+    joins its neighbour with the energy-weighted intensity, so no command is
+    shorter than the minimum unless the whole on-period is.
+    """
+    by_actuator: dict[Actuator, list[Span]] = {}
+    for command in commands:
+        if command.intensity > 0 and command.duration_ms > 0:
+            span = (command.start_ms, command.end_ms, command.intensity)
+            by_actuator.setdefault((command.row, command.column), []).append(span)
+    return commands_from_spans(by_actuator, min_command_ms)
+
+
+def commands_from_spans(
+    by_actuator: dict[Actuator, list[Span]], min_command_ms: float
+) -> tuple[Command, ...]:
+    """Each actuator's spans merged, as commands sorted by start, then row, then column."""
+    # One actuator's pieces never share a start, so sorting these tuples whole
+    # orders them exactly as that key does.
+    pieces = [
+        (start, row, column, end, intensity)
+        for (row, column), spans in by_actuator.items()
+        for start, end, intensity in _actuator_pieces(spans, min_command_ms)
+    ]
+    pieces.sort()
+    return tuple(
+        [
+            Command(row, column, start, end - start, intensity)
+            for start, row, column, end, intensity in pieces
+        ]
+    )
+
+
+def _actuator_pieces(spans: list[Span], min_command_ms: float) -> list[Piece]:
+    """What one actuator does: its spans' energies summed, short pieces joined."""
+    if len(spans) == 1:
+        return _lone_piece(*spans[0])  # most actuators of a stroke render one burst
+    return _join_short(_energy_pieces(spans), min_command_ms)
+
+
+def _energy_pieces(spans: list[Span]) -> list[Piece]:
+    """Piecewise-constant intensity of one actuator: energies summed, capped at 1."""
+    bounds = sorted({t for start, end, _ in spans for t in (start, end)})
+    # The energies on each interval between bounds, in the spans' order (the
+    # order they are summed in): one pass over the spans, not one per interval.
+    energies: list[list[float]] = [[] for _ in range(len(bounds) - 1)]
+    for start, end, intensity in spans:
+        energy = intensity**2
+        for terms in energies[bisect_left(bounds, start) : bisect_left(bounds, end)]:
+            terms.append(energy)
+    pieces: list[Piece] = []
+    for (start, end), terms in zip(itertools.pairwise(bounds), energies, strict=True):
+        energy = sum(terms)
+        if energy <= 0:
+            continue
+        intensity = min(1.0, math.sqrt(energy))
+        if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
+            pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
+        else:
+            pieces.append((start, end, intensity))
+    return pieces
+
+
+def _lone_piece(start: float, end: float, intensity: float) -> list[Piece]:
+    """``_energy_pieces`` of a single span (which ``_join_short`` leaves alone)."""
+    energy = intensity**2
+    if energy <= 0 or not start < end:  # underflow, or a span shorter than its start's ulp
+        return []
+    return [(start, end, min(1.0, math.sqrt(energy)))]
+
+
+def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
+    """Join pieces shorter than the minimum to an adjacent piece of the same on-period."""
+    if len(pieces) < 2:
+        return pieces  # nothing to join with
+    pieces = list(pieces)
+    while True:
+        short = [
+            i
+            for i, (s, e, _) in enumerate(pieces)
+            if e - s < min_command_ms and _neighbour(pieces, i) is not None
+        ]
+        if not short:
+            return pieces
+        i = min(short, key=lambda k: pieces[k][1] - pieces[k][0])
+        j = _neighbour(pieces, i)
+        assert j is not None
+        a, b = sorted((i, j))
+        pieces[a : b + 1] = [_joined(pieces[a], pieces[b])]
+
+
+def _neighbour(pieces: list[Piece], i: int) -> int | None:
+    """The adjacent piece touching piece i (previous preferred), or None if it stands alone."""
+    if i > 0 and pieces[i - 1][1] == pieces[i][0]:
+        return i - 1
+    if i + 1 < len(pieces) and pieces[i + 1][0] == pieces[i][1]:
+        return i + 1
+    return None
+
+
+def _joined(first: Piece, second: Piece) -> Piece:
+    """Two touching pieces as one, keeping the energy (intensity squared x time)."""
+    d1, d2 = first[1] - first[0], second[1] - second[0]
+    energy = first[2] ** 2 * d1 + second[2] ** 2 * d2
+    return (first[0], second[1], min(1.0, math.sqrt(energy / (d1 + d2))))
