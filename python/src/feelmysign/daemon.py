@@ -31,6 +31,7 @@ import paho.mqtt.client as mqtt
 
 from feelmysign import __version__
 from feelmysign.backends.base import Backend
+from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError, StrokeError
@@ -67,6 +68,7 @@ KEEPALIVE_S = 15
 # Cancelled drawings remembered, so that their later strokes do not start them again.
 REMEMBERED_CANCELS = 64
 RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
+NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disconnect
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
 # "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
 LOGIN_REFUSED_CODES = (134, 135)
@@ -113,8 +115,10 @@ class Sleeve:
         options: SleeveOptions,
         *,
         player: Player | None = None,
+        telemetry: ActuatorTelemetry | None = None,
     ) -> None:
         self._settings = settings
+        self._telemetry = telemetry  # flushed at stop, so previews see the final all-off
         self._layout = layout
         self._options = options
         self._id = options.sleeve_id
@@ -128,6 +132,7 @@ class Sleeve:
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         self._client = self._make_client()
+        self._network: threading.Thread | None = None
 
     @property
     def player(self) -> Player:
@@ -149,6 +154,8 @@ class Sleeve:
         try:
             self._client.connect_async(self._settings.host, self._settings.port, KEEPALIVE_S)
             self._client.loop_start()
+            # Our own handle on paho's network thread: see _stop_network.
+            self._network = self._client._thread
             log.info("sleeve %s: connecting to %s", self._id, self._settings.url)
             self._stopped.wait()
             if self._fatal is not None:
@@ -170,6 +177,10 @@ class Sleeve:
                     stroke.received_wall_ms,
                 )
         finally:
+            if self._telemetry is not None:
+                # Every motor is off: that frame goes out (after any older one) before the
+                # outbox closes, so a preview does not keep showing a motor on.
+                self._telemetry.stop()
             self._outbox.put(None)  # the events still queued go out before the goodbye
             publisher.join(timeout=5.0)
             self._say_goodbye()
@@ -188,6 +199,22 @@ class Sleeve:
         except (RuntimeError, ValueError, OSError) as error:
             log.warning("sleeve %s: could not say goodbye to the broker: %s", self._id, error)
         finally:
+            self._stop_network()
+
+    def _stop_network(self) -> None:
+        """Wait for paho's network thread, which ends by itself after ``disconnect()``.
+
+        paho's ``loop_stop()`` reads its thread twice (``!= self._thread``, then
+        ``self._thread.join()``), and that thread sets it to None as it ends: called
+        right after ``disconnect()`` it raised AttributeError about one stop in a
+        thousand. So join our own handle, and ask the thread to stop only if it is
+        still running (the disconnect failed), when it cannot be ending on its own.
+        """
+        network, self._network = self._network, None
+        if network is None:
+            return
+        network.join(timeout=NETWORK_STOP_S)
+        if network.is_alive():
             self._client.loop_stop()
 
     # --- MQTT ----------------------------------------------------------------------

@@ -159,7 +159,7 @@ def run_sleeve(
             emulate_state=emulate_state,
         ) as opened,
     ):
-        sleeve = Sleeve(settings, layout, opened, options)
+        sleeve = Sleeve(settings, layout, opened, options, telemetry=telemetry)
         sleeves.append(sleeve)
         on_start(sleeve)
         sleeve.run()

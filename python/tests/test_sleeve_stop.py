@@ -1,0 +1,161 @@
+"""Stopping the sleeve: the last actuators frame says every motor is off, and paho's thread
+race at stop cannot take the sleeve down."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+import types
+import uuid
+from collections.abc import Iterator
+from typing import Any
+
+import paho.mqtt.client as mqtt
+import pytest
+
+from feelmysign.backends.sim import SimBackend
+from feelmysign.broker import Broker, Credentials
+from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.layout import Layout
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
+
+WAIT_S = 60.0
+PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
+
+
+def _settings(c: Credentials, role: str) -> BrokerSettings:
+    account = c.sleeve if role == "sleeve" else c.sender
+    return BrokerSettings(
+        c.mqtt_host, c.mqtt_port, username=account.username, password=account.password
+    )
+
+
+class Watch:
+    """Every message on the sleeve's status and actuators topics, in order."""
+
+    def __init__(self, c: Credentials) -> None:
+        self.client = new_client(_settings(c, "sender"), client_id=f"stop-{uuid.uuid4()}")
+        self.messages: list[tuple[str, dict[str, Any]]] = []
+        self._changed = threading.Condition()
+        sid = c.sleeve_id
+        self.client.on_connect = lambda client, *_: client.subscribe(
+            [(telemetry_topic(sid, "status"), 1), (telemetry_topic(sid, "actuators"), 0)]
+        )
+        self.client.on_message = self._on_message
+        self.client.connect(c.mqtt_host, c.mqtt_port)
+        self.client.loop_start()
+        self.strokes = strokes_topic(sid)
+
+    def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
+        with self._changed:
+            name = message.topic.rsplit("/", 1)[-1]
+            self.messages.append((name, json.loads(message.payload)))
+            self._changed.notify_all()
+
+    def wait(self, what: str, check: Any) -> None:
+        with self._changed:
+            assert self._changed.wait_for(
+                lambda: any(check(n, body) for n, body in self.messages), WAIT_S
+            ), f"never saw {what}: {self.messages[-3:]}"
+
+    def close(self) -> None:
+        self.client.loop_stop()
+        self.client.disconnect()
+
+
+@pytest.fixture
+def watch(broker: Broker) -> Iterator[Watch]:
+    watching = Watch(broker.credentials)
+    yield watching
+    watching.close()
+
+
+def _on(name: str, body: dict[str, Any]) -> bool:
+    return name == "actuators" and any(any(row) for row in body["intensities"])
+
+
+def test_sigterm_mid_stroke_publishes_an_all_off_frame_before_going_offline(
+    broker: Broker, watch: Watch
+) -> None:
+    sleeve = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "feelmysign",
+            "sleeve",
+            "--credentials",
+            str(broker.credentials_path),
+            "--no-legacy",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        watch.wait("online", lambda n, body: n == "status" and body["online"])
+        watch.client.publish(
+            watch.strokes, format_json(Stroke((0, 1), (3, 1), 8000.0, 0.9, "stop", 0)), qos=1
+        )
+        watch.wait("a motor on", _on)
+        sleeve.send_signal(signal.SIGTERM)
+        _, errors = sleeve.communicate(timeout=WAIT_S)
+    finally:
+        sleeve.kill()
+    assert sleeve.returncode == 0, errors
+    watch.wait("offline", lambda n, body: n == "status" and not body["online"])
+    with watch._changed:
+        messages = list(watch.messages)
+    offline = next(i for i, (n, b) in enumerate(messages) if n == "status" and not b["online"])
+    frames = [body for name, body in messages[:offline] if name == "actuators"]
+    assert any(_on("actuators", frame) for frame in frames)  # the stroke was playing
+    assert not _on("actuators", frames[-1]), frames[-1]  # and the last word is: all off
+
+
+class _SlowCurrentThread(types.SimpleNamespace):
+    """paho's ``threading`` with a slow ``current_thread``: it widens the moment between
+    loop_stop's two reads of its network thread, which a loaded machine hits by chance."""
+
+    def current_thread(self) -> threading.Thread:
+        time.sleep(1.5)  # longer than the network thread takes to end after a disconnect
+        return threading.current_thread()
+
+
+def test_paho_loop_stop_after_disconnect_races_its_thread_and_the_sleeve_never_hits_it(
+    broker: Broker, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    c = broker.credentials
+    names = [k for k in dir(threading) if k[0] != "_" and k != "current_thread"]
+    slow = _SlowCurrentThread(**{k: getattr(threading, k) for k in names})
+    monkeypatch.setattr(mqtt, "threading", slow)
+    # The race itself, with a bare client: what a sleeve stopped this way would hit.
+    bare = new_client(_settings(c, "sender"), client_id=f"race-{uuid.uuid4()}")
+    bare.connect(c.mqtt_host, c.mqtt_port)
+    bare.loop_start()
+    bare.disconnect()
+    with pytest.raises(AttributeError):
+        bare.loop_stop()
+
+    sleeve = Sleeve(
+        _settings(c, "sleeve"), PAPER, SimBackend(PAPER), SleeveOptions(sleeve_id=c.sleeve_id)
+    )
+    errors: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            sleeve.run()
+        except BaseException as error:
+            errors.append(error)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    assert sleeve.connected.wait(WAIT_S)
+    sleeve.stop()
+    thread.join(WAIT_S)
+    assert not thread.is_alive() and errors == []
