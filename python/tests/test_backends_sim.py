@@ -57,24 +57,35 @@ def test_sim_records_each_change_relative_to_its_start() -> None:
 def test_sim_writes_json_lines_as_it_goes(tmp_path: Path) -> None:
     record = tmp_path / "felt.jsonl"
     clock = FakeClock()
-    sim = SimBackend(PAPER, clock=clock, record=record)
+    opened_wall_ms = 1_795_000_000_000.0
+    sim = SimBackend(PAPER, clock=clock, record=record, wall_clock=lambda: opened_wall_ms)
+
+    def line(t_ms: float, row: int, column: int, intensity: float, *source: object) -> object:
+        drawing, seq = source or (None, None)
+        return {
+            **{"t_ms": t_ms, "wall_ms": opened_wall_ms + t_ms, "row": row, "column": column},
+            **{"intensity": intensity, "drawing": drawing, "seq": seq},
+        }
+
     with sim:
         clock.advance(3.0)
+        sim.note_source("d1", 0)
         sim.set_intensity(1, 2, 0.5)
         clock.advance(4.25)
+        sim.note_source("d1", 1)
         sim.set_intensity(1, 1, 1.0)
         # Readable before close: a crash would not lose these lines.
         lines = record.read_text(encoding="utf-8").splitlines()
-        assert [json.loads(line) for line in lines] == [
-            {"t_ms": 3.0, "row": 1, "column": 2, "intensity": 0.5},
-            {"t_ms": 7.25, "row": 1, "column": 1, "intensity": 1.0},
+        assert [json.loads(text) for text in lines] == [
+            line(3.0, 1, 2, 0.5, "d1", 0),
+            line(7.25, 1, 1, 1.0, "d1", 1),
         ]
         clock.advance(1.0)
-    # Closing switches off what was on, and records it.
+    # Closing switches off what was on, and records it: no stroke made those changes.
     lines = record.read_text(encoding="utf-8").splitlines()
-    assert [json.loads(line) for line in lines[2:]] == [
-        {"t_ms": 8.25, "row": 1, "column": 1, "intensity": 0.0},
-        {"t_ms": 8.25, "row": 1, "column": 2, "intensity": 0.0},
+    assert [json.loads(text) for text in lines[2:]] == [
+        line(8.25, 1, 1, 0.0),
+        line(8.25, 1, 2, 0.0),
     ]
     assert sim.record_path == record
 

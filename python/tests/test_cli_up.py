@@ -7,6 +7,7 @@ lines themselves, from real event objects, and ``make up ARGS=...``.
 
 from __future__ import annotations
 
+import json
 import os
 import queue
 import shutil
@@ -14,6 +15,7 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -86,15 +88,23 @@ def _wait_for(lines: queue.Queue[str], start: str, seen: list[str]) -> str:
 
 
 @pytest.mark.broker
-def test_up_prints_one_line_per_drawing_it_played(tmp_path: Path) -> None:
+def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
+    tmp_path: Path,
+) -> None:
     web = tmp_path / "web"
     web.mkdir()
     (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
     env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
     argv = [FEELMYSIGN, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
     ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
+    record = tmp_path / "felt.jsonl"
+    before_wall_ms = time.time() * 1000
     up = subprocess.Popen(
-        [*argv, *ports], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env
+        [*argv, *ports, "--record", str(record)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env=env,
     )
     seen: list[str] = []
     try:
@@ -122,6 +132,15 @@ def test_up_prints_one_line_per_drawing_it_played(tmp_path: Path) -> None:
             if up.poll() is None:
                 up.kill()
     assert up.returncode == 0, seen
+    changes = [json.loads(line) for line in record.read_text(encoding="utf-8").splitlines()]
+    played = [c for c in changes if c["drawing"] is not None]
+    assert {c["drawing"] for c in played} == {drawing}
+    assert {c["seq"] for c in played} == {0, 1, 2, 3}  # the square's four strokes
+    first_seen = list(dict.fromkeys(c["seq"] for c in played))
+    assert first_seen == [0, 1, 2, 3]  # started in order
+    walls = [c["wall_ms"] for c in changes]
+    assert walls == sorted(walls) and before_wall_ms <= walls[0] <= time.time() * 1000
+    assert all(c["drawing"] is None and c["intensity"] == 0.0 for c in changes[len(played) :])
 
 
 @pytest.mark.skipif(shutil.which("make") is None, reason="needs make")

@@ -287,9 +287,14 @@ class Player:
             self._capped(capped)
 
     def _write(self, changes: list[Change]) -> None:
+        # A recording backend (the simulator) is told whose command each change is.
+        note: Callable[[object, object], None] | None = getattr(self._backend, "note_source", None)
         for change in changes:
             self.timing_errors_ms.append(self._clock() - change.t_ms)
             try:
+                if note is not None:
+                    info = change.tag.info if isinstance(change.tag, PlannedStroke) else {}
+                    note(info.get("drawing"), info.get("seq"))
                 self._backend.set_intensity(change.row, change.column, change.intensity)
             except Exception as error:  # a motor that fails must not stop the others
                 log.warning("actuator (%d, %d): %s", change.row, change.column, error)
@@ -300,6 +305,8 @@ class Player:
                 )
                 if change.intensity == 0.0:
                     self._force_off(change)
+        if note is not None:
+            note(None, None)  # what follows (an all-off at exit) belongs to no stroke
 
     def _force_off(self, change: Change) -> None:
         """An 'off' that failed: try once more, then every motor off (a glitch must not leave

@@ -30,12 +30,16 @@ Actuator = tuple[int, int]
 
 @dataclass(frozen=True)
 class Change:
-    """Set an actuator's intensity at a planned time (ms on the player's clock)."""
+    """Set an actuator's intensity at a planned time (ms on the player's clock).
+
+    ``tag`` is the stroke whose command made this change (for records; not compared).
+    """
 
     t_ms: float
     row: int
     column: int
     intensity: float
+    tag: object = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
@@ -133,11 +137,11 @@ class Timeline:
         due = Due()
         while self._events and self._events[0].t_ms <= now_ms:
             t_ms = self._events[0].t_ms
-            touched: set[Actuator] = set()
+            touched: dict[Actuator, object] = {}  # each actuator, and the stroke that last moved it
             while self._events and self._events[0].t_ms == t_ms:
                 self._apply(heapq.heappop(self._events), touched, due)
             for actuator in sorted(touched):
-                self._settle(actuator, t_ms, due)
+                self._settle(actuator, t_ms, due, touched[actuator])
         return due
 
     def cancel(self, match: Callable[[object], bool], now_ms: float) -> Cut:
@@ -158,16 +162,16 @@ class Timeline:
         for tag in (e.tag for e in dropped):
             if all(tag is not t for t in [*unstarted, *started, *refused]):
                 started.append(tag)
-        touched: set[Actuator] = set()
+        touched: dict[Actuator, object] = {}
         for event in dropped:
             # An "off" still planned whose "on" has happened: that command is running now.
             running = self._active.get(event.actuator)
             if event.kind == "off" and running is not None and event.command in running:
                 del running[event.command]
-                touched.add(event.actuator)
+                touched[event.actuator] = event.tag
         due = Due()
         for actuator in sorted(touched):
-            self._settle(actuator, now_ms, due)
+            self._settle(actuator, now_ms, due, touched[actuator])
         return Cut(due.changes, started, unstarted)
 
     def tags(self) -> list[object]:
@@ -196,7 +200,7 @@ class Timeline:
         event.order = next(self._order)  # ties at one time keep the order they were added in
         heapq.heappush(self._events, event)
 
-    def _apply(self, event: _Event, touched: set[Actuator], due: Due) -> None:
+    def _apply(self, event: _Event, touched: dict[Actuator, object], due: Due) -> None:
         if event.stroke is not None:
             self._start(event.stroke, event.t_ms, due)
         elif event.command in self._dropped:
@@ -204,10 +208,10 @@ class Timeline:
                 self._dropped.discard(event.command)
         elif event.kind == "on":
             self._active.setdefault(event.actuator, {})[event.command] = event.energy
-            touched.add(event.actuator)
+            touched[event.actuator] = event.tag
         else:
             self._active.get(event.actuator, {}).pop(event.command, None)
-            touched.add(event.actuator)
+            touched[event.actuator] = event.tag
 
     def _start(self, stroke: _Stroke, t_ms: float, due: Due) -> None:
         refusal = self.duty_cycle.check(stroke.drives, t_ms)
@@ -218,7 +222,7 @@ class Timeline:
             self._dropped.update(stroke.commands)
             due.capped.append(Capped(stroke.tag, refusal))
 
-    def _settle(self, actuator: Actuator, t_ms: float, due: Due) -> None:
+    def _settle(self, actuator: Actuator, t_ms: float, due: Due, tag: object = None) -> None:
         active = self._active.get(actuator)
         if not active:
             self._active.pop(actuator, None)
@@ -228,4 +232,4 @@ class Timeline:
             return
         self._output[actuator] = wanted
         self.duty_cycle.output(actuator, t_ms, wanted)
-        due.changes.append(Change(t_ms, actuator[0], actuator[1], wanted))
+        due.changes.append(Change(t_ms, actuator[0], actuator[1], wanted, tag))

@@ -4,9 +4,14 @@ It has the hardware backend's interface (``--backend sim``), so the player
 never knows which one it drives. Every change is kept with its time on an
 injected clock, relative to when the backend was opened; with ``record`` it is
 also appended to a JSON-lines file, one line per change and flushed line by
-line, so that a crash loses at most the line being written:
+line, so that a crash loses at most the line being written. ``wall_ms`` is the
+same moment on the wall clock (ms since the Unix epoch), to line a record up
+with the sleeve's events and the sender's ``sent_at_ms``; ``drawing`` and
+``seq`` name the stroke whose command made the change (null for a change no
+stroke made, such as the all-off at exit, and for legacy strokes):
 
-    {"t_ms": 12.5, "row": 0, "column": 3, "intensity": 0.8}
+    {"t_ms": 12.5, "wall_ms": 1795410070998.5, "row": 0, "column": 3, "intensity": 0.8,
+     "drawing": "3f2a9c1e-...", "seq": 4}
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import threading
+import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -62,6 +68,7 @@ class SimBackend(GridBackend):
         record: str | os.PathLike[str] | None = None,
         telemetry: ActuatorTelemetry | None = None,
         keep_changes: int | None = DEFAULT_KEEP_CHANGES,
+        wall_clock: Callable[[], float] = lambda: time.time() * 1000.0,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
         if keep_changes is not None and keep_changes < 0:
@@ -72,6 +79,9 @@ class SimBackend(GridBackend):
         self._changes: deque[Change] = deque(maxlen=keep_changes)
         self._changes_lock = threading.Lock()
         self._start_ms = 0.0
+        self._wall_clock = wall_clock
+        self._wall_start_ms = 0.0
+        self._source: tuple[object, object] = (None, None)
 
     @property
     def record_path(self) -> Path | None:
@@ -88,6 +98,7 @@ class SimBackend(GridBackend):
             # Line buffering: every change reaches the file when its line ends.
             self._record = self._record_path.open("w", encoding="utf-8", buffering=1)
         self._start_ms = self._clock()
+        self._wall_start_ms = self._wall_clock()
 
     def _write(self, row: int, column: int, intensity: float) -> None:
         t_ms = round(self._clock() - self._start_ms, _T_DECIMALS)
@@ -95,7 +106,20 @@ class SimBackend(GridBackend):
         with self._changes_lock:
             self._changes.append(change)
         if self._record is not None:
-            self._record.write(json.dumps(change.as_dict()) + "\n")
+            # The wall clock read once, at opening: a clock step cannot reorder the record.
+            wall_ms = round(self._wall_start_ms + t_ms, _T_DECIMALS)
+            drawing, seq = self._source
+            line = {"t_ms": t_ms, "wall_ms": wall_ms, **change.as_dict()}
+            self._record.write(json.dumps({**line, "drawing": drawing, "seq": seq}) + "\n")
+        self._source = (None, None)  # one note, one change: the next write is told anew
+
+    def note_source(self, drawing: object, seq: object) -> None:
+        """The stroke (``drawing``, ``seq``) whose command the next change is, for the record.
+
+        Called by the player before each write; the hardware backend has no record and
+        no such method.
+        """
+        self._source = (drawing, seq)
 
     def _all_off(self) -> None:
         for row, intensities in enumerate(self.snapshot()):
