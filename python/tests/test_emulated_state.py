@@ -169,3 +169,45 @@ def test_a_buzz_killed_with_sigkill_leaves_its_motor_on_until_the_next_start(
     assert done.returncode == 0, done.stderr
     assert set(drive_levels(path).values()) == {0.0}
     assert time.monotonic() - started < WAIT_S
+
+
+def test_off_after_a_sigkill_switches_every_reachable_motor_off_and_names_the_missing(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "bus.json"
+    state = ["--emulate-state", str(path)]
+    buzz = subprocess.Popen(
+        [sys.executable, "-m", "feelmysign", "buzz", "1", "1", "--layout", PAPER, *state],
+        stdout=subprocess.DEVNULL,
+    )
+    try:
+        assert wait_until(lambda: path.exists() and drive_levels(path)["0x70/5"] > 0)
+        buzz.send_signal(signal.SIGKILL)
+        buzz.wait(WAIT_S)
+    finally:
+        buzz.kill()
+    bus = read_state(path)
+    bus.detach_chip(0x71, 3)
+    write_state(bus, path)
+    assert drive_levels(path)["0x70/5"] > 0
+    off = [sys.executable, "-m", "feelmysign", "off", "--layout", PAPER, *state]
+    done = subprocess.run(off, capture_output=True, text=True, timeout=WAIT_S)
+    assert set(drive_levels(path).values()) == {0.0}
+    assert done.returncode == 1 and done.stderr.startswith("Error: Not every motor")
+    assert "multiplexer 0x71 channel 3" in done.stderr and "Traceback" not in done.stderr
+    bus = read_state(path)
+    bus.attach_chip(0x71, 3)
+    write_state(bus, path)
+    done = subprocess.run(off, capture_output=True, text=True, timeout=WAIT_S)
+    assert (done.returncode, done.stdout) == (
+        0,
+        f"Every motor is off (12 DRV2605L on the emulated bus in {path}).\n",
+    )
+
+
+def test_the_service_switches_every_motor_off_whenever_the_sleeve_ends() -> None:
+    service = (REPO / "deploy" / "feelmysign-sleeve.service").read_text()
+    start = next(line for line in service.splitlines() if line.startswith("ExecStart="))
+    stop_post = next(line for line in service.splitlines() if line.startswith("ExecStopPost="))
+    layout = start.split("--layout ", 1)[1].split()[0]
+    assert stop_post == f"ExecStopPost=/opt/feelmysign/bin/feelmysign off --layout {layout}"

@@ -38,6 +38,7 @@ SUBCOMMANDS = (
     "stop",
     "scan",
     "buzz",
+    "off",
 )
 
 

@@ -1,0 +1,72 @@
+"""``feelmysign off``: switch every motor of the sleeve off, whatever state the chips are in.
+
+    feelmysign off --layout /etc/feelmysign/layout.toml
+    feelmysign off --layout deploy/layouts/paper-sleeve.toml --emulate-state bus.json
+
+Writes "off" to every DRV2605L the layout wires (real-time level 0, then
+standby), trying each one even when another does not answer, and checks
+nothing first. Meant for after a crash: the sleeve's service runs it as soon
+as the sleeve process has ended, however it ended (``ExecStopPost``), so a
+motor left on by a ``kill -9`` or a crash is not left on until the restart.
+Exit 0 when every chip took the "off", 1 (naming the chips) otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+from feelmysign.backends.drv2605 import Drv2605Backend
+from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.i2c import I2CBus
+from feelmysign.cli._emulation import add_emulate_state_option
+from feelmysign.cli._options import LAYOUT_ENV
+from feelmysign.errors import HardwareError, LayoutError
+from feelmysign.layout import load_layout
+
+
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    parser = subparsers.add_parser(
+        "off",
+        help="switch every motor of the sleeve off (after a crash)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--layout",
+        metavar="FILE",
+        help=f"sleeve layout TOML file with an [i2c] table (default: ${LAYOUT_ENV})",
+    )
+    add_emulate_state_option(parser)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    path = args.layout or os.environ.get(LAYOUT_ENV, "")
+    if not path:
+        raise LayoutError(
+            "feelmysign off",
+            [f"no layout: give --layout FILE (or set {LAYOUT_ENV}) with the sleeve's [i2c] wiring"],
+        )
+    layout = load_layout(path)
+    if not layout.wiring:
+        raise LayoutError(
+            layout.name,
+            ["i2c.wiring: missing, so there is no chip to switch off; give the sleeve's layout"],
+        )
+    bus: I2CBus | None = None
+    where = f"/dev/i2c-{layout.i2c_bus}"
+    if args.emulate_state:
+        bus, where = (
+            open_state_bus(args.emulate_state, layout),
+            f"the emulated bus in {args.emulate_state}",
+        )
+    problems = Drv2605Backend(layout, bus=bus).switch_off_unchecked()
+    if problems:
+        listed = "\n".join(f"  - {p}" for p in problems)
+        raise HardwareError(
+            f"Not every motor could be switched off on {where}; if one keeps vibrating, cut the "
+            f"sleeve's power:\n{listed}"
+        )
+    print(f"Every motor is off ({len(layout.wiring)} DRV2605L on {where}).", flush=True)
+    return 0
