@@ -23,7 +23,17 @@ import {
   serveDist,
   tempDir,
 } from "./harness";
-import { CANVAS, drawingArea, drawWithMouse, nextFrame, screenshot, toGrid, waitForData, walk } from "./page";
+import {
+  CANVAS,
+  drawingArea,
+  drawWithMouse,
+  nextFrame,
+  screenshot,
+  toGrid,
+  waitForData,
+  walk,
+  openAdvanced,
+} from "./page";
 
 /** Grid units: the live frames see a corner up to check_frames frames late or early (~20 px here). */
 const CORNER_TOLERANCE = 0.15;
@@ -186,6 +196,7 @@ describe("drawing with a mouse on a desktop", () => {
   });
 
   it("keeps pen pressure and lets it set the intensity", async () => {
+    await page.locator('[data-testid="new-button"]').click();
     const area = await drawingArea(page);
     const cdp = await page.context().newCDPSession(page);
     const before = sleeve.strokes().length;
@@ -225,6 +236,7 @@ describe("drawing with a mouse on a desktop", () => {
     const panel = page.locator('[data-testid="settings-panel"]');
     await panel.waitFor({ state: "visible" });
     await screenshot(page, "desktop-settings");
+    await openAdvanced(page);
     const checkFrames = page.locator('[data-testid="setting-check_frames"]');
     await checkFrames.fill("1");
     await expect(page.locator("#setting-check_frames-error").innerText()).resolves.toBe(
@@ -232,6 +244,11 @@ describe("drawing with a mouse on a desktop", () => {
     );
     expect(await page.locator('[data-testid="settings-save"]').isDisabled()).toBe(true);
     await screenshot(page, "desktop-settings-error");
+    // Only decimal numbers: 0x1 is not read as 1.
+    await page.locator('[data-testid="setting-intensity"]').fill("0x1");
+    await expect(page.locator("#setting-intensity-error").innerText()).resolves.toContain(
+      "Intensity must be",
+    );
     await checkFrames.fill("6");
     await page.locator('[data-testid="setting-intensity"]').fill("0.5");
     expect(await page.locator('[data-testid="settings-save"]').isDisabled()).toBe(false);
@@ -239,6 +256,7 @@ describe("drawing with a mouse on a desktop", () => {
     await panel.waitFor({ state: "hidden" });
     await page.reload();
     await page.locator('[data-testid="settings-button"]').click();
+    await openAdvanced(page);
     await expect(page.locator('[data-testid="setting-check_frames"]').inputValue()).resolves.toBe("6");
     await expect(page.locator('[data-testid="setting-intensity"]').inputValue()).resolves.toBe("0.5");
     await page.locator("#settings-reset").click();
@@ -250,6 +268,7 @@ describe("drawing with a mouse on a desktop", () => {
   it("sends legacy text to the legacy topic when chosen", async () => {
     await sleeve.client.subscribeAsync("deviceOne/line", { qos: 1 });
     await page.locator('[data-testid="settings-button"]').click();
+    await openAdvanced(page);
     await page.locator('label:has([data-testid="setting-protocol"][value="legacy"])').click();
     await page.locator('[data-testid="settings-save"]').click();
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
@@ -308,8 +327,15 @@ describe("a broker that goes away", () => {
     await page.goto(server.url);
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
 
+    const stageBefore = await page.locator(CANVAS).boundingBox();
     await broker.stop();
     await waitForData(page, '[data-testid="broker-status"]', "state", "offline");
+    // Reconnection attempts every 2 s: the notice stays up and the drawing area does not move.
+    for (let k = 0; k < 60; k++) {
+      expect(await page.locator("#notice").isVisible(), `notice hidden at ${k * 50} ms`).toBe(true);
+      expect(await page.locator(CANVAS).boundingBox()).toEqual(stageBefore);
+      await new Promise((wake) => setTimeout(wake, 50));
+    }
     const area = await drawingArea(page);
     const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
     await drawWithMouse(page, [at(0.2, 0.2), at(0.2, 0.8), at(0.8, 0.8)]);
@@ -324,6 +350,8 @@ describe("a broker that goes away", () => {
     expect(strokes.map((stroke) => stroke["seq"])).toEqual([0, 1]);
     await waitForData(page, '[data-testid="unsent-count"]', "count", "0");
     expect(await page.locator(CANVAS).isVisible()).toBe(true);
+    await page.locator("#notice").waitFor({ state: "hidden" });
+    expect(await page.locator(CANVAS).boundingBox()).toEqual(stageBefore);
   });
 });
 

@@ -211,6 +211,53 @@ export async function launchBrowser(
   };
 }
 
+// ---- feelmysign up ----------------------------------------------------------------------------
+
+const UP_READY_TIMEOUT_MS = 30_000;
+
+/** Starts `feelmysign up` on free ports and resolves with its page URL once it prints it. */
+export async function startUp(
+  stateDir: string,
+  extraArgs: readonly string[] = [],
+): Promise<{ child: ChildProcess; url: string }> {
+  const child = spawn(
+    FEELMYSIGN,
+    ["up", "--state-dir", stateDir, "--http-port", "0", "--port", "0", "--ws-port", "0", ...extraArgs],
+    { stdio: ["ignore", "pipe", "pipe"] },
+  );
+  let output = "";
+  const url = await new Promise<string>((ready, fail) => {
+    const timer = setTimeout(
+      () => fail(new Error(`feelmysign up printed no URL in ${UP_READY_TIMEOUT_MS} ms:\n${output}`)),
+      UP_READY_TIMEOUT_MS,
+    );
+    const collect = (chunk: Buffer) => {
+      output += chunk.toString();
+      const match = /(http:\/\/127\.0\.0\.1:\d+\/)/.exec(output);
+      if (match && /Ctrl-C/.test(output)) {
+        clearTimeout(timer);
+        ready(match[1]!);
+      }
+    };
+    child.stdout!.on("data", collect);
+    child.stderr!.on("data", collect);
+    child.once("exit", (code) => {
+      clearTimeout(timer);
+      fail(new Error(`feelmysign up exited with ${code}:\n${output}`));
+    });
+  });
+  return { child, url };
+}
+
+export async function stopUp(child: ChildProcess): Promise<void> {
+  if (child.exitCode !== null || child.signalCode !== null) return;
+  const exited = new Promise((done) => child.once("exit", done));
+  child.kill("SIGINT");
+  const timer = setTimeout(() => child.kill("SIGKILL"), 10_000);
+  await exited;
+  clearTimeout(timer);
+}
+
 // ---- the sleeve, played by the test ----------------------------------------------------------
 
 export interface Received {

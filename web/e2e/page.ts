@@ -136,3 +136,10 @@ export async function waitForData(
     throw new Error(`${selector} data-${key}: expected ${value}, still ${actual} after ${timeoutMs} ms`);
   }
 }
+
+/** Opens the settings' Advanced level (whatever state it was left in). */
+export async function openAdvanced(page: Page): Promise<void> {
+  await page.locator('[data-testid="settings-advanced"]').evaluate((details) => {
+    (details as HTMLDetailsElement).open = true;
+  });
+}

@@ -15,7 +15,7 @@ import {
   serveDist,
   tempDir,
 } from "./harness";
-import { CANVAS, drawingArea, drawWithTouch, screenshot, toGrid, waitForData } from "./page";
+import { CANVAS, drawingArea, drawWithTouch, screenshot, toGrid, waitForData, openAdvanced } from "./page";
 
 /** Grid units: see desktop.e2e.ts; finger steps are the same 5 px per frame. */
 const CORNER_TOLERANCE = 0.15;
@@ -106,6 +106,7 @@ describe("drawing with a finger on a phone", () => {
     const box = await panel.boundingBox();
     expect(box?.width).toBeCloseTo(390, 0);
     await screenshot(page, "phone-settings");
+    await openAdvanced(page);
     const password = page.locator('[data-testid="setting-password"]');
     await password.scrollIntoViewIfNeeded();
     expect(await password.isVisible()).toBe(true);
@@ -133,6 +134,7 @@ describe("a page served without /config.json (vite dev)", () => {
         "No server config (/config.json: HTTP 404)",
       );
       await page.locator('[data-testid="settings-button"]').tap();
+      await openAdvanced(page);
       const url = page.locator('[data-testid="setting-ws_url"]');
       expect(await url.isEnabled()).toBe(true);
       expect(await page.locator('[data-field="broker_custom"]').isHidden()).toBe(true);

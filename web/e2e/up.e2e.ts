@@ -4,7 +4,7 @@
  * with the mouse, the sleeve playing its four strokes, the preview lighting up.
  * Skipped, saying why, on a checkout whose CLI has no `up` yet.
  */
-import { spawn, spawnSync, type ChildProcess } from "node:child_process";
+import { spawnSync } from "node:child_process";
 import { readFileSync, rmSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
@@ -14,55 +14,16 @@ import {
   FakeSleeve,
   FEELMYSIGN,
   launchBrowser,
+  startUp,
+  stopUp,
   tempDir,
   type Credentials,
 } from "./harness";
 import { drawingArea, drawWithMouse, screenshot, toGrid, waitForData } from "./page";
 
-const UP_READY_TIMEOUT_MS = 30_000;
 /** Grid units, as in desktop.e2e.ts. */
 const CORNER_TOLERANCE = 0.15;
 const hasUp = spawnSync(FEELMYSIGN, ["up", "--help"], { stdio: "ignore" }).status === 0;
-
-/** Starts `feelmysign up` on free ports and resolves with its page URL once it prints it. */
-async function startUp(stateDir: string): Promise<{ child: ChildProcess; url: string }> {
-  const child = spawn(
-    FEELMYSIGN,
-    ["up", "--state-dir", stateDir, "--http-port", "0", "--port", "0", "--ws-port", "0"],
-    { stdio: ["ignore", "pipe", "pipe"] },
-  );
-  let output = "";
-  const url = await new Promise<string>((ready, fail) => {
-    const timer = setTimeout(
-      () => fail(new Error(`feelmysign up printed no URL in ${UP_READY_TIMEOUT_MS} ms:\n${output}`)),
-      UP_READY_TIMEOUT_MS,
-    );
-    const collect = (chunk: Buffer) => {
-      output += chunk.toString();
-      const match = /(http:\/\/127\.0\.0\.1:\d+\/)/.exec(output);
-      if (match && /Ctrl-C/.test(output)) {
-        clearTimeout(timer);
-        ready(match[1]!);
-      }
-    };
-    child.stdout!.on("data", collect);
-    child.stderr!.on("data", collect);
-    child.once("exit", (code) => {
-      clearTimeout(timer);
-      fail(new Error(`feelmysign up exited with ${code}:\n${output}`));
-    });
-  });
-  return { child, url };
-}
-
-async function stopUp(child: ChildProcess): Promise<void> {
-  if (child.exitCode !== null || child.signalCode !== null) return;
-  const exited = new Promise((done) => child.once("exit", done));
-  child.kill("SIGINT");
-  const timer = setTimeout(() => child.kill("SIGKILL"), 10_000);
-  await exited;
-  clearTimeout(timer);
-}
 
 describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", () => {
   const cleanups: (() => Promise<void>)[] = [];

@@ -11,8 +11,6 @@ export const CANCEL_ALL = "*";
 /** The same limit as a stroke's payload: the sleeve checks every message alike. */
 const MAX_PAYLOAD_BYTES = 512;
 
-export const controlTopic = (sleeveId: string): string => `feelmysign/${sleeveId}/control`;
-
 export interface ControlRefusal {
   readonly reason: string;
   readonly field: string | null;

@@ -98,8 +98,48 @@ export class Drawing {
     return drawn.stroke?.seq != null && this.#acked.has(drawn.stroke.seq);
   }
 
+  /** Strokes numbered so far (sent, or queued to be), including those of undone paths. */
   get strokeCount(): number {
     return this.#nextSeq;
+  }
+
+  /** The strokes of the paths still in the drawing, in order. */
+  get strokes(): Stroke[] {
+    return this.segments.flatMap((drawn) => (drawn.stroke === null ? [] : [drawn.stroke]));
+  }
+
+  /**
+   * Forgets the last path (Undo): its samples, frames and segments. Its strokes
+   * keep their seq (the sleeve has them already); the next path continues after.
+   */
+  removeLastPath(): boolean {
+    const path = this.currentPath;
+    if (path < 0) return false;
+    this.paths.pop();
+    this.frames.pop();
+    this.pointerKinds.pop();
+    while (this.segments.length > 0 && this.segments[this.segments.length - 1]!.path === path) {
+      const drawn = this.segments.pop()!;
+      if (drawn.stroke?.seq != null) this.#bySeq.delete(drawn.stroke.seq);
+    }
+    return true;
+  }
+
+  /**
+   * The same paths and segments under another id, strokes numbered from 0 again:
+   * what Play again sends (the sleeve would refuse the old id's seqs as duplicates).
+   */
+  copyAs(id: string, params: SimplifierParams = this.params): Drawing {
+    const copy = new Drawing(id, params);
+    this.paths.forEach((samples, path) => {
+      copy.beginPath(this.pointerKinds[path] ?? "mouse");
+      copy.paths[path]!.push(...samples);
+      copy.frames[path]!.push(...(this.frames[path] ?? []));
+      for (const drawn of this.segments) {
+        if (drawn.path === path) copy.addSegment(drawn.segment, drawn.stroke?.intensity ?? 1);
+      }
+    });
+    return copy;
   }
 
   /**

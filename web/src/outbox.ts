@@ -7,6 +7,8 @@
 export interface OutboxEntry<T> {
   readonly id: number;
   readonly item: T;
+  /** When it was added (performance.now() ms): how long it has waited. */
+  readonly added_ms: number;
 }
 
 export class Outbox<T> {
@@ -14,8 +16,8 @@ export class Outbox<T> {
   readonly #inFlight = new Map<number, OutboxEntry<T>>();
   #nextId = 0;
 
-  add(item: T): void {
-    this.#queued.push({ id: this.#nextId++, item });
+  add(item: T, nowMs: number = performance.now()): void {
+    this.#queued.push({ id: this.#nextId++, item, added_ms: nowMs });
   }
 
   /** Queued plus in flight: every stroke the sleeve may not have yet. */
@@ -47,6 +49,13 @@ export class Outbox<T> {
     this.#inFlight.delete(id);
     this.#queued.push(entry);
     this.#queued.sort((a, b) => a.id - b.id);
+  }
+
+  /** Removes the queued (not in flight) entries `drop` picks; returns their items. */
+  dropQueued(drop: (item: T, entry: OutboxEntry<T>) => boolean): T[] {
+    const dropped = this.#queued.filter((entry) => drop(entry.item, entry)).map((entry) => entry.item);
+    this.#queued = this.#queued.filter((entry) => !drop(entry.item, entry));
+    return dropped;
   }
 
   /** A new connection replaces the old one: everything in flight is sent again. */

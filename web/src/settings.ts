@@ -19,6 +19,10 @@ import type { Algorithm, SimplifierParams } from "./simplify/registry";
 import { windowParamSpec, type WindowParamName, type WindowParams } from "./simplify/window-params";
 
 export type WireProtocol = "json" | "legacy";
+/** Strokes that could not be sent at once (no broker): sent when it is back, or dropped. */
+export type LateStrokes = "send" | "drop";
+/** With "drop": a stroke not sent within this time is no longer the drawing's touch. */
+export const LATE_LIMIT_MS = 2000;
 export type GridSource = "status" | "manual";
 
 export interface Settings {
@@ -35,6 +39,7 @@ export interface Settings {
   readonly min_length: number;
   readonly stretch: boolean;
   readonly clear_on_press: boolean;
+  readonly late_strokes: LateStrokes;
   /** Where the grid comes from: the sleeve's retained status, or rows/columns below. */
   readonly grid_source: GridSource;
   readonly rows: number;
@@ -123,7 +128,24 @@ function textProblem(value: unknown, check: (text: string) => string | null): st
 }
 
 export const FIELDS: readonly FieldSpec[] = [
-  paramField("clear_on_press", "drawing", "Clear on press"),
+  {
+    ...paramField("clear_on_press", "drawing", "Clear on press"),
+    help:
+      "on: every press starts a new drawing, as in the paper; off: a press adds a path to the drawing " +
+      "(letters of several strokes), and New drawing starts over",
+  },
+  {
+    key: "late_strokes",
+    section: "drawing",
+    label: "Timing",
+    help: `strokes drawn while the broker is out of reach: sent when it is back (felt late), or dropped after ${LATE_LIMIT_MS / 1000} s`,
+    kind: "choice",
+    choices: [
+      { value: "send", label: "Send late" },
+      { value: "drop", label: "Drop late" },
+    ],
+    problem: (value) => (value === "send" || value === "drop" ? null : "must be a listed choice"),
+  },
   {
     key: "intensity",
     section: "drawing",
@@ -284,7 +306,9 @@ export const DEFAULT_SETTINGS: Settings = Object.freeze({
   min_duration_ms: paramDefault<number>("min_duration_ms"),
   min_length: paramDefault<number>("min_length"),
   stretch: paramDefault<boolean>("stretch"),
-  clear_on_press: paramDefault<boolean>("clear_on_press"),
+  // The paper cleared the drawing at every press; people expect a letter of several paths.
+  clear_on_press: false,
+  late_strokes: "send",
   grid_source: "status",
   rows: paramDefault<number>("rows"),
   columns: paramDefault<number>("columns"),

@@ -255,6 +255,7 @@ class Sleeve:
         client.publish(
             telemetry_topic(self._id, "status"), self._status(online=True), qos=1, retain=True
         )
+        self._count("connections")  # `up` tells the terminal when the sleeve is back
         self._connected.set()
         session = "resumed" if getattr(flags, "session_present", False) else "new"
         log.info("sleeve %s: connected to %s (%s session)", self._id, self._settings.url, session)

@@ -6,9 +6,10 @@
  * honest. `sent_at_ms` is stamped when a stroke actually goes out.
  */
 import mqtt, { type IClientOptions, type MqttClient } from "mqtt";
+import { CANCEL_ALL, formatControl } from "../control";
 import { Outbox } from "../outbox";
 import { formatJson, formatLegacy, StrokeError, type Stroke } from "../protocol";
-import { strokesTopic, telemetryTopic } from "./topics";
+import { controlTopic, strokesTopic, telemetryTopic } from "./topics";
 
 export type BrokerState = "connecting" | "connected" | "offline";
 export type WireProtocol = "json" | "legacy";
@@ -32,6 +33,8 @@ export interface SenderListener {
   acked(stroke: Stroke): void;
   /** A stroke that could not be formatted: reported, never silently dropped. */
   refused(stroke: Stroke, error: StrokeError): void;
+  /** Strokes that waited longer than the late limit and were dropped (the "drop late" policy). */
+  late(strokes: Stroke[]): void;
 }
 
 /** How long to wait between reconnection attempts. */
@@ -52,6 +55,10 @@ export class StrokeSender {
   readonly #decoder = new TextDecoder();
   #client: MqttClient | null = null;
   #target: SenderTarget | null = null;
+  /** Cancels not yet acknowledged by the broker, sent before any stroke when it is back. */
+  #cancels: string[] = [];
+  /** Strokes not sent within this many ms are dropped; null: they go out whenever possible. */
+  #lateLimitMs: number | null = null;
 
   constructor(listener: SenderListener) {
     this.#listener = listener;
@@ -146,6 +153,23 @@ export class StrokeSender {
     this.#flush();
   }
 
+  /**
+   * Cancels a drawing (or everything: "*") on the sleeve: its strokes still in
+   * the outbox are dropped here, and a control message tells the sleeve to stop
+   * playing and drop the rest. Returns how many unsent strokes were dropped.
+   */
+  cancel(drawing: string): number {
+    const dropped = this.#outbox.dropQueued((stroke) => drawing === CANCEL_ALL || stroke.drawing === drawing);
+    this.#cancels = [...this.#cancels.filter((d) => d !== drawing), drawing];
+    this.#flush();
+    return dropped.length;
+  }
+
+  /** The timing policy for strokes drawn while the broker is out of reach. */
+  setLateLimit(limitMs: number | null): void {
+    this.#lateLimitMs = limitMs;
+  }
+
   stop(): void {
     this.#close();
   }
@@ -160,6 +184,18 @@ export class StrokeSender {
     const client = this.#client;
     const target = this.#target;
     if (client !== null && target !== null && client.connected) {
+      const limit = this.#lateLimitMs;
+      if (limit !== null) {
+        const now = performance.now();
+        const late = this.#outbox.dropQueued((_stroke, entry) => now - entry.added_ms > limit);
+        if (late.length > 0) this.#listener.late(late);
+      }
+      for (const drawing of this.#cancels) {
+        // QoS 1 as strokes: published in order, ahead of what is queued now.
+        client.publish(controlTopic(target.sleeve_id), formatControl(drawing), { qos: 1 }, (error) => {
+          if (client === this.#client && !error) this.#cancels = this.#cancels.filter((d) => d !== drawing);
+        });
+      }
       for (const entry of this.#outbox.takeQueued()) {
         const message = this.#format(entry.item, target);
         if (message instanceof StrokeError) {

@@ -8,13 +8,15 @@
  *         (dim) and sent ones (solid, drawn over the dim line on PUBACK), dropped
  *         ones (dashed red), strokes the sleeve refused; only the new bits are
  *         drawn each frame, and everything only on a resize or a new drawing
+ *   compare  the same paths under the A/B comparison's settings (dashed), when shown
+ *   marker   where the brush is on the sleeve now, while a drawing is felt
  *   live  the stroke being drawn, highlighted; cleared and redrawn alone each frame
  *
  * Coordinates: the simplifier sees the drawing's own canvas pixels (fixed when
  * the drawing starts); the screen may be resized since, so they are scaled.
  */
 import type { Drawing, DrawnSegment } from "../drawing";
-import type { Sample } from "../simplify/segment";
+import type { Point, Sample } from "../simplify/segment";
 import { AREA_MARGIN_PX, fitArea, gridToCanvas, type GridSize, type MappingShape } from "./geometry";
 
 const COLORS = {
@@ -25,6 +27,8 @@ const COLORS = {
   sent: "#ff8a5b",
   waiting: "rgba(255, 138, 91, 0.35)",
   live: "#ffd166",
+  compare: "#5ec8ff",
+  marker: "#ffd166",
   dropped: "#ff6b6b",
   rejected: "#ff6b6b",
   /** The stage's own colour (--surface): a refused stroke is first wiped out with it. */
@@ -46,8 +50,13 @@ export class DrawingView {
   readonly surface: HTMLCanvasElement;
   readonly #gridCanvas: HTMLCanvasElement;
   readonly #inkCanvas: HTMLCanvasElement;
+  readonly #compareCanvas: HTMLCanvasElement;
+  readonly #markerCanvas: HTMLCanvasElement;
   readonly #grid2d: CanvasRenderingContext2D;
   readonly #ink2d: CanvasRenderingContext2D;
+  readonly #compare2d: CanvasRenderingContext2D;
+  readonly #marker2d: CanvasRenderingContext2D;
+  #compareSegments: readonly (readonly [Point, Point])[] | null = null;
   readonly #live2d: CanvasRenderingContext2D;
   #grid: GridSize = { rows: 3, columns: 4 };
   #stretch = false;
@@ -70,12 +79,16 @@ export class DrawingView {
     this.stage = stage;
     this.#gridCanvas = this.#addCanvas("grid");
     this.#inkCanvas = this.#addCanvas("ink");
+    this.#compareCanvas = this.#addCanvas("compare");
+    this.#markerCanvas = this.#addCanvas("marker");
     this.surface = this.#addCanvas("live");
     this.surface.dataset["testid"] = "drawing-canvas";
     this.surface.setAttribute("role", "img");
     this.surface.setAttribute("aria-label", "Drawing area: draw with a finger, pen or mouse");
     this.#grid2d = context(this.#gridCanvas);
     this.#ink2d = context(this.#inkCanvas);
+    this.#compare2d = context(this.#compareCanvas);
+    this.#marker2d = context(this.#markerCanvas);
     this.#live2d = context(this.surface);
   }
 
@@ -115,12 +128,19 @@ export class DrawingView {
     const heightPx = area.height_px + 2 * AREA_MARGIN_PX;
     this.stage.style.width = `${widthPx}px`;
     this.stage.style.height = `${heightPx}px`;
-    for (const canvas of [this.#gridCanvas, this.#inkCanvas, this.surface]) {
+    const canvases = [
+      this.#gridCanvas,
+      this.#inkCanvas,
+      this.#compareCanvas,
+      this.#markerCanvas,
+      this.surface,
+    ];
+    for (const canvas of canvases) {
       // Backing store in device pixels: sharp lines on HiDPI screens.
       canvas.width = Math.round(widthPx * dpr);
       canvas.height = Math.round(heightPx * dpr);
     }
-    for (const ctx of [this.#grid2d, this.#ink2d, this.#live2d]) {
+    for (const ctx of [this.#grid2d, this.#ink2d, this.#compare2d, this.#marker2d, this.#live2d]) {
       ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
       ctx.lineCap = "round";
       ctx.lineJoin = "round";
@@ -131,6 +151,7 @@ export class DrawingView {
     this.surface.dataset["areaHeightPx"] = String(area.height_px);
     this.#drawGrid();
     this.#redrawInk();
+    this.#drawCompare();
     this.#liveShown = true;
     this.clearLive();
   }
@@ -141,6 +162,49 @@ export class DrawingView {
     this.#rejected = [];
     this.#acked = [];
     this.#redrawInk();
+  }
+
+  /** The A/B comparison's strokes (grid units, the drawing's mapping), or null to hide them. */
+  setCompare(segments: readonly (readonly [Point, Point])[] | null): void {
+    this.#compareSegments = segments;
+    this.#drawCompare();
+  }
+
+  /** Where the brush is on the sleeve now (grid units), or null. */
+  drawMarker(point: Point | null): void {
+    const ctx = this.#marker2d;
+    ctx.clearRect(0, 0, this.#markerCanvas.width, this.#markerCanvas.height);
+    const shape = this.#segmentShape();
+    this.surface.dataset["marker"] = point === null ? "" : `${point[0].toFixed(2)},${point[1].toFixed(2)}`;
+    if (point === null || shape === null) return;
+    const [x, y] = this.#gridToCss(point[0], point[1], shape);
+    ctx.save();
+    ctx.shadowColor = COLORS.marker;
+    ctx.shadowBlur = 18;
+    ctx.strokeStyle = COLORS.marker;
+    ctx.lineWidth = 3;
+    ctx.beginPath();
+    ctx.arc(x, y, 11, 0, 2 * Math.PI);
+    ctx.stroke();
+    ctx.restore();
+  }
+
+  #drawCompare(): void {
+    const ctx = this.#compare2d;
+    ctx.clearRect(0, 0, this.#compareCanvas.width, this.#compareCanvas.height);
+    const shape = this.#segmentShape();
+    if (this.#compareSegments === null || shape === null) return;
+    ctx.save();
+    ctx.strokeStyle = COLORS.compare;
+    ctx.lineWidth = 2.5;
+    ctx.setLineDash([8, 5]);
+    for (const [start, end] of this.#compareSegments) {
+      ctx.beginPath();
+      ctx.moveTo(...this.#gridToCss(start[0], start[1], shape));
+      ctx.lineTo(...this.#gridToCss(end[0], end[1], shape));
+      ctx.stroke();
+    }
+    ctx.restore();
   }
 
   /** A stroke the broker acknowledged: drawn solid on the next flush. */

@@ -38,6 +38,8 @@ export class DrawingSession {
   #sampler = new FrameSampler(60);
   #pointerKind: PointerKind = "mouse";
   #pointer: Sample | null = null;
+  /** A finished drawing stays on the canvas, but the next press starts a new one (after Stop). */
+  #closed = false;
   #loopRunning = false;
   #flushScheduled = false;
   readonly #frameWorkMs: number[] = [];
@@ -59,7 +61,7 @@ export class DrawingSession {
   /** `readSample` is called once the drawing is chosen: its canvas converts the position. */
   press(readSample: () => Sample, kind: PointerKind): void {
     const settings = this.#host.settings();
-    if (this.#drawing === null || settings.clear_on_press) this.#newDrawing(settings);
+    if (this.#drawing === null || this.#closed || settings.clear_on_press) this.#newDrawing(settings);
     const drawing = this.#drawing!;
     const sample = readSample();
     this.#pointerKind = kind;
@@ -99,8 +101,37 @@ export class DrawingSession {
     if (this.#sampler.pressed) return;
     this.#drawing = null;
     this.#simplifier = null;
+    this.#closed = false;
     this.#view.setDrawing(null);
     this.#host.changed(null);
+  }
+
+  /** Keeps the drawing on the canvas but starts a new one at the next press. */
+  close(): void {
+    this.#closed = true;
+  }
+
+  /** Takes back the last path; false when there is none (or while drawing). */
+  undo(): boolean {
+    const drawing = this.#drawing;
+    if (this.#sampler.pressed || drawing === null || !drawing.removeLastPath()) return false;
+    if (drawing.paths.length === 0) {
+      this.clear();
+      return true;
+    }
+    this.#view.setDrawing(drawing);
+    this.#host.changed(drawing);
+    return true;
+  }
+
+  /** Shows `drawing` (loaded, re-simplified or played again) as the current one; drawing on adds to it. */
+  adopt(drawing: Drawing): void {
+    if (this.#sampler.pressed) return;
+    this.#drawing = drawing;
+    this.#simplifier = makeSimplifier(drawing.params);
+    this.#closed = false;
+    this.#view.setDrawing(drawing);
+    this.#host.changed(drawing);
   }
 
   /** The broker acknowledged `stroke`: drawn solid. */

@@ -18,6 +18,7 @@ export class SleevePreview {
   #frame: ActuatorFrame | null = null;
   #scheduled = false;
   #framesSeen = 0;
+  #online = false;
 
   constructor(canvas: HTMLCanvasElement, caption: HTMLElement) {
     this.#canvas = canvas;
@@ -44,9 +45,13 @@ export class SleevePreview {
     this.#schedule();
   }
 
-  /** The sleeve went away: nothing is felt any more. */
-  reset(message: string): void {
-    this.#frame = null;
+  /**
+   * The sleeve's state changed: `message` says so (the same as the status chip). Offline,
+   * absent or unknown, nothing is felt any more; online, the frames that follow take over.
+   */
+  reset(message: string, online = false): void {
+    if (!online) this.#frame = null;
+    this.#online = online;
     this.#caption.textContent = message;
     this.#schedule();
   }
@@ -114,7 +119,7 @@ export class SleevePreview {
         ? "Sleeve preview: all actuators off"
         : `Sleeve preview: ${lit} actuator(s) on, strongest ${Math.round(strongest * 100)}%`,
     );
-    if (this.#frame !== null) {
+    if (this.#frame !== null && this.#online) {
       this.#caption.textContent =
         lit === 0
           ? `${rows} × ${columns} actuators · all still`

@@ -16,6 +16,13 @@ import {
 import type { GridSize } from "./geometry";
 import { byId } from "./status";
 import { ONLY_FOR } from "../simplify/registry";
+import { DETAIL_LEVELS, detailLevel, detailValues } from "./detail";
+
+/** The few settings most people change; everything else is under Advanced. */
+const BASIC: readonly SettingKey[] = ["intensity", "late_strokes", "clear_on_press", "sleeve_id"];
+const DETAIL_NAMES = ["coarse", "broad", "medium", "fine", "finest"] as const;
+/** A decimal number as people type it: no hex (0x10), no words (Infinity), no digit separators. */
+const DECIMAL = /^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$/;
 
 const SECTIONS: readonly { id: FieldSpec["section"]; title: string; note?: string }[] = [
   { id: "drawing", title: "Drawing" },
@@ -36,6 +43,8 @@ export interface SettingsPanelContext {
   readonly config: ServerConfig | null;
   /** The grid the sleeve reports, for the "From the sleeve" choice. */
   readonly sleeveGrid: GridSize | null;
+  /** The sleeve's actuator spacing: what one grid unit is on the skin. */
+  readonly spacingCm?: number | null;
 }
 
 export class SettingsPanel {
@@ -52,6 +61,9 @@ export class SettingsPanel {
   #current: Settings = defaultSettings(null);
   #gridNote: HTMLElement | null = null;
   #brokerNote: HTMLElement | null = null;
+  #unitNote: HTMLElement | null = null;
+  #detail: HTMLInputElement | null = null;
+  #detailText: HTMLElement | null = null;
 
   constructor(root: Document, onSave: (settings: Settings) => void) {
     this.#dialog = byId<HTMLDialogElement>(root, "settings");
@@ -89,12 +101,29 @@ export class SettingsPanel {
   }
 
   #build(): void {
+    const basic = document.createElement("fieldset");
+    const basicLegend = document.createElement("legend");
+    basicLegend.textContent = "Basic";
+    basic.append(basicLegend, this.#fieldRow(FIELDS.find((f) => f.key === "intensity")!), this.#detailRow());
+    for (const field of FIELDS.filter((f) => BASIC.includes(f.key) && f.key !== "intensity"))
+      basic.append(this.#fieldRow(field));
+    this.#body.append(basic);
+    const advanced = document.createElement("details");
+    advanced.className = "settings-level";
+    advanced.dataset["testid"] = "settings-advanced";
+    const summary = document.createElement("summary");
+    summary.textContent = "Advanced: every research parameter";
+    advanced.append(summary);
     for (const section of SECTIONS) {
       const fieldset = document.createElement("fieldset");
       const legend = document.createElement("legend");
       legend.textContent = section.title;
       fieldset.append(legend);
       if (section.note !== undefined) fieldset.append(paragraph("section-note", section.note));
+      if (section.id === "simplifier") {
+        this.#unitNote = paragraph("section-note", "");
+        fieldset.append(this.#unitNote);
+      }
       if (section.id === "sleeve") {
         this.#gridNote = paragraph("section-note", "");
         fieldset.append(this.#gridNote);
@@ -103,10 +132,53 @@ export class SettingsPanel {
         this.#brokerNote = paragraph("section-note", "");
         fieldset.append(this.#brokerNote);
       }
-      for (const field of FIELDS.filter((f) => f.section === section.id))
+      for (const field of FIELDS.filter((f) => f.section === section.id && !BASIC.includes(f.key)))
         fieldset.append(this.#fieldRow(field));
-      this.#body.append(fieldset);
+      advanced.append(fieldset);
     }
+    this.#body.append(advanced);
+  }
+
+  /** One control for how closely strokes follow the hand; it sets max error and max angle. */
+  #detailRow(): HTMLElement {
+    const row = document.createElement("div");
+    row.className = "field";
+    row.dataset["kind"] = "range";
+    const label = document.createElement("label");
+    label.className = "field-label";
+    label.htmlFor = "setting-detail";
+    label.textContent = "Detail";
+    const input = document.createElement("input");
+    input.type = "range";
+    input.id = "setting-detail";
+    input.min = "1";
+    input.max = String(DETAIL_LEVELS);
+    input.step = "1";
+    input.dataset["testid"] = "setting-detail";
+    const value = paragraph("unit", "", "span");
+    const control = document.createElement("div");
+    control.className = "field-control";
+    control.append(input, value);
+    const help = paragraph(
+      "field-help",
+      "Coarse: few long strokes; finest: many short ones that follow the hand closely. " +
+        "Sets the max error (window) and max angle (angle) under Advanced.",
+      "span",
+    );
+    input.addEventListener("input", () => {
+      const values = detailValues(Number(input.value));
+      const set = (key: SettingKey, number: number) => {
+        const target = this.#inputs.get(key)?.[0];
+        if (target !== undefined) target.value = String(number);
+      };
+      set("max_error", values.max_error);
+      set("max_angle_deg", values.max_angle_deg);
+      this.#validate();
+    });
+    this.#detail = input;
+    this.#detailText = value;
+    row.append(label, control, help);
+    return row;
   }
 
   #fieldRow(field: FieldSpec): HTMLElement {
@@ -185,6 +257,7 @@ export class SettingsPanel {
   }
 
   #fill(settings: Settings): void {
+    if (this.#detail !== null) this.#detail.value = String(detailLevel(settings.algorithm, settings));
     for (const field of FIELDS) {
       const inputs = this.#inputs.get(field.key) ?? [];
       const value = settings[field.key];
@@ -216,6 +289,10 @@ export class SettingsPanel {
     const candidate = this.#read();
     const errors = validateSettings(candidate);
     this.#applyDependencies(candidate);
+    if (this.#detailText !== null && this.#detail !== null) {
+      const level = Number(this.#detail.value);
+      this.#detailText.textContent = `${level} · ${DETAIL_NAMES[level - 1] ?? ""}`;
+    }
     let count = 0;
     for (const field of FIELDS) {
       const message = this.#isDisabled(field.key, candidate) ? undefined : errors[field.key];
@@ -258,7 +335,12 @@ export class SettingsPanel {
       this.#rows.get(key)!.dataset["disabled"] = String(disabled);
       for (const input of this.#inputs.get(key) ?? []) input.disabled = disabled;
     }
-    const { config, sleeveGrid } = this.#context;
+    const { config, sleeveGrid, spacingCm } = this.#context;
+    if (this.#unitNote) {
+      this.#unitNote.textContent =
+        "Lengths are in grid units: 1 grid unit is the spacing between two neighbouring actuators" +
+        (spacingCm != null ? ` (${spacingCm} cm on this sleeve).` : " (the sleeve's layout gives it in cm).");
+    }
     const customRow = this.#rows.get("broker_custom");
     if (customRow) customRow.hidden = config === null;
     if (this.#brokerNote) {
@@ -303,10 +385,10 @@ function capitalize(text: string): string {
   return text.charAt(0).toUpperCase() + text.slice(1);
 }
 
-/** A number as typed: "" and anything unreadable give NaN, which the field reports. */
+/** A decimal number as typed (a decimal comma too); "", 0x10 and anything else give NaN, which the field reports. */
 function parseNumber(text: string): number {
   const trimmed = text.trim().replace(",", ".");
-  return trimmed === "" ? Number.NaN : Number(trimmed);
+  return DECIMAL.test(trimmed) ? Number(trimmed) : Number.NaN;
 }
 
 function paragraph(className: string, text: string, tag: "p" | "span" = "p"): HTMLElement {

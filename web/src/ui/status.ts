@@ -1,7 +1,8 @@
 /** The connection indicator: broker, sleeve, unsent strokes, and one notice line for problems. */
 import type { BrokerState } from "../mqtt/sender";
 
-export type SleeveState = "online" | "offline" | "unknown";
+/** unknown: not heard of yet; absent: the broker holds no status for this id (nothing listens). */
+export type SleeveState = "online" | "offline" | "unknown" | "absent";
 
 export class StatusBar {
   readonly #broker: HTMLElement;
@@ -30,6 +31,7 @@ export class StatusBar {
       online: `Sleeve ${sleeveId}: online`,
       offline: `Sleeve ${sleeveId}: offline`,
       unknown: `Sleeve ${sleeveId}: not seen yet`,
+      absent: `Sleeve ${sleeveId}: none listening`,
     }[state];
     setChip(this.#sleeve, state, text, detail ?? text);
   }
@@ -43,10 +45,12 @@ export class StatusBar {
   }
 
   /** One line above the canvas; null hides it. Errors are shown until resolved. */
-  setNotice(text: string | null, kind: "info" | "error" = "info"): void {
-    this.#notice.hidden = text === null;
-    this.#notice.textContent = text ?? "";
-    this.#notice.dataset["kind"] = kind;
+  setNotice(text: string | null, kind: "info" | "warn" | "error" = "info"): void {
+    // Only real changes touch the DOM: a notice rewritten on every reconnection attempt would flicker.
+    const hidden = text === null;
+    if (this.#notice.hidden !== hidden) this.#notice.hidden = hidden;
+    if (this.#notice.textContent !== (text ?? "")) this.#notice.textContent = text ?? "";
+    if (this.#notice.dataset["kind"] !== kind) this.#notice.dataset["kind"] = kind;
   }
 }
 

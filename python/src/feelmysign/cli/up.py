@@ -14,6 +14,7 @@ from feelmysign.cli._drawing_log import DrawingLog
 from feelmysign.cli._inputs import output_file, port, sleeve_id
 from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._signals import call_on_stop_signals
+from feelmysign.cli._watchdog import Watchdog
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
@@ -94,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
     port = _port_or_free(args.port, DEFAULT_MQTT_PORT, "MQTT")
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
     broker = Broker(state_dir=args.state_dir, port=port, ws_port=ws_port, sleeve_id=args.sleeve_id)
-    with broker:
+    watchdog = Watchdog(broker)
+    with broker, watchdog:
         c = broker.credentials
         config = {
             "ws_url": c.ws_url,
@@ -114,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
 
             def started(sleeve: Sleeve) -> None:
                 _stop_on_signals(sleeve)
+                watchdog.watch(sleeve)
                 threading.Thread(
                     target=_announce, args=(sleeve, web.url, broker), daemon=True
                 ).start()

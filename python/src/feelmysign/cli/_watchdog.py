@@ -1,0 +1,100 @@
+"""``feelmysign up`` keeps its parts alive and says what happens to them.
+
+Mosquitto is a separate process: if it dies (killed, out of memory), the
+watchdog says so and starts it again on the same ports with the same
+credentials, so the sleeve and the page reconnect by themselves. It also says
+when the sleeve loses the broker and when it is back. The sleeve itself runs
+in ``up``'s own process: if it stops, ``up`` stops with its error.
+"""
+
+from __future__ import annotations
+
+import threading
+from types import TracebackType
+from urllib.parse import urlsplit
+
+from feelmysign.broker import Broker
+from feelmysign.daemon import Sleeve
+from feelmysign.errors import BrokerError
+
+CHECK_INTERVAL_S = 0.5  # how soon a dead broker or a lost sleeve is noticed
+
+
+class Watchdog:
+    """Use as a context manager around the broker's life; ``watch`` the sleeve once it runs."""
+
+    def __init__(self, broker: Broker) -> None:
+        self._broker = broker
+        self._stopped = threading.Event()
+        self._sleeve: Sleeve | None = None
+        self._thread = threading.Thread(target=self._run, name="feelmysign-watchdog", daemon=True)
+
+    def __enter__(self) -> Watchdog:
+        # Kept now: a broker that died no longer tells its ports and accounts.
+        self._credentials = self._broker.credentials
+        self._thread.start()
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self._stopped.set()
+        self._thread.join(timeout=5.0)
+        self._broker.stop()  # a broker started here again is stopped here too
+
+    def watch(self, sleeve: Sleeve) -> None:
+        self._sleeve = sleeve
+
+    def _run(self) -> None:
+        connections = 0
+        lost = False
+        while not self._stopped.wait(CHECK_INTERVAL_S):
+            restarted = self._check_broker()
+            sleeve = self._sleeve
+            if sleeve is None:
+                continue
+            if restarted or (connections > 0 and not sleeve.connected.is_set() and not lost):
+                lost = True
+                print("The sleeve lost the broker; it reconnects by itself.", flush=True)
+            now = sleeve.counts["connections"]
+            if lost and now > connections and sleeve.connected.is_set():
+                lost = False
+                print("The sleeve is back: connected to the broker again.", flush=True)
+            if not lost:
+                connections = now
+
+    def _check_broker(self) -> bool:
+        """True when the broker had died and was started again."""
+        try:
+            self._broker.check_running()
+        except BrokerError as error:
+            if self._stopped.is_set():
+                return False
+            print(f"The broker stopped: {error}", flush=True)
+            return self._restart()
+        return False
+
+    def _restart(self) -> bool:
+        c = self._credentials
+        broker = Broker(
+            state_dir=self._broker.state_dir,
+            port=urlsplit(c.mqtt_url).port or 0,
+            ws_port=urlsplit(c.ws_url).port or 0,
+            sleeve_id=c.sleeve_id,
+        )
+        try:
+            broker.start()
+        except BrokerError as error:
+            print(
+                f"Could not start the broker again: {error}\n"
+                "Stop with Ctrl-C and run 'make up' again.",
+                flush=True,
+            )
+            self._stopped.set()
+            return False
+        self._broker = broker
+        print(f"The broker is running again on {broker.credentials.mqtt_url}.", flush=True)
+        return True

@@ -1,0 +1,80 @@
+"""``feelmysign up`` notices its broker died, starts it again, says when the sleeve is back.
+
+A real ``feelmysign up`` process (its own Mosquitto, the simulated sleeve); the
+test kills that Mosquitto with SIGKILL, by its process id.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+WAIT_S = 60.0
+
+
+def _lines(process: subprocess.Popen[str]) -> queue.Queue[str]:
+    lines: queue.Queue[str] = queue.Queue()
+
+    def read() -> None:
+        assert process.stdout is not None
+        for line in process.stdout:
+            lines.put(line)
+
+    threading.Thread(target=read, daemon=True).start()
+    return lines
+
+
+def _wait_for(lines: queue.Queue[str], text: str, seen: list[str]) -> None:
+    deadline = time.monotonic() + WAIT_S
+    while time.monotonic() < deadline:
+        try:
+            line = lines.get(timeout=0.5)
+        except queue.Empty:
+            continue
+        seen.append(line)
+        if text in line:
+            return
+    pytest.fail(f"no line with {text!r} in {WAIT_S:g} s:\n{''.join(seen)}")
+
+
+def _mosquitto_children(pid: int) -> list[int]:
+    found = subprocess.run(["pgrep", "-P", str(pid), "mosquitto"], capture_output=True, text=True)
+    return [int(p) for p in found.stdout.split()]
+
+
+def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path) -> None:
+    web = tmp_path / "web"
+    web.mkdir()
+    (web / "index.html").write_text("<!doctype html><title>test</title>")
+    command = [sys.executable, "-m", "feelmysign", "up", "--state-dir", str(tmp_path / "state")]
+    command += ["--http-port", "0", "--port", "0", "--ws-port", "0", "--web-dir", str(web)]
+    process = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1
+    )
+    seen: list[str] = []
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        (mosquitto,) = _mosquitto_children(process.pid)
+        os.kill(mosquitto, signal.SIGKILL)
+        _wait_for(lines, "The broker stopped", seen)
+        _wait_for(lines, "The broker is running again on", seen)
+        _wait_for(lines, "The sleeve is back", seen)
+        assert _mosquitto_children(process.pid) not in ([], [mosquitto])
+    finally:
+        process.send_signal(signal.SIGINT)
+        try:
+            code = process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            raise
+    assert code == 0, "".join(seen)
+    assert _mosquitto_children(process.pid) == []

@@ -1,0 +1,257 @@
+/**
+ * The page against `feelmysign up --record FILE`, the simulated sleeve really
+ * playing: a letter of two paths kept whole, Undo and New drawing, the felt
+ * timeline filled from the sleeve's events, Stop in the middle of a long
+ * drawing (every motor off in the sleeve's record within 20 ms of the cancel),
+ * a saved recording loaded back and played again, and an unknown sleeve id.
+ */
+import { readFileSync, rmSync } from "node:fs";
+import { join } from "node:path";
+import mqtt, { type MqttClient } from "mqtt";
+import type { Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import {
+  checkPrerequisites,
+  launchBrowser,
+  RESULTS_DIR,
+  startUp,
+  stopUp,
+  tempDir,
+  type Credentials,
+} from "./harness";
+import { drawingArea, drawWithMouse, screenshot, waitForData, type Area } from "./page";
+
+type Point = readonly [number, number];
+/** The issue's bound: every motor off this soon after the sleeve received the cancel. */
+const OFF_WITHIN_MS = 20;
+
+interface RecordLine {
+  t_ms: number;
+  row: number;
+  column: number;
+  intensity: number;
+}
+
+function readRecord(path: string): RecordLine[] {
+  return readFileSync(path, "utf8")
+    .split("\n")
+    .filter((line) => line.trim() !== "")
+    .map((line) => JSON.parse(line) as RecordLine);
+}
+
+/** Everything the sleeve says on its events topic, read with the sender's account. */
+class EventWatcher {
+  readonly events: Record<string, unknown>[] = [];
+  readonly client: MqttClient;
+
+  private constructor(client: MqttClient) {
+    this.client = client;
+    client.on("message", (_topic, payload) => this.events.push(JSON.parse(payload.toString("utf8"))));
+  }
+
+  static async connect(credentials: Credentials): Promise<EventWatcher> {
+    const client = await mqtt.connectAsync(credentials.mqtt_url, {
+      username: credentials.sender.username,
+      password: credentials.sender.password,
+      clientId: `test-events-${process.pid}-${Date.now()}`,
+    });
+    const watcher = new EventWatcher(client);
+    await client.subscribeAsync(`feelmysign/${credentials.sleeve.id}/events`, { qos: 1 });
+    return watcher;
+  }
+
+  async waitFor(
+    what: string,
+    test: (events: Record<string, unknown>[]) => boolean,
+    timeoutMs = 30_000,
+  ): Promise<Record<string, unknown>[]> {
+    const deadline = Date.now() + timeoutMs;
+    while (!test(this.events)) {
+      if (Date.now() > deadline)
+        throw new Error(`no ${what} after ${timeoutMs} ms: ${JSON.stringify(this.events.slice(-5))}`);
+      await new Promise((wake) => setTimeout(wake, 20));
+    }
+    return this.events;
+  }
+
+  of(drawing: string, type?: string): Record<string, unknown>[] {
+    return this.events.filter((e) => e["drawing"] === drawing && (type === undefined || e["type"] === type));
+  }
+}
+
+async function drawingId(page: Page): Promise<string> {
+  return page.evaluate(() => window.feelmysign?.drawingId ?? "");
+}
+
+async function dataOf(page: Page, testid: string, key: string): Promise<string> {
+  return page
+    .locator(`[data-testid="${testid}"]`)
+    .evaluate((el, k) => (el as HTMLElement).dataset[k] ?? "", key);
+}
+
+describe("the felt drawing, served by feelmysign up with the simulated sleeve", () => {
+  const cleanups: (() => Promise<void>)[] = [];
+  let page: Page;
+  let area: Area;
+  let watcher: EventWatcher;
+  let recordPath: string;
+  const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
+
+  beforeAll(async () => {
+    checkPrerequisites();
+    const stateDir = tempDir("felt");
+    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
+    recordPath = join(stateDir, "record.jsonl");
+    const up = await startUp(stateDir, ["--record", recordPath]);
+    cleanups.push(() => stopUp(up.child));
+    const credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
+    watcher = await EventWatcher.connect(credentials);
+    cleanups.push(() => watcher.client.endAsync(true));
+    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 }, deviceScaleFactor: 1 });
+    cleanups.push(browser.close);
+    page = await browser.context.newPage();
+    await page.goto(up.url);
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
+    area = await drawingArea(page);
+  });
+
+  afterAll(async () => {
+    for (const cleanup of cleanups.reverse()) await cleanup();
+  });
+
+  it("keeps a Z and then a square as one drawing, played, on the timeline", async () => {
+    await drawWithMouse(page, [at(0.1, 0.1), at(0.45, 0.1), at(0.1, 0.9), at(0.45, 0.9)]);
+    const drawing = await drawingId(page);
+    const zStrokes = Number(await dataOf(page, "timeline", "strokes"));
+    expect(zStrokes).toBeGreaterThanOrEqual(3);
+    await drawWithMouse(page, [at(0.6, 0.2), at(0.9, 0.2), at(0.9, 0.8), at(0.6, 0.8), at(0.6, 0.2)]);
+    // The second press did not start another drawing: both paths, one id, every stroke sent.
+    expect(await drawingId(page)).toBe(drawing);
+    const total = Number(await dataOf(page, "timeline", "strokes"));
+    expect(total).toBeGreaterThanOrEqual(zStrokes + 4);
+    await watcher.waitFor("every stroke played", () => watcher.of(drawing, "played").length >= total);
+    await waitForData(page, '[data-testid="played-summary"]', "played", String(total), 30_000);
+    await expect(page.locator('[data-testid="timeline-caption"]').innerText()).resolves.toContain(
+      "as the sleeve played them",
+    );
+    await screenshot(page, "felt-z-and-square");
+
+    // Undo takes back the square only; New drawing empties the page and its card.
+    await page.locator('[data-testid="undo-button"]').click();
+    await waitForData(page, '[data-testid="timeline"]', "strokes", String(zStrokes));
+    await page.locator('[data-testid="new-button"]').click();
+    await waitForData(page, '[data-testid="timeline"]', "strokes", "0");
+    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toBe(
+      "No strokes sent yet.",
+    );
+    await expect(page.locator('[data-testid="log-title"]').textContent()).resolves.toBe("Sleeve says");
+  });
+
+  it("stops a long drawing mid-way: every motor off in the sleeve's record within 20 ms", async () => {
+    // The sleeve is idle: what the record gets next is this drawing's.
+    await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0", 30_000);
+    const before = readRecord(recordPath).length;
+    // A slow zigzag: each leg takes about a second to draw, so its stroke plays that long.
+    const legs: Point[] = [at(0.05, 0.1), at(0.3, 0.9), at(0.55, 0.1), at(0.8, 0.9), at(0.95, 0.1)];
+    await drawWithMouse(page, legs, { stepPx: 4 });
+    const drawing = await drawingId(page);
+    await watcher.waitFor("a played stroke", () => watcher.of(drawing, "played").length >= 1);
+    await page.keyboard.press("Escape");
+    const events = await watcher.waitFor(
+      "every stroke of the drawing played or cancelled",
+      () => watcher.of(drawing, "cancelled").length >= 1,
+    );
+    await new Promise((wake) => setTimeout(wake, 300));
+    const cancelled = watcher.of(drawing, "cancelled");
+    const cut = cancelled.find((e) => e["started"] === true);
+    expect(cut, JSON.stringify(events.slice(-6))).toBeDefined();
+    const record = readRecord(recordPath).slice(before);
+    // The record's clock starts at the sleeve's start; the played event of stroke 0 ties it to the wall clock.
+    const first = watcher.of(drawing, "played").find((e) => e["seq"] === 0)!;
+    const firstOn = record.find((line) => line.intensity > 0)!;
+    const offsetMs = (first["first_command_at_ms"] as number) - firstOn.t_ms;
+    const cancelAt = (cut!["cancelled_at_ms"] as number) - offsetMs;
+    const on = new Map<string, number>();
+    let allOffAt: number | null = null;
+    for (const line of record) {
+      // Already all off when the cancel came (between two bursts): off at the cancel itself.
+      if (allOffAt === null && line.t_ms > cancelAt && on.size === 0) allOffAt = cancelAt;
+      if (allOffAt !== null && line.t_ms > allOffAt) {
+        // Nothing of this drawing comes on again after the cancel.
+        expect(line.intensity, `a motor on at ${line.t_ms} ms, after the cancel`).toBe(0);
+      }
+      const key = `${line.row},${line.column}`;
+      if (line.intensity > 0) on.set(key, line.intensity);
+      else on.delete(key);
+      if (allOffAt === null && line.t_ms >= cancelAt && on.size === 0) allOffAt = line.t_ms;
+    }
+    if (allOffAt === null && on.size === 0) allOffAt = cancelAt;
+    expect(allOffAt).not.toBeNull();
+    const offAfterMs = allOffAt! - cancelAt;
+    console.log(`cancel -> every motor off: ${offAfterMs.toFixed(2)} ms (sleeve's record)`);
+    expect(offAfterMs).toBeLessThanOrEqual(OFF_WITHIN_MS);
+    await waitForData(page, '[data-testid="played-summary"]', "cancelled", String(cancelled.length));
+    await screenshot(page, "felt-stopped");
+  });
+
+  it("loads a saved recording back, shows what would be felt, and plays it again", async () => {
+    await page.locator('[data-testid="new-button"]').click();
+    await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.5, 0.85), at(0.2, 0.2)]);
+    const original = await drawingId(page);
+    const strokes = Number(await dataOf(page, "timeline", "strokes"));
+    await watcher.waitFor("the triangle played", () => watcher.of(original, "played").length >= strokes);
+    const [download] = await Promise.all([
+      page.waitForEvent("download"),
+      page.locator('[data-testid="record-button"]').click(),
+    ]);
+    const file = join(RESULTS_DIR, "felt-recording.json");
+    await download.saveAs(file);
+    await page.locator('[data-testid="new-button"]').click();
+    await waitForData(page, '[data-testid="timeline"]', "strokes", "0");
+
+    await page.locator('[data-testid="load-file"]').setInputFiles(file);
+    await waitForData(page, '[data-testid="timeline"]', "strokes", String(strokes));
+    await expect(page.locator('[data-testid="timeline-caption"]').innerText()).resolves.toContain(
+      "what would be felt",
+    );
+    const loaded = await drawingId(page);
+    expect(loaded).not.toBe(original);
+    expect(watcher.of(loaded)).toHaveLength(0); // loading sends nothing
+    await screenshot(page, "felt-loaded");
+
+    await page.locator('[data-testid="replay-button"]').click();
+    const again = await drawingId(page);
+    await watcher.waitFor("the replay played", () => watcher.of(again, "played").length >= strokes);
+    const sent = watcher.of(again, "played").map((e) => e["seq"]);
+    expect(sent).toEqual([...Array(strokes).keys()]);
+    await waitForData(page, '[data-testid="played-summary"]', "played", String(strokes), 30_000);
+  });
+
+  it("compares the drawing under a coarser detail, overlaid", async () => {
+    await page.locator('[data-testid="compare-toggle"]').check();
+    await expect(dataOf(page, "timeline", "compare")).resolves.toMatch(/^\d+$/);
+    await screenshot(page, "felt-compare");
+    await page.locator('[data-testid="compare-toggle"]').uncheck();
+    await expect(dataOf(page, "timeline", "compare")).resolves.toBe("off");
+  });
+
+  it("warns when no sleeve listens on the chosen id", async () => {
+    await page.locator('[data-testid="settings-button"]').click();
+    await page.locator('[data-testid="setting-sleeve_id"]').fill("sleeve2");
+    await page.locator('[data-testid="settings-save"]').click();
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "absent", 15_000);
+    await expect(page.locator('[data-testid="notice"]').innerText()).resolves.toContain(
+      "No sleeve listens on id 'sleeve2'",
+    );
+    await expect(page.locator('[data-testid="preview-caption"]').innerText()).resolves.toContain(
+      "No sleeve answers on id sleeve2",
+    );
+    await screenshot(page, "felt-unknown-sleeve");
+    await page.locator('[data-testid="settings-button"]').click();
+    await page.locator('[data-testid="setting-sleeve_id"]').fill("sleeve1");
+    await page.locator('[data-testid="settings-save"]').click();
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online", 15_000);
+    expect(await page.locator('[data-testid="notice"]').isHidden()).toBe(true);
+  });
+});

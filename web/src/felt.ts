@@ -1,0 +1,118 @@
+/**
+ * What the wearer feels over time, for the page's timeline: each stroke placed
+ * at the time the sleeve plays it, and the brush along it rendered on the
+ * actuators around it by funneling (Israr & Poupyrev 2011, the energy model:
+ * a virtual point between actuators is felt when their energies, intensity
+ * squared, add up to its own, split by proximity). This is the page's view
+ * of the Tactile Brush, not the sleeve's exact plan (which times its bursts
+ * by the apparent-motion model): it shows where and when the touch is.
+ *
+ * Times: where the sleeve told when it played a stroke, that time; otherwise
+ * the sleeve's own rule (docs/protocol.md, "Playback"): a stroke starts when
+ * it arrives, or when the one before it ends if that is later.
+ */
+import type { Point } from "./simplify/segment";
+
+export interface FeltStroke {
+  readonly seq: number;
+  readonly start: Point;
+  readonly end: Point;
+  readonly duration_ms: number;
+  readonly intensity: number;
+  /** When it reaches the sleeve, ms on the timeline's clock. */
+  readonly arrives_ms: number;
+}
+
+export interface PlacedStroke extends FeltStroke {
+  /** When it plays, ms on the timeline's clock. */
+  readonly start_ms: number;
+  /** True when the sleeve reported it; false for the page's own estimate. */
+  readonly reported: boolean;
+  /** Cut short (or dropped) by a cancel: it ends at `start_ms + played_ms`. */
+  readonly played_ms: number;
+}
+
+export interface Grid {
+  readonly rows: number;
+  readonly columns: number;
+}
+
+/** One actuator's share of a touch: its row, column and intensity 0..1. */
+export interface Drive {
+  readonly row: number;
+  readonly column: number;
+  readonly intensity: number;
+}
+
+/**
+ * Places strokes in time: a reported start wins; otherwise arrival, or the end
+ * of the stroke before, whichever is later. `reported` maps seq -> start (ms);
+ * `cut` maps seq -> ms after its start when a cancel stopped it.
+ */
+export function placeStrokes(
+  strokes: readonly FeltStroke[],
+  reported: ReadonlyMap<number, number> = new Map(),
+  cut: ReadonlyMap<number, number> = new Map(),
+): PlacedStroke[] {
+  const placed: PlacedStroke[] = [];
+  let tail = Number.NEGATIVE_INFINITY;
+  for (const stroke of [...strokes].sort((a, b) => a.seq - b.seq)) {
+    const known = reported.get(stroke.seq);
+    const start_ms = known ?? Math.max(stroke.arrives_ms, tail);
+    const played_ms = Math.min(stroke.duration_ms, Math.max(0, cut.get(stroke.seq) ?? stroke.duration_ms));
+    tail = start_ms + played_ms;
+    placed.push({ ...stroke, start_ms, reported: known !== undefined, played_ms });
+  }
+  return placed;
+}
+
+/** Where the brush is `t_ms` into the stroke (clamped to its ends). */
+export function brushAt(stroke: FeltStroke, t_ms: number): Point {
+  const k = stroke.duration_ms > 0 ? Math.min(Math.max(t_ms / stroke.duration_ms, 0), 1) : 1;
+  return [
+    stroke.start[0] + (stroke.end[0] - stroke.start[0]) * k,
+    stroke.start[1] + (stroke.end[1] - stroke.start[1]) * k,
+  ];
+}
+
+/**
+ * The actuators that render a point at `intensity`: the (up to) four around it,
+ * each with energy in proportion to its closeness along each axis (bilinear), so
+ * the energies add up to intensity squared and a point on an actuator is that one alone.
+ */
+export function funnel(point: Point, intensity: number, grid: Grid): Drive[] {
+  const x = Math.min(Math.max(point[0], 0), grid.columns - 1);
+  const y = Math.min(Math.max(point[1], 0), grid.rows - 1);
+  const c0 = Math.floor(x);
+  const r0 = Math.floor(y);
+  const fx = x - c0;
+  const fy = y - r0;
+  const drives: Drive[] = [];
+  const add = (row: number, column: number, weight: number) => {
+    if (weight > 1e-9 && row < grid.rows && column < grid.columns) {
+      drives.push({ row, column, intensity: intensity * Math.sqrt(weight) });
+    }
+  };
+  add(r0, c0, (1 - fx) * (1 - fy));
+  add(r0, c0 + 1, fx * (1 - fy));
+  add(r0 + 1, c0, (1 - fx) * fy);
+  add(r0 + 1, c0 + 1, fx * fy);
+  return drives;
+}
+
+/** The stroke playing at `t_ms` and how far into it, or null between strokes. */
+export function playingAt(
+  placed: readonly PlacedStroke[],
+  t_ms: number,
+): { stroke: PlacedStroke; into_ms: number } | null {
+  for (const stroke of placed) {
+    const into_ms = t_ms - stroke.start_ms;
+    if (into_ms >= 0 && into_ms <= stroke.played_ms) return { stroke, into_ms };
+  }
+  return null;
+}
+
+/** When the last stroke ends (0 for none). */
+export function totalMs(placed: readonly PlacedStroke[]): number {
+  return placed.reduce((end, stroke) => Math.max(end, stroke.start_ms + stroke.played_ms), 0);
+}

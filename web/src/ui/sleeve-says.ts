@@ -1,0 +1,102 @@
+/**
+ * The "Sleeve says" card for the current drawing: its name, what became of
+ * its strokes (played, refused, cancelled, dropped, late), and the latest
+ * notes. Reset with every new drawing, so nothing of an old drawing lingers.
+ */
+import { EventLog, type LogKind } from "./event-log";
+
+/** A stroke started this long after it was sent is marked late (a touch felt that much later). */
+export const LATE_MS = 500;
+/** Adjustments smaller than this share of the duration asked for are not worth a line. */
+export const NOTABLE_ADJUSTMENT = 0.05;
+
+export interface Counts {
+  played: number;
+  refused: number;
+  cancelled: number;
+  /** Not sent: cancelled before they left, or dropped by the timing policy. */
+  dropped: number;
+  late: number;
+  latestLateMs: number;
+}
+
+const zero = (): Counts => ({ played: 0, refused: 0, cancelled: 0, dropped: 0, late: 0, latestLateMs: 0 });
+
+export class SleeveSays {
+  readonly #title: HTMLElement;
+  readonly #log: EventLog;
+  readonly #list: HTMLOListElement;
+  readonly #summary: HTMLElement;
+  #counts: Counts = zero();
+  #sent = 0;
+  #drawing: string | null = null;
+
+  constructor(title: HTMLElement, list: HTMLOListElement, summary: HTMLElement) {
+    this.#title = title;
+    this.#list = list;
+    this.#summary = summary;
+    this.#log = new EventLog(list, summary);
+  }
+
+  get counts(): Readonly<Counts> {
+    return this.#counts;
+  }
+
+  /** A new drawing (or none): counts and notes start again. */
+  reset(drawing: string | null): void {
+    if (drawing === this.#drawing) return;
+    this.#drawing = drawing;
+    this.#counts = zero();
+    this.#sent = 0;
+    this.#list.replaceChildren();
+    this.#title.textContent =
+      drawing === null ? "Sleeve says" : `Sleeve says · drawing ${drawing.slice(0, 8)}`;
+    this.#title.title = drawing ?? "";
+    this.#render();
+  }
+
+  count(what: Exclude<keyof Counts, "latestLateMs">, late_ms = 0): void {
+    this.#counts[what]++;
+    if (what === "late") this.#counts.latestLateMs = late_ms;
+    this.#render();
+  }
+
+  addDropped(count: number): void {
+    this.#counts.dropped += count;
+    this.#render();
+  }
+
+  setSent(sent: number): void {
+    this.#sent = sent;
+    this.#render();
+  }
+
+  add(kind: LogKind, text: string): void {
+    this.#log.add(kind, text);
+  }
+
+  #render(): void {
+    const { played, refused, cancelled, dropped, late, latestLateMs } = this.#counts;
+    const summary = this.#summary;
+    summary.dataset["played"] = String(played);
+    summary.dataset["sent"] = String(this.#sent);
+    summary.dataset["refused"] = String(refused);
+    summary.dataset["cancelled"] = String(cancelled);
+    summary.dataset["dropped"] = String(dropped);
+    summary.dataset["late"] = String(late);
+    if (this.#sent === 0 && dropped === 0) {
+      summary.textContent = "No strokes sent yet.";
+      return;
+    }
+    const parts = [`${played} of ${this.#sent} stroke${this.#sent === 1 ? "" : "s"} played`];
+    if (refused > 0) parts.push(`${refused} refused`);
+    if (cancelled > 0) parts.push(`${cancelled} cancelled`);
+    if (dropped > 0) parts.push(`${dropped} dropped unsent`);
+    if (late > 0) parts.push(`${late} late (last by ${seconds(latestLateMs)})`);
+    summary.textContent = `${parts.join(", ")}.`;
+  }
+}
+
+export function seconds(ms: number): string {
+  return ms >= 1000 ? `${(ms / 1000).toFixed(1)} s` : `${Math.round(ms)} ms`;
+}

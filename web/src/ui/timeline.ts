@@ -1,0 +1,170 @@
+/**
+ * The felt drawing, whole: one lane per actuator (row, column) against time,
+ * each stroke's touch drawn as the intensity it gives each actuator
+ * (felt.ts), with a cursor at the moment being felt. An A/B comparison
+ * overlays a second drawing's lanes as outlines. Redrawn at most once per
+ * animation frame; the cursor alone is cheap (a second canvas).
+ */
+import { brushAt, funnel, totalMs, type Grid, type PlacedStroke } from "../felt";
+
+/** Time resolution of the lanes: finer than a frame, coarse enough to stay cheap. */
+const STEP_MS = 10;
+const LABEL_WIDTH_PX = 34;
+const AXIS_HEIGHT_PX = 16;
+const MIN_LABEL_GAP_PX = 44;
+const COLORS = {
+  a: "255, 138, 91",
+  b: "94, 200, 255",
+  lane: "rgba(143, 160, 178, 0.08)",
+  label: "rgba(143, 160, 178, 0.8)",
+  cursor: "#ffd166",
+} as const;
+
+export class TimelineView {
+  readonly #canvas: HTMLCanvasElement;
+  readonly #cursorCanvas: HTMLCanvasElement;
+  readonly #caption: HTMLElement;
+  readonly #ctx: CanvasRenderingContext2D;
+  readonly #cursorCtx: CanvasRenderingContext2D;
+  #grid: Grid = { rows: 3, columns: 4 };
+  #a: readonly PlacedStroke[] = [];
+  #b: readonly PlacedStroke[] | null = null;
+  #cursorMs: number | null = null;
+  #scheduled = false;
+
+  constructor(canvas: HTMLCanvasElement, cursor: HTMLCanvasElement, caption: HTMLElement) {
+    this.#canvas = canvas;
+    this.#cursorCanvas = cursor;
+    this.#caption = caption;
+    this.#ctx = context(canvas);
+    this.#cursorCtx = context(cursor);
+    new ResizeObserver(() => this.#schedule()).observe(canvas);
+  }
+
+  /** The drawing to show (A), and the one to compare it with (B) or null. */
+  show(grid: Grid, a: readonly PlacedStroke[], b: readonly PlacedStroke[] | null = null): void {
+    this.#grid = grid;
+    this.#a = a;
+    this.#b = b;
+    this.#canvas.dataset["strokes"] = String(a.length);
+    this.#canvas.dataset["compare"] = b === null ? "off" : String(b.length);
+    this.#canvas.dataset["totalMs"] = String(Math.round(this.totalMs));
+    this.#schedule();
+  }
+
+  get totalMs(): number {
+    return Math.max(totalMs(this.#a), this.#b === null ? 0 : totalMs(this.#b));
+  }
+
+  /** The moment being felt (ms on the timeline), or null to hide the cursor. */
+  setCursor(t_ms: number | null): void {
+    if (t_ms === this.#cursorMs) return;
+    this.#cursorMs = t_ms;
+    this.#canvas.dataset["cursorMs"] = t_ms === null ? "" : String(Math.round(t_ms));
+    this.#drawCursor();
+  }
+
+  setCaption(text: string): void {
+    this.#caption.textContent = text;
+  }
+
+  #schedule(): void {
+    if (this.#scheduled) return;
+    this.#scheduled = true;
+    requestAnimationFrame(() => {
+      this.#scheduled = false;
+      this.#draw();
+      this.#drawCursor();
+    });
+  }
+
+  #size(canvas: HTMLCanvasElement): { width: number; height: number; dpr: number } {
+    const dpr = window.devicePixelRatio || 1;
+    const width = canvas.clientWidth;
+    const height = canvas.clientHeight;
+    if (canvas.width !== Math.round(width * dpr) || canvas.height !== Math.round(height * dpr)) {
+      canvas.width = Math.round(width * dpr);
+      canvas.height = Math.round(height * dpr);
+    }
+    return { width, height, dpr };
+  }
+
+  #lane(row: number, column: number, height: number): { top: number; height: number } {
+    const lanes = this.#grid.rows * this.#grid.columns;
+    const laneHeight = (height - AXIS_HEIGHT_PX) / Math.max(lanes, 1);
+    return { top: (row * this.#grid.columns + column) * laneHeight, height: laneHeight };
+  }
+
+  #draw(): void {
+    const { width, height, dpr } = this.#size(this.#canvas);
+    if (width === 0 || height === 0) return;
+    const ctx = this.#ctx;
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.clearRect(0, 0, width, height);
+    const { rows, columns } = this.#grid;
+    const total = Math.max(this.totalMs, 1);
+    const plotWidth = width - LABEL_WIDTH_PX;
+    ctx.font = "10px system-ui, sans-serif";
+    ctx.textBaseline = "middle";
+    for (let row = 0; row < rows; row++) {
+      for (let column = 0; column < columns; column++) {
+        const lane = this.#lane(row, column, height);
+        ctx.fillStyle = (row * columns + column) % 2 === 0 ? COLORS.lane : "transparent";
+        ctx.fillRect(LABEL_WIDTH_PX, lane.top, plotWidth, lane.height);
+        if (lane.height >= 9) {
+          ctx.fillStyle = COLORS.label;
+          ctx.fillText(`${row},${column}`, 4, lane.top + lane.height / 2);
+        }
+      }
+    }
+    const paint = (placed: readonly PlacedStroke[], rgb: string, outline: boolean) => {
+      for (const stroke of placed) {
+        for (let t = 0; t < stroke.played_ms; t += STEP_MS) {
+          const x = LABEL_WIDTH_PX + ((stroke.start_ms + t) / total) * plotWidth;
+          const w = Math.max((Math.min(STEP_MS, stroke.played_ms - t) / total) * plotWidth, 1);
+          for (const drive of funnel(brushAt(stroke, t), stroke.intensity, this.#grid)) {
+            const lane = this.#lane(drive.row, drive.column, height);
+            if (outline) {
+              ctx.fillStyle = `rgba(${rgb}, ${0.25 + 0.6 * drive.intensity})`;
+              ctx.fillRect(x, lane.top + lane.height * 0.7, w, lane.height * 0.25);
+            } else {
+              const alpha = (stroke.reported ? 0.3 : 0.15) + 0.7 * drive.intensity;
+              ctx.fillStyle = `rgba(${rgb}, ${alpha})`;
+              ctx.fillRect(x, lane.top + 1, w, lane.height * 0.62);
+            }
+          }
+        }
+      }
+    };
+    paint(this.#a, COLORS.a, false);
+    if (this.#b !== null) paint(this.#b, COLORS.b, true);
+    // The time axis: whole seconds (or tenths for a short drawing).
+    ctx.fillStyle = COLORS.label;
+    // Labels at least MIN_LABEL_GAP_PX apart, on a round step (0.1, 0.2, 0.5, 1, 2, 5... s).
+    const steps = [100, 200, 500, 1000, 2000, 5000, 10_000, 20_000, 60_000];
+    const tick = steps.find((step) => (step / total) * plotWidth >= MIN_LABEL_GAP_PX) ?? 120_000;
+    for (let t = 0; t <= total; t += tick) {
+      const x = LABEL_WIDTH_PX + (t / total) * plotWidth;
+      ctx.fillRect(x, height - AXIS_HEIGHT_PX, 1, 4);
+      ctx.fillText(`${(t / 1000).toFixed(tick >= 1000 ? 0 : 1)} s`, x + 2, height - 6);
+    }
+  }
+
+  #drawCursor(): void {
+    const { width, height, dpr } = this.#size(this.#cursorCanvas);
+    const ctx = this.#cursorCtx;
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.clearRect(0, 0, width, height);
+    if (this.#cursorMs === null || width === 0) return;
+    const total = Math.max(this.totalMs, 1);
+    const x = LABEL_WIDTH_PX + (Math.min(this.#cursorMs, total) / total) * (width - LABEL_WIDTH_PX);
+    ctx.fillStyle = COLORS.cursor;
+    ctx.fillRect(x - 1, 0, 2, height - AXIS_HEIGHT_PX);
+  }
+}
+
+function context(canvas: HTMLCanvasElement): CanvasRenderingContext2D {
+  const ctx = canvas.getContext("2d");
+  if (ctx === null) throw new Error("This browser cannot draw on a canvas (no 2D context).");
+  return ctx;
+}

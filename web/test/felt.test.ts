@@ -1,0 +1,59 @@
+/** The felt view: strokes placed by the sleeve's playback rule, the brush funneled on the grid. */
+import fc from "fast-check";
+import { describe, expect, it } from "vitest";
+import { brushAt, funnel, placeStrokes, playingAt, totalMs, type FeltStroke } from "../src/felt";
+
+const GRID = { rows: 3, columns: 4 };
+
+function stroke(seq: number, arrives_ms: number, duration_ms = 100): FeltStroke {
+  return { seq, start: [0, 0], end: [2, 0], duration_ms, intensity: 0.8, arrives_ms };
+}
+
+describe("placeStrokes", () => {
+  it("starts a stroke on arrival, or when the one before ends", () => {
+    const placed = placeStrokes([stroke(0, 0), stroke(1, 50), stroke(2, 500)]);
+    expect(placed.map((s) => s.start_ms)).toEqual([0, 100, 500]);
+    expect(totalMs(placed)).toBe(600);
+  });
+
+  it("takes the sleeve's reported start over its own estimate, and the cut length", () => {
+    const placed = placeStrokes([stroke(0, 0), stroke(1, 0)], new Map([[0, 30]]), new Map([[0, 40]]));
+    expect(placed.map((s) => [s.start_ms, s.played_ms, s.reported])).toEqual([
+      [30, 40, true],
+      [70, 100, false],
+    ]);
+  });
+});
+
+describe("the brush", () => {
+  it("moves from start to end over the duration", () => {
+    expect(brushAt(stroke(0, 0, 200), 100)).toEqual([1, 0]);
+    expect(brushAt(stroke(0, 0, 200), 999)).toEqual([2, 0]);
+    const placed = placeStrokes([stroke(0, 0, 200)]);
+    expect(playingAt(placed, 50)?.into_ms).toBe(50);
+    expect(playingAt(placed, 250)).toBeNull();
+  });
+
+  it("on an actuator, drives that one alone", () => {
+    expect(funnel([2, 1], 0.5, GRID)).toEqual([{ row: 1, column: 2, intensity: 0.5 }]);
+  });
+
+  it("between actuators, shares the energy: the squares add up to the intensity squared", () => {
+    fc.assert(
+      fc.property(
+        fc.double({ min: 0, max: 3, noNaN: true }),
+        fc.double({ min: 0, max: 2, noNaN: true }),
+        fc.double({ min: 0.01, max: 1, noNaN: true }),
+        (x, y, intensity) => {
+          const drives = funnel([x, y], intensity, GRID);
+          const energy = drives.reduce((sum, d) => sum + d.intensity ** 2, 0);
+          expect(energy).toBeCloseTo(intensity ** 2, 9);
+          for (const d of drives) {
+            expect(Math.abs(d.column - x)).toBeLessThanOrEqual(1);
+            expect(Math.abs(d.row - y)).toBeLessThanOrEqual(1);
+          }
+        },
+      ),
+    );
+  });
+});
