@@ -65,6 +65,8 @@ RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
 # the broker kept for a sleeve that was away is not rate-limited on its return.
 BURST = MAX_PENDING
 KEEPALIVE_S = 15
+# A stroke felt this long after it was sent (beyond its wait in the queue) is reported as late.
+LATE_MS = 1000.0
 # Cancelled drawings remembered, so that their later strokes do not start them again.
 REMEMBERED_CANCELS = 64
 RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
@@ -393,6 +395,7 @@ class Sleeve:
         """Called from the player thread too: only queues, never touches the network."""
         if isinstance(event, Played):
             self._count("played")
+            self._say_if_late(event)
         elif isinstance(event, Cancelled):
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":
@@ -403,6 +406,22 @@ class Sleeve:
             )
             self._stopped.set()
         self._outbox.put((telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+
+    def _say_if_late(self, event: Played) -> None:
+        """A stroke felt long after it was sent (held by the broker, a slow network): logged, with
+        how late. Waiting behind the strokes before it is how a drawing plays, not lateness."""
+        if event.sent_at_ms is None:
+            return
+        late_ms = event.first_command_at_ms - event.sent_at_ms - event.queued_ms
+        if late_ms > LATE_MS:
+            log.warning(
+                "sleeve %s: stroke %s of drawing %s played %.1f s late (it waited at the broker "
+                "or on the way)",
+                self._id,
+                event.seq,
+                event.drawing,
+                late_ms / 1000,
+            )
 
     def _count(self, *names: str) -> None:
         with self._counts_lock:
