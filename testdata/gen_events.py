@@ -50,6 +50,30 @@ EVENTS: dict[str, tuple[str, dict[str, Any]]] = {
         "the sender stamped sent_at_ms",
         {"type": "played", **STROKE, "sent_at_ms": 1795326267600, **TIMING},
     ),
+    "played-with-pace": (
+        "how old the stroke was and how late it started (the pace rules)",
+        {
+            "type": "played",
+            **STROKE,
+            "sent_at_ms": 1795326267600,
+            "age_ms": 64.3,
+            "lag_ms": 0,
+            **TIMING,
+        },
+    ),
+    "rejected-late": (
+        "a stroke skipped to catch up after a stall",
+        {
+            "type": "rejected",
+            "reason": "late",
+            "message": "the stroke would start 4.20 s after it was due",
+            **STROKE,
+            "sent_at_ms": 1795326263400,
+            "age_ms": 4264.3,
+            "lag_ms": 4200.5,
+            "received_at_ms": 1795326267664.25,
+        },
+    ),
     "played-unknown-keys": (
         "keys a newer sleeve may add are ignored",
         {"type": "played", **STROKE, **TIMING, "colour": "red", "extra": {"a": [1]}},

@@ -12,6 +12,10 @@ interface StrokeRef {
   readonly drawing: string | null;
   readonly seq: number | null;
   readonly sent_at_ms: number | null;
+  /** Received minus sent_at_ms: how old the stroke was on arrival (docs/protocol.md, pace). */
+  readonly age_ms: number | null;
+  /** How much later than due it starts (or would have: a `late` rejection). */
+  readonly lag_ms: number | null;
 }
 
 interface Timing {
@@ -116,6 +120,8 @@ const STROKE: readonly Field[] = [
   ["drawing", "text", false],
   ["seq", "index", false],
   ["sent_at_ms", "number", false],
+  ["age_ms", "number", false],
+  ["lag_ms", "number", false],
 ];
 const TIMING: readonly Field[] = [
   ["received_at_ms", "number", true],

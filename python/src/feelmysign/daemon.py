@@ -13,10 +13,24 @@ adjusted or rejected, with the reason and the latency figures).
 
 The message handler cannot raise: every failure becomes a counted, reported
 ``rejected`` event, and the strokes around it play on.
+
+Delivery: a stroke is acknowledged to the broker (PUBACK, paho's manual
+acknowledgement) only once the sleeve is done with it: played, or refused with
+an event. The acknowledgement follows the event out on the same connection, so
+a broker that has the acknowledgement has the event too. A stroke the sleeve
+received but had not played when it died (``kill -9``, a power cut) was never
+acknowledged, and the broker delivers it again when the sleeve returns; so is
+one still waiting at a clean stop (reported ``stopped``). Redeliveries of a
+stroke already played are dropped by ``drawing``/``seq`` (the player).
+
+Pace: ``feelmysign.pace`` refuses strokes older than ``max_age_ms`` (``stale``)
+and skips those the sleeve is too late for after a stall (``late``).
 """
 
 from __future__ import annotations
 
+import hashlib
+import hmac
 import json
 import logging
 import queue
@@ -32,7 +46,7 @@ import paho.mqtt.client as mqtt
 from feelmysign import __version__
 from feelmysign.backends.base import Backend
 from feelmysign.backends.telemetry import ActuatorTelemetry
-from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
 from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError, StrokeError
 from feelmysign.events import (
@@ -46,6 +60,7 @@ from feelmysign.events import (
     StatusLayout,
 )
 from feelmysign.layout import Layout
+from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS, PacePolicy
 from feelmysign.planner import plan
 from feelmysign.player import (
     MAX_PENDING,
@@ -69,11 +84,50 @@ KEEPALIVE_S = 15
 LATE_MS = 1000.0
 # Cancelled drawings remembered, so that their later strokes do not start them again.
 REMEMBERED_CANCELS = 64
-RECONNECT_MIN_S, RECONNECT_MAX_S = 1, 30
 NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disconnect
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
 # "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
 LOGIN_REFUSED_CODES = (134, 135)
+# Rejections after which the broker must deliver the stroke again: the sleeve did not play it
+# and is going away, not refusing it.
+NOT_ACKNOWLEDGED = frozenset({"stopped", "player_stopped"})
+CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
+
+
+def sleeve_client_id(sleeve_id: str, password: str | None) -> str:
+    """The sleeve's MQTT client id, ``feelmysign-sleeve-<id>-<32 hex digits>``.
+
+    The broker lets any logged-in client take over the session of a client id, so a
+    sender's login could kick the sleeve off by using its id. The suffix is an HMAC of the
+    id under the sleeve's password: only a holder of the sleeve's password can name the
+    sleeve's session. (Without a password, the plain ``feelmysign-sleeve-<id>``.)
+    """
+    if not password:
+        return f"feelmysign-sleeve-{sleeve_id}"
+    digest = hmac.new(
+        password.encode(), f"feelmysign client id {sleeve_id}".encode(), hashlib.sha256
+    ).hexdigest()
+    return f"feelmysign-sleeve-{sleeve_id}-{digest[:CLIENT_ID_DIGEST_HEX]}"
+
+
+@dataclass
+class _Ack:
+    """A QoS 1 stroke to acknowledge once, on the connection it came in on."""
+
+    mid: int
+    connection: int
+    sent: bool = False
+
+
+@dataclass(frozen=True)
+class _Publish:
+    topic: str
+    payload: str
+    qos: int
+    retain: bool
+
+
+_Outgoing = _Publish | _Ack
 
 
 class TokenBucket:
@@ -104,6 +158,8 @@ class SleeveOptions:
     burst: int = BURST
     strict: bool = False
     backend_name: str = "sim"
+    max_age_ms: float = MAX_AGE_MS
+    max_lag_ms: float = MAX_LAG_MS
 
 
 class Sleeve:
@@ -124,9 +180,11 @@ class Sleeve:
         self._layout = layout
         self._options = options
         self._id = options.sleeve_id
-        self._outbox: queue.SimpleQueue[tuple[str, str, int, bool] | None] = queue.SimpleQueue()
+        self._outbox: queue.SimpleQueue[_Outgoing | None] = queue.SimpleQueue()
         self._player = player or Player(backend, layout, on_event=self._event)
         self._bucket = TokenBucket(options.rate_per_s, options.burst, monotonic_ms)
+        self._pace = PacePolicy(max_age_ms=options.max_age_ms, max_lag_ms=options.max_lag_ms)
+        self._connection = 0  # counts connections: an acknowledgement is valid on its own only
         self._stopped = threading.Event()
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
@@ -223,12 +281,14 @@ class Sleeve:
 
     def _make_client(self) -> mqtt.Client:
         client = new_client(
-            self._settings, client_id=f"feelmysign-sleeve-{self._id}", persistent_session=True
+            self._settings,
+            client_id=sleeve_client_id(self._id, self._settings.password),
+            persistent_session=True,
         )
+        client.manual_ack_set(True)  # acknowledged once played or refused, not on receipt
         client.will_set(
             telemetry_topic(self._id, "status"), self._status(online=False), qos=1, retain=True
         )
-        client.reconnect_delay_set(RECONNECT_MIN_S, RECONNECT_MAX_S)
         client.on_connect = self._on_connect
         client.on_connect_fail = self._on_connect_fail
         client.on_disconnect = self._on_disconnect
@@ -250,6 +310,7 @@ class Sleeve:
                 self._stopped.set()
             log.error(message)
             return
+        self._connection += 1
         subscriptions = [(strokes_topic(self._id), 1), (control_topic(self._id), 1)]
         if self._options.legacy_topic:
             subscriptions.append((self._options.legacy_topic, 1))
@@ -265,7 +326,7 @@ class Sleeve:
     def _on_connect_fail(self, client: mqtt.Client, userdata: Any) -> None:
         log.warning(
             "sleeve %s: cannot reach the broker at %s (nothing answers, or the host is unknown); "
-            "retrying every %d s at most. Start one with 'feelmysign broker' or check --broker.",
+            "retrying every %g s at most. Start one with 'feelmysign broker' or check --broker.",
             self._id,
             self._settings.url,
             RECONNECT_MAX_S,
@@ -300,24 +361,27 @@ class Sleeve:
 
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
         received_at_ms, received_wall_ms = monotonic_ms(), wall_ms()
+        info: dict[str, Any] = {"topic": message.topic}
+        ack = _Ack(message.mid, self._connection) if message.qos > 0 else None
         try:
-            self._handle(message, received_at_ms, received_wall_ms)
+            self._handle(message, info, ack, received_at_ms, received_wall_ms)
         except Exception as error:  # the handler must never take the sleeve down
             log.exception("sleeve %s: unexpected error handling a message", self._id)
             self._reject(
-                "internal_error",
-                f"unexpected error: {error}",
-                {"topic": message.topic},
-                received_wall_ms,
+                "internal_error", f"unexpected error: {error}", info, received_wall_ms, ack
             )
 
     def _handle(
-        self, message: mqtt.MQTTMessage, received_at_ms: float, received_wall_ms: float
+        self,
+        message: mqtt.MQTTMessage,
+        info: dict[str, Any],
+        ack: _Ack | None,
+        received_at_ms: float,
+        received_wall_ms: float,
     ) -> None:
         self._count("received")
         name = message.topic
         legacy = name == self._options.legacy_topic
-        info: dict[str, Any] = {"topic": name}
         if message.retain:
             # A stroke kept by the broker would play again at every start.
             self._reject(
@@ -326,15 +390,16 @@ class Sleeve:
                 "the retain flag, and clear this one with an empty retained message",
                 info,
                 received_wall_ms,
+                ack,
             )
             return
         payload = message.payload
         if name == control_topic(self._id):
-            self._control(payload, info, received_wall_ms)
+            self._control(payload, info, received_wall_ms, ack)
             return
         result = parse(payload, self._layout, format="legacy" if legacy else "json")
         if not isinstance(result, Accepted):
-            self._reject(result.reason, result.message, info, received_wall_ms)
+            self._reject(result.reason, result.message, info, received_wall_ms, ack)
             return
         stroke = result.stroke
         known = (
@@ -346,7 +411,7 @@ class Sleeve:
         if stroke.drawing is not None and stroke.drawing in self._cancelled:
             # A stroke of a cancelled drawing (one the broker held, or sent just after the cancel).
             cancelled_at_ms = self._cancelled[stroke.drawing]
-            self._event(cancelled(info, received_wall_ms, cancelled_at_ms, started=False))
+            self._event(cancelled(info, received_wall_ms, cancelled_at_ms, started=False), ack)
             return
         if not self._bucket.take():
             self._reject(
@@ -355,22 +420,39 @@ class Sleeve:
                 f"(bursts of {self._options.burst}); send more slowly",
                 info,
                 received_wall_ms,
+                ack,
             )
             return
         try:
             schedule = plan(stroke, self._layout, strict=self._options.strict)
         except StrokeError as error:
-            self._reject(error.reason, error.message, info, received_wall_ms)
+            self._reject(error.reason, error.message, info, received_wall_ms, ack)
+            return
+        verdict = self._pace.check(
+            drawing=stroke.drawing,
+            sent_at_ms=stroke.sent_at_ms,
+            received_wall_ms=received_wall_ms,
+            start_wall_ms=received_wall_ms + self._player.wait_ms(received_at_ms),
+            duration_ms=schedule.duration_ms,
+        )
+        figures = (("age_ms", verdict.age_ms), ("lag_ms", verdict.lag_ms))
+        info.update({k: round(v, 1) for k, v in figures if v is not None})
+        if verdict.reason is not None:
+            self._reject(verdict.reason, verdict.message, info, received_wall_ms, ack)
             return
         planned = PlannedStroke(schedule, received_at_ms, received_wall_ms, info)
+        if ack is not None:
+            planned.acknowledge = lambda: self._outbox.put(ack)
         refusal = self._player.submit(planned)
         if refusal is not None:
-            self._reject(refusal.reason, refusal.message, info, received_wall_ms)
+            self._reject(refusal.reason, refusal.message, info, received_wall_ms, ack)
 
-    def _control(self, payload: object, info: dict[str, Any], received_wall_ms: float) -> None:
+    def _control(
+        self, payload: object, info: dict[str, Any], received_wall_ms: float, ack: _Ack | None
+    ) -> None:
         result = parse_control(payload)
         if not isinstance(result, Cancel):
-            self._reject(result.reason, result.message, info, received_wall_ms)
+            self._reject(result.reason, result.message, info, received_wall_ms, ack)
             return
         if not result.everything:
             self._cancelled[result.drawing] = received_wall_ms
@@ -380,19 +462,32 @@ class Sleeve:
         what = "every drawing" if result.everything else f"drawing {result.drawing}"
         log.info("sleeve %s: cancel %s", self._id, what)
         self._player.cancel(result, received_wall_ms)
+        if ack is not None:
+            self._outbox.put(ack)
 
     # --- what the sleeve tells the world -----------------------------------------------
 
     def _reject(
-        self, reason: str, message: str, info: dict[str, Any], received_wall_ms: float
+        self,
+        reason: str,
+        message: str,
+        info: dict[str, Any],
+        received_wall_ms: float,
+        ack: _Ack | None = None,
     ) -> None:
+        """Report a stroke that will not play; acknowledge it after the event unless the
+        sleeve is only going away (then the broker must deliver it again)."""
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
         rejected = Rejected(reason=reason, message=message, **info, received_at_ms=received_wall_ms)
-        self._event(rejected)
+        self._event(rejected, None if reason in NOT_ACKNOWLEDGED else ack)
 
-    def _event(self, event: Event) -> None:
-        """Called from the player thread too: only queues, never touches the network."""
+    def _event(self, event: Event, ack: _Ack | None = None) -> None:
+        """Called from the player thread too: only queues, never touches the network.
+
+        A stroke's acknowledgement goes out after the event about it (same queue, same
+        connection).
+        """
         if isinstance(event, Played):
             self._count("played")
             self._say_if_late(event)
@@ -405,7 +500,9 @@ class Sleeve:
                 "the player stopped on an unexpected error (see the log); every motor is off"
             )
             self._stopped.set()
-        self._outbox.put((telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+        self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+        if ack is not None:
+            self._outbox.put(ack)
 
     def _say_if_late(self, event: Played) -> None:
         """A stroke felt long after it was sent (held by the broker, a slow network): logged, with
@@ -430,15 +527,31 @@ class Sleeve:
 
     def publish_actuators(self, frame: dict[str, Any]) -> None:
         """Telemetry for previews: best effort (QoS 0), never retained."""
-        self._outbox.put((telemetry_topic(self._id, "actuators"), json.dumps(frame), 0, False))
+        self._outbox.put(
+            _Publish(telemetry_topic(self._id, "actuators"), json.dumps(frame), 0, False)
+        )
 
     def _publish_loop(self) -> None:
         while (item := self._outbox.get()) is not None:
-            name, payload, qos, retain = item
+            if isinstance(item, _Ack):
+                self._acknowledge(item)
+                continue
             try:
-                self._client.publish(name, payload, qos=qos, retain=retain)
+                self._client.publish(item.topic, item.payload, qos=item.qos, retain=item.retain)
             except (RuntimeError, ValueError, OSError) as error:
-                log.warning("sleeve %s: could not publish on %s: %s", self._id, name, error)
+                log.warning("sleeve %s: could not publish on %s: %s", self._id, item.topic, error)
+
+    def _acknowledge(self, ack: _Ack) -> None:
+        # Once only: a message id is reused by the broker as soon as it is acknowledged. And
+        # on the connection the stroke came in on only: after a reconnect the broker sends it
+        # again, and that copy is acknowledged (as a duplicate) instead.
+        if ack.sent or ack.connection != self._connection:
+            return
+        ack.sent = True
+        try:
+            self._client.ack(ack.mid, 1)
+        except (RuntimeError, ValueError, OSError) as error:
+            log.warning("sleeve %s: could not acknowledge a stroke: %s", self._id, error)
 
     def _status(self, *, online: bool) -> str:
         layout = self._layout

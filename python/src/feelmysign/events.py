@@ -117,6 +117,8 @@ class Played(_Event):
     drawing: str | None = None
     seq: int | None = None
     sent_at_ms: float | None = None
+    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
+    lag_ms: float | None = None  # how much later than due it starts
     received_at_ms: float
     start_at_ms: float  # planned start
     first_command_at_ms: float
@@ -133,6 +135,8 @@ class Played(_Event):
             "drawing": r.text("drawing", required=False),
             "seq": r.index("seq", required=False),
             "sent_at_ms": r.number("sent_at_ms", required=False),
+            "age_ms": r.number("age_ms", required=False),
+            "lag_ms": r.number("lag_ms", required=False),
             "received_at_ms": r.number("received_at_ms"),
             "start_at_ms": r.number("start_at_ms"),
             "first_command_at_ms": r.number("first_command_at_ms"),
@@ -171,6 +175,8 @@ class Rejected(_Event):
     drawing: str | None = None
     seq: int | None = None
     sent_at_ms: float | None = None
+    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
+    lag_ms: float | None = None  # how much later than due it starts
     received_at_ms: float
 
     @classmethod
@@ -182,6 +188,8 @@ class Rejected(_Event):
             "drawing": r.text("drawing", required=False),
             "seq": r.index("seq", required=False),
             "sent_at_ms": r.number("sent_at_ms", required=False),
+            "age_ms": r.number("age_ms", required=False),
+            "lag_ms": r.number("lag_ms", required=False),
             "received_at_ms": r.number("received_at_ms"),
         }
 
@@ -198,6 +206,8 @@ class Cancelled(_Event):
     drawing: str | None = None
     seq: int | None = None
     sent_at_ms: float | None = None
+    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
+    lag_ms: float | None = None  # how much later than due it starts
     received_at_ms: float
     cancelled_at_ms: float
     started: bool
@@ -211,6 +221,8 @@ class Cancelled(_Event):
             "drawing": r.text("drawing", required=False),
             "seq": r.index("seq", required=False),
             "sent_at_ms": r.number("sent_at_ms", required=False),
+            "age_ms": r.number("age_ms", required=False),
+            "lag_ms": r.number("lag_ms", required=False),
             "received_at_ms": r.number("received_at_ms"),
             "cancelled_at_ms": r.number("cancelled_at_ms"),
             "started": r.flag("started"),

@@ -71,6 +71,9 @@ class PlannedStroke:
         default_factory=dict
     )  # e.g. drawing, seq, topic: copied into events
     start_ms: float = 0.0
+    # Called once the event saying what became of the stroke is out (played, refused by the
+    # duty-cycle cap, cancelled): the daemon then acknowledges the message to the broker.
+    acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
 
 
@@ -146,6 +149,11 @@ class Player:
             self._inbox.append(stroke)
         self._wake.set()
         return None
+
+    def wait_ms(self, now_ms: float) -> float:
+        """How long a stroke submitted at ``now_ms`` would wait for the strokes before it."""
+        with self._lock:
+            return max(0.0, self._tail_ms - now_ms)
 
     def _check_order(self, drawing: object, seq: object) -> Refusal | None:
         if not isinstance(drawing, str) or not isinstance(seq, int):
@@ -265,6 +273,8 @@ class Player:
                         at_ms = request.received_wall_ms
                         event = cancelled(tag.info, tag.received_wall_ms, at_ms, started=started)
                         self._on_event(event)
+                        if tag.acknowledge is not None:  # (once only: a started one was)
+                            tag.acknowledge()
 
     def _step(self) -> None:
         next_ms = self._timeline.next_ms()
@@ -350,6 +360,8 @@ class Player:
                 window_ms=refusal.window_ms,
             )
         )
+        if isinstance(capped.tag, PlannedStroke) and capped.tag.acknowledge is not None:
+            capped.tag.acknowledge()  # refused, and said so: the broker must not send it again
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:
@@ -377,6 +389,8 @@ class Player:
         else:
             event = Played(**timing)
         self._on_event(event)
+        if stroke.acknowledge is not None:
+            stroke.acknowledge()
 
 
 def cancelled(

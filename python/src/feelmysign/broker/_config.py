@@ -99,6 +99,9 @@ listener {ws_port} {ws_bind}
 protocol websockets
 
 max_packet_size {MAX_PACKET_SIZE_BYTES}
+# The sleeve acknowledges a stroke once it has played it, so a drawing can have many strokes
+# in flight; with a limit, Mosquitto 2.0 queues the rest and may then send them out of order.
+max_inflight_messages 0
 # Strokes are small and latency-bound: send each at once rather than batch them (Nagle).
 set_tcp_nodelay true
 

@@ -19,9 +19,12 @@ from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
 from feelmysign.layout import Layout
+from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.topics import LEGACY_TOPIC
 
 TELEMETRY_RATE_HZ = 20.0  # previews look smooth at 20 frames a second; more only costs traffic
+MAX_AGE_RANGE_MS = (100.0, 3_600_000.0)
+MAX_LAG_RANGE_MS = (10.0, 600_000.0)
 
 MIN_RATE_PER_S = 0.1  # one stroke in 10 s: slower is a sleeve that refuses everything
 MAX_RATE_PER_S = 10_000.0  # far above what a person draws; the planner is the limit
@@ -81,6 +84,23 @@ def register(subparsers: Any) -> None:
         help=f"strokes accepted per second on average (default: {RATE_PER_S:g}; bursts of {BURST})",
     )
     parser.add_argument(
+        "--max-age-ms",
+        type=number(*MAX_AGE_RANGE_MS, unit="milliseconds"),
+        default=MAX_AGE_MS,
+        metavar="MS",
+        help="refuse strokes sent longer ago than this, by the sender's clock (reason stale; "
+        f"default: {MAX_AGE_MS:g}, in [{MAX_AGE_RANGE_MS[0]:g}, {MAX_AGE_RANGE_MS[1]:g}])",
+    )
+    parser.add_argument(
+        "--max-lag-ms",
+        type=number(*MAX_LAG_RANGE_MS, unit="milliseconds"),
+        default=MAX_LAG_MS,
+        metavar="MS",
+        help="skip strokes that would start later than this after they were due, to catch up "
+        f"after a stall (reason late; default: {MAX_LAG_MS:g}, in "
+        f"[{MAX_LAG_RANGE_MS[0]:g}, {MAX_LAG_RANGE_MS[1]:g}])",
+    )
+    parser.add_argument(
         "--log-level",
         default="info",
         choices=["debug", "info", "warning", "error"],
@@ -106,6 +126,8 @@ def run(args: argparse.Namespace) -> int:
         strict=args.strict,
         backend_name=args.backend
         + (" (emulated bus)" if args.emulate or args.emulate_state else ""),
+        max_age_ms=args.max_age_ms,
+        max_lag_ms=args.max_lag_ms,
     )
     print(
         f"Sleeve {options.sleeve_id}: {layout.rows} x {layout.columns} actuators, "

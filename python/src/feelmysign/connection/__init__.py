@@ -1,6 +1,13 @@
 """Connecting to a broker: settings and URL parsing, the client factory, failure messages."""
 
-from feelmysign.connection.client import DEFAULT_TIMEOUT_S, connect_client, new_client
+from feelmysign.connection.client import (
+    DEFAULT_TIMEOUT_S,
+    RECONNECT_MAX_S,
+    RECONNECT_MIN_S,
+    connect_client,
+    jitter_reconnects,
+    new_client,
+)
 from feelmysign.connection.failures import connect_failure_message
 from feelmysign.connection.settings import (
     DEFAULT_BROKER_URL,
@@ -13,11 +20,14 @@ from feelmysign.errors import BrokerConnectionError
 __all__ = [
     "DEFAULT_BROKER_URL",
     "DEFAULT_TIMEOUT_S",
+    "RECONNECT_MAX_S",
+    "RECONNECT_MIN_S",
     "SCHEMES",
     "BrokerConnectionError",
     "BrokerSettings",
     "connect_client",
     "connect_failure_message",
+    "jitter_reconnects",
     "new_client",
     "parse_broker_url",
 ]

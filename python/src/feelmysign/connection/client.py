@@ -5,8 +5,10 @@ transport, TLS and protocol choices.
 
 from __future__ import annotations
 
+import random
 import ssl
 import time
+from collections.abc import Callable
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -19,6 +21,10 @@ from feelmysign.errors import BrokerConnectionError
 
 DEFAULT_TIMEOUT_S = 10.0  # a broker on the same continent answers in well under a second
 KEEPALIVE_S = 30  # a dead connection is noticed within 1.5 x this
+# Between reconnection attempts: a few seconds at most, so a sleeve is back soon after its
+# broker, drawn at random each time so that many clients do not return all at once.
+RECONNECT_MIN_S = 0.5
+RECONNECT_MAX_S = 3.0
 
 
 def new_client(
@@ -56,7 +62,30 @@ def new_client(
         client.tls_set(cert_reqs=ssl.CERT_REQUIRED)
     if settings.username is not None:
         client.username_pw_set(settings.username, settings.password)
+    jitter_reconnects(client)
     return client
+
+
+def jitter_reconnects(
+    client: mqtt.Client,
+    *,
+    min_s: float = RECONNECT_MIN_S,
+    max_s: float = RECONNECT_MAX_S,
+    uniform: Callable[[float, float], float] = random.uniform,
+) -> None:
+    """Wait a random ``min_s``..``max_s`` seconds before each of paho's automatic reconnects.
+
+    Paho's own backoff doubles up to a fixed maximum and has no jitter; drawing the next
+    wait before every attempt (``on_pre_connect``) gives a capped wait with jitter.
+    """
+
+    def draw_next_wait(client: mqtt.Client, _userdata: object) -> None:
+        wait_s = uniform(min_s, max_s)
+        # Typed int, but paho waits any number of seconds (it compares clock readings).
+        client.reconnect_delay_set(wait_s, wait_s)  # type: ignore[arg-type]
+
+    client.on_pre_connect = draw_next_wait
+    draw_next_wait(client, None)
 
 
 def connect_client(

@@ -1,0 +1,123 @@
+"""Keeping the sleeve in real time with its senders: stale strokes and a way back after a stall.
+
+A stroke is the sender's touch at the moment it was drawn; felt half a minute
+later it is no longer that touch. Two rules, both on the stroke's
+``sent_at_ms`` (the sender's wall clock), so a stroke without it (the legacy
+format) is never refused by them:
+
+- **stale**: a stroke received more than ``max_age_ms`` after it was sent is
+  refused. This catches strokes the broker kept while the sleeve was away. It
+  compares two clocks, the sender's and the sleeve's, so it needs them to agree
+  to well within ``max_age_ms`` (NTP does; a sender whose clock is behind by more
+  gets every stroke refused, and the message says to check its clock).
+- **late**: a stroke that would start more than ``max_lag_ms`` after it was due
+  is skipped. When a stroke is due is the sender's own time line: its
+  ``sent_at_ms``, but never before the stroke before it in the same drawing has
+  ended (a drawing sent all at once is due back to back). How late it starts is
+  measured against the smallest delay seen in that drawing, so a constant
+  clock difference between sender and sleeve cancels out. After a stall (the
+  network or the broker away for 10 s) the backlog arrives at once: the sleeve
+  skips strokes until it is back within ``catch_up_ms`` of the sender's time line
+  (a quarter of ``max_lag_ms``), so it is back in real time at once instead of
+  running 10 s late for the rest of the drawing.
+
+The policy is pure (numbers in, a verdict out); the daemon feeds it and reports
+the verdicts as ``rejected`` events with reason ``stale`` or ``late``.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from dataclasses import dataclass
+
+# Strokes older than this are refused. Long enough for a sender's clock a few seconds off
+# and for a broker restart; short enough that a drawing is not felt long after the fact.
+MAX_AGE_MS = 10_000.0
+# How far playback may trail the sender's time line before strokes are skipped to catch up:
+# above network jitter on a busy machine, below what feels like a different moment.
+MAX_LAG_MS = 1_000.0
+# Once skipping, skip down to this much behind: strokes of a drawing play back to back, so
+# the lag left when skipping stops stays for the rest of the drawing.
+CATCH_UP_FRACTION = 0.25
+REMEMBERED_DRAWINGS = 64  # drawings whose time line is kept (the player remembers as many)
+
+STALE = "stale"
+LATE = "late"
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """``reason`` None: play it. ``age_ms`` and ``lag_ms`` are None without ``sent_at_ms``."""
+
+    reason: str | None = None
+    message: str = ""
+    age_ms: float | None = None
+    lag_ms: float | None = None
+
+
+@dataclass
+class _TimeLine:
+    smallest_delay_ms: float  # receive minus send: transit time plus the clocks' difference
+    due_end_ms: float  # when the stroke before ends on the sender's time line
+    catching_up: bool = False
+
+
+class PacePolicy:
+    """Call ``check`` once per stroke, in the order the strokes arrive (one thread)."""
+
+    def __init__(self, *, max_age_ms: float = MAX_AGE_MS, max_lag_ms: float = MAX_LAG_MS) -> None:
+        self.max_age_ms = max_age_ms
+        self.max_lag_ms = max_lag_ms
+        self.catch_up_ms = max_lag_ms * CATCH_UP_FRACTION
+        self._drawings: OrderedDict[str, _TimeLine] = OrderedDict()
+
+    def check(
+        self,
+        *,
+        drawing: str | None,
+        sent_at_ms: float | None,
+        received_wall_ms: float,
+        start_wall_ms: float,
+        duration_ms: float,
+    ) -> Verdict:
+        """The verdict on a stroke received at ``received_wall_ms`` that would start at
+        ``start_wall_ms`` (both on the sleeve's wall clock) and last ``duration_ms``."""
+        if sent_at_ms is None:
+            return Verdict()
+        age_ms = received_wall_ms - sent_at_ms
+        line = self._time_line(drawing, sent_at_ms)
+        due_ms = max(sent_at_ms, line.due_end_ms)
+        line.due_end_ms = due_ms + duration_ms
+        if age_ms > self.max_age_ms:
+            return Verdict(
+                STALE,
+                f"the stroke was sent {age_ms / 1000:.1f} s ago (by the sender's clock); the "
+                f"sleeve plays strokes at most {self.max_age_ms / 1000:g} s old. If it was just "
+                "sent, the sender's clock is behind the sleeve's: set both by NTP",
+                age_ms=age_ms,
+            )
+        line.smallest_delay_ms = min(line.smallest_delay_ms, age_ms)
+        lag_ms = start_wall_ms - due_ms - line.smallest_delay_ms
+        line.catching_up = lag_ms > (self.catch_up_ms if line.catching_up else self.max_lag_ms)
+        if line.catching_up:
+            return Verdict(
+                LATE,
+                f"the stroke would start {lag_ms / 1000:.2f} s after it was due; a sleeve more "
+                f"than {self.max_lag_ms / 1000:g} s behind its sender skips strokes until it is "
+                f"within {self.catch_up_ms / 1000:g} s (after a stall of the network, the "
+                "broker or the sleeve)",
+                age_ms=age_ms,
+                lag_ms=lag_ms,
+            )
+        return Verdict(age_ms=age_ms, lag_ms=max(lag_ms, 0.0))
+
+    def _time_line(self, drawing: str | None, sent_at_ms: float) -> _TimeLine:
+        if drawing is None:  # no drawing: nothing to chain or compare with
+            return _TimeLine(float("inf"), sent_at_ms)
+        line = self._drawings.get(drawing)
+        if line is None:
+            line = self._drawings[drawing] = _TimeLine(float("inf"), sent_at_ms)
+            while len(self._drawings) > REMEMBERED_DRAWINGS:
+                self._drawings.popitem(last=False)
+        self._drawings.move_to_end(drawing)
+        return line

@@ -1,0 +1,207 @@
+"""Real processes for the delivery tests: a ``feelmysign sleeve`` to kill, a watcher of its
+events and a sender that knows which strokes the broker acknowledged."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign.broker import Credentials
+from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
+
+WAIT_S = 60.0  # generous: the machine running the tests may be busy
+
+
+def settings(credentials: Credentials, role: str) -> BrokerSettings:
+    account = credentials.sleeve if role == "sleeve" else credentials.sender
+    return BrokerSettings(
+        credentials.mqtt_host,
+        credentials.mqtt_port,
+        username=account.username,
+        password=account.password,
+    )
+
+
+def wait_for(condition: Callable[[], bool], what: str, timeout_s: float = WAIT_S) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.02)  # another process's progress: nothing here to wait on
+
+
+class SleeveProcess:
+    """``feelmysign sleeve`` (simulator, --record) as a child process."""
+
+    def __init__(self, credentials_path: Path, record: Path, *extra: str) -> None:
+        self.record = record
+        self.log = record.with_suffix(".log")
+        command = [
+            sys.executable,
+            "-m",
+            "feelmysign",
+            "sleeve",
+            "--credentials",
+            str(credentials_path),
+            "--record",
+            str(record),
+            "--log-level",
+            "info",
+            *extra,
+        ]
+        with self.log.open("ab") as log:
+            self.process = subprocess.Popen(command, stdout=log, stderr=log)
+
+    def kill(self) -> None:
+        self.process.send_signal(signal.SIGKILL)
+        self.process.wait(10)
+
+    def pause(self) -> None:
+        os.kill(self.process.pid, signal.SIGSTOP)
+
+    def resume(self) -> None:
+        os.kill(self.process.pid, signal.SIGCONT)
+
+    def stop(self) -> None:
+        if self.process.poll() is None:
+            self.resume()
+            self.process.terminate()
+            try:
+                self.process.wait(15)
+            except subprocess.TimeoutExpired:
+                self.kill()
+
+    def changes(self) -> list[dict[str, Any]]:
+        if not self.record.exists():
+            return []
+        lines = self.record.read_text().splitlines()
+        return [json.loads(line) for line in lines if line.strip()]
+
+
+class Watcher:
+    """Every event and status the sleeve publishes, through broker restarts (persistent)."""
+
+    def __init__(self, credentials: Credentials) -> None:
+        self.events: list[dict[str, Any]] = []
+        self.status: list[dict[str, Any]] = []
+        self._lock = threading.Lock()
+        sid = credentials.sleeve_id
+        self.client = new_client(
+            settings(credentials, "sender"),
+            client_id=f"watch-{uuid.uuid4()}",
+            persistent_session=True,
+        )
+        self.client.on_message = self._on_message
+        self.client.on_connect = lambda client, *_: client.subscribe(
+            [(telemetry_topic(sid, "events"), 1), (telemetry_topic(sid, "status"), 1)]
+        )
+        self.client.connect(credentials.mqtt_host, credentials.mqtt_port)
+        self.client.loop_start()
+
+    def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        data = json.loads(message.payload)
+        with self._lock:
+            if message.topic.endswith("/status"):
+                self.status.append(data)
+            else:
+                self.events.append(data)
+
+    def snapshot(self) -> list[dict[str, Any]]:
+        with self._lock:
+            return list(self.events)
+
+    def is_online(self, since_wall_ms: float = 0.0) -> bool:
+        """Whether the sleeve's last status says online, published at or after ``since_wall_ms``."""
+        with self._lock:
+            return (
+                bool(self.status)
+                and self.status[-1]["online"]
+                and (self.status[-1]["at_ms"] >= since_wall_ms)
+            )
+
+    def stop(self) -> None:
+        self.client.loop_stop()
+        self.client.disconnect()
+
+
+class Sender:
+    """Publishes strokes of one drawing with QoS 1 and records which ones the broker acked."""
+
+    def __init__(self, credentials: Credentials, *, persistent: bool = True) -> None:
+        self.topic = strokes_topic(credentials.sleeve_id)
+        self.drawing = str(uuid.uuid4())
+        self.acked: set[int] = set()
+        self.connections = 0
+        self._seq_of_mid: dict[int, int] = {}
+        self._early: set[int] = set()  # acks that came before publish() returned the mid
+        self._lock = threading.Lock()
+        self.client = new_client(
+            settings(credentials, "sender"),
+            client_id=f"send-{uuid.uuid4()}",
+            persistent_session=persistent,
+        )
+        self.client.on_publish = self._on_publish
+        self.client.on_connect = self._on_connect
+        self.client.connect(credentials.mqtt_host, credentials.mqtt_port)
+        self.client.loop_start()
+
+    def _on_connect(self, *_: Any) -> None:
+        with self._lock:
+            self.connections += 1
+
+    def _on_publish(self, _client: mqtt.Client, _userdata: Any, mid: int, *_: Any) -> None:
+        with self._lock:
+            if mid in self._seq_of_mid:
+                self.acked.add(self._seq_of_mid.pop(mid))
+            else:
+                self._early.add(mid)
+
+    def publish(self, seq: int, stroke: Stroke) -> None:
+        payload = format_json(stroke)
+        # Not under our lock: paho calls on_publish holding its own locks, which publish takes.
+        info = self.client.publish(self.topic, payload, qos=1)
+        with self._lock:
+            if info.mid in self._early:  # acknowledged before we knew its id
+                self._early.discard(info.mid)
+                self.acked.add(seq)
+            else:
+                self._seq_of_mid[info.mid] = seq
+
+    def acked_seqs(self) -> set[int]:
+        with self._lock:
+            return set(self.acked)
+
+    def stop(self) -> None:
+        self.client.loop_stop()
+        self.client.disconnect()
+
+
+def stroke(drawing: str, seq: int, duration_ms: float, *, sent_at_ms: float | None) -> Stroke:
+    """Strokes of a drawing walking along the grid's top row, back and forth."""
+    x = float(seq % 3)
+    return Stroke((x, 0.0), (x + 1.0, 0.0), duration_ms, 0.8, drawing, seq, sent_at_ms)
+
+
+def by_seq(events: list[dict[str, Any]], drawing: str) -> dict[int, list[dict[str, Any]]]:
+    found: dict[int, list[dict[str, Any]]] = {}
+    for event in events:
+        if event.get("drawing") == drawing and "seq" in event:
+            found.setdefault(event["seq"], []).append(event)
+    return found
+
+
+def played(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [e for e in events if e["type"] in ("played", "adjusted")]

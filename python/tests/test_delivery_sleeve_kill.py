@@ -1,0 +1,59 @@
+"""``kill -9`` of a real sleeve mid-drawing: nothing it acknowledged vanishes.
+
+The sleeve acknowledges a stroke only once it has played it (or refused it with
+an event), so the strokes it held unplayed when it died are delivered again by
+the broker to the restarted sleeve, which plays them.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from conftest import StartBroker
+from delivery import Sender, SleeveProcess, Watcher, by_seq, played, stroke, wait_for
+
+STROKES = 20
+DURATION_MS = 300.0  # 20 strokes: 6 s of playing, so most are still waiting at the kill
+KILL_AFTER_PLAYED = 4
+
+
+def test_a_killed_sleeve_loses_no_stroke_it_received(
+    start_broker: StartBroker, tmp_path: Path
+) -> None:
+    broker = start_broker(state_dir=tmp_path / "state")
+    watcher = Watcher(broker.credentials)
+    first = SleeveProcess(broker.credentials_path, tmp_path / "first.jsonl")
+    sender = Sender(broker.credentials)
+    second: SleeveProcess | None = None
+    try:
+        wait_for(watcher.is_online, "the sleeve to come online")
+        for seq in range(STROKES):
+            now_ms = time.time() * 1000
+            sender.publish(seq, stroke(sender.drawing, seq, DURATION_MS, sent_at_ms=now_ms))
+        wait_for(lambda: len(sender.acked_seqs()) == STROKES, "the broker's acknowledgements")
+        wait_for(lambda: len(played(watcher.snapshot())) >= KILL_AFTER_PLAYED, "the first strokes")
+        first.kill()
+        before = by_seq(watcher.snapshot(), sender.drawing)
+        assert len(before) < STROKES, "the drawing ended before the kill: nothing was tested"
+
+        second = SleeveProcess(broker.credentials_path, tmp_path / "second.jsonl")
+        wait_for(
+            lambda: len(by_seq(watcher.snapshot(), sender.drawing)) == STROKES,
+            "an event for every stroke",
+        )
+        events = by_seq(watcher.snapshot(), sender.drawing)
+        for seq in range(STROKES):
+            kinds = [(e["type"], e.get("reason")) for e in events[seq]]
+            assert any(kind in ("played", "adjusted", "rejected") for kind, _ in kinds), kinds
+        replayed = [seq for seq in range(STROKES) if seq not in before]
+        # What the first sleeve held unplayed, the second one felt: motors moved after restart.
+        second_played = {e["seq"] for e in played(watcher.snapshot()) if e["seq"] in replayed}
+        assert second_played, f"none of {replayed} played after the restart: {events}"
+        assert any(change["intensity"] > 0 for change in second.changes())
+    finally:
+        sender.stop()
+        watcher.stop()
+        first.stop()
+        if second is not None:
+            second.stop()
