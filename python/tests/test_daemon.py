@@ -258,6 +258,10 @@ def test_strokes_sent_while_the_broker_restarts_are_played(
         sender.connect(c.mqtt_host, c.mqtt_port)
         sender.loop_start()
         broker.stop()
+        for _ in range(1000):  # paho notices the closed socket on its own thread
+            if not sender.is_connected():
+                break
+            threading.Event().wait(0.01)
         infos = [
             sender.publish(
                 topic(c.sleeve_id, "strokes"),
