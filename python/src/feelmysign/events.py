@@ -244,6 +244,8 @@ class Safety(_Event):
     drawing: str | None = None
     seq: int | None = None
     sent_at_ms: float | None = None
+    age_ms: float | None = None
+    lag_ms: float | None = None
     received_at_ms: float | None = None
     duty_cycle: float | None = None  # what the window would have held, 0..1 of full drive
     max_duty_cycle: float | None = None
@@ -260,6 +262,8 @@ class Safety(_Event):
             "drawing": r.text("drawing", required=False),
             "seq": r.index("seq", required=False),
             "sent_at_ms": r.number("sent_at_ms", required=False),
+            "age_ms": r.number("age_ms", required=False),
+            "lag_ms": r.number("lag_ms", required=False),
             "received_at_ms": r.number("received_at_ms", required=False),
             "duty_cycle": r.number("duty_cycle", required=False),
             "max_duty_cycle": r.number("max_duty_cycle", required=False),

@@ -49,7 +49,14 @@ REMEMBERED_DRAWINGS = 64  # drawings whose last seq is kept, for dropping redeli
 TIMING_SAMPLES = 100_000
 
 
-_STROKE_FIELDS = ("topic", "drawing", "seq", "sent_at_ms")  # of PlannedStroke.info
+_STROKE_FIELDS = (
+    "topic",
+    "drawing",
+    "seq",
+    "sent_at_ms",
+    "age_ms",
+    "lag_ms",
+)  # of PlannedStroke.info
 
 
 def monotonic_ms() -> float:
