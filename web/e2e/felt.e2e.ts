@@ -236,6 +236,21 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     await expect(dataOf(page, "timeline", "compare")).resolves.toBe("off");
   });
 
+  it("re-simplifies the drawing on the canvas when a setting changes, without sending it", async () => {
+    const before = await drawingId(page);
+    await page.locator('[data-testid="settings-button"]').click();
+    await page.locator('[data-testid="setting-detail"]').fill("1");
+    await page.locator('[data-testid="settings-save"]').click();
+    await expect(page.locator('[data-testid="event-log"] li').first().innerText()).resolves.toContain(
+      "Re-simplified with the new settings",
+    );
+    const after = await drawingId(page);
+    expect(after).not.toBe(before);
+    expect(Number(await dataOf(page, "timeline", "strokes"))).toBeGreaterThan(0);
+    await new Promise((wake) => setTimeout(wake, 500));
+    expect(watcher.of(after)).toHaveLength(0);
+  });
+
   it("warns when no sleeve listens on the chosen id", async () => {
     await page.locator('[data-testid="settings-button"]').click();
     await page.locator('[data-testid="setting-sleeve_id"]').fill("sleeve2");

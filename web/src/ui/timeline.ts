@@ -146,7 +146,9 @@ export class TimelineView {
     for (let t = 0; t <= total; t += tick) {
       const x = LABEL_WIDTH_PX + (t / total) * plotWidth;
       ctx.fillRect(x, height - AXIS_HEIGHT_PX, 1, 4);
-      ctx.fillText(`${(t / 1000).toFixed(tick >= 1000 ? 0 : 1)} s`, x + 2, height - 6);
+      // The last label would be cut at the right edge: its tick alone says enough.
+      if (x + MIN_LABEL_GAP_PX <= width)
+        ctx.fillText(`${(t / 1000).toFixed(tick >= 1000 ? 0 : 1)} s`, x + 2, height - 6);
     }
   }
 
