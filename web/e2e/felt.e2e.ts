@@ -156,7 +156,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     const legs: Point[] = [at(0.05, 0.1), at(0.3, 0.9), at(0.55, 0.1), at(0.8, 0.9), at(0.95, 0.1)];
     await drawWithMouse(page, legs, { stepPx: 4 });
     const drawing = await drawingId(page);
-    await watcher.waitFor("a played stroke", () => watcher.of(drawing, "played").length >= 1);
+    // Mid-way: the last stroke has started (it lasts as long as its leg took to draw, over a second).
+    const last = Number(await dataOf(page, "timeline", "strokes")) - 1;
+    await watcher.waitFor("the last stroke playing", () =>
+      watcher.of(drawing, "played").some((e) => e["seq"] === last),
+    );
     await page.keyboard.press("Escape");
     const events = await watcher.waitFor(
       "every stroke of the drawing played or cancelled",
@@ -220,6 +224,8 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     expect(watcher.of(loaded)).toHaveLength(0); // loading sends nothing
     await screenshot(page, "felt-loaded");
 
+    // The sleeve idle first: a stroke that would start more than 1 s after it was sent is refused.
+    await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0", 30_000);
     await page.locator('[data-testid="replay-button"]').click();
     const again = await drawingId(page);
     await watcher.waitFor("the replay played", () => watcher.of(again, "played").length >= strokes);
