@@ -94,3 +94,19 @@ class BrokerConnectionError(BrokerError):
     def __init__(self, reason: str, message: str, *, url: str | None = None) -> None:
         super().__init__(reason, message)
         self.url = url
+
+
+class StudyError(FeelMySignError):
+    """A study that cannot go on as asked: an unknown participant, a trial already answered,
+    a study file of another version. The message says what to do."""
+
+
+class DesignError(StudyError):
+    """A study design file that is wrong; ``problems`` lists every problem found, not only the
+    first."""
+
+    def __init__(self, source: str, problems: list[str]) -> None:
+        self.source = source
+        self.problems = list(problems)
+        lines = "\n".join(f"  - {p}" for p in self.problems)
+        super().__init__(f"{source}: {len(self.problems)} problem(s) in the study design:\n{lines}")

@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import platform
 
-from feelmysign.bench import algorithms, lasa_points, planner_lasa, restart_off, sleeve
+from feelmysign.bench import (
+    algorithms,
+    lasa_points,
+    planner_lasa,
+    restart_off,
+    sleeve,
+    study_recovery,
+)
 
 
 def main() -> None:
@@ -22,6 +29,7 @@ def main() -> None:
         lasa_points.report,
         sleeve.report,
         restart_off.report,
+        study_recovery.report,
     )
     for report in reports:
         for line in report():

@@ -31,6 +31,7 @@ SUBCOMMANDS = (
     "simplify",
     "replay",
     "evaluate",
+    "study",
     "validate",
     "sleeve",
     "broker",

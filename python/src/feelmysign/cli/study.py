@@ -1,0 +1,203 @@
+"""``feelmysign study``: the recognition study of the paper's section 6, and SQ2.2's thresholds.
+
+    feelmysign study check deploy/studies/paper.toml            # validate a design
+    feelmysign study new deploy/studies/paper.toml --out s.sqlite
+    feelmysign study simulate s.sqlite --participants 12        # a dry run, no sleeve needed
+    feelmysign study run s.sqlite                               # a session in the terminal
+    feelmysign up --study s.sqlite                              # ... or on the page /study
+    feelmysign study review s.sqlite                            # decide unclear answers
+    feelmysign study status s.sqlite
+    feelmysign study analyse s.sqlite --out results/            # export + analysis + report
+    feelmysign study threshold s.sqlite --participant P-XXXXX --dimension length
+
+See docs/study.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import Any
+
+from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.errors import StudyError
+from feelmysign.study.analysis import analyse_study
+from feelmysign.study.analysis.psychometric import BOOTSTRAP_SAMPLES
+from feelmysign.study.design_file import load_design
+from feelmysign.study.dry_run import dry_run
+from feelmysign.study.export import export_study
+from feelmysign.study.store import StudyStore
+from feelmysign.study.terminal import review_in_terminal, run_in_terminal
+from feelmysign.study.threshold_cli import add_threshold_parser
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "study",
+        help="run the paper's recognition study (design, sessions, coding, analysis, thresholds)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    commands = parser.add_subparsers(dest="study_command", metavar="STEP", required=True)
+
+    check = commands.add_parser("check", help="validate a design file and show its plan")
+    check.add_argument("design", type=Path, help="the design file (TOML)")
+    check.set_defaults(handler=_check)
+
+    new = commands.add_parser("new", help="create a study file from a design")
+    new.add_argument("design", type=Path, help="the design file (TOML)")
+    new.add_argument(
+        "--out", type=Path, required=True, metavar="FILE", help="the study file to create"
+    )
+    new.set_defaults(handler=_new)
+
+    status = commands.add_parser("status", help="participants, progress and answers to review")
+    status.add_argument("study", type=Path, help="the study file")
+    status.set_defaults(handler=_status)
+
+    simulate = commands.add_parser(
+        "simulate", help="dry run: add simulated participants and run their whole sessions"
+    )
+    simulate.add_argument("study", type=Path, help="the study file")
+    simulate.add_argument(
+        "--participants", type=int, default=12, metavar="N", help="how many (default 12)"
+    )
+    simulate.add_argument("--seed", type=int, default=0, help="the simulation's seed (default 0)")
+    simulate.set_defaults(handler=_simulate)
+
+    run = commands.add_parser("run", help="run a session in the terminal (the sleeve over MQTT)")
+    run.add_argument("study", type=Path, help="the study file")
+    run.add_argument(
+        "--participant", metavar="CODE", help="resume this participant (default: a new one)"
+    )
+    add_broker_options(run, role="sender")
+    run.set_defaults(handler=_run)
+
+    review = commands.add_parser("review", help="decide the answers the synonyms could not code")
+    review.add_argument("study", type=Path, help="the study file")
+    review.set_defaults(handler=_review)
+
+    for name, what in (
+        ("export", "anonymised CSV + design JSON"),
+        ("analyse", "export, then analysis, plots and report"),
+    ):
+        command = commands.add_parser(name, help=what)
+        command.add_argument("study", type=Path, help="the study file")
+        command.add_argument(
+            "--out",
+            type=Path,
+            metavar="DIR",
+            help="output folder (default: study-results/<study>-<date-time>)",
+        )
+        if name == "analyse":
+            command.add_argument(
+                "--bootstrap",
+                type=int,
+                default=BOOTSTRAP_SAMPLES,
+                metavar="B",
+                help=f"bootstrap samples per shape (default {BOOTSTRAP_SAMPLES})",
+            )
+        command.set_defaults(handler=_export if name == "export" else _analyse)
+
+    add_threshold_parser(commands)
+
+
+def _out_dir(args: argparse.Namespace) -> Path:
+    if args.out is not None:
+        return Path(args.out)
+    return Path("study-results") / f"{args.study.stem}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def _check(args: argparse.Namespace) -> int:
+    design = load_design(args.design)
+    print(f"{args.design}: valid. {design.name}")
+    print(
+        f"  {len(design.shapes)} shapes x {len(design.resolutions)} resolutions x "
+        f"{design.repetitions} repetitions = {design.main_trials} measured trials per participant, "
+        f"after {len(design.practice)} practice trial(s); order: {design.randomisation}"
+    )
+    for shape in design.shapes:
+        strokes = ", ".join(str(level.strokes) for level in shape.levels)
+        print(f"  {shape.name:<10} strokes {strokes}; synonyms: {', '.join(shape.synonyms)}")
+    return 0
+
+
+def _new(args: argparse.Namespace) -> int:
+    design = load_design(args.design)
+    StudyStore.create(args.out, args.design, design).close()
+    print(
+        f"Created {args.out} for {design.name!r}. Next: 'feelmysign up --study {args.out}' "
+        f"(page /study), or 'feelmysign study run {args.out}'."
+    )
+    return 0
+
+
+def _status(args: argparse.Namespace) -> int:
+    store = StudyStore(args.study)
+    codings = store.latest_codings()
+    print(f"{args.study}: {store.design.name}")
+    for row in store.participants():
+        trials = store.trials(row["code"])
+        answered = sum(1 for t in trials if t["answered_at_ms"] is not None)
+        unclear = sum(
+            1 for t in trials if t["id"] in codings and codings[t["id"]]["status"] == "unclear"
+        )
+        state = "done" if row["finished_at_ms"] else ("paused" if row["paused"] else "open")
+        kind = " (simulated)" if row["simulated"] else ""
+        print(
+            f"  {row['code']}{kind}: {answered}/{len(trials)} answered, {unclear} unclear, {state}"
+        )
+    if not store.participants():
+        print("  no participant yet")
+    return 0
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    if not 1 <= args.participants <= 500:
+        raise StudyError(f"--participants must be 1 to 500; got {args.participants}")
+    store = StudyStore(args.study)
+    codes = dry_run(
+        store,
+        args.participants,
+        seed=args.seed,
+        progress=lambda n, code: print(
+            f"  simulated participant {n}/{args.participants}: {code}", flush=True
+        ),
+    )
+    print(
+        f"Ran {len(codes)} simulated sessions into {args.study}. "
+        f"Next: 'feelmysign study analyse {args.study}'."
+    )
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    store = StudyStore(args.study)
+    settings = broker_settings_from_args(args, "sender")
+    return run_in_terminal(store, settings, args.participant)
+
+
+def _review(args: argparse.Namespace) -> int:
+    return review_in_terminal(StudyStore(args.study))
+
+
+def _export(args: argparse.Namespace) -> int:
+    out = _out_dir(args)
+    for path in export_study(StudyStore(args.study), out):
+        print(path)
+    return 0
+
+
+def _analyse(args: argparse.Namespace) -> int:
+    if not 50 <= args.bootstrap <= 100_000:
+        raise StudyError(f"--bootstrap must be 50 to 100000; got {args.bootstrap}")
+    out = _out_dir(args)
+    analysis = analyse_study(StudyStore(args.study), out, samples=args.bootstrap)
+    print(
+        f"{analysis.participants} participants, {analysis.trials} trials, "
+        f"{analysis.unclear} awaiting review."
+    )
+    for path in analysis.files:
+        print(path)
+    return 0

@@ -1,0 +1,146 @@
+"""Analyse a study file: accuracy tables, psychometric fits, the shape model, plots, report.
+
+Only main trials with a coded answer count; unclear answers still waiting for
+review are left out and counted in the report (so a report is never silently
+incomplete). Simulated participants are analysed like real ones but the report
+says how many there were.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from feelmysign.study.analysis.models import ModelResult, shape_differences
+from feelmysign.study.analysis.plots import accuracy_plot, threshold_plot
+from feelmysign.study.analysis.psychometric import (
+    BOOTSTRAP_SAMPLES,
+    Threshold,
+    counts_by_level,
+    threshold_with_interval,
+)
+from feelmysign.study.analysis.report import write_report
+from feelmysign.study.analysis.wilson import wilson_interval
+from feelmysign.study.export import export_study, trial_rows
+from feelmysign.study.store import StudyStore
+
+
+@dataclass(frozen=True)
+class Analysis:
+    participants: int
+    simulated: int
+    trials: int
+    unclear: int
+    accuracy: dict[str, list[tuple[int, int, int, float, float]]]  # strokes, k, n, low, high
+    thresholds: dict[str, Threshold]
+    model: ModelResult | None
+    criterion: float
+    files: list[Path]
+
+
+def main_trials(store: StudyStore) -> pd.DataFrame:
+    rows = [r for r in trial_rows(store) if r["block"] == "main"]
+    return pd.DataFrame(rows)
+
+
+def analyse_study(
+    store: StudyStore, out_dir: Path, *, samples: int = BOOTSTRAP_SAMPLES, seed: int = 0
+) -> Analysis:
+    """Export, then analyse into ``out_dir``: CSVs, design.json, PNGs, report.md, results.json."""
+    files = export_study(store, out_dir)
+    design = store.design
+    frame = main_trials(store)
+    unclear = int((frame["coded_status"] == "unclear").sum()) if len(frame) else 0
+    coded = frame[frame["coded_status"] != "unclear"].copy() if len(frame) else frame
+    if len(coded):
+        coded["correct"] = coded["correct"].astype(int)
+    accuracy: dict[str, list[tuple[int, int, int, float, float]]] = {}
+    thresholds: dict[str, Threshold] = {}
+    for shape in design.shapes:
+        levels = np.array(sorted({lv.strokes for lv in shape.levels}), dtype=float)
+        mine = coded[coded["shape"] == shape.name] if len(coded) else coded
+        rows = []
+        for strokes in levels:
+            at = mine[mine["segments"] == strokes] if len(mine) else mine
+            k, n = int(at["correct"].sum()) if len(at) else 0, len(at)
+            rows.append((int(strokes), k, n, *wilson_interval(k, n)))
+        accuracy[shape.name] = rows
+        if len(mine) and len(levels) > 1:
+            per_participant = [
+                counts_by_level(
+                    group["segments"].to_numpy(float), group["correct"].to_numpy(float), levels
+                )
+                for _, group in mine.groupby("participant")
+            ]
+            thresholds[shape.name] = threshold_with_interval(
+                per_participant,
+                levels,
+                criterion=design.criterion,
+                guess=design.guess_rate,
+                samples=samples,
+                seed=seed,
+            )
+    model = None
+    if len(coded) and coded["shape"].nunique() > 1 and coded["participant"].nunique() > 1:
+        model = shape_differences(coded[["participant", "shape", "segments", "correct"]])
+    participants = store.participants()
+    analysis = Analysis(
+        participants=int(frame["participant"].nunique()) if len(frame) else 0,
+        simulated=sum(1 for p in participants if p["simulated"]),
+        trials=len(frame),
+        unclear=unclear,
+        accuracy=accuracy,
+        thresholds=thresholds,
+        model=model,
+        criterion=design.criterion,
+        files=files,
+    )
+    files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
+    if thresholds:
+        files.append(
+            threshold_plot(out_dir / "needed-resolution.png", thresholds, design.criterion)
+        )
+    files.append(_results_json(out_dir / "results.json", analysis))
+    files.append(write_report(out_dir / "report.md", store, analysis))
+    return analysis
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def _results_json(path: Path, analysis: Analysis) -> Path:
+    data: dict[str, Any] = {
+        "participants": analysis.participants,
+        "trials": analysis.trials,
+        "unclear": analysis.unclear,
+        "criterion": analysis.criterion,
+        "accuracy": {
+            shape: [
+                dict(zip(("strokes", "correct", "total", "low", "high"), r, strict=True))
+                for r in rows
+            ]
+            for shape, rows in analysis.accuracy.items()
+        },
+        "needed_strokes": {
+            shape: {
+                "strokes": _finite(t.strokes),
+                "low": _finite(t.low),
+                "high": _finite(t.high),
+                "bootstrap_low": _finite(t.boot_low),
+                "bootstrap_high": _finite(t.boot_high),
+                "midpoint_log2": t.fit.midpoint,
+                "slope_per_doubling": t.fit.slope,
+            }
+            for shape, t in analysis.thresholds.items()
+        },
+        "shape_model": asdict(analysis.model) if analysis.model else None,
+    }
+    path.write_text(json.dumps(data, indent=2, default=str) + "\n", encoding="utf-8")
+    return path

@@ -1,0 +1,80 @@
+"""The study's figures (PNG, small enough for a paper column): accuracy by resolution with
+Wilson intervals and the fitted curves, and the needed resolution per shape."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only: no display on a lab machine or CI
+import matplotlib.pyplot as plt
+import numpy as np
+
+from feelmysign.study.analysis.psychometric import Threshold
+
+DPI = 110
+FIGURE_IN = (6.4, 4.0)
+
+
+def accuracy_plot(
+    path: Path,
+    accuracy: dict[str, list[tuple[int, int, int, float, float]]],
+    thresholds: dict[str, Threshold],
+    criterion: float,
+) -> Path:
+    """Per shape: points (strokes, share correct) with Wilson bars, and the fitted curve."""
+    figure, axes = plt.subplots(figsize=FIGURE_IN, dpi=DPI)
+    colours = plt.get_cmap("tab10")
+    for index, (shape, rows) in enumerate(accuracy.items()):
+        colour = colours(index % 10)
+        strokes = np.array([r[0] for r in rows], dtype=float)
+        share = np.array([r[1] / r[2] if r[2] else math.nan for r in rows])
+        low = np.array([r[3] for r in rows])
+        high = np.array([r[4] for r in rows])
+        axes.errorbar(
+            strokes * (1 + 0.015 * (index - len(accuracy) / 2)),
+            share,
+            yerr=[np.clip(share - low, 0, None), np.clip(high - share, 0, None)],
+            fmt="o",
+            color=colour,
+            capsize=2,
+            markersize=4,
+            label=shape,
+        )
+        if shape in thresholds and len(strokes) > 1:
+            grid = np.geomspace(strokes.min() * 0.8, strokes.max() * 1.25, 100)
+            axes.plot(grid, thresholds[shape].fit.accuracy(grid), color=colour, linewidth=1)
+    axes.axhline(criterion, color="grey", linestyle=":", linewidth=1)
+    axes.set_xscale("log", base=2)
+    axes.set_xlabel("strokes per shape (log scale)")
+    axes.set_ylabel("share named correctly")
+    axes.set_ylim(-0.02, 1.02)
+    axes.set_title("Recognition by resolution (95% Wilson intervals, fitted curves)")
+    axes.legend(fontsize="small", ncol=2, loc="lower right")
+    figure.tight_layout()
+    figure.savefig(path)
+    plt.close(figure)
+    return path
+
+
+def threshold_plot(path: Path, thresholds: dict[str, Threshold], criterion: float) -> Path:
+    """The strokes each shape needs for the criterion accuracy, with 95% intervals."""
+    figure, axes = plt.subplots(figsize=(FIGURE_IN[0], 0.45 * len(thresholds) + 1.2), dpi=DPI)
+    names = list(thresholds)
+    for row, name in enumerate(names):
+        result = thresholds[name]
+        if math.isfinite(result.strokes):
+            axes.plot([result.low, result.high], [row, row], color="black", linewidth=1.5)
+            axes.plot(result.strokes, row, "o", color="black")
+        else:
+            axes.text(1, row, "not reached", va="center", fontsize="small")
+    axes.set_yticks(range(len(names)), names)
+    axes.set_xscale("log", base=2)
+    axes.set_xlabel(f"strokes needed for {criterion:.0%} correct (95% interval)")
+    axes.invert_yaxis()
+    figure.tight_layout()
+    figure.savefig(path)
+    plt.close(figure)
+    return path

@@ -1,0 +1,111 @@
+"""The short Markdown report of an analysis: what was done, the tables, the figures."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from feelmysign.study.store import StudyStore
+
+if TYPE_CHECKING:
+    from feelmysign.study.analysis.analyse import Analysis
+
+
+def _strokes(value: float, tested: tuple[float, float]) -> str:
+    """A needed resolution, or where it lies when the tested range does not contain it."""
+    if not math.isfinite(value) or value > tested[1]:
+        return f"> {tested[1]:g}"
+    if value < tested[0]:
+        return f"< {tested[0]:g}"
+    return f"{value:.1f}"
+
+
+def _p(value: float) -> str:
+    return "p < 0.001" if value < 0.001 else f"p = {value:.3f}"
+
+
+def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
+    design = store.design
+    lines = [
+        f"# {design.name}",
+        "",
+        f"{analysis.participants} participants ({analysis.simulated} simulated), "
+        f"{analysis.trials} measured trials: {len(design.shapes)} shapes x "
+        f"{len(design.resolutions)} resolutions x {design.repetitions} repetitions, order by "
+        f"{design.randomisation} (seed {design.seed}). Answers were free; they were coded to "
+        f"shapes by synonyms, unclear ones by the researcher. "
+        f"{analysis.unclear} answer(s) still await review and are left out.",
+        "",
+        "## Accuracy by shape and resolution",
+        "",
+        "Share named correctly, with 95% Wilson intervals.",
+        "",
+        "| shape | " + " | ".join(design.resolutions) + " |",
+        "|---|" + "---|" * len(design.resolutions),
+    ]
+    for shape, rows in analysis.accuracy.items():
+        cells = [
+            f"{k}/{n} = {k / n:.0%} [{low:.0%}, {high:.0%}] ({strokes} strokes)" if n else "-"
+            for strokes, k, n, low, high in rows
+        ]
+        lines.append(f"| {shape} | " + " | ".join(cells) + " |")
+    lines += [
+        "",
+        "![accuracy](accuracy.png)",
+        "",
+        f"## Resolution needed for {analysis.criterion:.0%} correct (SQ2.3)",
+        "",
+        "Per shape, a logistic psychometric function of log2(strokes) (guess rate "
+        f"{design.guess_rate:g}, lapse rate fixed at 2%) fitted by maximum likelihood. "
+        "Interval: profile likelihood, 95%; beside it the cluster bootstrap over participants "
+        "(bias-corrected percentiles).",
+        "",
+        "| shape | strokes needed | 95% interval | bootstrap 95% | slope per doubling |",
+        "|---|---|---|---|---|",
+    ]
+    for shape, t in analysis.thresholds.items():
+        rows = analysis.accuracy[shape]
+        tested = (float(rows[0][0]), float(rows[-1][0]))
+        lines.append(
+            f"| {shape} | {_strokes(t.strokes, tested)} | {_strokes(t.low, tested)} - "
+            f"{_strokes(t.high, tested)} | {_strokes(t.boot_low, tested)} - "
+            f"{_strokes(t.boot_high, tested)} | {t.fit.slope:.2f} |"
+        )
+    lines += [
+        "",
+        "'< n': every tested resolution was already recognised at the criterion; '> n': not "
+        "even the finest one was.",
+    ]
+    lines += [
+        "",
+        "![needed resolution](needed-resolution.png)",
+        "",
+        "## Do shapes differ? (SQ2.4)",
+        "",
+    ]
+    model = analysis.model
+    if model is None:
+        lines.append("Not enough data (two shapes and two participants at least).")
+    else:
+        lines += [
+            "Logistic models of a correct answer on shape and log2(strokes). Test: GLM with "
+            "standard errors clustered by participant, Wald test that every shape effect is 0: "
+            f"chi2({model.wald_df}) = {model.wald_chi2:.2f}, {_p(model.wald_p)}.",
+            "",
+            f"Mixed-effects model (participant random intercept; {model.note}): reference shape "
+            f"{model.reference}; slope {model.slope_per_doubling:.2f} log odds per doubling of "
+            f"strokes; participant SD {model.participant_sd:.2f} log odds.",
+            "",
+            "| shape | log odds vs " + model.reference + " | posterior SD |",
+            "|---|---|---|",
+            *(f"| {e.shape} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.mixed),
+        ]
+    lines += [
+        "",
+        "Files: trials.csv (one row per trial, anonymised), questionnaire.csv, threshold.csv, "
+        "design.json, results.json.",
+        "",
+    ]
+    path.write_text("\n".join(lines), encoding="utf-8")
+    return path

@@ -1,0 +1,352 @@
+"""Read and check a study design file (TOML), reporting every problem at once.
+
+See ``deploy/studies/paper.toml`` (the paper's design) and docs/study.md. A
+design is checked completely before anything is sent: every shape's levels
+must be drawable on the sleeve (segments allowed for that shape, or simplifier
+settings that leave strokes of the recording), and no synonym may name two
+shapes.
+"""
+
+from __future__ import annotations
+
+import sys
+import uuid
+from pathlib import Path
+from typing import Any
+
+from feelmysign.errors import DesignError, FeelMySignError
+from feelmysign.shapes import SHAPES
+from feelmysign.simplify.replay import ALGORITHMS
+from feelmysign.study.coding import normalise
+from feelmysign.study.design import (
+    RANDOMISATIONS,
+    Design,
+    Level,
+    PracticeTrial,
+    Questionnaire,
+    Randomisation,
+    Shape,
+    Stimulus,
+    Threshold,
+    ThresholdDimension,
+)
+from feelmysign.study.problems import MISSING, Problems
+from feelmysign.study.stimulus import recorded_strokes, stimulus_layout
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+MAX_SHAPES = 24
+MAX_LEVELS = 12
+MAX_REPETITIONS = 20
+MAX_LIKERT_POINTS = 11
+_TOP = ("study", "stimulus", "shapes", "practice", "comfort", "questionnaire", "threshold")
+_STUDY = ("name", "seed", "randomisation", "repetitions", "resolutions", "criterion", "guess_rate")
+
+
+def load_design(path: str | Path) -> Design:
+    """The design in ``path``; DesignError listing every problem, or naming the unreadable file."""
+    file = Path(path)
+    try:
+        text = file.read_text(encoding="utf-8")
+    except OSError as error:
+        raise DesignError(
+            str(path), [f"cannot read the file: {error.strerror or error}"]
+        ) from error
+    return parse_design(text, source=str(path), base_dir=file.resolve().parent)
+
+
+def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path(".")) -> Design:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise DesignError(source, [f"not valid TOML: {error}"]) from error
+    problems = Problems(source)
+    problems.unknown("", data, _TOP)
+    study = problems.table("study", data.get("study", MISSING), required=True)
+    problems.unknown("study", study, _STUDY)
+    resolutions = problems.texts("study.resolutions", study.get("resolutions", MISSING))
+    if len(resolutions) > MAX_LEVELS:
+        problems.add("study.resolutions", f"at most {MAX_LEVELS} resolutions")
+    if len(set(resolutions)) != len(resolutions):
+        problems.add("study.resolutions", "each resolution needs its own label")
+    stimulus = _stimulus(problems, data.get("stimulus", MISSING), base_dir)
+    shapes = _shapes(problems, data.get("shapes", MISSING), len(resolutions), stimulus, base_dir)
+    design = Design(
+        name=problems.text("study.name", study.get("name", MISSING)) or "",
+        seed=problems.integer("study.seed", study.get("seed", MISSING), 0, 2**63 - 1) or 0,
+        randomisation=_randomisation(problems, study.get("randomisation", MISSING)),
+        repetitions=problems.integer(
+            "study.repetitions", study.get("repetitions", MISSING), 1, MAX_REPETITIONS
+        )
+        or 1,
+        resolutions=resolutions,
+        shapes=shapes,
+        practice=_practice(problems, data.get("practice", []), stimulus, base_dir),
+        questionnaire=_questionnaire(problems, data.get("questionnaire", MISSING)),
+        comfort=_comfort(problems, data.get("comfort", {})),
+        stimulus=stimulus,
+        criterion=_number_or(problems, "study.criterion", study, 0.05, 0.99, 0.75),
+        guess_rate=_number_or(problems, "study.guess_rate", study, 0.0, 0.5, 0.0),
+        threshold=_threshold(problems, data.get("threshold", {})),
+        source=source,
+    )
+    if design.guess_rate >= design.criterion:
+        problems.add("study.criterion", "must be above study.guess_rate")
+    problems.raise_if_any()
+    return design
+
+
+def _number_or(
+    problems: Problems, key: str, table: dict[str, Any], low: float, high: float, default: float
+) -> float:
+    value = problems.number(
+        key, table.get(key.rsplit(".", 1)[-1], MISSING), low, high, required=False
+    )
+    return default if value is None else value
+
+
+def _randomisation(problems: Problems, value: Any) -> Randomisation:
+    chosen = problems.choice("study.randomisation", value, RANDOMISATIONS, "latin-square")
+    return "shuffled-blocks" if chosen == "shuffled-blocks" else "latin-square"
+
+
+def _stimulus(problems: Problems, value: Any, base_dir: Path) -> Stimulus:
+    table = problems.table("stimulus", value)
+    problems.unknown("stimulus", table, ("speed_cm_s", "margin", "intensity", "layout"))
+    speed = problems.number("stimulus.speed_cm_s", table.get("speed_cm_s", 5.0), 0.5, 50.0)
+    margin = problems.number("stimulus.margin", table.get("margin", 0.0), 0.0, 1.0)
+    intensity = problems.number(
+        "stimulus.intensity", table.get("intensity", MISSING), 0.05, 1.0, required=False
+    )
+    layout = problems.text("stimulus.layout", table.get("layout", MISSING), required=False)
+    stimulus = Stimulus(speed or 5.0, margin or 0.0, intensity, layout)
+    try:
+        stimulus_layout(stimulus, base_dir)
+    except FeelMySignError as error:
+        problems.add("stimulus.layout", str(error))
+        return Stimulus(stimulus.speed_cm_s, stimulus.margin, intensity, None)
+    return stimulus
+
+
+def _shapes(
+    problems: Problems, value: Any, levels: int, stimulus: Stimulus, base_dir: Path
+) -> tuple[Shape, ...]:
+    items = problems.array("shapes", value)
+    if items is None:
+        return ()
+    if not 1 <= len(items) <= MAX_SHAPES:
+        problems.add("shapes", f"give 1 to {MAX_SHAPES} [[shapes]]; got {len(items)}")
+    shapes: list[Shape] = []
+    for index, item in enumerate(items):
+        shape = _shape(problems, f"shapes[{index}]", item, levels, stimulus, base_dir)
+        if shape is not None:
+            shapes.append(shape)
+    _check_names_and_synonyms(problems, shapes)
+    return tuple(shapes)
+
+
+def _shape(
+    problems: Problems, key: str, item: Any, levels: int, stimulus: Stimulus, base_dir: Path
+) -> Shape | None:
+    table = problems.table(key, item, required=True)
+    problems.unknown(
+        key, table, ("name", "segments", "recording", "simplifier", "settings", "synonyms")
+    )
+    name = problems.text(f"{key}.name", table.get("name", MISSING), max_chars=40)
+    synonyms = problems.texts(f"{key}.synonyms", table.get("synonyms", []))
+    if name is None:
+        return None
+    words = tuple(dict.fromkeys([normalise(name), *(normalise(s) for s in synonyms)]))
+    recording = problems.text(f"{key}.recording", table.get("recording", MISSING), required=False)
+    if recording is None:
+        found = _library_levels(problems, key, name, table.get("segments", MISSING), levels)
+    else:
+        found = _recorded_levels(problems, key, table, recording, levels, stimulus, base_dir)
+    return None if found is None else Shape(name, found, words, recording)
+
+
+def _library_levels(
+    problems: Problems, key: str, name: str, value: Any, levels: int
+) -> tuple[Level, ...] | None:
+    spec = SHAPES.get(name)
+    if spec is None:
+        problems.add(
+            f"{key}.name",
+            f"{name!r} is not a library shape ({', '.join(SHAPES)}); for a drawing of your "
+            "own give recording = 'file.json' with simplifier and settings",
+        )
+        return None
+    segments = problems.array(f"{key}.segments", value)
+    if segments is None:
+        return None
+    if len(segments) != levels:
+        problems.add(f"{key}.segments", f"give one per resolution ({levels}); got {len(segments)}")
+        return None
+    out = []
+    for i, count in enumerate(segments):
+        if not isinstance(count, int) or isinstance(count, bool) or not spec.accepts(count):
+            problems.add(f"{key}.segments[{i}]", f"a {name} takes {spec.allowed()}; got {count!r}")
+            return None
+        out.append(Level(strokes=count, segments=count))
+    return tuple(out)
+
+
+def _recorded_levels(
+    problems: Problems,
+    key: str,
+    table: dict[str, Any],
+    recording: str,
+    levels: int,
+    stimulus: Stimulus,
+    base_dir: Path,
+) -> tuple[Level, ...] | None:
+    simplifier = problems.choice(
+        f"{key}.simplifier", table.get("simplifier", MISSING), tuple(ALGORITHMS), "window"
+    )
+    settings = problems.array(f"{key}.settings", table.get("settings", MISSING))
+    if simplifier is None or settings is None:
+        return None
+    if len(settings) != levels:
+        problems.add(f"{key}.settings", f"give one per resolution ({levels}); got {len(settings)}")
+        return None
+    layout = stimulus_layout(stimulus, base_dir)
+    out = []
+    for i, overrides in enumerate(settings):
+        where = f"{key}.settings[{i}]"
+        if not isinstance(overrides, dict):
+            problems.add(
+                where, "must be a table of the simplifier's settings, e.g. {max_error = 0.5}"
+            )
+            return None
+        specs = ALGORITHMS[simplifier].specs
+        unknown = [name for name in overrides if name not in specs]
+        if unknown:
+            problems.add(
+                where, f"{', '.join(unknown)}: not a {simplifier} setting ({', '.join(specs)})"
+            )
+            return None
+        try:
+            for name, setting in overrides.items():
+                specs[name].check(setting)
+            strokes = recorded_strokes(
+                base_dir / recording, simplifier, overrides, stimulus, layout, str(uuid.uuid4())
+            )
+        except FeelMySignError as error:
+            problems.add(where, str(error))
+            return None
+        out.append(Level(len(strokes), simplifier=simplifier, settings=dict(overrides)))
+    return tuple(out)
+
+
+def _check_names_and_synonyms(problems: Problems, shapes: list[Shape]) -> None:
+    owners: dict[str, str] = {}
+    for shape in shapes:
+        if any(other.name == shape.name for other in shapes if other is not shape):
+            problems.add("shapes", f"{shape.name!r} is listed twice")
+        for word in shape.synonyms:
+            owner = owners.setdefault(word, shape.name)
+            if owner != shape.name:
+                problems.add(
+                    f"shapes ({shape.name})",
+                    f"synonym {word!r} also names {owner!r}: an answer must point to one shape",
+                )
+
+
+def _practice(
+    problems: Problems, value: Any, stimulus: Stimulus, base_dir: Path
+) -> tuple[PracticeTrial, ...]:
+    items = problems.array("practice", value, required=False) or []
+    out = []
+    for index, item in enumerate(items):
+        key = f"practice[{index}]"
+        table = problems.table(key, item, required=True)
+        problems.unknown(key, table, ("shape", "segments"))
+        name = problems.choice(f"{key}.shape", table.get("shape", MISSING), tuple(SHAPES), "")
+        if not name:
+            if name == "":
+                problems.add(f"{key}.shape", f"missing; give one of {', '.join(SHAPES)}")
+            continue
+        spec = SHAPES[name]
+        segments = table.get("segments", spec.default_segments)
+        if (
+            not isinstance(segments, int)
+            or isinstance(segments, bool)
+            or not spec.accepts(segments)
+        ):
+            problems.add(f"{key}.segments", f"a {name} takes {spec.allowed()}; got {segments!r}")
+            continue
+        out.append(PracticeTrial(name, segments))
+    return tuple(out)
+
+
+def _comfort(problems: Problems, value: Any) -> tuple[str, ...]:
+    table = problems.table("comfort", value)
+    problems.unknown("comfort", table, ("questions",))
+    default = ["Does the sleeve sit comfortably?", "Can you feel the test buzz clearly?"]
+    return problems.texts("comfort.questions", table.get("questions", default))
+
+
+def _questionnaire(problems: Problems, value: Any) -> Questionnaire:
+    table = problems.table("questionnaire", value, required=True)
+    problems.unknown("questionnaire", table, ("points", "labels", "items"))
+    points = problems.integer("questionnaire.points", table.get("points", 5), 2, MAX_LIKERT_POINTS)
+    labels = problems.texts("questionnaire.labels", table.get("labels", []), required=False)
+    items = problems.texts("questionnaire.items", table.get("items", MISSING))
+    if points is not None and labels and len(labels) != points:
+        problems.add("questionnaire.labels", f"give one label per point ({points}) or none")
+    if not items:
+        problems.add("questionnaire.items", "give at least one Likert item")
+    return Questionnaire(items, points or 5, labels)
+
+
+def _threshold(problems: Problems, value: Any) -> Threshold:
+    table = problems.table("threshold", value)
+    problems.unknown(
+        "threshold",
+        table,
+        ("trials", "max_trials", "stop_width", "lapse_rate", "length", "duration"),
+    )
+    trials = problems.integer("threshold.trials", table.get("trials", 40), 5, 500) or 40
+    max_trials = problems.integer("threshold.max_trials", table.get("max_trials", trials), 5, 1000)
+    if max_trials is not None and max_trials < trials:
+        problems.add("threshold.max_trials", f"must be at least threshold.trials ({trials})")
+    length = _dimension(
+        problems, "threshold.length", table.get("length", {}), (0.1, 3.0, 25), "duration_ms", 500.0
+    )
+    duration = _dimension(
+        problems, "threshold.duration", table.get("duration", {}), (20.0, 1500.0, 25), "length", 2.0
+    )
+    return Threshold(
+        trials=trials,
+        max_trials=max_trials or trials,
+        stop_width=problems.number("threshold.stop_width", table.get("stop_width", 0.0), 0, 10)
+        or 0.0,
+        lapse_rate=problems.number("threshold.lapse_rate", table.get("lapse_rate", 0.02), 0, 0.2)
+        or 0.0,
+        length=length,
+        duration=duration,
+    )
+
+
+def _dimension(
+    problems: Problems,
+    key: str,
+    value: Any,
+    defaults: tuple[float, float, int],
+    fixed_name: str,
+    fixed_default: float,
+) -> ThresholdDimension:
+    table = problems.table(key, value)
+    problems.unknown(key, table, ("minimum", "maximum", "steps", fixed_name))
+    low = problems.number(f"{key}.minimum", table.get("minimum", defaults[0]), 1e-3, 1e5)
+    high = problems.number(f"{key}.maximum", table.get("maximum", defaults[1]), 1e-3, 1e5)
+    steps = problems.integer(f"{key}.steps", table.get("steps", defaults[2]), 5, 200)
+    fixed = problems.number(f"{key}.{fixed_name}", table.get(fixed_name, fixed_default), 1e-3, 1e5)
+    if low is not None and high is not None and low >= high:
+        problems.add(key, f"minimum ({low:g}) must be below maximum ({high:g})")
+    return ThresholdDimension(
+        low or defaults[0], high or defaults[1], steps or defaults[2], fixed or fixed_default
+    )

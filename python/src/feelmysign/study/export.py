@@ -1,0 +1,184 @@
+"""Export a study: anonymised long-format CSV (one row per trial), the questionnaire, the
+threshold trials, and the design as JSON.
+
+Anonymised: participant codes are replaced by P01, P02, ... in the order they
+were added (the codes may be on signed consent forms; the export must not link
+to them), no times of day are exported (only durations), and no comfort notes
+exist to leak (the comfort check is yes/no). The free answers are exported:
+they are what was coded, and a reader may re-code them.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any
+
+from feelmysign.study.runner import events_summary
+from feelmysign.study.store import StudyStore
+
+TRIAL_COLUMNS = (
+    "participant",
+    "simulated",
+    "trial",
+    "block",
+    "repetition",
+    "shape",
+    "resolution",
+    "level",
+    "segments",
+    "answer",
+    "felt_nothing",
+    "confidence",
+    "coded_status",
+    "coded_shape",
+    "coded_by",
+    "decisions",
+    "correct",
+    "sends",
+    "played",
+    "adjusted",
+    "rejected",
+    "latency_ms_max",
+    "felt_duration_ms",
+    "response_time_s",
+)
+
+
+def anonymous_labels(store: StudyStore) -> dict[str, str]:
+    rows = store.participants()
+    width = max(2, len(str(len(rows))))
+    return {row["code"]: f"P{row['number'] + 1:0{width}d}" for row in rows}
+
+
+def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
+    """Every answered trial with its coding in force and its sleeve events, anonymised."""
+    labels = anonymous_labels(store)
+    codings = store.latest_codings()
+    decisions = {
+        int(r["trial"]): int(r["n"])
+        for r in store.query("SELECT trial, COUNT(*) AS n FROM codings GROUP BY trial")
+    }
+    design = store.design
+    out = []
+    for participant in store.participants():
+        for trial in store.trials(participant["code"]):
+            if trial["answered_at_ms"] is None:
+                continue
+            coding = codings.get(trial["id"])
+            sends = store.sends(trial["id"])
+            events = [json.loads(e["json"]) for s in sends[-1:] for e in store.events(s["id"])]
+            strokes = len(json.loads(sends[-1]["strokes_json"])) if sends else 0
+            summary = events_summary(events, strokes)
+            status = coding["status"] if coding else "unclear"
+            correct = (
+                ""
+                if status == "unclear"
+                else int(coding is not None and coding["shape"] == trial["shape"])
+            )
+            level = trial["level"]
+            first_sent = sends[0]["sent_at_ms"] if sends else trial["answered_at_ms"]
+            out.append(
+                {
+                    "participant": labels[participant["code"]],
+                    "simulated": int(participant["simulated"]),
+                    "trial": trial["position"] + 1,
+                    "block": trial["block"],
+                    "repetition": trial["repetition"],
+                    "shape": trial["shape"],
+                    "resolution": "" if level is None else design.resolutions[level],
+                    "level": "" if level is None else level + 1,
+                    "segments": trial["segments"],
+                    "answer": trial["answer"],
+                    "felt_nothing": trial["felt_nothing"],
+                    "confidence": "" if trial["confidence"] is None else trial["confidence"],
+                    "coded_status": status,
+                    "coded_shape": (coding["shape"] if coding else None) or "",
+                    "coded_by": coding["decided_by"] if coding else "",
+                    "decisions": decisions.get(trial["id"], 0),
+                    "correct": correct,
+                    "sends": len(sends),
+                    "played": summary["played"],
+                    "adjusted": summary["adjusted"],
+                    "rejected": len(summary["rejected"]),
+                    "latency_ms_max": ""
+                    if summary["latency_ms_max"] is None
+                    else summary["latency_ms_max"],
+                    "felt_duration_ms": summary["felt_duration_ms"],
+                    "response_time_s": round((trial["answered_at_ms"] - first_sent) / 1000, 3),
+                }
+            )
+    return out
+
+
+def questionnaire_rows(store: StudyStore) -> list[dict[str, Any]]:
+    labels = anonymous_labels(store)
+    items = store.design.questionnaire.items
+    rows = store.query("SELECT * FROM questionnaire ORDER BY participant, item")
+    return [
+        {
+            "participant": labels[r["participant"]],
+            "item": r["item"] + 1,
+            "text": items[r["item"]],
+            "value": r["value"],
+        }
+        for r in sorted(rows, key=lambda r: (labels[r["participant"]], r["item"]))
+    ]
+
+
+def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
+    labels = anonymous_labels(store)
+    out = []
+    for run in store.threshold_runs():
+        for trial in store.threshold_trials(run["id"]):
+            out.append(
+                {
+                    "participant": labels[run["participant"]],
+                    "run": run["id"],
+                    "dimension": run["dimension"],
+                    "trial": trial["position"] + 1,
+                    "value": trial["value"],
+                    "direction": trial["direction"],
+                    "response": trial["response"],
+                    "correct": trial["correct"],
+                }
+            )
+    return out
+
+
+def _write_csv(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...]) -> None:
+    with path.open("w", newline="", encoding="utf-8") as file:
+        writer = csv.DictWriter(file, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
+    """Write trials.csv, questionnaire.csv, threshold.csv and design.json into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files = {
+        "trials.csv": (trial_rows(store), TRIAL_COLUMNS),
+        "questionnaire.csv": (questionnaire_rows(store), ("participant", "item", "text", "value")),
+        "threshold.csv": (
+            threshold_rows(store),
+            (
+                "participant",
+                "run",
+                "dimension",
+                "trial",
+                "value",
+                "direction",
+                "response",
+                "correct",
+            ),
+        ),
+    }
+    written = []
+    for name, (rows, columns) in files.items():
+        _write_csv(out_dir / name, rows, columns)
+        written.append(out_dir / name)
+    design = out_dir / "design.json"
+    design.write_text(json.dumps(store.design.to_json(), indent=2) + "\n", encoding="utf-8")
+    written.append(design)
+    return written

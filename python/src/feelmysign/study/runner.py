@@ -1,0 +1,233 @@
+"""One participant's session, step by step, as section 6.1 describes it; shared by the
+researcher's page (``api``) and the terminal (``feelmysign study run``).
+
+Steps: consent -> comfort check -> trials (practice, then the measured ones)
+-> questionnaire -> done. The step is always computed from the study file,
+never kept in memory, so after a crash or a restart the session continues
+exactly where the last stored answer left it. ``Play`` sends a trial's strokes
+to the sleeve and returns the sleeve's events (``SleeveLink.play``, or the
+offline ``simulated_sleeve.play_offline`` for dry runs without a sleeve).
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+import uuid
+from collections.abc import Callable
+from typing import Any
+
+from feelmysign.errors import FeelMySignError, StudyError
+from feelmysign.layout import Layout
+from feelmysign.schedule import stroke_to_json
+from feelmysign.stroke import Stroke
+from feelmysign.study.coding import code_answer
+from feelmysign.study.simulated import SimulatedParticipant, templates
+from feelmysign.study.stimulus import stimulus_layout, trial_strokes
+from feelmysign.study.store import StudyStore
+
+Play = Callable[[list[Stroke]], list[dict[str, Any]]]
+MAX_ANSWER_CHARS = 200
+CONFIDENCE_POINTS = 5
+
+
+def stroke_from_json(data: dict[str, Any]) -> Stroke:
+    return Stroke(
+        start=(float(data["start"][0]), float(data["start"][1])),
+        end=(float(data["end"][0]), float(data["end"][1])),
+        duration_ms=float(data["duration_ms"]),
+        intensity=data.get("intensity"),
+        drawing=data.get("drawing"),
+        seq=data.get("seq"),
+    )
+
+
+def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]:
+    played = [e for e in events if e.get("type") in ("played", "adjusted")]
+    latencies = [
+        float(e["latency_ms"]) for e in played if isinstance(e.get("latency_ms"), (int, float))
+    ]
+    return {
+        "strokes": strokes,
+        "played": len(played),
+        "adjusted": sum(1 for e in events if e.get("type") == "adjusted"),
+        "rejected": [str(e.get("reason")) for e in events if e.get("type") == "rejected"],
+        "latency_ms_max": round(max(latencies), 3) if latencies else None,
+        "felt_duration_ms": round(sum(float(e.get("duration_ms", 0)) for e in played), 1),
+    }
+
+
+class Session:
+    """``Session(store, play)``: the operations on one study's participants."""
+
+    def __init__(self, store: StudyStore, play: Play | None, *, simulation_seed: int = 0) -> None:
+        self.store = store
+        self._play = play
+        self.layout: Layout = stimulus_layout(store.design.stimulus, store.base_dir)
+        self._templates = templates(store.design, self.layout)
+        self._simulation_seed = simulation_seed
+
+    # ---- what the page shows -----------------------------------------------------------
+
+    def step(self, code: str) -> str:
+        row = self.store.participant(code)
+        if row["withdrawn"]:
+            return "withdrawn"
+        if row["consent"] != 1:
+            return "consent"
+        if row["comfort_json"] is None:
+            return "comfort"
+        if self.store.current_trial(code) is not None:
+            return "trial"
+        if not self.store.questionnaire(code):
+            return "questionnaire"
+        return "done"
+
+    def state(self, code: str) -> dict[str, Any]:
+        row = self.store.participant(code)
+        trials = self.store.trials(row["code"])
+        answered = sum(1 for t in trials if t["answered_at_ms"] is not None)
+        current = self.store.current_trial(row["code"])
+        return {
+            "participant": row["code"],
+            "simulated": bool(row["simulated"]),
+            "step": self.step(row["code"]),
+            "paused": bool(row["paused"]),
+            "answered": answered,
+            "total": len(trials),
+            "trial": None if current is None else self._trial_state(current, len(trials)),
+        }
+
+    def _trial_state(self, trial: sqlite3.Row, total: int) -> dict[str, Any]:
+        design = self.store.design
+        sends = self.store.sends(trial["id"])
+        last = None
+        if sends:
+            events = [json.loads(e["json"]) for e in self.store.events(sends[-1]["id"])]
+            strokes = len(json.loads(sends[-1]["strokes_json"]))
+            last = {**events_summary(events, strokes), "error": sends[-1]["error"]}
+        level = trial["level"]
+        return {
+            "id": trial["id"],
+            "number": trial["position"] + 1,
+            "total": total,
+            "block": trial["block"],
+            "repetition": trial["repetition"],
+            "shape": trial["shape"],
+            "resolution": None if level is None else design.resolutions[level],
+            "segments": trial["segments"],
+            "sends": len(sends),
+            "last_send": last,
+        }
+
+    # ---- the steps ---------------------------------------------------------------------
+
+    def consent(self, code: str, given: bool) -> None:
+        self.store.set_consent(code, given)
+
+    def comfort(self, code: str, answers: list[bool], adjusted: bool) -> None:
+        self.store.record_comfort(code, answers, adjusted)
+
+    def _current(self, code: str, trial_id: int | None) -> sqlite3.Row:
+        row = self.store.participant(code)
+        if row["paused"]:
+            raise StudyError(f"the session of {row['code']} is paused; resume it first")
+        if self.step(row["code"]) != "trial":
+            raise StudyError(f"{row['code']} is at the {self.step(row['code'])} step, not a trial")
+        current = self.store.current_trial(row["code"])
+        assert current is not None
+        if trial_id is not None and current["id"] != trial_id:
+            raise StudyError(
+                f"trial {trial_id} is not the current one ({current['id']}): the page is out of "
+                "date; reload it"
+            )
+        return current
+
+    def strokes_of(self, trial: sqlite3.Row, drawing: str) -> list[Stroke]:
+        return trial_strokes(
+            self.store.design,
+            self.store.base_dir,
+            trial["shape"],
+            level=trial["level"],
+            segments=trial["segments"],
+            drawing=drawing,
+            layout=self.layout,
+        )
+
+    def send(self, code: str, trial_id: int | None = None) -> dict[str, Any]:
+        """Send the current trial's shape; its events are stored with the trial."""
+        if self._play is None:
+            raise StudyError("no sleeve is connected to this runner; start it with a broker")
+        trial = self._current(code, trial_id)
+        drawing = str(uuid.uuid4())
+        strokes = self.strokes_of(trial, drawing)
+        send_id = self.store.record_send(trial["id"], drawing, [stroke_to_json(s) for s in strokes])
+        try:
+            events = self._play(strokes)
+        except FeelMySignError as error:
+            self.store.record_send_error(send_id, str(error))
+            raise
+        self.store.record_events(send_id, events)
+        return events_summary(events, len(strokes))
+
+    def answer(
+        self,
+        code: str,
+        trial_id: int | None,
+        *,
+        answer: str,
+        felt_nothing: bool,
+        confidence: int | None,
+    ) -> dict[str, Any]:
+        trial = self._current(code, trial_id)
+        if not self.store.sends(trial["id"]):
+            raise StudyError("send the shape to the sleeve before recording an answer")
+        text = answer.strip()
+        if len(text) > MAX_ANSWER_CHARS:
+            raise StudyError(f"an answer is at most {MAX_ANSWER_CHARS} characters")
+        if not text and not felt_nothing:
+            raise StudyError("type the answer, or choose 'felt nothing'")
+        if confidence is not None and not 1 <= confidence <= CONFIDENCE_POINTS:
+            raise StudyError(f"confidence is 1 to {CONFIDENCE_POINTS}, or none")
+        synonyms = [(s.name, s.synonyms) for s in self.store.design.shapes]
+        coding = code_answer(text, felt_nothing, synonyms)
+        self.store.record_answer(
+            trial["id"],
+            answer=text,
+            felt_nothing=felt_nothing,
+            confidence=confidence,
+            coding=(coding.status, coding.shape, coding.rule),
+        )
+        return {"status": coding.status, "shape": coding.shape, "rule": coding.rule}
+
+    def pause(self, code: str, paused: bool) -> None:
+        self.store.set_paused(code, paused)
+
+    def questionnaire(self, code: str, values: list[int]) -> None:
+        if self.step(code) != "questionnaire":
+            raise StudyError(f"{code} is at the {self.step(code)} step, not the questionnaire")
+        self.store.record_questionnaire(code, values)
+
+    # ---- dry runs ----------------------------------------------------------------------
+
+    def simulated_answer(self, code: str) -> dict[str, Any]:
+        """What the simulated participant answers to the current trial (as last sent)."""
+        row = self.store.participant(code)
+        if not row["simulated"]:
+            raise StudyError(
+                f"{row['code']} is a real participant; only simulated ones answer here"
+            )
+        trial = self._current(row["code"], None)
+        sends = self.store.sends(trial["id"])
+        if not sends:
+            raise StudyError("send the shape first: the simulated participant answers what it felt")
+        strokes = [stroke_from_json(s) for s in json.loads(sends[-1]["strokes_json"])]
+        participant = SimulatedParticipant(seed=self._simulation_seed + int(row["number"]))
+        result = participant.answer(
+            strokes, self.layout, self.store.design, self._templates, f"{row['code']}:{trial['id']}"
+        )
+        return {
+            "answer": result.answer,
+            "felt_nothing": result.felt_nothing,
+            "confidence": result.confidence,
+        }

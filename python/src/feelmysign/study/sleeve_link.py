@@ -1,0 +1,102 @@
+"""Send a trial's strokes to the sleeve and collect what the sleeve says it did with them.
+
+One MQTT connection with the sender's login: strokes go out through the same
+``StrokeSender`` as ``feelmysign send`` (QoS 1, at drawing pace, each
+acknowledged by the broker), and the sleeve's ``events`` topic is read for the
+events of this drawing (played, adjusted with its latency and duration, or
+rejected with the reason), which are stored with the trial.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+import uuid
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign.cli._broker_options import BrokerSettings, connect_client
+from feelmysign.sending import OutgoingStroke, StrokeSender
+from feelmysign.stroke import Stroke
+
+# Beyond the drawing's own duration: the sleeve's queue, its latency and the event's trip.
+EVENTS_GRACE_S = 5.0
+FINAL_TYPES = ("played", "adjusted", "rejected")
+
+
+class _Events:
+    """The sleeve's events by drawing id, from paho's thread."""
+
+    def __init__(self) -> None:
+        self._condition = threading.Condition()
+        self._by_drawing: dict[str, list[dict[str, Any]]] = {}
+
+    def on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        try:
+            event = json.loads(message.payload)
+        except ValueError:
+            return  # not ours to judge: the sleeve's events are JSON
+        if not isinstance(event, dict) or not isinstance(event.get("drawing"), str):
+            return
+        with self._condition:
+            self._by_drawing.setdefault(event["drawing"], []).append(event)
+            self._condition.notify_all()
+
+    def wait(self, drawing: str, count: int, timeout_s: float) -> list[dict[str, Any]]:
+        """The drawing's events once each of its ``count`` strokes has a final one (or timeout)."""
+
+        def done() -> bool:
+            seen = {
+                e.get("seq")
+                for e in self._by_drawing.get(drawing, ())
+                if e.get("type") in FINAL_TYPES
+            }
+            return len(seen) >= count
+
+        with self._condition:
+            self._condition.wait_for(done, timeout_s)
+            return list(self._by_drawing.pop(drawing, []))
+
+
+class SleeveLink:
+    """``with SleeveLink(settings) as link: events = link.play(strokes)``."""
+
+    def __init__(self, settings: BrokerSettings, *, timeout_s: float = 10.0) -> None:
+        self._settings = settings
+        self._timeout_s = timeout_s
+        self._events = _Events()
+        self._lock = threading.Lock()  # one trial on the sleeve at a time
+        self._client: mqtt.Client | None = None
+
+    def __enter__(self) -> SleeveLink:
+        client = connect_client(
+            self._settings, f"feelmysign-study-{uuid.uuid4().hex[:12]}", timeout_s=self._timeout_s
+        )
+        topic = f"feelmysign/{self._settings.sleeve_id}/events"
+        client.on_message = self._events.on_message
+        # Subscribed again on every reconnection: a clean session forgets subscriptions.
+        client.on_connect = lambda c, *_: c.subscribe(topic, qos=1)
+        client.subscribe(topic, qos=1)
+        self._client = client
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._client is not None:
+            self._client.disconnect()
+            self._client.loop_stop()
+
+    def play(self, strokes: list[Stroke]) -> list[dict[str, Any]]:
+        """Publish ``strokes`` (one drawing) at their pace; the sleeve's events for them."""
+        assert self._client is not None, "use SleeveLink in a with block"
+        with self._lock:
+            drawing = strokes[0].drawing or ""
+            topic = self._settings.strokes_topic
+            messages = [OutgoingStroke(i, topic, s) for i, s in enumerate(strokes)]
+            sender = StrokeSender(self._client, self._settings, timeout_s=self._timeout_s)
+            started_s = time.monotonic()
+            sender.send(messages, pace="realtime")
+            total_s = sum(s.duration_ms for s in strokes) / 1000
+            left_s = max(0.0, started_s + total_s - time.monotonic()) + EVENTS_GRACE_S
+            return self._events.wait(drawing, len(strokes), left_s)

@@ -1,0 +1,452 @@
+"""One study in one SQLite file: the design, participants, trials, answers, sleeve events.
+
+Opened with write-ahead logging and ``synchronous=FULL``, in autocommit mode:
+every answer is on disk when the call that records it returns, so a crash,
+a ``kill -9`` or Ctrl-C loses nothing already given, and the participant's
+session resumes at the first trial without an answer. Safe to share between
+the web server's threads (one connection behind a lock).
+"""
+
+from __future__ import annotations
+
+import json
+import secrets
+import sqlite3
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from feelmysign.errors import StudyError
+from feelmysign.study.design import Design
+from feelmysign.study.design_file import parse_design
+from feelmysign.study.order import participant_order
+from feelmysign.study.schema import SCHEMA, SCHEMA_VERSION
+
+# Participant codes: 5 characters without look-alikes (0/O, 1/I/L): 28^5 = 17 million.
+CODE_ALPHABET = "23456789ABCDEFGHJKMNPQRSTUVWXYZ"
+CODE_LENGTH = 5
+
+
+def now_ms() -> int:
+    return round(time.time() * 1000)
+
+
+class StudyStore:
+    """``StudyStore.create(path, design_path)`` once, then ``StudyStore(path)``."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        if not self.path.is_file():
+            raise StudyError(
+                f"no study file at {self.path}; create one with "
+                "'feelmysign study new DESIGN.toml --out FILE.sqlite'"
+            )
+        self._lock = threading.RLock()
+        self._db = self._connect(self.path)
+        version = self.meta("schema_version")
+        if version != str(SCHEMA_VERSION):
+            raise StudyError(
+                f"{self.path} is not a study file of this version (schema {version!r}, "
+                f"expected {SCHEMA_VERSION}); open it with the feelmysign that made it"
+            )
+        base_dir = Path(self.meta("base_dir") or ".")
+        self.design: Design = parse_design(
+            self.meta("design_toml") or "",
+            source=self.meta("design_source") or "",
+            base_dir=base_dir,
+        )
+        self.base_dir = base_dir
+
+    @staticmethod
+    def _connect(path: Path) -> sqlite3.Connection:
+        try:
+            db = sqlite3.connect(path, isolation_level=None, check_same_thread=False, timeout=10)
+            db.execute("PRAGMA journal_mode=WAL")
+            db.execute("PRAGMA synchronous=FULL")
+            db.execute("PRAGMA foreign_keys=ON")
+        except sqlite3.DatabaseError as error:
+            raise StudyError(f"{path} is not a study file ({error})") from error
+        db.row_factory = sqlite3.Row
+        return db
+
+    @classmethod
+    def create(cls, path: str | Path, design_path: str | Path, design: Design) -> StudyStore:
+        """A new study file for ``design`` (already checked); refuses to overwrite one."""
+        target = Path(path)
+        if target.exists():
+            raise StudyError(f"{target} exists already; give another --out, or run the study in it")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        source = Path(design_path)
+        db = cls._connect(target)
+        with db:
+            db.executescript(SCHEMA)
+            for key, value in {
+                "schema_version": str(SCHEMA_VERSION),
+                "design_toml": source.read_text(encoding="utf-8"),
+                "design_source": str(source),
+                "base_dir": str(source.resolve().parent),
+                "design_json": json.dumps(design.to_json()),
+                "created_at_ms": str(now_ms()),
+            }.items():
+                db.execute("INSERT INTO meta (key, value) VALUES (?, ?)", (key, value))
+        db.close()
+        return cls(target)
+
+    def close(self) -> None:
+        with self._lock:
+            self._db.close()
+
+    @contextmanager
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
+        with self._lock:
+            self._db.execute("BEGIN IMMEDIATE")
+            try:
+                yield self._db
+            except BaseException:
+                self._db.execute("ROLLBACK")
+                raise
+            self._db.execute("COMMIT")
+
+    def query(self, sql: str, args: tuple[Any, ...] = ()) -> list[sqlite3.Row]:
+        with self._lock:
+            return list(self._db.execute(sql, args))
+
+    def meta(self, key: str) -> str | None:
+        rows = self.query("SELECT value FROM meta WHERE key = ?", (key,))
+        return str(rows[0]["value"]) if rows else None
+
+    # ---- participants ------------------------------------------------------------------
+
+    def add_participant(self, *, simulated: bool = False) -> str:
+        """A new participant with a random code and their whole trial order, stored at once."""
+        with self._transaction() as db:
+            number = db.execute("SELECT COUNT(*) FROM participants").fetchone()[0]
+            code = self._fresh_code(db)
+            db.execute(
+                "INSERT INTO participants (code, number, created_at_ms, simulated) "
+                "VALUES (?,?,?,?)",
+                (code, number, now_ms(), int(simulated)),
+            )
+            for position, trial in enumerate(participant_order(self.design, number)):
+                db.execute(
+                    "INSERT INTO trials (participant, position, block, repetition, shape, level, "
+                    "segments) VALUES (?,?,?,?,?,?,?)",
+                    (
+                        code,
+                        position,
+                        trial.block,
+                        trial.repetition,
+                        trial.shape,
+                        trial.level,
+                        trial.segments,
+                    ),
+                )
+        return code
+
+    @staticmethod
+    def _fresh_code(db: sqlite3.Connection) -> str:
+        while True:
+            code = "P-" + "".join(secrets.choice(CODE_ALPHABET) for _ in range(CODE_LENGTH))
+            if not db.execute("SELECT 1 FROM participants WHERE code = ?", (code,)).fetchone():
+                return code
+
+    def participant(self, code: str) -> sqlite3.Row:
+        rows = self.query("SELECT * FROM participants WHERE code = ?", (code.strip().upper(),))
+        if not rows:
+            raise StudyError(
+                f"no participant {code!r} in {self.path}; 'feelmysign study status {self.path}' "
+                "lists them"
+            )
+        return rows[0]
+
+    def participants(self) -> list[sqlite3.Row]:
+        return self.query("SELECT * FROM participants ORDER BY number")
+
+    def set_consent(self, code: str, consent: bool) -> None:
+        code = self.participant(code)["code"]
+        with self._transaction() as db:
+            db.execute(
+                "UPDATE participants SET consent = ?, consent_at_ms = ? WHERE code = ?",
+                (int(consent), now_ms(), code),
+            )
+
+    def record_comfort(self, code: str, answers: list[bool], adjusted: bool) -> None:
+        row = self.participant(code)
+        self._require_consent(row)
+        if len(answers) != len(self.design.comfort):
+            raise StudyError(
+                f"the comfort check has {len(self.design.comfort)} question(s); got "
+                f"{len(answers)} answer(s)"
+            )
+        data = json.dumps({"answers": answers, "adjusted": adjusted})
+        with self._transaction() as db:
+            db.execute(
+                "UPDATE participants SET comfort_json = ?, comfort_at_ms = ? WHERE code = ?",
+                (data, now_ms(), row["code"]),
+            )
+
+    def _require_consent(self, row: sqlite3.Row) -> None:
+        if row["consent"] != 1:
+            raise StudyError(
+                f"participant {row['code']} has not given consent; nothing is recorded"
+            )
+        if row["withdrawn"]:
+            raise StudyError(f"participant {row['code']} has withdrawn; nothing more is recorded")
+
+    def set_paused(self, code: str, paused: bool) -> None:
+        row = self.participant(code)
+        if bool(row["paused"]) == paused:
+            return
+        with self._transaction() as db:
+            db.execute(
+                "UPDATE participants SET paused = ? WHERE code = ?", (int(paused), row["code"])
+            )
+            if paused:
+                db.execute(
+                    "INSERT INTO pauses (participant, paused_at_ms) VALUES (?, ?)",
+                    (row["code"], now_ms()),
+                )
+            else:
+                db.execute(
+                    "UPDATE pauses SET resumed_at_ms = ? WHERE participant = ? AND resumed_at_ms "
+                    "IS NULL",
+                    (now_ms(), row["code"]),
+                )
+
+    def withdraw(self, code: str) -> None:
+        row = self.participant(code)
+        with self._transaction() as db:
+            db.execute("UPDATE participants SET withdrawn = 1 WHERE code = ?", (row["code"],))
+
+    # ---- trials ------------------------------------------------------------------------
+
+    def trials(self, code: str) -> list[sqlite3.Row]:
+        return self.query(
+            "SELECT * FROM trials WHERE participant = ? ORDER BY position", (code.upper(),)
+        )
+
+    def trial(self, trial_id: int) -> sqlite3.Row:
+        rows = self.query("SELECT * FROM trials WHERE id = ?", (trial_id,))
+        if not rows:
+            raise StudyError(f"no trial {trial_id} in {self.path}")
+        return rows[0]
+
+    def current_trial(self, code: str) -> sqlite3.Row | None:
+        """The first trial without an answer: where the session goes on after any stop."""
+        rows = self.query(
+            "SELECT * FROM trials WHERE participant = ? AND answered_at_ms IS NULL "
+            "ORDER BY position LIMIT 1",
+            (self.participant(code)["code"],),
+        )
+        return rows[0] if rows else None
+
+    def record_send(self, trial_id: int, drawing: str, strokes: list[dict[str, Any]]) -> int:
+        with self._transaction() as db:
+            cursor = db.execute(
+                "INSERT INTO sends (trial, drawing, sent_at_ms, strokes_json) VALUES (?,?,?,?)",
+                (trial_id, drawing, now_ms(), json.dumps(strokes)),
+            )
+            return int(cursor.lastrowid or 0)
+
+    def record_send_error(self, send_id: int, error: str) -> None:
+        with self._transaction() as db:
+            db.execute("UPDATE sends SET error = ? WHERE id = ?", (error, send_id))
+
+    def record_events(self, send_id: int, events: list[dict[str, Any]]) -> None:
+        with self._transaction() as db:
+            for event in events:
+                db.execute(
+                    "INSERT INTO events (send, type, seq, latency_ms, duration_ms, "
+                    "requested_duration_ms, reason, json) VALUES (?,?,?,?,?,?,?,?)",
+                    (
+                        send_id,
+                        str(event.get("type", "")),
+                        event.get("seq"),
+                        event.get("latency_ms"),
+                        event.get("duration_ms"),
+                        event.get("requested_duration_ms"),
+                        event.get("reason"),
+                        json.dumps(event),
+                    ),
+                )
+
+    def sends(self, trial_id: int) -> list[sqlite3.Row]:
+        return self.query("SELECT * FROM sends WHERE trial = ? ORDER BY id", (trial_id,))
+
+    def events(self, send_id: int) -> list[sqlite3.Row]:
+        return self.query("SELECT * FROM events WHERE send = ? ORDER BY id", (send_id,))
+
+    def record_answer(
+        self,
+        trial_id: int,
+        *,
+        answer: str,
+        felt_nothing: bool,
+        confidence: int | None,
+        coding: tuple[str, str | None, str],
+    ) -> None:
+        """The answer, once (a second answer to a trial is refused), and its automatic coding."""
+        trial = self.trial(trial_id)
+        self._require_consent(self.participant(trial["participant"]))
+        at_ms = now_ms()
+        with self._transaction() as db:
+            cursor = db.execute(
+                "UPDATE trials SET answer = ?, felt_nothing = ?, confidence = ?, "
+                "answered_at_ms = ? "
+                "WHERE id = ? AND answered_at_ms IS NULL",
+                (answer, int(felt_nothing), confidence, at_ms, trial_id),
+            )
+            if cursor.rowcount != 1:
+                raise StudyError(
+                    f"trial {trial['position'] + 1} of {trial['participant']} has an answer "
+                    "already; answers are never overwritten"
+                )
+            status, shape, rule = coding
+            db.execute(
+                "INSERT INTO codings (trial, status, shape, rule, decided_by, decided_at_ms) "
+                "VALUES (?,?,?,?,?,?)",
+                (trial_id, status, shape, rule, "auto", at_ms),
+            )
+            left = db.execute(
+                "SELECT COUNT(*) FROM trials WHERE participant = ? AND answered_at_ms IS NULL",
+                (trial["participant"],),
+            ).fetchone()[0]
+            if left == 0 and self._questionnaire_done(db, trial["participant"]):
+                self._finish(db, trial["participant"])
+
+    # ---- coding decisions --------------------------------------------------------------
+
+    def decide(self, trial_id: int, shape: str | None, rule: str) -> None:
+        """The researcher's decision on an answer: a shape, or None for no shape."""
+        trial = self.trial(trial_id)
+        if trial["answered_at_ms"] is None:
+            raise StudyError(f"trial {trial_id} has no answer yet to decide on")
+        if shape is not None and shape not in self.design.shape_names:
+            raise StudyError(
+                f"{shape!r} is not a shape of this study ({', '.join(self.design.shape_names)})"
+            )
+        with self._transaction() as db:
+            db.execute(
+                "INSERT INTO codings (trial, status, shape, rule, decided_by, decided_at_ms) "
+                "VALUES (?,?,?,?,?,?)",
+                (trial_id, "shape" if shape else "none", shape, rule, "researcher", now_ms()),
+            )
+
+    def latest_codings(self) -> dict[int, sqlite3.Row]:
+        """The decision in force for each answered trial: the latest one."""
+        rows = self.query(
+            "SELECT * FROM codings WHERE id IN (SELECT MAX(id) FROM codings GROUP BY trial)"
+        )
+        return {int(row["trial"]): row for row in rows}
+
+    def codings(self, trial_id: int) -> list[sqlite3.Row]:
+        return self.query("SELECT * FROM codings WHERE trial = ? ORDER BY id", (trial_id,))
+
+    # ---- questionnaire -----------------------------------------------------------------
+
+    def record_questionnaire(self, code: str, values: list[int]) -> None:
+        row = self.participant(code)
+        self._require_consent(row)
+        items, points = self.design.questionnaire.items, self.design.questionnaire.points
+        if len(values) != len(items) or not all(1 <= v <= points for v in values):
+            raise StudyError(
+                f"the questionnaire has {len(items)} item(s), each answered 1..{points}; got "
+                f"{values}"
+            )
+        at_ms = now_ms()
+        with self._transaction() as db:
+            for item, value in enumerate(values):
+                db.execute(
+                    "INSERT OR REPLACE INTO questionnaire VALUES (?,?,?,?)",
+                    (row["code"], item, value, at_ms),
+                )
+            left = db.execute(
+                "SELECT COUNT(*) FROM trials WHERE participant = ? AND answered_at_ms IS NULL",
+                (row["code"],),
+            ).fetchone()[0]
+            if left == 0:
+                self._finish(db, row["code"])
+
+    def questionnaire(self, code: str) -> list[sqlite3.Row]:
+        return self.query(
+            "SELECT * FROM questionnaire WHERE participant = ? ORDER BY item", (code.upper(),)
+        )
+
+    @staticmethod
+    def _questionnaire_done(db: sqlite3.Connection, code: str) -> bool:
+        count = db.execute("SELECT COUNT(*) FROM questionnaire WHERE participant = ?", (code,))
+        return bool(count.fetchone()[0])
+
+    @staticmethod
+    def _finish(db: sqlite3.Connection, code: str) -> None:
+        db.execute(
+            "UPDATE participants SET finished_at_ms = ? WHERE code = ? AND finished_at_ms IS NULL",
+            (now_ms(), code),
+        )
+
+    # ---- threshold procedure -----------------------------------------------------------
+
+    def start_threshold_run(self, code: str, dimension: str, settings: dict[str, Any]) -> int:
+        row = self.participant(code)
+        self._require_consent(row)
+        with self._transaction() as db:
+            cursor = db.execute(
+                "INSERT INTO threshold_runs (participant, dimension, settings_json, started_at_ms) "
+                "VALUES (?,?,?,?)",
+                (row["code"], dimension, json.dumps(settings), now_ms()),
+            )
+            return int(cursor.lastrowid or 0)
+
+    def threshold_runs(self, code: str | None = None) -> list[sqlite3.Row]:
+        if code is None:
+            return self.query("SELECT * FROM threshold_runs ORDER BY id")
+        return self.query(
+            "SELECT * FROM threshold_runs WHERE participant = ? ORDER BY id", (code.upper(),)
+        )
+
+    def record_threshold_trial(
+        self,
+        run_id: int,
+        *,
+        value: float,
+        direction: str,
+        response: str,
+        events: list[dict[str, Any]],
+    ) -> int:
+        with self._transaction() as db:
+            position = db.execute(
+                "SELECT COUNT(*) FROM threshold_trials WHERE run = ?", (run_id,)
+            ).fetchone()[0]
+            db.execute(
+                "INSERT INTO threshold_trials (run, position, value, direction, response, correct, "
+                "events_json, answered_at_ms) VALUES (?,?,?,?,?,?,?,?)",
+                (
+                    run_id,
+                    position,
+                    value,
+                    direction,
+                    response,
+                    int(direction == response),
+                    json.dumps(events),
+                    now_ms(),
+                ),
+            )
+            return int(position)
+
+    def threshold_trials(self, run_id: int) -> list[sqlite3.Row]:
+        return self.query(
+            "SELECT * FROM threshold_trials WHERE run = ? ORDER BY position", (run_id,)
+        )
+
+    def finish_threshold_run(
+        self, run_id: int, *, threshold: float, low: float, high: float, stop_reason: str
+    ) -> None:
+        with self._transaction() as db:
+            db.execute(
+                "UPDATE threshold_runs SET finished_at_ms = ?, threshold = ?, low = ?, high = ?, "
+                "stop_reason = ? WHERE id = ?",
+                (now_ms(), threshold, low, high, stop_reason, run_id),
+            )

@@ -1,0 +1,88 @@
+"""A session, and the review of unclear answers, in the terminal (``feelmysign study run``).
+
+The same steps as the page, through the same ``Session``; Ctrl-C at any prompt
+stops with every answer given so far stored, and the same command resumes.
+"""
+
+from __future__ import annotations
+
+from feelmysign.cli._broker_options import BrokerSettings
+from feelmysign.study.runner import Session
+from feelmysign.study.sleeve_link import SleeveLink
+from feelmysign.study.store import StudyStore
+
+
+def _yes(question: str) -> bool:
+    return input(f"{question} [y/n] ").strip().lower().startswith("y")
+
+
+def run_in_terminal(store: StudyStore, settings: BrokerSettings, participant: str | None) -> int:
+    with SleeveLink(settings) as link:
+        session = Session(store, link.play)
+        code = participant or store.add_participant()
+        print(f"Participant {code} ({store.design.name}). Ctrl-C stops; the same command resumes.")
+        design = store.design
+        if session.step(code) == "consent":
+            session.consent(code, _yes("Has the participant given informed consent?"))
+            if session.step(code) == "consent":
+                print("No consent: nothing is recorded.")
+                return 1
+        if session.step(code) == "comfort":
+            answers = [_yes(q) for q in design.comfort]
+            session.comfort(code, answers, adjusted=_yes("Was the sleeve adjusted?"))
+        while session.step(code) == "trial":
+            trial = session.state(code)["trial"]
+            what = trial["resolution"] or "practice"
+            print(
+                f"Trial {trial['number']}/{trial['total']}: {trial['shape']}, {what}, "
+                f"{trial['segments']} strokes"
+            )
+            input("  Enter sends the shape to the sleeve. ")
+            sent = session.send(code)
+            print(
+                f"  played {sent['played']}/{sent['strokes']} strokes, "
+                f"rejected {sent['rejected'] or 'none'}"
+            )
+            answer = input("  Answer (empty = felt nothing, 'r' = send again): ").strip()
+            if answer == "r":
+                continue
+            confidence = input("  Confidence 1-5 (empty = none): ").strip()
+            coding = session.answer(
+                code,
+                trial["id"],
+                answer=answer,
+                felt_nothing=not answer,
+                confidence=int(confidence) if confidence.isdigit() else None,
+            )
+            print(f"  coded: {coding['shape'] or coding['status']} ({coding['rule']})")
+        if session.step(code) == "questionnaire":
+            points = design.questionnaire.points
+            values = []
+            for item in design.questionnaire.items:
+                while (
+                    not (reply := input(f"{item} (1-{points}): ").strip()).isdigit()
+                    or not 1 <= int(reply) <= points
+                ):
+                    print(f"  Type a number from 1 to {points}.")
+                values.append(int(reply))
+            session.questionnaire(code, values)
+        print(f"Session of {code}: {session.step(code)}.")
+    return 0
+
+
+def review_in_terminal(store: StudyStore) -> int:
+    shapes = store.design.shape_names
+    codings = store.latest_codings()
+    waiting = [t for t, c in codings.items() if c["status"] == "unclear"]
+    print(
+        f"{len(waiting)} answer(s) to review. Shapes: {', '.join(shapes)}; "
+        "'-' = no shape; Enter skips."
+    )
+    for trial_id in waiting:
+        trial = store.trial(trial_id)
+        reply = input(f"  {trial['answer']!r} (sent: {trial['shape']}) -> ").strip().lower()
+        if reply == "-":
+            store.decide(trial_id, None, "researcher: no shape named")
+        elif reply in shapes:
+            store.decide(trial_id, reply, f"researcher: {reply}")
+    return 0

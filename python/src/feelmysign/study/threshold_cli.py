@@ -1,0 +1,86 @@
+"""``feelmysign study threshold``: SQ2.2's QUEST+ run for one participant, in the terminal.
+
+With ``--simulated-observer T`` a simulated wearer with threshold T answers and
+the sleeve is the offline planner: a dry run of the procedure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import random
+from pathlib import Path
+from typing import Any
+
+from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.errors import StudyError
+from feelmysign.study.simulated_sleeve import offline_player
+from feelmysign.study.sleeve_link import SleeveLink
+from feelmysign.study.stimulus import stimulus_layout
+from feelmysign.study.store import StudyStore
+from feelmysign.study.threshold import DIMENSIONS, DIRECTIONS, SimulatedObserver
+from feelmysign.study.threshold_run import run_threshold
+
+_KEYS = {d[0]: d for d in DIRECTIONS}  # u, d, l, r
+
+
+def add_threshold_parser(commands: Any) -> None:
+    parser = commands.add_parser(
+        "threshold",
+        help="SQ2.2: shortest stroke length or duration whose direction is felt (QUEST+)",
+        description=__doc__,
+    )
+    parser.add_argument("study", type=Path, help="the study file")
+    parser.add_argument("--participant", required=True, metavar="CODE", help="who takes part")
+    parser.add_argument("--dimension", choices=DIMENSIONS, required=True, help="what varies")
+    parser.add_argument(
+        "--simulated-observer",
+        type=float,
+        metavar="T",
+        help="dry run: a simulated wearer whose threshold is T (grid units or ms)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="the simulated wearer's seed")
+    add_broker_options(parser, role="sender")
+    parser.set_defaults(handler=run)
+
+
+def _ask(direction: str, value: float) -> str:
+    while True:
+        said = input("  Which way did it move? [u]p, [d]own, [l]eft, [r]ight: ").strip().lower()
+        if said[:1] in _KEYS:
+            return _KEYS[said[:1]]
+        print("  Type u, d, l or r.")
+
+
+def run(args: argparse.Namespace) -> int:
+    store = StudyStore(args.study)
+    layout = stimulus_layout(store.design.stimulus, store.base_dir)
+    unit = "grid units" if args.dimension == "length" else "ms"
+
+    def progress(n: int, value: float, sent: str, said: str) -> None:
+        mark = "right" if sent == said else "wrong"
+        print(f"  trial {n}: {value:.3g} {unit} {sent}, answered {said} ({mark})", flush=True)
+
+    if args.simulated_observer is not None:
+        if not args.simulated_observer > 0:
+            raise StudyError(f"--simulated-observer must be above 0; got {args.simulated_observer}")
+        observer = SimulatedObserver(args.simulated_observer)
+        rng = random.Random(args.seed)
+        estimate = run_threshold(
+            store,
+            args.participant,
+            args.dimension,
+            layout,
+            offline_player(layout),
+            lambda direction, value: observer.respond(direction, value, rng),
+            progress,
+        )
+    else:
+        with SleeveLink(broker_settings_from_args(args, "sender")) as link:
+            estimate = run_threshold(
+                store, args.participant, args.dimension, layout, link.play, _ask, progress
+            )
+    print(
+        f"Threshold ({args.dimension}): {estimate.threshold:.3g} {unit}, 95% interval "
+        f"{estimate.low:.3g} to {estimate.high:.3g}, after {estimate.trials} trials."
+    )
+    return 0

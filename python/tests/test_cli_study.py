@@ -1,0 +1,45 @@
+"""``feelmysign study``: errors a person can act on, and the dry run from the command line."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from study_helpers import PAPER_DESIGN
+
+
+def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "feelmysign", "study", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=300,
+    )
+
+
+def test_a_bad_design_is_refused_with_every_problem_and_no_traceback(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text(PAPER_DESIGN.read_text().replace("repetitions = 3", "repetitions = 'three'"))
+    result = _cli("check", str(bad), cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.startswith("Error: ")
+    assert "study.repetitions: must be a whole number from 1 to 20; got 'three'" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_new_simulate_status_analyse(tmp_path: Path) -> None:
+    study = tmp_path / "s.sqlite"
+    assert _cli("new", str(PAPER_DESIGN), "--out", str(study), cwd=tmp_path).returncode == 0
+    again = _cli("new", str(PAPER_DESIGN), "--out", str(study), cwd=tmp_path)
+    assert again.returncode == 1 and "exists already" in again.stderr
+    assert _cli("simulate", str(study), "--participants", "2", cwd=tmp_path).returncode == 0
+    status = _cli("status", str(study), cwd=tmp_path)
+    assert status.stdout.count("74/74 answered") == 2
+    out = tmp_path / "results"
+    analysed = _cli("analyse", str(study), "--out", str(out), "--bootstrap", "50", cwd=tmp_path)
+    assert analysed.returncode == 0, analysed.stderr
+    assert (out / "report.md").is_file() and (out / "accuracy.png").is_file()
+    missing = _cli("status", str(tmp_path / "none.sqlite"), cwd=tmp_path)
+    assert missing.returncode == 1 and "no study file" in missing.stderr

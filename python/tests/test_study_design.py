@@ -1,0 +1,104 @@
+"""The design file: the paper's example loads; every problem of a bad one is listed at once."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from study_helpers import PAPER_DESIGN
+
+from feelmysign.errors import DesignError
+from feelmysign.study import load_design, parse_design
+from feelmysign.study.order import participant_order, williams_rows
+
+MINIMAL = """
+[study]
+name = "t"
+seed = 1
+repetitions = 2
+resolutions = ["low", "high"]
+[[shapes]]
+name = "circle"
+segments = [4, 16]
+[[shapes]]
+name = "square"
+segments = [4, 8]
+[questionnaire]
+items = ["comfortable"]
+"""
+
+
+def test_the_papers_design_has_six_shapes_four_resolutions_three_repetitions() -> None:
+    design = load_design(PAPER_DESIGN)
+    assert len(design.shapes) == 6
+    assert len(design.resolutions) == 4
+    assert design.repetitions == 3
+    assert design.main_trials == 72
+    assert "ring" in design.shape("circle").synonyms
+
+
+def test_every_problem_is_listed_with_where_and_what() -> None:
+    bad = MINIMAL.replace("segments = [4, 8]", "segments = [5, 8]").replace(
+        "repetitions = 2", "repetitions = 0\ncolour = 'red'"
+    )
+    bad += '[[shapes]]\nname = "blob"\nsegments = [1, 2]\n'
+    with pytest.raises(DesignError) as caught:
+        parse_design(bad, source="bad.toml")
+    text = str(caught.value)
+    assert "shapes[1].segments[0]: a square takes a multiple of 4" in text
+    assert "study.repetitions: must be a whole number from 1 to 20; got 0" in text
+    assert "study.colour: unknown key" in text
+    assert "'blob' is not a library shape" in text
+    assert len(caught.value.problems) == 4
+
+
+def test_a_synonym_may_name_only_one_shape() -> None:
+    bad = MINIMAL.replace("segments = [4, 16]", 'segments = [4, 16]\nsynonyms = ["box"]')
+    bad = bad.replace("segments = [4, 8]", 'segments = [4, 8]\nsynonyms = ["Box"]')
+    with pytest.raises(DesignError, match="synonym 'box' also names 'circle'"):
+        parse_design(bad)
+
+
+def test_a_recorded_drawing_gets_its_strokes_from_the_simplifier(tmp_path: Path) -> None:
+    recording = tmp_path / "zigzag.json"
+    samples = [
+        {
+            "t_ms": i * 16.0,
+            "x": 10.0 + i * 8,
+            "y": 50.0 + (40 if (i // 6) % 2 else 0) + (i % 6) * (6 if (i // 6) % 2 == 0 else -6),
+        }
+        for i in range(48)
+    ]
+    recording.write_text(
+        '{"canvas": {"width_px": 400, "height_px": 300}, "paths": ['
+        + str(samples).replace("'", '"')
+        + "]}"
+    )
+    text = MINIMAL + (
+        '[[shapes]]\nname = "zigzag"\nrecording = "zigzag.json"\nsimplifier = "window"\n'
+        "settings = [{max_error = 1.5}, {max_error = 0.05}]\n"
+    )
+    design = parse_design(text, base_dir=tmp_path)
+    coarse, fine = design.shape("zigzag").levels
+    assert coarse.strokes < fine.strokes
+
+
+def test_latin_square_rows_are_balanced_for_first_order_carry_over() -> None:
+    for n in (4, 5, 24):
+        rows = williams_rows(n)
+        pairs = [(row[i], row[i + 1]) for row in rows for i in range(n - 1)]
+        assert len(set(pairs)) == n * (n - 1)  # every ordered pair of conditions ...
+        assert len(pairs) == len(rows) * (n - 1)  # ... equally often
+        for position in range(n):
+            assert sorted(row[position] for row in rows[:n]) == list(range(n))
+
+
+def test_each_block_holds_every_condition_once_and_orders_repeat_from_the_seed() -> None:
+    design = load_design(PAPER_DESIGN)
+    order = participant_order(design, 3)
+    main = [t for t in order if t.block == "main"]
+    for repetition in (1, 2, 3):
+        block = [(t.shape, t.level) for t in main if t.repetition == repetition]
+        assert len(set(block)) == 24
+    assert participant_order(design, 3) == order
+    assert participant_order(design, 4) != order

@@ -1,0 +1,66 @@
+"""SQ2.2: QUEST+ finds a simulated wearer's known threshold, and a run survives a restart."""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import pytest
+from study_helpers import PAPER_DESIGN, new_study
+
+from feelmysign.errors import StudyError
+from feelmysign.layout import grid_layout
+from feelmysign.study import StudyStore, load_design
+from feelmysign.study.runner import Session
+from feelmysign.study.simulated_sleeve import offline_player
+from feelmysign.study.threshold import Procedure, SimulatedObserver, check_fits
+from feelmysign.study.threshold_run import run_threshold
+
+
+@pytest.mark.parametrize(("dimension", "truth"), [("length", 0.6), ("duration", 150.0)])
+def test_the_interval_covers_a_known_threshold_about_95_percent(
+    dimension: str, truth: float
+) -> None:
+    design = load_design(PAPER_DESIGN)
+    runs, covered = 20, 0
+    for run in range(runs):
+        procedure = Procedure(design.threshold, dimension)  # type: ignore[arg-type]
+        observer, rng = SimulatedObserver(truth), random.Random(run)
+        while procedure.stop_reason() is None:
+            value, direction = procedure.next_value(), rng.choice(["up", "down", "left", "right"])
+            procedure.update(value, observer.respond(direction, value, rng) == direction)
+        estimate = procedure.estimate()
+        assert estimate.trials == design.threshold.trials
+        covered += estimate.low <= truth <= estimate.high
+    assert covered >= 16  # P(X >= 16) = 0.98 for a 95% interval over 20 runs
+
+
+def test_a_run_is_stored_trial_by_trial_and_resumes(tmp_path: Path) -> None:
+    store = new_study(tmp_path)
+    code = store.add_participant(simulated=True)
+    store.set_consent(code, True)
+    layout = Session(store, None).layout
+    observer, rng = SimulatedObserver(0.5), random.Random(1)
+    calls = 0
+
+    def respond(direction: str, value: float) -> str:
+        nonlocal calls
+        calls += 1
+        if calls == 8:
+            raise KeyboardInterrupt  # Ctrl-C at the eighth answer
+        return observer.respond(direction, value, rng)
+
+    with pytest.raises(KeyboardInterrupt):
+        run_threshold(store, code, "length", layout, offline_player(layout), respond)
+    reopened = StudyStore(store.path)
+    (run,) = reopened.threshold_runs(code)
+    assert len(reopened.threshold_trials(run["id"])) == 7
+    estimate = run_threshold(reopened, code, "length", layout, offline_player(layout), respond)
+    assert len(reopened.threshold_trials(run["id"])) == reopened.design.threshold.trials
+    assert reopened.threshold_runs(code)[0]["threshold"] == pytest.approx(estimate.threshold)
+
+
+def test_a_stroke_longer_than_the_sleeve_is_refused_before_any_trial() -> None:
+    design = load_design(PAPER_DESIGN)
+    with pytest.raises(StudyError, match="at most 1"):
+        check_fits(grid_layout(2, 4, 3.0), design.threshold)
