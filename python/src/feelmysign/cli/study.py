@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.errors import StudyError
 from feelmysign.study.analysis import analyse_study
 from feelmysign.study.analysis.psychometric import BOOTSTRAP_SAMPLES
@@ -29,7 +30,6 @@ from feelmysign.study.dry_run import dry_run
 from feelmysign.study.export import export_study
 from feelmysign.study.store import StudyStore
 from feelmysign.study.terminal import review_in_terminal, run_in_terminal
-from feelmysign.study.threshold_cli import add_threshold_parser
 
 
 def register(subparsers: Any) -> None:

@@ -16,7 +16,7 @@ from typing import Any
 
 from feelmysign.errors import DesignError, FeelMySignError
 from feelmysign.shapes import SHAPES
-from feelmysign.simplify.replay import ALGORITHMS
+from feelmysign.simplify.registry import ALGORITHMS
 from feelmysign.study.coding import normalise
 from feelmysign.study.design import (
     RANDOMISATIONS,

@@ -17,7 +17,7 @@ from typing import Any
 
 import paho.mqtt.client as mqtt
 
-from feelmysign.cli._broker_options import BrokerSettings, connect_client
+from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.sending import OutgoingStroke, StrokeSender
 from feelmysign.stroke import Stroke
 

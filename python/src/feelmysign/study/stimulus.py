@@ -18,7 +18,7 @@ from feelmysign.research.evaluate import params_for
 from feelmysign.research.rerun import rerun
 from feelmysign.shapes import shape_strokes
 from feelmysign.simplify.recording import load_recording
-from feelmysign.simplify.replay import ALGORITHMS
+from feelmysign.simplify.registry import ALGORITHMS
 from feelmysign.stroke import Stroke
 from feelmysign.study.design import Design, Stimulus
 

@@ -6,7 +6,7 @@ stops with every answer given so far stored, and the same command resumes.
 
 from __future__ import annotations
 
-from feelmysign.cli._broker_options import BrokerSettings
+from feelmysign.connection import BrokerSettings
 from feelmysign.study.runner import Session
 from feelmysign.study.sleeve_link import SleeveLink
 from feelmysign.study.store import StudyStore
