@@ -15,6 +15,13 @@ export default defineConfig({
     outDir: "dist",
     emptyOutDir: true,
     target: "es2022",
+    // Two pages: the drawing client, and the researcher's study page (served at /study).
+    rollupOptions: {
+      input: {
+        main: fileURLToPath(new URL("index.html", import.meta.url)),
+        study: fileURLToPath(new URL("study.html", import.meta.url)),
+      },
+    },
   },
   test: {
     include: ["test/**/*.test.ts"],

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import threading
+from collections.abc import Callable
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -16,12 +17,42 @@ from typing import Any
 from feelmysign.errors import FeelMySignError
 
 WEB_DIST = Path(__file__).resolve().parents[3] / "web" / "dist"
+# An API mounted under /api/ (the study's): (method, path, host, body, content type) ->
+# (status, content type, body). It answers every error itself.
+Api = Callable[[str, str, str, bytes, str], tuple[int, str, bytes]]
+MAX_API_BODY_BYTES = 64 * 1024
 
 
 class _Handler(SimpleHTTPRequestHandler):
     config: bytes = b"{}"
+    api: Api | None = None
+
+    def _api(self, method: str) -> bool:
+        path = self.path.split("?")[0]
+        if self.api is None or not path.startswith("/api/"):
+            return False
+        length = min(int(self.headers.get("Content-Length") or 0), MAX_API_BODY_BYTES + 1)
+        body = self.rfile.read(length) if length > 0 else b""
+        status, kind, payload = self.api(
+            method, path, self.headers.get("Host", ""), body, self.headers.get("Content-Type", "")
+        )
+        self.send_response(status)
+        self.send_header("Content-Type", kind)
+        self.send_header("Cache-Control", "no-store")
+        self.send_header("Content-Length", str(len(payload)))
+        self.end_headers()
+        self.wfile.write(payload)
+        return True
+
+    def do_POST(self) -> None:
+        if not self._api("POST"):
+            self.send_error(404)
 
     def do_GET(self) -> None:
+        if self._api("GET"):
+            return
+        if self.path.split("?")[0] in ("/study", "/study/"):
+            self.path = "/study.html"  # the researcher's page of the recognition study
         if self.path.split("?")[0] == "/config.json":
             self.send_response(200)
             self.send_header("Content-Type", "application/json")
@@ -44,14 +75,25 @@ class _Handler(SimpleHTTPRequestHandler):
 class WebServer:
     """``with WebServer(port=8000, config={...}) as server: server.url``."""
 
-    def __init__(self, *, port: int, config: dict[str, Any], directory: Path = WEB_DIST) -> None:
+    def __init__(
+        self,
+        *,
+        port: int,
+        config: dict[str, Any],
+        directory: Path = WEB_DIST,
+        api: Api | None = None,
+    ) -> None:
         index = directory / "index.html"
         if not index.is_file():
             raise FeelMySignError(
                 f"the drawing client is not built ({index} is missing); run 'make web-build' "
                 "(or 'make up', which builds it)"
             )
-        handler = type("ConfigHandler", (_Handler,), {"config": json.dumps(config).encode()})
+        handler = type(
+            "ConfigHandler",
+            (_Handler,),
+            {"config": json.dumps(config).encode(), "api": staticmethod(api) if api else None},
+        )
         try:
             self._server = ThreadingHTTPServer(
                 ("127.0.0.1", port), partial(handler, directory=str(directory))

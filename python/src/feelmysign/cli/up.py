@@ -18,6 +18,7 @@ from feelmysign.cli._watchdog import Watchdog
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.study.served import study_api
 from feelmysign.webserver import WEB_DIST, WebServer
 
 DEFAULT_HTTP_PORT = 8000
@@ -84,6 +85,13 @@ def register(subparsers: Any) -> None:
         metavar="DIR",
         help="the built drawing client (default: web/dist of this checkout)",
     )
+    parser.add_argument(
+        "--study",
+        type=Path,
+        metavar="FILE",
+        help="serve this study file's researcher page at /study (make one with "
+        "'feelmysign study new DESIGN.toml --out FILE')",
+    )
     add_layout_options(parser)
     parser.set_defaults(handler=run)
 
@@ -96,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
     broker = Broker(state_dir=args.state_dir, port=port, ws_port=ws_port, sleeve_id=args.sleeve_id)
     watchdog = Watchdog(broker)
-    with broker, watchdog:
+    with broker, watchdog, study_api(args.study, broker.credentials) as api:
         c = broker.credentials
         config = {
             "ws_url": c.ws_url,
@@ -104,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
             "username": c.sender.username,
             "password": c.sender.password,
         }
-        with WebServer(port=args.http_port, config=config, directory=args.web_dir) as web:
+        with WebServer(port=args.http_port, config=config, directory=args.web_dir, api=api) as web:
             settings = BrokerSettings(
                 c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
             )
@@ -118,7 +126,9 @@ def run(args: argparse.Namespace) -> int:
                 _stop_on_signals(sleeve)
                 watchdog.watch(sleeve)
                 threading.Thread(
-                    target=_announce, args=(sleeve, web.url, broker), daemon=True
+                    target=_announce,
+                    args=(sleeve, web.url, broker, api is not None),
+                    daemon=True,
                 ).start()
 
             with DrawingLog(sender, c.sleeve_id):  # one line per drawing, from its events
@@ -154,7 +164,7 @@ def _port_or_free(asked: int | None, default: int, name: str) -> int:
     return default
 
 
-def _announce(sleeve: Sleeve, url: str, broker: Broker) -> None:
+def _announce(sleeve: Sleeve, url: str, broker: Broker, study: bool = False) -> None:
     if not sleeve.connected.wait(15):
         print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
         return
@@ -162,7 +172,8 @@ def _announce(sleeve: Sleeve, url: str, broker: Broker) -> None:
     print(
         f"feelmysign is up.\n"
         f"  Draw here:   {url}\n"
-        f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
+        + (f"  Study:       {url}study\n" if study else "")
+        + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
         f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"
         f"One line per drawing follows here once it has been played.\n"

@@ -24,6 +24,7 @@ from feelmysign.stroke import Stroke
 # Beyond the drawing's own duration: the sleeve's queue, its latency and the event's trip.
 EVENTS_GRACE_S = 5.0
 FINAL_TYPES = ("played", "adjusted", "rejected")
+MAX_FELT_WAIT_S = 30.0  # the sleeve's own cap on queued strokes
 
 
 class _Events:
@@ -99,4 +100,19 @@ class SleeveLink:
             sender.send(messages, pace="realtime")
             total_s = sum(s.duration_ms for s in strokes) / 1000
             left_s = max(0.0, started_s + total_s - time.monotonic()) + EVENTS_GRACE_S
-            return self._events.wait(drawing, len(strokes), left_s)
+            events = self._events.wait(drawing, len(strokes), left_s)
+            _until_felt(events)
+            return events
+
+
+def _until_felt(events: list[dict[str, Any]]) -> None:
+    """Return once the last stroke has finished on the skin, not when it started: the
+    participant is asked only after the whole shape was felt."""
+    ends_ms = [
+        float(e["first_command_at_ms"]) + float(e["duration_ms"])
+        for e in events
+        if isinstance(e.get("first_command_at_ms"), (int, float))
+        and isinstance(e.get("duration_ms"), (int, float))
+    ]
+    if ends_ms:
+        time.sleep(min(MAX_FELT_WAIT_S, max(0.0, max(ends_ms) / 1000 - time.time())))

@@ -103,9 +103,9 @@ def analyse_study(
     )
     files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
     if thresholds:
-        files.append(
-            threshold_plot(out_dir / "needed-resolution.png", thresholds, design.criterion)
-        )
+        every = [float(lv.strokes) for s in design.shapes for lv in s.levels]
+        path = out_dir / "needed-resolution.png"
+        files.append(threshold_plot(path, thresholds, (min(every), max(every)), design.criterion))
     files.append(_results_json(out_dir / "results.json", analysis))
     files.append(write_report(out_dir / "report.md", store, analysis))
     return analysis

@@ -59,20 +59,33 @@ def accuracy_plot(
     return path
 
 
-def threshold_plot(path: Path, thresholds: dict[str, Threshold], criterion: float) -> Path:
-    """The strokes each shape needs for the criterion accuracy, with 95% intervals."""
+def threshold_plot(
+    path: Path, thresholds: dict[str, Threshold], tested: tuple[float, float], criterion: float
+) -> Path:
+    """The strokes each shape needs for the criterion accuracy, with 95% intervals, drawn
+    within half the tested range's lowest and twice its highest resolution; what lies
+    beyond is an arrow (the data cannot say how far)."""
+    low_edge, high_edge = tested[0] / 2, tested[1] * 2
     figure, axes = plt.subplots(figsize=(FIGURE_IN[0], 0.45 * len(thresholds) + 1.2), dpi=DPI)
     names = list(thresholds)
+    axes.axvspan(tested[0], tested[1], color="#eeeeee", zorder=0)
     for row, name in enumerate(names):
         result = thresholds[name]
-        if math.isfinite(result.strokes):
-            axes.plot([result.low, result.high], [row, row], color="black", linewidth=1.5)
+        low = min(max(result.low, low_edge), high_edge)
+        high = (
+            min(max(result.high, low_edge), high_edge) if math.isfinite(result.high) else high_edge
+        )
+        axes.plot([low, high], [row, row], color="black", linewidth=1.5)
+        if result.high > high_edge or not math.isfinite(result.high):
+            axes.plot(high_edge, row, ">", color="black")
+        if result.low < low_edge:
+            axes.plot(low_edge, row, "<", color="black")
+        if math.isfinite(result.strokes) and low_edge <= result.strokes <= high_edge:
             axes.plot(result.strokes, row, "o", color="black")
-        else:
-            axes.text(1, row, "not reached", va="center", fontsize="small")
+    axes.set_xlim(low_edge * 0.9, high_edge * 1.1)
     axes.set_yticks(range(len(names)), names)
     axes.set_xscale("log", base=2)
-    axes.set_xlabel(f"strokes needed for {criterion:.0%} correct (95% interval)")
+    axes.set_xlabel(f"strokes needed for {criterion:.0%} correct (95% interval; grey: tested)")
     axes.invert_yaxis()
     figure.tight_layout()
     figure.savefig(path)

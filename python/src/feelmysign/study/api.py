@@ -1,0 +1,210 @@
+"""The study's HTTP JSON API under ``/api/study/``, for the researcher's page ``/study``.
+
+Served by ``feelmysign up --study FILE`` on 127.0.0.1 only. Requests must name
+this machine in their Host header (a page on another site cannot reach it by
+DNS rebinding), and every POST must be JSON (a cross-site form cannot post
+JSON without the browser asking first, which this server never allows).
+
+    GET  /api/study                                   design, participants, answers to review
+    POST /api/study/participants                      {"simulated": bool} -> {"code"}
+    GET  /api/study/participants/CODE                 the session's step and current trial
+    POST /api/study/participants/CODE/consent         {"consent": bool}
+    POST /api/study/participants/CODE/comfort         {"answers": [bool], "adjusted": bool}
+    POST /api/study/participants/CODE/send            {"trial": id} -> what the sleeve did
+    POST /api/study/participants/CODE/answer          {"trial", "answer", "felt_nothing",
+                                                       "confidence"}
+    POST /api/study/participants/CODE/pause           {"paused": bool}
+    POST /api/study/participants/CODE/questionnaire   {"values": [int]}
+    GET  /api/study/participants/CODE/simulated-answer
+    GET  /api/study/review                            answers waiting for a decision (blind)
+    POST /api/study/review/TRIAL                      {"shape": name or null}
+    POST /api/study/analyse                           export + analysis -> files, report
+    GET  /api/study/results/NAME                      a file of the latest analysis
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import re
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from feelmysign.errors import FeelMySignError, StudyError
+from feelmysign.study.analysis import analyse_study
+from feelmysign.study.runner import Session
+
+log = logging.getLogger(__name__)
+
+Response = tuple[int, str, bytes]
+JSON = "application/json"
+_RESULT_TYPES = {
+    ".png": "image/png",
+    ".csv": "text/csv; charset=utf-8",
+    ".md": "text/markdown; charset=utf-8",
+    ".json": JSON,
+}
+_LOCAL_HOSTS = ("127.0.0.1", "localhost")
+_PARTICIPANT = re.compile(r"^/api/study/participants/([A-Za-z0-9-]{1,16})(/[a-z-]+)?$")
+_REVIEW = re.compile(r"^/api/study/review/(\d{1,12})$")
+_RESULT = re.compile(r"^/api/study/results/([a-z0-9-]+\.(png|csv|md|json))$")
+MAX_BODY_BYTES = 64 * 1024
+
+
+def _json(status: int, data: Any) -> Response:
+    return status, JSON, json.dumps(data).encode()
+
+
+class StudyApi:
+    def __init__(self, session: Session, results_dir: Path, *, bootstrap: int = 1000) -> None:
+        self.session = session
+        self.store = session.store
+        self.results_dir = results_dir
+        self._bootstrap = bootstrap
+        self._latest: Path | None = None
+        self._analysing = threading.Lock()
+
+    def handle(self, method: str, path: str, host: str, body: bytes, content_type: str) -> Response:
+        """Answer one request; never raises."""
+        if host.rsplit(":", 1)[0].strip("[]") not in _LOCAL_HOSTS:
+            return _json(403, {"error": "the study API answers only requests to 127.0.0.1"})
+        try:
+            if method == "POST":
+                if not content_type.startswith(JSON):
+                    return _json(415, {"error": "send JSON (Content-Type: application/json)"})
+                if len(body) > MAX_BODY_BYTES:
+                    return _json(413, {"error": f"a request is at most {MAX_BODY_BYTES} bytes"})
+                data = json.loads(body or b"{}")
+                if not isinstance(data, dict):
+                    return _json(400, {"error": "the body must be a JSON object"})
+                return self._post(path, data)
+            return self._get(path)
+        except StudyError as error:
+            return _json(400, {"error": str(error)})
+        except FeelMySignError as error:
+            return _json(502, {"error": str(error)})
+        except (ValueError, KeyError, TypeError) as error:
+            return _json(400, {"error": f"bad request: {error}"})
+        except Exception as error:  # a bug must not take the server down, and must be seen
+            log.exception("study API: %s %s failed", method, path)
+            return _json(500, {"error": f"internal error: {error}"})
+
+    # ---- GET -------------------------------------------------------------------------------
+
+    def _get(self, path: str) -> Response:
+        if path == "/api/study":
+            return _json(200, self.overview())
+        if path == "/api/study/review":
+            return _json(200, self.review())
+        if match := _PARTICIPANT.match(path):
+            code, action = match.group(1), match.group(2)
+            if action is None:
+                return _json(200, self.session.state(code))
+            if action == "/simulated-answer":
+                return _json(200, self.session.simulated_answer(code))
+        if (match := _RESULT.match(path)) and self._latest is not None:
+            file = self._latest / match.group(1)
+            if file.is_file():
+                return 200, _RESULT_TYPES["." + match.group(2)], file.read_bytes()
+        return _json(404, {"error": f"no such study resource: {path}"})
+
+    def overview(self) -> dict[str, Any]:
+        design = self.store.design
+        participants = []
+        for row in self.store.participants():
+            state = self.session.state(row["code"])
+            participants.append(
+                {
+                    k: state[k]
+                    for k in ("participant", "simulated", "step", "paused", "answered", "total")
+                }
+            )
+        return {
+            "name": design.name,
+            "file": str(self.store.path),
+            "shapes": list(design.shape_names),
+            "resolutions": list(design.resolutions),
+            "comfort": list(design.comfort),
+            "questionnaire": {
+                "items": list(design.questionnaire.items),
+                "points": design.questionnaire.points,
+                "labels": list(design.questionnaire.labels),
+            },
+            "participants": participants,
+            "review": len(self.review()),
+            "results": None if self._latest is None else self._latest.name,
+        }
+
+    def review(self) -> list[dict[str, Any]]:
+        """Unclear answers, without the shape that was sent: the decision is made blind."""
+        codings = self.store.latest_codings()
+        waiting = [trial for trial, c in sorted(codings.items()) if c["status"] == "unclear"]
+        return [
+            {"trial": t, "answer": self.store.trial(t)["answer"], "rule": codings[t]["rule"]}
+            for t in waiting
+        ]
+
+    # ---- POST ------------------------------------------------------------------------------
+
+    def _post(self, path: str, data: dict[str, Any]) -> Response:
+        if path == "/api/study/participants":
+            code = self.store.add_participant(simulated=bool(data.get("simulated", False)))
+            return _json(201, {"code": code})
+        if path == "/api/study/analyse":
+            return _json(200, self.analyse())
+        if match := _REVIEW.match(path):
+            shape = data.get("shape")
+            rule = f"researcher: {shape}" if shape else "researcher: no shape named"
+            self.store.decide(int(match.group(1)), shape if shape else None, rule)
+            return _json(200, {"review": len(self.review())})
+        match = _PARTICIPANT.match(path)
+        if match is None or match.group(2) is None:
+            return _json(404, {"error": f"no such study action: {path}"})
+        return self._participant_action(match.group(1), match.group(2)[1:], data)
+
+    def _participant_action(self, code: str, action: str, data: dict[str, Any]) -> Response:
+        s = self.session
+        trial = data.get("trial")
+        trial_id = int(trial) if trial is not None else None
+        if action == "consent":
+            s.consent(code, bool(data["consent"]))
+        elif action == "comfort":
+            s.comfort(code, [bool(a) for a in data["answers"]], bool(data.get("adjusted", False)))
+        elif action == "send":
+            return _json(200, {"sent": s.send(code, trial_id), "state": s.state(code)})
+        elif action == "answer":
+            confidence = data.get("confidence")
+            coding = s.answer(
+                code,
+                trial_id,
+                answer=str(data.get("answer", "")),
+                felt_nothing=bool(data.get("felt_nothing", False)),
+                confidence=int(confidence) if confidence is not None else None,
+            )
+            return _json(200, {"coding": coding, "state": s.state(code)})
+        elif action == "pause":
+            s.pause(code, bool(data["paused"]))
+        elif action == "questionnaire":
+            s.questionnaire(code, [int(v) for v in data["values"]])
+        else:
+            return _json(404, {"error": f"no such participant action: {action}"})
+        return _json(200, {"state": s.state(code)})
+
+    def analyse(self) -> dict[str, Any]:
+        if not self._analysing.acquire(blocking=False):
+            raise StudyError("an analysis is already running; wait for it")
+        try:
+            out = self.results_dir / time.strftime("%Y%m%d-%H%M%S")
+            analysis = analyse_study(self.store, out, samples=self._bootstrap)
+            self._latest = out
+        finally:
+            self._analysing.release()
+        return {
+            "folder": str(out),
+            "files": [p.name for p in analysis.files],
+            "report": (out / "report.md").read_text(encoding="utf-8"),
+            "participants": analysis.participants,
+            "unclear": analysis.unclear,
+        }

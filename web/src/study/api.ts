@@ -1,0 +1,133 @@
+/** The study server's JSON API (python/src/feelmysign/study/api.py), typed. */
+
+export interface ParticipantSummary {
+  participant: string;
+  simulated: boolean;
+  step: Step;
+  paused: boolean;
+  answered: number;
+  total: number;
+}
+
+export type Step = "consent" | "comfort" | "trial" | "questionnaire" | "done" | "withdrawn";
+
+export interface Overview {
+  name: string;
+  file: string;
+  shapes: string[];
+  resolutions: string[];
+  comfort: string[];
+  questionnaire: { items: string[]; points: number; labels: string[] };
+  participants: ParticipantSummary[];
+  review: number;
+  results: string | null;
+}
+
+export interface SendSummary {
+  strokes: number;
+  played: number;
+  adjusted: number;
+  rejected: string[];
+  latency_ms_max: number | null;
+  felt_duration_ms: number;
+  error?: string | null;
+}
+
+export interface Trial {
+  id: number;
+  number: number;
+  total: number;
+  block: "practice" | "main";
+  repetition: number;
+  shape: string;
+  resolution: string | null;
+  segments: number;
+  sends: number;
+  last_send: SendSummary | null;
+}
+
+export interface State extends ParticipantSummary {
+  trial: Trial | null;
+}
+
+export interface Coding {
+  status: "shape" | "none" | "unclear";
+  shape: string | null;
+  rule: string;
+}
+
+export interface ReviewItem {
+  trial: number;
+  answer: string;
+  rule: string;
+}
+
+export interface AnalysisResult {
+  folder: string;
+  files: string[];
+  report: string;
+  participants: number;
+  unclear: number;
+}
+
+export interface SimulatedAnswer {
+  answer: string;
+  felt_nothing: boolean;
+  confidence: number | null;
+}
+
+/** An answer of the server that says what went wrong, in its own words. */
+export class StudyApiError extends Error {
+  readonly status: number;
+  constructor(status: number, message: string) {
+    super(message);
+    this.status = status;
+  }
+}
+
+async function call<T>(method: "GET" | "POST", path: string, body?: object): Promise<T> {
+  const init: RequestInit = { method, headers: { accept: "application/json" } };
+  if (body !== undefined) {
+    init.headers = { ...init.headers, "content-type": "application/json" };
+    init.body = JSON.stringify(body);
+  }
+  let response: Response;
+  try {
+    response = await fetch(`/api/study${path}`, init);
+  } catch {
+    throw new StudyApiError(0, "The study server does not answer: is 'feelmysign up --study FILE' running?");
+  }
+  const data = (await response.json().catch(() => ({}))) as { error?: string };
+  if (!response.ok) throw new StudyApiError(response.status, data.error ?? `HTTP ${response.status}`);
+  return data as T;
+}
+
+const participant = (code: string, action = "") => `/participants/${encodeURIComponent(code)}${action}`;
+
+export const api = {
+  overview: () => call<Overview>("GET", ""),
+  addParticipant: (simulated: boolean) => call<{ code: string }>("POST", "/participants", { simulated }),
+  state: (code: string) => call<State>("GET", participant(code)),
+  consent: (code: string, consent: boolean) =>
+    call<{ state: State }>("POST", participant(code, "/consent"), { consent }),
+  comfort: (code: string, answers: boolean[], adjusted: boolean) =>
+    call<{ state: State }>("POST", participant(code, "/comfort"), { answers, adjusted }),
+  send: (code: string, trial: number) =>
+    call<{ sent: SendSummary; state: State }>("POST", participant(code, "/send"), { trial }),
+  answer: (code: string, trial: number, answer: string, feltNothing: boolean, confidence: number | null) =>
+    call<{ coding: Coding; state: State }>("POST", participant(code, "/answer"), {
+      trial,
+      answer,
+      felt_nothing: feltNothing,
+      confidence,
+    }),
+  pause: (code: string, paused: boolean) =>
+    call<{ state: State }>("POST", participant(code, "/pause"), { paused }),
+  questionnaire: (code: string, values: number[]) =>
+    call<{ state: State }>("POST", participant(code, "/questionnaire"), { values }),
+  simulatedAnswer: (code: string) => call<SimulatedAnswer>("GET", participant(code, "/simulated-answer")),
+  review: () => call<ReviewItem[]>("GET", "/review"),
+  decide: (trial: number, shape: string | null) =>
+    call<{ review: number }>("POST", `/review/${trial}`, { shape }),
+  analyse: () => call<AnalysisResult>("POST", "/analyse", {}),
+};
