@@ -149,15 +149,15 @@ def _python_start_ms() -> float:
 def _figures(name: str, values: list[float], baseline: float) -> str:
     median = statistics.median(values)
     return (
-        f"  {name:<48} median {median:7.1f} ms   max {max(values):7.1f} ms"
-        f"   (n={len(values)})   {median / baseline:5.1f}x baseline"
+        f"  {name:<50} min {min(values):6.1f}  median {median:6.1f}  max {max(values):6.1f} ms"
+        f"  (n={len(values)})  median {median / baseline:4.1f}x baseline"
     )
 
 
 def report(rounds: int = ROUNDS) -> list[str]:
     lines = ["Restart after kill -9 mid-stroke (emulated state file, real Mosquitto)"]
     baseline = statistics.median(_python_start_ms() for _ in range(rounds))
-    lines.append(f"  {'baseline: spawn python -c pass':<48} median {baseline:7.1f} ms")
+    lines.append(f"  {'baseline: spawn python -c pass':<50} median {baseline:6.1f} ms")
     with (
         tempfile.TemporaryDirectory() as directory,
         Broker(state_dir=Path(directory) / "broker", port=0, ws_port=0) as broker,
