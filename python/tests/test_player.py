@@ -115,3 +115,33 @@ def _wait_idle(player: Player, timeout_s: float = 10.0) -> None:
     while not player.idle:
         assert monotonic_ms() < deadline, "player never went idle"
         threading.Event().wait(0.01)
+
+
+def test_a_player_that_crashes_mid_stroke_switches_every_motor_off_first(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from feelmysign.timeline import Timeline
+
+    backend = SimBackend(PAPER)
+    events = Events()
+    player = Player(backend, PAPER, on_event=events)
+    real_pop_due = Timeline.pop_due
+
+    def pop_due_then_crash(self: Timeline, now_ms: float) -> Any:
+        if any(any(row) for row in backend.snapshot()):  # a motor is on: now crash
+            raise RuntimeError("a bug in the player")
+        return real_pop_due(self, now_ms)
+
+    monkeypatch.setattr(Timeline, "pop_due", pop_due_then_crash)
+    player.start()
+    try:
+        assert player.submit(_planned(0, 0, 3, 0, 2000, drawing="crash", seq=0)) is None
+        told = events.wait_for(2)
+    finally:
+        player.stop()
+    assert [e["type"] for e in told] == ["played", "error"]
+    assert told[1]["reason"] == "player_crashed"
+    assert any(change.intensity > 0 for change in backend.changes)  # it did play
+    assert backend.snapshot() == [[0.0] * 4 for _ in range(3)]  # and ended all off
+    assert backend.changes[-1].intensity == 0.0
+    backend.close()

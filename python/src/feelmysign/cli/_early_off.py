@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import stat
 from collections.abc import Sequence
 from typing import NoReturn
 
@@ -26,6 +27,7 @@ log = logging.getLogger(__name__)
 # The commands that drive motors, and their --backend default ("scan" only reads).
 EARLY_COMMANDS = {"sleeve": "sim", "buzz": "drv2605"}
 LAYOUT_ENV = "FEELMYSIGN_LAYOUT"  # as cli/_options.py reads it
+MAX_LAYOUT_BYTES = 1_000_000  # a layout is a few kB; this pass reads nothing bigger
 
 
 class _Unparsable(Exception):
@@ -56,7 +58,17 @@ def switch_off_early(command: str | None, arguments: Sequence[str]) -> None:
         return  # the simulator, or a bare grid (which wires no chip)
     if options.emulate and options.emulate_state is None:
         return  # a fresh emulated bus starts with every motor off
+    if not _plain_small_file(options.layout):
+        return  # a fifo or a device would hang or flood this pass: the real parser refuses it
     _switch_off(options.layout, options.emulate_state)
+
+
+def _plain_small_file(path: str) -> bool:
+    try:
+        status = os.stat(path)
+    except OSError:
+        return False
+    return stat.S_ISREG(status.st_mode) and status.st_size <= MAX_LAYOUT_BYTES
 
 
 def _switch_off(layout_path: str, emulate_state: str | None) -> None:
