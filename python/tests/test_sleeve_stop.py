@@ -8,7 +8,6 @@ import signal
 import subprocess
 import sys
 import threading
-import time
 import types
 import uuid
 from collections.abc import Iterator
@@ -119,12 +118,17 @@ def test_sigterm_mid_stroke_publishes_an_all_off_frame_before_going_offline(
 
 
 class _SlowCurrentThread(types.SimpleNamespace):
-    """paho's ``threading`` with a slow ``current_thread``: it widens the moment between
-    loop_stop's two reads of its network thread, which a loaded machine hits by chance."""
+    """paho's ``threading`` with a ``current_thread`` that first waits for every other paho
+    network thread to end: it widens, to certainty, the moment between loop_stop's two reads
+    of its network thread, which a loaded machine hits by chance (only the client being
+    stopped has a network thread when it is called here)."""
 
     def current_thread(self) -> threading.Thread:
-        time.sleep(1.5)  # longer than the network thread takes to end after a disconnect
-        return threading.current_thread()
+        me = threading.current_thread()
+        for thread in threading.enumerate():
+            if thread is not me and thread.name.startswith("paho-mqtt-client-"):
+                thread.join(WAIT_S)
+        return me
 
 
 def test_paho_loop_stop_after_disconnect_races_its_thread_and_the_sleeve_never_hits_it(
