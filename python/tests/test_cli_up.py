@@ -28,14 +28,16 @@ REPO = Path(__file__).resolve().parents[2]
 WAIT_S = 60.0  # start-up of Mosquitto, the sleeve and the web server on a loaded machine
 
 
-def _played(drawing: str | None, latency_ms: float, **extra: object) -> Played:
+def _played(
+    drawing: str | None, latency_ms: float, queued_ms: float = 0.0, **extra: object
+) -> Played:
     times = {
         "received_at_ms": 1000.0,
         "start_at_ms": 1001.0,
         "first_command_at_ms": 1000.0 + latency_ms,
         "latency_ms": latency_ms,
         "start_error_ms": 0.0,
-        "queued_ms": 0.0,
+        "queued_ms": queued_ms,
         "duration_ms": 500.0,
         "commands": 3,
     }
@@ -46,8 +48,11 @@ def _played(drawing: str | None, latency_ms: float, **extra: object) -> Played:
 
 def test_one_line_per_drawing_once_it_is_quiet() -> None:
     summaries = DrawingSummaries(quiet_s=1.5)
-    summaries.add(_played("aaaaaaaa-1111", 3.0), now_s=0.0)
-    summaries.add(_played("aaaaaaaa-1111", 9.0, reason="too_fast", requested_duration_ms=50), 0.2)
+    drawing = "aaaaaaaa-1111"
+    summaries.add(_played(drawing, 3.0), now_s=0.0)
+    # Waited 500 ms behind the first stroke, then started 9 ms late: its delay is 9 ms.
+    slowed = _played(drawing, 509.0, 500.0, reason="too_fast", requested_duration_ms=50)
+    summaries.add(slowed, now_s=0.2)
     rejected = Rejected(
         reason="outside_grid", message="m", drawing="aaaaaaaa-1111", received_at_ms=1
     )
@@ -58,12 +63,12 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     lines = summaries.finished(1.9)
     assert lines == [
         "Drawing aaaaaaaa: 2 strokes played (1 slowed to be felt), 1 rejected (outside_grid); "
-        "latency median 6 ms, max 9 ms"
+        "start delay median 6 ms, max 9 ms"
     ]
     cancelled = Cancelled(message="m", received_at_ms=1.0, cancelled_at_ms=2.0, started=False)
     summaries.add(cancelled, now_s=2.0)
     assert summaries.finished(2.1, all_of_them=True) == [
-        f"{LEGACY_DRAWING}: 1 stroke played, 1 cancelled; latency median 1 ms, max 1 ms"
+        f"{LEGACY_DRAWING}: 1 stroke played, 1 cancelled; start delay median 1 ms, max 1 ms"
     ]
     assert summaries.finished(100.0, all_of_them=True) == []
 
@@ -123,7 +128,7 @@ def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
         drawing = sent.stdout.rsplit("(drawing ", 1)[1].split(")")[0]
         line = _wait_for(out, "Drawing ", seen)
         assert line.startswith(f"Drawing {drawing[:8]}: 4 strokes played"), seen
-        assert "latency median" in line and "rejected" not in line
+        assert "start delay median" in line and "rejected" not in line
     finally:
         up.send_signal(signal.SIGINT)
         try:

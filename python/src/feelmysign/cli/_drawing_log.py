@@ -4,11 +4,14 @@
 sender's account) and, once a drawing has been quiet for ``QUIET_S``, prints::
 
     Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 rejected (outside_grid);
-    latency median 3 ms, max 9 ms        (on one line)
+    start delay median 3 ms, max 9 ms        (on one line)
 
-Strokes without a drawing id (the legacy text format) count as one drawing
-per quiet spell. The summary is built by ``DrawingSummaries`` (pure: events
-and a clock in, lines out); ``DrawingLog`` is its MQTT listener.
+The start delay of a stroke is the time from its turn (its arrival, or the end
+of the strokes queued before it) to its first motor: the sleeve's own lateness,
+not the wait behind a drawing sent all at once. Strokes without a drawing id
+(the legacy text format) count as one drawing per quiet spell. The summary is
+built by ``DrawingSummaries`` (pure: events and a clock in, lines out);
+``DrawingLog`` is its MQTT listener.
 """
 
 from __future__ import annotations
@@ -48,7 +51,7 @@ class _Drawing:
     slowed: int = 0
     cancelled: int = 0
     rejected: Counter[str] = field(default_factory=Counter)
-    latencies_ms: list[float] = field(default_factory=list)
+    delays_ms: list[float] = field(default_factory=list)
 
     def line(self, name: str) -> str:
         shown = name if name == LEGACY_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
@@ -61,10 +64,10 @@ class _Drawing:
         if self.cancelled:
             parts.append(f"{self.cancelled} cancelled")
         text = f"{shown}: " + ", ".join(parts)
-        if self.latencies_ms:
+        if self.delays_ms:
             text += (
-                f"; latency median {statistics.median(self.latencies_ms):.0f} ms, "
-                f"max {max(self.latencies_ms):.0f} ms"
+                f"; start delay median {statistics.median(self.delays_ms):.0f} ms, "
+                f"max {max(self.delays_ms):.0f} ms"
             )
         return text
 
@@ -85,7 +88,7 @@ class DrawingSummaries:
         if isinstance(event, Played):
             drawing.played += 1
             drawing.slowed += isinstance(event, Adjusted)
-            drawing.latencies_ms.append(event.latency_ms)
+            drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
         elif isinstance(event, Rejected):
             drawing.rejected[event.reason] += 1
         else:

@@ -22,8 +22,8 @@ from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, Rejected, parse, stroke_to_dict
 
 EPILOG = """\
-A payload that starts with '-' (a negative coordinate) must follow '--':
-  feelmysign validate -- -1,0,2,0,1000
+A payload may start with '-' (a negative coordinate): it is judged, not taken for an option:
+  feelmysign validate -1,0,2,0,1000      # Rejected (outside_grid), exit 1
 Formats: legacy 'startX,startY,endX,endY,duration' (grid units, ms) or JSON v1;
 see docs/protocol.md for every field, range and reason code.
 """
