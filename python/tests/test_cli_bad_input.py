@@ -73,7 +73,9 @@ def files(tmp_path: Path) -> dict[str, str]:
     a_file = tmp_path / "a-file"
     a_file.write_text("not a folder\n", encoding="utf-8")
     names = {"deep": deep, "fifo": fifo, "huge": huge, "good": good, "rows_a": rows_a}
-    return {name: str(path) for name, path in names.items()} | {"under_file": f"{a_file}/x"}
+    paper = Path(__file__).resolve().parents[2] / "deploy" / "layouts" / "paper-sleeve.toml"
+    extra = {"under_file": f"{a_file}/x", "paper": str(paper)}
+    return {name: str(path) for name, path in names.items()} | extra
 
 
 BAD_FILES = [
@@ -109,6 +111,15 @@ BAD_VALUES = [
     (["send", "0,0,1,0,500", "--timeout-s", "nan"], ["--timeout-s", "above 0"]),
     (["replay", "{good}", "--send", "--timeout-s", "1e308"], ["--timeout-s"]),
     (["stop", "--timeout-s", "1e308"], ["--timeout-s", "at most 3600 s"]),
+    (["scan", "--emulate-state", "/dev/zero"], ["--emulate-state", "'/dev/zero' is a device"]),
+    (["buzz", "0", "0", "--emulate-state", "{fifo}"], ["--emulate-state", "fifo"]),
+    # The early all-off reads the layout and state file before the command line is parsed.
+    (
+        ["sleeve", "--backend", "drv2605", "--layout", "{paper}", "--emulate-state", "{fifo}"],
+        ["--emulate-state", "fifo"],
+    ),
+    (["scan", "--layout", ""], ["--layout", "an empty layout file"]),
+    (["evaluate", "{good}", "--out", ""], ["--out", "an empty output folder"]),
     (["send", "0,0,1,0,500", "--legacy", "--legacy-topic", "#"], ["--legacy-topic", "wildcards"]),
     (["sleeve", "--legacy-topic", "#"], ["--legacy-topic", "'#' cannot be used"]),
     (["sleeve", "--legacy-topic", "a/+/b"], ["--legacy-topic"]),

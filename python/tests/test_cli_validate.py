@@ -135,7 +135,10 @@ def test_help_gives_units_and_defaults(capsys: pytest.CaptureFixture[str]) -> No
         main(["validate", "--help"])
     out = capsys.readouterr().out
     assert (
-        "in cm" in out and "(default: 3)" in out and LAYOUT_ENV in out and "validate -1,0,2,0,1000" in out
+        "in cm" in out
+        and "(default: 3)" in out
+        and LAYOUT_ENV in out
+        and "validate -1,0,2,0,1000" in out
     )
 
 

@@ -29,6 +29,7 @@ MIB = 1024 * KIB
 MAX_LAYOUT_BYTES = 1 * MIB  # the paper's sleeve is 2 KiB; a 64 x 64 wiring table ~400 KiB
 MAX_CREDENTIALS_BYTES = 64 * KIB  # the broker writes about 400 bytes
 MAX_RECORDING_BYTES = 64 * MIB  # an hour of drawing at 240 samples a second is ~60 MiB
+MAX_STATE_BYTES = 1 * MIB  # the emulated bus of 64 chips is about 40 KiB
 MAX_STDIN_BYTES = 16 * MIB  # strokes or one document piped in: 200,000 strokes fit
 # MQTT allows 65,535 bytes; the broker's ACL file and the sleeve's status take this much.
 MAX_TOPIC_BYTES = 256
@@ -144,8 +145,23 @@ def not_empty(what: str) -> Callable[[str], str]:
     def parse(text: str) -> str:
         if not text:
             raise argparse.ArgumentTypeError(
-                f"the {what} is empty; give one, or leave the option out"
+                f"an empty {what} was given; give one, or leave the option out"
             )
+        return text
+
+    parse.__name__ = what
+    return parse
+
+
+def existing_or_new_file(what: str, max_bytes: int) -> Callable[[str], str]:
+    """A file read if it exists (and created if not): refused if it is a fifo, device or huge."""
+
+    def parse(text: str) -> str:
+        not_empty(what)(text)
+        try:
+            check_input_file(text, what=what, max_bytes=max_bytes)
+        except InputError as error:
+            raise argparse.ArgumentTypeError(str(error).rstrip(".")) from None
         return text
 
     parse.__name__ = what

@@ -34,10 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from feelmysign.cli._inputs import (
-    output_folder,
-    whole_number,
-)
+from feelmysign.cli._inputs import not_empty, output_folder, whole_number
 from feelmysign.cli.simplify import load
 from feelmysign.errors import FeelMySignError
 from feelmysign.research.sweep import (
@@ -95,6 +92,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--out",
         metavar="DIR",
+        type=not_empty("output folder"),
         help="folder for the CSV files and plots (default: evaluations/<date>-<time>/)",
     )
     parser.add_argument(

@@ -26,7 +26,7 @@ from feelmysign.backends.i2c import I2CBus, open_smbus
 from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
 from feelmysign.cli._emulation import add_emulate_state_option
-from feelmysign.cli._inputs import MAX_LAYOUT_BYTES, check_input_file
+from feelmysign.cli._inputs import MAX_LAYOUT_BYTES, check_input_file, not_empty
 from feelmysign.cli._options import LAYOUT_ENV
 from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
@@ -74,6 +74,7 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     parser.add_argument(
         "--layout",
         metavar="FILE",
+        type=not_empty("layout file"),
         help=f"sleeve layout TOML file with an [i2c] table, e.g. deploy/layouts/paper-sleeve.toml "
         f"(default: ${LAYOUT_ENV}; without a wired layout every address 0x70..0x77 is probed "
         "and nothing is compared)",
