@@ -158,6 +158,8 @@ def existing_or_new_file(what: str, max_bytes: int) -> Callable[[str], str]:
 
     def parse(text: str) -> str:
         not_empty(what)(text)
+        if os.path.isdir(text):
+            return text  # the loader says what it expects there, in its own words
         try:
             check_input_file(text, what=what, max_bytes=max_bytes)
         except InputError as error:
