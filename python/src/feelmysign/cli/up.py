@@ -5,11 +5,18 @@ from __future__ import annotations
 import argparse
 import socket
 import threading
+from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
 from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES
-from feelmysign.broker import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID, DEFAULT_WS_PORT, Broker
+from feelmysign.broker import (
+    DEFAULT_MQTT_PORT,
+    DEFAULT_SLEEVE_ID,
+    DEFAULT_WS_PORT,
+    Broker,
+    Credentials,
+)
 from feelmysign.cli._drawing_log import DrawingLog
 from feelmysign.cli._inputs import output_file, port, sleeve_id
 from feelmysign.cli._options import add_layout_options, layout_from_args
@@ -18,8 +25,7 @@ from feelmysign.cli._watchdog import Watchdog
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
-from feelmysign.study.served import study_api
-from feelmysign.webserver import WEB_DIST, WebServer
+from feelmysign.webserver import WEB_DIST, Api, WebServer
 
 DEFAULT_HTTP_PORT = 8000
 
@@ -104,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
     broker = Broker(state_dir=args.state_dir, port=port, ws_port=ws_port, sleeve_id=args.sleeve_id)
     watchdog = Watchdog(broker)
-    with broker, watchdog, study_api(args.study, broker.credentials) as api:
+    with broker, watchdog, _study_api(args.study, broker.credentials) as api:
         c = broker.credentials
         config = {
             "ws_url": c.ws_url,
@@ -142,6 +148,19 @@ def run(args: argparse.Namespace) -> int:
                 )
     print("Stopped: sleeve (every motor off), drawing client and broker.", flush=True)
     return 0
+
+
+def _study_api(path: Path | None, credentials: Credentials) -> AbstractContextManager[Api | None]:
+    """The study page's API with --study, else nothing.
+
+    Imported only when asked for: the study's analysis needs the [research] extra
+    (pandas, statsmodels), which 'make up' does not install.
+    """
+    if path is None:
+        return nullcontext(None)
+    from feelmysign.study.served import study_api
+
+    return study_api(path, credentials)
 
 
 def _port_or_free(asked: int | None, default: int, name: str) -> int:
