@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from feelmysign.study import StudyStore, load_design
@@ -12,3 +13,24 @@ PAPER_DESIGN = REPO / "deploy" / "studies" / "paper.toml"
 
 def new_study(tmp_path: Path, design_path: Path = PAPER_DESIGN) -> StudyStore:
     return StudyStore.create(tmp_path / "study.sqlite", design_path, load_design(design_path))
+
+
+def zigzag_recording(path: Path) -> Path:
+    """A drawn zigzag (three teeth), as the page's "Save recording" writes it."""
+    samples = []
+    for i in range(48):
+        up = (i // 8) % 2 == 0
+        y = 60.0 + (i % 8) * (10 if up else -10) + (0 if up else 70)
+        samples.append({"t_ms": i * 16.0, "x": 20.0 + i * 7.5, "y": y})
+    path.write_text(json.dumps({"canvas": {"width_px": 400, "height_px": 300}, "paths": [samples]}))
+    return path
+
+
+ZIGZAG_SHAPE = """
+[[shapes]]
+name = "zigzag"
+recording = "zigzag.json"
+simplifier = "window"
+settings = [{max_error = 1.5}, {max_error = 0.05}]
+synonyms = ["zig zag", "lightning"]
+"""

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from study_helpers import PAPER_DESIGN
+from study_helpers import PAPER_DESIGN, ZIGZAG_SHAPE, zigzag_recording
 
 from feelmysign.errors import DesignError
 from feelmysign.study import load_design, parse_design
@@ -60,27 +60,13 @@ def test_a_synonym_may_name_only_one_shape() -> None:
 
 
 def test_a_recorded_drawing_gets_its_strokes_from_the_simplifier(tmp_path: Path) -> None:
-    recording = tmp_path / "zigzag.json"
-    samples = [
-        {
-            "t_ms": i * 16.0,
-            "x": 10.0 + i * 8,
-            "y": 50.0 + (40 if (i // 6) % 2 else 0) + (i % 6) * (6 if (i // 6) % 2 == 0 else -6),
-        }
-        for i in range(48)
-    ]
-    recording.write_text(
-        '{"canvas": {"width_px": 400, "height_px": 300}, "paths": ['
-        + str(samples).replace("'", '"')
-        + "]}"
-    )
-    text = MINIMAL + (
-        '[[shapes]]\nname = "zigzag"\nrecording = "zigzag.json"\nsimplifier = "window"\n'
-        "settings = [{max_error = 1.5}, {max_error = 0.05}]\n"
-    )
-    design = parse_design(text, base_dir=tmp_path)
+    zigzag_recording(tmp_path / "zigzag.json")
+    design = parse_design(MINIMAL + ZIGZAG_SHAPE, base_dir=tmp_path)
     coarse, fine = design.shape("zigzag").levels
     assert coarse.strokes < fine.strokes
+    bad = (MINIMAL + ZIGZAG_SHAPE).replace("max_error = 1.5", "max_eror = 1.5")
+    with pytest.raises(DesignError, match=r"settings\[0\]: max_eror: not a window setting"):
+        parse_design(bad, base_dir=tmp_path)
 
 
 def test_latin_square_rows_are_balanced_for_first_order_carry_over() -> None:

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import os
+import random
 import signal
 import subprocess
 import sys
@@ -11,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from study_helpers import PAPER_DESIGN, new_study
+from study_helpers import PAPER_DESIGN, ZIGZAG_SHAPE, new_study, zigzag_recording
 
 from feelmysign.errors import StudyError
 from feelmysign.study import StudyStore
@@ -98,7 +100,7 @@ def test_a_killed_session_loses_no_answer_and_resumes_at_the_next_trial(tmp_path
     current = reopened.current_trial(code)
     assert current is not None and current["position"] == len(answered)
     session = Session(reopened, offline_player(Session(reopened, None).layout))
-    run_simulated_participant(session, code, __import__("random").Random(1))
+    run_simulated_participant(session, code, random.Random(1))
     final = reopened.trials(code)
     assert all(t["answered_at_ms"] is not None for t in final)
     assert len(final) == 74
@@ -130,3 +132,25 @@ def test_pause_is_kept_and_blocks_sending(tmp_path: Path) -> None:
     assert session.send(code)["played"] >= 1
     pauses = store.query("SELECT * FROM pauses")
     assert len(pauses) == 1 and pauses[0]["resumed_at_ms"] is not None
+
+
+def test_a_dry_run_sends_and_answers_a_recorded_drawing_too(tmp_path: Path) -> None:
+    zigzag_recording(tmp_path / "zigzag.json")
+    design = tmp_path / "design.toml"
+    design.write_text(
+        PAPER_DESIGN.read_text()
+        .split("[[shapes]]")[0]
+        .replace("repetitions = 3", "repetitions = 1")
+        .replace('resolutions = ["coarse", "low", "medium", "fine"]', 'resolutions = ["c", "f"]')
+        + ZIGZAG_SHAPE
+        + '[questionnaire]\nitems = ["comfortable"]\n'
+    )
+    store = new_study(tmp_path, design)
+    dry_run(store, 3, seed=5)
+    rows = store.query("SELECT * FROM trials WHERE shape = 'zigzag'")
+    assert len(rows) == 3 * 2 and all(r["answered_at_ms"] is not None for r in rows)
+    strokes = store.query(
+        "SELECT s.strokes_json FROM sends s JOIN trials t ON s.trial = t.id "
+        "WHERE t.shape = 'zigzag'"
+    )
+    assert {len(json.loads(r[0])) for r in strokes} == {t["segments"] for t in rows}

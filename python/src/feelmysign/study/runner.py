@@ -64,7 +64,7 @@ class Session:
         self.store = store
         self._play = play
         self.layout: Layout = stimulus_layout(store.design.stimulus, store.base_dir)
-        self._templates = templates(store.design, self.layout)
+        self._templates = templates(store.design, self.layout, store.base_dir)
         self._simulation_seed = simulation_seed
 
     # ---- what the page shows -----------------------------------------------------------

@@ -23,12 +23,14 @@ from __future__ import annotations
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from feelmysign.layout import Layout
 from feelmysign.shapes import MAX_SEGMENTS, SHAPES, shape_strokes
 from feelmysign.stroke import Point, Stroke
 from feelmysign.study.design import Design
 from feelmysign.study.recognise import Scorer, dollar_scores, felt_path, outline
+from feelmysign.study.stimulus import trial_strokes
 
 _PHRASES = ("{}", "a {}", "{} I think", "it felt like a {}", "maybe a {}")
 _UNCLEAR = ("something pointy", "a kind of zigzag", "hard to say, a wave?", "some loops")
@@ -43,15 +45,21 @@ class SimulatedAnswer:
     intended: str | None  # the shape the simulated participant meant (None: no shape)
 
 
-def templates(design: Design, layout: Layout) -> dict[str, list[Point]]:
+def templates(design: Design, layout: Layout, base_dir: Path) -> dict[str, list[Point]]:
     """Each shape's ideal outline: a library shape at its finest allowed count; a recorded
-    drawing at its finest level."""
+    drawing at its finest level (what the participant has in mind)."""
     out: dict[str, list[Point]] = {}
     for shape in design.shapes:
         spec = SHAPES.get(shape.name)
         if shape.recording is None and spec is not None:
             finest = spec.max_segments if spec.step > 1 else MAX_SEGMENTS
             out[shape.name] = outline(shape_strokes(shape.name, layout=layout, segments=finest))
+        else:
+            level = len(shape.levels) - 1
+            strokes = trial_strokes(
+                design, base_dir, shape.name, level=level, segments=None, drawing="t", layout=layout
+            )
+            out[shape.name] = outline(strokes)
     return out
 
 

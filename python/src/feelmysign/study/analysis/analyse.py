@@ -27,7 +27,7 @@ from feelmysign.study.analysis.psychometric import (
 )
 from feelmysign.study.analysis.report import write_report
 from feelmysign.study.analysis.wilson import wilson_interval
-from feelmysign.study.export import export_study, trial_rows
+from feelmysign.study.export import anonymous_labels, export_study, trial_rows
 from feelmysign.study.store import StudyStore
 
 
@@ -42,6 +42,7 @@ class Analysis:
     model: ModelResult | None
     criterion: float
     files: list[Path]
+    threshold_runs: list[dict[str, Any]]
 
 
 def main_trials(store: StudyStore) -> pd.DataFrame:
@@ -100,6 +101,7 @@ def analyse_study(
         model=model,
         criterion=design.criterion,
         files=files,
+        threshold_runs=threshold_summaries(store),
     )
     files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
     if thresholds:
@@ -109,6 +111,23 @@ def analyse_study(
     files.append(_results_json(out_dir / "results.json", analysis))
     files.append(write_report(out_dir / "report.md", store, analysis))
     return analysis
+
+
+def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
+    """Every threshold run (SQ2.2), anonymised, with its result when it has finished."""
+    labels = anonymous_labels(store)
+    return [
+        {
+            "participant": labels[run["participant"]],
+            "dimension": run["dimension"],
+            "threshold": run["threshold"],
+            "low": run["low"],
+            "high": run["high"],
+            "trials": len(store.threshold_trials(run["id"])),
+            "stop_reason": run["stop_reason"],
+        }
+        for run in store.threshold_runs()
+    ]
 
 
 def _finite(value: float) -> float | None:
@@ -141,6 +160,7 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
             for shape, t in analysis.thresholds.items()
         },
         "shape_model": asdict(analysis.model) if analysis.model else None,
+        "thresholds": analysis.threshold_runs,
     }
     path.write_text(json.dumps(data, indent=2, default=str) + "\n", encoding="utf-8")
     return path

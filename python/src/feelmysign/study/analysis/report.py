@@ -21,6 +21,14 @@ def _strokes(value: float, tested: tuple[float, float]) -> str:
     return f"{value:.1f}"
 
 
+def _interval(low: float, high: float, tested: tuple[float, float]) -> str:
+    if high < tested[0]:
+        return f"below the tested range (< {tested[0]:g})"
+    if low > tested[1]:
+        return f"above the tested range (> {tested[1]:g})"
+    return f"{_strokes(low, tested)} - {_strokes(high, tested)}"
+
+
 def _p(value: float) -> str:
     return "p < 0.001" if value < 0.001 else f"p = {value:.3f}"
 
@@ -68,9 +76,8 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         rows = analysis.accuracy[shape]
         tested = (float(rows[0][0]), float(rows[-1][0]))
         lines.append(
-            f"| {shape} | {_strokes(t.strokes, tested)} | {_strokes(t.low, tested)} - "
-            f"{_strokes(t.high, tested)} | {_strokes(t.boot_low, tested)} - "
-            f"{_strokes(t.boot_high, tested)} | {t.fit.slope:.2f} |"
+            f"| {shape} | {_strokes(t.strokes, tested)} | {_interval(t.low, t.high, tested)} | "
+            f"{_interval(t.boot_low, t.boot_high, tested)} | {t.fit.slope:.2f} |"
         )
     lines += [
         "",
@@ -101,6 +108,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             "|---|---|---|",
             *(f"| {e.shape} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.mixed),
         ]
+    lines += _threshold_section(analysis)
     lines += [
         "",
         "Files: trials.csv (one row per trial, anonymised), questionnaire.csv, threshold.csv, "
@@ -109,3 +117,31 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     path.write_text("\n".join(lines), encoding="utf-8")
     return path
+
+
+def _threshold_section(analysis: Analysis) -> list[str]:
+    if not analysis.threshold_runs:
+        return []
+    lines = [
+        "",
+        "## Shortest and briefest stroke whose direction is felt (SQ2.2)",
+        "",
+        "QUEST+ on a Weibull function, four directions (25% by chance); threshold = posterior "
+        "mean (about 71% correct), interval = 95% credible interval.",
+        "",
+        "| participant | varied | threshold | 95% interval | trials | stopped after |",
+        "|---|---|---|---|---|---|",
+    ]
+    for run in analysis.threshold_runs:
+        unit = "grid units" if run["dimension"] == "length" else "ms"
+        if run["threshold"] is None:
+            lines.append(
+                f"| {run['participant']} | {run['dimension']} | not finished | | "
+                f"{run['trials']} | |"
+            )
+            continue
+        lines.append(
+            f"| {run['participant']} | {run['dimension']} | {run['threshold']:.3g} {unit} | "
+            f"{run['low']:.3g} - {run['high']:.3g} | {run['trials']} | {run['stop_reason']} |"
+        )
+    return lines

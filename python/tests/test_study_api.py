@@ -1,0 +1,99 @@
+"""The study's HTTP API: only for this machine, JSON only, every step of a session, blind review."""
+
+from __future__ import annotations
+
+import json
+import urllib.error
+import urllib.request
+from pathlib import Path
+from typing import Any
+
+from study_helpers import new_study
+
+from feelmysign.study.api import StudyApi
+from feelmysign.study.runner import Session
+from feelmysign.study.simulated_sleeve import offline_player
+from feelmysign.webserver import WebServer
+
+HOST = "127.0.0.1:8000"
+
+
+def _api(tmp_path: Path) -> StudyApi:
+    store = new_study(tmp_path)
+    layout = Session(store, None).layout
+    return StudyApi(Session(store, offline_player(layout)), tmp_path / "results", bootstrap=50)
+
+
+def _call(
+    api: StudyApi, method: str, path: str, body: dict[str, Any] | None = None
+) -> tuple[int, Any]:
+    raw = json.dumps(body or {}).encode()
+    status, _kind, payload = api.handle(method, path, HOST, raw, "application/json")
+    return status, json.loads(payload)
+
+
+def test_requests_for_another_host_or_not_json_are_refused(tmp_path: Path) -> None:
+    api = _api(tmp_path)
+    status, _, body = api.handle("GET", "/api/study", "evil.example:8000", b"", "")
+    assert status == 403 and b"127.0.0.1" in body
+    status, _, body = api.handle("POST", "/api/study/participants", HOST, b"a=1", "text/plain")
+    assert status == 415
+    assert api.store.participants() == []
+
+
+def test_a_session_through_the_api_and_a_blind_review(tmp_path: Path) -> None:
+    api = _api(tmp_path)
+    status, created = _call(api, "POST", "/api/study/participants", {"simulated": False})
+    code = created["code"]
+    assert status == 201 and code.startswith("P-")
+    base = f"/api/study/participants/{code}"
+    status, refused = _call(api, "POST", f"{base}/comfort", {"answers": [True, True]})
+    assert status == 400 and "consent" in refused["error"]
+    _call(api, "POST", f"{base}/consent", {"consent": True})
+    _call(api, "POST", f"{base}/comfort", {"answers": [True, True], "adjusted": False})
+    status, state = _call(api, "GET", base)
+    trial = state["trial"]
+    assert state["step"] == "trial" and trial["block"] == "practice"
+    status, sent = _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
+    assert status == 200 and sent["sent"]["played"] == sent["sent"]["strokes"]
+    status, answered = _call(
+        api, "POST", f"{base}/answer", {"trial": trial["id"], "answer": "a wobbly thing"}
+    )
+    assert answered["coding"]["status"] == "unclear"
+    assert answered["state"]["answered"] == 1
+    status, review = _call(api, "GET", "/api/study/review")
+    assert review == [{"trial": trial["id"], "answer": "a wobbly thing", "rule": review[0]["rule"]}]
+    assert "shape" not in review[0]  # the shape that was sent is not shown: blind decision
+    status, decided = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": "line"})
+    assert decided == {"review": 0}
+    decisions = api.store.codings(trial["id"])
+    assert [d["decided_by"] for d in decisions] == ["auto", "researcher"]
+    status, missing = _call(api, "GET", "/api/study/participants/P-NOONE")
+    assert status == 400 and "no participant" in missing["error"]
+
+
+def test_the_web_server_mounts_the_api_and_serves_the_study_page(tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "index.html").write_text("<p>draw</p>")
+    (site / "study.html").write_text("<p>study page</p>")
+    api = _api(tmp_path)
+    with WebServer(port=0, config={}, directory=site, api=api.handle) as server:
+        with urllib.request.urlopen(f"{server.url}study") as page:
+            assert b"study page" in page.read()
+        request = urllib.request.Request(
+            f"{server.url}api/study/participants",
+            data=b'{"simulated": true}',
+            headers={"Content-Type": "application/json"},
+        )
+        with urllib.request.urlopen(request) as response:
+            assert response.status == 201
+        with urllib.request.urlopen(f"{server.url}api/study") as response:
+            overview = json.load(response)
+        assert len(overview["participants"]) == 1 and overview["participants"][0]["simulated"]
+        try:
+            urllib.request.urlopen(f"{server.url}api/study/nothing")
+        except urllib.error.HTTPError as error:
+            assert error.code == 404
+        else:
+            raise AssertionError("an unknown API path must be a 404")
