@@ -403,6 +403,20 @@ def test_the_local_broker_s_file_is_used_only_when_nothing_else_is_given(tmp_pat
     assert (elsewhere.host, elsewhere.username, elsewhere.password) == ("other", None, None)
 
 
+def test_a_user_and_password_keep_the_local_broker_s_url_and_sleeve(tmp_path: Path) -> None:
+    _write_credentials(tmp_path / "state" / "feelmysign" / "broker" / "credentials.json")
+    args = _settings_args("--username", "alice", "--password", "secret1")
+    settings = broker_settings_from_args(args, "sender")
+    # The URL and sleeve id from the file (not the default 1883), the account as given.
+    assert (settings.port, settings.username, settings.password) == (4321, "alice", "secret1")
+    assert (
+        settings.sleeve_id
+        == json.loads(
+            (tmp_path / "state" / "feelmysign" / "broker" / "credentials.json").read_text()
+        )["sleeve"]["id"]
+    )
+
+
 def test_without_anything_the_default_is_the_local_broker_anonymously() -> None:
     settings = broker_settings_from_args(_settings_args(), "sender")
     assert (settings.url, settings.username, settings.sleeve_id) == (
