@@ -34,6 +34,7 @@ from paho.mqtt.reasoncodes import ReasonCode
 from feelmysign.broker import Account, Broker, BrokerError, Credentials, load_credentials
 from feelmysign.broker._config import hash_password
 from feelmysign.broker._process import find_mosquitto
+from feelmysign.broker.credentials import new_password
 
 pytestmark = pytest.mark.broker
 
@@ -553,3 +554,12 @@ def test_command_rejects_a_bad_port_as_usage_error(tmp_path: Path) -> None:
     )
     assert result.returncode == 2
     assert "70000 is out of range" in result.stderr
+
+
+def test_generated_passwords_can_follow_password_on_any_command_line() -> None:
+    # A password that starts with '-' is read by argparse as an option, so
+    # `feelmysign send --password <it>` would fail for about one account in 30.
+    passwords = [new_password() for _ in range(2000)]
+    assert all(p.isalnum() and p.isascii() for p in passwords)
+    assert all(len(p) >= 32 for p in passwords)
+    assert len(set(passwords)) == len(passwords)

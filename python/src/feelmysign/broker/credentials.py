@@ -16,6 +16,7 @@ import json
 import os
 import re
 import secrets
+import string
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -28,7 +29,8 @@ SLEEVE_USERNAME_PREFIX = "sleeve-"
 # A sleeve id becomes one level of a topic: no '/', and no MQTT wildcards '+' '#'.
 SLEEVE_ID_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,64}")
 # 24 random bytes (192 bits), URL-safe so a password needs no quoting anywhere.
-PASSWORD_BYTES = 24
+PASSWORD_ALPHABET = string.ascii_letters + string.digits
+PASSWORD_LENGTH = 32  # 32 of 62 symbols: about 190 bits
 # What a password file line and a URL can hold without escaping.
 _PASSWORD_PATTERN = re.compile(r"[!-~]{8,256}")
 CREDENTIALS_FILE_MODE = 0o600
@@ -93,7 +95,9 @@ def sleeve_username(sleeve_id: str) -> str:
 
 
 def new_password() -> str:
-    return secrets.token_urlsafe(PASSWORD_BYTES)
+    # Letters and digits only: a password that starts with '-' would be read as an option
+    # by every command line that takes `--password`.
+    return "".join(secrets.choice(PASSWORD_ALPHABET) for _ in range(PASSWORD_LENGTH))
 
 
 def load_credentials(path: str | Path) -> Credentials:
