@@ -53,6 +53,10 @@ class Credentials:
     sleeve_id: str
     sleeve: Account
     sender: Account
+    # Off loopback (feelmysign up --lan): the TLS listener, and the SHA-256 of the local
+    # CA's certificate that join tokens carry (None with a publicly trusted certificate).
+    mqtts_url: str | None = None
+    ca_fingerprint: str | None = None
 
     @property
     def mqtt_host(self) -> str:
@@ -67,7 +71,11 @@ class Credentials:
         return urlsplit(self.ws_url).port or 80
 
     def to_json(self) -> dict[str, Any]:
+        tls = {"mqtts_url": self.mqtts_url} if self.mqtts_url else {}
+        if self.ca_fingerprint:
+            tls["ca_fingerprint"] = self.ca_fingerprint
         return {
+            **tls,
             "mqtt_url": self.mqtt_url,
             "ws_url": self.ws_url,
             "sleeve": {
@@ -127,6 +135,8 @@ def _credentials_from_json(data: object, path: Path) -> Credentials:
             sleeve_id=_text(sleeve["id"]),
             sleeve=Account(_text(sleeve["username"]), _text(sleeve["password"])),
             sender=Account(_text(sender["username"]), _text(sender["password"])),
+            mqtts_url=_optional_text(data.get("mqtts_url")),
+            ca_fingerprint=_optional_text(data.get("ca_fingerprint")),
         )
     except (KeyError, TypeError):
         raise _bad_file(
@@ -147,6 +157,10 @@ def _text(value: object) -> str:
     return value
 
 
+def _optional_text(value: object) -> str | None:
+    return None if value is None else _text(value)
+
+
 def _bad_file(path: Path, problem: str) -> BrokerError:
     return BrokerError(
         "credentials-file",
@@ -155,7 +169,15 @@ def _bad_file(path: Path, problem: str) -> BrokerError:
     )
 
 
-def reuse_or_create(path: Path, *, sleeve_id: str, mqtt_url: str, ws_url: str) -> Credentials:
+def reuse_or_create(
+    path: Path,
+    *,
+    sleeve_id: str,
+    mqtt_url: str,
+    ws_url: str,
+    mqtts_url: str | None = None,
+    ca_fingerprint: str | None = None,
+) -> Credentials:
     """The credentials to run with: the passwords in ``path`` when it exists, fresh ones otherwise.
 
     The URLs always follow the ports of this run. A different sleeve id gets a new sleeve
@@ -167,7 +189,13 @@ def reuse_or_create(path: Path, *, sleeve_id: str, mqtt_url: str, ws_url: str) -
         if previous.sleeve_id != sleeve_id:
             sleeve = Account(sleeve_username(sleeve_id), new_password())
         return replace(
-            previous, mqtt_url=mqtt_url, ws_url=ws_url, sleeve_id=sleeve_id, sleeve=sleeve
+            previous,
+            mqtt_url=mqtt_url,
+            ws_url=ws_url,
+            sleeve_id=sleeve_id,
+            sleeve=sleeve,
+            mqtts_url=mqtts_url,
+            ca_fingerprint=ca_fingerprint,
         )
     return Credentials(
         mqtt_url=mqtt_url,
@@ -175,6 +203,8 @@ def reuse_or_create(path: Path, *, sleeve_id: str, mqtt_url: str, ws_url: str) -
         sleeve_id=sleeve_id,
         sleeve=Account(sleeve_username(sleeve_id), new_password()),
         sender=Account(SENDER_USERNAME, new_password()),
+        mqtts_url=mqtts_url,
+        ca_fingerprint=ca_fingerprint,
     )
 
 

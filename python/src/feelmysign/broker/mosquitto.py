@@ -21,17 +21,13 @@ import re
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 from types import TracebackType
 
 from feelmysign.broker import _process as process_
-from feelmysign.broker._config import (
-    LOOPBACK_ADDRESS,
-    StateFiles,
-    render_acl,
-    render_config,
-    write_password_file,
-)
+from feelmysign.broker._config import LOOPBACK_ADDRESS, StateFiles, TlsListener, render_config
+from feelmysign.broker.accounts import write_auth_files, write_runtime
 from feelmysign.broker.credentials import (
     Account,
     Credentials,
@@ -40,6 +36,7 @@ from feelmysign.broker.credentials import (
     write_credentials,
     write_private_file,
 )
+from feelmysign.broker.tls import LanOptions, TlsFiles
 from feelmysign.errors import BrokerError
 from feelmysign.topics import LEGACY_TOPIC
 
@@ -87,8 +84,11 @@ class Broker:
         mosquitto: str | Path | None = None,
         ready_timeout_s: float = DEFAULT_READY_TIMEOUT_S,
         stop_timeout_s: float = DEFAULT_STOP_TIMEOUT_S,
+        lan: LanOptions | None = None,
     ) -> None:
         _check_port(port, "--port")
+        if lan is not None:
+            _check_port(lan.port, "--tls-port")
         _check_port(ws_port, "--ws-port")
         if port == ws_port != 0:
             raise BrokerError(
@@ -105,6 +105,8 @@ class Broker:
         self._requested_ws_port = ws_port
         self._sleeve_id = check_sleeve_id(sleeve_id)
         self._legacy_topic = legacy_topic
+        self._lan = lan
+        self._tls: TlsFiles | None = None
         self._mosquitto = mosquitto
         self._ready_timeout_s = ready_timeout_s
         self._stop_timeout_s = stop_timeout_s
@@ -128,6 +130,20 @@ class Broker:
     @property
     def config_path(self) -> Path:
         return self._files.config
+
+    @property
+    def files(self) -> StateFiles:
+        return self._files
+
+    @property
+    def lan(self) -> LanOptions | None:
+        """Where the broker listens off loopback (its port chosen once started), or None."""
+        return self._lan
+
+    @property
+    def tls(self) -> TlsFiles | None:
+        """The certificate off loopback (None on loopback only), known once started."""
+        return self._tls
 
     @property
     def pid(self) -> int | None:
@@ -165,6 +181,9 @@ class Broker:
         executable = process_.find_mosquitto(self._mosquitto, process_.search_dirs())
         self.version = process_.mosquitto_version(executable)
         self._make_state_dir()
+        if self._lan is not None:
+            self._lan = self._bindable(self._lan)
+            self._tls = self._lan.tls_files(self._files.tls_dir)
         attempts_left = AUTO_PORT_ATTEMPTS
         while True:
             port, ws_port = self._choose_ports()
@@ -187,6 +206,7 @@ class Broker:
         atexit.unregister(self.stop)
         if process is not None:
             process_.stop(process, timeout_s=self._stop_timeout_s)
+            self._files.runtime.unlink(missing_ok=True)
 
     def check_running(self, *, wait_s: float = 0.0) -> None:
         """Wait up to ``wait_s`` for Mosquitto to exit; BrokerError ``exited`` if it did."""
@@ -233,6 +253,8 @@ class Broker:
             sleeve_id=self._sleeve_id,
             mqtt_url=f"mqtt://{LOOPBACK_ADDRESS}:{port}",
             ws_url=f"ws://{LOOPBACK_ADDRESS}:{ws_port}",
+            mqtts_url=self._mqtts_url(),
+            ca_fingerprint=self._tls.ca_fingerprint if self._tls else None,
         )
         self._write_files(credentials, executable, port, ws_port)
         _rotate(self._files.log)
@@ -242,6 +264,12 @@ class Broker:
         with os.fdopen(log_fd, "ab") as log:
             self._process = process_.spawn(executable, self._files.config, log)
         atexit.register(self.stop)
+        write_runtime(
+            self._files,
+            pid=self._process.pid,
+            legacy_topic=self._legacy_topic,
+            executable=executable,
+        )
         try:
             self._wait_until_ready(credentials.sender, port, ws_port, log_offset_bytes)
         except BaseException:
@@ -255,27 +283,47 @@ class Broker:
     ) -> None:
         files = self._files
         write_credentials(files.credentials, credentials)
-        passwd_tool = process_.find_executable(
-            "mosquitto_passwd", [str(Path(executable).parent), *process_.search_dirs()]
-        )
-        write_password_file(
-            files.passwords, [credentials.sleeve, credentials.sender], mosquitto_passwd=passwd_tool
-        )
-        acl = render_acl(
-            sleeve_id=credentials.sleeve_id,
-            sleeve_username=credentials.sleeve.username,
-            sender_username=credentials.sender.username,
+        write_auth_files(
+            files,
+            credentials,
             legacy_topic=self._legacy_topic,
+            mosquitto_dir=str(Path(executable).parent),
         )
-        write_private_file(files.acl, acl)
         config = render_config(
             files,
             port=port,
             ws_port=ws_port,
             ws_bind=_ws_bind(self.version),
             run_as_user=_user_name(),
+            tls=self._tls_listener(),
         )
         write_private_file(files.config, config)
+
+    @staticmethod
+    def _bindable(lan: LanOptions) -> LanOptions:
+        """``lan`` with its port chosen when 0; BrokerError when the address is not ours."""
+        try:
+            port = lan.port or process_.free_port(lan.host)
+            process_.check_port_free(lan.host, port, what="MQTT TLS", option="--tls-port")
+        except OSError as error:
+            raise BrokerError(
+                "bad-option",
+                f"Cannot listen on {lan.host} ({error.strerror}): give --host one of this "
+                "machine's own addresses (see 'ip -brief address'), or leave it out for --lan "
+                "to pick the address of the default route.",
+            ) from None
+        return replace(lan, port=port)
+
+    def _mqtts_url(self) -> str | None:
+        if self._lan is None:
+            return None
+        host = f"[{self._lan.host}]" if ":" in self._lan.host else self._lan.host
+        return f"mqtts://{host}:{self._lan.port}"
+
+    def _tls_listener(self) -> TlsListener | None:
+        if self._lan is None or self._tls is None:
+            return None
+        return TlsListener(self._lan.host, self._lan.port, self._tls.cert, self._tls.key)
 
     def _wait_until_ready(
         self, sender: Account, port: int, ws_port: int, log_offset_bytes: int
@@ -294,7 +342,14 @@ class Broker:
             accepted = process_.accepts_login(LOOPBACK_ADDRESS, port, sender, timeout_s=probe_s)
             if accepted is False:
                 raise self._login_refused_error(port, log_offset_bytes)
-            if accepted and process_.accepts_tcp(LOOPBACK_ADDRESS, ws_port, timeout_s=probe_s):
+            if (
+                accepted
+                and process_.accepts_tcp(LOOPBACK_ADDRESS, ws_port, timeout_s=probe_s)
+                and (
+                    self._lan is None
+                    or process_.accepts_tcp(self._lan.host, self._lan.port, timeout_s=probe_s)
+                )
+            ):
                 return
             # No event to wait on: the listener does not exist yet, so poll.
             time.sleep(READY_POLL_S)

@@ -26,6 +26,7 @@ from feelmysign.broker import DEFAULT_SLEEVE_ID, default_state_dir
 from feelmysign.broker.credentials import Credentials, check_sleeve_id, load_credentials
 from feelmysign.cli._inputs import MAX_CREDENTIALS_BYTES, check_input_file, not_empty, sleeve_id
 from feelmysign.connection import DEFAULT_BROKER_URL, BrokerSettings, parse_broker_url
+from feelmysign.connection.join_token import default_trust_dir, join_settings
 from feelmysign.connection.settings import PASSWORD_ENV, USERNAME_ENV
 from feelmysign.errors import BrokerConnectionError
 
@@ -34,6 +35,7 @@ Role = Literal["sender", "sleeve"]
 BROKER_ENV = "FEELMYSIGN_BROKER"
 SLEEVE_ID_ENV = "FEELMYSIGN_SLEEVE_ID"
 CREDENTIALS_ENV = "FEELMYSIGN_CREDENTIALS"
+JOIN_ENV = "FEELMYSIGN_JOIN"
 
 
 def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
@@ -73,6 +75,14 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
         help=f"MQTT password (default: ${PASSWORD_ENV}; prefer it or --credentials: "
         "other users can see command lines)",
     )
+    if role == "sleeve":
+        group.add_argument(
+            "--join",
+            metavar="TOKEN",
+            help=f"the one-line token of 'feelmysign broker add-sleeve ID': broker URL (TLS), "
+            f"its CA's fingerprint, this sleeve's id and login; replaces the other broker "
+            f"options (default: ${JOIN_ENV})",
+        )
     group.add_argument(
         "--credentials",
         metavar="FILE",
@@ -89,8 +99,14 @@ def local_credentials_path() -> Path:
 
 
 def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSettings:
-    """The settings the options and environment ask for; BrokerError saying what is wrong."""
+    """The settings the options and environment ask for; BrokerError saying what is wrong.
+
+    A join token (sleeve only) fetches and checks the broker's CA the first time.
+    """
     env = os.environ
+    token = getattr(args, "join", None) or (env.get(JOIN_ENV) if role == "sleeve" else None)
+    if token:
+        return join_settings(token, default_trust_dir())
     url = args.broker or env.get(BROKER_ENV) or None
     username = args.username or env.get(USERNAME_ENV) or None
     password = args.password or env.get(PASSWORD_ENV) or None

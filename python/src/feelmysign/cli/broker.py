@@ -1,6 +1,8 @@
 """feelmysign broker: run a local Mosquitto for a sleeve and a sender until interrupted.
 
     feelmysign broker [--state-dir DIR] [--port P] [--ws-port W] [--sleeve-id ID]
+                      [--lan | --host ADDRESS] [--tls-port P] [--tls-cert FILE --tls-key FILE]
+    feelmysign broker [--state-dir DIR] add-sleeve ID    # prints the sleeve's join token
 
 Prints the URLs, the credentials file and the log file, then "Ready." once the broker
 accepts connections. Ctrl-C (SIGINT), SIGTERM or SIGHUP stop Mosquitto and exit 0.
@@ -21,6 +23,8 @@ from feelmysign.broker import (
     Broker,
     default_state_dir,
 )
+from feelmysign.cli._join import run_add_sleeve
+from feelmysign.cli._lan_options import add_lan_options, lan_from_args
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 # How often the CLI notices a stop request or a Mosquitto that died.
@@ -67,7 +71,27 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         metavar="PATH",
         help="the mosquitto executable (default: found on PATH, then in /usr/sbin)",
     )
+    add_lan_options(parser)
     parser.set_defaults(handler=run)
+    commands = parser.add_subparsers(title="commands", metavar="COMMAND")
+    add = commands.add_parser(
+        "add-sleeve",
+        help="give a sleeve on another machine its account; print its one-line join token",
+        description=(
+            "Create (or show again) the account of sleeve ID on this broker, allowed only its "
+            "own topics, and print a one-line join token with the broker's TLS URL, its CA's "
+            "fingerprint and the login. On the sleeve: feelmysign sleeve --join TOKEN. "
+            "A running broker takes the new account at once."
+        ),
+    )
+    add.add_argument("new_sleeve_id", metavar="ID", help="1-64 letters, digits, '_' or '-'")
+    add.add_argument(
+        "--url",
+        metavar="URL",
+        help="the broker's URL as the sleeve reaches it, mqtts:// or wss:// (default: the "
+        "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
+    )
+    add.set_defaults(handler=run_add_sleeve)
 
 
 def _port(text: str) -> int:
@@ -87,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
         ws_port=args.ws_port,
         sleeve_id=args.sleeve_id,
         mosquitto=args.mosquitto,
+        lan=lan_from_args(args),
     )
     with _stop_requests() as stop_requested, broker:
         _announce(broker)
@@ -122,6 +147,7 @@ def _announce(broker: Broker) -> None:
         f"Mosquitto {version} running (pid {broker.pid}) with state in {broker.state_dir}",
         f"  MQTT:        {credentials.mqtt_url}",
         f"  WebSockets:  {credentials.ws_url}",
+        *([f"  TLS:         {credentials.mqtts_url}"] if credentials.mqtts_url else []),
         f"  Credentials: {broker.credentials_path} "
         f"(sleeve user {credentials.sleeve.username}, sender user {credentials.sender.username})",
         f"  Log:         {broker.log_path}",

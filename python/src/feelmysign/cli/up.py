@@ -19,13 +19,15 @@ from feelmysign.broker import (
 )
 from feelmysign.cli._drawing_log import DrawingLog
 from feelmysign.cli._inputs import output_file, port, sleeve_id
+from feelmysign.cli._lan_options import add_lan_options, lan_from_args
 from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli._page_server import page_server, qr_text
 from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.cli._watchdog import Watchdog
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
-from feelmysign.webserver import WEB_DIST, Api, WebServer
+from feelmysign.webserver import WEB_DIST, Api
 
 DEFAULT_HTTP_PORT = 8000
 
@@ -99,6 +101,7 @@ def register(subparsers: Any) -> None:
         "'feelmysign study new DESIGN.toml --out FILE')",
     )
     add_layout_options(parser)
+    add_lan_options(parser)
     parser.set_defaults(handler=run)
 
 
@@ -108,17 +111,20 @@ def run(args: argparse.Namespace) -> int:
     layout = layout_from_args(args)
     port = _port_or_free(args.port, DEFAULT_MQTT_PORT, "MQTT")
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
-    broker = Broker(state_dir=args.state_dir, port=port, ws_port=ws_port, sleeve_id=args.sleeve_id)
+    broker = Broker(
+        state_dir=args.state_dir,
+        port=port,
+        ws_port=ws_port,
+        sleeve_id=args.sleeve_id,
+        lan=lan_from_args(args),
+    )
     watchdog = Watchdog(broker)
     with broker, watchdog, _study_api(args.study, broker.credentials) as api:
         c = broker.credentials
-        config = {
-            "ws_url": c.ws_url,
-            "sleeve_id": c.sleeve_id,
-            "username": c.sender.username,
-            "password": c.sender.password,
-        }
-        with WebServer(port=args.http_port, config=config, directory=args.web_dir, api=api) as web:
+        server, page_url = page_server(
+            broker, http_port=args.http_port, directory=args.web_dir, api=api
+        )
+        with server:
             settings = BrokerSettings(
                 c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
             )
@@ -133,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
                 watchdog.watch(sleeve)
                 threading.Thread(
                     target=_announce,
-                    args=(sleeve, web.url, broker, api is not None),
+                    args=(sleeve, page_url, broker, api is not None),
                     daemon=True,
                 ).start()
 
@@ -188,10 +194,20 @@ def _announce(sleeve: Sleeve, url: str, broker: Broker, study: bool = False) -> 
         print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
         return
     c = broker.credentials
+    lan = ""
+    if c.mqtts_url is not None:
+        fingerprint = f" (CA SHA-256 {c.ca_fingerprint[:16]}...)" if c.ca_fingerprint else ""
+        lan = (
+            f"  Phone:       scan this code, accept the certificate{fingerprint} once:\n"
+            f"{qr_text(url)}"
+            f"  Sleeves:     {c.mqtts_url}; for a sleeve on another machine run\n"
+            f"               feelmysign broker --state-dir {broker.state_dir} add-sleeve ID\n"
+        )
     print(
         f"feelmysign is up.\n"
         f"  Draw here:   {url}\n"
-        + (f"  Study:       {url}study\n" if study else "")
+        + (f"  Study:       {url.split('?')[0]}study\n" if study else "")
+        + lan
         + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
         f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"

@@ -39,7 +39,10 @@ def new_client(
     A persistent session (fixed client id, clean session off) lets the broker
     keep QoS 1 messages for a sleeve that is away, and its subscriptions.
     Persistent sessions are an MQTT 3.1.1 notion here (``clean_session``).
+    A password is never sent in clear text off loopback: BrokerConnectionError
+    ``plain-text`` says to use mqtts:// or wss:// instead.
     """
+    check_no_plain_text_password(settings)
     if protocol == mqtt.MQTTv5:
         client = mqtt.Client(
             CallbackAPIVersion.VERSION2,
@@ -59,7 +62,7 @@ def new_client(
     if settings.transport == "websockets":
         client.ws_set_options(path=settings.path)
     if settings.tls:
-        client.tls_set(cert_reqs=ssl.CERT_REQUIRED)
+        client.tls_set(ca_certs=settings.ca_file, cert_reqs=ssl.CERT_REQUIRED)
     if settings.username is not None:
         client.username_pw_set(settings.username, settings.password)
     jitter_reconnects(client)
@@ -86,6 +89,19 @@ def jitter_reconnects(
 
     client.on_pre_connect = draw_next_wait
     draw_next_wait(client, None)
+
+
+def check_no_plain_text_password(settings: BrokerSettings) -> None:
+    if settings.tls or settings.password is None or settings.on_loopback:
+        return
+    secure = "mqtts" if settings.transport == "tcp" else "wss"
+    raise BrokerConnectionError(
+        "plain-text",
+        f"Refusing to send the password for {settings.username!r} in clear text to "
+        f"{settings.url}, which is not this machine: use {secure}:// (TLS), e.g. the URL "
+        "'feelmysign up --lan' prints, or a join token from 'feelmysign broker add-sleeve'.",
+        url=settings.url,
+    )
 
 
 def connect_client(

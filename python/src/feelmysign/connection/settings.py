@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ipaddress
 from dataclasses import dataclass
 from typing import Literal
 from urllib.parse import urlsplit
@@ -35,6 +36,18 @@ class BrokerSettings:
     username: str | None = None
     password: str | None = None
     sleeve_id: str = DEFAULT_SLEEVE_ID
+    # The CA certificate (PEM) to verify the broker with; None: the system's trusted CAs.
+    ca_file: str | None = None
+
+    @property
+    def on_loopback(self) -> bool:
+        """The broker is on this machine: the only place a password may go in clear text."""
+        if self.host == "localhost":
+            return True
+        try:
+            return ipaddress.ip_address(self.host).is_loopback
+        except ValueError:
+            return False
 
     @property
     def url(self) -> str:

@@ -1,0 +1,56 @@
+"""``feelmysign broker add-sleeve ID``: a sleeve's account on this broker and its join token."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from feelmysign.broker import default_state_dir, load_credentials
+from feelmysign.broker._config import StateFiles
+from feelmysign.broker.accounts import reload_running_broker
+from feelmysign.broker.credentials import check_sleeve_id
+from feelmysign.broker.sleeves import add_sleeve
+from feelmysign.connection.join_token import JoinToken
+from feelmysign.connection.settings import parse_broker_url
+from feelmysign.errors import BrokerError
+
+
+def run_add_sleeve(args: argparse.Namespace) -> int:
+    files = StateFiles(Path(args.state_dir or default_state_dir()).absolute())
+    credentials = load_credentials(files.credentials)
+    sleeve_id = check_sleeve_id(args.new_sleeve_id)
+    url = args.url or credentials.mqtts_url
+    if url is None:
+        raise BrokerError(
+            "bad-option",
+            "This broker has no TLS listener for a sleeve on another machine: start it with "
+            "'feelmysign up --lan' (or 'feelmysign broker --lan') first, or give the URL the "
+            "sleeve reaches it by with --url mqtts://HOST:PORT.",
+        )
+    if not parse_broker_url(url).tls:
+        raise BrokerError(
+            "bad-option", f"--url {url} is not mqtts:// or wss://: a sleeve joins over TLS only."
+        )
+    if sleeve_id == credentials.sleeve_id:
+        account = credentials.sleeve
+    else:
+        account = add_sleeve(files.sleeves, sleeve_id)
+    # A user's own certificate (--tls-cert) is publicly trusted: nothing to pin then.
+    fingerprint = credentials.ca_fingerprint if args.url is None else None
+    pid = reload_running_broker(files, credentials)
+    token = JoinToken(url, sleeve_id, account.username, account.password, fingerprint)
+    print(token.encode(), flush=True)
+    where = (
+        f"the running broker (pid {pid}) has it now"
+        if pid
+        else "the broker has it at its next start"
+    )
+    print(
+        f"Sleeve {sleeve_id}: account {account.username}, {where}. On the sleeve run\n"
+        f"  feelmysign sleeve --join TOKEN\n"
+        "with the line above as TOKEN (it holds a password: keep it like one).",
+        file=sys.stderr,
+        flush=True,
+    )
+    return 0

@@ -1,0 +1,102 @@
+"""Join tokens: one line holding what a sleeve on another machine needs to reach its broker.
+
+``feelmysign broker add-sleeve arm2`` prints one; ``feelmysign sleeve --join TOKEN``
+reads it. The token is ``fms1.`` followed by URL-safe base64 of compact JSON::
+
+    {"url": "mqtts://192.168.1.5:8883", "ca": "<sha-256 of the CA certificate, hex>",
+     "id": "arm2", "user": "sleeve-arm2", "pass": "..."}
+
+``ca`` is absent for a broker whose certificate is publicly trusted. The token holds a
+password: treat it as one (the systemd unit reads it from a file only root can read).
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import json
+import os
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from feelmysign.connection.pinned_ca import pinned_ca_file
+from feelmysign.connection.settings import BrokerSettings, parse_broker_url
+from feelmysign.errors import BrokerConnectionError
+
+TOKEN_PREFIX = "fms1."
+_FINGERPRINT = re.compile(r"[0-9a-f]{64}")
+
+
+@dataclass(frozen=True)
+class JoinToken:
+    url: str
+    sleeve_id: str
+    username: str
+    password: str
+    ca_fingerprint: str | None = None
+
+    def encode(self) -> str:
+        data = {"url": self.url, "id": self.sleeve_id, "user": self.username}
+        data["pass"] = self.password
+        if self.ca_fingerprint:
+            data["ca"] = self.ca_fingerprint
+        raw = json.dumps(data, separators=(",", ":")).encode()
+        return TOKEN_PREFIX + base64.urlsafe_b64encode(raw).decode().rstrip("=")
+
+    def settings(self, *, ca_file: str | None = None) -> BrokerSettings:
+        """Where and how to connect; ``ca_file`` is the pinned CA once fetched and checked."""
+        base = parse_broker_url(
+            self.url, username=self.username, password=self.password, sleeve_id=self.sleeve_id
+        )
+        return replace(base, ca_file=ca_file)
+
+
+def join_settings(text: str, trust_dir: Path) -> BrokerSettings:
+    """Settings from a join token, its CA (if any) fetched, checked and kept in ``trust_dir``."""
+    token = decode_join_token(text)
+    settings = token.settings()
+    if token.ca_fingerprint is None:
+        return settings
+    ca_file = pinned_ca_file(settings, token.ca_fingerprint, trust_dir)
+    return token.settings(ca_file=str(ca_file))
+
+
+def default_trust_dir() -> Path:
+    """``$XDG_STATE_HOME/feelmysign/trusted``: the CAs of joined brokers."""
+    state_home = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
+    return Path(state_home) / "feelmysign" / "trusted"
+
+
+def decode_join_token(text: str) -> JoinToken:
+    """The token in ``text``; BrokerConnectionError ``bad-token`` saying what is wrong."""
+    token = text.strip()
+    if not token.startswith(TOKEN_PREFIX):
+        raise _bad(f"it does not start with {TOKEN_PREFIX!r}")
+    body = token[len(TOKEN_PREFIX) :]
+    try:
+        data = json.loads(base64.urlsafe_b64decode(body + "=" * (-len(body) % 4)))
+    except (binascii.Error, ValueError):
+        raise _bad("it is cut or mistyped (not base64 JSON)") from None
+    if not isinstance(data, dict) or not all(
+        isinstance(data.get(key), str) for key in ("url", "id", "user", "pass")
+    ):
+        raise _bad("it lacks the URL, sleeve id, user name or password")
+    fingerprint = data.get("ca")
+    if fingerprint is not None and (
+        not isinstance(fingerprint, str) or not _FINGERPRINT.fullmatch(fingerprint)
+    ):
+        raise _bad("its CA fingerprint is not 64 hex digits")
+    joined = JoinToken(data["url"], data["id"], data["user"], data["pass"], fingerprint)
+    settings = joined.settings()  # checks the URL
+    if not settings.tls:
+        raise _bad(f"its URL {joined.url} is not mqtts:// or wss://; a sleeve joins over TLS only")
+    return joined
+
+
+def _bad(problem: str) -> BrokerConnectionError:
+    return BrokerConnectionError(
+        "bad-token",
+        f"The join token is not usable: {problem}. Copy the whole line that "
+        "'feelmysign broker add-sleeve ID' printed (it starts with fms1.).",
+    )

@@ -1,0 +1,261 @@
+"""Off loopback with TLS, against real processes: a broker on a LAN address, a sleeve
+joined with a token from another network namespace, the refusals that keep passwords
+and topics private."""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import socket
+import subprocess
+import sys
+import uuid
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import paho.mqtt.client as mqtt
+import pytest
+from lan import Lan, lan
+
+from feelmysign.broker import Broker
+from feelmysign.broker.tls import LanOptions, ensure_local_ca
+from feelmysign.connection import BrokerConnectionError, BrokerSettings, new_client
+from feelmysign.connection.join_token import JoinToken, decode_join_token
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
+
+WAIT_S = 30.0
+
+pytestmark = pytest.mark.broker
+
+
+@pytest.fixture(scope="module")
+def network() -> Iterator[Lan]:
+    with lan() as setup:
+        yield setup
+
+
+@pytest.fixture
+def lan_broker(tmp_path: Path, network: Lan) -> Iterator[Broker]:
+    broker = Broker(
+        state_dir=tmp_path / "state",
+        port=0,
+        ws_port=0,
+        lan=LanOptions(host=network.host_address, port=0),
+    )
+    with broker:
+        yield broker
+
+
+def feelmysign(*args: str, prefix: list[str] | None = None, **kwargs: Any) -> list[str]:
+    return [*(prefix or []), sys.executable, "-m", "feelmysign", *args]
+
+
+def add_sleeve(broker: Broker, sleeve_id: str) -> str:
+    result = subprocess.run(
+        feelmysign("broker", "--state-dir", str(broker.state_dir), "add-sleeve", sleeve_id),
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+        check=True,
+    )
+    return result.stdout.strip()
+
+
+def tls_client(broker: Broker, username: str, password: str) -> mqtt.Client:
+    """A client on the broker's TLS listener, trusting its local CA."""
+    assert broker.lan is not None and broker.tls is not None and broker.tls.ca is not None
+    settings = BrokerSettings(
+        broker.lan.host,
+        broker.lan.port,
+        tls=True,
+        username=username,
+        password=password,
+        ca_file=str(broker.tls.ca),
+    )
+    client = new_client(settings, client_id=f"test-{uuid.uuid4()}")
+    connected: queue.Queue[Any] = queue.Queue()
+    client.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
+    client.connect(settings.host, settings.port)
+    client.loop_start()
+    code = connected.get(timeout=WAIT_S)
+    assert not code.is_failure, code
+    return client
+
+
+def inbox(client: mqtt.Client, topic: str) -> queue.Queue[tuple[str, bytes]]:
+    received: queue.Queue[tuple[str, bytes]] = queue.Queue()
+    client.on_message = lambda _c, _u, message: received.put(
+        (message.topic, bytes(message.payload))
+    )
+    subscribed: queue.Queue[Any] = queue.Queue()
+    client.on_subscribe = lambda _c, _u, _mid, codes, _p: subscribed.put(codes)
+    client.subscribe(topic, qos=1)
+    subscribed.get(timeout=WAIT_S)
+    return received
+
+
+def test_a_sleeve_joined_by_token_plays_strokes_over_tls(
+    lan_broker: Broker, network: Lan, tmp_path: Path
+) -> None:
+    token = add_sleeve(lan_broker, "arm2")
+    assert decode_join_token(token).url == f"mqtts://{network.host_address}:{lan_broker.lan.port}"  # type: ignore[union-attr]
+    env = {**os.environ, "XDG_STATE_HOME": str(tmp_path / "pi-state")}
+    sleeve = subprocess.Popen(
+        feelmysign("sleeve", "--join", token, prefix=network.run_prefix),
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    c = lan_broker.credentials
+    sender = tls_client(lan_broker, c.sender.username, c.sender.password)
+    try:
+        statuses = inbox(sender, telemetry_topic("arm2", "status"))
+        _topic, payload = statuses.get(timeout=WAIT_S)
+        assert json.loads(payload)["online"] is True
+        events = inbox(sender, telemetry_topic("arm2", "events"))
+        for seq in range(3):
+            stroke = Stroke((0.0, 0.0), (1.0, 0.0), 400.0, 0.8, "lan-drawing", seq)
+            sender.publish(strokes_topic("arm2"), format_json(stroke), qos=1).wait_for_publish(5)
+        played = [json.loads(events.get(timeout=WAIT_S)[1]) for _ in range(3)]
+        assert [(e["type"], e["seq"]) for e in played] == [
+            ("played", 0),
+            ("played", 1),
+            ("played", 2),
+        ]
+    finally:
+        sender.loop_stop()
+        sleeve.terminate()
+        output = sleeve.communicate(timeout=WAIT_S)[0]
+    assert f"mqtts://{network.host_address}" in output
+    trusted = list((tmp_path / "pi-state" / "feelmysign" / "trusted").iterdir())
+    assert [p.read_text() for p in trusted] == [lan_broker.tls.ca.read_text()]  # type: ignore[union-attr]
+
+
+def test_a_token_for_another_ca_is_refused_before_any_login(
+    lan_broker: Broker, network: Lan, tmp_path: Path
+) -> None:
+    other_ca = ensure_local_ca(tmp_path / "other-tls", ["example.invalid"])
+    genuine = decode_join_token(add_sleeve(lan_broker, "arm2"))
+    forged = JoinToken(
+        genuine.url, "arm2", genuine.username, genuine.password, other_ca.ca_fingerprint
+    )
+    result = subprocess.run(
+        feelmysign("sleeve", "--join", forged.encode(), prefix=network.run_prefix),
+        env={**os.environ, "XDG_STATE_HOME": str(tmp_path / "pi-state")},
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert "does not show the certificate authority of the join token" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert "sleeve-arm2" not in lan_broker.log_path.read_text()  # no login was attempted
+
+
+def test_a_client_trusting_another_ca_fails_the_handshake(
+    lan_broker: Broker, tmp_path: Path
+) -> None:
+    other_ca = ensure_local_ca(tmp_path / "other-tls", [lan_broker.lan.host])  # type: ignore[union-attr]
+    settings = BrokerSettings(
+        lan_broker.lan.host,  # type: ignore[union-attr]
+        lan_broker.lan.port,  # type: ignore[union-attr]
+        tls=True,
+        username="sender",
+        password=lan_broker.credentials.sender.password,
+        ca_file=str(other_ca.ca),
+    )
+    client = new_client(settings, client_id="wrong-ca")
+    with pytest.raises(ssl_error_types()) as caught:
+        client.connect(settings.host, settings.port)
+    assert "CERTIFICATE_VERIFY_FAILED" in str(caught.value)
+
+
+def ssl_error_types() -> tuple[type[BaseException], ...]:
+    import ssl
+
+    return (ssl.SSLCertVerificationError,)
+
+
+def test_a_plain_text_login_off_loopback_is_refused(lan_broker: Broker, network: Lan) -> None:
+    host, tls_port = lan_broker.lan.host, lan_broker.lan.port  # type: ignore[union-attr]
+    c = lan_broker.credentials
+    # Our clients refuse to send it.
+    result = subprocess.run(
+        feelmysign(
+            "send",
+            "--shape",
+            "line",
+            "--broker",
+            f"mqtt://{host}:{tls_port}",
+            "--username",
+            "sender",
+            "--password",
+            c.sender.password,
+            prefix=network.run_prefix,
+        ),
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    assert result.returncode == 1
+    assert result.stderr.startswith("Error: Refusing to send the password for 'sender' in clear")
+    with pytest.raises(BrokerConnectionError) as refused:
+        new_client(BrokerSettings(host, tls_port, username="sender", password="x"))
+    assert refused.value.reason == "plain-text"
+    # The broker has no clear-text listener off loopback: its loopback ports are closed
+    # there, and its TLS port answers a clear-text CONNECT with no CONNACK.
+    with pytest.raises(ConnectionRefusedError):
+        socket.create_connection((host, c.mqtt_port), timeout=5).close()
+    assert mqtt_connack_in_clear(host, tls_port, "sender", c.sender.password) is None
+
+
+def mqtt_connack_in_clear(host: str, port: int, username: str, password: str) -> bytes | None:
+    """Send an MQTT 3.1.1 CONNECT without TLS; the CONNACK bytes, or None if none came."""
+    payload = b"".join(
+        len(part).to_bytes(2, "big") + part
+        for part in (b"clear-text-probe", username.encode(), password.encode())
+    )
+    variable = b"\x00\x04MQTT\x04\xc2\x00\x3c"
+    body = variable + payload
+    packet = b"\x10" + bytes([len(body)]) + body
+    with socket.create_connection((host, port), timeout=5) as raw:
+        raw.sendall(packet)
+        try:
+            answer = raw.recv(4)
+        except (ConnectionResetError, TimeoutError):
+            return None
+    return answer if answer.startswith(b"\x20") else None
+
+
+def test_a_second_sleeve_s_topics_are_not_readable_with_the_first_s_login(
+    lan_broker: Broker,
+) -> None:
+    second = decode_join_token(add_sleeve(lan_broker, "arm2"))
+    c = lan_broker.credentials
+    first_sleeve = tls_client(lan_broker, c.sleeve.username, c.sleeve.password)
+    second_sleeve = tls_client(lan_broker, second.username, second.password)
+    sender = tls_client(lan_broker, c.sender.username, c.sender.password)
+    try:
+        # One publisher's messages reach a subscriber in order: the first sleeve's own
+        # stroke, sent after the second's, arrives only after anything it could read of it.
+        first_inbox = inbox(first_sleeve, "feelmysign/#")
+        second_inbox = inbox(second_sleeve, strokes_topic("arm2"))
+        private = format_json(Stroke((0.0, 0.0), (1.0, 1.0), 100.0, 0.5, "private", 0))
+        own = format_json(Stroke((1.0, 1.0), (2.0, 1.0), 100.0, 0.5, "own", 0))
+        sender.publish(strokes_topic("arm2"), private, qos=1).wait_for_publish(5)
+        sender.publish(strokes_topic(c.sleeve_id), own, qos=1).wait_for_publish(5)
+        assert second_inbox.get(timeout=WAIT_S) == (strokes_topic("arm2"), private.encode())
+        assert first_inbox.get(timeout=WAIT_S) == (strokes_topic(c.sleeve_id), own.encode())
+        # Nor can the second sleeve write the first one's telemetry (same ordering argument).
+        watcher = inbox(sender, telemetry_topic("+", "status"))
+        second_sleeve.publish(telemetry_topic(c.sleeve_id, "status"), b"forged", qos=1)
+        second_sleeve.publish(telemetry_topic("arm2", "status"), b"genuine", qos=1)
+        assert watcher.get(timeout=WAIT_S) == (telemetry_topic("arm2", "status"), b"genuine")
+    finally:
+        for client in (first_sleeve, second_sleeve, sender):
+            client.loop_stop()
