@@ -188,6 +188,10 @@ export interface BrowserOptions {
   deviceScaleFactor?: number;
   hasTouch?: boolean;
   isMobile?: boolean;
+  /** Another Chromium, e.g. a wrapper that starts it in a network namespace. */
+  executablePath?: string;
+  /** Flags beyond the usual ones, e.g. the one certificate to trust. */
+  extraArgs?: string[];
 }
 
 /** Chromium with a fresh profile; `close` also removes the profile. */
@@ -195,12 +199,13 @@ export async function launchBrowser(
   options: BrowserOptions,
 ): Promise<{ context: BrowserContext; close: () => Promise<void> }> {
   const profile = tempDir("chromium");
+  const { executablePath, extraArgs, ...contextOptions } = options;
   const context = await chromium.launchPersistentContext(profile, {
-    executablePath: CHROMIUM,
+    executablePath: executablePath ?? CHROMIUM,
     headless: true,
-    args: CHROMIUM_ARGS,
+    args: [...CHROMIUM_ARGS, ...(extraArgs ?? [])],
     acceptDownloads: true,
-    ...options,
+    ...contextOptions,
   });
   return {
     context,
