@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import random
 import ssl
+import sys
 import time
 from collections.abc import Callable
 from typing import Any
@@ -20,11 +21,17 @@ from feelmysign.connection.settings import BrokerSettings
 from feelmysign.errors import BrokerConnectionError
 
 DEFAULT_TIMEOUT_S = 10.0  # a broker on the same continent answers in well under a second
+# MQTT 5's CONNACK "Unsupported protocol version": a 3.1.1-only broker (NATS, older ones).
+UNSUPPORTED_PROTOCOL_VERSION = 132
 KEEPALIVE_S = 30  # a dead connection is noticed within 1.5 x this
 # Between reconnection attempts: a few seconds at most, so a sleeve is back soon after its
 # broker, drawn at random each time so that many clients do not return all at once.
 RECONNECT_MIN_S = 0.5
 RECONNECT_MAX_S = 3.0
+
+
+def _to_stderr(text: str) -> None:
+    print(text, file=sys.stderr, flush=True)
 
 
 def new_client(
@@ -66,6 +73,8 @@ def new_client(
     if settings.username is not None:
         client.username_pw_set(settings.username, settings.password)
     jitter_reconnects(client)
+    if settings.fallbacks:
+        _fail_over(client, settings)
     return client
 
 
@@ -91,6 +100,28 @@ def jitter_reconnects(
     draw_next_wait(client, None)
 
 
+def _fail_over(client: mqtt.Client, settings: BrokerSettings) -> None:
+    """Before every (re)connection attempt, move to the next server of the cluster.
+
+    paho calls ``on_pre_connect`` before each attempt, the automatic reconnections of
+    its network thread included, before it opens the socket. Its ``host``/``port``
+    setters refuse while connecting, so the fields they set are written directly
+    (paho 2.x reads them when it opens the socket). The first attempt goes to the
+    first server.
+    """
+    servers = [(settings.host, settings.port), *settings.fallbacks]
+    attempts = [0]
+    before = client.on_pre_connect  # the jittered reconnect wait: kept
+
+    def next_server(client: mqtt.Client, userdata: Any) -> None:
+        if before is not None:
+            before(client, userdata)
+        client._host, client._port = servers[attempts[0] % len(servers)]
+        attempts[0] += 1
+
+    client.on_pre_connect = next_server
+
+
 def check_no_plain_text_password(settings: BrokerSettings) -> None:
     if settings.tls or settings.password is None or settings.on_loopback:
         return
@@ -105,15 +136,53 @@ def check_no_plain_text_password(settings: BrokerSettings) -> None:
 
 
 def connect_client(
-    settings: BrokerSettings, client_id: str, *, timeout_s: float = DEFAULT_TIMEOUT_S
+    settings: BrokerSettings,
+    client_id: str,
+    *,
+    timeout_s: float = DEFAULT_TIMEOUT_S,
+    note: Callable[[str], None] = _to_stderr,
 ) -> mqtt.Client:
-    """An MQTT 5 client (clean start), logged in, its network loop running on a thread.
+    """A client (clean start), logged in, its network loop running on a thread.
 
-    MQTT 5, because only its acknowledgements say when a publish is refused.
-    Returns once the broker accepted the login; BrokerConnectionError saying what
-    to do otherwise. The caller disconnects it and stops its loop.
+    MQTT 5 where the broker offers it, because only its acknowledgements say when a
+    publish is refused; MQTT 3.1.1 otherwise (``note`` says so). With several servers,
+    each is tried in turn. Returns once a broker accepted the login; BrokerConnectionError
+    saying what to do otherwise. The caller disconnects it and stops its loop.
     """
-    client = new_client(settings, client_id=client_id, protocol=mqtt.MQTTv5)
+    failure: BrokerConnectionError | None = None
+    for endpoint in settings.endpoints():
+        try:
+            return _connect_one(endpoint, client_id, timeout_s, note)
+        except BrokerConnectionError as error:
+            if error.reason == "login-refused":
+                raise
+            failure = error
+    assert failure is not None
+    raise failure
+
+
+def _connect_one(
+    settings: BrokerSettings, client_id: str, timeout_s: float, note: Callable[[str], None]
+) -> mqtt.Client:
+    try:
+        return _connect_with(settings, client_id, timeout_s, mqtt.MQTTv5)
+    except BrokerConnectionError as error:
+        if error.reason != "old-protocol":
+            raise
+    note(
+        f"Note: {settings.url} speaks MQTT 3.1.1, not 5: a stroke its access rules refuse "
+        "cannot be reported as refused (MQTT 3.1.1 acknowledges every publish)."
+    )
+    return _connect_with(settings, client_id, timeout_s, mqtt.MQTTv311)
+
+
+def _connect_with(
+    settings: BrokerSettings,
+    client_id: str,
+    timeout_s: float,
+    protocol: MQTTProtocolVersion,
+) -> mqtt.Client:
+    client = new_client(settings, client_id=client_id, protocol=protocol)
     client.connect_timeout = timeout_s
     answers: list[ReasonCode] = []
 
@@ -146,6 +215,8 @@ def connect_client(
     client.on_connect = None
     if answers[0].is_failure:
         client.disconnect()
+        if protocol == mqtt.MQTTv5 and answers[0].value == UNSUPPORTED_PROTOCOL_VERSION:
+            raise BrokerConnectionError("old-protocol", "MQTT 5 is not offered", url=settings.url)
         raise BrokerConnectionError(
             "login-refused", connect_failure_message(settings, answers[0]), url=settings.url
         )

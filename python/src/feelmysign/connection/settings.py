@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import ipaddress
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 from urllib.parse import urlsplit
 
@@ -38,6 +38,17 @@ class BrokerSettings:
     sleeve_id: str = DEFAULT_SLEEVE_ID
     # The CA certificate (PEM) to verify the broker with; None: the system's trusted CAs.
     ca_file: str | None = None
+    # Further servers of the same cluster (host, port), tried in turn when one fails.
+    fallbacks: tuple[tuple[str, int], ...] = ()
+
+    def endpoints(self) -> list[BrokerSettings]:
+        """These settings once per server: the first, then each fallback."""
+        return [self] + [replace(self, host=h, port=p, fallbacks=()) for h, p in self.fallbacks]
+
+    @property
+    def urls(self) -> str:
+        """Every server's URL, comma separated (as --broker takes them)."""
+        return ",".join(endpoint.url for endpoint in self.endpoints())
 
     @property
     def on_loopback(self) -> bool:
@@ -72,7 +83,13 @@ def parse_broker_url(
     password: str | None = None,
     sleeve_id: str = DEFAULT_SLEEVE_ID,
 ) -> BrokerSettings:
-    """Settings for ``url``; BrokerConnectionError ``bad-url`` naming what is wrong with it."""
+    """Settings for ``url``; BrokerConnectionError ``bad-url`` naming what is wrong with it.
+
+    Several URLs separated by commas are the servers of one cluster: the client fails
+    over between them. They must share the scheme (and the path, for WebSockets).
+    """
+    if "," in url:
+        return _parse_cluster(url, username=username, password=password, sleeve_id=sleeve_id)
     text = url.strip()
     if "://" not in text:
         return _bad_url(url, "has no scheme", f"write it as mqtt://{text or '127.0.0.1:1883'}")
@@ -118,6 +135,26 @@ def parse_broker_url(
         password=password,
         sleeve_id=sleeve_id,
     )
+
+
+def _parse_cluster(
+    urls: str, *, username: str | None, password: str | None, sleeve_id: str
+) -> BrokerSettings:
+    parts = [
+        parse_broker_url(u, username=username, password=password, sleeve_id=sleeve_id)
+        for u in urls.split(",")
+        if u.strip()
+    ]
+    first = parts[0]
+    for other in parts[1:]:
+        if (other.transport, other.tls, other.path) != (first.transport, first.tls, first.path):
+            _bad_url(
+                urls,
+                "mixes schemes or paths",
+                "the servers of one cluster are reached the same way, e.g. "
+                "mqtt://a:1883,mqtt://b:1883",
+            )
+    return replace(first, fallbacks=tuple((p.host, p.port) for p in parts[1:]))
 
 
 def _scheme_hint(scheme: str) -> str:
