@@ -131,3 +131,25 @@ bench: web-bench
 up: web-build
 clean: web-clean
 # ==== end of web ===========================================================================
+
+# ==== NATS: the pinned nats-server of the cluster tests and the load benchmark ============
+# Built from source through the Go module proxy into .cache/ (ignored by git), once per
+# checkout: GOPATH, the module cache and the build cache stay inside the repository.
+NATS_VERSION := v2.15.2
+GO_DIR := $(CURDIR)/.cache/go
+NATS_BIN := .cache/go-bin/nats-server
+NATS_STAMP := .cache/go-bin/.nats-server-$(NATS_VERSION)
+
+.PHONY: nats
+nats: $(NATS_STAMP)
+
+$(NATS_STAMP):
+	@command -v go >/dev/null || { echo "Error: go not found; install Go (e.g. 'sudo apt-get install golang'), then run make again." >&2; exit 1; }
+	GOPATH=$(GO_DIR) GOMODCACHE=$(GO_DIR)/mod GOCACHE=$(GO_DIR)/build GOFLAGS=-modcacherw \
+	  GOBIN=$(CURDIR)/.cache/go-bin go install github.com/nats-io/nats-server/v2@$(NATS_VERSION)
+	touch $@
+
+pytest: $(NATS_STAMP)
+web-browser-test: $(NATS_STAMP)
+bench: $(NATS_STAMP)
+# ==== end of NATS =========================================================================

@@ -38,7 +38,7 @@ import threading
 import time
 from collections import Counter, OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -216,7 +216,7 @@ class Sleeve:
             self._client.loop_start()
             # Our own handle on paho's network thread: see _stop_network.
             self._network = self._client._thread
-            log.info("sleeve %s: connecting to %s", self._id, self._settings.url)
+            log.info("sleeve %s: connecting to %s", self._id, self._settings.urls)
             self._stopped.wait()
             if self._fatal is not None:
                 raise self._fatal
@@ -321,7 +321,9 @@ class Sleeve:
         self._count("connections")  # `up` tells the terminal when the sleeve is back
         self._connected.set()
         session = "resumed" if getattr(flags, "session_present", False) else "new"
-        log.info("sleeve %s: connected to %s (%s session)", self._id, self._settings.url, session)
+        # With several servers, the one reached (failover moves it between attempts).
+        server = replace(self._settings, host=client.host, port=client.port, fallbacks=())
+        log.info("sleeve %s: connected to %s (%s session)", self._id, server.url, session)
 
     def _on_connect_fail(self, client: mqtt.Client, userdata: Any) -> None:
         log.warning(

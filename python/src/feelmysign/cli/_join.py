@@ -1,4 +1,5 @@
-"""``feelmysign broker add-sleeve ID``: a sleeve's account on this broker and its join token."""
+"""``feelmysign broker add-sleeve ID`` (a sleeve's account and its join token) and
+``feelmysign broker nats-accounts`` (the same accounts for a NATS cluster)."""
 
 from __future__ import annotations
 
@@ -10,10 +11,12 @@ from feelmysign.broker import default_state_dir, load_credentials
 from feelmysign.broker._config import StateFiles
 from feelmysign.broker.accounts import reload_running_broker
 from feelmysign.broker.credentials import check_sleeve_id
-from feelmysign.broker.sleeves import add_sleeve
+from feelmysign.broker.nats_accounts import render_nats_accounts
+from feelmysign.broker.sleeves import add_sleeve, load_sleeves
 from feelmysign.connection.join_token import JoinToken
 from feelmysign.connection.settings import parse_broker_url
 from feelmysign.errors import BrokerError
+from feelmysign.topics import LEGACY_TOPIC
 
 
 def run_add_sleeve(args: argparse.Namespace) -> int:
@@ -53,4 +56,12 @@ def run_add_sleeve(args: argparse.Namespace) -> int:
         file=sys.stderr,
         flush=True,
     )
+    return 0
+
+
+def run_nats_accounts(args: argparse.Namespace) -> int:
+    files = StateFiles(Path(args.state_dir or default_state_dir()).absolute())
+    credentials = load_credentials(files.credentials)
+    others = {i: a for i, a in load_sleeves(files.sleeves).items() if i != credentials.sleeve_id}
+    print(render_nats_accounts(credentials, others, legacy_topic=LEGACY_TOPIC), end="")
     return 0

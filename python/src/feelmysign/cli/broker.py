@@ -23,7 +23,7 @@ from feelmysign.broker import (
     Broker,
     default_state_dir,
 )
-from feelmysign.cli._join import run_add_sleeve
+from feelmysign.cli._join import run_add_sleeve, run_nats_accounts
 from feelmysign.cli._lan_options import add_lan_options, lan_from_args
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -92,6 +92,15 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
     )
     add.set_defaults(handler=run_add_sleeve)
+    nats = commands.add_parser(
+        "nats-accounts",
+        help="print the accounts.conf of a NATS cluster with this broker's accounts and ACL",
+        description=(
+            "Print, for deploy/nats/node.conf to include, the NATS accounts of this broker's "
+            "sleeves and sender with permissions mirroring its ACL (it holds passwords)."
+        ),
+    )
+    nats.set_defaults(handler=run_nats_accounts)
 
 
 def _port(text: str) -> int:

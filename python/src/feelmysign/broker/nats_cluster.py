@@ -1,0 +1,255 @@
+"""A 3-node NATS cluster on loopback, from ``deploy/nats/node.conf``, for tests and benchmarks.
+
+::
+
+    with NatsCluster(state_dir, credentials) as cluster:
+        cluster.nodes[0].mqtt_url      # "mqtt://127.0.0.1:40123"
+        cluster.mqtt_urls              # all three, comma separated, for failover
+        cluster.kill(0)                # SIGKILL node a
+
+Every node runs the same ``node.conf`` (copied into the state directory next to the
+``accounts.conf`` rendered from ``credentials``), its ports and routes given through
+the environment, as in production. ``python -m feelmysign.broker.nats_cluster DIR``
+runs one until Ctrl-C and prints its URLs and accounts as JSON (the browser tests use it).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+from types import TracebackType
+
+import paho.mqtt.client as mqtt
+from paho.mqtt.enums import CallbackAPIVersion
+
+from feelmysign.broker import _process as process_
+from feelmysign.broker.credentials import (
+    Account,
+    Credentials,
+    load_credentials,
+    reuse_or_create,
+    write_credentials,
+    write_private_file,
+)
+from feelmysign.broker.nats_accounts import render_nats_accounts
+from feelmysign.errors import BrokerError
+from feelmysign.topics import LEGACY_TOPIC
+
+REPO = Path(__file__).resolve().parents[4]
+NODE_CONF = REPO / "deploy" / "nats" / "node.conf"
+NATS_SERVER_ENV = "FEELMYSIGN_NATS_SERVER"
+DEFAULT_NATS_SERVER = REPO / ".cache" / "go-bin" / "nats-server"
+NODE_NAMES = ("a", "b", "c")
+# JetStream elects its meta leader and creates the MQTT streams (R3) after the routes are up.
+READY_TIMEOUT_S = 60.0
+READY_POLL_S = 0.2
+STOP_TIMEOUT_S = 10.0
+
+
+@dataclass(frozen=True)
+class NatsNode:
+    name: str
+    client_port: int
+    cluster_port: int
+    mqtt_port: int
+    ws_port: int
+
+    @property
+    def mqtt_url(self) -> str:
+        return f"mqtt://127.0.0.1:{self.mqtt_port}"
+
+    @property
+    def ws_url(self) -> str:
+        return f"ws://127.0.0.1:{self.ws_port}/mqtt"
+
+
+def nats_server_path() -> Path:
+    """The pinned nats-server that ``make nats`` builds; BrokerError saying how if missing."""
+    path = Path(os.environ.get(NATS_SERVER_ENV) or DEFAULT_NATS_SERVER)
+    if not path.is_file():
+        raise BrokerError(
+            "nats-missing",
+            f"nats-server was not found at {path}: run 'make nats' in the repository (it "
+            f"builds nats-server v2.15.2 with go), or set ${NATS_SERVER_ENV}.",
+        )
+    return path
+
+
+class NatsCluster:
+    """Three nats-server processes on 127.0.0.1 with JetStream, MQTT and MQTT over WebSockets."""
+
+    def __init__(
+        self,
+        state_dir: Path,
+        credentials: Credentials,
+        *,
+        other_sleeves: dict[str, Account] | None = None,
+    ) -> None:
+        self.state_dir = state_dir
+        self.credentials = credentials
+        self._others = other_sleeves or {}
+        self.nodes: list[NatsNode] = []
+        self._processes: list[subprocess.Popen[bytes] | None] = []
+
+    @property
+    def mqtt_urls(self) -> str:
+        return ",".join(node.mqtt_url for node in self.nodes)
+
+    def __enter__(self) -> NatsCluster:
+        self.start()
+        return self
+
+    def __exit__(
+        self,
+        _type: type[BaseException] | None,
+        _value: BaseException | None,
+        _traceback: TracebackType | None,
+    ) -> None:
+        self.stop()
+
+    def start(self) -> None:
+        executable = nats_server_path()
+        self.state_dir.mkdir(mode=0o700, parents=True, exist_ok=True)
+        shutil.copyfile(NODE_CONF, self.state_dir / "node.conf")
+        accounts = render_nats_accounts(self.credentials, self._others, legacy_topic=LEGACY_TOPIC)
+        write_private_file(self.state_dir / "accounts.conf", accounts)
+        self.nodes = [
+            NatsNode(name, *(process_.free_port("127.0.0.1") for _ in range(4)))
+            for name in NODE_NAMES
+        ]
+        try:
+            self._processes = [self._spawn(executable, node) for node in self.nodes]
+            for index in range(len(self.nodes)):
+                self._wait_ready(index)
+        except BaseException:
+            self.stop()
+            raise
+
+    def _spawn(self, executable: Path, node: NatsNode) -> subprocess.Popen[bytes]:
+        others = [n for n in self.nodes if n is not node]
+        env = {
+            **os.environ,
+            "NODE_NAME": node.name,
+            "BIND_HOST": "127.0.0.1",
+            "CLIENT_PORT": str(node.client_port),
+            "CLUSTER_PORT": str(node.cluster_port),
+            "MQTT_PORT": str(node.mqtt_port),
+            "WS_PORT": str(node.ws_port),
+            "STORE_DIR": str(self.state_dir / f"store-{node.name}"),
+            "ROUTE_1": f"nats-route://127.0.0.1:{others[0].cluster_port}",
+            "ROUTE_2": f"nats-route://127.0.0.1:{others[1].cluster_port}",
+        }
+        log = (self.state_dir / f"{node.name}.log").open("ab")
+        with log:
+            return subprocess.Popen(
+                [str(executable), "-c", str(self.state_dir / "node.conf")],
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=log,
+                start_new_session=True,
+                # Killed with us: a test that dies must not leave a cluster behind.
+                preexec_fn=process_._parent_death_signal(os.getpid()),
+            )
+
+    def _wait_ready(self, index: int) -> None:
+        """Until node ``index`` accepts an MQTT login (possible only once JetStream is up)."""
+        node, sender = self.nodes[index], self.credentials.sender
+        deadline = time.monotonic() + READY_TIMEOUT_S
+        while time.monotonic() < deadline:
+            process = self._processes[index]
+            if process is not None and process.poll() is not None:
+                raise BrokerError(
+                    "start-failed", f"nats-server {node.name} exited: {self.log(index)}"
+                )
+            if _accepts_mqtt_login(node.mqtt_port, sender):
+                return
+            time.sleep(READY_POLL_S)
+        raise BrokerError(
+            "start-failed",
+            f"nats-server {node.name} did not accept MQTT logins within {READY_TIMEOUT_S:g} s: "
+            f"{self.log(index)}",
+        )
+
+    def log(self, index: int) -> str:
+        path = self.state_dir / f"{self.nodes[index].name}.log"
+        return process_.log_tail(path)
+
+    def kill(self, index: int) -> None:
+        """SIGKILL node ``index``: a crash, not a shutdown."""
+        process = self._processes[index]
+        if process is not None:
+            process.kill()
+            process.wait()
+            self._processes[index] = None
+
+    def stop(self) -> None:
+        for index, process in enumerate(self._processes):
+            if process is not None:
+                process.send_signal(signal.SIGTERM)
+                try:
+                    process.wait(timeout=STOP_TIMEOUT_S)
+                except subprocess.TimeoutExpired:
+                    process.kill()
+                    process.wait()
+                self._processes[index] = None
+
+
+def _accepts_mqtt_login(port: int, account: Account) -> bool:
+    connacks: list[bool] = []
+    client = mqtt.Client(
+        CallbackAPIVersion.VERSION2, client_id=f"ready-{os.getpid()}", protocol=mqtt.MQTTv311
+    )
+    client.username_pw_set(account.username, account.password)
+    client.on_connect = lambda _c, _u, _f, code, _p: connacks.append(not code.is_failure)
+    try:
+        client.connect("127.0.0.1", port, keepalive=10)
+    except OSError:
+        return False
+    deadline = time.monotonic() + 2.0
+    while not connacks and time.monotonic() < deadline:
+        if client.loop(timeout=0.1) != mqtt.MQTT_ERR_SUCCESS:
+            break
+    client.disconnect()
+    return bool(connacks and connacks[0])
+
+
+def main(argv: list[str]) -> int:
+    """Run a cluster in DIR until SIGINT/SIGTERM; print its URLs and accounts as one JSON line."""
+    state_dir = Path(argv[0] if argv else "nats-cluster").absolute()
+    state_dir.mkdir(parents=True, exist_ok=True)
+    path = state_dir / "credentials.json"
+    credentials = (
+        load_credentials(path)
+        if path.exists()
+        else reuse_or_create(path, sleeve_id="sleeve1", mqtt_url="mqtt://unused", ws_url="ws://x")
+    )
+    write_credentials(path, credentials)
+    stop: list[int] = []
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda number, _frame: stop.append(number))
+    with NatsCluster(state_dir, credentials) as cluster:
+        first, last = cluster.nodes[0], cluster.nodes[-1]
+        credentials = replace(credentials, mqtt_url=first.mqtt_url, ws_url=last.ws_url)
+        info = {
+            "nodes": [
+                {"name": n.name, "mqtt_url": n.mqtt_url, "ws_url": n.ws_url} for n in cluster.nodes
+            ],
+            "credentials": credentials.to_json(),
+        }
+        print(json.dumps(info), flush=True)
+        print("Ready.", flush=True)
+        while not stop:
+            time.sleep(0.1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

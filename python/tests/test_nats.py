@@ -1,0 +1,207 @@
+"""feelmysign on a real 3-node NATS cluster (JetStream, MQTT listeners, deploy/nats/node.conf):
+the sleeve, the CLI sender and the ACL mirrored as NATS permissions, and a node killed
+while a drawing is sent."""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import subprocess
+import sys
+import threading
+import time
+import uuid
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import paho.mqtt.client as mqtt
+import pytest
+
+from feelmysign.broker.credentials import Account, reuse_or_create
+from feelmysign.broker.nats_cluster import NatsCluster
+from feelmysign.connection import BrokerSettings, new_client, parse_broker_url
+from feelmysign.topics import strokes_topic, telemetry_topic
+
+WAIT_S = 60.0
+SLEEVE = "sleeve1"
+OTHER = Account("sleeve-arm2", "arm2-password-0123456789")
+
+pytestmark = pytest.mark.broker
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[NatsCluster]:
+    state = tmp_path_factory.mktemp("nats")
+    credentials = reuse_or_create(
+        state / "credentials.json", sleeve_id=SLEEVE, mqtt_url="mqtt://x:1", ws_url="ws://x:2"
+    )
+    with NatsCluster(state, credentials, other_sleeves={"arm2": OTHER}) as running:
+        yield running
+
+
+def client(url: str, account: Account, *, client_id: str | None = None) -> mqtt.Client:
+    settings = parse_broker_url(url, username=account.username, password=account.password)
+    paho = new_client(settings, client_id=client_id or f"test-{uuid.uuid4()}")
+    connected: queue.Queue[Any] = queue.Queue()
+    paho.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
+    paho.connect(settings.host, settings.port)
+    paho.loop_start()
+    code = connected.get(timeout=WAIT_S)
+    assert not code.is_failure, code
+    return paho
+
+
+def subscribe(paho: mqtt.Client, topic: str) -> queue.Queue[tuple[str, bytes]]:
+    received: queue.Queue[tuple[str, bytes]] = queue.Queue()
+    paho.on_message = lambda _c, _u, m: received.put((m.topic, bytes(m.payload)))
+    done: queue.Queue[Any] = queue.Queue()
+    paho.on_subscribe = lambda _c, _u, _mid, codes, _p: done.put(codes)
+    paho.subscribe(topic, qos=1)
+    done.get(timeout=WAIT_S)
+    return received
+
+
+def subscribe_all(
+    paho: mqtt.Client, topics: list[str]
+) -> tuple[queue.Queue[tuple[str, bytes]], list[Any]]:
+    received: queue.Queue[tuple[str, bytes]] = queue.Queue()
+    paho.on_message = lambda _c, _u, m: received.put((m.topic, bytes(m.payload)))
+    done: queue.Queue[Any] = queue.Queue()
+    paho.on_subscribe = lambda _c, _u, _mid, codes, _p: done.put(codes)
+    paho.subscribe([(topic, 1) for topic in topics])
+    return received, list(done.get(timeout=WAIT_S))
+
+
+def feelmysign(*args: str) -> list[str]:
+    return [sys.executable, "-m", "feelmysign", *args]
+
+
+def test_the_acl_holds_on_nats_a_sleeve_reads_only_its_own_strokes(cluster: NatsCluster) -> None:
+    a, b = cluster.nodes[0].mqtt_url, cluster.nodes[1].mqtt_url
+    c = cluster.credentials
+    first = client(a, c.sleeve)
+    second = client(b, OTHER)
+    sender = client(b, c.sender)
+    try:
+        # NATS refuses the subscription outright (SUBACK 0x80), where Mosquitto grants it
+        # and filters what it delivers; either way nothing of arm2's may arrive.
+        spy, codes = subscribe_all(first, [strokes_topic("arm2"), strokes_topic(SLEEVE)])
+        assert [code.is_failure for code in codes] == [True, False]
+        own = subscribe(second, strokes_topic("arm2"))
+        sender.publish(strokes_topic("arm2"), b"private", qos=1).wait_for_publish(10)
+        sender.publish(strokes_topic(SLEEVE), b"own", qos=1).wait_for_publish(10)
+        assert own.get(timeout=WAIT_S) == (strokes_topic("arm2"), b"private")
+        # Ordered per publisher: "own" comes after anything the spy could have read.
+        assert spy.get(timeout=WAIT_S) == (strokes_topic(SLEEVE), b"own")
+        assert spy.empty()
+    finally:
+        for paho in (first, second, sender):
+            paho.loop_stop()
+
+
+class Events:
+    """The sleeve's events as the sender sees them, on a node that stays up."""
+
+    def __init__(self, url: str, account: Account) -> None:
+        self.played: dict[tuple[str, int], set[str]] = {}
+        self._lock = threading.Condition()
+        self.client = client(url, account)
+        self.client.on_message = self._on_message
+        self.client.subscribe(telemetry_topic(SLEEVE, "events"), qos=1)
+
+    def _on_message(self, _c: Any, _u: Any, message: mqtt.MQTTMessage) -> None:
+        event = json.loads(message.payload)
+        if event.get("type") in ("played", "adjusted"):
+            key = (event["drawing"], event["seq"])
+            with self._lock:
+                # A QoS 1 event sent again after a failover is the same bytes; a stroke
+                # played twice would be two events with different timestamps.
+                self.played.setdefault(key, set()).add(message.payload.decode())
+                self._lock.notify_all()
+
+    def wait_for(self, count: int) -> dict[tuple[str, int], set[str]]:
+        with self._lock:
+            self._lock.wait_for(lambda: len(self.played) >= count, WAIT_S)
+            return dict(self.played)
+
+
+def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
+    cluster: NatsCluster, tmp_path: Path
+) -> None:
+    c = cluster.credentials
+    env = {**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password}
+    # The sleeve is given node a first; b and c to fail over to.
+    sleeve = subprocess.Popen(
+        feelmysign(
+            *("sleeve", "--broker", cluster.mqtt_urls, "--id", SLEEVE),
+            *("--username", c.sleeve.username),
+        ),
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    events = Events(cluster.nodes[1].mqtt_url, c.sender)
+    try:
+        _wait_online(cluster, c.sender)
+        # A drawing of 12 strokes sent from node b at a hand's pace (about 6 s); node a,
+        # the sleeve's, is killed while it is being sent.
+        send = subprocess.Popen(
+            feelmysign(
+                *("send", "--broker", cluster.nodes[1].mqtt_url, "--id", SLEEVE),
+                *("--username", c.sender.username, "--shape", "circle", "--segments", "12"),
+            ),
+            env={**os.environ, "FEELMYSIGN_PASSWORD": c.sender.password},
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        events.wait_for(2)
+        cluster.kill(0)
+        out = send.communicate(timeout=WAIT_S)[0]
+        assert send.returncode == 0, out
+        drawing = _drawing_of(out)
+        played = events.wait_for(12)
+        keys = sorted(seq for (d, seq) in played if d == drawing)
+        assert keys == list(range(12)), f"played {keys} of 0..11"
+        assert all(len(payloads) == 1 for payloads in played.values()), "a stroke played twice"
+    finally:
+        events.client.loop_stop()
+        sleeve.terminate()
+        sleeve_out = sleeve.communicate(timeout=WAIT_S)[0]
+    assert f"connected to mqtt://127.0.0.1:{cluster.nodes[0].mqtt_port}" in sleeve_out
+    moved = [f"connected to {n.mqtt_url}" in sleeve_out for n in cluster.nodes[1:]]
+    assert any(moved), sleeve_out
+
+
+def _wait_online(cluster: NatsCluster, sender: Account) -> None:
+    watcher = client(cluster.nodes[1].mqtt_url, sender)
+    try:
+        statuses = subscribe(watcher, telemetry_topic(SLEEVE, "status"))
+        deadline = time.monotonic() + WAIT_S
+        while time.monotonic() < deadline:
+            _topic, payload = statuses.get(timeout=WAIT_S)
+            if json.loads(payload).get("online"):
+                return
+        raise AssertionError("the sleeve never came online")
+    finally:
+        watcher.loop_stop()
+
+
+def _drawing_of(output: str) -> str:
+    for line in output.splitlines():
+        if '"drawing":"' in line:
+            return line.split('"drawing":"')[1].split('"')[0]
+    raise AssertionError(f"no drawing id in: {output}")
+
+
+def test_settings_take_several_urls_of_one_cluster() -> None:
+    settings = parse_broker_url("mqtt://a:1883,mqtt://b:1884, mqtt://c:1885")
+    assert [e.url for e in settings.endpoints()] == [
+        "mqtt://a:1883",
+        "mqtt://b:1884",
+        "mqtt://c:1885",
+    ]
+    assert isinstance(settings, BrokerSettings) and settings.urls.count(",") == 2
