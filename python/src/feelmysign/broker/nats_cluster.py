@@ -222,7 +222,10 @@ def _accepts_mqtt_login(port: int, account: Account) -> bool:
 
 
 def main(argv: list[str]) -> int:
-    """Run a cluster in DIR until SIGINT/SIGTERM; print its URLs and accounts as one JSON line."""
+    """Run a cluster in DIR until SIGINT/SIGTERM; print its URLs and accounts as one JSON line.
+
+    SIGUSR1 kills node a.
+    """
     state_dir = Path(argv[0] if argv else "nats-cluster").absolute()
     state_dir.mkdir(parents=True, exist_ok=True)
     path = state_dir / "credentials.json"
@@ -233,8 +236,11 @@ def main(argv: list[str]) -> int:
     )
     write_credentials(path, credentials)
     stop: list[int] = []
+    kills: list[int] = []
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda number, _frame: stop.append(number))
+    # SIGUSR1 kills node a (SIGKILL), as a crash would: the failover tests' trigger.
+    signal.signal(signal.SIGUSR1, lambda number, _frame: kills.append(number))
     with NatsCluster(state_dir, credentials) as cluster:
         first, last = cluster.nodes[0], cluster.nodes[-1]
         credentials = replace(credentials, mqtt_url=first.mqtt_url, ws_url=last.ws_url)
@@ -247,6 +253,10 @@ def main(argv: list[str]) -> int:
         print(json.dumps(info), flush=True)
         print("Ready.", flush=True)
         while not stop:
+            if kills:
+                kills.clear()
+                cluster.kill(0)
+                print("Killed a.", flush=True)
             time.sleep(0.1)
     return 0
 

@@ -1,0 +1,205 @@
+/**
+ * feelmysign on a real 3-node NATS cluster (deploy/nats/node.conf, JetStream and its
+ * MQTT listeners): the sleeve on node a (failing over to b and c), the CLI sender on
+ * b, and the page in Chromium on c's MQTT-over-WebSocket listener. Node a is killed
+ * while the CLI's drawing plays: the sleeve moves to another node, and every stroke of
+ * both drawings is played, none twice.
+ */
+import { spawn, type ChildProcess } from "node:child_process";
+import { rmSync } from "node:fs";
+import { join } from "node:path";
+import mqtt, { type MqttClient } from "mqtt";
+import type { Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import {
+  checkPrerequisites,
+  FEELMYSIGN,
+  launchBrowser,
+  REPO_DIR,
+  serveDist,
+  SLEEVE_ID,
+  tempDir,
+  type Credentials,
+} from "./harness";
+import { drawingArea, drawWithMouse, screenshot, waitForData } from "./page";
+
+const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
+const READY_TIMEOUT_MS = 90_000;
+
+interface Cluster {
+  nodes: { name: string; mqtt_url: string; ws_url: string }[];
+  credentials: Credentials;
+}
+
+function output(child: ChildProcess): { text: () => string; until: (pattern: RegExp) => Promise<string> } {
+  let text = "";
+  const waiters: (() => void)[] = [];
+  const collect = (chunk: Buffer) => {
+    text += chunk.toString();
+    for (const wake of waiters.splice(0)) wake();
+  };
+  child.stdout?.on("data", collect);
+  child.stderr?.on("data", collect);
+  return {
+    text: () => text,
+    until: async (pattern) => {
+      const deadline = Date.now() + READY_TIMEOUT_MS;
+      while (!pattern.test(text)) {
+        if (Date.now() > deadline) throw new Error(`nothing matched ${pattern}:\n${text}`);
+        if (child.exitCode !== null) throw new Error(`exited with ${child.exitCode}:\n${text}`);
+        await new Promise<void>((wake) => {
+          waiters.push(wake);
+          setTimeout(wake, 500);
+        });
+      }
+      return text;
+    },
+  };
+}
+
+async function stop(child: ChildProcess): Promise<void> {
+  if (child.exitCode !== null || child.signalCode !== null) return;
+  const exited = new Promise((done) => child.once("exit", done));
+  child.kill("SIGINT");
+  const timer = setTimeout(() => child.kill("SIGKILL"), 15_000);
+  await exited;
+  clearTimeout(timer);
+}
+
+/** The sleeve's played strokes by drawing and seq; a QoS 1 repeat is the same payload. */
+class PlayedEvents {
+  readonly byKey = new Map<string, Set<string>>();
+  constructor(readonly client: MqttClient) {
+    client.on("message", (_topic, payload) => {
+      const text = payload.toString("utf8");
+      const event = JSON.parse(text) as { type: string; drawing: string; seq: number };
+      if (event.type !== "played" && event.type !== "adjusted") return;
+      const key = `${event.drawing}/${event.seq}`;
+      this.byKey.set(key, (this.byKey.get(key) ?? new Set()).add(text));
+    });
+  }
+  count(drawing: string): number {
+    return [...this.byKey.keys()].filter((key) => key.startsWith(`${drawing}/`)).length;
+  }
+  async waitFor(drawing: string, count: number, timeoutMs = 60_000): Promise<void> {
+    const deadline = Date.now() + timeoutMs;
+    while (this.count(drawing) < count) {
+      if (Date.now() > deadline) throw new Error(`${this.count(drawing)} of ${count} played for ${drawing}`);
+      await new Promise((wake) => setTimeout(wake, 100));
+    }
+  }
+}
+
+describe("on a 3-node NATS cluster: sleeve on a, CLI on b, page on c; a dies", () => {
+  const cleanups: (() => Promise<void> | void)[] = [];
+  let cluster: Cluster;
+  let runner: ChildProcess;
+  let runnerOut: ReturnType<typeof output>;
+  let sleeveOut: ReturnType<typeof output>;
+  let events: PlayedEvents;
+  let page: Page;
+
+  beforeAll(async () => {
+    checkPrerequisites();
+    const dir = tempDir("nats");
+    cleanups.push(() => rmSync(dir, { recursive: true, force: true }));
+    runner = spawn(PYTHON, ["-m", "feelmysign.broker.nats_cluster", dir], {
+      stdio: ["ignore", "pipe", "pipe"],
+    });
+    cleanups.push(() => stop(runner));
+    runnerOut = output(runner);
+    const text = await runnerOut.until(/^Ready\./m);
+    cluster = JSON.parse(text.split("\n").find((line) => line.startsWith("{"))!) as Cluster;
+    const [a, b, c] = cluster.nodes;
+    const sleeve = spawn(
+      FEELMYSIGN,
+      ["sleeve", "--broker", cluster.nodes.map((n) => n.mqtt_url).join(","), "--id", SLEEVE_ID].concat([
+        "--username",
+        cluster.credentials.sleeve.username,
+      ]),
+      {
+        stdio: ["ignore", "pipe", "pipe"],
+        env: { ...process.env, FEELMYSIGN_PASSWORD: cluster.credentials.sleeve.password },
+      },
+    );
+    cleanups.push(() => stop(sleeve));
+    sleeveOut = output(sleeve);
+    await sleeveOut.until(new RegExp(`connected to ${a!.mqtt_url}`));
+    const watcher = await mqtt.connectAsync(b!.mqtt_url, {
+      username: cluster.credentials.sender.username,
+      password: cluster.credentials.sender.password,
+      protocolVersion: 4,
+    });
+    cleanups.push(() => watcher.endAsync(true));
+    events = new PlayedEvents(watcher);
+    await watcher.subscribeAsync(`feelmysign/${SLEEVE_ID}/events`, { qos: 1 });
+    const server = await serveDist({
+      ws_url: c!.ws_url,
+      sleeve_id: SLEEVE_ID,
+      username: cluster.credentials.sender.username,
+      password: cluster.credentials.sender.password,
+    });
+    cleanups.push(server.stop);
+    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 } });
+    cleanups.push(browser.close);
+    page = await browser.context.newPage();
+    await page.goto(server.url);
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected", 30_000);
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online", 30_000);
+  });
+
+  afterAll(async () => {
+    for (const cleanup of cleanups.reverse()) await cleanup();
+  });
+
+  it("plays the CLI's drawing and the page's, every stroke once, after node a is killed mid-drawing", async () => {
+    const b = cluster.nodes[1]!;
+    const send = spawn(
+      FEELMYSIGN,
+      [
+        "send",
+        "--broker",
+        b.mqtt_url,
+        "--id",
+        SLEEVE_ID,
+        "--username",
+        cluster.credentials.sender.username,
+      ].concat(["--shape", "circle", "--segments", "10", "--json"]),
+      {
+        stdio: ["ignore", "pipe", "pipe"],
+        env: { ...process.env, FEELMYSIGN_PASSWORD: cluster.credentials.sender.password },
+      },
+    );
+    const sendOut = output(send);
+    const first = await sendOut.until(/drawing[\\":]+([0-9a-f-]{36})/);
+    const drawing = /drawing[\\":]+([0-9a-f-]{36})/.exec(first)![1]!;
+    await events.waitFor(drawing, 1);
+    runner.kill("SIGUSR1"); // node a, the sleeve's, crashes
+    await runnerOut.until(/Killed a\./);
+    const exit = await new Promise<number | null>((done) => send.once("exit", done));
+    expect(exit, sendOut.text()).toBe(0);
+    await events.waitFor(drawing, 10);
+
+    const area = await drawingArea(page);
+    const side = area.height * 0.6;
+    const left = area.left + (area.width - side) / 2;
+    const top = area.top + (area.height - side) / 2;
+    const corners = [
+      [left, top],
+      [left + side, top],
+      [left + side, top + side],
+      [left, top + side],
+    ] as const;
+    await drawWithMouse(page, [...corners, corners[0]]);
+    await waitForData(page, '[data-testid="played-summary"]', "played", "4", 60_000);
+    await screenshot(page, "nats-failover");
+
+    expect(events.count(drawing)).toBe(10);
+    for (const [key, payloads] of events.byKey) expect(payloads.size, `${key} played twice`).toBe(1);
+    expect(events.byKey.size).toBe(14);
+    const moved = cluster.nodes
+      .slice(1)
+      .some((node) => sleeveOut.text().includes(`connected to ${node.mqtt_url}`));
+    expect(moved, sleeveOut.text()).toBe(true);
+  });
+});
