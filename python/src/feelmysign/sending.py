@@ -44,9 +44,12 @@ class OutgoingStroke:
 
 
 class _Acks:
-    """PUBACKs by message id, from paho's thread; waiting ends early if the connection drops.
+    """PUBACKs by message id, from paho's thread.
 
     An acknowledgement may arrive before ``publish`` has returned its id, hence a dict.
+    A dropped connection does not end the wait: paho's network thread reconnects (to the
+    next server, given several) and sends the unacknowledged stroke again, and the sleeve
+    drops a repeat by its drawing and seq. Only the timeout ends it, naming the drop.
     """
 
     def __init__(self) -> None:
@@ -69,14 +72,12 @@ class _Acks:
             self._condition.notify_all()
 
     def wait(self, mid: int, timeout_s: float) -> ReasonCode | str:
-        """The PUBACK's reason code, or why none will come ('timeout' or the disconnect)."""
+        """The PUBACK's reason code, or why none came: 'timeout', or the last disconnect."""
         with self._condition:
-            arrived = self._condition.wait_for(
-                lambda: mid in self._codes or self._lost is not None, max(timeout_s, 0.0)
-            )
+            self._condition.wait_for(lambda: mid in self._codes, max(timeout_s, 0.0))
             if mid in self._codes:
                 return self._codes.pop(mid)
-            return self._lost if arrived and self._lost is not None else "timeout"
+            return self._lost if self._lost is not None else "timeout"
 
 
 class StrokeSender:
@@ -120,7 +121,8 @@ class StrokeSender:
     def _publish(self, message: OutgoingStroke) -> tuple[str, int]:
         payload = message.payload()
         info = self._client.publish(message.topic, payload, qos=1)
-        if info.rc != mqtt.MQTT_ERR_SUCCESS:
+        # Not connected right now: paho keeps the stroke and sends it once reconnected.
+        if info.rc not in (mqtt.MQTT_ERR_SUCCESS, mqtt.MQTT_ERR_NO_CONN):
             raise BrokerConnectionError(
                 "closed",
                 f"Lost the connection to {self._settings.url} before stroke {message.index + 1} "
@@ -145,8 +147,9 @@ class StrokeSender:
         if isinstance(answer, str):
             raise BrokerConnectionError(
                 "closed",
-                f"{url} closed the connection ({answer}) before acknowledging {number}; "
-                "check the broker's log, then send the drawing again.",
+                f"{url} closed the connection ({answer}) and, reconnecting, did not acknowledge "
+                f"{number} within {self._timeout_s:g} s; check the broker's log, then send the "
+                "drawing again.",
                 url=url,
             )
         if answer.is_failure:
