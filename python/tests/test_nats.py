@@ -101,30 +101,81 @@ def test_the_acl_holds_on_nats_a_sleeve_reads_only_its_own_strokes(cluster: Nats
             paho.loop_stop()
 
 
+# After an outage the sleeve returns to real time: a stroke that arrives too late to be
+# felt as drawn is refused with one of these reasons and reported (docs/protocol.md).
+OUT_OF_TIME = ("late", "stale")
+
+
 class Events:
-    """The sleeve's events as the sender sees them, on a node that stays up."""
+    """The sleeve's events as the sender sees them, on a node that stays up.
+
+    ``outcomes`` maps each stroke (drawing, seq) to the distinct payloads of its
+    played events and of its refusals for being out of time. A QoS 1 event sent
+    again after a failover is the same bytes; a stroke played twice would be two
+    events with different timestamps.
+    """
 
     def __init__(self, url: str, account: Account) -> None:
         self.played: dict[tuple[str, int], set[str]] = {}
+        self.refused: dict[tuple[str, int], set[str]] = {}
         self._lock = threading.Condition()
-        self.client = client(url, account)
+        # A persistent session, subscribed on every connect: a node that drops its
+        # clients while JetStream moves its leaders must not make the watcher miss events.
+        settings = parse_broker_url(url, username=account.username, password=account.password)
+        self.client = new_client(settings, client_id="events-watcher", persistent_session=True)
         self.client.on_message = self._on_message
-        self.client.subscribe(telemetry_topic(SLEEVE, "events"), qos=1)
+        subscribed = threading.Event()
+
+        def on_connect(paho: mqtt.Client, *_args: Any) -> None:
+            paho.subscribe(telemetry_topic(SLEEVE, "events"), qos=1)
+
+        self.client.on_connect = on_connect
+        self.client.on_subscribe = lambda *_args: subscribed.set()
+        self.client.connect(settings.host, settings.port)
+        self.client.loop_start()
+        assert subscribed.wait(WAIT_S), "the events watcher could not subscribe"
 
     def _on_message(self, _c: Any, _u: Any, message: mqtt.MQTTMessage) -> None:
         event = json.loads(message.payload)
-        if event.get("type") in ("played", "adjusted"):
-            key = (event["drawing"], event["seq"])
-            with self._lock:
-                # A QoS 1 event sent again after a failover is the same bytes; a stroke
-                # played twice would be two events with different timestamps.
-                self.played.setdefault(key, set()).add(message.payload.decode())
-                self._lock.notify_all()
-
-    def wait_for(self, count: int) -> dict[tuple[str, int], set[str]]:
+        if "drawing" not in event or "seq" not in event:
+            return
+        key = (event["drawing"], event["seq"])
         with self._lock:
-            self._lock.wait_for(lambda: len(self.played) >= count, WAIT_S)
-            return dict(self.played)
+            if event.get("type") in ("played", "adjusted"):
+                self.played.setdefault(key, set()).add(message.payload.decode())
+            elif event.get("type") == "rejected" and event.get("reason") in OUT_OF_TIME:
+                self.refused.setdefault(key, set()).add(message.payload.decode())
+            self._lock.notify_all()
+
+    def settled(self, drawing: str) -> set[int]:
+        with self._lock:
+            return {seq for (d, seq) in [*self.played, *self.refused] if d == drawing}
+
+    def wait_for(self, drawing: str, count: int) -> None:
+        with self._lock:
+            self._lock.wait_for(lambda: len(self.settled(drawing)) >= count, WAIT_S)
+
+    def played_seqs(self, drawing: str) -> list[int]:
+        with self._lock:
+            return sorted(seq for (d, seq) in self.played if d == drawing)
+
+
+def _send(cluster: NatsCluster, *shape: str) -> subprocess.Popen[str]:
+    """The CLI sender on node b, drawing ``shape`` at a hand's pace."""
+    c = cluster.credentials
+    return subprocess.Popen(
+        feelmysign(
+            *("send", "--broker", cluster.nodes[1].mqtt_url, "--id", SLEEVE),
+            *("--username", c.sender.username, "--shape", *shape),
+            # Node b may drop its clients while JetStream elects new leaders for the
+            # streams node a led; the sender reconnects and sends the stroke again.
+            *("--timeout-s", "40"),
+        ),
+        env={**os.environ, "FEELMYSIGN_PASSWORD": c.sender.password},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
 
 
 def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
@@ -146,34 +197,46 @@ def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
     events = Events(cluster.nodes[1].mqtt_url, c.sender)
     try:
         _wait_online(cluster, c.sender)
-        # A drawing of 12 strokes sent from node b at a hand's pace (about 6 s); node a,
-        # the sleeve's, is killed while it is being sent.
-        send = subprocess.Popen(
-            feelmysign(
-                *("send", "--broker", cluster.nodes[1].mqtt_url, "--id", SLEEVE),
-                *("--username", c.sender.username, "--shape", "circle", "--segments", "12"),
-            ),
-            env={**os.environ, "FEELMYSIGN_PASSWORD": c.sender.password},
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        events.wait_for(2)
+        # A drawing of 12 strokes sent from node b at a hand's pace; node a, the
+        # sleeve's, is killed (SIGKILL) once the first strokes were played.
+        send = _send(cluster, "circle", "--segments", "12")
+        first = _drawing_of_first_line(send)
+        events.wait_for(first, 2)
         cluster.kill(0)
-        out = send.communicate(timeout=WAIT_S)[0]
+        out = first_out = send.communicate(timeout=WAIT_S * 2)[0]
         assert send.returncode == 0, out
-        drawing = _drawing_of(out)
-        played = events.wait_for(12)
-        keys = sorted(seq for (d, seq) in played if d == drawing)
-        assert keys == list(range(12)), f"played {keys} of 0..11"
-        assert all(len(payloads) == 1 for payloads in played.values()), "a stroke played twice"
+        events.wait_for(first, 12)
+        # Back on another node: the next drawing plays in full.
+        second_send = _send(cluster, "square")
+        second = _drawing_of_first_line(second_send)
+        out = second_send.communicate(timeout=WAIT_S)[0]
+        assert second_send.returncode == 0, out
+        events.wait_for(second, 4)
     finally:
         events.client.loop_stop()
         sleeve.terminate()
         sleeve_out = sleeve.communicate(timeout=WAIT_S)[0]
+    said = f"the sender said:\n{first_out}\nthe sleeve said:\n{sleeve_out}"
+    # Every stroke of the cut drawing is accounted for: played, or refused as too late
+    # to be felt as drawn (the sleeve's real-time policy), and reported; none vanished.
+    assert events.settled(first) == set(range(12)), said
+    assert events.played_seqs(second) == [0, 1, 2, 3], said
+    assert all(len(payloads) == 1 for payloads in events.played.values()), "played twice"
+    assert not set(events.played) & set(events.refused), "both played and refused"
     assert f"connected to mqtt://127.0.0.1:{cluster.nodes[0].mqtt_port}" in sleeve_out
     moved = [f"connected to {n.mqtt_url}" in sleeve_out for n in cluster.nodes[1:]]
     assert any(moved), sleeve_out
+
+
+def _drawing_of_first_line(send: subprocess.Popen[str]) -> str:
+    """The drawing id in the first stroke line the sender prints."""
+    assert send.stdout is not None
+    while True:
+        line = send.stdout.readline()
+        if not line:
+            raise AssertionError(f"the sender printed no stroke (exit {send.wait()})")
+        if '"drawing":"' in line:
+            return line.split('"drawing":"')[1].split('"')[0]
 
 
 def _wait_online(cluster: NatsCluster, sender: Account) -> None:
@@ -188,13 +251,6 @@ def _wait_online(cluster: NatsCluster, sender: Account) -> None:
         raise AssertionError("the sleeve never came online")
     finally:
         watcher.loop_stop()
-
-
-def _drawing_of(output: str) -> str:
-    for line in output.splitlines():
-        if '"drawing":"' in line:
-            return line.split('"drawing":"')[1].split('"')[0]
-    raise AssertionError(f"no drawing id in: {output}")
 
 
 def test_settings_take_several_urls_of_one_cluster() -> None:
