@@ -16,12 +16,14 @@ import segno
 
 from feelmysign.broker import Broker
 from feelmysign.broker.sleeves import load_sleeves
-from feelmysign.webserver import WebServer
+from feelmysign.webserver import Api, WebServer
 
 ACCESS_KEY_BYTES = 16  # 128 bits: not guessable from the LAN
 
 
-def page_server(broker: Broker, *, http_port: int, directory: Path) -> tuple[WebServer, str]:
+def page_server(
+    broker: Broker, *, http_port: int, directory: Path, api: Api | None = None
+) -> tuple[WebServer, str]:
     """The server (not yet started) and the URL to open, with its key when off loopback."""
     c = broker.credentials
     config: dict[str, Any] = {
@@ -32,13 +34,14 @@ def page_server(broker: Broker, *, http_port: int, directory: Path) -> tuple[Web
         "password": c.sender.password,
     }
     if broker.lan is None:
-        server = WebServer(port=http_port, config=config, directory=directory)
+        server = WebServer(port=http_port, config=config, directory=directory, api=api)
         return server, server.url
     key = secrets.token_urlsafe(ACCESS_KEY_BYTES)
     server = WebServer(
         port=http_port,
         config=config,
         directory=directory,
+        api=api,
         host=broker.lan.host,
         tls=broker.tls,
         access_key=key,
