@@ -101,25 +101,40 @@ class StrokeSender:
 
     def send(self, messages: list[OutgoingStroke], *, pace: Pace) -> None:
         if pace == "burst":
-            sent = [(message, *self._publish(message)) for message in messages]
+            sent = [(message, self._publish(message, message.payload())) for message in messages]
             deadline_s = time.monotonic() + self._timeout_s
-            for message, payload, mid in sent:
+            for message, (payload, mid) in sent:
                 self._confirm(message, payload, mid, deadline_s, len(messages))
             return
         offsets_ms = list(itertools.accumulate((m.stroke.duration_ms for m in messages), initial=0))
         self.send_at(messages, offsets_ms[:-1])
 
     def send_at(self, messages: list[OutgoingStroke], offsets_ms: list[float]) -> None:
-        """Each message published ``offsets_ms`` after the first, once the previous is acked."""
+        """Each message published ``offsets_ms`` after this call, once the previous is acked.
+
+        From the second message on, the pace counts from the moment the first one was
+        stamped with its ``sent_at_ms`` rather than from this call: whatever held the first
+        one up (a busy machine) holds the rest up as much, so no two strokes leave closer
+        together than their offsets say, and their ``sent_at_ms`` show it.
+        """
         start_s = time.monotonic()
+        first: tuple[float, float] | None = None  # (monotonic s after its stamp, its offset)
         for message, offset_ms in zip(messages, offsets_ms, strict=True):
+            if first is None:
+                due_s = start_s + offset_ms / 1000
+            else:
+                first_s, first_offset_ms = first
+                due_s = first_s + (offset_ms - first_offset_ms) / 1000
             # Drawing time, not a wait for an event: the pace is the point.
-            time.sleep(max(0.0, start_s + offset_ms / 1000 - time.monotonic()))
-            payload, mid = self._publish(message)
+            time.sleep(max(0.0, due_s - time.monotonic()))
+            payload = message.payload()
+            if first is None:
+                # Read after the stamp: the moment it counts from is never before it.
+                first = (time.monotonic(), offset_ms)
+            payload, mid = self._publish(message, payload)
             self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
 
-    def _publish(self, message: OutgoingStroke) -> tuple[str, int]:
-        payload = message.payload()
+    def _publish(self, message: OutgoingStroke, payload: str) -> tuple[str, int]:
         info = self._client.publish(message.topic, payload, qos=1)
         # Not connected right now: paho keeps the stroke and sends it once reconnected.
         if info.rc not in (mqtt.MQTT_ERR_SUCCESS, mqtt.MQTT_ERR_NO_CONN):
