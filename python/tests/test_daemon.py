@@ -68,13 +68,18 @@ class Running:
         self.watcher.on_connect = lambda client, *_: client.subscribe(
             [(topic(sid, "events"), 1), (topic(sid, "status"), 1)]
         )
+        # Its subscription is in the broker (and in what a restarted broker loads) only once
+        # granted: before that, events would be dropped.
+        self._watching = threading.Event()
+        self.watcher.on_subscribe = lambda *_: self._watching.set()
         self.watcher.reconnect_delay_set(1, 2)
         self.watcher.connect(credentials.mqtt_host, credentials.mqtt_port)
         self.watcher.loop_start()
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.error: BaseException | None = None
         self.thread.start()
-        assert self.sleeve.connected.wait(10), "the sleeve did not connect"
+        assert self.sleeve.connected.wait(30), "the sleeve did not connect"
+        assert self._watching.wait(30), "the watcher did not subscribe"
 
     def _run(self) -> None:
         try:

@@ -200,6 +200,9 @@ class Sleeve:
 
     @property
     def connected(self) -> threading.Event:
+        """Set once the broker has granted the sleeve's subscriptions (not at CONNACK: a
+        stroke sent between the two, or a broker that stops between them, would miss it);
+        cleared when the connection drops."""
         return self._connected
 
     # --- life cycle --------------------------------------------------------------
@@ -319,7 +322,6 @@ class Sleeve:
             telemetry_topic(self._id, "status"), self._status(online=True), qos=1, retain=True
         )
         self._count("connections")  # `up` tells the terminal when the sleeve is back
-        self._connected.set()
         session = "resumed" if getattr(flags, "session_present", False) else "new"
         # With several servers, the one reached (failover moves it between attempts).
         server = replace(self._settings, host=client.host, port=client.port, fallbacks=())
@@ -353,6 +355,8 @@ class Sleeve:
             )
             log.error("%s", self._fatal)
             self._stopped.set()
+            return
+        self._connected.set()
 
     def _on_disconnect(
         self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
