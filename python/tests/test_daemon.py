@@ -165,10 +165,15 @@ def test_legacy_payload_from_mosquitto_pub_plays_the_planned_commands(
         for ch in reversed(running.backend.changes)
         if ch.intensity
     }
+    # Each actuator comes on in the planned order (how late, on a busy machine, is a figure
+    # of make bench: the sleeve's timing errors).
+    planned_on: dict[tuple[int, int], float] = {}
     for cmd in schedule.commands:
-        assert (
-            first_on[(cmd.row, cmd.column)] <= cmd.start_ms + 50
-        )  # loose: timing is for make bench
+        key = (cmd.row, cmd.column)
+        planned_on[key] = min(cmd.start_ms, planned_on.get(key, cmd.start_ms))
+    for a, b in itertools.permutations(planned_on, 2):
+        if planned_on[a] < planned_on[b]:
+            assert first_on[a] <= first_on[b], (a, b, first_on, planned_on)
 
 
 def test_a_drawing_plays_in_order_back_to_back(running: Running, broker: Broker) -> None:
@@ -304,12 +309,10 @@ def test_a_wrong_password_is_refused_with_a_clear_error(broker: Broker) -> None:
 
 
 def _wait_quiet(running: Running) -> None:
-    deadline = threading.Event()
-    for _ in range(1000):
-        if running.sleeve.player.idle:
-            return
-        deadline.wait(0.01)
-    raise AssertionError("the sleeve kept playing")
+    deadline = time.monotonic() + 60
+    while not running.sleeve.player.idle:
+        assert time.monotonic() < deadline, "the sleeve kept playing"
+        time.sleep(0.01)
 
 
 def test_a_retained_stroke_is_not_played_again_and_again(broker: Broker) -> None:
@@ -334,8 +337,9 @@ def test_strokes_still_waiting_at_stop_are_reported(broker: Broker) -> None:
         sender.publish(topic(sid, "strokes"), format_json(stroke), qos=1).wait_for_publish(5)
     running.wait_events(1)
     # All three in the sleeve's hands (acknowledged by the broker is not yet received).
-    deadline = time.monotonic() + 10
-    while running.sleeve.counts["received"] < 3 and time.monotonic() < deadline:
+    deadline = time.monotonic() + 60
+    while running.sleeve.counts["received"] < 3:
+        assert time.monotonic() < deadline, f"the sleeve received {running.sleeve.counts}"
         time.sleep(0.01)
     running.sleeve.stop()
     running.thread.join(10)
