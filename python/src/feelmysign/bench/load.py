@@ -23,6 +23,7 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
+import resource
 import sys
 import tempfile
 import threading
@@ -318,6 +319,10 @@ def report(counts: tuple[int, ...] = DEFAULT_COUNTS) -> list[str]:
 
 def main(argv: list[str]) -> None:
     counts = tuple(int(a) for a in argv) or DEFAULT_COUNTS
+    # Each paho client holds a socket and a wake-up pair: 3 N clients need more than the
+    # usual 1024 descriptors. Raised to the hard limit, as a broker's service would be.
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    resource.setrlimit(resource.RLIMIT_NOFILE, (max(soft, hard), hard))
     # The sleeves' own log lines (a stroke played late, ...) would bury the figures.
     logging.getLogger("feelmysign").setLevel(logging.ERROR)
     report(counts)
