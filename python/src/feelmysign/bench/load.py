@@ -23,6 +23,7 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
+import multiprocessing
 import resource
 import sys
 import tempfile
@@ -170,6 +171,34 @@ def _draw_all(target: Target, senders: list[mqtt.Client], ids: list[str]) -> dic
     return sent
 
 
+def _senders_main(target: Target, ids: list[str], out: Any) -> None:
+    """In a process of its own: N sender clients draw at once; their sent_at times to ``out``.
+
+    paho waits on its sockets with select(), which takes descriptors below 1024 only:
+    one process holds about 340 clients, so the N senders get a process of their own.
+    """
+    senders = [
+        _connected(target.settings(target.sender), f"sender-{i}-{uuid.uuid4()}")
+        for i in range(len(ids))
+    ]
+    sent = _draw_all(target, senders, ids)
+    time.sleep(1.0)  # the last PUBACKs
+    for client in senders:
+        client.loop_stop()
+        client.disconnect()
+    out.put(sent)
+
+
+def _draw_in_process(target: Target, ids: list[str]) -> dict[str, float]:
+    context = multiprocessing.get_context("spawn")  # a fresh descriptor table, no threads
+    out = context.Queue()
+    process = context.Process(target=_senders_main, args=(target, ids, out))
+    process.start()
+    sent: dict[str, float] = out.get(timeout=CONNECT_S + SETTLE_S)
+    process.join(SETTLE_S)
+    return sent
+
+
 def _stroke_key(payload: bytes) -> str | None:
     try:
         data = json.loads(payload)
@@ -207,15 +236,11 @@ def baseline(target: Target) -> tuple[list[float], int]:
         receiver = _connected(settings, f"bare-{sleeve_id}-{uuid.uuid4()}", arrivals)
         receiver.subscribe(strokes_topic(sleeve_id), qos=1)
         receivers.append(receiver)
-    senders = [
-        _connected(target.settings(target.sender), f"sender-{i}-{uuid.uuid4()}")
-        for i in range(len(ids))
-    ]
     time.sleep(1.0)  # SUBACKs: paho has no waiter for them
-    sent = _draw_all(target, senders, ids)
+    sent = _draw_in_process(target, ids)
     _wait(arrivals.count, len(sent))
     latencies = [arrivals.at_ms[k] - sent[k] for k in sent if k in arrivals.at_ms]
-    for client in receivers + senders:
+    for client in receivers:
         client.loop_stop()
         client.disconnect()
     return latencies, len(sent) - len(latencies)
@@ -248,19 +273,14 @@ def sleeves(target: Target) -> tuple[list[float], int, Counter[str]]:
     watcher.subscribe(telemetry_topic("+", "events"), qos=1)
     running = [_start_sleeve(target, sleeve_id) for sleeve_id in ids]
     try:
-        senders = [
-            _connected(target.settings(target.sender), f"sender-{i}-{uuid.uuid4()}")
-            for i in range(len(ids))
-        ]
-        sent = _draw_all(target, senders, ids)
+        sent = _draw_in_process(target, ids)
         _wait(lambda: len(played.keys() | refused.keys()), len(sent))
         with lock:
             latencies = [played[k] - sent[k] for k in sent if k in played]
             reasons = Counter(refused[k] for k in sent if k in refused and k not in played)
             lost = sum(1 for k in sent if k not in played and k not in refused)
-        for client in [*senders, watcher]:
-            client.loop_stop()
-            client.disconnect()
+        watcher.loop_stop()
+        watcher.disconnect()
     finally:
         for sleeve, thread, backend in running:
             sleeve.stop()
