@@ -5,7 +5,7 @@ Each case: the full parameter set, the canvas, the pointer samples of each path
 and the expected segments. An implementation resamples each path into frames
 with ``frames_from_samples(samples, fps)``, pushes every frame, calls ``end``,
 and must reproduce ``expected.segments`` (path index, start, end, times,
-dropped reason) and ``expected.frames`` (frames per path) within ``tolerance``.
+dropped reason) and ``expected.inputs`` (frames per path) within ``tolerance``.
 ``params.json`` is the parameter table (defaults and allowed ranges).
 """
 
@@ -18,10 +18,10 @@ from collections.abc import Callable
 from dataclasses import asdict, fields
 from typing import Any
 
-from feelmysign.simplify import AngleParams, Sample, frames_from_samples, simplify_paths
+from feelmysign.simplify import AngleParams, Sample, simplify_paths
 from feelmysign.simplify.angle import ANGLE_PARAMS
 from feelmysign.simplify.params import ParamSpec
-from feelmysign.simplify.registry import Params
+from feelmysign.simplify.registry import Params, algorithm_of
 
 W, H = 1200.0, 800.0  # the canvas of every case: the 3 x 2 grid's aspect ratio
 
@@ -61,6 +61,30 @@ def _pause() -> Path:
     return first + held + [Sample(s.t_ms + held[-1].t_ms, s.x, s.y) for s in second[1:]]
 
 
+def _flick_back() -> Path:
+    out = [Sample(k * 8.0, 300.0 + 800.0 * k / 75, 400.0) for k in range(76)]
+    return out + [Sample(600.0 + 8.0 * k, 1100.0 - 800.0 * k / 5, 400.0) for k in range(1, 6)]
+
+
+def _late_release() -> Path:
+    samples = [Sample(k * 8.0, 200.0 + 6.0 * k, 300.0 + 2.0 * k) for k in range(63)]
+    frame_ms = 1000.0 / 60.0 * 30  # the 30th frame after the press
+    return [*samples, Sample(frame_ms + 0.0003, 200.0 + 6.0 * 63, 300.0 + 2.0 * 63)]
+
+
+def _brace() -> Path:
+    rng = random.Random(4)
+    samples = []
+    for k in range(121):
+        u = k / 120  # 0..1 down the brace; the tip halfway
+        y = 100.0 + 600.0 * u
+        bulge = 120.0 * math.sin(math.pi * 2 * u) ** 2
+        tip = 160.0 * max(0.0, 1 - abs(u - 0.5) * 12)
+        x = 600.0 - bulge * 0.5 + tip + rng.uniform(-1.5, 1.5)
+        samples.append(Sample(k * 8.0, x, y))
+    return samples
+
+
 def _pressure(path: Path) -> Path:
     return [
         Sample(s.t_ms, s.x, s.y, round(0.2 + 0.6 * k / len(path), 4)) for k, s in enumerate(path)
@@ -81,6 +105,12 @@ SHAPES: dict[str, Callable[[], list[Path]]] = {
     ],
     "tap": lambda: [[Sample(0.0, 300, 300), Sample(40.0, 300.4, 300.2)]],
     "pressure": lambda: [_pressure(_line([(100, 700), (600, 100), (1100, 700)], 0.5))],
+    # Out 2 grid units in 600 ms, flicked back onto the start in 40 ms: two strokes.
+    "flick-back": lambda: [_flick_back()],
+    # A pen at 125 Hz whose release lands a rounding error after a 60 fps frame.
+    "late-release": lambda: [_late_release()],
+    # A brace: two arcs meeting at a sharp tip, drawn with a little hand tremor.
+    "brace": lambda: [_brace()],
 }
 
 VARIATIONS: dict[str, dict[str, Any]] = {
@@ -100,7 +130,7 @@ VARIATIONS: dict[str, dict[str, Any]] = {
 }
 
 # Every shape with the defaults; the richer shapes with every variation.
-VARIED_SHAPES = ("circle", "zigzag", "right-angle", "pause")
+VARIED_SHAPES = ("circle", "zigzag", "right-angle", "pause", "brace")
 
 
 def _segments(params: Params, paths: list[Path]) -> dict[str, Any]:
@@ -117,8 +147,9 @@ def _segments(params: Params, paths: list[Path]) -> dict[str, Any]:
         for p in simplify_paths(params, paths)
         for s in [p.segment]
     ]
+    algorithm = algorithm_of(params)
     return {
-        "frames": [len(frames_from_samples(path, params.fps)) for path in paths],
+        "inputs": [len(algorithm.inputs(params, path)) for path in paths],
         "segments": segments,
     }
 

@@ -3,10 +3,10 @@
 The shapes are gen_angle's (imported, not copied), so both simplifiers are
 pinned on the same input. Each case: the full parameter set, the canvas, the
 pointer samples of each path (``[t_ms, x_px, y_px, pressure]``) and the
-expected segments. An implementation resamples each path into frames with
-``frames_from_samples(samples, fps)``, pushes every frame, calls ``end``, and
-must reproduce ``expected.segments`` (path index, start, end, times, dropped
-reason) and ``expected.frames`` within ``tolerance``. ``params.json`` is the
+expected segments. An implementation pushes every sample of a path (the window
+simplifier takes samples, not frames), calls ``end``, and must reproduce
+``expected.segments`` (path index, start, end, times, dropped reason) and
+``expected.inputs`` (samples per path) within ``tolerance``. ``params.json`` is the
 parameter table (defaults and allowed ranges).
 """
 
@@ -26,7 +26,8 @@ VARIATIONS: dict[str, dict[str, Any]] = {
     "max-window-1": {"max_window": 1},
     "max-window-8": {"max_window": 8},
     "max-window-1000": {"max_window": 1000},
-    "fps-30": {"fps": 30.0},
+    "max-stroke-ms-100": {"max_stroke_ms": 100.0},
+    "max-stroke-ms-300": {"max_stroke_ms": 300.0},
     "min-duration-200": {"min_duration_ms": 200.0},
     "min-length-0.5": {"min_length": 0.5},
     "stretch": {"stretch": True, "canvas_width_px": 1600.0},

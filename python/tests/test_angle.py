@@ -35,7 +35,7 @@ def test_vector(name: str, case: dict[str, Any]) -> None:
     params = AngleParams(**case["params"])
     paths = [[Sample(*s) for s in path] for path in case["paths"]]
     tolerance = case["tolerance"]
-    assert [len(frames_from_samples(p, params.fps)) for p in paths] == case["expected"]["frames"]
+    assert [len(frames_from_samples(p, params.fps)) for p in paths] == case["expected"]["inputs"]
     actual = _run(params, paths)
     expected = case["expected"]["segments"]
     assert len(actual) == len(expected), name
@@ -105,6 +105,17 @@ def test_square_is_four_strokes_with_its_corners() -> None:
     assert [s.dropped for s in segments] == [None] * 4
     for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
         assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+
+
+@pytest.mark.parametrize("gap_px", [0.0, 1.0])
+def test_a_line_flicked_back_onto_its_start_is_two_strokes(gap_px: float) -> None:
+    # Out 2 grid units in 600 ms, back in 40 ms to within gap_px of the start.
+    params = AngleParams(canvas_width_px=1200, canvas_height_px=800)
+    out = [Sample(k * 8.0, 300.0 + 800.0 * k / 75, 400.0) for k in range(76)]
+    back = [Sample(600.0 + 8.0 * k, 1100.0 - (800.0 - gap_px) * k / 5, 400.0) for k in range(1, 6)]
+    segments = [s for _, s in _run(params, [out + back])]
+    assert [s.dropped for s in segments] == [None, None]
+    assert segments[0].length > 1.5 and segments[1].length > 1.5
 
 
 def test_mapping_keeps_a_circle_round() -> None:

@@ -91,11 +91,14 @@ def test_replaying_twice_gives_identical_strokes(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     recording = str(browser_recording(tmp_path / "drawing.json"))
-    for algorithm in ("angle", "window"):
-        first = replay_json(capsys, recording, "--algorithm", algorithm, "--fps", "50")
-        second = replay_json(capsys, recording, "--algorithm", algorithm, "--fps", "50")
+    for flags, source in (
+        (["--algorithm", "angle", "--fps", "50"], "resampled at 50 fps"),
+        (["--algorithm", "window"], "every sample"),
+    ):
+        first = replay_json(capsys, recording, *flags)
+        second = replay_json(capsys, recording, *flags)
         assert first == second
-        assert first["strokes"] and first["frames"] == "resampled at 50 fps"
+        assert first["strokes"] and first["frames"] == source
 
 
 def test_the_recorded_frames_replay_to_the_recorded_strokes(

@@ -21,7 +21,6 @@ from feelmysign.simplify import (
     Segment,
     WindowParams,
     WindowSimplifier,
-    frames_from_samples,
     simplify_paths,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
@@ -53,7 +52,7 @@ def test_vector(name: str, case: dict[str, Any]) -> None:
     params = WindowParams(**case["params"])
     paths = [[Sample(*s) for s in path] for path in case["paths"]]
     tolerance = case["tolerance"]
-    assert [len(frames_from_samples(p, params.fps)) for p in paths] == case["expected"]["frames"]
+    assert [len(p) for p in paths] == case["expected"]["inputs"]
     actual = _run(params, paths)
     expected = case["expected"]["segments"]
     assert len(actual) == len(expected), name
@@ -81,7 +80,8 @@ def test_parameter_table_matches_the_defaults() -> None:
         ("max_error", math.inf),
         ("max_window", 0),
         ("max_window", 2.5),
-        ("fps", math.nan),
+        ("max_stroke_ms", math.nan),
+        ("max_stroke_ms", -1),
         ("min_length", -0.1),
         ("stretch", 1),
     ],
@@ -93,7 +93,7 @@ def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: o
 
 
 def test_square_is_four_strokes_with_its_corners() -> None:
-    # 10 px a frame is 0.033 grid units: above the error, so a corner shows at once.
+    # 10 px a sample is 0.033 grid units: above the error, so a corner shows at once.
     params = WindowParams(
         canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000
     )
@@ -103,27 +103,59 @@ def test_square_is_four_strokes_with_its_corners() -> None:
         for (x0, y0), (x1, y1) in itertools.pairwise(corners)
         for k in range(40)
     ] + [corners[-1]]
-    path = [Sample(i * 1000 / 60, x, y) for i, (x, y) in enumerate(points)]
+    path = [Sample(i * 8.0, x, y) for i, (x, y) in enumerate(points)]
     segments = [s for _, s in _run(params, [path])]
     grid = [params.mapping.to_grid(x, y) for x, y in corners]
     assert [s.dropped for s in segments] == [None] * 4
     for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
         assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
-    # Each corner is found one frame later, when the next frame leaves the line.
-    assert [s.emitted_at_ms - s.end_ms for s in segments[:3]] == pytest.approx([1000 / 60] * 3)
+    # Each corner is found one sample later, when the next sample leaves the line.
+    assert [s.emitted_at_ms - s.end_ms for s in segments[:3]] == pytest.approx([8.0] * 3)
 
 
-def test_a_stroke_ends_at_the_frame_before_the_one_that_breaks_the_bound() -> None:
+def test_the_cut_goes_on_the_feature_not_where_the_bound_first_breaks() -> None:
+    # A shallow tent: up 4 px over 20 samples, then down. The bound (0.05 grid units,
+    # 5 px here) breaks well past the tip; the stroke still ends on the tip.
     params = WindowParams(
         canvas_width_px=300, canvas_height_px=200, max_error=0.05, min_duration_ms=0
     )
-    simplifier = WindowSimplifier(params)
-    frames = [Sample(10.0 * k, 10.0 * k, 100) for k in range(5)] + [Sample(50.0, 40, 150)]
-    out = [segment for frame in frames for segment in simplifier.push(frame)]
-    assert len(out) == 1 and out[0].end_ms == 40.0 and out[0].emitted_at_ms == 50.0
-    assert simplifier.line_start == frames[4]
+    up = [Sample(8.0 * k, 5.0 * k, 100 - 0.6 * k) for k in range(21)]
+    down = [Sample(8.0 * (20 + k), 100 + 5.0 * k, 88 + 0.6 * k) for k in range(1, 41)]
+    segments = [s for _, s in _run(params, [up + down])]
+    tip = params.mapping.to_grid(up[-1].x, up[-1].y)
+    assert segments[0].end == tip and segments[0].end_ms == up[-1].t_ms
+    assert segments[0].emitted_at_ms > up[-1].t_ms + 8.0  # found later, cut back on the tip
+    assert [s.dropped for s in segments] == [None, None]
+
+
+def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
+    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=100)
+    line = [Sample(8.0 * k, 1.0 * k, 100) for k in range(76)]  # 600 ms, straight
+    segments = [s for _, s in _run(params, [line])]
+    assert all(s.duration_ms <= 100 for s in segments)
+    # Samples 8 ms apart: each stroke covers 12 of them (96 ms), the seventh the rest.
+    assert [s.duration_ms for s in segments] == [96.0] * 6 + [24.0]
+    assert segments[0].emitted_at_ms == 104.0  # let go by the sample that would pass 100 ms
+    assert segments[-1].end_ms == 600.0
+
+
+def test_a_release_a_rounding_error_after_a_frame_still_reaches_the_end() -> None:
+    # A 125 Hz pen; the release comes 0.0003 ms after the 30th 60 fps frame, moved on.
+    samples = [Sample(k * 8.0, 200.0 + 6.0 * k, 300.0 + 2.0 * k) for k in range(63)]
+    release = Sample(500.0 + 0.0003, 200.0 + 6.0 * 63, 300.0 + 2.0 * 63)
+    params = WindowParams(canvas_width_px=1200, canvas_height_px=800)
+    segments = [s for _, s in _run(params, [[*samples, release]])]
+    assert [s.dropped for s in segments] == [None]
+    assert segments[-1].end == params.mapping.to_grid(release.x, release.y)
+
+
+def test_a_sample_earlier_than_the_one_before_is_taken_at_its_time() -> None:
+    simplifier = WindowSimplifier(WindowParams(canvas_width_px=300, canvas_height_px=200))
+    simplifier.push(Sample(10.0, 0, 100))
+    simplifier.push(Sample(20.0, 100, 100))
+    simplifier.push(Sample(19.0, 200, 100))
     (last,) = simplifier.end()
-    assert last.start == out[0].end and last.end_ms == 50.0
+    assert last.end_ms == 20.0 and last.duration_ms == 10.0
 
 
 def test_window_cap_cuts_at_the_current_frame() -> None:
@@ -162,7 +194,7 @@ def _recording(case: dict[str, Any], path: Path) -> Path:
 
 def _flags(params: dict[str, Any]) -> list[str]:
     flags = ["--algorithm", "window"]
-    for name in ("max_error", "max_window", "fps", "min_duration_ms", "min_length"):
+    for name in ("max_error", "max_window", "max_stroke_ms", "min_duration_ms", "min_length"):
         flags += ["--" + name.replace("_", "-"), repr(params[name])]
     return flags + (["--stretch"] if params["stretch"] else [])
 
@@ -231,11 +263,11 @@ def test_cli_uses_the_recordings_algorithm_and_parameters(
 
 
 @st.composite
-def paths(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
+def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list[Sample]]:
     params = WindowParams(
         max_error=draw(st.sampled_from([0.001, 0.02, 0.05, 0.2, 1.0])),
         max_window=draw(st.sampled_from([1, 2, 5, 64, 1000])),
-        fps=draw(st.sampled_from([30.0, 60.0, 120.0])),
+        max_stroke_ms=draw(st.sampled_from([0.0, 50.0, 300.0])),
         min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
         min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
         stretch=draw(st.booleans()),
@@ -245,7 +277,7 @@ def paths(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
     count = draw(st.integers(1, 150))
     steps = draw(
         st.lists(
-            st.tuples(st.floats(-40, 40), st.floats(-40, 40), st.floats(0, 30)),
+            st.tuples(st.floats(-40, 40), st.floats(-40, 40), st.floats(min_step_ms, 30)),
             min_size=count,
             max_size=count,
         )
@@ -259,46 +291,44 @@ def paths(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
     return params, samples
 
 
-def _covered(
-    params: WindowParams, samples: list[Sample]
-) -> tuple[list[Sample], list[tuple[int, int, Segment]]]:
-    """The frames, and each segment with the indices of the first and last frame it covers.
+def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:
+    """Each segment with the indices of the first and last sample it covers.
 
-    Segments join end to start, so each starts at the frame the one before
-    ended on; it ends on the last frame (from there) with its end time and
-    point. Frame times only repeat when a whole path has a single time.
+    Segments join end to start, so each starts at the sample the one before
+    ended on; it ends on the last sample (from there) with its end time and
+    point.
     """
-    frames = frames_from_samples(samples, params.fps)
     segments = [s for _, s in _run(params, [samples])]
     mapping = params.mapping
     covered: list[tuple[int, int, Segment]] = []
     start = 0
-    for segment in segments:
+    for number, segment in enumerate(segments, start=1):
         ends = [
             j
-            for j in range(start, len(frames))
-            if frames[j].t_ms == segment.end_ms
-            and mapping.to_grid(frames[j].x, frames[j].y) == segment.end
+            for j in range(min(start + 1, len(samples) - 1), len(samples))
+            if samples[j].t_ms == segment.end_ms
+            and mapping.to_grid(samples[j].x, samples[j].y) == segment.end
         ]
-        assert ends, f"{segment} does not end on a frame"
-        covered.append((start, ends[-1], segment))
-        start = ends[-1]
-    assert start == len(frames) - 1, "the last segment ends on the last frame"
-    return frames, covered
+        assert ends, f"{segment} does not end on a sample"
+        # Repeated samples (same time and place) are one: the first, but the last for the last.
+        end = ends[-1] if number == len(segments) else ends[0]
+        covered.append((start, end, segment))
+        start = end
+    assert start == len(samples) - 1, "the last segment ends on the last sample"
+    return covered
 
 
 @settings(max_examples=500, deadline=None)
 @given(paths())
-def test_every_frame_lies_within_max_error_of_its_stroke(
+def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
     case: tuple[WindowParams, list[Sample]],
 ) -> None:
     params, samples = case
-    frames, covered = _covered(params, samples)
     mapping = params.mapping
-    for first, last, segment in covered:
-        for frame in frames[first : last + 1]:
-            distance = _distance(mapping.to_grid(frame.x, frame.y), segment.start, segment.end)
-            assert distance <= params.max_error + FLOAT_TOLERANCE, (segment, frame, distance)
+    for first, last, segment in _covered(params, samples):
+        for sample in samples[first : last + 1]:
+            distance = _distance(mapping.to_grid(sample.x, sample.y), segment.start, segment.end)
+            assert distance <= params.max_error + FLOAT_TOLERANCE, (segment, sample, distance)
 
 
 @settings(max_examples=300, deadline=None)
@@ -316,17 +346,18 @@ def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sam
 
 
 @settings(max_examples=300, deadline=None)
-@given(paths())
-def test_no_stroke_covers_more_than_the_window_and_each_is_emitted_at_most_a_frame_late(
+@given(paths(min_step_ms=0.01))  # every sample its own time: each stroke's samples are known
+def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
     case: tuple[WindowParams, list[Sample]],
 ) -> None:
     params, samples = case
-    frames, covered = _covered(params, samples)
-    for first, last, segment in covered:
-        assert last - first + 1 <= params.max_window + 1
-        assert last > first or len(frames) == 1, "only a one-frame path gives an empty stroke"
-        next_time = frames[min(last + 1, len(frames) - 1)].t_ms
-        assert segment.emitted_at_ms in (frames[last].t_ms, next_time)
+    times = {s.t_ms for s in samples}
+    for first, last, segment in _covered(params, samples):
+        assert last - first <= params.max_window
+        assert last > first or len(samples) == 1, "only a one-sample path gives an empty stroke"
+        if params.max_stroke_ms and last - first > 1:
+            assert segment.duration_ms <= params.max_stroke_ms
+        assert segment.emitted_at_ms in times and segment.emitted_at_ms >= segment.end_ms
 
 
 @settings(max_examples=300, deadline=None)

@@ -30,6 +30,7 @@ export interface Settings {
   readonly algorithm: Algorithm;
   readonly max_error: number;
   readonly max_window: number;
+  readonly max_stroke_ms: number;
   readonly check_frames: number;
   readonly max_angle_deg: number;
   readonly frame_max: number;
@@ -176,7 +177,8 @@ export const FIELDS: readonly FieldSpec[] = [
     problem: (value) => (value === "angle" || value === "window" ? null : "must be a listed choice"),
   },
   windowField("max_error", "Max error", "grid units"),
-  windowField("max_window", "Window cap", "frames"),
+  windowField("max_window", "Window cap", "samples"),
+  windowField("max_stroke_ms", "Longest stroke", "ms"),
   paramField("check_frames", "simplifier", "Check frames", "frames"),
   paramField("max_angle_deg", "simplifier", "Max angle", "°"),
   paramField("frame_max", "simplifier", "Frame max", "frames"),
@@ -298,6 +300,7 @@ export const DEFAULT_SETTINGS: Settings = Object.freeze({
   algorithm: "angle",
   max_error: windowParamSpec("max_error").default as number,
   max_window: windowParamSpec("max_window").default as number,
+  max_stroke_ms: windowParamSpec("max_stroke_ms").default as number,
   check_frames: paramDefault<number>("check_frames"),
   max_angle_deg: paramDefault<number>("max_angle_deg"),
   frame_max: paramDefault<number>("frame_max"),
@@ -411,7 +414,8 @@ export function angleParams(
     max_angle_deg: settings.max_angle_deg,
     frame_max: settings.frame_max,
     recover: settings.recover,
-    ...frameAndGrid(settings, grid, canvas),
+    fps: settings.fps,
+    ...dropAndGrid(settings, grid, canvas),
   };
 }
 
@@ -425,18 +429,18 @@ export function windowParams(
     algorithm: "window",
     max_error: settings.max_error,
     max_window: settings.max_window,
-    ...frameAndGrid(settings, grid, canvas),
+    max_stroke_ms: settings.max_stroke_ms,
+    ...dropAndGrid(settings, grid, canvas),
   };
 }
 
-/** The frame, drop and grid parameters every simplifier has. */
-function frameAndGrid(
+/** The drop and grid parameters every simplifier has. */
+function dropAndGrid(
   settings: Settings,
   grid: { readonly rows: number; readonly columns: number },
   canvas: { readonly width_px: number; readonly height_px: number },
 ) {
   return {
-    fps: settings.fps,
     clear_on_press: settings.clear_on_press,
     min_duration_ms: settings.min_duration_ms,
     min_length: settings.min_length,

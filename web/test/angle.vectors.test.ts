@@ -4,9 +4,8 @@
  * file's own tolerance.
  */
 import { describe, expect, it } from "vitest";
-import { framesFromSamples } from "../src/simplify/frames";
 import type { AngleParams } from "../src/simplify/params";
-import { simplifyPaths } from "../src/simplify/registry";
+import { inputsFor, simplifyPaths } from "../src/simplify/registry";
 import type { Sample } from "../src/simplify/segment";
 import { vectors } from "./testdata";
 
@@ -25,7 +24,7 @@ interface AngleVector {
   tolerance: number;
   params: Omit<AngleParams, "algorithm">;
   paths: [number, number, number, number][][];
-  expected: { frames: number[]; segments: ExpectedSegment[] };
+  expected: { inputs: number[]; segments: ExpectedSegment[] };
 }
 
 const cases = vectors("angle").filter(([name]) => !name.endsWith("params.json")) as [string, AngleVector][];
@@ -45,10 +44,9 @@ describe("angle vectors", () => {
     const paths: Sample[][] = vector.paths.map((path) =>
       path.map(([t_ms, x, y, pressure]) => ({ t_ms, x, y, pressure })),
     );
-    expect(paths.map((path) => framesFromSamples(path, vector.params.fps).length)).toEqual(
-      vector.expected.frames,
-    );
-    const actual = simplifyPaths({ ...vector.params, algorithm: "angle" }, paths);
+    const params = { ...vector.params, algorithm: "angle" } as const;
+    expect(paths.map((path) => inputsFor(params, path).length)).toEqual(vector.expected.inputs);
+    const actual = simplifyPaths(params, paths);
     expect(actual.length, "segment count").toBe(vector.expected.segments.length);
     const tol = vector.tolerance;
     vector.expected.segments.forEach((want, i) => {

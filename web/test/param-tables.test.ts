@@ -35,8 +35,10 @@ describe("parameter tables", () => {
       max_angle_deg: "angle",
       frame_max: "angle",
       recover: "angle",
+      fps: "angle",
       max_error: "window",
       max_window: "window",
+      max_stroke_ms: "window",
     });
   });
 

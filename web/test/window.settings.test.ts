@@ -34,7 +34,7 @@ describe("window settings", () => {
   it("validates max error and the window cap with the reference's ranges", () => {
     const errors = validateSettings({ ...DEFAULT_SETTINGS, max_error: 0, max_window: 2.5, algorithm: "dp" });
     expect(errors.max_error).toBe("Max error must be a number from 0.001 to 100.");
-    expect(errors.max_window).toBe("Window cap must be a whole number from 1 to 1000.");
+    expect(errors.max_window).toBe("Window cap must be a whole number from 1 to 10000.");
     expect(errors.algorithm).toBe("Simplifier must be a listed choice.");
   });
 
@@ -75,7 +75,8 @@ describe("a window recording", () => {
 
   it("names the algorithm and its parameters, without the canvas and grid", () => {
     expect(recording.simplifier.algorithm).toBe("window");
-    expect(recording.simplifier.params).toMatchObject({ max_error: 0.02, max_window: 64, fps: 60 });
+    expect(recording.simplifier.params).toMatchObject({ max_error: 0.02, max_window: 256 });
+    expect(Object.keys(recording.simplifier.params)).not.toContain("fps");
     expect(Object.keys(recording.simplifier.params)).not.toContain("rows");
   });
 

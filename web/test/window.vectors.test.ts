@@ -4,8 +4,7 @@
  * reason), within the file's own tolerance.
  */
 import { describe, expect, it } from "vitest";
-import { framesFromSamples } from "../src/simplify/frames";
-import { simplifyPaths } from "../src/simplify/registry";
+import { inputsFor, simplifyPaths } from "../src/simplify/registry";
 import type { Sample } from "../src/simplify/segment";
 import type { WindowParams } from "../src/simplify/window-params";
 import { vectors } from "./testdata";
@@ -25,7 +24,7 @@ interface WindowVector {
   tolerance: number;
   params: Omit<WindowParams, "algorithm">;
   paths: [number, number, number, number][][];
-  expected: { frames: number[]; segments: ExpectedSegment[] };
+  expected: { inputs: number[]; segments: ExpectedSegment[] };
 }
 
 const cases = vectors("window").filter(([name]) => !name.endsWith("params.json")) as [string, WindowVector][];
@@ -45,10 +44,9 @@ describe("window vectors", () => {
     const paths: Sample[][] = vector.paths.map((path) =>
       path.map(([t_ms, x, y, pressure]) => ({ t_ms, x, y, pressure })),
     );
-    expect(paths.map((path) => framesFromSamples(path, vector.params.fps).length)).toEqual(
-      vector.expected.frames,
-    );
-    const actual = simplifyPaths({ ...vector.params, algorithm: "window" }, paths);
+    const params = { ...vector.params, algorithm: "window" } as const;
+    expect(paths.map((path) => inputsFor(params, path).length)).toEqual(vector.expected.inputs);
+    const actual = simplifyPaths(params, paths);
     expect(actual.length, "segment count").toBe(vector.expected.segments.length);
     const tol = vector.tolerance;
     vector.expected.segments.forEach((want, i) => {

@@ -17,7 +17,7 @@ import { CanvasMapping } from "./mapping";
 import { checkAngleParams, type AngleParams } from "./params";
 import { finishSegment, type Sample, type Segment } from "./segment";
 
-/** Movements shorter than this (pixels) have no direction: the check passes. */
+/** Movements shorter than this (pixels) have no direction. */
 const STILL_PX = 1e-9;
 
 /** The line being drawn: where it starts and where its last passed check was. */
@@ -112,9 +112,13 @@ export class AngleSimplifier {
     const uy = frame.y - line.start.y;
     const vx = frame.x - line.last.x;
     const vy = frame.y - line.last.y;
-    const norms = Math.sqrt(ux * ux + uy * uy) * Math.sqrt(vx * vx + vy * vy);
-    if (norms <= STILL_PX) return false;
-    return (ux * vx + uy * vy) / norms < this.#cosMax;
+    const moved = Math.sqrt(vx * vx + vy * vy);
+    // The pointer rested since the last check: no new direction.
+    if (moved <= STILL_PX) return false;
+    const lineSoFar = Math.sqrt(ux * ux + uy * uy);
+    // It moved, back onto the line's start: a full reversal.
+    if (lineSoFar <= STILL_PX) return true;
+    return (ux * vx + uy * vy) / (lineSoFar * moved) < this.#cosMax;
   }
 
   #finish(start: Sample, end: Sample): Segment {

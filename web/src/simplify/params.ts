@@ -59,8 +59,10 @@ export const FPS_SPEC: ParamSpec<FrameAndGridName> = {
   help: "frames per second of the drawing loop",
 };
 
-/** The drop and grid settings every simplifier has, after its own and `fps`. */
-export const DROP_AND_GRID_SPECS: readonly ParamSpec<FrameAndGridName>[] = [
+export type DropAndGridName = Exclude<FrameAndGridName, "fps">;
+
+/** The drop and grid settings every simplifier has, after its own (and `fps` for frames). */
+export const DROP_AND_GRID_SPECS: readonly ParamSpec<DropAndGridName>[] = [
   {
     name: "clear_on_press",
     type: "boolean",

@@ -1,9 +1,9 @@
 /**
  * The simplifiers by name (the reference's `ALGORITHMS` in
  * `simplify/registry.py`), and a whole recording through one,
- * deterministically: every path resampled into frames at `params.fps`, pushed,
- * and ended, in order. Parameters say which simplifier they are for in their
- * `algorithm` field.
+ * deterministically: every path fed to it (as animation frames or as every
+ * sample, see `AlgorithmEntry.input`) and ended, in order. Parameters say which
+ * simplifier they are for in their `algorithm` field.
  */
 import { AngleSimplifier } from "./angle";
 import { framesFromSamples } from "./frames";
@@ -15,14 +15,17 @@ import { DEFAULT_WINDOW_PARAMS, WINDOW_PARAM_SPECS, type WindowParams } from "./
 export type SimplifierParams = AngleParams | WindowParams;
 export type Algorithm = SimplifierParams["algorithm"];
 
-/** What every simplifier offers: frames in, finished segments out. */
+/** What every simplifier offers: frames or samples in, finished segments out. */
 export interface Simplifier {
   readonly drawing: boolean;
   /** Where the stroke being drawn starts (canvas pixels); null between paths. */
   readonly lineStart: Sample | null;
-  push(frame: Sample): Segment[];
+  push(input: Sample): Segment[];
   end(): Segment[];
 }
+
+/** What a simplifier is fed: animation frames (resampled at `fps`), or every pointer sample. */
+export type InputKind = "frames" | "samples";
 
 /** A simplifier by name: its parameter table, its defaults, how to make one. */
 export interface AlgorithmEntry<P extends SimplifierParams> {
@@ -30,6 +33,7 @@ export interface AlgorithmEntry<P extends SimplifierParams> {
   readonly summary: string;
   readonly specs: readonly ParamSpec<string>[];
   readonly defaults: P;
+  readonly input: InputKind;
   make(params: P): Simplifier;
 }
 
@@ -42,13 +46,15 @@ export const ALGORITHMS: {
     summary: "the paper's turn-angle rule",
     specs: PARAM_SPECS,
     defaults: DEFAULT_ANGLE_PARAMS,
+    input: "frames",
     make: (params) => new AngleSimplifier(params),
   },
   window: {
     name: "window",
-    summary: "error-bounded opening window",
+    summary: "error-bounded, cut at features",
     specs: WINDOW_PARAM_SPECS,
     defaults: DEFAULT_WINDOW_PARAMS,
+    input: "samples",
     make: (params) => new WindowSimplifier(params),
   },
 };
@@ -80,6 +86,11 @@ export function makeSimplifier(params: SimplifierParams): Simplifier {
   }
 }
 
+/** What the simplifier the parameters are for is fed for one path drawn as `samples`. */
+export function inputsFor(params: SimplifierParams, samples: readonly Sample[]): Sample[] {
+  return params.algorithm === "angle" ? framesFromSamples(samples, params.fps) : [...samples];
+}
+
 export function simplifyPaths(
   params: SimplifierParams,
   paths: readonly (readonly Sample[])[],
@@ -87,8 +98,8 @@ export function simplifyPaths(
   const simplifier = makeSimplifier(params);
   const out: PathSegment[] = [];
   paths.forEach((samples, path) => {
-    for (const frame of framesFromSamples(samples, params.fps)) {
-      for (const segment of simplifier.push(frame)) out.push({ path, segment });
+    for (const input of inputsFor(params, samples)) {
+      for (const segment of simplifier.push(input)) out.push({ path, segment });
     }
     for (const segment of simplifier.end()) out.push({ path, segment });
   });

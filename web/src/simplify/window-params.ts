@@ -3,7 +3,7 @@
  * table as the Python reference's (a test holds it equal to
  * `testdata/window/params.json`, which the reference writes).
  */
-import { checkParams, defaultsOf, DROP_AND_GRID_SPECS, FPS_SPEC, type ParamSpec } from "./params";
+import { checkParams, defaultsOf, DROP_AND_GRID_SPECS, type ParamSpec } from "./params";
 
 /** The parameters of `WindowParams` in the reference, snake_case as in every file that holds them. */
 export interface WindowParams {
@@ -11,7 +11,7 @@ export interface WindowParams {
   readonly algorithm: "window";
   readonly max_error: number;
   readonly max_window: number;
-  readonly fps: number;
+  readonly max_stroke_ms: number;
   readonly clear_on_press: boolean;
   readonly min_duration_ms: number;
   readonly min_length: number;
@@ -37,12 +37,19 @@ export const WINDOW_PARAM_SPECS: readonly ParamSpec<WindowParamName>[] = [
   {
     name: "max_window",
     type: "integer",
-    default: 64,
+    default: 256,
     minimum: 1,
-    maximum: 1000,
-    help: "longest stroke in frames after its start (bounds the work)",
+    maximum: 10000,
+    help: "longest stroke in samples after its start (bounds the work per sample)",
   },
-  FPS_SPEC,
+  {
+    name: "max_stroke_ms",
+    type: "number",
+    default: 0,
+    minimum: 0,
+    maximum: 60000,
+    help: "longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
+  },
   ...DROP_AND_GRID_SPECS,
 ];
 

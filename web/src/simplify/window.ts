@@ -1,24 +1,27 @@
 /**
- * The window simplifier: an error-bounded online simplifier (plain opening
- * window, "before opening window" form; Meratnia & de By 2004), ported from
- * the Python reference `feelmysign/simplify/window.py`, which it reproduces
- * exactly on the shared vectors in `testdata/window/`.
+ * The window simplifier: an error-bounded online simplifier over every drawn
+ * sample, cut at features, ported from the Python reference
+ * `feelmysign/simplify/window.py`, which it reproduces exactly on the shared
+ * vectors in `testdata/window/` (the method and its sources are described there
+ * and in docs/research.md).
  *
- * A stroke grows one frame at a time from its anchor; when the next frame
- * would put a frame since the anchor farther than `max_error` (grid units)
- * from the stroke, the stroke ends at the previous frame and is emitted now,
- * and that frame anchors the next. A stroke is cut at the current frame when
- * it covers `max_window` frames after its anchor, bounding the work per frame.
- * Too short or too brief strokes are dropped with their reason, as by the
- * angle simplifier. The float operations follow the reference's order.
+ * It takes every pointer sample (every pointer event, coalesced ones included),
+ * not animation frames. A stroke grows one sample at a time from its anchor;
+ * when a sample would put a sample since the anchor farther than `max_error`
+ * (grid units) from the stroke, the stroke is cut at the sample farthest from
+ * the chord (among those whose own stroke keeps the bound), emitted now, and
+ * the samples after the cut are taken again into the next stroke. A stroke
+ * lasts at most `max_stroke_ms` of drawing (the latency cap) and holds at most
+ * `max_window` samples (the work cap). Too short or too brief strokes are
+ * dropped with their reason. The float operations follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
 import { finishSegment, type Point, type Sample, type Segment } from "./segment";
 import { checkWindowParams, type WindowParams } from "./window-params";
 
-interface Frame {
+interface Drawn {
   readonly sample: Sample;
-  /** The frame in grid units. */
+  /** The sample in grid units. */
   readonly point: Point;
 }
 
@@ -26,8 +29,8 @@ export class WindowSimplifier {
   readonly params: WindowParams;
   readonly #maxErrorSq: number;
   readonly #mapping: CanvasMapping;
-  /** The frames of the stroke being drawn: its anchor first, then every frame since. */
-  #window: Frame[] = [];
+  /** The samples of the stroke being drawn: its anchor first, then every sample since. */
+  #window: Drawn[] = [];
   #pointer: Sample | null = null;
   #emittedInPath = false;
 
@@ -44,7 +47,7 @@ export class WindowSimplifier {
     });
   }
 
-  /** True between the first frame of a path and `end`. */
+  /** True between the first sample of a path and `end`. */
   get drawing(): boolean {
     return this.#window.length > 0;
   }
@@ -54,27 +57,23 @@ export class WindowSimplifier {
     return this.#window[0]?.sample ?? null;
   }
 
-  /** One animation frame while the pointer is down; the first frame of a path is the press. */
-  push(frame: Sample): Segment[] {
-    this.#pointer = frame;
-    const current: Frame = { sample: frame, point: this.#mapping.toGrid(frame.x, frame.y) };
-    let window = this.#window;
-    if (window.length === 0) {
+  /** One pointer sample while the pointer is down; the first of a path is the press. */
+  push(input: Sample): Segment[] {
+    const previous = this.#window[this.#window.length - 1];
+    // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
+    const sample =
+      previous !== undefined && input.t_ms < previous.sample.t_ms
+        ? { ...input, t_ms: previous.sample.t_ms }
+        : input;
+    this.#pointer = sample;
+    const current: Drawn = { sample, point: this.#mapping.toGrid(sample.x, sample.y) };
+    if (this.#window.length === 0) {
       this.#window = [current];
       this.#emittedInPath = false;
       return [];
     }
     const out: Segment[] = [];
-    if (!this.#fits(window, current.point)) {
-      const previous = window[window.length - 1]!;
-      out.push(this.#finish(window[0]!, previous));
-      window = this.#window = [previous];
-    }
-    window.push(current);
-    if (window.length - 1 >= this.params.max_window) {
-      out.push(this.#finish(window[0]!, current));
-      this.#window = [current];
-    }
+    this.#add(current, out);
     return out;
   }
 
@@ -85,33 +84,67 @@ export class WindowSimplifier {
     const first = window[0];
     const last = window[window.length - 1];
     if (first === undefined || last === undefined) return [];
-    // The last frame already ends a stroke (a cut at the window cap).
+    // The last sample already ends a stroke (a cut at the work cap).
     if (window.length === 1 && this.#emittedInPath) return [];
     return [this.#finish(first, last)];
   }
 
-  /** Whether every frame after the anchor lies within max_error of anchor -> end. */
-  #fits(window: readonly Frame[], end: Point): boolean {
-    const [ax, ay] = window[0]!.point;
-    const dx = end[0] - ax;
-    const dy = end[1] - ay;
-    const lengthSq = dx * dx + dy * dy;
-    for (let i = 1; i < window.length; i++) {
-      const point = window[i]!.point;
-      let qx = point[0] - ax;
-      let qy = point[1] - ay;
-      if (lengthSq > 0) {
-        // The nearest point of the segment: the projection, clamped onto it.
-        const t = Math.min(Math.max((qx * dx + qy * dy) / lengthSq, 0), 1);
-        qx = qx - t * dx;
-        qy = qy - t * dy;
+  /** `current` joins the stroke being drawn, cutting it first where it must. */
+  #add(current: Drawn, out: Segment[]): void {
+    // A stack: the next sample to take is last. A cut gives back the samples after it.
+    const pending: Drawn[] = [current];
+    for (let item = pending.pop(); item !== undefined; item = pending.pop()) {
+      let window = this.#window;
+      const anchor = window[0]!;
+      const capMs = this.params.max_stroke_ms;
+      if (capMs > 0 && window.length > 1 && item.sample.t_ms - anchor.sample.t_ms > capMs) {
+        const last = window[window.length - 1]!;
+        out.push(this.#finish(anchor, last));
+        window = this.#window = [last];
       }
-      if (qx * qx + qy * qy > this.#maxErrorSq) return false;
+      if (!this.#fits(window, 1, window.length, item.point)) {
+        const cut = this.#feature(window, item.point);
+        out.push(this.#finish(window[0]!, window[cut]!));
+        pending.push(item);
+        pending.push(...window.slice(cut + 1).reverse());
+        this.#window = [window[cut]!];
+        continue;
+      }
+      window.push(item);
+      if (window.length - 1 >= this.params.max_window) {
+        out.push(this.#finish(window[0]!, item));
+        this.#window = [item];
+      }
+    }
+  }
+
+  /**
+   * Where to cut: the sample farthest from anchor -> end whose own stroke keeps
+   * the bound (the last sample always does). Ties go to the later sample.
+   */
+  #feature(window: readonly Drawn[], end: Point): number {
+    const anchor = window[0]!.point;
+    const ranked: { index: number; distanceSq: number }[] = [];
+    for (let i = 1; i < window.length; i++) {
+      ranked.push({ index: i, distanceSq: distanceSq(window[i]!.point, anchor, end) });
+    }
+    ranked.sort((a, b) => b.distanceSq - a.distanceSq || b.index - a.index);
+    for (const { index } of ranked) {
+      if (this.#fits(window, 1, index, window[index]!.point)) return index;
+    }
+    return window.length - 1; // unreachable: the last sample fits by construction
+  }
+
+  /** Whether window[first..stop) all lie within max_error of window[0] -> end. */
+  #fits(window: readonly Drawn[], first: number, stop: number, end: Point): boolean {
+    const anchor = window[0]!.point;
+    for (let i = first; i < stop; i++) {
+      if (distanceSq(window[i]!.point, anchor, end) > this.#maxErrorSq) return false;
     }
     return true;
   }
 
-  #finish(start: Frame, end: Frame): Segment {
+  #finish(start: Drawn, end: Drawn): Segment {
     this.#emittedInPath = true;
     return finishSegment(
       start.point,
@@ -122,4 +155,21 @@ export class WindowSimplifier {
       this.params,
     );
   }
+}
+
+/** Squared distance from `point` to the segment start -> end (its nearest point). */
+function distanceSq(point: Point, start: Point, end: Point): number {
+  const [ax, ay] = start;
+  const dx = end[0] - ax;
+  const dy = end[1] - ay;
+  let qx = point[0] - ax;
+  let qy = point[1] - ay;
+  const lengthSq = dx * dx + dy * dy;
+  if (lengthSq > 0) {
+    // The nearest point of the segment: the projection, clamped onto it.
+    const t = Math.min(Math.max((qx * dx + qy * dy) / lengthSq, 0), 1);
+    qx = qx - t * dx;
+    qy = qy - t * dy;
+  }
+  return qx * qx + qy * qy;
 }

@@ -1,6 +1,6 @@
 /**
- * One drawing in progress: pointer samples in, animation frames to the chosen
- * simplifier (angle or window), finished segments to the drawing and its strokes to the sender,
+ * One drawing in progress: pointer samples in, animation frames (angle) or every
+ * pointer sample (window) to the chosen simplifier, finished segments to the drawing and its strokes to the sender,
  * ink to the canvas. The animation loop runs only while a pointer is down, and
  * each frame costs the same however much has been drawn.
  */
@@ -9,7 +9,7 @@ import { newDrawingId } from "../drawing-id";
 import { FrameSampler } from "../frame-sampler";
 import type { Stroke } from "../protocol";
 import { simplifierParams, type Settings } from "../settings";
-import { makeSimplifier, type Simplifier } from "../simplify/registry";
+import { ALGORITHMS, makeSimplifier, type Simplifier } from "../simplify/registry";
 import type { Sample, Segment } from "../simplify/segment";
 import type { DrawingView } from "./canvas";
 import type { GridSize } from "./geometry";
@@ -35,6 +35,8 @@ export class DrawingSession {
   readonly #host: SessionHost;
   #drawing: Drawing | null = null;
   #simplifier: Simplifier | null = null;
+  /** The simplifier takes every pointer sample (coalesced ones included), not frames. */
+  #feedsSamples = false;
   #sampler = new FrameSampler(60);
   #pointerKind: PointerKind = "mouse";
   #pointer: Sample | null = null;
@@ -79,6 +81,7 @@ export class DrawingSession {
     for (const sample of samples) {
       drawing.addSample(sample);
       this.#sampler.hold(sample);
+      if (this.#feedsSamples) this.#pushFrame(sample);
     }
     this.#pointer = samples[samples.length - 1] ?? this.#pointer;
   }
@@ -88,7 +91,8 @@ export class DrawingSession {
     const simplifier = this.#simplifier;
     if (drawing === null || simplifier === null || !this.#sampler.pressed) return;
     drawing.addSample(sample);
-    this.#pushFrame(this.#sampler.release(sample));
+    const last = this.#sampler.release(sample);
+    this.#pushFrame(this.#feedsSamples ? sample : last);
     for (const segment of simplifier.end()) this.#handleSegment(segment);
     this.#pointer = null;
     this.#view.flush();
@@ -175,6 +179,7 @@ export class DrawingSession {
   #newDrawing(settings: Settings): void {
     const params = simplifierParams(settings, this.#host.grid(), this.#view.area);
     this.#simplifier = makeSimplifier(params);
+    this.#feedsSamples = ALGORITHMS[params.algorithm].input === "samples";
     this.#drawing = new Drawing(newDrawingId(), params);
     this.#view.setDrawing(this.#drawing);
     this.#host.changed(this.#drawing);
@@ -187,7 +192,7 @@ export class DrawingSession {
     const step = (tMs: number): void => {
       const started = performance.now();
       const frame = this.#sampler.tick(tMs);
-      if (frame !== null) this.#pushFrame(frame);
+      if (frame !== null && !this.#feedsSamples) this.#pushFrame(frame);
       this.#view.flush();
       this.#view.drawLive(this.#simplifier?.lineStart ?? null, this.#pointer);
       this.#frameWorkMs.push(performance.now() - started);

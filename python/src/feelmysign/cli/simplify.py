@@ -55,8 +55,17 @@ def register(subparsers: Any) -> None:
         "--max-window",
         int,
         "N",
-        "window: longest stroke in frames after its start",
+        "window: longest stroke in samples after its start (bounds the work)",
         WINDOW_DEFAULTS.max_window,
+    )
+    _option(
+        parser,
+        "--max-stroke-ms",
+        float,
+        "MS",
+        "window: longest stroke in ms of drawing, so a long line is felt before it ends; "
+        "0 = no limit",
+        WINDOW_DEFAULTS.max_stroke_ms,
     )
     _option(
         parser, "--check-frames", int, "N", "angle: frames between checks", DEFAULTS.check_frames
@@ -77,7 +86,9 @@ def register(subparsers: Any) -> None:
         "angle: longest line in frames, 0 = no limit",
         DEFAULTS.frame_max,
     )
-    _option(parser, "--fps", float, "F", "frames per second of the drawing loop", DEFAULTS.fps)
+    _option(
+        parser, "--fps", float, "F", "angle: frames per second of the drawing loop", DEFAULTS.fps
+    )
     parser.add_argument(
         "--no-recover",
         dest="recover",
@@ -203,6 +214,8 @@ def to_json(result: list[PathSegment], params: Params) -> dict[str, Any]:
         entry = {
             "start": list(s.start),
             "end": list(s.end),
+            "start_ms": s.start_ms,
+            "end_ms": s.end_ms,
             "duration_ms": s.duration_ms,
             "path": item.path,
             "emitted_at_ms": s.emitted_at_ms,
@@ -223,7 +236,7 @@ def describe(result: list[PathSegment], params: Params, source: str) -> str:
     sent = [r for r in result if r.segment.dropped is None]
     lines = [
         f"{source}: {len({r.path for r in result})} path(s) -> {len(sent)} stroke(s) sent, "
-        f"{len(result) - len(sent)} dropped ({_settings(params)}, {params.fps:g} fps; "
+        f"{len(result) - len(sent)} dropped ({_settings(params)}; "
         f"{params.rows} x {params.columns} grid)",
         "",
         f"{'path':>4}  {'start':>15}  {'end':>15}  {'ms':>8}  {'emitted at':>10}  note",
@@ -240,11 +253,14 @@ def describe(result: list[PathSegment], params: Params, source: str) -> str:
 
 def _settings(params: Params) -> str:
     if isinstance(params, WindowParams):
+        cap = f"{params.max_stroke_ms:g} ms" if params.max_stroke_ms else "no limit"
         return (
-            f"window: max error {params.max_error:g} grid units, "
-            f"at most {params.max_window} frames a stroke"
+            f"window: max error {params.max_error:g} grid units, every sample, longest stroke {cap}"
         )
-    return f"angle: check every {params.check_frames} frames, max {params.max_angle_deg:g} deg"
+    return (
+        f"angle: check every {params.check_frames} frames, max {params.max_angle_deg:g} deg, "
+        f"{params.fps:g} fps"
+    )
 
 
 def _p(point: tuple[float, float]) -> str:

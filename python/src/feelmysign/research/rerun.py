@@ -26,10 +26,14 @@ MATCH_TOLERANCE = 1e-6
 
 @dataclass(frozen=True)
 class Rerun:
-    """The frames fed to the simplifier (per path), where they came from, and its segments."""
+    """What was fed to the simplifier (per path), where it came from, and its segments.
+
+    ``frames`` are animation frames for a simplifier fed frames (angle), the
+    pointer samples themselves for one fed every sample (window).
+    """
 
     frames: tuple[tuple[Sample, ...], ...]
-    frames_source: str  # "recorded" or "resampled at F fps"
+    frames_source: str  # "recorded", "resampled at F fps" or "every sample"
     segments: list[PathSegment]
 
 
@@ -46,8 +50,16 @@ def frames_for(recording: Recording, fps: float) -> tuple[tuple[tuple[Sample, ..
     return resampled, f"resampled at {fps:g} fps"
 
 
+def inputs_for(recording: Recording, params: Params) -> tuple[tuple[tuple[Sample, ...], ...], str]:
+    """What the simplifier ``params`` is for is fed, per path: frames, or every sample."""
+    fps = getattr(params, "fps", None)
+    if algorithm_of(params).input == "samples" or not isinstance(fps, (int, float)):
+        return recording.paths, "every sample"
+    return frames_for(recording, fps)
+
+
 def run_frames(params: Params, frames: Sequence[Sequence[Sample]]) -> list[PathSegment]:
-    """Every path's frames pushed in order and ended, through the simplifier ``params`` is for."""
+    """Every path's inputs pushed in order and ended, through the simplifier ``params`` is for."""
     simplifier = algorithm_of(params).make(params)
     out: list[PathSegment] = []
     for index, path in enumerate(frames):
@@ -58,7 +70,7 @@ def run_frames(params: Params, frames: Sequence[Sequence[Sample]]) -> list[PathS
 
 
 def rerun(recording: Recording, params: Params) -> Rerun:
-    frames, source = frames_for(recording, params.fps)
+    frames, source = inputs_for(recording, params)
     return Rerun(frames, source, run_frames(params, frames))
 
 

@@ -31,7 +31,7 @@ from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 
-# Movements shorter than this (pixels) have no direction: the check passes.
+# Movements shorter than this (pixels) have no direction.
 STILL_PX = 1e-9
 
 ANGLE_PARAMS: dict[str, ParamSpec] = {
@@ -140,10 +140,13 @@ class AngleSimplifier:
         """Whether start -> frame and last check -> frame differ by more than the maximum angle."""
         ux, uy = frame.x - line.start.x, frame.y - line.start.y
         vx, vy = frame.x - line.last.x, frame.y - line.last.y
-        norms = math.sqrt(ux * ux + uy * uy) * math.sqrt(vx * vx + vy * vy)
-        if norms <= STILL_PX:
-            return False
-        return (ux * vx + uy * vy) / norms < self._cos_max
+        moved = math.sqrt(vx * vx + vy * vy)
+        if moved <= STILL_PX:
+            return False  # the pointer rested since the last check: no new direction
+        line_so_far = math.sqrt(ux * ux + uy * uy)
+        if line_so_far <= STILL_PX:
+            return True  # it moved, back onto the line's start: a full reversal
+        return (ux * vx + uy * vy) / (line_so_far * moved) < self._cos_max
 
     def _finish(self, start: Sample, end: Sample) -> Segment:
         return finish_segment(

@@ -63,9 +63,8 @@ def check_all(params: object, specs: dict[str, ParamSpec]) -> None:
         specs[field.name].check(getattr(params, field.name))
 
 
-# The frame, drop and grid settings every simplifier has (beside its own).
-FRAME_AND_GRID_SPECS = (
-    ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
+# The drop and grid settings every simplifier has (beside its own).
+DROP_AND_GRID_SPECS = (
     ParamSpec("clear_on_press", bool, None, None, "a new press clears the drawing"),
     ParamSpec("min_duration_ms", float, 0, 10_000, "shortest stroke to send, in ms"),
     ParamSpec("min_length", float, 0, 100, "shortest stroke to send, in grid units"),
@@ -74,6 +73,11 @@ FRAME_AND_GRID_SPECS = (
     ParamSpec("canvas_width_px", float, 1, 100_000, "drawing area width in pixels"),
     ParamSpec("canvas_height_px", float, 1, 100_000, "drawing area height in pixels"),
     ParamSpec("stretch", bool, None, None, "stretch the canvas onto the grid (the paper's)"),
+)
+# A simplifier that sees animation frames has their rate too.
+FRAME_AND_GRID_SPECS = (
+    ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
+    *DROP_AND_GRID_SPECS,
 )
 
 

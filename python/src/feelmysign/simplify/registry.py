@@ -22,28 +22,49 @@ Params = AngleParams | WindowParams
 
 
 class Simplifier(Protocol):
-    def push(self, frame: Sample) -> list[Segment]: ...
+    def push(self, item: Sample) -> list[Segment]: ...
 
     def end(self) -> list[Segment]: ...
 
 
 @dataclass(frozen=True)
 class Algorithm:
-    """A simplifier by name: its parameters (with defaults), how to make one, its table."""
+    """A simplifier by name: its parameters (with defaults), how to make one, its table.
+
+    ``input`` is what it is fed: ``"frames"`` (animation frames, resampled from
+    the samples at ``params.fps``) or ``"samples"`` (every pointer sample).
+    """
 
     name: str
     params: type[Any]
     make: Callable[[Any], Simplifier]
     specs: dict[str, ParamSpec]
     summary: str
+    input: str
+
+    def inputs(self, params: Any, samples: Sequence[Sample]) -> list[Sample]:
+        """What this simplifier is fed for one path drawn as ``samples``."""
+        if self.input == "frames":
+            return frames_from_samples(samples, params.fps)
+        return list(samples)
 
 
 ALGORITHMS: dict[str, Algorithm] = {
     "angle": Algorithm(
-        "angle", AngleParams, AngleSimplifier, ANGLE_PARAMS, "the paper's turn-angle rule"
+        "angle",
+        AngleParams,
+        AngleSimplifier,
+        ANGLE_PARAMS,
+        "the paper's turn-angle rule",
+        "frames",
     ),
     "window": Algorithm(
-        "window", WindowParams, WindowSimplifier, WINDOW_PARAMS, "error-bounded opening window"
+        "window",
+        WindowParams,
+        WindowSimplifier,
+        WINDOW_PARAMS,
+        "error-bounded, cut at features",
+        "samples",
     ),
 }
 
@@ -77,14 +98,15 @@ class PathSegment:
 
 
 def simplify_paths(params: Params, paths: Sequence[Sequence[Sample]]) -> list[PathSegment]:
-    """Every path resampled into frames at ``params.fps``, pushed, and ended, in order.
+    """Every path fed to the simplifier (as frames or samples, see ``Algorithm``) and ended.
 
     The simplifier is the one ``params`` belongs to (``AngleParams`` -> angle).
     """
-    simplifier = algorithm_of(params).make(params)
+    algorithm = algorithm_of(params)
+    simplifier = algorithm.make(params)
     out: list[PathSegment] = []
     for index, samples in enumerate(paths):
-        for frame in frames_from_samples(samples, params.fps):
-            out += [PathSegment(index, s) for s in simplifier.push(frame)]
+        for item in algorithm.inputs(params, samples):
+            out += [PathSegment(index, s) for s in simplifier.push(item)]
         out += [PathSegment(index, s) for s in simplifier.end()]
     return out

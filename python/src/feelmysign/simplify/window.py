@@ -1,29 +1,38 @@
-"""The window simplifier: an error-bounded online simplifier (opening window).
+"""The window simplifier: an error-bounded online simplifier over every drawn sample.
 
-The plain opening window of the line-simplification literature, in its
-"before opening window" form (Meratnia & de By 2004, "Spatiotemporal
-compression techniques for moving point objects", EDBT; the family goes back
-to Sklansky & Gonzalez 1980 and Williams 1978, whose cone intersection makes
-the same test in O(1) per sample but bounds the distance to an infinite line,
-not to the stroke, and ends strokes off the samples). Here:
+An opening window (Meratnia & de By 2004, "Spatiotemporal compression
+techniques for moving point objects", EDBT; the family goes back to Sklansky
+& Gonzalez 1980 and Williams 1978) that cuts where Douglas-Peucker would
+(Douglas & Peucker 1973): at the drawn point farthest from the chord, so that
+corners land on the drawing's features. Here:
 
-- A stroke starts at an anchor frame and grows one frame at a time. When a
-  frame arrives, the stroke anchor -> frame is tried: every frame since the
+- It takes every pointer sample (in the browser every pointer event, coalesced
+  ones included; in a recording every sample), not animation frames: the bound
+  holds for everything drawn, and strokes start and end on real samples at
+  their real times.
+- A stroke starts at an anchor sample and grows one sample at a time. When a
+  sample arrives, the stroke anchor -> sample is tried: every sample since the
   anchor must lie within ``max_error`` (grid units, after mapping) of that
   segment — the distance to the segment, not to its line.
-- If one does not, the stroke ends at the previous frame and is emitted now,
-  one frame after its end; the previous frame becomes the next anchor, so
-  strokes join end to start.
-- When a stroke covers ``max_window`` frames after its anchor it is cut at the
-  current frame: the work per frame is at most ``max_window`` distance tests.
-- On release the rest is one stroke. A path's first and last frames are
-  always stroke ends, and every stroke starts and ends on a frame.
+- If one does not, the stroke is cut at a feature: of the samples since the
+  anchor, the one farthest from the chord anchor -> new sample among those
+  whose own stroke (anchor -> it) keeps the bound (the sample before the new
+  one always does). That stroke is emitted now; the cut sample anchors the
+  next stroke, and the samples after it are taken again, so strokes join end
+  to start and every sample keeps the bound.
+- Latency cap: a stroke lasts at most ``max_stroke_ms`` of drawing. A sample
+  that would make it longer cuts it at the sample before, so the wearer feels
+  a long line begin before it ends (the paper's "frame max", in ms).
+- Work cap: when a stroke holds ``max_window`` samples after its anchor it is
+  cut at the current sample (each sample costs at most that many tests).
+- On release the rest is one stroke. A path's first and last samples are
+  always stroke ends.
 - A stroke too short (grid units) or too brief (ms) is dropped with its reason,
   as the angle simplifier does; it still ends where the next one starts.
 
-It takes the same animation frames (``frames_from_samples`` at ``fps``) as
-the angle simplifier, so the two are compared on the same input. Pure and
-streaming: ``push`` one frame at a time, ``end`` on release.
+Pure and streaming: ``push`` one sample at a time, ``end`` on release. A
+sample earlier than the one before it (clocks of two event sources) is taken
+at the earlier one's time, so times never run backwards.
 """
 
 from __future__ import annotations
@@ -31,7 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
-from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
+from feelmysign.simplify.params import DROP_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.stroke import Point
 
@@ -46,24 +55,35 @@ WINDOW_PARAMS: dict[str, ParamSpec] = {
             "farthest a drawn point may lie from its stroke, in grid units",
         ),
         ParamSpec(
-            "max_window", int, 1, 1000, "longest stroke in frames after its start (bounds the work)"
+            "max_window",
+            int,
+            1,
+            10_000,
+            "longest stroke in samples after its start (bounds the work per sample)",
         ),
-        *FRAME_AND_GRID_SPECS,
+        ParamSpec(
+            "max_stroke_ms",
+            float,
+            0,
+            60_000,
+            "longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
+        ),
+        *DROP_AND_GRID_SPECS,
     )
 }
 
 
 @dataclass(frozen=True)
 class WindowParams(FrameAndGrid):
-    """The error bound and window cap, then the same frame, drop and grid settings as angle.
+    """The error bound, the caps, then the same drop and grid settings as angle.
 
     ``max_error`` 0.1 grid units is 3 mm on the paper's sleeve (3 cm spacing),
-    the same as its minimum stroke length; 64 frames is about a second at 60 fps.
+    the same as its minimum stroke length.
     """
 
     max_error: float = 0.1
-    max_window: int = 64
-    fps: float = 60.0
+    max_window: int = 256
+    max_stroke_ms: float = 0.0
     clear_on_press: bool = True
     min_duration_ms: float = 6.1
     min_length: float = 0.1
@@ -78,16 +98,16 @@ class WindowParams(FrameAndGrid):
 
 
 @dataclass(frozen=True)
-class _Frame:
+class _Point:
     sample: Sample
-    point: Point  # the frame in grid units
+    point: Point  # the sample in grid units
 
 
 @dataclass
 class WindowSimplifier:
     params: WindowParams = field(default_factory=WindowParams)
-    # The frames of the stroke being drawn: its anchor first, then every frame since.
-    _window: list[_Frame] = field(default_factory=list)
+    # The samples of the stroke being drawn: its anchor first, then every sample since.
+    _window: list[_Point] = field(default_factory=list)
     _pointer: Sample | None = None
     _emitted_in_path: bool = False
     _max_error_sq: float = field(init=False)
@@ -99,7 +119,7 @@ class WindowSimplifier:
 
     @property
     def drawing(self) -> bool:
-        """True between the first frame of a path and ``end``."""
+        """True between the first sample of a path and ``end``."""
         return bool(self._window)
 
     @property
@@ -107,23 +127,18 @@ class WindowSimplifier:
         """Where the stroke being drawn starts (canvas pixels); None between paths."""
         return self._window[0].sample if self._window else None
 
-    def push(self, frame: Sample) -> list[Segment]:
-        """One animation frame while the pointer is down; the first frame of a path is the press."""
-        self._pointer = frame
-        current = _Frame(frame, self._mapping.to_grid(frame.x, frame.y))
-        window = self._window
-        if not window:
+    def push(self, sample: Sample) -> list[Segment]:
+        """One pointer sample while the pointer is down; the first of a path is the press."""
+        if self._window and sample.t_ms < self._window[-1].sample.t_ms:
+            sample = Sample(self._window[-1].sample.t_ms, sample.x, sample.y, sample.pressure)
+        self._pointer = sample
+        current = _Point(sample, self._mapping.to_grid(sample.x, sample.y))
+        if not self._window:
             self._window = [current]
             self._emitted_in_path = False
             return []
         out: list[Segment] = []
-        if not self._fits(window, current.point):
-            out.append(self._finish(window[0], window[-1]))
-            window = self._window = [window[-1]]
-        window.append(current)
-        if len(window) - 1 >= self.params.max_window:
-            out.append(self._finish(window[0], current))
-            self._window = [current]
+        self._add(current, out)
         return out
 
     def end(self) -> list[Segment]:
@@ -133,25 +148,62 @@ class WindowSimplifier:
         if not window:
             return []
         if len(window) == 1 and self._emitted_in_path:
-            return []  # the last frame already ends a stroke (a cut at the window cap)
+            return []  # the last sample already ends a stroke (a cut at the work cap)
         return [self._finish(window[0], window[-1])]
 
-    def _fits(self, window: list[_Frame], end: Point) -> bool:
-        """Whether every frame after the anchor lies within max_error of anchor -> end."""
-        ax, ay = window[0].point
-        dx, dy = end[0] - ax, end[1] - ay
-        length_sq = dx * dx + dy * dy
-        for item in window[1:]:
-            qx, qy = item.point[0] - ax, item.point[1] - ay
-            if length_sq > 0.0:
-                # The nearest point of the segment: the projection, clamped onto it.
-                t = min(max((qx * dx + qy * dy) / length_sq, 0.0), 1.0)
-                qx, qy = qx - t * dx, qy - t * dy
-            if qx * qx + qy * qy > self._max_error_sq:
+    def _add(self, current: _Point, out: list[Segment]) -> None:
+        """``current`` joins the stroke being drawn, cutting it first where it must.
+
+        A cut at a feature gives back the samples after it: they are taken
+        again, in order, into the stroke that now starts at the cut.
+        """
+        pending = [current]  # a stack: the next sample to take is last
+        while pending:
+            item = pending.pop()
+            window = self._window
+            anchor = window[0]
+            cap_ms = self.params.max_stroke_ms
+            if cap_ms > 0 and len(window) > 1 and item.sample.t_ms - anchor.sample.t_ms > cap_ms:
+                out.append(self._finish(anchor, window[-1]))
+                window = self._window = [window[-1]]
+            if not self._fits(window, 1, len(window), item.point):
+                cut = self._feature(window, item.point)
+                out.append(self._finish(window[0], window[cut]))
+                pending.append(item)
+                pending.extend(reversed(window[cut + 1 :]))
+                self._window = [window[cut]]
+                continue
+            window.append(item)
+            if len(window) - 1 >= self.params.max_window:
+                out.append(self._finish(window[0], item))
+                self._window = [item]
+
+    def _feature(self, window: list[_Point], end: Point) -> int:
+        """Where to cut: the sample farthest from anchor -> end whose own stroke keeps the bound.
+
+        The last sample always qualifies (the window kept the bound up to it).
+        Ties go to the later sample, so the stroke is the longer.
+        """
+        anchor = window[0].point
+        ranked = sorted(
+            range(1, len(window)),
+            key=lambda i: (_distance_sq(window[i].point, anchor, end), i),
+            reverse=True,
+        )
+        for index in ranked:
+            if self._fits(window, 1, index, window[index].point):
+                return index
+        return len(window) - 1  # unreachable: the last sample fits by construction
+
+    def _fits(self, window: list[_Point], first: int, stop: int, end: Point) -> bool:
+        """Whether window[first:stop] all lie within max_error of window[0] -> end."""
+        anchor = window[0].point
+        for index in range(first, stop):
+            if _distance_sq(window[index].point, anchor, end) > self._max_error_sq:
                 return False
         return True
 
-    def _finish(self, start: _Frame, end: _Frame) -> Segment:
+    def _finish(self, start: _Point, end: _Point) -> Segment:
         self._emitted_in_path = True
         return finish_segment(
             start.point,
@@ -162,3 +214,16 @@ class WindowSimplifier:
             min_length=self.params.min_length,
             min_duration_ms=self.params.min_duration_ms,
         )
+
+
+def _distance_sq(point: Point, start: Point, end: Point) -> float:
+    """Squared distance from ``point`` to the segment start -> end (its nearest point)."""
+    ax, ay = start
+    dx, dy = end[0] - ax, end[1] - ay
+    qx, qy = point[0] - ax, point[1] - ay
+    length_sq = dx * dx + dy * dy
+    if length_sq > 0.0:
+        # The nearest point of the segment: the projection, clamped onto it.
+        t = min(max((qx * dx + qy * dy) / length_sq, 0.0), 1.0)
+        qx, qy = qx - t * dx, qy - t * dy
+    return qx * qx + qy * qy
