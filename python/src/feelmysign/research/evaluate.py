@@ -1,11 +1,19 @@
 """Run simplifiers over recordings and parameter grids, and measure every result.
 
 One ``Row`` per recording x algorithm x parameter set; ``summarize`` folds
-them per algorithm and parameter set; ``frontier`` runs offline
-Douglas-Peucker over a range of errors on the same frames. Every recording is
-run with its canvas and sleeve and the algorithm's defaults, overridden only
-by the parameter set, so that one set means the same on every recording (the
-parameters a recording's sender used are not applied).
+them per source set (LASA as drawn, or re-timed slow, normal, fast), algorithm
+and parameter set; ``frontier`` runs offline Douglas-Peucker over a range of
+errors on the same samples. Every recording is run with its canvas and sleeve
+and the algorithm's defaults, overridden only by the parameter set, so that
+one set means the same on every recording (the parameters a recording's sender
+used are not applied).
+
+Each row measures the shape (deviation of every drawn sample, Fréchet
+distance, strokes against Douglas-Peucker at the same error), the timing as
+the sleeve would play it (``playback``: time on the skin against drawing time,
+release to felt end, pen to skin) and, when the recording is a LASA shape,
+whether the $1 recogniser (``dollar``) names the shape from the drawing and
+from the polyline of the strokes sent.
 """
 
 from __future__ import annotations
@@ -20,26 +28,37 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from feelmysign.research import metrics
+from feelmysign.layout import PAPER_SLEEVE, Layout, grid_layout
+from feelmysign.research import dollar, metrics
+from feelmysign.research.playback import simulate
 from feelmysign.research.rerun import rerun
 from feelmysign.research.sweep import label
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import Algorithm, Params
-from feelmysign.simplify.segment import Sample
+from feelmysign.simplify.segment import Sample, Segment
 
 # Errors (grid units) at which the Douglas-Peucker frontier is drawn: from far below
 # a millimetre to a whole actuator spacing on the paper's sleeve.
 FRONTIER_ERRORS = tuple(float(e) for e in np.geomspace(0.01, 1.0, 13))
 LAG_PERCENTILE = 95
+# Douglas-Peucker keeps a point lying exactly at its tolerance: run at a hair above a
+# row's deviation, so that a tie does not cost it a stroke the online simplifier saved.
+DP_TIE_MARGIN = 1e-9
 
 
 @dataclass(frozen=True)
 class Source:
-    """A recording to evaluate, its name and the group it belongs to (a LASA shape)."""
+    """A recording to evaluate, its name, its group (a LASA shape) and its set.
+
+    ``template`` is the recording's own index among the recogniser's templates
+    (left out when it is recognised), or None when it has no shape to recognise.
+    """
 
     name: str
     group: str
     recording: Recording
+    set: str = "files"
+    template: int | None = None
 
 
 @dataclass(frozen=True)
@@ -58,6 +77,7 @@ class Run:
 class Row:
     recording: str
     group: str
+    set: str
     algorithm: str
     setting: str
     overrides: dict[str, Any]
@@ -68,12 +88,23 @@ class Row:
     frechet: float
     dp_strokes: int  # Douglas-Peucker's strokes at this row's max deviation
     lags_ms: tuple[float, ...] = field(repr=False)
+    drawing_ms: float = 0.0
+    skin_ms: float = 0.0
+    release_ms: tuple[float, ...] = field(default=(), repr=False)
+    pen_to_skin_ms: tuple[float, ...] = field(default=(), repr=False)
+    recognised_drawn: bool | None = None
+    recognised_sent: bool | None = None
+
+    @property
+    def skin_ratio(self) -> float:
+        return self.skin_ms / self.drawing_ms if self.drawing_ms > 0 else float("nan")
 
     def csv_fields(self) -> dict[str, Any]:
         lags = np.array(self.lags_ms)
         return {
             "recording": self.recording,
             "group": self.group,
+            "set": self.set,
             "algorithm": self.algorithm,
             "setting": self.setting,
             **self.overrides,
@@ -86,11 +117,22 @@ class Row:
             "lag_mean_ms": _round(lags.mean()) if len(lags) else "",
             "lag_p95_ms": _round(np.percentile(lags, LAG_PERCENTILE)) if len(lags) else "",
             "lag_max_ms": _round(lags.max()) if len(lags) else "",
+            "drawing_ms": _round(self.drawing_ms),
+            "skin_ms": _round(self.skin_ms),
+            "skin_ratio": _round(self.skin_ratio),
+            "release_to_felt_end_ms": _round(max(self.release_ms)) if self.release_ms else "",
+            "pen_to_skin_max_ms": _round(max(self.pen_to_skin_ms)) if self.pen_to_skin_ms else "",
+            "recognised_drawn": _flag(self.recognised_drawn),
+            "recognised_sent": _flag(self.recognised_sent),
         }
 
 
 def _round(value: Any) -> float:
     return round(float(value), 3)
+
+
+def _flag(value: bool | None) -> int | str:
+    return "" if value is None else int(value)
 
 
 def params_for(algorithm: Algorithm, recording: Recording, overrides: dict[str, Any]) -> Params:
@@ -112,23 +154,70 @@ def grid_points(params: Params, frames: Sequence[Sample]) -> metrics.Points:
     return metrics.as_points([mapping.to_grid(f.x, f.y) for f in frames])
 
 
-def evaluate_one(source: Source, run: Run) -> Row:
-    """Run one recording through one parameter set and measure it, path by path."""
+def layout_for(params: Params) -> Layout:
+    """The sleeve the strokes are planned on: the paper's, or a grid of the recording's size."""
+    if (params.rows, params.columns) == (PAPER_SLEEVE.rows, PAPER_SLEEVE.columns):
+        return PAPER_SLEEVE
+    return grid_layout(params.rows, params.columns, PAPER_SLEEVE.spacing_cm)
+
+
+def sent_polyline(segments: Sequence[Segment]) -> metrics.Points:
+    """The strokes sent, chained: the first one's start, then every end."""
+    sent = [s for s in segments if s.dropped is None]
+    if not sent:
+        return metrics.as_points([])
+    return metrics.as_points([sent[0].start, *(s.end for s in sent)])
+
+
+class Recogniser:
+    """The $1 recogniser with the LASA drawings as templates, one left out per candidate."""
+
+    def __init__(self, templates: dollar.Templates) -> None:
+        self._templates = templates
+        self._drawn: dict[str, bool] = {}
+
+    def names(self, source: Source, candidate: metrics.Points) -> bool | None:
+        """Whether ``candidate`` is recognised as the source's shape (None: nothing to test)."""
+        if source.template is None:
+            return None
+        if len(candidate) < 2 or not np.any(candidate != candidate[0]):
+            return False
+        name, _ = dollar.recognise(candidate, self._templates.without(source.template))
+        return name == source.group
+
+    def drawn(self, source: Source, points: metrics.Points) -> bool | None:
+        if source.name not in self._drawn:
+            self._drawn[source.name] = bool(self.names(source, points))
+        return self._drawn[source.name] if source.template is not None else None
+
+
+def evaluate_one(source: Source, run: Run, recogniser: Recogniser | None = None) -> Row:
+    """Run one recording through one parameter set and measure it, path by path.
+
+    Deviation is measured on every drawn sample (not only on the frames an
+    animation loop saw): a sample's distance to the stroke whose time covers it.
+    """
     params = params_for(run.algorithm, source.recording, run.overrides)
     result = rerun(source.recording, params)
     deviation, frechet, dp_strokes, frames = 0.0, 0.0, 0, 0
     segments = [item.segment for item in result.segments]
-    for index, path in enumerate(result.frames):
+    drawn_paths = []
+    for index, path in enumerate(source.recording.paths):
         own = [item.segment for item in result.segments if item.path == index]
         points = grid_points(params, path)
-        path_deviation = metrics.max_deviation([f.t_ms for f in path], points, own)
+        drawn_paths.append(points)
+        path_deviation = metrics.max_deviation([s.t_ms for s in path], points, own)
         deviation = max(deviation, path_deviation)
         frechet = max(frechet, metrics.path_frechet(points, own))
-        dp_strokes += metrics.douglas_peucker_strokes(points, path_deviation)
-        frames += len(path)
+        tolerance = path_deviation * (1 + DP_TIE_MARGIN) + DP_TIE_MARGIN
+        dp_strokes += metrics.douglas_peucker_strokes(points, tolerance)
+        frames += len(result.frames[index]) if index < len(result.frames) else 0
+    playback = simulate(result.segments, source.recording.paths, layout_for(params))
+    drawn = np.concatenate(drawn_paths) if drawn_paths else metrics.as_points([])
     return Row(
         recording=source.name,
         group=source.group,
+        set=source.set,
         algorithm=run.algorithm.name,
         setting=run.label,
         overrides=run.overrides,
@@ -139,31 +228,44 @@ def evaluate_one(source: Source, run: Run) -> Row:
         frechet=frechet,
         dp_strokes=dp_strokes,
         lags_ms=tuple(float(v) for v in metrics.emission_lags_ms(segments)),
+        drawing_ms=playback.drawing_ms,
+        skin_ms=playback.skin_ms,
+        release_ms=playback.release_to_felt_end_ms,
+        pen_to_skin_ms=playback.pen_to_skin_ms,
+        recognised_drawn=recogniser.drawn(source, drawn) if recogniser else None,
+        recognised_sent=recogniser.names(source, sent_polyline(segments)) if recogniser else None,
     )
 
 
 def evaluate(
-    sources: Sequence[Source], runs: Sequence[Run], advance: Callable[[], None] = lambda: None
+    sources: Sequence[Source],
+    runs: Sequence[Run],
+    advance: Callable[[], None] = lambda: None,
+    recogniser: Recogniser | None = None,
 ) -> list[Row]:
     """Every source through every run, in that order; ``advance`` is called after each."""
     rows = []
     for run in runs:
         for source in sources:
-            rows.append(evaluate_one(source, run))
+            rows.append(evaluate_one(source, run, recogniser))
             advance()
     return rows
 
 
 def summarize(rows: Sequence[Row]) -> list[dict[str, Any]]:
-    """Per algorithm and parameter set, in first-seen order: the figures of ``--json``."""
-    groups: dict[tuple[str, str], list[Row]] = {}
+    """Per set, algorithm and parameter set, in first-seen order: the figures of ``--json``."""
+    groups: dict[tuple[str, str, str], list[Row]] = {}
     for row in rows:
-        groups.setdefault((row.algorithm, row.setting), []).append(row)
+        groups.setdefault((row.set, row.algorithm, row.setting), []).append(row)
     summary = []
-    for (algorithm, setting), members in groups.items():
+    for (source_set, algorithm, setting), members in groups.items():
         lags = np.array([lag for r in members for lag in r.lags_ms])
+        ratios = np.array([r.skin_ratio for r in members if r.drawing_ms > 0])
+        release = np.array([v for r in members for v in r.release_ms])
+        pen = np.array([v for r in members for v in r.pen_to_skin_ms])
         summary.append(
             {
+                "set": source_set,
                 "algorithm": algorithm,
                 "setting": setting,
                 "params": members[0].overrides,
@@ -173,13 +275,29 @@ def summarize(rows: Sequence[Row]) -> list[dict[str, Any]]:
                 "max_deviation_max": round(max(r.max_deviation for r in members), 6),
                 "max_deviation_mean": _mean([r.max_deviation for r in members]),
                 "frechet_mean": _mean([r.frechet for r in members]),
-                "lag_p95_ms": _round(np.percentile(lags, LAG_PERCENTILE)) if len(lags) else None,
+                "lag_p95_ms": _percentile(lags),
                 "lag_mean_ms": _round(lags.mean()) if len(lags) else None,
                 "dropped_total": sum(r.dropped for r in members),
                 "dp_strokes_mean": _mean([r.dp_strokes for r in members]),
+                "skin_ratio_mean": _round(ratios.mean()) if len(ratios) else None,
+                "skin_ratio_p95": _percentile(ratios),
+                "release_to_felt_end_median_ms": _percentile(release, 50),
+                "release_to_felt_end_p95_ms": _percentile(release),
+                "pen_to_skin_p95_ms": _percentile(pen),
+                "recognised_drawn_pct": _percent([r.recognised_drawn for r in members]),
+                "recognised_sent_pct": _percent([r.recognised_sent for r in members]),
             }
         )
     return summary
+
+
+def _percentile(values: NDArray[np.float64], q: float = LAG_PERCENTILE) -> float | None:
+    return _round(np.percentile(values, q)) if len(values) else None
+
+
+def _percent(flags: Sequence[bool | None]) -> float | None:
+    known = [f for f in flags if f is not None]
+    return round(100.0 * sum(known) / len(known), 2) if known else None
 
 
 def _mean(values: Sequence[float]) -> float:
@@ -189,7 +307,7 @@ def _mean(values: Sequence[float]) -> float:
 def frontier(
     sources: Sequence[Source], algorithm: Algorithm, errors: Sequence[float] = FRONTIER_ERRORS
 ) -> list[dict[str, float]]:
-    """Douglas-Peucker at each error on every source's frames (the algorithm's default grid).
+    """Douglas-Peucker at each error on every source's samples (the algorithm's default grid).
 
     Each point: the error, the mean strokes per recording, the mean of each
     recording's actual maximum deviation (at most the error).
@@ -197,8 +315,7 @@ def frontier(
     prepared = []
     for source in sources:
         params = params_for(algorithm, source.recording, {})
-        frames = rerun(source.recording, params).frames
-        prepared.append([grid_points(params, path) for path in frames])
+        prepared.append([grid_points(params, path) for path in source.recording.paths])
     points = []
     for error in errors:
         strokes, deviations = [], []
