@@ -24,6 +24,8 @@ const WIDTH_PX = 900;
 const HEIGHT_PX = 600;
 /** Room for a distance computed another way than the simplifier's (last bits only). */
 const FLOAT_TOLERANCE = 1e-12;
+/** Hundreds of random paths: generous, for a loaded machine (the work is bounded, not timed). */
+const PROPERTY_TIMEOUT_MS = 120_000;
 
 /** A pointer path: a random walk inside (and a little outside) the canvas, times increasing. */
 const pathArb = fc
@@ -116,62 +118,74 @@ function covered(params: WindowParams, samples: readonly Sample[]) {
 }
 
 describe("window simplifier invariants", () => {
-  it("every drawn sample lies within max_error of its stroke; strokes keep the caps", () => {
-    fc.assert(
-      fc.property(paramsArb, pathArb, (params, samples) => {
-        const { spans, map } = covered(params, samples);
-        for (const { first, last, segment } of spans) {
-          expect(last - first).toBeLessThanOrEqual(params.max_window);
-          if (params.max_stroke_ms > 0 && last - first > 1) {
-            expect(segment.duration_ms).toBeLessThanOrEqual(params.max_stroke_ms);
+  it(
+    "every drawn sample lies within max_error of its stroke; strokes keep the caps",
+    () => {
+      fc.assert(
+        fc.property(paramsArb, pathArb, (params, samples) => {
+          const { spans, map } = covered(params, samples);
+          for (const { first, last, segment } of spans) {
+            expect(last - first).toBeLessThanOrEqual(params.max_window);
+            if (params.max_stroke_ms > 0 && last - first > 1) {
+              expect(segment.duration_ms).toBeLessThanOrEqual(params.max_stroke_ms);
+            }
+            for (let j = first; j <= last; j++) {
+              const point = map.toGrid(samples[j]!.x, samples[j]!.y);
+              expect(distance(point, segment.start, segment.end)).toBeLessThanOrEqual(
+                params.max_error + FLOAT_TOLERANCE,
+              );
+            }
           }
-          for (let j = first; j <= last; j++) {
-            const point = map.toGrid(samples[j]!.x, samples[j]!.y);
-            expect(distance(point, segment.start, segment.end)).toBeLessThanOrEqual(
-              params.max_error + FLOAT_TOLERANCE,
-            );
-          }
-        }
-      }),
-      { numRuns: 400 },
-    );
-  });
+        }),
+        { numRuns: 400 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
 
-  it("strokes join end to start from the press to the release", () => {
-    fc.assert(
-      fc.property(paramsArb, pathArb, (params, samples) => {
-        const { segments, map } = covered(params, samples);
-        const first = samples[0]!;
-        const last = samples[samples.length - 1]!;
-        expect(segments[0]!.start).toEqual(map.toGrid(first.x, first.y));
-        expect(segments[segments.length - 1]!.end).toEqual(map.toGrid(last.x, last.y));
-        for (let i = 1; i < segments.length; i++) {
-          expect(segments[i]!.start).toEqual(segments[i - 1]!.end);
-          expect(segments[i]!.start_ms).toBe(segments[i - 1]!.end_ms);
-        }
-      }),
-      { numRuns: 200 },
-    );
-  });
-
-  it("sent strokes meet the minimums and dropped ones say why", () => {
-    fc.assert(
-      fc.property(paramsArb, pathArb, (params, samples) => {
-        for (const segment of covered(params, samples).segments) {
-          const duration = segment.end_ms - segment.start_ms;
-          if (segment.dropped === null) {
-            expect(segmentLength(segment)).toBeGreaterThanOrEqual(params.min_length);
-            expect(duration).toBeGreaterThanOrEqual(params.min_duration_ms);
-          } else if (segment.dropped === NOT_ENOUGH_DISTANCE) {
-            expect(segmentLength(segment)).toBeLessThan(params.min_length);
-          } else {
-            expect(segment.dropped).toBe(NOT_ENOUGH_DURATION);
-            expect(duration).toBeLessThan(params.min_duration_ms);
+  it(
+    "strokes join end to start from the press to the release",
+    () => {
+      fc.assert(
+        fc.property(paramsArb, pathArb, (params, samples) => {
+          const { segments, map } = covered(params, samples);
+          const first = samples[0]!;
+          const last = samples[samples.length - 1]!;
+          expect(segments[0]!.start).toEqual(map.toGrid(first.x, first.y));
+          expect(segments[segments.length - 1]!.end).toEqual(map.toGrid(last.x, last.y));
+          for (let i = 1; i < segments.length; i++) {
+            expect(segments[i]!.start).toEqual(segments[i - 1]!.end);
+            expect(segments[i]!.start_ms).toBe(segments[i - 1]!.end_ms);
           }
-          expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
-        }
-      }),
-      { numRuns: 200 },
-    );
-  });
+        }),
+        { numRuns: 200 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+
+  it(
+    "sent strokes meet the minimums and dropped ones say why",
+    () => {
+      fc.assert(
+        fc.property(paramsArb, pathArb, (params, samples) => {
+          for (const segment of covered(params, samples).segments) {
+            const duration = segment.end_ms - segment.start_ms;
+            if (segment.dropped === null) {
+              expect(segmentLength(segment)).toBeGreaterThanOrEqual(params.min_length);
+              expect(duration).toBeGreaterThanOrEqual(params.min_duration_ms);
+            } else if (segment.dropped === NOT_ENOUGH_DISTANCE) {
+              expect(segmentLength(segment)).toBeLessThan(params.min_length);
+            } else {
+              expect(segment.dropped).toBe(NOT_ENOUGH_DURATION);
+              expect(duration).toBeLessThan(params.min_duration_ms);
+            }
+            expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
+          }
+        }),
+        { numRuns: 200 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
 });
