@@ -35,8 +35,6 @@ export class DrawingSession {
   readonly #host: SessionHost;
   #drawing: Drawing | null = null;
   #simplifier: Simplifier | null = null;
-  /** The simplifier takes every pointer sample (coalesced ones included), not frames. */
-  #feedsSamples = false;
   #sampler = new FrameSampler(60);
   #pointerKind: PointerKind = "mouse";
   #pointer: Sample | null = null;
@@ -49,6 +47,12 @@ export class DrawingSession {
   constructor(view: DrawingView, host: SessionHost) {
     this.#view = view;
     this.#host = host;
+  }
+
+  /** The drawing's simplifier takes every pointer sample (coalesced ones included), not frames. */
+  get #feedsSamples(): boolean {
+    const drawing = this.#drawing;
+    return drawing !== null && ALGORITHMS[drawing.params.algorithm].input === "samples";
   }
 
   get drawing(): Drawing | null {
@@ -179,7 +183,6 @@ export class DrawingSession {
   #newDrawing(settings: Settings): void {
     const params = simplifierParams(settings, this.#host.grid(), this.#view.area);
     this.#simplifier = makeSimplifier(params);
-    this.#feedsSamples = ALGORITHMS[params.algorithm].input === "samples";
     this.#drawing = new Drawing(newDrawingId(), params);
     this.#view.setDrawing(this.#drawing);
     this.#host.changed(this.#drawing);
