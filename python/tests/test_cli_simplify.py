@@ -30,6 +30,8 @@ def _recording(case: dict[str, Any], path: Path) -> Path:
 
 def _flags(params: dict[str, Any]) -> list[str]:
     flags = [
+        "--algorithm",
+        "angle",
         "--check-frames",
         str(params["check_frames"]),
         "--max-angle-deg",
@@ -120,5 +122,5 @@ def test_missing_file_and_bad_parameter(tmp_path: Path, capsys: pytest.CaptureFi
     assert main(["simplify", str(tmp_path / "absent.json")]) == 1
     assert "cannot read recording" in capsys.readouterr().err
     recording = _recording(ANGLE["circle/defaults"], tmp_path / "c.json")
-    assert main(["simplify", str(recording), "--check-frames", "1"]) == 1
+    assert main(["simplify", str(recording), "--paper", "--check-frames", "1"]) == 1
     assert "check_frames" in capsys.readouterr().err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import random
@@ -100,7 +101,9 @@ def test_douglas_peucker_runs_above_a_tie_with_the_rows_deviation() -> None:
         at = int((bump_x - 100) / 10)
         samples = (*line[: at + 1], Sample(line[at].t_ms + 1, bump_x, bump_y), *line[at + 1 :])
         recording = Recording(1200.0, 800.0, (samples,), 3, 4)
-        run = Run(ALGORITHMS["window"], {"max_error": 0.6, "min_duration_ms": 0.0})
+        run = Run(
+            ALGORITHMS["window"], {"max_error": 0.6, "min_duration_ms": 0.0, "max_stroke_ms": 0.0}
+        )
         row = evaluate_one(Source("bump", "bump", recording), run)
         assert row.strokes == 1 and row.dp_strokes == 1
         points = grid_points(params_for(run.algorithm, recording, run.overrides), samples)
@@ -115,9 +118,13 @@ def test_simplify_json_gives_each_stroke_its_drawn_times(
     path = tmp_path / "line.json"
     path.write_text(json.dumps({"canvas": {"width_px": 800, "height_px": 600}, "paths": [line]}))
     assert main(["simplify", str(path), "--algorithm", "window", "--json"]) == 0
-    strokes = json.loads(capsys.readouterr().out)["strokes"]
-    assert strokes and strokes[0]["start_ms"] == 0.0 and strokes[-1]["end_ms"] == 590.0
-    for stroke in strokes:
+    document = json.loads(capsys.readouterr().out)
+    strokes = document["strokes"]
+    every = sorted(strokes + document["dropped"], key=lambda s: s["start_ms"])
+    assert strokes and every[0]["start_ms"] == 0.0 and every[-1]["end_ms"] == 590.0
+    for before, after in itertools.pairwise(every):
+        assert after["start_ms"] == before["end_ms"]
+    for stroke in every:
         assert stroke["duration_ms"] == pytest.approx(stroke["end_ms"] - stroke["start_ms"])
 
 

@@ -95,7 +95,7 @@ def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: o
 def test_square_is_four_strokes_with_its_corners() -> None:
     # 10 px a sample is 0.033 grid units: above the error, so a corner shows at once.
     params = WindowParams(
-        canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000
+        canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000, max_stroke_ms=0
     )
     corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
     points = [
@@ -117,7 +117,11 @@ def test_the_cut_goes_on_the_feature_not_where_the_bound_first_breaks() -> None:
     # A shallow tent: up 4 px over 20 samples, then down. The bound (0.05 grid units,
     # 5 px here) breaks well past the tip; the stroke still ends on the tip.
     params = WindowParams(
-        canvas_width_px=300, canvas_height_px=200, max_error=0.05, min_duration_ms=0
+        canvas_width_px=300,
+        canvas_height_px=200,
+        max_error=0.05,
+        min_duration_ms=0,
+        max_stroke_ms=0,
     )
     up = [Sample(8.0 * k, 5.0 * k, 100 - 0.6 * k) for k in range(21)]
     down = [Sample(8.0 * (20 + k), 100 + 5.0 * k, 88 + 0.6 * k) for k in range(1, 41)]
@@ -143,7 +147,7 @@ def test_a_release_a_rounding_error_after_a_frame_still_reaches_the_end() -> Non
     # A 125 Hz pen; the release comes 0.0003 ms after the 30th 60 fps frame, moved on.
     samples = [Sample(k * 8.0, 200.0 + 6.0 * k, 300.0 + 2.0 * k) for k in range(63)]
     release = Sample(500.0 + 0.0003, 200.0 + 6.0 * 63, 300.0 + 2.0 * 63)
-    params = WindowParams(canvas_width_px=1200, canvas_height_px=800)
+    params = WindowParams(canvas_width_px=1200, canvas_height_px=800, max_stroke_ms=0)
     segments = [s for _, s in _run(params, [[*samples, release]])]
     assert [s.dropped for s in segments] == [None]
     assert segments[-1].end == params.mapping.to_grid(release.x, release.y)
@@ -233,10 +237,18 @@ def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixt
     assert exit_.value.code == 2
     assert "--check-frames only applies to --algorithm angle" in capsys.readouterr().err
     with pytest.raises(SystemExit):
-        main(["simplify", str(recording), "--max-error", "0.1"])
+        main(["simplify", str(recording), "--paper", "--max-error", "0.1"])
     assert "--max-error only applies to --algorithm window" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["simplify", str(recording), "--paper", "--algorithm", "window"])
+    assert "--paper is the angle simplifier" in capsys.readouterr().err
+    # The project's default is the window simplifier at its defaults; --paper is the paper's.
     assert main(["simplify", str(recording), "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["algorithm"] == "angle"
+    default = json.loads(capsys.readouterr().out)
+    assert default["algorithm"] == "window" and default["params"]["max_error"] == 0.25
+    assert main(["simplify", str(recording), "--paper", "--json"]) == 0
+    paper = json.loads(capsys.readouterr().out)
+    assert paper["algorithm"] == "angle" and paper["params"]["max_angle_deg"] == 20.0
 
 
 def test_cli_uses_the_recordings_algorithm_and_parameters(
@@ -355,8 +367,11 @@ def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
     for first, last, segment in _covered(params, samples):
         assert last - first <= params.max_window
         assert last > first or len(samples) == 1, "only a one-sample path gives an empty stroke"
-        if params.max_stroke_ms and last - first > 1:
-            assert segment.duration_ms <= params.max_stroke_ms
+        if params.max_stroke_ms and segment.duration_ms > params.max_stroke_ms:
+            # Only a single step, or a stroke still too short to send a sample earlier.
+            before = params.mapping.to_grid(samples[last - 1].x, samples[last - 1].y)
+            short = math.dist(segment.start, before) < params.min_length
+            assert last - first == 1 or short
         assert segment.emitted_at_ms in times and segment.emitted_at_ms >= segment.end_ms
 
 

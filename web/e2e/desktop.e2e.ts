@@ -35,7 +35,7 @@ import {
   openAdvanced,
 } from "./page";
 
-/** Grid units: the live frames see a corner up to check_frames frames late or early (~20 px here). */
+/** Grid units: a corner is the drawn sample nearest it (mouse steps of 5 px), a little off under load. */
 const CORNER_TOLERANCE = 0.15;
 /** The default min_length, grid units: the longest gap a dropped segment leaves. */
 const MIN_LENGTH = 0.1;
@@ -43,6 +43,13 @@ const UUID = /^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{1
 const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3.0 }, version: "test" };
 
 type Point = readonly [number, number];
+
+/** Distance from a point to the segment a -> b. */
+function sideDistance(point: Point, a: Point, b: Point): number {
+  const [dx, dy] = [b[0] - a[0], b[1] - a[1]];
+  const t = Math.min(Math.max(((point[0] - a[0]) * dx + (point[1] - a[1]) * dy) / (dx * dx + dy * dy), 0), 1);
+  return Math.hypot(point[0] - a[0] - t * dx, point[1] - a[1] - t * dy);
+}
 
 function near(actual: unknown, expected: readonly [number, number], what: string): void {
   const [x, y] = actual as [number, number];
@@ -61,6 +68,8 @@ describe("drawing with a mouse on a desktop", () => {
   let page: Page;
   let pageUrl: string;
   const pageErrors: string[] = [];
+  /** The strokes the square was sent as (four sides, a long one cut by the latency cap). */
+  let sentCount = 0;
 
   beforeAll(async () => {
     checkPrerequisites();
@@ -99,7 +108,7 @@ describe("drawing with a mouse on a desktop", () => {
     await screenshot(page, "desktop-idle");
   });
 
-  it("sends a square drawn with the mouse as four strokes with the square's corners", async () => {
+  it("sends a square drawn with the mouse as strokes along its four sides, with its corners", async () => {
     const area = await drawingArea(page);
     const side = area.height * 0.6;
     const left = area.left + (area.width - side) / 2;
@@ -115,13 +124,29 @@ describe("drawing with a mouse on a desktop", () => {
         await screenshot(page, "desktop-drawing");
       },
     });
-    const strokes = await sleeve.waitForStrokes(4);
-    await waitForData(page, '[data-testid="played-summary"]', "sent", "4");
-    expect(strokes).toHaveLength(4);
+    // Every stroke leaves on release at the latest; a long side may be cut by the latency cap.
+    await nextFrame(page);
+    sentCount = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
+    expect(sentCount).toBeGreaterThanOrEqual(4);
+    const strokes = await sleeve.waitForStrokes(sentCount);
+    expect(strokes).toHaveLength(sentCount);
     const grid = corners.map(([x, y]) => toGrid(area, x, y));
+    near(strokes[0]!["start"], grid[0]!, "the first stroke's start");
+    near(strokes.at(-1)!["end"], grid[0]!, "the last stroke's end");
+    for (const [i, corner] of grid.slice(1).entries()) {
+      const ends = strokes.map((stroke) => stroke["end"] as [number, number]);
+      const nearest = Math.min(...ends.map(([x, y]) => Math.hypot(x - corner[0], y - corner[1])));
+      expect(nearest, `corner ${i + 1} is a stroke's end`).toBeLessThanOrEqual(CORNER_TOLERANCE);
+    }
     strokes.forEach((stroke, i) => {
-      near(stroke["start"], grid[i]!, `stroke ${i} start`);
-      near(stroke["end"], grid[(i + 1) % 4]!, `stroke ${i} end`);
+      // Each stroke lies along one side: both its ends near that side.
+      const onSide = grid.some((a, k) => {
+        const b = grid[(k + 1) % 4]!;
+        return [stroke["start"], stroke["end"]].every(
+          (p) => sideDistance(p as Point, a, b) <= CORNER_TOLERANCE,
+        );
+      });
+      expect(onSide, `stroke ${i} lies along a side`).toBe(true);
       expect(stroke).toMatchObject({ v: 1, seq: i, intensity: 0.8 });
       expect(stroke["duration_ms"] as number).toBeGreaterThan(0);
       expect(Math.abs((stroke["sent_at_ms"] as number) - Date.now())).toBeLessThan(60_000);
@@ -171,7 +196,7 @@ describe("drawing with a mouse on a desktop", () => {
     const log = page.locator('[data-testid="event-log"] li').first();
     await expect(log.innerText()).resolves.toContain("Stroke 2 refused: duration_ms is 12000");
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toBe(
-      "3 of 4 strokes played, 1 refused.",
+      `3 of ${sentCount} strokes played, 1 refused.`,
     );
     await screenshot(page, "desktop-after");
   });
@@ -186,7 +211,7 @@ describe("drawing with a mouse on a desktop", () => {
     await download.saveAs(file);
     const recording = JSON.parse(readFileSync(file, "utf8"));
     expect(recording.sleeve).toEqual({ rows: 3, columns: 4 });
-    expect(recording.strokes).toHaveLength(4);
+    expect(recording.strokes).toHaveLength(sentCount);
     const replay = JSON.parse(execFileSync(FEELMYSIGN, ["simplify", file, "--json"], { encoding: "utf8" }));
     // Replay resamples pointer events into frames; the press and the release are frames in both.
     const sent = sleeve.strokes();
@@ -237,10 +262,12 @@ describe("drawing with a mouse on a desktop", () => {
     await panel.waitFor({ state: "visible" });
     await screenshot(page, "desktop-settings");
     await openAdvanced(page);
-    const checkFrames = page.locator('[data-testid="setting-check_frames"]');
-    await checkFrames.fill("1");
-    await expect(page.locator("#setting-check_frames-error").innerText()).resolves.toBe(
-      "Check frames must be a whole number from 2 to 600.",
+    // The default simplifier is the window one: its max error is open, the angle options locked.
+    expect(await page.locator('[data-testid="setting-check_frames"]').isDisabled()).toBe(true);
+    const maxError = page.locator('[data-testid="setting-max_error"]');
+    await maxError.fill("0");
+    await expect(page.locator("#setting-max_error-error").innerText()).resolves.toBe(
+      "Max error must be a number from 0.001 to 100.",
     );
     expect(await page.locator('[data-testid="settings-save"]').isDisabled()).toBe(true);
     await screenshot(page, "desktop-settings-error");
@@ -249,7 +276,7 @@ describe("drawing with a mouse on a desktop", () => {
     await expect(page.locator("#setting-intensity-error").innerText()).resolves.toContain(
       "Intensity must be",
     );
-    await checkFrames.fill("6");
+    await maxError.fill("0.3");
     await page.locator('[data-testid="setting-intensity"]').fill("0.5");
     expect(await page.locator('[data-testid="settings-save"]').isDisabled()).toBe(false);
     await page.locator('[data-testid="settings-save"]').click();
@@ -257,10 +284,10 @@ describe("drawing with a mouse on a desktop", () => {
     await page.reload();
     await page.locator('[data-testid="settings-button"]').click();
     await openAdvanced(page);
-    await expect(page.locator('[data-testid="setting-check_frames"]').inputValue()).resolves.toBe("6");
+    await expect(page.locator('[data-testid="setting-max_error"]').inputValue()).resolves.toBe("0.3");
     await expect(page.locator('[data-testid="setting-intensity"]').inputValue()).resolves.toBe("0.5");
     await page.locator("#settings-reset").click();
-    await expect(page.locator('[data-testid="setting-check_frames"]').inputValue()).resolves.toBe("5");
+    await expect(page.locator('[data-testid="setting-max_error"]').inputValue()).resolves.toBe("0.25");
     await page.locator('[data-testid="settings-save"]').click();
     await panel.waitFor({ state: "hidden" });
   });
@@ -284,7 +311,8 @@ describe("drawing with a mouse on a desktop", () => {
       await nextFrame(page);
       legacy = sleeve.received.filter((message) => message.topic === "deviceOne/line");
     }
-    expect(legacy).toHaveLength(1);
+    // The line's first stroke (a long line may be cut by the latency cap into several).
+    expect(legacy.length).toBeGreaterThanOrEqual(1);
     // startX,startY,endX,endY,duration: grid units with at most 4 decimals, then milliseconds.
     const fields = legacy[0]!.payload.split(",");
     expect(fields).toHaveLength(5);
@@ -339,15 +367,20 @@ describe("a broker that goes away", () => {
     const area = await drawingArea(page);
     const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
     await drawWithMouse(page, [at(0.2, 0.2), at(0.2, 0.8), at(0.8, 0.8)]);
-    await waitForData(page, '[data-testid="unsent-count"]', "count", "2");
-    await expect(page.locator('[data-testid="unsent-count"]').innerText()).resolves.toBe("2 strokes unsent");
+    await nextFrame(page);
+    // Two legs; a long leg may be cut by the latency cap, so two strokes or more.
+    const unsent = Number(await page.locator('[data-testid="unsent-count"]').getAttribute("data-count"));
+    expect(unsent).toBeGreaterThanOrEqual(2);
+    await expect(page.locator('[data-testid="unsent-count"]').innerText()).resolves.toBe(
+      `${unsent} strokes unsent`,
+    );
     await expect(page.locator("#notice").innerText()).resolves.toContain("No connection to");
     await screenshot(page, "desktop-offline");
     expect(sleeve.strokes()).toHaveLength(0);
 
     broker = await Broker.start(stateDir, ports);
-    const strokes = await sleeve.waitForStrokes(2, 20_000);
-    expect(strokes.map((stroke) => stroke["seq"])).toEqual([0, 1]);
+    const strokes = await sleeve.waitForStrokes(unsent, 20_000);
+    expect(strokes.map((stroke) => stroke["seq"])).toEqual([...Array(unsent).keys()]);
     await waitForData(page, '[data-testid="unsent-count"]', "count", "0");
     expect(await page.locator(CANVAS).isVisible()).toBe(true);
     await page.locator("#notice").waitFor({ state: "hidden" });

@@ -19,7 +19,7 @@ import {
   tempDir,
   type Credentials,
 } from "./harness";
-import { drawingArea, drawWithMouse, screenshot, toGrid, waitForData } from "./page";
+import { drawingArea, drawWithMouse, nextFrame, screenshot, toGrid, waitForData } from "./page";
 
 /** Grid units, as in desktop.e2e.ts. */
 const CORNER_TOLERANCE = 0.15;
@@ -55,7 +55,7 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
   });
 
-  it("plays a square drawn with the mouse: four strokes at its corners, the preview lights up", async () => {
+  it("plays a square drawn with the mouse: strokes from its corners, the preview lights up", async () => {
     const area = await drawingArea(page);
     const side = area.height * 0.6;
     const left = area.left + (area.width - side) / 2;
@@ -67,12 +67,16 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
       [left, top + side],
     ] as const;
     await drawWithMouse(page, [...corners, corners[0]]);
-    const strokes = await sleeve.waitForStrokes(4);
-    expect(strokes).toHaveLength(4);
-    strokes.forEach((stroke, i) => {
-      const [x, y] = stroke["start"] as [number, number];
-      const [wx, wy] = toGrid(area, ...corners[i]!);
-      expect(Math.hypot(x - wx, y - wy), `stroke ${i} start`).toBeLessThan(CORNER_TOLERANCE);
+    await nextFrame(page);
+    // Four sides; a long side may be cut by the latency cap, so four strokes or more.
+    const sent = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
+    expect(sent).toBeGreaterThanOrEqual(4);
+    const strokes = await sleeve.waitForStrokes(sent);
+    const starts = strokes.map((stroke) => stroke["start"] as [number, number]);
+    corners.forEach((corner, i) => {
+      const [wx, wy] = toGrid(area, ...corner);
+      const nearest = Math.min(...starts.map(([x, y]) => Math.hypot(x - wx, y - wy)));
+      expect(nearest, `corner ${i} starts a stroke`).toBeLessThan(CORNER_TOLERANCE);
     });
     await page.waitForFunction(
       () =>
@@ -81,6 +85,6 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
       { timeout: 15_000 },
     );
     await screenshot(page, "up-playing");
-    await waitForData(page, '[data-testid="played-summary"]', "played", "4", 30_000);
+    await waitForData(page, '[data-testid="played-summary"]', "played", String(sent), 30_000);
   });
 });

@@ -297,7 +297,8 @@ function paramDefault<T extends number | boolean>(name: AngleParamName): T {
 }
 
 export const DEFAULT_SETTINGS: Settings = Object.freeze({
-  algorithm: "angle",
+  // The project's default (docs/research.md, "Default settings"); "angle" is the paper's.
+  algorithm: "window",
   max_error: windowParamSpec("max_error").default as number,
   max_window: windowParamSpec("max_window").default as number,
   max_stroke_ms: windowParamSpec("max_stroke_ms").default as number,

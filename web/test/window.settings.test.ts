@@ -22,13 +22,12 @@ const GRID = { rows: 3, columns: 4 };
 const CANVAS = { width_px: 600, height_px: 400 };
 
 describe("window settings", () => {
-  it("keeps the angle simplifier as the default, with the window's own defaults", () => {
-    expect(DEFAULT_SETTINGS.algorithm).toBe("angle");
+  it("makes the window simplifier the default, with its own defaults", () => {
+    expect(DEFAULT_SETTINGS.algorithm).toBe("window");
     expect(DEFAULT_SETTINGS.max_error).toBe(windowParamSpec("max_error").default);
     expect(DEFAULT_SETTINGS.max_window).toBe(windowParamSpec("max_window").default);
-    expect(makeSimplifier(simplifierParams(DEFAULT_SETTINGS, GRID, CANVAS))).not.toBeInstanceOf(
-      WindowSimplifier,
-    );
+    expect(DEFAULT_SETTINGS.max_stroke_ms).toBe(windowParamSpec("max_stroke_ms").default);
+    expect(makeSimplifier(simplifierParams(DEFAULT_SETTINGS, GRID, CANVAS))).toBeInstanceOf(WindowSimplifier);
   });
 
   it("validates max error and the window cap with the reference's ranges", () => {

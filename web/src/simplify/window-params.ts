@@ -29,7 +29,7 @@ export const WINDOW_PARAM_SPECS: readonly ParamSpec<WindowParamName>[] = [
   {
     name: "max_error",
     type: "number",
-    default: 0.1,
+    default: 0.25,
     minimum: 0.001,
     maximum: 100,
     help: "farthest a drawn point may lie from its stroke, in grid units",
@@ -45,7 +45,7 @@ export const WINDOW_PARAM_SPECS: readonly ParamSpec<WindowParamName>[] = [
   {
     name: "max_stroke_ms",
     type: "number",
-    default: 0,
+    default: 300,
     minimum: 0,
     maximum: 60000,
     help: "longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",

@@ -11,13 +11,16 @@
  * (grid units) from the stroke, the stroke is cut at the sample farthest from
  * the chord (among those whose own stroke keeps the bound), emitted now, and
  * the samples after the cut are taken again into the next stroke. A stroke
- * lasts at most `max_stroke_ms` of drawing (the latency cap) and holds at most
+ * long enough to send lasts at most `max_stroke_ms` of drawing (the latency cap) and holds at most
  * `max_window` samples (the work cap). Too short or too brief strokes are
  * dropped with their reason. The float operations follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
 import { finishSegment, type Point, type Sample, type Segment } from "./segment";
 import { checkWindowParams, type WindowParams } from "./window-params";
+
+/** The latency cap cuts at a feature only where the stroke bends by more than this share of max_error. */
+const CAP_BEND = 0.5;
 
 interface Drawn {
   readonly sample: Sample;
@@ -97,9 +100,21 @@ export class WindowSimplifier {
       let window = this.#window;
       const anchor = window[0]!;
       const capMs = this.params.max_stroke_ms;
-      if (capMs > 0 && window.length > 1 && item.sample.t_ms - anchor.sample.t_ms > capMs) {
+      if (
+        capMs > 0 &&
+        window.length > 1 &&
+        item.sample.t_ms - anchor.sample.t_ms > capMs &&
+        this.#sendable(anchor, window[window.length - 1]!)
+      ) {
+        const cut = this.#capCut(window);
+        out.push(this.#finish(anchor, window[cut]!));
+        if (cut < window.length - 1) {
+          pending.push(item);
+          pending.push(...window.slice(cut + 1).reverse());
+          this.#window = [window[cut]!];
+          continue;
+        }
         const last = window[window.length - 1]!;
-        out.push(this.#finish(anchor, last));
         window = this.#window = [last];
       }
       if (!this.#fits(window, 1, window.length, item.point)) {
@@ -116,6 +131,26 @@ export class WindowSimplifier {
         this.#window = [item];
       }
     }
+  }
+
+  /**
+   * Where the latency cap cuts: at a feature if the stroke so far bends by more
+   * than `CAP_BEND` x max_error from the chord anchor -> last sample, else at its end.
+   */
+  #capCut(window: readonly Drawn[]): number {
+    const last = window[window.length - 1]!;
+    const cut = this.#feature(window, last.point);
+    const farSq = distanceSq(window[cut]!.point, window[0]!.point, last.point);
+    const limit = CAP_BEND * this.params.max_error;
+    const bends = farSq > limit * limit && this.#sendable(window[0]!, window[cut]!);
+    return bends ? cut : window.length - 1;
+  }
+
+  /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
+  #sendable(start: Drawn, end: Drawn): boolean {
+    const dx = end.point[0] - start.point[0];
+    const dy = end.point[1] - start.point[1];
+    return dx * dx + dy * dy >= this.params.min_length * this.params.min_length;
   }
 
   /**

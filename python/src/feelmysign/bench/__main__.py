@@ -9,6 +9,7 @@ from feelmysign.bench import (
     lasa_points,
     planner_lasa,
     restart_off,
+    simplifier_timing,
     sleeve,
     study_recovery,
 )
@@ -26,6 +27,7 @@ def main() -> None:
     reports = (
         algorithms.report,
         planner_lasa.report,
+        simplifier_timing.report,
         lasa_points.report,
         sleeve.report,
         restart_off.report,

@@ -38,7 +38,7 @@ from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.research.rerun import Rerun, mismatch, rerun
 from feelmysign.sending import OutgoingStroke, StrokeSender, printer
 from feelmysign.simplify.recording import Recording
-from feelmysign.simplify.registry import Params
+from feelmysign.simplify.registry import DEFAULT_ALGORITHM, Params
 from feelmysign.stroke import Stroke
 
 MAX_SPEED = 1000.0  # a minute of drawing in 60 ms: faster is a burst, not a pace
@@ -118,7 +118,7 @@ def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> N
 
 
 def _recorded_algorithm(recording: Recording) -> str:
-    return str(recording.simplifier.get("algorithm", "angle"))
+    return str(recording.simplifier.get("algorithm", DEFAULT_ALGORITHM))
 
 
 def _verdict(recording: Recording, algorithm: str, difference: str | None) -> str:

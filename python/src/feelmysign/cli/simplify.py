@@ -18,7 +18,13 @@ from feelmysign.simplify import (
     simplify_paths,
 )
 from feelmysign.simplify.recording import Recording, RecordingError
-from feelmysign.simplify.registry import ONLY_FOR, Params, algorithm_of
+from feelmysign.simplify.registry import (
+    DEFAULT_ALGORITHM,
+    ONLY_FOR,
+    PAPER_ALGORITHM,
+    Params,
+    algorithm_of,
+)
 
 DEFAULTS = AngleParams()
 WINDOW_DEFAULTS = WindowParams()
@@ -39,8 +45,14 @@ def register(subparsers: Any) -> None:
         "--algorithm",
         choices=list(ALGORITHMS),
         default=None,
-        help="the simplifier: angle (the paper's) or window (error-bounded); "
-        "default: the recording's, else angle",
+        help="the simplifier: angle (the paper's) or window (error-bounded, cut at features); "
+        f"default: the recording's, else {DEFAULT_ALGORITHM}",
+    )
+    parser.add_argument(
+        "--paper",
+        action="store_true",
+        help="the paper's settings: the angle simplifier at its appendix B.1 values "
+        "(the same as --algorithm angle)",
     )
     _option(
         parser,
@@ -147,7 +159,8 @@ def params_from_args(args: argparse.Namespace, recording: Recording) -> Params:
     names = [f.name for f in fields(algorithm.params)]
     recorded = (
         recording.simplifier.get("params", {})
-        if recording.simplifier.get("algorithm", "angle") == algorithm.name
+        if recording.simplifier.get("algorithm", DEFAULT_ALGORITHM) == algorithm.name
+        and not getattr(args, "paper", False)
         else {}
     )
     base = algorithm.params(**{k: v for k, v in recorded.items() if k in names})
@@ -166,11 +179,13 @@ def params_from_args(args: argparse.Namespace, recording: Recording) -> Params:
 
 
 def chosen_algorithm(args: argparse.Namespace, recording: Recording) -> str:
-    """``--algorithm``, else the one the recording's sender used, else angle."""
+    """``--paper`` or ``--algorithm``, else the recording's sender's, else the default."""
+    if getattr(args, "paper", False):
+        return PAPER_ALGORITHM
     chosen = getattr(args, "algorithm", None)
     if chosen is not None:
         return str(chosen)
-    recorded = recording.simplifier.get("algorithm", "angle")
+    recorded = recording.simplifier.get("algorithm", DEFAULT_ALGORITHM)
     if recorded not in ALGORITHMS:
         raise RecordingError(
             f"{args.recording}: simplifier.algorithm {recorded!r} is unknown; "
@@ -201,6 +216,11 @@ def _check_usage(
     args: argparse.Namespace, algorithm: str, parser: argparse.ArgumentParser | None
 ) -> None:
     """Usage error (exit 2): an option of the other algorithm, which would be ignored."""
+    paper = getattr(args, "paper", False)
+    if paper and args.algorithm not in (None, PAPER_ALGORITHM) and parser:
+        parser.error(
+            f"--paper is the {PAPER_ALGORITHM} simplifier: drop --algorithm {args.algorithm}"
+        )
     for name, owner in ONLY_FOR.items():
         if owner != algorithm and getattr(args, name, None) is not None and parser:
             flag = "--no-recover" if name == "recover" else "--" + name.replace("_", "-")

@@ -77,6 +77,10 @@ def _only_for() -> dict[str, str]:
     return {name: names[0] for name, names in owners.items() if len(names) == 1}
 
 
+# The project's choice (see docs/research.md, "Default settings"), and the paper's.
+DEFAULT_ALGORITHM = "window"
+PAPER_ALGORITHM = "angle"
+
 # Parameter name -> the one algorithm that has it.
 ONLY_FOR: dict[str, str] = _only_for()
 

@@ -21,8 +21,12 @@ corners land on the drawing's features. Here:
   next stroke, and the samples after it are taken again, so strokes join end
   to start and every sample keeps the bound.
 - Latency cap: a stroke lasts at most ``max_stroke_ms`` of drawing. A sample
-  that would make it longer cuts it at the sample before, so the wearer feels
-  a long line begin before it ends (the paper's "frame max", in ms).
+  that would make it longer cuts it, so the wearer feels a long line begin
+  before it ends (the paper's "frame max", in ms): at a feature (as above,
+  against the chord to the sample before) where the stroke bends by more than
+  half the bound, else at the sample before. A stroke still too short to send
+  (``min_length``) is not cut: a slow pen's line would otherwise be cut into
+  pieces too short to feel, all dropped.
 - Work cap: when a stroke holds ``max_window`` samples after its anchor it is
   cut at the current sample (each sample costs at most that many tests).
 - On release the rest is one stroke. A path's first and last samples are
@@ -43,6 +47,10 @@ from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import DROP_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.stroke import Point
+
+# The latency cap cuts at a feature only where the stroke bends by more than this share
+# of max_error; a straight line is cut at its last sample, as late as the cap allows.
+CAP_BEND = 0.5
 
 WINDOW_PARAMS: dict[str, ParamSpec] = {
     s.name: s
@@ -77,13 +85,16 @@ WINDOW_PARAMS: dict[str, ParamSpec] = {
 class WindowParams(FrameAndGrid):
     """The error bound, the caps, then the same drop and grid settings as angle.
 
-    ``max_error`` 0.1 grid units is 3 mm on the paper's sleeve (3 cm spacing),
-    the same as its minimum stroke length.
+    The defaults are the project's (docs/research.md, "Default settings"):
+    ``max_error`` 0.25 grid units is 7.5 mm on the paper's sleeve (3 cm
+    spacing), well below the forearm's two-point threshold (about 35 mm);
+    strokes of at most 300 ms keep the felt drawing within about a third of a
+    second of the pen.
     """
 
-    max_error: float = 0.1
+    max_error: float = 0.25
     max_window: int = 256
-    max_stroke_ms: float = 0.0
+    max_stroke_ms: float = 300.0
     clear_on_press: bool = True
     min_duration_ms: float = 6.1
     min_length: float = 0.1
@@ -163,8 +174,19 @@ class WindowSimplifier:
             window = self._window
             anchor = window[0]
             cap_ms = self.params.max_stroke_ms
-            if cap_ms > 0 and len(window) > 1 and item.sample.t_ms - anchor.sample.t_ms > cap_ms:
-                out.append(self._finish(anchor, window[-1]))
+            if (
+                cap_ms > 0
+                and len(window) > 1
+                and item.sample.t_ms - anchor.sample.t_ms > cap_ms
+                and self._sendable(anchor, window[-1])
+            ):
+                cut = self._cap_cut(window)
+                out.append(self._finish(anchor, window[cut]))
+                if cut < len(window) - 1:
+                    pending.append(item)
+                    pending.extend(reversed(window[cut + 1 :]))
+                    self._window = [window[cut]]
+                    continue
                 window = self._window = [window[-1]]
             if not self._fits(window, 1, len(window), item.point):
                 cut = self._feature(window, item.point)
@@ -177,6 +199,24 @@ class WindowSimplifier:
             if len(window) - 1 >= self.params.max_window:
                 out.append(self._finish(window[0], item))
                 self._window = [item]
+
+    def _cap_cut(self, window: list[_Point]) -> int:
+        """Where the latency cap cuts: at a feature if the stroke so far bends, else at its end.
+
+        A bend is a sample farther than ``CAP_BEND`` x max_error from the chord
+        anchor -> last sample (whose stroke from the anchor is long enough to
+        send); a straight stroke is cut as late as it can be.
+        """
+        cut = self._feature(window, window[-1].point)
+        far_sq = _distance_sq(window[cut].point, window[0].point, window[-1].point)
+        limit = CAP_BEND * self.params.max_error
+        bends = far_sq > limit * limit and self._sendable(window[0], window[cut])
+        return cut if bends else len(window) - 1
+
+    def _sendable(self, start: _Point, end: _Point) -> bool:
+        """Whether start -> end is long enough to send (the cap never cuts off a dropped stroke)."""
+        dx, dy = end.point[0] - start.point[0], end.point[1] - start.point[1]
+        return dx * dx + dy * dy >= self.params.min_length * self.params.min_length
 
     def _feature(self, window: list[_Point], end: Point) -> int:
         """Where to cut: the sample farthest from anchor -> end whose own stroke keeps the bound.
