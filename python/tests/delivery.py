@@ -180,6 +180,10 @@ class Sender:
             else:
                 self._seq_of_mid[info.mid] = seq
 
+    def published(self) -> set[int]:
+        with self._lock:
+            return set(self._seq_of_mid.values()) | self.acked
+
     def acked_seqs(self) -> set[int]:
         with self._lock:
             return set(self.acked)

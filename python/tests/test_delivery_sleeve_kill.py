@@ -23,7 +23,7 @@ def test_a_killed_sleeve_loses_no_stroke_it_received(
 ) -> None:
     broker = start_broker(state_dir=tmp_path / "state")
     watcher = Watcher(broker.credentials)
-    first = SleeveProcess(broker.credentials_path, tmp_path / "first.jsonl")
+    first = SleeveProcess(broker.sleeve_credentials_path, tmp_path / "first.jsonl")
     sender = Sender(broker.credentials)
     second: SleeveProcess | None = None
     try:
@@ -37,7 +37,7 @@ def test_a_killed_sleeve_loses_no_stroke_it_received(
         before = by_seq(watcher.snapshot(), sender.drawing)
         assert len(before) < STROKES, "the drawing ended before the kill: nothing was tested"
 
-        second = SleeveProcess(broker.credentials_path, tmp_path / "second.jsonl")
+        second = SleeveProcess(broker.sleeve_credentials_path, tmp_path / "second.jsonl")
         wait_for(
             lambda: len(by_seq(watcher.snapshot(), sender.drawing)) == STROKES,
             "an event for every stroke",

@@ -5,6 +5,12 @@ On loopback by default: the page gets the sender's broker password from
 broker is reached through ``/mqtt`` on the same origin (``web_proxy``), and
 ``/config.json`` and ``/mqtt`` need the access key of the printed URL: opening
 ``/?key=KEY`` once leaves it in a cookie only this origin sees over HTTPS.
+
+``/config.json`` is also served only to requests whose ``Host`` header names this
+server: a loopback name (``127.0.0.1``, ``localhost``, ``[::1]``), the address it
+listens on, or one of ``hosts``, with its port; any other Host gets ``403
+Forbidden`` with the reason. Else a web page from anywhere could point its own
+host name at this machine (DNS rebinding) and read the password as its own.
 """
 
 from __future__ import annotations
@@ -13,7 +19,7 @@ import hmac
 import json
 import ssl
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import partial
 from http.cookies import SimpleCookie
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
@@ -30,6 +36,23 @@ WEB_DIST = Path(__file__).resolve().parents[3] / "web" / "dist"
 # (status, content type, body). It answers every error itself.
 Api = Callable[[str, str, str, bytes, str], tuple[int, str, bytes]]
 MAX_API_BODY_BYTES = 64 * 1024
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
+
+
+def host_header_names(hosts: Iterable[str], port: int) -> frozenset[str]:
+    """The ``Host`` values a browser sends for ``hosts`` on ``port`` (lower case).
+
+    An IPv6 address is written in brackets; port 80 may be left out, as browsers do.
+    """
+    names = set()
+    for host in hosts:
+        host = host.strip().lower()
+        if ":" in host and not host.startswith("["):
+            host = f"[{host}]"
+        names.add(f"{host}:{port}")
+        if port == 80:
+            names.add(host)
+    return frozenset(names)
 
 
 KEY_COOKIE = "feelmysign_key"
@@ -37,6 +60,7 @@ KEY_COOKIE = "feelmysign_key"
 
 class _Handler(SimpleHTTPRequestHandler):
     config: bytes = b"{}"
+    allowed_hosts: frozenset[str] = frozenset()
     api: Api | None = None
     access_key: str | None = None
     mqtt_ws_port: int | None = None
@@ -77,6 +101,8 @@ class _Handler(SimpleHTTPRequestHandler):
             relay_websocket(self, self.mqtt_ws_port)
             return
         if path == "/config.json":
+            if not self._host_allowed():
+                return
             self.send_response(200)
             self.send_header("Content-Type", "application/json")
             self.send_header("Cache-Control", "no-store")
@@ -109,6 +135,24 @@ class _Handler(SimpleHTTPRequestHandler):
         self.send_error(403, "Open the URL that 'feelmysign up' printed (it holds the key)")
         return False
 
+    def _host_allowed(self) -> bool:
+        """Whether the request names this server; else answer 403 saying why."""
+        host = (self.headers.get("Host") or "").strip().lower()
+        if host in self.allowed_hosts:
+            return True
+        body = (
+            f"Forbidden: /config.json holds the broker login and is served only to pages "
+            f"opened from this server ({', '.join(sorted(self.allowed_hosts))}), not to "
+            f"Host {host[:80]!r}. Open the drawing client at one of those addresses.\n"
+        ).encode()
+        self.send_response(403)
+        self.send_header("Content-Type", "text/plain; charset=utf-8")
+        self.send_header("Cache-Control", "no-store")
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+        return False
+
     def end_headers(self) -> None:
         if not self.path.startswith("/assets/"):
             self.send_header("Cache-Control", "no-cache")  # a rebuilt client is seen at once
@@ -119,7 +163,11 @@ class _Handler(SimpleHTTPRequestHandler):
 
 
 class WebServer:
-    """``with WebServer(port=8000, config={...}) as server: server.url``."""
+    """``with WebServer(port=8000, config={...}) as server: server.url``.
+
+    ``hosts``: names besides the loopback ones under which pages may read
+    ``/config.json`` (e.g. the machine's LAN address, when serving there).
+    """
 
     def __init__(
         self,
@@ -132,18 +180,21 @@ class WebServer:
         tls: TlsFiles | None = None,
         access_key: str | None = None,
         mqtt_ws_port: int | None = None,
+        hosts: Iterable[str] = (),
     ) -> None:
+        self._hosts = (*LOOPBACK_HOSTS, host, *hosts)
         index = directory / "index.html"
         if not index.is_file():
             raise FeelMySignError(
                 f"the drawing client is not built ({index} is missing); run 'make web-build' "
                 "(or 'make up', which builds it)"
             )
-        attributes = {
+        attributes: dict[str, object] = {
             "config": json.dumps(config).encode(),
             "api": staticmethod(api) if api else None,
             "access_key": access_key,
             "mqtt_ws_port": mqtt_ws_port,
+            "allowed_hosts": frozenset(),
         }
         handler: type[_Handler] = type("ConfigHandler", (_Handler,), attributes)
         self._handler = handler
@@ -166,6 +217,8 @@ class WebServer:
             self._server.socket = context.wrap_socket(
                 self._server.socket, server_side=True, do_handshake_on_connect=False
             )
+        # Known once bound (port 0 picks one): only now can the Host values be listed.
+        handler.allowed_hosts = host_header_names(self._hosts, self._server.server_address[1])
         self._thread = threading.Thread(target=self._server.serve_forever, daemon=True)
 
     def set_config(self, config: dict[str, Any]) -> None:

@@ -7,6 +7,7 @@ import platform
 from feelmysign.bench import (
     algorithms,
     lasa_points,
+    persistence,
     planner_lasa,
     restart_off,
     simplifier_timing,
@@ -32,6 +33,7 @@ def main() -> None:
         sleeve.report,
         restart_off.report,
         study_recovery.report,
+        persistence.report,
     )
     for report in reports:
         for line in report():

@@ -8,6 +8,10 @@ Shape of the file (mode 0600)::
 
 Passwords are kept across restarts (a running sleeve keeps working); a new
 sleeve id gets a new sleeve account, the sender's account is kept.
+
+Beside it, ``sleeve-credentials.json`` holds only what a sleeve needs (the
+same shape without ``ws_url`` and ``sender``): the file to copy to a sleeve on
+another machine, which must not get the sender's password.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ import secrets
 import string
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 from urllib.parse import urlsplit
 
 from feelmysign.errors import BrokerError
@@ -87,6 +91,16 @@ class Credentials:
         }
 
 
+@dataclass(frozen=True)
+class Login:
+    """What one program takes from a credentials file: the broker URL, the sleeve id, its
+    account."""
+
+    mqtt_url: str
+    sleeve_id: str
+    account: Account
+
+
 def check_sleeve_id(sleeve_id: str) -> str:
     """Return ``sleeve_id`` if it can be one topic level, else raise a BrokerError saying why."""
     if not SLEEVE_ID_PATTERN.fullmatch(sleeve_id):
@@ -111,17 +125,58 @@ def new_password() -> str:
 def load_credentials(path: str | Path) -> Credentials:
     """Read a ``credentials.json`` the broker wrote; a BrokerError names the file and problem."""
     path = Path(path)
+    return _credentials_from_json(_read_json(path), path)
+
+
+def load_login(path: str | Path, role: Literal["sleeve", "sender"]) -> Login:
+    """The login of ``role`` from a ``credentials.json`` or a ``sleeve-credentials.json``."""
+    path = Path(path)
+    data = _read_json(path)
+    if isinstance(data, dict) and "sender" not in data and "sleeve" in data:
+        if role == "sender":
+            raise _bad_file(
+                path,
+                "it holds only a sleeve's login (a sleeve-credentials.json); to send, use the "
+                "broker's credentials.json",
+            )
+        return _sleeve_login_from_json(data, path)
+    credentials = _credentials_from_json(data, path)
+    account = credentials.sender if role == "sender" else credentials.sleeve
+    return Login(credentials.mqtt_url, credentials.sleeve_id, account)
+
+
+def _read_json(path: Path) -> object:
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise BrokerError(
             "credentials-file",
             f"No credentials file at {path}; start the broker first ('feelmysign broker') "
-            "or pass the file it wrote (STATE_DIR/credentials.json).",
+            "or pass the file it wrote (STATE_DIR/credentials.json, or "
+            "STATE_DIR/sleeve-credentials.json for a sleeve).",
         ) from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
         raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
-    return _credentials_from_json(data, path)
+
+
+def _sleeve_login_from_json(data: dict[str, Any], path: Path) -> Login:
+    try:
+        sleeve = data["sleeve"]
+        login = Login(
+            mqtt_url=_text(data["mqtt_url"]),
+            sleeve_id=_text(sleeve["id"]),
+            account=Account(_text(sleeve["username"]), _text(sleeve["password"])),
+        )
+    except (KeyError, TypeError):
+        raise _bad_file(path, "it lacks mqtt_url or sleeve{id, username, password}") from None
+    check_sleeve_id(login.sleeve_id)
+    _check_account(login.account, path)
+    return login
+
+
+def _check_account(account: Account, path: Path) -> None:
+    if ":" in account.username or not _PASSWORD_PATTERN.fullmatch(account.password):
+        raise _bad_file(path, f"the account {account.username!r} has an unusable name or password")
 
 
 def _credentials_from_json(data: object, path: Path) -> Credentials:
@@ -144,10 +199,7 @@ def _credentials_from_json(data: object, path: Path) -> Credentials:
         ) from None
     check_sleeve_id(credentials.sleeve_id)
     for account in (credentials.sleeve, credentials.sender):
-        if ":" in account.username or not _PASSWORD_PATTERN.fullmatch(account.password):
-            raise _bad_file(
-                path, f"the account {account.username!r} has an unusable name or password"
-            )
+        _check_account(account, path)
     return credentials
 
 
@@ -225,3 +277,9 @@ def write_private_file(path: Path, text: str) -> None:
 
 def write_credentials(path: Path, credentials: Credentials) -> None:
     write_private_file(path, json.dumps(credentials.to_json(), indent=2) + "\n")
+
+
+def write_sleeve_credentials(path: Path, credentials: Credentials) -> None:
+    """The sleeve's part of ``credentials``: what a sleeve on another machine gets."""
+    sleeve_only = {"mqtt_url": credentials.mqtt_url, "sleeve": credentials.to_json()["sleeve"]}
+    write_private_file(path, json.dumps(sleeve_only, indent=2) + "\n")

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Literal
 
 from feelmysign.broker import DEFAULT_SLEEVE_ID, default_state_dir
-from feelmysign.broker.credentials import Credentials, check_sleeve_id, load_credentials
+from feelmysign.broker.credentials import Login, check_sleeve_id, load_login
 from feelmysign.cli._inputs import MAX_CREDENTIALS_BYTES, check_input_file, not_empty, sleeve_id
 from feelmysign.connection import DEFAULT_BROKER_URL, BrokerSettings, parse_broker_url
 from feelmysign.connection.join_token import default_trust_dir, join_settings
@@ -88,7 +88,9 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
         metavar="FILE",
         type=not_empty("credentials file"),
         help=f"the credentials.json written by 'feelmysign broker', for the {role} account, "
-        f"the URL and the sleeve id (default: ${CREDENTIALS_ENV}, else "
+        "the URL and the sleeve id"
+        + (" (or its sleeve-credentials.json, the sleeve's login only)" if role == "sleeve" else "")
+        + f" (default: ${CREDENTIALS_ENV}, else "
         f"{local_credentials_path()} when it exists and no --broker is given)",
     )
 
@@ -110,7 +112,7 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
     url = args.broker or env.get(BROKER_ENV) or None
     username = args.username or env.get(USERNAME_ENV) or None
     password = args.password or env.get(PASSWORD_ENV) or None
-    credentials = _credentials(args.credentials or env.get(CREDENTIALS_ENV), url)
+    login = _login(args.credentials or env.get(CREDENTIALS_ENV), url, role)
     if username is None and password is not None:
         raise BrokerConnectionError(
             "bad-option",
@@ -123,23 +125,22 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
             f"User {username!r} was given without a password: give --password too "
             f"(or ${PASSWORD_ENV}), or use --credentials FILE.",
         )
-    if username is None and credentials is not None:
-        account = credentials.sender if role == "sender" else credentials.sleeve
-        username, password = account.username, account.password
+    if username is None and login is not None:
+        username, password = login.account.username, login.account.password
     if url is None:
-        url = credentials.mqtt_url if credentials is not None else DEFAULT_BROKER_URL
+        url = login.mqtt_url if login is not None else DEFAULT_BROKER_URL
     sleeve_id = args.sleeve_id or env.get(SLEEVE_ID_ENV) or None
     if sleeve_id is None:
-        sleeve_id = credentials.sleeve_id if credentials is not None else DEFAULT_SLEEVE_ID
+        sleeve_id = login.sleeve_id if login is not None else DEFAULT_SLEEVE_ID
     return parse_broker_url(
         url, username=username, password=password, sleeve_id=check_sleeve_id(sleeve_id)
     )
 
 
-def _credentials(path: str | None, url: str | None) -> Credentials | None:
+def _login(path: str | None, url: str | None, role: Role) -> Login | None:
     local = local_credentials_path()
     if not path and (url is not None or not local.is_file()):
         return None
     chosen = path or local
     check_input_file(chosen, what="credentials file", max_bytes=MAX_CREDENTIALS_BYTES)
-    return load_credentials(chosen)
+    return load_login(chosen, role)

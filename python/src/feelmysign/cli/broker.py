@@ -159,6 +159,7 @@ def _announce(broker: Broker) -> None:
         *([f"  TLS:         {credentials.mqtts_url}"] if credentials.mqtts_url else []),
         f"  Credentials: {broker.credentials_path} "
         f"(sleeve user {credentials.sleeve.username}, sender user {credentials.sender.username})",
+        f"  For a sleeve on another machine: {broker.sleeve_credentials_path} (its login only)",
         f"  Log:         {broker.log_path}",
         "Ready. Press Ctrl-C to stop.",
     ]
