@@ -261,6 +261,10 @@ def test_strokes_sent_while_the_broker_restarts_are_played(
     c = broker.credentials
     running = Running(c)
     try:
+        # Its status follows its subscription on the same connection: once the status is
+        # out, the broker has the subscription (else the broker could stop without it).
+        with running._changed:
+            assert running._changed.wait_for(lambda: running.status, 30)
         sender = new_client(
             _settings(c, "sender"), client_id="restart-sender", persistent_session=True
         )
