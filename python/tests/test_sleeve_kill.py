@@ -27,6 +27,7 @@ import pytest
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.broker import Broker
 from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.daemon import sleeve_client_id
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic, telemetry_topic
@@ -149,11 +150,31 @@ def kill_mid_stroke(broker: Broker, watcher: Watcher, state: Path) -> dict[str, 
     return left
 
 
+def forget_sleeve_session(broker: Broker) -> None:
+    """Drop the killed sleeve's session: the stroke cut by the kill was never acknowledged,
+    so the broker would deliver it again at once (docs/protocol.md, Delivery) and drive a
+    motor right after the restart; here only what comes before going online counts."""
+    c = broker.credentials
+    settings = BrokerSettings(
+        c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
+    )
+    client_id = sleeve_client_id(c.sleeve_id, c.sleeve.password)
+    client = new_client(settings, client_id=client_id)  # a clean session replaces it
+    connected = threading.Event()
+    client.on_connect = lambda *args: connected.set()
+    client.connect(c.mqtt_host, c.mqtt_port)
+    client.loop_start()
+    assert connected.wait(WAIT_S)
+    client.disconnect()
+    client.loop_stop()
+
+
 def test_a_restart_after_sigkill_mid_stroke_switches_every_motor_off_before_going_online(
     broker: Broker, watcher: Watcher, tmp_path: Path
 ) -> None:
     state = tmp_path / "bus.json"
     kill_mid_stroke(broker, watcher, state)
+    forget_sleeve_session(broker)
 
     restarted = start_sleeve(broker, state)
     try:
