@@ -108,6 +108,19 @@ class _Event:
         return event
 
 
+def _read_stroke(r: _Reader, *, received_required: bool = True) -> dict[str, Any]:
+    """The fields that name the stroke an event is about, shared by every stroke event."""
+    return {
+        "topic": r.text("topic", required=False),
+        "drawing": r.text("drawing", required=False),
+        "seq": r.index("seq", required=False),
+        "sent_at_ms": r.number("sent_at_ms", required=False),
+        "age_ms": r.number("age_ms", required=False),
+        "lag_ms": r.number("lag_ms", required=False),
+        "received_at_ms": r.number("received_at_ms", required=received_required),
+    }
+
+
 @dataclass(frozen=True, kw_only=True)
 class Played(_Event):
     """The stroke's first command went out (times ``*_at_ms``: the sleeve's wall clock)."""
@@ -131,13 +144,7 @@ class Played(_Event):
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
         return {
-            "topic": r.text("topic", required=False),
-            "drawing": r.text("drawing", required=False),
-            "seq": r.index("seq", required=False),
-            "sent_at_ms": r.number("sent_at_ms", required=False),
-            "age_ms": r.number("age_ms", required=False),
-            "lag_ms": r.number("lag_ms", required=False),
-            "received_at_ms": r.number("received_at_ms"),
+            **_read_stroke(r),
             "start_at_ms": r.number("start_at_ms"),
             "first_command_at_ms": r.number("first_command_at_ms"),
             "latency_ms": r.number("latency_ms"),
@@ -184,13 +191,7 @@ class Rejected(_Event):
         return {
             "reason": r.text("reason"),
             "message": r.text("message"),
-            "topic": r.text("topic", required=False),
-            "drawing": r.text("drawing", required=False),
-            "seq": r.index("seq", required=False),
-            "sent_at_ms": r.number("sent_at_ms", required=False),
-            "age_ms": r.number("age_ms", required=False),
-            "lag_ms": r.number("lag_ms", required=False),
-            "received_at_ms": r.number("received_at_ms"),
+            **_read_stroke(r),
         }
 
 
@@ -217,13 +218,7 @@ class Cancelled(_Event):
         return {
             "reason": r.text("reason"),
             "message": r.text("message"),
-            "topic": r.text("topic", required=False),
-            "drawing": r.text("drawing", required=False),
-            "seq": r.index("seq", required=False),
-            "sent_at_ms": r.number("sent_at_ms", required=False),
-            "age_ms": r.number("age_ms", required=False),
-            "lag_ms": r.number("lag_ms", required=False),
-            "received_at_ms": r.number("received_at_ms"),
+            **_read_stroke(r),
             "cancelled_at_ms": r.number("cancelled_at_ms"),
             "started": r.flag("started"),
         }
@@ -258,13 +253,7 @@ class Safety(_Event):
             "row": r.index("row"),
             "column": r.index("column"),
             "message": r.text("message", required=False),
-            "topic": r.text("topic", required=False),
-            "drawing": r.text("drawing", required=False),
-            "seq": r.index("seq", required=False),
-            "sent_at_ms": r.number("sent_at_ms", required=False),
-            "age_ms": r.number("age_ms", required=False),
-            "lag_ms": r.number("lag_ms", required=False),
-            "received_at_ms": r.number("received_at_ms", required=False),
+            **_read_stroke(r, received_required=False),
             "duty_cycle": r.number("duty_cycle", required=False),
             "max_duty_cycle": r.number("max_duty_cycle", required=False),
             "window_ms": r.number("window_ms", required=False),
