@@ -10,7 +10,7 @@ import sys
 import threading
 import types
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -19,7 +19,7 @@ import pytest
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
-from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.daemon import NETWORK_STOP_S, Sleeve, SleeveOptions
 from feelmysign.layout import Layout
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
@@ -117,27 +117,59 @@ def test_sigterm_mid_stroke_publishes_an_all_off_frame_before_going_offline(
     assert not _on("actuators", frames[-1]), frames[-1]  # and the last word is: all off
 
 
-class _SlowCurrentThread(types.SimpleNamespace):
-    """paho's ``threading`` with a ``current_thread`` that first waits for every other paho
-    network thread to end: it widens, to certainty, the moment between loop_stop's two reads
-    of its network thread, which a loaded machine hits by chance (only the client being
-    stopped has a network thread when it is called here)."""
+# How long paho's ending network thread is held before it clears its handle: far longer
+# than a caller takes from disconnect() to loop_stop(), far shorter than NETWORK_STOP_S.
+HOLD_S = 2.0
 
-    def current_thread(self) -> threading.Thread:
+
+class _RaceGate:
+    """Widens, to certainty, the moment between loop_stop's two reads of paho's network
+    thread, which a loaded machine hits by chance.
+
+    paho's thread clears ``client._thread`` as it ends. Held here, an ending thread keeps
+    its handle (up to HOLD_S) until some caller's loop_stop has read it once; that caller's
+    ``threading.current_thread()`` then waits for the thread to end, so loop_stop's second
+    read finds None. A caller that joins the thread itself, as the sleeve does, never
+    enters loop_stop while the thread lives, and the held thread ends after HOLD_S."""
+
+    def __init__(self) -> None:
+        self._read = threading.Event()
+
+    def thread_main(self) -> Callable[[mqtt.Client], None]:
+        """paho's ``Client._thread_main``, holding its last step."""
+        return lambda client: self._thread_main(client)
+
+    def _thread_main(self, client: mqtt.Client) -> None:
+        try:
+            client.loop_forever(retry_first_connection=True)
+        finally:
+            self._read.wait(HOLD_S)
+            client._thread = None
+
+    def threading_module(self) -> types.SimpleNamespace:
+        names = [k for k in dir(threading) if k[0] != "_" and k != "current_thread"]
+        return types.SimpleNamespace(
+            current_thread=self._current_thread, **{k: getattr(threading, k) for k in names}
+        )
+
+    def _current_thread(self) -> threading.Thread:
         me = threading.current_thread()
+        self._read.set()
         for thread in threading.enumerate():
             if thread is not me and thread.name.startswith("paho-mqtt-client-"):
                 thread.join(WAIT_S)
+        self._read.clear()
         return me
 
 
 def test_paho_loop_stop_after_disconnect_races_its_thread_and_the_sleeve_never_hits_it(
     broker: Broker, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    assert HOLD_S < NETWORK_STOP_S
     c = broker.credentials
-    names = [k for k in dir(threading) if k[0] != "_" and k != "current_thread"]
-    slow = _SlowCurrentThread(**{k: getattr(threading, k) for k in names})
-    monkeypatch.setattr(mqtt, "threading", slow)
+    gate = _RaceGate()
+    monkeypatch.setattr(mqtt.Client, "_thread_main", gate.thread_main())
+    monkeypatch.setattr(mqtt, "threading", gate.threading_module())
     # The race itself, with a bare client: what a sleeve stopped this way would hit.
     bare = new_client(_settings(c, "sender"), client_id=f"race-{uuid.uuid4()}")
     bare.connect(c.mqtt_host, c.mqtt_port)
