@@ -34,32 +34,12 @@ import {
   walk,
   openAdvanced,
 } from "./page";
+import { expectStrokesFollow, strokeBounds } from "./strokes";
 
-/** Grid units: a corner is the drawn sample nearest it (mouse steps of 5 px), a little off under load. */
-const CORNER_TOLERANCE = 0.15;
-/** The default min_length, grid units: the longest gap a dropped segment leaves. */
-const MIN_LENGTH = 0.1;
 const UUID = /^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}$/;
 const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3.0 }, version: "test" };
 
 type Point = readonly [number, number];
-
-/** Distance from a point to the segment a -> b. */
-function sideDistance(point: Point, a: Point, b: Point): number {
-  const [dx, dy] = [b[0] - a[0], b[1] - a[1]];
-  const t = Math.min(Math.max(((point[0] - a[0]) * dx + (point[1] - a[1]) * dy) / (dx * dx + dy * dy), 0), 1);
-  return Math.hypot(point[0] - a[0] - t * dx, point[1] - a[1] - t * dy);
-}
-
-function near(actual: unknown, expected: readonly [number, number], what: string): void {
-  const [x, y] = actual as [number, number];
-  const distance = Math.hypot(x - expected[0], y - expected[1]);
-  if (!(distance <= CORNER_TOLERANCE)) {
-    throw new Error(
-      `${what}: got (${x}, ${y}), expected (${expected[0].toFixed(3)}, ${expected[1].toFixed(3)}) ± ${CORNER_TOLERANCE}`,
-    );
-  }
-}
 
 describe("drawing with a mouse on a desktop", () => {
   const cleanups: (() => Promise<void>)[] = [];
@@ -130,23 +110,9 @@ describe("drawing with a mouse on a desktop", () => {
     expect(sentCount).toBeGreaterThanOrEqual(4);
     const strokes = await sleeve.waitForStrokes(sentCount);
     expect(strokes).toHaveLength(sentCount);
-    const grid = corners.map(([x, y]) => toGrid(area, x, y));
-    near(strokes[0]!["start"], grid[0]!, "the first stroke's start");
-    near(strokes.at(-1)!["end"], grid[0]!, "the last stroke's end");
-    for (const [i, corner] of grid.slice(1).entries()) {
-      const ends = strokes.map((stroke) => stroke["end"] as [number, number]);
-      const nearest = Math.min(...ends.map(([x, y]) => Math.hypot(x - corner[0], y - corner[1])));
-      expect(nearest, `corner ${i + 1} is a stroke's end`).toBeLessThanOrEqual(CORNER_TOLERANCE);
-    }
+    const bounds = await strokeBounds(page, area);
+    expectStrokesFollow(strokes, [...corners, corners[0]!], area, bounds);
     strokes.forEach((stroke, i) => {
-      // Each stroke lies along one side: both its ends near that side.
-      const onSide = grid.some((a, k) => {
-        const b = grid[(k + 1) % 4]!;
-        return [stroke["start"], stroke["end"]].every(
-          (p) => sideDistance(p as Point, a, b) <= CORNER_TOLERANCE,
-        );
-      });
-      expect(onSide, `stroke ${i} lies along a side`).toBe(true);
       expect(stroke).toMatchObject({ v: 1, seq: i, intensity: 0.8 });
       expect(stroke["duration_ms"] as number).toBeGreaterThan(0);
       expect(Math.abs((stroke["sent_at_ms"] as number) - Date.now())).toBeLessThan(60_000);
@@ -154,7 +120,7 @@ describe("drawing with a mouse on a desktop", () => {
         // Sent strokes join end to start, or leave the gap of a dropped one (< min_length).
         const [x, y] = stroke["start"] as [number, number];
         const [px, py] = strokes[i - 1]!["end"] as [number, number];
-        expect(Math.hypot(x - px, y - py)).toBeLessThan(MIN_LENGTH);
+        expect(Math.hypot(x - px, y - py), `stroke ${i} joins the one before`).toBeLessThan(bounds.minLength);
       }
     });
     expect(stroke0Drawing(strokes)).toMatch(UUID);

@@ -15,19 +15,8 @@ import {
   serveDist,
   tempDir,
 } from "./harness";
-import {
-  CANVAS,
-  drawingArea,
-  drawWithTouch,
-  nextFrame,
-  openAdvanced,
-  screenshot,
-  toGrid,
-  waitForData,
-} from "./page";
-
-/** Grid units: see desktop.e2e.ts; finger steps are the same 5 px per frame. */
-const CORNER_TOLERANCE = 0.15;
+import { CANVAS, drawingArea, drawWithTouch, nextFrame, openAdvanced, screenshot, waitForData } from "./page";
+import { expectStrokesFollow, strokeBounds } from "./strokes";
 
 describe("drawing with a finger on a phone", () => {
   const cleanups: (() => Promise<void>)[] = [];
@@ -87,21 +76,7 @@ describe("drawing with a finger on a phone", () => {
     const sent = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
     expect(sent).toBeGreaterThanOrEqual(2);
     const strokes = await sleeve.waitForStrokes(sent);
-    const [sx, sy] = strokes[0]!["start"] as [number, number];
-    const [ex, ey] = strokes.at(-1)!["end"] as [number, number];
-    const [wantSx, wantSy] = toGrid(area, ...points[0]);
-    const [wantEx, wantEy] = toGrid(area, ...points[2]);
-    expect(Math.hypot(sx - wantSx, sy - wantSy)).toBeLessThan(CORNER_TOLERANCE);
-    expect(Math.hypot(ex - wantEx, ey - wantEy)).toBeLessThan(CORNER_TOLERANCE);
-    // The corner is where one stroke ends and the next begins.
-    const [wantCx, wantCy] = toGrid(area, ...points[1]);
-    const corner = Math.min(
-      ...strokes.map((stroke) => {
-        const [cx, cy] = stroke["end"] as [number, number];
-        return Math.hypot(cx - wantCx, cy - wantCy);
-      }),
-    );
-    expect(corner).toBeLessThan(CORNER_TOLERANCE);
+    expectStrokesFollow(strokes, points, area, await strokeBounds(page, area), 4);
     await sleeve.publish("actuators", {
       t_ms: 10,
       rows: 3,

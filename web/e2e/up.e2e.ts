@@ -19,10 +19,9 @@ import {
   tempDir,
   type Credentials,
 } from "./harness";
-import { drawingArea, drawWithMouse, nextFrame, screenshot, toGrid, waitForData } from "./page";
+import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData } from "./page";
+import { expectStrokesFollow, strokeBounds } from "./strokes";
 
-/** Grid units, as in desktop.e2e.ts. */
-const CORNER_TOLERANCE = 0.15;
 const hasUp = spawnSync(FEELMYSIGN, ["up", "--help"], { stdio: "ignore" }).status === 0;
 
 describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", () => {
@@ -55,7 +54,7 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
   });
 
-  it("plays a square drawn with the mouse: strokes from its corners, the preview lights up", async () => {
+  it("plays a square drawn with the mouse: strokes along it, cut at its corners, the preview lights up", async () => {
     const area = await drawingArea(page);
     const side = area.height * 0.6;
     const left = area.left + (area.width - side) / 2;
@@ -72,12 +71,7 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
     const sent = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
     expect(sent).toBeGreaterThanOrEqual(4);
     const strokes = await sleeve.waitForStrokes(sent);
-    const starts = strokes.map((stroke) => stroke["start"] as [number, number]);
-    corners.forEach((corner, i) => {
-      const [wx, wy] = toGrid(area, ...corner);
-      const nearest = Math.min(...starts.map(([x, y]) => Math.hypot(x - wx, y - wy)));
-      expect(nearest, `corner ${i} starts a stroke`).toBeLessThan(CORNER_TOLERANCE);
-    });
+    expectStrokesFollow(strokes, [...corners, corners[0]], area, await strokeBounds(page, area));
     await page.waitForFunction(
       () =>
         Number((document.querySelector('[data-testid="sleeve-preview"]') as HTMLElement).dataset["lit"]) > 0,
