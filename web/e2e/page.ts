@@ -11,6 +11,11 @@ export interface Area {
   top: number;
   width: number;
   height: number;
+  /**
+   * 90 when the page shows the sleeve turned a quarter clockwise (its top edge on the
+   * right, as on an upright phone): down the screen is then along the sleeve's columns.
+   */
+  turnDeg: 0 | 90;
 }
 
 export const CANVAS = '[data-testid="drawing-canvas"]';
@@ -26,6 +31,7 @@ export async function drawingArea(page: Page): Promise<Area> {
     top: box.y + Number(data["areaTopPx"]),
     width: Number(data["areaWidthPx"]),
     height: Number(data["areaHeightPx"]),
+    turnDeg: data["areaTurnDeg"] === "90" ? 90 : 0,
   };
 }
 
@@ -36,13 +42,17 @@ export function toGrid(
   y: number,
   grid = { rows: 3, columns: 4 },
 ): readonly [number, number] {
+  const u = x - area.left;
+  const v = y - area.top;
+  // Turned, the sleeve's canvas is the screen's area a quarter back: its x runs down, its y leftwards.
+  const turned = area.turnDeg === 90;
   const mapping = new CanvasMapping({
-    width_px: area.width,
-    height_px: area.height,
+    width_px: turned ? area.height : area.width,
+    height_px: turned ? area.width : area.height,
     ...grid,
     stretch: false,
   });
-  return mapping.toGrid(x - area.left, y - area.top);
+  return turned ? mapping.toGrid(v, area.width - u) : mapping.toGrid(u, v);
 }
 
 /** Waits for the page's next animation frame: one pointer step per frame, as a hand moves. */

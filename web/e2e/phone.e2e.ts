@@ -18,6 +18,15 @@ import {
 import { CANVAS, drawingArea, drawWithTouch, nextFrame, openAdvanced, screenshot, waitForData } from "./page";
 import { expectStrokesFollow, strokeBounds } from "./strokes";
 
+/** Toolbar and header labels cut short by their box ("Simpli…"): none may be. */
+async function truncatedLabels(page: Page): Promise<string[]> {
+  return page.evaluate(() =>
+    [...document.querySelectorAll<HTMLElement>(".topbar *, .toolbar *, .legend *")]
+      .filter((element) => element.offsetParent !== null && element.scrollWidth > element.clientWidth + 1)
+      .map((element) => element.textContent ?? ""),
+  );
+}
+
 describe("drawing with a finger on a phone", () => {
   const cleanups: (() => Promise<void>)[] = [];
   let sleeve: FakeSleeve;
@@ -52,15 +61,23 @@ describe("drawing with a finger on a phone", () => {
     for (const cleanup of cleanups.reverse()) await cleanup();
   });
 
-  it("fits the screen: the whole drawing area and the status are visible without scrolling", async () => {
+  it("uses the screen: the area is turned to the phone's shape, whole, with labelled buttons", async () => {
     const area = await drawingArea(page);
+    // A 3 x 4 sleeve is 3:2 across; on an upright phone it is shown turned, 2:3, to use the height.
+    expect(area.turnDeg).toBe(90);
+    expect(area.height / area.width).toBeCloseTo(1.5, 1);
+    expect(area.height).toBeGreaterThan(844 * 0.45);
     expect(area.left).toBeGreaterThanOrEqual(0);
     expect(area.left + area.width).toBeLessThanOrEqual(390);
     expect(area.top + area.height).toBeLessThanOrEqual(844);
-    expect(area.width).toBeGreaterThan(250);
-    expect(area.width / area.height).toBeCloseTo(1.5, 1);
+    expect(await page.locator('[data-testid="legend-turned"]').isVisible()).toBe(true);
     expect(await page.evaluate(() => document.documentElement.scrollWidth)).toBeLessThanOrEqual(390);
     expect(await page.locator('[data-testid="broker-status"]').isVisible()).toBe(true);
+    for (const id of ["new", "undo", "stop", "replay", "record", "load"]) {
+      const label = await page.locator(`[data-testid="${id}-button"]`).innerText();
+      expect(label.trim().length, `${id} button has a label`).toBeGreaterThan(2);
+    }
+    expect(await truncatedLabels(page)).toEqual([]);
   });
 
   it("sends an L drawn with touch as two strokes from the touch-down to the lift", async () => {
@@ -89,6 +106,24 @@ describe("drawing with a finger on a phone", () => {
     });
     await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "3");
     await screenshot(page, "phone");
+  });
+
+  it("on its side (844 x 390): upright, the toolbar beside it, the whole area on the first screen", async () => {
+    await page.setViewportSize({ width: 844, height: 390 });
+    await waitForData(page, CANVAS, "areaTurnDeg", "0");
+    const area = await drawingArea(page);
+    expect(area.width / area.height).toBeCloseTo(1.5, 1);
+    expect(area.height).toBeGreaterThan(390 * 0.5);
+    expect(area.top).toBeGreaterThanOrEqual(0);
+    expect(area.top + area.height).toBeLessThanOrEqual(390);
+    expect(area.left + area.width).toBeLessThanOrEqual(844);
+    expect(await page.locator('[data-testid="legend-turned"]').isVisible()).toBe(false);
+    const stop = await page.locator('[data-testid="stop-button"]').boundingBox();
+    expect(stop !== null && stop.y + stop.height <= 390, "Stop is on the first screen").toBe(true);
+    expect(await truncatedLabels(page)).toEqual([]);
+    await screenshot(page, "phone-landscape");
+    await page.setViewportSize({ width: 390, height: 844 });
+    await waitForData(page, CANVAS, "areaTurnDeg", "90");
   });
 
   it("opens the settings as a full-screen sheet that scrolls to its last field", async () => {

@@ -61,9 +61,13 @@ const TARGET_KEYS: readonly SettingKey[] = [
   "legacy_topic",
 ];
 /** The media query of styles.css under which the sleeve's cards go below the drawing area. */
-const STACKED_LAYOUT = "(max-width: 820px)";
-/** In that layout the drawing area takes this share of the window's height. */
-const STACKED_STAGE_SHARE = 0.62;
+const STACKED_LAYOUT = "(max-width: 820px), (max-height: 560px)";
+/** The one of styles.css for a phone on its side: the toolbar beside the area, the legend below it all. */
+const SHORT_LANDSCAPE = "(max-height: 560px) and (orientation: landscape)";
+/** Stacked, below the area: the gap to the legend and the workspace's padding (styles.css). */
+const STACKED_BELOW_PX = 10 + 12;
+/** Stacked, the area is never squeezed below this height: the page scrolls instead. */
+const STACKED_MIN_HEIGHT_PX = 240;
 /** A sleeve that listens has its retained status at the broker: none after this, none listens. */
 const STATUS_WAIT_MS = 2500;
 
@@ -88,6 +92,8 @@ export class App {
   readonly #buttons: Record<"undo" | "replay" | "record", HTMLButtonElement>;
   readonly #hint: HTMLElement;
   readonly #stageArea: HTMLElement;
+  readonly #legend: HTMLElement;
+  readonly #legendTurned: HTMLElement;
   readonly #compareToggle: HTMLInputElement;
   readonly #compareDetail: HTMLInputElement;
   #settings: Settings;
@@ -132,6 +138,8 @@ export class App {
     };
     this.#hint = byId(doc, "stage-hint");
     this.#stageArea = byId(doc, "stage-area");
+    this.#legend = byId(doc, "legend");
+    this.#legendTurned = byId(doc, "legend-turned");
     this.#compareToggle = byId<HTMLInputElement>(doc, "compare-toggle");
     this.#compareDetail = byId<HTMLInputElement>(doc, "compare-detail");
     this.#session = new DrawingSession(this.#view, {
@@ -339,11 +347,21 @@ export class App {
       this.#session.clear();
     }
     const width = this.#stageArea.clientWidth;
-    // Stacked (narrow) layout: the area takes its content's height, so the viewport sets the limit.
+    // Stacked (phone) layout: the area takes its content's height, so the viewport sets the limit.
     const stacked = window.matchMedia(STACKED_LAYOUT).matches;
-    const height = stacked ? window.innerHeight * STACKED_STAGE_SHARE : this.#stageArea.clientHeight;
+    const height = stacked ? this.#firstScreenHeight() : this.#stageArea.clientHeight;
     this.#view.fit(grid, this.#settings.stretch, width, height);
+    this.#legendTurned.hidden = !this.#view.turned;
     this.#preview.setGrid(grid);
+  }
+
+  /** Stacked, the area fills the first screen: from its top to the window's bottom, the legend under it. */
+  #firstScreenHeight(): number {
+    const workspace = this.#stageArea.closest(".workspace");
+    const top = this.#stageArea.getBoundingClientRect().top + (workspace?.scrollTop ?? 0) + window.scrollY;
+    // A phone on its side keeps every pixel of height for drawing: the legend follows below the fold.
+    const legend = window.matchMedia(SHORT_LANDSCAPE).matches ? 0 : this.#legend.offsetHeight;
+    return Math.max(STACKED_MIN_HEIGHT_PX, window.innerHeight - top - legend - STACKED_BELOW_PX);
   }
 
   // ---- settings ----------------------------------------------------------------------------

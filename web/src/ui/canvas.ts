@@ -14,10 +14,22 @@
  *
  * Coordinates: the simplifier sees the drawing's own canvas pixels (fixed when
  * the drawing starts); the screen may be resized since, so they are scaled.
+ * Those pixels are always in the sleeve's orientation. On a screen of the
+ * other shape (a phone held upright, a landscape sleeve) the area is shown
+ * turned a quarter clockwise: the sleeve's top edge on the right, marked there.
+ * One transform per canvas does the turn, so every drawing step is the same
+ * either way, and `toDrawing` undoes it for the pointer.
  */
 import type { Drawing, DrawnSegment } from "../drawing";
 import type { Point, Sample } from "../simplify/segment";
-import { AREA_MARGIN_PX, fitArea, gridToCanvas, type GridSize, type MappingShape } from "./geometry";
+import {
+  AREA_MARGIN_PX,
+  chooseArea,
+  gridToCanvas,
+  type AreaSize,
+  type GridSize,
+  type MappingShape,
+} from "./geometry";
 
 const COLORS = {
   grid: "rgba(143, 160, 178, 0.13)",
@@ -31,6 +43,7 @@ const COLORS = {
   marker: "#ffd166",
   dropped: "#ff6b6b",
   rejected: "#ff6b6b",
+  topEdge: "rgba(255, 138, 91, 0.75)",
   /** The stage's own colour (--surface): a refused stroke is first wiped out with it. */
   erase: "#151d26",
 } as const;
@@ -39,10 +52,7 @@ const ACTUATOR_RADIUS_PX = 7;
 const SENT_WIDTH_PX = 4;
 const LIVE_WIDTH_PX = 5;
 
-export interface AreaSize {
-  readonly width_px: number;
-  readonly height_px: number;
-}
+export type { AreaSize } from "./geometry";
 
 export class DrawingView {
   readonly stage: HTMLElement;
@@ -60,7 +70,10 @@ export class DrawingView {
   readonly #live2d: CanvasRenderingContext2D;
   #grid: GridSize = { rows: 3, columns: 4 };
   #stretch = false;
+  /** The area in the sleeve's orientation: a new drawing's canvas. */
   #area: AreaSize = { width_px: 300, height_px: 200 };
+  /** Shown turned a quarter clockwise (the sleeve's top edge on the right). */
+  #turned = false;
   #dpr = 1;
   #drawing: Drawing | null = null;
   /** Per path, how many samples are already on the ink canvas. */
@@ -108,13 +121,22 @@ export class DrawingView {
     return this.#grid;
   }
 
-  /** Sizes the stage to the largest area of the grid's aspect ratio that fits. */
+  /** Sleeve-oriented drawing pixels are shown turned a quarter (see the module's comment). */
+  get turned(): boolean {
+    return this.#turned;
+  }
+
+  /**
+   * Sizes the stage to the largest area of the grid's aspect ratio that fits,
+   * turned a quarter when that is much larger (a landscape sleeve on an upright phone).
+   */
   fit(grid: GridSize, stretch: boolean, availableWidthPx: number, availableHeightPx: number): void {
-    const area = fitArea(grid, availableWidthPx, availableHeightPx);
+    const { area, turned } = chooseArea(grid, availableWidthPx, availableHeightPx);
     const dpr = window.devicePixelRatio || 1;
     const same =
       area.width_px === this.#area.width_px &&
       area.height_px === this.#area.height_px &&
+      turned === this.#turned &&
       grid.rows === this.#grid.rows &&
       grid.columns === this.#grid.columns &&
       stretch === this.#stretch &&
@@ -123,9 +145,11 @@ export class DrawingView {
     this.#grid = grid;
     this.#stretch = stretch;
     this.#area = area;
+    this.#turned = turned;
     this.#dpr = dpr;
-    const widthPx = area.width_px + 2 * AREA_MARGIN_PX;
-    const heightPx = area.height_px + 2 * AREA_MARGIN_PX;
+    const screen = this.#screenArea();
+    const widthPx = screen.width_px + 2 * AREA_MARGIN_PX;
+    const heightPx = screen.height_px + 2 * AREA_MARGIN_PX;
     this.stage.style.width = `${widthPx}px`;
     this.stage.style.height = `${heightPx}px`;
     const canvases = [
@@ -140,20 +164,39 @@ export class DrawingView {
       canvas.width = Math.round(widthPx * dpr);
       canvas.height = Math.round(heightPx * dpr);
     }
+    // Sleeve-oriented area pixels -> device pixels: the margin, the quarter turn, the density.
+    const m = AREA_MARGIN_PX;
+    const [a, b, c, d, e, f] = turned ? [0, 1, -1, 0, m + screen.width_px, m] : [1, 0, 0, 1, m, m];
     for (const ctx of [this.#grid2d, this.#ink2d, this.#compare2d, this.#marker2d, this.#live2d]) {
-      ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+      ctx.setTransform(a * dpr, b * dpr, c * dpr, d * dpr, e * dpr, f * dpr);
       ctx.lineCap = "round";
       ctx.lineJoin = "round";
     }
-    this.surface.dataset["areaLeftPx"] = String(AREA_MARGIN_PX);
-    this.surface.dataset["areaTopPx"] = String(AREA_MARGIN_PX);
-    this.surface.dataset["areaWidthPx"] = String(area.width_px);
-    this.surface.dataset["areaHeightPx"] = String(area.height_px);
+    const data = this.surface.dataset;
+    data["areaLeftPx"] = String(m);
+    data["areaTopPx"] = String(m);
+    data["areaWidthPx"] = String(screen.width_px);
+    data["areaHeightPx"] = String(screen.height_px);
+    // How the tests (and anyone reading the page) convert a screen point to the sleeve's grid.
+    data["areaTurnDeg"] = turned ? "90" : "0";
+    this.stage.dataset["turned"] = String(turned);
+    this.surface.setAttribute(
+      "aria-label",
+      turned
+        ? "Drawing area, turned a quarter to fit the screen (the sleeve's top is on the right): draw with a finger, pen or mouse"
+        : "Drawing area: draw with a finger, pen or mouse",
+    );
     this.#drawGrid();
     this.#redrawInk();
     this.#drawCompare();
     this.#liveShown = true;
     this.clearLive();
+  }
+
+  /** The area as laid out on the screen (CSS pixels). */
+  #screenArea(): AreaSize {
+    const { width_px, height_px } = this.#area;
+    return this.#turned ? { width_px: height_px, height_px: width_px } : this.#area;
   }
 
   /** Shows `drawing` from scratch (a new or cleared drawing, or null for an empty canvas). */
@@ -173,7 +216,7 @@ export class DrawingView {
   /** Where the brush is on the sleeve now (grid units), or null. */
   drawMarker(point: Point | null): void {
     const ctx = this.#marker2d;
-    ctx.clearRect(0, 0, this.#markerCanvas.width, this.#markerCanvas.height);
+    clear(ctx);
     const shape = this.#segmentShape();
     this.surface.dataset["marker"] = point === null ? "" : `${point[0].toFixed(2)},${point[1].toFixed(2)}`;
     if (point === null || shape === null) return;
@@ -191,7 +234,7 @@ export class DrawingView {
 
   #drawCompare(): void {
     const ctx = this.#compare2d;
-    ctx.clearRect(0, 0, this.#compareCanvas.width, this.#compareCanvas.height);
+    clear(ctx);
     const shape = this.#segmentShape();
     if (this.#compareSegments === null || shape === null) return;
     ctx.save();
@@ -274,7 +317,7 @@ export class DrawingView {
 
   clearLive(): void {
     if (!this.#liveShown) return;
-    this.#live2d.clearRect(0, 0, this.surface.width, this.surface.height);
+    clear(this.#live2d);
     this.#liveShown = false;
   }
 
@@ -283,11 +326,15 @@ export class DrawingView {
     this.#pointerRect = this.surface.getBoundingClientRect();
   }
 
-  /** A pointer position (client pixels) in the drawing's canvas pixels. */
+  /** A pointer position (client pixels) in the drawing's canvas pixels (the sleeve's orientation). */
   toDrawing(clientX: number, clientY: number): [number, number] {
     const rect = this.#pointerRect ?? this.surface.getBoundingClientRect();
     const k = this.#drawingScale();
-    return [(clientX - rect.left - AREA_MARGIN_PX) / k, (clientY - rect.top - AREA_MARGIN_PX) / k];
+    const u = clientX - rect.left - AREA_MARGIN_PX;
+    const v = clientY - rect.top - AREA_MARGIN_PX;
+    // The inverse of the quarter turn in `fit`: down the screen is along the sleeve's columns.
+    const [x, y] = this.#turned ? [v, this.#area.height_px - u] : [u, v];
+    return [x / k, y / k];
   }
 
   /** CSS pixels per drawing pixel: 1 unless the screen was resized since the drawing began. */
@@ -296,21 +343,22 @@ export class DrawingView {
     return width === undefined ? 1 : this.#area.width_px / width;
   }
 
+  /** Drawing pixels -> area pixels (the contexts' transform places them on the screen). */
   #toCss(x: number, y: number): [number, number] {
     const k = this.#drawingScale();
-    return [AREA_MARGIN_PX + x * k, AREA_MARGIN_PX + y * k];
+    return [x * k, y * k];
   }
 
   #gridToCss(gx: number, gy: number, shape: MappingShape): [number, number] {
     const [x, y] = gridToCanvas(gx, gy, shape);
     const k = this.#area.width_px / shape.width_px;
-    return [AREA_MARGIN_PX + x * k, AREA_MARGIN_PX + y * k];
+    return [x * k, y * k];
   }
 
   #drawGrid(): void {
     const ctx = this.#grid2d;
     const { rows, columns } = this.#grid;
-    ctx.clearRect(0, 0, this.#gridCanvas.width, this.#gridCanvas.height);
+    clear(ctx);
     const shape: MappingShape = { ...this.#area, rows, columns, stretch: this.#stretch };
     const at = (column: number, row: number) => this.#gridToCss(column, row, shape);
     ctx.strokeStyle = COLORS.grid;
@@ -337,10 +385,32 @@ export class DrawingView {
         ctx.stroke();
       }
     }
+    if (this.#turned) this.#drawTopEdge(ctx);
+  }
+
+  /** Turned, the sleeve's top edge is marked, on the right: the sender sees which way is up. */
+  #drawTopEdge(ctx: CanvasRenderingContext2D): void {
+    const { width_px } = this.#area;
+    const y = -AREA_MARGIN_PX / 2;
+    ctx.save();
+    ctx.strokeStyle = COLORS.topEdge;
+    ctx.fillStyle = COLORS.topEdge;
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    ctx.moveTo(0, y);
+    ctx.lineTo(width_px * 0.5 - 52, y);
+    ctx.moveTo(width_px * 0.5 + 52, y);
+    ctx.lineTo(width_px, y);
+    ctx.stroke();
+    ctx.font = "600 11px system-ui, sans-serif";
+    ctx.textAlign = "center";
+    ctx.textBaseline = "middle";
+    ctx.fillText("SLEEVE TOP", width_px * 0.5, y);
+    ctx.restore();
   }
 
   #redrawInk(): void {
-    this.#ink2d.clearRect(0, 0, this.#inkCanvas.width, this.#inkCanvas.height);
+    clear(this.#ink2d);
     this.#rawDrawn = [];
     this.#rawPathFrom = 0;
     this.#segmentsDrawn = 0;
@@ -447,6 +517,14 @@ export class DrawingView {
     ctx.stroke();
     ctx.restore();
   }
+}
+
+/** Clears the whole canvas, whatever the context's transform. */
+function clear(ctx: CanvasRenderingContext2D): void {
+  ctx.save();
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.clearRect(0, 0, ctx.canvas.width, ctx.canvas.height);
+  ctx.restore();
 }
 
 function context(canvas: HTMLCanvasElement): CanvasRenderingContext2D {

@@ -4,6 +4,11 @@
  * points back to canvas pixels (the inverse of `CanvasMapping.toGrid`).
  */
 
+export interface AreaSize {
+  readonly width_px: number;
+  readonly height_px: number;
+}
+
 export interface GridSize {
   readonly rows: number;
   readonly columns: number;
@@ -35,6 +40,31 @@ export function fitArea(
   const height = Math.max(40, availableHeightPx - 2 * AREA_MARGIN_PX);
   const widthPx = Math.floor(Math.min(width, height * aspect));
   return { width_px: widthPx, height_px: Math.floor(widthPx / aspect) };
+}
+
+/**
+ * Turned a quarter, the area must be this many times larger to be chosen: a
+ * near-square window keeps the sleeve upright instead of flipping at every resize.
+ */
+export const TURN_GAIN = 1.3;
+
+/**
+ * The drawing area for the space given, in the sleeve's orientation, and
+ * whether to show it turned a quarter: a landscape sleeve on an upright phone
+ * gets about twice the area turned (2:3 instead of 3:2 across the phone's width).
+ */
+export function chooseArea(
+  grid: GridSize,
+  availableWidthPx: number,
+  availableHeightPx: number,
+): { area: AreaSize; turned: boolean } {
+  const upright = fitArea(grid, availableWidthPx, availableHeightPx);
+  // Laid out turned: the grid's rows across the screen, its columns down it.
+  const across = fitArea({ rows: grid.columns, columns: grid.rows }, availableWidthPx, availableHeightPx);
+  if (across.width_px * across.height_px > TURN_GAIN * upright.width_px * upright.height_px) {
+    return { area: { width_px: across.height_px, height_px: across.width_px }, turned: true };
+  }
+  return { area: upright, turned: false };
 }
 
 export interface MappingShape {
