@@ -272,21 +272,23 @@ export interface Received {
 
 export class FakeSleeve {
   readonly client: MqttClient;
+  readonly sleeveId: string;
   readonly received: Received[] = [];
   #waiters: (() => void)[] = [];
 
-  private constructor(client: MqttClient) {
+  private constructor(client: MqttClient, sleeveId: string) {
     this.client = client;
+    this.sleeveId = sleeveId;
     client.on("message", (topic, payload) => {
       this.received.push({ topic, payload: payload.toString("utf8") });
       for (const wake of this.#waiters.splice(0)) wake();
     });
   }
 
-  /** Logs in as the sleeve user and subscribes to its strokes (QoS 1). */
+  /** Logs in as the sleeve user and subscribes to its strokes (QoS 1); `sleeveId`: another sleeve's. */
   static async connect(
     credentials: Credentials,
-    options: { clientId?: string; clean?: boolean } = {},
+    options: { clientId?: string; clean?: boolean; sleeveId?: string } = {},
   ): Promise<FakeSleeve> {
     const client = await mqtt.connectAsync(credentials.mqtt_url, {
       username: credentials.sleeve.username,
@@ -295,8 +297,8 @@ export class FakeSleeve {
       clean: options.clean ?? true,
       reconnectPeriod: 200,
     });
-    const sleeve = new FakeSleeve(client);
-    await client.subscribeAsync(`feelmysign/${SLEEVE_ID}/strokes`, { qos: 1 });
+    const sleeve = new FakeSleeve(client, options.sleeveId ?? SLEEVE_ID);
+    await client.subscribeAsync(`feelmysign/${sleeve.sleeveId}/strokes`, { qos: 1 });
     return sleeve;
   }
 
@@ -328,7 +330,7 @@ export class FakeSleeve {
   }
 
   async publish(subtopic: "status" | "actuators" | "events", payload: object, retain = false): Promise<void> {
-    await this.client.publishAsync(`feelmysign/${SLEEVE_ID}/${subtopic}`, JSON.stringify(payload), {
+    await this.client.publishAsync(`feelmysign/${this.sleeveId}/${subtopic}`, JSON.stringify(payload), {
       qos: 1,
       retain,
     });

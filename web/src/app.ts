@@ -31,6 +31,7 @@ import type { GridSize } from "./ui/geometry";
 import { attachPointer } from "./ui/pointer";
 import { SleevePreview } from "./ui/preview";
 import { SettingsPanel } from "./ui/settings";
+import { SleevePicker } from "./ui/sleeve-picker";
 import { LATE_MS, NOTABLE_ADJUSTMENT, SleeveSays, seconds } from "./ui/sleeve-says";
 import { byId, StatusBar, type SleeveState } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
@@ -86,6 +87,7 @@ export class App {
   readonly #status: StatusBar;
   readonly #says: SleeveSays;
   readonly #panel: SettingsPanel;
+  readonly #picker: SleevePicker;
   readonly #sender: StrokeSender;
   readonly #felt: FeltPanel;
   readonly #session: DrawingSession;
@@ -131,6 +133,12 @@ export class App {
     );
     this.#felt = new FeltPanel(timeline, this.#view);
     this.#panel = new SettingsPanel(doc, (settings) => this.#applySettings(settings));
+    this.#picker = new SleevePicker(
+      byId<HTMLSelectElement>(doc, "sleeve-select"),
+      this.#settings.sleeve_id,
+      (sleeve_id) => this.#applySettings({ ...this.#settings, sleeve_id }),
+    );
+    this.#picker.setKnown(options.config?.sleeves ?? []);
     this.#buttons = {
       undo: byId<HTMLButtonElement>(doc, "undo-button"),
       replay: byId<HTMLButtonElement>(doc, "replay-button"),
@@ -154,6 +162,7 @@ export class App {
     this.#sender = new StrokeSender({
       broker: (state, detail) => this.#onBroker(state, detail),
       status: (payload) => this.#onStatus(payload),
+      sleeveStatus: (sleeveId, payload) => this.#picker.setStatus(sleeveId, payload),
       actuators: (payload) => this.#onActuators(payload),
       event: (payload) => this.#onEvent(payload),
       unsent: (count) => this.#status.setUnsent(count),
@@ -381,12 +390,22 @@ export class App {
       this.#fit();
     }
     if (changed(TARGET_KEYS)) {
-      if (previous.sleeve_id !== this.#settings.sleeve_id) {
+      const sleeveChanged = previous.sleeve_id !== this.#settings.sleeve_id;
+      if (sleeveChanged) {
+        // Its strokes went to the other sleeve: the next path starts a new drawing for this one.
+        this.#session.close();
+        this.#picker.setCurrent(this.#settings.sleeve_id);
+        this.#says.add(
+          "info",
+          `Now drawing on sleeve ${this.#settings.sleeve_id}; the next path starts a new drawing.`,
+        );
         this.#sleeve = null;
         this.#setSleeve("unknown");
         this.#fit();
       }
+      // Another sleeve on the same broker keeps the connection; its status, if known, comes at once.
       this.#sender.connect(this.#target());
+      if (sleeveChanged && this.#brokerState === "connected") this.#waitForStatus();
     }
   }
 
@@ -439,6 +458,7 @@ export class App {
       if (this.#statusTimer !== null) clearTimeout(this.#statusTimer);
       // Without the broker nothing is known about the sleeve any more.
       this.#setSleeve("unknown", "Not known while the broker is not connected.");
+      this.#picker.forget();
     }
   }
 

@@ -6,7 +6,10 @@
 
 export interface ServerConfig {
   readonly ws_url: string;
+  /** The server's own sleeve: the one drawn on until another is chosen. */
   readonly sleeve_id: string;
+  /** Every sleeve with an account on the server's broker (its own first); the picker lists them. */
+  readonly sleeves: readonly string[];
   readonly username: string;
   readonly password: string;
 }
@@ -24,9 +27,14 @@ export function readConfig(value: unknown): ServerConfig | string {
   for (const key of ["ws_url", "sleeve_id", "username", "password"]) {
     if (typeof data[key] !== "string") return `has no string "${key}"`;
   }
+  const sleeves = data["sleeves"] ?? [data["sleeve_id"]];
+  if (!Array.isArray(sleeves) || !sleeves.every((id) => typeof id === "string")) {
+    return 'has a "sleeves" that is not a list of sleeve ids';
+  }
   return {
     ws_url: data["ws_url"] as string,
     sleeve_id: data["sleeve_id"] as string,
+    sleeves: sleeves as string[],
     username: data["username"] as string,
     password: data["password"] as string,
   };

@@ -12,10 +12,23 @@ describe("fetchConfig", () => {
     expect(result.config).toEqual({
       ws_url: "ws://127.0.0.1:9001",
       sleeve_id: "sleeve1",
+      // An older server lists no sleeves: its own is the one.
+      sleeves: ["sleeve1"],
       username: "sender",
       password: "x",
     });
     expect(result.note).toBeNull();
+  });
+
+  it("reads every sleeve that shares the server's broker, and refuses a list that is not one", async () => {
+    const config = { ws_url: "ws://h:1", sleeve_id: "sleeve1", username: "s", password: "p" };
+    const listed = await fetchConfig(
+      respond(200, JSON.stringify({ ...config, sleeves: ["sleeve1", "arm2"] })),
+    );
+    expect(listed.config?.sleeves).toEqual(["sleeve1", "arm2"]);
+    const bad = await fetchConfig(respond(200, JSON.stringify({ ...config, sleeves: "arm2" })));
+    expect(bad.config).toBeNull();
+    expect(bad.note).toMatch(/"sleeves" that is not a list/);
   });
 
   it("says what is missing when there is no config (vite dev)", async () => {

@@ -51,6 +51,7 @@ function errorsFor(key: SettingKey, value: unknown): string | undefined {
 const CONFIG: ServerConfig = {
   ws_url: "ws://127.0.0.1:19001",
   sleeve_id: "armband",
+  sleeves: ["armband"],
   username: "sender",
   password: "from-the-server",
 };

@@ -4,12 +4,18 @@
  * broker is out of reach and go out in order when it is back; one leaves the
  * outbox only on the broker's PUBACK, so the count of unsent strokes shown is
  * honest. `sent_at_ms` is stamped when a stroke actually goes out.
+ *
+ * Several sleeves may share the broker. The page hears every sleeve's retained
+ * status (for the sleeve picker) and the chosen one's actuators and events.
+ * Choosing another sleeve swaps those two subscriptions on the same connection;
+ * each stroke keeps the sleeve it was drawn for, so one drawn offline for the
+ * first still goes to the first.
  */
 import mqtt, { type IClientOptions, type MqttClient } from "mqtt";
 import { CANCEL_ALL, formatControl } from "../control";
 import { Outbox } from "../outbox";
 import { formatJson, formatLegacy, StrokeError, type Stroke } from "../protocol";
-import { controlTopic, strokesTopic, telemetryTopic } from "./topics";
+import { ANY_SLEEVE, controlTopic, strokesTopic, telemetryTopic, TOPIC_ROOT } from "./topics";
 
 export type BrokerState = "connecting" | "connected" | "offline";
 export type WireProtocol = "json" | "legacy";
@@ -25,7 +31,10 @@ export interface SenderTarget {
 
 export interface SenderListener {
   broker(state: BrokerState, detail: string | null): void;
+  /** The chosen sleeve's retained status ("" when it was cleared). */
   status(payload: string): void;
+  /** Any sleeve's retained status, the chosen one's included: what the picker shows. */
+  sleeveStatus(sleeveId: string, payload: string): void;
   actuators(payload: string): void;
   event(payload: string): void;
   unsent(count: number): void;
@@ -48,15 +57,35 @@ const KEEPALIVE_S = 20;
  * user name or password, not authorized (MQTT 3.1.1: 4, 5; MQTT 5: 134, 135).
  */
 export const BAD_LOGIN_CODES: ReadonlySet<number> = new Set([4, 5, 134, 135]);
+/** Every sleeve's status, retained: who is online, for the picker. */
+const EVERY_STATUS = telemetryTopic(ANY_SLEEVE, "status");
+
+/** A stroke and the sleeve it was drawn for. */
+interface Addressed {
+  readonly stroke: Stroke;
+  readonly sleeveId: string;
+}
+
+/** The chosen sleeve's own telemetry: swapped when another sleeve is chosen. */
+const ownTopics = (sleeveId: string): string[] =>
+  (["actuators", "events"] as const).map((name) => telemetryTopic(sleeveId, name));
+
+/** `feelmysign/<id>/<name>` -> [id, name]; null for any other topic. */
+function sleeveTopicParts(topic: string): [string, string] | null {
+  const parts = topic.split("/");
+  return parts.length === 3 && parts[0] === TOPIC_ROOT ? [parts[1]!, parts[2]!] : null;
+}
 
 export class StrokeSender {
   readonly #listener: SenderListener;
-  readonly #outbox = new Outbox<Stroke>();
+  readonly #outbox = new Outbox<Addressed>();
   readonly #decoder = new TextDecoder();
   #client: MqttClient | null = null;
   #target: SenderTarget | null = null;
   /** Cancels not yet acknowledged by the broker, sent before any stroke when it is back. */
-  #cancels: string[] = [];
+  #cancels: { readonly drawing: string; readonly sleeveId: string }[] = [];
+  /** Every sleeve's last retained status heard on this connection. */
+  readonly #statuses = new Map<string, string>();
   /** Strokes not sent within this many ms are dropped; null: they go out whenever possible. */
   #lateLimitMs: number | null = null;
 
@@ -68,9 +97,27 @@ export class StrokeSender {
     return this.#outbox.size;
   }
 
-  /** (Re)connects to `target`. Strokes in flight on the old connection are sent again. */
+  /**
+   * (Re)connects to `target`. Strokes in flight on the old connection are sent again.
+   * Only another sleeve on the same broker and login keeps the connection: its
+   * subscriptions are swapped, and its status, if heard already, is told at once.
+   */
   connect(target: SenderTarget): void {
+    const old = this.#target;
+    if (
+      this.#client !== null &&
+      old !== null &&
+      old.ws_url === target.ws_url &&
+      old.username === target.username &&
+      old.password === target.password &&
+      old.protocol === target.protocol &&
+      old.legacy_topic === target.legacy_topic
+    ) {
+      this.#chooseSleeve(old.sleeve_id, target);
+      return;
+    }
     this.#close();
+    this.#statuses.clear();
     this.#target = target;
     this.#outbox.requeueInFlight();
     const options: IClientOptions = {
@@ -103,9 +150,8 @@ export class StrokeSender {
         "connected",
         `Connected to ${target.ws_url} as ${target.username || "anonymous"}`,
       );
-      const topics = (["status", "actuators", "events"] as const).map((name) =>
-        telemetryTopic(target.sleeve_id, name),
-      );
+      // The target now, not at connect(): another sleeve may have been chosen since.
+      const topics = [EVERY_STATUS, ...ownTopics(this.#target?.sleeve_id ?? target.sleeve_id)];
       client.subscribe(topics, { qos: 0 }, (error) => {
         if (error)
           this.#listener.broker(
@@ -140,16 +186,40 @@ export class StrokeSender {
     });
     client.on("message", (topic, payload) => {
       if (client !== this.#client) return;
+      const parts = sleeveTopicParts(topic);
+      if (parts === null) return;
+      const [sleeveId, name] = parts;
       const text = this.#decoder.decode(payload);
-      if (topic.endsWith("/status")) this.#listener.status(text);
-      else if (topic.endsWith("/actuators")) this.#listener.actuators(text);
-      else if (topic.endsWith("/events")) this.#listener.event(text);
+      const chosen = sleeveId === this.#target?.sleeve_id;
+      if (name === "status") {
+        if (text.trim() === "") this.#statuses.delete(sleeveId);
+        else this.#statuses.set(sleeveId, text);
+        this.#listener.sleeveStatus(sleeveId, text);
+        if (chosen) this.#listener.status(text);
+      } else if (!chosen) {
+        return; // the sleeve chosen before: its last messages, in flight while unsubscribing
+      } else if (name === "actuators") this.#listener.actuators(text);
+      else if (name === "events") this.#listener.event(text);
     });
   }
 
-  /** Queues a stroke and sends it now if the broker is connected. */
+  /** Another sleeve on this connection: its actuators and events instead of the old one's. */
+  #chooseSleeve(previous: string, target: SenderTarget): void {
+    this.#target = target;
+    const client = this.#client;
+    if (previous === target.sleeve_id || client === null) return;
+    if (client.connected) {
+      client.unsubscribe(ownTopics(previous));
+      client.subscribe(ownTopics(target.sleeve_id), { qos: 0 });
+    }
+    const status = this.#statuses.get(target.sleeve_id);
+    if (status !== undefined) this.#listener.status(status);
+  }
+
+  /** Queues a stroke for the chosen sleeve and sends it now if the broker is connected. */
   send(stroke: Stroke): void {
-    this.#outbox.add(stroke);
+    if (this.#target === null) throw new Error("send before connect");
+    this.#outbox.add({ stroke, sleeveId: this.#target.sleeve_id });
     this.#flush();
   }
 
@@ -159,8 +229,14 @@ export class StrokeSender {
    * playing and drop the rest. Returns how many unsent strokes were dropped.
    */
   cancel(drawing: string): number {
-    const dropped = this.#outbox.dropQueued((stroke) => drawing === CANCEL_ALL || stroke.drawing === drawing);
-    this.#cancels = [...this.#cancels.filter((d) => d !== drawing), drawing];
+    const sleeveId = this.#target?.sleeve_id;
+    if (sleeveId === undefined) return 0;
+    const dropped = this.#outbox.dropQueued(
+      ({ stroke, sleeveId: to }) => to === sleeveId && (drawing === CANCEL_ALL || stroke.drawing === drawing),
+    );
+    const same = (c: { drawing: string; sleeveId: string }) =>
+      c.drawing === drawing && c.sleeveId === sleeveId;
+    this.#cancels = [...this.#cancels.filter((c) => !same(c)), { drawing, sleeveId }];
     this.#flush();
     return dropped.length;
   }
@@ -187,20 +263,21 @@ export class StrokeSender {
       const limit = this.#lateLimitMs;
       if (limit !== null) {
         const now = performance.now();
-        const late = this.#outbox.dropQueued((_stroke, entry) => now - entry.added_ms > limit);
-        if (late.length > 0) this.#listener.late(late);
+        const late = this.#outbox.dropQueued((_item, entry) => now - entry.added_ms > limit);
+        if (late.length > 0) this.#listener.late(late.map((item) => item.stroke));
       }
-      for (const drawing of this.#cancels) {
+      for (const cancel of this.#cancels) {
         // QoS 1 as strokes: published in order, ahead of what is queued now.
-        client.publish(controlTopic(target.sleeve_id), formatControl(drawing), { qos: 1 }, (error) => {
-          if (client === this.#client && !error) this.#cancels = this.#cancels.filter((d) => d !== drawing);
+        const topic = controlTopic(cancel.sleeveId);
+        client.publish(topic, formatControl(cancel.drawing), { qos: 1 }, (error) => {
+          if (client === this.#client && !error) this.#cancels = this.#cancels.filter((c) => c !== cancel);
         });
       }
       for (const entry of this.#outbox.takeQueued()) {
         const message = this.#format(entry.item, target);
         if (message instanceof StrokeError) {
           this.#outbox.ack(entry.id);
-          this.#listener.refused(entry.item, message);
+          this.#listener.refused(entry.item.stroke, message);
           continue;
         }
         client.publish(message.topic, message.payload, { qos: 1 }, (error) => {
@@ -209,7 +286,7 @@ export class StrokeSender {
           if (error) this.#outbox.fail(entry.id);
           else {
             this.#outbox.ack(entry.id);
-            this.#listener.acked(entry.item);
+            this.#listener.acked(entry.item.stroke);
           }
           this.#listener.unsent(this.#outbox.size);
         });
@@ -218,13 +295,16 @@ export class StrokeSender {
     this.#listener.unsent(this.#outbox.size);
   }
 
-  #format(stroke: Stroke, target: SenderTarget): { topic: string; payload: string } | StrokeError {
+  #format(
+    { stroke, sleeveId }: Addressed,
+    target: SenderTarget,
+  ): { topic: string; payload: string } | StrokeError {
     try {
       if (target.protocol === "legacy") {
         return { topic: target.legacy_topic, payload: formatLegacy(stroke) };
       }
       return {
-        topic: strokesTopic(target.sleeve_id),
+        topic: strokesTopic(sleeveId),
         payload: formatJson({ ...stroke, sent_at_ms: Date.now() }),
       };
     } catch (error) {

@@ -1,0 +1,152 @@
+/**
+ * Two sleeves on one broker, as `feelmysign up` serves them after `broker
+ * add-sleeve arm2`: the page lists both with their state from the retained
+ * status, strokes go only to the sleeve chosen, switching back plays on the
+ * simulated sleeve, and the choice is remembered across a reload.
+ */
+import { spawnSync } from "node:child_process";
+import { readFileSync, rmSync } from "node:fs";
+import { join } from "node:path";
+import type { Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import {
+  Broker,
+  checkPrerequisites,
+  FakeSleeve,
+  FEELMYSIGN,
+  launchBrowser,
+  startUp,
+  stopUp,
+  tempDir,
+  type Credentials,
+} from "./harness";
+import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData } from "./page";
+
+const SECOND = "arm2";
+const PICKER = '[data-testid="sleeve-select"]';
+const CHIP = '[data-testid="sleeve-status"]';
+const LAYOUT = { rows: 3, columns: 4, spacing_cm: 3 };
+
+/** The picker's options as the sender reads them: "id · state". */
+async function options(page: Page): Promise<string[]> {
+  return page.locator(`${PICKER} option`).allInnerTexts();
+}
+
+async function waitForOption(page: Page, text: string): Promise<void> {
+  await page.waitForFunction(
+    ({ picker, text }) =>
+      [...(document.querySelector(picker) as HTMLSelectElement).options].some((o) => o.text === text),
+    { picker: PICKER, text },
+    { timeout: 15_000 },
+  );
+}
+
+/** A Z across the area: three strokes or more (a long leg may be cut by the latency cap). */
+async function drawZ(page: Page): Promise<number> {
+  const area = await drawingArea(page);
+  const at = (fx: number, fy: number) => [area.left + area.width * fx, area.top + area.height * fy] as const;
+  await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.2, 0.8), at(0.8, 0.8)]);
+  await nextFrame(page);
+  return Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
+}
+
+describe("two sleeves on one broker, chosen on the page", () => {
+  const cleanups: (() => Promise<void>)[] = [];
+  let page: Page;
+  let first: FakeSleeve;
+  let second: FakeSleeve;
+
+  beforeAll(async () => {
+    checkPrerequisites();
+    const stateDir = tempDir("sleeves");
+    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
+    // The broker's state first, then the second sleeve's account, then everything up.
+    const broker = await Broker.start(stateDir);
+    await broker.stop();
+    const added = spawnSync(
+      FEELMYSIGN,
+      ["broker", "--state-dir", stateDir, "add-sleeve", SECOND, "--url", "mqtts://127.0.0.1:8883"],
+      { encoding: "utf8" },
+    );
+    expect(added.status, added.stderr).toBe(0);
+    const up = await startUp(stateDir);
+    cleanups.push(() => stopUp(up.child));
+    const credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
+    const accounts = JSON.parse(readFileSync(join(stateDir, "sleeves.json"), "utf8")) as Record<
+      string,
+      { username: string; password: string }
+    >;
+    // A second login of the simulated sleeve's account, listening only: what it receives.
+    first = await FakeSleeve.connect(credentials);
+    cleanups.push(() => first.close());
+    // The second sleeve, played by the test with its own account.
+    second = await FakeSleeve.connect(
+      { ...credentials, sleeve: { id: SECOND, ...accounts[SECOND]! } },
+      { sleeveId: SECOND },
+    );
+    cleanups.push(() => second.close());
+    await second.publish("status", { online: true, layout: LAYOUT }, true);
+    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 } });
+    cleanups.push(browser.close);
+    page = await browser.context.newPage();
+    await page.goto(up.url);
+    await waitForData(page, CHIP, "state", "online", 30_000);
+  });
+
+  afterAll(async () => {
+    for (const cleanup of cleanups.reverse()) await cleanup();
+  });
+
+  it("lists both sleeves with their state from the retained status", async () => {
+    await waitForOption(page, `${SECOND} · online`);
+    await waitForOption(page, "sleeve1 · online");
+    expect(await page.locator(PICKER).isVisible()).toBe(true);
+    expect(await page.locator(PICKER).inputValue()).toBe("sleeve1");
+    await second.publish("status", { online: false, layout: LAYOUT }, true);
+    await waitForOption(page, `${SECOND} · offline`);
+    await second.publish("status", { online: true, layout: LAYOUT }, true);
+    await waitForOption(page, `${SECOND} · online`);
+    expect((await options(page)).length).toBe(2);
+  });
+
+  it("sends strokes only to the sleeve chosen", async () => {
+    await page.locator(PICKER).selectOption(SECOND);
+    await waitForData(page, CHIP, "state", "online");
+    await expect(page.locator(CHIP).innerText()).resolves.toContain(SECOND);
+    const sent = await drawZ(page);
+    expect(sent).toBeGreaterThanOrEqual(3);
+    const onSecond = await second.waitForStrokes(sent);
+    const drawingOnSecond = onSecond[0]!["drawing"];
+    expect(onSecond.every((stroke) => stroke["drawing"] === drawingOnSecond)).toBe(true);
+
+    // Back to the simulated sleeve: a new drawing, played there, and nothing more for arm2.
+    await page.locator(PICKER).selectOption("sleeve1");
+    await waitForData(page, CHIP, "state", "online");
+    const sentAgain = await drawZ(page);
+    const onFirst = await first.waitForStrokes(sentAgain);
+    expect(onFirst.length).toBe(sentAgain);
+    expect(onFirst.every((stroke) => stroke["drawing"] !== drawingOnSecond)).toBe(true);
+    // Every stroke the page sent is accounted for: sent - arm2's went to sleeve1, none to both.
+    expect(onFirst.length + onSecond.length).toBe(sent + sentAgain);
+    // Played there (every stroke, or skipped as late by a sleeve fallen behind on a loaded machine).
+    await page.waitForFunction(
+      () =>
+        Number((document.querySelector('[data-testid="played-summary"]') as HTMLElement).dataset["played"]) >
+        0,
+      undefined,
+      { timeout: 30_000 },
+    );
+    expect(second.strokes().length).toBe(sent);
+    await screenshot(page, "sleeves-picker");
+  });
+
+  it("remembers the choice across a reload", async () => {
+    await page.locator(PICKER).selectOption(SECOND);
+    await waitForData(page, CHIP, "state", "online");
+    await page.reload();
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected", 30_000);
+    await waitForData(page, CHIP, "state", "online", 30_000);
+    expect(await page.locator(PICKER).inputValue()).toBe(SECOND);
+    await expect(page.locator(CHIP).innerText()).resolves.toContain(SECOND);
+  });
+});
