@@ -1,11 +1,28 @@
 import { fileURLToPath } from "node:url";
+import type { Plugin } from "vite";
 import { defineConfig } from "vitest/config";
 
 const repoRoot = fileURLToPath(new URL("..", import.meta.url));
 
+/** The brand's dot, as the pages' icon. */
+const ICON =
+  "data:image/svg+xml,%3Csvg xmlns='http://www.w3.org/2000/svg' viewBox='0 0 16 16'%3E" +
+  "%3Ccircle cx='8' cy='8' r='6' fill='%23ff8a5b'/%3E%3C/svg%3E";
+
+/** What the head of every page has (charset, colour, icon): written once, added to each page. */
+const sharedHead: Plugin = {
+  name: "feelmysign-shared-head",
+  transformIndexHtml: () => [
+    { tag: "meta", attrs: { charset: "utf-8" }, injectTo: "head-prepend" },
+    { tag: "meta", attrs: { name: "theme-color", content: "#0e141b" }, injectTo: "head" },
+    { tag: "link", attrs: { rel: "icon", href: ICON }, injectTo: "head" },
+  ],
+};
+
 export default defineConfig({
   // Relative asset paths: `feelmysign up` may serve dist/ under any prefix.
   base: "./",
+  plugins: [sharedHead],
   server: {
     host: "127.0.0.1",
     // The settings import testdata/angle/params.json from outside web/.

@@ -2,6 +2,7 @@
 import "./styles.css";
 import { App } from "./app";
 import { fetchConfig } from "./config";
+import { buildToolbar } from "./ui/toolbar";
 
 declare global {
   interface Window {
@@ -32,5 +33,8 @@ function settingsStorage(): Storage {
   }
 }
 
+// The toolbar first: its place is taken before the config arrives, so nothing moves then.
+const toolbar = document.getElementById("toolbar");
+if (toolbar !== null) buildToolbar(toolbar);
 const { config, note } = await fetchConfig();
 window.feelmysign = new App(document, { config, configNote: note, storage: settingsStorage() });
