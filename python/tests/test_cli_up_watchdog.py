@@ -78,3 +78,30 @@ def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path)
             raise
     assert code == 0, "".join(seen)
     assert _mosquitto_children(process.pid) == []
+
+
+def test_up_says_it_is_stopping_on_ctrl_c_and_reports_no_fault(tmp_path: Path) -> None:
+    web = tmp_path / "web"
+    web.mkdir()
+    (web / "index.html").write_text("<!doctype html><title>test</title>")
+    command = [sys.executable, "-m", "feelmysign", "up", "--state-dir", str(tmp_path / "state")]
+    command += ["--http-port", "0", "--port", "0", "--ws-port", "0", "--web-dir", str(web)]
+    process = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1
+    )
+    seen: list[str] = []
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        process.send_signal(signal.SIGINT)
+        _wait_for(lines, "Stopped: sleeve (every motor off)", seen)
+        code = process.wait(timeout=30)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    output = "".join(seen)
+    assert code == 0, output
+    assert "Stopping: every motor off" in output
+    # A stop asked for is no fault: the sleeve leaving the broker is not reported as lost.
+    assert "lost the broker" not in output, output
+    assert output.index("Stopping:") < output.index("Stopped:")

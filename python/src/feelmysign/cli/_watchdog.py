@@ -4,7 +4,9 @@ Mosquitto is a separate process: if it dies (killed, out of memory), the
 watchdog says so and starts it again on the same ports with the same
 credentials, so the sleeve and the page reconnect by themselves. It also says
 when the sleeve loses the broker and when it is back. The sleeve itself runs
-in ``up``'s own process: if it stops, ``up`` stops with its error.
+in ``up``'s own process: if it stops, ``up`` stops with its error. A stop asked
+for (Ctrl-C) is no fault: once told ``stopping()``, it says it is stopping and
+reports nothing the shutdown itself causes.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ class Watchdog:
     def __init__(self, broker: Broker) -> None:
         self._broker = broker
         self._stopped = threading.Event()
+        self._stopping = threading.Event()
+        self._wake = threading.Event()  # set by a stop of either kind: no waiting out the interval
         self._sleeve: Sleeve | None = None
         self._thread = threading.Thread(target=self._run, name="feelmysign-watchdog", daemon=True)
 
@@ -42,16 +46,34 @@ class Watchdog:
         traceback: TracebackType | None,
     ) -> None:
         self._stopped.set()
+        self._wake.set()
         self._thread.join(timeout=5.0)
         self._broker.stop()  # a broker started here again is stopped here too
 
     def watch(self, sleeve: Sleeve) -> None:
         self._sleeve = sleeve
 
+    def stopping(self) -> None:
+        """A stop was asked for: what follows (the sleeve leaving the broker) is no fault.
+
+        Safe in a signal handler: it only sets events; the watchdog's thread prints.
+        """
+        self._stopping.set()
+        self._wake.set()
+
     def _run(self) -> None:
         connections = 0
         lost = False
-        while not self._stopped.wait(CHECK_INTERVAL_S):
+        while True:
+            self._wake.wait(CHECK_INTERVAL_S)
+            if self._stopping.is_set():
+                print(
+                    "Stopping: every motor off, then the drawing client and the broker.",
+                    flush=True,
+                )
+                return
+            if self._stopped.is_set():
+                return
             restarted = self._check_broker()
             sleeve = self._sleeve
             if sleeve is None:

@@ -135,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
             )
 
             def started(sleeve: Sleeve) -> None:
-                _stop_on_signals(sleeve)
+                _stop_on_signals(sleeve, watchdog)
                 watchdog.watch(sleeve)
                 threading.Thread(
                     target=_announce,
@@ -217,5 +217,9 @@ def _announce(sleeve: Sleeve, url: str, broker: Broker, study: bool = False) -> 
     )
 
 
-def _stop_on_signals(sleeve: Sleeve) -> None:
-    call_on_stop_signals(sleeve.stop)
+def _stop_on_signals(sleeve: Sleeve, watchdog: Watchdog) -> None:
+    def stop() -> None:
+        watchdog.stopping()  # first: the sleeve leaving the broker is then no fault
+        sleeve.stop()
+
+    call_on_stop_signals(stop)
