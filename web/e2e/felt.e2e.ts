@@ -19,7 +19,7 @@ import {
   tempDir,
   type Credentials,
 } from "./harness";
-import { drawingArea, drawWithMouse, screenshot, waitForData, type Area } from "./page";
+import { drawingArea, drawWithMouse, openAdvanced, screenshot, waitForData, type Area } from "./page";
 
 type Point = readonly [number, number];
 /** The bound: every motor off this soon after the sleeve received the cancel. */
@@ -89,6 +89,15 @@ async function dataOf(page: Page, testid: string, key: string): Promise<string> 
     .evaluate((el, k) => (el as HTMLElement).dataset[k] ?? "", key);
 }
 
+/** Settings → Advanced → Longest stroke (ms of drawing; 0 = no limit), saved. */
+async function setLongestStroke(page: Page, ms: string): Promise<void> {
+  await page.locator('[data-testid="settings-button"]').click();
+  await openAdvanced(page);
+  await page.locator('[data-testid="setting-max_stroke_ms"]').fill(ms);
+  await page.locator('[data-testid="settings-save"]').click();
+  await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
+}
+
 describe("the felt drawing, served by feelmysign up with the simulated sleeve", () => {
   const cleanups: (() => Promise<void>)[] = [];
   let page: Page;
@@ -156,7 +165,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     // The sleeve is idle: what the record gets next is this drawing's.
     await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0", 30_000);
     const before = readRecord(recordPath).length;
-    // A slow zigzag: each leg takes about a second to draw, so its stroke plays that long.
+    // One stroke a leg (no cap on a stroke's length), so the last one plays as long as its
+    // leg took to draw: seconds, however slowly this machine answers the Esc.
+    await setLongestStroke(page, "0");
+    await page.locator('[data-testid="new-button"]').click();
+    // A slow zigzag: each leg takes seconds to draw, so its stroke plays that long.
     const legs: Point[] = [at(0.05, 0.1), at(0.3, 0.9), at(0.55, 0.1), at(0.8, 0.9), at(0.95, 0.1)];
     await drawWithMouse(page, legs, { stepPx: 4 });
     const drawing = await drawingId(page);
@@ -201,6 +214,7 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     expect(offAfterMs).toBeLessThanOrEqual(OFF_WITHIN_MS);
     await waitForData(page, '[data-testid="played-summary"]', "cancelled", String(cancelled.length));
     await screenshot(page, "felt-stopped");
+    await setLongestStroke(page, "300"); // the default again, for what follows
   });
 
   it("loads a saved recording back, shows what would be felt, and plays it again", async () => {

@@ -41,6 +41,7 @@ const DRAWING_KEYS: readonly SettingKey[] = [
   "algorithm",
   "max_error",
   "max_window",
+  "max_stroke_ms",
   "check_frames",
   "max_angle_deg",
   "frame_max",
