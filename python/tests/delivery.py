@@ -207,5 +207,16 @@ def by_seq(events: list[dict[str, Any]], drawing: str) -> dict[int, list[dict[st
     return found
 
 
+def plays(events: list[dict[str, Any]], drawing: str) -> dict[int, int]:
+    """How many times each stroke of ``drawing`` started. A watcher may receive one event
+    twice across a broker restart (QoS 1 is at least once): such copies say the same
+    ``first_command_at_ms``, and count once."""
+    starts: dict[int, set[float]] = {}
+    for event in played(events):
+        if event.get("drawing") == drawing:
+            starts.setdefault(event["seq"], set()).add(event["first_command_at_ms"])
+    return {seq: len(times) for seq, times in starts.items()}
+
+
 def played(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return [e for e in events if e["type"] in ("played", "adjusted")]

@@ -419,6 +419,20 @@ class Sleeve:
             cancelled_at_ms = self._cancelled[stroke.drawing]
             self._event(cancelled(info, received_wall_ms, cancelled_at_ms, started=False), ack)
             return
+        if ack is not None and self._player.hold(
+            stroke.drawing, stroke.seq, lambda: self._outbox.put(ack)
+        ):
+            # The broker's copy of a stroke still waiting to play (the connection dropped
+            # before it was acknowledged): acknowledged when the stroke plays, not now, and
+            # not checked again (the pace rules and the rate limit took the original).
+            self._count("redelivered")
+            log.info(
+                "sleeve %s: stroke %s of drawing %s came again while it waits to play",
+                self._id,
+                stroke.seq,
+                stroke.drawing,
+            )
+            return
         if not self._bucket.take():
             self._reject(
                 "rate_limited",

@@ -5,7 +5,10 @@ starts the moment the one before it ends (its duration T), so the strokes of
 a drawing feel like one continuous touch; a stroke that arrives to an idle
 sleeve starts at once. Within a drawing, strokes play in ``seq`` order: a
 repeated or older ``seq`` (a redelivery) is dropped, and a gap (the sender
-drops strokes too short to feel) never waits for the missing one.
+drops strokes too short to feel) never waits for the missing one. A copy of a
+stroke still waiting to play (the broker sends again what was not acknowledged
+when a connection dropped) is not dropped but ``hold``: its acknowledgement
+waits for the stroke, so the broker keeps it until it is felt.
 
 The queue is bounded: a stroke that would start more than ``max_backlog_ms``
 from now, or beyond ``max_pending`` strokes not yet started, is refused
@@ -124,6 +127,9 @@ class Player:
         self._pending = 0
         self._tail_ms = float("-inf")
         self._last_seq: OrderedDict[str, int] = OrderedDict()
+        # Accepted, with a drawing and seq, and not yet started, refused or dropped: what a
+        # redelivered copy must wait for (see hold).
+        self._unplayed: dict[tuple[str, int], PlannedStroke] = {}
         self._running = False
         self._accepted = 0
         self._cancels: list[_CancelRequest] = []
@@ -148,6 +154,7 @@ class Player:
                 self._last_seq.move_to_end(drawing)
                 while len(self._last_seq) > REMEMBERED_DRAWINGS:
                     self._last_seq.popitem(last=False)
+                self._unplayed[(drawing, seq)] = stroke
             stroke.number = self._accepted
             self._accepted += 1
             stroke.start_ms = max(stroke.received_at_ms, self._tail_ms)
@@ -156,6 +163,30 @@ class Player:
             self._inbox.append(stroke)
         self._wake.set()
         return None
+
+    def hold(self, drawing: object, seq: object, acknowledge: Callable[[], None]) -> bool:
+        """A copy of a stroke accepted and not yet played: True, and ``acknowledge`` is called
+        when the stroke is done with (played, refused by the duty-cycle cap or cancelled), not
+        before. False when no such stroke waits (the copy is then checked like any stroke).
+
+        Acknowledging the copy at once would let the broker forget a stroke that so far only
+        this process holds: a ``kill -9`` before it plays would lose it.
+        """
+        if not isinstance(drawing, str) or not isinstance(seq, int):
+            return False
+        with self._lock:
+            original = self._unplayed.get((drawing, seq))
+            if original is None:
+                return False
+            original.acknowledge = _both(original.acknowledge, acknowledge)
+            return True
+
+    def _done(self, stroke: PlannedStroke) -> Callable[[], None] | None:
+        """Under the lock: the stroke leaves the unplayed ones; its acknowledgement, to call."""
+        drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        if isinstance(drawing, str) and isinstance(seq, int):
+            self._unplayed.pop((drawing, seq), None)
+        return stroke.acknowledge
 
     def wait_ms(self, now_ms: float) -> float:
         """How long a stroke submitted at ``now_ms`` would wait for the strokes before it."""
@@ -218,6 +249,7 @@ class Player:
                 tag for tag in self._timeline.unstarted() if isinstance(tag, PlannedStroke)
             ]
             self._inbox.clear()
+            self._unplayed.clear()  # never acknowledged: the broker sends them again
         return unplayed
 
     @property
@@ -266,6 +298,11 @@ class Player:
                 self._backend.all_off()  # nothing may run on after "cancel everything"
             with self._lock:
                 self._pending -= len(cut.unstarted)
+                acknowledgements = {
+                    id(tag): self._done(tag)
+                    for tag in cut.unstarted
+                    if isinstance(tag, PlannedStroke)
+                }
                 self._tail_ms = max(
                     (
                         tag.start_ms + tag.schedule.duration_ms
@@ -280,8 +317,9 @@ class Player:
                         at_ms = request.received_wall_ms
                         event = cancelled(tag.info, tag.received_wall_ms, at_ms, started=started)
                         self._on_event(event)
-                        if tag.acknowledge is not None:  # (once only: a started one was)
-                            tag.acknowledge()
+                        acknowledge = acknowledgements.get(id(tag))  # a started one was
+                        if acknowledge is not None:
+                            acknowledge()
 
     def _step(self) -> None:
         next_ms = self._timeline.next_ms()
@@ -344,6 +382,7 @@ class Player:
         """A stroke the duty-cycle cap kept from playing: said, and never called played."""
         with self._lock:
             self._pending -= 1
+            acknowledge = self._done(capped.tag) if isinstance(capped.tag, PlannedStroke) else None
         self.capped += 1
         refusal = capped.refusal
         row, column = refusal.actuator
@@ -367,12 +406,13 @@ class Player:
                 window_ms=refusal.window_ms,
             )
         )
-        if isinstance(capped.tag, PlannedStroke) and capped.tag.acknowledge is not None:
-            capped.tag.acknowledge()  # refused, and said so: the broker must not send it again
+        if acknowledge is not None:
+            acknowledge()  # refused, and said so: the broker must not send it again
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:
             self._pending -= 1
+            acknowledge = self._done(stroke)
         self.played += 1
         schedule = stroke.schedule
         timing = {
@@ -396,8 +436,19 @@ class Player:
         else:
             event = Played(**timing)
         self._on_event(event)
-        if stroke.acknowledge is not None:
-            stroke.acknowledge()
+        if acknowledge is not None:
+            acknowledge()
+
+
+def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Callable[[], None]:
+    if first is None:
+        return second
+
+    def both() -> None:
+        first()
+        second()
+
+    return both
 
 
 def cancelled(

@@ -1,0 +1,78 @@
+"""A connection that drops while the sleeve holds strokes unplayed, then a ``kill -9`` of the
+sleeve: nothing the broker acknowledged to the sender vanishes.
+
+When the sleeve comes back, the broker sends again every stroke the sleeve had not
+acknowledged, among them those still waiting in its player. Acknowledging such a copy at
+once (as a duplicate) would let the broker forget a stroke that only the sleeve's memory
+holds; the sleeve keeps the copy's acknowledgement until the stroke has played, so a
+``kill -9`` right after the reconnect loses nothing: the broker delivers the rest again to
+the restarted sleeve.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from conftest import StartBroker
+from delivery import Sender, SleeveProcess, Watcher, played, plays, stroke, wait_for
+
+STROKES = 20
+DURATION_MS = 500.0  # 10 s of playing: most strokes still wait when the connection drops
+NO_PACE = ("--max-age-ms", "3600000", "--max-lag-ms", "600000")  # this test is about delivery
+
+
+def test_strokes_sent_again_after_a_reconnect_survive_a_sigkill_of_the_sleeve(
+    start_broker: StartBroker, tmp_path: Path
+) -> None:
+    broker = start_broker(state_dir=tmp_path / "state")
+    c = broker.credentials
+    watcher = Watcher(c)
+    first = SleeveProcess(broker.credentials_path, tmp_path / "first.jsonl", *NO_PACE)
+    sender = Sender(c)
+    second: SleeveProcess | None = None
+    try:
+        wait_for(watcher.is_online, "the sleeve to come online")
+        for seq in range(STROKES):
+            sender.publish(seq, stroke(sender.drawing, seq, DURATION_MS, sent_at_ms=None))
+        wait_for(lambda: len(sender.acked_seqs()) == STROKES, "the broker's acknowledgements")
+        wait_for(lambda: len(played(watcher.snapshot())) >= 1, "the first stroke to play")
+
+        # The connection drops: the broker stops (saving its state) and starts again.
+        broker.stop()
+        restarted_ms = time.time() * 1000
+        broker = start_broker(state_dir=broker.state_dir, port=c.mqtt_port, ws_port=c.ws_port)
+        wait_for(lambda: watcher.is_online(restarted_ms), "the sleeve to come back")
+        # The broker sends the unacknowledged strokes again; wait until the sleeve has
+        # handled the copy of the last one (its log names it, whatever it made of it).
+        last = f"stroke {STROKES - 1} of drawing {sender.drawing}"
+        wait_for(lambda: last in first.log.read_text(), "the copies sent again")
+        # What the sleeve made of them goes out before anything it says later: so once a
+        # stroke that starts from now on is reported, the broker has every acknowledgement
+        # the sleeve gave for the copies (those of strokes it played while the broker was
+        # away among them), and the kill tests only what it still holds.
+        handled_ms = time.time() * 1000
+        wait_for(
+            lambda: any(e["first_command_at_ms"] > handled_ms for e in played(watcher.snapshot())),
+            "a stroke started after the copies",
+        )
+        first.kill()
+        before = set(plays(watcher.snapshot(), sender.drawing))
+        assert len(before) < STROKES, "the drawing ended before the kill: nothing was tested"
+
+        second = SleeveProcess(broker.credentials_path, tmp_path / "second.jsonl", *NO_PACE)
+        wait_for(
+            lambda: set(plays(watcher.snapshot(), sender.drawing)) == set(range(STROKES)),
+            f"every stroke to play (before the kill: {sorted(before)})",
+        )
+        second.stop()
+        # Started (and so acknowledged) once: the restarted sleeve played none of them again.
+        twice = {seq: n for seq, n in plays(watcher.snapshot(), sender.drawing).items() if n > 1}
+        assert not twice, f"played more than once: {twice}"
+        assert any(change["intensity"] > 0 for change in second.changes())
+    finally:
+        sender.stop()
+        watcher.stop()
+        first.stop()
+        if second is not None:
+            second.stop()
