@@ -7,7 +7,6 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import threading
 import time
 import uuid
@@ -16,24 +15,15 @@ from pathlib import Path
 from typing import Any
 
 import paho.mqtt.client as mqtt
+from sleeve_watch import SleeveWatch, settings, sleeve_command
 
 from feelmysign.broker import Credentials
-from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.connection import new_client
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
-from feelmysign.topics import strokes_topic, telemetry_topic
+from feelmysign.topics import strokes_topic
 
 WAIT_S = 60.0  # generous: the machine running the tests may be busy
-
-
-def settings(credentials: Credentials, role: str) -> BrokerSettings:
-    account = credentials.sleeve if role == "sleeve" else credentials.sender
-    return BrokerSettings(
-        credentials.mqtt_host,
-        credentials.mqtt_port,
-        username=account.username,
-        password=account.password,
-    )
 
 
 def wait_for(condition: Callable[[], bool], what: str, timeout_s: float = WAIT_S) -> None:
@@ -49,19 +39,9 @@ class SleeveProcess:
     def __init__(self, credentials_path: Path, record: Path, *extra: str) -> None:
         self.record = record
         self.log = record.with_suffix(".log")
-        command = [
-            sys.executable,
-            "-m",
-            "feelmysign",
-            "sleeve",
-            "--credentials",
-            str(credentials_path),
-            "--record",
-            str(record),
-            "--log-level",
-            "info",
-            *extra,
-        ]
+        command = sleeve_command(
+            credentials_path, "--record", str(record), "--log-level", "info", *extra
+        )
         with self.log.open("ab") as log:
             self.process = subprocess.Popen(command, stdout=log, stderr=log)
 
@@ -91,50 +71,22 @@ class SleeveProcess:
         return [json.loads(line) for line in lines if line.strip()]
 
 
-class Watcher:
+class Watcher(SleeveWatch):
     """Every event and status the sleeve publishes, through broker restarts (persistent)."""
 
     def __init__(self, credentials: Credentials) -> None:
-        self.events: list[dict[str, Any]] = []
-        self.status: list[dict[str, Any]] = []
-        self._lock = threading.Lock()
-        sid = credentials.sleeve_id
-        self.client = new_client(
-            settings(credentials, "sender"),
-            client_id=f"watch-{uuid.uuid4()}",
-            persistent_session=True,
-        )
-        self.client.on_message = self._on_message
-        self.client.on_connect = lambda client, *_: client.subscribe(
-            [(telemetry_topic(sid, "events"), 1), (telemetry_topic(sid, "status"), 1)]
-        )
-        self.client.connect(credentials.mqtt_host, credentials.mqtt_port)
-        self.client.loop_start()
-
-    def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
-        data = json.loads(message.payload)
-        with self._lock:
-            if message.topic.endswith("/status"):
-                self.status.append(data)
-            else:
-                self.events.append(data)
+        super().__init__(credentials, "events", "status", persistent=True)
 
     def snapshot(self) -> list[dict[str, Any]]:
-        with self._lock:
-            return list(self.events)
+        return self.received("events")
 
     def is_online(self, since_wall_ms: float = 0.0) -> bool:
         """Whether the sleeve's last status says online, published at or after ``since_wall_ms``."""
-        with self._lock:
-            return (
-                bool(self.status)
-                and self.status[-1]["online"]
-                and (self.status[-1]["at_ms"] >= since_wall_ms)
-            )
+        status = self.received("status")
+        return bool(status) and status[-1]["online"] and status[-1]["at_ms"] >= since_wall_ms
 
     def stop(self) -> None:
-        self.client.loop_stop()
-        self.client.disconnect()
+        self.close()
 
 
 class Sender:

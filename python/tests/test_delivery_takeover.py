@@ -8,7 +8,8 @@ import time
 from pathlib import Path
 
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, by_seq, played, settings, stroke, wait_for
+from delivery import Sender, SleeveProcess, Watcher, by_seq, played, stroke, wait_for
+from sleeve_watch import settings
 
 from feelmysign.connection import new_client
 from feelmysign.daemon import sleeve_client_id

@@ -15,23 +15,17 @@ import json
 import random
 import signal
 import subprocess
-import sys
-import threading
 import time
-import uuid
 from pathlib import Path
 from typing import Any
 
-import paho.mqtt.client as mqtt
+from sleeve_watch import SleeveWatch, online, sleeve_command
 
 from feelmysign.broker import Broker
-from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.layout import Layout, load_layout
 from feelmysign.planner import plan
-from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.timeline import Timeline
-from feelmysign.topics import strokes_topic, telemetry_topic
 
 REPO = Path(__file__).resolve().parents[2]
 PAPER = REPO / "deploy" / "layouts" / "paper-sleeve.toml"
@@ -42,52 +36,6 @@ TIGHT_SAFETY = (
     "[safety]\nmax_stroke_duration_ms = 1000\nmax_on_time_ms = 1000\n"
     "duty_cycle_window_ms = 2000\nmax_duty_cycle = 0.5\n"
 )
-
-
-class Events:
-    """The sleeve's events and status, as a sender sees them."""
-
-    def __init__(self, broker: Broker) -> None:
-        c = broker.credentials
-        settings = BrokerSettings(
-            c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
-        )
-        self.client = new_client(settings, client_id=f"felt-{uuid.uuid4()}")
-        self.events: list[dict[str, Any]] = []
-        self.online = threading.Event()
-        self._changed = threading.Condition()
-        sid = c.sleeve_id
-        self.client.on_connect = lambda client, *_: client.subscribe(
-            [(telemetry_topic(sid, "events"), 1), (telemetry_topic(sid, "status"), 1)]
-        )
-        self.client.on_message = self._on_message
-        self.client.connect(c.mqtt_host, c.mqtt_port)
-        self.client.loop_start()
-        self.strokes_topic = strokes_topic(sid)
-
-    def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
-        body = json.loads(message.payload)
-        if message.topic.endswith("/status"):
-            if body.get("online"):
-                self.online.set()
-            return
-        with self._changed:
-            self.events.append(body)
-            self._changed.notify_all()
-
-    def about(self, drawing: str, count: int) -> list[dict[str, Any]]:
-        """Wait for one event about each of ``count`` strokes of ``drawing``."""
-
-        def ours() -> list[dict[str, Any]]:
-            return [e for e in self.events if e.get("drawing") == drawing]
-
-        with self._changed:
-            assert self._changed.wait_for(lambda: len(ours()) >= count, WAIT_S), ours()[-3:]
-            return ours()
-
-    def close(self) -> None:
-        self.client.loop_stop()
-        self.client.disconnect()
 
 
 def _strokes(count: int, seed: int, *, spot: bool) -> list[Stroke]:
@@ -138,32 +86,35 @@ def _play_paced(
 ) -> tuple[list[dict[str, Any]], set[int]]:
     layout = load_layout(layout_file)
     record = tmp_path / "record.jsonl"
-    events = Events(broker)
+    events = SleeveWatch(broker.credentials, "events", "status")
     sleeve = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "feelmysign",
-            "sleeve",
-            "--credentials",
-            str(broker.credentials_path),
+        sleeve_command(
+            broker.credentials_path,
             "--layout",
             str(layout_file),
             "--record",
             str(record),
             "--no-legacy",
-        ],
+        ),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
     )
     try:
-        assert events.online.wait(WAIT_S), "the sleeve did not come online"
+        events.next(online, "the sleeve online")
         for stroke in strokes:
-            events.client.publish(events.strokes_topic, format_json(stroke), qos=1)
+            events.send(stroke)
             last_burst_ms = max(c.end_ms for c in plan(stroke, layout).commands)
             time.sleep(last_burst_ms / 1000 + MARGIN_S)
-        told = events.about("felt", len(strokes))
+        events.wait_until(
+            lambda: (
+                len([e for e in events.received("events") if e.get("drawing") == "felt"])
+                >= len(strokes)
+            ),
+            "an event about every stroke",
+            WAIT_S,
+        )
+        told = [e for e in events.received("events") if e.get("drawing") == "felt"]
     finally:
         sleeve.send_signal(signal.SIGTERM)
         _, errors = sleeve.communicate(timeout=WAIT_S)

@@ -14,46 +14,25 @@ from __future__ import annotations
 import json
 import signal
 import subprocess
-import sys
 import threading
-import uuid
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
-import paho.mqtt.client as mqtt
 import pytest
+from sleeve_watch import SleeveWatch, online, settings
 
 from feelmysign.backends.emulated_state import drive_levels
+from feelmysign.bench import restart_off
 from feelmysign.broker import Broker
-from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.connection import new_client
 from feelmysign.daemon import sleeve_client_id
-from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
-from feelmysign.topics import strokes_topic, telemetry_topic
 
-REPO = Path(__file__).resolve().parents[2]
-PAPER = str(REPO / "deploy" / "layouts" / "paper-sleeve.toml")
 WAIT_S = 60.0  # generous: a loaded 2-core machine starts Python slowly
-LONG_STROKE = Stroke((0.0, 1.0), (3.0, 1.0), 8000.0, 0.9, "kill", 0)  # row 1, 8 s
 
 
 def sleeve_command(broker: Broker, state: Path) -> list[str]:
-    return [
-        sys.executable,
-        "-m",
-        "feelmysign",
-        "sleeve",
-        "--backend",
-        "drv2605",
-        "--emulate-state",
-        str(state),
-        "--layout",
-        PAPER,
-        "--credentials",
-        str(broker.credentials_path),
-        "--no-legacy",
-    ]
+    return restart_off.sleeve_command(broker.credentials_path, state)
 
 
 def start_sleeve(broker: Broker, state: Path) -> subprocess.Popen[str]:
@@ -65,61 +44,10 @@ def start_sleeve(broker: Broker, state: Path) -> subprocess.Popen[str]:
     )
 
 
-class Watcher:
-    """The sleeve's retained status and its events, as a sender sees them."""
-
-    def __init__(self, broker: Broker) -> None:
-        c = broker.credentials
-        settings = BrokerSettings(
-            c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
-        )
-        self.client = new_client(settings, client_id=f"watch-{uuid.uuid4()}")
-        self.messages: list[tuple[str, dict[str, Any]]] = []
-        self._changed = threading.Condition()
-        sid = c.sleeve_id
-        self.client.on_connect = lambda client, *_: client.subscribe(
-            [(telemetry_topic(sid, "status"), 1), (telemetry_topic(sid, "events"), 1)]
-        )
-        self.client.on_message = self._on_message
-        self.client.connect(c.mqtt_host, c.mqtt_port)
-        self.client.loop_start()
-        self.sleeve_id = sid
-
-    def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
-        with self._changed:
-            name = message.topic.rsplit("/", 1)[-1]
-            self.messages.append((name, json.loads(message.payload)))
-            self._changed.notify_all()
-
-    def wait_for(self, check: Callable[[str, dict[str, Any]], bool]) -> dict[str, Any]:
-        with self._changed:
-            found: list[dict[str, Any]] = []
-
-            def seen() -> bool:
-                found.extend(body for name, body in self.messages if check(name, body))
-                self.messages.clear()
-                return bool(found)
-
-            assert self._changed.wait_for(seen, WAIT_S), "the sleeve never said it"
-            return found[0]
-
-    def send(self, stroke: Stroke) -> None:
-        self.client.publish(strokes_topic(self.sleeve_id), format_json(stroke), qos=1)
-
-    def close(self) -> None:
-        self.client.loop_stop()
-        self.client.disconnect()
-
-
 @pytest.fixture
-def watcher(broker: Broker) -> Iterator[Watcher]:
-    watching = Watcher(broker)
-    yield watching
-    watching.close()
-
-
-def online(name: str, body: dict[str, Any]) -> bool:
-    return name == "status" and body.get("online") is True
+def watcher(broker: Broker) -> Iterator[SleeveWatch]:
+    with SleeveWatch(broker.credentials, "status", "events") as watching:
+        yield watching
 
 
 def wait_until(condition: Callable[[], bool]) -> None:
@@ -131,12 +59,12 @@ def wait_until(condition: Callable[[], bool]) -> None:
     raise AssertionError("the state file never got there")
 
 
-def kill_mid_stroke(broker: Broker, watcher: Watcher, state: Path) -> dict[str, float]:
+def kill_mid_stroke(broker: Broker, watcher: SleeveWatch, state: Path) -> dict[str, float]:
     """Start a sleeve, send it a long stroke, SIGKILL it while a motor is on; what it left."""
     sleeve = start_sleeve(broker, state)
     try:
-        watcher.wait_for(online)
-        watcher.send(LONG_STROKE)
+        watcher.next(online, "the sleeve online")
+        watcher.send(restart_off.LONG_STROKE)  # row 1, 8 s
         wait_until(lambda: any(level > 0 for level in drive_levels(state).values()))
         sleeve.send_signal(signal.SIGKILL)
         assert sleeve.wait(WAIT_S) == -signal.SIGKILL
@@ -155,11 +83,8 @@ def forget_sleeve_session(broker: Broker) -> None:
     so the broker would deliver it again at once (docs/protocol.md, Delivery) and drive a
     motor right after the restart; here only what comes before going online counts."""
     c = broker.credentials
-    settings = BrokerSettings(
-        c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
-    )
     client_id = sleeve_client_id(c.sleeve_id, c.sleeve.password)
-    client = new_client(settings, client_id=client_id)  # a clean session replaces it
+    client = new_client(settings(c, "sleeve"), client_id=client_id)  # a clean session replaces it
     connected = threading.Event()
     client.on_connect = lambda *args: connected.set()
     client.connect(c.mqtt_host, c.mqtt_port)
@@ -170,7 +95,7 @@ def forget_sleeve_session(broker: Broker) -> None:
 
 
 def test_a_restart_after_sigkill_mid_stroke_switches_every_motor_off_before_going_online(
-    broker: Broker, watcher: Watcher, tmp_path: Path
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path
 ) -> None:
     state = tmp_path / "bus.json"
     kill_mid_stroke(broker, watcher, state)
@@ -178,15 +103,16 @@ def test_a_restart_after_sigkill_mid_stroke_switches_every_motor_off_before_goin
 
     restarted = start_sleeve(broker, state)
     try:
-        status = watcher.wait_for(online)
+        status = watcher.next(online, "the sleeve online")
         # Online is said only after the backend opened, so the off came first.
         assert status["backend"] == "drv2605 (emulated bus)"
         assert set(drive_levels(state).values()) == {0.0}
         # And the restarted sleeve plays again.
         watcher.send(Stroke((0.0, 0.0), (3.0, 0.0), 300.0, 0.9, "after", 0))
         # (The stroke cut by the kill was never acknowledged: the broker may deliver it again.)
-        played = watcher.wait_for(
-            lambda name, body: body.get("type") == "played" and body.get("drawing") == "after"
+        played = watcher.next(
+            lambda name, body: body.get("type") == "played" and body.get("drawing") == "after",
+            "the stroke after the restart played",
         )
         assert played["seq"] == 0
         restarted.send_signal(signal.SIGTERM)
@@ -199,7 +125,7 @@ def test_a_restart_after_sigkill_mid_stroke_switches_every_motor_off_before_goin
 
 @pytest.mark.parametrize("fault", ["missing", "wrong_id"])
 def test_a_restart_with_one_bad_chip_refuses_to_start_but_switches_the_others_off(
-    broker: Broker, watcher: Watcher, tmp_path: Path, fault: str
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path, fault: str
 ) -> None:
     state = tmp_path / "bus.json"
     left = kill_mid_stroke(broker, watcher, state)

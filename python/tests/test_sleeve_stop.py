@@ -3,10 +3,8 @@ race at stop cannot take the sleeve down."""
 
 from __future__ import annotations
 
-import json
 import signal
 import subprocess
-import sys
 import threading
 import types
 import uuid
@@ -15,65 +13,23 @@ from typing import Any
 
 import paho.mqtt.client as mqtt
 import pytest
+from sleeve_watch import SleeveWatch, online, settings, sleeve_command
 
 from feelmysign.backends.sim import SimBackend
-from feelmysign.broker import Broker, Credentials
-from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.broker import Broker
+from feelmysign.connection import new_client
 from feelmysign.daemon import NETWORK_STOP_S, Sleeve, SleeveOptions
 from feelmysign.layout import Layout
-from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
-from feelmysign.topics import strokes_topic, telemetry_topic
 
 WAIT_S = 60.0
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 
 
-def _settings(c: Credentials, role: str) -> BrokerSettings:
-    account = c.sleeve if role == "sleeve" else c.sender
-    return BrokerSettings(
-        c.mqtt_host, c.mqtt_port, username=account.username, password=account.password
-    )
-
-
-class Watch:
-    """Every message on the sleeve's status and actuators topics, in order."""
-
-    def __init__(self, c: Credentials) -> None:
-        self.client = new_client(_settings(c, "sender"), client_id=f"stop-{uuid.uuid4()}")
-        self.messages: list[tuple[str, dict[str, Any]]] = []
-        self._changed = threading.Condition()
-        sid = c.sleeve_id
-        self.client.on_connect = lambda client, *_: client.subscribe(
-            [(telemetry_topic(sid, "status"), 1), (telemetry_topic(sid, "actuators"), 0)]
-        )
-        self.client.on_message = self._on_message
-        self.client.connect(c.mqtt_host, c.mqtt_port)
-        self.client.loop_start()
-        self.strokes = strokes_topic(sid)
-
-    def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
-        with self._changed:
-            name = message.topic.rsplit("/", 1)[-1]
-            self.messages.append((name, json.loads(message.payload)))
-            self._changed.notify_all()
-
-    def wait(self, what: str, check: Any) -> None:
-        with self._changed:
-            assert self._changed.wait_for(
-                lambda: any(check(n, body) for n, body in self.messages), WAIT_S
-            ), f"never saw {what}: {self.messages[-3:]}"
-
-    def close(self) -> None:
-        self.client.loop_stop()
-        self.client.disconnect()
-
-
 @pytest.fixture
-def watch(broker: Broker) -> Iterator[Watch]:
-    watching = Watch(broker.credentials)
-    yield watching
-    watching.close()
+def watch(broker: Broker) -> Iterator[SleeveWatch]:
+    with SleeveWatch(broker.credentials, "status", "actuators") as watching:
+        yield watching
 
 
 def _on(name: str, body: dict[str, Any]) -> bool:
@@ -81,36 +37,26 @@ def _on(name: str, body: dict[str, Any]) -> bool:
 
 
 def test_sigterm_mid_stroke_publishes_an_all_off_frame_before_going_offline(
-    broker: Broker, watch: Watch
+    broker: Broker, watch: SleeveWatch
 ) -> None:
     sleeve = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "feelmysign",
-            "sleeve",
-            "--credentials",
-            str(broker.credentials_path),
-            "--no-legacy",
-        ],
+        sleeve_command(broker.credentials_path, "--no-legacy"),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
     )
     try:
-        watch.wait("online", lambda n, body: n == "status" and body["online"])
-        watch.client.publish(
-            watch.strokes, format_json(Stroke((0, 1), (3, 1), 8000.0, 0.9, "stop", 0)), qos=1
-        )
-        watch.wait("a motor on", _on)
+        watch.next(online, "the sleeve online")
+        watch.send(Stroke((0, 1), (3, 1), 8000.0, 0.9, "stop", 0))
+        watch.next(_on, "a motor on")
         sleeve.send_signal(signal.SIGTERM)
         _, errors = sleeve.communicate(timeout=WAIT_S)
     finally:
         sleeve.kill()
     assert sleeve.returncode == 0, errors
-    watch.wait("offline", lambda n, body: n == "status" and not body["online"])
+    watch.next(lambda n, body: n == "status" and not body["online"], "the sleeve offline")
     with watch._changed:
-        messages = list(watch.messages)
+        messages = list(watch.history)
     offline = next(i for i, (n, b) in enumerate(messages) if n == "status" and not b["online"])
     frames = [body for name, body in messages[:offline] if name == "actuators"]
     assert any(_on("actuators", frame) for frame in frames)  # the stroke was playing
@@ -171,7 +117,7 @@ def test_paho_loop_stop_after_disconnect_races_its_thread_and_the_sleeve_never_h
     monkeypatch.setattr(mqtt.Client, "_thread_main", gate.thread_main())
     monkeypatch.setattr(mqtt, "threading", gate.threading_module())
     # The race itself, with a bare client: what a sleeve stopped this way would hit.
-    bare = new_client(_settings(c, "sender"), client_id=f"race-{uuid.uuid4()}")
+    bare = new_client(settings(c, "sender"), client_id=f"race-{uuid.uuid4()}")
     bare.connect(c.mqtt_host, c.mqtt_port)
     bare.loop_start()
     bare.disconnect()
@@ -179,7 +125,7 @@ def test_paho_loop_stop_after_disconnect_races_its_thread_and_the_sleeve_never_h
         bare.loop_stop()
 
     sleeve = Sleeve(
-        _settings(c, "sleeve"), PAPER, SimBackend(PAPER), SleeveOptions(sleeve_id=c.sleeve_id)
+        settings(c, "sleeve"), PAPER, SimBackend(PAPER), SleeveOptions(sleeve_id=c.sleeve_id)
     )
     errors: list[BaseException] = []
 

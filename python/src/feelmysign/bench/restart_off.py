@@ -41,7 +41,9 @@ WAIT_S = 60.0
 LONG_STROKE = Stroke((0.0, 1.0), (3.0, 1.0), 8000.0, 0.9, "bench-kill", 0)
 
 
-def _command(credentials_path: Path, state: Path) -> list[str]:
+def sleeve_command(credentials_path: Path, state: Path, *extra: str) -> list[str]:
+    """``feelmysign sleeve`` on the paper's layout, its chips emulated with registers in
+    ``state`` (they outlive the process, as real chips' do)."""
     return [
         sys.executable,
         "-m",
@@ -56,8 +58,7 @@ def _command(credentials_path: Path, state: Path) -> list[str]:
         "--credentials",
         str(credentials_path),
         "--no-legacy",
-        "--log-level",
-        "warning",
+        *extra,
     ]
 
 
@@ -168,7 +169,9 @@ def report(rounds: int = ROUNDS) -> list[str]:
                 times = []
                 for index in range(rounds):
                     state = Path(directory) / f"bus-{missing}-{index}.json"
-                    command = _command(broker.credentials_path, state)
+                    command = sleeve_command(
+                        broker.credentials_path, state, "--log-level", "warning"
+                    )
                     _kill_mid_stroke(command, state, online)
                     if missing:
                         _remove_an_idle_chip(state)

@@ -1,0 +1,134 @@
+"""A sender's view of a sleeve in the tests: its status, events and actuator frames as they
+arrive from a real broker, and a way to wait for one of them."""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+import uuid
+from collections.abc import Callable
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+import paho.mqtt.client as mqtt
+
+from feelmysign.broker import Credentials
+from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+from feelmysign.topics import TelemetryName, strokes_topic, telemetry_topic
+
+WAIT_S = 60.0  # generous: the machine running the tests may be busy
+
+Check = Callable[[str, dict[str, Any]], bool]
+
+
+def settings(credentials: Credentials, role: str) -> BrokerSettings:
+    """How the ``sleeve`` or the ``sender`` account of a ``feelmysign broker`` logs in."""
+    account = credentials.sleeve if role == "sleeve" else credentials.sender
+    return BrokerSettings(
+        credentials.mqtt_host,
+        credentials.mqtt_port,
+        username=account.username,
+        password=account.password,
+    )
+
+
+def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:
+    """``feelmysign sleeve`` as its own process, logged in with ``credentials_path``."""
+    return [
+        sys.executable,
+        "-m",
+        "feelmysign",
+        "sleeve",
+        "--credentials",
+        str(credentials_path),
+        *extra,
+    ]
+
+
+def online(name: str, body: dict[str, Any]) -> bool:
+    return name == "status" and body.get("online") is True
+
+
+class SleeveWatch:
+    """Every message on the sleeve's ``topics`` (``status``, ``events``, ``actuators``), in
+    order, as ``(topic name, body)``; logged in as the sender. ``persistent`` keeps its
+    session (and so the messages for it) through broker restarts."""
+
+    def __init__(
+        self, credentials: Credentials, *topics: TelemetryName, persistent: bool = False
+    ) -> None:
+        sid = credentials.sleeve_id
+        self.sleeve_id = sid
+        self.history: list[tuple[str, dict[str, Any]]] = []
+        self._seen = 0  # messages before this one were passed by next()
+        self._changed = threading.Condition()
+        self.client = new_client(
+            settings(credentials, "sender"),
+            client_id=f"watch-{uuid.uuid4()}",
+            persistent_session=persistent,
+        )
+        wanted = [(telemetry_topic(sid, t), 0 if t == "actuators" else 1) for t in topics]
+        self.client.on_connect = lambda client, *_: client.subscribe(wanted)
+        self.client.on_message = self._on_message
+        self.client.connect(credentials.mqtt_host, credentials.mqtt_port)
+        self.client.loop_start()
+
+    def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        name = message.topic.rsplit("/", 1)[-1]
+        body = json.loads(message.payload)
+        with self._changed:
+            self.history.append((name, body))
+            self._changed.notify_all()
+
+    def received(self, name: str | None = None) -> list[dict[str, Any]]:
+        """The bodies received so far, on topic ``name`` or on any."""
+        with self._changed:
+            return [body for topic, body in self.history if name in (None, topic)]
+
+    def wait_until(
+        self, condition: Callable[[], bool], what: str, timeout_s: float = WAIT_S
+    ) -> None:
+        """Until ``condition()`` (called with the history locked) holds; fails after
+        ``timeout_s`` without a change that makes it hold."""
+        with self._changed:
+            assert self._changed.wait_for(condition, timeout_s), (
+                f"never saw {what}; last: {self.history[-3:]}"
+            )
+
+    def next(self, check: Check, what: str = "it") -> dict[str, Any]:
+        """The first message after those already passed that passes ``check``; the ones up to
+        it are passed."""
+        found: list[dict[str, Any]] = []
+
+        def seen() -> bool:
+            while not found and self._seen < len(self.history):
+                name, body = self.history[self._seen]
+                self._seen += 1
+                if check(name, body):
+                    found.append(body)
+            return bool(found)
+
+        self.wait_until(seen, what)
+        return found[0]
+
+    def send(self, stroke: Stroke) -> None:
+        self.client.publish(strokes_topic(self.sleeve_id), format_json(stroke), qos=1)
+
+    def close(self) -> None:
+        self.client.loop_stop()
+        self.client.disconnect()
+
+    def __enter__(self) -> SleeveWatch:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
