@@ -2,20 +2,23 @@
 
 ``python -m feelmysign.bench.load [N ...]`` (``make load``; N = 20 100 200 by default).
 
-For each broker and each N, in one run:
+For each broker and each N, in one run, on a broker started anew:
 
 - baseline: N bare receivers (each logged in as its sleeve) and N senders, each
   sender publishing ``STROKES`` strokes to its own sleeve at a hand's pace (QoS 1);
   publish -> receive, p50 and p99, and the messages that never arrived;
-- sleeves: N sleeve daemons (the simulator backend, all in this process) and N
-  senders drawing the same way; publish -> first actuator command (``sent_at_ms`` of
-  the stroke to ``first_command_at_ms`` of its ``played`` event), p50 and p99, and
-  the strokes never played.
+- sleeves: N sleeve daemons (the simulator backend) and N senders drawing the same
+  way; publish -> first actuator command (``sent_at_ms`` of the stroke to
+  ``first_command_at_ms`` of its ``played`` event), p50 and p99, as ratios to the
+  baseline; every stroke's outcome: played, refused (by reason: the sleeve reports
+  each), played twice, or lost (neither played nor reported).
 
-Every sleeve has its own account, and the ACL (or the NATS permissions) gives each
-only its own topics, as ``feelmysign broker add-sleeve`` does. Latencies are wall
-clock on one machine; the sleeve figures are reported as a ratio to the baseline of
-the same broker and N.
+Sleeves, senders and receivers run in worker processes of ``load_hosts.PER_PROCESS``
+clients each (``load_hosts``), so the figures measure the broker path rather than one
+Python process. On the cluster, client i starts on server i mod 3 (its sender on the
+next one), and has the others to fail over to. Every sleeve has its own account, and
+the ACL (or the NATS permissions) gives each only its own topics, as ``feelmysign
+broker add-sleeve`` does. Latencies are wall clock on one machine.
 """
 
 from __future__ import annotations
@@ -24,6 +27,8 @@ import contextlib
 import json
 import logging
 import multiprocessing
+import os
+import queue
 import resource
 import sys
 import tempfile
@@ -32,29 +37,24 @@ import time
 import uuid
 from collections import Counter
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import paho.mqtt.client as mqtt
 
-from feelmysign.backends.sim import SimBackend
+from feelmysign.bench import load_hosts
+from feelmysign.bench.load_hosts import PER_PROCESS, PUBACK_S, STROKE_MS, STROKES, stroke_key
 from feelmysign.broker import Broker
 from feelmysign.broker.credentials import Account, Credentials, reuse_or_create
 from feelmysign.broker.nats_cluster import NatsCluster
 from feelmysign.broker.sleeves import add_sleeve
-from feelmysign.connection import BrokerSettings, new_client, parse_broker_url
-from feelmysign.daemon import Sleeve, SleeveOptions
-from feelmysign.layout import PAPER_SLEEVE
-from feelmysign.protocol import format_json
-from feelmysign.stroke import Stroke
-from feelmysign.topics import strokes_topic, telemetry_topic
+from feelmysign.connection import new_client, parse_broker_url
+from feelmysign.topics import telemetry_topic
 
 DEFAULT_COUNTS = (20, 100, 200)
-STROKES = 10  # per sender: one short drawing
-STROKE_MS = 100.0  # each stroke's duration, and the pause between two (a quick hand)
-SETTLE_S = 60.0  # longest wait for the last stroke of a run
-CONNECT_S = 120.0  # N logins (and, on NATS, N durable sessions) on a loaded machine
+SETTLE_S = 60.0  # longest wait for the last stroke of a run, once all were sent
+START_S = 240.0  # longest wait for a kind of host to have all its clients logged in
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -64,17 +64,17 @@ def percentile(values: list[float], q: float) -> float:
 
 @dataclass(frozen=True)
 class Target:
-    """A broker under load: where clients connect and the accounts of its N sleeves."""
+    """A broker under load: its servers, the sender's account and the accounts of N sleeves."""
 
     name: str
-    url: str
+    urls: tuple[str, ...]
     sender: Account
     sleeves: dict[str, Account]
 
-    def settings(self, account: Account, sleeve_id: str = "s0") -> BrokerSettings:
-        return parse_broker_url(
-            self.url, username=account.username, password=account.password, sleeve_id=sleeve_id
-        )
+    def url_for(self, index: int) -> str:
+        """Client ``index``'s servers, comma separated, starting at server index mod count."""
+        first = index % len(self.urls)
+        return ",".join(self.urls[first:] + self.urls[:first])
 
 
 def _ids(count: int) -> list[str]:
@@ -88,7 +88,7 @@ def mosquitto(count: int, state: Path) -> Iterator[Target]:
         add_sleeve(state / "sleeves.json", sleeve_id)
     with Broker(state_dir=state, port=0, ws_port=0, sleeve_id=ids[0]) as broker:
         c = broker.credentials
-        yield Target("Mosquitto", c.mqtt_url, c.sender, _accounts(c, state, ids))
+        yield Target("Mosquitto", (c.mqtt_url,), c.sender, _accounts(c, state, ids))
 
 
 @contextlib.contextmanager
@@ -101,7 +101,7 @@ def nats(count: int, state: Path) -> Iterator[Target]:
     with NatsCluster(state / "nats", credentials, other_sleeves=others) as cluster:
         yield Target(
             "NATS (3 nodes)",
-            cluster.mqtt_urls,
+            tuple(node.mqtt_url for node in cluster.nodes),
             credentials.sender,
             _accounts(credentials, state, ids),
         )
@@ -111,239 +111,273 @@ def _accounts(c: Credentials, state: Path, ids: list[str]) -> dict[str, Account]
     return {ids[0]: c.sleeve} | {i: add_sleeve(state / "sleeves.json", i) for i in ids[1:]}
 
 
-def _connected(settings: BrokerSettings, client_id: str, on_message: Any = None) -> mqtt.Client:
-    client = new_client(settings, client_id=client_id)
-    ready = threading.Event()
-    client.on_connect = lambda *_args: ready.set()
-    if on_message is not None:
-        client.on_message = on_message
-    client.connect_async(settings.host, settings.port)
-    client.loop_start()
-    if not ready.wait(CONNECT_S):
-        raise TimeoutError(f"{client_id} could not log in to {settings.url}")
-    return client
+class _Hosts:
+    """Worker processes of one kind (``load_hosts``), each with a share of the clients."""
+
+    def __init__(self, what: str) -> None:
+        self.what = what
+        self._context = multiprocessing.get_context("spawn")  # no inherited threads, sockets
+        self.reports: Any = self._context.Queue()
+        self.flag: Any = self._context.Event()  # "stop" or "go", by kind
+        self._processes: list[Any] = []
+
+    def start(self, function: Callable[..., None], shares: list[tuple[Any, ...]]) -> None:
+        for args in shares:
+            process = self._context.Process(
+                target=function, args=(*args, self.reports, self.flag), daemon=True
+            )
+            process.start()
+            self._processes.append(process)
+        self.expect("ready", len(self._processes), START_S)
+
+    def expect(self, kind: str, count: int, timeout_s: float) -> list[tuple[Any, ...]]:
+        """``count`` reports of ``kind``; RuntimeError with a host's own error if one fails."""
+        found: list[tuple[Any, ...]] = []
+        deadline = time.monotonic() + timeout_s
+        while len(found) < count:
+            try:
+                report = self.reports.get(timeout=max(0.1, deadline - time.monotonic()))
+            except queue.Empty:
+                raise RuntimeError(
+                    f"{count - len(found)} {self.what} processes did not report {kind!r} "
+                    f"within {timeout_s:g} s"
+                ) from None
+            if report[0] == "error":
+                raise RuntimeError(f"a {self.what} process failed: {report[1]}")
+            if report[0] == kind:
+                found.append(report)
+            else:
+                self.other(report)
+        return found
+
+    def other(self, report: tuple[Any, ...]) -> None:
+        """A report of another kind than expected (receivers: arrivals while starting)."""
+
+    def stop(self, report: str | None = None) -> list[tuple[Any, ...]]:
+        """Stop every process, and collect its last ``report`` when one is named."""
+        self.flag.set()
+        found = []
+        if report is not None:
+            with contextlib.suppress(RuntimeError):
+                found = self.expect(report, len(self._processes), 60.0)
+        for process in self._processes:
+            process.join(30)
+            if process.is_alive():
+                process.kill()
+                process.join()
+        self._processes = []
+        return found
 
 
-class _Arrivals:
-    """Arrival times (wall ms) of payloads, keyed by what the payload names."""
-
-    def __init__(self, key: Callable[[bytes], str | None]) -> None:
-        self.at_ms: dict[str, float] = {}
-        self._key = key
-        self._lock = threading.Lock()
-
-    def __call__(self, _client: Any, _userdata: Any, message: mqtt.MQTTMessage) -> None:
-        now_ms = time.time_ns() / 1e6
-        key = self._key(bytes(message.payload))
-        if key is not None:
-            with self._lock:
-                self.at_ms.setdefault(key, now_ms)
-
-    def count(self) -> int:
-        with self._lock:
-            return len(self.at_ms)
-
-
-def _draw_all(target: Target, senders: list[mqtt.Client], ids: list[str]) -> dict[str, float]:
-    """Every sender draws STROKES strokes to its sleeve at once; sent_at (wall ms) by key."""
-    sent: dict[str, float] = {}
-    lock = threading.Lock()
-
-    def draw(sender: mqtt.Client, sleeve_id: str) -> None:
-        drawing = str(uuid.uuid4())
-        for seq in range(STROKES):
-            stroke = Stroke((0.0, 1.0), (1.0, 1.0), STROKE_MS, 0.5, drawing, seq)
-            now_ms = time.time_ns() / 1e6
-            stroke = replace(stroke, sent_at_ms=now_ms)
-            with lock:
-                sent[f"{drawing}/{seq}"] = now_ms
-            sender.publish(strokes_topic(sleeve_id), format_json(stroke), qos=1)
-            time.sleep(STROKE_MS / 1000)
-
-    threads = [
-        threading.Thread(target=draw, args=(sender, sleeve_id))
-        for sender, sleeve_id in zip(senders, ids, strict=True)
+def _shares(target: Target, offset: int) -> list[tuple[list[str], list[tuple[str, Account]]]]:
+    """(server lists, [(sleeve id, account)]) per process, ``PER_PROCESS`` clients each."""
+    items = list(target.sleeves.items())
+    return [
+        (
+            [target.url_for(i + offset) for i in range(start, start + len(chunk))],
+            chunk,
+        )
+        for start in range(0, len(items), PER_PROCESS)
+        for chunk in [items[start : start + PER_PROCESS]]
     ]
-    for thread in threads:
-        thread.start()
-    for thread in threads:
-        thread.join()
-    return sent
 
 
-def _senders_main(target: Target, ids: list[str], out: Any) -> None:
-    """In a process of its own: N sender clients draw at once; their sent_at times to ``out``.
-
-    paho waits on its sockets with select(), which takes descriptors below 1024 only:
-    one process holds about 340 clients, so the N senders get a process of their own.
-    """
-    senders = [
-        _connected(target.settings(target.sender), f"sender-{i}-{uuid.uuid4()}")
-        for i in range(len(ids))
+def _draw(target: Target) -> tuple[dict[str, float], set[str]]:
+    """N senders (in processes) draw at once: sent_at (wall ms), and what the broker never
+    acknowledged."""
+    senders = _Hosts("sender")
+    shares = [
+        (urls, target.sender, [sleeve_id for sleeve_id, _ in chunk])
+        for urls, chunk in _shares(target, offset=1)
     ]
-    sent = _draw_all(target, senders, ids)
-    time.sleep(1.0)  # the last PUBACKs
-    for client in senders:
-        client.loop_stop()
-        client.disconnect()
-    out.put(sent)
-
-
-def _draw_in_process(target: Target, ids: list[str]) -> dict[str, float]:
-    context = multiprocessing.get_context("spawn")  # a fresh descriptor table, no threads
-    out = context.Queue()
-    process = context.Process(target=_senders_main, args=(target, ids, out))
-    process.start()
-    sent: dict[str, float] = out.get(timeout=CONNECT_S + SETTLE_S)
-    process.join(SETTLE_S)
-    return sent
-
-
-def _stroke_key(payload: bytes) -> str | None:
     try:
-        data = json.loads(payload)
-    except ValueError:
-        return None
-    return f"{data['drawing']}/{data['seq']}" if "drawing" in data else None
+        senders.start(load_hosts.sender_host, shares)
+        senders.flag.set()  # go
+        drawing_s = STROKES * STROKE_MS / 1000
+        reports = senders.expect("sent", len(shares), drawing_s + PUBACK_S + 30)
+    finally:
+        senders.stop()
+    sent: dict[str, float] = {}
+    unacknowledged: set[str] = set()
+    for _kind, times, missing in reports:
+        sent |= times
+        unacknowledged |= set(missing)
+    return sent, unacknowledged
 
 
-def _outcome(payload: bytes) -> tuple[str, str, float] | None:
-    """(stroke key, 'played' or the refusal's reason, first command time or 0) of an event."""
-    data = json.loads(payload)
-    if "drawing" not in data or "seq" not in data:
-        return None
-    key = f"{data['drawing']}/{data['seq']}"
-    if data.get("type") in ("played", "adjusted"):
-        return key, "played", float(data["first_command_at_ms"])
-    if data.get("type") == "rejected":
-        return key, str(data.get("reason")), 0.0
-    return None
-
-
-def _wait(done: Callable[[], int], total: int) -> None:
+def _wait(done: Callable[[], int], total: int, poll: Callable[[], None] = lambda: None) -> None:
     deadline = time.monotonic() + SETTLE_S
     while done() < total and time.monotonic() < deadline:
+        poll()
         time.sleep(0.1)
 
 
-def baseline(target: Target) -> tuple[list[float], int]:
-    """Publish -> receive for N senders to N bare receivers; latencies and messages lost."""
-    ids = list(target.sleeves)
-    arrivals = _Arrivals(_stroke_key)
-    receivers = []
-    for sleeve_id in ids:
-        settings = target.settings(target.sleeves[sleeve_id], sleeve_id)
-        receiver = _connected(settings, f"bare-{sleeve_id}-{uuid.uuid4()}", arrivals)
-        receiver.subscribe(strokes_topic(sleeve_id), qos=1)
-        receivers.append(receiver)
-    time.sleep(1.0)  # SUBACKs: paho has no waiter for them
-    sent = _draw_in_process(target, ids)
-    _wait(arrivals.count, len(sent))
-    latencies = [arrivals.at_ms[k] - sent[k] for k in sent if k in arrivals.at_ms]
-    for client in receivers:
-        client.loop_stop()
-        client.disconnect()
-    return latencies, len(sent) - len(latencies)
+@dataclass
+class Outcome:
+    """What became of every stroke of a run."""
+
+    latencies_ms: list[float]
+    sent: int
+    lost: int  # neither played nor reported: the one thing that must never happen
+    unacknowledged: int = 0  # publishes the broker never acknowledged to the sender
+    refused: Counter[str] = field(default_factory=Counter)  # reported, by reason
+    twice: int = 0  # strokes played more than once
+    cpu_s: float = 0.0  # processor time the sleeves used, all of them together
 
 
-def sleeves(target: Target) -> tuple[list[float], int, Counter[str]]:
-    """Publish -> first actuator command for N sleeve daemons.
+class _Receivers(_Hosts):
+    def __init__(self) -> None:
+        super().__init__("receiver")
+        self.arrived: dict[str, float] = {}
 
-    Returns the latencies of the played strokes, the strokes lost (no event at all: never
-    reached the sleeve, or vanished), and the refusals by reason: a sleeve that falls
-    more than a second behind its sender refuses strokes as ``late`` to return to real
-    time, and reports each (the daemon's documented policy), which is not a loss.
-    """
-    ids = list(target.sleeves)
-    played: dict[str, float] = {}
-    refused: dict[str, str] = {}
-    lock = threading.Lock()
+    def other(self, report: tuple[Any, ...]) -> None:
+        if report[0] == "arrived":
+            for key, at_ms in report[1].items():
+                self.arrived.setdefault(key, at_ms)
 
-    def on_event(_client: Any, _userdata: Any, message: mqtt.MQTTMessage) -> None:
-        found = _outcome(bytes(message.payload))
-        if found is not None:
-            key, outcome, first_ms = found
-            with lock:
-                if outcome == "played":
-                    played.setdefault(key, first_ms)
-                else:
-                    refused.setdefault(key, outcome)
+    def poll(self) -> None:
+        with contextlib.suppress(queue.Empty):
+            while True:
+                self.other(self.reports.get_nowait())
 
-    watcher = _connected(target.settings(target.sender), f"watcher-{uuid.uuid4()}", on_event)
-    watcher.subscribe(telemetry_topic("+", "events"), qos=1)
-    running = [_start_sleeve(target, sleeve_id) for sleeve_id in ids]
+
+def baseline(target: Target) -> Outcome:
+    """Publish -> receive for N senders to N bare receivers."""
+    receivers = _Receivers()
     try:
-        sent = _draw_in_process(target, ids)
-        _wait(lambda: len(played.keys() | refused.keys()), len(sent))
-        with lock:
-            latencies = [played[k] - sent[k] for k in sent if k in played]
-            reasons = Counter(refused[k] for k in sent if k in refused and k not in played)
-            lost = sum(1 for k in sent if k not in played and k not in refused)
-        watcher.loop_stop()
-        watcher.disconnect()
+        receivers.start(load_hosts.receiver_host, _shares(target, offset=0))
+        sent, unacknowledged = _draw(target)
+        _wait(lambda: len(receivers.arrived.keys() & sent.keys()), len(sent), receivers.poll)
     finally:
-        for sleeve, thread, backend in running:
-            sleeve.stop()
-            thread.join(10)
-            backend.close()
-    return latencies, lost, reasons
+        receivers.stop()
+    receivers.poll()
+    arrived = receivers.arrived
+    latencies = [arrived[k] - sent[k] for k in sent if k in arrived]
+    return Outcome(latencies, len(sent), len(sent) - len(latencies), len(unacknowledged))
 
 
-def _start_sleeve(target: Target, sleeve_id: str) -> tuple[Sleeve, threading.Thread, SimBackend]:
-    backend = SimBackend(PAPER_SLEEVE)
-    options = SleeveOptions(sleeve_id=sleeve_id, legacy_topic=None)
-    settings = target.settings(target.sleeves[sleeve_id], sleeve_id)
-    sleeve = Sleeve(settings, PAPER_SLEEVE, backend, options)
-    thread = threading.Thread(target=sleeve.run, daemon=True)
-    thread.start()
-    if not sleeve.connected.wait(CONNECT_S):
-        raise TimeoutError(f"sleeve {sleeve_id} did not connect to {target.url}")
-    return sleeve, thread, backend
+class _Watcher:
+    """The sleeves' events, as the sender's account sees them: each stroke's outcome."""
+
+    def __init__(self, target: Target) -> None:
+        self.played: dict[str, set[bytes]] = {}
+        self.first_command_ms: dict[str, float] = {}
+        self.refused: dict[str, str] = {}
+        self._lock = threading.Lock()
+        settings = parse_broker_url(
+            target.url_for(0), username=target.sender.username, password=target.sender.password
+        )
+        self.client = new_client(settings, client_id=f"watcher-{uuid.uuid4()}")
+        subscribed = threading.Event()
+        self.client.on_connect = lambda c, *_args: c.subscribe(
+            telemetry_topic("+", "events"), qos=1
+        )
+        self.client.on_subscribe = lambda *_args: subscribed.set()
+        self.client.on_message = self._on_message
+        self.client.connect_async(settings.host, settings.port)
+        self.client.loop_start()
+        if not subscribed.wait(START_S):
+            raise RuntimeError(f"the events watcher could not subscribe on {settings.url}")
+
+    def _on_message(self, _client: Any, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        payload = bytes(message.payload)
+        key = stroke_key(payload)
+        if key is None:
+            return
+        event = json.loads(payload)
+        with self._lock:
+            if event.get("type") in ("played", "adjusted"):
+                self.played.setdefault(key, set()).add(payload)
+                self.first_command_ms.setdefault(key, float(event["first_command_at_ms"]))
+            elif event.get("type") in ("rejected", "cancelled", "safety"):
+                self.refused.setdefault(key, str(event.get("reason")))
+
+    def settled(self, keys: dict[str, float]) -> int:
+        with self._lock:
+            return len((self.played.keys() | self.refused.keys()) & keys.keys())
+
+    def outcome(self, sent: dict[str, float], unacknowledged: set[str]) -> Outcome:
+        with self._lock:
+            latencies = [self.first_command_ms[k] - sent[k] for k in sent if k in self.played]
+            refused = Counter(
+                self.refused[k] for k in sent if k in self.refused and k not in self.played
+            )
+            lost = sum(1 for k in sent if k not in self.played and k not in self.refused)
+            twice = sum(1 for k in sent if len(self.played.get(k, ())) > 1)
+        return Outcome(latencies, len(sent), lost, len(unacknowledged), refused, twice)
+
+    def close(self) -> None:
+        self.client.loop_stop()
+        self.client.disconnect()
 
 
-def _line(
-    what: str,
-    latencies: list[float],
-    lost: int,
-    base_p99: float | None,
-    refused: Counter[str] | None = None,
-) -> str:
-    if not latencies:
-        return f"  {what:<30} nothing arrived ({lost} lost)"
-    p50, p99 = percentile(latencies, 50), percentile(latencies, 99)
-    ratio = f", p99 {p99 / base_p99:.2f}x baseline" if base_p99 else ""
-    out = f", refused {dict(refused)}" if refused else ""
-    return (
-        f"  {what:<30} {len(latencies)} arrived: p50 {p50:7.1f} ms, p99 {p99:7.1f} ms"
-        f"{ratio}; lost {lost}{out}"
-    )
+def sleeves(target: Target) -> Outcome:
+    """Publish -> first actuator command for N sleeve daemons, and every stroke's outcome."""
+    hosts = _Hosts("sleeve")
+    watcher: _Watcher | None = None
+    try:
+        hosts.start(load_hosts.sleeve_host, _shares(target, offset=0))
+        watcher = _Watcher(target)
+        sent, unacknowledged = _draw(target)
+        _wait(lambda: watcher.settled(sent) if watcher else 0, len(sent))
+        outcome = watcher.outcome(sent, unacknowledged)
+    finally:
+        if watcher is not None:
+            watcher.close()
+        cpu = hosts.stop("cpu")
+    return replace(outcome, cpu_s=sum(seconds for _kind, seconds in cpu))
+
+
+def _line(what: str, outcome: Outcome, base: Outcome | None) -> str:
+    if not outcome.latencies_ms:
+        return f"  {what:<28} nothing arrived of {outcome.sent} ({outcome.lost} lost)"
+    p50 = percentile(outcome.latencies_ms, 50)
+    p99 = percentile(outcome.latencies_ms, 99)
+    text = f"  {what:<28} p50 {p50:7.1f} ms"
+    if base is not None and base.latencies_ms:
+        text += f" ({p50 / percentile(base.latencies_ms, 50):5.1f}x)"
+    text += f", p99 {p99:7.1f} ms"
+    if base is not None and base.latencies_ms:
+        text += f" ({p99 / percentile(base.latencies_ms, 99):5.1f}x)"
+    counted = "played" if base is not None else "received"
+    text += f"; {counted} {len(outcome.latencies_ms)}/{outcome.sent}, lost {outcome.lost}"
+    if outcome.refused:
+        text += ", refused " + ", ".join(f"{n} {r}" for r, n in sorted(outcome.refused.items()))
+    if outcome.twice:
+        text += f", played twice {outcome.twice}"
+    if outcome.unacknowledged:
+        text += f", not acknowledged by the broker {outcome.unacknowledged}"
+    if outcome.cpu_s:
+        text += f"; sleeves' CPU {1000 * outcome.cpu_s / outcome.sent:.1f} ms a stroke"
+    return text
 
 
 def report(counts: tuple[int, ...] = DEFAULT_COUNTS) -> list[str]:
     lines = [
         f"Load: N sleeves and N senders drawing at once ({STROKES} strokes of {STROKE_MS:g} ms "
-        "each per sender, QoS 1); publish -> received (bare) and publish -> played (sleeve)"
+        f"per sender, QoS 1; {PER_PROCESS} clients per process) on {os.cpu_count()} cores, "
+        f"load average {os.getloadavg()[0]:.1f} at the start. Ratios: to the bare "
+        "publish -> receive of the same broker and N, this run"
     ]
+    print(lines[0], flush=True)
     for start in (mosquitto, nats):
         for count in counts:
             with tempfile.TemporaryDirectory() as state, start(count, Path(state)) as target:
-                base, base_lost = baseline(target)
-                played, lost, refused = sleeves(target)
-            base_p99 = percentile(base, 99) if base else None
-            lines.append(f"{target.name}, N = {count}")
-            lines.append(_line("bare publish -> receive", base, base_lost, None))
-            lines.append(_line("publish -> played (sleeve)", played, lost, base_p99, refused))
+                base = baseline(target)
+                played = sleeves(target)
+            lines.append(f"{target.name}, N = {count}: {played.sent} strokes")
+            lines.append(_line("bare publish -> receive", base, None))
+            lines.append(_line("publish -> played (sleeve)", played, base))
             print("\n".join(lines[-3:]), flush=True)
     return lines
 
 
 def main(argv: list[str]) -> None:
     counts = tuple(int(a) for a in argv) or DEFAULT_COUNTS
-    # Each paho client holds a socket and a wake-up pair: 3 N clients need more than the
-    # usual 1024 descriptors. Raised to the hard limit, as a broker's service would be.
+    # Each paho client holds a socket and a wake-up pair; a broker under load holds
+    # thousands: raised to the hard limit, as a broker's service would be.
     soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
     resource.setrlimit(resource.RLIMIT_NOFILE, (max(soft, hard), hard))
-    # The sleeves' own log lines (a stroke played late, ...) would bury the figures.
     logging.getLogger("feelmysign").setLevel(logging.ERROR)
     report(counts)
 
