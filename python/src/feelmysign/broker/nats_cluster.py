@@ -1,4 +1,4 @@
-"""A 3-node NATS cluster on loopback, from ``deploy/nats/node.conf``, for tests and benchmarks.
+"""A 3-node NATS cluster on loopback, from ``deploy/nats/``, for tests and benchmarks.
 
 ::
 
@@ -7,9 +7,12 @@
         cluster.mqtt_urls              # all three, comma separated, for failover
         cluster.kill(0)                # SIGKILL node a
 
-Every node runs the same ``node.conf`` (copied into the state directory next to the
-``accounts.conf`` rendered from ``credentials``), its ports and routes given through
-the environment, as in production. ``python -m feelmysign.broker.nats_cluster DIR``
+Every node runs the same configuration (``deploy/nats/*.conf``, copied into the state
+directory next to the ``accounts.conf`` rendered from ``credentials``), its ports and
+routes given through the environment, as in production: ``node-loopback.conf``, or
+with ``tls=`` (a certificate for 127.0.0.1, e.g. from ``broker.tls.ensure_local_ca``)
+``node.conf``, whose MQTT and WebSocket listeners speak only TLS (``mqtts://``,
+``wss://``). ``python -m feelmysign.broker.nats_cluster DIR``
 runs one until Ctrl-C and prints its URLs and accounts as JSON (the browser tests use it).
 """
 
@@ -39,11 +42,13 @@ from feelmysign.broker.credentials import (
     write_private_file,
 )
 from feelmysign.broker.nats_accounts import render_nats_accounts
+from feelmysign.broker.tls import TlsFiles
 from feelmysign.errors import BrokerError
 from feelmysign.topics import LEGACY_TOPIC
 
 REPO = Path(__file__).resolve().parents[4]
-NODE_CONF = REPO / "deploy" / "nats" / "node.conf"
+DEPLOY_DIR = REPO / "deploy" / "nats"
+TLS_CONF, LOOPBACK_CONF = "node.conf", "node-loopback.conf"
 NATS_SERVER_ENV = "FEELMYSIGN_NATS_SERVER"
 DEFAULT_NATS_SERVER = REPO / ".cache" / "go-bin" / "nats-server"
 NODE_NAMES = ("a", "b", "c")
@@ -60,14 +65,15 @@ class NatsNode:
     cluster_port: int
     mqtt_port: int
     ws_port: int
+    tls: bool = False
 
     @property
     def mqtt_url(self) -> str:
-        return f"mqtt://127.0.0.1:{self.mqtt_port}"
+        return f"{'mqtts' if self.tls else 'mqtt'}://127.0.0.1:{self.mqtt_port}"
 
     @property
     def ws_url(self) -> str:
-        return f"ws://127.0.0.1:{self.ws_port}/mqtt"
+        return f"{'wss' if self.tls else 'ws'}://127.0.0.1:{self.ws_port}/mqtt"
 
 
 def nats_server_path() -> Path:
@@ -91,9 +97,11 @@ class NatsCluster:
         credentials: Credentials,
         *,
         other_sleeves: dict[str, Account] | None = None,
+        tls: TlsFiles | None = None,
     ) -> None:
         self.state_dir = state_dir
         self.credentials = credentials
+        self.tls = tls
         self._others = other_sleeves or {}
         self.nodes: list[NatsNode] = []
         self._processes: list[subprocess.Popen[bytes] | None] = []
@@ -117,11 +125,20 @@ class NatsCluster:
     def start(self) -> None:
         executable = nats_server_path()
         self.state_dir.mkdir(mode=0o700, parents=True, exist_ok=True)
-        shutil.copyfile(NODE_CONF, self.state_dir / "node.conf")
+        for conf in DEPLOY_DIR.glob("*.conf"):
+            shutil.copyfile(conf, self.state_dir / conf.name)
         accounts = render_nats_accounts(self.credentials, self._others, legacy_topic=LEGACY_TOPIC)
         write_private_file(self.state_dir / "accounts.conf", accounts)
+        free = process_.free_port
         self.nodes = [
-            NatsNode(name, *(process_.free_port("127.0.0.1") for _ in range(4)))
+            NatsNode(
+                name,
+                free("127.0.0.1"),
+                free("127.0.0.1"),
+                free("127.0.0.1"),
+                free("127.0.0.1"),
+                tls=self.tls is not None,
+            )
             for name in NODE_NAMES
         ]
         try:
@@ -146,10 +163,13 @@ class NatsCluster:
             "ROUTE_1": f"nats-route://127.0.0.1:{others[0].cluster_port}",
             "ROUTE_2": f"nats-route://127.0.0.1:{others[1].cluster_port}",
         }
+        if self.tls is not None:
+            env |= {"TLS_CERT": str(self.tls.cert), "TLS_KEY": str(self.tls.key)}
+        conf = TLS_CONF if self.tls is not None else LOOPBACK_CONF
         log = (self.state_dir / f"{node.name}.log").open("ab")
         with log:
             return subprocess.Popen(
-                [str(executable), "-c", str(self.state_dir / "node.conf")],
+                [str(executable), "-c", str(self.state_dir / conf)],
                 env=env,
                 stdin=subprocess.DEVNULL,
                 stdout=log,
@@ -169,7 +189,7 @@ class NatsCluster:
                 raise BrokerError(
                     "start-failed", f"nats-server {node.name} exited: {self.log(index)}"
                 )
-            if _accepts_mqtt_login(node.mqtt_port, sender):
+            if _accepts_mqtt_login(node.mqtt_port, sender, self.tls):
                 return
             time.sleep(READY_POLL_S)
         raise BrokerError(
@@ -202,11 +222,13 @@ class NatsCluster:
                 self._processes[index] = None
 
 
-def _accepts_mqtt_login(port: int, account: Account) -> bool:
+def _accepts_mqtt_login(port: int, account: Account, tls: TlsFiles | None) -> bool:
     connacks: list[bool] = []
     client = mqtt.Client(
         CallbackAPIVersion.VERSION2, client_id=f"ready-{os.getpid()}", protocol=mqtt.MQTTv311
     )
+    if tls is not None:
+        client.tls_set(ca_certs=str(tls.ca) if tls.ca else None)
     client.username_pw_set(account.username, account.password)
     client.on_connect = lambda _c, _u, _f, code, _p: connacks.append(not code.is_failure)
     try:

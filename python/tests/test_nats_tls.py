@@ -1,0 +1,127 @@
+"""The NATS cluster with TLS on its MQTT and WebSocket listeners (deploy/nats/node.conf), its
+certificate from the project's own CA: a sleeve joins with a token that pins the CA and
+plays a stroke sent over wss:// to another node; a client trusting another CA is refused
+before it sends anything, on both listeners."""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import ssl
+import subprocess
+import sys
+import uuid
+from collections.abc import Iterator
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import paho.mqtt.client as mqtt
+import pytest
+
+from feelmysign.broker.credentials import reuse_or_create
+from feelmysign.broker.nats_cluster import NatsCluster
+from feelmysign.broker.tls import ensure_local_ca
+from feelmysign.connection import BrokerSettings, new_client, parse_broker_url
+from feelmysign.connection.join_token import JoinToken
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
+from feelmysign.topics import strokes_topic, telemetry_topic
+
+WAIT_S = 60.0
+SLEEVE = "sleeve1"
+
+pytestmark = pytest.mark.broker
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[NatsCluster]:
+    state = tmp_path_factory.mktemp("nats-tls")
+    credentials = reuse_or_create(
+        state / "credentials.json", sleeve_id=SLEEVE, mqtt_url="mqtt://x:1", ws_url="ws://x:2"
+    )
+    tls = ensure_local_ca(state / "tls", ["127.0.0.1"])
+    with NatsCluster(state / "cluster", credentials, tls=tls) as running:
+        yield running
+
+
+def _sender(cluster: NatsCluster, url: str, ca_file: Path | None) -> BrokerSettings:
+    sender = cluster.credentials.sender
+    settings = parse_broker_url(url, username=sender.username, password=sender.password)
+    return replace(settings, ca_file=str(ca_file) if ca_file else None)
+
+
+def _connect(settings: BrokerSettings) -> tuple[mqtt.Client, queue.Queue[Any]]:
+    """A client logged in over TLS (verifying with ``settings.ca_file``), and its messages."""
+    client = new_client(settings, client_id=f"test-{uuid.uuid4()}")
+    connected: queue.Queue[Any] = queue.Queue()
+    received: queue.Queue[Any] = queue.Queue()
+    client.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
+    client.on_message = lambda _c, _u, message: received.put(json.loads(message.payload))
+    client.connect(settings.host, settings.port)  # the TLS handshake happens here
+    client.loop_start()
+    code = connected.get(timeout=WAIT_S)
+    assert not code.is_failure, code
+    return client, received
+
+
+def test_the_listeners_speak_only_tls(cluster: NatsCluster) -> None:
+    node = cluster.nodes[0]
+    assert node.mqtt_url.startswith("mqtts://") and node.ws_url.startswith("wss://")
+
+
+def test_a_sleeve_joins_the_cluster_over_tls_and_plays_a_stroke_sent_over_wss(
+    cluster: NatsCluster, tmp_path: Path
+) -> None:
+    c = cluster.credentials
+    assert cluster.tls is not None and cluster.tls.ca_fingerprint is not None
+    # The token carries every node, and the CA's fingerprint instead of its file.
+    token = JoinToken(
+        ",".join(node.mqtt_url for node in cluster.nodes),
+        SLEEVE,
+        c.sleeve.username,
+        c.sleeve.password,
+        cluster.tls.ca_fingerprint,
+    ).encode()
+    sleeve = subprocess.Popen(
+        [sys.executable, "-m", "feelmysign", "sleeve", "--join", token],
+        env={**os.environ, "XDG_STATE_HOME": str(tmp_path / "state")},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    # The sender's page would be on node c's WebSocket listener.
+    sender, events = _connect(_sender(cluster, cluster.nodes[2].ws_url, cluster.tls.ca))
+    try:
+        sender.subscribe(telemetry_topic(SLEEVE, "status"), qos=1)
+        sender.subscribe(telemetry_topic(SLEEVE, "events"), qos=1)
+        while not events.get(timeout=WAIT_S).get("online"):
+            pass
+        stroke = Stroke((0.0, 1.0), (2.0, 1.0), 300.0, 0.5, str(uuid.uuid4()), 0)
+        sender.publish(strokes_topic(SLEEVE), format_json(stroke), qos=1)
+        while (event := events.get(timeout=WAIT_S)).get("drawing") != stroke.drawing:
+            pass
+        assert event["type"] == "played", event
+    finally:
+        sender.loop_stop()
+        sleeve.terminate()
+        out = sleeve.communicate(timeout=WAIT_S)[0]
+    assert f"connected to {cluster.nodes[0].mqtt_url}" in out, out
+
+
+@pytest.mark.parametrize("listener", ["mqtts", "wss"])
+def test_a_client_trusting_another_ca_is_refused_before_it_logs_in(
+    cluster: NatsCluster, tmp_path: Path, listener: str
+) -> None:
+    other = ensure_local_ca(tmp_path / "other-ca", ["127.0.0.1"])
+    node = cluster.nodes[1]
+    url = node.mqtt_url if listener == "mqtts" else node.ws_url
+    client = new_client(_sender(cluster, url, other.ca), client_id=f"test-{uuid.uuid4()}")
+    settings = parse_broker_url(url)
+    with pytest.raises(ssl.SSLCertVerificationError):
+        client.connect(settings.host, settings.port)
+    # The system's trusted CAs do not know the cluster's CA either.
+    client = new_client(_sender(cluster, url, None), client_id=f"test-{uuid.uuid4()}")
+    with pytest.raises(ssl.SSLCertVerificationError):
+        client.connect(settings.host, settings.port)
