@@ -29,6 +29,9 @@ SLEEVE = "sleeve1"
 OTHER = Account("sleeve-arm2", "arm2-password-0123456789")
 
 pytestmark = pytest.mark.broker
+# The sleeve's pace limits on a cluster (docs/deploy.md): a node's failure may hold
+# strokes back for up to about 10 s, and they still play.
+CLUSTER_PACE = ("--max-lag-ms", "30000", "--max-age-ms", "60000")
 
 
 @pytest.fixture(scope="module")
@@ -101,18 +104,13 @@ def test_the_acl_holds_on_nats_a_sleeve_reads_only_its_own_strokes(cluster: Nats
             paho.loop_stop()
 
 
-# After an outage the sleeve returns to real time: a stroke that arrives too late to be
-# felt as drawn is refused with one of these reasons and reported (docs/protocol.md).
-OUT_OF_TIME = ("late", "stale")
-
-
 class Events:
     """The sleeve's events as the sender sees them, on a node that stays up.
 
-    ``outcomes`` maps each stroke (drawing, seq) to the distinct payloads of its
-    played events and of its refusals for being out of time. A QoS 1 event sent
-    again after a failover is the same bytes; a stroke played twice would be two
-    events with different timestamps.
+    ``played`` maps each stroke (drawing, seq) to the distinct payloads of its played
+    events: a QoS 1 event sent again after a failover is the same bytes, a stroke
+    played twice would be two events with different timestamps. ``refused`` maps each
+    stroke to the reasons it was refused for.
     """
 
     def __init__(self, url: str, account: Account) -> None:
@@ -143,21 +141,21 @@ class Events:
         with self._lock:
             if event.get("type") in ("played", "adjusted"):
                 self.played.setdefault(key, set()).add(message.payload.decode())
-            elif event.get("type") == "rejected" and event.get("reason") in OUT_OF_TIME:
-                self.refused.setdefault(key, set()).add(message.payload.decode())
+            elif event.get("type") in ("rejected", "cancelled", "safety"):
+                self.refused.setdefault(key, set()).add(str(event.get("reason")))
             self._lock.notify_all()
 
-    def settled(self, drawing: str) -> set[int]:
+    def wait_played(self, drawing: str, count: int) -> None:
         with self._lock:
-            return {seq for (d, seq) in [*self.played, *self.refused] if d == drawing}
-
-    def wait_for(self, drawing: str, count: int) -> None:
-        with self._lock:
-            self._lock.wait_for(lambda: len(self.settled(drawing)) >= count, WAIT_S)
+            self._lock.wait_for(lambda: len(self.played_seqs(drawing)) >= count, WAIT_S)
 
     def played_seqs(self, drawing: str) -> list[int]:
         with self._lock:
             return sorted(seq for (d, seq) in self.played if d == drawing)
+
+    def refusals(self, drawing: str) -> dict[int, set[str]]:
+        with self._lock:
+            return {seq: reasons for (d, seq), reasons in self.refused.items() if d == drawing}
 
 
 def _send(cluster: NatsCluster, *shape: str) -> subprocess.Popen[str]:
@@ -183,11 +181,14 @@ def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
 ) -> None:
     c = cluster.credentials
     env = {**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password}
-    # The sleeve is given node a first; b and c to fail over to.
+    # The sleeve is given node a first; b and c to fail over to. JetStream holds the
+    # strokes sent while it elects new leaders for what node a led (4 to 9 s): the
+    # sleeve's pace limits, as docs/deploy.md sets them for a cluster, let it play them
+    # late rather than skip them.
     sleeve = subprocess.Popen(
         feelmysign(
             *("sleeve", "--broker", cluster.mqtt_urls, "--id", SLEEVE),
-            *("--username", c.sleeve.username),
+            *("--username", c.sleeve.username, *CLUSTER_PACE),
         ),
         env=env,
         stdout=subprocess.PIPE,
@@ -201,28 +202,29 @@ def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
         # sleeve's, is killed (SIGKILL) once the first strokes were played.
         send = _send(cluster, "circle", "--segments", "12")
         first = _drawing_of_first_line(send)
-        events.wait_for(first, 2)
+        events.wait_played(first, 2)
         cluster.kill(0)
         out = first_out = send.communicate(timeout=WAIT_S * 2)[0]
         assert send.returncode == 0, out
-        events.wait_for(first, 12)
+        events.wait_played(first, 12)
         # Back on another node: the next drawing plays in full.
         second_send = _send(cluster, "square")
         second = _drawing_of_first_line(second_send)
         out = second_send.communicate(timeout=WAIT_S)[0]
         assert second_send.returncode == 0, out
-        events.wait_for(second, 4)
+        events.wait_played(second, 4)
     finally:
         events.client.loop_stop()
         sleeve.terminate()
         sleeve_out = sleeve.communicate(timeout=WAIT_S)[0]
     said = f"the sender said:\n{first_out}\nthe sleeve said:\n{sleeve_out}"
-    # Every stroke of the cut drawing is accounted for: played, or refused as too late
-    # to be felt as drawn (the sleeve's real-time policy), and reported; none vanished.
-    assert events.settled(first) == set(range(12)), said
+    # Every stroke of the cut drawing played exactly once: none lost, none refused (a
+    # copy the broker delivers again after the failover is dropped as a duplicate), none
+    # played twice.
+    assert events.played_seqs(first) == list(range(12)), said
+    assert all(reasons == {"duplicate"} for reasons in events.refusals(first).values()), said
     assert events.played_seqs(second) == [0, 1, 2, 3], said
     assert all(len(payloads) == 1 for payloads in events.played.values()), "played twice"
-    assert not set(events.played) & set(events.refused), "both played and refused"
     assert f"connected to mqtt://127.0.0.1:{cluster.nodes[0].mqtt_port}" in sleeve_out
     moved = [f"connected to {n.mqtt_url}" in sleeve_out for n in cluster.nodes[1:]]
     assert any(moved), sleeve_out
