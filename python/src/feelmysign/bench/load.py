@@ -53,6 +53,11 @@ from feelmysign.connection import new_client, parse_broker_url
 from feelmysign.topics import telemetry_topic
 
 DEFAULT_COUNTS = (20, 100, 200)
+# A sleeve refuses, and reports, a stroke it would play more than 1 s behind its sender
+# (or 10 s after it was sent). When the sleeves did, the run is repeated with room for a
+# minute, as a cluster's sleeves may run (docs/deploy.md): is every stroke played then?
+OUT_OF_TIME = {"late", "stale"}
+RELAXED_PACE = (120_000.0, 60_000.0)  # max_age_ms, max_lag_ms
 SETTLE_S = 60.0  # longest wait for the last stroke of a run, once all were sent
 START_S = 240.0  # longest wait for a kind of host to have all its clients logged in
 
@@ -311,12 +316,16 @@ class _Watcher:
         self.client.disconnect()
 
 
-def sleeves(target: Target) -> Outcome:
-    """Publish -> first actuator command for N sleeve daemons, and every stroke's outcome."""
+def sleeves(target: Target, pace: tuple[float, float] | None = None) -> Outcome:
+    """Publish -> first actuator command for N sleeve daemons, and every stroke's outcome.
+
+    ``pace``: the sleeves' (max_age_ms, max_lag_ms), instead of their defaults.
+    """
     hosts = _Hosts("sleeve")
     watcher: _Watcher | None = None
     try:
-        hosts.start(load_hosts.sleeve_host, _shares(target, offset=0))
+        shares = [(urls, chunk, pace) for urls, chunk in _shares(target, offset=0)]
+        hosts.start(load_hosts.sleeve_host, shares)
         watcher = _Watcher(target)
         sent, unacknowledged = _draw(target)
         _wait(lambda: watcher.settled(sent) if watcher else 0, len(sent))
@@ -343,7 +352,7 @@ def _line(what: str, outcome: Outcome, base: Outcome | None) -> str:
     text += f"; {counted} {len(outcome.latencies_ms)}/{outcome.sent}, lost {outcome.lost}"
     if outcome.refused:
         text += ", refused " + ", ".join(f"{n} {r}" for r, n in sorted(outcome.refused.items()))
-    if outcome.twice:
+    if base is not None:
         text += f", played twice {outcome.twice}"
     if outcome.unacknowledged:
         text += f", not acknowledged by the broker {outcome.unacknowledged}"
@@ -360,15 +369,27 @@ def report(counts: tuple[int, ...] = DEFAULT_COUNTS) -> list[str]:
         "publish -> receive of the same broker and N, this run"
     ]
     print(lines[0], flush=True)
+    began_s = time.monotonic()
     for start in (mosquitto, nats):
         for count in counts:
+            run_s = time.monotonic()
+            relaxed = None
             with tempfile.TemporaryDirectory() as state, start(count, Path(state)) as target:
                 base = baseline(target)
                 played = sleeves(target)
-            lines.append(f"{target.name}, N = {count}: {played.sent} strokes")
+                if played.refused.keys() & OUT_OF_TIME:
+                    relaxed = sleeves(target, RELAXED_PACE)
+            lines.append(
+                f"{target.name}, N = {count}: {played.sent} strokes "
+                f"(load average {os.getloadavg()[0]:.1f}; {time.monotonic() - run_s:.0f} s)"
+            )
             lines.append(_line("bare publish -> receive", base, None))
             lines.append(_line("publish -> played (sleeve)", played, base))
-            print("\n".join(lines[-3:]), flush=True)
+            if relaxed is not None:
+                lines.append(_line("  the same, late allowed", relaxed, base))
+            print("\n".join(lines[-4 if relaxed else -3 :]), flush=True)
+    lines.append(f"({time.monotonic() - began_s:.0f} s in all)")
+    print(lines[-1], flush=True)
     return lines
 
 

@@ -116,19 +116,26 @@ def _connect_all(
 
 
 def _close(clients: list[mqtt.Client]) -> None:
-    # The network thread first: paho's loop_stop() right after disconnect() can race the
-    # thread's own end (AttributeError). The broker sees the sockets close with the process.
+    """Log every client out; their network threads end by themselves with the process.
+
+    paho's loop_stop() waits for one client's thread at a time, up to a second each:
+    minutes for a few hundred clients.
+    """
     for client in clients:
-        client.loop_stop()
         client.disconnect()
 
 
 def sleeve_host(
-    urls: list[str], sleeves: list[tuple[str, Account]], reports: Reports, stop: Flag
+    urls: list[str],
+    sleeves: list[tuple[str, Account]],
+    pace: tuple[float, float] | None,
+    reports: Reports,
+    stop: Flag,
 ) -> None:
     """Run ``sleeves`` (sleeve id, account) as sleeve daemons on the simulator until ``stop``.
 
     Sleeve i connects to ``urls[i]`` first (the server list, rotated, on a cluster).
+    ``pace``: (max_age_ms, max_lag_ms) instead of the sleeve's defaults.
     """
     _quiet()
     running: list[tuple[Sleeve, threading.Thread, SimBackend]] = []
@@ -138,12 +145,10 @@ def sleeve_host(
                 url, username=account.username, password=account.password, sleeve_id=sleeve_id
             )
             backend = SimBackend(PAPER_SLEEVE)
-            sleeve = Sleeve(
-                settings,
-                PAPER_SLEEVE,
-                backend,
-                SleeveOptions(sleeve_id=sleeve_id, legacy_topic=None),
-            )
+            options = SleeveOptions(sleeve_id=sleeve_id, legacy_topic=None)
+            if pace is not None:
+                options = replace(options, max_age_ms=pace[0], max_lag_ms=pace[1])
+            sleeve = Sleeve(settings, PAPER_SLEEVE, backend, options)
             thread = threading.Thread(target=sleeve.run, daemon=True)
             thread.start()
             running.append((sleeve, thread, backend))

@@ -211,11 +211,15 @@ class NatsCluster:
             self._processes[index] = None
 
     def stop(self) -> None:
-        for index, process in enumerate(self._processes):
+        # All three at once: each may take seconds to shut down with many sessions.
+        for process in self._processes:
             if process is not None:
                 process.send_signal(signal.SIGTERM)
+        deadline = time.monotonic() + STOP_TIMEOUT_S
+        for index, process in enumerate(self._processes):
+            if process is not None:
                 try:
-                    process.wait(timeout=STOP_TIMEOUT_S)
+                    process.wait(timeout=max(0.1, deadline - time.monotonic()))
                 except subprocess.TimeoutExpired:
                     process.kill()
                     process.wait()
