@@ -50,7 +50,8 @@ def _mosquitto_children(pid: int) -> list[int]:
     return [int(p) for p in found.stdout.split()]
 
 
-def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path) -> None:
+def _start_up(tmp_path: Path) -> subprocess.Popen[str]:
+    """``feelmysign up`` on free ports with a stand-in page, its output in one stream."""
     web = tmp_path / "web"
     web.mkdir()
     (web / "index.html").write_text("<!doctype html><title>test</title>")
@@ -59,6 +60,11 @@ def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path)
     process = subprocess.Popen(
         command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1
     )
+    return process
+
+
+def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path) -> None:
+    process = _start_up(tmp_path)
     seen: list[str] = []
     try:
         lines = _lines(process)
@@ -81,14 +87,7 @@ def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path)
 
 
 def test_up_says_it_is_stopping_on_ctrl_c_and_reports_no_fault(tmp_path: Path) -> None:
-    web = tmp_path / "web"
-    web.mkdir()
-    (web / "index.html").write_text("<!doctype html><title>test</title>")
-    command = [sys.executable, "-m", "feelmysign", "up", "--state-dir", str(tmp_path / "state")]
-    command += ["--http-port", "0", "--port", "0", "--ws-port", "0", "--web-dir", str(web)]
-    process = subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1
-    )
+    process = _start_up(tmp_path)
     seen: list[str] = []
     try:
         lines = _lines(process)

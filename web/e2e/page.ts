@@ -147,6 +147,16 @@ export async function waitForData(
   }
 }
 
+/** Waits until the sleeve has played at least one stroke of the page's current drawing. */
+export async function waitForPlayed(page: Page, timeoutMs = 30_000): Promise<void> {
+  await page.waitForFunction(
+    () =>
+      Number((document.querySelector('[data-testid="played-summary"]') as HTMLElement).dataset["played"]) > 0,
+    undefined,
+    { timeout: timeoutMs },
+  );
+}
+
 /** Opens the settings' Advanced level (whatever state it was left in). */
 export async function openAdvanced(page: Page): Promise<void> {
   await page.locator('[data-testid="settings-advanced"]').evaluate((details) => {

@@ -15,16 +15,38 @@ import {
   serveDist,
   tempDir,
 } from "./harness";
-import { CANVAS, drawingArea, drawWithTouch, nextFrame, openAdvanced, screenshot, waitForData } from "./page";
+import {
+  CANVAS,
+  drawingArea,
+  drawWithTouch,
+  nextFrame,
+  openAdvanced,
+  screenshot,
+  waitForData,
+  type Area,
+} from "./page";
 import { expectStrokesFollow, strokeBounds } from "./strokes";
 
-/** Toolbar and header labels cut short by their box ("Simpli…"): none may be. */
+/** Labels cut short by their box ("Simpli…"): none may be, in the bars or the settings. */
 async function truncatedLabels(page: Page): Promise<string[]> {
   return page.evaluate(() =>
-    [...document.querySelectorAll<HTMLElement>(".topbar *, .toolbar *, .legend *")]
+    [
+      ...document.querySelectorAll<HTMLElement>(
+        ".topbar *, .toolbar *, .legend *, .sheet label, .sheet legend, .sheet .button",
+      ),
+    ]
       .filter((element) => element.offsetParent !== null && element.scrollWidth > element.clientWidth + 1)
       .map((element) => element.textContent ?? ""),
   );
+}
+
+/** The whole area on the first screen, at least `share` of its height: no scrolling to draw. */
+function expectOnScreen(area: Area, screen: { width: number; height: number }, share: number): void {
+  expect(area.height).toBeGreaterThan(screen.height * share);
+  expect(area.left).toBeGreaterThanOrEqual(0);
+  expect(area.top).toBeGreaterThanOrEqual(0);
+  expect(area.left + area.width).toBeLessThanOrEqual(screen.width);
+  expect(area.top + area.height).toBeLessThanOrEqual(screen.height);
 }
 
 describe("drawing with a finger on a phone", () => {
@@ -66,10 +88,7 @@ describe("drawing with a finger on a phone", () => {
     // A 3 x 4 sleeve is 3:2 across; on an upright phone it is shown turned, 2:3, to use the height.
     expect(area.turnDeg).toBe(90);
     expect(area.height / area.width).toBeCloseTo(1.5, 1);
-    expect(area.height).toBeGreaterThan(844 * 0.45);
-    expect(area.left).toBeGreaterThanOrEqual(0);
-    expect(area.left + area.width).toBeLessThanOrEqual(390);
-    expect(area.top + area.height).toBeLessThanOrEqual(844);
+    expectOnScreen(area, { width: 390, height: 844 }, 0.45);
     expect(await page.locator('[data-testid="legend-turned"]').isVisible()).toBe(true);
     expect(await page.evaluate(() => document.documentElement.scrollWidth)).toBeLessThanOrEqual(390);
     expect(await page.locator('[data-testid="broker-status"]').isVisible()).toBe(true);
@@ -113,10 +132,7 @@ describe("drawing with a finger on a phone", () => {
     await waitForData(page, CANVAS, "areaTurnDeg", "0");
     const area = await drawingArea(page);
     expect(area.width / area.height).toBeCloseTo(1.5, 1);
-    expect(area.height).toBeGreaterThan(390 * 0.5);
-    expect(area.top).toBeGreaterThanOrEqual(0);
-    expect(area.top + area.height).toBeLessThanOrEqual(390);
-    expect(area.left + area.width).toBeLessThanOrEqual(844);
+    expectOnScreen(area, { width: 844, height: 390 }, 0.5);
     expect(await page.locator('[data-testid="legend-turned"]').isVisible()).toBe(false);
     const stop = await page.locator('[data-testid="stop-button"]').boundingBox();
     expect(stop !== null && stop.y + stop.height <= 390, "Stop is on the first screen").toBe(true);
@@ -134,6 +150,7 @@ describe("drawing with a finger on a phone", () => {
     expect(box?.width).toBeCloseTo(390, 0);
     await screenshot(page, "phone-settings");
     await openAdvanced(page);
+    expect(await truncatedLabels(page)).toEqual([]);
     const password = page.locator('[data-testid="setting-password"]');
     await password.scrollIntoViewIfNeeded();
     expect(await password.isVisible()).toBe(true);

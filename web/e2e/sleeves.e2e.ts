@@ -20,7 +20,7 @@ import {
   tempDir,
   type Credentials,
 } from "./harness";
-import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData } from "./page";
+import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData, waitForPlayed } from "./page";
 
 const SECOND = "arm2";
 const PICKER = '[data-testid="sleeve-select"]';
@@ -129,13 +129,7 @@ describe("two sleeves on one broker, chosen on the page", () => {
     // Every stroke the page sent is accounted for: sent - arm2's went to sleeve1, none to both.
     expect(onFirst.length + onSecond.length).toBe(sent + sentAgain);
     // Played there (every stroke, or skipped as late by a sleeve fallen behind on a loaded machine).
-    await page.waitForFunction(
-      () =>
-        Number((document.querySelector('[data-testid="played-summary"]') as HTMLElement).dataset["played"]) >
-        0,
-      undefined,
-      { timeout: 30_000 },
-    );
+    await waitForPlayed(page);
     expect(second.strokes().length).toBe(sent);
     await screenshot(page, "sleeves-picker");
   });

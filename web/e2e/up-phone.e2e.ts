@@ -9,7 +9,15 @@ import { rmSync } from "node:fs";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { checkPrerequisites, launchBrowser, startUp, stopUp, tempDir } from "./harness";
-import { CANVAS, drawingArea, drawWithTouch, nextFrame, screenshot, waitForData } from "./page";
+import {
+  CANVAS,
+  drawingArea,
+  drawWithTouch,
+  nextFrame,
+  screenshot,
+  waitForData,
+  waitForPlayed,
+} from "./page";
 
 const BROKER = '[data-testid="broker-status"]';
 
@@ -77,13 +85,7 @@ describe("a phone against feelmysign up, its broker killed and started again", (
       [area.left + area.width * fx, area.top + area.height * fy] as const;
     await drawWithTouch(page, cdp, [at(0.2, 0.2), at(0.8, 0.2), at(0.8, 0.8)]);
     await nextFrame(page);
-    await page.waitForFunction(
-      () =>
-        Number((document.querySelector('[data-testid="played-summary"]') as HTMLElement).dataset["played"]) >
-        0,
-      undefined,
-      { timeout: 30_000 },
-    );
+    await waitForPlayed(page);
     expect(await page.locator(CANVAS).boundingBox()).toEqual(before);
     await screenshot(page, "up-phone");
   });

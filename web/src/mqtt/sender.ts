@@ -150,6 +150,8 @@ export class StrokeSender {
         "connected",
         `Connected to ${target.ws_url} as ${target.username || "anonymous"}`,
       );
+      // Retained statuses come again with the subscription; one cleared meanwhile would not.
+      this.#statuses.clear();
       // The target now, not at connect(): another sleeve may have been chosen since.
       const topics = [EVERY_STATUS, ...ownTopics(this.#target?.sleeve_id ?? target.sleeve_id)];
       client.subscribe(topics, { qos: 0 }, (error) => {
@@ -208,10 +210,10 @@ export class StrokeSender {
     this.#target = target;
     const client = this.#client;
     if (previous === target.sleeve_id || client === null) return;
-    if (client.connected) {
-      client.unsubscribe(ownTopics(previous));
-      client.subscribe(ownTopics(target.sleeve_id), { qos: 0 });
-    }
+    // Offline, nothing is said: the connect handler subscribes for the sleeve chosen by then.
+    if (!client.connected) return;
+    client.unsubscribe(ownTopics(previous));
+    client.subscribe(ownTopics(target.sleeve_id), { qos: 0 });
     const status = this.#statuses.get(target.sleeve_id);
     if (status !== undefined) this.#listener.status(status);
   }
