@@ -13,6 +13,7 @@ import threading
 import time
 import uuid
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -149,6 +150,16 @@ class Events:
         with self._lock:
             self._lock.wait_for(lambda: len(self.played_seqs(drawing)) >= count, WAIT_S)
 
+    def wait_settled(self, drawing: str, count: int) -> None:
+        """Until ``count`` strokes of ``drawing`` were played or refused (not as copies)."""
+        with self._lock:
+            self._lock.wait_for(lambda: len(self.settled(drawing)) >= count, WAIT_S)
+
+    def settled(self, drawing: str) -> set[int]:
+        with self._lock:
+            refused = {seq for seq, why in self.refusals(drawing).items() if why != {"duplicate"}}
+            return set(self.played_seqs(drawing)) | refused
+
     def played_seqs(self, drawing: str) -> list[int]:
         with self._lock:
             return sorted(seq for (d, seq) in self.played if d == drawing)
@@ -176,37 +187,50 @@ def _send(cluster: NatsCluster, *shape: str) -> subprocess.Popen[str]:
     )
 
 
-def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
-    cluster: NatsCluster, tmp_path: Path
-) -> None:
+@pytest.fixture
+def fresh_cluster(tmp_path: Path) -> Iterator[NatsCluster]:
+    """A cluster of its own, for a test that kills one of its nodes."""
+    credentials = reuse_or_create(
+        tmp_path / "credentials.json", sleeve_id=SLEEVE, mqtt_url="mqtt://x:1", ws_url="ws://x:2"
+    )
+    with NatsCluster(tmp_path / "cluster", credentials) as running:
+        yield running
+
+
+@dataclass
+class Failover:
+    events: Events
+    first: str  # the drawing node a's death cut
+    second: str  # the drawing sent after it
+    said: str  # what the sender and the sleeve printed
+
+
+def _kill_the_sleeves_node_mid_drawing(cluster: NatsCluster, *pace: str) -> Failover:
+    """A sleeve on node a (b and c to fail over to) with the sleeve options ``pace``; a
+    drawing of 12 strokes sent from node b at a hand's pace; node a killed (SIGKILL)
+    once two strokes played; then a drawing of 4 strokes."""
     c = cluster.credentials
-    env = {**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password}
-    # The sleeve is given node a first; b and c to fail over to. JetStream holds the
-    # strokes sent while it elects new leaders for what node a led (4 to 9 s): the
-    # sleeve's pace limits, as docs/deploy.md sets them for a cluster, let it play them
-    # late rather than skip them.
     sleeve = subprocess.Popen(
         feelmysign(
             *("sleeve", "--broker", cluster.mqtt_urls, "--id", SLEEVE),
-            *("--username", c.sleeve.username, *CLUSTER_PACE),
+            *("--username", c.sleeve.username, *pace),
         ),
-        env=env,
+        env={**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password},
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
     )
     events = Events(cluster.nodes[1].mqtt_url, c.sender)
+    first_out = ""
     try:
         _wait_online(cluster, c.sender)
-        # A drawing of 12 strokes sent from node b at a hand's pace; node a, the
-        # sleeve's, is killed (SIGKILL) once the first strokes were played.
         send = _send(cluster, "circle", "--segments", "12")
         first = _drawing_of_first_line(send)
         events.wait_played(first, 2)
         cluster.kill(0)
         out = first_out = send.communicate(timeout=WAIT_S * 2)[0]
         assert send.returncode == 0, out
-        events.wait_played(first, 12)
+        events.wait_settled(first, 12)
         # Back on another node: the next drawing plays in full.
         second_send = _send(cluster, "square")
         second = _drawing_of_first_line(second_send)
@@ -217,17 +241,44 @@ def test_a_sleeve_moves_to_another_node_when_its_node_dies_mid_drawing(
         events.client.loop_stop()
         sleeve.terminate()
         sleeve_out = sleeve.communicate(timeout=WAIT_S)[0]
+    assert f"connected to {cluster.nodes[0].mqtt_url}" in sleeve_out, sleeve_out
+    moved = [f"connected to {n.mqtt_url}" in sleeve_out for n in cluster.nodes[1:]]
+    assert any(moved), sleeve_out
     said = f"the sender said:\n{first_out}\nthe sleeve said:\n{sleeve_out}"
+    return Failover(events, first, second, said)
+
+
+def test_a_sleeve_moves_to_another_node_when_its_node_dies_and_plays_every_stroke_once(
+    fresh_cluster: NatsCluster,
+) -> None:
+    # JetStream holds the strokes sent while it elects new leaders for what node a led
+    # (4 to 9 s): the sleeve's pace limits for a cluster (docs/deploy.md) let it play
+    # them late rather than skip them.
+    run = _kill_the_sleeves_node_mid_drawing(fresh_cluster, *CLUSTER_PACE)
+    events, said = run.events, run.said
     # Every stroke of the cut drawing played exactly once: none lost, none refused (a
     # copy the broker delivers again after the failover is dropped as a duplicate), none
     # played twice.
-    assert events.played_seqs(first) == list(range(12)), said
-    assert all(reasons == {"duplicate"} for reasons in events.refusals(first).values()), said
-    assert events.played_seqs(second) == [0, 1, 2, 3], said
+    assert events.played_seqs(run.first) == list(range(12)), said
+    assert all(why == {"duplicate"} for why in events.refusals(run.first).values()), said
+    assert events.played_seqs(run.second) == [0, 1, 2, 3], said
     assert all(len(payloads) == 1 for payloads in events.played.values()), "played twice"
-    assert f"connected to mqtt://127.0.0.1:{cluster.nodes[0].mqtt_port}" in sleeve_out
-    moved = [f"connected to {n.mqtt_url}" in sleeve_out for n in cluster.nodes[1:]]
-    assert any(moved), sleeve_out
+
+
+def test_with_the_default_pace_a_failover_skips_strokes_only_out_loud(
+    fresh_cluster: NatsCluster,
+) -> None:
+    run = _kill_the_sleeves_node_mid_drawing(fresh_cluster)
+    events, said = run.events, run.said
+    # The sleeve keeps to real time: what the election held back more than 1 s may be
+    # refused as late (or stale), and each refusal is reported. Every stroke of the cut
+    # drawing is played or reported, none is played twice, and none both.
+    assert events.settled(run.first) == set(range(12)), said
+    refused = {seq: why - {"duplicate"} for seq, why in events.refusals(run.first).items()}
+    assert all(why <= {"late", "stale"} for why in refused.values()), said
+    assert not {seq for seq, why in refused.items() if why} & set(events.played_seqs(run.first))
+    assert events.played_seqs(run.second) == [0, 1, 2, 3], said
+    assert all(len(payloads) == 1 for payloads in events.played.values()), "played twice"
 
 
 def _drawing_of_first_line(send: subprocess.Popen[str]) -> str:
