@@ -15,6 +15,11 @@ the mean distance between corresponding points, and the template with the least
 distance names the shape (score ``1 - d / (0.5 sqrt(2 SIZE^2))``). The search runs
 for all templates at once (numpy): every template starts from the same range,
 so the search takes the same steps for each.
+
+With ``fixed_orientation`` (shapes whose orientation is part of their meaning, as on an
+arm: a square turned 45 degrees is a diamond, not a square) step 2 and the search are
+left out, as the paper suggests for orientation-dependent gestures, and step 3 scales
+uniformly by the larger side, so that a line stays a line (the paper's 1-D limitation).
 """
 
 from __future__ import annotations
@@ -52,16 +57,20 @@ def resample(points: Points, n: int = N) -> Points:
     return np.stack([x, y], axis=1)
 
 
-def normalise(points: Points) -> Points:
-    """Steps 1 to 4: resampled, rotated to its indicative angle, scaled, centred."""
+def normalise(points: Points, *, fixed_orientation: bool = False) -> Points:
+    """Steps 1 to 4: resampled, rotated to its indicative angle, scaled, centred (without the
+    rotation and with uniform scaling when ``fixed_orientation``)."""
     path = resample(points)
     centre = path.mean(axis=0)
-    angle = math.atan2(centre[1] - path[0, 1], centre[0] - path[0, 0])
-    path = _rotate(path - centre, -angle)
+    if fixed_orientation:
+        path = path - centre
+    else:
+        angle = math.atan2(centre[1] - path[0, 1], centre[0] - path[0, 0])
+        path = _rotate(path - centre, -angle)
     low, high = path.min(axis=0), path.max(axis=0)
     # A straight line has no height: keep it from dividing by zero (the paper's 1-D limit).
     extent = np.maximum(high - low, 1e-9)
-    path = path * (SIZE / extent)
+    path = path * (SIZE / (extent.max() if fixed_orientation else extent))
     result: Points = path - path.mean(axis=0)
     return result
 
@@ -78,21 +87,29 @@ class Templates:
 
     names: tuple[str, ...]
     points: NDArray[np.float64]  # (templates, N, 2)
+    fixed_orientation: bool = False
 
     @classmethod
-    def of(cls, named: Sequence[tuple[str, Points]]) -> Templates:
-        return cls(tuple(n for n, _ in named), np.stack([normalise(p) for _, p in named]))
+    def of(
+        cls, named: Sequence[tuple[str, Points]], *, fixed_orientation: bool = False
+    ) -> Templates:
+        normalised = [normalise(p, fixed_orientation=fixed_orientation) for _, p in named]
+        return cls(tuple(n for n, _ in named), np.stack(normalised), fixed_orientation)
 
     def without(self, index: int) -> Templates:
         """All templates but one (leave-one-out)."""
         keep = [i for i in range(len(self.names)) if i != index]
-        return Templates(tuple(self.names[i] for i in keep), self.points[keep])
+        return Templates(
+            tuple(self.names[i] for i in keep), self.points[keep], self.fixed_orientation
+        )
 
 
 def distances(candidate: Points, templates: Templates) -> NDArray[np.float64]:
     """The paper's distance at the best angle, from the candidate to every template."""
-    points = normalise(candidate)
+    points = normalise(candidate, fixed_orientation=templates.fixed_orientation)
     count = len(templates.names)
+    if templates.fixed_orientation:
+        return _distances_at(points, templates.points, np.zeros(count))
     low = np.full(count, -ANGLE_RANGE_RAD)
     high = np.full(count, ANGLE_RANGE_RAD)
     x1 = PHI * low + (1 - PHI) * high
@@ -127,8 +144,14 @@ def _distances_at(
     return result
 
 
+def scores(candidate: Points, templates: Templates) -> NDArray[np.float64]:
+    """The paper's score against every template (1 is a perfect match)."""
+    result: NDArray[np.float64] = 1.0 - distances(candidate, templates) / HALF_DIAGONAL
+    return result
+
+
 def recognise(candidate: Points, templates: Templates) -> tuple[str, float]:
     """The name of the nearest template and the paper's score (1 is a perfect match)."""
-    found = distances(candidate, templates)
-    best = int(np.argmin(found))
-    return templates.names[best], 1.0 - float(found[best]) / HALF_DIAGONAL
+    found = scores(candidate, templates)
+    best = int(np.argmax(found))
+    return templates.names[best], float(found[best])

@@ -3,15 +3,14 @@ simulated participant.
 
 The felt path is what the sleeve renders: the virtual actuators (bursts) of
 the sleeve's own planner, in the order they are felt. It is compared with
-each shape's ideal outline by the $1 recogniser's template distance
-(Wobbrock, Wilson & Li, UIST 2007): both are resampled to ``RESAMPLE_POINTS``
-points, scaled to a unit square and centred, and the mean point-to-point
-distance gives a score in [0, 1] (1 = the same path). Rotation is not
-searched: a shape on the arm has a known orientation, and a tilted square
-(a diamond) should not score as a square.
+each shape's ideal outline by the $1 recogniser of ``feelmysign.research.dollar``
+(Wobbrock, Wilson & Li, UIST 2007) with a fixed orientation: a shape on the arm
+has a known orientation, so rotation is not searched (a tilted square, a
+diamond, should not score as a square) and paths are scaled uniformly (a line
+stays a line). The score is the paper's, in [0, 1] (1 = the same path).
 
-``Scorer`` is the interface: any recogniser giving one score per template
-(for example the one in ``feelmysign.research``) can replace ``dollar_scores``.
+``Scorer`` is the interface: any recogniser giving one score per template can
+replace ``dollar_scores``.
 """
 
 from __future__ import annotations
@@ -20,14 +19,11 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
-from numpy.typing import NDArray
 
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
+from feelmysign.research import dollar
 from feelmysign.stroke import Point, Stroke
-
-RESAMPLE_POINTS = 64  # the $1 recogniser's N
-HALF_DIAGONAL = 0.5 * math.sqrt(2.0)  # $1: the largest distance between unit-square paths
 
 Scorer = Callable[[Sequence[Point], Mapping[str, Sequence[Point]]], dict[str, float]]
 
@@ -52,36 +48,13 @@ def outline(strokes: Sequence[Stroke]) -> list[Point]:
     return [strokes[0].start, *(s.end for s in strokes)]
 
 
-def _resample(points: Sequence[Point], n: int) -> NDArray[np.float64]:
-    path = np.asarray(points, dtype=float)
-    if len(path) == 1:
-        return np.repeat(path, n, axis=0)
-    steps = np.hypot(*np.diff(path, axis=0).T)
-    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
-    if cumulative[-1] == 0:
-        return np.repeat(path[:1], n, axis=0)
-    targets = np.linspace(0.0, cumulative[-1], n)
-    return np.column_stack(
-        [np.interp(targets, cumulative, path[:, 0]), np.interp(targets, cumulative, path[:, 1])]
-    )
-
-
-def _normalised(points: Sequence[Point]) -> NDArray[np.float64]:
-    path = _resample(points, RESAMPLE_POINTS)
-    size = np.ptp(path, axis=0)
-    # Uniform scale by the larger side: a line stays a line instead of filling the square.
-    path = path / max(float(size.max()), 1e-9)
-    centred: NDArray[np.float64] = path - path.mean(axis=0)
-    return centred
-
-
 def dollar_scores(
     path: Sequence[Point], templates: Mapping[str, Sequence[Point]]
 ) -> dict[str, float]:
-    """$1 score of ``path`` against each template: 1 - mean distance / half the unit diagonal."""
-    candidate = _normalised(path)
-    scores = {}
-    for name, template in templates.items():
-        distance = float(np.mean(np.hypot(*(candidate - _normalised(template)).T)))
-        scores[name] = max(0.0, 1.0 - distance / HALF_DIAGONAL)
-    return scores
+    """$1 score of ``path`` against each template, orientation fixed, at least 0."""
+    known = dollar.Templates.of(
+        [(name, np.asarray(points, dtype=float)) for name, points in templates.items()],
+        fixed_orientation=True,
+    )
+    found = dollar.scores(np.asarray(path, dtype=float), known)
+    return {name: max(0.0, float(score)) for name, score in zip(known.names, found, strict=True)}
