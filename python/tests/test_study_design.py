@@ -69,6 +69,23 @@ def test_a_recorded_drawing_gets_its_strokes_from_the_simplifier(tmp_path: Path)
         parse_design(bad, base_dir=tmp_path)
 
 
+def test_practice_may_play_a_recorded_drawing_at_one_of_its_resolutions(tmp_path: Path) -> None:
+    zigzag_recording(tmp_path / "zigzag.json")
+    practice = '[[practice]]\nshape = "zigzag"\nresolution = "low"\n[[practice]]\nshape = "line"\n'
+    design = parse_design(MINIMAL + ZIGZAG_SHAPE + practice, base_dir=tmp_path)
+    recorded, library = design.practice
+    coarse = design.shape("zigzag").levels[0]
+    assert (recorded.shape, recorded.level, recorded.segments) == ("zigzag", 0, coarse.strokes)
+    assert library.level is None
+    first = participant_order(design, 0)[0]
+    assert (first.block, first.shape, first.level) == ("practice", "zigzag", 0)
+    wrong = practice.replace('resolution = "low"', 'segments = 3\nresolution = "mid"')
+    with pytest.raises(DesignError) as error:
+        parse_design(MINIMAL + ZIGZAG_SHAPE + wrong + 'resolution = "low"\n', base_dir=tmp_path)
+    assert "practice[0].segments: 'zigzag' is a recorded drawing" in str(error.value)
+    assert "practice[1].resolution: only for a recorded drawing" in str(error.value)
+
+
 def test_latin_square_rows_are_balanced_for_first_order_carry_over() -> None:
     for n in (4, 5, 24):
         rows = williams_rows(n)

@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from study_helpers import REPO
 
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker
@@ -17,26 +18,8 @@ from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.study import StudyStore, load_design
 
-DESIGN = """
-[study]
-name = "terminal"
-seed = 3
-repetitions = 1
-resolutions = ["coarse", "fine"]
-[stimulus]
-speed_cm_s = 30.0
-[[shapes]]
-name = "square"
-segments = [4, 8]
-synonyms = ["box"]
-[[practice]]
-shape = "line"
-[comfort]
-questions = ["Comfortable?"]
-[questionnaire]
-points = 5
-items = ["The sleeve was comfortable."]
-"""
+# The browser test (web/e2e/study.e2e.ts) runs the same design on the page.
+QUICK_DESIGN = REPO / "deploy" / "studies" / "quick.toml"
 
 
 @pytest.fixture
@@ -59,13 +42,13 @@ def sleeve(broker: Broker) -> Iterator[Sleeve]:
 def test_a_whole_session_in_the_terminal_plays_every_shape(
     tmp_path: Path, broker: Broker, sleeve: Sleeve
 ) -> None:
-    design = tmp_path / "design.toml"
-    design.write_text(DESIGN)
     study = tmp_path / "study.sqlite"
-    StudyStore.create(study, design, load_design(design)).close()
+    StudyStore.create(study, QUICK_DESIGN, load_design(QUICK_DESIGN)).close()
     # consent, comfort (1 question + adjusted), then per trial: Enter to send, the answer,
-    # the confidence; then the questionnaire.
-    typed = "y\ny\nn\n" + "\nline\n5\n" + "\na box\n4\n" + "\nno idea\n\n" + "4\n"
+    # the confidence (2 practice trials, a library shape and a recorded drawing, then 4
+    # measured ones); then the questionnaire's 2 items.
+    answers = ["line", "lightning", "a box", "no idea", "zig zag", "it was a square"]
+    typed = "y\ny\nn\n" + "".join(f"\n{a}\n4\n" for a in answers) + "4\n5\n"
     result = subprocess.run(
         [
             sys.executable,
@@ -83,12 +66,15 @@ def test_a_whole_session_in_the_terminal_plays_every_shape(
         timeout=120,
     )
     assert result.returncode == 0, result.stdout + result.stderr
-    assert "coded: square" in result.stdout
+    assert "coded: square" in result.stdout and "coded: zigzag" in result.stdout
     store = StudyStore(study)
     (participant,) = store.participants()
     trials = store.trials(participant["code"])
-    assert [t["answer"] for t in trials] == ["line", "a box", "no idea"]
+    assert [t["answer"] for t in trials] == answers
+    assert [t["shape"] for t in trials[:2]] == ["line", "zigzag"]  # practice, then measured
+    assert {t["shape"] for t in trials[2:]} == {"square", "zigzag"}
     played = store.query("SELECT COUNT(*) FROM events WHERE type IN ('played', 'adjusted')")
     strokes = sum(t["segments"] for t in trials)
     assert played[0][0] == strokes  # every stroke of every shape played by the sleeve
+    assert [row["value"] for row in store.questionnaire(participant["code"])] == [4, 5]
     assert participant["finished_at_ms"] is not None

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import random
 from pathlib import Path
+from typing import Any
 
 import pytest
 from study_helpers import PAPER_DESIGN, new_study
@@ -11,6 +13,7 @@ from study_helpers import PAPER_DESIGN, new_study
 from feelmysign.errors import StudyError
 from feelmysign.layout import grid_layout
 from feelmysign.study import StudyStore, load_design
+from feelmysign.study.api import StudyApi
 from feelmysign.study.runner import Session
 from feelmysign.study.simulated_sleeve import offline_player
 from feelmysign.study.threshold import Procedure, SimulatedObserver, check_fits
@@ -64,3 +67,68 @@ def test_a_stroke_longer_than_the_sleeve_is_refused_before_any_trial() -> None:
     design = load_design(PAPER_DESIGN)
     with pytest.raises(StudyError, match="at most 1"):
         check_fits(grid_layout(2, 4, 3.0), design.threshold)
+
+
+def _desk_call(api: StudyApi, method: str, path: str, body: dict[str, Any]) -> tuple[int, Any]:
+    raw = json.dumps(body).encode()
+    status, _kind, payload = api.handle(method, path, "127.0.0.1:8000", raw, "application/json")
+    return status, json.loads(payload)
+
+
+def test_the_page_runs_the_procedure_step_by_step_and_resumes_after_a_restart(
+    tmp_path: Path,
+) -> None:
+    store = new_study(tmp_path)
+    code = store.add_participant(simulated=True)
+    store.set_consent(code, True)
+    layout = Session(store, None).layout
+
+    def api() -> StudyApi:
+        return StudyApi(Session(StudyStore(store.path), offline_player(layout)), tmp_path / "r")
+
+    page, base = api(), f"/api/study/participants/{code}"
+    status, refused = _desk_call(
+        page, "POST", f"{base}/threshold-answer", {"dimension": "length", "position": 0}
+    )
+    assert status == 400 and "has not been sent" in refused["error"]
+    for _ in range(5):
+        status, state = _desk_call(page, "POST", f"{base}/threshold-send", {"dimension": "length"})
+        run = state["dimensions"]["length"]["run"]
+        assert status == 200 and run["next"]["sent"] and "direction" not in run["next"]
+        assert run["last_send"]["played"] == 1
+        answer = {"dimension": "length", "position": run["next"]["position"]}
+        status, state = _desk_call(
+            page,
+            "POST",
+            f"{base}/threshold-answer",
+            {**answer, "response": run["simulated_answer"]},
+        )
+        assert status == 200
+    before = state["dimensions"]["length"]["run"]
+    assert len(before["trials"]) == 5 and before["estimate"]["low"] < before["estimate"]["high"]
+    # A restarted server: the run is replayed from the file and goes on with the same trial.
+    page = api()
+    status, after = _desk_call(page, "GET", f"{base}/threshold", {})
+    assert after["dimensions"]["length"]["run"]["trials"] == before["trials"]
+    assert after["dimensions"]["length"]["run"]["next"] == {**before["next"], "sent": False}
+    assert after["dimensions"]["length"]["run"]["estimate"] == pytest.approx(before["estimate"])
+    status, refused = _desk_call(
+        page, "POST", f"{base}/threshold-answer", {**answer, "position": 5, "response": "up"}
+    )
+    assert status == 400  # sent before the restart only: send it again
+    while after["dimensions"]["length"]["run"] is not None:
+        _, after = _desk_call(page, "POST", f"{base}/threshold-send", {"dimension": "length"})
+        run = after["dimensions"]["length"]["run"]
+        answer = {"dimension": "length", "position": run["next"]["position"]}
+        _, after = _desk_call(
+            page,
+            "POST",
+            f"{base}/threshold-answer",
+            {**answer, "response": run["simulated_answer"]},
+        )
+    (finished,) = after["dimensions"]["length"]["finished_runs"]
+    assert finished["trials"] == store.design.threshold.trials
+    assert finished["low"] <= finished["threshold"] <= finished["high"]
+    (stored,) = StudyStore(store.path).threshold_runs(code)
+    assert stored["stop_reason"] == f"{store.design.threshold.trials} trials"
+    assert len(StudyStore(store.path).threshold_trials(stored["id"])) == finished["trials"]

@@ -6,7 +6,7 @@
  * with every answer kept (checked in the SQLite file); questionnaire, review, analysis.
  */
 import { spawn, spawnSync, type ChildProcess } from "node:child_process";
-import { rmSync, writeFileSync } from "node:fs";
+import { rmSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
@@ -14,32 +14,18 @@ import { checkPrerequisites, FEELMYSIGN, launchBrowser, REPO_DIR, tempDir } from
 import { screenshot } from "./page";
 
 const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
-const UP_READY_TIMEOUT_MS = 40_000;
+// Generous: on a loaded two-core machine the Python start-up alone can take half a minute.
+const UP_READY_TIMEOUT_MS = 90_000;
+const SETUP_TIMEOUT_MS = 240_000;
+const RESTART_TEST_TIMEOUT_MS = 240_000;
 const hasStudy = spawnSync(FEELMYSIGN, ["study", "--help"], { stdio: "ignore" }).status === 0;
 
-// Small, so the test is quick: 1 practice + 2 shapes x 2 resolutions x 1 repetition = 5 trials.
-const DESIGN = `
-[study]
-name = "Browser dry run"
-seed = 7
-repetitions = 1
-resolutions = ["coarse", "fine"]
-[stimulus]
-speed_cm_s = 30.0
-[[shapes]]
-name = "line"
-segments = [1, 2]
-[[shapes]]
-name = "square"
-segments = [4, 8]
-synonyms = ["box"]
-[[practice]]
-shape = "line"
-[comfort]
-questions = ["Does the sleeve sit comfortably?"]
-[questionnaire]
-items = ["The sleeve was comfortable.", "The vibrations were pleasant."]
-`;
+// The quick design (also run in the terminal by python/tests/test_study_terminal.py): 2 practice
+// trials (a library shape and a recorded drawing) + 2 shapes x 2 resolutions = 6 trials, and a
+// threshold run of 12 trials.
+const DESIGN = join(REPO_DIR, "deploy", "studies", "quick.toml");
+const TRIALS = 6;
+const THRESHOLD_TRIALS = 12;
 
 interface Up {
   child: ChildProcess;
@@ -94,7 +80,14 @@ async function killGroup(up: Up, signal: NodeJS.Signals): Promise<void> {
 }
 
 /** Counts in the study file, read by Python's sqlite3 while the server is down or up. */
-function rows(study: string): { answered: number; codings: number; played: number; questionnaire: number } {
+function rows(study: string): {
+  answered: number;
+  codings: number;
+  played: number;
+  questionnaire: number;
+  threshold_trials: number;
+  threshold_finished: number;
+} {
   const script = `
 import json, sqlite3, sys
 db = sqlite3.connect(sys.argv[1])
@@ -104,6 +97,8 @@ print(json.dumps({
   "codings": one("SELECT COUNT(DISTINCT trial) FROM codings"),
   "played": one("SELECT COUNT(*) FROM events WHERE type IN ('played', 'adjusted')"),
   "questionnaire": one("SELECT COUNT(*) FROM questionnaire"),
+  "threshold_trials": one("SELECT COUNT(*) FROM threshold_trials"),
+  "threshold_finished": one("SELECT COUNT(*) FROM threshold_runs WHERE threshold IS NOT NULL"),
 }))`;
   const result = spawnSync(PYTHON, ["-c", script, study], { encoding: "utf8" });
   if (result.status !== 0) throw new Error(result.stderr);
@@ -146,6 +141,33 @@ async function runTrial(page: Page): Promise<void> {
   );
 }
 
+/** One threshold trial: send, wait until played, answer what the simulated wearer said. */
+async function thresholdTrial(page: Page, byKeyboard: boolean): Promise<void> {
+  const run = page.locator('[data-testid="threshold-run"]');
+  const position = Number(await run.getAttribute("data-position"));
+  await page.click('[data-testid="threshold-send"]');
+  const said = page.locator('[data-testid="threshold-simulated"]');
+  await said.waitFor({ timeout: 30_000 });
+  const status = (await page.locator('[data-testid="threshold-send-status"]').textContent()) ?? "";
+  expect(status, "the stroke was played by the sleeve").toMatch(/played 1 of 1/);
+  const direction = (await said.getAttribute("data-answer"))!;
+  if (byKeyboard) {
+    const key = { up: "ArrowUp", down: "ArrowDown", left: "ArrowLeft", right: "ArrowRight" }[direction]!;
+    await page.keyboard.press(key);
+  } else {
+    await page.click(`[data-testid="threshold-answer-${direction}"]`);
+  }
+  await page.waitForFunction(
+    (before) => {
+      const next = document.querySelector('[data-testid="threshold-run"]');
+      if (next === null) return document.querySelector('[data-testid="threshold-finished"]') !== null;
+      return Number(next.getAttribute("data-position")) > before;
+    },
+    position,
+    { timeout: 15_000 },
+  );
+}
+
 describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () => {
   const cleanups: (() => Promise<void>)[] = [];
   const dir = tempDir("study");
@@ -157,8 +179,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
   beforeAll(async () => {
     checkPrerequisites();
     cleanups.push(async () => rmSync(dir, { recursive: true, force: true }));
-    writeFileSync(join(dir, "design.toml"), DESIGN);
-    const made = spawnSync(FEELMYSIGN, ["study", "new", join(dir, "design.toml"), "--out", study], {
+    const made = spawnSync(FEELMYSIGN, ["study", "new", DESIGN, "--out", study], {
       encoding: "utf8",
     });
     expect(made.status, made.stderr).toBe(0);
@@ -168,7 +189,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
     cleanups.push(browser.close);
     page = await browser.context.newPage();
     await page.goto(up.url);
-  });
+  }, SETUP_TIMEOUT_MS);
 
   afterAll(async () => {
     for (const cleanup of cleanups.reverse()) await cleanup();
@@ -185,19 +206,23 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
     await screenshot(page, "study-trial");
   });
 
-  it("loses nothing when the server is killed, and resumes at the next trial", async () => {
-    await killGroup(up, "SIGKILL");
-    const stored = rows(study);
-    expect(stored.answered).toBe(3);
-    expect(stored.codings).toBe(3);
-    expect(stored.played).toBeGreaterThanOrEqual(1 + 1 + 1);
-    up = await startUp(stateDir, study);
-    const code = (await page.locator('[data-testid="participant-code"]').textContent())!;
-    await page.goto(`${up.url}#${code}`);
-    await page.waitForFunction(() => document.querySelector('[data-testid="progress"]') !== null);
-    expect(await answered(page)).toBe(3);
-    await page.locator('[data-testid="trial"]').waitFor();
-  });
+  it(
+    "loses nothing when the server is killed, and resumes at the next trial",
+    async () => {
+      await killGroup(up, "SIGKILL");
+      const stored = rows(study);
+      expect(stored.answered).toBe(3);
+      expect(stored.codings).toBe(3);
+      expect(stored.played).toBeGreaterThanOrEqual(1 + 1 + 1);
+      up = await startUp(stateDir, study);
+      const code = (await page.locator('[data-testid="participant-code"]').textContent())!;
+      await page.goto(`${up.url}#${code}`);
+      await page.waitForFunction(() => document.querySelector('[data-testid="progress"]') !== null);
+      expect(await answered(page)).toBe(3);
+      await page.locator('[data-testid="trial"]').waitFor();
+    },
+    RESTART_TEST_TIMEOUT_MS,
+  );
 
   it("finishes the trials and the questionnaire", async () => {
     while ((await page.locator('[data-testid="trial"]').count()) > 0) await runTrial(page);
@@ -205,9 +230,46 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
     await page.click('[data-testid="questionnaire-done"]');
     await page.locator('[data-testid="done"]').waitFor();
     const stored = rows(study);
-    expect(stored.answered).toBe(5);
+    expect(stored.answered).toBe(TRIALS);
     expect(stored.questionnaire).toBe(2);
   });
+
+  it(
+    "runs the threshold procedure from the page, and resumes it after a kill",
+    async () => {
+      const code = (await page.locator('[data-testid="participant-code"]').textContent())!;
+      await page.click('[data-testid="threshold-tab"]');
+      await page.click('[data-testid="threshold-length"]');
+      await page.locator('[data-testid="threshold-start"]').waitFor();
+      await page.click('[data-testid="threshold-send"]'); // opens the run with its first stroke
+      await page.locator('[data-testid="threshold-simulated"]').waitFor({ timeout: 30_000 });
+      const first = (await page.locator('[data-testid="threshold-simulated"]').getAttribute("data-answer"))!;
+      await page.click(`[data-testid="threshold-answer-${first}"]`);
+      await page.locator('[data-testid="threshold-run"][data-position="1"]').waitFor();
+      for (let i = 1; i < 4; i++) await thresholdTrial(page, i % 2 === 0);
+      expect(await page.locator('[data-testid="threshold-estimate"]').textContent()).toMatch(
+        /Estimate after 4 trials: [\d.]+ grid units \(95% interval [\d.]+ to [\d.]+\)/,
+      );
+      await killGroup(up, "SIGKILL");
+      expect(rows(study).threshold_trials).toBe(4);
+      up = await startUp(stateDir, study);
+      await page.goto(`${up.url}#${code}`);
+      await page.waitForFunction(() => document.querySelector('[data-testid="progress"]') !== null);
+      await page.click('[data-testid="threshold-tab"]');
+      await page.locator('[data-testid="threshold-run"][data-position="4"]').waitFor();
+      for (let i = 4; i < THRESHOLD_TRIALS; i++) await thresholdTrial(page, i % 2 === 0);
+      const finished = page.locator('[data-testid="threshold-finished"] li');
+      expect(await finished.count()).toBe(1);
+      expect(await finished.textContent()).toMatch(
+        new RegExp(`95% interval [\\d.]+ to [\\d.]+, after ${THRESHOLD_TRIALS} trials`),
+      );
+      const stored = rows(study);
+      expect(stored.threshold_trials).toBe(THRESHOLD_TRIALS);
+      expect(stored.threshold_finished).toBe(1);
+      await screenshot(page, "study-threshold");
+    },
+    RESTART_TEST_TIMEOUT_MS,
+  );
 
   it("reviews unclear answers, then exports and analyses with plots and a report", async () => {
     await page.click('[data-testid="review-tab"]');

@@ -131,3 +131,59 @@ export const api = {
     call<{ review: number }>("POST", `/review/${trial}`, { shape }),
   analyse: () => call<AnalysisResult>("POST", "/analyse", {}),
 };
+
+export type Dimension = "length" | "duration";
+export type Direction = "up" | "down" | "left" | "right";
+
+export interface ThresholdEstimate {
+  threshold: number;
+  low: number;
+  high: number;
+}
+
+export interface ThresholdTrial {
+  position: number;
+  value: number;
+  direction: Direction;
+  response: Direction;
+  correct: boolean;
+}
+
+export interface ThresholdRun {
+  run: number;
+  trials: ThresholdTrial[];
+  estimate: ThresholdEstimate | null;
+  /** The direction stays hidden until the answer is recorded. */
+  next: { position: number; value: number; sent: boolean };
+  last_send: SendSummary | null;
+  simulated_answer?: Direction;
+}
+
+export interface FinishedThresholdRun extends ThresholdEstimate {
+  run: number;
+  stop_reason: string;
+  trials: number;
+}
+
+export interface ThresholdDimension {
+  unit: string;
+  range: [number, number];
+  fixed: number;
+  finished_runs: FinishedThresholdRun[];
+  run: ThresholdRun | null;
+}
+
+export interface ThresholdState {
+  participant: string;
+  simulated: boolean;
+  stopping_rule: string;
+  dimensions: Record<Dimension, ThresholdDimension>;
+}
+
+export const thresholdApi = {
+  state: (code: string) => call<ThresholdState>("GET", participant(code, "/threshold")),
+  send: (code: string, dimension: Dimension) =>
+    call<ThresholdState>("POST", participant(code, "/threshold-send"), { dimension }),
+  answer: (code: string, dimension: Dimension, position: number, response: Direction) =>
+    call<ThresholdState>("POST", participant(code, "/threshold-answer"), { dimension, position, response }),
+};

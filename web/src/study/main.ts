@@ -5,6 +5,7 @@ import { byId, h } from "./dom";
 import { ResultsView } from "./results-view";
 import { ReviewView } from "./review-view";
 import { SessionView } from "./session-view";
+import { ThresholdView } from "./threshold-view";
 
 let overview: Overview | null = null;
 const notice = byId<HTMLDivElement>("notice");
@@ -33,6 +34,7 @@ const review = new ReviewView(
   fail,
 );
 new ResultsView(byId("view-results"), fail);
+const threshold = new ThresholdView(byId("view-threshold"), () => session.code, fail);
 
 function renderParticipants(data: Overview): void {
   byId("study-name").textContent = data.name;
@@ -48,7 +50,11 @@ function renderParticipants(data: Overview): void {
           {
             type: "button",
             class: "participant",
-            onclick: () => void session.open(p.participant).catch(fail),
+            onclick: () =>
+              void session
+                .open(p.participant)
+                .then(() => (byId("view-threshold").hidden ? undefined : threshold.show()))
+                .catch(fail),
           },
           h("strong", {}, p.participant),
           ` ${p.simulated ? "simulated · " : ""}${p.paused ? "paused" : p.step} · ${p.answered}/${p.total}`,
@@ -84,6 +90,7 @@ function showView(name: string): void {
     byId(`view-${tab.dataset["view"]}`).hidden = !active;
   }
   if (name === "review") void review.show().catch(fail);
+  if (name === "threshold") void threshold.show().catch(fail);
 }
 
 byId("new-participant").addEventListener("click", () => void add(false));

@@ -16,6 +16,9 @@ JSON without the browser asking first, which this server never allows).
     POST /api/study/participants/CODE/pause           {"paused": bool}
     POST /api/study/participants/CODE/questionnaire   {"values": [int]}
     GET  /api/study/participants/CODE/simulated-answer
+    GET  /api/study/participants/CODE/threshold       SQ2.2: runs, estimate, next trial
+    POST /api/study/participants/CODE/threshold-send  {"dimension": "length" | "duration"}
+    POST /api/study/participants/CODE/threshold-answer {"dimension", "position", "response"}
     GET  /api/study/review                            answers waiting for a decision (blind)
     POST /api/study/review/TRIAL                      {"shape": name or null}
     POST /api/study/analyse                           export + analysis -> files, report
@@ -35,6 +38,7 @@ from typing import Any
 from feelmysign.errors import FeelMySignError, StudyError
 from feelmysign.study.analysis import analyse_study
 from feelmysign.study.runner import Session
+from feelmysign.study.threshold_desk import ThresholdDesk, dimension_of
 
 log = logging.getLogger(__name__)
 
@@ -65,6 +69,7 @@ class StudyApi:
         self._bootstrap = bootstrap
         self._latest: Path | None = None
         self._analysing = threading.Lock()
+        self.threshold = ThresholdDesk(session.store, session.player, session.layout)
 
     def handle(self, method: str, path: str, host: str, body: bytes, content_type: str) -> Response:
         """Answer one request; never raises."""
@@ -104,6 +109,8 @@ class StudyApi:
                 return _json(200, self.session.state(code))
             if action == "/simulated-answer":
                 return _json(200, self.session.simulated_answer(code))
+            if action == "/threshold":
+                return _json(200, self.threshold.state(code))
         if (match := _RESULT.match(path)) and self._latest is not None:
             file = self._latest / match.group(1)
             if file.is_file():
@@ -188,6 +195,12 @@ class StudyApi:
             s.pause(code, bool(data["paused"]))
         elif action == "questionnaire":
             s.questionnaire(code, [int(v) for v in data["values"]])
+        elif action == "threshold-send":
+            return _json(200, self.threshold.send(code, dimension_of(data.get("dimension"))))
+        elif action == "threshold-answer":
+            dimension = dimension_of(data.get("dimension"))
+            position, response = int(data["position"]), str(data.get("response", ""))
+            return _json(200, self.threshold.answer(code, dimension, position, response))
         else:
             return _json(404, {"error": f"no such participant action: {action}"})
         return _json(200, {"state": s.state(code)})

@@ -43,10 +43,12 @@ class Shape:
 
 @dataclass(frozen=True)
 class PracticeTrial:
-    """A trial before the measured ones, not analysed: a library shape at ``segments``."""
+    """A trial before the measured ones, not analysed: a library shape at ``segments``, or a
+    recorded drawing of the design at resolution ``level`` (``segments`` is then its count)."""
 
     shape: str
     segments: int
+    level: int | None = None
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,7 @@ from feelmysign.study.design import (
 )
 from feelmysign.study.problems import MISSING, Problems
 from feelmysign.study.stimulus import recorded_strokes, stimulus_layout
+from feelmysign.study.threshold import check_fits
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -84,7 +85,7 @@ def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path("
         or 1,
         resolutions=resolutions,
         shapes=shapes,
-        practice=_practice(problems, data.get("practice", []), stimulus, base_dir),
+        practice=_practice(problems, data.get("practice", []), shapes, resolutions),
         questionnaire=_questionnaire(problems, data.get("questionnaire", MISSING)),
         comfort=_comfort(problems, data.get("comfort", {})),
         stimulus=stimulus,
@@ -95,6 +96,10 @@ def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path("
     )
     if design.guess_rate >= design.criterion:
         problems.add("study.criterion", "must be above study.guess_rate")
+    try:
+        check_fits(stimulus_layout(stimulus, base_dir), design.threshold)
+    except FeelMySignError as error:
+        problems.add("threshold", str(error))
     problems.raise_if_any()
     return design
 
@@ -256,18 +261,42 @@ def _check_names_and_synonyms(problems: Problems, shapes: list[Shape]) -> None:
 
 
 def _practice(
-    problems: Problems, value: Any, stimulus: Stimulus, base_dir: Path
+    problems: Problems, value: Any, shapes: tuple[Shape, ...], resolutions: tuple[str, ...]
 ) -> tuple[PracticeTrial, ...]:
+    """Library shapes at ``segments``, or the design's recorded drawings at ``resolution``."""
+    recorded = {shape.name: shape for shape in shapes if shape.recording is not None}
     items = problems.array("practice", value, required=False) or []
     out = []
     for index, item in enumerate(items):
         key = f"practice[{index}]"
         table = problems.table(key, item, required=True)
-        problems.unknown(key, table, ("shape", "segments"))
-        name = problems.choice(f"{key}.shape", table.get("shape", MISSING), tuple(SHAPES), "")
+        problems.unknown(key, table, ("shape", "segments", "resolution"))
+        names = (*SHAPES, *recorded)
+        name = problems.choice(f"{key}.shape", table.get("shape", MISSING), names, "")
         if not name:
             if name == "":
-                problems.add(f"{key}.shape", f"missing; give one of {', '.join(SHAPES)}")
+                problems.add(f"{key}.shape", f"missing; give one of {', '.join(names)}")
+            continue
+        if name in recorded:
+            if "segments" in table:
+                problems.add(
+                    f"{key}.segments",
+                    f"{name!r} is a recorded drawing: give its resolution "
+                    f"({', '.join(resolutions)}) instead of segments",
+                )
+                continue
+            label = table.get("resolution", resolutions[-1] if resolutions else "")
+            if label not in resolutions:
+                problems.add(f"{key}.resolution", f"one of {', '.join(resolutions)}; got {label!r}")
+                continue
+            level = resolutions.index(label)
+            out.append(PracticeTrial(name, recorded[name].levels[level].strokes, level))
+            continue
+        if "resolution" in table:
+            problems.add(
+                f"{key}.resolution",
+                f"only for a recorded drawing of the design; {name!r} takes segments",
+            )
             continue
         spec = SHAPES[name]
         segments = table.get("segments", spec.default_segments)
@@ -314,7 +343,7 @@ def _threshold(problems: Problems, value: Any) -> Threshold:
     if max_trials is not None and max_trials < trials:
         problems.add("threshold.max_trials", f"must be at least threshold.trials ({trials})")
     length = _dimension(
-        problems, "threshold.length", table.get("length", {}), (0.1, 3.0, 25), "duration_ms", 500.0
+        problems, "threshold.length", table.get("length", {}), (0.1, 2.0, 25), "duration_ms", 500.0
     )
     duration = _dimension(
         problems, "threshold.duration", table.get("duration", {}), (20.0, 1500.0, 25), "length", 2.0

@@ -28,7 +28,7 @@ class PlannedTrial:
     block: str  # "practice" or "main"
     repetition: int  # 0 for practice; 1..R for main
     shape: str
-    level: int | None  # index into the shape's levels; None for practice
+    level: int | None  # index into the shape's levels; None for a library practice shape
     segments: int  # strokes the trial sends (a recording's: what its simplifier gives)
 
 
@@ -58,7 +58,7 @@ def participant_order(design: Design, number: int) -> list[PlannedTrial]:
         for shape in design.shapes
         for level in range(len(design.resolutions))
     ]
-    trials = [PlannedTrial("practice", 0, p.shape, None, p.segments) for p in design.practice]
+    trials = [PlannedTrial("practice", 0, p.shape, p.level, p.segments) for p in design.practice]
     rng = random.Random(f"{design.seed}:{number}")
     rows = williams_rows(len(conditions))
     for repetition in range(1, design.repetitions + 1):

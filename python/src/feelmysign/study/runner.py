@@ -67,6 +67,11 @@ class Session:
         self._templates = templates(store.design, self.layout, store.base_dir)
         self._simulation_seed = simulation_seed
 
+    @property
+    def player(self) -> Play | None:
+        """What plays strokes on the sleeve (None: no sleeve connected)."""
+        return self._play
+
     # ---- what the page shows -----------------------------------------------------------
 
     def step(self, code: str) -> str:

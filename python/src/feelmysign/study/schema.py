@@ -33,7 +33,7 @@ CREATE TABLE IF NOT EXISTS trials (
     block TEXT NOT NULL,                  -- practice | main
     repetition INTEGER NOT NULL,
     shape TEXT NOT NULL,
-    level INTEGER,                        -- index of the resolution; NULL for practice
+    level INTEGER,                        -- index of the resolution; NULL: library practice
     segments INTEGER NOT NULL,
     answer TEXT,
     felt_nothing INTEGER,

@@ -415,11 +415,19 @@ class StudyStore:
         direction: str,
         response: str,
         events: list[dict[str, Any]],
+        position: int | None = None,
     ) -> int:
+        """Store the run's next trial; ``position``, when given, must be that next one."""
         with self._transaction() as db:
-            position = db.execute(
+            stored = db.execute(
                 "SELECT COUNT(*) FROM threshold_trials WHERE run = ?", (run_id,)
             ).fetchone()[0]
+            if position is not None and position != stored:
+                raise StudyError(
+                    f"trial {position + 1} of threshold run {run_id} is not the next one "
+                    f"(that is trial {stored + 1}): the page is out of date; reload it"
+                )
+            position = stored
             db.execute(
                 "INSERT INTO threshold_trials (run, position, value, direction, response, correct, "
                 "events_json, answered_at_ms) VALUES (?,?,?,?,?,?,?,?)",

@@ -1,0 +1,246 @@
+/**
+ * SQ2.2 on the researcher's page: the QUEST+ direction-threshold procedure for the chosen
+ * participant. Send the stroke QUEST+ chose, ask "Which way did it move?", click (or press
+ * the arrow key of) the direction the wearer named. The running estimate, its 95% interval
+ * and the stopping rule are shown after every answer; every trial is in the study file.
+ * The direction sent is hidden until the answer is in, so the researcher records blind.
+ */
+import { sentText } from "./session-view";
+import {
+  thresholdApi,
+  type Dimension,
+  type Direction,
+  type ThresholdDimension,
+  type ThresholdRun,
+  type ThresholdState,
+} from "./api";
+import { h } from "./dom";
+
+const DIRECTIONS: Direction[] = ["up", "down", "left", "right"];
+const ARROWS: Record<string, Direction> = {
+  ArrowUp: "up",
+  ArrowDown: "down",
+  ArrowLeft: "left",
+  ArrowRight: "right",
+};
+const SYMBOL: Record<Direction, string> = { up: "↑", down: "↓", left: "←", right: "→" };
+
+const number = (value: number) => String(Number(value.toPrecision(3)));
+
+export class ThresholdView {
+  readonly #root: HTMLElement;
+  readonly #code: () => string | null;
+  readonly #fail: (error: unknown) => void;
+  #dimension: Dimension = "length";
+  #busy = false;
+  #answerKey: ((event: KeyboardEvent) => void) | null = null;
+
+  constructor(root: HTMLElement, code: () => string | null, fail: (error: unknown) => void) {
+    this.#root = root;
+    this.#code = code;
+    this.#fail = fail;
+    document.addEventListener("keydown", (event) => this.#answerKey?.(event));
+  }
+
+  async show(): Promise<void> {
+    const code = this.#code();
+    if (code === null) {
+      this.#answerKey = null;
+      this.#root.replaceChildren(
+        h("h2", {}, "Threshold (SQ2.2)"),
+        h("p", { class: "hint" }, "Choose or add a participant (with consent) first."),
+      );
+      return;
+    }
+    this.render(await thresholdApi.state(code));
+  }
+
+  #act(action: () => Promise<ThresholdState>): void {
+    if (this.#busy) return;
+    this.#busy = true;
+    this.#root.dataset["busy"] = "true";
+    action()
+      .then((state) => this.render(state))
+      .catch(this.#fail)
+      .finally(() => {
+        this.#busy = false;
+        delete this.#root.dataset["busy"];
+      });
+  }
+
+  render(state: ThresholdState): void {
+    const dimension = state.dimensions[this.#dimension];
+    const choose = h(
+      "div",
+      { class: "row", role: "group", "aria-label": "What varies" },
+      ...(["length", "duration"] as Dimension[]).map((d) =>
+        h(
+          "button",
+          {
+            type: "button",
+            class: "button",
+            "aria-pressed": String(d === this.#dimension),
+            "data-testid": `threshold-${d}`,
+            onclick: () => {
+              this.#dimension = d;
+              this.render(state);
+            },
+          },
+          d === "length" ? "Shortest stroke (length)" : "Briefest stroke (duration)",
+        ),
+      ),
+    );
+    const fixed =
+      this.#dimension === "length"
+        ? `Each stroke lasts ${dimension.fixed} ms; its length varies from ${dimension.range[0]} to ${dimension.range[1]} grid units.`
+        : `Each stroke is ${dimension.fixed} grid units long; its duration varies from ${dimension.range[0]} to ${dimension.range[1]} ms.`;
+    this.#root.replaceChildren(
+      h("h2", {}, `Threshold (SQ2.2) · ${state.participant}`),
+      h(
+        "p",
+        { class: "hint" },
+        "A straight stroke through the middle of the sleeve, up, down, left or right; the wearer says which way it moved (four alternatives). QUEST+ chooses each stroke.",
+      ),
+      choose,
+      h("p", { class: "hint" }, `${fixed} The run ${state.stopping_rule}.`),
+      dimension.run ? this.#run(state, dimension, dimension.run) : this.#start(state, dimension),
+      ...(dimension.finished_runs.length > 0 ? [this.#finished(dimension)] : []),
+    );
+    this.#root.dataset["dimension"] = this.#dimension;
+  }
+
+  #start(state: ThresholdState, dimension: ThresholdDimension): HTMLElement {
+    this.#answerKey = null;
+    const started = dimension.finished_runs.length > 0;
+    return h(
+      "div",
+      { class: "card", "data-testid": "threshold-start" },
+      h(
+        "button",
+        {
+          type: "button",
+          class: "button button-primary",
+          "data-testid": "threshold-send",
+          onclick: () => this.#act(() => thresholdApi.send(state.participant, this.#dimension)),
+        },
+        started ? "Start another run: send the first stroke" : "Start: send the first stroke",
+      ),
+    );
+  }
+
+  #run(state: ThresholdState, dimension: ThresholdDimension, run: ThresholdRun): HTMLElement {
+    const { next } = run;
+    const answer = (response: Direction) =>
+      this.#act(() => thresholdApi.answer(state.participant, this.#dimension, next.position, response));
+    this.#answerKey = next.sent
+      ? (event) => {
+          const direction = ARROWS[event.key];
+          if (direction && !(event.target instanceof HTMLInputElement)) {
+            event.preventDefault();
+            answer(direction);
+          }
+        }
+      : null;
+    const estimate = run.estimate
+      ? `${number(run.estimate.threshold)} ${dimension.unit} (95% interval ${number(run.estimate.low)} to ${number(run.estimate.high)})`
+      : "none yet";
+    const card = h(
+      "div",
+      { class: "card trial", "data-testid": "threshold-run", "data-position": next.position },
+      h(
+        "p",
+        { class: "trial-number" },
+        `Trial ${next.position + 1} · ${next.sent ? "sent: ask “Which way did it move?”" : "not sent yet"}`,
+      ),
+      h("p", { class: "trial-shape" }, `${number(next.value)} ${dimension.unit}`),
+      h(
+        "div",
+        { class: "row" },
+        h(
+          "button",
+          {
+            type: "button",
+            class: next.sent ? "button" : "button button-primary",
+            "data-testid": "threshold-send",
+            onclick: () => this.#act(() => thresholdApi.send(state.participant, this.#dimension)),
+          },
+          next.sent ? "Send again" : "Send to the sleeve",
+        ),
+      ),
+      h(
+        "p",
+        { class: "send-status", "data-testid": "threshold-send-status" },
+        run.last_send ? sentText(run.last_send) : "Not sent yet.",
+      ),
+      h(
+        "div",
+        { class: "row directions", role: "group", "aria-label": "The direction the wearer named" },
+        ...DIRECTIONS.map((direction) =>
+          h(
+            "button",
+            {
+              type: "button",
+              class: "button",
+              disabled: !next.sent,
+              "data-testid": `threshold-answer-${direction}`,
+              onclick: () => answer(direction),
+            },
+            `${SYMBOL[direction]} ${direction}`,
+          ),
+        ),
+      ),
+      h(
+        "p",
+        { "data-testid": "threshold-estimate" },
+        `Estimate after ${run.trials.length} trial${run.trials.length === 1 ? "" : "s"}: ${estimate}`,
+      ),
+    );
+    if (run.simulated_answer) {
+      card.append(
+        h(
+          "p",
+          { class: "simulated", "data-testid": "threshold-simulated", "data-answer": run.simulated_answer },
+          `Simulated participant: “${run.simulated_answer}”`,
+        ),
+      );
+    }
+    if (run.trials.length > 0) {
+      card.append(
+        h(
+          "ol",
+          { class: "threshold-trials", reversed: true, "data-testid": "threshold-trials" },
+          ...run.trials
+            .slice()
+            .reverse()
+            .map((t) =>
+              h(
+                "li",
+                { class: t.correct ? "right" : "wrong" },
+                `${number(t.value)} ${dimension.unit}: sent ${SYMBOL[t.direction]}, answered ${SYMBOL[t.response]} (${t.correct ? "right" : "wrong"})`,
+              ),
+            ),
+        ),
+      );
+    }
+    return card;
+  }
+
+  #finished(dimension: ThresholdDimension): HTMLElement {
+    return h(
+      "div",
+      { class: "card" },
+      h("h3", {}, "Finished runs"),
+      h(
+        "ul",
+        { "data-testid": "threshold-finished" },
+        ...dimension.finished_runs.map((r) =>
+          h(
+            "li",
+            { "data-run": r.run },
+            `${number(r.threshold)} ${dimension.unit}, 95% interval ${number(r.low)} to ${number(r.high)}, after ${r.trials} trials (${r.stop_reason})`,
+          ),
+        ),
+      ),
+    );
+  }
+}
