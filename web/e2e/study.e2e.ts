@@ -250,6 +250,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       expect(await page.locator('[data-testid="threshold-estimate"]').textContent()).toMatch(
         /Estimate after 4 trials: [\d.]+ grid units \(95% interval [\d.]+ to [\d.]+\)/,
       );
+      await screenshot(page, "study-threshold");
       await killGroup(up, "SIGKILL");
       expect(rows(study).threshold_trials).toBe(4);
       up = await startUp(stateDir, study);
@@ -266,7 +267,6 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       const stored = rows(study);
       expect(stored.threshold_trials).toBe(THRESHOLD_TRIALS);
       expect(stored.threshold_finished).toBe(1);
-      await screenshot(page, "study-threshold");
     },
     RESTART_TEST_TIMEOUT_MS,
   );

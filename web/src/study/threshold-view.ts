@@ -237,7 +237,7 @@ export class ThresholdView {
           h(
             "li",
             { "data-run": r.run },
-            `${number(r.threshold)} ${dimension.unit}, 95% interval ${number(r.low)} to ${number(r.high)}, after ${r.trials} trials (${r.stop_reason})`,
+            `${number(r.threshold)} ${dimension.unit}, 95% interval ${number(r.low)} to ${number(r.high)}, after ${r.trials} trials${r.stop_reason === `${r.trials} trials` ? "" : ` (stopped: ${r.stop_reason})`}`,
           ),
         ),
       ),
