@@ -39,7 +39,10 @@ export class ThresholdView {
     this.#root = root;
     this.#code = code;
     this.#fail = fail;
-    document.addEventListener("keydown", (event) => this.#answerKey?.(event));
+    // Arrow keys answer only while this view is shown.
+    document.addEventListener("keydown", (event) => {
+      if (!this.#root.hidden) this.#answerKey?.(event);
+    });
   }
 
   async show(): Promise<void> {

@@ -6,11 +6,12 @@ from __future__ import annotations
 import random
 from collections.abc import Iterator
 
-from feelmysign.study.analysis.recovery import coverage, paper_truths
+from feelmysign.study.analysis.recovery import coverage, describe, paper_truths
+from feelmysign.study.analysis.wilson import wilson_interval
 from feelmysign.study.design_file import parse_design
 from feelmysign.study.threshold import DIRECTIONS, Dimension, Procedure, SimulatedObserver
 
-RUNS = 200
+RUNS = 400
 _DESIGN = """
 [study]
 name = "recovery"
@@ -25,7 +26,7 @@ items = ["x"]
 """
 
 
-def _threshold_coverage(dimension: Dimension, truth: float, runs: int) -> float:
+def _threshold_coverage(dimension: Dimension, truth: float, runs: int) -> int:
     settings = parse_design(_DESIGN).threshold
     covered = 0
     for run in range(runs):
@@ -39,17 +40,25 @@ def _threshold_coverage(dimension: Dimension, truth: float, runs: int) -> float:
             procedure.update(value, observer.respond(direction, value, rng) == direction)
         estimate = procedure.estimate()
         covered += estimate.low <= truth <= estimate.high
-    return covered / runs
+    return covered
 
 
 def report(runs: int = RUNS) -> Iterator[str]:
-    yield f"Study analysis: 95% interval coverage over {runs} seeded simulated studies"
+    yield (
+        f"Study analysis: 95% interval coverage over {runs} seeded simulated studies "
+        "(each share with its own 95% Wilson interval)"
+    )
     for name, truth in paper_truths().items():
-        profile, boot = coverage(runs, truth=truth, samples=300)
+        result = coverage(runs, truth=truth)
         yield (
-            f"  needed resolution, {name} (true {truth.strokes:.2f}): profile likelihood "
-            f"{profile:.1%}, cluster bootstrap {boot:.1%}"
+            f"  needed resolution, {name}: parametric bootstrap (reported) "
+            f"{describe(result, 'bootstrap')}, profile likelihood {describe(result, 'profile')}, "
+            f"cluster bootstrap {describe(result, 'cluster')}"
         )
     for dimension, known, unit in (("length", 0.6, "grid units"), ("duration", 150.0, "ms")):
-        share = _threshold_coverage(dimension, known, runs)  # type: ignore[arg-type]
-        yield f"  QUEST+ {dimension} threshold (true {known:g} {unit}): {share:.1%}"
+        covered = _threshold_coverage(dimension, known, runs)  # type: ignore[arg-type]
+        low, high = wilson_interval(covered, runs)
+        yield (
+            f"  QUEST+ {dimension} threshold (true {known:g} {unit}): {covered / runs:.1%} "
+            f"({low:.1%} to {high:.1%})"
+        )

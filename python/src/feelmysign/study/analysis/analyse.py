@@ -150,10 +150,15 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
         "needed_strokes": {
             shape: {
                 "strokes": _finite(t.strokes),
-                "low": _finite(t.low),
-                "high": _finite(t.high),
-                "bootstrap_low": _finite(t.boot_low),
-                "bootstrap_high": _finite(t.boot_high),
+                "interval": "parametric bootstrap, bias-corrected percentiles",
+                "low": _finite(t.boot_low),
+                "high": _finite(t.boot_high),
+                "profile_low": _finite(t.low),
+                "profile_high": _finite(t.high),
+                "cluster_bootstrap_low": _finite(t.cluster_low),
+                "cluster_bootstrap_high": _finite(t.cluster_high),
+                "dispersion": _finite(t.dispersion),
+                "bootstrap_samples": t.samples,
                 "midpoint_log2": t.fit.midpoint,
                 "slope_per_doubling": t.fit.slope,
             }

@@ -71,21 +71,23 @@ def threshold_plot(
     axes.axvspan(tested[0], tested[1], color="#eeeeee", zorder=0)
     for row, name in enumerate(names):
         result = thresholds[name]
-        low = min(max(result.low, low_edge), high_edge)
-        high = (
-            min(max(result.high, low_edge), high_edge) if math.isfinite(result.high) else high_edge
-        )
+        # The reported interval: the parametric bootstrap.
+        first, last = result.boot_low, result.boot_high
+        low = min(max(first, low_edge), high_edge)
+        high = min(max(last, low_edge), high_edge) if math.isfinite(last) else high_edge
         axes.plot([low, high], [row, row], color="black", linewidth=1.5)
-        if result.high > high_edge or not math.isfinite(result.high):
+        if last > high_edge or not math.isfinite(last):
             axes.plot(high_edge, row, ">", color="black")
-        if result.low < low_edge:
+        if first < low_edge:
             axes.plot(low_edge, row, "<", color="black")
         if math.isfinite(result.strokes) and low_edge <= result.strokes <= high_edge:
             axes.plot(result.strokes, row, "o", color="black")
     axes.set_xlim(low_edge * 0.9, high_edge * 1.1)
     axes.set_yticks(range(len(names)), names)
     axes.set_xscale("log", base=2)
-    axes.set_xlabel(f"strokes needed for {criterion:.0%} correct (95% interval; grey: tested)")
+    axes.set_xlabel(
+        f"strokes needed for {criterion:.0%} correct (95% bootstrap interval; grey: tested)"
+    )
     axes.invert_yaxis()
     figure.tight_layout()
     figure.savefig(path)

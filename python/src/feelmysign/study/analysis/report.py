@@ -66,18 +66,26 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "",
         "Per shape, a logistic psychometric function of log2(strokes) (guess rate "
         f"{design.guess_rate:g}, lapse rate fixed at 2%) fitted by maximum likelihood. "
-        "Interval: profile likelihood, 95%; beside it the cluster bootstrap over participants "
-        "(bias-corrected percentiles).",
+        "Interval: parametric bootstrap, 95% (new studies of the same design drawn from the "
+        "fitted curve and refitted; bias-corrected percentiles). Beside it the profile-"
+        "likelihood interval, and the cluster bootstrap over participants, which also carries "
+        "differences between participants but is too narrow with few of them. Dispersion: "
+        "Pearson chi-square per degree of freedom of each participant's number of correct "
+        "answers against the fitted curve; well above 1, participants differ more than chance "
+        "allows and every interval here is too narrow.",
         "",
-        "| shape | strokes needed | 95% interval | bootstrap 95% | slope per doubling |",
-        "|---|---|---|---|---|",
+        "| shape | strokes needed | 95% interval | profile likelihood | cluster bootstrap "
+        "| slope per doubling | dispersion |",
+        "|---|---|---|---|---|---|---|",
     ]
     for shape, t in analysis.thresholds.items():
         rows = analysis.accuracy[shape]
         tested = (float(rows[0][0]), float(rows[-1][0]))
         lines.append(
-            f"| {shape} | {_strokes(t.strokes, tested)} | {_interval(t.low, t.high, tested)} | "
-            f"{_interval(t.boot_low, t.boot_high, tested)} | {t.fit.slope:.2f} |"
+            f"| {shape} | {_strokes(t.strokes, tested)} | "
+            f"{_interval(t.boot_low, t.boot_high, tested)} | {_interval(t.low, t.high, tested)} | "
+            f"{_interval(t.cluster_low, t.cluster_high, tested)} | {t.fit.slope:.2f} | "
+            f"{t.dispersion:.2f} |"
         )
     lines += [
         "",
