@@ -269,8 +269,13 @@ def test_strokes_sent_while_the_broker_restarts_are_played(
             _settings(c, "sender"), client_id="restart-sender", persistent_session=True
         )
         sender.reconnect_delay_set(1, 2)
+        # Connected (CONNACK in) before the broker stops: else a late CONNACK could mark it
+        # connected after the stop, and the publishes below would go to a closed socket.
+        sender_connected = threading.Event()
+        sender.on_connect = lambda *_: sender_connected.set()
         sender.connect(c.mqtt_host, c.mqtt_port)
         sender.loop_start()
+        assert sender_connected.wait(30), "the sender did not connect"
         broker.stop()
         for _ in range(1000):  # paho notices the closed socket on its own thread
             if not sender.is_connected():

@@ -75,6 +75,9 @@ export function brushAt(stroke: FeltStroke, t_ms: number): Point {
   ];
 }
 
+/** A share of the energy this small or smaller drives no actuator (so a point on one is that one alone). */
+export const NEGLIGIBLE_WEIGHT = 1e-9;
+
 /**
  * The actuators that render a point at `intensity`: the (up to) four around it,
  * each with energy in proportion to its closeness along each axis (bilinear), so
@@ -89,7 +92,7 @@ export function funnel(point: Point, intensity: number, grid: Grid): Drive[] {
   const fy = y - r0;
   const drives: Drive[] = [];
   const add = (row: number, column: number, weight: number) => {
-    if (weight > 1e-9 && row < grid.rows && column < grid.columns) {
+    if (weight > NEGLIGIBLE_WEIGHT && row < grid.rows && column < grid.columns) {
       drives.push({ row, column, intensity: intensity * Math.sqrt(weight) });
     }
   };

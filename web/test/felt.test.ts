@@ -1,7 +1,15 @@
 /** The felt view: strokes placed by the sleeve's playback rule, the brush funneled on the grid. */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
-import { brushAt, funnel, placeStrokes, playingAt, totalMs, type FeltStroke } from "../src/felt";
+import {
+  brushAt,
+  funnel,
+  NEGLIGIBLE_WEIGHT,
+  placeStrokes,
+  playingAt,
+  totalMs,
+  type FeltStroke,
+} from "../src/felt";
 
 const GRID = { rows: 3, columns: 4 };
 
@@ -47,7 +55,10 @@ describe("the brush", () => {
         (x, y, intensity) => {
           const drives = funnel([x, y], intensity, GRID);
           const energy = drives.reduce((sum, d) => sum + d.intensity ** 2, 0);
-          expect(energy).toBeCloseTo(intensity ** 2, 9);
+          // Relative: up to three shares of NEGLIGIBLE_WEIGHT each are left out, and the
+          // rounding of the products is relative to the intensity squared too.
+          const tolerance = intensity ** 2 * (3 * NEGLIGIBLE_WEIGHT + 1e-12);
+          expect(Math.abs(energy - intensity ** 2)).toBeLessThanOrEqual(tolerance);
           for (const d of drives) {
             expect(Math.abs(d.column - x)).toBeLessThanOrEqual(1);
             expect(Math.abs(d.row - y)).toBeLessThanOrEqual(1);
