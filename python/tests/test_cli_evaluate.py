@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -163,3 +164,107 @@ def test_speeds_need_lasa(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     with pytest.raises(SystemExit):
         main(["evaluate", *recordings(tmp_path), "--speeds"])
     assert "--speeds re-times the LASA drawings" in capsys.readouterr().err
+
+
+def gesture_log(
+    path: Path, name: str, speed: str, points: list[tuple[float, float, float]]
+) -> None:
+    """A $1 gesture log (Wobbrock, Wilson & Li's XML), as s01/fast/arrow01.xml holds one."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    body = "".join(f'<Point X="{x:.0f}" Y="{y:.0f}" T="{t:.0f}" />' for x, y, t in points)
+    path.write_text(
+        f'<?xml version="1.0" encoding="utf-8" standalone="yes"?>\n<Gesture Name="{name}" '
+        f'Subject="1" Speed="{speed}" Number="1" NumPts="{len(points)}">{body}</Gesture>\n'
+    )
+
+
+def gesture_folder(root: Path) -> Path:
+    """Two people's circles and carets (a V turned up), fast and slow, with epoch times."""
+    start = 1_156_372_112_609.0
+    for person in (1, 2):
+        for speed, step_ms in (("fast", 8.0), ("slow", 24.0)):
+            wobble = 3.0 * person
+            circle = [
+                (
+                    100 + (60 + wobble) * math.cos(2 * math.pi * k / 40),
+                    100 + 60 * math.sin(2 * math.pi * k / 40),
+                    start + step_ms * k,
+                )
+                for k in range(41)
+            ]
+            caret = [
+                (40 + 3.0 * k, 200 - (4.0 + 0.1 * person) * min(k, 40 - k), start + step_ms * k)
+                for k in range(41)
+            ]
+            folder = root / f"s0{person}" / speed
+            gesture_log(folder / "circle01.xml", "circle01", speed, circle)
+            gesture_log(folder / "caret01.xml", "caret01", speed, caret)
+    return root
+
+
+def test_a_folder_of_gesture_logs_is_recognised_per_speed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    root = gesture_folder(tmp_path / "gestures")
+    out = tmp_path / "out"
+    document = evaluate_json(
+        capsys, str(root), "--defaults", "--algorithm", "window", "--out", str(out)
+    )
+    assert document["recordings"] == 8
+    summary = {s["set"]: s for s in document["summary"]}
+    assert set(summary) == {"fast", "slow"}
+    for entry in summary.values():
+        assert entry["recordings"] == 4
+        # Each drawing is named among the other three of its speed: the other person's.
+        assert entry["recognised_drawn_pct"] == 100.0
+        assert entry["recognised_sent_pct"] == 100.0
+        assert entry["skin_ratio_mean"] > 0
+    with (out / "results.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert {r["group"] for r in rows} == {"circle", "caret"}
+    # Times from the first point: a fast gesture lasts 40 x 8 ms.
+    fast = [r for r in rows if r["set"] == "fast"]
+    assert {float(r["drawing_ms"]) for r in fast} == {320.0}
+
+
+def test_a_gesture_alone_in_its_set_is_not_recognised(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    document = evaluate_json(
+        capsys,
+        *recordings(tmp_path),
+        "--defaults",
+        "--algorithm",
+        "window",
+        "--out",
+        str(tmp_path / "o"),
+    )
+    assert document["summary"][0]["recognised_sent_pct"] is None
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "<Gesture Name='x'><Point X='1' Y='2'/><Point X='2' Y='2' T='5'/></Gesture>",
+            "numeric X, Y and T",
+        ),
+        ("<Gesture Name='x'><Point X='1' Y='2' T='0'/></Gesture>", "at least 2 points"),
+        ("<Gestures/>", "expected a $1 gesture log"),
+        ("<Gesture", "not valid XML"),
+    ],
+)
+def test_a_bad_gesture_log_says_what_is_wrong(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, message: str
+) -> None:
+    bad = tmp_path / "bad01.xml"
+    bad.write_text(text)
+    assert main(["evaluate", str(bad), "--defaults", "--out", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("Error:") and message in err and "Traceback" not in err
+
+
+def test_an_empty_folder_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "empty").mkdir()
+    assert main(["evaluate", str(tmp_path / "empty"), "--out", str(tmp_path / "o")]) == 1
+    assert "no recordings (*.json) or $1 gesture logs (*.xml)" in capsys.readouterr().err

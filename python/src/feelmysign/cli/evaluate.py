@@ -5,9 +5,10 @@
     feelmysign evaluate a.json b.json --sweep max_angle_deg=10:40:5
     feelmysign evaluate --lasa --limit 14 --sweep max_error=0.05:0.5:0.05 --out /tmp/e
     feelmysign evaluate --lasa --speeds --defaults           # the figures behind the defaults
+    feelmysign evaluate research/gestures --defaults         # recorded gestures at three speeds
 
-Every recording (RECORDING files, or the LASA handwriting data set with
---lasa) is run through every chosen algorithm at every point of its parameter
+Every recording (RECORDING files, folders of them, or the LASA handwriting data
+set with --lasa) is run through every chosen algorithm at every point of its parameter
 grid: the product of the --sweep values of its own parameters (NAME=FROM:TO:STEP,
 TO included; NAME=VALUE fixes one), its defaults otherwise. Without --sweep:
 angle max_angle_deg=10:40:10 x check_frames=5:15:5, window max_error=0.05:0.3:0.05.
@@ -21,9 +22,15 @@ polyline, strokes sent and dropped, the emission lag of each stroke, and the
 strokes offline Douglas-Peucker needs at the same error; in time, with every
 stroke planned as the sleeve plans it and played back to back as the sleeve
 plays them: time on the skin / drawing time, release to felt end, pen to skin;
-and, on LASA, whether the $1 recogniser (LASA demonstrations as templates, the
-drawing's own left out) names the shape from the drawing and from the strokes
-sent (see docs/research.md).
+and whether the $1 recogniser names the shape from the drawing and from the
+strokes sent: on LASA against its demonstrations, on recordings against the
+other drawings of their set (the drawing's own left out; see docs/research.md).
+
+A folder is searched for recordings (*.json) and $1 gesture logs (*.xml, as
+s01/fast/arrow01.xml: <Gesture Name= Speed=><Point X= Y= T=/>...). A drawing's
+gesture is its Name (else its file name) without trailing digits; its set is
+its Speed (else the folder it lies in, else "files"); each set is summarised
+apart.
 
 Written to --out (default: evaluations/<date>-<time>/ under the current folder):
 results.csv (one row per recording x algorithm x parameter set), frontier.csv
@@ -72,7 +79,10 @@ def register(subparsers: Any) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "recordings", nargs="*", metavar="RECORDING", help="recording JSON files (or --lasa)"
+        "recordings",
+        nargs="*",
+        metavar="RECORDING",
+        help="recording JSON files, $1 gesture logs (.xml), or folders of them (or --lasa)",
     )
     parser.add_argument(
         "--lasa",
@@ -215,17 +225,19 @@ def _check_params(algorithm: Algorithm, overrides: dict[str, Any]) -> None:
 
 
 def _sources(args: argparse.Namespace) -> tuple[list[Source], Recogniser | None]:
-    """The recordings, and for LASA the $1 recogniser with its demonstrations as templates."""
+    """The recordings and the $1 recogniser: for files and folders, each set's drawings are the
+    templates of its own (``research.gestures``); for LASA, its demonstrations."""
     import numpy as np
 
     from feelmysign.research.dollar import Templates
-    from feelmysign.research.evaluate import Recogniser, Source
+    from feelmysign.research.evaluate import Recogniser, Source, file_sources
+    from feelmysign.research.gestures import load_all
     from feelmysign.research.lasa import load_lasa
     from feelmysign.research.speeds import SPEEDS_MS, retimed
 
     if not args.lasa:
-        sources = [Source(path, Path(path).stem, load(path)) for path in args.recordings]
-        return (sources[: args.limit] if args.limit is not None else sources), None
+        gestures = load_all(args.recordings, load)
+        return file_sources(gestures[: args.limit] if args.limit is not None else gestures)
     demos = load_lasa()
     templates = Templates.of([(d.shape, np.asarray(_xy(d.recording))) for d in demos])
     chosen = list(enumerate(demos))[: args.limit]

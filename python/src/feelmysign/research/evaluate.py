@@ -50,8 +50,9 @@ DP_TIE_MARGIN = 1e-9
 class Source:
     """A recording to evaluate, its name, its group (a LASA shape) and its set.
 
-    ``template`` is the recording's own index among the recogniser's templates
-    (left out when it is recognised), or None when it has no shape to recognise.
+    ``template`` is the recording's own index among the recogniser's templates of
+    its ``pool`` (left out when it is recognised), or None when it has no shape to
+    recognise.
     """
 
     name: str
@@ -59,6 +60,7 @@ class Source:
     recording: Recording
     set: str = "files"
     template: int | None = None
+    pool: str = ""
 
 
 @dataclass(frozen=True)
@@ -170,10 +172,14 @@ def sent_polyline(segments: Sequence[Segment]) -> metrics.Points:
 
 
 class Recogniser:
-    """The $1 recogniser with the LASA drawings as templates, one left out per candidate."""
+    """The $1 recogniser with drawings as templates, one left out per candidate.
 
-    def __init__(self, templates: dollar.Templates) -> None:
-        self._templates = templates
+    ``templates`` may be one pool (every source's ``pool`` is ``""``: LASA) or
+    one per pool (the recordings of each set, recognised among themselves).
+    """
+
+    def __init__(self, templates: dollar.Templates | dict[str, dollar.Templates]) -> None:
+        self._pools = templates if isinstance(templates, dict) else {"": templates}
         self._drawn: dict[str, bool] = {}
 
     def names(self, source: Source, candidate: metrics.Points) -> bool | None:
@@ -182,13 +188,39 @@ class Recogniser:
             return None
         if len(candidate) < 2 or not np.any(candidate != candidate[0]):
             return False
-        name, _ = dollar.recognise(candidate, self._templates.without(source.template))
+        templates = self._pools[source.pool].without(source.template)
+        name, _ = dollar.recognise(candidate, templates)
         return name == source.group
 
     def drawn(self, source: Source, points: metrics.Points) -> bool | None:
         if source.name not in self._drawn:
             self._drawn[source.name] = bool(self.names(source, points))
         return self._drawn[source.name] if source.template is not None else None
+
+
+def file_sources(gestures: Sequence[Any]) -> tuple[list[Source], Recogniser]:
+    """Recorded drawings as sources, each recognised among the others of its set.
+
+    ``gestures`` are ``research.gestures.Gesture``s. A drawing is recognised
+    (``template`` set) when its set holds another drawing of the same gesture;
+    its templates are the other drawings of its set whose gesture is drawn at
+    least twice there (its own left out).
+    """
+    counts: dict[tuple[str, str], int] = {}
+    for g in gestures:
+        counts[(g.set, g.gesture)] = counts.get((g.set, g.gesture), 0) + 1
+    pools: dict[str, list[tuple[str, metrics.Points]]] = {}
+    sources = []
+    for g in gestures:
+        index = None
+        if counts[(g.set, g.gesture)] >= 2:
+            pool = pools.setdefault(g.set, [])
+            index = len(pool)
+            points = [(s.x, s.y) for path in g.recording.paths for s in path]
+            pool.append((g.gesture, metrics.as_points(points)))
+        sources.append(Source(g.name, g.gesture, g.recording, g.set, index, g.set))
+    templates = {name: dollar.Templates.of(named) for name, named in pools.items()}
+    return sources, Recogniser(templates)
 
 
 def evaluate_one(source: Source, run: Run, recogniser: Recogniser | None = None) -> Row:

@@ -111,13 +111,29 @@ def recording_from_demo(
 ) -> Recording:
     """A one-path recording of a demonstration: ``positions`` (2, n) y up, ``times_s`` (n,)."""
     xs, ys = np.asarray(positions[0], float), np.asarray(positions[1], float)
+    times_ms = np.asarray(times_s, float) * 1000.0
+    return recording_in_box(xs, -ys, times_ms, px_per_unit=PX_PER_UNIT)  # y up in the data
+
+
+def recording_in_box(
+    xs: np.ndarray[Any, Any],
+    ys: np.ndarray[Any, Any],
+    times_ms: np.ndarray[Any, Any],
+    *,
+    px_per_unit: float,
+) -> Recording:
+    """A one-path recording of a drawing (``ys`` down), on its bounding box plus a margin.
+
+    The canvas is the bounding box plus ``MARGIN_FRACTION`` of its larger side on
+    every side, ``px_per_unit`` pixels a unit; pressure ``PRESSURE``.
+    """
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     low_x, high_x, low_y, high_y = xs.min(), xs.max(), ys.min(), ys.max()
     margin = MARGIN_FRACTION * max(high_x - low_x, high_y - low_y)
-    width_px = (high_x - low_x + 2 * margin) * PX_PER_UNIT
-    height_px = (high_y - low_y + 2 * margin) * PX_PER_UNIT
-    canvas_x = (xs - low_x + margin) * PX_PER_UNIT
-    canvas_y = (high_y + margin - ys) * PX_PER_UNIT  # y up in the data, down on a canvas
-    times_ms = np.asarray(times_s, float) * 1000.0
+    width_px = (high_x - low_x + 2 * margin) * px_per_unit
+    height_px = (high_y - low_y + 2 * margin) * px_per_unit
+    canvas_x = (xs - low_x + margin) * px_per_unit
+    canvas_y = (ys - low_y + margin) * px_per_unit
     samples = tuple(
         Sample(float(t), float(x), float(y), PRESSURE)
         for t, x, y in zip(times_ms, canvas_x, canvas_y, strict=True)

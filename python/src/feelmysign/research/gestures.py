@@ -1,0 +1,128 @@
+"""Recorded gestures to evaluate: folders of recordings, and the $1 gesture-log XML format.
+
+``feelmysign evaluate`` takes recording files and folders of them. A folder is
+searched for ``*.json`` (feelmysign recordings) and ``*.xml`` (the gesture
+logs of Wobbrock, Wilson & Li's $1 study, UIST 2007: one unistroke gesture a
+file, laid out as ``s01/fast/arrow01.xml``)::
+
+    <Gesture Name="arrow01" Subject="1" Speed="fast" Number="1" NumPts="46"
+             Milliseconds="640" ...>
+      <Point X="72" Y="150" T="1156372112609" /> ...
+    </Gesture>
+
+A gesture log becomes a one-path recording: screen pixels as drawn (y down),
+times in ms from the first point (a time earlier than the one before is taken
+at the one before), the canvas the bounding box plus a margin on every side (as
+for LASA, ``lasa.recording_in_box``).
+
+Each recording is named by its path; its gesture (what the recogniser must
+name) is the gesture's ``Name`` (else the file name) without trailing digits
+(``arrow01`` -> ``arrow``); its set is the ``Speed`` (else the folder it lies
+in under the folder given, else ``files``), so that a gesture log's speeds are
+summarised apart.
+"""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ElementTree
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from feelmysign.research.lasa import recording_in_box
+from feelmysign.simplify.recording import Recording, RecordingError, load_recording
+
+EXTENSIONS = (".json", ".xml")
+FILES_SET = "files"
+MAX_GESTURE_BYTES = 10_000_000
+
+
+@dataclass(frozen=True)
+class Gesture:
+    """A recording to evaluate, with its name, gesture and set."""
+
+    name: str
+    gesture: str
+    set: str
+    recording: Recording
+
+
+def gesture_name(text: str) -> str:
+    """A drawing's name without its trailing number: ``arrow01`` -> ``arrow``."""
+    stripped = re.sub(r"[\s_-]*\d+$", "", text)
+    return stripped or text
+
+
+def expand(paths: list[str]) -> list[tuple[Path, str | None]]:
+    """Every file given, and every recording under every folder given (sorted), each with
+    the folder it lies in under its given folder (None for a file given by itself)."""
+    found: list[tuple[Path, str | None]] = []
+    for given in paths:
+        path = Path(given)
+        if not path.is_dir():
+            found.append((path, None))
+            continue
+        inside = sorted(
+            p for p in path.rglob("*") if p.suffix.lower() in EXTENSIONS and p.is_file()
+        )
+        if not inside:
+            raise RecordingError(
+                f"{path}: no recordings (*.json) or $1 gesture logs (*.xml) in this folder"
+            )
+        for item in inside:
+            parent = item.parent.relative_to(path)
+            found.append((item, parent.name if parent.parts else None))
+    return found
+
+
+def load_gesture(
+    path: Path, folder: str | None, load_json: Callable[[str], Recording] = load_recording
+) -> Gesture:
+    """One file: a $1 gesture log (``.xml``) or a feelmysign recording (anything else)."""
+    if path.suffix.lower() == ".xml":
+        return load_gesture_log(path, folder)
+    recording = load_json(str(path))
+    return Gesture(str(path), gesture_name(path.stem), folder or FILES_SET, recording)
+
+
+def load_gesture_log(path: Path, folder: str | None = None) -> Gesture:
+    """A $1 gesture log as a one-path recording (see the module's notes)."""
+    try:
+        if path.stat().st_size > MAX_GESTURE_BYTES:
+            raise RecordingError(
+                f"{path}: larger than {MAX_GESTURE_BYTES} bytes; a gesture log is a few kB"
+            )
+        root = ElementTree.parse(path).getroot()
+    except OSError as error:
+        raise RecordingError(f"cannot read {path}: {error.strerror or error}") from error
+    except ElementTree.ParseError as error:
+        raise RecordingError(f"{path}: not valid XML ({error})") from error
+    if root.tag != "Gesture":
+        raise RecordingError(
+            f"{path}: expected a $1 gesture log (<Gesture Name=...><Point X= Y= T=/>...), "
+            f"found <{root.tag}>"
+        )
+    points = root.findall("Point")
+    try:
+        xyt = np.array([[float(p.attrib[k]) for k in ("X", "Y", "T")] for p in points])
+    except (KeyError, ValueError) as error:
+        raise RecordingError(
+            f"{path}: every <Point> needs numeric X, Y and T attributes ({error})"
+        ) from error
+    if len(xyt) < 2 or not np.all(np.isfinite(xyt)):
+        raise RecordingError(f"{path}: a gesture needs at least 2 points with finite X, Y and T")
+    times = np.maximum.accumulate(xyt[:, 2]) - xyt[0, 2]
+    recording = recording_in_box(xyt[:, 0], xyt[:, 1], times, px_per_unit=1.0)
+    name = root.attrib.get("Name") or path.stem
+    speed = root.attrib.get("Speed") or folder or FILES_SET
+    return Gesture(str(path), gesture_name(name), speed, recording)
+
+
+def load_all(
+    paths: list[str], load_json: Callable[[str], Recording] = load_recording
+) -> list[Gesture]:
+    """Every recording in ``paths`` (files and folders), in the order given, folders sorted."""
+    return [load_gesture(path, folder, load_json) for path, folder in expand(paths)]
