@@ -4,7 +4,8 @@ A set to test the simplifiers on something other than LASA, in the layout and
 format of Wobbrock, Wilson & Li's $1 gesture logs (UIST 2007):
 ``sNN/{slow,medium,fast}/NAME01.xml``, integer pixels and epoch milliseconds,
 one drawing per person, gesture and speed (16 x 10 x 3 = 480 files). The shapes
-are this module's own outlines of the 16 gestures the $1 paper names.
+are this module's own outlines of the 16 gestures of the $1 paper, named as in
+its gesture logs (``left_sq_bracket``, ``question_mark``, ...).
 
 The hand model, per drawing:
 
@@ -65,13 +66,26 @@ SHAPES: dict[str, tuple[str, list[tuple[float, float]]]] = {
     ),
     "check": ("poly", [(0.0, 0.55), (0.3, 1.0), (1.0, 0.0)]),
     "caret": ("poly", [(0.0, 1.0), (0.5, 0.0), (1.0, 1.0)]),
-    "zig-zag": ("poly", [(0.0, 0.2), (0.2, 0.8), (0.4, 0.2), (0.6, 0.8), (0.8, 0.2), (1.0, 0.8)]),
+    "question_mark": (
+        "curve",
+        [
+            (0.15, 0.3),
+            (0.25, 0.08),
+            (0.5, 0.0),
+            (0.75, 0.08),
+            (0.8, 0.28),
+            (0.65, 0.45),
+            (0.5, 0.58),
+            (0.5, 0.8),
+            (0.5, 1.0),
+        ],
+    ),
     "arrow": ("poly", [(0.0, 1.0), (1.0, 0.0), (0.5, 0.08), (1.0, 0.0), (0.92, 0.5)]),
-    "left square bracket": ("poly", [(0.7, 0.0), (0.2, 0.0), (0.2, 1.0), (0.7, 1.0)]),
-    "right square bracket": ("poly", [(0.3, 0.0), (0.8, 0.0), (0.8, 1.0), (0.3, 1.0)]),
+    "left_sq_bracket": ("poly", [(0.7, 0.0), (0.2, 0.0), (0.2, 1.0), (0.7, 1.0)]),
+    "right_sq_bracket": ("poly", [(0.3, 0.0), (0.8, 0.0), (0.8, 1.0), (0.3, 1.0)]),
     "v": ("poly", [(0.0, 0.0), (0.5, 1.0), (1.0, 0.0)]),
-    "delete": ("poly", [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)]),
-    "left curly brace": (
+    "delete_mark": ("poly", [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)]),
+    "left_curly_brace": (
         "curve",
         [
             (0.7, 0.0),
@@ -85,7 +99,7 @@ SHAPES: dict[str, tuple[str, list[tuple[float, float]]]] = {
             (0.7, 1.0),
         ],
     ),
-    "right curly brace": (
+    "right_curly_brace": (
         "curve",
         [
             (0.3, 0.0),
