@@ -4,6 +4,7 @@ arrive from a real broker, and a way to wait for one of them."""
 from __future__ import annotations
 
 import json
+import queue
 import sys
 import threading
 import uuid
@@ -34,6 +35,42 @@ def settings(credentials: Credentials, role: str) -> BrokerSettings:
         username=account.username,
         password=account.password,
     )
+
+
+def connected_client(
+    broker_settings: BrokerSettings, *, client_id: str | None = None, wait_s: float = WAIT_S
+) -> mqtt.Client:
+    """A paho client logged in with ``broker_settings``, its network loop running; the test
+    fails unless the broker accepts the login within ``wait_s``."""
+    client = new_client(broker_settings, client_id=client_id or f"test-{uuid.uuid4()}")
+    connected: queue.Queue[Any] = queue.Queue()
+    client.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
+    client.connect(broker_settings.host, broker_settings.port)
+    client.loop_start()
+    code = connected.get(timeout=wait_s)
+    assert not code.is_failure, code
+    return client
+
+
+Inbox = queue.Queue[tuple[str, bytes]]
+
+
+def subscribe_all(
+    client: mqtt.Client, topics: list[str], *, wait_s: float = WAIT_S
+) -> tuple[Inbox, list[Any]]:
+    """Every message ``client`` receives from now on, as ``(topic, payload)``, once it has
+    subscribed to ``topics`` (QoS 1); with the broker's answer, a reason code a topic."""
+    received: Inbox = queue.Queue()
+    client.on_message = lambda _c, _u, m: received.put((m.topic, bytes(m.payload)))
+    done: queue.Queue[Any] = queue.Queue()
+    client.on_subscribe = lambda _c, _u, _mid, codes, _p: done.put(codes)
+    client.subscribe([(topic, 1) for topic in topics])
+    return received, list(done.get(timeout=wait_s))
+
+
+def subscribe(client: mqtt.Client, topic: str, *, wait_s: float = WAIT_S) -> Inbox:
+    """Every message on ``topic`` that ``client`` receives from now on, once subscribed."""
+    return subscribe_all(client, [topic], wait_s=wait_s)[0]
 
 
 def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:

@@ -6,11 +6,9 @@ from __future__ import annotations
 
 import json
 import os
-import queue
 import socket
 import subprocess
 import sys
-import uuid
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -18,6 +16,7 @@ from typing import Any
 import paho.mqtt.client as mqtt
 import pytest
 from lan import Lan, lan
+from sleeve_watch import connected_client, subscribe
 
 from feelmysign.broker import Broker
 from feelmysign.broker.tls import LanOptions, ensure_local_ca
@@ -76,26 +75,7 @@ def tls_client(broker: Broker, username: str, password: str) -> mqtt.Client:
         password=password,
         ca_file=str(broker.tls.ca),
     )
-    client = new_client(settings, client_id=f"test-{uuid.uuid4()}")
-    connected: queue.Queue[Any] = queue.Queue()
-    client.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
-    client.connect(settings.host, settings.port)
-    client.loop_start()
-    code = connected.get(timeout=WAIT_S)
-    assert not code.is_failure, code
-    return client
-
-
-def inbox(client: mqtt.Client, topic: str) -> queue.Queue[tuple[str, bytes]]:
-    received: queue.Queue[tuple[str, bytes]] = queue.Queue()
-    client.on_message = lambda _c, _u, message: received.put(
-        (message.topic, bytes(message.payload))
-    )
-    subscribed: queue.Queue[Any] = queue.Queue()
-    client.on_subscribe = lambda _c, _u, _mid, codes, _p: subscribed.put(codes)
-    client.subscribe(topic, qos=1)
-    subscribed.get(timeout=WAIT_S)
-    return received
+    return connected_client(settings, wait_s=WAIT_S)
 
 
 def test_a_sleeve_joined_by_token_plays_strokes_over_tls(
@@ -114,10 +94,10 @@ def test_a_sleeve_joined_by_token_plays_strokes_over_tls(
     c = lan_broker.credentials
     sender = tls_client(lan_broker, c.sender.username, c.sender.password)
     try:
-        statuses = inbox(sender, telemetry_topic("arm2", "status"))
+        statuses = subscribe(sender, telemetry_topic("arm2", "status"))
         _topic, payload = statuses.get(timeout=WAIT_S)
         assert json.loads(payload)["online"] is True
-        events = inbox(sender, telemetry_topic("arm2", "events"))
+        events = subscribe(sender, telemetry_topic("arm2", "events"))
         for seq in range(3):
             stroke = Stroke((0.0, 0.0), (1.0, 0.0), 400.0, 0.8, "lan-drawing", seq)
             sender.publish(strokes_topic("arm2"), format_json(stroke), qos=1).wait_for_publish(5)
@@ -243,8 +223,8 @@ def test_a_second_sleeve_s_topics_are_not_readable_with_the_first_s_login(
     try:
         # One publisher's messages reach a subscriber in order: the first sleeve's own
         # stroke, sent after the second's, arrives only after anything it could read of it.
-        first_inbox = inbox(first_sleeve, "feelmysign/#")
-        second_inbox = inbox(second_sleeve, strokes_topic("arm2"))
+        first_inbox = subscribe(first_sleeve, "feelmysign/#")
+        second_inbox = subscribe(second_sleeve, strokes_topic("arm2"))
         private = format_json(Stroke((0.0, 0.0), (1.0, 1.0), 100.0, 0.5, "private", 0))
         own = format_json(Stroke((1.0, 1.0), (2.0, 1.0), 100.0, 0.5, "own", 0))
         sender.publish(strokes_topic("arm2"), private, qos=1).wait_for_publish(5)
@@ -252,7 +232,7 @@ def test_a_second_sleeve_s_topics_are_not_readable_with_the_first_s_login(
         assert second_inbox.get(timeout=WAIT_S) == (strokes_topic("arm2"), private.encode())
         assert first_inbox.get(timeout=WAIT_S) == (strokes_topic(c.sleeve_id), own.encode())
         # Nor can the second sleeve write the first one's telemetry (same ordering argument).
-        watcher = inbox(sender, telemetry_topic("+", "status"))
+        watcher = subscribe(sender, telemetry_topic("+", "status"))
         second_sleeve.publish(telemetry_topic(c.sleeve_id, "status"), b"forged", qos=1)
         second_sleeve.publish(telemetry_topic("arm2", "status"), b"genuine", qos=1)
         assert watcher.get(timeout=WAIT_S) == (telemetry_topic("arm2", "status"), b"genuine")

@@ -6,12 +6,10 @@ from __future__ import annotations
 
 import json
 import os
-import queue
 import subprocess
 import sys
 import threading
 import time
-import uuid
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +17,7 @@ from typing import Any
 
 import paho.mqtt.client as mqtt
 import pytest
+from sleeve_watch import connected_client, subscribe, subscribe_all
 
 from feelmysign.broker.credentials import Account, reuse_or_create
 from feelmysign.broker.nats_cluster import NatsCluster
@@ -47,35 +46,7 @@ def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[NatsCluster]:
 
 def client(url: str, account: Account, *, client_id: str | None = None) -> mqtt.Client:
     settings = parse_broker_url(url, username=account.username, password=account.password)
-    paho = new_client(settings, client_id=client_id or f"test-{uuid.uuid4()}")
-    connected: queue.Queue[Any] = queue.Queue()
-    paho.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
-    paho.connect(settings.host, settings.port)
-    paho.loop_start()
-    code = connected.get(timeout=WAIT_S)
-    assert not code.is_failure, code
-    return paho
-
-
-def subscribe(paho: mqtt.Client, topic: str) -> queue.Queue[tuple[str, bytes]]:
-    received: queue.Queue[tuple[str, bytes]] = queue.Queue()
-    paho.on_message = lambda _c, _u, m: received.put((m.topic, bytes(m.payload)))
-    done: queue.Queue[Any] = queue.Queue()
-    paho.on_subscribe = lambda _c, _u, _mid, codes, _p: done.put(codes)
-    paho.subscribe(topic, qos=1)
-    done.get(timeout=WAIT_S)
-    return received
-
-
-def subscribe_all(
-    paho: mqtt.Client, topics: list[str]
-) -> tuple[queue.Queue[tuple[str, bytes]], list[Any]]:
-    received: queue.Queue[tuple[str, bytes]] = queue.Queue()
-    paho.on_message = lambda _c, _u, m: received.put((m.topic, bytes(m.payload)))
-    done: queue.Queue[Any] = queue.Queue()
-    paho.on_subscribe = lambda _c, _u, _mid, codes, _p: done.put(codes)
-    paho.subscribe([(topic, 1) for topic in topics])
-    return received, list(done.get(timeout=WAIT_S))
+    return connected_client(settings, client_id=client_id, wait_s=WAIT_S)
 
 
 def feelmysign(*args: str) -> list[str]:
