@@ -9,6 +9,7 @@ on stderr, and that this line names what was wrong.
 from __future__ import annotations
 
 import argparse
+import base64
 import json
 import os
 import subprocess
@@ -72,10 +73,29 @@ def files(tmp_path: Path) -> dict[str, str]:
     rows_a.write_text(json.dumps({**RECORDING, "sleeve": {"rows": "a"}}), encoding="utf-8")
     a_file = tmp_path / "a-file"
     a_file.write_text("not a folder\n", encoding="utf-8")
+    deep_json = tmp_path / "deep.json"
+    deep_json.write_text("[" * 5000 + "]" * 5000, encoding="utf-8")
+    deep_design = tmp_path / "deep-design.toml"
+    deep_design.write_text("[study]\nname = " + "{a=" * 5000 + "}" * 5000 + "\n", "utf-8")
     names = {"deep": deep, "fifo": fifo, "huge": huge, "good": good, "rows_a": rows_a}
+    names |= {"deep_json": deep_json, "deep_design": deep_design}
+    names |= {"fifo_design": _design_naming(tmp_path / "fifo-study", fifo)}
     paper = Path(__file__).resolve().parents[2] / "deploy" / "layouts" / "paper-sleeve.toml"
-    extra = {"under_file": f"{a_file}/x", "paper": str(paper)}
+    body = base64.urlsafe_b64encode(b"[" * 5000 + b"]" * 5000).decode().rstrip("=")
+    extra = {"under_file": f"{a_file}/x", "paper": str(paper), "deep_token": f"fms1.{body}"}
     return {name: str(path) for name, path in names.items()} | extra
+
+
+def _design_naming(folder: Path, fifo: Path) -> Path:
+    """The quick study design, its layout and its recording both the fifo ``fifo``."""
+    quick = Path(__file__).resolve().parents[2] / "deploy" / "studies" / "quick.toml"
+    (folder / "recordings").mkdir(parents=True)
+    os.symlink(fifo, folder / "recordings" / "zigzag.json")
+    os.symlink(fifo, folder / "layout.toml")
+    design = folder / "design.toml"
+    text = quick.read_text(encoding="utf-8")
+    design.write_text(text.replace("[stimulus]\n", '[stimulus]\nlayout = "layout.toml"\n'))
+    return design
 
 
 BAD_FILES = [
@@ -94,6 +114,21 @@ BAD_FILES = [
     (["sleeve", "--record", "{under_file}"], ["--record", "is a file, not a folder"]),
     (["up", "--record", "/nonexistent/felt.jsonl"], ["--record", "does not exist"]),
     (["send", "0,0,1,0,500", "--broker", "mqtt://[::1"], ["mqtt://[::1", "cannot be read"]),
+    # Nested deeper than Python's stack: refused as malformed, not a RecursionError.
+    (["scan", "--layout", "{paper}", "--emulate-state", "{deep_json}"], ["nested too deeply"]),
+    (["off", "--layout", "{paper}", "--emulate-state", "{deep_json}"], ["nested too deeply"]),
+    (
+        ["sleeve", "--backend", "drv2605", "--layout", "{paper}", "--emulate-state", "{deep_json}"],
+        ["emulated I2C bus state", "nested too deeply"],
+    ),
+    (["sleeve", "--join", "{deep_token}"], ["join token is not usable"]),
+    (["study", "check", "{deep_design}"], ["study design", "nested too deeply"]),
+    (["simplify", "{deep_json}"], ["not valid JSON", "nested too deeply"]),
+    (["send", "--shape", "circle", "--credentials", "{deep_json}"], ["credentials file"]),
+    # Study designs, and the layouts and recordings a design names, are read as safely.
+    (["study", "check", "{fifo}"], ["study design", "fifo (named pipe)"]),
+    (["study", "new", "/dev/zero", "--out", "s.sqlite"], ["study design", "a device"]),
+    (["study", "check", "{fifo_design}"], ["stimulus.layout", "recording", "fifo (named pipe)"]),
 ]
 
 
@@ -122,6 +157,7 @@ BAD_VALUES = [
     (["evaluate", "{good}", "--out", ""], ["--out", "an empty output folder"]),
     (["send", "0,0,1,0,500", "--legacy", "--legacy-topic", "#"], ["--legacy-topic", "wildcards"]),
     (["sleeve", "--legacy-topic", "#"], ["--legacy-topic", "'#' cannot be used"]),
+    (["sleeve", "--join", ""], ["--join", "an empty join token"]),
     (["sleeve", "--legacy-topic", "a/+/b"], ["--legacy-topic"]),
     (["sleeve", "--legacy-topic", "$SYS/x"], ["--legacy-topic"]),
     (["send", "0,0,1,0,500", "--broker", ""], ["--broker", "empty"]),

@@ -18,6 +18,8 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any, ClassVar, Literal, TypeVar
 
+from feelmysign.input_files import loads_json
+
 EventType = Literal["played", "adjusted", "rejected", "cancelled", "safety", "error"]
 
 
@@ -290,7 +292,7 @@ def event_from_json(data: object) -> Event:
     """An event from its JSON object (or text); EventError if it is not one."""
     if isinstance(data, str | bytes):
         try:
-            data = json.loads(data)
+            data = loads_json(data)
         except ValueError as error:
             raise EventError(f"not JSON: {error}") from None
     r = _Reader(data, "an event")
@@ -367,7 +369,7 @@ class Status:
     def from_json(cls, data: object) -> Status:
         if isinstance(data, str | bytes):
             try:
-                data = json.loads(data)
+                data = loads_json(data)
             except ValueError as error:
                 raise EventError(f"not JSON: {error}") from None
         r = _Reader(data, "a status")

@@ -38,10 +38,10 @@ import math
 import sys
 from dataclasses import dataclass, fields
 from os import PathLike
-from pathlib import Path
 from typing import Any, Literal
 
 from feelmysign.errors import LayoutError
+from feelmysign.input_files import MAX_LAYOUT_BYTES, read_text
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -157,7 +157,7 @@ def load_layout(path: str | PathLike[str]) -> Layout:
     """Read and validate a layout file; LayoutError names the path and every problem."""
     source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_text(path, max_bytes=MAX_LAYOUT_BYTES)
     except FileNotFoundError:
         raise LayoutError(
             source,

@@ -43,11 +43,10 @@ from typing import Any
 
 from feelmysign.backends.emulated_i2c import EmulatedDRV2605L, EmulatedI2CBus
 from feelmysign.errors import FeelMySignError
+from feelmysign.input_files import MAX_STATE_BYTES, loads_json, read_text
 from feelmysign.layout import Layout
 
 STATE_FORMAT = "feelmysign-emulated-i2c/1"
-# Far above any real state file (a few kB), far below what would hurt to read.
-MAX_STATE_BYTES = 1_000_000
 
 
 class EmulatedStateError(FeelMySignError):
@@ -108,13 +107,11 @@ def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
     """The bus saved in ``path`` (no write-through: for looking, or for a test to edit)."""
     state_path = Path(path)
     try:
-        if state_path.stat().st_size > MAX_STATE_BYTES:
-            raise EmulatedStateError(state_path, f"larger than {MAX_STATE_BYTES} bytes")
-        data = json.loads(state_path.read_text(encoding="utf-8"))
+        data = loads_json(read_text(state_path, max_bytes=MAX_STATE_BYTES))
     except OSError as error:
         problem = f"cannot be read: {error.strerror or error}"
         raise EmulatedStateError(state_path, problem) from error
-    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+    except (UnicodeDecodeError, ValueError) as error:
         raise EmulatedStateError(state_path, f"not JSON: {error}") from error
     try:
         return bus_from_state(data)

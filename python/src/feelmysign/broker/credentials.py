@@ -27,6 +27,7 @@ from typing import Any, Literal
 from urllib.parse import urlsplit
 
 from feelmysign.errors import BrokerError
+from feelmysign.input_files import MAX_CREDENTIALS_BYTES, loads_json, read_text
 
 SENDER_USERNAME = "sender"
 SLEEVE_USERNAME_PREFIX = "sleeve-"
@@ -147,7 +148,7 @@ def load_login(path: str | Path, role: Literal["sleeve", "sender"]) -> Login:
 
 def _read_json(path: Path) -> object:
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        return loads_json(read_text(path, max_bytes=MAX_CREDENTIALS_BYTES))
     except FileNotFoundError:
         raise BrokerError(
             "credentials-file",
@@ -155,7 +156,7 @@ def _read_json(path: Path) -> object:
             "or pass the file it wrote (STATE_DIR/credentials.json, or "
             "STATE_DIR/sleeve-credentials.json for a sleeve).",
         ) from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
+    except (OSError, ValueError) as error:
         raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
 
 

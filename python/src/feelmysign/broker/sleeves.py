@@ -22,15 +22,16 @@ from feelmysign.broker.credentials import (
     write_private_file,
 )
 from feelmysign.errors import BrokerError
+from feelmysign.input_files import MAX_CREDENTIALS_BYTES, loads_json, read_text
 
 
 def load_sleeves(path: Path) -> dict[str, Account]:
     """The added sleeves by id; none when the file does not exist yet."""
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = loads_json(read_text(path, max_bytes=MAX_CREDENTIALS_BYTES))
     except FileNotFoundError:
         return {}
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+    except (OSError, ValueError) as error:
         raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
     if not isinstance(data, dict):
         raise _bad_file(path, "it is not a JSON object")

@@ -79,6 +79,7 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
         group.add_argument(
             "--join",
             metavar="TOKEN",
+            type=not_empty("join token"),
             help=f"the one-line token of 'feelmysign broker add-sleeve ID': broker URL (TLS), "
             f"its CA's fingerprint, this sleeve's id and login; replaces the other broker "
             f"options (default: ${JOIN_ENV})",

@@ -16,20 +16,31 @@ import argparse
 import math
 import os
 import re
-import stat
 import sys
 from collections.abc import Callable
 from pathlib import Path
 
 from feelmysign.errors import FeelMySignError
+from feelmysign.input_files import (
+    MAX_CREDENTIALS_BYTES,
+    MAX_DESIGN_BYTES,
+    MAX_LAYOUT_BYTES,
+    MAX_RECORDING_BYTES,
+    MAX_STATE_BYTES,
+    MIB,
+    UnusableFile,
+    check_regular,
+)
+from feelmysign.input_files import size_text as _size
 
-KIB = 1024
-MIB = 1024 * KIB
-# Caps on what is read into memory: far above any real file, far below a machine's memory.
-MAX_LAYOUT_BYTES = 1 * MIB  # the paper's sleeve is 2 KiB; a 64 x 64 wiring table ~400 KiB
-MAX_CREDENTIALS_BYTES = 64 * KIB  # the broker writes about 400 bytes
-MAX_RECORDING_BYTES = 64 * MIB  # an hour of drawing at 240 samples a second is ~60 MiB
-MAX_STATE_BYTES = 1 * MIB  # the emulated bus of 64 chips is about 40 KiB
+__all__ = [
+    "MAX_CREDENTIALS_BYTES",
+    "MAX_DESIGN_BYTES",
+    "MAX_LAYOUT_BYTES",
+    "MAX_RECORDING_BYTES",
+    "MAX_STATE_BYTES",
+]
+
 MAX_STDIN_BYTES = 16 * MIB  # strokes or one document piped in: 200,000 strokes fit
 # MQTT allows 65,535 bytes; the broker's ACL file and the sleeve's status take this much.
 MAX_TOPIC_BYTES = 256
@@ -177,43 +188,18 @@ def check_input_file(path: str | os.PathLike[str], *, what: str, max_bytes: int)
     """Refuse what cannot be read whole and at once: a fifo, a device, a folder, a huge file.
 
     ``os.stat`` never blocks (opening a fifo would wait for a writer). A path that
-    does not exist passes: the loader then says so in its own words.
+    does not exist passes: the loader then says so in its own words. The loaders
+    read through ``feelmysign.input_files``, which checks the opened file again.
     """
     try:
         info = os.stat(path)
     except OSError:
         return
-    if stat.S_ISDIR(info.st_mode):
-        raise InputError(f"The {what} {str(path)!r} is a folder: give the path of a file in it.")
-    if not stat.S_ISREG(info.st_mode):
-        kind = _kind(info.st_mode)
-        raise InputError(
-            f"The {what} {str(path)!r} is {kind}, not a regular file: save it to a file "
-            "first, then give that file's path."
-        )
-    if info.st_size > max_bytes:
-        raise InputError(
-            f"The {what} {str(path)!r} is {_size(info.st_size)}; at most {_size(max_bytes)} is "
-            f"read: check that this is the right file."
-        )
-
-
-def _kind(mode: int) -> str:
-    if stat.S_ISFIFO(mode):
-        return "a fifo (named pipe)"
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        return "a device"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    return "not a regular file"
-
-
-def _size(n_bytes: int) -> str:
-    if n_bytes >= MIB:
-        return f"{n_bytes / MIB:.1f} MiB"
-    if n_bytes >= KIB:
-        return f"{n_bytes / KIB:.1f} KiB"
-    return f"{n_bytes} bytes"
+    try:
+        check_regular(path, info, max_bytes=max_bytes)
+    except UnusableFile as error:
+        problem = str(error.strerror).removeprefix("it ")
+        raise InputError(f"The {what} {str(path)!r} {problem}.") from None
 
 
 def read_stdin(*, what: str, max_bytes: int = MAX_STDIN_BYTES) -> bytes:

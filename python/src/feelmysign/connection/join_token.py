@@ -23,6 +23,7 @@ from pathlib import Path
 from feelmysign.connection.pinned_ca import pinned_ca_file
 from feelmysign.connection.settings import BrokerSettings, parse_broker_url
 from feelmysign.errors import BrokerConnectionError
+from feelmysign.input_files import loads_json
 
 TOKEN_PREFIX = "fms1."
 _FINGERPRINT = re.compile(r"[0-9a-f]{64}")
@@ -75,7 +76,7 @@ def decode_join_token(text: str) -> JoinToken:
         raise _bad(f"it does not start with {TOKEN_PREFIX!r}")
     body = token[len(TOKEN_PREFIX) :]
     try:
-        data = json.loads(base64.urlsafe_b64decode(body + "=" * (-len(body) % 4)))
+        data = loads_json(base64.urlsafe_b64decode(body + "=" * (-len(body) % 4)))
     except (binascii.Error, ValueError):
         raise _bad("it is cut or mistyped (not base64 JSON)") from None
     if not isinstance(data, dict) or not all(

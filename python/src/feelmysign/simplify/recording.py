@@ -20,13 +20,13 @@ origin top-left and y down, pressure 0..1 (optional, 0.5 when absent).
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeGuard
 
 from feelmysign.errors import FeelMySignError
+from feelmysign.input_files import MAX_RECORDING_BYTES, loads_json, read_text
 from feelmysign.simplify.segment import Sample
 from feelmysign.stroke import Point
 
@@ -60,7 +60,7 @@ class Recording:
 
 def load_recording(path: str | Path) -> Recording:
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_text(path, max_bytes=MAX_RECORDING_BYTES)
     except OSError as error:
         raise RecordingError(f"cannot read recording {path}: {error.strerror or error}") from error
     return parse_recording(text, source=str(path))
@@ -68,8 +68,8 @@ def load_recording(path: str | Path) -> Recording:
 
 def parse_recording(text: str, *, source: str = "<recording>") -> Recording:
     try:
-        data = json.loads(text, parse_constant=_reject_constant)
-    except (ValueError, RecursionError) as error:
+        data = loads_json(text, parse_constant=_reject_constant)
+    except ValueError as error:
         raise RecordingError(f"{source}: not valid JSON ({error})") from error
     if not isinstance(data, dict):
         raise RecordingError(f"{source}: the recording must be a JSON object with canvas and paths")

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from feelmysign.errors import DesignError, FeelMySignError
+from feelmysign.input_files import MAX_DESIGN_BYTES, read_text
 from feelmysign.shapes import SHAPES
 from feelmysign.simplify.registry import ALGORITHMS
 from feelmysign.study.coding import normalise
@@ -51,7 +52,7 @@ def load_design(path: str | Path) -> Design:
     """The design in ``path``; DesignError listing every problem, or naming the unreadable file."""
     file = Path(path)
     try:
-        text = file.read_text(encoding="utf-8")
+        text = read_text(file, max_bytes=MAX_DESIGN_BYTES)
     except OSError as error:
         raise DesignError(
             str(path), [f"cannot read the file: {error.strerror or error}"]
@@ -64,6 +65,10 @@ def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path("
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise DesignError(source, [f"not valid TOML: {error}"]) from error
+    except RecursionError:
+        raise DesignError(
+            source, ["nested too deeply to read; a design nests arrays and tables 3 levels deep"]
+        ) from None
     problems = Problems(source)
     problems.unknown("", data, _TOP)
     study = problems.table("study", data.get("study", MISSING), required=True)
