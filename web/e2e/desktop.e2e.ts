@@ -34,7 +34,7 @@ import {
   walk,
   openAdvanced,
 } from "./page";
-import { expectStrokesFollow, strokeBounds } from "./strokes";
+import { drawSquare, expectStrokesFollow, strokeBounds } from "./strokes";
 
 const UUID = /^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}$/;
 const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3.0 }, version: "test" };
@@ -89,29 +89,16 @@ describe("drawing with a mouse on a desktop", () => {
   });
 
   it("sends a square drawn with the mouse as strokes along its four sides, with its corners", async () => {
-    const area = await drawingArea(page);
-    const side = area.height * 0.6;
-    const left = area.left + (area.width - side) / 2;
-    const top = area.top + (area.height - side) / 2;
-    const corners: Point[] = [
-      [left, top],
-      [left + side, top],
-      [left + side, top + side],
-      [left, top + side],
-    ];
-    await drawWithMouse(page, [...corners, corners[0]!], {
+    const { area, path, sent } = await drawSquare(page, {
       beforeRelease: async () => {
         await screenshot(page, "desktop-drawing");
       },
     });
-    // Every stroke leaves on release at the latest; a long side may be cut by the latency cap.
-    await nextFrame(page);
-    sentCount = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
-    expect(sentCount).toBeGreaterThanOrEqual(4);
+    sentCount = sent;
     const strokes = await sleeve.waitForStrokes(sentCount);
     expect(strokes).toHaveLength(sentCount);
     const bounds = await strokeBounds(page, area);
-    expectStrokesFollow(strokes, [...corners, corners[0]!], area, bounds);
+    expectStrokesFollow(strokes, path, area, bounds);
     strokes.forEach((stroke, i) => {
       expect(stroke).toMatchObject({ v: 1, seq: i, intensity: 0.8 });
       expect(stroke["duration_ms"] as number).toBeGreaterThan(0);

@@ -5,21 +5,14 @@
  * drawing (every motor off in the sleeve's record within 20 ms of the cancel),
  * a saved recording loaded back and played again, and an unknown sleeve id.
  */
-import { readFileSync, rmSync } from "node:fs";
+import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import mqtt, { type MqttClient } from "mqtt";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import {
-  checkPrerequisites,
-  launchBrowser,
-  RESULTS_DIR,
-  startUp,
-  stopUp,
-  tempDir,
-  type Credentials,
-} from "./harness";
+import { RESULTS_DIR, type Credentials } from "./harness";
 import { drawingArea, drawWithMouse, openAdvanced, screenshot, waitForData, type Area } from "./page";
+import { DESKTOP, Processes } from "./processes";
 
 type Point = readonly [number, number];
 /** The bound: every motor off this soon after the sleeve received the cancel. */
@@ -99,7 +92,7 @@ async function setLongestStroke(page: Page, ms: string): Promise<void> {
 }
 
 describe("the felt drawing, served by feelmysign up with the simulated sleeve", () => {
-  const cleanups: (() => Promise<void>)[] = [];
+  const processes = new Processes();
   let page: Page;
   let area: Area;
   let watcher: EventWatcher;
@@ -107,27 +100,17 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
   const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
 
   beforeAll(async () => {
-    checkPrerequisites();
-    const stateDir = tempDir("felt");
-    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
-    recordPath = join(stateDir, "record.jsonl");
-    const up = await startUp(stateDir, ["--record", recordPath]);
-    cleanups.push(() => stopUp(up.child));
-    const credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
-    watcher = await EventWatcher.connect(credentials);
-    cleanups.push(() => watcher.client.endAsync(true));
-    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 }, deviceScaleFactor: 1 });
-    cleanups.push(browser.close);
-    page = await browser.context.newPage();
-    await page.goto(up.url);
+    recordPath = join(processes.dir("felt-record"), "record.jsonl");
+    const up = await processes.up("felt", { args: ["--record", recordPath] });
+    watcher = await EventWatcher.connect(up.credentials);
+    processes.add(() => watcher.client.endAsync(true));
+    page = await processes.page(up.url, { ...DESKTOP, deviceScaleFactor: 1 });
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
     area = await drawingArea(page);
   });
 
-  afterAll(async () => {
-    for (const cleanup of cleanups.reverse()) await cleanup();
-  });
+  afterAll(() => processes.stop());
 
   it("keeps a Z and then a square as one drawing, played, on the timeline", async () => {
     await drawWithMouse(page, [at(0.1, 0.1), at(0.45, 0.1), at(0.1, 0.9), at(0.45, 0.9)]);

@@ -13,7 +13,8 @@ import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { checkPrerequisites, CHROMIUM, FEELMYSIGN, launchBrowser, tempDir } from "./harness";
-import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData } from "./page";
+import { screenshot, waitForData } from "./page";
+import { drawSquare } from "./strokes";
 
 const READY_TIMEOUT_MS = 40_000;
 const SLEEVE_ID = "arm2";
@@ -184,21 +185,7 @@ describe("a phone and a sleeve on the LAN, over TLS", () => {
     await page.locator('[data-testid="setting-sleeve_id"]').fill(SLEEVE_ID);
     await page.locator('[data-testid="settings-save"]').click();
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online", 30_000);
-    const area = await drawingArea(page);
-    const side = area.height * 0.6;
-    const left = area.left + (area.width - side) / 2;
-    const top = area.top + (area.height - side) / 2;
-    const corners = [
-      [left, top],
-      [left + side, top],
-      [left + side, top + side],
-      [left, top + side],
-    ] as const;
-    await drawWithMouse(page, [...corners, corners[0]]);
-    await nextFrame(page);
-    // Four sides; a long side may be cut by the latency cap, so four strokes or more.
-    const sent = await page.locator('[data-testid="played-summary"]').getAttribute("data-sent");
-    expect(Number(sent)).toBeGreaterThanOrEqual(4);
+    const { sent } = await drawSquare(page);
     await waitForData(page, '[data-testid="played-summary"]', "played", String(sent), 30_000);
     await screenshot(page, "lan-played");
   });

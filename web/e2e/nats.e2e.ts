@@ -23,7 +23,8 @@ import {
   tempDir,
   type Credentials,
 } from "./harness";
-import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData } from "./page";
+import { screenshot, waitForData } from "./page";
+import { drawSquare } from "./strokes";
 
 const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
 const READY_TIMEOUT_MS = 90_000;
@@ -191,21 +192,7 @@ describe("on a 3-node NATS cluster: sleeve on a, CLI on b, page on c; a dies", (
     expect(exit, sendOut.text()).toBe(0);
     await events.waitFor(drawing, 10);
 
-    const area = await drawingArea(page);
-    const side = area.height * 0.6;
-    const left = area.left + (area.width - side) / 2;
-    const top = area.top + (area.height - side) / 2;
-    const corners = [
-      [left, top],
-      [left + side, top],
-      [left + side, top + side],
-      [left, top + side],
-    ] as const;
-    await drawWithMouse(page, [...corners, corners[0]]);
-    await nextFrame(page);
-    // Four sides; a long side may be cut by the latency cap, so four strokes or more.
-    const sent = await page.locator('[data-testid="played-summary"]').getAttribute("data-sent");
-    expect(Number(sent)).toBeGreaterThanOrEqual(4);
+    const { sent } = await drawSquare(page);
     await waitForData(page, '[data-testid="played-summary"]', "played", String(sent), 60_000);
     await screenshot(page, "nats-failover");
 

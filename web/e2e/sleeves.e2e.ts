@@ -5,22 +5,13 @@
  * simulated sleeve, and the choice is remembered across a reload.
  */
 import { spawnSync } from "node:child_process";
-import { readFileSync, rmSync } from "node:fs";
+import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import {
-  Broker,
-  checkPrerequisites,
-  FakeSleeve,
-  FEELMYSIGN,
-  launchBrowser,
-  startUp,
-  stopUp,
-  tempDir,
-  type Credentials,
-} from "./harness";
+import { Broker, FakeSleeve, FEELMYSIGN } from "./harness";
 import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData, waitForPlayed } from "./page";
+import { Processes } from "./processes";
 
 const SECOND = "arm2";
 const PICKER = '[data-testid="sleeve-select"]';
@@ -51,51 +42,45 @@ async function drawZ(page: Page): Promise<number> {
 }
 
 describe("two sleeves on one broker, chosen on the page", () => {
-  const cleanups: (() => Promise<void>)[] = [];
+  const processes = new Processes();
   let page: Page;
   let first: FakeSleeve;
   let second: FakeSleeve;
 
   beforeAll(async () => {
-    checkPrerequisites();
-    const stateDir = tempDir("sleeves");
-    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
     // The broker's state first, then the second sleeve's account, then everything up.
-    const broker = await Broker.start(stateDir);
-    await broker.stop();
-    const added = spawnSync(
-      FEELMYSIGN,
-      ["broker", "--state-dir", stateDir, "add-sleeve", SECOND, "--url", "mqtts://127.0.0.1:8883"],
-      { encoding: "utf8" },
-    );
-    expect(added.status, added.stderr).toBe(0);
-    const up = await startUp(stateDir);
-    cleanups.push(() => stopUp(up.child));
-    const credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
+    const up = await processes.up("sleeves", {
+      prepare: async (stateDir) => {
+        const broker = await Broker.start(stateDir);
+        await broker.stop();
+        const added = spawnSync(
+          FEELMYSIGN,
+          ["broker", "--state-dir", stateDir, "add-sleeve", SECOND, "--url", "mqtts://127.0.0.1:8883"],
+          { encoding: "utf8" },
+        );
+        expect(added.status, added.stderr).toBe(0);
+      },
+    });
+    const { stateDir, credentials } = up;
     const accounts = JSON.parse(readFileSync(join(stateDir, "sleeves.json"), "utf8")) as Record<
       string,
       { username: string; password: string }
     >;
     // A second login of the simulated sleeve's account, listening only: what it receives.
     first = await FakeSleeve.connect(credentials);
-    cleanups.push(() => first.close());
+    processes.add(() => first.close());
     // The second sleeve, played by the test with its own account.
     second = await FakeSleeve.connect(
       { ...credentials, sleeve: { id: SECOND, ...accounts[SECOND]! } },
       { sleeveId: SECOND },
     );
-    cleanups.push(() => second.close());
+    processes.add(() => second.close());
     await second.publish("status", { online: true, layout: LAYOUT }, true);
-    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 } });
-    cleanups.push(browser.close);
-    page = await browser.context.newPage();
-    await page.goto(up.url);
+    page = await processes.page(up.url);
     await waitForData(page, CHIP, "state", "online", 30_000);
   });
 
-  afterAll(async () => {
-    for (const cleanup of cleanups.reverse()) await cleanup();
-  });
+  afterAll(() => processes.stop());
 
   it("lists both sleeves with their state from the retained status", async () => {
     await waitForOption(page, `${SECOND} · online`);

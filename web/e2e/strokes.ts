@@ -23,7 +23,7 @@
 import type { Page } from "playwright-core";
 import { expect } from "vitest";
 import { loadSettings, STORAGE_KEY } from "../src/settings";
-import { toGrid, walk, type Area } from "./page";
+import { drawingArea, drawWithMouse, nextFrame, toGrid, walk, type Area } from "./page";
 
 type Point = readonly [number, number];
 
@@ -132,4 +132,36 @@ export function expectStrokesFollow(
       bounds.maxError + bounds.slack,
     );
   }
+}
+
+/** A square in the middle of the area, 0.6 of its height a side: the press, its four corners and back. */
+export function squarePath(area: Area): Point[] {
+  const side = area.height * 0.6;
+  const left = area.left + (area.width - side) / 2;
+  const top = area.top + (area.height - side) / 2;
+  const corners: Point[] = [
+    [left, top],
+    [left + side, top],
+    [left + side, top + side],
+    [left, top + side],
+  ];
+  return [...corners, corners[0]!];
+}
+
+/**
+ * Draws `squarePath` with the mouse and resolves, a frame after the release (every stroke
+ * leaves on release at the latest), with the area, the path and how many strokes the page
+ * sent: four or more, checked, as a long side may be cut by the latency cap.
+ */
+export async function drawSquare(
+  page: Page,
+  options: Parameters<typeof drawWithMouse>[2] = {},
+): Promise<{ area: Area; path: Point[]; sent: number }> {
+  const area = await drawingArea(page);
+  const path = squarePath(area);
+  await drawWithMouse(page, path, options);
+  await nextFrame(page);
+  const sent = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
+  expect(sent, "strokes sent for the square's four sides").toBeGreaterThanOrEqual(4);
+  return { area, path, sent };
 }

@@ -5,10 +5,8 @@
  * simulated sleeve plays what is drawn afterwards.
  */
 import { spawnSync, type ChildProcess } from "node:child_process";
-import { rmSync } from "node:fs";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { checkPrerequisites, launchBrowser, startUp, stopUp, tempDir } from "./harness";
 import {
   CANVAS,
   drawingArea,
@@ -18,6 +16,7 @@ import {
   waitForData,
   waitForPlayed,
 } from "./page";
+import { Processes } from "./processes";
 
 const BROKER = '[data-testid="broker-status"]';
 
@@ -30,32 +29,23 @@ function mosquittoOf(up: ChildProcess): number {
 }
 
 describe("a phone against feelmysign up, its broker killed and started again", () => {
-  const cleanups: (() => Promise<void>)[] = [];
+  const processes = new Processes();
   let page: Page;
   let up: ChildProcess;
 
   beforeAll(async () => {
-    checkPrerequisites();
-    const stateDir = tempDir("up-phone");
-    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
-    const started = await startUp(stateDir);
+    const started = await processes.up("up-phone");
     up = started.child;
-    cleanups.push(() => stopUp(up));
-    const browser = await launchBrowser({
+    page = await processes.page(started.url, {
       viewport: { width: 390, height: 844 },
       deviceScaleFactor: 2,
       hasTouch: true,
       isMobile: true,
     });
-    cleanups.push(browser.close);
-    page = await browser.context.newPage();
-    await page.goto(started.url);
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online", 30_000);
   });
 
-  afterAll(async () => {
-    for (const cleanup of cleanups.reverse()) await cleanup();
-  });
+  afterAll(() => processes.stop());
 
   it("keeps the drawing area still while offline and back, then plays what is drawn", async () => {
     const before = await page.locator(CANVAS).boundingBox();

@@ -5,49 +5,29 @@
  * Skipped, saying why, on a checkout whose CLI has no `up` yet.
  */
 import { spawnSync } from "node:child_process";
-import { readFileSync, rmSync } from "node:fs";
-import { join } from "node:path";
 import type { Page } from "playwright-core";
-import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import {
-  checkPrerequisites,
-  FakeSleeve,
-  FEELMYSIGN,
-  launchBrowser,
-  startUp,
-  stopUp,
-  tempDir,
-  type Credentials,
-} from "./harness";
-import { drawingArea, drawWithMouse, nextFrame, screenshot, waitForData } from "./page";
-import { expectStrokesFollow, strokeBounds } from "./strokes";
+import { afterAll, beforeAll, describe, it } from "vitest";
+import { FakeSleeve, FEELMYSIGN } from "./harness";
+import { screenshot, waitForData } from "./page";
+import { Processes } from "./processes";
+import { drawSquare, expectStrokesFollow, strokeBounds } from "./strokes";
 
 const hasUp = spawnSync(FEELMYSIGN, ["up", "--help"], { stdio: "ignore" }).status === 0;
 
 describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", () => {
-  const cleanups: (() => Promise<void>)[] = [];
+  const processes = new Processes();
   let page: Page;
   let sleeve: FakeSleeve;
 
   beforeAll(async () => {
-    checkPrerequisites();
-    const stateDir = tempDir("up");
-    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
-    const up = await startUp(stateDir);
-    cleanups.push(() => stopUp(up.child));
+    const up = await processes.up("up");
     // A second login of the sleeve account, listening only: what the simulated sleeve receives.
-    const credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
-    sleeve = await FakeSleeve.connect(credentials);
-    cleanups.push(() => sleeve.close());
-    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 } });
-    cleanups.push(browser.close);
-    page = await browser.context.newPage();
-    await page.goto(up.url);
+    sleeve = await FakeSleeve.connect(up.credentials);
+    processes.add(() => sleeve.close());
+    page = await processes.page(up.url);
   });
 
-  afterAll(async () => {
-    for (const cleanup of cleanups.reverse()) await cleanup();
-  });
+  afterAll(() => processes.stop());
 
   it("connects with nothing typed and sees the sleeve online", async () => {
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
@@ -55,23 +35,9 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
   });
 
   it("plays a square drawn with the mouse: strokes along it, cut at its corners, the preview lights up", async () => {
-    const area = await drawingArea(page);
-    const side = area.height * 0.6;
-    const left = area.left + (area.width - side) / 2;
-    const top = area.top + (area.height - side) / 2;
-    const corners = [
-      [left, top],
-      [left + side, top],
-      [left + side, top + side],
-      [left, top + side],
-    ] as const;
-    await drawWithMouse(page, [...corners, corners[0]]);
-    await nextFrame(page);
-    // Four sides; a long side may be cut by the latency cap, so four strokes or more.
-    const sent = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
-    expect(sent).toBeGreaterThanOrEqual(4);
+    const { area, path, sent } = await drawSquare(page);
     const strokes = await sleeve.waitForStrokes(sent);
-    expectStrokesFollow(strokes, [...corners, corners[0]], area, await strokeBounds(page, area));
+    expectStrokesFollow(strokes, path, area, await strokeBounds(page, area));
     await page.waitForFunction(
       () =>
         Number((document.querySelector('[data-testid="sleeve-preview"]') as HTMLElement).dataset["lit"]) > 0,
