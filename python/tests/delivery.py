@@ -10,14 +10,16 @@ import subprocess
 import threading
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import paho.mqtt.client as mqtt
+from conftest import StartBroker
 from sleeve_watch import SleeveWatch, settings, sleeve_command
 
-from feelmysign.broker import Credentials
+from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import new_client
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
@@ -143,6 +145,34 @@ class Sender:
     def stop(self) -> None:
         self.client.loop_stop()
         self.client.disconnect()
+
+
+class Delivery(NamedTuple):
+    broker: Broker
+    watcher: Watcher
+    sleeve: SleeveProcess
+    sender: Sender
+
+
+@contextmanager
+def delivery(
+    start_broker: StartBroker, tmp_path: Path, *sleeve_options: str, sleeve_login: bool = False
+) -> Iterator[Delivery]:
+    """A broker (state in ``tmp_path``/state), a watcher, a sleeve as its own process (with
+    ``sleeve_options``; ``sleeve_login``: the sleeve's own credentials file rather than the
+    broker's) and a sender, once the sleeve is online; all stopped at the end."""
+    broker = start_broker(state_dir=tmp_path / "state")
+    watcher = Watcher(broker.credentials)
+    credentials_path = broker.sleeve_credentials_path if sleeve_login else broker.credentials_path
+    sleeve = SleeveProcess(credentials_path, tmp_path / "sleeve.jsonl", *sleeve_options)
+    sender = Sender(broker.credentials)
+    try:
+        wait_for(watcher.is_online, "the sleeve to come online")
+        yield Delivery(broker, watcher, sleeve, sender)
+    finally:
+        sender.stop()
+        watcher.stop()
+        sleeve.stop()
 
 
 def stroke(drawing: str, seq: int, duration_ms: float, *, sent_at_ms: float | None) -> Stroke:

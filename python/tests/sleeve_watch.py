@@ -10,13 +10,13 @@ import threading
 import uuid
 from collections.abc import Callable
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
 import paho.mqtt.client as mqtt
 
 from feelmysign.broker import Credentials
 from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.lifecycle import Closing
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import TelemetryName, strokes_topic, telemetry_topic
@@ -90,7 +90,7 @@ def online(name: str, body: dict[str, Any]) -> bool:
     return name == "status" and body.get("online") is True
 
 
-class SleeveWatch:
+class SleeveWatch(Closing):
     """Every message on the sleeve's ``topics`` (``status``, ``events``, ``actuators``), in
     order, as ``(topic name, body)``; logged in as the sender. ``persistent`` keeps its
     session (and so the messages for it) through broker restarts."""
@@ -158,14 +158,3 @@ class SleeveWatch:
     def close(self) -> None:
         self.client.loop_stop()
         self.client.disconnect()
-
-    def __enter__(self) -> SleeveWatch:
-        return self
-
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        error: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, by_seq, played, stroke, wait_for
+from delivery import Sender, SleeveProcess, Watcher, by_seq, delivery, played, stroke, wait_for
 
 from feelmysign.broker import Broker
 
@@ -33,13 +33,8 @@ NO_PACE = ("--max-age-ms", "3600000", "--max-lag-ms", "600000")
 def test_every_stroke_the_broker_acknowledged_is_felt_once_after_a_sigkill(
     start_broker: StartBroker, tmp_path: Path, first: str
 ) -> None:
-    broker = start_broker(state_dir=tmp_path / "state")
-    watcher = Watcher(broker.credentials)
-    sleeve = SleeveProcess(broker.credentials_path, tmp_path / "sleeve.jsonl", *NO_PACE)
-    sender = Sender(broker.credentials)
     kill_at = random.randrange(5, STROKES - 5)
-    try:
-        wait_for(watcher.is_online, "the sleeve to come online")
+    with delivery(start_broker, tmp_path, *NO_PACE) as (broker, watcher, sleeve, sender):
         start_s = time.monotonic()
         for seq in range(STROKES):
             if seq == kill_at:
@@ -58,10 +53,6 @@ def test_every_stroke_the_broker_acknowledged_is_felt_once_after_a_sigkill(
         twice = {seq: len(group) for seq, group in events.items() if len(group) > 1}
         assert not twice, f"played more than once (broker killed at stroke {kill_at}): {twice}"
         assert any(change["intensity"] > 0 for change in sleeve.changes())
-    finally:
-        sender.stop()
-        watcher.stop()
-        sleeve.stop()
 
 
 def _kill_and_restart(

@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, by_seq, played, stroke, wait_for
+from delivery import by_seq, delivery, played, stroke, wait_for
 
 from feelmysign.pace import MAX_LAG_MS
 
@@ -24,13 +24,8 @@ SETTLE_S = 1.5  # once both are back: within this the sleeve must play every str
 def test_the_sleeve_is_back_in_real_time_after_an_outage(
     start_broker: StartBroker, tmp_path: Path
 ) -> None:
-    broker = start_broker(state_dir=tmp_path / "state")
-    c = broker.credentials
-    watcher = Watcher(c)
-    sleeve = SleeveProcess(broker.credentials_path, tmp_path / "sleeve.jsonl")
-    sender = Sender(c)
-    try:
-        wait_for(watcher.is_online, "the sleeve to come online")
+    with delivery(start_broker, tmp_path) as (broker, watcher, sleeve, sender):
+        c = broker.credentials
         sent_at_s: list[float] = []
         back_s: float | None = None
         start_s = time.monotonic()
@@ -84,7 +79,3 @@ def test_the_sleeve_is_back_in_real_time_after_an_outage(
             f"max {max((e['lag_ms'] for e in after), default=0):.0f} ms; both back "
             f"{(back_s - start_s - BEFORE_S - OUTAGE_S):.2f} s after the broker"
         )
-    finally:
-        sender.stop()
-        watcher.stop()
-        sleeve.stop()

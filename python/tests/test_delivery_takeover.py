@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, by_seq, played, stroke, wait_for
+from delivery import by_seq, delivery, played, stroke, wait_for
 from sleeve_watch import settings
 
 from feelmysign.connection import new_client
@@ -22,32 +22,30 @@ ATTEMPTS = 5
 def test_sender_logins_with_the_sleeves_client_id_do_not_disconnect_it(
     start_broker: StartBroker, tmp_path: Path
 ) -> None:
-    broker = start_broker(state_dir=tmp_path / "state")
-    c = broker.credentials
-    watcher = Watcher(c)
-    sleeve = SleeveProcess(broker.sleeve_credentials_path, tmp_path / "sleeve.jsonl")
-    sender = Sender(c)
-    # What an attacker with the sender's login would try: the sleeve's former client id,
-    # and the scheme's id computed with the password it has.
-    guesses = [f"feelmysign-sleeve-{c.sleeve_id}", sleeve_client_id(c.sleeve_id, c.sender.password)]
-    taken: list[str] = []
+    with delivery(start_broker, tmp_path, sleeve_login=True) as (broker, watcher, sleeve, sender):
+        c = broker.credentials
+        # What an attacker with the sender's login would try: the sleeve's former client id,
+        # and the scheme's id computed with the password it has.
+        guesses = [
+            f"feelmysign-sleeve-{c.sleeve_id}",
+            sleeve_client_id(c.sleeve_id, c.sender.password),
+        ]
+        taken: list[str] = []
 
-    def take_over() -> None:
-        for attempt in range(ATTEMPTS):
-            client_id = guesses[attempt % 2]
-            intruder = new_client(settings(c, "sender"), client_id=client_id)
-            accepted = threading.Event()
-            intruder.on_connect = lambda *args, accepted=accepted: accepted.set()
-            intruder.connect(c.mqtt_host, c.mqtt_port)
-            intruder.loop_start()
-            if accepted.wait(10):  # the broker let it in under that id
-                taken.append(client_id)
-            time.sleep(0.2)  # it stays a while, as a takeover would
-            intruder.loop_stop()
-            intruder.disconnect()
+        def take_over() -> None:
+            for attempt in range(ATTEMPTS):
+                client_id = guesses[attempt % 2]
+                intruder = new_client(settings(c, "sender"), client_id=client_id)
+                accepted = threading.Event()
+                intruder.on_connect = lambda *args, accepted=accepted: accepted.set()
+                intruder.connect(c.mqtt_host, c.mqtt_port)
+                intruder.loop_start()
+                if accepted.wait(10):  # the broker let it in under that id
+                    taken.append(client_id)
+                time.sleep(0.2)  # it stays a while, as a takeover would
+                intruder.loop_stop()
+                intruder.disconnect()
 
-    try:
-        wait_for(watcher.is_online, "the sleeve to come online")
         log_start = broker.log_path.stat().st_size
         intruders = threading.Thread(target=take_over)
         intruders.start()
@@ -65,10 +63,6 @@ def test_sender_logins_with_the_sleeves_client_id_do_not_disconnect_it(
         log = broker.log_path.read_bytes()[log_start:].decode(errors="replace")
         assert "closing old connection" not in log, log
         assert "lost the broker" not in sleeve.log.read_text()
-    finally:
-        sender.stop()
-        watcher.stop()
-        sleeve.stop()
 
 
 def test_the_client_id_depends_on_the_sleeves_password() -> None:

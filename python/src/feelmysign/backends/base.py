@@ -19,6 +19,7 @@ from typing import Literal, Protocol, TypeVar, runtime_checkable
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
+from feelmysign.lifecycle import Closing
 
 _B = TypeVar("_B", bound="Backend")
 _G = TypeVar("_G", bound="GridBackend")
@@ -77,7 +78,7 @@ def check_actuator(layout: Layout, row: int, column: int) -> None:
         raise ParameterError("column", column, f"an integer in 0..{layout.columns - 1} ({grid})")
 
 
-class GridBackend(ABC):
+class GridBackend(Closing, ABC):
     """Shared behaviour of the backends; subclasses write to their output in ``_write``.
 
     Lifecycle: new -> open -> closed. ``set_intensity`` needs an open backend
@@ -159,14 +160,6 @@ class GridBackend(ABC):
     def __enter__(self: _G) -> _G:
         self.open()
         return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
 
     @abstractmethod
     def _open(self) -> None:

@@ -26,9 +26,9 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from types import TracebackType
 
 from feelmysign.errors import ParameterError
+from feelmysign.lifecycle import Started
 
 _log = logging.getLogger(__name__)
 
@@ -60,7 +60,7 @@ class ActuatorFrame:
         }
 
 
-class ActuatorTelemetry:
+class ActuatorTelemetry(Started):
     """Hands the latest actuator grid to ``publish`` at most ``rate_hz`` times a second.
 
     ``clock`` returns milliseconds. :meth:`start` runs the publisher on a daemon
@@ -139,18 +139,6 @@ class ActuatorTelemetry:
         if thread is not None:
             thread.join()
         self.flush()
-
-    def __enter__(self) -> ActuatorTelemetry:
-        self.start()
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.stop()
 
     def _due_in_ms_locked(self, now_ms: float) -> float | None:
         if self._pending is None:

@@ -23,7 +23,6 @@ import sys
 import time
 from dataclasses import replace
 from pathlib import Path
-from types import TracebackType
 
 from feelmysign.broker import _process as process_
 from feelmysign.broker._config import LOOPBACK_ADDRESS, StateFiles, TlsListener, render_config
@@ -39,6 +38,7 @@ from feelmysign.broker.credentials import (
 )
 from feelmysign.broker.tls import LanOptions, TlsFiles
 from feelmysign.errors import BrokerError
+from feelmysign.lifecycle import Started
 from feelmysign.topics import LEGACY_TOPIC
 
 DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
@@ -64,7 +64,7 @@ def default_state_dir() -> Path:
     return Path(state_home) / "feelmysign" / "broker"
 
 
-class Broker:
+class Broker(Started):
     """Mosquitto on 127.0.0.1 with one sleeve account, one sender account and their ACL.
 
     Options are checked when the object is made; ``start()`` (or ``with``) writes the
@@ -171,18 +171,6 @@ class Broker:
                 "not-running", "The broker is not running: call start() or use 'with Broker(...)'."
             )
         return self._credentials
-
-    def __enter__(self) -> Broker:
-        self.start()
-        return self
-
-    def __exit__(
-        self,
-        _type: type[BaseException] | None,
-        _value: BaseException | None,
-        _traceback: TracebackType | None,
-    ) -> None:
-        self.stop()
 
     def start(self) -> Credentials:
         """Write the files, start Mosquitto, wait until it accepts a login; return credentials."""

@@ -27,7 +27,6 @@ import sys
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from types import TracebackType
 
 import paho.mqtt.client as mqtt
 from paho.mqtt.enums import CallbackAPIVersion
@@ -44,6 +43,7 @@ from feelmysign.broker.credentials import (
 from feelmysign.broker.nats_accounts import render_nats_accounts
 from feelmysign.broker.tls import TlsFiles
 from feelmysign.errors import BrokerError
+from feelmysign.lifecycle import Started
 from feelmysign.topics import LEGACY_TOPIC
 
 REPO = Path(__file__).resolve().parents[4]
@@ -88,7 +88,7 @@ def nats_server_path() -> Path:
     return path
 
 
-class NatsCluster:
+class NatsCluster(Started):
     """Three nats-server processes on 127.0.0.1 with JetStream, MQTT and MQTT over WebSockets."""
 
     def __init__(
@@ -109,18 +109,6 @@ class NatsCluster:
     @property
     def mqtt_urls(self) -> str:
         return ",".join(node.mqtt_url for node in self.nodes)
-
-    def __enter__(self) -> NatsCluster:
-        self.start()
-        return self
-
-    def __exit__(
-        self,
-        _type: type[BaseException] | None,
-        _value: BaseException | None,
-        _traceback: TracebackType | None,
-    ) -> None:
-        self.stop()
 
     def start(self) -> None:
         executable = nats_server_path()

@@ -12,17 +12,17 @@ reports nothing the shutdown itself causes.
 from __future__ import annotations
 
 import threading
-from types import TracebackType
 from urllib.parse import urlsplit
 
 from feelmysign.broker import Broker
 from feelmysign.daemon import Sleeve
 from feelmysign.errors import BrokerError
+from feelmysign.lifecycle import Started
 
 CHECK_INTERVAL_S = 0.5  # how soon a dead broker or a lost sleeve is noticed
 
 
-class Watchdog:
+class Watchdog(Started):
     """Use as a context manager around the broker's life; ``watch`` the sleeve once it runs."""
 
     def __init__(self, broker: Broker) -> None:
@@ -33,18 +33,12 @@ class Watchdog:
         self._sleeve: Sleeve | None = None
         self._thread = threading.Thread(target=self._run, name="feelmysign-watchdog", daemon=True)
 
-    def __enter__(self) -> Watchdog:
+    def start(self) -> None:
         # Kept now: a broker that died no longer tells its ports and accounts.
         self._credentials = self._broker.credentials
         self._thread.start()
-        return self
 
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        error: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
+    def stop(self) -> None:
         self._stopped.set()
         self._wake.set()
         self._thread.join(timeout=5.0)
