@@ -197,6 +197,34 @@ def test_a_drawing_plays_in_order_back_to_back(running: Running, broker: Broker)
     sender.loop_stop()
 
 
+def test_a_stroke_after_later_ones_plays_and_every_copy_is_a_duplicate(
+    running: Running, broker: Broker
+) -> None:
+    # What a broker that fails over does (NATS after ack_wait): a stroke comes again after
+    # later ones, as a copy of one already played or refused, or for the first time.
+    sender = _sender(broker.credentials)
+    drawing = str(uuid.uuid4())
+    now_ms = time.time() * 1000
+
+    def send(seq: int, sent_at_ms: float = now_ms) -> None:
+        stroke = Stroke((0.0, 0.0), (3.0, 2.0), 120.0, 0.8, drawing, seq, sent_at_ms)
+        sid = broker.credentials.sleeve_id
+        sender.publish(topic(sid, "strokes"), format_json(stroke), qos=1).wait_for_publish(5)
+
+    for seq in (0, 2, 3, 1):
+        send(seq)
+    played = running.wait_events(4)
+    assert [e["seq"] for e in played] == [0, 2, 3, 1]
+    assert {e["type"] for e in played} <= {"played", "adjusted"}
+    send(4, sent_at_ms=now_ms - 60_000)  # stale
+    assert running.wait_events(5)[4]["reason"] == "stale"
+    for seq in (2, 4, 1):
+        send(seq)  # copies, and fresh by their send time: still played or refused once
+    copies = running.wait_events(8)[5:]
+    assert [(e["reason"], e["seq"]) for e in copies] == [("duplicate", s) for s in (2, 4, 1)]
+    sender.loop_stop()
+
+
 def _garbage() -> list[tuple[str, bytes, str]]:
     """Every invalid protocol vector as (topic kind, payload, expected reason)."""
     items = []

@@ -22,6 +22,7 @@ class Sleeve:
         start_ms = max(received_ms, self.tail_ms)
         verdict = self.policy.check(
             drawing="d",
+            seq=seq,
             sent_at_ms=sent_at_ms,
             received_wall_ms=received_ms,
             start_wall_ms=start_ms,
@@ -85,3 +86,25 @@ def test_strokes_without_a_send_time_are_never_refused() -> None:
         drawing="d", sent_at_ms=None, received_wall_ms=1e9, start_wall_ms=2e9, duration_ms=1.0
     )
     assert verdict == Verdict()
+
+
+def test_a_stroke_after_later_ones_is_due_at_its_own_time_and_moves_nothing() -> None:
+    # A broker that failed over delivers stroke 3 again after 4..9 played: under the
+    # cluster's pace it plays; it is measured against its own send time, not the line's,
+    # and the strokes after it keep to their own time line.
+    policy = PacePolicy(max_age_ms=60_000.0, max_lag_ms=30_000.0)
+    sleeve = Sleeve(policy)
+    for k in (0, 1, 2, 4, 5, 6, 7, 8, 9):
+        assert sleeve.receive(k, 1e6 + k * DURATION_MS, 5.0).reason is None
+    redelivered = sleeve.receive(3, 1e6 + 3 * DURATION_MS, 10_000.0)
+    assert redelivered.reason is None
+    assert redelivered.lag_ms == pytest.approx(10_000.0 - 5.0)
+    after = [sleeve.receive(k, 1e6 + k * DURATION_MS, 5.0) for k in range(60, 70)]
+    assert all(v.reason is None and v.lag_ms == pytest.approx(0.0) for v in after)
+    # Under the default pace the same copy is late, and only it: no catch-up follows.
+    policy = PacePolicy()
+    sleeve = Sleeve(policy)
+    for k in (0, 1, 2, 4, 5):
+        assert sleeve.receive(k, 1e6 + k * DURATION_MS, 5.0).reason is None
+    assert sleeve.receive(3, 1e6 + 3 * DURATION_MS, 5_000.0).reason == LATE
+    assert sleeve.receive(6, 1e6 + 6 * DURATION_MS, 5.0).reason is None

@@ -433,6 +433,13 @@ class Sleeve:
                 stroke.drawing,
             )
             return
+        repeat = self._player.repeat(stroke.drawing, stroke.seq)
+        if repeat is not None:
+            # A copy of a stroke played or refused before, whose acknowledgement was lost
+            # (a dropped connection, a failed server): dropped before the rate limit and the
+            # pace rules see it, so it is reported as what it is and changes nothing.
+            self._reject(repeat.reason, repeat.message, info, received_wall_ms, ack)
+            return
         if not self._bucket.take():
             self._reject(
                 "rate_limited",
@@ -450,6 +457,7 @@ class Sleeve:
             return
         verdict = self._pace.check(
             drawing=stroke.drawing,
+            seq=stroke.seq,
             sent_at_ms=stroke.sent_at_ms,
             received_wall_ms=received_wall_ms,
             start_wall_ms=received_wall_ms + self._player.wait_ms(received_at_ms),
@@ -500,7 +508,12 @@ class Sleeve:
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
         rejected = Rejected(reason=reason, message=message, **info, received_at_ms=received_wall_ms)
-        self._event(rejected, None if reason in NOT_ACKNOWLEDGED else ack)
+        if reason in NOT_ACKNOWLEDGED:
+            ack = None
+        elif ack is not None:
+            # Settled: a copy the broker delivers again gets no second verdict.
+            self._player.remember(info.get("drawing"), info.get("seq"))
+        self._event(rejected, ack)
 
     def _event(self, event: Event, ack: _Ack | None = None) -> None:
         """Called from the player thread too: only queues, never touches the network.

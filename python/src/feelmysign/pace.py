@@ -19,7 +19,11 @@ format) is never refused by them:
   network or the broker away for 10 s) the backlog arrives at once: the sleeve
   skips strokes until it is back within ``catch_up_ms`` of the sender's time line
   (a quarter of ``max_lag_ms``), so it is back in real time at once instead of
-  running 10 s late for the rest of the drawing.
+  running 10 s late for the rest of the drawing. A stroke that comes after a
+  later one of its drawing (a broker that failed over delivers it again) is due
+  at its own ``sent_at_ms`` and leaves the time line as it was: it is late when
+  it starts more than ``max_lag_ms`` after that, and neither pushes the
+  strokes after it back nor starts a catch-up.
 
 The policy is pure (numbers in, a verdict out); the daemon feeds it and reports
 the verdicts as ``rejected`` events with reason ``stale`` or ``late``.
@@ -60,6 +64,7 @@ class _TimeLine:
     smallest_delay_ms: float  # receive minus send: transit time plus the clocks' difference
     due_end_ms: float  # when the stroke before ends on the sender's time line
     catching_up: bool = False
+    last_seq: int | None = None  # the highest seq checked so far
 
 
 class PacePolicy:
@@ -75,6 +80,7 @@ class PacePolicy:
         self,
         *,
         drawing: str | None,
+        seq: int | None = None,
         sent_at_ms: float | None,
         received_wall_ms: float,
         start_wall_ms: float,
@@ -86,6 +92,10 @@ class PacePolicy:
             return Verdict()
         age_ms = received_wall_ms - sent_at_ms
         line = self._time_line(drawing, sent_at_ms)
+        if seq is not None and line.last_seq is not None and seq < line.last_seq:
+            line = _TimeLine(line.smallest_delay_ms, sent_at_ms)  # on its own, not kept
+        elif seq is not None:
+            line.last_seq = seq
         due_ms = max(sent_at_ms, line.due_end_ms)
         line.due_end_ms = due_ms + duration_ms
         if age_ms > self.max_age_ms:

@@ -3,9 +3,13 @@
 Strokes play back to back: a stroke that arrives while another is playing
 starts the moment the one before it ends (its duration T), so the strokes of
 a drawing feel like one continuous touch; a stroke that arrives to an idle
-sleeve starts at once. Within a drawing, strokes play in ``seq`` order: a
-repeated or older ``seq`` (a redelivery) is dropped, and a gap (the sender
-drops strokes too short to feel) never waits for the missing one. A copy of a
+sleeve starts at once. Strokes play in the order they arrive, each ``seq`` of a
+drawing once: a copy of a stroke already played or refused (a redelivery) is
+dropped as a ``duplicate``, a gap (the sender drops strokes too short to feel)
+never waits for the missing one, and a missing one that comes after all still
+plays (a broker that fails over delivers a stroke again, after later ones,
+when the acknowledgement died with the server or it never reached the
+sleeve: the sender was told it was delivered). A copy of a
 stroke still waiting to play (the broker sends again what was not acknowledged
 when a connection dropped) is not dropped but ``hold``: its acknowledgement
 waits for the stroke, so the broker keeps it until it is felt.
@@ -22,6 +26,7 @@ each write's lateness is kept for ``timing_errors_ms``.
 
 from __future__ import annotations
 
+import bisect
 import logging
 import sys
 import threading
@@ -48,7 +53,7 @@ SWITCH_INTERVAL_S = 0.0002
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
 MAX_PENDING = 256
 MAX_BACKLOG_MS = 30_000.0
-REMEMBERED_DRAWINGS = 64  # drawings whose last seq is kept, for dropping redeliveries
+REMEMBERED_DRAWINGS = 64  # drawings whose seqs are kept, for dropping redeliveries
 TIMING_SAMPLES = 100_000
 
 
@@ -100,6 +105,40 @@ class Refusal:
     message: str
 
 
+class SeenSeqs:
+    """The seqs of one drawing seen so far, as sorted disjoint ranges [low, high): a drawing
+    sent in order is one range whatever its length, each gap adds one."""
+
+    def __init__(self) -> None:
+        self._lows: list[int] = []
+        self._highs: list[int] = []
+
+    def __contains__(self, seq: int) -> bool:
+        i = bisect.bisect_right(self._lows, seq) - 1
+        return i >= 0 and seq < self._highs[i]
+
+    def add(self, seq: int) -> None:
+        if seq in self:
+            return
+        i = bisect.bisect_right(self._lows, seq)  # the range after seq, if any
+        joins_before = i > 0 and self._highs[i - 1] == seq
+        joins_after = i < len(self._lows) and self._lows[i] == seq + 1
+        if joins_before and joins_after:
+            self._highs[i - 1] = self._highs[i]
+            del self._lows[i], self._highs[i]
+        elif joins_before:
+            self._highs[i - 1] = seq + 1
+        elif joins_after:
+            self._lows[i] = seq
+        else:
+            self._lows.insert(i, seq)
+            self._highs.insert(i, seq + 1)
+
+    @property
+    def ranges(self) -> int:
+        return len(self._lows)
+
+
 class Player:
     """Call ``start`` once, ``submit`` from any thread, ``stop`` to end with every motor off."""
 
@@ -126,7 +165,8 @@ class Player:
         self._inbox: deque[PlannedStroke] = deque()
         self._pending = 0
         self._tail_ms = float("-inf")
-        self._last_seq: OrderedDict[str, int] = OrderedDict()
+        # Per drawing, the seqs accepted or settled (see remember): a copy of one is a duplicate.
+        self._seen: OrderedDict[str, SeenSeqs] = OrderedDict()
         # Accepted, with a drawing and seq, and not yet started, refused or dropped: what a
         # redelivered copy must wait for (see hold).
         self._unplayed: dict[tuple[str, int], PlannedStroke] = {}
@@ -146,14 +186,11 @@ class Player:
         if not self._running:
             return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
         with self._lock:
-            refusal = self._check_order(drawing, seq) or self._check_room(stroke)
+            refusal = self._check_repeat(drawing, seq) or self._check_room(stroke)
             if refusal:
                 return refusal
             if isinstance(drawing, str) and isinstance(seq, int):
-                self._last_seq[drawing] = seq
-                self._last_seq.move_to_end(drawing)
-                while len(self._last_seq) > REMEMBERED_DRAWINGS:
-                    self._last_seq.popitem(last=False)
+                self._remember(drawing, seq)
                 self._unplayed[(drawing, seq)] = stroke
             stroke.number = self._accepted
             self._accepted += 1
@@ -193,17 +230,36 @@ class Player:
         with self._lock:
             return max(0.0, self._tail_ms - now_ms)
 
-    def _check_order(self, drawing: object, seq: object) -> Refusal | None:
+    def repeat(self, drawing: object, seq: object) -> Refusal | None:
+        """A ``duplicate`` refusal when this stroke was accepted or settled before, else None:
+        for checking a copy before anything else counts it (the rate limit, the pace rules)."""
+        with self._lock:
+            return self._check_repeat(drawing, seq)
+
+    def remember(self, drawing: object, seq: object) -> None:
+        """A stroke settled without playing (refused and acknowledged): a copy of it the broker
+        delivers again is a ``duplicate`` too, not a second verdict."""
+        if isinstance(drawing, str) and isinstance(seq, int):
+            with self._lock:
+                self._remember(drawing, seq)
+
+    def _remember(self, drawing: str, seq: int) -> None:
+        seen = self._seen.get(drawing)
+        if seen is None:
+            seen = self._seen[drawing] = SeenSeqs()
+            while len(self._seen) > REMEMBERED_DRAWINGS:
+                self._seen.popitem(last=False)
+        self._seen.move_to_end(drawing)
+        seen.add(seq)
+
+    def _check_repeat(self, drawing: object, seq: object) -> Refusal | None:
         if not isinstance(drawing, str) or not isinstance(seq, int):
             return None
-        last = self._last_seq.get(drawing)
-        if last is None or seq > last:
+        seen = self._seen.get(drawing)
+        if seen is None or seq not in seen:
             return None
-        if seq == last:
-            return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already accepted")
         return Refusal(
-            "out_of_order",
-            f"stroke {seq} of drawing {drawing} arrived after stroke {last}; strokes play in order",
+            "duplicate", f"stroke {seq} of drawing {drawing} was already played or refused"
         )
 
     def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
