@@ -1,7 +1,8 @@
-"""The NATS cluster with TLS on its MQTT and WebSocket listeners (deploy/nats/node.conf), its
-certificate from the project's own CA: a sleeve joins with a token that pins the CA and
-plays a stroke sent over wss:// to another node; a client trusting another CA is refused
-before it sends anything, on both listeners."""
+"""The NATS cluster with TLS on its MQTT and WebSocket listeners and its routes
+(deploy/nats/node.conf), its certificate from the project's own CA: a sleeve joins with a
+token that pins the CA and plays a stroke sent over wss:// to another node (through the
+routes); a client trusting another CA is refused before it sends anything, on both
+listeners; a server with a certificate from another CA cannot join the cluster."""
 
 from __future__ import annotations
 
@@ -11,18 +12,24 @@ import queue
 import ssl
 import subprocess
 import sys
+import time
+import urllib.error
+import urllib.request
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import paho.mqtt.client as mqtt
 import pytest
+from cryptography import x509
+from cryptography.hazmat.primitives import hashes
 
+from feelmysign.broker import _process as process_
 from feelmysign.broker.credentials import reuse_or_create
-from feelmysign.broker.nats_cluster import NatsCluster
-from feelmysign.broker.tls import ensure_local_ca
+from feelmysign.broker.nats_cluster import NatsCluster, NatsNode, nats_server_path
+from feelmysign.broker.tls import TlsFiles, ensure_local_ca
 from feelmysign.connection import BrokerSettings, new_client, parse_broker_url
 from feelmysign.connection.join_token import JoinToken
 from feelmysign.protocol import format_json
@@ -125,3 +132,64 @@ def test_a_client_trusting_another_ca_is_refused_before_it_logs_in(
     client = new_client(_sender(cluster, url, None), client_id=f"test-{uuid.uuid4()}")
     with pytest.raises(ssl.SSLCertVerificationError):
         client.connect(settings.host, settings.port)
+
+
+def _routes(monitor_port: int) -> int:
+    """How many routes the server with this monitoring port has (its /routez); -1 while it
+    does not listen yet."""
+    url = f"http://127.0.0.1:{monitor_port}/routez"
+    try:
+        with urllib.request.urlopen(url, timeout=10) as reply:
+            return int(json.load(reply)["num_routes"])
+    except urllib.error.URLError:
+        return -1
+
+
+def _until(condition: Callable[[], bool], what: str) -> None:
+    deadline = time.monotonic() + WAIT_S
+    while not condition():
+        assert time.monotonic() < deadline, what
+        time.sleep(0.2)
+
+
+def test_a_server_with_a_certificate_from_another_ca_cannot_join_the_cluster(
+    cluster: NatsCluster, tmp_path: Path
+) -> None:
+    assert cluster.tls is not None and cluster.tls.ca is not None
+    free = process_.free_port
+    # It trusts the cluster's CA (so only the cluster's check of its certificate stands in
+    # its way), and presents a certificate for 127.0.0.1 from another CA.
+    other = ensure_local_ca(tmp_path / "other-ca", ["127.0.0.1"])
+    intruder_tls = replace(other, ca=cluster.tls.ca)
+    leaf = x509.load_pem_x509_certificates(other.cert.read_bytes())[0]
+    leaf_sha256 = leaf.fingerprint(hashes.SHA256()).hex()
+    executable = nats_server_path()
+    a, b = cluster.nodes[0], cluster.nodes[1]
+
+    def server(name: str, tls: TlsFiles) -> tuple[subprocess.Popen[bytes], int]:
+        node = NatsNode(name, free("127.0.0.1"), free("127.0.0.1"), 0, 0, tls=True)
+        node = replace(node, mqtt_port=free("127.0.0.1"), ws_port=free("127.0.0.1"))
+        monitor = free("127.0.0.1")
+        return cluster.spawn(executable, node, [a, b], tls, "-m", str(monitor)), monitor
+
+    def refused_by(node: NatsNode) -> bool:
+        log = (cluster.state_dir / f"{node.name}.log").read_text(errors="replace")
+        return any(
+            "TLS route handshake error" in line and leaf_sha256 in line for line in log.splitlines()
+        )
+
+    intruder, intruder_monitor = server("x", intruder_tls)
+    try:
+        _until(lambda: refused_by(a) and refused_by(b), "a and b never refused the intruder")
+        assert _routes(intruder_monitor) == 0
+        assert intruder.poll() is None  # it is still trying: refused, not misconfigured
+    finally:
+        intruder.kill()
+        intruder.wait()
+    # The same server with the cluster's own certificate joins: the refusal was the CA's.
+    member, member_monitor = server("y", cluster.tls)
+    try:
+        _until(lambda: _routes(member_monitor) >= 2, "a server with the cluster's CA never joined")
+    finally:
+        member.kill()
+        member.wait()

@@ -10,9 +10,10 @@
 Every node runs the same configuration (``deploy/nats/*.conf``, copied into the state
 directory next to the ``accounts.conf`` rendered from ``credentials``), its ports and
 routes given through the environment, as in production: ``node-loopback.conf``, or
-with ``tls=`` (a certificate for 127.0.0.1, e.g. from ``broker.tls.ensure_local_ca``)
-``node.conf``, whose MQTT and WebSocket listeners speak only TLS (``mqtts://``,
-``wss://``). ``python -m feelmysign.broker.nats_cluster DIR``
+with ``tls=`` (a certificate for 127.0.0.1 from ``broker.tls.ensure_local_ca``)
+``node.conf``, whose MQTT and WebSocket listeners and routes speak only TLS
+(``mqtts://``, ``wss://``; a route only with a certificate from the same CA).
+``python -m feelmysign.broker.nats_cluster DIR``
 runs one until Ctrl-C and prints its URLs and accounts as JSON (the browser tests use it).
 """
 
@@ -139,6 +140,22 @@ class NatsCluster(Started):
 
     def _spawn(self, executable: Path, node: NatsNode) -> subprocess.Popen[bytes]:
         others = [n for n in self.nodes if n is not node]
+        return self.spawn(executable, node, others, self.tls)
+
+    def spawn(
+        self,
+        executable: Path,
+        node: NatsNode,
+        routes_to: list[NatsNode],
+        tls: TlsFiles | None,
+        *args: str,
+    ) -> subprocess.Popen[bytes]:
+        """nats-server for ``node``, with its routes to two ``routes_to``, on this cluster's
+        configuration and TLS files ``tls`` (its CA trusted on the routes), with the
+        command-line options ``args``. Not one of ``nodes``: for a test of a server trying
+        to join the cluster."""
+        if tls is not None and tls.ca is None:
+            raise BrokerError("tls", "the routes need a CA of the cluster's own to trust")
         env = {
             **os.environ,
             "NODE_NAME": node.name,
@@ -148,16 +165,18 @@ class NatsCluster(Started):
             "MQTT_PORT": str(node.mqtt_port),
             "WS_PORT": str(node.ws_port),
             "STORE_DIR": str(self.state_dir / f"store-{node.name}"),
-            "ROUTE_1": f"nats-route://127.0.0.1:{others[0].cluster_port}",
-            "ROUTE_2": f"nats-route://127.0.0.1:{others[1].cluster_port}",
+            "ROUTE_1": f"nats-route://127.0.0.1:{routes_to[0].cluster_port}",
+            "ROUTE_2": f"nats-route://127.0.0.1:{routes_to[1].cluster_port}",
         }
-        if self.tls is not None:
-            env |= {"TLS_CERT": str(self.tls.cert), "TLS_KEY": str(self.tls.key)}
-        conf = TLS_CONF if self.tls is not None else LOOPBACK_CONF
+        if tls is not None:
+            cert, key = str(tls.cert), str(tls.key)
+            env |= {"TLS_CERT": cert, "TLS_KEY": key, "ROUTE_CERT": cert, "ROUTE_KEY": key}
+            env["ROUTE_CA"] = str(tls.ca)
+        conf = TLS_CONF if tls is not None else LOOPBACK_CONF
         log = (self.state_dir / f"{node.name}.log").open("ab")
         with log:
             return subprocess.Popen(
-                [str(executable), "-c", str(self.state_dir / conf)],
+                [str(executable), "-c", str(self.state_dir / conf), *args],
                 env=env,
                 stdin=subprocess.DEVNULL,
                 stdout=log,

@@ -37,6 +37,7 @@ RENEW_BEFORE_DAYS = 30
 # Clocks on a Pi without a real-time clock can be behind at boot.
 BACKDATE = datetime.timedelta(days=1)
 CA_NAME = "feelmysign local CA"
+SERVER_USAGES = (ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH)
 
 
 DEFAULT_MQTTS_PORT = 8883  # IANA's MQTT-over-TLS port
@@ -167,6 +168,7 @@ def _server_cert_fits(
     try:
         cert = x509.load_pem_x509_certificates(server_pem.read_bytes())[0]
         names = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+        usages = cert.extensions.get_extension_for_class(x509.ExtendedKeyUsage).value
     except (ValueError, x509.ExtensionNotFound):
         return False
     wanted = set(_general_names(hosts))
@@ -174,6 +176,7 @@ def _server_cert_fits(
     return (
         cert.issuer == ca_cert.subject
         and wanted <= set(names)
+        and set(SERVER_USAGES) <= set(usages)
         and left > datetime.timedelta(days=RENEW_BEFORE_DAYS)
     )
 
@@ -197,7 +200,9 @@ def _write_server_cert(
         .not_valid_after(now + datetime.timedelta(days=SERVER_VALIDITY_DAYS))
         .add_extension(x509.SubjectAlternativeName(_general_names(hosts)), critical=False)
         .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
-        .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), critical=False)
+        # Client use too: the servers of a NATS cluster present it to each other on their
+        # routes, both ways (deploy/nats/node.conf).
+        .add_extension(x509.ExtendedKeyUsage(SERVER_USAGES), critical=False)
         .add_extension(
             x509.AuthorityKeyIdentifier.from_issuer_public_key(ca_key.public_key()),
             critical=False,
