@@ -21,7 +21,7 @@ help:
 	@echo "             options for 'feelmysign up' go in ARGS, e.g. make up ARGS=\"--http-port 8080\""
 	@echo "make test    install what is needed, then lint, type-check and run every test"
 	@echo "make bench   print performance figures"
-	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200)"
+	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 
 $(RUN_STAMP): python/pyproject.toml
@@ -153,9 +153,10 @@ $(NATS_STAMP):
 pytest: $(NATS_STAMP)
 web-browser-test: $(NATS_STAMP)
 
-# N sleeves and N senders at once on Mosquitto and on the NATS cluster (N = 20, 100, 200),
-# against a bare publish -> receive baseline of the same run. Several minutes.
+# N sleeves and N senders at once on Mosquitto and on the NATS cluster (N = 20, 100, 200,
+# or make load N='20 100'), against a bare publish -> receive baseline of the same run.
+# Several minutes.
 .PHONY: load
 load: $(STAMP) system $(NATS_STAMP)
-	$(PY) -m feelmysign.bench.load
+	$(PY) -m feelmysign.bench.load $(N)
 # ==== end of NATS =========================================================================

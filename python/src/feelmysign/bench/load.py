@@ -1,6 +1,7 @@
 """Load: N sleeves and N senders drawing at once, on Mosquitto and on a 3-node NATS cluster.
 
-``python -m feelmysign.bench.load [N ...]`` (``make load``; N = 20 100 200 by default).
+``python -m feelmysign.bench.load [N ...]`` (``make load``, or ``make load N='20 100'``;
+N = 20 100 200 by default, each 1 to 1000).
 
 For each broker and each N, in one run, on a broker started anew:
 
@@ -49,10 +50,15 @@ from feelmysign.broker import Broker
 from feelmysign.broker.credentials import Account, Credentials, reuse_or_create
 from feelmysign.broker.nats_cluster import NatsCluster
 from feelmysign.broker.sleeves import add_sleeve
+from feelmysign.cli._inputs import whole_number
+from feelmysign.cli._parser import CliParser
 from feelmysign.connection import new_client, parse_broker_url
 from feelmysign.topics import telemetry_topic
 
 DEFAULT_COUNTS = (20, 100, 200)
+# Each N is 3 N clients and 2 N worker-process threads on one machine: beyond this the
+# figures measure the machine's limits, not the broker path.
+MAX_COUNT = 1000
 # A sleeve refuses, and reports, a stroke it would play more than 1 s behind its sender
 # (or 10 s after it was sent). When the sleeves did, the run is repeated with room for a
 # minute, as a cluster's sleeves may run (docs/deploy.md): is every stroke played then?
@@ -393,8 +399,26 @@ def report(counts: tuple[int, ...] = DEFAULT_COUNTS) -> list[str]:
     return lines
 
 
+def parse_counts(argv: list[str]) -> tuple[int, ...]:
+    """The N of each run, from the command line; one ``Error:`` line and exit 2 if bad."""
+    parser = CliParser(
+        prog="python -m feelmysign.bench.load",
+        description="N sleeves and N senders drawing at once, on Mosquitto and on a 3-node "
+        "NATS cluster (make load N='20 100').",
+    )
+    parser.add_argument(
+        "counts",
+        nargs="*",
+        type=whole_number(1, MAX_COUNT),
+        metavar="N",
+        help=f"sleeves (and senders) at once, 1 to {MAX_COUNT}; default "
+        + " ".join(map(str, DEFAULT_COUNTS)),
+    )
+    return tuple(parser.parse_args(argv).counts) or DEFAULT_COUNTS
+
+
 def main(argv: list[str]) -> None:
-    counts = tuple(int(a) for a in argv) or DEFAULT_COUNTS
+    counts = parse_counts(argv)
     # Each paho client holds a socket and a wake-up pair; a broker under load holds
     # thousands: raised to the hard limit, as a broker's service would be.
     soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
