@@ -2,13 +2,16 @@
 (deploy/nats/node.conf), its certificate from the project's own CA: a sleeve joins with a
 token that pins the CA and plays a stroke sent over wss:// to another node (through the
 routes); a client trusting another CA is refused before it sends anything, on both
-listeners; a server with a certificate from another CA cannot join the cluster."""
+listeners; the NATS client port takes no password in clear text; a server with a
+certificate from another CA cannot join the cluster."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import queue
+import socket
 import ssl
 import subprocess
 import sys
@@ -193,3 +196,21 @@ def test_a_server_with_a_certificate_from_another_ca_cannot_join_the_cluster(
     finally:
         member.kill()
         member.wait()
+
+
+def test_the_nats_client_port_takes_no_password_in_clear_text(cluster: NatsCluster) -> None:
+    # Its users are the MQTT accounts: a core NATS client sending its password in the
+    # clear would give it away. The server asks for TLS first, and a plain CONNECT gets
+    # nothing back but the end of the connection.
+    sender = cluster.credentials.sender
+    with socket.create_connection(("127.0.0.1", cluster.nodes[0].client_port), WAIT_S) as plain:
+        plain.settimeout(WAIT_S)
+        reader = plain.makefile("rb")
+        info = reader.readline()
+        assert info.startswith(b"INFO ") and json.loads(info[5:]).get("tls_required") is True
+        login = {"user": sender.username, "pass": sender.password, "verbose": True}
+        with contextlib.suppress(OSError):  # the server may close before it reads it all
+            plain.sendall(b"CONNECT " + json.dumps(login).encode() + b"\r\nPING\r\n")
+        with contextlib.suppress(OSError):
+            reply = reader.read()
+            assert b"+OK" not in reply and b"PONG" not in reply, reply
