@@ -17,6 +17,8 @@ const SECOND = "arm2";
 const PICKER = '[data-testid="sleeve-select"]';
 const CHIP = '[data-testid="sleeve-status"]';
 const LAYOUT = { rows: 3, columns: 4, spacing_cm: 3 };
+/** Telemetry of every actuator of a 3 x 4 sleeve at full strength. */
+const ALL_ON = { rows: 3, columns: 4, intensities: [1, 1, 1].map(() => [1, 1, 1, 1]) };
 
 /** The picker's options as the sender reads them: "id · state". */
 async function options(page: Page): Promise<string[]> {
@@ -117,6 +119,47 @@ describe("two sleeves on one broker, chosen on the page", () => {
     await waitForPlayed(page);
     expect(second.strokes().length).toBe(sent);
     await screenshot(page, "sleeves-picker");
+  });
+
+  it("once another sleeve is picked, shows none of the first sleeve's events or telemetry", async () => {
+    await page.locator(PICKER).selectOption("sleeve1");
+    await waitForData(page, CHIP, "state", "online");
+    // The first sleeve's events still show while it is the one chosen.
+    await first.publish("events", {
+      type: "error",
+      reason: "backend",
+      message: "sleeve1 speaks while chosen",
+    });
+    await page.getByText("sleeve1 speaks while chosen").waitFor({ timeout: 15_000 });
+    // And its actuators light the preview (again if the simulated sleeve's own frame came between).
+    for (let tries = 0; ; tries++) {
+      await first.publish("actuators", ALL_ON);
+      try {
+        await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "12", 2000);
+        break;
+      } catch (error) {
+        if (tries === 10) throw error;
+      }
+    }
+
+    await page.locator(PICKER).selectOption(SECOND);
+    await waitForData(page, CHIP, "state", "online");
+    await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0");
+    // Then the first sleeve speaks and vibrates, and after it (acknowledged by the broker first,
+    // so delivered first) the second: once the second's line shows, the first's would have.
+    await first.publish("events", {
+      type: "error",
+      reason: "backend",
+      message: "sleeve1 speaks after the switch",
+    });
+    await first.publish("actuators", ALL_ON);
+    await second.publish("events", { type: "error", reason: "backend", message: `${SECOND} speaks` });
+    await page.getByText(`${SECOND} speaks`).waitFor({ timeout: 15_000 });
+    await nextFrame(page);
+    const log = await page.locator('[data-testid="event-log"]').innerText();
+    expect(log).not.toContain("sleeve1 speaks after the switch");
+    await expect(page.locator('[data-testid="sleeve-preview"]').getAttribute("data-lit")).resolves.toBe("0");
+    await expect(page.locator(CHIP).innerText()).resolves.toContain(SECOND);
   });
 
   it("remembers the choice across a reload", async () => {
