@@ -1,5 +1,6 @@
 /**
- * A phone against `feelmysign up`: its broker killed (SIGKILL, by its process
+ * A phone against `feelmysign up`: the preview turned as the drawing area is,
+ * a touch along the sleeve's top lighting its right; then its broker killed (SIGKILL, by its process
  * id) and started again by `up`, while the page goes offline and back: the
  * drawing area never moves, however the status chips change, and the
  * simulated sleeve plays what is drawn afterwards.
@@ -19,6 +20,7 @@ import {
 import { Processes } from "./processes";
 
 const BROKER = '[data-testid="broker-status"]';
+const PREVIEW = '[data-testid="sleeve-preview"]';
 
 /** The Mosquitto `up` runs, by parent process id: the one this test may kill. */
 function mosquittoOf(up: ChildProcess): number {
@@ -46,6 +48,78 @@ describe("a phone against feelmysign up, its broker killed and started again", (
   });
 
   afterAll(() => processes.stop());
+
+  it("turns the preview as the drawing area is turned: a touch along the sleeve's top lights its right", async () => {
+    const area = await drawingArea(page);
+    expect(area.turnDeg).toBe(90);
+    // Below the area on a phone: drawn all the same, and read from its pixels.
+    const preview = page.locator(PREVIEW);
+    await waitForData(page, PREVIEW, "lit", "0", 30_000);
+    await nextFrame(page);
+    // What the preview shows while lit, as the screen shows it: where its glow is, frame by frame.
+    await preview.evaluate((canvas) => {
+      const c = canvas as HTMLCanvasElement;
+      const ctx = c.getContext("2d")!;
+      const idle = ctx.getImageData(0, 0, c.width, c.height).data;
+      const seen: { x: number; y: number }[] = [];
+      const shared = window as unknown as { glow: typeof seen; glowDone?: boolean };
+      shared.glow = seen;
+      const look = () => {
+        if (Number(c.dataset["lit"]) > 0) {
+          const now = ctx.getImageData(0, 0, c.width, c.height).data;
+          let n = 0;
+          let sx = 0;
+          let sy = 0;
+          for (let i = 0; i < now.length; i += 4) {
+            // Redder than when all was still: an actuator glowing (the top marker is in both),
+            // weighed by how much redder (a neighbouring row may glow a little too).
+            const redder = now[i]! - idle[i]!;
+            if (redder > 30) {
+              const p = i / 4;
+              sx += redder * (p % c.width);
+              sy += redder * Math.floor(p / c.width);
+              n += redder;
+            }
+          }
+          // From the canvas's centre, as a share of its height.
+          if (n > 0)
+            seen.push({ x: (sx / n - c.width / 2) / c.height, y: (sy / n - c.height / 2) / c.height });
+        }
+        if (shared.glowDone !== true) requestAnimationFrame(look);
+      };
+      requestAnimationFrame(look);
+    });
+    // Down the right of the area: the sleeve's top row, from its first column to its last.
+    const cdp = await page.context().newCDPSession(page);
+    const at = (fx: number, fy: number) =>
+      [area.left + area.width * fx, area.top + area.height * fy] as const;
+    await drawWithTouch(page, cdp, [at(0.98, 0.05), at(0.98, 0.95)]);
+    await waitForPlayed(page);
+    // Felt from the screen's top down: the glow reaches the preview's lower half.
+    await page
+      .waitForFunction(
+        () => (window as unknown as { glow: { y: number }[] }).glow.some((g) => g.y > 0),
+        undefined,
+        { timeout: 30_000 },
+      )
+      .catch(() => undefined); // asserted below, with what was seen
+    const glow = await page.evaluate(() => {
+      const shared = window as unknown as { glow: { x: number; y: number }[]; glowDone?: boolean };
+      shared.glowDone = true;
+      return shared.glow;
+    });
+    expect(glow.length, "frames of the preview seen lit").toBeGreaterThan(1);
+    // The top row is on the right of the preview, as on the area; it is felt from the screen's top down.
+    for (const { x } of glow) expect(x).toBeGreaterThan(0.05);
+    expect(glow[0]!.y).toBeLessThan(0);
+    expect(Math.max(...glow.map((g) => g.y))).toBeGreaterThan(0);
+    await expect(preview.getAttribute("data-turned")).resolves.toBe("true");
+    await preview.scrollIntoViewIfNeeded();
+    await screenshot(page, "up-phone-preview");
+    // Back to the first screen, where the page opened, for the test that follows.
+    await page.locator(".workspace").evaluate((workspace) => workspace.scrollTo(0, 0));
+    await page.evaluate(() => window.scrollTo(0, 0));
+  });
 
   it("keeps the drawing area still while offline and back, then plays what is drawn", async () => {
     const before = await page.locator(CANVAS).boundingBox();

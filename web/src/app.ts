@@ -362,7 +362,7 @@ export class App {
     const height = stacked ? this.#firstScreenHeight() : this.#stageArea.clientHeight;
     this.#view.fit(grid, this.#settings.stretch, width, height);
     this.#legendTurned.hidden = !this.#view.turned;
-    this.#preview.setGrid(grid);
+    this.#preview.setGrid(grid, this.#view.turned);
   }
 
   /** Stacked, the area fills the first screen: from its top to the window's bottom, the legend under it. */

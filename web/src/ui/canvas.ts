@@ -166,9 +166,8 @@ export class DrawingView {
     }
     // Sleeve-oriented area pixels -> device pixels: the margin, the quarter turn, the density.
     const m = AREA_MARGIN_PX;
-    const [a, b, c, d, e, f] = turned ? [0, 1, -1, 0, m + screen.width_px, m] : [1, 0, 0, 1, m, m];
     for (const ctx of [this.#grid2d, this.#ink2d, this.#compare2d, this.#marker2d, this.#live2d]) {
-      ctx.setTransform(a * dpr, b * dpr, c * dpr, d * dpr, e * dpr, f * dpr);
+      setSleeveTransform(ctx, turned, screen.width_px, m, dpr);
       ctx.lineCap = "round";
       ctx.lineJoin = "round";
     }
@@ -385,28 +384,7 @@ export class DrawingView {
         ctx.stroke();
       }
     }
-    if (this.#turned) this.#drawTopEdge(ctx);
-  }
-
-  /** Turned, the sleeve's top edge is marked, on the right: the sender sees which way is up. */
-  #drawTopEdge(ctx: CanvasRenderingContext2D): void {
-    const { width_px } = this.#area;
-    const y = -AREA_MARGIN_PX / 2;
-    ctx.save();
-    ctx.strokeStyle = COLORS.topEdge;
-    ctx.fillStyle = COLORS.topEdge;
-    ctx.lineWidth = 2;
-    ctx.beginPath();
-    ctx.moveTo(0, y);
-    ctx.lineTo(width_px * 0.5 - 52, y);
-    ctx.moveTo(width_px * 0.5 + 52, y);
-    ctx.lineTo(width_px, y);
-    ctx.stroke();
-    ctx.font = "600 11px system-ui, sans-serif";
-    ctx.textAlign = "center";
-    ctx.textBaseline = "middle";
-    ctx.fillText("SLEEVE TOP", width_px * 0.5, y);
-    ctx.restore();
+    if (this.#turned) drawSleeveTop(ctx, this.#area.width_px, -AREA_MARGIN_PX / 2);
   }
 
   #redrawInk(): void {
@@ -531,4 +509,46 @@ function context(canvas: HTMLCanvasElement): CanvasRenderingContext2D {
   const ctx = canvas.getContext("2d");
   if (ctx === null) throw new Error("This browser cannot draw on a canvas (no 2D context).");
   return ctx;
+}
+
+/**
+ * Sleeve-oriented pixels -> device pixels on `ctx`: shifted by `marginPx`, scaled by `dpr`, and
+ * turned a quarter clockwise when `turned` (the sleeve's top edge then on the right of an area
+ * `screenWidthPx` wide). The drawing area and the preview turn alike through this one transform.
+ */
+export function setSleeveTransform(
+  ctx: CanvasRenderingContext2D,
+  turned: boolean,
+  screenWidthPx: number,
+  marginPx: number,
+  dpr: number,
+): void {
+  const m = marginPx;
+  const [a, b, c, d, e, f] = turned ? [0, 1, -1, 0, m + screenWidthPx, m] : [1, 0, 0, 1, m, m];
+  ctx.setTransform(a * dpr, b * dpr, c * dpr, d * dpr, e * dpr, f * dpr);
+}
+
+/**
+ * The sleeve's top edge marked along sleeve-oriented y = `y`, `widthPx` long: drawn on a turned
+ * canvas it shows on the right, so the sender sees which way is up.
+ */
+const SLEEVE_TOP = "SLEEVE TOP";
+
+export function drawSleeveTop(ctx: CanvasRenderingContext2D, widthPx: number, y: number): void {
+  ctx.save();
+  ctx.strokeStyle = COLORS.topEdge;
+  ctx.fillStyle = COLORS.topEdge;
+  ctx.lineWidth = 2;
+  ctx.font = "600 11px system-ui, sans-serif";
+  const gap = ctx.measureText(SLEEVE_TOP).width / 2 + 8;
+  ctx.beginPath();
+  ctx.moveTo(0, y);
+  ctx.lineTo(Math.max(0, widthPx * 0.5 - gap), y);
+  ctx.moveTo(Math.min(widthPx, widthPx * 0.5 + gap), y);
+  ctx.lineTo(widthPx, y);
+  ctx.stroke();
+  ctx.textAlign = "center";
+  ctx.textBaseline = "middle";
+  ctx.fillText(SLEEVE_TOP, widthPx * 0.5, y);
+  ctx.restore();
 }

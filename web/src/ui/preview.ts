@@ -1,11 +1,16 @@
 /**
  * The sleeve, live: one circle per actuator that glows with the intensity the
  * sleeve's `actuators` telemetry reports, so the sender sees what the wearer
- * feels, when they feel it. Redrawn at most once per animation frame.
+ * feels, when they feel it. Redrawn at most once per animation frame. Turned
+ * a quarter, with the sleeve's top marked, whenever the drawing area is (an
+ * upright phone), so a touch drawn on the right lights the right of the preview.
  */
 import type { ActuatorFrame } from "../telemetry";
+import { drawSleeveTop, setSleeveTransform } from "./canvas";
 import type { GridSize } from "./geometry";
 
+/** Turned, the strip along the sleeve's top edge (its right on the screen) for its marker. */
+const TOP_STRIP_PX = 16;
 /** Below this an actuator counts as off (telemetry rounding, a motor spinning down). */
 const LIT_THRESHOLD = 0.02;
 const GLOW = "255, 138, 91";
@@ -19,6 +24,7 @@ export class SleevePreview {
   #scheduled = false;
   #framesSeen = 0;
   #online = false;
+  #turned = false;
 
   constructor(canvas: HTMLCanvasElement, caption: HTMLElement) {
     this.#canvas = canvas;
@@ -30,11 +36,19 @@ export class SleevePreview {
     this.#schedule();
   }
 
-  /** The grid to show while no telemetry has arrived (the sleeve's status, or the settings). */
-  setGrid(grid: GridSize): void {
-    if (grid.rows === this.#grid.rows && grid.columns === this.#grid.columns) return;
+  /**
+   * The grid to show while no telemetry has arrived (the sleeve's status, or the settings), and
+   * whether it is shown turned a quarter clockwise, as the drawing area is.
+   */
+  setGrid(grid: GridSize, turned = this.#turned): void {
+    if (grid.rows === this.#grid.rows && grid.columns === this.#grid.columns && turned === this.#turned)
+      return;
     this.#grid = grid;
-    this.#canvas.style.aspectRatio = `${Math.max(grid.columns, 1)} / ${Math.max(grid.rows, 1)}`;
+    this.#turned = turned;
+    const across = Math.max(turned ? grid.rows : grid.columns, 1);
+    const down = Math.max(turned ? grid.columns : grid.rows, 1);
+    this.#canvas.style.aspectRatio = `${across} / ${down}`;
+    this.#canvas.dataset["turned"] = String(turned);
     this.#schedule();
   }
 
@@ -78,11 +92,23 @@ export class SleevePreview {
     const ctx = this.#ctx;
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     ctx.clearRect(0, 0, width, height);
+    // Drawn in the sleeve's orientation; turned, the canvas's height is the sleeve's width.
+    const turned = this.#turned;
+    setSleeveTransform(ctx, turned, width, 0, dpr);
+    const across = turned ? height : width;
+    const down = turned ? width - TOP_STRIP_PX : height;
     const { rows, columns } = this.#grid;
-    const cell = Math.min(width / columns, height / rows);
+    const cell = Math.min(across / columns, down / rows);
     const radius = cell * 0.26;
-    const left = (width - cell * columns) / 2 + cell / 2;
-    const top = (height - cell * rows) / 2 + cell / 2;
+    const left = (across - cell * columns) / 2 + cell / 2;
+    const top = (turned ? TOP_STRIP_PX : 0) + (down - cell * rows) / 2 + cell / 2;
+    if (turned) {
+      // Along the grid's top edge, as long as the grid: the marker stays beside the actuators.
+      ctx.save();
+      ctx.translate(left - cell / 2, 0);
+      drawSleeveTop(ctx, cell * columns, top - cell / 2 - TOP_STRIP_PX / 2);
+      ctx.restore();
+    }
     let lit = 0;
     let strongest = 0;
     for (let row = 0; row < rows; row++) {
