@@ -137,6 +137,13 @@ describe("a phone against feelmysign up, its broker killed and started again", (
       if (states.has("offline") && broker === "connected" && sleeve === "online") break;
       if (states.has("offline") && !shot) {
         shot = true;
+        // Seen before, it is not "not seen yet": without the broker its state is unknown.
+        const chips = await page.evaluate(() => ({
+          broker: document.querySelector<HTMLElement>('[data-testid="broker-status"]')!.dataset["state"],
+          sleeve: document.querySelector<HTMLElement>('[data-testid="sleeve-status"] .chip-text')!
+            .textContent,
+        }));
+        if (chips.broker !== "connected") expect(chips.sleeve).toBe("Sleeve sleeve1: unknown");
         await screenshot(page, "up-phone-offline");
       }
       await new Promise((wake) => setTimeout(wake, 50));

@@ -488,7 +488,7 @@ export class App {
   #setSleeve(state: SleeveState, detail: string | null = null): void {
     this.#sleeveState = state;
     const id = this.#settings.sleeve_id;
-    this.#status.setSleeve(state, id, detail);
+    this.#status.setSleeve(state, id, detail, this.#brokerState === "connected");
     const layout = this.#sleeve?.layout;
     const caption = {
       online: `Sleeve ${id} online${layout ? `: ${layout.rows} × ${layout.columns} actuators` : ""}, waiting for strokes.`,

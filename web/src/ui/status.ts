@@ -26,11 +26,17 @@ export class StatusBar {
     setChip(this.#broker, state, text, detail ?? text);
   }
 
-  setSleeve(state: SleeveState, sleeveId: string, detail: string | null = null): void {
+  /** `brokerConnected`: unknown then means not heard from yet; without the broker it cannot be known. */
+  setSleeve(
+    state: SleeveState,
+    sleeveId: string,
+    detail: string | null = null,
+    brokerConnected = true,
+  ): void {
     const text = {
       online: `Sleeve ${sleeveId}: online`,
       offline: `Sleeve ${sleeveId}: offline`,
-      unknown: `Sleeve ${sleeveId}: not seen yet`,
+      unknown: brokerConnected ? `Sleeve ${sleeveId}: not seen yet` : `Sleeve ${sleeveId}: unknown`,
       absent: `Sleeve ${sleeveId}: none listening`,
     }[state];
     setChip(this.#sleeve, state, text, detail ?? text);
