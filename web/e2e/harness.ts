@@ -220,45 +220,76 @@ export async function launchBrowser(
 
 const UP_READY_TIMEOUT_MS = 30_000;
 
-/** Starts `feelmysign up` on free ports and resolves with its page URL once it prints it. */
+/**
+ * Resolves with the first match of `pattern` in what `child` prints (stdout and stderr
+ * together); fails, with the output, if it exits first or nothing matches in `timeoutMs`.
+ */
+export function collectUntil(
+  child: ChildProcess,
+  pattern: RegExp,
+  what: string,
+  timeoutMs: number,
+): Promise<RegExpExecArray> {
+  let output = "";
+  return new Promise((ready, fail) => {
+    const timer = setTimeout(
+      () => fail(new Error(`${what}: nothing matched ${pattern} in ${timeoutMs} ms:\n${output}`)),
+      timeoutMs,
+    );
+    const collect = (chunk: Buffer) => {
+      output += chunk.toString();
+      const match = pattern.exec(output);
+      if (match) {
+        clearTimeout(timer);
+        ready(match);
+      }
+    };
+    child.stdout?.on("data", collect);
+    child.stderr?.on("data", collect);
+    child.once("exit", (code) => {
+      clearTimeout(timer);
+      fail(new Error(`${what} exited with ${code}:\n${output}`));
+    });
+  });
+}
+
+/**
+ * Starts `feelmysign up` on free ports and resolves with its page URL once it prints it
+ * (`url`: the first group of another pattern, e.g. the study's page); `detached`: in its
+ * own process group, so that `stopChild(..., { group: true })` takes its broker too.
+ */
 export async function startUp(
   stateDir: string,
   extraArgs: readonly string[] = [],
+  options: { url?: RegExp; detached?: boolean; timeoutMs?: number } = {},
 ): Promise<{ child: ChildProcess; url: string }> {
   const child = spawn(
     FEELMYSIGN,
     ["up", "--state-dir", stateDir, "--http-port", "0", "--port", "0", "--ws-port", "0", ...extraArgs],
-    { stdio: ["ignore", "pipe", "pipe"] },
+    { stdio: ["ignore", "pipe", "pipe"], detached: options.detached ?? false },
   );
-  let output = "";
-  const url = await new Promise<string>((ready, fail) => {
-    const timer = setTimeout(
-      () => fail(new Error(`feelmysign up printed no URL in ${UP_READY_TIMEOUT_MS} ms:\n${output}`)),
-      UP_READY_TIMEOUT_MS,
-    );
-    const collect = (chunk: Buffer) => {
-      output += chunk.toString();
-      const match = /(http:\/\/127\.0\.0\.1:\d+\/)/.exec(output);
-      if (match && /Ctrl-C/.test(output)) {
-        clearTimeout(timer);
-        ready(match[1]!);
-      }
-    };
-    child.stdout!.on("data", collect);
-    child.stderr!.on("data", collect);
-    child.once("exit", (code) => {
-      clearTimeout(timer);
-      fail(new Error(`feelmysign up exited with ${code}:\n${output}`));
-    });
-  });
-  return { child, url };
+  const url = options.url ?? /(http:\/\/127\.0\.0\.1:\d+\/)/;
+  // The URL, then the last line it prints once everything runs.
+  const ready = new RegExp(`${url.source}[\\s\\S]*Ctrl-C`);
+  const match = await collectUntil(child, ready, "feelmysign up", options.timeoutMs ?? UP_READY_TIMEOUT_MS);
+  return { child, url: match[1]! };
 }
 
-export async function stopUp(child: ChildProcess): Promise<void> {
+/**
+ * Stops `child` (SIGINT, or `signal`; to its whole process group with `group`), SIGKILL
+ * after `killAfterMs` unless null; resolves once it has exited.
+ */
+export async function stopChild(
+  child: ChildProcess,
+  options: { signal?: NodeJS.Signals; group?: boolean; killAfterMs?: number | null } = {},
+): Promise<void> {
   if (child.exitCode !== null || child.signalCode !== null) return;
   const exited = new Promise((done) => child.once("exit", done));
-  child.kill("SIGINT");
-  const timer = setTimeout(() => child.kill("SIGKILL"), 10_000);
+  const send = (signal: NodeJS.Signals) =>
+    options.group ? process.kill(-child.pid!, signal) : child.kill(signal);
+  send(options.signal ?? "SIGINT");
+  const killAfterMs = options.killAfterMs === undefined ? 10_000 : options.killAfterMs;
+  const timer = killAfterMs === null ? undefined : setTimeout(() => send("SIGKILL"), killAfterMs);
   await exited;
   clearTimeout(timer);
 }

@@ -6,13 +6,21 @@
  * join token (`broker add-sleeve`) plays the strokes. Without the certificate, the
  * page is refused.
  */
-import { spawn, execFileSync, type ChildProcess } from "node:child_process";
+import { spawn, execFileSync } from "node:child_process";
 import { createHash, X509Certificate } from "node:crypto";
 import { chmodSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { checkPrerequisites, CHROMIUM, FEELMYSIGN, launchBrowser, tempDir } from "./harness";
+import {
+  checkPrerequisites,
+  CHROMIUM,
+  collectUntil,
+  FEELMYSIGN,
+  launchBrowser,
+  stopChild,
+  tempDir,
+} from "./harness";
 import { screenshot, waitForData } from "./page";
 import { drawSquare } from "./strokes";
 
@@ -69,39 +77,6 @@ function network(): Network {
   return { host, prefix: [], cleanup: () => {} };
 }
 
-function collectUntil(child: ChildProcess, pattern: RegExp, what: string): Promise<RegExpExecArray> {
-  let output = "";
-  return new Promise((ready, fail) => {
-    const timer = setTimeout(
-      () => fail(new Error(`${what}: nothing matched ${pattern} in ${READY_TIMEOUT_MS} ms:\n${output}`)),
-      READY_TIMEOUT_MS,
-    );
-    const collect = (chunk: Buffer) => {
-      output += chunk.toString();
-      const match = pattern.exec(output);
-      if (match) {
-        clearTimeout(timer);
-        ready(match);
-      }
-    };
-    child.stdout?.on("data", collect);
-    child.stderr?.on("data", collect);
-    child.once("exit", (code) => {
-      clearTimeout(timer);
-      fail(new Error(`${what} exited with ${code}:\n${output}`));
-    });
-  });
-}
-
-async function stop(child: ChildProcess): Promise<void> {
-  if (child.exitCode !== null || child.signalCode !== null) return;
-  const exited = new Promise((done) => child.once("exit", done));
-  child.kill("SIGINT");
-  const timer = setTimeout(() => child.kill("SIGKILL"), 10_000);
-  await exited;
-  clearTimeout(timer);
-}
-
 /** base64 SHA-256 of the server certificate's public key: what Chromium is told to trust. */
 function spkiHash(serverPem: string): string {
   const spki = new X509Certificate(serverPem).publicKey.export({ type: "spki", format: "der" });
@@ -132,8 +107,13 @@ describe("a phone and a sleeve on the LAN, over TLS", () => {
       ]),
       { stdio: ["ignore", "pipe", "pipe"] },
     );
-    cleanups.push(() => stop(up));
-    const printed = await collectUntil(up, /Draw here: +(https:\/\/\S+)[\s\S]*Ctrl-C/, "feelmysign up");
+    cleanups.push(() => stopChild(up));
+    const printed = await collectUntil(
+      up,
+      /Draw here: +(https:\/\/\S+)[\s\S]*Ctrl-C/,
+      "feelmysign up",
+      READY_TIMEOUT_MS,
+    );
     pageUrl = printed[1]!;
     const token = execFileSync(FEELMYSIGN, ["broker", "--state-dir", stateDir, "add-sleeve", SLEEVE_ID], {
       encoding: "utf8",
@@ -145,8 +125,8 @@ describe("a phone and a sleeve on the LAN, over TLS", () => {
       stdio: ["ignore", "pipe", "pipe"],
       env: { ...process.env, XDG_STATE_HOME: piState },
     });
-    cleanups.push(() => stop(sleeve));
-    await collectUntil(sleeve, /connected to mqtts:\/\//, "the joined sleeve");
+    cleanups.push(() => stopChild(sleeve));
+    await collectUntil(sleeve, /connected to mqtts:\/\//, "the joined sleeve", READY_TIMEOUT_MS);
     chromiumInNet = join(piState, "chromium");
     writeFileSync(chromiumInNet, `#!/bin/sh\nexec ${[...net.prefix, CHROMIUM].join(" ")} "$@"\n`);
     chmodSync(chromiumInNet, 0o755);

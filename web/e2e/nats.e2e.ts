@@ -20,6 +20,7 @@ import {
   REPO_DIR,
   serveDist,
   SLEEVE_ID,
+  stopChild,
   tempDir,
   type Credentials,
 } from "./harness";
@@ -60,15 +61,6 @@ function output(child: ChildProcess): { text: () => string; until: (pattern: Reg
       return text;
     },
   };
-}
-
-async function stop(child: ChildProcess): Promise<void> {
-  if (child.exitCode !== null || child.signalCode !== null) return;
-  const exited = new Promise((done) => child.once("exit", done));
-  child.kill("SIGINT");
-  const timer = setTimeout(() => child.kill("SIGKILL"), 15_000);
-  await exited;
-  clearTimeout(timer);
 }
 
 /**
@@ -118,7 +110,7 @@ describe("on a 3-node NATS cluster: sleeve on a, CLI on b, page on c; a dies", (
     runner = spawn(PYTHON, ["-m", "feelmysign.broker.nats_cluster", dir], {
       stdio: ["ignore", "pipe", "pipe"],
     });
-    cleanups.push(() => stop(runner));
+    cleanups.push(() => stopChild(runner, { killAfterMs: 15_000 }));
     runnerOut = output(runner);
     const text = await runnerOut.until(/^Ready\./m);
     cluster = JSON.parse(text.split("\n").find((line) => line.startsWith("{"))!) as Cluster;
@@ -134,7 +126,7 @@ describe("on a 3-node NATS cluster: sleeve on a, CLI on b, page on c; a dies", (
         env: { ...process.env, FEELMYSIGN_PASSWORD: cluster.credentials.sleeve.password },
       },
     );
-    cleanups.push(() => stop(sleeve));
+    cleanups.push(() => stopChild(sleeve, { killAfterMs: 15_000 }));
     sleeveOut = output(sleeve);
     await sleeveOut.until(new RegExp(`connected to ${a!.mqtt_url}`));
     const watcher = await mqtt.connectAsync(b!.mqtt_url, {

@@ -11,7 +11,7 @@ import {
   checkPrerequisites,
   launchBrowser,
   startUp,
-  stopUp,
+  stopChild,
   tempDir,
   type BrowserOptions,
   type Credentials,
@@ -56,7 +56,7 @@ export class Processes {
     const stateDir = this.dir(prefix);
     await options.prepare?.(stateDir);
     const { child, url } = await startUp(stateDir, options.args);
-    this.add(() => stopUp(child));
+    this.add(() => stopChild(child));
     const credentials = JSON.parse(readFileSync(join(stateDir, "credentials.json"), "utf8")) as Credentials;
     return { stateDir, url, child, credentials };
   }

@@ -5,12 +5,20 @@
  * session (the whole process group, as a power cut) and restarted, the session resuming
  * with every answer kept (checked in the SQLite file); questionnaire, review, analysis.
  */
-import { spawn, spawnSync, type ChildProcess } from "node:child_process";
+import { spawnSync, type ChildProcess } from "node:child_process";
 import { rmSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { checkPrerequisites, FEELMYSIGN, launchBrowser, REPO_DIR, tempDir } from "./harness";
+import {
+  checkPrerequisites,
+  FEELMYSIGN,
+  launchBrowser,
+  REPO_DIR,
+  startUp,
+  stopChild,
+  tempDir,
+} from "./harness";
 import { screenshot } from "./page";
 
 const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
@@ -33,50 +41,16 @@ interface Up {
 }
 
 /** `feelmysign up --study` in its own process group, so that a kill takes its broker too. */
-async function startUp(stateDir: string, study: string): Promise<Up> {
-  const args = [
-    "up",
-    "--state-dir",
-    stateDir,
-    "--http-port",
-    "0",
-    "--port",
-    "0",
-    "--ws-port",
-    "0",
-    "--study",
-    study,
-  ];
-  const child = spawn(FEELMYSIGN, args, { stdio: ["ignore", "pipe", "pipe"], detached: true });
-  let output = "";
-  const url = await new Promise<string>((ready, fail) => {
-    const timer = setTimeout(
-      () => fail(new Error(`no study URL in ${UP_READY_TIMEOUT_MS} ms:\n${output}`)),
-      UP_READY_TIMEOUT_MS,
-    );
-    const collect = (chunk: Buffer) => {
-      output += chunk.toString();
-      const match = /Study:\s+(http:\/\/127\.0\.0\.1:\d+\/study)/.exec(output);
-      if (match && /Ctrl-C/.test(output)) {
-        clearTimeout(timer);
-        ready(match[1]!);
-      }
-    };
-    child.stdout!.on("data", collect);
-    child.stderr!.on("data", collect);
-    child.once("exit", (code) => {
-      clearTimeout(timer);
-      fail(new Error(`feelmysign up exited with ${code}:\n${output}`));
-    });
+async function startStudyUp(stateDir: string, study: string): Promise<Up> {
+  return startUp(stateDir, ["--study", study], {
+    url: /Study:\s+(http:\/\/127\.0\.0\.1:\d+\/study)/,
+    detached: true,
+    timeoutMs: UP_READY_TIMEOUT_MS,
   });
-  return { child, url };
 }
 
 async function killGroup(up: Up, signal: NodeJS.Signals): Promise<void> {
-  if (up.child.exitCode !== null || up.child.signalCode !== null) return;
-  const exited = new Promise((done) => up.child.once("exit", done));
-  process.kill(-up.child.pid!, signal);
-  await exited;
+  await stopChild(up.child, { signal, group: true, killAfterMs: null });
 }
 
 /** Counts in the study file, read by Python's sqlite3 while the server is down or up. */
@@ -183,7 +157,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       encoding: "utf8",
     });
     expect(made.status, made.stderr).toBe(0);
-    up = await startUp(stateDir, study);
+    up = await startStudyUp(stateDir, study);
     cleanups.push(() => killGroup(up, "SIGINT"));
     const browser = await launchBrowser({ viewport: { width: 1280, height: 900 } });
     cleanups.push(browser.close);
@@ -214,7 +188,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       expect(stored.answered).toBe(3);
       expect(stored.codings).toBe(3);
       expect(stored.played).toBeGreaterThanOrEqual(1 + 1 + 1);
-      up = await startUp(stateDir, study);
+      up = await startStudyUp(stateDir, study);
       const code = (await page.locator('[data-testid="participant-code"]').textContent())!;
       await page.goto(`${up.url}#${code}`);
       await page.waitForFunction(() => document.querySelector('[data-testid="progress"]') !== null);
@@ -253,7 +227,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       await screenshot(page, "study-threshold");
       await killGroup(up, "SIGKILL");
       expect(rows(study).threshold_trials).toBe(4);
-      up = await startUp(stateDir, study);
+      up = await startStudyUp(stateDir, study);
       await page.goto(`${up.url}#${code}`);
       await page.waitForFunction(() => document.querySelector('[data-testid="progress"]') !== null);
       await page.click('[data-testid="threshold-tab"]');
