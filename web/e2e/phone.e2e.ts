@@ -142,6 +142,35 @@ describe("drawing with a finger on a phone", () => {
     await waitForData(page, CANVAS, "areaTurnDeg", "90");
   });
 
+  it("on a small phone (320 x 640): turned and staying so, no label cut short, both chips on the screen", async () => {
+    try {
+      await page.setViewportSize({ width: 320, height: 640 });
+      await waitForData(page, CANVAS, "areaTurnDeg", "90");
+      // The turn changes the legend under the area, which must not change the turn back: watch it.
+      const turns = await page.locator(CANVAS).evaluate(async (canvas) => {
+        const seen: string[] = [];
+        const watch = new MutationObserver(() => seen.push((canvas as HTMLElement).dataset["areaTurnDeg"]!));
+        watch.observe(canvas, { attributeFilter: ["data-area-turn-deg"] });
+        for (let i = 0; i < 30; i++) await new Promise((done) => requestAnimationFrame(done));
+        watch.disconnect();
+        return seen;
+      });
+      expect(turns.filter((turn) => turn !== "90")).toEqual([]);
+      expectOnScreen(await drawingArea(page), { width: 320, height: 640 }, 0.4);
+      expect(await truncatedLabels(page)).toEqual([]);
+      expect(await page.evaluate(() => document.documentElement.scrollWidth)).toBeLessThanOrEqual(320);
+      for (const chip of ["broker-status", "sleeve-status"]) {
+        const box = await page.locator(`[data-testid="${chip}"]`).boundingBox();
+        expect(box !== null && box.x >= 0 && box.x + box.width <= 320, `${chip} on the screen`).toBe(true);
+      }
+      await screenshot(page, "phone-small");
+    } finally {
+      // The phone upright again for what follows, whatever happened above.
+      await page.setViewportSize({ width: 390, height: 844 });
+    }
+    await waitForData(page, CANVAS, "areaTurnDeg", "90");
+  });
+
   it("opens the settings as a full-screen sheet that scrolls to its last field", async () => {
     await page.locator('[data-testid="settings-button"]').tap();
     const panel = page.locator('[data-testid="settings-panel"]');

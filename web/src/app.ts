@@ -370,8 +370,21 @@ export class App {
     const workspace = this.#stageArea.closest(".workspace");
     const top = this.#stageArea.getBoundingClientRect().top + (workspace?.scrollTop ?? 0) + window.scrollY;
     // A phone on its side keeps every pixel of height for drawing: the legend follows below the fold.
-    const legend = window.matchMedia(SHORT_LANDSCAPE).matches ? 0 : this.#legend.offsetHeight;
+    const legend = window.matchMedia(SHORT_LANDSCAPE).matches ? 0 : this.#legendHeightTurned();
     return Math.max(STACKED_MIN_HEIGHT_PX, window.innerHeight - top - legend - STACKED_BELOW_PX);
+  }
+
+  /**
+   * The legend's height with its "turned" line shown, whether it is or not: the height left for
+   * the area must not depend on the turn it decides, or a small phone would flip between the two.
+   */
+  #legendHeightTurned(): number {
+    const line = this.#legendTurned;
+    if (!line.hidden) return this.#legend.offsetHeight;
+    line.hidden = false;
+    const height = this.#legend.offsetHeight;
+    line.hidden = true;
+    return height;
   }
 
   // ---- settings ----------------------------------------------------------------------------
