@@ -64,6 +64,7 @@ from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS, PacePolicy
 from feelmysign.planner import plan
 from feelmysign.player import (
     MAX_PENDING,
+    SPIN_MS,
     PlannedStroke,
     Player,
     cancelled,
@@ -160,6 +161,10 @@ class SleeveOptions:
     backend_name: str = "sim"
     max_age_ms: float = MAX_AGE_MS
     max_lag_ms: float = MAX_LAG_MS
+    # The player spins (busy-waits) this long before each motor command, for sub-millisecond
+    # timing on a machine of its own; 0 where many sleeves share the processors (the load
+    # bench), which cannot all spin.
+    spin_ms: float = SPIN_MS
 
 
 class Sleeve:
@@ -181,7 +186,9 @@ class Sleeve:
         self._options = options
         self._id = options.sleeve_id
         self._outbox: queue.SimpleQueue[_Outgoing | None] = queue.SimpleQueue()
-        self._player = player or Player(backend, layout, on_event=self._event)
+        self._player = player or Player(
+            backend, layout, on_event=self._event, spin_ms=options.spin_ms
+        )
         self._bucket = TokenBucket(options.rate_per_s, options.burst, monotonic_ms)
         self._pace = PacePolicy(max_age_ms=options.max_age_ms, max_lag_ms=options.max_lag_ms)
         self._connection = 0  # counts connections: an acknowledgement is valid on its own only

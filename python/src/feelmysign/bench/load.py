@@ -53,6 +53,7 @@ from feelmysign.broker.sleeves import add_sleeve
 from feelmysign.cli._inputs import whole_number
 from feelmysign.cli._parser import CliParser
 from feelmysign.connection import new_client, parse_broker_url
+from feelmysign.player import SPIN_MS
 from feelmysign.topics import telemetry_topic
 
 DEFAULT_COUNTS = (20, 100, 200)
@@ -64,6 +65,13 @@ MAX_COUNT = 1000
 # minute, as a cluster's sleeves may run (docs/deploy.md): is every stroke played then?
 OUT_OF_TIME = {"late", "stale"}
 RELAXED_PACE = (120_000.0, 60_000.0)  # max_age_ms, max_lag_ms
+# A sleeve busy-waits the last SPIN_MS before each motor command, for sub-millisecond timing
+# on a Pi of its own. N sleeves on 2 cores cannot all spin: at N = 100 on Mosquitto,
+# without it their processor time fell from 1.1 to 0.9-1.1 ms a stroke and publish ->
+# played from 2.0-7.5x the baseline's p50 to 1.5-1.9x (two runs each). Their commands
+# then go out a few tenths of a millisecond later than planned: nothing beside these
+# latencies.
+SLEEVE_SPIN_MS = 0.0
 SETTLE_S = 60.0  # longest wait for the last stroke of a run, once all were sent
 START_S = 240.0  # longest wait for a kind of host to have all its clients logged in
 
@@ -322,15 +330,20 @@ class _Watcher:
         self.client.disconnect()
 
 
-def sleeves(target: Target, pace: tuple[float, float] | None = None) -> Outcome:
+def sleeves(
+    target: Target, pace: tuple[float, float] | None = None, *, spin_ms: float = SLEEVE_SPIN_MS
+) -> Outcome:
     """Publish -> first actuator command for N sleeve daemons, and every stroke's outcome.
 
     ``pace``: the sleeves' (max_age_ms, max_lag_ms), instead of their defaults.
     """
     hosts = _Hosts("sleeve")
     watcher: _Watcher | None = None
+    tuning = {"spin_ms": spin_ms}
+    if pace is not None:
+        tuning |= {"max_age_ms": pace[0], "max_lag_ms": pace[1]}
     try:
-        shares = [(urls, chunk, pace) for urls, chunk in _shares(target, offset=0)]
+        shares = [(urls, chunk, tuning) for urls, chunk in _shares(target, offset=0)]
         hosts.start(load_hosts.sleeve_host, shares)
         watcher = _Watcher(target)
         sent, unacknowledged = _draw(target)
@@ -370,7 +383,8 @@ def _line(what: str, outcome: Outcome, base: Outcome | None) -> str:
 def report(counts: tuple[int, ...] = DEFAULT_COUNTS) -> list[str]:
     lines = [
         f"Load: N sleeves and N senders drawing at once ({STROKES} strokes of {STROKE_MS:g} ms "
-        f"per sender, QoS 1; {PER_PROCESS} clients per process) on {os.cpu_count()} cores, "
+        f"per sender, QoS 1; {PER_PROCESS} clients per process; sleeves without the "
+        f"{SPIN_MS:g} ms busy-wait) on {os.cpu_count()} cores, "
         f"load average {os.getloadavg()[0]:.1f} at the start. Ratios: to the bare "
         "publish -> receive of the same broker and N, this run"
     ]

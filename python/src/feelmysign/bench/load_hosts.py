@@ -128,14 +128,15 @@ def _close(clients: list[mqtt.Client]) -> None:
 def sleeve_host(
     urls: list[str],
     sleeves: list[tuple[str, Account]],
-    pace: tuple[float, float] | None,
+    tuning: dict[str, float],
     reports: Reports,
     stop: Flag,
 ) -> None:
     """Run ``sleeves`` (sleeve id, account) as sleeve daemons on the simulator until ``stop``.
 
     Sleeve i connects to ``urls[i]`` first (the server list, rotated, on a cluster).
-    ``pace``: (max_age_ms, max_lag_ms) instead of the sleeve's defaults.
+    ``tuning``: SleeveOptions fields (max_age_ms, max_lag_ms, spin_ms) instead of the
+    sleeve's defaults.
     """
     _quiet()
     running: list[tuple[Sleeve, threading.Thread, SimBackend]] = []
@@ -146,8 +147,12 @@ def sleeve_host(
             )
             backend = SimBackend(PAPER_SLEEVE)
             options = SleeveOptions(sleeve_id=sleeve_id, legacy_topic=None)
-            if pace is not None:
-                options = replace(options, max_age_ms=pace[0], max_lag_ms=pace[1])
+            options = replace(
+                options,
+                max_age_ms=tuning.get("max_age_ms", options.max_age_ms),
+                max_lag_ms=tuning.get("max_lag_ms", options.max_lag_ms),
+                spin_ms=tuning.get("spin_ms", options.spin_ms),
+            )
             sleeve = Sleeve(settings, PAPER_SLEEVE, backend, options)
             thread = threading.Thread(target=sleeve.run, daemon=True)
             thread.start()
