@@ -154,6 +154,46 @@ describe("drawing with a mouse on a desktop", () => {
     await screenshot(page, "desktop-after");
   });
 
+  it("keeps adjustments under 5% quiet, names a larger one, and marks a late stroke with how late", async () => {
+    const drawing = stroke0Drawing(sleeve.strokes());
+    const before = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-played"));
+    const now = Date.now();
+    const timing = { received_at_ms: now, start_at_ms: now, first_command_at_ms: now, latency_ms: 0.3 };
+    const played = { ...timing, start_error_ms: 0, queued_ms: 0, duration_ms: 418, commands: 4 };
+    const adjusted = { type: "adjusted", drawing, reason: "min_duration" };
+    // 418 ms instead of 417: noise. 600 instead of 417: felt.
+    await sleeve.publish("events", { ...adjusted, seq: 0, ...played, requested_duration_ms: 417 });
+    await sleeve.publish("events", {
+      ...adjusted,
+      seq: 1,
+      ...played,
+      duration_ms: 600,
+      requested_duration_ms: 417,
+    });
+    // Sent 1.5 s before it was felt, none of it waiting behind other strokes: late by 1.5 s.
+    await sleeve.publish("events", { type: "played", drawing, seq: 2, ...played, sent_at_ms: now - 1500 });
+    // Sent as long before, but all of that behind the strokes before it (played back to back): not late.
+    await sleeve.publish("events", {
+      type: "played",
+      drawing,
+      seq: 3,
+      ...played,
+      sent_at_ms: now - 1500,
+      queued_ms: 1500,
+    });
+    // All four taken in (an adjusted stroke was played too), then what the card says of them.
+    await waitForData(page, '[data-testid="played-summary"]', "played", String(before + 4));
+    await waitForData(page, '[data-testid="played-summary"]', "late", "1");
+    const log = await page.locator('[data-testid="event-log"]').innerText();
+    expect(log).toContain("Stroke 1 played in 600 ms instead of 417 ms (min duration).");
+    expect(log).toContain("Stroke 2 played 1.5 s late");
+    expect(log).not.toContain("Stroke 0 played in");
+    expect(log).not.toContain("Stroke 3 played");
+    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
+      "1 late (last by 1.5 s)",
+    );
+  });
+
   it("downloads a recording that feelmysign simplify reads, with the same ends", async () => {
     const [download] = await Promise.all([
       page.waitForEvent("download"),
