@@ -327,7 +327,7 @@ describe("a broker that goes away", () => {
     for (const cleanup of cleanups.reverse()) await cleanup();
   });
 
-  it("keeps the strokes drawn meanwhile, shows them as unsent, and sends them when it is back", async () => {
+  it("keeps the strokes drawn meanwhile and sends them when it is back; with Drop late, drops and counts them", async () => {
     checkPrerequisites();
     const stateDir = tempDir("broker");
     cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
@@ -378,6 +378,36 @@ describe("a broker that goes away", () => {
     expect(await page.locator(CANVAS).isVisible()).toBe(true);
     await page.locator("#notice").waitFor({ state: "hidden" });
     expect(await page.locator(CANVAS).boundingBox()).toEqual(stageBefore);
+
+    // Timing "Drop late": what waited longer than 2 s for the broker is dropped, counted, never sent.
+    await page.locator('[data-testid="settings-button"]').click();
+    await page.getByText("Drop late").click();
+    await page.locator('[data-testid="settings-save"]').click();
+    await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
+    await broker.stop();
+    await waitForData(page, '[data-testid="broker-status"]', "state", "offline");
+    await drawWithMouse(page, [at(0.3, 0.3), at(0.7, 0.3)]);
+    await nextFrame(page);
+    const late = Number(await page.locator('[data-testid="unsent-count"]').getAttribute("data-count"));
+    expect(late).toBeGreaterThanOrEqual(1);
+    await new Promise((wake) => setTimeout(wake, 2500)); // longer than the 2 s the policy allows
+    broker = await Broker.start(stateDir, ports);
+    await waitForData(page, '[data-testid="played-summary"]', "dropped", String(late), 20_000);
+    await waitForData(page, '[data-testid="unsent-count"]', "count", "0");
+    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
+      `${late} dropped unsent`,
+    );
+    await expect(page.locator('[data-testid="event-log"] li').first().innerText()).resolves.toContain(
+      "dropped: not sent within 2 s",
+    );
+    // A path drawn now is sent; nothing of the dropped one ever was.
+    await drawWithMouse(page, [at(0.3, 0.6), at(0.7, 0.6)]);
+    await nextFrame(page);
+    const sentNow = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
+    const after = await sleeve.waitForStrokes(sentNow - late, 20_000);
+    expect(after.map((stroke) => stroke["seq"])).toEqual(
+      [...Array(sentNow).keys()].filter((seq) => seq < unsent || seq >= unsent + late),
+    );
   });
 });
 
