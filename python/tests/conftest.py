@@ -30,8 +30,20 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 from feelmysign.broker import Broker, Credentials
+
+# No property test may fail for taking long: Hypothesis' own timing checks (a deadline
+# of 200 ms an example, data generation "too slow") fail on a loaded machine. Built on the
+# profile Hypothesis chose (on CI its "ci" profile, derandomized).
+settings.register_profile(
+    "feelmysign",
+    parent=settings.get_profile(settings.get_current_profile_name()),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.load_profile("feelmysign")
 
 BROKER_FIXTURES = frozenset({"broker", "broker_credentials", "start_broker"})
 
