@@ -43,5 +43,7 @@ export default defineConfig({
   test: {
     include: ["test/**/*.test.ts"],
     environment: "node",
+    // Not vitest's 5 s: a property test that takes 0.7 s here may take seconds on a busy machine.
+    testTimeout: 60_000,
   },
 });
