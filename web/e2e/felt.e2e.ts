@@ -246,6 +246,10 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
   it("re-simplifies the drawing on the canvas when a setting changes, without sending it", async () => {
     const before = await drawingId(page);
     await page.locator('[data-testid="settings-button"]').click();
+    // The units, from the spacing the simulated sleeve reports (the paper's sleeve: 3 cm).
+    await expect(page.locator('[data-testid="settings-panel"]').textContent()).resolves.toContain(
+      "1 grid unit is the spacing between two neighbouring actuators (3 cm on this sleeve).",
+    );
     await page.locator('[data-testid="setting-detail"]').fill("1");
     await page.locator('[data-testid="settings-save"]').click();
     await expect(page.locator('[data-testid="event-log"] li').first().innerText()).resolves.toContain(
