@@ -116,17 +116,23 @@ def test_a_sleeve_joined_by_token_plays_strokes_over_tls(
     assert [p.read_text() for p in trusted] == [lan_broker.tls.ca.read_text()]  # type: ignore[union-attr]
 
 
+@pytest.mark.parametrize("given", ["option", "environment"])
 def test_a_token_for_another_ca_is_refused_before_any_login(
-    lan_broker: Broker, network: Lan, tmp_path: Path
+    lan_broker: Broker, network: Lan, tmp_path: Path, given: str
 ) -> None:
     other_ca = ensure_local_ca(tmp_path / "other-tls", ["example.invalid"])
     genuine = decode_join_token(add_sleeve(lan_broker, "arm2"))
     forged = JoinToken(
         genuine.url, "arm2", genuine.username, genuine.password, other_ca.ca_fingerprint
-    )
+    ).encode()
+    # The systemd unit passes the token as FEELMYSIGN_JOIN (in sleeve.env).
+    options = ("--join", forged) if given == "option" else ()
+    env = {**os.environ, "XDG_STATE_HOME": str(tmp_path / "pi-state")}
+    if given == "environment":
+        env["FEELMYSIGN_JOIN"] = forged
     result = subprocess.run(
-        feelmysign("sleeve", "--join", forged.encode(), prefix=network.run_prefix),
-        env={**os.environ, "XDG_STATE_HOME": str(tmp_path / "pi-state")},
+        feelmysign("sleeve", *options, prefix=network.run_prefix),
+        env=env,
         capture_output=True,
         text=True,
         timeout=WAIT_S,
