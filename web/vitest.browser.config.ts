@@ -7,7 +7,9 @@ export default defineConfig({
     environment: "node",
     // One browser and one broker at a time: the machine has two cores.
     fileParallelism: false,
-    testTimeout: 90_000,
-    hookTimeout: 60_000,
+    // Generous, as every wait inside them: a loaded two-core machine starts Python, Mosquitto
+    // and Chromium slowly. They pass in far less; only a failure waits this long.
+    testTimeout: 180_000,
+    hookTimeout: 180_000,
   },
 });

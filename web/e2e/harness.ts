@@ -22,7 +22,8 @@ export const FEELMYSIGN = process.env["FEELMYSIGN_BIN"] ?? join(REPO_DIR, ".venv
 export const CHROMIUM = process.env["CHROMIUM_BIN"] ?? "/usr/bin/chromium";
 export const SLEEVE_ID = "sleeve1";
 
-const BROKER_READY_TIMEOUT_MS = 20_000;
+// Generous: on a loaded two-core machine the Python start-up alone can take half a minute.
+const BROKER_READY_TIMEOUT_MS = 60_000;
 const STOP_TIMEOUT_MS = 5_000;
 
 export interface Credentials {
@@ -218,7 +219,7 @@ export async function launchBrowser(
 
 // ---- feelmysign up ----------------------------------------------------------------------------
 
-const UP_READY_TIMEOUT_MS = 30_000;
+const UP_READY_TIMEOUT_MS = 90_000;
 
 /**
  * Resolves with the first match of `pattern` in what `child` prints (stdout and stderr
@@ -340,7 +341,7 @@ export class FakeSleeve {
   }
 
   /** Resolves when `count` strokes have arrived; fails after `timeoutMs` saying how many did. */
-  async waitForStrokes(count: number, timeoutMs = 15_000): Promise<Record<string, unknown>[]> {
+  async waitForStrokes(count: number, timeoutMs = 30_000): Promise<Record<string, unknown>[]> {
     const deadline = Date.now() + timeoutMs;
     while (this.strokes().length < count) {
       const left = deadline - Date.now();

@@ -129,7 +129,7 @@ export async function waitForData(
   selector: string,
   key: string,
   value: string,
-  timeoutMs = 15_000,
+  timeoutMs = 30_000,
 ): Promise<void> {
   try {
     await page.waitForFunction(
