@@ -196,6 +196,10 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     console.log(`cancel -> every motor off: ${offAfterMs.toFixed(2)} ms (sleeve's record)`);
     expect(offAfterMs).toBeLessThanOrEqual(OFF_WITHIN_MS);
     await waitForData(page, '[data-testid="played-summary"]', "cancelled", String(cancelled.length));
+    // The stroke stopped mid-way was played in part: the card says it was cut short.
+    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
+      "1 cut short by Stop",
+    );
     await screenshot(page, "felt-stopped");
     await setLongestStroke(page, "300"); // the default again, for what follows
   });

@@ -612,6 +612,7 @@ export class App {
       case "cancelled":
         if (!ours) return;
         this.#says.count("cancelled");
+        if (event.started) this.#says.count("cut");
         this.#felt.cancelled(event);
         this.#says.add(
           "info",

@@ -14,13 +14,23 @@ export interface Counts {
   played: number;
   refused: number;
   cancelled: number;
+  /** Of the cancelled, those cut short while playing (also counted as played). */
+  cut: number;
   /** Not sent: cancelled before they left, or dropped by the timing policy. */
   dropped: number;
   late: number;
   latestLateMs: number;
 }
 
-const zero = (): Counts => ({ played: 0, refused: 0, cancelled: 0, dropped: 0, late: 0, latestLateMs: 0 });
+const zero = (): Counts => ({
+  played: 0,
+  refused: 0,
+  cancelled: 0,
+  cut: 0,
+  dropped: 0,
+  late: 0,
+  latestLateMs: 0,
+});
 
 export class SleeveSays {
   readonly #title: HTMLElement;
@@ -76,7 +86,7 @@ export class SleeveSays {
   }
 
   #render(): void {
-    const { played, refused, cancelled, dropped, late, latestLateMs } = this.#counts;
+    const { played, refused, cancelled, cut, dropped, late, latestLateMs } = this.#counts;
     const summary = this.#summary;
     summary.dataset["played"] = String(played);
     summary.dataset["sent"] = String(this.#sent);
@@ -90,7 +100,9 @@ export class SleeveSays {
     }
     const parts = [`${played} of ${this.#sent} stroke${this.#sent === 1 ? "" : "s"} played`];
     if (refused > 0) parts.push(`${refused} refused`);
-    if (cancelled > 0) parts.push(`${cancelled} cancelled`);
+    // A stroke stopped while playing was played in part: "4 of 4 played, 1 cancelled" would puzzle.
+    if (cut > 0) parts.push(`${cut} cut short by Stop`);
+    if (cancelled > cut) parts.push(`${cancelled - cut} cancelled before playing`);
     if (dropped > 0) parts.push(`${dropped} dropped unsent`);
     if (late > 0) parts.push(`${late} late (last by ${seconds(latestLateMs)})`);
     summary.textContent = `${parts.join(", ")}.`;
