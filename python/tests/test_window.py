@@ -143,6 +143,30 @@ def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
     assert segments[-1].end_ms == 600.0
 
 
+def _bumped_line(params: WindowParams, bump_ms: float, height: float) -> list[Sample]:
+    """A straight line drawn for 400 ms with a bump ``height`` grid units high at ``bump_ms``."""
+    origin, right = params.mapping.to_grid(0, 0), params.mapping.to_grid(100, 0)
+    px = 100.0 / (right[0] - origin[0])  # pixels per grid unit
+    return [
+        Sample(8.0 * k, 1.0 * k, 100.0 - height * px * max(0.0, 1 - abs(8.0 * k - bump_ms) / 24))
+        for k in range(51)
+    ]
+
+
+def test_the_latency_cap_cuts_at_a_feature_of_the_strokes_second_half_only() -> None:
+    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=300)
+    # A bump 0.2 high (within the bound) 40 ms in: cutting there would leave a 40 ms
+    # stroke, too brief to be felt in its drawn time; the line after it is straight, so
+    # the cap cuts at the last sample it allows.
+    early = [s for _, s in _run(params, [_bumped_line(params, 40.0, 0.2)])]
+    assert [s.dropped for s in early] == [None, None]
+    assert (early[0].start_ms, early[0].end_ms) == (0.0, 296.0)
+    # The same bump 200 ms in lies in the stroke's second half: the cut is on it.
+    late = [s for _, s in _run(params, [_bumped_line(params, 200.0, 0.2)])]
+    assert (late[0].start_ms, late[0].end_ms) == (0.0, 200.0)
+    assert late[-1].end_ms == 400.0
+
+
 def test_a_release_a_rounding_error_after_a_frame_still_reaches_the_end() -> None:
     # A 125 Hz pen; the release comes 0.0003 ms after the 30th 60 fps frame, moved on.
     samples = [Sample(k * 8.0, 200.0 + 6.0 * k, 300.0 + 2.0 * k) for k in range(63)]

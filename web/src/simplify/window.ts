@@ -19,8 +19,16 @@ import { CanvasMapping } from "./mapping";
 import { finishSegment, type Point, type Sample, type Segment } from "./segment";
 import { checkWindowParams, type WindowParams } from "./window-params";
 
-/** The latency cap cuts at a feature only where the stroke bends by more than this share of max_error. */
-const CAP_BEND = 0.5;
+/**
+ * The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
+ * stroke's start, so that the stroke it ends is not too brief to be felt in its drawn time.
+ */
+const CAP_FEATURE_SHARE = 0.5;
+/**
+ * A stroke whose samples all lie within this share of max_error of its chord is straight
+ * (rounding, not a feature): the cap cuts it at its last sample, as late as it can.
+ */
+const STRAIGHT = 1e-6;
 
 interface Drawn {
   readonly sample: Sample;
@@ -134,16 +142,23 @@ export class WindowSimplifier {
   }
 
   /**
-   * Where the latency cap cuts: at a feature if the stroke so far bends by more
-   * than `CAP_BEND` x max_error from the chord anchor -> last sample, else at its end.
+   * Where the latency cap cuts: at a feature in the stroke's later part, else at
+   * its end. The feature is the sample farthest from the chord anchor -> last
+   * sample among those drawn at least `CAP_FEATURE_SHARE` x max_stroke_ms after
+   * the anchor whose own stroke keeps the bound and is long enough to send; if it
+   * lies on the chord (a straight stroke, to `STRAIGHT`), at the last sample.
    */
   #capCut(window: readonly Drawn[]): number {
+    const anchor = window[0]!;
     const last = window[window.length - 1]!;
-    const cut = this.#feature(window, last.point);
-    const farSq = distanceSq(window[cut]!.point, window[0]!.point, last.point);
-    const limit = CAP_BEND * this.params.max_error;
-    const bends = farSq > limit * limit && this.#sendable(window[0]!, window[cut]!);
-    return bends ? cut : window.length - 1;
+    const earliest = anchor.sample.t_ms + CAP_FEATURE_SHARE * this.params.max_stroke_ms;
+    let first = 1;
+    while (first < window.length - 1 && window[first]!.sample.t_ms < earliest) first++;
+    const cut = this.#feature(window, last.point, first);
+    const straight = STRAIGHT * this.params.max_error;
+    const farSq = distanceSq(window[cut]!.point, anchor.point, last.point);
+    const bends = farSq > straight * straight;
+    return bends && this.#sendable(anchor, window[cut]!) ? cut : window.length - 1;
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
@@ -157,10 +172,10 @@ export class WindowSimplifier {
    * Where to cut: the sample farthest from anchor -> end whose own stroke keeps
    * the bound (the last sample always does). Ties go to the later sample.
    */
-  #feature(window: readonly Drawn[], end: Point): number {
+  #feature(window: readonly Drawn[], end: Point, first = 1): number {
     const anchor = window[0]!.point;
     const ranked: { index: number; distanceSq: number }[] = [];
-    for (let i = 1; i < window.length; i++) {
+    for (let i = first; i < window.length; i++) {
       ranked.push({ index: i, distanceSq: distanceSq(window[i]!.point, anchor, end) });
     }
     ranked.sort((a, b) => b.distanceSq - a.distanceSq || b.index - a.index);

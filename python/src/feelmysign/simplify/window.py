@@ -23,10 +23,11 @@ corners land on the drawing's features. Here:
 - Latency cap: a stroke lasts at most ``max_stroke_ms`` of drawing. A sample
   that would make it longer cuts it, so the wearer feels a long line begin
   before it ends (the paper's "frame max", in ms): at a feature (as above,
-  against the chord to the sample before) where the stroke bends by more than
-  half the bound, else at the sample before. A stroke still too short to send
-  (``min_length``) is not cut: a slow pen's line would otherwise be cut into
-  pieces too short to feel, all dropped.
+  against the chord to the sample before) among the samples of the stroke's
+  second half (``CAP_FEATURE_SHARE``), so the stroke it ends is not too brief
+  to be felt in its drawn time; a straight stroke at the sample before. A
+  stroke still too short to send (``min_length``) is not cut: a slow pen's
+  line would otherwise be cut into pieces too short to feel, all dropped.
 - Work cap: when a stroke holds ``max_window`` samples after its anchor it is
   cut at the current sample (each sample costs at most that many tests).
 - On release the rest is one stroke. A path's first and last samples are
@@ -48,9 +49,12 @@ from feelmysign.simplify.params import DROP_AND_GRID_SPECS, FrameAndGrid, ParamS
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.stroke import Point
 
-# The latency cap cuts at a feature only where the stroke bends by more than this share
-# of max_error; a straight line is cut at its last sample, as late as the cap allows.
-CAP_BEND = 0.5
+# The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
+# stroke's start, so that the stroke it ends is not too brief to be felt in its drawn time.
+CAP_FEATURE_SHARE = 0.5
+# A stroke whose samples all lie within this share of max_error of its chord is straight
+# (rounding, not a feature): the cap cuts it at its last sample, as late as it can.
+STRAIGHT = 1e-6
 
 WINDOW_PARAMS: dict[str, ParamSpec] = {
     s.name: s
@@ -201,24 +205,31 @@ class WindowSimplifier:
                 self._window = [item]
 
     def _cap_cut(self, window: list[_Point]) -> int:
-        """Where the latency cap cuts: at a feature if the stroke so far bends, else at its end.
+        """Where the latency cap cuts: at a feature in the stroke's later part, else at its end.
 
-        A bend is a sample farther than ``CAP_BEND`` x max_error from the chord
-        anchor -> last sample (whose stroke from the anchor is long enough to
-        send); a straight stroke is cut as late as it can be.
+        The feature is the sample farthest from the chord anchor -> last sample
+        among those drawn at least ``CAP_FEATURE_SHARE`` x max_stroke_ms after the
+        anchor whose own stroke keeps the bound and is long enough to send; if it
+        lies on the chord (a straight stroke, to ``STRAIGHT``), at the last sample.
         """
-        cut = self._feature(window, window[-1].point)
-        far_sq = _distance_sq(window[cut].point, window[0].point, window[-1].point)
-        limit = CAP_BEND * self.params.max_error
-        bends = far_sq > limit * limit and self._sendable(window[0], window[cut])
-        return cut if bends else len(window) - 1
+        anchor = window[0]
+        earliest = anchor.sample.t_ms + CAP_FEATURE_SHARE * self.params.max_stroke_ms
+        first = next(
+            (i for i in range(1, len(window)) if window[i].sample.t_ms >= earliest),
+            len(window) - 1,
+        )
+        cut = self._feature(window, window[-1].point, first)
+        straight = STRAIGHT * self.params.max_error
+        far_sq = _distance_sq(window[cut].point, anchor.point, window[-1].point)
+        bends = far_sq > straight * straight
+        return cut if bends and self._sendable(anchor, window[cut]) else len(window) - 1
 
     def _sendable(self, start: _Point, end: _Point) -> bool:
         """Whether start -> end is long enough to send (the cap never cuts off a dropped stroke)."""
         dx, dy = end.point[0] - start.point[0], end.point[1] - start.point[1]
         return dx * dx + dy * dy >= self.params.min_length * self.params.min_length
 
-    def _feature(self, window: list[_Point], end: Point) -> int:
+    def _feature(self, window: list[_Point], end: Point, first: int = 1) -> int:
         """Where to cut: the sample farthest from anchor -> end whose own stroke keeps the bound.
 
         The last sample always qualifies (the window kept the bound up to it).
@@ -226,7 +237,7 @@ class WindowSimplifier:
         """
         anchor = window[0].point
         ranked = sorted(
-            range(1, len(window)),
+            range(first, len(window)),
             key=lambda i: (_distance_sq(window[i].point, anchor, end), i),
             reverse=True,
         )
