@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import json
 import os
+import queue
 import subprocess
 import sys
 import threading
 import time
+import uuid
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +24,9 @@ from sleeve_watch import connected_client, subscribe, subscribe_all
 from feelmysign.broker.credentials import Account, reuse_or_create
 from feelmysign.broker.nats_cluster import NatsCluster
 from feelmysign.connection import BrokerSettings, new_client, parse_broker_url
+from feelmysign.daemon import sleeve_client_id
+from feelmysign.protocol import format_json
+from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic, telemetry_topic
 
 WAIT_S = 60.0
@@ -32,6 +37,7 @@ pytestmark = pytest.mark.broker
 # The sleeve's pace limits on a cluster (docs/deploy.md): a node's failure may hold
 # strokes back for up to about 10 s, and they still play.
 CLUSTER_PACE = ("--max-lag-ms", "30000", "--max-age-ms", "60000")
+ACK_WAIT_S = 10.0  # deploy/nats/mqtt.conf: a stroke not acknowledged is sent again after it
 
 
 @pytest.fixture(scope="module")
@@ -88,6 +94,7 @@ class Events:
     def __init__(self, url: str, account: Account) -> None:
         self.played: dict[tuple[str, int], set[str]] = {}
         self.refused: dict[tuple[str, int], set[str]] = {}
+        self._order: list[tuple[str, int]] = []  # the strokes, in the order they played
         self._lock = threading.Condition()
         # A persistent session, subscribed on every connect: a node that drops its
         # clients while JetStream moves its leaders must not make the watcher miss events.
@@ -112,6 +119,8 @@ class Events:
         key = (event["drawing"], event["seq"])
         with self._lock:
             if event.get("type") in ("played", "adjusted"):
+                if key not in self.played:
+                    self._order.append(key)
                 self.played.setdefault(key, set()).add(message.payload.decode())
             elif event.get("type") in ("rejected", "cancelled", "safety"):
                 self.refused.setdefault(key, set()).add(str(event.get("reason")))
@@ -134,6 +143,10 @@ class Events:
     def played_seqs(self, drawing: str) -> list[int]:
         with self._lock:
             return sorted(seq for (d, seq) in self.played if d == drawing)
+
+    def order(self, drawing: str) -> list[int]:
+        with self._lock:
+            return [seq for (d, seq) in self._order if d == drawing]
 
     def refusals(self, drawing: str) -> dict[int, set[str]]:
         with self._lock:
@@ -285,3 +298,69 @@ def test_settings_take_several_urls_of_one_cluster() -> None:
         "mqtt://c:1885",
     ]
     assert isinstance(settings, BrokerSettings) and settings.urls.count(",") == 2
+
+
+def test_a_stroke_redelivered_after_later_ones_plays_once(cluster: NatsCluster) -> None:
+    """A stroke the broker acknowledged to its sender and never got acknowledged for (the
+    sleeve's connection went away with it in flight, as when its node dies) comes again
+    after ack_wait: on NATS, after the strokes sent since. It plays, once: it is not
+    refused for coming out of order (it was, as ``out_of_order``, and so lost)."""
+    c = cluster.credentials
+    node = cluster.nodes[2]
+    # The sleeve's session receives stroke 0 and goes away without acknowledging it.
+    settings = parse_broker_url(
+        node.mqtt_url, username=c.sleeve.username, password=c.sleeve.password
+    )
+    session = sleeve_client_id(SLEEVE, c.sleeve.password)
+    away = new_client(settings, client_id=session, persistent_session=True)
+    away.manual_ack_set(True)
+    got: queue.Queue[bytes] = queue.Queue()
+    away.on_message = lambda _c, _u, m: got.put(bytes(m.payload))
+    subscribed = threading.Event()
+    away.on_connect = lambda paho, *_: paho.subscribe(strokes_topic(SLEEVE), qos=1)
+    away.on_subscribe = lambda *_: subscribed.set()
+    away.connect(settings.host, settings.port)
+    away.loop_start()
+    assert subscribed.wait(WAIT_S)
+    sender = client(node.mqtt_url, c.sender)
+    drawing = str(uuid.uuid4())
+
+    def send(seq: int) -> None:
+        stroke = Stroke((0.0, 1.0), (2.0, 1.0), 200.0, 0.5, drawing, seq, time.time() * 1000)
+        sender.publish(strokes_topic(SLEEVE), format_json(stroke), qos=1).wait_for_publish(10)
+
+    events = Events(node.mqtt_url, c.sender)
+    sleeve: subprocess.Popen[str] | None = None
+    try:
+        send(0)
+        assert json.loads(got.get(timeout=WAIT_S))["seq"] == 0
+        delivered_s = time.monotonic()
+        away.disconnect()  # a clean exit: the session, and stroke 0 unacknowledged, stay
+        away.loop_stop()
+        sleeve = subprocess.Popen(
+            feelmysign(
+                *("sleeve", "--broker", node.mqtt_url, "--id", SLEEVE),
+                *("--username", c.sleeve.username, *CLUSTER_PACE),
+            ),
+            env={**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password},
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        _wait_online(cluster, c.sender)
+        back_within_ack_wait = time.monotonic() - delivered_s < ACK_WAIT_S - 2
+        for seq in (1, 2, 3):
+            send(seq)
+        events.wait_settled(drawing, 4)
+    finally:
+        events.client.loop_stop()
+        sender.loop_stop()
+        said = ""
+        if sleeve is not None:
+            sleeve.terminate()
+            said = sleeve.communicate(timeout=WAIT_S)[0]
+    assert events.played_seqs(drawing) == [0, 1, 2, 3], (events.refusals(drawing), said)
+    assert all(why == {"duplicate"} for why in events.refusals(drawing).values()), said
+    assert all(len(payloads) == 1 for payloads in events.played.values()), "played twice"
+    if back_within_ack_wait:  # else NATS may send stroke 0 again before the others
+        assert events.order(drawing) == [1, 2, 3, 0], said
