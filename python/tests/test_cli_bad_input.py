@@ -169,6 +169,14 @@ BAD_VALUES = [
     (["plan", "0,0,1,0,500", "--rows", "1e9"], ["--rows", "1 to 64"]),
     (["plan", "0,0,1,0,500", "--spacing-cm", "inf"], ["--spacing-cm", "at most 20 cm"]),
     (["sleeve", "--rate-per-s", "1e308"], ["--rate-per-s", "10000"]),
+    # Decimal digits only: Python alone would read 1_0 as 10 and \u0663 (Arabic-Indic) as 3.
+    (["simplify", "{good}", "--max-error", "1_0"], ["--max-error", "'1_0' is not a decimal"]),
+    (["simplify", "{good}", "--max-error", "0x10"], ["--max-error", "digits 0-9"]),
+    (["simplify", "{good}", "--max-error", "inf"], ["--max-error", "not a decimal number"]),
+    (["plan", "0,0,1,0,500", "--rows", "1_0"], ["--rows", "1 to 64"]),
+    (["plan", "0,0,1,0,500", "--spacing-cm", "\u0663"], ["--spacing-cm", "at most 20 cm"]),
+    (["up", "--http-port", "80_80"], ["--http-port", "1 to 65535"]),
+    (["buzz", "0", "1_0"], ["COLUMN", "'1_0' is not a whole decimal number"]),
 ]
 
 

@@ -19,6 +19,7 @@ import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 from feelmysign.errors import FeelMySignError
 from feelmysign.input_files import (
@@ -48,6 +49,50 @@ MAX_TIMEOUT_S = 3600.0  # an hour: a longer wait for a broker is a hang, not a w
 _TOPIC_FORBIDDEN = re.compile(r"[\s+#\x00]")
 
 
+# Numbers as people write them in decimal, ASCII digits only: Python's float() and int() also
+# take 1_0 (10), 0x10 with int(.., 0), inf, nan and other scripts' digits (٣ is 3).
+_DECIMAL = re.compile(r"\s*[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\s*")
+_WHOLE = re.compile(r"\s*[+-]?[0-9]+\s*")
+
+
+def decimal_float(text: str) -> float:
+    """A number written in decimal (1, 0.5, .5, 2e-3); ValueError for anything else."""
+    if not _DECIMAL.fullmatch(text):
+        raise ValueError(f"not a decimal number: {text!r}")
+    return float(text)
+
+
+def decimal_int(text: str) -> int:
+    """A whole number written in decimal digits; ValueError for anything else."""
+    if not _WHOLE.fullmatch(text):
+        raise ValueError(f"not a whole decimal number: {text!r}")
+    return int(text, 10)
+
+
+_Number = TypeVar("_Number", int, float)
+
+
+def _decimal_option(
+    parse: Callable[[str], _Number], what: str, example: str
+) -> Callable[[str], _Number]:
+    """An argparse type from ``parse``: a usage error naming what to write instead."""
+
+    def option(text: str) -> _Number:
+        try:
+            return parse(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not {what}; write it with the digits 0-9, e.g. {example}"
+            ) from None
+
+    return option
+
+
+# ``type=float`` and ``type=int`` of every option (CliParser registers them).
+decimal_float_option = _decimal_option(decimal_float, "a decimal number", "0.25, 12 or 2e-3")
+decimal_int_option = _decimal_option(decimal_int, "a whole decimal number", "3")
+
+
 class InputError(FeelMySignError):
     """An input file, standard input or output folder that cannot be used; says what to do."""
 
@@ -69,7 +114,7 @@ def number(
 
     def parse(text: str) -> float:
         try:
-            value = float(text)
+            value = decimal_float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number; give {allowed}") from None
         too_low = value <= low if above_low else value < low
@@ -87,7 +132,7 @@ def whole_number(low: int, high: int, *, unit: str = "") -> Callable[[str], int]
 
     def parse(text: str) -> int:
         try:
-            value = int(text.strip(), 10)
+            value = decimal_int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(
                 f"{text!r} is not a whole number; give {allowed}"
@@ -106,7 +151,7 @@ def port(*, allow_zero: bool = True) -> Callable[[str], int]:
 
     def parse(text: str) -> int:
         try:
-            value = int(text.strip(), 10)
+            value = decimal_int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(
                 f"{text!r} is not a port number; give {allowed}"

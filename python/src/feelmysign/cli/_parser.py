@@ -16,6 +16,8 @@ import re
 import sys
 from typing import NoReturn
 
+from feelmysign.cli._inputs import decimal_float_option, decimal_int_option
+
 USAGE_ERROR_EXIT = 2
 # '-' then a digit, or '-.' then a digit: a number or a stroke, never one of our options.
 _NEGATIVE_NUMBER = re.compile(r"^-\.?\d")
@@ -28,6 +30,9 @@ class CliParser(argparse.ArgumentParser):
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         self._negative_number_matcher = _NEGATIVE_NUMBER
+        # Every type=float and type=int option takes decimal digits only: "1_0" is not 10.
+        self.register("type", float, decimal_float_option)
+        self.register("type", int, decimal_int_option)
 
     def error(self, message: str) -> NoReturn:
         text = " ".join(message.split()).rstrip(".")
