@@ -3,8 +3,12 @@
 ``up`` listens on ``feelmysign/<id>/events`` like any page does (with the
 sender's account) and, once a drawing has been quiet for ``QUIET_S``, prints::
 
-    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 rejected (outside_grid);
-    start delay median 3 ms, max 9 ms        (on one line)
+    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 played late (by 1.6 s),
+    1 rejected (outside_grid); start delay median 3 ms, max 9 ms        (on one line)
+
+A stroke played late was felt more than ``LATE_MS`` after its sender sent it, not
+counting its wait behind the strokes before it (the page marks the same ones): it
+waited at the broker or on the way, the sleeve offline or the network slow.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
 of the strokes queued before it) to its first motor: the sleeve's own lateness,
@@ -42,6 +46,9 @@ QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted
 CHECK_INTERVAL_S = 0.25
 LEGACY_DRAWING = "Legacy strokes"
 SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one session
+# Felt this long after it was sent (less its wait behind other strokes), a stroke is late: the
+# page's rule too (web/src/ui/sleeve-says.ts, LATE_MS).
+LATE_MS = 500.0
 
 
 @dataclass
@@ -52,12 +59,16 @@ class _Drawing:
     cancelled: int = 0
     rejected: Counter[str] = field(default_factory=Counter)
     delays_ms: list[float] = field(default_factory=list)
+    late_ms: list[float] = field(default_factory=list)
 
     def line(self, name: str) -> str:
         shown = name if name == LEGACY_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
         parts = [f"{self.played} stroke{'s' if self.played != 1 else ''} played"]
         if self.slowed:
             parts[0] += f" ({self.slowed} slowed to be felt)"
+        if self.late_ms:
+            parts.append(f"{len(self.late_ms)} played late (by {_seconds(max(self.late_ms))}")
+            parts[-1] += " at most)" if len(self.late_ms) > 1 else ")"
         if self.rejected:
             reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in self.rejected.items())
             parts.append(f"{sum(self.rejected.values())} rejected ({reasons})")
@@ -70,6 +81,11 @@ class _Drawing:
                 f"max {max(self.delays_ms):.0f} ms"
             )
         return text
+
+
+def _seconds(ms: float) -> str:
+    """As the page writes a delay: ms below a second, else seconds to a tenth."""
+    return f"{ms / 1000:.1f} s" if ms >= 1000 else f"{ms:.0f} ms"
 
 
 class DrawingSummaries:
@@ -89,6 +105,10 @@ class DrawingSummaries:
             drawing.played += 1
             drawing.slowed += isinstance(event, Adjusted)
             drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
+            if event.sent_at_ms is not None:
+                late_ms = event.first_command_at_ms - event.sent_at_ms - event.queued_ms
+                if late_ms > LATE_MS:
+                    drawing.late_ms.append(late_ms)
         elif isinstance(event, Rejected):
             drawing.rejected[event.reason] += 1
         else:
