@@ -21,6 +21,7 @@ from sleeve_watch import SleeveWatch, settings, sleeve_command
 
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import new_client
+from feelmysign.lifecycle import Closing
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic
@@ -35,8 +36,8 @@ def wait_for(condition: Callable[[], bool], what: str, timeout_s: float = WAIT_S
         time.sleep(0.02)  # another process's progress: nothing here to wait on
 
 
-class SleeveProcess:
-    """``feelmysign sleeve`` (simulator, --record) as a child process."""
+class SleeveProcess(Closing):
+    """``feelmysign sleeve`` (simulator, --record) as a child process; ``with`` stops it."""
 
     def __init__(self, credentials_path: Path, record: Path, *extra: str) -> None:
         self.record = record
@@ -65,6 +66,9 @@ class SleeveProcess:
                 self.process.wait(15)
             except subprocess.TimeoutExpired:
                 self.kill()
+
+    def close(self) -> None:
+        self.stop()
 
     def changes(self) -> list[dict[str, Any]]:
         if not self.record.exists():

@@ -12,10 +12,11 @@ the restarted sleeve.
 from __future__ import annotations
 
 import time
+from contextlib import ExitStack
 from pathlib import Path
 
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, played, plays, stroke, wait_for
+from delivery import SleeveProcess, delivery, played, plays, stroke, wait_for
 
 STROKES = 20
 DURATION_MS = 500.0  # 10 s of playing: most strokes still wait when the connection drops
@@ -25,14 +26,11 @@ NO_PACE = ("--max-age-ms", "3600000", "--max-lag-ms", "600000")  # this test is 
 def test_strokes_sent_again_after_a_reconnect_survive_a_sigkill_of_the_sleeve(
     start_broker: StartBroker, tmp_path: Path
 ) -> None:
-    broker = start_broker(state_dir=tmp_path / "state")
-    c = broker.credentials
-    watcher = Watcher(c)
-    first = SleeveProcess(broker.credentials_path, tmp_path / "first.jsonl", *NO_PACE)
-    sender = Sender(c)
-    second: SleeveProcess | None = None
-    try:
-        wait_for(watcher.is_online, "the sleeve to come online")
+    with (
+        delivery(start_broker, tmp_path, *NO_PACE) as (broker, watcher, first, sender),
+        ExitStack() as later,
+    ):
+        c = broker.credentials
         for seq in range(STROKES):
             sender.publish(seq, stroke(sender.drawing, seq, DURATION_MS, sent_at_ms=None))
         wait_for(lambda: len(sender.acked_seqs()) == STROKES, "the broker's acknowledgements")
@@ -60,7 +58,9 @@ def test_strokes_sent_again_after_a_reconnect_survive_a_sigkill_of_the_sleeve(
         before = set(plays(watcher.snapshot(), sender.drawing))
         assert len(before) < STROKES, "the drawing ended before the kill: nothing was tested"
 
-        second = SleeveProcess(broker.credentials_path, tmp_path / "second.jsonl", *NO_PACE)
+        second = later.enter_context(
+            SleeveProcess(broker.credentials_path, tmp_path / "second.jsonl", *NO_PACE)
+        )
         wait_for(
             lambda: set(plays(watcher.snapshot(), sender.drawing)) == set(range(STROKES)),
             f"every stroke to play (before the kill: {sorted(before)})",
@@ -70,9 +70,3 @@ def test_strokes_sent_again_after_a_reconnect_survive_a_sigkill_of_the_sleeve(
         twice = {seq: n for seq, n in plays(watcher.snapshot(), sender.drawing).items() if n > 1}
         assert not twice, f"played more than once: {twice}"
         assert any(change["intensity"] > 0 for change in second.changes())
-    finally:
-        sender.stop()
-        watcher.stop()
-        first.stop()
-        if second is not None:
-            second.stop()

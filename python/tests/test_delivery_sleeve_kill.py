@@ -8,10 +8,11 @@ the broker to the restarted sleeve, which plays them.
 from __future__ import annotations
 
 import time
+from contextlib import ExitStack
 from pathlib import Path
 
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, by_seq, played, stroke, wait_for
+from delivery import SleeveProcess, by_seq, delivery, played, stroke, wait_for
 
 STROKES = 20
 DURATION_MS = 300.0  # 20 strokes: 6 s of playing, so most are still waiting at the kill
@@ -21,13 +22,10 @@ KILL_AFTER_PLAYED = 4
 def test_a_killed_sleeve_loses_no_stroke_it_received(
     start_broker: StartBroker, tmp_path: Path
 ) -> None:
-    broker = start_broker(state_dir=tmp_path / "state")
-    watcher = Watcher(broker.credentials)
-    first = SleeveProcess(broker.sleeve_credentials_path, tmp_path / "first.jsonl")
-    sender = Sender(broker.credentials)
-    second: SleeveProcess | None = None
-    try:
-        wait_for(watcher.is_online, "the sleeve to come online")
+    with (
+        delivery(start_broker, tmp_path, sleeve_login=True) as (broker, watcher, first, sender),
+        ExitStack() as later,
+    ):
         for seq in range(STROKES):
             now_ms = time.time() * 1000
             sender.publish(seq, stroke(sender.drawing, seq, DURATION_MS, sent_at_ms=now_ms))
@@ -37,7 +35,9 @@ def test_a_killed_sleeve_loses_no_stroke_it_received(
         before = by_seq(watcher.snapshot(), sender.drawing)
         assert len(before) < STROKES, "the drawing ended before the kill: nothing was tested"
 
-        second = SleeveProcess(broker.sleeve_credentials_path, tmp_path / "second.jsonl")
+        second = later.enter_context(
+            SleeveProcess(broker.sleeve_credentials_path, tmp_path / "second.jsonl")
+        )
         wait_for(
             lambda: len(by_seq(watcher.snapshot(), sender.drawing)) == STROKES,
             "an event for every stroke",
@@ -51,9 +51,3 @@ def test_a_killed_sleeve_loses_no_stroke_it_received(
         second_played = {e["seq"] for e in played(watcher.snapshot()) if e["seq"] in replayed}
         assert second_played, f"none of {replayed} played after the restart: {events}"
         assert any(change["intensity"] > 0 for change in second.changes())
-    finally:
-        sender.stop()
-        watcher.stop()
-        first.stop()
-        if second is not None:
-            second.stop()
