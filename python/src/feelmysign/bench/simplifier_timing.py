@@ -11,15 +11,26 @@ drawings the $1 recogniser names from the strokes sent, against the drawings
 themselves. The same figures come from
 ``feelmysign evaluate --lasa --speeds --defaults``.
 
-``python -m feelmysign.bench.simplifier_timing`` prints this group alone.
+The simulated gesture recordings in ``research/gestures`` follow, as ratios
+only. ``python -m feelmysign.bench.simplifier_timing`` prints this group alone.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from feelmysign.research.dollar import Templates
-from feelmysign.research.evaluate import Recogniser, Run, Source, evaluate, summarize
+from feelmysign.research.evaluate import (
+    Recogniser,
+    Run,
+    Source,
+    evaluate,
+    file_sources,
+    summarize,
+)
+from feelmysign.research.gestures import load_all
 from feelmysign.research.lasa import load_lasa
 from feelmysign.research.speeds import SPEEDS_MS, retimed
 from feelmysign.simplify.registry import ALGORITHMS, DEFAULT_ALGORITHM, PAPER_ALGORITHM
@@ -56,6 +67,30 @@ def report() -> list[str]:
                 f"{entry['recognised_sent_pct']:.1f} % sent / "
                 f"{entry['recognised_drawn_pct']:.1f} % drawn; {entry['strokes_mean']:.2f} strokes"
             )
+    lines += gesture_report()
+    return lines
+
+
+# The simulated gesture recordings (research/gestures), when run from the repository.
+GESTURES = Path(__file__).resolve().parents[4] / "research" / "gestures"
+
+
+def gesture_report() -> list[str]:
+    """The same at the default settings on the simulated gestures, as ratios only."""
+    if not GESTURES.is_dir():
+        return []
+    found, recogniser = file_sources(load_all([str(GESTURES)]))
+    rows = evaluate(found, [Run(ALGORITHMS[DEFAULT_ALGORITHM], {})], recogniser=recogniser)
+    lines = [
+        "Simulated gestures (research/gestures, 16 gestures x 10 people x 3 speeds) at the "
+        "defaults: skin = time on the skin / drawing time; recognised = sent / drawn"
+    ]
+    for entry in summarize(rows):
+        lines.append(
+            f"  default ({DEFAULT_ALGORITHM}) {entry['set']:<6}: skin mean "
+            f"{entry['skin_ratio_mean']:.3f}, p95 {entry['skin_ratio_p95']:.3f}; recognised "
+            f"{entry['recognised_sent_pct'] / entry['recognised_drawn_pct']:.3f}"
+        )
     return lines
 
 
