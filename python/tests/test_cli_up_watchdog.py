@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import os
 import queue
+import select
 import signal
 import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
+from typing import IO
 
 import pytest
 
@@ -50,16 +52,14 @@ def _mosquitto_children(pid: int) -> list[int]:
     return [int(p) for p in found.stdout.split()]
 
 
-def _start_up(tmp_path: Path) -> subprocess.Popen[str]:
+def _start_up(tmp_path: Path, stderr: IO[str] | int = subprocess.STDOUT) -> subprocess.Popen[str]:
     """``feelmysign up`` on free ports with a stand-in page, its output in one stream."""
     web = tmp_path / "web"
     web.mkdir()
     (web / "index.html").write_text("<!doctype html><title>test</title>")
     command = [sys.executable, "-m", "feelmysign", "up", "--state-dir", str(tmp_path / "state")]
     command += ["--http-port", "0", "--port", "0", "--ws-port", "0", "--web-dir", str(web)]
-    process = subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1
-    )
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=stderr, text=True, bufsize=1)
     return process
 
 
@@ -104,3 +104,45 @@ def test_up_says_it_is_stopping_on_ctrl_c_and_reports_no_fault(tmp_path: Path) -
     # A stop asked for is no fault: the sleeve leaving the broker is not reported as lost.
     assert "lost the broker" not in output, output
     assert output.index("Stopping:") < output.index("Stopped:")
+
+
+def _read_until(descriptor: int, text: bytes) -> None:
+    """Read from ``descriptor`` in this thread (a reading thread would hold the pipe open)."""
+    read = b""
+    deadline = time.monotonic() + WAIT_S
+    while text not in read:
+        assert time.monotonic() < deadline, f"no {text!r} in {WAIT_S:g} s: {read!r}"
+        ready, _, _ = select.select([descriptor], [], [], 0.5)
+        if ready:
+            chunk = os.read(descriptor, 4096)
+            assert chunk, f"the output ended before {text!r}: {read!r}"
+            read += chunk
+
+
+def test_up_goes_on_watching_after_its_reader_left(tmp_path: Path) -> None:
+    """``feelmysign up | head -8``: the pipe closes, and the watchdog still restarts the broker."""
+    with (tmp_path / "stderr.txt").open("w+") as stderr:
+        process = _start_up(tmp_path, stderr)
+        try:
+            assert process.stdout is not None
+            _read_until(process.stdout.fileno(), b"Press Ctrl-C")
+            (mosquitto,) = _mosquitto_children(process.pid)
+            process.stdout.close()  # what head does once it has its lines
+            os.kill(mosquitto, signal.SIGKILL)  # the watchdog now prints into the closed pipe
+            deadline = time.monotonic() + WAIT_S
+            while _mosquitto_children(process.pid) in ([], [mosquitto]):
+                assert process.poll() is None, "up ended when its reader left"
+                assert time.monotonic() < deadline, "the watchdog did not restart the broker"
+                time.sleep(0.2)
+        finally:
+            process.send_signal(signal.SIGINT)
+            try:
+                code = process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                raise
+        stderr.seek(0)
+        errors = stderr.read()
+    assert "Traceback" not in errors and "BrokenPipe" not in errors, errors
+    assert code == 0, errors
+    assert _mosquitto_children(process.pid) == []

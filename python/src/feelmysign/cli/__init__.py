@@ -15,6 +15,7 @@ import importlib
 import os
 import sys
 from collections.abc import Sequence
+from typing import Any, TextIO, cast
 
 from feelmysign import __version__
 from feelmysign.cli._early_off import switch_off_early
@@ -100,6 +101,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     arguments = sys.argv[1:] if argv is None else list(argv)
     command = _named_subcommand(arguments)
     switch_off_early(command, arguments)  # before the imports of build_parser
+    stdout = sys.stdout
+    sys.stdout = cast(TextIO, _ReaderMayLeave(stdout))
+    try:
+        return _run(arguments, command)
+    finally:
+        sys.stdout = stdout
+
+
+def _run(arguments: list[str], command: str | None) -> int:
     try:
         args = build_parser(command).parse_args(arguments)
         code: int = args.handler(args)
@@ -126,6 +136,35 @@ def _bug_message(error: Exception) -> str:
         f"please report it with the command you ran; run it again with {DEBUG_ENV}=1 to "
         "see where it happened."
     )
+
+
+class _ReaderMayLeave:
+    """Standard output that outlives its reader (``feelmysign up | head -3``).
+
+    A command that runs on (``up``, ``sleeve``, ``broker``) prints from several
+    threads; a closed pipe must not end the thread that prints (the watchdog that
+    restarts the broker, the MQTT thread that logs drawings). Once the reader has
+    gone, what is printed goes nowhere.
+    """
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            _silence_stdout()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            _silence_stdout()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
 
 
 def _silence_stdout() -> None:
