@@ -23,6 +23,8 @@ interface RecordLine {
   row: number;
   column: number;
   intensity: number;
+  drawing: string | null;
+  seq: number | null;
 }
 
 function readRecord(path: string): RecordLine[] {
@@ -171,10 +173,23 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     const cut = cancelled.find((e) => e["started"] === true);
     expect(cut, JSON.stringify(events.slice(-6))).toBeDefined();
     const record = readRecord(recordPath).slice(before);
-    // The record's clock starts at the sleeve's start; the played event of stroke 0 ties it to the wall clock.
-    const first = watcher.of(drawing, "played").find((e) => e["seq"] === 0)!;
-    const firstOn = record.find((line) => line.intensity > 0)!;
-    const offsetMs = (first["first_command_at_ms"] as number) - firstOn.t_ms;
+    // The record's clock starts at the sleeve's start. The drawing's first stroke played ties it
+    // to the sleeve's wall clock: it starts from every motor off (the sleeve was idle), so its
+    // first command is its first line in the record (a line names its drawing and seq).
+    const played = watcher.of(drawing, "played");
+    const first = played.reduce<Record<string, unknown> | undefined>(
+      (a, e) =>
+        a === undefined || (e["first_command_at_ms"] as number) < (a["first_command_at_ms"] as number)
+          ? e
+          : a,
+      undefined,
+    );
+    expect(first, "a stroke of the drawing played").toBeDefined();
+    const firstOn = record.find(
+      (line) => line.drawing === drawing && line.seq === first!["seq"] && line.intensity > 0,
+    );
+    expect(firstOn, `stroke ${first!["seq"]}, played first, in the sleeve's record`).toBeDefined();
+    const offsetMs = (first!["first_command_at_ms"] as number) - firstOn!.t_ms;
     const cancelAt = (cut!["cancelled_at_ms"] as number) - offsetMs;
     const on = new Map<string, number>();
     let allOffAt: number | null = null;
