@@ -34,6 +34,7 @@ import {
   walk,
   openAdvanced,
 } from "./page";
+import { DESKTOP, Processes } from "./processes";
 import { drawSquare, expectStrokesFollow, strokeBounds } from "./strokes";
 
 const UUID = /^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}$/;
@@ -42,7 +43,7 @@ const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm:
 type Point = readonly [number, number];
 
 describe("drawing with a mouse on a desktop", () => {
-  const cleanups: (() => Promise<void>)[] = [];
+  const processes = new Processes();
   let broker: Broker;
   let sleeve: FakeSleeve;
   let page: Page;
@@ -52,19 +53,10 @@ describe("drawing with a mouse on a desktop", () => {
   let sentCount = 0;
 
   beforeAll(async () => {
-    checkPrerequisites();
-    const stateDir = tempDir("broker");
-    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
-    broker = await Broker.start(stateDir);
-    cleanups.push(() => broker.stop());
-    const server = await serveDist(pageConfig(broker.credentials));
-    cleanups.push(server.stop);
-    pageUrl = server.url;
+    ({ broker, url: pageUrl } = await processes.brokerAndPage());
     sleeve = await FakeSleeve.connect(broker.credentials);
-    cleanups.push(() => sleeve.close());
-    const browser = await launchBrowser({ viewport: { width: 1280, height: 800 }, deviceScaleFactor: 1 });
-    cleanups.push(browser.close);
-    page = await browser.context.newPage();
+    processes.add(() => sleeve.close());
+    page = await (await processes.browser({ ...DESKTOP, deviceScaleFactor: 1 })).newPage();
     page.on("pageerror", (error) => pageErrors.push(String(error)));
     page.on("console", (message) => {
       if (message.type() === "error") pageErrors.push(message.text());
@@ -72,9 +64,7 @@ describe("drawing with a mouse on a desktop", () => {
     await page.goto(pageUrl);
   });
 
-  afterAll(async () => {
-    for (const cleanup of cleanups.reverse()) await cleanup();
-  });
+  afterAll(() => processes.stop());
 
   it("connects with the server's config and shows the sleeve online from its retained status", async () => {
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");

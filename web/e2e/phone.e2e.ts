@@ -3,18 +3,9 @@
  * finger (real touch events through the DevTools protocol) sends strokes, and
  * the layout and the settings sheet fit the small screen.
  */
-import { rmSync } from "node:fs";
 import type { CDPSession, Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import {
-  Broker,
-  checkPrerequisites,
-  FakeSleeve,
-  launchBrowser,
-  pageConfig,
-  serveDist,
-  tempDir,
-} from "./harness";
+import { checkPrerequisites, FakeSleeve, launchBrowser, serveDist } from "./harness";
 import {
   CANVAS,
   drawingArea,
@@ -25,6 +16,7 @@ import {
   waitForData,
   type Area,
 } from "./page";
+import { Processes } from "./processes";
 import { expectStrokesFollow, strokeBounds } from "./strokes";
 
 /** Labels cut short by their box ("Simpli…"): none may be, in the bars or the settings. */
@@ -50,38 +42,29 @@ function expectOnScreen(area: Area, screen: { width: number; height: number }, s
 }
 
 describe("drawing with a finger on a phone", () => {
-  const cleanups: (() => Promise<void>)[] = [];
+  const processes = new Processes();
   let sleeve: FakeSleeve;
   let page: Page;
   let cdp: CDPSession;
 
   beforeAll(async () => {
-    checkPrerequisites();
-    const stateDir = tempDir("broker");
-    cleanups.push(async () => rmSync(stateDir, { recursive: true, force: true }));
-    const broker = await Broker.start(stateDir);
-    cleanups.push(() => broker.stop());
-    const server = await serveDist(pageConfig(broker.credentials));
-    cleanups.push(server.stop);
+    const { broker, url } = await processes.brokerAndPage();
     sleeve = await FakeSleeve.connect(broker.credentials);
-    cleanups.push(() => sleeve.close());
+    processes.add(() => sleeve.close());
     await sleeve.publish("status", { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3 } }, true);
-    const browser = await launchBrowser({
+    const context = await processes.browser({
       viewport: { width: 390, height: 844 },
       deviceScaleFactor: 3,
       hasTouch: true,
       isMobile: true,
     });
-    cleanups.push(browser.close);
-    page = await browser.context.newPage();
-    cdp = await browser.context.newCDPSession(page);
-    await page.goto(server.url);
+    page = await context.newPage();
+    cdp = await context.newCDPSession(page);
+    await page.goto(url);
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
   });
 
-  afterAll(async () => {
-    for (const cleanup of cleanups.reverse()) await cleanup();
-  });
+  afterAll(() => processes.stop());
 
   it("uses the screen: the area is turned to the phone's shape, whole, with labelled buttons", async () => {
     const area = await drawingArea(page);

@@ -6,10 +6,13 @@
 import type { ChildProcess } from "node:child_process";
 import { readFileSync, rmSync } from "node:fs";
 import { join } from "node:path";
-import type { Page } from "playwright-core";
+import type { BrowserContext, Page } from "playwright-core";
 import {
+  Broker,
   checkPrerequisites,
   launchBrowser,
+  pageConfig,
+  serveDist,
   startUp,
   stopChild,
   tempDir,
@@ -61,11 +64,29 @@ export class Processes {
     return { stateDir, url, child, credentials };
   }
 
-  /** A fresh Chromium (`options`: its window) with a page opened on `url`; closed at the end. */
-  async page(url: string, options: BrowserOptions = DESKTOP): Promise<Page> {
+  /**
+   * Checks the prerequisites, then starts `feelmysign broker` in a fresh state directory
+   * and serves the built page with the broker's config beside it; both stopped at the end.
+   */
+  async brokerAndPage(prefix = "broker"): Promise<{ broker: Broker; url: string }> {
+    checkPrerequisites();
+    const broker = await Broker.start(this.dir(prefix));
+    this.add(() => broker.stop());
+    const server = await serveDist(pageConfig(broker.credentials));
+    this.add(server.stop);
+    return { broker, url: server.url };
+  }
+
+  /** A fresh Chromium (`options`: its window); closed at the end. */
+  async browser(options: BrowserOptions = DESKTOP): Promise<BrowserContext> {
     const browser = await launchBrowser(options);
     this.add(browser.close);
-    const page = await browser.context.newPage();
+    return browser.context;
+  }
+
+  /** A fresh Chromium (`options`: its window) with a page opened on `url`; closed at the end. */
+  async page(url: string, options: BrowserOptions = DESKTOP): Promise<Page> {
+    const page = await (await this.browser(options)).newPage();
     await page.goto(url);
     return page;
   }
