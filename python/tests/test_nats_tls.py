@@ -28,6 +28,7 @@ import paho.mqtt.client as mqtt
 import pytest
 from cryptography import x509
 from cryptography.hazmat.primitives import hashes
+from sleeve_watch import connected_client
 
 from feelmysign.broker import _process as process_
 from feelmysign.broker.credentials import reuse_or_create
@@ -64,15 +65,9 @@ def _sender(cluster: NatsCluster, url: str, ca_file: Path | None) -> BrokerSetti
 
 def _connect(settings: BrokerSettings) -> tuple[mqtt.Client, queue.Queue[Any]]:
     """A client logged in over TLS (verifying with ``settings.ca_file``), and its messages."""
-    client = new_client(settings, client_id=f"test-{uuid.uuid4()}")
-    connected: queue.Queue[Any] = queue.Queue()
+    client = connected_client(settings, wait_s=WAIT_S)  # the TLS handshake happens here
     received: queue.Queue[Any] = queue.Queue()
-    client.on_connect = lambda _c, _u, _f, code, _p: connected.put(code)
     client.on_message = lambda _c, _u, message: received.put(json.loads(message.payload))
-    client.connect(settings.host, settings.port)  # the TLS handshake happens here
-    client.loop_start()
-    code = connected.get(timeout=WAIT_S)
-    assert not code.is_failure, code
     return client, received
 
 
