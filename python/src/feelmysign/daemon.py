@@ -72,6 +72,7 @@ from feelmysign.player import (
     wall_ms,
 )
 from feelmysign.protocol import Accepted, parse
+from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 
 log = logging.getLogger(__name__)
@@ -220,7 +221,11 @@ class Sleeve:
             target=self._publish_loop, name="feelmysign-events", daemon=True
         )
         publisher.start()
-        self._player.start()
+        self._player.start()  # every motor off (the backend's open), then the player's thread
+        manager = ServiceManager.from_environment()
+        feeder = WatchdogFeeder(manager, self._player.alive) if manager is not None else None
+        if feeder is not None:
+            feeder.start()
         try:
             self._client.connect_async(self._settings.host, self._settings.port, KEEPALIVE_S)
             self._client.loop_start()
@@ -231,6 +236,8 @@ class Sleeve:
             if self._fatal is not None:
                 raise self._fatal
         finally:
+            if feeder is not None:
+                feeder.stop()
             self._shutdown(publisher)
 
     def stop(self) -> None:

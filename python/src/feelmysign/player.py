@@ -174,6 +174,7 @@ class Player:
         self._accepted = 0
         self._cancels: list[_CancelRequest] = []
         self._thread: threading.Thread | None = None
+        self._beat_s = time.monotonic()  # when the player's loop last went round (``alive``)
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
         self.played = 0
         self.capped = 0
@@ -315,9 +316,16 @@ class Player:
 
     # --- the player thread --------------------------------------------------------
 
+    def alive(self, max_age_s: float) -> bool:
+        """The player's thread went round its loop in the last ``max_age_s`` (it is not stuck)."""
+        thread = self._thread
+        fresh = time.monotonic() - self._beat_s <= max_age_s
+        return thread is not None and thread.is_alive() and self._running and fresh
+
     def _run(self) -> None:
         try:
             while self._running:
+                self._beat_s = time.monotonic()
                 self._wake.clear()
                 self._take_inbox()
                 self._apply_cancels()
