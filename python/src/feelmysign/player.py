@@ -178,6 +178,7 @@ class Player:
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
         self.played = 0
         self.capped = 0
+        self.cut = 0  # strokes cut for a chip that stopped answering
 
     # --- any thread ------------------------------------------------------------
 
@@ -335,7 +336,10 @@ class Player:
             self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
-            self._backend.all_off()
+            try:
+                self._backend.all_off()
+            except Exception as error:  # a lost chip: stop() tries again and says so
+                log.warning("all motors off as the player stops: %s", error)
 
     def _take_inbox(self) -> None:
         with self._lock:
@@ -398,17 +402,24 @@ class Player:
             time.sleep(0)  # let the network thread take the interpreter meanwhile
         due = self._timeline.pop_due(self._clock())
         written_at_ms = self._clock()  # the first command of a stroke goes out now
-        self._write(due.changes)
+        lost = self._write(due.changes)
+        if lost is not None:
+            self._chip_lost(*lost, not_yet_played=due.started)
         for tag in due.started:
-            if isinstance(tag, PlannedStroke):
+            if isinstance(tag, PlannedStroke) and not (lost and any(tag is t for t in lost[2])):
                 self._started(tag, written_at_ms)
         for capped in due.capped:
             self._capped(capped)
 
-    def _write(self, changes: list[Change]) -> None:
+    def _write(self, changes: list[Change]) -> tuple[Change, str, list[PlannedStroke]] | None:
+        """Output ``changes``; a stroke's motor that could not be switched on is a lost chip:
+        returns that change, the error and the strokes cut for it (after every motor went off)."""
+        lost: tuple[Change, str, list[PlannedStroke]] | None = None
         # A recording backend (the simulator) is told whose command each change is.
         note: Callable[[object, object], None] | None = getattr(self._backend, "note_source", None)
         for change in changes:
+            if lost is not None and any(change.tag is stroke for stroke in lost[2]):
+                continue  # cut, its motors off: nothing of it plays on
             self.timing_errors_ms.append(self._clock() - change.t_ms)
             try:
                 if note is not None:
@@ -424,8 +435,51 @@ class Player:
                 )
                 if change.intensity == 0.0:
                     self._force_off(change)
+                elif lost is None and isinstance(change.tag, PlannedStroke):
+                    lost = (change, str(error), self._cut_playing())
         if note is not None:
             note(None, None)  # what follows (an all-off at exit) belongs to no stroke
+        return lost
+
+    def _cut_playing(self) -> list[PlannedStroke]:
+        """Every stroke that has started, cut, and every motor off: a chip that stopped
+        answering cannot be trusted to be silent, and a stroke missing a motor is not felt."""
+        now = self._clock()
+        cut = self._timeline.cancel(
+            lambda tag: isinstance(tag, PlannedStroke) and tag.start_ms <= now, now
+        )
+        try:
+            self._backend.all_off()  # tries every chip; the lost one fails again
+        except Exception as error:
+            log.warning("all motors off after a lost chip: %s", error)
+        return [tag for tag in cut.started if isinstance(tag, PlannedStroke)]
+
+    def _chip_lost(
+        self, change: Change, error: str, cut: list[PlannedStroke], *, not_yet_played: list[object]
+    ) -> None:
+        """Each stroke cut for a lost chip: a ``safety`` event naming the chip; one whose first
+        command was this step's is never reported played (and is acknowledged here)."""
+        for stroke in cut:
+            fresh = any(stroke is tag for tag in not_yet_played)
+            acknowledge = None
+            if fresh:
+                with self._lock:
+                    self._pending -= 1
+                    acknowledge = self._done(stroke)
+            self.cut += 1
+            when = "before it was felt" if fresh else "part-way, after its played event"
+            self._on_event(
+                Safety(
+                    reason="chip_lost",
+                    row=change.row,
+                    column=change.column,
+                    message=f"cut {when}: {error} Every motor was switched off.",
+                    **{k: v for k, v in stroke.info.items() if k in _STROKE_FIELDS},
+                    received_at_ms=stroke.received_wall_ms,
+                )
+            )
+            if acknowledge is not None:
+                acknowledge()  # reported, never to play: the broker must not send it again
 
     def _force_off(self, change: Change) -> None:
         """An 'off' that failed: try once more, then every motor off (a glitch must not leave

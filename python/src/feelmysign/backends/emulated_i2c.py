@@ -237,6 +237,8 @@ class EmulatedI2CBus:
         self.max_enabled_channels = 0  # the most channels ever enabled at once, all multiplexers
         self.closed = False
         self.on_write: Callable[[EmulatedI2CBus], None] | None = None
+        # Called before every transaction, bus locked: a fault injected from outside lands.
+        self.before_transaction: Callable[[EmulatedI2CBus], None] | None = None
 
     @classmethod
     def for_layout(
@@ -344,6 +346,8 @@ class EmulatedI2CBus:
             if byte is not None and not 0 <= byte <= limit:
                 raise ValueError(f"{name} {byte} is outside the allowed range 0..{limit}")
         with self._lock:
+            if self.before_transaction is not None:
+                self.before_transaction(self)
             devices = self._answering(address)
             if len(devices) != 1:
                 error = self._no_answer(address, devices)

@@ -84,7 +84,9 @@ def open_state_bus(path: str | os.PathLike[str], layout: Layout) -> EmulatedI2CB
             raise EmulatedStateError(
                 state_path, f"cannot be written: {error.strerror or error}"
             ) from error
-    bus.on_write = _WriteThrough(state_path)
+    write_through = _WriteThrough(state_path)
+    bus.on_write = write_through
+    bus.before_transaction = write_through.take_faults
     return bus
 
 
@@ -95,12 +97,32 @@ class _WriteThrough:
     def __init__(self, path: Path) -> None:
         self._path = path
         self._last = ""
+        self._written = _identity(path)
 
     def __call__(self, bus: EmulatedI2CBus) -> None:
+        self.take_faults(bus)  # an edit made since the last write is not overwritten unseen
         text = _as_text(bus)
         if text != self._last:
             _replace(self._path, text)
             self._last = text
+            self._written = _identity(self._path)
+
+    def take_faults(self, bus: EmulatedI2CBus) -> None:
+        """A file someone else changed while this process drives it: its faults land now.
+
+        A chip left out of ``chips``, or ``"connected": false``, stops answering at once,
+        as a chip whose wire comes loose mid-drawing would (registers kept: its motor runs on).
+        """
+        found = _identity(self._path)
+        if found == self._written or found is None:
+            return
+        self._written = found
+        try:
+            saved = dict(read_state(self._path).chips)
+        except EmulatedStateError:
+            return  # half-edited by hand: the next change is looked at again
+        for key, chip in bus.chips.items():
+            chip.connected = key in saved and saved[key].connected
 
 
 def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
@@ -133,6 +155,14 @@ def _replace(path: Path, text: str) -> None:
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     temporary.write_text(text, encoding="utf-8")
     os.replace(temporary, path)
+
+
+def _identity(path: Path) -> tuple[int, int, int] | None:
+    try:
+        info = path.stat()
+    except OSError:
+        return None
+    return (info.st_ino, info.st_mtime_ns, info.st_size)
 
 
 def drive_levels(path: str | os.PathLike[str]) -> dict[str, float]:
