@@ -6,6 +6,8 @@ test kills that Mosquitto with SIGKILL, by its process id.
 
 from __future__ import annotations
 
+import http.client
+import json
 import os
 import queue
 import select
@@ -146,3 +148,40 @@ def test_up_goes_on_watching_after_its_reader_left(tmp_path: Path) -> None:
     assert "Traceback" not in errors and "BrokenPipe" not in errors, errors
     assert code == 0, errors
     assert _mosquitto_children(process.pid) == []
+
+
+def test_up_refuses_its_config_to_a_foreign_host_header(tmp_path: Path) -> None:
+    """DNS rebinding: a page on attacker.example that resolves to 127.0.0.1 gets no password."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Draw here:", seen)
+        page = seen[-1].split("Draw here:", 1)[1].strip()
+        port = int(page.split("://", 1)[1].split("/", 1)[0].rsplit(":", 1)[1])
+        answers = {
+            host: _get_config(port, host) for host in ("attacker.example", f"127.0.0.1:{port}")
+        }
+    finally:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            raise
+    password = json.loads(answers[f"127.0.0.1:{port}"][1])["password"]
+    assert answers[f"127.0.0.1:{port}"][0] == 200 and password
+    status, body = answers["attacker.example"]
+    assert status == 403 and password.encode() not in body
+
+
+def _get_config(port: int, host: str) -> tuple[int, bytes]:
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=WAIT_S)
+    try:
+        connection.putrequest("GET", "/config.json", skip_host=True)
+        connection.putheader("Host", host)
+        connection.endheaders()
+        response = connection.getresponse()
+        return response.status, response.read()
+    finally:
+        connection.close()
