@@ -1,12 +1,21 @@
-"""feelmysign: draw a shape and have it felt, as it is drawn, on a vibrotactile sleeve."""
+"""feelmysign: draw a shape and have it felt, as it is drawn, on a vibrotactile sleeve.
 
-from feelmysign.errors import FeelMySignError, HardwareError, LayoutError, StrokeError
-from feelmysign.layout import Layout, Wire
-from feelmysign.schedule import Adjustment, Command, Schedule
-from feelmysign.stroke import Stroke
+Names are imported when first used: a sleeve restarted after a crash imports this
+package before it switches its motors off, and must not wait for the rest.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from feelmysign.errors import FeelMySignError, HardwareError, LayoutError, StrokeError
+    from feelmysign.layout import Layout, Wire
+    from feelmysign.schedule import Adjustment, Command, Schedule
+    from feelmysign.stroke import Stroke
 
 __version__ = "0.1.0"
-
 __all__ = [
     "Adjustment",
     "Command",
@@ -20,3 +29,25 @@ __all__ = [
     "Wire",
     "__version__",
 ]
+
+_WHERE = {
+    "FeelMySignError": "feelmysign.errors",
+    "HardwareError": "feelmysign.errors",
+    "LayoutError": "feelmysign.errors",
+    "StrokeError": "feelmysign.errors",
+    "Layout": "feelmysign.layout",
+    "Wire": "feelmysign.layout",
+    "Adjustment": "feelmysign.schedule",
+    "Command": "feelmysign.schedule",
+    "Schedule": "feelmysign.schedule",
+    "Stroke": "feelmysign.stroke",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

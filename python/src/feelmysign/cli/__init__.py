@@ -15,12 +15,14 @@ import importlib
 import os
 import sys
 from collections.abc import Sequence
-from typing import Any, TextIO, cast
+from typing import TYPE_CHECKING, Any, TextIO, cast
 
 from feelmysign import __version__
 from feelmysign.cli._early_off import switch_off_early
-from feelmysign.cli._parser import CliParser
 from feelmysign.errors import FeelMySignError
+
+if TYPE_CHECKING:  # imported by build_parser, after the early all-off
+    from feelmysign.cli._parser import CliParser
 
 DEBUG_ENV = "FEELMYSIGN_DEBUG"
 BUG_EXIT = 70  # EX_SOFTWARE (sysexits.h): an internal error, not the user's
@@ -46,6 +48,8 @@ SUBCOMMANDS = (
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The whole command; with ``only``, just that subcommand (its module alone is imported)."""
+    from feelmysign.cli._parser import CliParser
+
     parser = CliParser(
         prog="feelmysign",
         description="Draw a shape and have it felt, as it is drawn, on a vibrotactile sleeve.",

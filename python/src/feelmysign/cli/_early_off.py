@@ -74,15 +74,12 @@ def _plain_small_file(path: str) -> bool:
 def _switch_off(layout_path: str, emulate_state: str | None) -> None:
     from feelmysign.backends.drv2605 import Drv2605Backend
     from feelmysign.backends.i2c import I2CBus
-    from feelmysign.cli._inputs import MAX_LAYOUT_BYTES, MAX_STATE_BYTES, check_input_file
     from feelmysign.errors import FeelMySignError
     from feelmysign.layout import load_layout
 
     try:
-        # A fifo would block here, and /dev/zero fill the memory: the command says why later.
-        check_input_file(layout_path, what="layout file", max_bytes=MAX_LAYOUT_BYTES)
-        if emulate_state is not None:
-            check_input_file(emulate_state, what="emulated state file", max_bytes=MAX_STATE_BYTES)
+        # Both files are read through feelmysign.input_files: a fifo or /dev/zero is refused
+        # without waiting (the command says why later).
         layout = load_layout(layout_path)
         bus: I2CBus | None = None
         if emulate_state is not None:
