@@ -129,6 +129,21 @@ BAD_FILES = [
     (["study", "check", "{fifo}"], ["study design", "fifo (named pipe)"]),
     (["study", "new", "/dev/zero", "--out", "s.sqlite"], ["study design", "a device"]),
     (["study", "check", "{fifo_design}"], ["stimulus.layout", "recording", "fifo (named pipe)"]),
+    (
+        [
+            "up",
+            "--lan",
+            "--port",
+            "0",
+            "--http-port",
+            "0",
+            "--tls-cert",
+            "{fifo}",
+            "--tls-key",
+            "x",
+        ],
+        ["--tls-cert", "fifo (named pipe)"],
+    ),
 ]
 
 

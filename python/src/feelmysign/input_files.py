@@ -28,6 +28,7 @@ MAX_CREDENTIALS_BYTES = 64 * KIB  # the broker writes about 400 bytes
 MAX_RECORDING_BYTES = 64 * MIB  # an hour of drawing at 240 samples a second is ~60 MiB
 MAX_STATE_BYTES = 1 * MIB  # the emulated bus of 64 chips is about 40 KiB
 MAX_DESIGN_BYTES = 1 * MIB  # the paper's study design is 3 KiB
+MAX_PEM_BYTES = 1 * MIB  # a certificate chain is a few KiB
 
 
 class UnusableFile(OSError):

@@ -28,6 +28,7 @@ from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
 from feelmysign.broker.credentials import write_private_file
 from feelmysign.errors import BrokerError
+from feelmysign.input_files import MAX_PEM_BYTES, read_bytes
 
 CA_VALIDITY_DAYS = 3650
 # Apple's and Chromium's limit for a certificate a user accepts by hand.
@@ -107,12 +108,19 @@ def ensure_local_ca(tls_dir: Path, hosts: list[str]) -> TlsFiles:
 
 def user_certificate(cert: Path, key: Path) -> TlsFiles:
     """The user's own certificate (e.g. Let's Encrypt's fullchain.pem and privkey.pem)."""
+    pem: dict[str, bytes] = {}
     for path, option in ((cert, "--tls-cert"), (key, "--tls-key")):
-        if not path.is_file():
-            raise BrokerError("bad-option", f"{option} {path}: no such file.")
+        try:
+            pem[option] = read_bytes(path, max_bytes=MAX_PEM_BYTES)
+        except FileNotFoundError:
+            raise BrokerError("bad-option", f"{option} {path}: no such file.") from None
+        except OSError as error:
+            raise BrokerError(
+                "bad-option", f"{option} {path} cannot be read: {error.strerror or error}."
+            ) from None
     try:
-        x509.load_pem_x509_certificates(cert.read_bytes())
-        serialization.load_pem_private_key(key.read_bytes(), password=None)
+        x509.load_pem_x509_certificates(pem["--tls-cert"])
+        serialization.load_pem_private_key(pem["--tls-key"], password=None)
     except (ValueError, TypeError) as error:
         raise BrokerError(
             "bad-option",
