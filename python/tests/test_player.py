@@ -176,3 +176,39 @@ def test_a_player_that_crashes_mid_stroke_switches_every_motor_off_first(
     assert backend.snapshot() == [[0.0] * 4 for _ in range(3)]  # and ended all off
     assert backend.changes[-1].intensity == 0.0
     backend.close()
+
+
+class _WaitsSeen(threading.Event):
+    """An Event that keeps every timeout the player's loop waits with."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.timeouts: list[float | None] = []
+
+    def wait(self, timeout: float | None = None) -> bool:
+        self.timeouts.append(timeout)
+        return super().wait(timeout)
+
+
+def test_the_loop_goes_round_at_least_once_an_idle_wait_during_a_long_command() -> None:
+    """systemd's watchdog hears from the sleeve only while the player's loop goes round."""
+    from feelmysign.player import IDLE_WAIT_S
+
+    backend = SimBackend(PAPER)
+    player = Player(backend, PAPER)
+    waits = _WaitsSeen()
+    player._wake = waits
+    player.start()
+    try:
+        # One motor, on for 4 s: its off is the only thing due for seconds.
+        assert player.submit(_planned(0, 0, 0, 0, 4000.0)) is None
+        event = threading.Event()
+        for _ in range(2000):  # 100 s at most; a few seconds on any machine
+            if len([t for t in waits.timeouts if t is not None and t > 0.2]) >= 3:
+                break
+            event.wait(0.05)
+        assert player.alive(max_age_s=60.0)
+    finally:
+        player.stop()
+        backend.close()
+    assert max(t for t in waits.timeouts if t is not None) <= IDLE_WAIT_S

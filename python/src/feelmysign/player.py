@@ -396,7 +396,8 @@ class Player:
             return
         wait_ms = next_ms - self._clock() - self._spin_ms
         if wait_ms > 0:
-            self._wake.wait(wait_ms / 1000.0)
+            # Never longer than when idle: the service's watchdog needs the loop to go round.
+            self._wake.wait(min(wait_ms / 1000.0, IDLE_WAIT_S))
             return  # new strokes may have come in: look again
         while self._clock() < next_ms:
             time.sleep(0)  # let the network thread take the interpreter meanwhile
