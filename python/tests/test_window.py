@@ -24,6 +24,7 @@ from feelmysign.simplify import (
     simplify_paths,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
+from feelmysign.simplify.window import LINE_SHARE
 from feelmysign.stroke import Point
 
 WINDOW = dict(load("window"))
@@ -111,6 +112,26 @@ def test_square_is_four_strokes_with_its_corners() -> None:
         assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
     # Each corner is found one sample later, when the next sample leaves the line.
     assert [s.emitted_at_ms - s.end_ms for s in segments[:3]] == pytest.approx([8.0] * 3)
+
+
+def test_a_straight_line_the_latency_cap_cuts_stays_one_straight_line() -> None:
+    # A level line drawn in 1 s at 125 Hz, each sample 0.6 px (0.0025 grid units) above or below
+    # it: the cap cuts it into strokes of at most 300 ms, and their ends are not the noisy
+    # samples but points on the line of the first, so the felt line does not bend.
+    params = WindowParams()
+    path = [Sample(i * 8.0, 100 + 12.0 * i, 540 + (0.6 if i % 2 else -0.6)) for i in range(126)]
+    segments = [s for _, s in _run(params, [path]) if s.dropped is None]
+    assert len(segments) >= 4
+    (x0, y0), (x1, y1) = segments[0].start, segments[0].end
+    for segment in segments[1:]:
+        for x, y in (segment.start, segment.end):
+            assert abs((x1 - x0) * (y - y0) - (y1 - y0) * (x - x0)) < 1e-9, segment
+    # The bound holds on every sample: each lies within max_error of the chain of strokes.
+    mapping = params.mapping
+    for sample in path:
+        point = mapping.to_grid(sample.x, sample.y)
+        nearest = min(_distance(point, s.start, s.end) for s in segments)
+        assert nearest <= params.max_error + FLOAT_TOLERANCE
 
 
 def test_the_cut_goes_on_the_feature_not_where_the_bound_first_breaks() -> None:
@@ -331,11 +352,13 @@ def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int
     """Each segment with the indices of the first and last sample it covers.
 
     Segments join end to start, so each starts at the sample the one before
-    ended on; it ends on the last sample (from there) with its end time and
-    point.
+    ended on; it ends on the last sample (from there) with its end time, at its
+    point or, going on along a line the latency cap cut, within LINE_SHARE x
+    max_error of it.
     """
     segments = [s for _, s in _run(params, [samples])]
     mapping = params.mapping
+    moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE
     covered: list[tuple[int, int, Segment]] = []
     start = 0
     for number, segment in enumerate(segments, start=1):
@@ -343,7 +366,7 @@ def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int
             j
             for j in range(min(start + 1, len(samples) - 1), len(samples))
             if samples[j].t_ms == segment.end_ms
-            and mapping.to_grid(samples[j].x, samples[j].y) == segment.end
+            and math.dist(mapping.to_grid(samples[j].x, samples[j].y), segment.end) <= moved
         ]
         assert ends, f"{segment} does not end on a sample"
         # Repeated samples (same time and place) are one: the first, but the last for the last.
@@ -375,7 +398,8 @@ def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sam
     assert segments, "a path always gives at least one segment (sent or dropped)"
     mapping = params.mapping
     assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
-    assert segments[-1].end == mapping.to_grid(samples[-1].x, samples[-1].y)
+    release = mapping.to_grid(samples[-1].x, samples[-1].y)
+    assert math.dist(segments[-1].end, release) <= LINE_SHARE * params.max_error + FLOAT_TOLERANCE
     assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
     for before, after in itertools.pairwise(segments):
         assert after.start == before.end and after.start_ms == before.end_ms

@@ -12,7 +12,10 @@
  * the chord (among those whose own stroke keeps the bound), emitted now, and
  * the samples after the cut are taken again into the next stroke. A stroke
  * long enough to send lasts at most `max_stroke_ms` of drawing (the latency cap) and holds at most
- * `max_window` samples (the work cap). Too short or too brief strokes are
+ * `max_window` samples (the work cap). The stroke after one the latency cap
+ * ended, if the cap or the release ends it too, ends on the line of the stroke
+ * before (its end sample projected onto it) when the bound allows, so a straight
+ * line cut by the cap stays straight. Too short or too brief strokes are
  * dropped with their reason. The float operations follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
@@ -29,6 +32,12 @@ const CAP_FEATURE_SHARE = 0.5;
  * (rounding, not a feature): the cap cuts it at its last sample, as late as it can.
  */
 const STRAIGHT = 1e-6;
+/**
+ * A stroke the latency cap ends is a line when all its samples lie within this share of
+ * max_error of it; the stroke after it then goes on along that line where the bound allows, by
+ * moving its end at most this share of max_error off its drawn sample (no drift along a bend).
+ */
+export const LINE_SHARE = 0.25;
 
 interface Drawn {
   readonly sample: Sample;
@@ -44,6 +53,11 @@ export class WindowSimplifier {
   #window: Drawn[] = [];
   #pointer: Sample | null = null;
   #emittedInPath = false;
+  /**
+   * The direction of the stroke the latency cap ended last, while the next one may go on along
+   * it (null at a path's start and after any other cut).
+   */
+  #line: Point | null = null;
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
@@ -81,6 +95,7 @@ export class WindowSimplifier {
     if (this.#window.length === 0) {
       this.#window = [current];
       this.#emittedInPath = false;
+      this.#line = null;
       return [];
     }
     const out: Segment[] = [];
@@ -97,7 +112,7 @@ export class WindowSimplifier {
     if (first === undefined || last === undefined) return [];
     // The last sample already ends a stroke (a cut at the work cap).
     if (window.length === 1 && this.#emittedInPath) return [];
-    return [this.#finish(first, last)];
+    return [this.#finish(first, this.#continued(window, window.length - 1))];
   }
 
   /** `current` joins the stroke being drawn, cutting it first where it must. */
@@ -115,19 +130,21 @@ export class WindowSimplifier {
         this.#sendable(anchor, window[window.length - 1]!)
       ) {
         const cut = this.#capCut(window);
-        out.push(this.#finish(anchor, window[cut]!));
+        const vertex = this.#continued(window, cut);
+        out.push(this.#finish(anchor, vertex));
+        this.#line = this.#lineOf(window, cut, vertex);
         if (cut < window.length - 1) {
           pending.push(item);
           pending.push(...window.slice(cut + 1).reverse());
-          this.#window = [window[cut]!];
+          this.#window = [vertex];
           continue;
         }
-        const last = window[window.length - 1]!;
-        window = this.#window = [last];
+        window = this.#window = [vertex];
       }
       if (!this.#fits(window, 1, window.length, item.point)) {
         const cut = this.#feature(window, item.point);
         out.push(this.#finish(window[0]!, window[cut]!));
+        this.#line = null;
         pending.push(item);
         pending.push(...window.slice(cut + 1).reverse());
         this.#window = [window[cut]!];
@@ -136,6 +153,7 @@ export class WindowSimplifier {
       window.push(item);
       if (window.length - 1 >= this.params.max_window) {
         out.push(this.#finish(window[0]!, item));
+        this.#line = null;
         this.#window = [item];
       }
     }
@@ -159,6 +177,41 @@ export class WindowSimplifier {
     const farSq = distanceSq(window[cut]!.point, anchor.point, last.point);
     const bends = farSq > straight * straight;
     return bends && this.#sendable(anchor, window[cut]!) ? cut : window.length - 1;
+  }
+
+  /**
+   * Where a stroke that the latency cap or the release ends, ending at window[cut], ends.
+   * After a stroke the latency cap ended, the stroke that follows it goes on along the same
+   * line when it can: its end is window[cut] projected onto that line, if every sample up to
+   * window[cut] keeps the bound to the projected end and the stroke is still long enough to
+   * send; else window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
+   * straight line cut into strokes stays one straight line.
+   */
+  #continued(window: readonly Drawn[], cut: number): Drawn {
+    const at = window[cut]!;
+    if (this.#line === null) return at;
+    const [ux, uy] = this.#line;
+    const [ax, ay] = window[0]!.point;
+    const along = (at.point[0] - ax) * ux + (at.point[1] - ay) * uy;
+    if (along <= 0) return at;
+    const end: Drawn = { sample: at.sample, point: [ax + along * ux, ay + along * uy] };
+    const limit = LINE_SHARE * this.params.max_error;
+    if (distanceSq(at.point, end.point, end.point) > limit * limit) return at; // a bend, not noise
+    if (!this.#sendable(window[0]!, end) || !this.#fits(window, 1, cut + 1, end.point)) return at;
+    return end;
+  }
+
+  /**
+   * The direction of the stroke window[0] -> end if it is a line (every sample up to
+   * window[cut] within `LINE_SHARE` x max_error of it), else null.
+   */
+  #lineOf(window: readonly Drawn[], cut: number, end: Drawn): Point | null {
+    const limit = LINE_SHARE * this.params.max_error;
+    const anchor = window[0]!.point;
+    for (let i = 1; i <= cut; i++) {
+      if (distanceSq(window[i]!.point, anchor, end.point) > limit * limit) return null;
+    }
+    return direction(anchor, end.point);
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
@@ -205,6 +258,14 @@ export class WindowSimplifier {
       this.params,
     );
   }
+}
+
+/** The unit vector from `start` to `end` (null if they coincide). */
+function direction(start: Point, end: Point): Point | null {
+  const dx = end[0] - start[0];
+  const dy = end[1] - start[1];
+  const length = Math.sqrt(dx * dx + dy * dy);
+  return length > 0 ? [dx / length, dy / length] : null;
 }
 
 /** Squared distance from `point` to the segment start -> end (its nearest point). */

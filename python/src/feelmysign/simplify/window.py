@@ -8,7 +8,8 @@ corners land on the drawing's features. Here:
 
 - It takes every pointer sample (in the browser every pointer event, coalesced
   ones included; in a recording every sample), not animation frames: the bound
-  holds for everything drawn, and strokes start and end on real samples at
+  holds for everything drawn, and strokes start and end on real samples (or,
+  where a line the latency cap cut goes on, next to one, below) at
   their real times.
 - A stroke starts at an anchor sample and grows one sample at a time. When a
   sample arrives, the stroke anchor -> sample is tried: every sample since the
@@ -28,10 +29,20 @@ corners land on the drawing's features. Here:
   to be felt in its drawn time; a straight stroke at the sample before. A
   stroke still too short to send (``min_length``) is not cut: a slow pen's
   line would otherwise be cut into pieces too short to feel, all dropped.
+- A line the cap cut goes on straight: after a stroke the cap ended whose
+  samples all lie within ``LINE_SHARE`` x max_error of it, the next stroke, if
+  the cap or the release ends it too, ends on that stroke's line (its end
+  sample projected onto it) when that moves the end at most ``LINE_SHARE`` x
+  max_error, every sample since its start keeps the bound to that end and it
+  is still long enough to send; else at the sample. The cap cuts a line, not
+  a corner, and the $1 recogniser scales a thin line to a square, so one
+  sample's sideways noise would show as a bend. Such an end lies within
+  ``LINE_SHARE`` x max_error of its drawn sample, not on it.
 - Work cap: when a stroke holds ``max_window`` samples after its anchor it is
   cut at the current sample (each sample costs at most that many tests).
-- On release the rest is one stroke. A path's first and last samples are
-  always stroke ends.
+- On release the rest is one stroke. A path's first sample always starts a
+  stroke and its last sample's time always ends one (at the sample, or on the
+  line it goes on along).
 - A stroke too short (grid units) or too brief (ms) is dropped with its reason,
   as the angle simplifier does; it still ends where the next one starts.
 
@@ -42,6 +53,7 @@ at the earlier one's time, so times never run backwards.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
@@ -55,6 +67,10 @@ CAP_FEATURE_SHARE = 0.5
 # A stroke whose samples all lie within this share of max_error of its chord is straight
 # (rounding, not a feature): the cap cuts it at its last sample, as late as it can.
 STRAIGHT = 1e-6
+# A stroke the latency cap ends is a line when all its samples lie within this share of
+# max_error of it; the stroke after it then goes on along that line where the bound allows, by
+# moving its end at most this share of max_error off its drawn sample (no drift along a bend).
+LINE_SHARE = 0.25
 
 WINDOW_PARAMS: dict[str, ParamSpec] = {
     s.name: s
@@ -125,6 +141,9 @@ class WindowSimplifier:
     _window: list[_Point] = field(default_factory=list)
     _pointer: Sample | None = None
     _emitted_in_path: bool = False
+    # The direction of the stroke the latency cap ended last, while the next one may go on along
+    # it (None at a path's start and after any other cut).
+    _line: tuple[float, float] | None = None
     _max_error_sq: float = field(init=False)
     _mapping: CanvasMapping = field(init=False)
 
@@ -151,6 +170,7 @@ class WindowSimplifier:
         if not self._window:
             self._window = [current]
             self._emitted_in_path = False
+            self._line = None
             return []
         out: list[Segment] = []
         self._add(current, out)
@@ -164,7 +184,7 @@ class WindowSimplifier:
             return []
         if len(window) == 1 and self._emitted_in_path:
             return []  # the last sample already ends a stroke (a cut at the work cap)
-        return [self._finish(window[0], window[-1])]
+        return [self._finish(window[0], self._continued(window, len(window) - 1))]
 
     def _add(self, current: _Point, out: list[Segment]) -> None:
         """``current`` joins the stroke being drawn, cutting it first where it must.
@@ -185,16 +205,19 @@ class WindowSimplifier:
                 and self._sendable(anchor, window[-1])
             ):
                 cut = self._cap_cut(window)
-                out.append(self._finish(anchor, window[cut]))
+                vertex = self._continued(window, cut)
+                out.append(self._finish(anchor, vertex))
+                self._line = self._line_of(window, cut, vertex)
                 if cut < len(window) - 1:
                     pending.append(item)
                     pending.extend(reversed(window[cut + 1 :]))
-                    self._window = [window[cut]]
+                    self._window = [vertex]
                     continue
-                window = self._window = [window[-1]]
+                window = self._window = [vertex]
             if not self._fits(window, 1, len(window), item.point):
                 cut = self._feature(window, item.point)
                 out.append(self._finish(window[0], window[cut]))
+                self._line = None
                 pending.append(item)
                 pending.extend(reversed(window[cut + 1 :]))
                 self._window = [window[cut]]
@@ -202,6 +225,7 @@ class WindowSimplifier:
             window.append(item)
             if len(window) - 1 >= self.params.max_window:
                 out.append(self._finish(window[0], item))
+                self._line = None
                 self._window = [item]
 
     def _cap_cut(self, window: list[_Point]) -> int:
@@ -223,6 +247,46 @@ class WindowSimplifier:
         far_sq = _distance_sq(window[cut].point, anchor.point, window[-1].point)
         bends = far_sq > straight * straight
         return cut if bends and self._sendable(anchor, window[cut]) else len(window) - 1
+
+    def _continued(self, window: list[_Point], cut: int) -> _Point:
+        """Where a stroke that the latency cap or the release ends, ending at window[cut], ends.
+
+        After a stroke the latency cap ended that is a line (``_line_of``), the
+        stroke that follows it goes on along that line when it can: its end is
+        window[cut] projected onto it, if that moves it at most ``LINE_SHARE`` x
+        max_error, every sample up to window[cut] keeps the bound to the
+        projected end and the stroke is still long enough to send; else
+        window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
+        straight line cut into strokes stays one straight line (a sample's
+        sideways noise would otherwise bend it).
+        """
+        at = window[cut]
+        if self._line is None:
+            return at
+        ux, uy = self._line
+        ax, ay = window[0].point
+        along = (at.point[0] - ax) * ux + (at.point[1] - ay) * uy
+        if along <= 0:
+            return at
+        end = _Point(at.sample, (ax + along * ux, ay + along * uy))
+        limit = LINE_SHARE * self.params.max_error
+        if _distance_sq(at.point, end.point, end.point) > limit * limit:  # a bend, not noise
+            return at
+        if not self._sendable(window[0], end) or not self._fits(window, 1, cut + 1, end.point):
+            return at
+        return end
+
+    def _line_of(self, window: list[_Point], cut: int, end: _Point) -> tuple[float, float] | None:
+        """The direction of the stroke window[0] -> end if it is a line, else None.
+
+        A line: every sample up to window[cut] lies within ``LINE_SHARE`` x max_error of it.
+        """
+        limit = LINE_SHARE * self.params.max_error
+        anchor = window[0].point
+        for index in range(1, cut + 1):
+            if _distance_sq(window[index].point, anchor, end.point) > limit * limit:
+                return None
+        return _direction(anchor, end.point)
 
     def _sendable(self, start: _Point, end: _Point) -> bool:
         """Whether start -> end is long enough to send (the cap never cuts off a dropped stroke)."""
@@ -265,6 +329,13 @@ class WindowSimplifier:
             min_length=self.params.min_length,
             min_duration_ms=self.params.min_duration_ms,
         )
+
+
+def _direction(start: Point, end: Point) -> tuple[float, float] | None:
+    """The unit vector from ``start`` to ``end`` (None if they coincide)."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    length = math.sqrt(dx * dx + dy * dy)
+    return (dx / length, dy / length) if length > 0.0 else None
 
 
 def _distance_sq(point: Point, start: Point, end: Point) -> float:
