@@ -12,8 +12,8 @@ import pytest
 from study_helpers import new_study
 
 from feelmysign.study.analysis import analyse_study
-from feelmysign.study.analysis.psychometric import LAPSE, Fit, fit
-from feelmysign.study.analysis.recovery import coverage, paper_truths
+from feelmysign.study.analysis.psychometric import LAPSE, Fit, Population, fit, fit_population
+from feelmysign.study.analysis.recovery import Truth, coverage, paper_truths, synthetic_counts
 from feelmysign.study.analysis.wilson import wilson_interval
 from feelmysign.study.dry_run import dry_run
 
@@ -33,6 +33,33 @@ def test_the_fit_finds_the_curve_that_made_noise_free_counts() -> None:
     assert found.slope == pytest.approx(2.5, rel=0.02)
 
 
+def test_the_population_fit_finds_how_much_participants_differ() -> None:
+    # 300 participants of 10 answers per level, each one's curve shifted by a normal amount
+    # of SD 0.5 doublings: the marginal likelihood finds the curve and the spread; when
+    # participants are alike, it finds (almost) none.
+    levels = np.array([2.0, 4.0, 6.0, 8.0, 16.0])
+    truth = Fit(math.log2(6.0), 2.5, 0.0, LAPSE)
+    for sd, expected in ((0.5, 0.5), (0.0, 0.0)):
+        made = Truth(truth, 0.75, sd)
+        data = synthetic_counts(
+            made, levels, participants=300, repetitions=10, rng=np.random.default_rng(3)
+        )
+        found = fit_population(data, levels)
+        assert found.spread == pytest.approx(expected, abs=0.08)
+        assert found.fit.midpoint == pytest.approx(truth.midpoint, abs=0.08)
+        assert found.strokes_at(0.75) == pytest.approx(made.strokes, rel=0.05)
+
+
+def test_the_average_participant_is_flatter_than_each_one() -> None:
+    one = Fit(math.log2(6.0), 3.0, 0.0, LAPSE)
+    spread = Population(one, 0.5)
+    assert spread.strokes_at(0.5 * (1 - LAPSE)) == pytest.approx(6.0, rel=1e-4)  # symmetric
+    assert spread.strokes_at(0.75) > one.strokes_at(0.75)
+    assert float(spread.accuracy(16.0)) < float(one.accuracy(16.0))
+    assert Population(one).strokes_at(0.75) == one.strokes_at(0.75)
+    assert math.isinf(spread.strokes_at(0.99))  # above 1 - lapse: never reached
+
+
 @pytest.mark.parametrize("name", list(paper_truths()))
 def test_intervals_cover_the_true_needed_resolution_about_95_percent(name: str) -> None:
     # 40 seeded studies of 12 participants; `make bench` runs 400. With 40 runs a 95%
@@ -41,6 +68,14 @@ def test_intervals_cover_the_true_needed_resolution_about_95_percent(name: str) 
     result = coverage(40, truth=paper_truths()[name], samples=200, seed=7)
     assert result.bootstrap >= 34
     assert result.profile >= 34
+
+
+@pytest.mark.parametrize("name", list(paper_truths(participant_sd=0.3)))
+def test_the_reported_interval_covers_it_when_participants_differ(name: str) -> None:
+    # Each participant's curve shifted by a normal amount of SD 0.3 doublings of strokes; the
+    # truth is where the average participant reaches 75%. The same rule as above (34 of 40).
+    result = coverage(40, truth=paper_truths(participant_sd=0.3)[name], samples=200, seed=7)
+    assert result.bootstrap >= 34
 
 
 def test_a_dry_run_of_the_papers_design_gives_tables_plots_and_report(tmp_path: Path) -> None:

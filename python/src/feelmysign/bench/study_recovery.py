@@ -48,10 +48,12 @@ def report(runs: int = RUNS) -> Iterator[str]:
         f"Study analysis: 95% interval coverage over {runs} seeded simulated studies "
         "(each share with its own 95% Wilson interval)"
     )
-    for name, truth in paper_truths().items():
+    truths = [(sd, item) for sd in (0.0, 0.3) for item in paper_truths(0.75, sd).items()]
+    for sd, (name, truth) in truths:
         result = coverage(runs, truth=truth)
         yield (
-            f"  needed resolution, {name}: parametric bootstrap (reported) "
+            f"  needed resolution, {name}, participant SD {sd:g}: parametric bootstrap with the "
+            f"participants' spread (reported) "
             f"{describe(result, 'bootstrap')}, profile likelihood {describe(result, 'profile')}, "
             f"cluster bootstrap {describe(result, 'cluster')}"
         )

@@ -150,7 +150,8 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
         "needed_strokes": {
             shape: {
                 "strokes": _finite(t.strokes),
-                "interval": "parametric bootstrap, bias-corrected percentiles",
+                "interval": "parametric bootstrap with the participants' spread, "
+                "bias-corrected percentiles",
                 "low": _finite(t.boot_low),
                 "high": _finite(t.boot_high),
                 "profile_low": _finite(t.low),
@@ -158,6 +159,7 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
                 "cluster_bootstrap_low": _finite(t.cluster_low),
                 "cluster_bootstrap_high": _finite(t.cluster_high),
                 "dispersion": _finite(t.dispersion),
+                "participant_sd_doublings": t.population.spread,
                 "bootstrap_samples": t.samples,
                 "midpoint_log2": t.fit.midpoint,
                 "slope_per_doubling": t.fit.slope,

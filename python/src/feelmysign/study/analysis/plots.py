@@ -71,7 +71,7 @@ def threshold_plot(
     axes.axvspan(tested[0], tested[1], color="#eeeeee", zorder=0)
     for row, name in enumerate(names):
         result = thresholds[name]
-        # The reported interval: the parametric bootstrap.
+        # The reported interval: the parametric bootstrap with the participants' spread.
         first, last = result.boot_low, result.boot_high
         low = min(max(first, low_edge), high_edge)
         high = min(max(last, low_edge), high_edge) if math.isfinite(last) else high_edge

@@ -1,14 +1,14 @@
 """Does the analysis recover what it should? Synthetic answers drawn from a psychometric
 function with a known needed resolution, analysed as a study would be, many times.
 
-``coverage`` counts how often each 95% interval (the reported parametric bootstrap,
-the profile likelihood, the cluster bootstrap) contains the true needed resolution;
-a trustworthy interval does so in about 95% of seeded runs. With ``participant_sd``
-the participants differ: each one's curve is shifted by a normal amount (SD in
-doublings of strokes), and the truth is where the average participant's accuracy
-reaches the criterion. Used by the tests (a few runs) and by ``make bench`` /
-``python -m feelmysign.study.analysis.recovery`` (many runs; prints each share with
-its own 95% Wilson interval).
+``coverage`` counts how often each 95% interval (the reported parametric bootstrap
+with the participants' spread, the profile likelihood, the cluster bootstrap)
+contains the true needed resolution; a trustworthy interval does so in about 95%
+of seeded runs. With ``participant_sd`` the participants differ: each one's curve
+is shifted by a normal amount (SD in doublings of strokes), and the truth is where
+the average participant's accuracy reaches the criterion. Used by the tests (a few
+runs) and by ``make bench`` / ``python -m feelmysign.study.analysis.recovery``
+(many runs; prints each share with its own 95% Wilson interval).
 
     python -m feelmysign.study.analysis.recovery --runs 400
     python -m feelmysign.study.analysis.recovery --runs 400 --participant-sd 0.3
@@ -21,14 +21,17 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
-from feelmysign.study.analysis.psychometric import LAPSE, Fit, threshold_with_interval
+from feelmysign.study.analysis.psychometric import (
+    LAPSE,
+    Fit,
+    Population,
+    threshold_with_interval,
+)
 from feelmysign.study.analysis.wilson import wilson_interval
 
 # The paper's design for one shape: 4 resolutions, 3 repetitions, 12 participants.
 PAPER_LEVELS = (4.0, 6.0, 8.0, 16.0)
-_NODES, _WEIGHTS = np.polynomial.hermite_e.hermegauss(40)  # for the average participant
 
 
 @dataclass(frozen=True)
@@ -39,26 +42,11 @@ class Truth:
 
     def accuracy(self, strokes: float) -> float:
         """The average participant's accuracy."""
-        if self.participant_sd == 0:
-            return float(self.fit.accuracy(strokes))
-        shifted = [
-            Fit(
-                self.fit.midpoint + self.participant_sd * z,
-                self.fit.slope,
-                self.fit.guess,
-                self.fit.lapse,
-            )
-            for z in _NODES
-        ]
-        values = np.array([float(f.accuracy(strokes)) for f in shifted])
-        return float(np.sum(_WEIGHTS * values) / np.sum(_WEIGHTS))
+        return float(Population(self.fit, self.participant_sd).accuracy(strokes))
 
     @property
     def strokes(self) -> float:
-        if self.participant_sd == 0:
-            return self.fit.strokes_at(self.criterion)
-        log2_n = brentq(lambda x: self.accuracy(2.0**x) - self.criterion, -6.0, 12.0)
-        return float(2.0**log2_n)
+        return Population(self.fit, self.participant_sd).strokes_at(self.criterion)
 
 
 def synthetic_counts(
@@ -157,8 +145,9 @@ def main() -> None:
         print(
             f"needed resolution ({name} at {truth.criterion:.0%}, participant SD "
             f"{args.participant_sd:g}), {args.runs} runs, 95% intervals cover it in: parametric "
-            f"bootstrap {describe(result, 'bootstrap')}, profile likelihood "
-            f"{describe(result, 'profile')}, cluster bootstrap {describe(result, 'cluster')}",
+            f"bootstrap with the participants' spread {describe(result, 'bootstrap')}, profile "
+            f"likelihood {describe(result, 'profile')}, cluster bootstrap "
+            f"{describe(result, 'cluster')}",
             flush=True,
         )
 

@@ -66,17 +66,21 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "",
         "Per shape, a logistic psychometric function of log2(strokes) (guess rate "
         f"{design.guess_rate:g}, lapse rate fixed at 2%) fitted by maximum likelihood. "
-        "Interval: parametric bootstrap, 95% (new studies of the same design drawn from the "
-        "fitted curve and refitted; bias-corrected percentiles). Beside it the profile-"
-        "likelihood interval, and the cluster bootstrap over participants, which also carries "
-        "differences between participants but is too narrow with few of them. Dispersion: "
-        "Pearson chi-square per degree of freedom of each participant's number of correct "
-        "answers against the fitted curve; well above 1, participants differ more than chance "
-        "allows and every interval here is too narrow.",
+        "Interval: parametric bootstrap with the participants' spread, 95% (each participant's "
+        "curve shifted along log2(strokes) by a normal amount; the curve and the SD of the "
+        "shifts fitted by maximum marginal likelihood; each new study of the same design "
+        "draws an SD from its profile likelihood and the curve most likely at that SD, every "
+        "simulated participant with a shift of their own, pooled and refitted; bias-corrected "
+        "percentiles). Beside it the profile-likelihood interval and "
+        "the cluster bootstrap over participants, both too narrow when participants differ. "
+        "Participants' SD: the fitted SD of the shifts, in doublings of strokes (0: alike). "
+        "Dispersion: Pearson chi-square per degree of freedom of each participant's number of "
+        "correct answers against the fitted curve (about 1 when participants differ only by "
+        "chance).",
         "",
         "| shape | strokes needed | 95% interval | profile likelihood | cluster bootstrap "
-        "| slope per doubling | dispersion |",
-        "|---|---|---|---|---|---|---|",
+        "| slope per doubling | participants' SD | dispersion |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for shape, t in analysis.thresholds.items():
         rows = analysis.accuracy[shape]
@@ -85,7 +89,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             f"| {shape} | {_strokes(t.strokes, tested)} | "
             f"{_interval(t.boot_low, t.boot_high, tested)} | {_interval(t.low, t.high, tested)} | "
             f"{_interval(t.cluster_low, t.cluster_high, tested)} | {t.fit.slope:.2f} | "
-            f"{t.dispersion:.2f} |"
+            f"{t.population.spread:.2f} | {t.dispersion:.2f} |"
         )
     lines += [
         "",
