@@ -65,17 +65,17 @@ def _start_up(tmp_path: Path, stderr: IO[str] | int = subprocess.STDOUT) -> subp
     return process
 
 
-def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path) -> None:
+def test_up_restarts_a_killed_broker_and_says_so_once(tmp_path: Path) -> None:
+    """One line for the loss (what, and what up does), one for the return; nothing twice."""
     process = _start_up(tmp_path)
     seen: list[str] = []
     try:
         lines = _lines(process)
         _wait_for(lines, "Press Ctrl-C", seen)
         (mosquitto,) = _mosquitto_children(process.pid)
+        before = len(seen)
         os.kill(mosquitto, signal.SIGKILL)
-        _wait_for(lines, "The broker stopped", seen)
-        _wait_for(lines, "The broker is running again on", seen)
-        _wait_for(lines, "The sleeve is back", seen)
+        _wait_for(lines, "Back: the broker is running again on", seen)
         assert _mosquitto_children(process.pid) not in ([], [mosquitto])
     finally:
         process.send_signal(signal.SIGINT)
@@ -86,6 +86,13 @@ def test_up_restarts_a_killed_broker_and_says_the_sleeve_is_back(tmp_path: Path)
             raise
     assert code == 0, "".join(seen)
     assert _mosquitto_children(process.pid) == []
+    outage = seen[before:]
+    assert len(outage) == 2, "".join(outage)
+    lost, back = outage
+    assert lost.startswith("The broker stopped (exit code -9; its log: "), lost
+    assert "starting it again on the same ports" in lost, lost
+    assert back.startswith("Back: the broker is running again on mqtt://127.0.0.1:"), back
+    assert "the sleeve is connected to it" in back, back
 
 
 def test_up_says_it_is_stopping_on_ctrl_c_and_reports_no_fault(tmp_path: Path) -> None:

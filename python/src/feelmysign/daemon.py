@@ -93,6 +93,9 @@ LOGIN_REFUSED_CODES = (134, 135)
 # Rejections after which the broker must deliver the stroke again: the sleeve did not play it
 # and is going away, not refusing it.
 NOT_ACKNOWLEDGED = frozenset({"stopped", "player_stopped"})
+# Marks the log records that say the sleeve lost or cannot reach its broker: a program
+# that reports these itself in its own words (``feelmysign up``) filters them out.
+CONNECTION_STATE = {"connection_state": True}
 CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
 
 
@@ -348,6 +351,7 @@ class Sleeve:
             self._id,
             self._settings.url,
             RECONNECT_MAX_S,
+            extra=CONNECTION_STATE,
         )
 
     def _on_subscribe(
@@ -377,7 +381,12 @@ class Sleeve:
     ) -> None:
         self._connected.clear()
         if not self._stopped.is_set():
-            log.warning("sleeve %s: lost the broker (%s); reconnecting", self._id, reason)
+            log.warning(
+                "sleeve %s: lost the broker (%s); reconnecting",
+                self._id,
+                reason,
+                extra=CONNECTION_STATE,
+            )
 
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
         received_at_ms, received_wall_ms = monotonic_ms(), wall_ms()

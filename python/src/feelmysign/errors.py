@@ -64,7 +64,8 @@ class BrokerError(FeelMySignError):
     - ``start-failed``: Mosquitto exited or never accepted connections at start-up;
     - ``exited``: Mosquitto stopped while it should have been running.
 
-    ``log_path`` is Mosquitto's log file when there is one to look at.
+    ``log_path`` is Mosquitto's log file when there is one to look at; ``exit_code``
+    is how Mosquitto ended, for ``exited``.
     """
 
     def __init__(
@@ -74,12 +75,14 @@ class BrokerError(FeelMySignError):
         *,
         port: int | None = None,
         log_path: Path | None = None,
+        exit_code: int | None = None,
     ) -> None:
         super().__init__(message)
         self.reason = reason
         self.message = message
         self.port = port
         self.log_path = log_path
+        self.exit_code = exit_code
 
 
 class BrokerConnectionError(BrokerError):

@@ -223,6 +223,7 @@ class Broker(Started):
                 f"Mosquitto stopped unexpectedly (exit code {code}). "
                 f"Last lines of {self.log_path}:\n{_indent(tail)}",
                 log_path=self.log_path,
+                exit_code=code,
             )
 
     def _make_state_dir(self) -> None:
