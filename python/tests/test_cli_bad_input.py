@@ -129,6 +129,18 @@ BAD_FILES = [
     (["study", "check", "{fifo}"], ["study design", "fifo (named pipe)"]),
     (["study", "new", "/dev/zero", "--out", "s.sqlite"], ["study design", "a device"]),
     (["study", "check", "{fifo_design}"], ["stimulus.layout", "recording", "fifo (named pipe)"]),
+    # A study file is a SQLite file: a fifo, a device or a folder is said to be one.
+    (["study", "status", "{fifo}"], ["study file", "is a fifo (named pipe)", "study new"]),
+    (["study", "status", "/dev/null"], ["study file '/dev/null' is a device", "study new"]),
+    (["study", "status", "."], ["study file '.' is a folder", "study new"]),
+    (
+        ["study", "threshold", "{fifo}", "--participant", "P-2345X", "--dimension", "length"],
+        ["study file", "is a fifo (named pipe)", "study new"],
+    ),
+    (
+        ["study", "threshold", "/dev/zero", "--participant", "P", "--dimension", "duration"],
+        ["study file '/dev/zero' is a device", "study new"],
+    ),
     (
         [
             "up",

@@ -71,6 +71,14 @@ def read_text(path: str | os.PathLike[str], *, max_bytes: int) -> str:
 
 def check_regular(path: str | os.PathLike[str], info: os.stat_result, *, max_bytes: int) -> None:
     """UnusableFile unless ``info`` is of a regular file of at most ``max_bytes``."""
+    check_kind(path, info)
+    if info.st_size > max_bytes:
+        raise UnusableFile(path, _too_large(info.st_size, max_bytes))
+
+
+def check_kind(path: str | os.PathLike[str], info: os.stat_result) -> None:
+    """UnusableFile unless ``info`` is of a regular file (of any size: a SQLite file is opened,
+    not read whole)."""
     if stat.S_ISDIR(info.st_mode):
         raise UnusableFile(path, "it is a folder: give the path of a file in it")
     if not stat.S_ISREG(info.st_mode):
@@ -79,8 +87,6 @@ def check_regular(path: str | os.PathLike[str], info: os.stat_result, *, max_byt
             f"it is {file_kind(info.st_mode)}, not a regular file: save it to a file first, "
             "then give that file's path",
         )
-    if info.st_size > max_bytes:
-        raise UnusableFile(path, _too_large(info.st_size, max_bytes))
 
 
 def file_kind(mode: int) -> str:

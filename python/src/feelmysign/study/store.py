@@ -10,6 +10,7 @@ the web server's threads (one connection behind a lock).
 from __future__ import annotations
 
 import json
+import os
 import secrets
 import sqlite3
 import threading
@@ -20,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from feelmysign.errors import StudyError
+from feelmysign.input_files import UnusableFile, check_kind
 from feelmysign.study.design import Design
 from feelmysign.study.design_file import parse_design
 from feelmysign.study.order import participant_order
@@ -39,11 +41,7 @@ class StudyStore:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        if not self.path.is_file():
-            raise StudyError(
-                f"no study file at {self.path}; create one with "
-                "'feelmysign study new DESIGN.toml --out FILE.sqlite'"
-            )
+        self._check_path()
         self._lock = threading.RLock()
         self._db = self._connect(self.path)
         version = self.meta("schema_version")
@@ -59,6 +57,26 @@ class StudyStore:
             base_dir=base_dir,
         )
         self.base_dir = base_dir
+
+    def _check_path(self) -> None:
+        """A study file is there and is a regular file (``os.stat`` does not block on a fifo)."""
+        try:
+            info = os.stat(self.path)
+        except FileNotFoundError:
+            raise StudyError(
+                f"no study file at {self.path}; create one with "
+                "'feelmysign study new DESIGN.toml --out FILE.sqlite'"
+            ) from None
+        except OSError as error:
+            raise StudyError(f"cannot read the study file {self.path}: {error.strerror}") from None
+        try:
+            check_kind(self.path, info)
+        except UnusableFile as error:
+            what = str(error.strerror).removeprefix("it ").split(":")[0]  # "is a fifo ..."
+            raise StudyError(
+                f"the study file {str(self.path)!r} {what}: give the path of the file that "
+                "'feelmysign study new DESIGN.toml --out FILE.sqlite' made"
+            ) from None
 
     @staticmethod
     def _connect(path: Path) -> sqlite3.Connection:
