@@ -339,12 +339,18 @@ describe("a broker that goes away", () => {
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
 
     const stageBefore = await page.locator(CANVAS).boundingBox();
+    const legendBefore = await page.locator("#legend").boundingBox();
+    // The legend follows the area (its 10 px gap), with no empty band between them.
+    const below = legendBefore!.y - (stageBefore!.y + stageBefore!.height);
+    expect(below, "from the area's bottom to its legend").toBeGreaterThanOrEqual(0);
+    expect(below, "from the area's bottom to its legend").toBeLessThan(20);
     await broker.stop();
     await waitForData(page, '[data-testid="broker-status"]', "state", "offline");
     // Reconnection attempts every 2 s: the notice stays up and the drawing area does not move.
     for (let k = 0; k < 60; k++) {
       expect(await page.locator("#notice").isVisible(), `notice hidden at ${k * 50} ms`).toBe(true);
       expect(await page.locator(CANVAS).boundingBox()).toEqual(stageBefore);
+      expect(await page.locator("#legend").boundingBox()).toEqual(legendBefore);
       await new Promise((wake) => setTimeout(wake, 50));
     }
     const area = await drawingArea(page);

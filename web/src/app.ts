@@ -193,7 +193,9 @@ export class App {
       release: (sample) => this.#session.release(sample),
     });
     this.#wireButtons();
-    new ResizeObserver(() => this.#fit()).observe(this.#stageArea);
+    const resized = new ResizeObserver(() => this.#fit());
+    resized.observe(this.#stageArea);
+    resized.observe(byId(this.#doc, "stage-wrap")); // the area's height follows its content
     window.addEventListener("resize", () => this.#fit());
     this.#fit();
     this.#drawingChanged(null);
@@ -357,9 +359,10 @@ export class App {
       this.#session.clear();
     }
     const width = this.#stageArea.clientWidth;
-    // Stacked (phone) layout: the area takes its content's height, so the viewport sets the limit.
+    // The area takes its content's height, the legend right under it: the viewport (stacked,
+    // phone) or the column (desktop) sets the limit.
     const stacked = window.matchMedia(STACKED_LAYOUT).matches;
-    const height = stacked ? this.#firstScreenHeight() : this.#stageArea.clientHeight;
+    const height = stacked ? this.#firstScreenHeight() : this.#columnHeight();
     this.#view.fit(grid, this.#settings.stretch, width, height);
     this.#legendTurned.hidden = !this.#view.turned;
     this.#preview.setGrid(grid, this.#view.turned);
@@ -372,6 +375,16 @@ export class App {
     // A phone on its side keeps every pixel of height for drawing: the legend follows below the fold.
     const legend = window.matchMedia(SHORT_LANDSCAPE).matches ? 0 : this.#legendHeightTurned();
     return Math.max(STACKED_MIN_HEIGHT_PX, window.innerHeight - top - legend - STACKED_BELOW_PX);
+  }
+
+  /** Desktop, the area fills its column but for the legend, which follows it with no gap to fill. */
+  #columnHeight(): number {
+    const column = this.#stageArea.parentElement;
+    if (!column) return this.#stageArea.clientHeight;
+    const gap = parseFloat(getComputedStyle(column).rowGap) || 0;
+    const bottom = column.getBoundingClientRect().bottom;
+    const top = this.#stageArea.getBoundingClientRect().top;
+    return Math.max(0, bottom - top - gap - this.#legendHeightTurned());
   }
 
   /**
