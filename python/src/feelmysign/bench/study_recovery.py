@@ -8,8 +8,9 @@ from collections.abc import Iterator
 
 from feelmysign.study.analysis.recovery import coverage, describe, paper_truths
 from feelmysign.study.analysis.wilson import wilson_interval
+from feelmysign.study.choices import DIRECTIONS, Dimension
 from feelmysign.study.design_file import parse_design
-from feelmysign.study.threshold import DIRECTIONS, Dimension, Procedure, SimulatedObserver
+from feelmysign.study.threshold import Procedure, SimulatedObserver
 
 RUNS = 400
 _DESIGN = """

@@ -13,12 +13,7 @@ from typing import Any
 
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.errors import StudyError
-from feelmysign.study.simulated_sleeve import offline_player
-from feelmysign.study.sleeve_link import SleeveLink
-from feelmysign.study.stimulus import stimulus_layout
-from feelmysign.study.store import StudyStore
-from feelmysign.study.threshold import DIMENSIONS, DIRECTIONS, SimulatedObserver
-from feelmysign.study.threshold_run import run_threshold
+from feelmysign.study.choices import DIMENSIONS, DIRECTIONS
 
 _KEYS = {d[0]: d for d in DIRECTIONS}  # u, d, l, r
 
@@ -52,6 +47,13 @@ def _ask(direction: str, value: float) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from feelmysign.study.simulated_sleeve import offline_player
+    from feelmysign.study.sleeve_link import SleeveLink
+    from feelmysign.study.stimulus import stimulus_layout
+    from feelmysign.study.store import StudyStore
+    from feelmysign.study.threshold import SimulatedObserver
+    from feelmysign.study.threshold_run import run_threshold
+
     store = StudyStore(args.study)
     layout = stimulus_layout(store.design.stimulus, store.base_dir)
     unit = "grid units" if args.dimension == "length" else "ms"

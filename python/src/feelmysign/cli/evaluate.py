@@ -49,24 +49,16 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
 from feelmysign.cli._inputs import not_empty, output_folder, whole_number
 from feelmysign.cli.simplify import load
 from feelmysign.errors import FeelMySignError
-from feelmysign.research.sweep import (
-    DEFAULT_SWEEPS,
-    Sweep,
-    SweepError,
-    check_names,
-    parameter_sets,
-    parse_sweep,
-)
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import ALGORITHMS, Algorithm
 
 if TYPE_CHECKING:
     from feelmysign.research.evaluate import Recogniser, Row, Run, Source
+
+# The research tools and rich are imported when 'evaluate' runs, not by 'feelmysign --help'.
 
 DEFAULT_OUT_ROOT = Path("evaluations")
 
@@ -158,6 +150,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         parser.error("--speeds re-times the LASA drawings: give it with --lasa")
     if args.defaults and args.sweep:
         parser.error("give either --defaults or --sweep, not both")
+    from feelmysign.research.sweep import SweepError
+
     try:
         runs = _runs(algorithms, [] if args.defaults else args.sweep, defaults=args.defaults)
     except SweepError as error:
@@ -201,6 +195,13 @@ def _algorithms(text: str, parser: argparse.ArgumentParser) -> list[Algorithm]:
 
 def _runs(algorithms: list[Algorithm], texts: list[str], *, defaults: bool = False) -> list[Run]:
     from feelmysign.research.evaluate import Run
+    from feelmysign.research.sweep import (
+        DEFAULT_SWEEPS,
+        Sweep,
+        check_names,
+        parameter_sets,
+        parse_sweep,
+    )
 
     runs = []
     for algorithm in algorithms:
@@ -272,6 +273,14 @@ def _out_folder(given: str | None) -> Path:
 def _evaluate_with_progress(
     sources: list[Source], runs: list[Run], recogniser: Recogniser | None
 ) -> list[Row]:
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     from feelmysign.research.evaluate import evaluate
 
     columns = (

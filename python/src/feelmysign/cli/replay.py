@@ -26,7 +26,7 @@ import argparse
 import functools
 import json
 import uuid
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli import simplify
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
@@ -35,11 +35,13 @@ from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_cli
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
-from feelmysign.research.rerun import Rerun, mismatch, rerun
 from feelmysign.sending import OutgoingStroke, StrokeSender, printer
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import DEFAULT_ALGORITHM, Params
 from feelmysign.stroke import Stroke
+
+if TYPE_CHECKING:
+    from feelmysign.research.rerun import Rerun
 
 MAX_SPEED = 1000.0  # a minute of drawing in 60 ms: faster is a burst, not a pace
 BROKER_DESTS = ("broker", "sleeve_id", "username", "password", "credentials")
@@ -87,6 +89,8 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
+    from feelmysign.research.rerun import mismatch, rerun  # not by 'feelmysign --help'
+
     _check_usage(args, parser)
     recording = simplify.load(args.recording)
     algorithm = simplify.chosen_algorithm(args, recording)

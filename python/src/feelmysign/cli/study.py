@@ -23,13 +23,10 @@ from typing import Any
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.errors import StudyError
-from feelmysign.study.analysis import analyse_study
-from feelmysign.study.analysis.psychometric import BOOTSTRAP_SAMPLES
-from feelmysign.study.design_file import load_design
-from feelmysign.study.dry_run import dry_run
-from feelmysign.study.export import export_study
-from feelmysign.study.store import StudyStore
-from feelmysign.study.terminal import review_in_terminal, run_in_terminal
+from feelmysign.study.choices import BOOTSTRAP_SAMPLES
+
+# The study's modules (numpy, scipy, statsmodels, matplotlib, questplus) are imported by the
+# step that runs, not by 'feelmysign --help'.
 
 
 def register(subparsers: Any) -> None:
@@ -110,6 +107,8 @@ def _out_dir(args: argparse.Namespace) -> Path:
 
 
 def _check(args: argparse.Namespace) -> int:
+    from feelmysign.study.design_file import load_design
+
     design = load_design(args.design)
     print(f"{args.design}: valid. {design.name}")
     print(
@@ -124,6 +123,9 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _new(args: argparse.Namespace) -> int:
+    from feelmysign.study.design_file import load_design
+    from feelmysign.study.store import StudyStore
+
     design = load_design(args.design)
     StudyStore.create(args.out, args.design, design).close()
     print(
@@ -134,6 +136,8 @@ def _new(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
+    from feelmysign.study.store import StudyStore
+
     store = StudyStore(args.study)
     codings = store.latest_codings()
     print(f"{args.study}: {store.design.name}")
@@ -156,6 +160,9 @@ def _status(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     if not 1 <= args.participants <= 500:
         raise StudyError(f"--participants must be 1 to 500; got {args.participants}")
+    from feelmysign.study.dry_run import dry_run
+    from feelmysign.study.store import StudyStore
+
     store = StudyStore(args.study)
     codes = dry_run(
         store,
@@ -173,16 +180,25 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from feelmysign.study.store import StudyStore
+    from feelmysign.study.terminal import run_in_terminal
+
     store = StudyStore(args.study)
     settings = broker_settings_from_args(args, "sender")
     return run_in_terminal(store, settings, args.participant)
 
 
 def _review(args: argparse.Namespace) -> int:
+    from feelmysign.study.store import StudyStore
+    from feelmysign.study.terminal import review_in_terminal
+
     return review_in_terminal(StudyStore(args.study))
 
 
 def _export(args: argparse.Namespace) -> int:
+    from feelmysign.study.export import export_study
+    from feelmysign.study.store import StudyStore
+
     out = _out_dir(args)
     for path in export_study(StudyStore(args.study), out):
         print(path)
@@ -192,6 +208,9 @@ def _export(args: argparse.Namespace) -> int:
 def _analyse(args: argparse.Namespace) -> int:
     if not 50 <= args.bootstrap <= 100_000:
         raise StudyError(f"--bootstrap must be 50 to 100000; got {args.bootstrap}")
+    from feelmysign.study.analysis import analyse_study
+    from feelmysign.study.store import StudyStore
+
     out = _out_dir(args)
     analysis = analyse_study(StudyStore(args.study), out, samples=args.bootstrap)
     print(

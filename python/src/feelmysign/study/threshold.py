@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 import random
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 import questplus
@@ -31,11 +30,9 @@ import questplus
 from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
 from feelmysign.stroke import Stroke
+from feelmysign.study.choices import DIRECTIONS, Dimension
 from feelmysign.study.design import Threshold, ThresholdDimension
 
-Dimension = Literal["length", "duration"]
-DIMENSIONS: tuple[Dimension, ...] = ("length", "duration")
-DIRECTIONS = {"up": (0.0, -1.0), "down": (0.0, 1.0), "left": (-1.0, 0.0), "right": (1.0, 0.0)}
 GUESS_RATE = 0.25  # four alternatives
 SLOPES = (1.5, 2.0, 3.0, 4.5, 6.0)  # Weibull slopes QUEST+ considers
 # The posterior's threshold grid is finer than the stimulus grid: its 95% interval is read

@@ -22,12 +22,11 @@ from typing import Any
 
 from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
+from feelmysign.study.choices import DIMENSIONS, Dimension
 from feelmysign.study.runner import Play, events_summary
 from feelmysign.study.store import StudyStore
 from feelmysign.study.threshold import (
-    DIMENSIONS,
     MIN_TRIALS,
-    Dimension,
     Procedure,
     SimulatedObserver,
     check_fits,

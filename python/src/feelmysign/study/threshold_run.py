@@ -19,11 +19,10 @@ from typing import Any
 from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
 from feelmysign.stroke import Stroke
+from feelmysign.study.choices import DIRECTIONS, Dimension
 from feelmysign.study.runner import Play
 from feelmysign.study.store import StudyStore
 from feelmysign.study.threshold import (
-    DIRECTIONS,
-    Dimension,
     Estimate,
     Procedure,
     check_fits,

@@ -20,13 +20,13 @@ import pandas as pd
 from feelmysign.study.analysis.models import ModelResult, shape_differences
 from feelmysign.study.analysis.plots import accuracy_plot, threshold_plot
 from feelmysign.study.analysis.psychometric import (
-    BOOTSTRAP_SAMPLES,
     Threshold,
     counts_by_level,
     threshold_with_interval,
 )
 from feelmysign.study.analysis.report import write_report
 from feelmysign.study.analysis.wilson import wilson_interval
+from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 from feelmysign.study.export import anonymous_labels, export_study, trial_rows
 from feelmysign.study.store import StudyStore
 

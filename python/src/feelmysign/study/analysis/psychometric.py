@@ -54,9 +54,10 @@ from scipy.optimize import brentq, minimize
 from scipy.special import expit, logsumexp
 from scipy.stats import norm
 
+from feelmysign.study.choices import BOOTSTRAP_SAMPLES
+
 LAPSE = 0.02  # Wichmann & Hill 2001: a small fixed lapse keeps the slope unbiased
 SLOPE_BOUNDS = (0.05, 40.0)  # per doubling of strokes; 40 is a step, 0.05 is flat
-BOOTSTRAP_SAMPLES = 1000
 SPREAD_BOUNDS = (0.0, 3.0)  # SD of the participants' shifts, doublings of strokes
 
 
