@@ -190,3 +190,25 @@ def test_cancelling_a_refused_stroke_does_not_call_it_cut_short() -> None:
     cut = timeline.cancel(lambda tag: True, 1200.0)
     assert (cut.started, cut.unstarted, cut.changes) == ([], [], [])
     assert timeline.next_ms() is None and not timeline.busy
+
+
+def test_a_stroke_that_takes_over_the_motors_left_on_changes_nothing_until_it_moves() -> None:
+    # Back to back, the second starting where the first ends: at the joint the first's last
+    # burst goes off as the second's first comes on, at the same intensity. No change there,
+    # so no change (and no --record line) names the second stroke at its start.
+    first, second = (
+        plan(Stroke((0, 0), (1, 0), 400), PAPER),
+        plan(Stroke((1, 0), (2, 0), 400), PAPER),
+    )
+    timeline = Timeline(PAPER)
+    timeline.add(first, 0.0, tag="first")
+    timeline.add(second, first.duration_ms, tag="second")
+    changes, started, _ = _run(timeline)
+    assert started == ["first", "second"]
+    at_joint = [c for c in changes if c.t_ms == first.duration_ms]
+    assert at_joint == []  # (0, 1) stays on: now the second stroke's
+    ons = [(c.tag, c.t_ms) for c in changes if c.intensity > 0]
+    assert ons[0] == ("first", 0.0)
+    assert min(t for tag, t in ons if tag == "second") > first.duration_ms
+    off = next(c for c in changes if (c.row, c.column) == (0, 1) and c.t_ms > first.duration_ms)
+    assert off.intensity == 0.0 and off.tag == "second"

@@ -175,8 +175,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     const record = readRecord(recordPath).slice(before);
     // The record's clock starts at the sleeve's start. The drawing's first stroke played ties it
     // to the sleeve's wall clock: it starts from every motor off (the sleeve was idle), so its
-    // first command is its first line in the record (a line names its drawing and seq).
-    const played = watcher.of(drawing, "played");
+    // first command is its first line in the record (a line names its drawing and seq). Only the
+    // first: a later stroke starts where the one before it ends, on the motors that one still
+    // drives at the same intensity, so its first command changes nothing and makes no line. A
+    // stroke slowed to be felt is played too (an "adjusted" event, not "played").
+    const played = [...watcher.of(drawing, "played"), ...watcher.of(drawing, "adjusted")];
     const first = played.reduce<Record<string, unknown> | undefined>(
       (a, e) =>
         a === undefined || (e["first_command_at_ms"] as number) < (a["first_command_at_ms"] as number)

@@ -8,7 +8,10 @@ line, so that a crash loses at most the line being written. ``wall_ms`` is the
 same moment on the wall clock (ms since the Unix epoch), to line a record up
 with the sleeve's events and the sender's ``sent_at_ms``; ``drawing`` and
 ``seq`` name the stroke whose command made the change (null for a change no
-stroke made, such as the all-off at exit, and for legacy strokes):
+stroke made, such as the all-off at exit, and for legacy strokes). Only changes
+are lines: a stroke that starts where the one before it ends, on the motors
+that one still drives at the same intensity, takes them over without a line of
+its own (its first line is its next change, or its motors going off):
 
     {"t_ms": 12.5, "wall_ms": 1795410070998.5, "row": 0, "column": 3, "intensity": 0.8,
      "drawing": "3f2a9c1e-...", "seq": 4}
