@@ -12,8 +12,8 @@ import json
 import subprocess
 import sys
 
-# Numerics, plots and statistics: the study and research tools.
-HEAVY_PACKAGES = ("numpy", "scipy", "matplotlib", "statsmodels", "pandas", "questplus")
+# Numerics, plots and statistics (the study and research tools), and MQTT (paho).
+HEAVY_PACKAGES = ("numpy", "scipy", "matplotlib", "statsmodels", "pandas", "questplus", "paho")
 # The study's command-line choices are the one module of the study package parsing needs.
 LIGHT_STUDY_MODULES = ("feelmysign.study", "feelmysign.study.choices")
 

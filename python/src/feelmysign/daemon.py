@@ -39,9 +39,7 @@ import time
 from collections import Counter, OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
-
-import paho.mqtt.client as mqtt
+from typing import TYPE_CHECKING, Any
 
 from feelmysign import __version__
 from feelmysign.backends.base import Backend
@@ -74,6 +72,9 @@ from feelmysign.player import (
 from feelmysign.protocol import Accepted, parse
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    import paho.mqtt.client as mqtt
 
 log = logging.getLogger(__name__)
 

@@ -14,15 +14,16 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any, Literal
-
-import paho.mqtt.client as mqtt
-from paho.mqtt.reasoncodes import ReasonCode
+from typing import TYPE_CHECKING, Any, Literal
 
 from feelmysign.connection import BrokerSettings
 from feelmysign.errors import BrokerConnectionError
 from feelmysign.protocol import format_json, format_legacy
 from feelmysign.stroke import Stroke
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.reasoncodes import ReasonCode
 
 Pace = Literal["realtime", "burst"]
 
@@ -135,6 +136,8 @@ class StrokeSender:
             self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
 
     def _publish(self, message: OutgoingStroke, payload: str) -> tuple[str, int]:
+        import paho.mqtt.client as mqtt
+
         info = self._client.publish(message.topic, payload, qos=1)
         # Not connected right now: paho keeps the stroke and sends it once reconnected.
         if info.rc not in (mqtt.MQTT_ERR_SUCCESS, mqtt.MQTT_ERR_NO_CONN):

@@ -20,12 +20,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import IO
-
-import paho.mqtt.client as mqtt
-from paho.mqtt.enums import CallbackAPIVersion
-from paho.mqtt.properties import Properties
-from paho.mqtt.reasoncodes import ReasonCode
+from typing import IO, TYPE_CHECKING
 
 from feelmysign.broker.credentials import Account
 from feelmysign.errors import BrokerError
@@ -33,6 +28,11 @@ from feelmysign.errors import BrokerError
 INSTALL_HINT = (
     "Install it with 'sudo apt-get install mosquitto' (or 'make system' in the repository)."
 )
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.properties import Properties
+    from paho.mqtt.reasoncodes import ReasonCode
 # Debian installs the broker in sbin, which is not on a normal user's PATH.
 SBIN_DIRS = ("/usr/sbin", "/usr/local/sbin")
 VERSION_TIMEOUT_S = 5.0
@@ -186,6 +186,9 @@ def log_tail(path: Path, *, start_offset_bytes: int = 0, lines: int = 15) -> str
 
 def accepts_login(host: str, port: int, account: Account, *, timeout_s: float) -> bool | None:
     """Try one MQTT login: True if accepted, False if refused, None if nobody answered yet."""
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.enums import CallbackAPIVersion
+
     connack: list[bool] = []
     client = mqtt.Client(
         CallbackAPIVersion.VERSION2, client_id=f"feelmysign-ready-probe-{os.getpid()}"

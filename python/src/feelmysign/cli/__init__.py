@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import os
 import sys
 from collections.abc import Sequence
@@ -62,18 +63,37 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         except ImportError as error:
             if (error.name or "feelmysign").startswith("feelmysign"):
                 raise  # our own module missing is a bug, not an extra left out
-            _register_missing_extra(subparsers, name, error)
+            _register_missing_extra(subparsers, name, error.name or str(error))
+            continue
+        missing = _first_missing(getattr(module, "REQUIRES", ()))
+        if missing is not None:
+            _register_missing_extra(subparsers, name, missing)
             continue
         module.register(subparsers)
     return parser
 
 
+def _first_missing(packages: Sequence[str]) -> str | None:
+    """The first of ``packages`` that cannot be imported here, found without importing it.
+
+    A subcommand imports its heavy packages when it runs, not when the parser is built
+    (``feelmysign --help`` stays quick); its ``REQUIRES`` names them so that a command
+    whose extra is not installed is still listed as such.
+    """
+    for package in packages:
+        try:
+            if importlib.util.find_spec(package) is None:
+                return package
+        except (ImportError, ValueError):  # ValueError: sys.modules[package] is None
+            return package
+    return None
+
+
 def _register_missing_extra(
-    subparsers: argparse._SubParsersAction[CliParser], name: str, error: ImportError
+    subparsers: argparse._SubParsersAction[CliParser], name: str, missing: str
 ) -> None:
     """A command whose packages are not installed ('make up' leaves the [research] extra out):
     listed, and saying how to get them when run."""
-    missing = error.name or str(error)
     parser = subparsers.add_parser(
         name,
         help=f"(not installed here: needs {missing}, from 'make test')",

@@ -26,9 +26,7 @@ import uuid
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
-
-import paho.mqtt.client as mqtt
+from typing import TYPE_CHECKING, Any
 
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.events import (
@@ -41,6 +39,9 @@ from feelmysign.events import (
     event_from_json,
 )
 from feelmysign.topics import telemetry_topic
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    import paho.mqtt.client as mqtt
 
 QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted and put down
 CHECK_INTERVAL_S = 0.25

@@ -5,10 +5,7 @@ from __future__ import annotations
 import argparse
 import threading
 import uuid
-from typing import Any
-
-import paho.mqtt.client as mqtt
-from paho.mqtt.reasoncodes import ReasonCode
+from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.cli._inputs import MAX_TIMEOUT_S, number
@@ -17,6 +14,10 @@ from feelmysign.control import CANCEL_ALL, Cancel, format_control
 from feelmysign.errors import BrokerConnectionError, ParameterError
 from feelmysign.protocol import MAX_DRAWING_ID_CHARS, is_drawing_id
 from feelmysign.topics import control_topic
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.reasoncodes import ReasonCode
 
 
 def register(subparsers: Any) -> None:

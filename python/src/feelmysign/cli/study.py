@@ -25,6 +25,18 @@ from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.errors import StudyError
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 
+# Checked (not imported) when the parser is built: without them 'study' is listed as not installed.
+REQUIRES = (
+    "numpy",
+    "scipy",
+    "matplotlib",
+    "statsmodels",
+    "pandas",
+    "questplus",
+    "similaritymeasures",
+    "simplification",
+)
+
 # The study's modules (numpy, scipy, statsmodels, matplotlib, questplus) are imported by the
 # step that runs, not by 'feelmysign --help'.
 

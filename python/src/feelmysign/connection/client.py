@@ -10,15 +10,16 @@ import ssl
 import sys
 import time
 from collections.abc import Callable
-from typing import Any
-
-import paho.mqtt.client as mqtt
-from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
-from paho.mqtt.reasoncodes import ReasonCode
+from typing import TYPE_CHECKING, Any
 
 from feelmysign.connection.failures import connect_failure_message, failure_reason
 from feelmysign.connection.settings import BrokerSettings
 from feelmysign.errors import BrokerConnectionError
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.enums import MQTTProtocolVersion
+    from paho.mqtt.reasoncodes import ReasonCode
 
 DEFAULT_TIMEOUT_S = 10.0  # a broker on the same continent answers in well under a second
 # MQTT 5's CONNACK "Unsupported protocol version": a 3.1.1-only broker (NATS, older ones).
@@ -39,7 +40,7 @@ def new_client(
     *,
     client_id: str = "",
     persistent_session: bool = False,
-    protocol: MQTTProtocolVersion = mqtt.MQTTv311,
+    protocol: MQTTProtocolVersion | None = None,
 ) -> mqtt.Client:
     """A paho-mqtt 2 client set up for ``settings``; not yet connected.
 
@@ -47,9 +48,15 @@ def new_client(
     keep QoS 1 messages for a sleeve that is away, and its subscriptions.
     Persistent sessions are an MQTT 3.1.1 notion here (``clean_session``).
     A password is never sent in clear text off loopback: BrokerConnectionError
-    ``plain-text`` says to use mqtts:// or wss:// instead.
+    ``plain-text`` says to use mqtts:// or wss:// instead. ``protocol`` is MQTT 3.1.1
+    unless given.
     """
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.enums import CallbackAPIVersion
+
     check_no_plain_text_password(settings)
+    if protocol is None:
+        protocol = mqtt.MQTTv311
     if protocol == mqtt.MQTTv5:
         client = mqtt.Client(
             CallbackAPIVersion.VERSION2,
@@ -164,6 +171,8 @@ def connect_client(
 def _connect_one(
     settings: BrokerSettings, client_id: str, timeout_s: float, note: Callable[[str], None]
 ) -> mqtt.Client:
+    import paho.mqtt.client as mqtt
+
     try:
         return _connect_with(settings, client_id, timeout_s, mqtt.MQTTv5)
     except BrokerConnectionError as error:
@@ -182,6 +191,8 @@ def _connect_with(
     timeout_s: float,
     protocol: MQTTProtocolVersion,
 ) -> mqtt.Client:
+    import paho.mqtt.client as mqtt
+
     client = new_client(settings, client_id=client_id, protocol=protocol)
     client.connect_timeout = timeout_s
     answers: list[ReasonCode] = []

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import socket
 import ssl
-
-import paho.mqtt.client as mqtt
-from paho.mqtt.reasoncodes import ReasonCode
+from typing import TYPE_CHECKING
 
 from feelmysign.connection.settings import BrokerSettings
+
+if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
+    from paho.mqtt.reasoncodes import ReasonCode
 
 # MQTT 5 CONNACK reason codes that mean "these credentials": Bad user name or
 # password, Not authorized.
@@ -28,6 +29,9 @@ def failure_reason(error: BaseException) -> str:
 
 def connect_failure_message(settings: BrokerSettings, failure: BaseException | ReasonCode) -> str:
     """Why connecting to ``settings`` failed and what to do, for an error or a CONNACK code."""
+    import paho.mqtt.client as mqtt
+    from paho.mqtt.reasoncodes import ReasonCode
+
     url = settings.url
     if isinstance(failure, ReasonCode):
         return _login_refused_message(settings, failure)
