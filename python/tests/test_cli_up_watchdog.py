@@ -6,7 +6,6 @@ test kills that Mosquitto with SIGKILL, by its process id.
 
 from __future__ import annotations
 
-import http.client
 import json
 import os
 import queue
@@ -20,6 +19,7 @@ from pathlib import Path
 from typing import IO
 
 import pytest
+from host_header import get
 
 WAIT_S = 60.0
 
@@ -47,6 +47,16 @@ def _wait_for(lines: queue.Queue[str], text: str, seen: list[str]) -> None:
         if text in line:
             return
     pytest.fail(f"no line with {text!r} in {WAIT_S:g} s:\n{''.join(seen)}")
+
+
+def _interrupt(process: subprocess.Popen[str]) -> int:
+    """Ctrl-C to up, and its exit code; killed (and the test failed) if it does not end."""
+    process.send_signal(signal.SIGINT)
+    try:
+        return process.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        raise
 
 
 def _mosquitto_children(pid: int) -> list[int]:
@@ -78,12 +88,7 @@ def test_up_restarts_a_killed_broker_and_says_so_once(tmp_path: Path) -> None:
         _wait_for(lines, "Back: the broker is running again on", seen)
         assert _mosquitto_children(process.pid) not in ([], [mosquitto])
     finally:
-        process.send_signal(signal.SIGINT)
-        try:
-            code = process.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            raise
+        code = _interrupt(process)
     assert code == 0, "".join(seen)
     assert _mosquitto_children(process.pid) == []
     outage = seen[before:]
@@ -144,12 +149,7 @@ def test_up_goes_on_watching_after_its_reader_left(tmp_path: Path) -> None:
                 assert time.monotonic() < deadline, "the watchdog did not restart the broker"
                 time.sleep(0.2)
         finally:
-            process.send_signal(signal.SIGINT)
-            try:
-                code = process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                raise
+            code = _interrupt(process)
         stderr.seek(0)
         errors = stderr.read()
     assert "Traceback" not in errors and "BrokenPipe" not in errors, errors
@@ -167,28 +167,12 @@ def test_up_refuses_its_config_to_a_foreign_host_header(tmp_path: Path) -> None:
         page = seen[-1].split("Draw here:", 1)[1].strip()
         port = int(page.split("://", 1)[1].split("/", 1)[0].rsplit(":", 1)[1])
         answers = {
-            host: _get_config(port, host) for host in ("attacker.example", f"127.0.0.1:{port}")
+            host: get(port, "/config.json", host, WAIT_S)
+            for host in ("attacker.example", f"127.0.0.1:{port}")
         }
     finally:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            raise
+        _interrupt(process)
     password = json.loads(answers[f"127.0.0.1:{port}"][1])["password"]
     assert answers[f"127.0.0.1:{port}"][0] == 200 and password
     status, body = answers["attacker.example"]
     assert status == 403 and password.encode() not in body
-
-
-def _get_config(port: int, host: str) -> tuple[int, bytes]:
-    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=WAIT_S)
-    try:
-        connection.putrequest("GET", "/config.json", skip_host=True)
-        connection.putheader("Host", host)
-        connection.endheaders()
-        response = connection.getresponse()
-        return response.status, response.read()
-    finally:
-        connection.close()

@@ -155,16 +155,20 @@ class Events:
 
 def _send(cluster: NatsCluster, *shape: str) -> subprocess.Popen[str]:
     """The CLI sender on node b, drawing ``shape`` at a hand's pace."""
-    c = cluster.credentials
+    return _run_as(
+        cluster.credentials.sender,
+        *("send", "--broker", cluster.nodes[1].mqtt_url, "--id", SLEEVE, "--shape", *shape),
+        # Node b may drop its clients while JetStream elects new leaders for the
+        # streams node a led; the sender reconnects and sends the stroke again.
+        *("--timeout-s", "40"),
+    )
+
+
+def _run_as(account: Account, command: str, *args: str) -> subprocess.Popen[str]:
+    """``feelmysign command args`` logged in as ``account``, its output in one pipe."""
     return subprocess.Popen(
-        feelmysign(
-            *("send", "--broker", cluster.nodes[1].mqtt_url, "--id", SLEEVE),
-            *("--username", c.sender.username, "--shape", *shape),
-            # Node b may drop its clients while JetStream elects new leaders for the
-            # streams node a led; the sender reconnects and sends the stroke again.
-            *("--timeout-s", "40"),
-        ),
-        env={**os.environ, "FEELMYSIGN_PASSWORD": c.sender.password},
+        feelmysign(command, "--username", account.username, *args),
+        env={**os.environ, "FEELMYSIGN_PASSWORD": account.password},
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -194,16 +198,7 @@ def _kill_the_sleeves_node_mid_drawing(cluster: NatsCluster, *pace: str) -> Fail
     drawing of 12 strokes sent from node b at a hand's pace; node a killed (SIGKILL)
     once two strokes played; then a drawing of 4 strokes."""
     c = cluster.credentials
-    sleeve = subprocess.Popen(
-        feelmysign(
-            *("sleeve", "--broker", cluster.mqtt_urls, "--id", SLEEVE),
-            *("--username", c.sleeve.username, *pace),
-        ),
-        env={**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password},
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
+    sleeve = _run_as(c.sleeve, "sleeve", "--broker", cluster.mqtt_urls, "--id", SLEEVE, *pace)
     events = Events(cluster.nodes[1].mqtt_url, c.sender)
     first_out = ""
     try:
@@ -337,15 +332,8 @@ def test_a_stroke_redelivered_after_later_ones_plays_once(cluster: NatsCluster) 
         delivered_s = time.monotonic()
         away.disconnect()  # a clean exit: the session, and stroke 0 unacknowledged, stay
         away.loop_stop()
-        sleeve = subprocess.Popen(
-            feelmysign(
-                *("sleeve", "--broker", node.mqtt_url, "--id", SLEEVE),
-                *("--username", c.sleeve.username, *CLUSTER_PACE),
-            ),
-            env={**os.environ, "FEELMYSIGN_PASSWORD": c.sleeve.password},
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
+        sleeve = _run_as(
+            c.sleeve, "sleeve", "--broker", node.mqtt_url, "--id", SLEEVE, *CLUSTER_PACE
         )
         _wait_online(cluster, c.sender)
         back_within_ack_wait = time.monotonic() - delivered_s < ACK_WAIT_S - 2

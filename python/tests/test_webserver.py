@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import http.client
 import json
 from pathlib import Path
 
 import pytest
+from host_header import get
 
 from feelmysign.webserver import WebServer, host_header_names
 
@@ -20,16 +20,7 @@ def site(tmp_path: Path) -> Path:
 
 
 def _get(server: WebServer, path: str, host: str) -> tuple[int, bytes]:
-    port = int(server.url.rstrip("/").rsplit(":", 1)[1])
-    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
-    try:
-        connection.putrequest("GET", path, skip_host=True)
-        connection.putheader("Host", host)
-        connection.endheaders()
-        response = connection.getresponse()
-        return response.status, response.read()
-    finally:
-        connection.close()
+    return get(_port(server), path, host, timeout_s=10)
 
 
 def _port(server: WebServer) -> int:
