@@ -285,3 +285,19 @@ def test_a_chip_that_does_not_answer_on_the_raw_bus_is_named_and_the_rest_go_on(
     rtp, mode = all_off.REG_RTP_INPUT, all_off.REG_MODE
     assert bus.writes == [(2, rtp, 0), (8, rtp, 0), (2, mode, 0x40), (8, mode, 0x40)]
     assert bus.control == 0
+
+
+@pytest.mark.parametrize("debug", ["", "1"])
+def test_a_bug_in_the_early_pass_does_not_keep_the_start_up_from_its_own_all_off(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], debug: str
+) -> None:
+    import feelmysign.cli._early_off as early
+
+    def broken(layout_path: str, state_path: str | None) -> list[str]:
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(early, "_switch_off", broken)
+    monkeypatch.setenv("FEELMYSIGN_DEBUG", debug)
+    problems = switch_off_early("sleeve", ["--backend", "drv2605", "--layout", PAPER])
+    assert problems == ["early all-off failed: RuntimeError: a bug"]
+    assert ("RuntimeError: a bug" in capsys.readouterr().err) == bool(debug)

@@ -44,7 +44,7 @@ if TYPE_CHECKING:
 # "off" has no --backend: it always drives the chips.
 EARLY_COMMANDS = {"sleeve": "sim", "buzz": "drv2605", "off": "drv2605"}
 LAYOUT_ENV = "FEELMYSIGN_LAYOUT"  # as cli/_options.py reads it
-DEBUG_ENV = "FEELMYSIGN_DEBUG"  # as cli/__init__.py reads it: a bug here then shows
+DEBUG_ENV = "FEELMYSIGN_DEBUG"  # as cli/__init__.py reads it: a bug here is then printed
 MEMO_FORMAT = b"feelmysign-wiring/1"
 MAX_MEMO_BYTES = MAX_LAYOUT_BYTES + 64 * 1024  # the layout's text plus a few lines of wiring
 
@@ -67,9 +67,11 @@ def switch_off_early(command: str | None, arguments: Sequence[str]) -> list[str]
     layout_path, state_path = options
     try:
         return _switch_off(layout_path, state_path)
-    except Exception as error:  # a bug here must not keep the command from starting
+    except Exception as error:  # a bug here must not keep the start-up from its own all-off
         if os.environ.get(DEBUG_ENV):
-            raise
+            import traceback
+
+            traceback.print_exc()
         return [f"early all-off failed: {type(error).__name__}: {error}"]
 
 
