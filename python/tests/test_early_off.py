@@ -162,7 +162,14 @@ def test_after_an_edit_the_chips_the_old_layout_wired_are_switched_off_too(
 
 
 @pytest.mark.parametrize(
-    "memo", [b"", b"garbage", b"feelmysign-wiring/1\nsource /x\nlayout 3\nabc", b"\xff" * 100]
+    "memo",
+    [
+        b"",
+        b"garbage",
+        b"feelmysign-wiring/1 0.1.0\nsource /x\nlayout 3\nabc",  # another layout's
+        b"feelmysign-wiring/0 0.0.1\nsource " + PAPER.encode() + b"\nlayout 3\nabc",
+        b"\xff" * 100,
+    ],
 )
 def test_an_unreadable_memo_is_a_miss_and_is_replaced(
     tmp_path: Path, state_home: Path, memo: bytes
@@ -176,7 +183,7 @@ def test_an_unreadable_memo_is_a_miss_and_is_replaced(
     _left_on(state)
     switch_off_early("sleeve", arguments)
     assert set(drive_levels(state).values()) == {0.0}
-    assert path.read_bytes().startswith(b"feelmysign-wiring/1\n")
+    assert path.read_bytes().startswith(b"feelmysign-wiring/1 ")
 
 
 def test_a_memo_of_another_text_is_not_used(

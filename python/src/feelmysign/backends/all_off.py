@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from typing import Protocol
 
     class WriteBus(Protocol):
-        """The writes the off sequence needs: an ``I2CBus``, or a :class:`RawI2CBus`."""
+        """What the off sequence needs of a bus: an ``I2CBus``, or a :class:`RawI2CBus`."""
 
         def write_byte(self, i2c_addr: int, value: int, /) -> None: ...
 

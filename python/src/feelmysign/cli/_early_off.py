@@ -31,6 +31,7 @@ from __future__ import annotations
 import os
 import sys
 
+from feelmysign import __version__
 from feelmysign.backends.all_off import CHANNELS, RawI2CBus, switch_off
 from feelmysign.input_files import MAX_LAYOUT_BYTES, read_bytes
 
@@ -45,7 +46,9 @@ if TYPE_CHECKING:
 EARLY_COMMANDS = {"sleeve": "sim", "buzz": "drv2605", "off": "drv2605"}
 LAYOUT_ENV = "FEELMYSIGN_LAYOUT"  # as cli/_options.py reads it
 DEBUG_ENV = "FEELMYSIGN_DEBUG"  # as cli/__init__.py reads it: a bug here is then printed
-MEMO_FORMAT = b"feelmysign-wiring/1"
+# The memo's first line: a memo another version of feelmysign wrote is a miss (its reader
+# of the layout may have differed).
+MEMO_FORMAT = f"feelmysign-wiring/1 {__version__}".encode()
 MAX_MEMO_BYTES = MAX_LAYOUT_BYTES + 64 * 1024  # the layout's text plus a few lines of wiring
 
 _VALUE_OPTIONS = ("--backend", "--layout", "--emulate-state")
@@ -187,7 +190,7 @@ def _parse_wiring(text: bytes, source: str) -> Targets | None:
 # --- the memo ------------------------------------------------------------------------------
 # Text, so that a person can read it:
 #
-#     feelmysign-wiring/1
+#     feelmysign-wiring/1 0.1.0           (the memo's format, then feelmysign's version)
 #     source /etc/feelmysign/layout.toml
 #     mux 1 0x70 0 1 2 3 4 5 6 7        (bus, multiplexer, channels)
 #     mux 1 0x71 0 1 2 3
