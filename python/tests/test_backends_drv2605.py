@@ -19,14 +19,9 @@ import smbus2
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from feelmysign.backends import (
-    Backend,
-    Drv2605Backend,
-    EmulatedI2CBus,
-    compare_with_layout,
-    scan,
-)
+from feelmysign.backends import Backend, Drv2605Backend, EmulatedI2CBus, compare_with_layout
 from feelmysign.backends.emulated_i2c import DRV2604_DEVICE_ID
+from feelmysign.backends.scan import scan
 from feelmysign.errors import HardwareError, LayoutError
 from feelmysign.layout import ActuatorType, Layout, Wire
 

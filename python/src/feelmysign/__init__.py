@@ -6,9 +6,7 @@ package before it switches its motors off, and must not wait for the rest.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
-
+TYPE_CHECKING = False  # typing itself costs a start-up import; mypy reads this name as True
 if TYPE_CHECKING:
     from feelmysign.errors import FeelMySignError, HardwareError, LayoutError, StrokeError
     from feelmysign.layout import Layout, Wire
@@ -44,10 +42,12 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     module = _WHERE.get(name)
     if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
     value = getattr(importlib.import_module(module), name)
     globals()[name] = value
     return value

@@ -6,7 +6,9 @@ values, not exceptions; these are for what a caller cannot go on from.
 
 from __future__ import annotations
 
-from pathlib import Path
+TYPE_CHECKING = False  # typing and pathlib cost start-up imports; mypy reads this name as True
+if TYPE_CHECKING:
+    from pathlib import Path
 
 
 class FeelMySignError(Exception):

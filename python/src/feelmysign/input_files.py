@@ -15,10 +15,12 @@ allows into a plain ``ValueError`` like any other malformed JSON.
 from __future__ import annotations
 
 import errno
-import json
 import os
 import stat
-from typing import Any
+
+TYPE_CHECKING = False  # typing itself costs a start-up import; mypy reads this name as True
+if TYPE_CHECKING:  # a restarting sleeve reads its layout through here before any other import
+    from typing import Any
 
 KIB = 1024
 MIB = 1024 * KIB
@@ -117,6 +119,8 @@ def _too_large(size: int, max_bytes: int, *, grew: bool = False) -> str:
 
 def loads_json(text: str | bytes, **options: Any) -> Any:
     """``json.loads``, with nesting too deep for the stack a ValueError like other bad JSON."""
+    import json  # here: the early all-off reads a layout through this module, and no JSON
+
     try:
         return json.loads(text, **options)
     except RecursionError:

@@ -23,6 +23,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ParamSpec, TypeVar
 
+from feelmysign.backends.all_off import DRV2605_ADDRESS as DRV2605_ADDRESS  # re-exported
+from feelmysign.backends.all_off import MODE_STANDBY, REG_MODE, REG_RTP_INPUT
 from feelmysign.backends.base import GridBackend
 from feelmysign.backends.i2c import I2CBus, is_no_answer, open_smbus
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES, Multiplexers
@@ -30,19 +32,17 @@ from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.errors import HardwareError, LayoutError, ParameterError
 from feelmysign.layout import ActuatorType, Layout, Wire
 
-DRV2605_ADDRESS = 0x5A  # fixed in silicon: the reason for the multiplexers
-
-# Register map (datasheet names).
+# Register map (datasheet names); the ones the all-off writes come from all_off.
 _REG_STATUS = 0x00
-_REG_MODE = 0x01
-_REG_RTP_INPUT = 0x02
+_REG_MODE = REG_MODE
+_REG_RTP_INPUT = REG_RTP_INPUT
 _REG_FEEDBACK_CONTROL = 0x1A
 _REG_CONTROL3 = 0x1D
 
 _STATUS_DEVICE_ID_SHIFT = 5  # STATUS[7:5] = DEVICE_ID
 _MODE_INTERNAL_TRIGGER = 0x00  # active (STANDBY = 0), plays nothing until GO
 _MODE_REAL_TIME_PLAYBACK = 0x05  # active, output amplitude = RTP_INPUT
-_MODE_STANDBY = 0x40  # STANDBY (bit 6): low power, output off, registers kept
+_MODE_STANDBY = MODE_STANDBY
 _FEEDBACK_N_ERM_LRA = 0x80  # N_ERM_LRA (bit 7): 1 = LRA, 0 = ERM
 _CONTROL3_DATA_FORMAT_RTP = 0x08  # DATA_FORMAT_RTP (bit 3): 1 = unsigned, 0x00 off .. 0xFF full
 

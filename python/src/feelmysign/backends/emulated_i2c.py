@@ -32,12 +32,18 @@ from __future__ import annotations
 
 import errno
 import threading
-from collections import Counter, deque
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Literal
+from collections import Counter, deque, namedtuple
 
-from feelmysign.layout import Layout
+# A restarting sleeve on an emulated bus imports this before it switches its motors
+# off: no typing, dataclasses or TOML reader at run time. mypy reads this name as True.
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Literal, NamedTuple
+
+    from feelmysign.layout import Layout
+
+    Operation = Literal["read_byte", "write_byte", "read_byte_data", "write_byte_data"]
 
 DRV2605L_ADDRESS = 0x5A
 DRV2605L_DEVICE_ID = 7
@@ -104,16 +110,22 @@ class BusConflictError(OSError):
         self.devices = devices
 
 
-@dataclass(frozen=True)
-class Transaction:
-    """One bus transaction: ``device`` that answered (None: nobody), ``error`` when it failed."""
+if TYPE_CHECKING:
 
-    op: Literal["read_byte", "write_byte", "read_byte_data", "write_byte_data"]
-    address: int
-    register: int | None
-    value: int | None
-    device: str | None
-    error: str | None = None
+    class Transaction(NamedTuple):
+        """One bus transaction: ``device`` that answered (None: nobody); ``error`` if it failed."""
+
+        op: Operation
+        address: int
+        register: int | None
+        value: int | None
+        device: str | None
+        error: str | None = None
+
+else:  # the same tuple, without importing typing
+    Transaction = namedtuple(
+        "Transaction", "op address register value device error", defaults=(None,)
+    )
 
 
 class EmulatedDRV2605L:
@@ -334,7 +346,7 @@ class EmulatedI2CBus:
 
     def _transact(
         self,
-        op: Literal["read_byte", "write_byte", "read_byte_data", "write_byte_data"],
+        op: Operation,
         address: int,
         register: int | None,
         value: int | None,

@@ -38,13 +38,18 @@ from __future__ import annotations
 
 import json
 import os
-from pathlib import Path
-from typing import Any
 
 from feelmysign.backends.emulated_i2c import EmulatedDRV2605L, EmulatedI2CBus
 from feelmysign.errors import FeelMySignError
 from feelmysign.input_files import MAX_STATE_BYTES, loads_json, read_text
-from feelmysign.layout import Layout
+
+# A restarting sleeve on an emulated bus opens its state file before anything else:
+# no typing, pathlib or TOML reader at run time. mypy reads this name as True.
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any
+
+    from feelmysign.layout import Layout
 
 STATE_FORMAT = "feelmysign-emulated-i2c/1"
 
@@ -52,7 +57,7 @@ STATE_FORMAT = "feelmysign-emulated-i2c/1"
 class EmulatedStateError(FeelMySignError):
     """A state file that cannot be used; ``path`` and ``problem`` say which and why."""
 
-    def __init__(self, path: Path, problem: str) -> None:
+    def __init__(self, path: str | os.PathLike[str], problem: str) -> None:
         super().__init__(
             f"{path}: not a usable emulated I2C bus state file ({problem}); fix it, or delete it "
             "to start from a fresh bus wired as the layout says"
@@ -66,15 +71,17 @@ def chip_key(multiplexer: int, channel: int) -> str:
     return f"0x{multiplexer:02X}/{channel}"
 
 
-def open_state_bus(path: str | os.PathLike[str], layout: Layout) -> EmulatedI2CBus:
+def open_state_bus(path: str | os.PathLike[str], layout: Layout | None) -> EmulatedI2CBus:
     """The bus kept in ``path``, written through on every write.
 
     A file that does not exist yet becomes a fresh bus wired as ``layout``
     says (every chip at its power-on reset values); an existing file is the
-    truth, whatever the layout says, as the hardware would be.
+    truth, whatever the layout says, as the hardware would be. Without a
+    layout (the early all-off, before any TOML is read) the file must exist:
+    EmulatedStateError otherwise.
     """
-    state_path = Path(path)
-    if state_path.exists():
+    state_path = os.fspath(path)  # os.path, not pathlib: a restarting sleeve imports this early
+    if layout is None or os.path.exists(state_path):
         bus = read_state(state_path)
     else:
         bus = EmulatedI2CBus.for_layout(layout)
@@ -94,7 +101,7 @@ class _WriteThrough:
     """Saves the bus after each write that changed it (a write of what a register holds
     changes nothing, and skipping it keeps a burst of writes quick)."""
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: str) -> None:
         self._path = path
         self._last = ""
         self._written = _identity(path)
@@ -127,7 +134,7 @@ class _WriteThrough:
 
 def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
     """The bus saved in ``path`` (no write-through: for looking, or for a test to edit)."""
-    state_path = Path(path)
+    state_path = os.fspath(path)
     try:
         data = loads_json(read_text(state_path, max_bytes=MAX_STATE_BYTES))
     except OSError as error:
@@ -143,23 +150,25 @@ def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
 
 def write_state(bus: EmulatedI2CBus, path: str | os.PathLike[str]) -> None:
     """Save ``bus`` to ``path`` atomically: a reader, or a killed writer, never sees half a file."""
-    _replace(Path(path), _as_text(bus))
+    _replace(os.fspath(path), _as_text(bus))
 
 
 def _as_text(bus: EmulatedI2CBus) -> str:
     return json.dumps(state_of(bus), indent=1) + "\n"
 
 
-def _replace(path: Path, text: str) -> None:
+def _replace(path: str, text: str) -> None:
     # A rename replaces the file in one step: readers see the old or the new one.
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    temporary.write_text(text, encoding="utf-8")
+    folder, name = os.path.split(path)
+    temporary = os.path.join(folder, f".{name}.{os.getpid()}.tmp")
+    with open(temporary, "w", encoding="utf-8") as file:
+        file.write(text)
     os.replace(temporary, path)
 
 
-def _identity(path: Path) -> tuple[int, int, int] | None:
+def _identity(path: str) -> tuple[int, int, int] | None:
     try:
-        info = path.stat()
+        info = os.stat(path)
     except OSError:
         return None
     return (info.st_ino, info.st_mtime_ns, info.st_size)

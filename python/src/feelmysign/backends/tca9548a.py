@@ -16,12 +16,13 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 
+from feelmysign.backends.all_off import CHANNELS as CHANNELS  # re-exported
+from feelmysign.backends.all_off import CONTROL_NONE
+from feelmysign.backends.all_off import MULTIPLEXER_ADDRESSES as MULTIPLEXER_ADDRESSES
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.errors import HardwareError, ParameterError
 
-MULTIPLEXER_ADDRESSES = range(0x70, 0x78)  # set by the A2..A0 pins
-CHANNELS = range(8)
-_CONTROL_NONE = 0x00  # control register value with every channel disabled
+_CONTROL_NONE = CONTROL_NONE
 
 
 def _hex(address: int) -> str:

@@ -10,19 +10,19 @@ a bug: it still gets one ``Error:`` line, with a request to report it, and exit
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import importlib.util
 import os
 import sys
-from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, TextIO, cast
 
-from feelmysign import __version__
+# Nothing else at module level: a sleeve restarted after a crash imports this
+# package, then switches its motors off (main), before any other import.
 from feelmysign.cli._early_off import switch_off_early
-from feelmysign.errors import FeelMySignError
 
-if TYPE_CHECKING:  # imported by build_parser, after the early all-off
+TYPE_CHECKING = False  # typing itself costs a start-up import; mypy reads this name as True
+if TYPE_CHECKING:
+    import argparse
+    from collections.abc import Sequence
+    from typing import Any, TextIO
+
     from feelmysign.cli._parser import CliParser
 
 DEBUG_ENV = "FEELMYSIGN_DEBUG"
@@ -49,6 +49,9 @@ SUBCOMMANDS = (
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The whole command; with ``only``, just that subcommand (its module alone is imported)."""
+    import importlib
+
+    from feelmysign import __version__
     from feelmysign.cli._parser import CliParser
 
     parser = CliParser(
@@ -80,6 +83,8 @@ def _first_missing(packages: Sequence[str]) -> str | None:
     (``feelmysign --help`` stays quick); its ``REQUIRES`` names them so that a command
     whose extra is not installed is still listed as such.
     """
+    import importlib.util
+
     for package in packages:
         try:
             if importlib.util.find_spec(package) is None:
@@ -94,6 +99,10 @@ def _register_missing_extra(
 ) -> None:
     """A command whose packages are not installed ('make up' leaves the [research] extra out):
     listed, and saying how to get them when run."""
+    import argparse
+
+    from feelmysign.errors import FeelMySignError
+
     parser = subparsers.add_parser(
         name,
         help=f"(not installed here: needs {missing}, from 'make test')",
@@ -124,7 +133,9 @@ def _named_subcommand(argv: Sequence[str]) -> str | None:
 def main(argv: Sequence[str] | None = None) -> int:
     arguments = sys.argv[1:] if argv is None else list(argv)
     command = _named_subcommand(arguments)
-    switch_off_early(command, arguments)  # before the imports of build_parser
+    switch_off_early(command, arguments)  # first: before any other import
+    from typing import TextIO, cast
+
     stdout = sys.stdout
     sys.stdout = cast(TextIO, _ReaderMayLeave(stdout))
     try:
@@ -134,6 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(arguments: list[str], command: str | None) -> int:
+    from feelmysign.errors import FeelMySignError
+
     try:
         args = build_parser(command).parse_args(arguments)
         code: int = args.handler(args)
