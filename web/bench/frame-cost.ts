@@ -1,6 +1,6 @@
 /**
  * Scripting time per animation frame while drawing, in real Chromium, after
- * 10 and after 10,000 drawn strokes. The paper's sketch redrew every stroke on
+ * 10, 1,000 and 10,000 drawn strokes. The paper's sketch redrew every stroke on
  * every frame, so its frames grew with the drawing; ours should not (the ratio
  * should stay near 1). Scripting time is Chromium's own ScriptDuration (CDP
  * Performance metrics) over a mouse drawing of a fixed number of frames.
@@ -24,6 +24,8 @@ export interface FramePhase {
 export interface FrameCostFigures {
   browser: string;
   few: FramePhase;
+  /** After 1,000 strokes, then 10,000. */
+  more: FramePhase;
   many: FramePhase;
 }
 
@@ -92,9 +94,11 @@ export async function benchFrameCost(): Promise<FrameCostFigures> {
     const strokes = () => page.evaluate(() => window.feelmysign!.drawSynthetic(0));
     await page.evaluate(() => window.feelmysign!.drawSynthetic(10));
     const few = { strokes: await strokes(), ...(await measure(page, cdp)) };
+    await page.evaluate((n) => window.feelmysign!.drawSynthetic(n), 1000 - (await strokes()));
+    const more = { strokes: await strokes(), ...(await measure(page, cdp)) };
     await page.evaluate((n) => window.feelmysign!.drawSynthetic(n), 10_000 - (await strokes()));
     const many = { strokes: await strokes(), ...(await measure(page, cdp)) };
-    return { browser: version.product, few, many };
+    return { browser: version.product, few, more, many };
   } finally {
     await browser.close();
     await server.stop();
