@@ -141,15 +141,22 @@ async function drawPath(page: Page, cdp: CDPSession, area: Area, shape: Shape): 
   await page.mouse.move(at(0).x, at(0).y);
   const started = performance.now();
   await mouse("mousePressed", 0, 1);
+  // Each move's failure is kept and thrown after the path, never left unhandled meanwhile.
   const moves: Promise<unknown>[] = [];
+  const kept = (sent: Promise<unknown>) =>
+    sent.then(
+      () => null,
+      (error: unknown) => error,
+    );
   for (let k = 1; ; k++) {
     await sleep(started + k * SAMPLE_MS - performance.now());
     const elapsed = performance.now() - started;
     if (elapsed >= PATH_MS) break;
-    moves.push(mouse("mouseMoved", elapsed / PATH_MS, 1));
+    moves.push(kept(mouse("mouseMoved", elapsed / PATH_MS, 1)));
   }
-  moves.push(mouse("mouseMoved", 1, 1));
-  await Promise.all(moves);
+  moves.push(kept(mouse("mouseMoved", 1, 1)));
+  const failed = (await Promise.all(moves)).find((error) => error !== null);
+  if (failed !== undefined) throw failed;
   await mouse("mouseReleased", 1, 0);
   return moves.length;
 }
