@@ -11,8 +11,8 @@ import type { FeltPlacement } from "../felt-placement";
 
 /** Time resolution of the touch along a stroke: finer than a frame, coarse enough to stay cheap. */
 export const STEP_MS = 10;
-/** Bins per lane: the most the timeline reads per frame. */
-const CAPACITY_BINS = 2048;
+/** Bins per lane: the most the timeline reads per frame (about the plot's device pixels). */
+const CAPACITY_BINS = 1024;
 
 /** Per lane, the largest value painted into each time bin (0: nothing). */
 export class LaneRaster {

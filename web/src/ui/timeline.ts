@@ -37,6 +37,7 @@ export class TimelineView {
   /** One row per lane, one pixel per column: the lanes as drawn, stretched to their height. */
   readonly #rows = document.createElement("canvas");
   #column = new Float32Array(0);
+  #image: ImageData | null = null;
   #cursorMs: number | null = null;
   #scheduled = false;
 
@@ -171,7 +172,12 @@ export class TimelineView {
     if (this.#column.length < columns) this.#column = new Float32Array(columns);
     const rowsCtx = this.#rows.getContext("2d");
     if (rowsCtx === null) return;
-    const image = rowsCtx.createImageData(columns, lanes);
+    // One image kept for every frame of this size: no allocation per frame.
+    if (this.#image === null || this.#image.width !== columns || this.#image.height !== lanes) {
+      this.#image = rowsCtx.createImageData(columns, lanes);
+    }
+    const image = this.#image;
+    image.data.fill(0);
     const [r, g, b] = rgb.split(",").map((part) => Number(part.trim())) as [number, number, number];
     for (let lane = 0; lane < lanes; lane++) {
       raster.columns(lane, total, columns, this.#column);
