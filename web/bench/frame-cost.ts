@@ -1,9 +1,10 @@
 /**
  * Scripting time per animation frame while drawing, in real Chromium, after
- * 10 and after 10,000 drawn strokes. The paper's sketch redrew every stroke on
+ * 10, 1,000 and 10,000 drawn strokes. The paper's sketch redrew every stroke on
  * every frame, so its frames grew with the drawing; ours should not (the ratio
  * should stay near 1). Scripting time is Chromium's own ScriptDuration (CDP
- * Performance metrics) over a mouse drawing of a fixed number of frames.
+ * Performance metrics) over a mouse drawing of a fixed number of frames; the
+ * least of three such drawings per phase, as the machine's other work only adds.
  */
 import { createServer } from "node:net";
 import type { CDPSession, Page } from "playwright-core";
@@ -24,6 +25,8 @@ export interface FramePhase {
 export interface FrameCostFigures {
   browser: string;
   few: FramePhase;
+  /** After 1,000 strokes, then 10,000. */
+  more: FramePhase;
   many: FramePhase;
 }
 
@@ -33,6 +36,21 @@ async function unusedPort(): Promise<number> {
   const { port } = server.address() as { port: number };
   await new Promise<void>((closed) => server.close(() => closed()));
   return port;
+}
+
+/** Measured drawings per phase; the least scripting time is kept (other work on the machine only adds). */
+const REPEATS = 3;
+/** No further repeat once a phase has taken this long (the old page took seconds per frame). */
+const PHASE_LIMIT_MS = 20_000;
+
+async function measureLeast(page: Page, cdp: CDPSession): Promise<Omit<FramePhase, "strokes">> {
+  const started = Date.now();
+  let best = await measure(page, cdp);
+  for (let run = 1; run < REPEATS && Date.now() - started < PHASE_LIMIT_MS; run++) {
+    const next = await measure(page, cdp);
+    if (next.scriptMsPerFrame < best.scriptMsPerFrame) best = next;
+  }
+  return best;
 }
 
 async function measure(page: Page, cdp: CDPSession): Promise<Omit<FramePhase, "strokes">> {
@@ -91,10 +109,12 @@ export async function benchFrameCost(): Promise<FrameCostFigures> {
     const version = await cdp.send("Browser.getVersion");
     const strokes = () => page.evaluate(() => window.feelmysign!.drawSynthetic(0));
     await page.evaluate(() => window.feelmysign!.drawSynthetic(10));
-    const few = { strokes: await strokes(), ...(await measure(page, cdp)) };
+    const few = { strokes: await strokes(), ...(await measureLeast(page, cdp)) };
+    await page.evaluate((n) => window.feelmysign!.drawSynthetic(n), 1000 - (await strokes()));
+    const more = { strokes: await strokes(), ...(await measureLeast(page, cdp)) };
     await page.evaluate((n) => window.feelmysign!.drawSynthetic(n), 10_000 - (await strokes()));
-    const many = { strokes: await strokes(), ...(await measure(page, cdp)) };
-    return { browser: version.product, few, many };
+    const many = { strokes: await strokes(), ...(await measureLeast(page, cdp)) };
+    return { browser: version.product, few, more, many };
   } finally {
     await browser.close();
     await server.stop();

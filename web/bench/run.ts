@@ -4,12 +4,18 @@
  *   - the TypeScript angle and window simplifiers' throughput on the LASA points
  *     (written by the Python bench) beside simplify-js (Douglas-Peucker) on the
  *     same points, as ratios;
- *   - scripting time per frame while drawing in Chromium, after 10 and after
- *     10,000 drawn strokes, and their ratio (incremental rendering keeps it ~1).
- * Needs `vite build` (dist/) and Debian's chromium.
+ *   - scripting time per frame while drawing in Chromium, after 10, 1,000 and
+ *     10,000 drawn strokes, and the ratios to the first (budget <= 1.2: every
+ *     per-frame cost is independent of what has been drawn);
+ *   - the requestAnimationFrame interval (p95) while scribbling path after path
+ *     for a minute on the page `feelmysign up` serves, its simulated sleeve
+ *     playing: the last seconds against the first (budget <= 1.2).
+ * Needs `vite build` (dist/), the Python venv (feelmysign) and Debian's chromium.
+ * FEELMYSIGN_BENCH_WEB_DIR measures the scribble on another build of the page.
  */
 import { benchFrameCost, type FramePhase } from "./frame-cost";
 import { benchLasa, type LasaRate } from "./lasa";
+import { benchScribble, PATH_SECONDS } from "./scribble";
 import { benchSimplifier } from "./simplifier";
 
 function millions(value: number): string {
@@ -54,11 +60,38 @@ if (lasa !== null) {
   for (const rate of [highQuality, fast]) console.log(line(rate, "segments"));
 }
 
+/** Budget of the two growth ratios below: the page's cost must not grow with the drawing. */
+const GROWTH_BUDGET = 1.2;
+
 const frames = await benchFrameCost();
 console.log(`web: scripting time per frame while drawing (${frames.browser}, headless)`);
 console.log(phase("after 10 strokes:", frames.few));
-console.log(phase(`after ${frames.many.strokes} strokes:`, frames.many));
+console.log(phase(`after ${frames.more.strokes.toLocaleString("en")} strokes:`, frames.more));
+console.log(phase(`after ${frames.many.strokes.toLocaleString("en")} strokes:`, frames.many));
+for (const [label, figures] of [
+  ["1,000 / 10", frames.more],
+  ["10,000 / 10", frames.many],
+] as const) {
+  console.log(
+    `  ratio (${label}): ${(figures.scriptMsPerFrame / frames.few.scriptMsPerFrame).toFixed(2)}` +
+      ` (scripting; budget <= ${GROWTH_BUDGET}), ${(figures.pageWorkMeanMs / frames.few.pageWorkMeanMs).toFixed(2)} (page frame work)`,
+  );
+}
+
+const scribble = await benchScribble();
 console.log(
-  `  ratio (10,000 / 10): ${(frames.many.scriptMsPerFrame / frames.few.scriptMsPerFrame).toFixed(2)}` +
-    ` (scripting), ${(frames.many.pageWorkMeanMs / frames.few.pageWorkMeanMs).toFixed(2)} (page frame work)`,
+  `web: a minute of scribbling on 'feelmysign up' with its simulated sleeve (${scribble.browser}, headless):` +
+    ` ${scribble.paths} paths of ${PATH_SECONDS} s in one drawing, ${scribble.samples.toLocaleString("en")} pointer samples,` +
+    ` ${scribble.strokes} strokes sent, ${scribble.played} reported played`,
+);
+console.log(
+  `  frame interval p95: first 5 s ${scribble.first.p95Ms.toFixed(1)} ms, last 5 s ${scribble.last.p95Ms.toFixed(1)} ms,` +
+    ` ratio ${(scribble.last.p95Ms / scribble.first.p95Ms).toFixed(2)} (budget <= ${GROWTH_BUDGET};` +
+    ` ${scribble.first.frames} and ${scribble.last.frames} frames)`,
+);
+const percent = (share: number) => `${(share * 100).toFixed(1)}%`;
+console.log(
+  `  main thread busy: first 5 s ${percent(scribble.first.busy)} (scripts ${percent(scribble.first.scripting)}),` +
+    ` last 5 s ${percent(scribble.last.busy)} (scripts ${percent(scribble.last.scripting)}),` +
+    ` ratio ${(scribble.last.busy / scribble.first.busy).toFixed(2)}`,
 );

@@ -241,7 +241,7 @@ export class App {
     const hasPaths = drawing !== null && drawing.paths.length > 0;
     this.#buttons.undo.disabled = !hasPaths;
     this.#buttons.record.disabled = !hasPaths;
-    this.#buttons.replay.disabled = drawing === null || drawing.strokes.length === 0;
+    this.#buttons.replay.disabled = drawing === null || drawing.keptStrokeCount === 0;
     if (drawing === null || drawing.id !== this.#feltDrawing) {
       this.#feltDrawing = drawing?.id ?? null;
       this.#felt.setDrawing(drawing, this.#grid(), this.#arrival);

@@ -32,6 +32,8 @@ export class Drawing {
   readonly #bySeq = new Map<number, DrawnSegment>();
   readonly #acked = new Set<number>();
   #nextSeq = 0;
+  /** Segments kept as strokes (not dropped) in the paths still in the drawing. */
+  #kept = 0;
 
   constructor(id: string, params: SimplifierParams) {
     this.id = id;
@@ -80,6 +82,7 @@ export class Drawing {
     const drawn: DrawnSegment = { index: this.segments.length, path: this.currentPath, segment, stroke };
     this.segments.push(drawn);
     if (stroke?.seq != null) this.#bySeq.set(stroke.seq, drawn);
+    if (stroke !== null) this.#kept++;
     return drawn;
   }
 
@@ -103,6 +106,11 @@ export class Drawing {
     return this.#nextSeq;
   }
 
+  /** How many `strokes` there are, without building the list. */
+  get keptStrokeCount(): number {
+    return this.#kept;
+  }
+
   /** The strokes of the paths still in the drawing, in order. */
   get strokes(): Stroke[] {
     return this.segments.flatMap((drawn) => (drawn.stroke === null ? [] : [drawn.stroke]));
@@ -121,6 +129,7 @@ export class Drawing {
     while (this.segments.length > 0 && this.segments[this.segments.length - 1]!.path === path) {
       const drawn = this.segments.pop()!;
       if (drawn.stroke?.seq != null) this.#bySeq.delete(drawn.stroke.seq);
+      if (drawn.stroke !== null) this.#kept--;
     }
     return true;
   }

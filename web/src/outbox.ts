@@ -60,6 +60,10 @@ export class Outbox<T> {
 
   /** A new connection replaces the old one: everything in flight is sent again. */
   requeueInFlight(): void {
-    for (const id of [...this.#inFlight.keys()]) this.fail(id);
+    if (this.#inFlight.size === 0) return;
+    // One sort for all of them: a thousand strokes kept offline come back at once.
+    for (const entry of this.#inFlight.values()) this.#queued.push(entry);
+    this.#inFlight.clear();
+    this.#queued.sort((a, b) => a.id - b.id);
   }
 }

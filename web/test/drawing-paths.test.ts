@@ -67,6 +67,7 @@ describe("a drawing of several paths", () => {
     expect(drawing.paths).toHaveLength(2);
     expect(drawing.strokes.map((s) => s.seq)).toEqual([...Array(drawing.strokes.length).keys()]);
     expect(drawing.strokes.length).toBeGreaterThanOrEqual(7);
+    expect(drawing.keptStrokeCount).toBe(drawing.strokes.length);
   });
 
   it("Undo takes back the last path; its seqs are not used again", () => {
@@ -76,9 +77,11 @@ describe("a drawing of several paths", () => {
     expect(drawing.removeLastPath()).toBe(true);
     expect(drawing.paths).toHaveLength(1);
     expect(drawing.strokes).toHaveLength(zStrokes);
+    expect(drawing.keptStrokeCount).toBe(zStrokes);
     expect(drawing.strokeCount).toBe(numbered);
     expect(drawing.bySeq(numbered - 1)).toBeUndefined();
     expect(drawing.removeLastPath()).toBe(true);
+    expect(drawing.keptStrokeCount).toBe(0);
     expect(drawing.removeLastPath()).toBe(false);
   });
 

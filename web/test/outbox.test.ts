@@ -35,4 +35,16 @@ describe("Outbox", () => {
     expect(outbox.queuedCount).toBe(2);
     expect(outbox.takeQueued().map((entry) => entry.item)).toEqual([1, 2]);
   });
+
+  it("requeued, strokes in flight go back among the queued ones in their order", () => {
+    const outbox = new Outbox<number>();
+    [1, 2, 3].forEach((item) => outbox.add(item));
+    outbox.takeQueued();
+    [4, 5].forEach((item) => outbox.add(item));
+    outbox.requeueInFlight();
+    expect(outbox.size).toBe(5);
+    expect(outbox.takeQueued().map((entry) => entry.item)).toEqual([1, 2, 3, 4, 5]);
+    outbox.requeueInFlight();
+    expect(outbox.takeQueued().map((entry) => entry.item)).toEqual([1, 2, 3, 4, 5]);
+  });
 });

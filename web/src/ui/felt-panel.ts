@@ -4,18 +4,13 @@
  * events (its own estimate until they come), the timeline with a cursor
  * moving at the moment being felt, a marker on the canvas where the brush is,
  * and an A/B comparison with the same paths simplified under other settings.
+ * A new stroke or a sleeve event costs the same however long the drawing is:
+ * the placement is kept (felt-placement.ts), only the new strokes added.
  */
-import type { Drawing } from "../drawing";
+import type { Drawing, DrawnSegment } from "../drawing";
 import type { CancelledEvent, AdjustedEvent, PlayedEvent } from "../events";
-import {
-  brushAt,
-  placeStrokes,
-  playingAt,
-  totalMs,
-  type FeltStroke,
-  type Grid,
-  type PlacedStroke,
-} from "../felt";
+import { brushAt, placeStrokes, type FeltStroke, type Grid, type PlacedStroke } from "../felt";
+import { FeltPlacement } from "../felt-placement";
 import { simplifyPaths, type SimplifierParams } from "../simplify/registry";
 import type { Point } from "../simplify/segment";
 import type { DrawingView } from "./canvas";
@@ -32,10 +27,12 @@ export class FeltPanel {
   #grid: Grid = { rows: 3, columns: 4 };
   /** seq -> when the sleeve started it, on the sleeve's wall clock. */
   readonly #startedAt = new Map<number, number>();
-  /** seq -> ms into the stroke at which a cancel cut it (0: dropped before it started). */
-  readonly #cut = new Map<number, number>();
   #b: { params: SimplifierParams; placed: PlacedStroke[]; segments: [Point, Point][] } | null = null;
-  #placed: PlacedStroke[] = [];
+  /** The drawing's strokes in time, with the sleeve's reports and cuts. */
+  #placement = new FeltPlacement();
+  /** How many of the drawing's segments the placement has seen, and the last of them. */
+  #segmentsSeen = 0;
+  #lastSeen: object | null = null;
   /** The cursor runs from `t_ms` at `at` (performance.now()). */
   #anchor: { t_ms: number; at: number } | null = null;
   #running = false;
@@ -51,7 +48,9 @@ export class FeltPanel {
     this.#grid = grid;
     this.#arrival = arrival;
     this.#startedAt.clear();
-    this.#cut.clear();
+    this.#placement = new FeltPlacement();
+    this.#segmentsSeen = 0;
+    this.#lastSeen = null;
     this.#anchor = null;
     this.#b = null;
     this.#view.setCompare(null);
@@ -60,11 +59,12 @@ export class FeltPanel {
 
   /** The drawing gained or lost strokes: placed again. */
   refresh(): void {
-    this.#placed = this.#place();
-    this.#timeline.show(this.#grid, this.#placed, this.#b?.placed ?? null);
-    const count = this.#placed.length;
-    const seconds = (totalMs(this.#placed) / 1000).toFixed(1);
-    const reported = this.#placed.filter((s) => s.reported).length;
+    this.#sync();
+    const placement = this.#placement;
+    this.#timeline.show(this.#grid, placement, this.#b?.placed ?? null);
+    const count = placement.placed.length;
+    const seconds = (placement.totalMs / 1000).toFixed(1);
+    const reported = placement.reportedCount;
     this.#timeline.setCaption(
       count === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
@@ -81,8 +81,10 @@ export class FeltPanel {
   played(event: PlayedEvent | AdjustedEvent): void {
     if (event.seq === null) return;
     this.#startedAt.set(event.seq, event.start_at_ms);
+    this.#sync();
+    this.#placement.report(event.seq, event.start_at_ms);
     this.refresh();
-    const stroke = this.#placed.find((s) => s.seq === event.seq);
+    const stroke = this.#placement.bySeq(event.seq);
     if (stroke === undefined) return;
     // Time since the sleeve started it: its report took a moment to arrive.
     const lag = Math.max(0, Math.min(event.latency_ms, stroke.duration_ms));
@@ -93,7 +95,11 @@ export class FeltPanel {
   cancelled(event: CancelledEvent): void {
     if (event.seq === null) return;
     const started = this.#startedAt.get(event.seq);
-    this.#cut.set(event.seq, event.started && started !== undefined ? event.cancelled_at_ms - started : 0);
+    this.#sync();
+    this.#placement.cut(
+      event.seq,
+      event.started && started !== undefined ? event.cancelled_at_ms - started : 0,
+    );
     this.refresh();
   }
 
@@ -128,34 +134,44 @@ export class FeltPanel {
     return pieces.length;
   }
 
-  #place(): PlacedStroke[] {
+  /**
+   * The placement follows the drawing: its new strokes appended (the usual case, one at a time);
+   * anything else (an undo) places them all again.
+   */
+  #sync(): void {
     const drawing = this.#drawing;
-    if (drawing === null) return [];
-    const origin = drawing.paths[0]?.[0]?.t_ms ?? 0;
-    const strokes: FeltStroke[] = drawing.segments.flatMap(({ segment, stroke }) =>
-      stroke === null || stroke.seq == null
-        ? []
-        : [
-            {
-              seq: stroke.seq,
-              start: stroke.start,
-              end: stroke.end,
-              duration_ms: stroke.duration_ms,
-              intensity: stroke.intensity ?? 0.8,
-              arrives_ms: this.#arrival === "at-once" ? 0 : segment.end_ms - origin,
-            },
-          ],
-    );
-    // The timeline starts with the first stroke, not with the first touch of the pen.
-    const start = Math.min(...strokes.map((s) => s.arrives_ms));
-    const shifted = strokes.map((s) => ({ ...s, arrives_ms: s.arrives_ms - start }));
-    const estimate = placeStrokes(shifted, new Map(), this.#cut);
-    // The sleeve's clock -> the timeline's: anchored on the first stroke it reported.
-    const first = estimate.find((s) => this.#startedAt.has(s.seq));
-    if (first === undefined) return estimate;
-    const offset = this.#startedAt.get(first.seq)! - first.start_ms;
-    const reported = new Map([...this.#startedAt].map(([seq, at]) => [seq, at - offset]));
-    return placeStrokes(shifted, reported, this.#cut);
+    const segments = drawing?.segments ?? [];
+    const seen = this.#segmentsSeen;
+    const kept = seen === 0 ? this.#lastSeen === null : segments[seen - 1] === this.#lastSeen;
+    if (seen <= segments.length && kept) {
+      for (let i = seen; i < segments.length; i++) {
+        const stroke = this.#feltStroke(segments[i]!);
+        if (stroke !== null) this.#placement.append(stroke);
+      }
+    } else {
+      const strokes: FeltStroke[] = [];
+      for (const drawn of segments) {
+        const stroke = this.#feltStroke(drawn);
+        if (stroke !== null) strokes.push(stroke);
+      }
+      this.#placement.reset(strokes);
+    }
+    this.#segmentsSeen = segments.length;
+    this.#lastSeen = segments[segments.length - 1] ?? null;
+  }
+
+  /** A drawn segment as felt (null for a dropped one): arriving when it was drawn, or at once. */
+  #feltStroke({ segment, stroke }: DrawnSegment): FeltStroke | null {
+    if (stroke === null || stroke.seq == null) return null;
+    const origin = this.#drawing?.paths[0]?.[0]?.t_ms ?? 0;
+    return {
+      seq: stroke.seq,
+      start: stroke.start,
+      end: stroke.end,
+      duration_ms: stroke.duration_ms,
+      intensity: stroke.intensity ?? 0.8,
+      arrives_ms: this.#arrival === "at-once" ? 0 : segment.end_ms - origin,
+    };
   }
 
   #run(): void {
@@ -163,7 +179,7 @@ export class FeltPanel {
     this.#running = true;
     const step = () => {
       const anchor = this.#anchor;
-      const total = totalMs(this.#placed);
+      const total = this.#placement.totalMs;
       const t = anchor === null ? null : anchor.t_ms + (performance.now() - anchor.at);
       if (t === null || t > total + 300) {
         this.#running = false;
@@ -172,7 +188,7 @@ export class FeltPanel {
         return;
       }
       this.#timeline.setCursor(t);
-      const now = playingAt(this.#placed, t);
+      const now = this.#placement.playingAt(t);
       this.#view.drawMarker(now === null ? null : brushAt(now.stroke, now.into_ms));
       requestAnimationFrame(step);
     };

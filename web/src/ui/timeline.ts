@@ -3,12 +3,14 @@
  * each stroke's touch drawn as the intensity it gives each actuator
  * (felt.ts), with a cursor at the moment being felt. An A/B comparison
  * overlays a second drawing's lanes as outlines. Redrawn at most once per
- * animation frame; the cursor alone is cheap (a second canvas).
+ * animation frame; the cursor alone is cheap (a second canvas). The lanes'
+ * picture is kept between frames (felt-raster.ts) and only what a new stroke
+ * or report moved is painted again: a frame's cost does not grow with the drawing.
  */
-import { brushAt, funnel, totalMs, type Grid, type PlacedStroke } from "../felt";
+import { totalMs, type Grid, type PlacedStroke } from "../felt";
+import type { FeltPlacement } from "../felt-placement";
+import { PlacementRaster, type LaneRaster } from "./felt-raster";
 
-/** Time resolution of the lanes: finer than a frame, coarse enough to stay cheap. */
-const STEP_MS = 10;
 const LABEL_WIDTH_PX = 34;
 const AXIS_HEIGHT_PX = 16;
 const MIN_LABEL_GAP_PX = 44;
@@ -27,8 +29,15 @@ export class TimelineView {
   readonly #ctx: CanvasRenderingContext2D;
   readonly #cursorCtx: CanvasRenderingContext2D;
   #grid: Grid = { rows: 3, columns: 4 };
-  #a: readonly PlacedStroke[] = [];
-  #b: readonly PlacedStroke[] | null = null;
+  readonly #a = new PlacementRaster((stroke, intensity) => (stroke.reported ? 0.3 : 0.15) + 0.7 * intensity);
+  readonly #b = new PlacementRaster((_stroke, intensity) => 0.25 + 0.6 * intensity);
+  #bShown: readonly PlacedStroke[] | null = null;
+  #aTotalMs = 0;
+  #bTotalMs = 0;
+  /** One row per lane, one pixel per column: the lanes as drawn, stretched to their height. */
+  readonly #rows = document.createElement("canvas");
+  #column = new Float32Array(0);
+  #image: ImageData | null = null;
   #cursorMs: number | null = null;
   #scheduled = false;
 
@@ -42,18 +51,23 @@ export class TimelineView {
   }
 
   /** The drawing to show (A), and the one to compare it with (B) or null. */
-  show(grid: Grid, a: readonly PlacedStroke[], b: readonly PlacedStroke[] | null = null): void {
+  show(grid: Grid, a: FeltPlacement, b: readonly PlacedStroke[] | null = null): void {
     this.#grid = grid;
-    this.#a = a;
-    this.#b = b;
-    this.#canvas.dataset["strokes"] = String(a.length);
+    this.#a.sync(a, grid);
+    this.#aTotalMs = a.totalMs;
+    if (b !== this.#bShown) {
+      this.#bShown = b;
+      if (b !== null) this.#b.paintAll(b, grid);
+      this.#bTotalMs = b === null ? 0 : totalMs(b);
+    }
+    this.#canvas.dataset["strokes"] = String(a.placed.length);
     this.#canvas.dataset["compare"] = b === null ? "off" : String(b.length);
     this.#canvas.dataset["totalMs"] = String(Math.round(this.totalMs));
     this.#schedule();
   }
 
   get totalMs(): number {
-    return Math.max(totalMs(this.#a), this.#b === null ? 0 : totalMs(this.#b));
+    return Math.max(this.#aTotalMs, this.#bShown === null ? 0 : this.#bTotalMs);
   }
 
   /** The moment being felt (ms on the timeline), or null to hide the cursor. */
@@ -117,27 +131,12 @@ export class TimelineView {
         }
       }
     }
-    const paint = (placed: readonly PlacedStroke[], rgb: string, outline: boolean) => {
-      for (const stroke of placed) {
-        for (let t = 0; t < stroke.played_ms; t += STEP_MS) {
-          const x = LABEL_WIDTH_PX + ((stroke.start_ms + t) / total) * plotWidth;
-          const w = Math.max((Math.min(STEP_MS, stroke.played_ms - t) / total) * plotWidth, 1);
-          for (const drive of funnel(brushAt(stroke, t), stroke.intensity, this.#grid)) {
-            const lane = this.#lane(drive.row, drive.column, height);
-            if (outline) {
-              ctx.fillStyle = `rgba(${rgb}, ${0.25 + 0.6 * drive.intensity})`;
-              ctx.fillRect(x, lane.top + lane.height * 0.7, w, lane.height * 0.25);
-            } else {
-              const alpha = (stroke.reported ? 0.3 : 0.15) + 0.7 * drive.intensity;
-              ctx.fillStyle = `rgba(${rgb}, ${alpha})`;
-              ctx.fillRect(x, lane.top + 1, w, lane.height * 0.62);
-            }
-          }
-        }
-      }
-    };
-    paint(this.#a, COLORS.a, false);
-    if (this.#b !== null) paint(this.#b, COLORS.b, true);
+    // Device pixels across: as sharp as the rectangles per 10 ms once drawn.
+    const pixels = Math.max(1, Math.round(plotWidth * dpr));
+    const lanes = (raster: LaneRaster, rgb: string, outline: boolean) =>
+      this.#paintLanes(ctx, raster, rgb, outline, total, pixels, plotWidth, height);
+    lanes(this.#a.raster, COLORS.a, false);
+    if (this.#bShown !== null) lanes(this.#b.raster, COLORS.b, true);
     // The time axis: whole seconds (or tenths for a short drawing).
     ctx.fillStyle = COLORS.label;
     // Labels at least MIN_LABEL_GAP_PX apart, on a round step (0.1, 0.2, 0.5, 1, 2, 5... s).
@@ -150,6 +149,61 @@ export class TimelineView {
       if (x + MIN_LABEL_GAP_PX <= width)
         ctx.fillText(`${(t / 1000).toFixed(tick >= 1000 ? 0 : 1)} s`, x + 2, height - 6);
     }
+  }
+
+  /** Every lane of `raster` from its bins, one row of pixels each, stretched to the lane. */
+  #paintLanes(
+    ctx: CanvasRenderingContext2D,
+    raster: LaneRaster,
+    rgb: string,
+    outline: boolean,
+    total: number,
+    columns: number,
+    plotWidth: number,
+    height: number,
+  ): void {
+    const { rows, columns: gridColumns } = this.#grid;
+    const lanes = rows * gridColumns;
+    if (lanes === 0 || raster.lanes !== lanes) return;
+    if (this.#rows.width !== columns || this.#rows.height !== lanes) {
+      this.#rows.width = columns;
+      this.#rows.height = lanes;
+    }
+    if (this.#column.length < columns) this.#column = new Float32Array(columns);
+    const rowsCtx = this.#rows.getContext("2d");
+    if (rowsCtx === null) return;
+    // One image kept for every frame of this size: no allocation per frame.
+    if (this.#image === null || this.#image.width !== columns || this.#image.height !== lanes) {
+      this.#image = rowsCtx.createImageData(columns, lanes);
+    }
+    const image = this.#image;
+    image.data.fill(0);
+    const [r, g, b] = rgb.split(",").map((part) => Number(part.trim())) as [number, number, number];
+    for (let lane = 0; lane < lanes; lane++) {
+      raster.columns(lane, total, columns, this.#column);
+      let at = lane * columns * 4;
+      for (let column = 0; column < columns; column++, at += 4) {
+        const value = this.#column[column]!;
+        if (value === 0) continue;
+        image.data[at] = r;
+        image.data[at + 1] = g;
+        image.data[at + 2] = b;
+        image.data[at + 3] = Math.round(Math.min(value, 1) * 255);
+      }
+    }
+    rowsCtx.putImageData(image, 0, 0);
+    ctx.save();
+    ctx.imageSmoothingEnabled = false;
+    for (let row = 0; row < rows; row++) {
+      for (let column = 0; column < gridColumns; column++) {
+        const lane = this.#lane(row, column, height);
+        const top = outline ? lane.top + lane.height * 0.7 : lane.top + 1;
+        const laneHeight = lane.height * (outline ? 0.25 : 0.62);
+        const index = row * gridColumns + column;
+        ctx.drawImage(this.#rows, 0, index, columns, 1, LABEL_WIDTH_PX, top, plotWidth, laneHeight);
+      }
+    }
+    ctx.restore();
   }
 
   #drawCursor(): void {
