@@ -109,6 +109,13 @@ export class WindowSimplifier {
   #reach = 0;
   /** Reach + step at most this: every sample keeps the bound. */
   readonly #reachLimit: number;
+  /**
+   * The reach each sample of the stroke had when it was the last: a bound on the distances of
+   * the samples before it to anchor -> it, which stay as they are while the stroke goes on. So
+   * a test of window[1..i) against anchor -> window[i] or a point near it (a cut's feature, a
+   * line's end) needs no sample tested when that bound says so.
+   */
+  readonly #reaches: number[] = [];
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
@@ -215,6 +222,7 @@ export class WindowSimplifier {
         this.#reach = 0;
       } else {
         window.push(x, y, t, sample);
+        this.#reaches[count] = this.#reach;
         if (count >= maxWindow) {
           out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, [x, y], t));
           this.#line = null;
@@ -254,6 +262,17 @@ export class WindowSimplifier {
     if (farthestSq < 0) return false;
     this.#reach = Math.sqrt(farthestSq) + ROUNDING_SLACK;
     return true;
+  }
+
+  /**
+   * Whether window[1..index] surely lie within `limit` + ROUNDING_SLACK of anchor -> (endX, endY),
+   * a point near window[index], by its reach (moving the end moves the segment at most as far):
+   * then a test of each finds them all within. False when unsure (a NaN too): test each.
+   */
+  #reachesNear(index: number, endX: number, endY: number, limit: number): boolean {
+    const dx = endX - this.#window.xs[index]!;
+    const dy = endY - this.#window.ys[index]!;
+    return this.#reaches[index]! + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK <= limit;
   }
 
   /**
@@ -313,7 +332,13 @@ export class WindowSimplifier {
     const limit = LINE_SHARE * this.params.max_error;
     // A bend, not noise.
     if (distanceSq(atX, atY, endX, endY, endX, endY) > limit * limit) return [atX, atY];
-    if (!this.#sendable(ax, ay, endX, endY) || !this.#within(cut + 1, endX, endY, this.#maxErrorSq)) {
+    if (
+      !this.#sendable(ax, ay, endX, endY) ||
+      !(
+        this.#reachesNear(cut, endX, endY, this.#reachLimit) ||
+        this.#within(cut + 1, endX, endY, this.#maxErrorSq)
+      )
+    ) {
       return [atX, atY];
     }
     return [endX, endY];
@@ -325,7 +350,8 @@ export class WindowSimplifier {
    */
   #lineOf(cut: number, end: Point): Point | null {
     const limit = LINE_SHARE * this.params.max_error;
-    if (!this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
+    const certain = this.#reachesNear(cut, end[0], end[1], limit - ROUNDING_SLACK);
+    if (!certain && !this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
     return direction([this.#window.xs[0]!, this.#window.ys[0]!], end);
   }
 
@@ -365,7 +391,12 @@ export class WindowSimplifier {
         }
       }
       if (best < 0) return count - 1; // unreachable: the last sample fits by construction
-      if (this.#within(best, xs[best]!, ys[best]!, this.#maxErrorSq)) return best;
+      if (
+        this.#reaches[best]! <= this.#reachLimit ||
+        this.#within(best, xs[best]!, ys[best]!, this.#maxErrorSq)
+      ) {
+        return best;
+      }
       distances[best] = -1;
     }
   }
@@ -380,7 +411,12 @@ export class WindowSimplifier {
     for (let i = first; i < count; i++) ranked.push({ index: i, distanceSq: this.#distances[i]! });
     ranked.sort((a, b) => b.distanceSq - a.distanceSq || b.index - a.index);
     for (const { index } of ranked) {
-      if (this.#within(index, xs[index]!, ys[index]!, this.#maxErrorSq)) return index;
+      if (
+        this.#reaches[index]! <= this.#reachLimit ||
+        this.#within(index, xs[index]!, ys[index]!, this.#maxErrorSq)
+      ) {
+        return index;
+      }
     }
     return count - 1; // unreachable: the last sample fits by construction
   }
