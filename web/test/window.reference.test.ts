@@ -65,6 +65,9 @@ const pathArb = fc.record({
 const drawingArb = fc.record({
   params: paramsArb,
   stepShare: fc.constantFrom(0.1, 0.5, 1, 3),
+  // Sideways noise against max_error: none (lines the latency cap cuts, straight on), a line's
+  // (within LINE_SHARE), or a scribble's.
+  noiseShare: fc.constantFrom(0, 0.05, 0.3, 1),
   grid: fc.constantFrom("none", "none", "pixel", "step"),
   paths: fc.array(pathArb, { minLength: 1, maxLength: 3 }),
 });
@@ -72,7 +75,7 @@ const drawingArb = fc.record({
 type Drawing = typeof drawingArb extends fc.Arbitrary<infer T> ? T : never;
 
 /** The drawing's paths in canvas pixels: mostly straight on, with sideways noise, and corners. */
-function pathsOf({ params, stepShare, grid, paths }: Drawing): Sample[][] {
+function pathsOf({ params, stepShare, noiseShare, grid, paths }: Drawing): Sample[][] {
   const mapping = new CanvasMapping({
     width_px: params.canvas_width_px,
     height_px: params.canvas_height_px,
@@ -81,6 +84,7 @@ function pathsOf({ params, stepShare, grid, paths }: Drawing): Sample[][] {
     stretch: params.stretch,
   });
   const stepPx = (stepShare * params.max_error) / (mapping.scale || 1);
+  const noisePx = (noiseShare * params.max_error) / (mapping.scale || 1);
   const gridPx = grid === "pixel" ? 1 : grid === "step" ? stepPx : null;
   return paths.map(({ x0, y0, t0, heading: heading0, steps }) => {
     let [x, y, tMs, heading] = [x0, y0, t0, heading0];
@@ -88,8 +92,8 @@ function pathsOf({ params, stepShare, grid, paths }: Drawing): Sample[][] {
     for (const { turn, dx, dy, dtMs } of steps) {
       if (turn !== null) heading = turn;
       const along = gridPx === null ? stepPx : 0;
-      const sideX = gridPx === null ? dx * stepPx : Math.round(dx * 3) * gridPx;
-      const sideY = gridPx === null ? dy * stepPx : Math.round(dy * 3) * gridPx;
+      const sideX = gridPx === null ? dx * noisePx : Math.round(dx * 3) * gridPx;
+      const sideY = gridPx === null ? dy * noisePx : Math.round(dy * 3) * gridPx;
       const nextX = x + along * Math.cos(heading) + sideX;
       const nextY = y + along * Math.sin(heading) + sideY;
       if (Number.isNaN(nextX)) {

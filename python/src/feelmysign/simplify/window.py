@@ -155,6 +155,11 @@ class WindowSimplifier:
     # to the new segment without testing each one, as testing each one would find; else they are
     # tested, and their farthest distance is the new reach. The same strokes, fewer tests.
     _reach: float = 0.0
+    # The reach each sample of the stroke had when it was the last: a bound on the distances of
+    # the samples before it to anchor -> it, which stay as they are while the stroke goes on. So
+    # a test of points[1:i] against anchor -> points[i] or a point near it (a cut's feature, a
+    # line's end) needs no sample tested when that bound says so. Index 0 is never read.
+    _reaches: list[float] = field(default_factory=lambda: [0.0])
     _max_error_sq: float = field(init=False)
     _min_length_sq: float = field(init=False)
     _reach_limit: float = field(
@@ -261,6 +266,11 @@ class WindowSimplifier:
             points.append(point)
             times.append(t_ms)
             samples.append(sample)
+            reaches = self._reaches
+            if len(reaches) < len(points):
+                reaches.append(self._reach)
+            else:
+                reaches[len(points) - 1] = self._reach
             if len(points) - 1 >= max_window:
                 out.append(self._finish(points[0], times[0], point, t_ms))
                 self._line = None
@@ -291,6 +301,18 @@ class WindowSimplifier:
             return False
         self._reach = math.sqrt(farthest_sq) + ROUNDING_SLACK
         return True
+
+    def _reaches_near(self, points: list[Point], index: int, end: Point, limit: float) -> bool:
+        """Whether points[1:index + 1] surely lie within ``limit`` + slack of points[0] -> ``end``.
+
+        ``end`` is a point near points[index]: moving the end moves the segment at most as far,
+        so index's reach plus that step bounds them all; then a test of each finds them all
+        within. False when unsure (a NaN too): test each.
+        """
+        if index == 0:
+            return False
+        dx, dy = end[0] - points[index][0], end[1] - points[index][1]
+        return self._reaches[index] + math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK <= limit
 
     def _cap_cut(self, points: list[Point], times: list[float]) -> int:
         """Where the latency cap cuts: at a feature in the stroke's later part, else at its end.
@@ -335,7 +357,9 @@ class WindowSimplifier:
         limit = LINE_SHARE * self.params.max_error
         if _distance_sq(at, end, end) > limit * limit:  # a bend, not noise
             return at
-        if not self._sendable(points[0], end) or not _within(
+        if not self._sendable(points[0], end):
+            return at
+        if not self._reaches_near(points, cut, end, self._reach_limit) and not _within(
             points, cut + 1, end, self._max_error_sq
         ):
             return at
@@ -347,7 +371,8 @@ class WindowSimplifier:
         A line: every sample up to points[cut] lies within ``LINE_SHARE`` x max_error of it.
         """
         limit = LINE_SHARE * self.params.max_error
-        if not _within(points, cut + 1, end, limit * limit):
+        certain = self._reaches_near(points, cut, end, limit - ROUNDING_SLACK)
+        if not certain and not _within(points, cut + 1, end, limit * limit):
             return None
         return _direction(points[0], end)
 
@@ -369,9 +394,9 @@ class WindowSimplifier:
             zip(_distances_sq(points, first, stop, anchor, end), range(first, stop), strict=True),
             reverse=True,
         )
-        max_error_sq = self._max_error_sq
+        max_error_sq, reaches, reach_limit = self._max_error_sq, self._reaches, self._reach_limit
         for _, index in ranked:
-            if _within(points, index, points[index], max_error_sq):
+            if reaches[index] <= reach_limit or _within(points, index, points[index], max_error_sq):
                 return index
         return stop - 1  # unreachable: the last sample fits by construction
 
