@@ -115,7 +115,7 @@ export class WindowSimplifier {
    * a test of window[1..i) against anchor -> window[i] or a point near it (a cut's feature, a
    * line's end) needs no sample tested when that bound says so.
    */
-  readonly #reaches: number[] = [];
+  readonly #reaches: number[] = [0]; // index 0 (the anchor) is never read; kept packed
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
