@@ -13,6 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from vectors import load
+from window_reference import ReferenceWindowSimplifier
 
 from feelmysign.cli import main
 from feelmysign.errors import ParameterError
@@ -446,3 +447,90 @@ def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
 def test_replay_is_deterministic(case: tuple[WindowParams, list[Sample]]) -> None:
     params, samples = case
     assert _run(params, [samples]) == _run(params, [samples])
+
+
+# ---- The same strokes, to the last bit, as the simplifier first written (window_reference) ----
+
+
+def _bits(segments: list[Segment]) -> list[tuple[object, ...]]:
+    """Every float as its hex form, so -0.0 differs from 0.0 and a NaN equals a NaN."""
+    return [
+        (
+            *(float(v).hex() for v in (*s.start, *s.end, s.start_ms, s.end_ms, s.emitted_at_ms)),
+            s.dropped,
+        )
+        for s in segments
+    ]
+
+
+def _coordinate(draw: st.DrawFn, scale: float, grid_px: float | None) -> float:
+    """A step: on a coarse pixel grid (ties, repeats, collinear runs) or anywhere, rarely NaN."""
+    if draw(st.integers(0, 199)) == 0:
+        return math.nan
+    if grid_px is not None:
+        return draw(st.integers(-3, 3)) * grid_px
+    return draw(st.floats(-scale, scale))
+
+
+@st.composite
+def drawings(draw: st.DrawFn) -> tuple[WindowParams, list[list[Sample]]]:
+    """Parameters and paths that put samples near max_error of their strokes, often.
+
+    Steps are drawn at a scale against max_error (in pixels) so that strokes both skip and make
+    the full test; some paths run on a coarse pixel grid so that distances tie exactly; times
+    may stand still or run backwards; samples may leave the canvas or be NaN.
+    """
+    columns, rows = draw(st.integers(1, 8)), draw(st.integers(1, 8))
+    params = WindowParams(
+        max_error=draw(st.sampled_from([0.001, 0.02, 0.25, 1.0])),
+        max_window=draw(st.sampled_from([1, 2, 7, 256, 1000])),
+        max_stroke_ms=draw(st.sampled_from([0.0, 50.0, 300.0])),
+        min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
+        min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
+        rows=rows,
+        columns=columns,
+        stretch=draw(st.booleans()),
+        canvas_width_px=800,
+        canvas_height_px=600,
+    )
+    scale = params.mapping.scale or 1.0  # grid units per pixel
+    step_px = draw(st.sampled_from([0.1, 0.5, 1.0, 3.0])) * params.max_error / scale
+    # Sideways noise against max_error: none (lines the latency cap cuts, straight on), a
+    # line's (within LINE_SHARE), or a scribble's.
+    noise_px = draw(st.sampled_from([0.0, 0.05, 0.3, 1.0])) * params.max_error / scale
+    grid_px = draw(st.sampled_from([None, None, 1.0, step_px]))
+    drawn = []
+    for _ in range(draw(st.integers(1, 2))):
+        x, y, t_ms = draw(st.floats(-50, 850)), draw(st.floats(-50, 650)), draw(st.floats(0, 100))
+        heading = draw(st.floats(-math.pi, math.pi))
+        path = [Sample(t_ms, x, y)]
+        for _ in range(draw(st.integers(0, 80))):
+            # Mostly straight on, with sideways noise: lines the latency cap cuts, and corners.
+            if draw(st.integers(0, 15)) == 0:
+                heading = draw(st.floats(-math.pi, math.pi))
+            along = step_px if grid_px is None else 0.0
+            x += along * math.cos(heading) + _coordinate(draw, noise_px, grid_px)
+            y += along * math.sin(heading) + _coordinate(draw, noise_px, grid_px)
+            if math.isnan(x) or math.isnan(y):
+                path.append(Sample(t_ms, x, y))
+                x, y = path[-2].x, path[-2].y
+                continue
+            t_ms += draw(st.sampled_from([0.0, -3.0, 8.0, 16.7, 40.0]))
+            path.append(Sample(t_ms, x, y))
+        drawn.append(path)
+    return params, drawn
+
+
+@settings(max_examples=600, deadline=None)
+@given(drawings())
+def test_the_same_strokes_to_the_last_bit_as_the_reference(
+    case: tuple[WindowParams, list[list[Sample]]],
+) -> None:
+    params, drawn = case
+    fast, reference = WindowSimplifier(params), ReferenceWindowSimplifier(params)
+    for path in drawn:
+        for sample in path:
+            assert _bits(fast.push(sample)) == _bits(reference.push(sample)), sample
+            assert fast.line_start == reference.line_start and fast.drawing == reference.drawing
+        assert _bits(fast.end()) == _bits(reference.end())
+        assert fast.line_start is None and not fast.drawing

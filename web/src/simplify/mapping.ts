@@ -30,19 +30,25 @@ export class CanvasMapping {
 
   /** Grid point (x = column, y = row) of a canvas pixel, clamped onto the grid. */
   toGrid(xPx: number, yPx: number): Point {
-    const { width_px, height_px, columns, rows, stretch } = this.#options;
+    return [this.gridX(xPx), this.gridY(yPx)];
+  }
+
+  /** The grid column of a canvas pixel's x, clamped onto the grid (`toGrid`'s x, no tuple made). */
+  gridX(xPx: number): number {
+    const { width_px, columns, stretch } = this.#options;
     const xExtent = columns - 1;
+    // Same operation order as the reference, so results agree to the last bit.
+    const x = stretch ? (xPx * xExtent) / width_px : (xExtent - width_px * this.scale) / 2 + xPx * this.scale;
+    return Math.min(Math.max(x, 0), xExtent);
+  }
+
+  /** The grid row of a canvas pixel's y, clamped onto the grid (`toGrid`'s y, no tuple made). */
+  gridY(yPx: number): number {
+    const { height_px, rows, stretch } = this.#options;
     const yExtent = rows - 1;
-    let x: number;
-    let y: number;
-    if (stretch) {
-      x = (xPx * xExtent) / width_px;
-      y = (yPx * yExtent) / height_px;
-    } else {
-      // Same operation order as the reference, so results agree to the last bit.
-      x = (xExtent - width_px * this.scale) / 2 + xPx * this.scale;
-      y = (yExtent - height_px * this.scale) / 2 + yPx * this.scale;
-    }
-    return [Math.min(Math.max(x, 0), xExtent), Math.min(Math.max(y, 0), yExtent)];
+    const y = stretch
+      ? (yPx * yExtent) / height_px
+      : (yExtent - height_px * this.scale) / 2 + yPx * this.scale;
+    return Math.min(Math.max(y, 0), yExtent);
   }
 }

@@ -39,18 +39,58 @@ const STRAIGHT = 1e-6;
  */
 export const LINE_SHARE = 0.25;
 
-interface Drawn {
-  readonly sample: Sample;
-  /** The sample in grid units. */
-  readonly point: Point;
+/**
+ * Far more than any rounding error of a distance computed here (grid coordinates are at most 63,
+ * so under 1e-12 grid units), far less than the least max_error (0.001): what the reach of a
+ * stroke (below) adds for rounding, so that it never understates a true distance, and the room
+ * it keeps below max_error, so that no distance it lets through could compute above it.
+ */
+const ROUNDING_SLACK = 1e-9;
+
+/**
+ * Samples as flat arrays of numbers (grid x, grid y, time) and their Sample objects: the stroke
+ * being drawn, or the samples a cut gives back. Every sample is tested against the chord at
+ * every new one, so the tests read numbers (arrays of doubles, stored unboxed) instead of an
+ * object and a tuple per sample. Arrays grow as a stroke needs and are kept from one stroke to
+ * the next: `count` says how many hold samples now.
+ */
+class Samples {
+  readonly xs: number[] = [];
+  readonly ys: number[] = [];
+  readonly ts: number[] = [];
+  readonly samples: Sample[] = [];
+  count = 0;
+
+  push(x: number, y: number, t: number, sample: Sample): void {
+    const at = this.count;
+    this.xs[at] = x;
+    this.ys[at] = y;
+    this.ts[at] = t;
+    this.samples[at] = sample;
+    this.count = at + 1;
+  }
+
+  /** Only this sample: at (x, y), with the time and Sample of the one at `index`. */
+  restart(x: number, y: number, index: number): void {
+    this.xs[0] = x;
+    this.ys[0] = y;
+    this.ts[0] = this.ts[index]!;
+    this.samples[0] = this.samples[index]!;
+    this.count = 1;
+  }
 }
 
 export class WindowSimplifier {
   readonly params: WindowParams;
   readonly #maxErrorSq: number;
+  readonly #minLengthSq: number;
   readonly #mapping: CanvasMapping;
   /** The samples of the stroke being drawn: its anchor first, then every sample since. */
-  #window: Drawn[] = [];
+  readonly #window: Samples;
+  /** A stack of samples a cut gave back, to take again: the next to take is last. */
+  readonly #pending: Samples;
+  /** Each sample's squared distance to a chord, while a cut looks for its feature. */
+  readonly #distances: number[] = [];
   #pointer: Sample | null = null;
   #emittedInPath = false;
   /**
@@ -58,11 +98,31 @@ export class WindowSimplifier {
    * it (null at a path's start and after any other cut).
    */
   #line: Point | null = null;
+  /**
+   * The reach of the stroke being drawn: no sample since its anchor lies farther than this from
+   * the segment anchor -> last sample (grid units; true distances, rounding allowed for).
+   * A sample that moves the end by a step moves every point of that segment by at most the step,
+   * so when reach + step stays under max_error (by ROUNDING_SLACK) every sample keeps the bound
+   * to the new segment without testing each one, as testing each one would find; else they are
+   * tested, and their farthest distance is the new reach. The same strokes, fewer tests.
+   */
+  #reach = 0;
+  /** Reach + step at most this: every sample keeps the bound. */
+  readonly #reachLimit: number;
+  /**
+   * The reach each sample of the stroke had when it was the last: a bound on the distances of
+   * the samples before it to anchor -> it, which stay as they are while the stroke goes on. So
+   * a test of window[1..i) against anchor -> window[i] or a point near it (a cut's feature, a
+   * line's end) needs no sample tested when that bound says so.
+   */
+  readonly #reaches: number[] = [0]; // index 0 (the anchor) is never read; kept packed
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
     this.params = params;
     this.#maxErrorSq = params.max_error * params.max_error;
+    this.#minLengthSq = params.min_length * params.min_length;
+    this.#reachLimit = params.max_error - ROUNDING_SLACK;
     this.#mapping = new CanvasMapping({
       width_px: params.canvas_width_px,
       height_px: params.canvas_height_px,
@@ -70,92 +130,161 @@ export class WindowSimplifier {
       rows: params.rows,
       stretch: params.stretch,
     });
+    this.#window = new Samples();
+    this.#pending = new Samples();
   }
 
   /** True between the first sample of a path and `end`. */
   get drawing(): boolean {
-    return this.#window.length > 0;
+    return this.#window.count > 0;
   }
 
   /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
   get lineStart(): Sample | null {
-    return this.#window[0]?.sample ?? null;
+    return this.#window.count > 0 ? this.#window.samples[0]! : null;
   }
 
   /** One pointer sample while the pointer is down; the first of a path is the press. */
   push(input: Sample): Segment[] {
-    const previous = this.#window[this.#window.length - 1];
+    const window = this.#window;
+    const count = window.count;
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
     const sample =
-      previous !== undefined && input.t_ms < previous.sample.t_ms
-        ? { ...input, t_ms: previous.sample.t_ms }
-        : input;
+      count > 0 && input.t_ms < window.ts[count - 1]! ? { ...input, t_ms: window.ts[count - 1]! } : input;
     this.#pointer = sample;
-    const current: Drawn = { sample, point: this.#mapping.toGrid(sample.x, sample.y) };
-    if (this.#window.length === 0) {
-      this.#window = [current];
+    const x = this.#mapping.gridX(sample.x);
+    const y = this.#mapping.gridY(sample.y);
+    if (count === 0) {
+      window.push(x, y, sample.t_ms, sample);
+      this.#reach = 0;
       this.#emittedInPath = false;
       this.#line = null;
       return [];
     }
     const out: Segment[] = [];
-    this.#add(current, out);
+    this.#add(x, y, sample, out);
     return out;
   }
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
   end(): Segment[] {
     const window = this.#window;
-    this.#window = [];
-    const first = window[0];
-    const last = window[window.length - 1];
-    if (first === undefined || last === undefined) return [];
+    const count = window.count;
+    if (count === 0) return [];
+    window.count = 0;
     // The last sample already ends a stroke (a cut at the work cap).
-    if (window.length === 1 && this.#emittedInPath) return [];
-    return [this.#finish(first, this.#continued(window, window.length - 1))];
+    if (count === 1 && this.#emittedInPath) return [];
+    const end = this.#continued(count - 1);
+    return [this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[count - 1]!)];
   }
 
-  /** `current` joins the stroke being drawn, cutting it first where it must. */
-  #add(current: Drawn, out: Segment[]): void {
-    // A stack: the next sample to take is last. A cut gives back the samples after it.
-    const pending: Drawn[] = [current];
-    for (let item = pending.pop(); item !== undefined; item = pending.pop()) {
-      let window = this.#window;
-      const anchor = window[0]!;
-      const capMs = this.params.max_stroke_ms;
+  /** The sample at (x, y) joins the stroke being drawn, cutting it first where it must. */
+  #add(x: number, y: number, sample: Sample, out: Segment[]): void {
+    const window = this.#window;
+    const pending = this.#pending;
+    const capMs = this.params.max_stroke_ms;
+    const maxWindow = this.params.max_window;
+    for (;;) {
+      let count = window.count;
+      const t = sample.t_ms;
       if (
         capMs > 0 &&
-        window.length > 1 &&
-        item.sample.t_ms - anchor.sample.t_ms > capMs &&
-        this.#sendable(anchor, window[window.length - 1]!)
+        count > 1 &&
+        t - window.ts[0]! > capMs &&
+        this.#sendable(window.xs[0]!, window.ys[0]!, window.xs[count - 1]!, window.ys[count - 1]!)
       ) {
-        const cut = this.#capCut(window);
-        const vertex = this.#continued(window, cut);
-        out.push(this.#finish(anchor, vertex));
-        this.#line = this.#lineOf(window, cut, vertex);
-        if (cut < window.length - 1) {
-          pending.push(item);
-          pending.push(...window.slice(cut + 1).reverse());
-          this.#window = [vertex];
+        const cut = this.#capCut(count);
+        const vertex = this.#continued(cut);
+        out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, vertex, window.ts[cut]!));
+        this.#line = this.#lineOf(cut, vertex);
+        if (cut < count - 1) {
+          this.#giveBack(x, y, sample, cut);
+          window.restart(vertex[0], vertex[1], cut);
+          this.#reach = 0;
+          const next = pending.count - 1;
+          x = pending.xs[next]!;
+          y = pending.ys[next]!;
+          sample = pending.samples[next]!;
+          pending.count = next;
           continue;
         }
-        window = this.#window = [vertex];
+        window.restart(vertex[0], vertex[1], cut);
+        this.#reach = 0;
+        count = 1;
       }
-      if (!this.#fits(window, 1, window.length, item.point)) {
-        const cut = this.#feature(window, item.point);
-        out.push(this.#finish(window[0]!, window[cut]!));
+      if (!this.#keepsBound(count, x, y)) {
+        const cut = this.#feature(count, x, y, 1);
+        const end: Point = [window.xs[cut]!, window.ys[cut]!];
+        out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[cut]!));
         this.#line = null;
-        pending.push(item);
-        pending.push(...window.slice(cut + 1).reverse());
-        this.#window = [window[cut]!];
-        continue;
+        this.#giveBack(x, y, sample, cut);
+        window.restart(end[0], end[1], cut);
+        this.#reach = 0;
+      } else {
+        window.push(x, y, t, sample);
+        this.#reaches[count] = this.#reach;
+        if (count >= maxWindow) {
+          out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, [x, y], t));
+          this.#line = null;
+          window.restart(x, y, count);
+          this.#reach = 0;
+        }
       }
-      window.push(item);
-      if (window.length - 1 >= this.params.max_window) {
-        out.push(this.#finish(window[0]!, item));
-        this.#line = null;
-        this.#window = [item];
-      }
+      const next = pending.count - 1;
+      if (next < 0) return;
+      x = pending.xs[next]!;
+      y = pending.ys[next]!;
+      sample = pending.samples[next]!;
+      pending.count = next;
+    }
+  }
+
+  /**
+   * Whether every sample since the anchor (window[1..count)) lies within max_error of
+   * anchor -> (x, y), as `#within` finds; sets the reach for (x, y) as the stroke's new last
+   * sample. A NaN drawn is never farther than max_error (no comparison with NaN is true), in
+   * `#within` as here: a NaN step tests every sample, a NaN sample counts in no reach.
+   */
+  #keepsBound(count: number, x: number, y: number): boolean {
+    if (count === 1) {
+      this.#reach = 0;
+      return true;
+    }
+    const { xs, ys } = this.#window;
+    const dx = x - xs[count - 1]!;
+    const dy = y - ys[count - 1]!;
+    const reach = this.#reach + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK;
+    if (reach <= this.#reachLimit) {
+      this.#reach = reach;
+      return true;
+    }
+    const farthestSq = this.#farthestSq(count, x, y, this.#maxErrorSq);
+    if (farthestSq < 0) return false;
+    this.#reach = Math.sqrt(farthestSq) + ROUNDING_SLACK;
+    return true;
+  }
+
+  /**
+   * Whether window[1..index] surely lie within `limit` + ROUNDING_SLACK of anchor -> (endX, endY),
+   * a point near window[index], by its reach (moving the end moves the segment at most as far):
+   * then a test of each finds them all within. False when unsure (a NaN too): test each.
+   */
+  #reachesNear(index: number, endX: number, endY: number, limit: number): boolean {
+    const dx = endX - this.#window.xs[index]!;
+    const dy = endY - this.#window.ys[index]!;
+    return this.#reaches[index]! + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK <= limit;
+  }
+
+  /**
+   * A cut at window[cut] gives back the sample being taken and the window's samples after the
+   * cut, to take again in order: onto the stack, the sample being taken first.
+   */
+  #giveBack(x: number, y: number, sample: Sample, cut: number): void {
+    const window = this.#window;
+    const pending = this.#pending;
+    pending.push(x, y, sample.t_ms, sample);
+    for (let i = window.count - 1; i > cut; i--) {
+      pending.push(window.xs[i]!, window.ys[i]!, window.ts[i]!, window.samples[i]!);
     }
   }
 
@@ -166,97 +295,184 @@ export class WindowSimplifier {
    * the anchor whose own stroke keeps the bound and is long enough to send; if it
    * lies on the chord (a straight stroke, to `STRAIGHT`), at the last sample.
    */
-  #capCut(window: readonly Drawn[]): number {
-    const anchor = window[0]!;
-    const last = window[window.length - 1]!;
-    const earliest = anchor.sample.t_ms + CAP_FEATURE_SHARE * this.params.max_stroke_ms;
+  #capCut(count: number): number {
+    const { xs, ys, ts } = this.#window;
+    const last = count - 1;
+    const earliest = ts[0]! + CAP_FEATURE_SHARE * this.params.max_stroke_ms;
     let first = 1;
-    while (first < window.length - 1 && window[first]!.sample.t_ms < earliest) first++;
-    const cut = this.#feature(window, last.point, first);
+    while (first < last && ts[first]! < earliest) first++;
+    const cut = this.#feature(count, xs[last]!, ys[last]!, first);
     const straight = STRAIGHT * this.params.max_error;
-    const farSq = distanceSq(window[cut]!.point, anchor.point, last.point);
+    const farSq = distanceSq(xs[cut]!, ys[cut]!, xs[0]!, ys[0]!, xs[last]!, ys[last]!);
     const bends = farSq > straight * straight;
-    return bends && this.#sendable(anchor, window[cut]!) ? cut : window.length - 1;
+    return bends && this.#sendable(xs[0]!, ys[0]!, xs[cut]!, ys[cut]!) ? cut : last;
   }
 
   /**
-   * Where a stroke that the latency cap or the release ends, ending at window[cut], ends.
+   * Where a stroke that the latency cap or the release ends, ending at window[cut], ends
+   * (at window[cut]'s time).
    * After a stroke the latency cap ended, the stroke that follows it goes on along the same
    * line when it can: its end is window[cut] projected onto that line, if every sample up to
    * window[cut] keeps the bound to the projected end and the stroke is still long enough to
    * send; else window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
    * straight line cut into strokes stays one straight line.
    */
-  #continued(window: readonly Drawn[], cut: number): Drawn {
-    const at = window[cut]!;
-    if (this.#line === null) return at;
+  #continued(cut: number): Point {
+    const { xs, ys } = this.#window;
+    const atX = xs[cut]!;
+    const atY = ys[cut]!;
+    if (this.#line === null) return [atX, atY];
     const [ux, uy] = this.#line;
-    const [ax, ay] = window[0]!.point;
-    const along = (at.point[0] - ax) * ux + (at.point[1] - ay) * uy;
-    if (along <= 0) return at;
-    const end: Drawn = { sample: at.sample, point: [ax + along * ux, ay + along * uy] };
+    const ax = xs[0]!;
+    const ay = ys[0]!;
+    const along = (atX - ax) * ux + (atY - ay) * uy;
+    if (along <= 0) return [atX, atY];
+    const endX = ax + along * ux;
+    const endY = ay + along * uy;
     const limit = LINE_SHARE * this.params.max_error;
-    if (distanceSq(at.point, end.point, end.point) > limit * limit) return at; // a bend, not noise
-    if (!this.#sendable(window[0]!, end) || !this.#fits(window, 1, cut + 1, end.point)) return at;
-    return end;
+    // A bend, not noise.
+    if (distanceSq(atX, atY, endX, endY, endX, endY) > limit * limit) return [atX, atY];
+    if (
+      !this.#sendable(ax, ay, endX, endY) ||
+      !(
+        this.#reachesNear(cut, endX, endY, this.#reachLimit) ||
+        this.#within(cut + 1, endX, endY, this.#maxErrorSq)
+      )
+    ) {
+      return [atX, atY];
+    }
+    return [endX, endY];
   }
 
   /**
    * The direction of the stroke window[0] -> end if it is a line (every sample up to
    * window[cut] within `LINE_SHARE` x max_error of it), else null.
    */
-  #lineOf(window: readonly Drawn[], cut: number, end: Drawn): Point | null {
+  #lineOf(cut: number, end: Point): Point | null {
     const limit = LINE_SHARE * this.params.max_error;
-    const anchor = window[0]!.point;
-    for (let i = 1; i <= cut; i++) {
-      if (distanceSq(window[i]!.point, anchor, end.point) > limit * limit) return null;
-    }
-    return direction(anchor, end.point);
+    const certain = this.#reachesNear(cut, end[0], end[1], limit - ROUNDING_SLACK);
+    if (!certain && !this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
+    return direction([this.#window.xs[0]!, this.#window.ys[0]!], end);
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
-  #sendable(start: Drawn, end: Drawn): boolean {
-    const dx = end.point[0] - start.point[0];
-    const dy = end.point[1] - start.point[1];
-    return dx * dx + dy * dy >= this.params.min_length * this.params.min_length;
+  #sendable(startX: number, startY: number, endX: number, endY: number): boolean {
+    const dx = endX - startX;
+    const dy = endY - startY;
+    return dx * dx + dy * dy >= this.#minLengthSq;
   }
 
   /**
    * Where to cut: the sample farthest from anchor -> end whose own stroke keeps
    * the bound (the last sample always does). Ties go to the later sample.
    */
-  #feature(window: readonly Drawn[], end: Point, first = 1): number {
-    const anchor = window[0]!.point;
-    const ranked: { index: number; distanceSq: number }[] = [];
-    for (let i = first; i < window.length; i++) {
-      ranked.push({ index: i, distanceSq: distanceSq(window[i]!.point, anchor, end) });
+  #feature(count: number, endX: number, endY: number, first: number): number {
+    const { xs, ys } = this.#window;
+    const distances = this.#distances;
+    const ax = xs[0]!;
+    const ay = ys[0]!;
+    let finite = true;
+    for (let i = first; i < count; i++) {
+      const d = distanceSq(xs[i]!, ys[i]!, ax, ay, endX, endY);
+      distances[i] = d;
+      if (Number.isNaN(d)) finite = false;
     }
+    if (!finite) return this.#featureSorted(count, first);
+    // Farthest first and, at equal distances, the later sample first: the order of a sort by
+    // (distance, index) descending, taken one at a time since the farthest nearly always fits.
+    // Distances are >= 0, so -1 marks a sample tried.
+    for (;;) {
+      let best = -1;
+      let bestDistance = -1;
+      for (let i = count - 1; i >= first; i--) {
+        if (distances[i]! > bestDistance) {
+          bestDistance = distances[i]!;
+          best = i;
+        }
+      }
+      if (best < 0) return count - 1; // unreachable: the last sample fits by construction
+      if (
+        this.#reaches[best]! <= this.#reachLimit ||
+        this.#within(best, xs[best]!, ys[best]!, this.#maxErrorSq)
+      ) {
+        return best;
+      }
+      distances[best] = -1;
+    }
+  }
+
+  /**
+   * `#feature` for distances that are not all numbers (a NaN drawn): the candidates in the order
+   * of a sort with the same comparator, which a NaN makes inconsistent, so the sort itself.
+   */
+  #featureSorted(count: number, first: number): number {
+    const { xs, ys } = this.#window;
+    const ranked: { index: number; distanceSq: number }[] = [];
+    for (let i = first; i < count; i++) ranked.push({ index: i, distanceSq: this.#distances[i]! });
     ranked.sort((a, b) => b.distanceSq - a.distanceSq || b.index - a.index);
     for (const { index } of ranked) {
-      if (this.#fits(window, 1, index, window[index]!.point)) return index;
+      if (
+        this.#reaches[index]! <= this.#reachLimit ||
+        this.#within(index, xs[index]!, ys[index]!, this.#maxErrorSq)
+      ) {
+        return index;
+      }
     }
-    return window.length - 1; // unreachable: the last sample fits by construction
+    return count - 1; // unreachable: the last sample fits by construction
   }
 
-  /** Whether window[first..stop) all lie within max_error of window[0] -> end. */
-  #fits(window: readonly Drawn[], first: number, stop: number, end: Point): boolean {
-    const anchor = window[0]!.point;
-    for (let i = first; i < stop; i++) {
-      if (distanceSq(window[i]!.point, anchor, end) > this.#maxErrorSq) return false;
-    }
-    return true;
+  /** Whether window[1..stop) all lie within sqrt(limitSq) of window[0] -> (endX, endY). */
+  #within(stop: number, endX: number, endY: number, limitSq: number): boolean {
+    return this.#farthestSq(stop, endX, endY, limitSq) >= 0;
   }
 
-  #finish(start: Drawn, end: Drawn): Segment {
+  /**
+   * The greatest squared distance of window[1..stop) to window[0] -> (endX, endY) (0 if none,
+   * NaN counting as none), or -1 as soon as one exceeds limitSq: the inner loop of every
+   * sample. `distanceSq` inlined, its chord terms computed once and its float operations in its
+   * order, so every distance is the same to the last bit: t <= 0 leaves q as it is (q - 0 * d
+   * is q; a zero's sign is squared away), t >= 1 subtracts d itself (1 * d is d), and a NaN t
+   * falls to the projection as through Math.max and Math.min.
+   */
+  #farthestSq(stop: number, endX: number, endY: number, limitSq: number): number {
+    const { xs, ys } = this.#window;
+    const ax = xs[0]!;
+    const ay = ys[0]!;
+    const dx = endX - ax;
+    const dy = endY - ay;
+    const lengthSq = dx * dx + dy * dy;
+    let farthest = 0;
+    if (lengthSq > 0) {
+      for (let i = 1; i < stop; i++) {
+        let qx = xs[i]! - ax;
+        let qy = ys[i]! - ay;
+        const t = (qx * dx + qy * dy) / lengthSq;
+        if (t >= 1) {
+          qx = qx - dx;
+          qy = qy - dy;
+        } else if (!(t <= 0)) {
+          qx = qx - t * dx;
+          qy = qy - t * dy;
+        }
+        const d = qx * qx + qy * qy;
+        if (d > limitSq) return -1;
+        if (d > farthest) farthest = d;
+      }
+    } else {
+      for (let i = 1; i < stop; i++) {
+        const qx = xs[i]! - ax;
+        const qy = ys[i]! - ay;
+        const d = qx * qx + qy * qy;
+        if (d > limitSq) return -1;
+        if (d > farthest) farthest = d;
+      }
+    }
+    return farthest;
+  }
+
+  #finish(start: Point, startMs: number, end: Point, endMs: number): Segment {
     this.#emittedInPath = true;
-    return finishSegment(
-      start.point,
-      end.point,
-      start.sample.t_ms,
-      end.sample.t_ms,
-      this.#pointer ? this.#pointer.t_ms : end.sample.t_ms,
-      this.params,
-    );
+    return finishSegment(start, end, startMs, endMs, this.#pointer ? this.#pointer.t_ms : endMs, this.params);
   }
 }
 
@@ -268,13 +484,12 @@ function direction(start: Point, end: Point): Point | null {
   return length > 0 ? [dx / length, dy / length] : null;
 }
 
-/** Squared distance from `point` to the segment start -> end (its nearest point). */
-function distanceSq(point: Point, start: Point, end: Point): number {
-  const [ax, ay] = start;
-  const dx = end[0] - ax;
-  const dy = end[1] - ay;
-  let qx = point[0] - ax;
-  let qy = point[1] - ay;
+/** Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey) (its nearest point). */
+function distanceSq(px: number, py: number, ax: number, ay: number, ex: number, ey: number): number {
+  const dx = ex - ax;
+  const dy = ey - ay;
+  let qx = px - ax;
+  let qy = py - ay;
   const lengthSq = dx * dx + dy * dy;
   if (lengthSq > 0) {
     // The nearest point of the segment: the projection, clamped onto it.

@@ -71,6 +71,12 @@ STRAIGHT = 1e-6
 # max_error of it; the stroke after it then goes on along that line where the bound allows, by
 # moving its end at most this share of max_error off its drawn sample (no drift along a bend).
 LINE_SHARE = 0.25
+# Far more than any rounding error of a distance computed here (grid coordinates are at most 63,
+# so under 1e-12 grid units), far less than the least max_error (0.001): what the reach of a
+# stroke (``WindowSimplifier._reach``) adds for rounding, so that it never understates a true
+# distance, and the room it keeps below max_error, so that no distance it lets through could
+# compute above it.
+ROUNDING_SLACK = 1e-9
 
 WINDOW_PARAMS: dict[str, ParamSpec] = {
     s.name: s
@@ -128,107 +134,187 @@ class WindowParams(FrameAndGrid):
         check_all(self, WINDOW_PARAMS)
 
 
-@dataclass(frozen=True)
-class _Point:
-    sample: Sample
-    point: Point  # the sample in grid units
-
-
 @dataclass
 class WindowSimplifier:
     params: WindowParams = field(default_factory=WindowParams)
-    # The samples of the stroke being drawn: its anchor first, then every sample since.
-    _window: list[_Point] = field(default_factory=list)
+    # The stroke being drawn, its anchor first, then every sample since, as three parallel lists:
+    # the points in grid units, their times and their samples. Plain lists of floats and tuples,
+    # not an object per sample: every sample is tested against the chord at every new one.
+    _points: list[Point] = field(default_factory=list)
+    _times: list[float] = field(default_factory=list)
+    _samples: list[Sample] = field(default_factory=list)
     _pointer: Sample | None = None
     _emitted_in_path: bool = False
     # The direction of the stroke the latency cap ended last, while the next one may go on along
     # it (None at a path's start and after any other cut).
     _line: tuple[float, float] | None = None
+    # The reach of the stroke being drawn: no sample since its anchor lies farther than this from
+    # the segment anchor -> last sample (grid units; true distances, rounding allowed for). A
+    # sample that moves the end by a step moves every point of that segment by at most the step,
+    # so while reach + step stays under max_error (by ROUNDING_SLACK) every sample keeps the bound
+    # to the new segment without testing each one, as testing each one would find; else they are
+    # tested, and their farthest distance is the new reach. The same strokes, fewer tests.
+    _reach: float = 0.0
+    # The reach each sample of the stroke had when it was the last: a bound on the distances of
+    # the samples before it to anchor -> it, which stay as they are while the stroke goes on. So
+    # a test of points[1:i] against anchor -> points[i] or a point near it (a cut's feature, a
+    # line's end) needs no sample tested when that bound says so. Index 0 is never read.
+    _reaches: list[float] = field(default_factory=lambda: [0.0])
     _max_error_sq: float = field(init=False)
+    _min_length_sq: float = field(init=False)
+    _reach_limit: float = field(
+        init=False
+    )  # reach + step at most this: every sample keeps the bound
     _mapping: CanvasMapping = field(init=False)
 
     def __post_init__(self) -> None:
         self._max_error_sq = self.params.max_error * self.params.max_error
+        self._min_length_sq = self.params.min_length * self.params.min_length
+        self._reach_limit = self.params.max_error - ROUNDING_SLACK
         self._mapping = self.params.mapping
 
     @property
     def drawing(self) -> bool:
         """True between the first sample of a path and ``end``."""
-        return bool(self._window)
+        return bool(self._points)
 
     @property
     def line_start(self) -> Sample | None:
         """Where the stroke being drawn starts (canvas pixels); None between paths."""
-        return self._window[0].sample if self._window else None
+        return self._samples[0] if self._samples else None
 
     def push(self, sample: Sample) -> list[Segment]:
         """One pointer sample while the pointer is down; the first of a path is the press."""
-        if self._window and sample.t_ms < self._window[-1].sample.t_ms:
-            sample = Sample(self._window[-1].sample.t_ms, sample.x, sample.y, sample.pressure)
+        times = self._times
+        if times and sample.t_ms < times[-1]:
+            sample = Sample(times[-1], sample.x, sample.y, sample.pressure)
         self._pointer = sample
-        current = _Point(sample, self._mapping.to_grid(sample.x, sample.y))
-        if not self._window:
-            self._window = [current]
+        point = self._mapping.to_grid(sample.x, sample.y)
+        if not times:
+            self._points, self._times, self._samples = [point], [sample.t_ms], [sample]
             self._emitted_in_path = False
             self._line = None
+            self._reach = 0.0
             return []
         out: list[Segment] = []
-        self._add(current, out)
+        self._add(point, sample, out)
         return out
 
     def end(self) -> list[Segment]:
         """Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0)."""
-        window = self._window
-        self._window = []
-        if not window:
+        points, times = self._points, self._times
+        self._points, self._times, self._samples = [], [], []
+        if not points:
             return []
-        if len(window) == 1 and self._emitted_in_path:
+        if len(points) == 1 and self._emitted_in_path:
             return []  # the last sample already ends a stroke (a cut at the work cap)
-        return [self._finish(window[0], self._continued(window, len(window) - 1))]
+        end = self._continued(points, len(points) - 1)
+        return [self._finish(points[0], times[0], end, times[-1])]
 
-    def _add(self, current: _Point, out: list[Segment]) -> None:
-        """``current`` joins the stroke being drawn, cutting it first where it must.
+    def _add(self, point: Point, sample: Sample, out: list[Segment]) -> None:
+        """``point`` (of ``sample``) joins the stroke being drawn, cutting it first where it must.
 
         A cut at a feature gives back the samples after it: they are taken
         again, in order, into the stroke that now starts at the cut.
         """
-        pending = [current]  # a stack: the next sample to take is last
-        while pending:
-            item = pending.pop()
-            window = self._window
-            anchor = window[0]
-            cap_ms = self.params.max_stroke_ms
+        cap_ms = self.params.max_stroke_ms
+        max_window = self.params.max_window
+        max_error_sq = self._max_error_sq
+        pending: list[tuple[Point, Sample]] = []  # a stack: the next sample to take is last
+        while True:
+            points, times, samples = self._points, self._times, self._samples
+            t_ms = sample.t_ms
             if (
                 cap_ms > 0
-                and len(window) > 1
-                and item.sample.t_ms - anchor.sample.t_ms > cap_ms
-                and self._sendable(anchor, window[-1])
+                and len(points) > 1
+                and t_ms - times[0] > cap_ms
+                and self._sendable(points[0], points[-1])
             ):
-                cut = self._cap_cut(window)
-                vertex = self._continued(window, cut)
-                out.append(self._finish(anchor, vertex))
-                self._line = self._line_of(window, cut, vertex)
-                if cut < len(window) - 1:
-                    pending.append(item)
-                    pending.extend(reversed(window[cut + 1 :]))
-                    self._window = [vertex]
+                cut = self._cap_cut(points, times)
+                vertex = self._continued(points, cut)
+                out.append(self._finish(points[0], times[0], vertex, times[cut]))
+                self._line = self._line_of(points, cut, vertex)
+                if cut < len(points) - 1:
+                    pending.append((point, sample))
+                    pending.extend(zip(points[:cut:-1], samples[:cut:-1], strict=True))
+                    self._points, self._times, self._samples = (
+                        [vertex],
+                        [times[cut]],
+                        [samples[cut]],
+                    )
+                    self._reach = 0.0
+                    point, sample = pending.pop()
                     continue
-                window = self._window = [vertex]
-            if not self._fits(window, 1, len(window), item.point):
-                cut = self._feature(window, item.point)
-                out.append(self._finish(window[0], window[cut]))
+                self._reach = 0.0
+                self._points = points = [vertex]
+                self._times = times = [times[cut]]
+                self._samples = samples = [samples[cut]]
+            if not self._keeps_bound(points, point, max_error_sq):
+                cut = self._feature(points, point)
+                out.append(self._finish(points[0], times[0], points[cut], times[cut]))
                 self._line = None
-                pending.append(item)
-                pending.extend(reversed(window[cut + 1 :]))
-                self._window = [window[cut]]
+                pending.append((point, sample))
+                pending.extend(zip(points[:cut:-1], samples[:cut:-1], strict=True))
+                self._points, self._times, self._samples = (
+                    [points[cut]],
+                    [times[cut]],
+                    [samples[cut]],
+                )
+                self._reach = 0.0
+                point, sample = pending.pop()
                 continue
-            window.append(item)
-            if len(window) - 1 >= self.params.max_window:
-                out.append(self._finish(window[0], item))
+            points.append(point)
+            times.append(t_ms)
+            samples.append(sample)
+            reaches = self._reaches
+            if len(reaches) < len(points):
+                reaches.append(self._reach)
+            else:
+                reaches[len(points) - 1] = self._reach
+            if len(points) - 1 >= max_window:
+                out.append(self._finish(points[0], times[0], point, t_ms))
                 self._line = None
-                self._window = [item]
+                self._points, self._times, self._samples = [point], [t_ms], [sample]
+                self._reach = 0.0
+            if not pending:
+                return
+            point, sample = pending.pop()
 
-    def _cap_cut(self, window: list[_Point]) -> int:
+    def _keeps_bound(self, points: list[Point], point: Point, max_error_sq: float) -> bool:
+        """Whether every sample since the anchor lies within max_error of anchor -> ``point``.
+
+        As ``_within`` finds; sets the reach for ``point`` as the stroke's new last sample. A
+        NaN drawn is never farther than max_error (no comparison with NaN is true), in
+        ``_within`` as here: a NaN step tests every sample, a NaN sample counts in no reach.
+        """
+        if len(points) == 1:
+            self._reach = 0.0
+            return True
+        last = points[-1]
+        dx, dy = point[0] - last[0], point[1] - last[1]
+        reach = self._reach + math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK
+        if reach <= self._reach_limit:
+            self._reach = reach
+            return True
+        farthest_sq = _farthest_sq(points, len(points), point, max_error_sq)
+        if farthest_sq < 0.0:
+            return False
+        self._reach = math.sqrt(farthest_sq) + ROUNDING_SLACK
+        return True
+
+    def _reaches_near(self, points: list[Point], index: int, end: Point, limit: float) -> bool:
+        """Whether points[1:index + 1] surely lie within ``limit`` + slack of points[0] -> ``end``.
+
+        ``end`` is a point near points[index]: moving the end moves the segment at most as far,
+        so index's reach plus that step bounds them all; then a test of each finds them all
+        within. False when unsure (a NaN too): test each.
+        """
+        if index == 0:
+            return False
+        dx, dy = end[0] - points[index][0], end[1] - points[index][1]
+        return self._reaches[index] + math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK <= limit
+
+    def _cap_cut(self, points: list[Point], times: list[float]) -> int:
         """Where the latency cap cuts: at a feature in the stroke's later part, else at its end.
 
         The feature is the sample farthest from the chord anchor -> last sample
@@ -236,96 +322,92 @@ class WindowSimplifier:
         anchor whose own stroke keeps the bound and is long enough to send; if it
         lies on the chord (a straight stroke, to ``STRAIGHT``), at the last sample.
         """
-        anchor = window[0]
-        earliest = anchor.sample.t_ms + CAP_FEATURE_SHARE * self.params.max_stroke_ms
-        first = next(
-            (i for i in range(1, len(window)) if window[i].sample.t_ms >= earliest),
-            len(window) - 1,
-        )
-        cut = self._feature(window, window[-1].point, first)
+        anchor = points[0]
+        last = len(points) - 1
+        earliest = times[0] + CAP_FEATURE_SHARE * self.params.max_stroke_ms
+        first = next((i for i in range(1, last + 1) if times[i] >= earliest), last)
+        cut = self._feature(points, points[last], first)
         straight = STRAIGHT * self.params.max_error
-        far_sq = _distance_sq(window[cut].point, anchor.point, window[-1].point)
+        far_sq = _distance_sq(points[cut], anchor, points[last])
         bends = far_sq > straight * straight
-        return cut if bends and self._sendable(anchor, window[cut]) else len(window) - 1
+        return cut if bends and self._sendable(anchor, points[cut]) else last
 
-    def _continued(self, window: list[_Point], cut: int) -> _Point:
-        """Where a stroke that the latency cap or the release ends, ending at window[cut], ends.
+    def _continued(self, points: list[Point], cut: int) -> Point:
+        """Where a stroke that the latency cap or the release ends, ending at points[cut], ends.
 
         After a stroke the latency cap ended that is a line (``_line_of``), the
         stroke that follows it goes on along that line when it can: its end is
-        window[cut] projected onto it, if that moves it at most ``LINE_SHARE`` x
-        max_error, every sample up to window[cut] keeps the bound to the
+        points[cut] projected onto it, if that moves it at most ``LINE_SHARE`` x
+        max_error, every sample up to points[cut] keeps the bound to the
         projected end and the stroke is still long enough to send; else
-        window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
-        straight line cut into strokes stays one straight line (a sample's
-        sideways noise would otherwise bend it).
+        points[cut] itself (the end keeps the time of the sample at the cut).
+        The cap cuts a drawn line, not a drawn corner, so a straight line cut
+        into strokes stays one straight line (a sample's sideways noise would
+        otherwise bend it).
         """
-        at = window[cut]
+        at = points[cut]
         if self._line is None:
             return at
         ux, uy = self._line
-        ax, ay = window[0].point
-        along = (at.point[0] - ax) * ux + (at.point[1] - ay) * uy
+        ax, ay = points[0]
+        along = (at[0] - ax) * ux + (at[1] - ay) * uy
         if along <= 0:
             return at
-        end = _Point(at.sample, (ax + along * ux, ay + along * uy))
+        end = (ax + along * ux, ay + along * uy)
         limit = LINE_SHARE * self.params.max_error
-        if _distance_sq(at.point, end.point, end.point) > limit * limit:  # a bend, not noise
+        if _distance_sq(at, end, end) > limit * limit:  # a bend, not noise
             return at
-        if not self._sendable(window[0], end) or not self._fits(window, 1, cut + 1, end.point):
+        if not self._sendable(points[0], end):
+            return at
+        if not self._reaches_near(points, cut, end, self._reach_limit) and not _within(
+            points, cut + 1, end, self._max_error_sq
+        ):
             return at
         return end
 
-    def _line_of(self, window: list[_Point], cut: int, end: _Point) -> tuple[float, float] | None:
-        """The direction of the stroke window[0] -> end if it is a line, else None.
+    def _line_of(self, points: list[Point], cut: int, end: Point) -> tuple[float, float] | None:
+        """The direction of the stroke points[0] -> end if it is a line, else None.
 
-        A line: every sample up to window[cut] lies within ``LINE_SHARE`` x max_error of it.
+        A line: every sample up to points[cut] lies within ``LINE_SHARE`` x max_error of it.
         """
         limit = LINE_SHARE * self.params.max_error
-        anchor = window[0].point
-        for index in range(1, cut + 1):
-            if _distance_sq(window[index].point, anchor, end.point) > limit * limit:
-                return None
-        return _direction(anchor, end.point)
+        certain = self._reaches_near(points, cut, end, limit - ROUNDING_SLACK)
+        if not certain and not _within(points, cut + 1, end, limit * limit):
+            return None
+        return _direction(points[0], end)
 
-    def _sendable(self, start: _Point, end: _Point) -> bool:
+    def _sendable(self, start: Point, end: Point) -> bool:
         """Whether start -> end is long enough to send (the cap never cuts off a dropped stroke)."""
-        dx, dy = end.point[0] - start.point[0], end.point[1] - start.point[1]
-        return dx * dx + dy * dy >= self.params.min_length * self.params.min_length
+        dx, dy = end[0] - start[0], end[1] - start[1]
+        return dx * dx + dy * dy >= self._min_length_sq
 
-    def _feature(self, window: list[_Point], end: Point, first: int = 1) -> int:
+    def _feature(self, points: list[Point], end: Point, first: int = 1) -> int:
         """Where to cut: the sample farthest from anchor -> end whose own stroke keeps the bound.
 
         The last sample always qualifies (the window kept the bound up to it).
         Ties go to the later sample, so the stroke is the longer.
         """
-        anchor = window[0].point
+        anchor = points[0]
+        stop = len(points)
+        # (distance, index), farthest first and, at equal distance, the later sample first.
         ranked = sorted(
-            range(first, len(window)),
-            key=lambda i: (_distance_sq(window[i].point, anchor, end), i),
+            zip(_distances_sq(points, first, stop, anchor, end), range(first, stop), strict=True),
             reverse=True,
         )
-        for index in ranked:
-            if self._fits(window, 1, index, window[index].point):
+        max_error_sq, reaches, reach_limit = self._max_error_sq, self._reaches, self._reach_limit
+        for _, index in ranked:
+            if reaches[index] <= reach_limit or _within(points, index, points[index], max_error_sq):
                 return index
-        return len(window) - 1  # unreachable: the last sample fits by construction
+        return stop - 1  # unreachable: the last sample fits by construction
 
-    def _fits(self, window: list[_Point], first: int, stop: int, end: Point) -> bool:
-        """Whether window[first:stop] all lie within max_error of window[0] -> end."""
-        anchor = window[0].point
-        for index in range(first, stop):
-            if _distance_sq(window[index].point, anchor, end) > self._max_error_sq:
-                return False
-        return True
-
-    def _finish(self, start: _Point, end: _Point) -> Segment:
+    def _finish(self, start: Point, start_ms: float, end: Point, end_ms: float) -> Segment:
         self._emitted_in_path = True
         return finish_segment(
-            start.point,
-            end.point,
-            start.sample.t_ms,
-            end.sample.t_ms,
-            self._pointer.t_ms if self._pointer else end.sample.t_ms,
+            start,
+            end,
+            start_ms,
+            end_ms,
+            self._pointer.t_ms if self._pointer else end_ms,
             min_length=self.params.min_length,
             min_duration_ms=self.params.min_duration_ms,
         )
@@ -336,6 +418,82 @@ def _direction(start: Point, end: Point) -> tuple[float, float] | None:
     dx, dy = end[0] - start[0], end[1] - start[1]
     length = math.sqrt(dx * dx + dy * dy)
     return (dx / length, dy / length) if length > 0.0 else None
+
+
+# The squared distance from a point to a segment start -> end (its nearest point), as
+# ``_distance_sq`` computes it, is the inner loop of the simplifier: ``_farthest_sq`` and
+# ``_distances_sq`` inline it over a stroke's samples, with the chord's terms computed once. The
+# float operations are ``_distance_sq``'s, in its order, so every result is the same to the last
+# bit: max(t, 0.0) and min(t, 1.0) are written as the comparisons Python's max and min make (a
+# NaN stays NaN), t <= 0 leaves q as it is (q - 0 * d is q; a zero's sign is squared away) and
+# t == 1 subtracts d itself (1.0 * d is d).
+
+
+def _within(points: list[Point], stop: int, end: Point, limit_sq: float) -> bool:
+    """Whether points[1:stop] all lie within sqrt(limit_sq) of the segment points[0] -> end."""
+    return _farthest_sq(points, stop, end, limit_sq) >= 0.0
+
+
+def _farthest_sq(points: list[Point], stop: int, end: Point, limit_sq: float) -> float:
+    """The greatest squared distance of points[1:stop] to points[0] -> end, or -1 past limit_sq.
+
+    0.0 when there are none; a NaN distance counts as none. Stops at the first past the limit.
+    """
+    ax, ay = points[0]
+    dx, dy = end[0] - ax, end[1] - ay
+    length_sq = dx * dx + dy * dy
+    farthest = 0.0
+    if length_sq > 0.0:
+        for px, py in points[1:stop]:
+            qx, qy = px - ax, py - ay
+            t = (qx * dx + qy * dy) / length_sq
+            if t <= 0.0:
+                distance_sq = qx * qx + qy * qy
+            elif t >= 1.0:
+                qx, qy = qx - dx, qy - dy
+                distance_sq = qx * qx + qy * qy
+            else:
+                qx, qy = qx - t * dx, qy - t * dy
+                distance_sq = qx * qx + qy * qy
+            if distance_sq > limit_sq:
+                return -1.0
+            if distance_sq > farthest:
+                farthest = distance_sq
+    else:
+        for px, py in points[1:stop]:
+            qx, qy = px - ax, py - ay
+            distance_sq = qx * qx + qy * qy
+            if distance_sq > limit_sq:
+                return -1.0
+            if distance_sq > farthest:
+                farthest = distance_sq
+    return farthest
+
+
+def _distances_sq(
+    points: list[Point], first: int, stop: int, start: Point, end: Point
+) -> list[float]:
+    """``_distance_sq`` of points[first:stop] to the segment start -> end."""
+    ax, ay = start
+    dx, dy = end[0] - ax, end[1] - ay
+    length_sq = dx * dx + dy * dy
+    out = []
+    if length_sq > 0.0:
+        for px, py in points[first:stop]:
+            qx, qy = px - ax, py - ay
+            t = (qx * dx + qy * dy) / length_sq
+            if t <= 0.0:
+                pass
+            elif t >= 1.0:
+                qx, qy = qx - dx, qy - dy
+            else:
+                qx, qy = qx - t * dx, qy - t * dy
+            out.append(qx * qx + qy * qy)
+    else:
+        for px, py in points[first:stop]:
+            qx, qy = px - ax, py - ay
+            out.append(qx * qx + qy * qy)
+    return out
 
 
 def _distance_sq(point: Point, start: Point, end: Point) -> float:
