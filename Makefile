@@ -35,7 +35,7 @@ help:
 	@echo "make check   the same parts one at a time"
 	@echo "make bench   print performance figures (a few minutes)"
 	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
-	@echo "             per case (about half an hour; RUNS=40 for a quick look)"
+	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 
@@ -98,7 +98,7 @@ bench: $(STAMP) system
 	$(PY) -m feelmysign.bench
 
 # The study analysis's coverage over many seeded simulated studies (python -m
-# feelmysign.bench.study_recovery; about half an hour at 400 runs), apart from make bench.
+# feelmysign.bench.study_recovery; about 50 minutes at 400 runs), apart from make bench.
 RUNS ?= 400
 bench-study: $(STAMP)
 	$(PY) -m feelmysign.bench.study_recovery $(RUNS)

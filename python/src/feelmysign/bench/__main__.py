@@ -1,6 +1,6 @@
 """``python -m feelmysign.bench``: print every benchmark's figures, in a few minutes.
 
-The study analysis's coverage over hundreds of simulated studies takes half an hour, so it
+The study analysis's coverage over hundreds of simulated studies takes about 50 minutes, so it
 is a run of its own: ``make bench-study`` (``python -m feelmysign.bench.study_recovery``).
 """
 
@@ -42,7 +42,7 @@ def main() -> None:
             print(line, flush=True)
         print()
     print(
-        "The study analysis's coverage over many simulated studies (about half an hour):"
+        "The study analysis's coverage over many simulated studies (about 50 minutes):"
         " make bench-study"
     )
 

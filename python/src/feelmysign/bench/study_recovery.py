@@ -1,7 +1,7 @@
 """Does the study's analysis recover known parameters? Coverage of its 95% intervals over many
 seeded simulated studies (the tests run a few of them).
 
-Long (about half an hour at 400 runs on 2 cores), so not part of ``make bench``:
+Long (about 50 minutes of one core at 400 runs), so not part of ``make bench``:
 
     make bench-study                                  # 400 runs per case
     python -m feelmysign.bench.study_recovery [RUNS]
