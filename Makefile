@@ -74,8 +74,12 @@ vectors: $(STAMP)
 vectors-check: $(STAMP)
 	$(PY) testdata/generate.py --check
 
+# The ten slowest tests are listed before pytest's summary, to keep an eye on what makes
+# `make test` long; e.g. make pytest PYTEST_ARGS="-x tests/test_planner.py".
+PYTEST_ARGS ?= --durations=10
+
 pytest: $(STAMP) system
-	cd python && ../$(BIN)/pytest
+	cd python && ../$(BIN)/pytest $(PYTEST_ARGS)
 
 # Everything `make test` installs; independent of each other, so `make -j` runs them at once.
 install: system $(STAMP)
