@@ -1,6 +1,14 @@
 # feelmysign — one Makefile for every part. `make test` works on a fresh Debian
 # machine: it installs what it needs (system packages through apt-get, Python
 # packages into .venv) and then runs lint, type checks and every test.
+#
+# `make test` runs side by side: first every install at once (apt-get, pip, npm ci,
+# go install: independent, mostly network), then the checks in TEST_JOBS lanes: pytest in
+# one, the browser tests (which mostly wait on timers) in another, the short checks (lint,
+# type checks, vectors, vitest units) one after another in the third. Each part's output
+# is held back and printed whole when it ends (make's --output-sync), so parallel parts
+# never interleave; every part runs even when another fails (--keep-going), and `make
+# test` fails if any did. `make check` runs the same checks one at a time.
 
 PYTHON ?= python3
 VENV := .venv
@@ -13,14 +21,21 @@ PIP_INSTALL := $(PY) -m pip install --disable-pip-version-check --progress-bar o
 # Options for `feelmysign up`, e.g. make up ARGS="--http-port 8080"
 ARGS ?=
 SYSTEM_PACKAGES := mosquitto mosquitto-clients
+# Lanes of `make test`: pytest, the browser tests, the short checks. The machine has two
+# cores; pytest and the browser tests each leave much of theirs idle.
+TEST_JOBS ?= 3
 
-.PHONY: help up test lint typecheck pytest vectors vectors-check bench system clean
+.PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study system clean
 
 help:
 	@echo "make up      set up and start everything (broker, sleeve simulator, drawing client);"
 	@echo "             options for 'feelmysign up' go in ARGS, e.g. make up ARGS=\"--http-port 8080\""
-	@echo "make test    install what is needed, then lint, type-check and run every test"
-	@echo "make bench   print performance figures"
+	@echo "make test    install what is needed, then lint, type-check and run every test,"
+	@echo "             side by side (TEST_JOBS=3 lanes; each part's output printed whole when it ends)"
+	@echo "make check   the same parts one at a time"
+	@echo "make bench   print performance figures (a few minutes)"
+	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
+	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 
@@ -59,13 +74,38 @@ vectors: $(STAMP)
 vectors-check: $(STAMP)
 	$(PY) testdata/generate.py --check
 
-pytest: $(STAMP) system
-	cd python && ../$(BIN)/pytest
+# The ten slowest tests are listed before pytest's summary, to keep an eye on what makes
+# `make test` long; e.g. make pytest PYTEST_ARGS="-x tests/test_planner.py".
+PYTEST_ARGS ?= --durations=10
 
-test: system $(STAMP) lint typecheck vectors-check pytest
+pytest: $(STAMP) system
+	cd python && ../$(BIN)/pytest $(PYTEST_ARGS)
+
+# Everything `make test` installs; independent of each other, so `make -j` runs them at once.
+install: system $(STAMP)
+
+# The longest parts first (pytest, then the browser tests of web/ below), so that they start
+# at once when the checks run side by side and the short ones share the third lane.
+check: pytest web-browser-test lint typecheck vectors-check
+
+# Installs at once, then the checks side by side (see the top of this file). The nested
+# makes get their own -j: side by side is what `make test` means, with or without -j.
+test:
+	@echo "==> make test: installing what is missing (side by side), then the checks in $(TEST_JOBS) lanes;"
+	@echo "    each part's output is printed whole when the part ends."
+	@$(MAKE) --no-print-directory -j4 --output-sync=target --keep-going install
+	@$(MAKE) --no-print-directory -j$(TEST_JOBS) --output-sync=target --keep-going check \
+	  || { echo "==> make test: FAILED (the parts marked Error above)" >&2; exit 1; }
+	@echo "==> make test: every part passed"
 
 bench: $(STAMP) system
 	$(PY) -m feelmysign.bench
+
+# The study analysis's coverage over many seeded simulated studies (python -m
+# feelmysign.bench.study_recovery; about 50 minutes at 400 runs), apart from make bench.
+RUNS ?= 400
+bench-study: $(STAMP)
+	$(PY) -m feelmysign.bench.study_recovery $(RUNS)
 
 up: $(RUN_STAMP) system
 	@echo "==> Starting feelmysign up $(ARGS)"
@@ -127,7 +167,8 @@ web-clean:
 	rm -rf $(WEB)/node_modules $(WEB)/dist $(WEB)/test-results
 
 # The web client joins the project-wide targets (extra prerequisites; their recipes stay above).
-test: web-test
+install: $(WEB_STAMP)
+check: web-test
 bench: web-bench
 up: web-build
 clean: web-clean
@@ -152,6 +193,7 @@ $(NATS_STAMP):
 
 pytest: $(NATS_STAMP)
 web-browser-test: $(NATS_STAMP)
+install: $(NATS_STAMP)
 
 # N sleeves and N senders at once on Mosquitto and on the NATS cluster (N = 20, 100, 200,
 # or make load N='20 100'), against a bare publish -> receive baseline of the same run.

@@ -158,7 +158,7 @@ def paths(draw: st.DrawFn) -> tuple[AngleParams, list[Sample]]:
     return params, samples
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(paths())
 def test_segments_join_and_keep_the_path_ends(case: tuple[AngleParams, list[Sample]]) -> None:
     params, samples = case
@@ -172,7 +172,7 @@ def test_segments_join_and_keep_the_path_ends(case: tuple[AngleParams, list[Samp
         assert after.start == before.end and after.start_ms == before.end_ms
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(paths())
 def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
     case: tuple[AngleParams, list[Sample]],

@@ -241,7 +241,7 @@ def test_one_command_per_actuator_at_a_time(case: tuple[Layout, Stroke, float]) 
             assert after.start_ms >= before.end_ms - 1e-9
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(strokes())
 def test_bursts_end_at_the_stroke_duration_and_move_forward(
     case: tuple[Layout, Stroke, float],
@@ -259,7 +259,7 @@ def test_bursts_end_at_the_stroke_duration_and_move_forward(
         assert schedule.duration_ms > case[1].duration_ms
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(strokes())
 def test_funneling_preserves_energy(case: tuple[Layout, Stroke, float]) -> None:
     layout = case[0]
@@ -269,7 +269,7 @@ def test_funneling_preserves_energy(case: tuple[Layout, Stroke, float]) -> None:
         assert len(rendered) in (1, 2, 4)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(strokes())
 def test_reverse_visits_the_same_places_in_opposite_order(
     case: tuple[Layout, Stroke, float],
@@ -292,7 +292,7 @@ def test_reverse_visits_the_same_places_in_opposite_order(
     assert actuators(backward.bursts) == actuators(forward.bursts)[::-1]
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(strokes())
 def test_strict_agrees_with_the_adjustment(case: tuple[Layout, Stroke, float]) -> None:
     layout, stroke, min_command_ms = case
@@ -306,7 +306,7 @@ def test_strict_agrees_with_the_adjustment(case: tuple[Layout, Stroke, float]) -
         assert plan(slowed, layout, min_command_ms=min_command_ms, strict=True).adjusted is None
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(strokes())
 def test_slowed_only_below_the_two_phantom_floor(case: tuple[Layout, Stroke, float]) -> None:
     _, stroke, min_command_ms = case
@@ -330,7 +330,7 @@ def test_thinning_keeps_the_ends_and_leaves_out_only_crossings(
     assert set(kept) <= set(points)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(strokes())
 def test_no_burst_ends_long_after_the_stroke(case: tuple[Layout, Stroke, float]) -> None:
     schedule = _planned(case)
@@ -341,7 +341,7 @@ def test_no_burst_ends_long_after_the_stroke(case: tuple[Layout, Stroke, float])
     assert all(c.end_ms <= latest for c in schedule.commands)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(strokes(), st.sampled_from(["start", "end"]), st.floats(0, 2 * math.pi))
 def test_moving_an_endpoint_by_a_hundredth_changes_the_duration_by_5_percent_at_most(
     case: tuple[Layout, Stroke, float], which: str, angle: float

@@ -378,7 +378,7 @@ def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int
     return covered
 
 
-@settings(max_examples=500, deadline=None)
+@settings(max_examples=250, deadline=None)
 @given(paths())
 def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
     case: tuple[WindowParams, list[Sample]],
@@ -391,7 +391,7 @@ def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
             assert distance <= params.max_error + FLOAT_TOLERANCE, (segment, sample, distance)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(paths())
 def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sample]]) -> None:
     params, samples = case
@@ -406,7 +406,7 @@ def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sam
         assert after.start == before.end and after.start_ms == before.end_ms
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(paths(min_step_ms=0.01))  # every sample its own time: each stroke's samples are known
 def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
     case: tuple[WindowParams, list[Sample]],
@@ -424,7 +424,7 @@ def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
         assert segment.emitted_at_ms in times and segment.emitted_at_ms >= segment.end_ms
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(paths())
 def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
     case: tuple[WindowParams, list[Sample]],

@@ -1,4 +1,8 @@
-"""``python -m feelmysign.bench``: print every benchmark's figures."""
+"""``python -m feelmysign.bench``: print every benchmark's figures, in a few minutes.
+
+The study analysis's coverage over hundreds of simulated studies takes about 50 minutes, so it
+is a run of its own: ``make bench-study`` (``python -m feelmysign.bench.study_recovery``).
+"""
 
 from __future__ import annotations
 
@@ -12,7 +16,6 @@ from feelmysign.bench import (
     restart_off,
     simplifier_timing,
     sleeve,
-    study_recovery,
 )
 
 
@@ -32,13 +35,16 @@ def main() -> None:
         lasa_points.report,
         sleeve.report,
         restart_off.report,
-        study_recovery.report,
         persistence.report,
     )
     for report in reports:
         for line in report():
             print(line, flush=True)
         print()
+    print(
+        "The study analysis's coverage over many simulated studies (about 50 minutes):"
+        " make bench-study"
+    )
 
 
 if __name__ == "__main__":

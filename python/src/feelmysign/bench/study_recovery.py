@@ -1,9 +1,16 @@
 """Does the study's analysis recover known parameters? Coverage of its 95% intervals over many
-seeded simulated studies (the tests run a few of them)."""
+seeded simulated studies (the tests run a few of them).
+
+Long (about 50 minutes of one core at 400 runs), so not part of ``make bench``:
+
+    make bench-study                                  # 400 runs per case
+    python -m feelmysign.bench.study_recovery [RUNS]
+"""
 
 from __future__ import annotations
 
 import random
+import sys
 from collections.abc import Iterator
 
 from feelmysign.study.analysis.recovery import coverage, describe, paper_truths
@@ -65,3 +72,8 @@ def report(runs: int = RUNS) -> Iterator[str]:
             f"  QUEST+ {dimension} threshold (true {known:g} {unit}): {covered / runs:.1%} "
             f"({low:.1%} to {high:.1%})"
         )
+
+
+if __name__ == "__main__":
+    for line in report(int(sys.argv[1]) if len(sys.argv) > 1 else RUNS):
+        print(line, flush=True)

@@ -7,7 +7,7 @@ contains the true needed resolution; a trustworthy interval does so in about 95%
 of seeded runs. With ``participant_sd`` the participants differ: each one's curve
 is shifted by a normal amount (SD in doublings of strokes), and the truth is where
 the average participant's accuracy reaches the criterion. Used by the tests (a few
-runs) and by ``make bench`` / ``python -m feelmysign.study.analysis.recovery``
+runs) and by ``make bench-study`` / ``python -m feelmysign.study.analysis.recovery``
 (many runs; prints each share with its own 95% Wilson interval).
 
     python -m feelmysign.study.analysis.recovery --runs 400
