@@ -79,6 +79,7 @@ describe("drawing with a mouse on a desktop", () => {
   });
 
   it("sends a square drawn with the mouse as strokes along its four sides, with its corners", async () => {
+    const drawnFromMs = Date.now();
     const { area, path, sent } = await drawSquare(page, {
       beforeRelease: async () => {
         await screenshot(page, "desktop-drawing");
@@ -92,7 +93,10 @@ describe("drawing with a mouse on a desktop", () => {
     strokes.forEach((stroke, i) => {
       expect(stroke).toMatchObject({ v: 1, seq: i, intensity: 0.8 });
       expect(stroke["duration_ms"] as number).toBeGreaterThan(0);
-      expect(Math.abs((stroke["sent_at_ms"] as number) - Date.now())).toBeLessThan(60_000);
+      // A wall-clock time (the page and this test share the machine's clock), taken while
+      // the square was drawn: not a page-relative or monotonic time. 1 s for rounding.
+      expect(stroke["sent_at_ms"] as number).toBeGreaterThanOrEqual(drawnFromMs - 1_000);
+      expect(stroke["sent_at_ms"] as number).toBeLessThanOrEqual(Date.now() + 1_000);
       if (i > 0) {
         // Sent strokes join end to start, or leave the gap of a dropped one (< min_length).
         const [x, y] = stroke["start"] as [number, number];
