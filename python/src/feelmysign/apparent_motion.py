@@ -84,14 +84,28 @@ def shortest_planned_ms(min_command_ms: float) -> float:
     microsecond. A point is held for at least as long, so that the duration does
     not jump as a stroke shrinks to a point.
     """
-    return fastest_feasible_ms(_TWO_PHANTOMS, min_command_ms)
+    # Asked once per stroke planned, with one of a few minimum bursts: kept.
+    shortest = _SHORTEST_MS.get(min_command_ms)
+    if shortest is None:
+        shortest = fastest_feasible_ms(_TWO_PHANTOMS, min_command_ms)
+        if len(_SHORTEST_MS) < _SHORTEST_KEPT:
+            _SHORTEST_MS[min_command_ms] = shortest
+    return shortest
+
+
+_SHORTEST_MS: dict[float, float] = {}
+_SHORTEST_KEPT = 64  # minimum bursts come from layouts and options: a handful
 
 
 def fits(burst_timings: Iterable[Timing], duration_ms: float, min_command_ms: float) -> bool:
     """Whether every burst lasts at least ``min_command_ms`` at ``duration_ms``."""
     # The same floor as fastest_feasible_ms, whose rounding up makes its result fit.
     floor = min_command_ms * (1 - 1e-12) - 1e-9
-    return all(a * duration_ms + b >= floor for _, _, a, b in burst_timings)
+    # A loop, not all(): no generator per stroke planned.
+    for _, _, a, b in burst_timings:  # noqa: SIM110
+        if not a * duration_ms + b >= floor:
+            return False
+    return True
 
 
 def thinned(fractions: Sequence[float], duration_ms: float, min_command_ms: float) -> list[int]:

@@ -59,7 +59,7 @@ from feelmysign.events import (
 )
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS, PacePolicy
-from feelmysign.planner import plan
+from feelmysign.planner import outline
 from feelmysign.player import (
     MAX_PENDING,
     SPIN_MS,
@@ -475,7 +475,8 @@ class Sleeve:
             )
             return
         try:
-            schedule = plan(stroke, self._layout, strict=self._options.strict)
+            # Its bursts only: the commands are planned by the player, the first ones first.
+            schedule = outline(stroke, self._layout, strict=self._options.strict)
         except StrokeError as error:
             self._reject(error.reason, error.message, info, received_wall_ms, ack)
             return

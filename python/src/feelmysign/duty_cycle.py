@@ -28,6 +28,11 @@ from dataclasses import dataclass
 
 Actuator = tuple[int, int]
 
+# surely_fits keeps this much of the budget in hand (a fraction of it, and ms of full
+# drive): far more than the rounding of its running totals over days, far less than felt.
+SURE_MARGIN = 1e-6
+SURE_MARGIN_MS = 1e-3
+
 
 @dataclass(frozen=True)
 class Drive:
@@ -61,6 +66,9 @@ class DutyCycle:
         self.max_duty_cycle = max_duty_cycle
         self.budget_ms = window_ms * max_duty_cycle
         self._past: dict[Actuator, deque[Drive]] = {}
+        # Per actuator, the energy of its past drives whole (what the window can hold of them
+        # at most): kept as they come and go, for ``surely_fits``.
+        self._past_total: dict[Actuator, float] = {}
         self._level: dict[Actuator, tuple[float, float]] = {}  # actuator -> (since_ms, energy)
         self._committed: dict[Actuator, list[Drive]] = {}
 
@@ -69,6 +77,8 @@ class DutyCycle:
         since = self._level.pop(actuator, None)
         if since is not None and t_ms > since[0]:
             self._past.setdefault(actuator, deque()).append(Drive(since[0], t_ms, since[1]))
+            total = self._past_total.get(actuator, 0.0)
+            self._past_total[actuator] = total + since[1] * (t_ms - since[0])
         if intensity > 0:
             self._level[actuator] = (t_ms, intensity * intensity)
         self._forget(actuator, t_ms)
@@ -95,6 +105,28 @@ class DutyCycle:
                 )
         return None
 
+    def surely_fits(self, energy_ms: float, now_ms: float) -> bool:
+        """True only if ``check`` would admit, at ``now_ms``, any stroke whose drive on each
+        of its actuators is at most ``energy_ms``; False when it cannot tell so cheaply.
+
+        Answers from running totals, without summing the window's drives, each bound
+        above: the past drives whole, the level held since it began, the committed drives
+        whole. The margin covers the rounding of the totals kept over time.
+        """
+        limit = self.budget_ms * (1 - SURE_MARGIN) - SURE_MARGIN_MS
+        if energy_ms * (1 + SURE_MARGIN) > limit:
+            return False
+        for actuator in {*self._past_total, *self._level, *self._committed}:
+            load = self._past_total.get(actuator, 0.0)
+            level = self._level.get(actuator)
+            if level is not None:
+                load += level[1] * max(0.0, now_ms - level[0])
+            for drive in self._committed.get(actuator, ()):
+                load += drive.energy * (drive.end_ms - drive.start_ms)
+            if load + energy_ms * (1 + SURE_MARGIN) > limit:
+                return False
+        return True
+
     def commit(self, drives: dict[Actuator, list[Drive]], now_ms: float) -> None:
         """The stroke with ``drives`` started: its drive counts until it is over."""
         for actuator, planned in drives.items():
@@ -108,7 +140,10 @@ class DutyCycle:
     def _forget(self, actuator: Actuator, now_ms: float) -> None:
         past = self._past.get(actuator)
         while past and past[0].end_ms <= now_ms - self.window_ms:
-            past.popleft()
+            gone = past.popleft()
+            self._past_total[actuator] -= gone.energy * (gone.end_ms - gone.start_ms)
+        if past is not None and not past:
+            self._past_total.pop(actuator, None)  # and with it any rounding kept so far
 
 
 def _overlap(drive: Drive, start_ms: float, end_ms: float) -> float:

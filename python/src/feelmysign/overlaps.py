@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from bisect import bisect_left
 from collections.abc import Iterable
 
 from feelmysign.schedule import Command
@@ -44,11 +43,17 @@ def commands_from_spans(
     """Each actuator's spans merged, as commands sorted by start, then row, then column."""
     # One actuator's pieces never share a start, so sorting these tuples whole
     # orders them exactly as that key does.
-    pieces = [
-        (start, row, column, end, intensity)
-        for (row, column), spans in by_actuator.items()
-        for start, end, intensity in _actuator_pieces(spans, min_command_ms)
-    ]
+    pieces = []
+    sqrt = math.sqrt
+    for (row, column), spans in by_actuator.items():
+        if len(spans) == 1:  # most actuators of a stroke render one burst: _lone_piece inline
+            start, end, intensity = spans[0]
+            energy = intensity**2
+            if not energy <= 0 and start < end:
+                pieces.append((start, row, column, end, min(1.0, sqrt(energy))))
+            continue
+        for start, end, intensity in _join_short(_energy_pieces(spans), min_command_ms):
+            pieces.append((start, row, column, end, intensity))
     pieces.sort()
     return tuple(
         [
@@ -68,23 +73,21 @@ def _actuator_pieces(spans: list[Span], min_command_ms: float) -> list[Piece]:
 def _energy_pieces(spans: list[Span]) -> list[Piece]:
     """Piecewise-constant intensity of one actuator: energies summed, capped at 1."""
     bounds = sorted({t for start, end, _ in spans for t in (start, end)})
-    # The energies on each interval between bounds, in the spans' order (the
-    # order they are summed in): one pass over the spans, not one per interval.
-    energies: list[list[float]] = [[] for _ in range(len(bounds) - 1)]
-    for start, end, intensity in spans:
-        energy = intensity**2
-        for terms in energies[bisect_left(bounds, start) : bisect_left(bounds, end)]:
-            terms.append(energy)
+    energies = [(start, end, intensity**2) for start, end, intensity in spans]
     pieces: list[Piece] = []
-    for (start, end), terms in zip(itertools.pairwise(bounds), energies, strict=True):
-        energy = sum(terms)
-        if energy <= 0:
-            continue
-        intensity = min(1.0, math.sqrt(energy))
-        if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
-            pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
-        else:
-            pieces.append((start, end, intensity))
+    start = bounds[0]
+    for end in itertools.islice(bounds, 1, None):
+        # The energies on [start, end), summed in the spans' order. A span covers
+        # it when it starts at or before its start and ends after it (every span
+        # starts and ends on a bound).
+        energy = sum([e for s, t, e in energies if s <= start < t])
+        if not energy <= 0:
+            intensity = min(1.0, math.sqrt(energy))
+            if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
+                pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
+            else:
+                pieces.append((start, end, intensity))
+        start = end
     return pieces
 
 
@@ -100,6 +103,8 @@ def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
     """Join pieces shorter than the minimum to an adjacent piece of the same on-period."""
     if len(pieces) < 2:
         return pieces  # nothing to join with
+    if all(e - s >= min_command_ms for s, e, _ in pieces):
+        return pieces  # none short: the common case, answered without looking for neighbours
     pieces = list(pieces)
     while True:
         short = [

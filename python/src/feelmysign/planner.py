@@ -61,7 +61,12 @@ MERGE_DISTANCE = 0.05
 # Coordinates within this of a grid line are on it (float noise, not geometry).
 ON_LINE_EPSILON = 1e-9
 
+_OFF_LINE = 1 - ON_LINE_EPSILON  # a coordinate this far into a cell is on its next line
+
 TOO_FAST = "too_fast"
+
+# One burst before it becomes a Burst: x, y (grid units), peak_ms, start_ms, duration_ms.
+RawBurst = tuple[float, float, float, float, float]
 
 # Planning runs on the sleeve before a stroke's first motor command, so the code
 # below works on plain tuples and builds the public dataclasses only for its
@@ -88,6 +93,25 @@ def plan(
     for a stroke that cannot be rendered at all (non-finite, outside the grid,
     bad duration).
     """
+    return outline(
+        stroke, layout, min_command_ms=min_command_ms, merge_distance=merge_distance, strict=strict
+    ).schedule()
+
+
+def outline(
+    stroke: Stroke,
+    layout: Layout,
+    *,
+    min_command_ms: float | None = None,
+    merge_distance: float = MERGE_DISTANCE,
+    strict: bool = False,
+) -> Outline:
+    """The stroke planned up to its bursts (``plan`` without the commands yet).
+
+    Every check ``plan`` makes is made here, so a stroke with an outline plans;
+    its ``schedule()`` is the one ``plan`` returns, and ``head()`` the first of
+    its commands, computed without the rest (see ``Outline``).
+    """
     start, end = _checked_stroke(stroke, layout)
     intensity = layout.default_intensity if stroke.intensity is None else stroke.intensity
     min_ms = layout.shortest_burst_ms if min_command_ms is None else min_command_ms
@@ -106,10 +130,107 @@ def plan(
         left_out = len(fractions) - len(kept)
         points, fractions = [points[i] for i in kept], [fractions[i] for i in kept]
         burst_timings = timings(fractions)
-    bursts = _bursts(points, fractions, burst_timings, duration_ms, intensity)
-    commands = commands_from_spans(_spans_by_actuator(bursts, layout), min_ms)
+    bursts = _bursts(points, fractions, burst_timings, duration_ms)
     stroke = _canonical(stroke, start, end)
-    return Schedule(stroke, commands, duration_ms, adjusted, bursts, left_out)
+    return Outline(stroke, layout, duration_ms, adjusted, intensity, min_ms, bursts, left_out)
+
+
+class Outline:
+    """A stroke planned up to its bursts, each ``(x, y, peak_ms, start_ms, duration_ms)``.
+
+    What admitting a stroke needs (its duration, whether it was slowed) is
+    here; the commands are not yet. ``schedule()`` makes all of them (what
+    ``plan`` returns); ``head(before_ms)`` only those that start before
+    ``before_ms``, exactly as ``schedule()`` has them, from the few bursts
+    around the actuators they drive: a sleeve starts a long stroke's first
+    motors without planning the rest first.
+    """
+
+    __slots__ = (
+        "_schedule",
+        "adjusted",
+        "bursts",
+        "duration_ms",
+        "intensity",
+        "layout",
+        "min_command_ms",
+        "stroke",
+        "thinned",
+    )
+
+    def __init__(
+        self,
+        stroke: Stroke,
+        layout: Layout,
+        duration_ms: float,
+        adjusted: Adjustment | None,
+        intensity: float,
+        min_command_ms: float,
+        bursts: list[RawBurst],
+        thinned: int,
+    ) -> None:
+        self.stroke = stroke
+        self.layout = layout
+        self.duration_ms = duration_ms
+        self.adjusted = adjusted
+        self.intensity = intensity
+        self.min_command_ms = min_command_ms
+        self.bursts = bursts
+        self.thinned = thinned
+        self._schedule: Schedule | None = None
+
+    def schedule(self) -> Schedule:
+        """The whole schedule (made once)."""
+        if self._schedule is None:
+            intensity = self.intensity
+            spans = _spans_by_actuator(self.bursts, intensity, self.layout)
+            self._schedule = Schedule(
+                self.stroke,
+                commands_from_spans(spans, self.min_command_ms),
+                self.duration_ms,
+                self.adjusted,
+                tuple([Burst(x, y, p, s, d, intensity) for x, y, p, s, d in self.bursts]),
+                self.thinned,
+            )
+        return self._schedule
+
+    def head(self, before_ms: float) -> tuple[Command, ...]:
+        """The schedule's commands that start before ``before_ms``, in its order.
+
+        Only an actuator a burst starting before ``before_ms`` drives can have
+        such a command; its commands depend on every burst that drives it (an
+        overlap merges them) and on nothing else. Those bursts lie within one
+        grid unit of it, and the stroke moves away monotonically along each
+        axis, so the bursts are read in order until one lies two grid units or
+        more from each of these actuators along some axis: no burst after it
+        comes back.
+        """
+        if self._schedule is not None:
+            return tuple(c for c in self._schedule.commands if c.start_ms < before_ms)
+        bursts = self.bursts
+        last_early = max((i for i, b in enumerate(bursts) if b[3] < before_ms), default=-1)
+        early: set[Actuator] = set()
+        spans: dict[Actuator, list[Span]] = {}
+        for i, burst in enumerate(bursts):
+            if i > last_early and _far_from(burst, early):
+                break
+            drives = _spans_by_actuator([burst], self.intensity, self.layout)
+            for actuator, actuator_spans in drives.items():
+                spans.setdefault(actuator, []).extend(actuator_spans)
+                if i <= last_early and burst[3] < before_ms:
+                    early.add(actuator)
+        commands = commands_from_spans({a: spans[a] for a in early}, self.min_command_ms)
+        return tuple(c for c in commands if c.start_ms < before_ms)
+
+    def energy_bound_ms(self) -> float:
+        """At least the energy (intensity squared x ms) any one actuator gets from the stroke.
+
+        Funneling splits a burst's energy among its actuators, overlaps add
+        energies (capped at full drive) and a join keeps them: so no actuator
+        gets more than the bursts' energy together.
+        """
+        energy = self.intensity**2
+        return sum(energy * d for _, _, _, _, d in self.bursts if d > 0)
 
 
 def overrun_allowance_ms(duration_ms: float) -> float:
@@ -187,9 +308,17 @@ def virtual_actuators(
     length = math.dist(start, end)
     if length <= ON_LINE_EPSILON:
         return [start], [0.0]
-    crossings = sorted({*_line_crossings(start[0], end[0]), *_line_crossings(start[1], end[1])})
+    (x0, y0), (x1, y1) = start, end
+    crossings = sorted({*_line_crossings(x0, x1), *_line_crossings(y0, y1)})
     fractions = _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
-    points = [_lerp(start, end, f) for f in fractions]
+    points = []
+    for f in fractions:
+        if f == 0.0:
+            points.append(start)
+        elif f == 1.0:
+            points.append(end)
+        else:
+            points.append((_snap(x0 + (x1 - x0) * f), _snap(y0 + (y1 - y0) * f)))
     return points, fractions
 
 
@@ -197,43 +326,28 @@ def _line_crossings(a: float, b: float) -> list[float]:
     """Fractions in (0, 1) where the coordinate goes from a to b through an integer."""
     if abs(b - a) <= ON_LINE_EPSILON:
         return []
-    low, high = min(a, b), max(a, b)
+    low, high = (a, b) if a < b else (b, a)
     first, last = math.ceil(low - ON_LINE_EPSILON), math.floor(high + ON_LINE_EPSILON)
     return [f for k in range(first, last + 1) if 0.0 < (f := (k - a) / (b - a)) < 1.0]
 
 
 def _merged_fractions(fractions: list[float], merge_fraction: float) -> list[float]:
-    """Group sorted fractions closer than ``merge_fraction``; keep 0 and 1 exactly."""
+    """Group sorted fractions closer than ``merge_fraction``; keep 0 and 1 exactly.
+
+    A group is represented by its midpoint, unless it holds an endpoint, which wins.
+    """
     merged: list[float] = []
     first = last = fractions[0]  # of the group being gathered; only they decide its point
     for f in itertools.islice(fractions, 1, None):
         if f - first < merge_fraction:
             last = f
         else:
-            merged.append(_representative(first, last))
+            merged.append(0.0 if first == 0.0 else 1.0 if last == 1.0 else (first + last) / 2)
             first = last = f
     if not merged:
         return [0.0, 1.0]  # shorter than the merge distance: just its two endpoints
-    merged.append(_representative(first, last))
+    merged.append(0.0 if first == 0.0 else 1.0 if last == 1.0 else (first + last) / 2)
     return merged
-
-
-def _representative(first: float, last: float) -> float:
-    if first == 0.0:
-        return 0.0
-    if last == 1.0:
-        return 1.0
-    return (first + last) / 2
-
-
-def _lerp(start: Point, end: Point, fraction: float) -> Point:
-    if fraction == 0.0:
-        return start
-    if fraction == 1.0:
-        return end
-    x = start[0] + (end[0] - start[0]) * fraction
-    y = start[1] + (end[1] - start[1]) * fraction
-    return (_snap(x), _snap(y))
 
 
 def _snap(value: float) -> float:
@@ -246,8 +360,7 @@ def _bursts(
     fractions: Sequence[float],
     timings: Sequence[Timing],
     duration_ms: float,
-    intensity: float,
-) -> tuple[Burst, ...]:
+) -> list[RawBurst]:
     """The bursts at stroke duration ``duration_ms``, the last ending exactly there.
 
     A burst that would run on past the end by more than the allowance is cut
@@ -256,21 +369,28 @@ def _bursts(
     """
     t = duration_ms
     latest_end = t + overrun_allowance_ms(t)
+    last = len(points) - 1
     bursts = []
-    for (x, y), f, (onset_a, onset_b, length_a, length_b) in zip(
-        points[:-1], fractions[:-1], timings[:-1], strict=True
-    ):
+    for i in range(last):
+        onset_a, onset_b, length_a, length_b = timings[i]
         start_ms = onset_a * t + onset_b
         length_ms = length_a * t + length_b
         if start_ms + length_ms > latest_end:
             length_ms = latest_end - start_ms
-        bursts.append(Burst(x, y, f * t, start_ms, length_ms, intensity))
+        x, y = points[i]
+        bursts.append((x, y, fractions[i] * t, start_ms, length_ms))
     # The model's last duration is T - S too, but evaluated as a T + b it would
     # leave a float residue after the stroke's end.
-    (x, y), onset_a, onset_b = points[-1], timings[-1][0], timings[-1][1]
+    (x, y), (onset_a, onset_b, _, _) = points[last], timings[last]
     start_ms = onset_a * t + onset_b
-    bursts.append(Burst(x, y, fractions[-1] * t, start_ms, t - start_ms, intensity))
-    return tuple(bursts)
+    bursts.append((x, y, fractions[last] * t, start_ms, t - start_ms))
+    return bursts
+
+
+def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
+    """Whether the burst lies two grid units or more from each actuator along some axis."""
+    x, y = burst[0], burst[1]
+    return all(abs(x - column) >= 2 or abs(y - row) >= 2 for row, column in actuators)
 
 
 def render_point(burst: Burst, layout: Layout) -> list[Command]:
@@ -307,25 +427,31 @@ def _axis_weights(coordinate: float, count: int) -> list[tuple[int, float]]:
     fraction = coordinate - low
     if fraction <= ON_LINE_EPSILON:
         return [(low, 1.0)]
-    if fraction >= 1 - ON_LINE_EPSILON:
+    if fraction >= _OFF_LINE:
         return [(low + 1, 1.0)]
     return [(low, 1.0 - fraction), (low + 1, fraction)]
 
 
-def _spans_by_actuator(bursts: Iterable[Burst], layout: Layout) -> dict[Actuator, list[Span]]:
+def _spans_by_actuator(
+    bursts: Iterable[RawBurst], intensity: float, layout: Layout
+) -> dict[Actuator, list[Span]]:
     """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
     by_actuator: dict[Actuator, list[Span]] = {}
-    for burst in bursts:
-        if burst.duration_ms <= 0:
+    columns, rows = layout.columns, layout.rows
+    sqrt = math.sqrt
+    for x, y, _, span_start, length_ms in bursts:
+        if length_ms <= 0:
             continue
-        span_start = burst.start_ms
-        span_end = burst.start_ms + burst.duration_ms  # as Command.end_ms computes it
-        column_weights = _axis_weights(burst.x, layout.columns)
+        span_end = span_start + length_ms  # as Command.end_ms computes it
+        column_weights = _axis_weights(x, columns)
         # _funneled, unrolled into this loop: no list per burst on the planning path.
-        for row, wy in _axis_weights(burst.y, layout.rows):
+        for row, wy in _axis_weights(y, rows):
             for column, wx in column_weights:
-                intensity = burst.intensity * math.sqrt(wx * wy)
-                if intensity > 0:
-                    span = (span_start, span_end, intensity)
-                    by_actuator.setdefault((row, column), []).append(span)
+                value = intensity * sqrt(wx * wy)
+                if value > 0:
+                    spans = by_actuator.get((row, column))
+                    if spans is None:
+                        by_actuator[(row, column)] = [(span_start, span_end, value)]
+                    else:
+                        spans.append((span_start, span_end, value))
     return by_actuator

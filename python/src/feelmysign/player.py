@@ -40,6 +40,7 @@ from feelmysign.backends.base import Backend
 from feelmysign.control import Cancel
 from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
+from feelmysign.planner import Outline
 from feelmysign.schedule import Schedule
 from feelmysign.timeline import Capped, Change, Timeline
 
@@ -79,7 +80,9 @@ def wall_ms() -> float:
 class PlannedStroke:
     """A stroke ready to play, with what the events report about it."""
 
-    schedule: Schedule
+    # An outline until the player needs the whole schedule: a stroke that starts at once
+    # gets its first motors on before the rest of it is planned.
+    schedule: Schedule | Outline
     received_at_ms: float  # player clock (monotonic)
     received_wall_ms: float
     info: dict[str, Any] = field(
@@ -90,6 +93,12 @@ class PlannedStroke:
     # duty-cycle cap, cancelled): the daemon then acknowledges the message to the broker.
     acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
+
+    def planned(self) -> Schedule:
+        """The whole schedule (planned now if it was an outline)."""
+        if isinstance(self.schedule, Outline):
+            self.schedule = self.schedule.schedule()
+        return self.schedule
 
 
 @dataclass(frozen=True)
@@ -342,10 +351,17 @@ class Player:
                 log.warning("all motors off as the player stops: %s", error)
 
     def _take_inbox(self) -> None:
-        with self._lock:
+        now = self._clock()
+        with self._lock:  # a stroke is in the inbox or the timeline, never between (idle)
             while self._inbox:
                 stroke = self._inbox.popleft()
-                self._timeline.add(stroke.schedule, stroke.start_ms, stroke)
+                schedule = stroke.schedule
+                if isinstance(schedule, Outline) and stroke.start_ms <= now:
+                    # Due now: its first commands go out before the rest is planned
+                    # (completed right after they are written, see _step).
+                    self._timeline.add_outline(schedule, stroke.start_ms, stroke)
+                else:
+                    self._timeline.add(stroke.planned(), stroke.start_ms, stroke)
 
     def _apply_cancels(self) -> None:
         with self._lock:
@@ -404,6 +420,7 @@ class Player:
         due = self._timeline.pop_due(self._clock())
         written_at_ms = self._clock()  # the first command of a stroke goes out now
         lost = self._write(due.changes)
+        self._timeline.complete()  # the rest of a stroke just started, while it plays
         if lost is not None:
             self._chip_lost(*lost, not_yet_played=due.started)
         for tag in due.started:
@@ -533,7 +550,7 @@ class Player:
             self._pending -= 1
             acknowledge = self._done(stroke)
         self.played += 1
-        schedule = stroke.schedule
+        schedule = stroke.planned()
         timing = {
             **stroke.info,
             "received_at_ms": stroke.received_wall_ms,

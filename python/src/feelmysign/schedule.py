@@ -17,6 +17,20 @@ class Command:
     duration_ms: float
     intensity: float
 
+    def __init__(
+        self, row: int, column: int, start_ms: float, duration_ms: float, intensity: float
+    ) -> None:
+        # The generated __init__ of a frozen dataclass sets each field through
+        # object.__setattr__: a planned stroke makes a dozen commands, and that
+        # took a quarter of planning it. One dict update sets the same fields.
+        self.__dict__.update(
+            row=row,
+            column=column,
+            start_ms=start_ms,
+            duration_ms=duration_ms,
+            intensity=intensity,
+        )
+
     @property
     def end_ms(self) -> float:
         return self.start_ms + self.duration_ms
@@ -36,6 +50,25 @@ class Burst:
     start_ms: float
     duration_ms: float
     intensity: float
+
+    def __init__(
+        self,
+        x: float,
+        y: float,
+        peak_ms: float,
+        start_ms: float,
+        duration_ms: float,
+        intensity: float,
+    ) -> None:
+        # As Command's: one dict update instead of a frozen dataclass's setattr per field.
+        self.__dict__.update(
+            x=x,
+            y=y,
+            peak_ms=peak_ms,
+            start_ms=start_ms,
+            duration_ms=duration_ms,
+            intensity=intensity,
+        )
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,28 @@ class Stroke:
     seq: int | None = None
     sent_at_ms: float | None = None
 
+    def __init__(
+        self,
+        start: Point,
+        end: Point,
+        duration_ms: float,
+        intensity: float | None = None,
+        drawing: str | None = None,
+        seq: int | None = None,
+        sent_at_ms: float | None = None,
+    ) -> None:
+        # A frozen dataclass's own __init__ sets each field through object.__setattr__;
+        # the sleeve makes two strokes per message before its first motor command.
+        self.__dict__.update(
+            start=start,
+            end=end,
+            duration_ms=duration_ms,
+            intensity=intensity,
+            drawing=drawing,
+            seq=seq,
+            sent_at_ms=sent_at_ms,
+        )
+
     @property
     def length(self) -> float:
         """Length in grid units."""

@@ -17,15 +17,21 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Literal
 
 from feelmysign.duty_cycle import Drive, DutyCycle, Refusal
 from feelmysign.layout import Layout
-from feelmysign.schedule import Schedule
+from feelmysign.planner import Outline
+from feelmysign.schedule import Command, Schedule
 
 Actuator = tuple[int, int]
+
+# A stroke added by its outline starts with its commands that start within this (ms after
+# its start), the rest added when it is completed: at least as long as float rounding of a
+# clock reading, so that no later command lands on the start time itself.
+FIRST_COMMANDS_MS = 1.0
 
 
 @dataclass(frozen=True)
@@ -69,13 +75,29 @@ class Cut:
     unstarted: list[object] = field(default_factory=list)
 
 
-@dataclass(frozen=True)
 class _Stroke:
-    """What the start event needs to admit a stroke or drop it: its drive and its commands."""
+    """What the start event needs to admit a stroke or drop it: its drive and its commands.
 
-    tag: object
-    drives: dict[Actuator, list[Drive]]
-    commands: frozenset[int]
+    A stroke added by its outline carries only its first commands until it is
+    completed: ``outline`` is then set, and ``started_ms`` once it started.
+    """
+
+    __slots__ = ("commands", "drives", "outline", "start_ms", "started_ms", "tag")
+
+    def __init__(
+        self,
+        tag: object,
+        drives: dict[Actuator, list[Drive]],
+        commands: set[int],
+        start_ms: float,
+        outline: Outline | None = None,
+    ) -> None:
+        self.tag = tag
+        self.drives = drives
+        self.commands = commands
+        self.start_ms = start_ms
+        self.outline = outline
+        self.started_ms: float | None = None
 
 
 _Kind = Literal["on", "off", "start"]
@@ -102,29 +124,73 @@ class Timeline:
         self._active: dict[Actuator, dict[int, float]] = {}
         self._output: dict[Actuator, float] = {}
         self._dropped: set[int] = set()  # commands of strokes the cap refused
+        self._incomplete: list[_Stroke] = []  # added by their outline, in the order added
         self.duty_cycle = DutyCycle(layout.duty_cycle_window_ms, layout.max_duty_cycle)
 
     def add(self, schedule: Schedule, start_ms: float, tag: object = None) -> None:
         """Play ``schedule`` from ``start_ms``; ``tag`` comes back in ``Due.started`` then
         (or in ``Due.capped``, when the duty-cycle cap keeps it from playing)."""
-        drives: dict[Actuator, list[Drive]] = {}
-        events = []
-        for command in schedule.commands:
+        self.complete()
+        stroke = _Stroke(tag, {}, set(), start_ms)
+        # First, so that it is admitted (or refused) before any of its commands.
+        self._push(_Event(start_ms, 0, "start", tag=tag, stroke=stroke))
+        self._push_commands(stroke, schedule.commands)
+
+    def add_outline(self, outline: Outline, start_ms: float, tag: object = None) -> None:
+        """Play a stroke from its outline: as ``add(outline.schedule(), ...)`` plays it.
+
+        Only its first commands (those within ``FIRST_COMMANDS_MS``) are added now;
+        the rest when ``complete`` is called, at the latest before anything after its
+        start is due. Its start admits it at once when the duty-cycle cap surely lets
+        it play (from an upper bound of its drive); otherwise it is completed there and
+        checked as any other stroke.
+        """
+        self.complete()
+        stroke = _Stroke(tag, {}, set(), start_ms, outline)
+        self._push(_Event(start_ms, 0, "start", tag=tag, stroke=stroke))
+        self._push_commands(stroke, outline.head(FIRST_COMMANDS_MS))
+        self._incomplete.append(stroke)
+
+    def complete(self) -> None:
+        """Add the rest of every stroke added by its outline (a stroke already admitted is
+        committed to the duty cycle now, as at its start)."""
+        while self._incomplete:
+            stroke = self._incomplete.pop(0)
+            outline = stroke.outline
+            assert outline is not None
+            commands = outline.schedule().commands
+            self._push_commands(stroke, [c for c in commands if not c.start_ms < FIRST_COMMANDS_MS])
+            stroke.outline = None
+            # The drives in the schedule's order, as ``add`` keeps them.
+            drives: dict[Actuator, list[Drive]] = {}
+            start_ms = stroke.start_ms
+            for command in commands:
+                on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
+                drive = Drive(on_ms, off_ms, command.intensity**2)
+                drives.setdefault((command.row, command.column), []).append(drive)
+            stroke.drives = drives
+            if stroke.started_ms is not None:
+                self.duty_cycle.commit(drives, stroke.started_ms)
+
+    def _push_commands(self, stroke: _Stroke, commands: Iterable[Command]) -> None:
+        start_ms, tag = stroke.start_ms, stroke.tag
+        for command in commands:
             ident = next(self._commands)
             actuator = (command.row, command.column)
             energy = command.intensity**2
             on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
-            drives.setdefault(actuator, []).append(Drive(on_ms, off_ms, energy))
-            events.append(_Event(on_ms, 0, "on", actuator, ident, energy, tag=tag))
-            events.append(_Event(off_ms, 0, "off", actuator, ident, tag=tag))
-        stroke = _Stroke(tag, drives, frozenset(e.command for e in events))
-        # First, so that it is admitted (or refused) before any of its commands.
-        self._push(_Event(start_ms, 0, "start", tag=tag, stroke=stroke))
-        for event in events:
-            self._push(event)
+            if stroke.outline is None:
+                stroke.drives.setdefault(actuator, []).append(Drive(on_ms, off_ms, energy))
+            stroke.commands.add(ident)
+            self._push(_Event(on_ms, 0, "on", actuator, ident, energy, tag=tag))
+            self._push(_Event(off_ms, 0, "off", actuator, ident, tag=tag))
 
     def next_ms(self) -> float | None:
         """When the next thing is due, or None when nothing is planned."""
+        if self._incomplete and (
+            not self._events or self._events[0].t_ms > self._incomplete[0].start_ms
+        ):
+            self.complete()  # started: its rest may be due first
         return self._events[0].t_ms if self._events else None
 
     @property
@@ -137,6 +203,9 @@ class Timeline:
         due = Due()
         while self._events and self._events[0].t_ms <= now_ms:
             t_ms = self._events[0].t_ms
+            if self._incomplete and t_ms > self._incomplete[0].start_ms:
+                self.complete()  # its rest may be due before this
+                continue
             touched: dict[Actuator, object] = {}  # each actuator, and the stroke that last moved it
             while self._events and self._events[0].t_ms == t_ms:
                 self._apply(heapq.heappop(self._events), touched, due)
@@ -147,6 +216,7 @@ class Timeline:
     def cancel(self, match: Callable[[object], bool], now_ms: float) -> Cut:
         """Drop everything still planned for the strokes whose tag ``match``es; their motors go
         off at ``now_ms`` (a motor another stroke also drives keeps that stroke's intensity)."""
+        self.complete()
         dropped = [e for e in self._events if e.tag is not None and match(e.tag)]
         if not dropped:
             return Cut()
@@ -176,6 +246,7 @@ class Timeline:
 
     def tags(self) -> list[object]:
         """The tags of strokes with anything still planned, each once."""
+        self.complete()
         seen: dict[int, object] = {}
         for event in self._events:
             if event.tag is not None:
@@ -189,6 +260,7 @@ class Timeline:
     def clear(self) -> list[Change]:
         """Drop everything planned; the changes that switch every running actuator off."""
         self._events.clear()
+        self._incomplete.clear()
         self._active.clear()
         self._dropped.clear()
         self.duty_cycle.clear()
@@ -214,6 +286,12 @@ class Timeline:
             touched[event.actuator] = event.tag
 
     def _start(self, stroke: _Stroke, t_ms: float, due: Due) -> None:
+        if stroke.outline is not None:
+            if self.duty_cycle.surely_fits(stroke.outline.energy_bound_ms(), t_ms):
+                stroke.started_ms = t_ms  # committed when completed, before anything else
+                due.started.append(stroke.tag)
+                return
+            self.complete()  # its whole drive decides, as for any stroke
         refusal = self.duty_cycle.check(stroke.drives, t_ms)
         if refusal is None:
             self.duty_cycle.commit(stroke.drives, t_ms)

@@ -4,7 +4,8 @@ Baseline: a bare MQTT publish -> receive on the same broker (QoS 1, the same
 two accounts). Measured: publish -> the sleeve's first actuator command (from
 its ``played`` events), the sleeve's own share (receive -> first command), the
 lateness of every actuator write against the plan, and the gap between
-consecutive strokes of a drawing, for short (1 cm) and long (10 cm) strokes.
+consecutive strokes of a drawing, for strokes of 1, 3, 10 and 30 cm (the share at
+each length: the sleeve starts a stroke's first burst before planning the rest).
 """
 
 from __future__ import annotations
@@ -39,7 +40,18 @@ from feelmysign.topics import strokes_topic, telemetry_topic
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 # 1 cm and 10 cm on the paper's 3 cm grid.
 SHORT = ((1.0, 1.0), (1.0 + 1 / 3, 1.0), 120.0)
+MEDIUM = ((1.0, 1.0), (2.0, 1.0), 300.0)  # 3 cm: one actuator to the next
 LONG = ((0.0, 0.0), (3.0, math.sqrt((10 / 3) ** 2 - 9.0)), 900.0)
+# 30 cm does not fit the paper's sleeve (9 x 6 cm): along a sleeve of 12 columns, 33 cm.
+WIDE_GRID = ("--rows", "3", "--columns", "12", "--spacing-cm", "3")
+LONGEST = ((0.5, 1.0), (10.5, 1.0), 1500.0)
+# (label, stroke, how many, grid options of the sleeve process): the sleeve's share at each.
+LENGTHS = (
+    ("1 cm", SHORT, 100, ()),
+    ("3 cm", MEDIUM, 50, ()),
+    ("10 cm", LONG, 30, ()),
+    ("30 cm", LONGEST, 30, WIDE_GRID),
+)
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -167,7 +179,9 @@ def stroke_latencies(
 
 
 @contextmanager
-def _sleeve_process(c: Credentials, credentials_path: Path) -> Iterator[Callable[[], bool]]:
+def _sleeve_process(
+    c: Credentials, credentials_path: Path, grid: tuple[str, ...] = ()
+) -> Iterator[Callable[[], bool]]:
     """``feelmysign sleeve`` in a process of its own, as on the Pi; yields an idle check."""
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "status"))
@@ -183,6 +197,7 @@ def _sleeve_process(c: Credentials, credentials_path: Path) -> Iterator[Callable
             "10000",
             "--log-level",
             "warning",
+            *grid,
         ],
         stdout=subprocess.DEVNULL,
     )
@@ -242,10 +257,10 @@ def report() -> list[str]:
         c = broker.credentials
         bare = bare_latency_ms(c)
         lines.append(_figures("baseline: bare MQTT publish -> receive (paced)", bare))
-        lines.append("  the sleeve in a process of its own:")
-        with _sleeve_process(c, broker.credentials_path) as is_idle:
-            stroke_latencies(c, is_idle, SHORT, 5)  # warm-up: first-use costs are not latency
-            for label, shape, count in (("1 cm", SHORT, 100), ("10 cm", LONG, 30)):
+        lines.append("  the sleeve in a process of its own (30 cm: on a 3 x 12 grid):")
+        for label, shape, count, grid in LENGTHS:
+            with _sleeve_process(c, broker.credentials_path, grid) as is_idle:
+                stroke_latencies(c, is_idle, shape, 5)  # warm-up: first-use costs are not latency
                 events = stroke_latencies(c, is_idle, shape, count)
                 end_to_end = [e["first_command_at_ms"] - e["published_at_ms"] for e in events]
                 ratio = percentile(end_to_end, 99) / percentile(bare, 99)
@@ -259,9 +274,9 @@ def report() -> list[str]:
                         [e["latency_ms"] for e in events],
                     )
                 )
-                lines.append(
-                    _figures(f"{label}: gap between strokes of a drawing", drawing_gaps(c, shape))
-                )
+                if not grid:
+                    gaps = drawing_gaps(c, shape)
+                    lines.append(_figures(f"{label}: gap between strokes of a drawing", gaps))
         lines.append("  the sleeve in this process (for the player's write times):")
         with _sleeve(c) as sleeve:
             for label, shape in (("1 cm", SHORT), ("10 cm", LONG)):
