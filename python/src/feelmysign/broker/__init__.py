@@ -6,13 +6,8 @@ accounts and ``credentials.json``; ``_config``: the files Mosquitto reads;
 """
 
 from feelmysign.broker.credentials import Account, Credentials, load_credentials
-from feelmysign.broker.mosquitto import (
-    DEFAULT_MQTT_PORT,
-    DEFAULT_SLEEVE_ID,
-    DEFAULT_WS_PORT,
-    Broker,
-    default_state_dir,
-)
+from feelmysign.broker.mosquitto import DEFAULT_WS_PORT, Broker, default_state_dir
+from feelmysign.connection.settings import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
 from feelmysign.errors import BrokerError
 
 __all__ = [

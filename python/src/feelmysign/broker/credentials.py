@@ -24,11 +24,12 @@ import string
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
-from urllib.parse import urlsplit
 
+from feelmysign.connection.settings import BrokerSettings, parse_broker_url
 from feelmysign.errors import BrokerError
 from feelmysign.input_files import MAX_CREDENTIALS_BYTES, loads_json, read_text
 
+Role = Literal["sleeve", "sender"]
 SENDER_USERNAME = "sender"
 SLEEVE_USERNAME_PREFIX = "sleeve-"
 # A sleeve id becomes one level of a topic: no '/', and no MQTT wildcards '+' '#'.
@@ -63,17 +64,27 @@ class Credentials:
     mqtts_url: str | None = None
     ca_fingerprint: str | None = None
 
+    def settings(self, role: Role) -> BrokerSettings:
+        """How ``role`` reaches the broker at ``mqtt_url``: its login, and this sleeve's id."""
+        account = self.sender if role == "sender" else self.sleeve
+        return parse_broker_url(
+            self.mqtt_url,
+            username=account.username,
+            password=account.password,
+            sleeve_id=self.sleeve_id,
+        )
+
     @property
     def mqtt_host(self) -> str:
-        return urlsplit(self.mqtt_url).hostname or "127.0.0.1"
+        return parse_broker_url(self.mqtt_url).host
 
     @property
     def mqtt_port(self) -> int:
-        return urlsplit(self.mqtt_url).port or 1883
+        return parse_broker_url(self.mqtt_url).port
 
     @property
     def ws_port(self) -> int:
-        return urlsplit(self.ws_url).port or 80
+        return parse_broker_url(self.ws_url).port
 
     def to_json(self) -> dict[str, Any]:
         tls = {"mqtts_url": self.mqtts_url} if self.mqtts_url else {}
@@ -129,7 +140,7 @@ def load_credentials(path: str | Path) -> Credentials:
     return _credentials_from_json(_read_json(path), path)
 
 
-def load_login(path: str | Path, role: Literal["sleeve", "sender"]) -> Login:
+def load_login(path: str | Path, role: Role) -> Login:
     """The login of ``role`` from a ``credentials.json`` or a ``sleeve-credentials.json``."""
     path = Path(path)
     data = _read_json(path)

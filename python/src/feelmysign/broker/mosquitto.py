@@ -37,13 +37,12 @@ from feelmysign.broker.credentials import (
     write_sleeve_credentials,
 )
 from feelmysign.broker.tls import LanOptions, TlsFiles
+from feelmysign.connection.settings import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
 from feelmysign.errors import BrokerError
 from feelmysign.lifecycle import Started
 from feelmysign.topics import LEGACY_TOPIC
 
-DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
 DEFAULT_WS_PORT = 9001  # the WebSocket port of Mosquitto's documentation and examples
-DEFAULT_SLEEVE_ID = "sleeve1"
 DEFAULT_READY_TIMEOUT_S = 10.0
 DEFAULT_STOP_TIMEOUT_S = 5.0
 # Ports chosen by us (port=0) can be taken by someone else before Mosquitto binds them.
