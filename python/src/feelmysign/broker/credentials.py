@@ -103,16 +103,6 @@ class Credentials:
         }
 
 
-@dataclass(frozen=True)
-class Login:
-    """What one program takes from a credentials file: the broker URL, the sleeve id, its
-    account."""
-
-    mqtt_url: str
-    sleeve_id: str
-    account: Account
-
-
 def check_sleeve_id(sleeve_id: str) -> str:
     """Return ``sleeve_id`` if it can be one topic level, else raise a BrokerError saying why."""
     if not SLEEVE_ID_PATTERN.fullmatch(sleeve_id):
@@ -140,8 +130,9 @@ def load_credentials(path: str | Path) -> Credentials:
     return _credentials_from_json(_read_json(path), path)
 
 
-def load_login(path: str | Path, role: Role) -> Login:
-    """The login of ``role`` from a ``credentials.json`` or a ``sleeve-credentials.json``."""
+def load_login(path: str | Path, role: Role) -> BrokerSettings:
+    """How ``role`` reaches the broker, from a ``credentials.json`` or a
+    ``sleeve-credentials.json``: its URL, the login of ``role`` and the sleeve id."""
     path = Path(path)
     data = _read_json(path)
     if isinstance(data, dict) and "sender" not in data and "sleeve" in data:
@@ -152,9 +143,7 @@ def load_login(path: str | Path, role: Role) -> Login:
                 "broker's credentials.json",
             )
         return _sleeve_login_from_json(data, path)
-    credentials = _credentials_from_json(data, path)
-    account = credentials.sender if role == "sender" else credentials.sleeve
-    return Login(credentials.mqtt_url, credentials.sleeve_id, account)
+    return _credentials_from_json(data, path).settings(role)
 
 
 def _read_json(path: Path) -> object:
@@ -171,19 +160,18 @@ def _read_json(path: Path) -> object:
         raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
 
 
-def _sleeve_login_from_json(data: dict[str, Any], path: Path) -> Login:
+def _sleeve_login_from_json(data: dict[str, Any], path: Path) -> BrokerSettings:
     try:
         sleeve = data["sleeve"]
-        login = Login(
-            mqtt_url=_text(data["mqtt_url"]),
-            sleeve_id=_text(sleeve["id"]),
-            account=Account(_text(sleeve["username"]), _text(sleeve["password"])),
-        )
+        mqtt_url, sleeve_id = _text(data["mqtt_url"]), _text(sleeve["id"])
+        account = Account(_text(sleeve["username"]), _text(sleeve["password"]))
     except (KeyError, TypeError):
         raise _bad_file(path, "it lacks mqtt_url or sleeve{id, username, password}") from None
-    check_sleeve_id(login.sleeve_id)
-    _check_account(login.account, path)
-    return login
+    check_sleeve_id(sleeve_id)
+    _check_account(account, path)
+    return parse_broker_url(
+        mqtt_url, username=account.username, password=account.password, sleeve_id=sleeve_id
+    )
 
 
 def _check_account(account: Account, path: Path) -> None:
