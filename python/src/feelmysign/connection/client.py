@@ -199,16 +199,8 @@ def _connect_with(
 
     client = new_client(settings, client_id=client_id, protocol=protocol)
     client.connect_timeout = timeout_s
-    answers: list[ReasonCode] = []
-
-    def on_connect(
-        _client: mqtt.Client, _userdata: Any, _flags: Any, code: ReasonCode, _props: Any
-    ) -> None:
-        answers.append(code)
-
-    client.on_connect = on_connect
     try:
-        client.connect(settings.host, settings.port, keepalive=KEEPALIVE_S)
+        answers = _send_login(client, settings, keepalive_s=KEEPALIVE_S)
     except (OSError, mqtt.WebsocketConnectionError) as error:
         raise BrokerConnectionError(
             failure_reason(error), connect_failure_message(settings, error), url=settings.url
@@ -236,8 +228,21 @@ def probe_login(
 ) -> bool | None:
     """Try one MQTT 3.1.1 login and leave: True if accepted, False if refused, None if
     nobody answered within ``timeout_s`` (the broker is not listening yet, or not ready)."""
-
     client = new_client(settings, client_id=client_id)
+    try:
+        answers = _send_login(client, settings, keepalive_s=PROBE_KEEPALIVE_S)
+    except OSError:
+        return None
+    _await_connack(client, answers, timeout_s=timeout_s, poll_s=poll_s)
+    # Without a network thread paho writes the DISCONNECT and closes the socket right here.
+    client.disconnect()
+    return not answers[0].is_failure if answers else None
+
+
+def _send_login(
+    client: mqtt.Client, settings: BrokerSettings, *, keepalive_s: int
+) -> list[ReasonCode]:
+    """Open the connection and send the CONNECT; the list ``on_connect`` puts the CONNACK in."""
     answers: list[ReasonCode] = []
 
     def on_connect(
@@ -246,14 +251,8 @@ def probe_login(
         answers.append(code)
 
     client.on_connect = on_connect
-    try:
-        client.connect(settings.host, settings.port, keepalive=PROBE_KEEPALIVE_S)
-    except OSError:
-        return None
-    _await_connack(client, answers, timeout_s=timeout_s, poll_s=poll_s)
-    # Without a network thread paho writes the DISCONNECT and closes the socket right here.
-    client.disconnect()
-    return not answers[0].is_failure if answers else None
+    client.connect(settings.host, settings.port, keepalive=keepalive_s)
+    return answers
 
 
 def _await_connack(
