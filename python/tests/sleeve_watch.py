@@ -28,13 +28,7 @@ Check = Callable[[str, dict[str, Any]], bool]
 
 def settings(credentials: Credentials, role: str) -> BrokerSettings:
     """How the ``sleeve`` or the ``sender`` account of a ``feelmysign broker`` logs in."""
-    account = credentials.sleeve if role == "sleeve" else credentials.sender
-    return BrokerSettings(
-        credentials.mqtt_host,
-        credentials.mqtt_port,
-        username=account.username,
-        password=account.password,
-    )
+    return credentials.settings("sleeve" if role == "sleeve" else "sender")
 
 
 def connected_client(

@@ -23,6 +23,7 @@ import sys
 import textwrap
 import threading
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import IO, Literal, Protocol
 
@@ -35,6 +36,7 @@ from feelmysign.broker import Account, Broker, BrokerError, Credentials, load_cr
 from feelmysign.broker._config import hash_password
 from feelmysign.broker._process import find_mosquitto
 from feelmysign.broker.credentials import new_password
+from feelmysign.connection import probe_login
 
 pytestmark = pytest.mark.broker
 
@@ -294,6 +296,15 @@ def test_bad_logins_are_refused(broker: Broker, account: Account | None) -> None
         assert client.connack() == NOT_AUTHORIZED
     finally:
         client.close()
+
+
+def test_a_login_probe_tells_accepted_refused_and_nobody_answering(broker: Broker) -> None:
+    c = broker.credentials
+    sender = c.settings("sender")
+    wrong = replace(sender, password="wrong-password")
+    nobody = replace(sender, port=free_port())
+    answers = [probe_login(s, client_id="probe", timeout_s=WAIT_S) for s in (sender, wrong, nobody)]
+    assert answers == [True, False, None]
 
 
 def test_oversized_packets_are_refused(broker: Broker, connect: Connect) -> None:

@@ -10,6 +10,7 @@ import threading
 import time
 import uuid
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -33,13 +34,8 @@ LEGACY = "deviceOne/line"
 
 
 def _settings(credentials: Credentials, role: str, password: str | None = None) -> BrokerSettings:
-    account = credentials.sleeve if role == "sleeve" else credentials.sender
-    return BrokerSettings(
-        credentials.mqtt_host,
-        credentials.mqtt_port,
-        username=account.username,
-        password=password or account.password,
-    )
+    settings = credentials.settings("sleeve" if role == "sleeve" else "sender")
+    return replace(settings, password=password or settings.password)
 
 
 class Running:

@@ -22,7 +22,12 @@ def test_the_broker_writes_a_private_sleeve_only_file(broker: Broker) -> None:
     c = broker.credentials
     assert c.sender.password not in text and "sender" not in json.loads(text)
     login = load_login(path, "sleeve")
-    assert (login.mqtt_url, login.sleeve_id, login.account) == (c.mqtt_url, c.sleeve_id, c.sleeve)
+    assert (login.url, login.sleeve_id, login.username, login.password) == (
+        c.mqtt_url,
+        c.sleeve_id,
+        c.sleeve.username,
+        c.sleeve.password,
+    )
 
 
 def test_a_sleeve_only_file_cannot_send(broker: Broker) -> None:

@@ -13,7 +13,6 @@ from study_helpers import REPO
 
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker
-from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.study import StudyStore, load_design
@@ -25,9 +24,7 @@ QUICK_DESIGN = REPO / "deploy" / "studies" / "quick.toml"
 @pytest.fixture
 def sleeve(broker: Broker) -> Iterator[Sleeve]:
     c = broker.credentials
-    settings = BrokerSettings(
-        c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
-    )
+    settings = c.settings("sleeve")
     backend = SimBackend(PAPER_SLEEVE)
     running = Sleeve(settings, PAPER_SLEEVE, backend, SleeveOptions(sleeve_id=c.sleeve_id))
     thread = threading.Thread(target=running.run, daemon=True)

@@ -10,7 +10,7 @@ the last state of a burst is always published, one interval after the frame
 before it at the latest. The daemon, for instance::
 
     telemetry = ActuatorTelemetry(
-        lambda frame: client.publish(f"feelmysign/{sleeve_id}/actuators",
+        lambda frame: client.publish(telemetry_topic(sleeve_id, "actuators"),
                                      json.dumps(frame.as_dict())),
         rate_hz=20.0,
     )

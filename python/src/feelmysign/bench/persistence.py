@@ -21,7 +21,7 @@ import uuid
 from pathlib import Path
 
 from feelmysign.broker import Broker
-from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.connection import new_client
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic
@@ -34,9 +34,7 @@ WAIT_S = 10.0
 def _round_trips_ms(broker: Broker, strokes: int) -> list[float]:
     c = broker.credentials
     sleeve = new_client(
-        BrokerSettings(
-            c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
-        ),
+        c.settings("sleeve"),
         client_id=f"bench-sleeve-{uuid.uuid4()}",
         persistent_session=True,
     )
@@ -46,9 +44,7 @@ def _round_trips_ms(broker: Broker, strokes: int) -> list[float]:
     sleeve.connect(c.mqtt_host, c.mqtt_port)
     sleeve.loop_start()
     sender = new_client(
-        BrokerSettings(
-            c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
-        ),
+        c.settings("sender"),
         client_id=f"bench-sender-{uuid.uuid4()}",
     )
     sender.connect(c.mqtt_host, c.mqtt_port)

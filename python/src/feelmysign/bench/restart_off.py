@@ -48,7 +48,7 @@ import paho.mqtt.client as mqtt
 import feelmysign
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.broker import Broker, Credentials
-from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.connection import new_client
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic, telemetry_topic
@@ -107,9 +107,7 @@ class _Online:
     """Counts the sleeve's "online" status messages."""
 
     def __init__(self, c: Credentials) -> None:
-        settings = BrokerSettings(
-            c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
-        )
+        settings = c.settings("sender")
         self.count = 0
         self._lock = threading.Lock()
         self.client = new_client(settings, client_id="bench-restart-watch")

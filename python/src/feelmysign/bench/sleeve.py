@@ -60,10 +60,7 @@ def percentile(values: list[float], q: float) -> float:
 
 
 def _settings(c: Credentials, role: str) -> BrokerSettings:
-    account = c.sleeve if role == "sleeve" else c.sender
-    return BrokerSettings(
-        c.mqtt_host, c.mqtt_port, username=account.username, password=account.password
-    )
+    return c.settings("sleeve" if role == "sleeve" else "sender")
 
 
 class _Inbox:

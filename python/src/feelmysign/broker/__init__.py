@@ -1,18 +1,16 @@
 """The local broker: Mosquitto run as a child process from a generated config.
 
 ``mosquitto``: the ``Broker`` object (start, wait, stop); ``credentials``: the
-accounts and ``credentials.json``; ``_config``: the files Mosquitto reads;
-``_process``: finding, starting and probing the executable.
+accounts and ``credentials.json`` (``Credentials.settings(role)``: how the sleeve or
+the sender connects, as ``connection.BrokerSettings``); ``_config``: the files
+Mosquitto reads (``StateFiles``, where they all live, is public here); ``_process``:
+finding, starting and stopping the executable.
 """
 
+from feelmysign.broker._config import StateFiles
 from feelmysign.broker.credentials import Account, Credentials, load_credentials
-from feelmysign.broker.mosquitto import (
-    DEFAULT_MQTT_PORT,
-    DEFAULT_SLEEVE_ID,
-    DEFAULT_WS_PORT,
-    Broker,
-    default_state_dir,
-)
+from feelmysign.broker.mosquitto import DEFAULT_WS_PORT, Broker, default_state_dir
+from feelmysign.connection.settings import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
 from feelmysign.errors import BrokerError
 
 __all__ = [
@@ -23,6 +21,7 @@ __all__ = [
     "Broker",
     "BrokerError",
     "Credentials",
+    "StateFiles",
     "default_state_dir",
     "load_credentials",
 ]

@@ -17,27 +17,18 @@ import socket
 import subprocess
 import sys
 import threading
-import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import IO, TYPE_CHECKING
+from typing import IO
 
-from feelmysign.broker.credentials import Account
 from feelmysign.errors import BrokerError
 
 INSTALL_HINT = (
     "Install it with 'sudo apt-get install mosquitto' (or 'make system' in the repository)."
 )
-
-if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
-    import paho.mqtt.client as mqtt
-    from paho.mqtt.properties import Properties
-    from paho.mqtt.reasoncodes import ReasonCode
 # Debian installs the broker in sbin, which is not on a normal user's PATH.
 SBIN_DIRS = ("/usr/sbin", "/usr/local/sbin")
 VERSION_TIMEOUT_S = 5.0
-PROBE_INTERVAL_S = 0.02
-PROBE_KEEPALIVE_S = 10
 PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
 LOG_TAIL_BYTES = 16_384
 
@@ -182,40 +173,6 @@ def log_tail(path: Path, *, start_offset_bytes: int = 0, lines: int = 15) -> str
     except OSError:
         return ""
     return "\n".join(text.splitlines()[-lines:])
-
-
-def accepts_login(host: str, port: int, account: Account, *, timeout_s: float) -> bool | None:
-    """Try one MQTT login: True if accepted, False if refused, None if nobody answered yet."""
-    import paho.mqtt.client as mqtt
-    from paho.mqtt.enums import CallbackAPIVersion
-
-    connack: list[bool] = []
-    client = mqtt.Client(
-        CallbackAPIVersion.VERSION2, client_id=f"feelmysign-ready-probe-{os.getpid()}"
-    )
-    client.username_pw_set(account.username, account.password)
-
-    def on_connect(
-        _client: mqtt.Client,
-        _userdata: object,
-        _flags: mqtt.ConnectFlags,
-        reason_code: ReasonCode,
-        _properties: Properties | None,
-    ) -> None:
-        connack.append(not reason_code.is_failure)
-
-    client.on_connect = on_connect
-    try:
-        client.connect(host, port, keepalive=PROBE_KEEPALIVE_S)
-    except OSError:
-        return None
-    deadline = time.monotonic() + timeout_s
-    while not connack and time.monotonic() < deadline:
-        if client.loop(timeout=PROBE_INTERVAL_S) != mqtt.MQTT_ERR_SUCCESS:
-            break
-    # Without a network thread paho writes the DISCONNECT and closes the socket right here.
-    client.disconnect()
-    return connack[0] if connack else None
 
 
 def accepts_tcp(host: str, port: int, *, timeout_s: float) -> bool:

@@ -24,11 +24,12 @@ import string
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
-from urllib.parse import urlsplit
 
+from feelmysign.connection.settings import BrokerSettings, parse_broker_url
 from feelmysign.errors import BrokerError
 from feelmysign.input_files import MAX_CREDENTIALS_BYTES, loads_json, read_text
 
+Role = Literal["sleeve", "sender"]
 SENDER_USERNAME = "sender"
 SLEEVE_USERNAME_PREFIX = "sleeve-"
 # A sleeve id becomes one level of a topic: no '/', and no MQTT wildcards '+' '#'.
@@ -63,17 +64,27 @@ class Credentials:
     mqtts_url: str | None = None
     ca_fingerprint: str | None = None
 
+    def settings(self, role: Role) -> BrokerSettings:
+        """How ``role`` reaches the broker at ``mqtt_url``: its login, and this sleeve's id."""
+        account = self.sender if role == "sender" else self.sleeve
+        return parse_broker_url(
+            self.mqtt_url,
+            username=account.username,
+            password=account.password,
+            sleeve_id=self.sleeve_id,
+        )
+
     @property
     def mqtt_host(self) -> str:
-        return urlsplit(self.mqtt_url).hostname or "127.0.0.1"
+        return parse_broker_url(self.mqtt_url).host
 
     @property
     def mqtt_port(self) -> int:
-        return urlsplit(self.mqtt_url).port or 1883
+        return parse_broker_url(self.mqtt_url).port
 
     @property
     def ws_port(self) -> int:
-        return urlsplit(self.ws_url).port or 80
+        return parse_broker_url(self.ws_url).port
 
     def to_json(self) -> dict[str, Any]:
         tls = {"mqtts_url": self.mqtts_url} if self.mqtts_url else {}
@@ -90,16 +101,6 @@ class Credentials:
             },
             "sender": {"username": self.sender.username, "password": self.sender.password},
         }
-
-
-@dataclass(frozen=True)
-class Login:
-    """What one program takes from a credentials file: the broker URL, the sleeve id, its
-    account."""
-
-    mqtt_url: str
-    sleeve_id: str
-    account: Account
 
 
 def check_sleeve_id(sleeve_id: str) -> str:
@@ -129,8 +130,9 @@ def load_credentials(path: str | Path) -> Credentials:
     return _credentials_from_json(_read_json(path), path)
 
 
-def load_login(path: str | Path, role: Literal["sleeve", "sender"]) -> Login:
-    """The login of ``role`` from a ``credentials.json`` or a ``sleeve-credentials.json``."""
+def load_login(path: str | Path, role: Role) -> BrokerSettings:
+    """How ``role`` reaches the broker, from a ``credentials.json`` or a
+    ``sleeve-credentials.json``: its URL, the login of ``role`` and the sleeve id."""
     path = Path(path)
     data = _read_json(path)
     if isinstance(data, dict) and "sender" not in data and "sleeve" in data:
@@ -141,9 +143,7 @@ def load_login(path: str | Path, role: Literal["sleeve", "sender"]) -> Login:
                 "broker's credentials.json",
             )
         return _sleeve_login_from_json(data, path)
-    credentials = _credentials_from_json(data, path)
-    account = credentials.sender if role == "sender" else credentials.sleeve
-    return Login(credentials.mqtt_url, credentials.sleeve_id, account)
+    return _credentials_from_json(data, path).settings(role)
 
 
 def _read_json(path: Path) -> object:
@@ -160,19 +160,18 @@ def _read_json(path: Path) -> object:
         raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
 
 
-def _sleeve_login_from_json(data: dict[str, Any], path: Path) -> Login:
+def _sleeve_login_from_json(data: dict[str, Any], path: Path) -> BrokerSettings:
     try:
         sleeve = data["sleeve"]
-        login = Login(
-            mqtt_url=_text(data["mqtt_url"]),
-            sleeve_id=_text(sleeve["id"]),
-            account=Account(_text(sleeve["username"]), _text(sleeve["password"])),
-        )
+        mqtt_url, sleeve_id = _text(data["mqtt_url"]), _text(sleeve["id"])
+        account = Account(_text(sleeve["username"]), _text(sleeve["password"]))
     except (KeyError, TypeError):
         raise _bad_file(path, "it lacks mqtt_url or sleeve{id, username, password}") from None
-    check_sleeve_id(login.sleeve_id)
-    _check_account(login.account, path)
-    return login
+    check_sleeve_id(sleeve_id)
+    _check_account(account, path)
+    return parse_broker_url(
+        mqtt_url, username=account.username, password=account.password, sleeve_id=sleeve_id
+    )
 
 
 def _check_account(account: Account, path: Path) -> None:

@@ -28,7 +28,6 @@ from feelmysign.broker import _process as process_
 from feelmysign.broker._config import LOOPBACK_ADDRESS, StateFiles, TlsListener, render_config
 from feelmysign.broker.accounts import write_auth_files, write_runtime
 from feelmysign.broker.credentials import (
-    Account,
     Credentials,
     check_sleeve_id,
     reuse_or_create,
@@ -37,13 +36,13 @@ from feelmysign.broker.credentials import (
     write_sleeve_credentials,
 )
 from feelmysign.broker.tls import LanOptions, TlsFiles
+from feelmysign.connection.client import probe_login
+from feelmysign.connection.settings import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
 from feelmysign.errors import BrokerError
 from feelmysign.lifecycle import Started
 from feelmysign.topics import LEGACY_TOPIC
 
-DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
 DEFAULT_WS_PORT = 9001  # the WebSocket port of Mosquitto's documentation and examples
-DEFAULT_SLEEVE_ID = "sleeve1"
 DEFAULT_READY_TIMEOUT_S = 10.0
 DEFAULT_STOP_TIMEOUT_S = 5.0
 # Ports chosen by us (port=0) can be taken by someone else before Mosquitto binds them.
@@ -270,7 +269,7 @@ class Broker(Started):
             executable=executable,
         )
         try:
-            self._wait_until_ready(credentials.sender, port, ws_port, log_offset_bytes)
+            self._wait_until_ready(credentials, port, ws_port, log_offset_bytes)
         except BaseException:
             self.stop()
             raise
@@ -327,10 +326,13 @@ class Broker(Started):
         return TlsListener(self._lan.host, self._lan.port, self._tls.cert, self._tls.key)
 
     def _wait_until_ready(
-        self, sender: Account, port: int, ws_port: int, log_offset_bytes: int
+        self, credentials: Credentials, port: int, ws_port: int, log_offset_bytes: int
     ) -> None:
-        """Return once Mosquitto accepts the sender's login on ``port`` and TCP on ``ws_port``."""
+        """Return once Mosquitto accepts the sender's login on ``port`` (the port of
+        ``credentials.mqtt_url``) and TCP on ``ws_port``."""
         assert self._process is not None
+        sender = credentials.settings("sender")
+        probe_id = f"feelmysign-ready-probe-{os.getpid()}"
         deadline = time.monotonic() + self._ready_timeout_s
         while True:
             code = self._process.poll()
@@ -340,7 +342,7 @@ class Broker(Started):
             if remaining_s <= 0:
                 raise self._not_ready_error(port, log_offset_bytes)
             probe_s = min(remaining_s, READY_PROBE_TIMEOUT_S)
-            accepted = process_.accepts_login(LOOPBACK_ADDRESS, port, sender, timeout_s=probe_s)
+            accepted = probe_login(sender, client_id=probe_id, timeout_s=probe_s)
             if accepted is False:
                 raise self._login_refused_error(port, log_offset_bytes)
             if (

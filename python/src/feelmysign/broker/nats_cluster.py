@@ -29,9 +29,6 @@ import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import paho.mqtt.client as mqtt
-from paho.mqtt.enums import CallbackAPIVersion
-
 from feelmysign.broker import _process as process_
 from feelmysign.broker.credentials import (
     Account,
@@ -43,6 +40,7 @@ from feelmysign.broker.credentials import (
 )
 from feelmysign.broker.nats_accounts import render_nats_accounts
 from feelmysign.broker.tls import TlsFiles
+from feelmysign.connection.client import probe_login
 from feelmysign.errors import BrokerError
 from feelmysign.lifecycle import Started
 from feelmysign.topics import LEGACY_TOPIC
@@ -188,7 +186,11 @@ class NatsCluster(Started):
 
     def _wait_ready(self, index: int) -> None:
         """Until node ``index`` accepts an MQTT login (possible only once JetStream is up)."""
-        node, sender = self.nodes[index], self.credentials.sender
+        node = self.nodes[index]
+        sender = replace(self.credentials, mqtt_url=node.mqtt_url).settings("sender")
+        if self.tls is not None:
+            sender = replace(sender, ca_file=str(self.tls.ca) if self.tls.ca else None)
+        probe_id = f"ready-{os.getpid()}"
         deadline = time.monotonic() + READY_TIMEOUT_S
         while time.monotonic() < deadline:
             process = self._processes[index]
@@ -196,7 +198,7 @@ class NatsCluster(Started):
                 raise BrokerError(
                     "start-failed", f"nats-server {node.name} exited: {self.log(index)}"
                 )
-            if _accepts_mqtt_login(node.mqtt_port, sender, self.tls):
+            if probe_login(sender, client_id=probe_id, timeout_s=2.0, poll_s=0.1):
                 return
             time.sleep(READY_POLL_S)
         raise BrokerError(
@@ -231,27 +233,6 @@ class NatsCluster(Started):
                     process.kill()
                     process.wait()
                 self._processes[index] = None
-
-
-def _accepts_mqtt_login(port: int, account: Account, tls: TlsFiles | None) -> bool:
-    connacks: list[bool] = []
-    client = mqtt.Client(
-        CallbackAPIVersion.VERSION2, client_id=f"ready-{os.getpid()}", protocol=mqtt.MQTTv311
-    )
-    if tls is not None:
-        client.tls_set(ca_certs=str(tls.ca) if tls.ca else None)
-    client.username_pw_set(account.username, account.password)
-    client.on_connect = lambda _c, _u, _f, code, _p: connacks.append(not code.is_failure)
-    try:
-        client.connect("127.0.0.1", port, keepalive=10)
-    except OSError:
-        return False
-    deadline = time.monotonic() + 2.0
-    while not connacks and time.monotonic() < deadline:
-        if client.loop(timeout=0.1) != mqtt.MQTT_ERR_SUCCESS:
-            break
-    client.disconnect()
-    return bool(connacks and connacks[0])
 
 
 def main(argv: list[str]) -> int:

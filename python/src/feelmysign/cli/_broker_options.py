@@ -19,18 +19,16 @@ from __future__ import annotations
 
 import argparse
 import os
+from dataclasses import replace
 from pathlib import Path
-from typing import Literal
 
 from feelmysign.broker import DEFAULT_SLEEVE_ID, default_state_dir
-from feelmysign.broker.credentials import Login, check_sleeve_id, load_login
+from feelmysign.broker.credentials import Role, check_sleeve_id, load_login
 from feelmysign.cli._inputs import MAX_CREDENTIALS_BYTES, check_input_file, not_empty, sleeve_id
 from feelmysign.connection import DEFAULT_BROKER_URL, BrokerSettings, parse_broker_url
 from feelmysign.connection.join_token import default_trust_dir, join_settings
 from feelmysign.connection.settings import PASSWORD_ENV, USERNAME_ENV
 from feelmysign.errors import BrokerConnectionError
-
-Role = Literal["sender", "sleeve"]
 
 BROKER_ENV = "FEELMYSIGN_BROKER"
 SLEEVE_ID_ENV = "FEELMYSIGN_SLEEVE_ID"
@@ -127,18 +125,19 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
             f"(or ${PASSWORD_ENV}), or use --credentials FILE.",
         )
     if username is None and login is not None:
-        username, password = login.account.username, login.account.password
-    if url is None:
-        url = login.mqtt_url if login is not None else DEFAULT_BROKER_URL
+        username, password = login.username, login.password
     sleeve_id = args.sleeve_id or env.get(SLEEVE_ID_ENV) or None
     if sleeve_id is None:
         sleeve_id = login.sleeve_id if login is not None else DEFAULT_SLEEVE_ID
+    sleeve_id = check_sleeve_id(sleeve_id)
+    if url is None and login is not None:
+        return replace(login, username=username, password=password, sleeve_id=sleeve_id)
     return parse_broker_url(
-        url, username=username, password=password, sleeve_id=check_sleeve_id(sleeve_id)
+        url or DEFAULT_BROKER_URL, username=username, password=password, sleeve_id=sleeve_id
     )
 
 
-def _login(path: str | None, url: str | None, role: Role) -> Login | None:
+def _login(path: str | None, url: str | None, role: Role) -> BrokerSettings | None:
     local = local_credentials_path()
     if not path and (url is not None or not local.is_file()):
         return None

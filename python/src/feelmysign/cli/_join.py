@@ -7,8 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from feelmysign.broker import default_state_dir, load_credentials
-from feelmysign.broker._config import StateFiles
+from feelmysign.broker import StateFiles, default_state_dir, load_credentials
 from feelmysign.broker.accounts import reload_running_broker
 from feelmysign.broker.credentials import check_sleeve_id
 from feelmysign.broker.nats_accounts import render_nats_accounts

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import logging
 import threading
-from urllib.parse import urlsplit
 
 from feelmysign.broker import Broker
 from feelmysign.daemon import CONNECTION_STATE, Sleeve
@@ -141,8 +140,8 @@ class Watchdog(Started):
         c = self._credentials
         broker = Broker(
             state_dir=self._broker.state_dir,
-            port=urlsplit(c.mqtt_url).port or 0,
-            ws_port=urlsplit(c.ws_url).port or 0,
+            port=c.mqtt_port,
+            ws_port=c.ws_port,
             sleeve_id=c.sleeve_id,
         )
         try:

@@ -25,7 +25,6 @@ from feelmysign.cli._page_server import page_server, qr_text
 from feelmysign.cli._signals import call_on_stop_signals
 from feelmysign.cli._watchdog import Watchdog
 from feelmysign.cli.sleeve import run_sleeve
-from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.webserver import WEB_DIST, Api
 
@@ -125,14 +124,10 @@ def run(args: argparse.Namespace) -> int:
             broker, http_port=args.http_port, directory=args.web_dir, api=api
         )
         with server:
-            settings = BrokerSettings(
-                c.mqtt_host, c.mqtt_port, username=c.sleeve.username, password=c.sleeve.password
-            )
+            settings = c.settings("sleeve")
             options = SleeveOptions(sleeve_id=c.sleeve_id, backend_name=args.sleeve_backend)
 
-            sender = BrokerSettings(
-                c.mqtt_host, c.mqtt_port, username=c.sender.username, password=c.sender.password
-            )
+            sender = c.settings("sender")
 
             def started(sleeve: Sleeve) -> None:
                 _stop_on_signals(sleeve, watchdog)

@@ -7,6 +7,7 @@ from feelmysign.connection.client import (
     connect_client,
     jitter_reconnects,
     new_client,
+    probe_login,
 )
 from feelmysign.connection.failures import connect_failure_message
 from feelmysign.connection.settings import (
@@ -30,4 +31,5 @@ __all__ = [
     "jitter_reconnects",
     "new_client",
     "parse_broker_url",
+    "probe_login",
 ]

@@ -1,6 +1,6 @@
 """The one MQTT client factory: every program of feelmysign (sleeve, sender, tools,
 benchmarks) connects through ``new_client`` or ``connect_client``, so they share the
-transport, TLS and protocol choices.
+transport, TLS and protocol choices; ``probe_login`` asks whether a broker is ready.
 """
 
 from __future__ import annotations
@@ -29,6 +29,10 @@ KEEPALIVE_S = 30  # a dead connection is noticed within 1.5 x this
 # broker, drawn at random each time so that many clients do not return all at once.
 RECONNECT_MIN_S = 0.5
 RECONNECT_MAX_S = 3.0
+# A readiness probe: a broker starting up on this machine answers within milliseconds.
+PROBE_POLL_S = 0.02
+PROBE_KEEPALIVE_S = 10
+CONNACK_POLL_S = 1.0
 
 
 def _to_stderr(text: str) -> None:
@@ -195,34 +199,18 @@ def _connect_with(
 
     client = new_client(settings, client_id=client_id, protocol=protocol)
     client.connect_timeout = timeout_s
-    answers: list[ReasonCode] = []
-
-    def on_connect(
-        _client: mqtt.Client, _userdata: Any, _flags: Any, code: ReasonCode, _props: Any
-    ) -> None:
-        answers.append(code)
-
-    client.on_connect = on_connect
     try:
-        client.connect(settings.host, settings.port, keepalive=KEEPALIVE_S)
+        answers = _send_login(client, settings, keepalive_s=KEEPALIVE_S)
     except (OSError, mqtt.WebsocketConnectionError) as error:
         raise BrokerConnectionError(
             failure_reason(error), connect_failure_message(settings, error), url=settings.url
         ) from None
-    # Driven by hand until the CONNACK: a network thread would retry a refused login.
-    deadline_s = time.monotonic() + timeout_s
-    while not answers:
-        remaining_s = deadline_s - time.monotonic()
-        if remaining_s <= 0 or client.loop(timeout=min(remaining_s, 1.0)) != mqtt.MQTT_ERR_SUCCESS:
-            if answers:
-                break
-            client.disconnect()
-            failure = TimeoutError() if remaining_s <= 0 else ConnectionResetError()
-            raise BrokerConnectionError(
-                failure_reason(failure),
-                connect_failure_message(settings, failure),
-                url=settings.url,
-            )
+    failure = _await_connack(client, answers, timeout_s=timeout_s, poll_s=CONNACK_POLL_S)
+    if failure is not None:
+        client.disconnect()
+        raise BrokerConnectionError(
+            failure_reason(failure), connect_failure_message(settings, failure), url=settings.url
+        )
     client.on_connect = None
     if answers[0].is_failure:
         client.disconnect()
@@ -233,3 +221,56 @@ def _connect_with(
         )
     client.loop_start()
     return client
+
+
+def probe_login(
+    settings: BrokerSettings, *, client_id: str, timeout_s: float, poll_s: float = PROBE_POLL_S
+) -> bool | None:
+    """Try one MQTT 3.1.1 login and leave: True if accepted, False if refused, None if
+    nobody answered within ``timeout_s`` (the broker is not listening yet, or not ready)."""
+    client = new_client(settings, client_id=client_id)
+    try:
+        answers = _send_login(client, settings, keepalive_s=PROBE_KEEPALIVE_S)
+    except OSError:
+        return None
+    _await_connack(client, answers, timeout_s=timeout_s, poll_s=poll_s)
+    # Without a network thread paho writes the DISCONNECT and closes the socket right here.
+    client.disconnect()
+    return not answers[0].is_failure if answers else None
+
+
+def _send_login(
+    client: mqtt.Client, settings: BrokerSettings, *, keepalive_s: int
+) -> list[ReasonCode]:
+    """Open the connection and send the CONNECT; the list ``on_connect`` puts the CONNACK in."""
+    answers: list[ReasonCode] = []
+
+    def on_connect(
+        _client: mqtt.Client, _userdata: Any, _flags: Any, code: ReasonCode, _props: Any
+    ) -> None:
+        answers.append(code)
+
+    client.on_connect = on_connect
+    client.connect(settings.host, settings.port, keepalive=keepalive_s)
+    return answers
+
+
+def _await_connack(
+    client: mqtt.Client, answers: list[ReasonCode], *, timeout_s: float, poll_s: float
+) -> OSError | None:
+    """Drive ``client`` by hand until ``on_connect`` has put the CONNACK in ``answers``.
+
+    By hand, not on a network thread: that would retry a refused login. None once the
+    CONNACK is in; else why not: TimeoutError, or ConnectionResetError if the connection
+    closed first.
+    """
+    import paho.mqtt.client as mqtt
+
+    deadline_s = time.monotonic() + timeout_s
+    while not answers:
+        remaining_s = deadline_s - time.monotonic()
+        if remaining_s <= 0:
+            return TimeoutError()
+        if client.loop(timeout=min(remaining_s, poll_s)) != mqtt.MQTT_ERR_SUCCESS and not answers:
+            return ConnectionResetError()
+    return None

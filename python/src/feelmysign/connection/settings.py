@@ -1,4 +1,10 @@
-"""Where the broker is, how to log in and which sleeve: one settings object and its URL parser."""
+"""Where the broker is, how to log in and which sleeve: one settings object and its URL parser.
+
+``BrokerSettings`` is the one broker identity of feelmysign: a broker URL (transport,
+host, port, path), its TLS (on, and the CA to verify with), the login on it and the
+sleeve. ``parse_broker_url`` is the only place a broker URL is read; the broker's
+``credentials.json`` gives settings for either of its logins with ``Credentials.settings``.
+"""
 
 from __future__ import annotations
 
@@ -7,10 +13,12 @@ from dataclasses import dataclass, replace
 from typing import Literal
 from urllib.parse import urlsplit
 
-from feelmysign.broker.mosquitto import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
 from feelmysign.errors import BrokerConnectionError
 from feelmysign.topics import strokes_topic
 
+# Here, not in the broker package: the broker's files read URLs with parse_broker_url.
+DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
+DEFAULT_SLEEVE_ID = "sleeve1"
 Transport = Literal["tcp", "websockets"]
 # scheme -> (transport, TLS on, default port)
 SCHEMES: dict[str, tuple[Transport, bool, int]] = {

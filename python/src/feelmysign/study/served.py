@@ -12,7 +12,6 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from feelmysign.broker import Credentials
-from feelmysign.connection import BrokerSettings
 from feelmysign.study.api import StudyApi
 from feelmysign.study.runner import Session
 from feelmysign.study.sleeve_link import SleeveLink
@@ -26,15 +25,8 @@ def study_api(path: Path | None, credentials: Credentials) -> Iterator[Api | Non
         yield None
         return
     store = StudyStore(path)
-    settings = BrokerSettings(
-        credentials.mqtt_host,
-        credentials.mqtt_port,
-        username=credentials.sender.username,
-        password=credentials.sender.password,
-        sleeve_id=credentials.sleeve_id,
-    )
     try:
-        with SleeveLink(settings) as link:
+        with SleeveLink(credentials.settings("sender")) as link:
             results = path.resolve().parent / f"{path.stem}-results"
             yield StudyApi(Session(store, link.play), results).handle
     finally:

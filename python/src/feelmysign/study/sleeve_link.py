@@ -20,6 +20,7 @@ import paho.mqtt.client as mqtt
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.sending import OutgoingStroke, StrokeSender
 from feelmysign.stroke import Stroke
+from feelmysign.topics import telemetry_topic
 
 # Beyond the drawing's own duration: the sleeve's queue, its latency and the event's trip.
 EVENTS_GRACE_S = 5.0
@@ -75,7 +76,7 @@ class SleeveLink:
         client = connect_client(
             self._settings, f"feelmysign-study-{uuid.uuid4().hex[:12]}", timeout_s=self._timeout_s
         )
-        topic = f"feelmysign/{self._settings.sleeve_id}/events"
+        topic = telemetry_topic(self._settings.sleeve_id, "events")
         client.on_message = self._events.on_message
         # Subscribed again on every reconnection: a clean session forgets subscriptions.
         client.on_connect = lambda c, *_: c.subscribe(topic, qos=1)
