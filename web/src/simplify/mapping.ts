@@ -19,6 +19,9 @@ export class CanvasMapping {
   readonly #options: CanvasMappingOptions;
   /** Grid units per pixel when the aspect ratio is kept (the tighter axis decides). */
   readonly scale: number;
+  /** Where pixel 0 lands on each axis when the aspect ratio is kept, computed once (the same value). */
+  readonly #offsetX: number;
+  readonly #offsetY: number;
 
   constructor(options: CanvasMappingOptions) {
     this.#options = options;
@@ -26,6 +29,8 @@ export class CanvasMapping {
     if (options.columns - 1 > 0) scales.push((options.columns - 1) / options.width_px);
     if (options.rows - 1 > 0) scales.push((options.rows - 1) / options.height_px);
     this.scale = scales.length > 0 ? Math.min(...scales) : 0;
+    this.#offsetX = (options.columns - 1 - options.width_px * this.scale) / 2;
+    this.#offsetY = (options.rows - 1 - options.height_px * this.scale) / 2;
   }
 
   /** Grid point (x = column, y = row) of a canvas pixel, clamped onto the grid. */
@@ -38,7 +43,7 @@ export class CanvasMapping {
     const { width_px, columns, stretch } = this.#options;
     const xExtent = columns - 1;
     // Same operation order as the reference, so results agree to the last bit.
-    const x = stretch ? (xPx * xExtent) / width_px : (xExtent - width_px * this.scale) / 2 + xPx * this.scale;
+    const x = stretch ? (xPx * xExtent) / width_px : this.#offsetX + xPx * this.scale;
     return Math.min(Math.max(x, 0), xExtent);
   }
 
@@ -46,9 +51,7 @@ export class CanvasMapping {
   gridY(yPx: number): number {
     const { height_px, rows, stretch } = this.#options;
     const yExtent = rows - 1;
-    const y = stretch
-      ? (yPx * yExtent) / height_px
-      : (yExtent - height_px * this.scale) / 2 + yPx * this.scale;
+    const y = stretch ? (yPx * yExtent) / height_px : this.#offsetY + yPx * this.scale;
     return Math.min(Math.max(y, 0), yExtent);
   }
 }

@@ -47,6 +47,9 @@ export const LINE_SHARE = 0.25;
  */
 const ROUNDING_SLACK = 1e-9;
 
+/** What `push` gives when no stroke is finished (most samples): one frozen array, none made. */
+const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
+
 /**
  * Samples as flat arrays of numbers (grid x, grid y, time) and their Sample objects: the stroke
  * being drawn, or the samples a cut gives back. Every sample is tested against the chord at
@@ -145,7 +148,7 @@ export class WindowSimplifier {
   }
 
   /** One pointer sample while the pointer is down; the first of a path is the press. */
-  push(input: Sample): Segment[] {
+  push(input: Sample): readonly Segment[] {
     const window = this.#window;
     const count = window.count;
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
@@ -159,11 +162,9 @@ export class WindowSimplifier {
       this.#reach = 0;
       this.#emittedInPath = false;
       this.#line = null;
-      return [];
+      return NO_SEGMENTS;
     }
-    const out: Segment[] = [];
-    this.#add(x, y, sample, out);
-    return out;
+    return this.#add(x, y, sample) ?? NO_SEGMENTS;
   }
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
@@ -178,8 +179,12 @@ export class WindowSimplifier {
     return [this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[count - 1]!)];
   }
 
-  /** The sample at (x, y) joins the stroke being drawn, cutting it first where it must. */
-  #add(x: number, y: number, sample: Sample, out: Segment[]): void {
+  /**
+   * The sample at (x, y) joins the stroke being drawn, cutting it first where it must: the
+   * strokes it finishes, or null if none (an array made only when one is).
+   */
+  #add(x: number, y: number, sample: Sample): Segment[] | null {
+    let out: Segment[] | null = null;
     const window = this.#window;
     const pending = this.#pending;
     const capMs = this.params.max_stroke_ms;
@@ -195,7 +200,9 @@ export class WindowSimplifier {
       ) {
         const cut = this.#capCut(count);
         const vertex = this.#continued(cut);
-        out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, vertex, window.ts[cut]!));
+        (out ??= []).push(
+          this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, vertex, window.ts[cut]!),
+        );
         this.#line = this.#lineOf(cut, vertex);
         if (cut < count - 1) {
           this.#giveBack(x, y, sample, cut);
@@ -215,7 +222,7 @@ export class WindowSimplifier {
       if (!this.#keepsBound(count, x, y)) {
         const cut = this.#feature(count, x, y, 1);
         const end: Point = [window.xs[cut]!, window.ys[cut]!];
-        out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[cut]!));
+        (out ??= []).push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[cut]!));
         this.#line = null;
         this.#giveBack(x, y, sample, cut);
         window.restart(end[0], end[1], cut);
@@ -224,14 +231,14 @@ export class WindowSimplifier {
         window.push(x, y, t, sample);
         this.#reaches[count] = this.#reach;
         if (count >= maxWindow) {
-          out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, [x, y], t));
+          (out ??= []).push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, [x, y], t));
           this.#line = null;
           window.restart(x, y, count);
           this.#reach = 0;
         }
       }
       const next = pending.count - 1;
-      if (next < 0) return;
+      if (next < 0) return out;
       x = pending.xs[next]!;
       y = pending.ys[next]!;
       sample = pending.samples[next]!;
