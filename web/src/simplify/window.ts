@@ -366,12 +366,27 @@ export class WindowSimplifier {
     const ax = xs[0]!;
     const ay = ys[0]!;
     let finite = true;
+    // The farthest, found as the distances are: nearly always the cut, so no second pass.
+    let farthest = -1;
+    let farthestDistance = -1;
     for (let i = first; i < count; i++) {
       const d = distanceSq(xs[i]!, ys[i]!, ax, ay, endX, endY);
       distances[i] = d;
       if (Number.isNaN(d)) finite = false;
+      else if (d >= farthestDistance) {
+        farthestDistance = d;
+        farthest = i;
+      }
     }
     if (!finite) return this.#featureSorted(count, first);
+    if (farthest < 0) return count - 1; // unreachable: the last sample fits by construction
+    if (
+      this.#reaches[farthest]! <= this.#reachLimit ||
+      this.#within(farthest, xs[farthest]!, ys[farthest]!, this.#maxErrorSq)
+    ) {
+      return farthest;
+    }
+    distances[farthest] = -1;
     // Farthest first and, at equal distances, the later sample first: the order of a sort by
     // (distance, index) descending, taken one at a time since the farthest nearly always fits.
     // Distances are >= 0, so -1 marks a sample tried.
