@@ -369,8 +369,24 @@ export class WindowSimplifier {
     // The farthest, found as the distances are: nearly always the cut, so no second pass.
     let farthest = -1;
     let farthestDistance = -1;
+    // `distanceSq` inlined as in `#farthestSq` (the same distances to the last bit).
+    const dx = endX - ax;
+    const dy = endY - ay;
+    const lengthSq = dx * dx + dy * dy;
     for (let i = first; i < count; i++) {
-      const d = distanceSq(xs[i]!, ys[i]!, ax, ay, endX, endY);
+      let qx = xs[i]! - ax;
+      let qy = ys[i]! - ay;
+      if (lengthSq > 0) {
+        const t = (qx * dx + qy * dy) / lengthSq;
+        if (t >= 1) {
+          qx = qx - dx;
+          qy = qy - dy;
+        } else if (!(t <= 0)) {
+          qx = qx - t * dx;
+          qy = qy - t * dy;
+        }
+      }
+      const d = qx * qx + qy * qy;
       distances[i] = d;
       if (Number.isNaN(d)) finite = false;
       else if (d >= farthestDistance) {
