@@ -16,16 +16,30 @@ export interface CanvasMappingOptions {
 }
 
 export class CanvasMapping {
-  readonly #options: CanvasMappingOptions;
   /** Grid units per pixel when the aspect ratio is kept (the tighter axis decides). */
   readonly scale: number;
+  // What gridX and gridY read, taken out of the options once: they run for every pointer sample.
+  readonly #stretch: boolean;
+  readonly #widthPx: number;
+  readonly #heightPx: number;
+  readonly #xExtent: number;
+  readonly #yExtent: number;
+  /** Where pixel 0 lands on each axis when the aspect ratio is kept, computed once (the same value). */
+  readonly #offsetX: number;
+  readonly #offsetY: number;
 
   constructor(options: CanvasMappingOptions) {
-    this.#options = options;
     const scales: number[] = [];
     if (options.columns - 1 > 0) scales.push((options.columns - 1) / options.width_px);
     if (options.rows - 1 > 0) scales.push((options.rows - 1) / options.height_px);
     this.scale = scales.length > 0 ? Math.min(...scales) : 0;
+    this.#stretch = options.stretch;
+    this.#widthPx = options.width_px;
+    this.#heightPx = options.height_px;
+    this.#xExtent = options.columns - 1;
+    this.#yExtent = options.rows - 1;
+    this.#offsetX = (this.#xExtent - options.width_px * this.scale) / 2;
+    this.#offsetY = (this.#yExtent - options.height_px * this.scale) / 2;
   }
 
   /** Grid point (x = column, y = row) of a canvas pixel, clamped onto the grid. */
@@ -35,20 +49,16 @@ export class CanvasMapping {
 
   /** The grid column of a canvas pixel's x, clamped onto the grid (`toGrid`'s x, no tuple made). */
   gridX(xPx: number): number {
-    const { width_px, columns, stretch } = this.#options;
-    const xExtent = columns - 1;
+    const xExtent = this.#xExtent;
     // Same operation order as the reference, so results agree to the last bit.
-    const x = stretch ? (xPx * xExtent) / width_px : (xExtent - width_px * this.scale) / 2 + xPx * this.scale;
+    const x = this.#stretch ? (xPx * xExtent) / this.#widthPx : this.#offsetX + xPx * this.scale;
     return Math.min(Math.max(x, 0), xExtent);
   }
 
   /** The grid row of a canvas pixel's y, clamped onto the grid (`toGrid`'s y, no tuple made). */
   gridY(yPx: number): number {
-    const { height_px, rows, stretch } = this.#options;
-    const yExtent = rows - 1;
-    const y = stretch
-      ? (yPx * yExtent) / height_px
-      : (yExtent - height_px * this.scale) / 2 + yPx * this.scale;
+    const yExtent = this.#yExtent;
+    const y = this.#stretch ? (yPx * yExtent) / this.#heightPx : this.#offsetY + yPx * this.scale;
     return Math.min(Math.max(y, 0), yExtent);
   }
 }

@@ -20,7 +20,8 @@ export interface Simplifier {
   readonly drawing: boolean;
   /** Where the stroke being drawn starts (canvas pixels); null between paths. */
   readonly lineStart: Sample | null;
-  push(input: Sample): Segment[];
+  /** The strokes this input finished (often none: a shared empty array, not to be changed). */
+  push(input: Sample): readonly Segment[];
   end(): Segment[];
 }
 

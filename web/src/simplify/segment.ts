@@ -66,16 +66,20 @@ export function finishSegment(
   emittedAtMs: number,
   limits: DropLimits,
 ): Segment {
-  const segment: Segment = {
+  // The reason first, so each piece is one object (what the app and the wire see is the same).
+  const dx = end[0] - start[0];
+  const dy = end[1] - start[1];
+  const durationMs = endMs - startMs;
+  let dropped: DropReason | null = null;
+  if (Math.sqrt(dx * dx + dy * dy) < limits.min_length) dropped = NOT_ENOUGH_DISTANCE;
+  else if (durationMs < limits.min_duration_ms) dropped = NOT_ENOUGH_DURATION;
+  return {
     start,
     end,
     start_ms: startMs,
     end_ms: endMs,
-    duration_ms: endMs - startMs,
+    duration_ms: durationMs,
     emitted_at_ms: emittedAtMs,
-    dropped: null,
+    dropped,
   };
-  if (segmentLength(segment) < limits.min_length) return { ...segment, dropped: NOT_ENOUGH_DISTANCE };
-  if (segment.duration_ms < limits.min_duration_ms) return { ...segment, dropped: NOT_ENOUGH_DURATION };
-  return segment;
 }

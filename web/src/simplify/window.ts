@@ -47,12 +47,17 @@ export const LINE_SHARE = 0.25;
  */
 const ROUNDING_SLACK = 1e-9;
 
+/** What `push` gives when no stroke is finished (most samples): one frozen array, none made. */
+const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
+
 /**
- * Samples as flat arrays of numbers (grid x, grid y, time) and their Sample objects: the stroke
- * being drawn, or the samples a cut gives back. Every sample is tested against the chord at
+ * The stroke being drawn as flat arrays of numbers (grid x, grid y, time) and their Sample
+ * objects, then the samples still to take into it. Every sample is tested against the chord at
  * every new one, so the tests read numbers (arrays of doubles, stored unboxed) instead of an
  * object and a tuple per sample. Arrays grow as a stroke needs and are kept from one stroke to
- * the next: `count` says how many hold samples now.
+ * the next: [0, count) is the stroke (its anchor first), [count, end) the samples to take next,
+ * in order: the new sample, after the samples a cut gave back. A cut moves the samples after it
+ * down behind the new anchor, where they are taken again without being copied anywhere else.
  */
 class Samples {
   readonly xs: number[] = [];
@@ -60,23 +65,37 @@ class Samples {
   readonly ts: number[] = [];
   readonly samples: Sample[] = [];
   count = 0;
+  end = 0;
 
-  push(x: number, y: number, t: number, sample: Sample): void {
-    const at = this.count;
+  /** A sample to take, after those already waiting. */
+  place(x: number, y: number, t: number, sample: Sample): void {
+    const at = this.end;
     this.xs[at] = x;
     this.ys[at] = y;
     this.ts[at] = t;
     this.samples[at] = sample;
-    this.count = at + 1;
+    this.end = at + 1;
   }
 
-  /** Only this sample: at (x, y), with the time and Sample of the one at `index`. */
+  /**
+   * Only one sample in the stroke, its anchor: at (x, y), with the time and Sample of the one at
+   * `index`; the samples after `index` are to take again, in order, behind it.
+   */
   restart(x: number, y: number, index: number): void {
-    this.xs[0] = x;
-    this.ys[0] = y;
-    this.ts[0] = this.ts[index]!;
-    this.samples[0] = this.samples[index]!;
+    const { xs, ys, ts, samples } = this;
+    xs[0] = x;
+    ys[0] = y;
+    ts[0] = ts[index]!;
+    samples[0] = samples[index]!;
+    const end = this.end;
+    for (let from = index + 1, to = 1; from < end; from++, to++) {
+      xs[to] = xs[from]!;
+      ys[to] = ys[from]!;
+      ts[to] = ts[from]!;
+      samples[to] = samples[from]!;
+    }
     this.count = 1;
+    this.end = end - index;
   }
 }
 
@@ -87,8 +106,6 @@ export class WindowSimplifier {
   readonly #mapping: CanvasMapping;
   /** The samples of the stroke being drawn: its anchor first, then every sample since. */
   readonly #window: Samples;
-  /** A stack of samples a cut gave back, to take again: the next to take is last. */
-  readonly #pending: Samples;
   /** Each sample's squared distance to a chord, while a cut looks for its feature. */
   readonly #distances: number[] = [];
   #pointer: Sample | null = null;
@@ -131,7 +148,6 @@ export class WindowSimplifier {
       stretch: params.stretch,
     });
     this.#window = new Samples();
-    this.#pending = new Samples();
   }
 
   /** True between the first sample of a path and `end`. */
@@ -145,7 +161,7 @@ export class WindowSimplifier {
   }
 
   /** One pointer sample while the pointer is down; the first of a path is the press. */
-  push(input: Sample): Segment[] {
+  push(input: Sample): readonly Segment[] {
     const window = this.#window;
     const count = window.count;
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
@@ -154,16 +170,15 @@ export class WindowSimplifier {
     this.#pointer = sample;
     const x = this.#mapping.gridX(sample.x);
     const y = this.#mapping.gridY(sample.y);
+    window.place(x, y, sample.t_ms, sample);
     if (count === 0) {
-      window.push(x, y, sample.t_ms, sample);
+      window.count = 1;
       this.#reach = 0;
       this.#emittedInPath = false;
       this.#line = null;
-      return [];
+      return NO_SEGMENTS;
     }
-    const out: Segment[] = [];
-    this.#add(x, y, sample, out);
-    return out;
+    return this.#add() ?? NO_SEGMENTS;
   }
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
@@ -172,70 +187,62 @@ export class WindowSimplifier {
     const count = window.count;
     if (count === 0) return [];
     window.count = 0;
+    window.end = 0;
     // The last sample already ends a stroke (a cut at the work cap).
     if (count === 1 && this.#emittedInPath) return [];
     const end = this.#continued(count - 1);
     return [this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[count - 1]!)];
   }
 
-  /** The sample at (x, y) joins the stroke being drawn, cutting it first where it must. */
-  #add(x: number, y: number, sample: Sample, out: Segment[]): void {
+  /**
+   * The samples to take (the new one, after any a cut gave back) join the stroke being drawn in
+   * order, each cutting it first where it must: the strokes they finish, or null if none (an
+   * array made only when one is).
+   */
+  #add(): Segment[] | null {
+    let out: Segment[] | null = null;
     const window = this.#window;
-    const pending = this.#pending;
+    const { xs, ys, ts } = window;
     const capMs = this.params.max_stroke_ms;
     const maxWindow = this.params.max_window;
     for (;;) {
-      let count = window.count;
-      const t = sample.t_ms;
+      const count = window.count;
+      const x = xs[count]!;
+      const y = ys[count]!;
+      const t = ts[count]!;
       if (
         capMs > 0 &&
         count > 1 &&
-        t - window.ts[0]! > capMs &&
-        this.#sendable(window.xs[0]!, window.ys[0]!, window.xs[count - 1]!, window.ys[count - 1]!)
+        t - ts[0]! > capMs &&
+        this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)
       ) {
         const cut = this.#capCut(count);
         const vertex = this.#continued(cut);
-        out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, vertex, window.ts[cut]!));
+        (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, vertex, ts[cut]!));
         this.#line = this.#lineOf(cut, vertex);
-        if (cut < count - 1) {
-          this.#giveBack(x, y, sample, cut);
-          window.restart(vertex[0], vertex[1], cut);
-          this.#reach = 0;
-          const next = pending.count - 1;
-          x = pending.xs[next]!;
-          y = pending.ys[next]!;
-          sample = pending.samples[next]!;
-          pending.count = next;
-          continue;
-        }
+        // The samples after the cut, this one included, are taken again into the next stroke.
         window.restart(vertex[0], vertex[1], cut);
         this.#reach = 0;
-        count = 1;
+        continue;
       }
       if (!this.#keepsBound(count, x, y)) {
         const cut = this.#feature(count, x, y, 1);
-        const end: Point = [window.xs[cut]!, window.ys[cut]!];
-        out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[cut]!));
+        const end: Point = [xs[cut]!, ys[cut]!];
+        (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, end, ts[cut]!));
         this.#line = null;
-        this.#giveBack(x, y, sample, cut);
         window.restart(end[0], end[1], cut);
         this.#reach = 0;
       } else {
-        window.push(x, y, t, sample);
+        window.count = count + 1;
         this.#reaches[count] = this.#reach;
         if (count >= maxWindow) {
-          out.push(this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, [x, y], t));
+          (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], t));
           this.#line = null;
           window.restart(x, y, count);
           this.#reach = 0;
         }
       }
-      const next = pending.count - 1;
-      if (next < 0) return;
-      x = pending.xs[next]!;
-      y = pending.ys[next]!;
-      sample = pending.samples[next]!;
-      pending.count = next;
+      if (window.count === window.end) return out;
     }
   }
 
@@ -273,19 +280,6 @@ export class WindowSimplifier {
     const dx = endX - this.#window.xs[index]!;
     const dy = endY - this.#window.ys[index]!;
     return this.#reaches[index]! + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK <= limit;
-  }
-
-  /**
-   * A cut at window[cut] gives back the sample being taken and the window's samples after the
-   * cut, to take again in order: onto the stack, the sample being taken first.
-   */
-  #giveBack(x: number, y: number, sample: Sample, cut: number): void {
-    const window = this.#window;
-    const pending = this.#pending;
-    pending.push(x, y, sample.t_ms, sample);
-    for (let i = window.count - 1; i > cut; i--) {
-      pending.push(window.xs[i]!, window.ys[i]!, window.ts[i]!, window.samples[i]!);
-    }
   }
 
   /**
@@ -372,12 +366,43 @@ export class WindowSimplifier {
     const ax = xs[0]!;
     const ay = ys[0]!;
     let finite = true;
+    // The farthest, found as the distances are: nearly always the cut, so no second pass.
+    let farthest = -1;
+    let farthestDistance = -1;
+    // `distanceSq` inlined as in `#farthestSq` (the same distances to the last bit).
+    const dx = endX - ax;
+    const dy = endY - ay;
+    const lengthSq = dx * dx + dy * dy;
     for (let i = first; i < count; i++) {
-      const d = distanceSq(xs[i]!, ys[i]!, ax, ay, endX, endY);
+      let qx = xs[i]! - ax;
+      let qy = ys[i]! - ay;
+      if (lengthSq > 0) {
+        const t = (qx * dx + qy * dy) / lengthSq;
+        if (t >= 1) {
+          qx = qx - dx;
+          qy = qy - dy;
+        } else if (!(t <= 0)) {
+          qx = qx - t * dx;
+          qy = qy - t * dy;
+        }
+      }
+      const d = qx * qx + qy * qy;
       distances[i] = d;
       if (Number.isNaN(d)) finite = false;
+      else if (d >= farthestDistance) {
+        farthestDistance = d;
+        farthest = i;
+      }
     }
     if (!finite) return this.#featureSorted(count, first);
+    if (farthest < 0) return count - 1; // unreachable: the last sample fits by construction
+    if (
+      this.#reaches[farthest]! <= this.#reachLimit ||
+      this.#within(farthest, xs[farthest]!, ys[farthest]!, this.#maxErrorSq)
+    ) {
+      return farthest;
+    }
+    distances[farthest] = -1;
     // Farthest first and, at equal distances, the later sample first: the order of a sort by
     // (distance, index) descending, taken one at a time since the farthest nearly always fits.
     // Distances are >= 0, so -1 marks a sample tried.
