@@ -19,7 +19,7 @@ from typing import Any
 
 import paho.mqtt.client as mqtt
 import pytest
-from sleeve_watch import connected_client, subscribe, subscribe_all
+from sleeve_watch import connected_client, stop_loop, subscribe, subscribe_all
 
 from feelmysign.broker.credentials import Account, reuse_or_create
 from feelmysign.broker.nats_cluster import NatsCluster
@@ -79,7 +79,7 @@ def test_the_acl_holds_on_nats_a_sleeve_reads_only_its_own_strokes(cluster: Nats
         assert spy.empty()
     finally:
         for paho in (first, second, sender):
-            paho.loop_stop()
+            stop_loop(paho)
 
 
 class Events:
@@ -217,7 +217,7 @@ def _kill_the_sleeves_node_mid_drawing(cluster: NatsCluster, *pace: str) -> Fail
         assert second_send.returncode == 0, out
         events.wait_played(second, 4)
     finally:
-        events.client.loop_stop()
+        stop_loop(events.client)
         sleeve.terminate()
         sleeve_out = sleeve.communicate(timeout=WAIT_S)[0]
     assert f"connected to {cluster.nodes[0].mqtt_url}" in sleeve_out, sleeve_out
@@ -282,7 +282,7 @@ def _wait_online(cluster: NatsCluster, sender: Account) -> None:
                 return
         raise AssertionError("the sleeve never came online")
     finally:
-        watcher.loop_stop()
+        stop_loop(watcher)
 
 
 def test_settings_take_several_urls_of_one_cluster() -> None:
@@ -331,7 +331,7 @@ def test_a_stroke_redelivered_after_later_ones_plays_once(cluster: NatsCluster) 
         assert json.loads(got.get(timeout=WAIT_S))["seq"] == 0
         delivered_s = time.monotonic()
         away.disconnect()  # a clean exit: the session, and stroke 0 unacknowledged, stay
-        away.loop_stop()
+        stop_loop(away)
         sleeve = _run_as(
             c.sleeve, "sleeve", "--broker", node.mqtt_url, "--id", SLEEVE, *CLUSTER_PACE
         )
@@ -341,8 +341,8 @@ def test_a_stroke_redelivered_after_later_ones_plays_once(cluster: NatsCluster) 
             send(seq)
         events.wait_settled(drawing, 4)
     finally:
-        events.client.loop_stop()
-        sender.loop_stop()
+        stop_loop(events.client)
+        stop_loop(sender)
         said = ""
         if sleeve is not None:
             sleeve.terminate()
