@@ -112,7 +112,7 @@ class _Inbox:
 
         def found() -> dict[str, Any] | None:
             for _, payload in self.items:
-                event = json.loads(payload)
+                event: dict[str, Any] = json.loads(payload)
                 if event.get("type") == kind and event.get("drawing") == drawing:
                     return event
             return None
