@@ -6,6 +6,7 @@ import itertools
 import json
 import math
 import random
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -109,6 +110,25 @@ def test_douglas_peucker_runs_above_a_tie_with_the_rows_deviation() -> None:
         points = grid_points(params_for(run.algorithm, recording, run.overrides), samples)
         ties += metrics.douglas_peucker_strokes(points, row.max_deviation) > 1
     assert ties > 0, "the cases include ties (else this test could not fail)"
+
+
+def test_rows_without_shape_metrics_keep_every_timing_figure() -> None:
+    """The bench leaves out the shape metrics (the Frechet distance is slow): the rest of a row,
+    and so every timing and recognition figure, is the same as with them."""
+    rng = np.random.default_rng(7)
+    samples = tuple(
+        Sample(12.0 * k, 100.0 + 9.0 * k, 300.0 + 80.0 * math.sin(k / 6) + rng.uniform(-2, 2))
+        for k in range(90)
+    )
+    recording = Recording(1200.0, 800.0, (samples,), 3, 4)
+    source = Source("wave", "wave", recording)
+    for name in ALGORITHMS:
+        full = evaluate_one(source, Run(ALGORITHMS[name], {}))
+        lean = evaluate_one(source, Run(ALGORITHMS[name], {}), shape_metrics=False)
+        assert full.strokes > 1 and full.frechet > 0 and full.dp_strokes > 0
+        assert math.isnan(lean.frechet) and math.isnan(lean.max_deviation)
+        shape = {"max_deviation": 0.0, "frechet": 0.0, "dp_strokes": 0}
+        assert replace(lean, **shape) == replace(full, **shape)
 
 
 def test_simplify_json_gives_each_stroke_its_drawn_times(

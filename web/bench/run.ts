@@ -18,6 +18,15 @@ import { benchLasa, type LasaRate } from "./lasa";
 import { benchScribble, PATH_SECONDS } from "./scribble";
 import { benchSimplifier } from "./simplifier";
 
+/** Each part's wall time, printed after its figures: make bench is meant to take minutes. */
+let partStarted = performance.now();
+function partTime(): void {
+  const now = performance.now();
+  console.log(`  (${((now - partStarted) / 1000).toFixed(1)} s)`);
+  partStarted = now;
+}
+const benchStarted = partStarted;
+
 function millions(value: number): string {
   return `${(value / 1e6).toFixed(2)} M`;
 }
@@ -38,6 +47,7 @@ console.log(
     ` ratio ${(simplifier.baselineFramesPerSecond / simplifier.framesPerSecond).toFixed(1)}x;` +
     ` ${simplifier.strokes} strokes from 200000 frames)`,
 );
+partTime();
 
 const lasa = benchLasa();
 if (lasa !== null) {
@@ -58,6 +68,7 @@ if (lasa !== null) {
     (rate.strokes === null ? "" : `  ${rate.strokes} ${label}`);
   for (const rate of lasa.rates) console.log(line(rate, "strokes (dropped ones too)"));
   for (const rate of [highQuality, fast]) console.log(line(rate, "segments"));
+  partTime();
 }
 
 /** Budget of the two growth ratios below: the page's cost must not grow with the drawing. */
@@ -78,6 +89,8 @@ for (const [label, figures] of [
   );
 }
 
+partTime();
+
 const scribble = await benchScribble();
 console.log(
   `web: a minute of scribbling on 'feelmysign up' with its simulated sleeve (${scribble.browser}, headless):` +
@@ -95,3 +108,5 @@ console.log(
     ` last 5 s ${percent(scribble.last.busy)} (scripts ${percent(scribble.last.scripting)}),` +
     ` ratio ${(scribble.last.busy / scribble.first.busy).toFixed(2)}`,
 );
+partTime();
+console.log(`web bench: ${((performance.now() - benchStarted) / 1000).toFixed(1)} s`);

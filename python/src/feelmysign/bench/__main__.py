@@ -7,6 +7,7 @@ is a run of its own: ``make bench-study`` (``python -m feelmysign.bench.study_re
 from __future__ import annotations
 
 import platform
+import time
 
 from feelmysign.bench import (
     algorithms,
@@ -37,10 +38,14 @@ def main() -> None:
         restart_off.report,
         persistence.report,
     )
+    # Each group's wall time, and the total: the whole of make bench is meant to take minutes.
+    total_start = time.perf_counter()
     for report in reports:
+        start = time.perf_counter()
         for line in report():
             print(line, flush=True)
-        print()
+        print(f"  ({time.perf_counter() - start:.1f} s)\n", flush=True)
+    print(f"All groups: {time.perf_counter() - total_start:.1f} s")
     print(
         "The study analysis's coverage over many simulated studies (about 50 minutes):"
         " make bench-study"

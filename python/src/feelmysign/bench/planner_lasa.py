@@ -23,7 +23,7 @@ from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.planner import plan
 from feelmysign.protocol import format_legacy, parse
 from feelmysign.research.evaluate import params_for
-from feelmysign.research.lasa import load_lasa
+from feelmysign.research.lasa import LasaDemo, load_lasa
 from feelmysign.research.rerun import rerun
 from feelmysign.simplify import ALGORITHMS
 from feelmysign.stroke import Stroke
@@ -43,10 +43,11 @@ class TimeKept:
     thinned: int
 
 
-def lasa_strokes(algorithm: str) -> list[Stroke]:
-    """The strokes one simplifier sends for all 210 drawings, at its defaults."""
+def lasa_strokes(algorithm: str, demos: list[LasaDemo] | None = None) -> list[Stroke]:
+    """The strokes one simplifier sends for all 210 drawings (``demos``: as loaded), at its
+    defaults."""
     strokes = []
-    for demo in load_lasa():
+    for demo in load_lasa() if demos is None else demos:
         params = params_for(ALGORITHMS[algorithm], demo.recording, {})
         for item in rerun(demo.recording, params).segments:
             segment = item.segment
@@ -71,8 +72,9 @@ def time_kept(strokes: list[Stroke]) -> TimeKept:
 
 def report() -> list[str]:
     lines = ["Planner on the LASA strokes (210 drawings, each simplifier at its defaults)"]
+    demos = load_lasa()  # read once for every simplifier
     for name in ALGORITHMS:
-        strokes = lasa_strokes(name)
+        strokes = lasa_strokes(name, demos)
         for speed in SPEEDS:
             kept = time_kept([faster(s, speed) for s in strokes])
             lines.append(

@@ -57,7 +57,9 @@ def report() -> list[str]:
         "skin = time on the skin / drawing time)"
     ]
     for label, name in (("default", DEFAULT_ALGORITHM), ("paper", PAPER_ALGORITHM)):
-        rows = evaluate(found, [Run(ALGORITHMS[name], {})], recogniser=recogniser)
+        rows = evaluate(
+            found, [Run(ALGORITHMS[name], {})], recogniser=recogniser, shape_metrics=False
+        )
         for entry in summarize(rows):
             lines.append(
                 f"  {label} ({name}) {entry['set']:<6}: skin mean {entry['skin_ratio_mean']:.3f}, "
@@ -80,7 +82,9 @@ def gesture_report() -> list[str]:
     if not GESTURES.is_dir():
         return []
     found, recogniser = file_sources(load_all([str(GESTURES)]))
-    rows = evaluate(found, [Run(ALGORITHMS[DEFAULT_ALGORITHM], {})], recogniser=recogniser)
+    rows = evaluate(
+        found, [Run(ALGORITHMS[DEFAULT_ALGORITHM], {})], recogniser=recogniser, shape_metrics=False
+    )
     lines = [
         "Simulated gestures (research/gestures, 16 gestures x 10 people x 3 speeds) at the "
         "defaults: skin = time on the skin / drawing time; recognised = sent / drawn"

@@ -6,6 +6,14 @@ its ``played`` events), the sleeve's own share (receive -> first command), the
 lateness of every actuator write against the plan, and the gap between
 consecutive strokes of a drawing, for strokes of 1, 3, 10 and 30 cm (the share at
 each length: the sleeve starts a stroke's first burst before planning the rest).
+
+Only a stroke's first command counts for latency, so each measured stroke is
+cancelled (the control message) once its ``played`` event is out, instead of
+being played to its end: the sleeve receives, checks and plans it as any other
+stroke, and its first command takes the same path; only the motors it would have
+driven later are switched off early. The next stroke is sent after the same
+pause as the baseline's (an idle sleeve, as an idle broker). The gaps between
+strokes of a drawing need real back-to-back play, so those strokes play out.
 """
 
 from __future__ import annotations
@@ -21,7 +29,7 @@ import tempfile
 import threading
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -31,11 +39,12 @@ import paho.mqtt.client as mqtt
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.control import Cancel, format_control
 from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.layout import Layout
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
-from feelmysign.topics import strokes_topic, telemetry_topic
+from feelmysign.topics import control_topic, strokes_topic, telemetry_topic
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 # 1 cm and 10 cm on the paper's 3 cm grid.
@@ -46,12 +55,20 @@ LONG = ((0.0, 0.0), (3.0, math.sqrt((10 / 3) ** 2 - 9.0)), 900.0)
 WIDE_GRID = ("--rows", "3", "--columns", "12", "--spacing-cm", "3")
 LONGEST = ((0.5, 1.0), (10.5, 1.0), 1500.0)
 # (label, stroke, how many, grid options of the sleeve process): the sleeve's share at each.
+# Enough strokes at each for a p99 (each is cancelled after its first command: see above).
 LENGTHS = (
     ("1 cm", SHORT, 100, ()),
-    ("3 cm", MEDIUM, 50, ()),
-    ("10 cm", LONG, 30, ()),
-    ("30 cm", LONGEST, 30, WIDE_GRID),
+    ("3 cm", MEDIUM, 100, ()),
+    ("10 cm", LONG, 100, ()),
+    ("30 cm", LONGEST, 100, WIDE_GRID),
 )
+# Between one stroke's end and the next publish, as between the baseline's messages: with
+# no pause every thread stays awake and latencies halve (see bare_latency_ms).
+PAUSE_S = 0.12
+WARM_UP = 5  # strokes first, unmeasured: first-use costs are not latency
+# Strokes of the drawings played back to back (for the gaps between them and the lateness of
+# writes): these play out, so the longer ones are fewer.
+DRAWING_STROKES = {"1 cm": 20, "3 cm": 20, "10 cm": 10}
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -87,6 +104,20 @@ class _Inbox:
                 raise TimeoutError(f"{len(played())} of {count} strokes were played")
             return played()[:count]
 
+    def wait_event(self, kind: str, drawing: str, timeout_s: float) -> dict[str, Any] | None:
+        """The first event of type ``kind`` about a stroke of ``drawing``; None if none came."""
+
+        def found() -> dict[str, Any] | None:
+            for _, payload in self.items:
+                event: dict[str, Any] = json.loads(payload)
+                if event.get("type") == kind and event.get("drawing") == drawing:
+                    return event
+            return None
+
+        with self.cond:
+            self.cond.wait_for(lambda: found() is not None, timeout_s)
+            return found()
+
     def wait(self, count: int, timeout_s: float = 30.0) -> list[tuple[float, bytes]]:
         with self.cond:
             if not self.cond.wait_for(lambda: len(self.items) >= count, timeout_s):
@@ -99,19 +130,22 @@ def _client(
 ) -> mqtt.Client:
     client = new_client(_settings(c, role), client_id=f"bench-{role}-{uuid.uuid4()}")
     connected = threading.Event()
+    subscribed = threading.Event()
     client.on_connect = lambda *a: connected.set()
+    client.on_subscribe = lambda *a: subscribed.set()
     if inbox is not None:
         client.on_message = inbox
     client.connect(c.mqtt_host, c.mqtt_port)
     client.loop_start()
     connected.wait(10)
     if subscribe:
-        client.subscribe(subscribe, qos=1)[1]
-        time.sleep(0.2)  # SUBACK has no waiter in paho's API; a moment is plenty on loopback
+        client.subscribe(subscribe, qos=1)
+        if not subscribed.wait(10):
+            raise TimeoutError(f"no SUBACK for {subscribe}")
     return client
 
 
-def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = 0.12) -> list[float]:
+def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = PAUSE_S) -> list[float]:
     """Publish -> receive on the same broker, sender to sleeve account, QoS 1.
 
     Paced like the strokes measured against it (one, then a pause as long as a
@@ -150,25 +184,35 @@ def _sleeve(c: Credentials) -> Iterator[Sleeve]:
         backend.close()
 
 
-def stroke_latencies(
-    c: Credentials, is_idle: Callable[[], bool], shape: Any, count: int
-) -> list[dict[str, Any]]:
-    """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event."""
+def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[dict[str, Any]]:
+    """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event.
+
+    Each stroke (a drawing of its own) is cancelled once its played event is out, i.e. after
+    its first command; the next is sent a pause later, once the sleeve reports it cancelled.
+    """
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "events"))
     sender = _client(c, "sender")
     (start, end, duration_ms) = shape
     results = []
-    for k in range(count):
-        stroke = Stroke(start, end, duration_ms, None, f"lat-{uuid.uuid4()}", 0)
+    for _ in range(count):
+        drawing = f"lat-{uuid.uuid4()}"
+        stroke = Stroke(start, end, duration_ms, None, drawing, 0)
+        with inbox.cond:
+            inbox.items.clear()  # the earlier strokes' events: each wait reads them all again
         published_ms = time.time_ns() / 1e6
         sender.publish(strokes_topic(c.sleeve_id), format_json(stroke), qos=1)
-        event = inbox.wait_played(k + 1)[-1]
+        event = inbox.wait_played(1)[-1]
+        if event.get("drawing") != drawing:
+            raise RuntimeError(f"expected a played event of {drawing}, got {event}")
         event["published_at_ms"] = published_ms
         results.append(event)
-        time.sleep(event["duration_ms"] / 1000)
-        while not is_idle():
-            time.sleep(0.005)
+        sender.publish(control_topic(c.sleeve_id), format_control(Cancel(drawing)), qos=1)
+        time.sleep(PAUSE_S)
+        # Its motors are off once it is reported cancelled (mostly during the pause); a stroke
+        # that ended before the cancel came is not reported: wait no longer than its end.
+        end_ms = event["first_command_at_ms"] + event["duration_ms"] + 100.0
+        inbox.wait_event("cancelled", drawing, max(0.0, end_ms - time.time_ns() / 1e6) / 1000)
     for client in (watcher, sender):
         client.loop_stop()
         client.disconnect()
@@ -178,8 +222,8 @@ def stroke_latencies(
 @contextmanager
 def _sleeve_process(
     c: Credentials, credentials_path: Path, grid: tuple[str, ...] = ()
-) -> Iterator[Callable[[], bool]]:
-    """``feelmysign sleeve`` in a process of its own, as on the Pi; yields an idle check."""
+) -> Iterator[None]:
+    """``feelmysign sleeve`` in a process of its own, as on the Pi, online."""
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "status"))
     process = subprocess.Popen(
@@ -204,7 +248,7 @@ def _sleeve_process(
             if time.monotonic() > deadline or process.poll() is not None:
                 raise RuntimeError("the sleeve process did not come online")
             time.sleep(0.05)
-        yield lambda: True  # strokes are paced by their duration (see stroke_latencies)
+        yield
     finally:
         process.send_signal(signal.SIGTERM)
         process.wait(10)
@@ -212,7 +256,7 @@ def _sleeve_process(
         watcher.disconnect()
 
 
-def drawing_gaps(c: Credentials, shape: Any, strokes: int = 20) -> list[float]:
+def drawing_gaps(c: Credentials, shape: Any, strokes: int) -> list[float]:
     """A drawing sent at once: each stroke should start as the one before it ends."""
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "events"))
@@ -245,6 +289,23 @@ def _figures(name: str, values: list[float]) -> str:
     )
 
 
+def _latency_lines(
+    c: Credentials, label: str, shape: Any, count: int, bare: list[float]
+) -> list[str]:
+    stroke_latencies(c, shape, WARM_UP)
+    events = stroke_latencies(c, shape, count)
+    end_to_end = [e["first_command_at_ms"] - e["published_at_ms"] for e in events]
+    ratio = percentile(end_to_end, 99) / percentile(bare, 99)
+    return [
+        _figures(f"{label}: publish -> first actuator command", end_to_end)
+        + f"   {ratio:.2f}x baseline p99",
+        _figures(
+            f"{label}: sleeve's share (receive -> first command)",
+            [e["latency_ms"] for e in events],
+        ),
+    ]
+
+
 def report() -> list[str]:
     lines = ["Sleeve (real Mosquitto on loopback, simulator backend)"]
     with (
@@ -255,30 +316,19 @@ def report() -> list[str]:
         bare = bare_latency_ms(c)
         lines.append(_figures("baseline: bare MQTT publish -> receive (paced)", bare))
         lines.append("  the sleeve in a process of its own (30 cm: on a 3 x 12 grid):")
-        for label, shape, count, grid in LENGTHS:
-            with _sleeve_process(c, broker.credentials_path, grid) as is_idle:
-                stroke_latencies(c, is_idle, shape, 5)  # warm-up: first-use costs are not latency
-                events = stroke_latencies(c, is_idle, shape, count)
-                end_to_end = [e["first_command_at_ms"] - e["published_at_ms"] for e in events]
-                ratio = percentile(end_to_end, 99) / percentile(bare, 99)
-                lines.append(
-                    _figures(f"{label}: publish -> first actuator command", end_to_end)
-                    + f"   {ratio:.2f}x baseline p99"
-                )
-                lines.append(
-                    _figures(
-                        f"{label}: sleeve's share (receive -> first command)",
-                        [e["latency_ms"] for e in events],
-                    )
-                )
-                if not grid:
-                    gaps = drawing_gaps(c, shape)
-                    lines.append(_figures(f"{label}: gap between strokes of a drawing", gaps))
+        # One process per grid: each length still starts with warm-up strokes of its own.
+        for grid in dict.fromkeys(grid for *_, grid in LENGTHS):
+            with _sleeve_process(c, broker.credentials_path, grid):
+                for label, shape, count, _ in (length for length in LENGTHS if length[3] == grid):
+                    lines += _latency_lines(c, label, shape, count, bare)
+                    if not grid:
+                        gaps = drawing_gaps(c, shape, DRAWING_STROKES[label])
+                        lines.append(_figures(f"{label}: gap between strokes of a drawing", gaps))
         lines.append("  the sleeve in this process (for the player's write times):")
         with _sleeve(c) as sleeve:
             for label, shape in (("1 cm", SHORT), ("10 cm", LONG)):
                 sleeve.player.timing_errors_ms.clear()
-                drawing_gaps(c, shape)
+                drawing_gaps(c, shape, DRAWING_STROKES[label])
                 lines.append(
                     _figures(
                         f"{label}: actuator write vs plan (lateness)",

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import csv
 import itertools
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
@@ -223,11 +224,16 @@ def file_sources(gestures: Sequence[Any]) -> tuple[list[Source], Recogniser]:
     return sources, Recogniser(templates)
 
 
-def evaluate_one(source: Source, run: Run, recogniser: Recogniser | None = None) -> Row:
+def evaluate_one(
+    source: Source, run: Run, recogniser: Recogniser | None = None, *, shape_metrics: bool = True
+) -> Row:
     """Run one recording through one parameter set and measure it, path by path.
 
     Deviation is measured on every drawn sample (not only on the frames an
     animation loop saw): a sample's distance to the stroke whose time covers it.
+    Without ``shape_metrics`` the deviation, Frechet distance and Douglas-Peucker
+    count are left out (NaN, NaN, 0): the Frechet distance takes most of the time,
+    and the timing figures do not need them.
     """
     params = params_for(run.algorithm, source.recording, run.overrides)
     result = rerun(source.recording, params)
@@ -238,12 +244,15 @@ def evaluate_one(source: Source, run: Run, recogniser: Recogniser | None = None)
         own = [item.segment for item in result.segments if item.path == index]
         points = grid_points(params, path)
         drawn_paths.append(points)
+        frames += len(result.frames[index]) if index < len(result.frames) else 0
+        if not shape_metrics:
+            deviation = frechet = math.nan
+            continue
         path_deviation = metrics.max_deviation([s.t_ms for s in path], points, own)
         deviation = max(deviation, path_deviation)
         frechet = max(frechet, metrics.path_frechet(points, own))
         tolerance = path_deviation * (1 + DP_TIE_MARGIN) + DP_TIE_MARGIN
         dp_strokes += metrics.douglas_peucker_strokes(points, tolerance)
-        frames += len(result.frames[index]) if index < len(result.frames) else 0
     playback = simulate(result.segments, source.recording.paths, layout_for(params))
     drawn = np.concatenate(drawn_paths) if drawn_paths else metrics.as_points([])
     return Row(
@@ -274,12 +283,14 @@ def evaluate(
     runs: Sequence[Run],
     advance: Callable[[], None] = lambda: None,
     recogniser: Recogniser | None = None,
+    *,
+    shape_metrics: bool = True,
 ) -> list[Row]:
     """Every source through every run, in that order; ``advance`` is called after each."""
     rows = []
     for run in runs:
         for source in sources:
-            rows.append(evaluate_one(source, run, recogniser))
+            rows.append(evaluate_one(source, run, recogniser, shape_metrics=shape_metrics))
             advance()
     return rows
 
@@ -333,7 +344,10 @@ def _percent(flags: Sequence[bool | None]) -> float | None:
 
 
 def _mean(values: Sequence[float]) -> float:
-    return round(float(np.nanmean(values)), 6) if values else float("nan")
+    # NaN, without numpy's warning, when nothing was measured (rows without shape metrics).
+    if not values or all(math.isnan(v) for v in values):
+        return float("nan")
+    return round(float(np.nanmean(values)), 6)
 
 
 def frontier(
