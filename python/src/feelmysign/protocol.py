@@ -330,9 +330,20 @@ def _reject_constant(name: str) -> float:
     raise _NonFiniteLiteral(name)
 
 
+# Made once: json.loads(parse_constant=...) builds a decoder for every message.
+_DECODER = json.JSONDecoder(parse_constant=_reject_constant)
+
+
+def _loads(body: str) -> Any:
+    """``json.loads(body, parse_constant=_reject_constant)``, with the same errors."""
+    if body.startswith("\ufeff"):
+        return json.loads(body, parse_constant=_reject_constant)  # its byte-order-mark error
+    return _DECODER.decode(body)
+
+
 def _parse_json(body: str) -> Stroke | Rejected:
     try:
-        document = json.loads(body, parse_constant=_reject_constant)
+        document = _loads(body)
     except _NonFiniteLiteral as error:
         return Rejected(
             INVALID_JSON,
