@@ -7,16 +7,19 @@ expected segments. An implementation pushes every sample of a path (the window
 simplifier takes samples, not frames), calls ``end``, and must reproduce
 ``expected.segments`` (path index, start, end, times, dropped reason) and
 ``expected.inputs`` (samples per path) within ``tolerance``. ``params.json`` is the
-parameter table (defaults and allowed ranges).
+parameter table (defaults and allowed ranges). Besides gen_angle's shapes, a window-only
+one (``EDGE_SHAPES``): a drawing along the canvas edges, whose strokes must stay on the grid.
 """
 
 from __future__ import annotations
 
+import random
+from dataclasses import asdict
 from typing import Any
 
-from feelmysign.simplify import WindowParams
+from feelmysign.simplify import Sample, WindowParams
 from feelmysign.simplify.window import WINDOW_PARAMS
-from gen_angle import simplifier_cases
+from gen_angle import H, Path, W, _line, _segments, simplifier_cases
 
 VARIATIONS: dict[str, dict[str, Any]] = {
     "defaults": {},
@@ -35,10 +38,53 @@ VARIATIONS: dict[str, dict[str, Any]] = {
 }
 
 
+def _edge_u(seed: int = 3) -> Path:
+    """A "U" drawn along the canvas's left, bottom and right edges, as a hand draws it.
+
+    Each sample lies up to 3 px inside its edge or up to 6 px beyond it (the mapping puts it on
+    the edge), so the strokes the latency cap ends point a little across the edge, and a line
+    going on along one would leave the grid.
+    """
+    rng = random.Random(seed)
+    samples = []
+    for s in _line([(0, 150), (0, H), (W, H), (W, 150)], 0.4):
+        x, y = s.x, s.y
+        if x == 0:
+            x = -rng.uniform(-3.0, 6.0)
+        elif x == W:
+            x = W + rng.uniform(-3.0, 6.0)
+        if y == H:
+            y = H + rng.uniform(-3.0, 6.0)
+        samples.append(Sample(s.t_ms, x, y))
+    return samples
+
+
+# Window-only shapes, each with the defaults and the latency cap's variations (W x H fills the
+# default 3 x 4 grid, so the canvas edges are the grid's).
+EDGE_SHAPES = {"edge-u": lambda: [_edge_u()]}
+EDGE_VARIATIONS = ("defaults", "max-stroke-ms-100", "max-error-0.05")
+
+
+def _edge_case(shape: str, variation: str) -> dict[str, Any]:
+    params = WindowParams(canvas_width_px=W, canvas_height_px=H, **VARIATIONS[variation])
+    paths = EDGE_SHAPES[shape]()
+    return {
+        "description": f"{shape} path, {variation}",
+        "tolerance": 1e-9,
+        "params": asdict(params),
+        "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
+        "expected": _segments(params, paths),
+    }
+
+
 def cases() -> dict[str, dict[str, Any]]:
-    return simplifier_cases(
+    result = simplifier_cases(
         WindowParams,
         WINDOW_PARAMS,
         VARIATIONS,
         "the window simplifier's parameters: defaults and allowed ranges",
     )
+    for shape in EDGE_SHAPES:
+        for variation in EDGE_VARIATIONS:
+            result[f"{shape}/{variation}.json"] = _edge_case(shape, variation)
+    return result

@@ -534,3 +534,76 @@ def test_the_same_strokes_to_the_last_bit_as_the_reference(
             assert fast.line_start == reference.line_start and fast.drawing == reference.drawing
         assert _bits(fast.end()) == _bits(reference.end())
         assert fast.line_start is None and not fast.drawing
+
+
+# ---- Drawings along the canvas edges: every stroke stays on the grid ----
+
+
+@st.composite
+def edge_drawings(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
+    """A line drawn along the canvas edges, on them and beyond, that the latency cap cuts.
+
+    The canvas has the grid's aspect ratio (or is stretched onto it), so its edges map onto the
+    grid's and a sample beyond one maps onto it. The line runs along one edge, or turns its
+    corners onto the next ones (a "U"); it may start inside and drift across the edge at a shallow
+    angle, wobble about it or run exactly on it, so that a stroke the cap ended may point a little
+    off the grid.
+    """
+    columns, rows = draw(st.integers(2, 8)), draw(st.integers(2, 8))
+    unit_px = draw(st.sampled_from([100.0, 250.0]))  # canvas pixels per grid unit
+    width_px, height_px = (columns - 1) * unit_px, (rows - 1) * unit_px
+    params = WindowParams(
+        max_error=draw(st.sampled_from([0.02, 0.1, 0.25, 0.5])),
+        max_window=draw(st.sampled_from([7, 256])),
+        max_stroke_ms=draw(st.sampled_from([50.0, 100.0, 300.0])),
+        min_length=draw(st.sampled_from([0.0, 0.1])),
+        min_duration_ms=draw(st.sampled_from([0.0, 6.1])),
+        rows=rows,
+        columns=columns,
+        stretch=draw(st.booleans()),
+        canvas_width_px=width_px,
+        canvas_height_px=height_px,
+    )
+    error_px = params.max_error * unit_px
+    # The canvas corners clockwise, and each edge's inward normal.
+    corners = [(0.0, 0.0), (width_px, 0.0), (width_px, height_px), (0.0, height_px)]
+    inward = [(0.0, 1.0), (-1.0, 0.0), (0.0, -1.0), (1.0, 0.0)]
+    first_edge, legs = draw(st.integers(0, 3)), draw(st.integers(1, 3))
+    # How far inside the edge the line runs (pixels; negative is beyond it) where it starts and
+    # where it ends, and its noise across the edge: none, a line's or more.
+    depth_from_px = draw(st.floats(-0.5, 1.0)) * error_px
+    depth_to_px = draw(st.floats(-0.5, 1.0)) * error_px
+    noise_px = draw(st.sampled_from([0.0, 0.05, 0.2])) * error_px
+    step_ms = draw(st.sampled_from([4.0, 8.0, 16.7]))
+    samples: list[Sample] = []
+    for leg in range(legs):
+        edge = (first_edge + leg) % 4
+        (x0, y0), (x1, y1) = corners[edge], corners[(edge + 1) % 4]
+        nx, ny = inward[edge]
+        # The first leg may start partway along, the last end partway (or overshoot a corner).
+        start = draw(st.floats(-0.05, 0.5)) if leg == 0 else 0.0
+        stop = draw(st.floats(0.5, 1.05)) if leg == legs - 1 else 1.0
+        count = draw(st.integers(2, 60))
+        noises = draw(st.lists(st.floats(-1.0, 1.0), min_size=count, max_size=count))
+        for k, noise in enumerate(noises):
+            share = k / (count - 1)
+            along = start + (stop - start) * share
+            depth = (leg + share) / legs * (depth_to_px - depth_from_px) + depth_from_px
+            depth += noise * noise_px
+            x, y = x0 + (x1 - x0) * along + nx * depth, y0 + (y1 - y0) * along + ny * depth
+            samples.append(Sample(len(samples) * step_ms, x, y))
+    return params, samples
+
+
+@settings(max_examples=400, deadline=None)
+@given(edge_drawings())
+def test_a_drawing_along_the_edges_gives_strokes_on_the_grid(
+    case: tuple[WindowParams, list[Sample]],
+) -> None:
+    # The sleeve refuses a stroke that starts or ends off the grid, and the mapping puts every
+    # drawn sample on it: a line going on along a stroke the cap ended must not leave it.
+    params, samples = case
+    x_max, y_max = params.columns - 1, params.rows - 1
+    for _, segment in _run(params, [samples]):
+        for x, y in (segment.start, segment.end):
+            assert 0.0 <= x <= x_max and 0.0 <= y <= y_max, segment

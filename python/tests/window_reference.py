@@ -2,8 +2,9 @@
 
 A reference for the property test that the simplifier in ``feelmysign.simplify.window``, which
 keeps its samples in flat lists and skips tests a bound proves needless, gives the same strokes
-to the last bit. It is the simplifier as of its straight-line rule, with the canvas-to-grid
-mapping computed in full for every sample (``_to_grid``). Kept in the tests, not in the package.
+to the last bit. It is the simplifier as of its straight-line rule (a line's end kept on the
+grid), with the canvas-to-grid mapping computed in full for every sample (``_to_grid``). Kept
+in the tests, not in the package.
 """
 
 from __future__ import annotations
@@ -156,9 +157,9 @@ class ReferenceWindowSimplifier:
         After a stroke the latency cap ended that is a line (``_line_of``), the
         stroke that follows it goes on along that line when it can: its end is
         window[cut] projected onto it, if that moves it at most ``LINE_SHARE`` x
-        max_error, every sample up to window[cut] keeps the bound to the
-        projected end and the stroke is still long enough to send; else
-        window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
+        max_error, lies on the grid, every sample up to window[cut] keeps the
+        bound to the projected end and the stroke is still long enough to send;
+        else window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
         straight line cut into strokes stays one straight line (a sample's
         sideways noise would otherwise bend it).
         """
@@ -171,6 +172,9 @@ class ReferenceWindowSimplifier:
         if along <= 0:
             return at
         end = _Point(at.sample, (ax + along * ux, ay + along * uy))
+        x_extent, y_extent = float(self.params.columns - 1), float(self.params.rows - 1)
+        if not (0.0 <= end.point[0] <= x_extent and 0.0 <= end.point[1] <= y_extent):
+            return at  # off the grid: the sleeve would refuse it
         limit = LINE_SHARE * self.params.max_error
         if _distance_sq(at.point, end.point, end.point) > limit * limit:  # a bend, not noise
             return at

@@ -2,8 +2,8 @@
  * The window simplifier as first written: every sample tested at every new one, no shortcuts.
  * A reference for the property test that `src/simplify/window.ts`, which keeps its samples in
  * flat arrays and skips tests a bound proves needless, gives the same strokes to the last bit.
- * It is the simplifier as of its straight-line rule, with the canvas-to-grid mapping computed as
- * first written (`toGrid`). Kept in the tests, not in the page.
+ * It is the simplifier as of its straight-line rule (a line's end kept on the grid), with the
+ * canvas-to-grid mapping computed as first written (`toGrid`). Kept in the tests, not in the page.
  */
 import type { CanvasMappingOptions } from "../src/simplify/mapping";
 import { finishSegment, type Point, type Sample, type Segment } from "../src/simplify/segment";
@@ -169,9 +169,9 @@ export class ReferenceWindowSimplifier {
   /**
    * Where a stroke that the latency cap or the release ends, ending at window[cut], ends.
    * After a stroke the latency cap ended, the stroke that follows it goes on along the same
-   * line when it can: its end is window[cut] projected onto that line, if every sample up to
-   * window[cut] keeps the bound to the projected end and the stroke is still long enough to
-   * send; else window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
+   * line when it can: its end is window[cut] projected onto that line, if it lies on the grid,
+   * every sample up to window[cut] keeps the bound to the projected end and the stroke is still
+   * long enough to send; else window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
    * straight line cut into strokes stays one straight line.
    */
   #continued(window: readonly Drawn[], cut: number): Drawn {
@@ -182,6 +182,11 @@ export class ReferenceWindowSimplifier {
     const along = (at.point[0] - ax) * ux + (at.point[1] - ay) * uy;
     if (along <= 0) return at;
     const end: Drawn = { sample: at.sample, point: [ax + along * ux, ay + along * uy] };
+    const xExtent = this.params.columns - 1;
+    const yExtent = this.params.rows - 1;
+    const [endX, endY] = end.point;
+    // Off the grid: the sleeve would refuse it.
+    if (!(0 <= endX && endX <= xExtent && 0 <= endY && endY <= yExtent)) return at;
     const limit = LINE_SHARE * this.params.max_error;
     if (distanceSq(at.point, end.point, end.point) > limit * limit) return at; // a bend, not noise
     if (!this.#sendable(window[0]!, end) || !this.#fits(window, 1, cut + 1, end.point)) return at;

@@ -4,8 +4,9 @@
  * stroke that covers it, no stroke covers more than max_window samples after
  * its start nor lasts longer than max_stroke_ms (unless it is a single step or
  * was too short to send until its last sample),
- * strokes join end to start from the press to the release, and a dropped
- * segment carries the reason that matches its size.
+ * strokes join end to start from the press to the release, a dropped
+ * segment carries the reason that matches its size, and a drawing along the
+ * canvas edges gives strokes that start and end on the grid.
  */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
@@ -196,6 +197,121 @@ describe("window simplifier invariants", () => {
           }
         }),
         { numRuns: 200 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+});
+
+/**
+ * A line drawn along the canvas edges, on them and beyond, that the latency cap cuts. The canvas
+ * has the grid's aspect ratio (or is stretched onto it), so its edges map onto the grid's and a
+ * sample beyond one maps onto it. The line runs along one edge, or turns its corners onto the
+ * next ones (a "U"); it may start inside and drift across the edge at a shallow angle, wobble
+ * about it or run exactly on it, so that a stroke the cap ended may point a little off the grid.
+ */
+const edgeDrawingArb = fc
+  .record({
+    columns: fc.integer({ min: 2, max: 8 }),
+    rows: fc.integer({ min: 2, max: 8 }),
+    unitPx: fc.constantFrom(100, 250), // canvas pixels per grid unit
+    maxError: fc.constantFrom(0.02, 0.1, 0.25, 0.5),
+    maxWindow: fc.constantFrom(7, 256),
+    maxStrokeMs: fc.constantFrom(50, 100, 300),
+    minLength: fc.constantFrom(0, 0.1),
+    minDurationMs: fc.constantFrom(0, 6.1),
+    stretch: fc.boolean(),
+    firstEdge: fc.integer({ min: 0, max: 3 }),
+    // How far inside the edge the line runs (in max_error; negative is beyond it) where it
+    // starts and where it ends, and its noise across the edge: none, a line's or more.
+    depthFrom: fc.double({ min: -0.5, max: 1, noNaN: true }),
+    depthTo: fc.double({ min: -0.5, max: 1, noNaN: true }),
+    noise: fc.constantFrom(0, 0.05, 0.2),
+    stepMs: fc.constantFrom(4, 8, 16.7),
+    // The first leg may start partway along, the last end partway (or overshoot a corner).
+    start: fc.double({ min: -0.05, max: 0.5, noNaN: true }),
+    stop: fc.double({ min: 0.5, max: 1.05, noNaN: true }),
+    legs: fc.array(fc.array(fc.double({ min: -1, max: 1, noNaN: true }), { minLength: 2, maxLength: 60 }), {
+      minLength: 1,
+      maxLength: 3,
+    }),
+  })
+  .map((d) => {
+    const widthPx = (d.columns - 1) * d.unitPx;
+    const heightPx = (d.rows - 1) * d.unitPx;
+    const params: WindowParams = {
+      algorithm: "window",
+      max_error: d.maxError,
+      max_window: d.maxWindow,
+      max_stroke_ms: d.maxStrokeMs,
+      clear_on_press: true,
+      min_duration_ms: d.minDurationMs,
+      min_length: d.minLength,
+      rows: d.rows,
+      columns: d.columns,
+      canvas_width_px: widthPx,
+      canvas_height_px: heightPx,
+      stretch: d.stretch,
+    };
+    const errorPx = d.maxError * d.unitPx;
+    // The canvas corners clockwise, and each edge's inward normal.
+    const corners: Point[] = [
+      [0, 0],
+      [widthPx, 0],
+      [widthPx, heightPx],
+      [0, heightPx],
+    ];
+    const inward: Point[] = [
+      [0, 1],
+      [-1, 0],
+      [0, -1],
+      [1, 0],
+    ];
+    const samples: Sample[] = [];
+    d.legs.forEach((noises, leg) => {
+      const edge = (d.firstEdge + leg) % 4;
+      const [x0, y0] = corners[edge]!;
+      const [x1, y1] = corners[(edge + 1) % 4]!;
+      const [nx, ny] = inward[edge]!;
+      const start = leg === 0 ? d.start : 0;
+      const stop = leg === d.legs.length - 1 ? d.stop : 1;
+      noises.forEach((noise, k) => {
+        const share = k / (noises.length - 1);
+        const along = start + (stop - start) * share;
+        const depthShare = ((leg + share) / d.legs.length) * (d.depthTo - d.depthFrom) + d.depthFrom;
+        const depth = depthShare * errorPx + noise * d.noise * errorPx;
+        samples.push({
+          t_ms: samples.length * d.stepMs,
+          x: x0 + (x1 - x0) * along + nx * depth,
+          y: y0 + (y1 - y0) * along + ny * depth,
+          pressure: 0.5,
+        });
+      });
+    });
+    return { params, samples };
+  });
+
+describe("window simplifier along the canvas edges", () => {
+  it(
+    "gives strokes that start and end on the grid",
+    () => {
+      // The sleeve refuses a stroke that starts or ends off the grid, and the mapping puts every
+      // drawn sample on it: a line going on along a stroke the cap ended must not leave it.
+      fc.assert(
+        fc.property(edgeDrawingArb, ({ params, samples }) => {
+          const simplifier = new WindowSimplifier(params);
+          const segments = samples.flatMap((sample) => simplifier.push(sample));
+          segments.push(...simplifier.end());
+          for (const segment of segments) {
+            for (const [x, y] of [segment.start, segment.end]) {
+              expect(
+                0 <= x && x <= params.columns - 1 && 0 <= y && y <= params.rows - 1,
+                String([x, y]),
+              ).toBe(true);
+            }
+          }
+        }),
+        { numRuns: 400 },
       );
     },
     PROPERTY_TIMEOUT_MS,

@@ -14,9 +14,9 @@
  * long enough to send lasts at most `max_stroke_ms` of drawing (the latency cap) and holds at most
  * `max_window` samples (the work cap). The stroke after one the latency cap
  * ended, if the cap or the release ends it too, ends on the line of the stroke
- * before (its end sample projected onto it) when the bound allows, so a straight
- * line cut by the cap stays straight. Too short or too brief strokes are
- * dropped with their reason. The float operations follow the reference's order.
+ * before (its end sample projected onto it) when the bound allows and that end
+ * stays on the grid, so a straight line cut by the cap stays straight. Too short
+ * or too brief strokes are dropped with their reason. The float operations follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
 import { finishSegment, type Point, type Sample, type Segment } from "./segment";
@@ -104,6 +104,9 @@ export class WindowSimplifier {
   readonly #maxErrorSq: number;
   readonly #minLengthSq: number;
   readonly #mapping: CanvasMapping;
+  /** The grid's extents (grid units): every stroke's start and end lies in [0, x] x [0, y]. */
+  readonly #xExtent: number;
+  readonly #yExtent: number;
   /** The samples of the stroke being drawn: its anchor first, then every sample since. */
   readonly #window: Samples;
   /** Each sample's squared distance to a chord, while a cut looks for its feature. */
@@ -140,6 +143,8 @@ export class WindowSimplifier {
     this.#maxErrorSq = params.max_error * params.max_error;
     this.#minLengthSq = params.min_length * params.min_length;
     this.#reachLimit = params.max_error - ROUNDING_SLACK;
+    this.#xExtent = params.columns - 1;
+    this.#yExtent = params.rows - 1;
     this.#mapping = new CanvasMapping({
       width_px: params.canvas_width_px,
       height_px: params.canvas_height_px,
@@ -306,10 +311,11 @@ export class WindowSimplifier {
    * Where a stroke that the latency cap or the release ends, ending at window[cut], ends
    * (at window[cut]'s time).
    * After a stroke the latency cap ended, the stroke that follows it goes on along the same
-   * line when it can: its end is window[cut] projected onto that line, if every sample up to
-   * window[cut] keeps the bound to the projected end and the stroke is still long enough to
-   * send; else window[cut] itself. The cap cuts a drawn line, not a drawn corner, so a
-   * straight line cut into strokes stays one straight line.
+   * line when it can: its end is window[cut] projected onto that line, if it lies on the grid
+   * (the sleeve refuses a stroke off it), every sample up to window[cut] keeps the bound to the
+   * projected end and the stroke is still long enough to send; else window[cut] itself. The
+   * cap cuts a drawn line, not a drawn corner, so a straight line cut into strokes stays one
+   * straight line.
    */
   #continued(cut: number): Point {
     const { xs, ys } = this.#window;
@@ -323,6 +329,12 @@ export class WindowSimplifier {
     if (along <= 0) return [atX, atY];
     const endX = ax + along * ux;
     const endY = ay + along * uy;
+    // On the line but off the grid (a line drawn along an edge, its noise clamped onto the
+    // edge): the sleeve refuses a stroke that ends off the grid, so keep the drawn sample, which
+    // the mapping put on it. Not the projection clamped: that would bend the line.
+    if (!(0 <= endX && endX <= this.#xExtent && 0 <= endY && endY <= this.#yExtent)) {
+      return [atX, atY];
+    }
     const limit = LINE_SHARE * this.params.max_error;
     // A bend, not noise.
     if (distanceSq(atX, atY, endX, endY, endX, endY) > limit * limit) return [atX, atY];

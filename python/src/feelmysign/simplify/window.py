@@ -33,8 +33,9 @@ corners land on the drawing's features. Here:
   samples all lie within ``LINE_SHARE`` x max_error of it, the next stroke, if
   the cap or the release ends it too, ends on that stroke's line (its end
   sample projected onto it) when that moves the end at most ``LINE_SHARE`` x
-  max_error, every sample since its start keeps the bound to that end and it
-  is still long enough to send; else at the sample. The cap cuts a line, not
+  max_error, the end stays on the grid (the sleeve refuses a stroke off it),
+  every sample since its start keeps the bound to that end and it is still
+  long enough to send; else at the sample. The cap cuts a line, not
   a corner, and the $1 recogniser scales a thin line to a square, so one
   sample's sideways noise would show as a bend. Such an end lies within
   ``LINE_SHARE`` x max_error of its drawn sample, not on it.
@@ -166,12 +167,17 @@ class WindowSimplifier:
         init=False
     )  # reach + step at most this: every sample keeps the bound
     _mapping: CanvasMapping = field(init=False)
+    # The grid's extents (grid units): every stroke's start and end lies in [0, x] x [0, y].
+    _x_extent: float = field(init=False)
+    _y_extent: float = field(init=False)
 
     def __post_init__(self) -> None:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._min_length_sq = self.params.min_length * self.params.min_length
         self._reach_limit = self.params.max_error - ROUNDING_SLACK
         self._mapping = self.params.mapping
+        self._x_extent = float(self.params.columns - 1)
+        self._y_extent = float(self.params.rows - 1)
 
     @property
     def drawing(self) -> bool:
@@ -338,9 +344,9 @@ class WindowSimplifier:
         After a stroke the latency cap ended that is a line (``_line_of``), the
         stroke that follows it goes on along that line when it can: its end is
         points[cut] projected onto it, if that moves it at most ``LINE_SHARE`` x
-        max_error, every sample up to points[cut] keeps the bound to the
-        projected end and the stroke is still long enough to send; else
-        points[cut] itself (the end keeps the time of the sample at the cut).
+        max_error, lies on the grid, every sample up to points[cut] keeps the
+        bound to the projected end and the stroke is still long enough to send;
+        else points[cut] itself (the end keeps the time of the sample at the cut).
         The cap cuts a drawn line, not a drawn corner, so a straight line cut
         into strokes stays one straight line (a sample's sideways noise would
         otherwise bend it).
@@ -354,6 +360,11 @@ class WindowSimplifier:
         if along <= 0:
             return at
         end = (ax + along * ux, ay + along * uy)
+        # On the line but off the grid (a line drawn along an edge, its noise clamped onto the
+        # edge): the sleeve refuses a stroke that ends off the grid, so keep the drawn sample,
+        # which the mapping put on it. Not the projection clamped: that would bend the line.
+        if not (0.0 <= end[0] <= self._x_extent and 0.0 <= end[1] <= self._y_extent):
+            return at
         limit = LINE_SHARE * self.params.max_error
         if _distance_sq(at, end, end) > limit * limit:  # a bend, not noise
             return at
