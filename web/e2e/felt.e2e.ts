@@ -154,9 +154,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     // leg took to draw: seconds, however slowly this machine answers the Esc.
     await setLongestStroke(page, "0");
     await page.locator('[data-testid="new-button"]').click();
-    // A slow zigzag: each leg takes seconds to draw, so its stroke plays that long.
+    // A slow zigzag: each leg takes seconds to draw, so its stroke plays that long. Not too
+    // slow: a leg drawn in over 10 s makes a stroke the sleeve refuses as too long, and a
+    // loaded machine took 8 to 10 s a leg at 4 px a pointer step; 8 px halves that.
     const legs: Point[] = [at(0.05, 0.1), at(0.3, 0.9), at(0.55, 0.1), at(0.8, 0.9), at(0.95, 0.1)];
-    await drawWithMouse(page, legs, { stepPx: 4 });
+    await drawWithMouse(page, legs, { stepPx: 8 });
     const drawing = await drawingId(page);
     // Mid-way: the last stroke has started (it lasts as long as its leg took to draw, over a second).
     const last = Number(await dataOf(page, "timeline", "strokes")) - 1;
