@@ -154,6 +154,24 @@ def _segments(params: Params, paths: list[Path]) -> dict[str, Any]:
     }
 
 
+def simplifier_case(
+    make_params: Callable[..., Params],
+    variation: dict[str, Any],
+    description: str,
+    paths: list[Path],
+) -> dict[str, Any]:
+    """One vector: ``paths`` with the ``variation``'s parameters, on the W x H canvas unless
+    the variation names another."""
+    params = make_params(**{"canvas_width_px": W, "canvas_height_px": H, **variation})
+    return {
+        "description": description,
+        "tolerance": 1e-9,
+        "params": asdict(params),
+        "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
+        "expected": _segments(params, paths),
+    }
+
+
 def simplifier_cases(
     make_params: Callable[..., Params],
     specs: dict[str, ParamSpec],
@@ -166,16 +184,9 @@ def simplifier_cases(
     """
 
     def case(shape: str, variation: str) -> dict[str, Any]:
-        overrides = {"canvas_width_px": W, "canvas_height_px": H, **variations[variation]}
-        params = make_params(**overrides)
-        paths = SHAPES[shape]()
-        return {
-            "description": f"{shape} path, {variation}",
-            "tolerance": 1e-9,
-            "params": asdict(params),
-            "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
-            "expected": _segments(params, paths),
-        }
+        return simplifier_case(
+            make_params, variations[variation], f"{shape} path, {variation}", SHAPES[shape]()
+        )
 
     result: dict[str, dict[str, Any]] = {}
     for shape in SHAPES:

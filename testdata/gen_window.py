@@ -14,12 +14,11 @@ one (``EDGE_SHAPES``): a drawing along the canvas edges, whose strokes must stay
 from __future__ import annotations
 
 import random
-from dataclasses import asdict
 from typing import Any
 
 from feelmysign.simplify import Sample, WindowParams
 from feelmysign.simplify.window import WINDOW_PARAMS
-from gen_angle import H, Path, W, _line, _segments, simplifier_cases
+from gen_angle import H, Path, W, _line, simplifier_case, simplifier_cases
 
 VARIATIONS: dict[str, dict[str, Any]] = {
     "defaults": {},
@@ -66,15 +65,9 @@ EDGE_VARIATIONS = ("defaults", "max-stroke-ms-100", "max-error-0.05")
 
 
 def _edge_case(shape: str, variation: str) -> dict[str, Any]:
-    params = WindowParams(canvas_width_px=W, canvas_height_px=H, **VARIATIONS[variation])
-    paths = EDGE_SHAPES[shape]()
-    return {
-        "description": f"{shape} path, {variation}",
-        "tolerance": 1e-9,
-        "params": asdict(params),
-        "paths": [[[s.t_ms, s.x, s.y, s.pressure] for s in path] for path in paths],
-        "expected": _segments(params, paths),
-    }
+    return simplifier_case(
+        WindowParams, VARIATIONS[variation], f"{shape} path, {variation}", EDGE_SHAPES[shape]()
+    )
 
 
 def cases() -> dict[str, dict[str, Any]]:
