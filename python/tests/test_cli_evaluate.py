@@ -268,3 +268,72 @@ def test_an_empty_folder_is_refused(tmp_path: Path, capsys: pytest.CaptureFixtur
     (tmp_path / "empty").mkdir()
     assert main(["evaluate", str(tmp_path / "empty"), "--out", str(tmp_path / "o")]) == 1
     assert "no recordings (*.json) or $1 gesture logs (*.xml)" in capsys.readouterr().err
+
+
+def templates_file(path: Path, mapping: dict[str, str]) -> None:
+    """$1 templates (a round one and an upturned V) under names unlike the gestures'."""
+    round_one = [
+        [100 + 50 * math.cos(2 * math.pi * k / 32), 100 + 50 * math.sin(2 * math.pi * k / 32)]
+        for k in range(33)
+    ]
+    upturned_v = [[40 + 3.0 * k, 200 - 4.0 * min(k, 40 - k)] for k in range(41)]
+    document = {"templates": [["ring", round_one], ["hat", upturned_v]]}
+    path.write_text(json.dumps({**document, "gesture_to_template": mapping}))
+
+
+@pytest.mark.parametrize(
+    ("mapping", "expected_pct"),
+    [({"circle": "ring", "caret": "hat"}, 100.0), ({"circle": "hat", "caret": "ring"}, 0.0)],
+)
+def test_a_templates_file_in_the_folder_is_what_drawings_are_named_against(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], mapping: dict[str, str], expected_pct: float
+) -> None:
+    root = gesture_folder(tmp_path / "gestures")
+    templates_file(root / "templates.json", mapping)
+    document = evaluate_json(
+        capsys, str(root), "--defaults", "--algorithm", "window", "--out", str(tmp_path / "o")
+    )
+    # The templates file is not read as a recording, and every drawing is named by it:
+    # a mapping to the wrong template names none of them.
+    assert document["recordings"] == 8
+    for entry in document["summary"]:
+        assert entry["recognised_drawn_pct"] == expected_pct
+        assert entry["recognised_sent_pct"] == expected_pct
+
+
+def test_templates_given_elsewhere_name_a_gesture_without_its_own_template_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    root = gesture_folder(tmp_path / "gestures")
+    templates = tmp_path / "only-ring.json"
+    templates_file(templates, {"circle": "ring"})
+    argv = ["evaluate", str(root), "--defaults", "--algorithm", "window"]
+    assert main([*argv, "--templates", str(templates), "--out", str(tmp_path / "o")]) == 0
+    table = capsys.readouterr().out
+    assert f"against the 2 templates of {templates}" in table
+    with (tmp_path / "o" / "results.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    # Carets have no template here: evaluated, not recognised; circles are named "ring".
+    assert {r["recognised_sent"] for r in rows if r["group"] == "caret"} == {""}
+    assert {r["recognised_sent"] for r in rows if r["group"] == "circle"} == {"1"}
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("{", "not valid JSON"),
+        ('{"gesture_to_template": {}}', "no 'templates' list"),
+        ('{"templates": [["ring", [[1, 2]]]]}', "at least 2 finite points"),
+        ('{"templates": [["ring"]]}', "is not [name, [[x, y], ...]]"),
+        ('{"templates": []}', "is empty"),
+        ('{"templates": [["a", [[0, 0], [1, 1]]]], "gesture_to_template": [1]}', "map names"),
+    ],
+)
+def test_a_bad_templates_file_says_what_is_wrong(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, message: str
+) -> None:
+    root = gesture_folder(tmp_path / "gestures")
+    (root / "templates.json").write_text(text)
+    assert main(["evaluate", str(root), "--defaults", "--out", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("Error:") and message in err and "Traceback" not in err

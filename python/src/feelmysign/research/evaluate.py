@@ -53,7 +53,8 @@ class Source:
 
     ``template`` is the recording's own index among the recogniser's templates of
     its ``pool`` (left out when it is recognised), or None when it has no shape to
-    recognise.
+    recognise; with a fixed set of templates (``template_sources``) nothing is left
+    out, and any index means "recognise it".
     """
 
     name: str
@@ -173,14 +174,27 @@ def sent_polyline(segments: Sequence[Segment]) -> metrics.Points:
 
 
 class Recogniser:
-    """The $1 recogniser with drawings as templates, one left out per candidate.
+    """The $1 recogniser, with drawings as templates (one left out per candidate) or with a
+    fixed set of templates (``leave_one_out=False``: nothing is left out).
 
-    ``templates`` may be one pool (every source's ``pool`` is ``""``: LASA) or
-    one per pool (the recordings of each set, recognised among themselves).
+    ``templates`` may be one pool (every source's ``pool`` is ``""``: LASA, or a
+    templates file) or one per pool (the recordings of each set, recognised among
+    themselves). ``expected`` maps a source's group to the template name it should be
+    recognised as (default: the group itself).
     """
 
-    def __init__(self, templates: dollar.Templates | dict[str, dollar.Templates]) -> None:
+    def __init__(
+        self,
+        templates: dollar.Templates | dict[str, dollar.Templates],
+        *,
+        leave_one_out: bool = True,
+        expected: dict[str, str] | None = None,
+        against: str = "the other drawings of its set",
+    ) -> None:
+        self.against = against  # what the drawings are recognised against, for a reader
         self._pools = templates if isinstance(templates, dict) else {"": templates}
+        self._leave_one_out = leave_one_out
+        self._expected = expected or {}
         self._drawn: dict[str, bool] = {}
 
     def names(self, source: Source, candidate: metrics.Points) -> bool | None:
@@ -189,9 +203,10 @@ class Recogniser:
             return None
         if len(candidate) < 2 or not np.any(candidate != candidate[0]):
             return False
-        templates = self._pools[source.pool].without(source.template)
+        pool = self._pools[source.pool]
+        templates = pool.without(source.template) if self._leave_one_out else pool
         name, _ = dollar.recognise(candidate, templates)
-        return name == source.group
+        return name == self._expected.get(source.group, source.group)
 
     def drawn(self, source: Source, points: metrics.Points) -> bool | None:
         if source.name not in self._drawn:
@@ -222,6 +237,28 @@ def file_sources(gestures: Sequence[Any]) -> tuple[list[Source], Recogniser]:
         sources.append(Source(g.name, g.gesture, g.recording, g.set, index, g.set))
     templates = {name: dollar.Templates.of(named) for name, named in pools.items()}
     return sources, Recogniser(templates)
+
+
+def template_sources(gestures: Sequence[Any], template_set: Any) -> tuple[list[Source], Recogniser]:
+    """Recorded drawings as sources, each recognised against a fixed set of templates.
+
+    ``template_set`` is a ``research.gestures.TemplateSet``. A drawing whose gesture has
+    no template there is evaluated but not recognised (``template`` None).
+    """
+    sources = []
+    for g in gestures:
+        index = 0 if template_set.expected(g.gesture) is not None else None
+        sources.append(Source(g.name, g.gesture, g.recording, g.set, index))
+    named = [(name, metrics.as_points(points)) for name, points in template_set.templates]
+    expected = {
+        g.gesture: name for g in gestures if (name := template_set.expected(g.gesture)) is not None
+    }
+    return sources, Recogniser(
+        dollar.Templates.of(named),
+        leave_one_out=False,
+        expected=expected,
+        against=f"the {len(named)} templates of {template_set.path}",
+    )
 
 
 def evaluate_one(

@@ -20,6 +20,12 @@ name) is the gesture's ``Name`` (else the file name) without trailing digits
 (``arrow01`` -> ``arrow``); its set is the ``Speed`` (else the folder it lies
 in under the folder given, else ``files``), so that a gesture log's speeds are
 summarised apart.
+
+A folder may also hold ``templates.json``: the templates the recogniser names
+its drawings against (``load_templates``), which is then not a recording::
+
+    {"templates": [[name, [[x, y], ...]], ...],
+     "gesture_to_template": {"delete_mark": "delete", ...}}
 """
 
 from __future__ import annotations
@@ -37,6 +43,8 @@ from feelmysign.simplify.recording import Recording, RecordingError, load_record
 
 EXTENSIONS = (".json", ".xml")
 FILES_SET = "files"
+TEMPLATES_FILE = "templates.json"
+MAX_TEMPLATES_BYTES = 10_000_000
 MAX_GESTURE_BYTES = 10_000_000
 
 
@@ -66,7 +74,9 @@ def expand(paths: list[str]) -> list[tuple[Path, str | None]]:
             found.append((path, None))
             continue
         inside = sorted(
-            p for p in path.rglob("*") if p.suffix.lower() in EXTENSIONS and p.is_file()
+            p
+            for p in path.rglob("*")
+            if p.suffix.lower() in EXTENSIONS and p.is_file() and p.name != TEMPLATES_FILE
         )
         if not inside:
             raise RecordingError(
@@ -126,3 +136,69 @@ def load_all(
 ) -> list[Gesture]:
     """Every recording in ``paths`` (files and folders), in the order given, folders sorted."""
     return [load_gesture(path, folder, load_json) for path, folder in expand(paths)]
+
+
+@dataclass(frozen=True)
+class TemplateSet:
+    """Named templates to recognise drawings against, and each gesture's template name
+    (a gesture not in ``gesture_to_template`` is expected to be named as itself)."""
+
+    path: Path
+    templates: list[tuple[str, list[tuple[float, float]]]]
+    gesture_to_template: dict[str, str]
+
+    def expected(self, gesture: str) -> str | None:
+        """The template a drawing of ``gesture`` should be named as (None: no such template)."""
+        name = self.gesture_to_template.get(gesture, gesture)
+        return name if any(n == name for n, _ in self.templates) else None
+
+
+def find_templates(paths: list[str]) -> Path | None:
+    """The ``templates.json`` at the top of the first folder given that has one."""
+    for given in paths:
+        candidate = Path(given) / TEMPLATES_FILE
+        if Path(given).is_dir() and candidate.is_file():
+            return candidate
+    return None
+
+
+def load_templates(path: Path) -> TemplateSet:
+    """A templates file (see the module's notes), every fault named with what was expected."""
+    import json
+
+    shape = (
+        'expected {"templates": [[name, [[x, y], ...]], ...], '
+        '"gesture_to_template": {gesture: name, ...}}'
+    )
+    try:
+        if path.stat().st_size > MAX_TEMPLATES_BYTES:
+            raise RecordingError(f"{path}: larger than {MAX_TEMPLATES_BYTES} bytes")
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise RecordingError(f"cannot read {path}: {error.strerror or error}") from error
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise RecordingError(f"{path}: not valid JSON ({error}); {shape}") from error
+    if not isinstance(data, dict) or not isinstance(data.get("templates"), list):
+        raise RecordingError(f"{path}: no 'templates' list; {shape}")
+    mapping = data.get("gesture_to_template", {})
+    if not isinstance(mapping, dict) or not all(
+        isinstance(k, str) and isinstance(v, str) for k, v in mapping.items()
+    ):
+        raise RecordingError(f"{path}: 'gesture_to_template' must map names to names; {shape}")
+    templates = []
+    for index, item in enumerate(data["templates"]):
+        try:
+            name, raw = item
+            points = [(float(x), float(y)) for x, y in raw]
+        except (TypeError, ValueError) as error:
+            raise RecordingError(f"{path}: template {index} is not [name, [[x, y], ...]]") from (
+                error
+            )
+        if not isinstance(name, str) or len(points) < 2 or not np.all(np.isfinite(points)):
+            raise RecordingError(
+                f"{path}: template {index} needs a name and at least 2 finite points"
+            )
+        templates.append((name, points))
+    if not templates:
+        raise RecordingError(f"{path}: the 'templates' list is empty; {shape}")
+    return TemplateSet(path, templates, dict(mapping))
