@@ -216,6 +216,8 @@ export class App {
 
   /** Stop: every motor off on the sleeve, the rest of this drawing dropped (also Esc). */
   stop(): void {
+    // A pen still down draws nothing more: its path ends here, before the cancels go out.
+    this.#session.endPath();
     const drawing = this.#session.drawing;
     let dropped = 0;
     if (drawing !== null) dropped += this.#sender.cancel(drawing.id);

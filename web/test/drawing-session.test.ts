@@ -213,6 +213,46 @@ describe("a drawing session", () => {
     expect(session.undo()).toBe(false);
   });
 
+  it("ends the path under way at Stop: nothing more is drawn or sent until the next press", () => {
+    const { session, sent, view, released } = setup();
+    const samples = along(L);
+    const corner = samples.findIndex((sample) => sample.x === 280);
+    // Pressed, along the top to the corner, then Stop with the pointer still down.
+    drawPath(session, samples.slice(0, corner + 1), false);
+    const drawing = session.drawing!;
+    const sentAtStop = sent.length;
+    const samplesAtStop = drawing.paths[0]!.length;
+    session.endPath();
+    expect(session.pressed).toBe(false);
+    expect(released()).toBe(1);
+    expect(view.live).toBeNull();
+    // The hand goes on down the side and lifts: none of it is drawn or sent.
+    for (const sample of samples.slice(corner + 1)) {
+      session.move([sample]);
+      frame();
+    }
+    session.release(samples[samples.length - 1]!);
+    expect(sent).toHaveLength(sentAtStop);
+    expect(drawing.paths[0]).toHaveLength(samplesAtStop);
+    expect(released()).toBe(1);
+    expect(waiting).toHaveLength(0);
+    // The next press draws again, into the same drawing (Stop's close() is the page's to call).
+    drawPath(
+      session,
+      along(
+        [
+          [20, 180],
+          [150, 100],
+        ],
+        9000,
+      ),
+    );
+    expect(session.drawing).toBe(drawing);
+    expect(drawing.paths).toHaveLength(2);
+    expect(sent.length).toBeGreaterThan(sentAtStop);
+    expect(sent.map((stroke) => stroke.seq)).toEqual(sent.map((_, i) => i));
+  });
+
   it("neither clears nor undoes while the pointer is down", () => {
     const { session } = setup();
     drawPath(session, along(L), false);

@@ -110,6 +110,24 @@ export class DrawingSession {
     this.#host.released();
   }
 
+  /**
+   * Ends the path being drawn where the pointer is now (Stop, or Esc with the pen down): the
+   * stroke under way is not sent, and the pointer draws nothing more until it is lifted and
+   * pressed again. The samples drawn so far stay in the drawing.
+   */
+  endPath(): void {
+    const drawing = this.#drawing;
+    const pointer = this.#pointer;
+    if (drawing === null || pointer === null || !this.#sampler.pressed) return;
+    this.#sampler.release(pointer);
+    // The stroke under way dies with its simplifier: a new one for the next path.
+    this.#simplifier = makeSimplifier(drawing.params);
+    this.#pointer = null;
+    this.#view.flush();
+    this.#view.clearLive();
+    this.#host.released();
+  }
+
   /** Empties the canvas; the next press starts a new drawing. Not while drawing. */
   clear(): void {
     if (this.#sampler.pressed) return;
