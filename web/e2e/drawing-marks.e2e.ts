@@ -1,17 +1,22 @@
 /**
- * What the drawing area does, in real Chromium: Esc with the pen down ends
- * the path there.
+ * What the drawing area shows, read from its pixels in real Chromium: Esc with
+ * the pen down ends the path there; a stroke the sleeve refused stays marked
+ * refused, whatever is redrawn.
  */
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { FakeSleeve } from "./harness";
-import { drawingArea, nextFrame, waitForData, walk } from "./page";
+import { drawingArea, nextFrame, screenshot, waitForData, walk } from "./page";
 import { DESKTOP, Processes } from "./processes";
 
 const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3.0 }, version: "test" };
 const SUMMARY = '[data-testid="played-summary"]';
+/** The ink of canvas.ts: a sent stroke, and a refused one. */
+const SENT_RGB = [0xff, 0x8a, 0x5b] as const;
+const REFUSED_RGB = [0xff, 0x6b, 0x6b] as const;
 
 type Point = readonly [number, number];
+type Rgb = readonly [number, number, number];
 
 describe("the drawing area's marks", () => {
   const processes = new Processes();
@@ -78,6 +83,35 @@ describe("the drawing area's marks", () => {
     return sent;
   }
 
+  /**
+   * Along the row at viewport y `y`, from x0 to x1: how many pixel columns of the ink canvas show
+   * the colour `rgb` within two pixels of the row.
+   */
+  async function columnsOf(layer: string, rgb: Rgb, y: number, x0: number, x1: number): Promise<number> {
+    return page.evaluate(
+      ({ layer, rgb, y, x0, x1 }) => {
+        const canvas = document.querySelector<HTMLCanvasElement>(`#stage canvas.${layer}`)!;
+        const rect = canvas.getBoundingClientRect();
+        const scale = canvas.width / rect.width;
+        const top = Math.round((y - rect.top) * scale) - 2;
+        const data = canvas.getContext("2d")!.getImageData(0, top, canvas.width, 5).data;
+        const near = (i: number) =>
+          Math.abs(data[i]! - rgb[0]) <= 10 &&
+          Math.abs(data[i + 1]! - rgb[1]) <= 12 &&
+          Math.abs(data[i + 2]! - rgb[2]) <= 12 &&
+          data[i + 3]! > 200;
+        let count = 0;
+        for (let x = Math.round((x0 - rect.left) * scale); x <= Math.round((x1 - rect.left) * scale); x++) {
+          let hit = false;
+          for (let row = 0; row < 5; row++) hit ||= near((row * canvas.width + x) * 4);
+          if (hit) count++;
+        }
+        return count;
+      },
+      { layer, rgb, y, x0, x1 },
+    );
+  }
+
   it("ends the path at Esc with the pen still down: what the hand draws after is neither drawn nor sent", async () => {
     const [a, b, c, d] = [await at(0.1, 0.2), await at(0.9, 0.2), await at(0.9, 0.8), await at(0.1, 0.8)];
     const halfway: Point = [(b[0] + c[0]) / 2, (b[1] + c[1]) / 2];
@@ -100,5 +134,43 @@ describe("the drawing area's marks", () => {
     expect(next).not.toBe(drawing);
     await allSent(next);
     expect(sleeveStrokes(drawing).map((stroke) => stroke["seq"])).toEqual([...Array(sentAtEsc).keys()]);
+  });
+
+  it("keeps a refused stroke marked refused when the drawing is redrawn (Undo)", async () => {
+    await page.locator('[data-testid="new-button"]').click();
+    const [left, right] = [await at(0.15, 0.3), await at(0.6, 0.3)];
+    await draw([left, right]);
+    const drawing = await drawingId();
+    const firstPath = await allSent(drawing);
+    await draw([await at(0.8, 0.2), await at(0.8, 0.8)]);
+    await allSent(drawing);
+    // The middle of the first path, clear of the joints at its strokes' ends.
+    const [x0, x1] = [left[0] + 0.1 * (right[0] - left[0]), left[0] + 0.9 * (right[0] - left[0])];
+    const span = x1 - x0;
+    const y = left[1];
+    expect(await columnsOf("ink", SENT_RGB, y, x0, x1)).toBeGreaterThan(0.8 * span);
+
+    const now = Date.now();
+    for (let seq = 0; seq < firstPath; seq++) {
+      await sleeve.publish("events", {
+        type: "rejected",
+        drawing,
+        seq,
+        received_at_ms: now,
+        reason: "duration_too_long",
+        message: "duration_ms is 12000; this sleeve plays strokes of at most 10000 ms.",
+      });
+    }
+    await waitForData(page, SUMMARY, "refused", String(firstPath));
+    await nextFrame(page);
+    await nextFrame(page);
+    expect(await columnsOf("ink", SENT_RGB, y, x0, x1)).toBeLessThan(0.2 * span);
+    expect(await columnsOf("ink", REFUSED_RGB, y, x0, x1)).toBeGreaterThan(0);
+
+    await page.locator('[data-testid="undo-button"]').click();
+    await nextFrame(page);
+    await screenshot(page, "refused-after-undo");
+    expect(await columnsOf("ink", SENT_RGB, y, x0, x1)).toBeLessThan(0.2 * span);
+    expect(await columnsOf("ink", REFUSED_RGB, y, x0, x1)).toBeGreaterThan(0);
   });
 });

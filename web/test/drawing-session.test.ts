@@ -192,6 +192,31 @@ describe("a drawing session", () => {
     expect(view.rejected.map((drawn) => drawn.stroke?.seq)).toEqual([1]);
   });
 
+  it("keeps a refused stroke refused: after a later path is undone, and whenever its ack comes", () => {
+    const { session, view, sent } = setup();
+    drawPath(session, along(L));
+    const drawing = session.drawing!;
+    drawPath(
+      session,
+      along(
+        [
+          [20, 180],
+          [150, 100],
+        ],
+        5000,
+      ),
+    );
+    session.refused(0);
+    session.acked(sent[0]!);
+    const first = drawing.bySeq(0)!;
+    expect(drawing.isRefused(first)).toBe(true);
+    expect(drawing.isRefused(drawing.bySeq(1)!)).toBe(false);
+    // Undo redraws the drawing from scratch: the canvas reads the refusal from the drawing.
+    expect(session.undo()).toBe(true);
+    expect(view.shown).toBe(drawing);
+    expect(drawing.isRefused(first)).toBe(true);
+  });
+
   it("takes back the last path, and clears the canvas with the first", () => {
     const { session, changes } = setup();
     drawPath(session, along(L));

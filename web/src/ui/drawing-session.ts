@@ -178,7 +178,7 @@ export class DrawingSession {
 
   /** The sleeve refused stroke `seq` of this drawing: marked on the canvas. */
   refused(seq: number): void {
-    const drawn = this.#drawing?.bySeq(seq);
+    const drawn = this.#drawing?.markRefused(seq);
     if (drawn === undefined) return;
     this.#view.markRejected(drawn);
     this.#scheduleFlush();
