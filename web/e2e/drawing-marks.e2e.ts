@@ -1,8 +1,10 @@
 /**
  * What the drawing area shows, read from its pixels in real Chromium: Esc with
  * the pen down ends the path there; a stroke the sleeve refused stays marked
- * refused, whatever is redrawn.
+ * refused, whatever is redrawn; the A/B comparison lies on the drawing it is
+ * compared with.
  */
+import { readFileSync } from "node:fs";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { FakeSleeve } from "./harness";
@@ -14,6 +16,8 @@ const SUMMARY = '[data-testid="played-summary"]';
 /** The ink of canvas.ts: a sent stroke, and a refused one. */
 const SENT_RGB = [0xff, 0x8a, 0x5b] as const;
 const REFUSED_RGB = [0xff, 0x6b, 0x6b] as const;
+/** The comparison's dashed line (canvas.ts COLORS.compare). */
+const COMPARE_RGB = [0x5e, 0xc8, 0xff] as const;
 
 type Point = readonly [number, number];
 type Rgb = readonly [number, number, number];
@@ -172,5 +176,69 @@ describe("the drawing area's marks", () => {
     await screenshot(page, "refused-after-undo");
     expect(await columnsOf("ink", SENT_RGB, y, x0, x1)).toBeLessThan(0.2 * span);
     expect(await columnsOf("ink", REFUSED_RGB, y, x0, x1)).toBeGreaterThan(0);
+  });
+
+  it("lays the A/B comparison on the drawing it compares: a straight line on itself", async () => {
+    await page.locator('[data-testid="new-button"]').click();
+    const [left, right] = [await at(0.15, 0.5), await at(0.85, 0.5)];
+    await draw([left, right]);
+    await allSent(await drawingId());
+    await page.locator('[data-testid="compare-toggle"]').check();
+    await nextFrame(page);
+    // Every layer of the stage covers it exactly.
+    const boxes = await page.evaluate(() =>
+      [...document.querySelectorAll<HTMLCanvasElement>("#stage canvas")].map((canvas) => {
+        const { left, top, width, height } = canvas.getBoundingClientRect();
+        return { layer: canvas.className, left, top, width, height };
+      }),
+    );
+    const live = boxes.find((box) => box.layer === "live")!;
+    for (const box of boxes) expect(box, box.layer).toEqual({ ...live, layer: box.layer });
+
+    // And on the screen: the dashed B line is centred on the solid A line (the same straight stroke).
+    const path = await screenshot(page, "compare-aligned");
+    const rows = await page.evaluate(
+      async ({ png, x0, x1, y, sent, compare }) => {
+        const image = new Image();
+        image.src = `data:image/png;base64,${png}`;
+        await image.decode();
+        const canvas = document.createElement("canvas");
+        canvas.width = image.width;
+        canvas.height = image.height;
+        const ctx = canvas.getContext("2d")!;
+        ctx.drawImage(image, 0, 0);
+        const near = (d: Uint8ClampedArray, i: number, rgb: readonly number[]) =>
+          Math.abs(d[i]! - rgb[0]!) <= 16 &&
+          Math.abs(d[i + 1]! - rgb[1]!) <= 16 &&
+          Math.abs(d[i + 2]! - rgb[2]!) <= 16;
+        const mean = (rgb: readonly number[]) => {
+          let sum = 0;
+          let count = 0;
+          for (let row = Math.round(y) - 20; row <= Math.round(y) + 20; row++) {
+            const d = ctx.getImageData(Math.round(x0), row, Math.round(x1 - x0), 1).data;
+            for (let i = 0; i < d.length; i += 4) {
+              if (near(d, i, rgb)) {
+                sum += row;
+                count++;
+              }
+            }
+          }
+          return count === 0 ? null : sum / count;
+        };
+        return { a: mean(sent), b: mean(compare) };
+      },
+      {
+        png: readFileSync(path).toString("base64"),
+        x0: left[0] + 0.1 * (right[0] - left[0]),
+        x1: left[0] + 0.9 * (right[0] - left[0]),
+        y: left[1],
+        sent: SENT_RGB,
+        compare: COMPARE_RGB,
+      },
+    );
+    expect(rows.a).not.toBeNull();
+    expect(rows.b).not.toBeNull();
+    expect(Math.abs(rows.b! - rows.a!), `B's row ${rows.b} against A's ${rows.a}`).toBeLessThanOrEqual(1);
+    await page.locator('[data-testid="compare-toggle"]').uncheck();
   });
 });
