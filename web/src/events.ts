@@ -296,6 +296,7 @@ export const NOTABLE_ADJUSTMENT = 0.05;
 
 /** What the "Sleeve says" card counts. */
 export type EventCount = "played" | "late" | "refused" | "cancelled" | "cut";
+/** A line of the "Sleeve says" log: a refusal, a stroke played otherwise than asked, an error, news. */
 export type NoteKind = "rejected" | "adjusted" | "error" | "info";
 
 export interface Note {
