@@ -6,22 +6,15 @@
  */
 import { CANCEL_ALL } from "./control";
 import type { ServerConfig } from "./config";
-import { Drawing } from "./drawing";
+import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
-import { parseEvent, parseStatus, type SleeveEvent, type SleeveStatus } from "./events";
-import { StrokeSender, type BrokerState, type SenderTarget } from "./mqtt/sender";
+import { interpretEvent, parseEvent } from "./events";
+import { StrokeSender, type BrokerState } from "./mqtt/sender";
 import { buildRecording, recordingFileName } from "./recording";
 import { drawingFromRecording, parseRecording } from "./recording-load";
-import {
-  LATE_LIMIT_MS,
-  loadSettings,
-  saveSettings,
-  simplifierParams,
-  withServerBroker,
-  type SettingKey,
-  type Settings,
-} from "./settings";
-import { simplifyPaths } from "./simplify/registry";
+import { LATE_LIMIT_MS, loadSettings, saveSettings, withServerBroker, type Settings } from "./settings";
+import { lateLimitMs, senderTarget, settingsChange } from "./settings-diff";
+import { offlineAdvice, SleeveWatch } from "./sleeve-state";
 import { parseActuators } from "./telemetry";
 import { DrawingView } from "./ui/canvas";
 import { detailParams } from "./ui/detail";
@@ -32,46 +25,10 @@ import { attachPointer } from "./ui/pointer";
 import { SleevePreview } from "./ui/preview";
 import { SettingsPanel } from "./ui/settings";
 import { SleevePicker } from "./ui/sleeve-picker";
-import { LATE_MS, NOTABLE_ADJUSTMENT, SleeveSays, seconds } from "./ui/sleeve-says";
-import { byId, StatusBar, type SleeveState } from "./ui/status";
+import { SleeveSays } from "./ui/sleeve-says";
+import { StageSpace } from "./ui/stage-space";
+import { byId, StatusBar } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
-
-/** Settings that change how a drawing is cut or mapped: changing one re-simplifies it. */
-const DRAWING_KEYS: readonly SettingKey[] = [
-  "algorithm",
-  "max_error",
-  "max_window",
-  "max_stroke_ms",
-  "check_frames",
-  "max_angle_deg",
-  "frame_max",
-  "fps",
-  "recover",
-  "min_duration_ms",
-  "min_length",
-  "stretch",
-];
-/** Settings that change the grid: a drawing mapped onto another grid cannot be shown on this one. */
-const GRID_KEYS: readonly SettingKey[] = ["grid_source", "rows", "columns"];
-/** Settings that change where and how strokes are published: changing one reconnects. */
-const TARGET_KEYS: readonly SettingKey[] = [
-  "ws_url",
-  "username",
-  "password",
-  "sleeve_id",
-  "protocol",
-  "legacy_topic",
-];
-/** The media query of styles.css under which the sleeve's cards go below the drawing area. */
-const STACKED_LAYOUT = "(max-width: 820px), (max-height: 560px)";
-/** The one of styles.css for a phone on its side: the toolbar beside the area, the legend below it all. */
-const SHORT_LANDSCAPE = "(max-height: 560px) and (orientation: landscape)";
-/** Stacked, below the area: the gap to the legend and the workspace's padding (styles.css). */
-const STACKED_BELOW_PX = 10 + 12;
-/** Stacked, the area is never squeezed below this height: the page scrolls instead. */
-const STACKED_MIN_HEIGHT_PX = 240;
-/** A sleeve that listens has its retained status at the broker: none after this, none listens. */
-const STATUS_WAIT_MS = 2500;
 
 export interface AppOptions {
   readonly config: ServerConfig | null;
@@ -94,24 +51,15 @@ export class App {
   readonly #session: DrawingSession;
   readonly #buttons: Record<"undo" | "replay" | "record", HTMLButtonElement>;
   readonly #hint: HTMLElement;
-  readonly #stageArea: HTMLElement;
-  readonly #legend: HTMLElement;
-  readonly #legendTurned: HTMLElement;
+  readonly #space: StageSpace;
   readonly #compareToggle: HTMLInputElement;
   readonly #compareDetail: HTMLInputElement;
+  readonly #sleeve: SleeveWatch;
   #settings: Settings;
-  #sleeve: SleeveStatus | null = null;
-  #sleeveState: SleeveState = "unknown";
-  #brokerState: BrokerState = "connecting";
-  #statusTimer: ReturnType<typeof setTimeout> | null = null;
   #refitPending = false;
   #arrival: Arrival = "as-drawn";
-  #notices: { broker: string | null; config: string | null; sleeve: string | null; page: string | null } = {
-    broker: null,
-    config: null,
-    sleeve: null,
-    page: null,
-  };
+  /** The drawing the felt panel shows. */
+  #feltDrawing: string | null = null;
 
   constructor(doc: Document, options: AppOptions) {
     this.#doc = doc;
@@ -146,9 +94,7 @@ export class App {
       record: byId<HTMLButtonElement>(doc, "record-button"),
     };
     this.#hint = byId(doc, "stage-hint");
-    this.#stageArea = byId(doc, "stage-area");
-    this.#legend = byId(doc, "legend");
-    this.#legendTurned = byId(doc, "legend-turned");
+    this.#space = new StageSpace(doc);
     this.#compareToggle = byId<HTMLInputElement>(doc, "compare-toggle");
     this.#compareDetail = byId<HTMLInputElement>(doc, "compare-detail");
     this.#session = new DrawingSession(this.#view, {
@@ -160,6 +106,24 @@ export class App {
         if (this.#refitPending) this.#fit();
       },
     });
+    this.#sleeve = new SleeveWatch(
+      {
+        sleeveId: () => this.#settings.sleeve_id,
+        offlineAdvice: (detail) =>
+          offlineAdvice(
+            detail,
+            this.#settings.ws_url,
+            this.#config !== null && !this.#settings.broker_custom,
+          ),
+        showBroker: (state, detail) => this.#status.setBroker(state, detail),
+        showSleeve: ({ state, id, detail, brokerConnected, caption }) => {
+          this.#status.setSleeve(state, id, detail, brokerConnected);
+          this.#preview.reset(caption, state === "online");
+        },
+        showNotice: (text, level) => this.#status.setNotice(text, level),
+      },
+      options.configNote,
+    );
     this.#sender = new StrokeSender({
       broker: (state, detail) => this.#onBroker(state, detail),
       status: (payload) => this.#onStatus(payload),
@@ -177,14 +141,11 @@ export class App {
         );
       },
     });
-    this.#sender.setLateLimit(this.#settings.late_strokes === "drop" ? LATE_LIMIT_MS : null);
+    this.#sender.setLateLimit(lateLimitMs(this.#settings));
 
-    this.#notices.config = options.configNote;
     if (loaded.replaced.length > 0) {
       this.#says.add("info", `Saved settings no longer valid were reset: ${loaded.replaced.join(", ")}.`);
     }
-    this.#showNotice();
-    this.#setSleeve("unknown");
     this.#status.setUnsent(0);
 
     attachPointer(this.#view, {
@@ -194,12 +155,12 @@ export class App {
     });
     this.#wireButtons();
     const resized = new ResizeObserver(() => this.#fit());
-    resized.observe(this.#stageArea);
+    resized.observe(this.#space.area);
     resized.observe(byId(this.#doc, "stage-wrap")); // the area's height follows its content
     window.addEventListener("resize", () => this.#fit());
     this.#fit();
     this.#drawingChanged(null);
-    this.#sender.connect(this.#target());
+    this.#sender.connect(senderTarget(this.#settings));
   }
 
   #wireButtons(): void {
@@ -219,8 +180,8 @@ export class App {
     byId(doc, "settings-button").addEventListener("click", () =>
       this.#panel.open(this.#settings, {
         config: this.#config,
-        sleeveGrid: this.#sleeve?.layout ?? null,
-        spacingCm: this.#sleeve?.layout?.spacing_cm ?? null,
+        sleeveGrid: this.#sleeve.status?.layout ?? null,
+        spacingCm: this.#sleeve.status?.layout?.spacing_cm ?? null,
       }),
     );
     doc.addEventListener("keydown", (event) => {
@@ -253,10 +214,10 @@ export class App {
     }
   }
 
-  #feltDrawing: string | null = null;
-
   /** Stop: every motor off on the sleeve, the rest of this drawing dropped (also Esc). */
   stop(): void {
+    // A pen still down draws nothing more: its path ends here, before the cancels go out.
+    this.#session.endPath();
     const drawing = this.#session.drawing;
     let dropped = 0;
     if (drawing !== null) dropped += this.#sender.cancel(drawing.id);
@@ -339,7 +300,7 @@ export class App {
   // ---- layout ------------------------------------------------------------------------------
 
   #grid(): GridSize {
-    const layout = this.#sleeve?.layout;
+    const layout = this.#sleeve.status?.layout;
     if (this.#settings.grid_source === "status" && layout)
       return { rows: layout.rows, columns: layout.columns };
     return { rows: this.#settings.rows, columns: this.#settings.columns };
@@ -358,46 +319,10 @@ export class App {
       // The strokes drawn were mapped onto another grid: showing them on this one would lie.
       this.#session.clear();
     }
-    const width = this.#stageArea.clientWidth;
-    // The area takes its content's height, the legend right under it: the viewport (stacked,
-    // phone) or the column (desktop) sets the limit.
-    const stacked = window.matchMedia(STACKED_LAYOUT).matches;
-    const height = stacked ? this.#firstScreenHeight() : this.#columnHeight();
-    this.#view.fit(grid, this.#settings.stretch, width, height);
-    this.#legendTurned.hidden = !this.#view.turned;
+    const { widthPx, heightPx } = this.#space.available();
+    this.#view.fit(grid, this.#settings.stretch, widthPx, heightPx);
+    this.#space.setTurned(this.#view.turned);
     this.#preview.setGrid(grid, this.#view.turned);
-  }
-
-  /** Stacked, the area fills the first screen: from its top to the window's bottom, the legend under it. */
-  #firstScreenHeight(): number {
-    const workspace = this.#stageArea.closest(".workspace");
-    const top = this.#stageArea.getBoundingClientRect().top + (workspace?.scrollTop ?? 0) + window.scrollY;
-    // A phone on its side keeps every pixel of height for drawing: the legend follows below the fold.
-    const legend = window.matchMedia(SHORT_LANDSCAPE).matches ? 0 : this.#legendHeightTurned();
-    return Math.max(STACKED_MIN_HEIGHT_PX, window.innerHeight - top - legend - STACKED_BELOW_PX);
-  }
-
-  /** Desktop, the area fills its column but for the legend, which follows it with no gap to fill. */
-  #columnHeight(): number {
-    const column = this.#stageArea.parentElement;
-    if (!column) return this.#stageArea.clientHeight;
-    const gap = parseFloat(getComputedStyle(column).rowGap) || 0;
-    const bottom = column.getBoundingClientRect().bottom;
-    const top = this.#stageArea.getBoundingClientRect().top;
-    return Math.max(0, bottom - top - gap - this.#legendHeightTurned());
-  }
-
-  /**
-   * The legend's height with its "turned" line shown, whether it is or not: the height left for
-   * the area must not depend on the turn it decides, or a small phone would flip between the two.
-   */
-  #legendHeightTurned(): number {
-    const line = this.#legendTurned;
-    if (!line.hidden) return this.#legend.offsetHeight;
-    line.hidden = false;
-    const height = this.#legend.offsetHeight;
-    line.hidden = true;
-    return height;
   }
 
   // ---- settings ----------------------------------------------------------------------------
@@ -406,19 +331,23 @@ export class App {
     const previous = this.#settings;
     this.#settings = withServerBroker(next, this.#config);
     saveSettings(this.#storage, next, this.#config);
-    this.#sender.setLateLimit(this.#settings.late_strokes === "drop" ? LATE_LIMIT_MS : null);
-    const changed = (keys: readonly SettingKey[]) =>
-      keys.some((key) => previous[key] !== this.#settings[key]);
-    if (changed(GRID_KEYS)) {
+    this.#sender.setLateLimit(lateLimitMs(this.#settings));
+    const change = settingsChange(previous, this.#settings);
+    if (change.grid) {
       this.#session.clear();
       this.#fit();
-    } else if (changed(DRAWING_KEYS)) {
-      this.#resimplify();
+    } else if (change.drawing) {
+      const again = this.#session.recut();
+      if (again !== null) {
+        this.#says.add(
+          "info",
+          `Re-simplified with the new settings: ${again.strokes.length} strokes, not sent. Play again sends them.`,
+        );
+      }
       this.#fit();
     }
-    if (changed(TARGET_KEYS)) {
-      const sleeveChanged = previous.sleeve_id !== this.#settings.sleeve_id;
-      if (sleeveChanged) {
+    if (change.target) {
+      if (change.sleeve) {
         // Its strokes went to the other sleeve: the next path starts a new drawing for this one.
         this.#session.close();
         this.#picker.setCurrent(this.#settings.sleeve_id);
@@ -426,147 +355,26 @@ export class App {
           "info",
           `Now drawing on sleeve ${this.#settings.sleeve_id}; the next path starts a new drawing.`,
         );
-        this.#sleeve = null;
-        this.#setSleeve("unknown");
+        this.#sleeve.sleeveChanged();
         this.#fit();
       }
       // Another sleeve on the same broker keeps the connection; its status, if known, comes at once.
-      this.#sender.connect(this.#target());
-      if (sleeveChanged && this.#brokerState === "connected") this.#waitForStatus();
+      this.#sender.connect(senderTarget(this.#settings));
+      if (change.sleeve) this.#sleeve.awaitStatus();
     }
-  }
-
-  /** The drawing on the canvas cut again under the new settings, at once (not sent: Play again). */
-  #resimplify(): void {
-    const drawing = this.#session.drawing;
-    if (drawing === null || drawing.paths.length === 0) return;
-    const params = simplifierParams(this.#settings, this.#grid(), {
-      width_px: drawing.params.canvas_width_px,
-      height_px: drawing.params.canvas_height_px,
-    });
-    const again = new Drawing(newDrawingId(), params);
-    const pieces = simplifyPaths(params, drawing.paths);
-    drawing.paths.forEach((samples, path) => {
-      again.beginPath(drawing.pointerKinds[path] ?? "mouse");
-      again.paths[path]!.push(...samples);
-      for (const piece of pieces) {
-        if (piece.path === path) again.addSegment(piece.segment, this.#settings.intensity);
-      }
-    });
-    this.#session.adopt(again);
-    this.#says.add(
-      "info",
-      `Re-simplified with the new settings: ${again.strokes.length} strokes, not sent. Play again sends them.`,
-    );
-  }
-
-  #target(): SenderTarget {
-    const { ws_url, username, password, sleeve_id, protocol, legacy_topic } = this.#settings;
-    return { ws_url, username, password, sleeve_id, protocol, legacy_topic };
   }
 
   // ---- broker and sleeve -------------------------------------------------------------------
 
   #onBroker(state: BrokerState, detail: string | null): void {
-    const wasOffline = this.#brokerState === "offline" || this.#notices.broker !== null;
-    this.#brokerState = state;
-    this.#status.setBroker(state, detail);
-    if (state === "connected") {
-      this.#notices.broker = null;
-      this.#waitForStatus();
-    } else if (state === "offline") {
-      this.#notices.broker = this.#offlineAdvice(detail);
-    } else if (!wasOffline) {
-      this.#notices.broker = null;
-    }
-    // A reconnection attempt ("connecting") keeps the offline notice: it is not back yet.
-    this.#showNotice();
-    if (state !== "connected") {
-      if (this.#statusTimer !== null) clearTimeout(this.#statusTimer);
-      // Without the broker nothing is known about the sleeve any more.
-      this.#setSleeve("unknown", "Not known while the broker is not connected.");
-      this.#picker.forget();
-    }
-  }
-
-  /** What to do about a lost broker, for the way this page was started. */
-  #offlineAdvice(detail: string | null): string {
-    if (detail !== null && detail.includes("refused the login")) return detail;
-    const where = this.#settings.ws_url;
-    if (this.#config !== null && !this.#settings.broker_custom) {
-      return (
-        `No connection to ${where}; retrying every 2 s. The broker runs inside 'feelmysign up' ` +
-        "(make up): its terminal says whether it is restarting; if that stopped, start it again."
-      );
-    }
-    return `No connection to ${where}; retrying every 2 s. Start a broker with 'make up', or set yours in Settings → Connection.`;
-  }
-
-  #waitForStatus(): void {
-    if (this.#statusTimer !== null) clearTimeout(this.#statusTimer);
-    this.#statusTimer = setTimeout(() => {
-      this.#statusTimer = null;
-      if (this.#sleeveState === "unknown" && this.#brokerState === "connected") this.#setSleeve("absent");
-    }, STATUS_WAIT_MS);
-  }
-
-  /** The chip, the preview's caption and the notice say the same thing about the sleeve. */
-  #setSleeve(state: SleeveState, detail: string | null = null): void {
-    this.#sleeveState = state;
-    const id = this.#settings.sleeve_id;
-    this.#status.setSleeve(state, id, detail, this.#brokerState === "connected");
-    const layout = this.#sleeve?.layout;
-    const caption = {
-      online: `Sleeve ${id} online${layout ? `: ${layout.rows} × ${layout.columns} actuators` : ""}, waiting for strokes.`,
-      offline: `Sleeve ${id} is offline: nothing is felt now.`,
-      absent: `No sleeve answers on id ${id}: nothing is felt.`,
-      unknown:
-        this.#brokerState === "connected"
-          ? `Waiting for sleeve ${id} to report…`
-          : `Not connected to the broker: the sleeve cannot be seen.`,
-    }[state];
-    this.#preview.reset(caption, state === "online");
-    this.#notices.sleeve =
-      state === "absent"
-        ? `No sleeve listens on id '${id}': nothing has ever reported there, so strokes sent now are not felt. ` +
-          "Check the sleeve id in Settings → Sleeve (a sleeve prints its id when it starts)."
-        : state === "offline"
-          ? `Sleeve '${id}' is offline: strokes wait at the broker and play when it is back.`
-          : null;
-    this.#showNotice();
-  }
-
-  #showNotice(): void {
-    const { broker, config, sleeve, page } = this.#notices;
-    // The missing config explains the broker problem that usually follows it: both, config first.
-    if (broker !== null) this.#status.setNotice(config === null ? broker : `${config} ${broker}`, "error");
-    else if (sleeve !== null) this.#status.setNotice(sleeve, "warn");
-    else this.#status.setNotice(config ?? page, "info");
+    this.#sleeve.onBroker(state, detail);
+    if (state !== "connected") this.#picker.forget();
   }
 
   #onStatus(payload: string): void {
-    if (payload.trim() === "") {
-      this.#sleeve = null;
-      this.#setSleeve("absent");
-      return;
-    }
-    const status = parseStatus(payload);
-    if (status === null) {
-      this.#setSleeve(
-        "unknown",
-        'The sleeve\'s status message is not understood (expected JSON with "online").',
-      );
-      return;
-    }
-    const wasOnline = this.#sleeveState === "online";
-    this.#sleeve = status;
-    this.#setSleeve(
-      status.online ? "online" : "offline",
-      status.online
-        ? `Online${status.layout ? `, ${status.layout.rows} × ${status.layout.columns} actuators` : ""}${status.version ? `, version ${status.version}` : ""}`
-        : "Offline: strokes sent now reach the sleeve when it is back (if its session is kept).",
-    );
-    if (status.online && !wasOnline && this.#says.counts.played + this.#says.counts.refused > 0) {
+    const read = this.#sleeve.onStatus(payload);
+    if (read === null) return;
+    if (read.back && this.#says.counts.played + this.#says.counts.refused > 0) {
       this.#says.add("info", `Sleeve ${this.#settings.sleeve_id} is back.`);
     }
     this.#fit();
@@ -580,68 +388,12 @@ export class App {
   #onEvent(payload: string): void {
     const event = parseEvent(payload);
     if (event === null) return;
-    const drawing = this.#session.drawing;
-    const ref = "seq" in event ? event : null;
-    const ours = drawing !== null && ref !== null && ref.drawing === drawing.id && ref.seq !== null;
-    const drawn = ours ? drawing.bySeq(ref.seq!) : undefined;
-    const label = ref === null || ref.seq === null ? "A stroke" : `Stroke ${ref.seq}`;
-    switch (event.type) {
-      case "played":
-      case "adjusted": {
-        if (!ours) return;
-        this.#says.count("played");
-        this.#felt.played(event);
-        // Late: sent -> felt, less the wait behind the strokes before it (playing back to back is
-        // the design, not lateness). What remains is the network, the broker holding it, the sleeve.
-        const late =
-          event.sent_at_ms === null ? 0 : event.first_command_at_ms - event.sent_at_ms - event.queued_ms;
-        if (late > LATE_MS) {
-          this.#says.count("late", late);
-          this.#says.add(
-            "adjusted",
-            `${label} played ${seconds(late)} late (it waited at the broker or on the way).`,
-          );
-        }
-        if (event.type === "adjusted") {
-          const change =
-            Math.abs(event.duration_ms - event.requested_duration_ms) / event.requested_duration_ms;
-          // "Played in 418 ms instead of 417 ms" is noise: only changes a person could feel.
-          if (change >= NOTABLE_ADJUSTMENT) {
-            this.#says.add(
-              "adjusted",
-              `${label} played in ${Math.round(event.duration_ms)} ms instead of ${Math.round(event.requested_duration_ms)} ms (${event.reason.replaceAll("_", " ")}).`,
-            );
-          }
-        }
-        return;
-      }
-      case "rejected":
-        if (ours) {
-          this.#says.count("refused");
-          if (drawn) this.#session.rejected(drawn);
-        }
-        if (ours || ref?.drawing == null) this.#says.add("rejected", `${label} refused: ${describe(event)}`);
-        return;
-      case "cancelled":
-        if (!ours) return;
-        this.#says.count("cancelled");
-        if (event.started) this.#says.count("cut");
-        this.#felt.cancelled(event);
-        this.#says.add(
-          "info",
-          `${label} cancelled${event.started ? " while playing" : " before it played"}.`,
-        );
-        return;
-      case "safety":
-        this.#says.add(
-          "error",
-          `Safety: actuator (${event.row}, ${event.column}) switched off: ${describe(event)}`,
-        );
-        return;
-      case "error":
-        this.#says.add("error", `The sleeve reports an error: ${describe(event)}`);
-        return;
-    }
+    const reading = interpretEvent(event, this.#session.drawing?.id ?? null);
+    for (const what of reading.counts) this.#says.count(what, reading.lateMs);
+    if (reading.played !== null) this.#felt.played(reading.played);
+    if (reading.cancelled !== null) this.#felt.cancelled(reading.cancelled);
+    if (reading.refusedSeq !== null) this.#session.refused(reading.refusedSeq);
+    for (const note of reading.notes) this.#says.add(note.kind, note.text);
   }
 
   // ---- for the benchmark and the browser tests ---------------------------------------------
@@ -664,9 +416,4 @@ export class App {
   get drawingId(): string | null {
     return this.#session.drawing?.id ?? null;
   }
-}
-
-function describe(event: SleeveEvent): string {
-  const message = "message" in event ? event.message : null;
-  return message ?? ("reason" in event ? event.reason.replaceAll("_", " ") : "no reason given");
 }

@@ -31,6 +31,7 @@ export class Drawing {
   readonly segments: DrawnSegment[] = [];
   readonly #bySeq = new Map<number, DrawnSegment>();
   readonly #acked = new Set<number>();
+  readonly #refused = new Set<number>();
   #nextSeq = 0;
   /** Segments kept as strokes (not dropped) in the paths still in the drawing. */
   #kept = 0;
@@ -99,6 +100,17 @@ export class Drawing {
 
   isAcked(drawn: DrawnSegment): boolean {
     return drawn.stroke?.seq != null && this.#acked.has(drawn.stroke.seq);
+  }
+
+  /** The sleeve refused stroke `seq`: it is not felt, however the broker acknowledged it. */
+  markRefused(seq: number): DrawnSegment | undefined {
+    const drawn = this.#bySeq.get(seq);
+    if (drawn !== undefined) this.#refused.add(seq);
+    return drawn;
+  }
+
+  isRefused(drawn: DrawnSegment): boolean {
+    return drawn.stroke?.seq != null && this.#refused.has(drawn.stroke.seq);
   }
 
   /** Strokes numbered so far (sent, or queued to be), including those of undone paths. */

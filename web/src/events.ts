@@ -5,6 +5,10 @@
  * field means absent, 3.0 is the whole number 3), kept equal by the vectors
  * in testdata/events. A message that is not one gives null, never an
  * exception: the page must survive whatever a broker delivers.
+ *
+ * `interpretEvent` says what an event means for the drawing on the page (what
+ * to count, note, place in time or mark): this module is the only one that
+ * tells events apart by their type.
  */
 
 interface StrokeRef {
@@ -281,4 +285,136 @@ export function statusToJson(status: SleeveStatus): Record<string, unknown> {
   if (status.layout !== null) out["layout"] = writeFields(status.layout, LAYOUT_FIELDS);
   if (status.at_ms !== null) out["at_ms"] = status.at_ms;
   return out;
+}
+
+// ---- what an event means for the drawing on the page ------------------------------------------
+
+/** A stroke started this long after it was sent (less its queueing) is marked late: felt that much later. */
+export const LATE_MS = 500;
+/** Adjustments smaller than this share of the duration asked for are not worth a line. */
+export const NOTABLE_ADJUSTMENT = 0.05;
+
+/** What the "Sleeve says" card counts. */
+export type EventCount = "played" | "late" | "refused" | "cancelled" | "cut";
+/** A line of the "Sleeve says" log: a refusal, a stroke played otherwise than asked, an error, news. */
+export type NoteKind = "rejected" | "adjusted" | "error" | "info";
+
+export interface Note {
+  readonly kind: NoteKind;
+  readonly text: string;
+}
+
+export interface EventReading {
+  /** What to count, in order (a cut stroke is counted cancelled and cut). */
+  readonly counts: readonly EventCount[];
+  /** How late, when `counts` has "late". */
+  readonly lateMs: number;
+  readonly notes: readonly Note[];
+  /** A stroke of the drawing was played: where it is in time. */
+  readonly played: PlayedEvent | AdjustedEvent | null;
+  /** A stroke of the drawing was cancelled: where it stopped. */
+  readonly cancelled: CancelledEvent | null;
+  /** The seq of a stroke of the drawing the sleeve refused. */
+  readonly refusedSeq: number | null;
+}
+
+const NOTHING: EventReading = {
+  counts: [],
+  lateMs: 0,
+  notes: [],
+  played: null,
+  cancelled: null,
+  refusedSeq: null,
+};
+
+/**
+ * How late a played stroke was felt: sent -> felt, less the wait behind the strokes before it
+ * (playing back to back is the design, not lateness). What remains is the network, the broker
+ * holding it, the sleeve. 0 when the stroke carried no sent time.
+ */
+export function feltLateMs(event: PlayedEvent | AdjustedEvent): number {
+  return event.sent_at_ms === null ? 0 : event.first_command_at_ms - event.sent_at_ms - event.queued_ms;
+}
+
+/** What `event` means for the page whose current drawing is `drawingId` (null: none). */
+export function interpretEvent(event: SleeveEvent, drawingId: string | null): EventReading {
+  const ref = "seq" in event ? event : null;
+  const ours = drawingId !== null && ref !== null && ref.drawing === drawingId && ref.seq !== null;
+  const label = ref === null || ref.seq === null ? "A stroke" : `Stroke ${ref.seq}`;
+  switch (event.type) {
+    case "played":
+    case "adjusted": {
+      if (!ours) return NOTHING;
+      const counts: EventCount[] = ["played"];
+      const notes: Note[] = [];
+      const late = feltLateMs(event);
+      if (late > LATE_MS) {
+        counts.push("late");
+        notes.push({
+          kind: "adjusted",
+          text: `${label} played ${seconds(late)} late (it waited at the broker or on the way).`,
+        });
+      }
+      if (event.type === "adjusted") {
+        const change =
+          Math.abs(event.duration_ms - event.requested_duration_ms) / event.requested_duration_ms;
+        // "Played in 418 ms instead of 417 ms" is noise: only changes a person could feel.
+        if (change >= NOTABLE_ADJUSTMENT) {
+          notes.push({
+            kind: "adjusted",
+            text: `${label} played in ${Math.round(event.duration_ms)} ms instead of ${Math.round(event.requested_duration_ms)} ms (${event.reason.replaceAll("_", " ")}).`,
+          });
+        }
+      }
+      return { ...NOTHING, counts, lateMs: late, notes, played: event };
+    }
+    case "rejected": {
+      // A refusal of no drawing in particular (a message the sleeve could not read) is shown too.
+      const shown = ours || ref?.drawing == null;
+      return {
+        ...NOTHING,
+        counts: ours ? ["refused"] : [],
+        notes: shown ? [{ kind: "rejected", text: `${label} refused: ${describe(event)}` }] : [],
+        refusedSeq: ours ? event.seq : null,
+      };
+    }
+    case "cancelled":
+      if (!ours) return NOTHING;
+      return {
+        ...NOTHING,
+        counts: event.started ? ["cancelled", "cut"] : ["cancelled"],
+        notes: [
+          {
+            kind: "info",
+            text: `${label} cancelled${event.started ? " while playing" : " before it played"}.`,
+          },
+        ],
+        cancelled: event,
+      };
+    case "safety":
+      return {
+        ...NOTHING,
+        notes: [
+          {
+            kind: "error",
+            text: `Safety: actuator (${event.row}, ${event.column}) switched off: ${describe(event)}`,
+          },
+        ],
+      };
+    case "error":
+      return {
+        ...NOTHING,
+        notes: [{ kind: "error", text: `The sleeve reports an error: ${describe(event)}` }],
+      };
+  }
+}
+
+function describe(event: SleeveEvent): string {
+  const message = "message" in event ? event.message : null;
+  return message ?? ("reason" in event ? event.reason.replaceAll("_", " ") : "no reason given");
+}
+
+/** A duration as a person reads it: "420 ms", "1.5 s". */
+export function seconds(ms: number): string {
+  return ms >= 1000 ? `${(ms / 1000).toFixed(1)} s` : `${Math.round(ms)} ms`;
 }

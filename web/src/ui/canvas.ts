@@ -80,8 +80,8 @@ export class DrawingView {
   #rawDrawn: number[] = [];
   #rawPathFrom = 0;
   #segmentsDrawn = 0;
+  /** Strokes refused since the last flush, to mark over their line. */
   #rejected: DrawnSegment[] = [];
-  #rejectedDrawn = 0;
   /** Strokes acknowledged since the last flush, to draw solid over their dim line. */
   #acked: DrawnSegment[] = [];
   #liveShown = false;
@@ -254,7 +254,7 @@ export class DrawingView {
     this.#acked.push(drawn);
   }
 
-  /** A stroke the sleeve refused: marked on the next flush. */
+  /** A stroke the sleeve refused (`Drawing.markRefused`): marked on the next flush, and kept so. */
   markRejected(drawn: DrawnSegment): void {
     this.#rejected.push(drawn);
   }
@@ -275,16 +275,19 @@ export class DrawingView {
     }
     this.#rawPathFrom = Math.max(0, drawing.paths.length - 1);
     const segments = drawing.segments;
+    // Segments drawn before this flush: the new ones are drawn as they stand now.
+    const drawnBefore = this.#segmentsDrawn;
     for (; this.#segmentsDrawn < segments.length; this.#segmentsDrawn++) {
       const drawn = segments[this.#segmentsDrawn]!;
-      this.#drawSegment(ctx, drawn, drawing.isAcked(drawn));
+      if (drawing.isRefused(drawn)) this.#drawRejected(ctx, drawn);
+      else this.#drawSegment(ctx, drawn, drawing.isAcked(drawn));
     }
     for (const drawn of this.#acked.splice(0)) {
-      // Not yet on the canvas: it will be drawn solid with the other new segments.
-      if (drawn.index < this.#segmentsDrawn) this.#drawSegment(ctx, drawn, true);
+      // A refused stroke stays marked refused, whenever the broker's acknowledgement comes.
+      if (drawn.index < drawnBefore && !drawing.isRefused(drawn)) this.#drawSegment(ctx, drawn, true);
     }
-    for (; this.#rejectedDrawn < this.#rejected.length; this.#rejectedDrawn++) {
-      this.#drawRejected(ctx, this.#rejected[this.#rejectedDrawn]!);
+    for (const drawn of this.#rejected.splice(0)) {
+      if (drawn.index < drawnBefore) this.#drawRejected(ctx, drawn);
     }
   }
 
@@ -392,7 +395,9 @@ export class DrawingView {
     this.#rawDrawn = [];
     this.#rawPathFrom = 0;
     this.#segmentsDrawn = 0;
-    this.#rejectedDrawn = 0;
+    // Everything is drawn again as the drawing stands: acknowledged solid, refused marked.
+    this.#acked = [];
+    this.#rejected = [];
     this.flush();
   }
 

@@ -4,12 +4,12 @@
  * ink to the canvas. The animation loop runs only while a pointer is down, and
  * each frame costs the same however much has been drawn.
  */
-import { Drawing, type DrawnSegment, type PointerKind } from "../drawing";
+import { Drawing, type PointerKind } from "../drawing";
 import { newDrawingId } from "../drawing-id";
 import { FrameSampler } from "../frame-sampler";
 import type { Stroke } from "../protocol";
 import { simplifierParams, type Settings } from "../settings";
-import { ALGORITHMS, makeSimplifier, type Simplifier } from "../simplify/registry";
+import { ALGORITHMS, makeSimplifier, simplifyPaths, type Simplifier } from "../simplify/registry";
 import type { Sample, Segment } from "../simplify/segment";
 import type { DrawingView } from "./canvas";
 import type { GridSize } from "./geometry";
@@ -18,6 +18,12 @@ import type { GridSize } from "./geometry";
 const FRAME_STATS_SIZE = 600;
 /** Intensities are sent with this many decimals: finer steps cannot be felt. */
 const INTENSITY_DECIMALS = 3;
+
+/** What the session draws on: the canvas (ui/canvas.ts), or a stand-in in the unit tests. */
+export type SessionView = Pick<
+  DrawingView,
+  "area" | "setDrawing" | "flush" | "clearLive" | "drawLive" | "markSent" | "markRejected"
+>;
 
 /** What the session needs from the page around it. */
 export interface SessionHost {
@@ -31,7 +37,7 @@ export interface SessionHost {
 }
 
 export class DrawingSession {
-  readonly #view: DrawingView;
+  readonly #view: SessionView;
   readonly #host: SessionHost;
   #drawing: Drawing | null = null;
   #simplifier: Simplifier | null = null;
@@ -44,7 +50,7 @@ export class DrawingSession {
   #flushScheduled = false;
   readonly #frameWorkMs: number[] = [];
 
-  constructor(view: DrawingView, host: SessionHost) {
+  constructor(view: SessionView, host: SessionHost) {
     this.#view = view;
     this.#host = host;
   }
@@ -104,6 +110,24 @@ export class DrawingSession {
     this.#host.released();
   }
 
+  /**
+   * Ends the path being drawn where the pointer is now (Stop, or Esc with the pen down): the
+   * stroke under way is not sent, and the pointer draws nothing more until it is lifted and
+   * pressed again. The samples drawn so far stay in the drawing.
+   */
+  endPath(): void {
+    const drawing = this.#drawing;
+    const pointer = this.#pointer;
+    if (drawing === null || pointer === null || !this.#sampler.pressed) return;
+    this.#sampler.release(pointer);
+    // The stroke under way dies with its simplifier: a new one for the next path.
+    this.#simplifier = makeSimplifier(drawing.params);
+    this.#pointer = null;
+    this.#view.flush();
+    this.#view.clearLive();
+    this.#host.released();
+  }
+
   /** Empties the canvas; the next press starts a new drawing. Not while drawing. */
   clear(): void {
     if (this.#sampler.pressed) return;
@@ -152,10 +176,37 @@ export class DrawingSession {
     this.#scheduleFlush();
   }
 
-  /** The sleeve refused a stroke of this drawing: marked on the canvas. */
-  rejected(drawn: DrawnSegment): void {
+  /** The sleeve refused stroke `seq` of this drawing: marked on the canvas. */
+  refused(seq: number): void {
+    const drawn = this.#drawing?.markRefused(seq);
+    if (drawn === undefined) return;
     this.#view.markRejected(drawn);
     this.#scheduleFlush();
+  }
+
+  /**
+   * The drawing's paths cut again under the settings now, as a new drawing shown at once (not
+   * sent: Play again sends it); null when there is nothing to cut, or while drawing.
+   */
+  recut(): Drawing | null {
+    const drawing = this.#drawing;
+    if (this.#sampler.pressed || drawing === null || drawing.paths.length === 0) return null;
+    const settings = this.#host.settings();
+    const params = simplifierParams(settings, this.#host.grid(), {
+      width_px: drawing.params.canvas_width_px,
+      height_px: drawing.params.canvas_height_px,
+    });
+    const again = new Drawing(newDrawingId(), params);
+    const pieces = simplifyPaths(params, drawing.paths);
+    drawing.paths.forEach((samples, path) => {
+      again.beginPath(drawing.pointerKinds[path] ?? "mouse");
+      again.paths[path]!.push(...samples);
+      for (const piece of pieces) {
+        if (piece.path === path) again.addSegment(piece.segment, settings.intensity);
+      }
+    });
+    this.adopt(again);
+    return again;
   }
 
   #pushFrame(frame: Sample): void {

@@ -1,8 +1,10 @@
 /** What the sleeve said about the strokes: a running count of played ones and the latest problems. */
+import type { NoteKind } from "../events";
 
 const MAX_ENTRIES = 6;
 
-export type LogKind = "rejected" | "adjusted" | "error" | "info";
+/** A line's kind (its colour): the notes `interpretEvent` gives, and the page's own. */
+export type LogKind = NoteKind;
 
 export class EventLog {
   readonly #list: HTMLOListElement;

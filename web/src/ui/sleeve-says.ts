@@ -3,12 +3,8 @@
  * its strokes (played, refused, cancelled, dropped, late), and the latest
  * notes. Reset with every new drawing, so nothing of an old drawing lingers.
  */
+import { seconds } from "../events";
 import { EventLog, type LogKind } from "./event-log";
-
-/** A stroke started this long after it was sent is marked late (a touch felt that much later). */
-export const LATE_MS = 500;
-/** Adjustments smaller than this share of the duration asked for are not worth a line. */
-export const NOTABLE_ADJUSTMENT = 0.05;
 
 export interface Counts {
   played: number;
@@ -107,8 +103,4 @@ export class SleeveSays {
     if (late > 0) parts.push(`${late} late (last by ${seconds(latestLateMs)})`);
     summary.textContent = `${parts.join(", ")}.`;
   }
-}
-
-export function seconds(ms: number): string {
-  return ms >= 1000 ? `${(ms / 1000).toFixed(1)} s` : `${Math.round(ms)} ms`;
 }
