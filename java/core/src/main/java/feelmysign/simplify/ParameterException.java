@@ -1,5 +1,7 @@
 package feelmysign.simplify;
 
+import feelmysign.json.PyRepr;
+
 /**
  * A parameter outside its allowed range, in the reference's words: "{name} = {value} is not
  * allowed; it must be {allowed}" (the value as Python's repr writes it).

@@ -1,15 +1,16 @@
-package feelmysign.simplify;
+package feelmysign.json;
 
-import feelmysign.json.Numbers;
+
 import java.math.BigInteger;
 import java.util.List;
 import java.util.Map;
 
 /** Python's {@code repr()} of the values a parameter can be given, for the same messages. */
-final class PyRepr {
+public final class PyRepr {
   private PyRepr() {}
 
-  static String of(Object value) {
+  /** Python's repr of a JSON-like value: True, 1.0, 'text', [1, 2], {'a': None}. */
+  public static String of(Object value) {
     if (value == null) {
       return "None";
     }
