@@ -206,7 +206,7 @@ load: $(STAMP) system $(NATS_STAMP)
 	$(PY) -m feelmysign.bench.load $(N)
 # ==== end of NATS =========================================================================
 
-# ==== Java: the Java port (java/: core, cli) =================================================
+# ==== Java: the Java port (java/: core, client, cli) =================================================
 # Maven, Java 17; every dependency and plugin pinned in java/pom.xml. Maven's local repository
 # is .cache/m2 in the checkout (ignored by git), so a fresh clone downloads what it needs once
 # and nothing outside the repository changes. Maven and the JDK come from Debian (`system`).
@@ -230,10 +230,10 @@ java-build: $(JAVA_STAMP)
 	@echo "==> Building the Java port (java/bin/feelmysign-java)"
 	$(MVN) -DskipTests package
 
-# Compiles once and runs every JUnit test (one JVM per module): the shared vectors, and the
-# command line against the Python reference (which needs the .venv). Maven is quiet; the
-# totals of Surefire's reports are printed after it.
-java-test: $(JAVA_STAMP) $(STAMP)
+# Compiles once and runs every JUnit test (one JVM per module): the shared vectors, the client
+# against a real Mosquitto and sleeve simulator, and the command line against the Python
+# reference (both from the .venv). Maven is quiet; the totals of Surefire's reports follow it.
+java-test: $(JAVA_STAMP) $(STAMP) system
 	rm -rf $(JAVA_DIR)/*/target/surefire-reports
 	$(MVN) verify
 	@cat $(JAVA_DIR)/*/target/surefire-reports/*.txt | awk '/^Tests run:/ { \

@@ -35,6 +35,11 @@ public record Stroke(
     return new Stroke(startX, startY, endX, endY, durationMs, intensity, drawingId, sequence, sentAt);
   }
 
+  /** This stroke stamped with the sender's clock (ms since 1970-01-01 UTC; null: none). */
+  public Stroke withSentAt(Double sentAt) {
+    return new Stroke(startX, startY, endX, endY, durationMs, intensity, drawing, seq, sentAt);
+  }
+
   /** This stroke at an intensity from 0 to 1 (null: the sleeve's default). */
   public Stroke withIntensity(Double value) {
     return new Stroke(startX, startY, endX, endY, durationMs, value, drawing, seq, sentAtMs);
