@@ -87,7 +87,7 @@ public final class Vectors {
       return list;
     }
     Map<String, Object> map = new java.util.LinkedHashMap<>();
-    node.fields().forEachRemaining(e -> map.put(e.getKey(), plain(e.getValue())));
+    node.properties().forEach(e -> map.put(e.getKey(), plain(e.getValue())));
     return map;
   }
 }

@@ -99,6 +99,7 @@ public final class SleeveClient implements AutoCloseable {
   private final WireFormat format;
   private final String legacyTopic;
   private final Path caCertificate;
+  private final String caFingerprint;
   private final Long lateLimitMs;
   private final Listener listener;
 
@@ -109,6 +110,7 @@ public final class SleeveClient implements AutoCloseable {
   private Mqtt3AsyncClient client;
   private boolean connected;
   private boolean loginRefused;
+  private String lastCertificateProblem;
   private String drawing;
   private long nextSeq;
 
@@ -120,6 +122,7 @@ public final class SleeveClient implements AutoCloseable {
     this.format = b.format;
     this.legacyTopic = b.legacyTopic;
     this.caCertificate = b.caCertificate;
+    this.caFingerprint = b.caFingerprint;
     this.lateLimitMs = b.lateLimitMs;
     this.listener = b.listener;
   }
@@ -138,6 +141,7 @@ public final class SleeveClient implements AutoCloseable {
     private WireFormat format = WireFormat.JSON;
     private String legacyTopic = Topics.LEGACY_TOPIC;
     private Path caCertificate;
+    private String caFingerprint;
     private Long lateLimitMs;
     private Listener listener = new Listener() {};
 
@@ -176,6 +180,16 @@ public final class SleeveClient implements AutoCloseable {
     /** The CA to trust for mqtts:// and wss:// (PEM; e.g. the one of feelmysign up --lan). */
     public Builder caCertificate(Path pem) {
       this.caCertificate = pem;
+      return this;
+    }
+
+    /**
+     * Trust the CA whose SHA-256 fingerprint this is (64 hex digits: a join token's, or
+     * credentials.json's ca_fingerprint), taken from the broker's own chain.
+     */
+    public Builder caFingerprint(String sha256) {
+      new PinnedCa(sha256); // checked now: a typo is told at once
+      this.caFingerprint = sha256;
       return this;
     }
 
@@ -239,6 +253,9 @@ public final class SleeveClient implements AutoCloseable {
   }
 
   private MqttClientSslConfig sslConfig() {
+    if (caFingerprint != null) {
+      return MqttClientSslConfig.builder().trustManagerFactory(new PinnedCa(caFingerprint)).build();
+    }
     if (caCertificate == null) {
       return MqttClientSslConfig.builder().build(); // the JVM's trusted CAs
     }
@@ -268,6 +285,7 @@ public final class SleeveClient implements AutoCloseable {
     synchronized (lock) {
       current = client;
       connected = true;
+      lastCertificateProblem = null;
     }
     listener.broker(
         State.CONNECTED,
@@ -324,6 +342,25 @@ public final class SleeveClient implements AutoCloseable {
       }
     }
     context.getReconnector().reconnect(true);
+    String certificate = certificateProblem(cause);
+    if (certificate != null) {
+      synchronized (lock) {
+        if (certificate.equals(lastCertificateProblem)) {
+          return; // told once; still retrying
+        }
+        lastCertificateProblem = certificate;
+      }
+      listener.broker(
+          State.OFFLINE,
+          "The broker at "
+              + url
+              + " has a certificate this client does not trust ("
+              + certificate
+              + "); retrying every "
+              + RECONNECT_PERIOD_MS / 1000
+              + " s. Give the broker's CA (caCertificate) or its fingerprint (caFingerprint).");
+      return;
+    }
     if (wasConnected || context.getReconnector().getAttempts() == 0) {
       listener.broker(
           State.OFFLINE,
@@ -335,6 +372,21 @@ public final class SleeveClient implements AutoCloseable {
               + RECONNECT_PERIOD_MS / 1000
               + " s. Is the broker running? ('make up' starts it.)");
     }
+  }
+
+  /** The certificate error in a failed connection's causes, or null. */
+  private static String certificateProblem(Throwable cause) {
+    for (Throwable t = cause; t != null; t = t.getCause()) {
+      if (t instanceof java.security.cert.CertificateException
+          || t instanceof javax.net.ssl.SSLHandshakeException) {
+        Throwable root = t;
+        while (root.getCause() != null) {
+          root = root.getCause();
+        }
+        return String.valueOf(root.getMessage());
+      }
+    }
+    return null;
   }
 
   private void onMessage(Mqtt3Publish publish) {

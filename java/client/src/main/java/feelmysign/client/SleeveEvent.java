@@ -3,7 +3,6 @@ package feelmysign.client;
 import feelmysign.json.JsonDecodeException;
 import feelmysign.json.NonFiniteLiteralException;
 import feelmysign.json.PyJson;
-import java.math.BigInteger;
 import java.util.Map;
 
 /**
@@ -36,12 +35,13 @@ public record SleeveEvent(
     @SuppressWarnings("unchecked")
     Map<String, Object> fields = (Map<String, Object>) map;
     Object seq = fields.get("seq");
-    Long seqValue =
-        seq instanceof Long l
-            ? l
-            : seq instanceof Double d && d == Math.rint(d) && Math.abs(d) < 9.007199254740992E15
-                ? (Long) (long) (double) d
-                : seq instanceof BigInteger ? null : null;
+    // 3.0 is 3 (JavaScript cannot tell them apart); anything else is no seq.
+    Long seqValue = null;
+    if (seq instanceof Long l) {
+      seqValue = l;
+    } else if (seq instanceof Double d && d == Math.rint(d) && Math.abs(d) <= 9.007199254740991E15) {
+      seqValue = (long) (double) d;
+    }
     return new SleeveEvent(
         type,
         fields.get("drawing") instanceof String s ? s : null,

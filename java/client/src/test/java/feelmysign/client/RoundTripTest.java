@@ -40,6 +40,8 @@ class RoundTripTest {
   private Process broker;
   private Process sleeve;
   private String mqttUrl;
+  private String mqttsUrl;
+  private String caFingerprint;
   private String senderUser;
   private String senderPassword;
 
@@ -62,7 +64,9 @@ class RoundTripTest {
     broker =
         new ProcessBuilder(
                 feelmysign.toString(), "broker", "--state-dir", state.toString(),
-                "--port", "0", "--ws-port", "0", "--sleeve-id", SLEEVE)
+                "--port", "0", "--ws-port", "0", "--sleeve-id", SLEEVE,
+                // TLS too, on loopback, with the broker's own CA: the --lan set-up.
+                "--host", "127.0.0.1", "--tls-port", "0")
             .redirectErrorStream(true)
             .start();
     BufferedReader out =
@@ -97,6 +101,8 @@ class RoundTripTest {
     Map<String, Object> document =
         (Map<String, Object>) PyJson.loads(Files.readString(credentials));
     mqttUrl = (String) document.get("mqtt_url");
+    mqttsUrl = (String) document.get("mqtts_url");
+    caFingerprint = (String) document.get("ca_fingerprint");
     @SuppressWarnings("unchecked")
     Map<String, Object> sender = (Map<String, Object>) document.get("sender");
     senderUser = (String) sender.get("username");
@@ -171,6 +177,73 @@ class RoundTripTest {
         .sleeveId(SLEEVE)
         .listener(heard)
         .build();
+  }
+
+  /** One stroke over the connection {@code client} makes: it comes back played. */
+  private static void playsOneStroke(SleeveClient client, Heard heard) throws InterruptedException {
+    client.connect();
+    heard.next(String.class, s -> s.contains("\"online\": true"), "the sleeve online");
+    String drawing = client.newDrawing();
+    client.send(new Stroke(0, 0, 3, 2, 300));
+    heard.next(
+        SleeveEvent.class,
+        e -> finished(e) && drawing.equals(e.drawing()) && e.seq() == 0,
+        "the stroke played");
+  }
+
+  @Test
+  void overTlsWithTheBrokersCa() throws InterruptedException {
+    Heard heard = new Heard();
+    try (SleeveClient client =
+        SleeveClient.builder(mqttsUrl)
+            .login(senderUser, senderPassword)
+            .sleeveId(SLEEVE)
+            .caCertificate(state.resolve("tls/ca.pem"))
+            .listener(heard)
+            .build()) {
+      playsOneStroke(client, heard);
+    }
+  }
+
+  @Test
+  void overTlsWithTheCasFingerprint() throws InterruptedException {
+    Heard heard = new Heard();
+    try (SleeveClient client =
+        SleeveClient.builder(mqttsUrl)
+            .login(senderUser, senderPassword)
+            .sleeveId(SLEEVE)
+            .caFingerprint(caFingerprint)
+            .listener(heard)
+            .build()) {
+      playsOneStroke(client, heard);
+    }
+  }
+
+  @Test
+  void aCertificateThatDoesNotMatchIsToldAndRetried() throws InterruptedException {
+    Heard heard = new Heard();
+    String other = "0".repeat(64);
+    try (SleeveClient client =
+        SleeveClient.builder(mqttsUrl)
+            .login(senderUser, senderPassword)
+            .sleeveId(SLEEVE)
+            .caFingerprint(other)
+            .listener(heard)
+            .build()) {
+      client.connect();
+      heard.next(SleeveClient.State.class, s -> s == SleeveClient.State.OFFLINE, "offline");
+      Thread.sleep(3 * SleeveClient.RECONNECT_PERIOD_MS);
+      synchronized (heard.brokerSaid) {
+        long told =
+            heard.brokerSaid.stream().filter(s -> s.contains("certificate this client does not trust")).count();
+        assertEquals(1, told, heard.brokerSaid.toString());
+      }
+      assertTrue(!client.connected());
+      assertTrue(!client.loginRefused(), "a certificate problem is retried");
+      // A stroke drawn meanwhile waits in the outbox.
+      client.send(new Stroke(0, 0, 1, 1, 200));
+      assertEquals(1, client.unsent());
+    }
   }
 
   private static boolean finished(SleeveEvent e) {
