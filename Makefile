@@ -218,7 +218,7 @@ JAVA_POMS := $(JAVA_DIR)/pom.xml $(wildcard $(JAVA_DIR)/*/pom.xml)
 JAVA_STAMP := .cache/m2/.installed-stamp
 SYSTEM_PACKAGES += maven openjdk-17-jdk-headless
 
-.PHONY: java-build java-test java-clean
+.PHONY: java-build java-test java-bench java-clean
 
 # Resolves every dependency and plugin (a build without tests) once per change of a pom.
 $(JAVA_STAMP): $(JAVA_POMS) | system
@@ -240,9 +240,15 @@ java-test: $(JAVA_STAMP) $(STAMP) system
 	  gsub(",", ""); run += $$3; failed += $$5 + $$7; skipped += $$9 } \
 	  END { printf "java: %d passed, %d failed, %d skipped\n", run - failed - skipped, failed, skipped }'
 
+# The Java simplifiers' throughput on the LASA frames of the web bench, beside a baseline
+# measured in the same JVM run.
+java-bench: java-build $(LASA_FRAMES)
+	java -cp $(JAVA_DIR)/cli/target/feelmysign-java.jar feelmysign.cli.Bench $(LASA_FRAMES)
+
 java-clean:
 	rm -rf $(JAVA_DIR)/*/target
 
 install: $(JAVA_STAMP)
+bench: java-bench
 clean: java-clean
 # ==== end of Java ==========================================================================

@@ -104,6 +104,8 @@ public final class SleeveClient implements AutoCloseable {
   private final Listener listener;
 
   private final Object lock = new Object();
+  /** Held while a flush takes and publishes, so two threads' flushes never interleave. */
+  private final Object flushLock = new Object();
   private final Outbox<Stroke> outbox = new Outbox<>();
   /** Cancels not yet acknowledged, sent before any stroke when the broker is back. */
   private final List<String> cancels = new ArrayList<>();
@@ -491,6 +493,14 @@ public final class SleeveClient implements AutoCloseable {
   }
 
   private void flush() {
+    // The sketch's thread (send, stop) and the network thread (a new connection) both flush;
+    // one at a time, so strokes go out in the order they were drawn.
+    synchronized (flushLock) {
+      flushInOrder();
+    }
+  }
+
+  private void flushInOrder() {
     List<Stroke> late = List.of();
     List<Runnable> publishes = new ArrayList<>();
     int unsent;
