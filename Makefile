@@ -38,6 +38,7 @@ help:
 	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
+	@echo "make java-build  build the Java port (java/bin/feelmysign-java); make java-test tests it"
 
 $(RUN_STAMP): python/pyproject.toml
 	@echo "==> Python packages to run feelmysign (python/pyproject.toml: dependencies) into $(VENV):"
@@ -86,7 +87,9 @@ install: system $(STAMP)
 
 # The longest parts first (pytest, then the browser tests of web/ below), so that they start
 # at once when the checks run side by side and the short ones share the third lane.
-check: pytest web-browser-test lint typecheck vectors-check
+check: pytest web-browser-test java-test lint typecheck vectors-check
+
+# (java-test, the Java port's tests, is in the Java section at the end.)
 
 # Installs at once, then the checks side by side (see the top of this file). The nested
 # makes get their own -j: side by side is what `make test` means, with or without -j.
@@ -202,3 +205,50 @@ install: $(NATS_STAMP)
 load: $(STAMP) system $(NATS_STAMP)
 	$(PY) -m feelmysign.bench.load $(N)
 # ==== end of NATS =========================================================================
+
+# ==== Java: the Java port (java/: core, client, cli) =================================================
+# Maven, Java 17; every dependency and plugin pinned in java/pom.xml. Maven's local repository
+# is .cache/m2 in the checkout (ignored by git), so a fresh clone downloads what it needs once
+# and nothing outside the repository changes. Maven and the JDK come from Debian (`system`).
+# java/bin/feelmysign-java runs the command line built here.
+
+JAVA_DIR := java
+MVN := mvn -B -q -Dstyle.color=never -Dmaven.repo.local=$(CURDIR)/.cache/m2 -f $(JAVA_DIR)/pom.xml
+JAVA_POMS := $(JAVA_DIR)/pom.xml $(wildcard $(JAVA_DIR)/*/pom.xml)
+JAVA_STAMP := .cache/m2/.installed-stamp
+SYSTEM_PACKAGES += maven openjdk-17-jdk-headless
+
+.PHONY: java-build java-test java-bench java-clean
+
+# Resolves every dependency and plugin (a build without tests) once per change of a pom.
+$(JAVA_STAMP): $(JAVA_POMS) | system
+	@echo "==> The Java port's Maven packages (java/pom.xml) into .cache/m2:"
+	$(MVN) -DskipTests package
+	touch $@
+
+java-build: $(JAVA_STAMP)
+	@echo "==> Building the Java port (java/bin/feelmysign-java)"
+	$(MVN) -DskipTests package
+
+# Compiles once and runs every JUnit test (one JVM per module): the shared vectors, the client
+# against a real Mosquitto and sleeve simulator, and the command line against the Python
+# reference (both from the .venv). Maven is quiet; the totals of Surefire's reports follow it.
+java-test: $(JAVA_STAMP) $(STAMP) system
+	rm -rf $(JAVA_DIR)/*/target/surefire-reports
+	$(MVN) verify
+	@cat $(JAVA_DIR)/*/target/surefire-reports/*.txt | awk '/^Tests run:/ { \
+	  gsub(",", ""); run += $$3; failed += $$5 + $$7; skipped += $$9 } \
+	  END { printf "java: %d passed, %d failed, %d skipped\n", run - failed - skipped, failed, skipped }'
+
+# The Java simplifiers' throughput on the LASA frames of the web bench, beside a baseline
+# measured in the same JVM run.
+java-bench: java-build $(LASA_FRAMES)
+	java -cp $(JAVA_DIR)/cli/target/feelmysign-java.jar feelmysign.cli.Bench $(LASA_FRAMES)
+
+java-clean:
+	rm -rf $(JAVA_DIR)/*/target
+
+install: $(JAVA_STAMP)
+bench: java-bench
+clean: java-clean
+# ==== end of Java ==========================================================================

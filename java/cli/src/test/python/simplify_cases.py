@@ -1,0 +1,227 @@
+"""Cases for comparing ``feelmysign-java simplify`` with the reference ``feelmysign simplify``.
+
+``python simplify_cases.py OUTDIR`` writes recordings to OUTDIR/recordings/ (LASA
+demonstrations, the gesture logs of research/gestures, seeded random drawings and some
+broken files) and OUTDIR/cases.json: for each case the arguments of ``simplify`` and what
+the reference printed (stdout, stderr) and its exit code, from the reference's own command
+line run in this process. The Java test runs the same arguments and compares.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import random
+import sys
+from pathlib import Path
+from typing import Any
+
+from feelmysign.cli import main
+from feelmysign.research.gestures import load_gesture_log
+from feelmysign.research.lasa import load_lasa
+from feelmysign.simplify.recording import Recording
+
+REPO = Path(__file__).resolve().parents[5]
+SEED = 20261126
+
+
+def recording_json(recording: Recording) -> dict[str, Any]:
+    document: dict[str, Any] = {
+        "canvas": {"width_px": recording.width_px, "height_px": recording.height_px},
+        "paths": [
+            [{"t_ms": s.t_ms, "x": s.x, "y": s.y, "pressure": s.pressure} for s in path]
+            for path in recording.paths
+        ],
+    }
+    return document
+
+
+def random_flags(rng: random.Random) -> list[str]:
+    """A seeded mix of both algorithms' flags, now and then one out of range."""
+    flags: list[str] = []
+    kind = rng.choice(["window", "window", "angle", "paper", "recorded"])
+    if kind == "paper":
+        flags.append("--paper")
+    elif kind != "recorded":
+        flags += ["--algorithm", kind]
+
+    def maybe(flag: str, value: str) -> None:
+        if rng.random() < 0.4:
+            flags.extend([flag, value])
+
+    if kind == "window":
+        maybe("--max-error", str(round(rng.uniform(0.001, 1.5), rng.choice([1, 3, 6]))))
+        maybe("--max-window", str(rng.choice([1, 2, 3, 8, 40, 256, 10000])))
+        maybe("--max-stroke-ms", str(rng.choice([0, 50, 100.5, 300, 1000, 60000])))
+    elif kind in ("angle", "paper"):
+        maybe("--check-frames", str(rng.randint(2, 30)))
+        maybe("--max-angle-deg", str(rng.choice([1, 5, 12.5, 20, 45, 90, 179])))
+        maybe("--frame-max", str(rng.choice([0, 1, 10, 60, 600])))
+        maybe("--fps", str(rng.choice([1, 24, 30, 60, 120, 240.5, 1000])))
+        if rng.random() < 0.3:
+            flags.append("--no-recover")
+    maybe("--min-duration-ms", str(rng.choice([0, 6.1, 50, 200])))
+    maybe("--min-length", str(rng.choice([0, 0.05, 0.1, 0.5])))
+    maybe("--rows", str(rng.choice([1, 2, 3, 4, 8, 64])))
+    maybe("--columns", str(rng.choice([1, 2, 4, 6, 64])))
+    if rng.random() < 0.25:
+        flags.append("--stretch")
+    if rng.random() < 0.05:  # out of range: the same sentence from both
+        flags += rng.choice(
+            [
+                ["--min-length", "500"],
+                ["--rows", "0"],
+                ["--min-duration-ms", "-1"],
+                ["--min-length", "nan"],
+                ["--columns", "65"],
+            ]
+        )
+    return flags
+
+
+def random_drawing(rng: random.Random) -> dict[str, Any]:
+    """Seeded random paths: walks, turns, pauses, equal times, several paths, on a random canvas."""
+    width = rng.choice([320.0, 800.0, 1200.0, 1920.0, rng.uniform(50, 3000)])
+    height = rng.choice([240.0, 600.0, 800.0, 1080.0, rng.uniform(50, 3000)])
+    paths = []
+    for _ in range(rng.choice([1, 1, 2, 3])):
+        x, y = rng.uniform(0, width), rng.uniform(0, height)
+        t = rng.uniform(0, 5000)
+        heading = rng.uniform(0, 6.283)
+        samples = []
+        for _ in range(rng.randint(1, 400)):
+            samples.append({"t_ms": t, "x": x, "y": y, "pressure": round(rng.random(), 3)})
+            t += rng.choice([0.0, 1.0, 4.0, 8.333, 16.667, rng.uniform(0, 40), 250.0])
+            if rng.random() < 0.1:
+                heading += rng.uniform(-3, 3)
+            step = rng.choice([0.0, 0.5, 2.0, rng.uniform(0, 30)])
+            # Off the canvas now and then: the mapping clamps onto the grid's edge.
+            x += step * math.cos(heading)
+            y += step * math.sin(heading)
+        paths.append(samples)
+    document: dict[str, Any] = {"canvas": {"width_px": width, "height_px": height}, "paths": paths}
+    if rng.random() < 0.3:
+        document["sleeve"] = {"rows": rng.randint(1, 8), "columns": rng.randint(1, 8)}
+    if rng.random() < 0.3:
+        algorithm = rng.choice(["angle", "window"])
+        params: dict[str, Any] = (
+            {"check_frames": rng.choice([3, 4.0]), "max_angle_deg": rng.choice([30, 25.5])}
+            if algorithm == "angle"
+            else {"max_error": rng.choice([0.1, 1]), "max_window": rng.choice([16, 64.0])}
+        )
+        params["colour"] = "ignored"
+        document["simplifier"] = {"algorithm": algorithm, "params": params}
+    return document
+
+
+BROKEN = {
+    "not-json.json": "{paths: []}",
+    "nan.json": '{"canvas": {"width_px": NaN, "height_px": 1}, "paths": []}',
+    "array.json": "[1, 2]",
+    "no-canvas.json": '{"paths": []}',
+    "zero-width.json": '{"canvas": {"width_px": 0, "height_px": 10}, "paths": []}',
+    "empty-path.json": '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [[]]}',
+    "bad-sample.json": (
+        '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [[{"t_ms": 0, "x": "1", "y": 2}]]}'
+    ),
+    "back-in-time.json": (
+        '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [[{"t_ms": 5, "x": 1, "y": 2},'
+        ' {"t_ms": 4.5, "x": 1, "y": 2}]]}'
+    ),
+    "pressure.json": (
+        '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [[{"t_ms": 0, "x": 1, "y": 2,'
+        ' "pressure": 2}]]}'
+    ),
+    "rows-zero.json": (
+        '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [], "sleeve": {"rows": 0}}'
+    ),
+    "unknown-algorithm.json": (
+        '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [],'
+        ' "simplifier": {"algorithm": "spline"}}'
+    ),
+    "recorded-out-of-range.json": (
+        '{"canvas": {"width_px": 10, "height_px": 10}, "paths": [],'
+        ' "simplifier": {"algorithm": "window", "params": {"max_error": 0}}}'
+    ),
+    "trailing.json": '{"canvas": {"width_px": 10, "height_px": 10}, "paths": []} x',
+}
+
+USAGE_ERRORS = [
+    ["--fps", "30"],  # an angle flag on the default (window) algorithm
+    ["--algorithm", "window", "--check-frames", "3"],
+    ["--paper", "--algorithm", "window"],
+    ["--algorithm", "spline"],
+    ["--rows", "2.5"],
+    ["--max-error", "abc"],
+    ["--bogus"],
+]
+
+
+def run(arguments: list[str]) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(["simplify", *arguments])
+        except SystemExit as stop:  # argparse's usage errors
+            code = stop.code if isinstance(stop.code, int) else 1
+    return code, out.getvalue(), err.getvalue()
+
+
+def main_(outdir: Path) -> None:
+    rng = random.Random(SEED)
+    folder = outdir / "recordings"
+    folder.mkdir(parents=True, exist_ok=True)
+    recordings: list[tuple[str, Path]] = []
+
+    def save(name: str, document: dict[str, Any] | str) -> Path:
+        path = folder / name
+        text = document if isinstance(document, str) else json.dumps(document)
+        path.write_text(text, encoding="utf-8")
+        return path
+
+    for demo in load_lasa():
+        if demo.demo not in (1, 4, 7):  # three of each shape's seven: the run stays short
+            continue
+        name = f"lasa-{demo.shape}-{demo.demo}.json"
+        recordings.append((name, save(name, recording_json(demo.recording))))
+    gestures = sorted((REPO / "research" / "gestures").rglob("*.xml"))
+    for path in gestures[::6]:
+        gesture = load_gesture_log(path)
+        name = "gesture-" + "-".join(path.relative_to(REPO / "research" / "gestures").parts)
+        name = name.removesuffix(".xml") + ".json"
+        recordings.append((name, save(name, recording_json(gesture.recording))))
+    for index in range(120):
+        name = f"random-{index:03d}.json"
+        recordings.append((name, save(name, random_drawing(rng))))
+
+    cases: list[dict[str, Any]] = []
+
+    def case(name: str, arguments: list[str]) -> None:
+        code, stdout, stderr = run(arguments)
+        cases.append(
+            {"name": name, "args": arguments, "code": code, "stdout": stdout, "stderr": stderr}
+        )
+
+    for index, (name, path) in enumerate(recordings):
+        # Each recording once: the defaults, the paper's settings or seeded flags, in turn;
+        # the random drawings always with seeded flags.
+        turn = 2 if name.startswith("random") else index % 3
+        flags = [[], ["--paper"], random_flags(rng)][turn]
+        case(name, [str(path), *flags, "--json"])
+    first = str(recordings[0][1])
+    case("text output", [first])
+    case("text output, angle", [first, "--paper", "--stretch"])
+    for name, text in BROKEN.items():
+        case(name, [str(save(name, text)), "--json"])
+    case("missing file", [str(folder / "absent.json"), "--json"])
+    case("a folder", [str(folder), "--json"])
+    for arguments in USAGE_ERRORS:
+        case(" ".join(arguments), [first, *arguments, "--json"])
+    (outdir / "cases.json").write_text(json.dumps(cases), encoding="utf-8")
+    print(f"{len(cases)} cases, {len(recordings)} recordings in {outdir}")
+
+
+if __name__ == "__main__":
+    main_(Path(sys.argv[1]))

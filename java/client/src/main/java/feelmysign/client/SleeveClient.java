@@ -1,0 +1,611 @@
+package feelmysign.client;
+
+import com.hivemq.client.mqtt.MqttClient;
+import com.hivemq.client.mqtt.MqttClientSslConfig;
+import com.hivemq.client.mqtt.MqttGlobalPublishFilter;
+import com.hivemq.client.mqtt.datatypes.MqttQos;
+import com.hivemq.client.mqtt.lifecycle.MqttClientDisconnectedContext;
+import com.hivemq.client.mqtt.lifecycle.MqttDisconnectSource;
+import com.hivemq.client.mqtt.mqtt3.Mqtt3AsyncClient;
+import com.hivemq.client.mqtt.mqtt3.Mqtt3ClientBuilder;
+import com.hivemq.client.mqtt.mqtt3.exceptions.Mqtt3ConnAckException;
+import com.hivemq.client.mqtt.mqtt3.message.connect.connack.Mqtt3ConnAckReturnCode;
+import com.hivemq.client.mqtt.mqtt3.message.publish.Mqtt3Publish;
+import feelmysign.protocol.Control;
+import feelmysign.protocol.Protocol;
+import feelmysign.protocol.Stroke;
+import feelmysign.protocol.StrokeException;
+import feelmysign.protocol.Topics;
+import feelmysign.protocol.WireFormat;
+import java.io.IOException;
+import java.io.InputStream;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.security.GeneralSecurityException;
+import java.security.KeyStore;
+import java.security.cert.Certificate;
+import java.security.cert.CertificateFactory;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.UUID;
+import java.util.concurrent.ThreadLocalRandom;
+import java.util.concurrent.TimeUnit;
+import javax.net.ssl.TrustManagerFactory;
+
+/**
+ * Sends strokes to one sleeve and hears back from it, as the drawing page does
+ * ({@code web/src/mqtt/sender.ts}): MQTT 3.1.1, strokes at QoS 1 on
+ * {@code feelmysign/<sleeve>/strokes} (JSON v1, with the drawing's id, {@code seq} counted from
+ * 0 and {@code sent_at_ms} stamped as each goes out) or on the legacy topic (the paper's text),
+ * Stop as the cancel message, the sleeve's {@code status} and {@code events} as callbacks.
+ *
+ * <p>Strokes wait in an outbox while the broker is out of reach and go out, in order, when it is
+ * back; one leaves the outbox only on the broker's PUBACK, so {@link #unsent()} is honest. With
+ * a late limit, strokes that waited longer are dropped instead and reported
+ * ({@link Listener#late}). The connection is retried every 2 s, except after a refused login,
+ * which retrying cannot fix. Callbacks come from the network thread; they must not block.
+ *
+ * <pre>
+ * SleeveClient client = SleeveClient.builder("mqtt://127.0.0.1:1883")
+ *     .login("sender", password).sleeveId("sleeve1").listener(listener).build();
+ * client.connect();
+ * client.newDrawing();
+ * client.send(new Stroke(0, 0, 2, 0, 500));
+ * client.stop();   // cancel the drawing on the sleeve
+ * </pre>
+ */
+public final class SleeveClient implements AutoCloseable {
+  /** How long to wait between reconnection attempts (the page's). */
+  public static final long RECONNECT_PERIOD_MS = 2000;
+  /** The broker notices a vanished sender after 1.5 x this. */
+  public static final int KEEPALIVE_S = 20;
+
+  /** The connection to the broker. */
+  public enum State {
+    CONNECTING,
+    CONNECTED,
+    OFFLINE
+  }
+
+  /** What the client tells; every method has a default that does nothing. */
+  public interface Listener {
+    /** The connection changed, with a sentence to show (what is wrong and what to do). */
+    default void broker(State state, String detail) {}
+
+    /** The sleeve's retained status (JSON; "" when it was cleared). */
+    default void status(String payload) {}
+
+    /** One event of the sleeve: played, adjusted, rejected, cancelled, safety, error. */
+    default void event(SleeveEvent event) {}
+
+    /** The broker acknowledged this stroke (PUBACK). */
+    default void acked(Stroke stroke) {}
+
+    /** A stroke that cannot be sent (outside what any sleeve accepts): never silently dropped. */
+    default void refused(Stroke stroke, StrokeException error) {}
+
+    /** Strokes that waited longer than the late limit and were dropped. */
+    default void late(List<Stroke> strokes) {}
+
+    /** How many strokes the sleeve may not have yet (queued or awaiting PUBACK). */
+    default void unsent(int count) {}
+  }
+
+  private final BrokerUrl url;
+  private final String username;
+  private final String password;
+  private final String sleeveId;
+  private final WireFormat format;
+  private final String legacyTopic;
+  private final Path caCertificate;
+  private final String caFingerprint;
+  private final Long lateLimitMs;
+  private final Listener listener;
+
+  private final Object lock = new Object();
+  /** Held while a flush takes and publishes, so two threads' flushes never interleave. */
+  private final Object flushLock = new Object();
+  private final Outbox<Stroke> outbox = new Outbox<>();
+  /** Cancels not yet acknowledged, sent before any stroke when the broker is back. */
+  private final List<String> cancels = new ArrayList<>();
+  private Mqtt3AsyncClient client;
+  private boolean connected;
+  private boolean loginRefused;
+  private String lastCertificateProblem;
+  private String drawing;
+  private long nextSeq;
+
+  private SleeveClient(Builder b) {
+    this.url = b.url;
+    this.username = b.username;
+    this.password = b.password;
+    this.sleeveId = b.sleeveId;
+    this.format = b.format;
+    this.legacyTopic = b.legacyTopic;
+    this.caCertificate = b.caCertificate;
+    this.caFingerprint = b.caFingerprint;
+    this.lateLimitMs = b.lateLimitMs;
+    this.listener = b.listener;
+  }
+
+  /** A client for the broker at {@code brokerUrl} (mqtt://, mqtts://, ws:// or wss://). */
+  public static Builder builder(String brokerUrl) {
+    return new Builder(BrokerUrl.parse(brokerUrl));
+  }
+
+  /** How to reach the broker and the sleeve. */
+  public static final class Builder {
+    private final BrokerUrl url;
+    private String username;
+    private String password;
+    private String sleeveId = "sleeve1";
+    private WireFormat format = WireFormat.JSON;
+    private String legacyTopic = Topics.LEGACY_TOPIC;
+    private Path caCertificate;
+    private String caFingerprint;
+    private Long lateLimitMs;
+    private Listener listener = new Listener() {};
+
+    private Builder(BrokerUrl url) {
+      this.url = url;
+    }
+
+    public Builder login(String user, String pass) {
+      this.username = user;
+      this.password = pass;
+      return this;
+    }
+
+    /** The sleeve's id: 1-64 letters, digits, '_' or '-' (default sleeve1). */
+    public Builder sleeveId(String id) {
+      if (id == null || !id.matches("[A-Za-z0-9_-]{1,64}")) {
+        throw new IllegalArgumentException(
+            "sleeve id " + id + " must be 1-64 letters, digits, '_' or '-' (e.g. sleeve1)");
+      }
+      this.sleeveId = id;
+      return this;
+    }
+
+    /** JSON v1 on the sleeve's strokes topic (default), or the paper's legacy text. */
+    public Builder format(WireFormat wireFormat) {
+      this.format = wireFormat;
+      return this;
+    }
+
+    /** Where legacy text goes (default deviceOne/line, the paper's). */
+    public Builder legacyTopic(String topic) {
+      this.legacyTopic = topic;
+      return this;
+    }
+
+    /** The CA to trust for mqtts:// and wss:// (PEM; e.g. the one of feelmysign up --lan). */
+    public Builder caCertificate(Path pem) {
+      this.caCertificate = pem;
+      return this;
+    }
+
+    /**
+     * Trust the CA whose SHA-256 fingerprint this is (64 hex digits: a join token's, or
+     * credentials.json's ca_fingerprint), taken from the broker's own chain.
+     */
+    public Builder caFingerprint(String sha256) {
+      new PinnedCa(sha256); // checked now: a typo is told at once
+      this.caFingerprint = sha256;
+      return this;
+    }
+
+    /** Strokes not sent within this many ms are dropped (null: sent whenever possible). */
+    public Builder lateLimitMs(Long limitMs) {
+      this.lateLimitMs = limitMs;
+      return this;
+    }
+
+    public Builder listener(Listener value) {
+      this.listener = value;
+      return this;
+    }
+
+    public SleeveClient build() {
+      return new SleeveClient(this);
+    }
+  }
+
+  /** Connects (and keeps reconnecting) in the background; returns at once. */
+  public void connect() {
+    Mqtt3ClientBuilder builder =
+        MqttClient.builder()
+            .useMqttVersion3()
+            .identifier(
+                "feelmysign-java-" + Long.toHexString(ThreadLocalRandom.current().nextLong()))
+            .serverHost(url.host())
+            .serverPort(url.port())
+            .automaticReconnect()
+            .initialDelay(RECONNECT_PERIOD_MS, TimeUnit.MILLISECONDS)
+            .maxDelay(RECONNECT_PERIOD_MS, TimeUnit.MILLISECONDS)
+            .applyAutomaticReconnect()
+            .addConnectedListener(context -> onConnected())
+            .addDisconnectedListener(this::onDisconnected);
+    if (url.tls()) {
+      builder = builder.sslConfig(sslConfig());
+    }
+    if (url.webSocket()) {
+      String path = url.path().startsWith("/") ? url.path().substring(1) : url.path();
+      builder = builder.webSocketConfig().serverPath(path).applyWebSocketConfig();
+    }
+    Mqtt3AsyncClient created = builder.buildAsync();
+    synchronized (lock) {
+      client = created;
+      connected = false;
+      loginRefused = false;
+      outbox.requeueInFlight();
+    }
+    created.publishes(MqttGlobalPublishFilter.SUBSCRIBED, this::onMessage);
+    listener.broker(State.CONNECTING, "Connecting to " + url + "...");
+    var connect = created.connectWith().cleanSession(true).keepAlive(KEEPALIVE_S);
+    if (username != null) {
+      connect
+          .simpleAuth()
+          .username(username)
+          .password(password == null ? new byte[0] : password.getBytes(StandardCharsets.UTF_8))
+          .applySimpleAuth();
+    }
+    // A failure is told by the disconnected listener, which also retries.
+    connect.send();
+  }
+
+  private MqttClientSslConfig sslConfig() {
+    if (caFingerprint != null) {
+      return MqttClientSslConfig.builder().trustManagerFactory(new PinnedCa(caFingerprint)).build();
+    }
+    if (caCertificate == null) {
+      return MqttClientSslConfig.builder().build(); // the JVM's trusted CAs
+    }
+    try (InputStream in = Files.newInputStream(caCertificate)) {
+      KeyStore store = KeyStore.getInstance(KeyStore.getDefaultType());
+      store.load(null, null);
+      int index = 0;
+      for (Certificate certificate : CertificateFactory.getInstance("X.509").generateCertificates(in)) {
+        store.setCertificateEntry("ca-" + index++, certificate);
+      }
+      if (index == 0) {
+        throw new IllegalArgumentException(
+            caCertificate + " holds no certificate; give the CA's PEM file (ca.pem)");
+      }
+      TrustManagerFactory trust =
+          TrustManagerFactory.getInstance(TrustManagerFactory.getDefaultAlgorithm());
+      trust.init(store);
+      return MqttClientSslConfig.builder().trustManagerFactory(trust).build();
+    } catch (IOException | GeneralSecurityException error) {
+      throw new IllegalArgumentException(
+          "cannot read the CA certificate " + caCertificate + ": " + error.getMessage(), error);
+    }
+  }
+
+  private void onConnected() {
+    Mqtt3AsyncClient current;
+    synchronized (lock) {
+      current = client;
+      connected = true;
+      lastCertificateProblem = null;
+    }
+    listener.broker(
+        State.CONNECTED,
+        "Connected to " + url + " as " + (username == null ? "anonymous" : username));
+    for (String name : List.of(Topics.STATUS, Topics.EVENTS)) {
+      current
+          .subscribeWith()
+          .topicFilter(Topics.telemetryTopic(sleeveId, name))
+          .qos(MqttQos.AT_MOST_ONCE)
+          .send()
+          .whenComplete(
+              (ack, error) -> {
+                if (error != null) {
+                  listener.broker(
+                      State.CONNECTED,
+                      "Connected, but cannot read the sleeve's " + name + ": " + error.getMessage());
+                }
+              });
+    }
+    flush();
+  }
+
+  private void onDisconnected(MqttClientDisconnectedContext context) {
+    Throwable cause = context.getCause();
+    boolean wasConnected;
+    synchronized (lock) {
+      wasConnected = connected;
+      connected = false;
+      outbox.requeueInFlight();
+    }
+    if (context.getSource() == MqttDisconnectSource.USER) {
+      context.getReconnector().reconnect(false);
+      return;
+    }
+    if (cause instanceof Mqtt3ConnAckException refused) {
+      Mqtt3ConnAckReturnCode code = refused.getMqttMessage().getReturnCode();
+      if (code == Mqtt3ConnAckReturnCode.BAD_USER_NAME_OR_PASSWORD
+          || code == Mqtt3ConnAckReturnCode.NOT_AUTHORIZED) {
+        // Retrying a refused login only fills the broker's log: stop until it is fixed.
+        context.getReconnector().reconnect(false);
+        synchronized (lock) {
+          loginRefused = true;
+        }
+        listener.broker(
+            State.OFFLINE,
+            "The broker at "
+                + url
+                + " refused the login of '"
+                + username
+                + "' ("
+                + code
+                + "). Fix the username or password.");
+        return;
+      }
+    }
+    context.getReconnector().reconnect(true);
+    String certificate = certificateProblem(cause);
+    if (certificate != null) {
+      synchronized (lock) {
+        if (certificate.equals(lastCertificateProblem)) {
+          return; // told once; still retrying
+        }
+        lastCertificateProblem = certificate;
+      }
+      listener.broker(
+          State.OFFLINE,
+          "The broker at "
+              + url
+              + " has a certificate this client does not trust ("
+              + certificate
+              + "); retrying every "
+              + RECONNECT_PERIOD_MS / 1000
+              + " s. Give the broker's CA (caCertificate) or its fingerprint (caFingerprint).");
+      return;
+    }
+    if (wasConnected || context.getReconnector().getAttempts() == 0) {
+      listener.broker(
+          State.OFFLINE,
+          "No connection to "
+              + url
+              + " ("
+              + (cause == null ? "closed" : cause.getMessage())
+              + "); retrying every "
+              + RECONNECT_PERIOD_MS / 1000
+              + " s. Is the broker running? ('make up' starts it.)");
+    }
+  }
+
+  /** The certificate error in a failed connection's causes, or null. */
+  private static String certificateProblem(Throwable cause) {
+    for (Throwable t = cause; t != null; t = t.getCause()) {
+      if (t instanceof java.security.cert.CertificateException
+          || t instanceof javax.net.ssl.SSLHandshakeException) {
+        Throwable root = t;
+        while (root.getCause() != null) {
+          root = root.getCause();
+        }
+        return String.valueOf(root.getMessage());
+      }
+    }
+    return null;
+  }
+
+  private void onMessage(Mqtt3Publish publish) {
+    String topic = publish.getTopic().toString();
+    String text = new String(publish.getPayloadAsBytes(), StandardCharsets.UTF_8);
+    if (topic.equals(Topics.telemetryTopic(sleeveId, Topics.STATUS))) {
+      listener.status(text);
+    } else if (topic.equals(Topics.telemetryTopic(sleeveId, Topics.EVENTS))) {
+      SleeveEvent event = SleeveEvent.parse(text);
+      if (event != null) {
+        listener.event(event);
+      }
+    }
+  }
+
+  /** Starts a new drawing: a new id (a random UUID), its strokes counted from 0. */
+  public String newDrawing() {
+    synchronized (lock) {
+      drawing = UUID.randomUUID().toString();
+      nextSeq = 0;
+      return drawing;
+    }
+  }
+
+  /** The drawing strokes are sent in (null before {@link #newDrawing}). */
+  public String drawing() {
+    synchronized (lock) {
+      return drawing;
+    }
+  }
+
+  /**
+   * Queues a stroke and sends it now if the broker is connected. A stroke without a drawing
+   * becomes the next of the current one (a drawing is started if there is none).
+   *
+   * @return the stroke as it is sent (its drawing and seq)
+   */
+  public Stroke send(Stroke stroke) {
+    Stroke addressed;
+    synchronized (lock) {
+      if (stroke.drawing() == null) {
+        if (drawing == null) {
+          newDrawing();
+        }
+        addressed = stroke.inDrawing(drawing, nextSeq++, 0).withSentAt(null);
+      } else {
+        addressed = stroke;
+      }
+      outbox.add(addressed, nowMs());
+    }
+    flush();
+    return addressed;
+  }
+
+  /**
+   * Stop: cancels the current drawing on the sleeve (its strokes still here are dropped, the
+   * sleeve stops playing and drops the rest). Returns how many unsent strokes were dropped.
+   */
+  public int stop() {
+    String current = drawing();
+    return current == null ? 0 : cancel(current);
+  }
+
+  /** Cancels a drawing, or everything with {@link Control#CANCEL_ALL}. */
+  public int cancel(String drawingId) {
+    List<Stroke> dropped;
+    synchronized (lock) {
+      dropped =
+          outbox.dropQueued(
+              (stroke, entry) ->
+                  drawingId.equals(Control.CANCEL_ALL) || drawingId.equals(stroke.drawing()));
+      cancels.remove(drawingId);
+      cancels.add(drawingId);
+    }
+    flush();
+    return dropped.size();
+  }
+
+  /** Queued plus awaiting PUBACK: every stroke the sleeve may not have yet. */
+  public int unsent() {
+    synchronized (lock) {
+      return outbox.size();
+    }
+  }
+
+  /** Whether the broker connection is up. */
+  public boolean connected() {
+    synchronized (lock) {
+      return connected;
+    }
+  }
+
+  /** Whether the broker refused the login (the client stopped retrying). */
+  public boolean loginRefused() {
+    synchronized (lock) {
+      return loginRefused;
+    }
+  }
+
+  private static long nowMs() {
+    return System.nanoTime() / 1_000_000;
+  }
+
+  private void flush() {
+    // The sketch's thread (send, stop) and the network thread (a new connection) both flush;
+    // one at a time, so strokes go out in the order they were drawn.
+    synchronized (flushLock) {
+      flushInOrder();
+    }
+  }
+
+  private void flushInOrder() {
+    List<Stroke> late = List.of();
+    List<Runnable> publishes = new ArrayList<>();
+    int unsent;
+    synchronized (lock) {
+      Mqtt3AsyncClient current = client;
+      if (current != null && connected) {
+        if (lateLimitMs != null) {
+          long now = nowMs();
+          late = outbox.dropQueued((stroke, entry) -> now - entry.addedMs() > lateLimitMs);
+        }
+        for (String cancel : List.copyOf(cancels)) {
+          byte[] payload =
+              Control.formatControl(new Control.Cancel(cancel)).getBytes(StandardCharsets.UTF_8);
+          publishes.add(
+              () ->
+                  publish(current, Topics.controlTopic(sleeveId), payload)
+                      .whenComplete(
+                          (ack, error) -> {
+                            if (error == null) {
+                              synchronized (lock) {
+                                if (client == current) {
+                                  cancels.remove(cancel);
+                                }
+                              }
+                            }
+                          }));
+        }
+        for (Outbox.Entry<Stroke> entry : outbox.takeQueued()) {
+          Stroke stroke = entry.item();
+          String topic;
+          String text;
+          try {
+            if (format == WireFormat.LEGACY) {
+              topic = legacyTopic;
+              text = Protocol.formatLegacy(stroke);
+            } else {
+              topic = Topics.strokesTopic(sleeveId);
+              text = Protocol.formatJson(stroke.withSentAt((double) System.currentTimeMillis()));
+            }
+          } catch (StrokeException error) {
+            outbox.ack(entry.id());
+            publishes.add(() -> listener.refused(stroke, error));
+            continue;
+          }
+          byte[] payload = text.getBytes(StandardCharsets.UTF_8);
+          publishes.add(
+              () ->
+                  publish(current, topic, payload)
+                      .whenComplete(
+                          (ack, error) -> {
+                            int left;
+                            synchronized (lock) {
+                              // A replaced connection's late answers must not touch the new one's.
+                              if (client != current) {
+                                return;
+                              }
+                              if (error != null) {
+                                outbox.fail(entry.id());
+                              } else {
+                                outbox.ack(entry.id());
+                              }
+                              left = outbox.size();
+                            }
+                            if (error == null) {
+                              listener.acked(stroke);
+                            }
+                            listener.unsent(left);
+                          }));
+        }
+      }
+      unsent = outbox.size();
+    }
+    if (!late.isEmpty()) {
+      listener.late(late);
+    }
+    // Published outside the lock, in order: cancels first, then the strokes.
+    publishes.forEach(Runnable::run);
+    listener.unsent(unsent);
+  }
+
+  private static java.util.concurrent.CompletableFuture<?> publish(
+      Mqtt3AsyncClient client, String topic, byte[] payload) {
+    return client
+        .publishWith()
+        .topic(topic)
+        .qos(MqttQos.AT_LEAST_ONCE)
+        .payload(payload)
+        .send();
+  }
+
+  /** Disconnects; strokes not yet acknowledged stay counted in {@link #unsent()}. */
+  @Override
+  public void close() {
+    Mqtt3AsyncClient current;
+    synchronized (lock) {
+      current = client;
+      client = null;
+      connected = false;
+    }
+    if (current != null) {
+      try {
+        current.disconnect().get(5, TimeUnit.SECONDS);
+      } catch (Exception notConnected) {
+        // Not connected, or already gone: nothing to close.
+      }
+    }
+  }
+}

@@ -1,0 +1,53 @@
+package feelmysign.client;
+
+import feelmysign.json.JsonDecodeException;
+import feelmysign.json.NonFiniteLiteralException;
+import feelmysign.json.PyJson;
+import java.util.Map;
+
+/**
+ * One message on a sleeve's {@code events} topic (docs/protocol.md, "Events"): a stroke
+ * {@code played}, {@code adjusted} (slowed to be felt), {@code rejected} (with its reason),
+ * {@code cancelled}, or a {@code safety} or {@code error} report. {@code fields} holds every
+ * field as sent.
+ */
+public record SleeveEvent(
+    String type, String drawing, Long seq, String reason, String message, Map<String, Object> fields) {
+
+  public static final String PLAYED = "played";
+  public static final String ADJUSTED = "adjusted";
+  public static final String REJECTED = "rejected";
+  public static final String CANCELLED = "cancelled";
+  public static final String SAFETY = "safety";
+  public static final String ERROR = "error";
+
+  /** The event in {@code payload}, or null for one that is not a JSON object with a type. */
+  public static SleeveEvent parse(String payload) {
+    Object document;
+    try {
+      document = PyJson.loads(payload);
+    } catch (JsonDecodeException | NonFiniteLiteralException error) {
+      return null;
+    }
+    if (!(document instanceof Map<?, ?> map) || !(map.get("type") instanceof String type)) {
+      return null;
+    }
+    @SuppressWarnings("unchecked")
+    Map<String, Object> fields = (Map<String, Object>) map;
+    Object seq = fields.get("seq");
+    // 3.0 is 3 (JavaScript cannot tell them apart); anything else is no seq.
+    Long seqValue = null;
+    if (seq instanceof Long l) {
+      seqValue = l;
+    } else if (seq instanceof Double d && d == Math.rint(d) && Math.abs(d) <= 9.007199254740991E15) {
+      seqValue = (long) (double) d;
+    }
+    return new SleeveEvent(
+        type,
+        fields.get("drawing") instanceof String s ? s : null,
+        seqValue,
+        fields.get("reason") instanceof String s ? s : null,
+        fields.get("message") instanceof String s ? s : null,
+        fields);
+  }
+}

@@ -1,0 +1,66 @@
+package feelmysign.simplify;
+
+/**
+ * A straight piece of a path, in grid units, and when the simplifier let it go.
+ *
+ * <p>{@code dropped} is null for a stroke to send, else the reason it is too short or too brief
+ * to feel ({@link #NOT_ENOUGH_DISTANCE}, {@link #NOT_ENOUGH_DURATION}). Sent and dropped segments
+ * of a path together join end to start, so a dropped one leaves a gap no longer than itself.
+ */
+public record Segment(
+    double startX,
+    double startY,
+    double endX,
+    double endY,
+    double startMs,
+    double endMs,
+    double emittedAtMs,
+    String dropped) {
+
+  /** The paper's NotEnoughDistanceException. */
+  public static final String NOT_ENOUGH_DISTANCE = "not_enough_distance";
+  /** The paper's NotEnoughDurationException. */
+  public static final String NOT_ENOUGH_DURATION = "not_enough_duration";
+
+  public double durationMs() {
+    return endMs - startMs;
+  }
+
+  public double length() {
+    double dx = endX - startX;
+    double dy = endY - startY;
+    return Math.sqrt(dx * dx + dy * dy);
+  }
+
+  /** Whether this is a stroke to send (not dropped). */
+  public boolean sent() {
+    return dropped == null;
+  }
+
+  /**
+   * A finished piece of a path: sent, or dropped as too short (first) or too brief to feel.
+   * Length is tested first, as the paper does: a tap is "not enough distance".
+   */
+  static Segment finish(
+      double startX,
+      double startY,
+      double endX,
+      double endY,
+      double startMs,
+      double endMs,
+      double emittedAtMs,
+      double minLength,
+      double minDurationMs) {
+    Segment segment =
+        new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, null);
+    String dropped = null;
+    if (segment.length() < minLength) {
+      dropped = NOT_ENOUGH_DISTANCE;
+    } else if (segment.durationMs() < minDurationMs) {
+      dropped = NOT_ENOUGH_DURATION;
+    }
+    return dropped == null
+        ? segment
+        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, dropped);
+  }
+}

@@ -1,0 +1,145 @@
+package feelmysign.simplify;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertThrows;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+
+import com.fasterxml.jackson.databind.JsonNode;
+import feelmysign.Vectors;
+import feelmysign.json.Numbers;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.Map;
+import java.util.stream.Stream;
+import org.junit.jupiter.api.Test;
+import org.junit.jupiter.params.ParameterizedTest;
+import org.junit.jupiter.params.provider.Arguments;
+import org.junit.jupiter.params.provider.MethodSource;
+
+/**
+ * The parameter tables against the reference's (testdata/angle/params.json and
+ * testdata/window/params.json): every name in order, kind, default (an integer stays one),
+ * range and help; and the refusals of values outside them, in the reference's words.
+ */
+class ParamTableTest {
+  static Stream<Arguments> tables() {
+    return Stream.of(
+        Arguments.of(Algorithm.ANGLE, "angle/params.json"),
+        Arguments.of(Algorithm.WINDOW, "window/params.json"));
+  }
+
+  private static List<JsonNode> parameters(String file) {
+    List<JsonNode> out = new ArrayList<>();
+    Vectors.read(Vectors.testdata().resolve(file)).get("parameters").forEach(out::add);
+    return out;
+  }
+
+  @ParameterizedTest(name = "{1}")
+  @MethodSource("tables")
+  void tableIsTheReferences(Algorithm algorithm, String file) {
+    List<JsonNode> table = parameters(file);
+    assertEquals(
+        table.stream().map(p -> p.get("name").asText()).toList(),
+        new ArrayList<>(algorithm.defaults().keySet()),
+        "names in the reference's order");
+    for (JsonNode row : table) {
+      String name = row.get("name").asText();
+      ParamSpec spec = algorithm.specs().get(name);
+      assertEquals(row.get("type").asText(), spec.kind().jsonName(), name + " type");
+      assertEquals(row.get("help").asText(), spec.help(), name + " help");
+      assertEquals(
+          row.get("minimum").isNull() ? null : row.get("minimum").asDouble(),
+          spec.minimum(),
+          name + " minimum");
+      assertEquals(
+          row.get("maximum").isNull() ? null : row.get("maximum").asDouble(),
+          spec.maximum(),
+          name + " maximum");
+      assertEquals(Vectors.plain(row.get("default")), algorithm.defaults().get(name), name);
+    }
+  }
+
+  @ParameterizedTest(name = "{1}")
+  @MethodSource("tables")
+  void outOfRangeNamesParameterValueAndRange(Algorithm algorithm, String file) {
+    for (JsonNode row : parameters(file)) {
+      String name = row.get("name").asText();
+      if (row.get("type").asText().equals("boolean")) {
+        ParameterException error =
+            assertThrows(ParameterException.class, () -> Params.of(algorithm, Map.of(name, 1L)));
+        assertEquals(name + " = 1 is not allowed; it must be true or false", error.getMessage());
+        continue;
+      }
+      double above = row.get("maximum").asDouble() + 1;
+      String range =
+          "["
+              + Numbers.pythonG(row.get("minimum").asDouble())
+              + ", "
+              + Numbers.pythonG(row.get("maximum").asDouble())
+              + "]";
+      ParameterException error =
+          assertThrows(ParameterException.class, () -> Params.of(algorithm, Map.of(name, above)));
+      assertEquals(name, error.name());
+      assertEquals(
+          name + " = " + Numbers.pythonRepr(above) + " is not allowed; it must be in " + range,
+          error.getMessage());
+      ParameterException text =
+          assertThrows(ParameterException.class, () -> Params.of(algorithm, Map.of(name, "x")));
+      assertEquals(
+          name + " = 'x' is not allowed; it must be a number in " + range, text.getMessage());
+      if (row.get("type").asText().equals("integer")) {
+        ParameterException half =
+            assertThrows(
+                ParameterException.class,
+                () -> Params.of(algorithm, Map.of(name, row.get("minimum").asDouble() + 0.5)));
+        assertTrue(half.getMessage().endsWith("it must be a whole number in " + range));
+      }
+    }
+  }
+
+  @Test
+  void thePapersNamesWorkAsAppendixB1() {
+    Params paper =
+        Params.angle()
+            .with("frameMax", 60)
+            .with("checkFrame", 7)
+            .with("maxAngleDifDeg", 30)
+            .with("fps", 30)
+            .with("clickClear", false)
+            .with("recover", false)
+            .with("sleeveX", 5)
+            .with("sleeveY", 3)
+            .with("screenX", 800)
+            .with("screenY", 600)
+            .with("minimumDuration", 10.5)
+            .with("minimumSize", 0.2);
+    assertEquals(60L, paper.get("frame_max"));
+    assertEquals(7L, paper.get("check_frames"));
+    assertEquals(30L, paper.get("max_angle_deg"));
+    assertEquals(30L, paper.get("fps"));
+    assertEquals(false, paper.get("clear_on_press"));
+    assertEquals(false, paper.get("recover"));
+    assertEquals(6, paper.columns(), "sleeveX counts from 0");
+    assertEquals(4, paper.rows(), "sleeveY counts from 0");
+    assertEquals(5L, paper.get("sleeveX"));
+    assertEquals(800L, paper.get("canvas_width_px"));
+    assertEquals(600L, paper.get("canvas_height_px"));
+    assertEquals(10.5, paper.get("min_duration_ms"));
+    assertEquals(0.2, paper.get("min_length"));
+    ParameterException error =
+        assertThrows(ParameterException.class, () -> Params.angle().with("sleeveX", 64));
+    assertEquals(
+        "sleeveX = 64 is not allowed; it must be a whole number in [0, 63]".replace(
+            "a whole number in", "in"),
+        error.getMessage());
+    IllegalArgumentException other =
+        assertThrows(IllegalArgumentException.class, () -> Params.angle().with("max_error", 1));
+    assertTrue(other.getMessage().contains("only applies to the window simplifier"));
+  }
+
+  @Test
+  void theParametersOfTheOtherAlgorithmAreRefused() {
+    assertThrows(IllegalArgumentException.class, () -> Params.window().with("checkFrame", 5));
+    assertThrows(IllegalArgumentException.class, () -> Params.window().with("colour", 5));
+  }
+}
