@@ -95,6 +95,7 @@ def test_readable_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     ("content", "words"),
     [
         ("not json", ["not valid JSON"]),
+        ('{"canvas": "\udcff"}', ["not UTF-8 text (byte 12)", "saved as UTF-8"]),
         ('{"paths": []}', ["canvas"]),
         ('{"canvas": {"width_px": 0, "height_px": 10}, "paths": []}', ["width_px", "> 0"]),
         (
@@ -112,7 +113,7 @@ def test_bad_recordings_say_what_is_wrong(
     content: str, words: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     path = tmp_path / "bad.json"
-    path.write_text(content)
+    path.write_bytes(content.encode("utf-8", "surrogateescape"))
     assert main(["simplify", str(path)]) == 1
     err = capsys.readouterr().err
     assert err.startswith("Error: ") and all(w in err for w in words), err

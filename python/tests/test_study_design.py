@@ -105,3 +105,13 @@ def test_each_block_holds_every_condition_once_and_orders_repeat_from_the_seed()
         assert len(set(block)) == 24
     assert participant_order(design, 3) == order
     assert participant_order(design, 4) != order
+
+
+def test_a_design_that_is_not_utf8_is_named_not_a_crash(tmp_path: Path) -> None:
+    bad = tmp_path / "latin1.toml"
+    bad.write_bytes('title = "Étude"\n'.encode("latin-1"))
+    with pytest.raises(DesignError) as caught:
+        load_design(bad)
+    assert "not UTF-8 text (byte 9)" in str(caught.value) and "save the design as UTF-8" in str(
+        caught.value
+    )

@@ -63,6 +63,10 @@ def load_recording(path: str | Path) -> Recording:
         text = read_text(path, max_bytes=MAX_RECORDING_BYTES)
     except OSError as error:
         raise RecordingError(f"cannot read recording {path}: {error.strerror or error}") from error
+    except UnicodeDecodeError as error:
+        raise RecordingError(
+            f"{path}: not UTF-8 text (byte {error.start}); a recording is JSON saved as UTF-8"
+        ) from None
     return parse_recording(text, source=str(path))
 
 

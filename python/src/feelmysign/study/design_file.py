@@ -57,6 +57,10 @@ def load_design(path: str | Path) -> Design:
         raise DesignError(
             str(path), [f"cannot read the file: {error.strerror or error}"]
         ) from error
+    except UnicodeDecodeError as error:
+        raise DesignError(
+            str(path), [f"not UTF-8 text (byte {error.start}); save the design as UTF-8 TOML"]
+        ) from None
     return parse_design(text, source=str(path), base_dir=file.resolve().parent)
 
 
