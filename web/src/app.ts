@@ -16,6 +16,7 @@ import {
   LATE_LIMIT_MS,
   loadSettings,
   saveSettings,
+  SIMPLIFIER_PARAM_KEYS,
   simplifierParams,
   withServerBroker,
   type SettingKey,
@@ -37,20 +38,7 @@ import { byId, StatusBar, type SleeveState } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
 
 /** Settings that change how a drawing is cut or mapped: changing one re-simplifies it. */
-const DRAWING_KEYS: readonly SettingKey[] = [
-  "algorithm",
-  "max_error",
-  "max_window",
-  "max_stroke_ms",
-  "check_frames",
-  "max_angle_deg",
-  "frame_max",
-  "fps",
-  "recover",
-  "min_duration_ms",
-  "min_length",
-  "stretch",
-];
+const DRAWING_KEYS: readonly SettingKey[] = ["algorithm", ...SIMPLIFIER_PARAM_KEYS];
 /** Settings that change the grid: a drawing mapped onto another grid cannot be shown on this one. */
 const GRID_KEYS: readonly SettingKey[] = ["grid_source", "rows", "columns"];
 /** Settings that change where and how strokes are published: changing one reconnects. */
