@@ -197,7 +197,7 @@ def simplifier_cases(
     defaults = make_params()
     result["params.json"] = {
         "description": params_description,
-        "parameters": [specs[f.name].to_json(getattr(defaults, f.name)) for f in fields(defaults)],
+        "parameters": [specs[f.name].to_json() for f in fields(defaults)],
     }
     return result
 

@@ -4,23 +4,10 @@
  * it). Pure: the page does what the change says.
  */
 import type { SenderTarget } from "./mqtt/sender";
-import { LATE_LIMIT_MS, type SettingKey, type Settings } from "./settings";
+import { LATE_LIMIT_MS, SIMPLIFIER_PARAM_KEYS, type SettingKey, type Settings } from "./settings";
 
 /** Settings that change how a drawing is cut or mapped: changing one re-simplifies it. */
-export const DRAWING_KEYS: readonly SettingKey[] = [
-  "algorithm",
-  "max_error",
-  "max_window",
-  "max_stroke_ms",
-  "check_frames",
-  "max_angle_deg",
-  "frame_max",
-  "fps",
-  "recover",
-  "min_duration_ms",
-  "min_length",
-  "stretch",
-];
+export const DRAWING_KEYS: readonly SettingKey[] = ["algorithm", ...SIMPLIFIER_PARAM_KEYS];
 /** Settings that change the grid: a drawing mapped onto another grid cannot be shown on this one. */
 export const GRID_KEYS: readonly SettingKey[] = ["grid_source", "rows", "columns"];
 /** Settings that change where and how strokes are published: changing one reconnects. */

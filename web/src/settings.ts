@@ -1,22 +1,26 @@
 /**
  * The sender's settings: every parameter of the paper's appendix B.1, the
  * sleeve, the intensity, the wire format and the broker. One table of fields
- * drives validation and the settings panel; the simplifiers' fields take their
- * defaults and ranges from `testdata/angle/params.json` and
- * `testdata/window/params.json` (the Python tables), so both sides accept
- * exactly the same values. Pure: storage is passed in.
+ * drives validation and the settings panel; the simplifiers' fields are the
+ * rows of their parameter table (`simplify/params.generated.ts`, generated from
+ * the Python reference's declarations) with its labels, units, defaults and
+ * ranges, so both sides accept exactly the same values. Pure: storage is passed in.
  */
 import type { ServerConfig } from "./config";
 import { LEGACY_TOPIC } from "./mqtt/topics";
 import {
+  ANGLE_PARAM_NAMES,
+  PARAMETERS,
+  WINDOW_PARAM_NAMES,
   paramProblem,
-  paramSpec,
-  type AngleParamName,
   type AngleParams,
+  type PanelParamName,
+  type PanelParams,
+  type PanelSection,
   type ParamSpec,
+  type WindowParams,
 } from "./simplify/params";
 import type { Algorithm, SimplifierParams } from "./simplify/registry";
-import { windowParamSpec, type WindowParamName, type WindowParams } from "./simplify/window-params";
 
 export type WireProtocol = "json" | "legacy";
 /** Strokes that could not be sent at once (no broker): sent when it is back, or dropped. */
@@ -25,26 +29,13 @@ export type LateStrokes = "send" | "drop";
 export const LATE_LIMIT_MS = 2000;
 export type GridSource = "status" | "manual";
 
-export interface Settings {
+/** Both simplifiers' parameters that a person sets (`PanelParams`), and the page's own settings. */
+export interface Settings extends PanelParams {
   /** The simplifier: the paper's angle rule, or the error-bounded window. */
   readonly algorithm: Algorithm;
-  readonly max_error: number;
-  readonly max_window: number;
-  readonly max_stroke_ms: number;
-  readonly check_frames: number;
-  readonly max_angle_deg: number;
-  readonly frame_max: number;
-  readonly fps: number;
-  readonly recover: boolean;
-  readonly min_duration_ms: number;
-  readonly min_length: number;
-  readonly stretch: boolean;
-  readonly clear_on_press: boolean;
   readonly late_strokes: LateStrokes;
   /** Where the grid comes from: the sleeve's retained status, or rows/columns below. */
   readonly grid_source: GridSource;
-  readonly rows: number;
-  readonly columns: number;
   readonly intensity: number;
   readonly pressure_sets_intensity: boolean;
   readonly protocol: WireProtocol;
@@ -62,7 +53,7 @@ export type FieldKind = "integer" | "number" | "boolean" | "text" | "password" |
 
 export interface FieldSpec {
   readonly key: SettingKey;
-  readonly section: "drawing" | "simplifier" | "sleeve" | "connection";
+  readonly section: PanelSection | "connection";
   readonly label: string;
   readonly help: string;
   readonly kind: FieldKind;
@@ -79,36 +70,32 @@ const SLEEVE_ID = /^[A-Za-z0-9_-]{1,64}$/;
 /** MQTT allows 65535 bytes; a topic a person types is far shorter, and a log line stays readable. */
 const MAX_TOPIC_CHARS = 256;
 
-function paramField(
-  name: AngleParamName,
-  section: FieldSpec["section"],
-  label: string,
-  unit?: string,
-): FieldSpec {
-  return specField(paramSpec(name), section, label, unit);
+/** The parameters the settings panel shows, in the table's order. */
+const PANEL_PARAMS = PARAMETERS.filter(
+  (spec): spec is ParamSpec<PanelParamName> & { panel: PanelSection } => spec.panel !== null,
+);
+
+/** The simplifier parameters whose change re-cuts a drawing (the panel's simplifier section). */
+export const SIMPLIFIER_PARAM_KEYS: readonly SettingKey[] = PANEL_PARAMS.filter(
+  (spec) => spec.panel === "simplifier",
+).map((spec) => spec.name);
+
+/** The panel's rows for the parameters of one section, from their table. */
+function paramFields(section: PanelSection): FieldSpec[] {
+  return PANEL_PARAMS.filter((spec) => spec.panel === section).map(specField);
 }
 
-function windowField(name: WindowParamName, label: string, unit?: string): FieldSpec {
-  return specField(windowParamSpec(name), "simplifier", label, unit);
-}
-
-function specField(
-  spec: ParamSpec<string>,
-  section: FieldSpec["section"],
-  label: string,
-  unit?: string,
-): FieldSpec {
-  const name = spec.name;
+function specField(spec: ParamSpec<PanelParamName> & { panel: PanelSection }): FieldSpec {
   const kind: FieldKind = spec.type === "boolean" ? "boolean" : spec.type;
   return {
-    key: name as SettingKey,
-    section,
-    label,
+    key: spec.name,
+    section: spec.panel,
+    label: spec.label,
     help: spec.help,
     kind,
     ...(spec.minimum !== null ? { minimum: spec.minimum } : {}),
     ...(spec.maximum !== null ? { maximum: spec.maximum } : {}),
-    ...(unit !== undefined ? { unit } : {}),
+    ...(spec.unit !== null ? { unit: spec.unit } : {}),
     problem: (value) => paramProblem(spec, value),
   };
 }
@@ -129,12 +116,17 @@ function textProblem(value: unknown, check: (text: string) => string | null): st
 }
 
 export const FIELDS: readonly FieldSpec[] = [
-  {
-    ...paramField("clear_on_press", "drawing", "Clear on press"),
-    help:
-      "on: every press starts a new drawing, as in the paper; off: a press adds a path to the drawing " +
-      "(letters of several strokes), and New drawing starts over",
-  },
+  // The page's own help: what a press does here, where New drawing starts over.
+  ...paramFields("drawing").map((field) =>
+    field.key === "clear_on_press"
+      ? {
+          ...field,
+          help:
+            "on: every press starts a new drawing, as in the paper; off: a press adds a path to the drawing " +
+            "(letters of several strokes), and New drawing starts over",
+        }
+      : field,
+  ),
   {
     key: "late_strokes",
     section: "drawing",
@@ -176,17 +168,7 @@ export const FIELDS: readonly FieldSpec[] = [
     ],
     problem: (value) => (value === "angle" || value === "window" ? null : "must be a listed choice"),
   },
-  windowField("max_error", "Max error", "grid units"),
-  windowField("max_window", "Window cap", "samples"),
-  windowField("max_stroke_ms", "Longest stroke", "ms"),
-  paramField("check_frames", "simplifier", "Check frames", "frames"),
-  paramField("max_angle_deg", "simplifier", "Max angle", "°"),
-  paramField("frame_max", "simplifier", "Frame max", "frames"),
-  paramField("fps", "simplifier", "Frames per second", "fps"),
-  paramField("recover", "simplifier", "Recover"),
-  paramField("min_duration_ms", "simplifier", "Min duration", "ms"),
-  paramField("min_length", "simplifier", "Min length", "grid units"),
-  paramField("stretch", "simplifier", "Stretch to the grid"),
+  ...paramFields("simplifier"),
   {
     key: "sleeve_id",
     section: "sleeve",
@@ -210,8 +192,7 @@ export const FIELDS: readonly FieldSpec[] = [
     ],
     problem: (value) => (value === "status" || value === "manual" ? null : "must be a listed choice"),
   },
-  paramField("rows", "sleeve", "Rows"),
-  paramField("columns", "sleeve", "Columns"),
+  ...paramFields("sleeve"),
   {
     key: "protocol",
     section: "connection",
@@ -292,30 +273,19 @@ export function fieldSpec(key: SettingKey): FieldSpec {
   return field;
 }
 
-function paramDefault<T extends number | boolean>(name: AngleParamName): T {
-  return paramSpec(name).default as T;
-}
+/** The reference's defaults of the parameters a person sets. */
+const PANEL_DEFAULTS = Object.fromEntries(
+  PANEL_PARAMS.map((spec) => [spec.name, spec.default]),
+) as unknown as PanelParams;
 
 export const DEFAULT_SETTINGS: Settings = Object.freeze({
+  ...PANEL_DEFAULTS,
   // The project's default (docs/research.md, "Default settings"); "angle" is the paper's.
   algorithm: "window",
-  max_error: windowParamSpec("max_error").default as number,
-  max_window: windowParamSpec("max_window").default as number,
-  max_stroke_ms: windowParamSpec("max_stroke_ms").default as number,
-  check_frames: paramDefault<number>("check_frames"),
-  max_angle_deg: paramDefault<number>("max_angle_deg"),
-  frame_max: paramDefault<number>("frame_max"),
-  fps: paramDefault<number>("fps"),
-  recover: paramDefault<boolean>("recover"),
-  min_duration_ms: paramDefault<number>("min_duration_ms"),
-  min_length: paramDefault<number>("min_length"),
-  stretch: paramDefault<boolean>("stretch"),
   // The paper cleared the drawing at every press; people expect a letter of several paths.
   clear_on_press: false,
   late_strokes: "send",
   grid_source: "status",
-  rows: paramDefault<number>("rows"),
-  columns: paramDefault<number>("columns"),
   intensity: 0.8,
   pressure_sets_intensity: true,
   protocol: "json",
@@ -403,62 +373,39 @@ export function saveSettings(
   }
 }
 
-/** The simplifier's parameters for a drawing area of this size on this grid. */
-export function angleParams(
-  settings: Settings,
-  grid: { readonly rows: number; readonly columns: number },
-  canvas: { readonly width_px: number; readonly height_px: number },
-): AngleParams {
-  return {
-    algorithm: "angle",
-    check_frames: settings.check_frames,
-    max_angle_deg: settings.max_angle_deg,
-    frame_max: settings.frame_max,
-    recover: settings.recover,
-    fps: settings.fps,
-    ...dropAndGrid(settings, grid, canvas),
-  };
-}
+type Grid = { readonly rows: number; readonly columns: number };
+type Canvas = { readonly width_px: number; readonly height_px: number };
 
-/** The window simplifier's parameters for a drawing area of this size on this grid. */
-export function windowParams(
+/** A simplifier's parameters from the settings, in its table's order, on this grid and canvas. */
+function paramsFrom<P extends SimplifierParams>(
+  algorithm: P["algorithm"],
+  names: readonly string[],
   settings: Settings,
-  grid: { readonly rows: number; readonly columns: number },
-  canvas: { readonly width_px: number; readonly height_px: number },
-): WindowParams {
-  return {
-    algorithm: "window",
-    max_error: settings.max_error,
-    max_window: settings.max_window,
-    max_stroke_ms: settings.max_stroke_ms,
-    ...dropAndGrid(settings, grid, canvas),
-  };
-}
-
-/** The drop and grid parameters every simplifier has. */
-function dropAndGrid(
-  settings: Settings,
-  grid: { readonly rows: number; readonly columns: number },
-  canvas: { readonly width_px: number; readonly height_px: number },
-) {
-  return {
-    clear_on_press: settings.clear_on_press,
-    min_duration_ms: settings.min_duration_ms,
-    min_length: settings.min_length,
+  grid: Grid,
+  canvas: Canvas,
+): P {
+  const values: Record<string, unknown> = {
+    ...settings,
     rows: grid.rows,
     columns: grid.columns,
     canvas_width_px: canvas.width_px,
     canvas_height_px: canvas.height_px,
-    stretch: settings.stretch,
   };
+  return Object.fromEntries([["algorithm", algorithm], ...names.map((name) => [name, values[name]])]) as P;
+}
+
+/** The simplifier's parameters for a drawing area of this size on this grid. */
+export function angleParams(settings: Settings, grid: Grid, canvas: Canvas): AngleParams {
+  return paramsFrom<AngleParams>("angle", ANGLE_PARAM_NAMES, settings, grid, canvas);
+}
+
+/** The window simplifier's parameters for a drawing area of this size on this grid. */
+export function windowParams(settings: Settings, grid: Grid, canvas: Canvas): WindowParams {
+  return paramsFrom<WindowParams>("window", WINDOW_PARAM_NAMES, settings, grid, canvas);
 }
 
 /** The chosen simplifier's parameters (their `algorithm` says which one). */
-export function simplifierParams(
-  settings: Settings,
-  grid: { readonly rows: number; readonly columns: number },
-  canvas: { readonly width_px: number; readonly height_px: number },
-): SimplifierParams {
+export function simplifierParams(settings: Settings, grid: Grid, canvas: Canvas): SimplifierParams {
   return settings.algorithm === "window"
     ? windowParams(settings, grid, canvas)
     : angleParams(settings, grid, canvas);

@@ -131,8 +131,8 @@ describe("the detail control", () => {
       expect(detailLevel("window", detailValues(level))).toBe(level);
       expect(detailLevel("angle", detailValues(level))).toBe(level);
     }
-    expect(detailValues(1).max_error).toBeGreaterThan(detailValues(5).max_error);
-    expect(detailValues(1).max_angle_deg).toBeGreaterThan(detailValues(5).max_angle_deg);
+    expect(detailValues(1).max_error!).toBeGreaterThan(detailValues(5).max_error!);
+    expect(detailValues(1).max_angle_deg!).toBeGreaterThan(detailValues(5).max_angle_deg!);
     expect(detailParams(params, 5)).toMatchObject({
       algorithm: "angle",
       max_angle_deg: detailValues(5).max_angle_deg,

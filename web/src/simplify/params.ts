@@ -1,126 +1,70 @@
 /**
- * Parameter tables of the simplifiers: defaults, allowed ranges, units, help,
- * and the angle simplifier's own (defaults from the paper, appendix B.1). The
- * tables are written here, not read from the `params.json` files in testdata/ (test data
- * stays out of the page), and a test holds them equal to those files, which the
- * Python reference writes: the browser validates with exactly its ranges.
+ * The simplifiers' parameters: their table, and the checks on it. The table
+ * (names, types, defaults, ranges, units, labels, help) is generated from the
+ * Python reference's declarations into `params.generated.ts`; the page reads it
+ * from there, not from testdata/ (test data stays out of the page), and a test
+ * holds it equal to `testdata/params/params.json`, so the browser accepts
+ * exactly the reference's values.
  */
-export type ParamType = "integer" | "number" | "boolean";
+import {
+  ANGLE_PARAM_NAMES,
+  PARAMETERS,
+  type AngleParams,
+  type PanelParams,
+  type WindowParams,
+} from "./params.generated";
 
-/** One row of a parameter table; `N` names the parameters of one simplifier. */
-export interface ParamSpec<N extends string = AngleParamName> {
+export { ANGLE_PARAM_NAMES, PARAMETERS, WINDOW_PARAM_NAMES } from "./params.generated";
+export type { AngleParams, PanelParams, SharedParams, WindowParams } from "./params.generated";
+
+export type ParamType = "integer" | "number" | "boolean";
+/** Where the settings panel shows a parameter; null: the page sets it (the drawing area's size). */
+export type PanelSection = "drawing" | "simplifier" | "sleeve";
+
+export type AngleParamName = Exclude<keyof AngleParams, "algorithm">;
+/** Every parameter's name, of every simplifier. */
+export type ParamName = AngleParamName | Exclude<keyof WindowParams, "algorithm">;
+/** The parameters a person sets in the settings panel. */
+export type PanelParamName = keyof PanelParams;
+
+/** One row of the parameter table; `N` narrows its name. */
+export interface ParamSpec<N extends string = ParamName> {
   readonly name: N;
+  /** The simplifiers that have it. */
+  readonly algorithms: readonly ("angle" | "window")[];
+  /** Its name in the paper's appendix B.1, where it has one. */
+  readonly paper: string | null;
   readonly type: ParamType;
   readonly default: number | boolean;
   readonly minimum: number | null;
   readonly maximum: number | null;
+  readonly unit: string | null;
+  readonly label: string;
   readonly help: string;
+  readonly panel: PanelSection | null;
+  /** The values of the detail control, coarse to fine, for the parameter it sets. */
+  readonly detail_levels: readonly number[] | null;
+  /** Its name in plot legends. */
+  readonly short: string | null;
 }
 
-/** The parameters of `AngleParams` in the reference, snake_case as in every file that holds them. */
-export interface AngleParams {
-  /** Which simplifier these parameters are for (see `registry.ts`). */
-  readonly algorithm: "angle";
-  readonly check_frames: number;
-  readonly max_angle_deg: number;
-  readonly frame_max: number;
-  readonly fps: number;
-  readonly recover: boolean;
-  readonly clear_on_press: boolean;
-  readonly min_duration_ms: number;
-  readonly min_length: number;
-  readonly rows: number;
-  readonly columns: number;
-  readonly canvas_width_px: number;
-  readonly canvas_height_px: number;
-  readonly stretch: boolean;
+const SPECS_BY_NAME = new Map<string, ParamSpec>(PARAMETERS.map((spec) => [spec.name, spec]));
+
+/** The rows of these parameters, in this order. */
+export function specsOf<N extends ParamName>(names: readonly N[]): readonly ParamSpec<N>[] {
+  return names.map((name) => SPECS_BY_NAME.get(name) as ParamSpec<N>);
 }
 
-export type AngleParamName = Exclude<keyof AngleParams, "algorithm">;
+/** The angle simplifier's parameters, in the reference's order. */
+export const PARAM_SPECS: readonly ParamSpec<AngleParamName>[] = specsOf(ANGLE_PARAM_NAMES);
 
-/** The frame, drop and grid parameters every simplifier has, named as in every simplifier. */
-export type FrameAndGridName =
-  | "fps"
-  | "clear_on_press"
-  | "min_duration_ms"
-  | "min_length"
-  | "rows"
-  | "columns"
-  | "canvas_width_px"
-  | "canvas_height_px"
-  | "stretch";
-
-export const FPS_SPEC: ParamSpec<FrameAndGridName> = {
-  name: "fps",
-  type: "number",
-  default: 60,
-  minimum: 1,
-  maximum: 1000,
-  help: "frames per second of the drawing loop",
-};
-
-export type DropAndGridName = Exclude<FrameAndGridName, "fps">;
-
-/** The drop and grid settings every simplifier has, after its own (and `fps` for frames). */
-export const DROP_AND_GRID_SPECS: readonly ParamSpec<DropAndGridName>[] = [
-  {
-    name: "clear_on_press",
-    type: "boolean",
-    default: true,
-    minimum: null,
-    maximum: null,
-    help: "a new press clears the drawing",
-  },
-  {
-    name: "min_duration_ms",
-    type: "number",
-    default: 6.1,
-    minimum: 0,
-    maximum: 10000,
-    help: "shortest stroke to send, in ms",
-  },
-  {
-    name: "min_length",
-    type: "number",
-    default: 0.1,
-    minimum: 0,
-    maximum: 100,
-    help: "shortest stroke to send, in grid units",
-  },
-  { name: "rows", type: "integer", default: 3, minimum: 1, maximum: 64, help: "actuator rows of the sleeve" },
-  {
-    name: "columns",
-    type: "integer",
-    default: 4,
-    minimum: 1,
-    maximum: 64,
-    help: "actuator columns of the sleeve",
-  },
-  {
-    name: "canvas_width_px",
-    type: "number",
-    default: 1920,
-    minimum: 1,
-    maximum: 100000,
-    help: "drawing area width in pixels",
-  },
-  {
-    name: "canvas_height_px",
-    type: "number",
-    default: 1080,
-    minimum: 1,
-    maximum: 100000,
-    help: "drawing area height in pixels",
-  },
-  {
-    name: "stretch",
-    type: "boolean",
-    default: false,
-    minimum: null,
-    maximum: null,
-    help: "stretch the canvas onto the grid (the paper's)",
-  },
-];
+export function paramSpec(name: AngleParamName): ParamSpec<AngleParamName> {
+  const spec = PARAM_SPECS.find((candidate) => candidate.name === name);
+  if (spec === undefined) {
+    throw new Error(`the angle simplifier has no parameter '${name}'`);
+  }
+  return spec;
+}
 
 /** The defaults of a table, as a parameter object. */
 export function defaultsOf<P>(specs: readonly ParamSpec<string>[], algorithm: string): P {
@@ -128,54 +72,6 @@ export function defaultsOf<P>(specs: readonly ParamSpec<string>[], algorithm: st
     algorithm,
     ...Object.fromEntries(specs.map((spec) => [spec.name, spec.default])),
   }) as unknown as P;
-}
-
-/** Every parameter, in the reference's order. */
-export const PARAM_SPECS: readonly ParamSpec[] = [
-  {
-    name: "check_frames",
-    type: "integer",
-    default: 5,
-    minimum: 2,
-    maximum: 600,
-    help: "frames between two checks (the paper's checkFrame)",
-  },
-  {
-    name: "max_angle_deg",
-    type: "number",
-    default: 20,
-    minimum: 1,
-    maximum: 179,
-    help: "largest turn, in degrees, that continues a line",
-  },
-  {
-    name: "frame_max",
-    type: "integer",
-    default: 0,
-    minimum: 0,
-    maximum: 36000,
-    help: "longest line in frames; 0 = no limit",
-  },
-  FPS_SPEC,
-  {
-    name: "recover",
-    type: "boolean",
-    default: true,
-    minimum: null,
-    maximum: null,
-    help: "start a new line at the last check (no gaps)",
-  },
-  ...DROP_AND_GRID_SPECS,
-];
-
-const SPECS_BY_NAME = new Map(PARAM_SPECS.map((spec) => [spec.name, spec]));
-
-export function paramSpec(name: AngleParamName): ParamSpec {
-  const spec = SPECS_BY_NAME.get(name);
-  if (spec === undefined) {
-    throw new Error(`the angle simplifier has no parameter '${name}'`);
-  }
-  return spec;
 }
 
 /** The paper's defaults, as the reference writes them. */

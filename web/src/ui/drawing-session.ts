@@ -287,8 +287,8 @@ export class DrawingSession {
     if (this.#sampler.pressed || strokes <= 0) return this.#drawing?.strokeCount ?? 0;
     const settings = this.#host.settings();
     const { width_px: width, height_px: height } = this.#view.area;
-    // A zigzag between the top and bottom of the area: every corner turns far more than
-    // max_angle_deg (and strays far beyond max_error), so every leg becomes one stroke.
+    // A zigzag between the top and bottom of the area: every corner turns far more than the
+    // angle rule's max angle (and strays far beyond max_error), so every leg becomes one stroke.
     const vertex = (i: number): [number, number] => [
       width * (0.05 + 0.9 * ((i * 0.1373) % 1)),
       height * (i % 2 === 0 ? 0.1 : 0.9),

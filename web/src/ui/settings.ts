@@ -166,13 +166,10 @@ export class SettingsPanel {
       "span",
     );
     input.addEventListener("input", () => {
-      const values = detailValues(Number(input.value));
-      const set = (key: SettingKey, number: number) => {
-        const target = this.#inputs.get(key)?.[0];
+      for (const [key, number] of Object.entries(detailValues(Number(input.value)))) {
+        const target = this.#inputs.get(key as SettingKey)?.[0];
         if (target !== undefined) target.value = String(number);
-      };
-      set("max_error", values.max_error);
-      set("max_angle_deg", values.max_angle_deg);
+      }
       this.#validate();
     });
     this.#detail = input;

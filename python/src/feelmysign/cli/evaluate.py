@@ -2,7 +2,7 @@
 
     feelmysign evaluate --lasa                                # 210 real pen drawings
     feelmysign evaluate --lasa --algorithm angle --json       # a summary for programs
-    feelmysign evaluate a.json b.json --sweep max_angle_deg=10:40:5
+    feelmysign evaluate a.json b.json --sweep check_frames=3:9:2
     feelmysign evaluate --lasa --limit 14 --sweep max_error=0.05:0.5:0.05 --out /tmp/e
     feelmysign evaluate --lasa --speeds --defaults           # the figures behind the defaults
     feelmysign evaluate research/gestures --defaults         # recorded gestures at three speeds
@@ -11,7 +11,7 @@ Every recording (RECORDING files, folders of them, or the LASA handwriting data
 set with --lasa) is run through every chosen algorithm at every point of its parameter
 grid: the product of the --sweep values of its own parameters (NAME=FROM:TO:STEP,
 TO included; NAME=VALUE fixes one), its defaults otherwise. Without --sweep:
-angle max_angle_deg=10:40:10 x check_frames=5:15:5, window max_error=0.05:0.3:0.05.
+{default_sweeps}.
 --speeds adds LASA re-timed to three drawing speeds (slow 2.4 s, normal 1.2 s,
 fast 0.6 s a shape, sampled at 125 Hz); --defaults runs each algorithm once, at
 its defaults, instead of a grid.
@@ -67,7 +67,7 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "evaluate",
         help="measure simplifiers (error, strokes, lag) on recordings or LASA, with plots",
-        description=__doc__,
+        description=(__doc__ or "").replace("{default_sweeps}", _default_sweeps_text()),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
@@ -200,6 +200,11 @@ def _algorithms(text: str, parser: argparse.ArgumentParser) -> list[Algorithm]:
         what = f"unknown algorithm {', '.join(map(repr, unknown))}" if unknown else "no algorithm"
         parser.error(f"{what}; the algorithms available are: {available}")
     return [ALGORITHMS[name] for name in dict.fromkeys(names)]
+
+
+def _default_sweeps_text() -> str:
+    """The sweeps without --sweep, in a sentence: ``angle a=1:2:1 x b=3, window c=0.1:0.2:0.1``."""
+    return ", ".join(f"{a.name} {' x '.join(a.sweeps)}" for a in ALGORITHMS.values())
 
 
 def _runs(algorithms: list[Algorithm], texts: list[str], *, defaults: bool = False) -> list[Run]:

@@ -11,23 +11,27 @@ from typing import Any
 from feelmysign.cli._inputs import MAX_RECORDING_BYTES, check_input_file
 from feelmysign.simplify import (
     ALGORITHMS,
-    AngleParams,
     PathSegment,
-    WindowParams,
     load_recording,
     simplify_paths,
 )
+from feelmysign.simplify.params import ParamSpec
 from feelmysign.simplify.recording import Recording, RecordingError
 from feelmysign.simplify.registry import (
     DEFAULT_ALGORITHM,
     ONLY_FOR,
+    OWNERS,
     PAPER_ALGORITHM,
+    PARAMETERS,
     Params,
     algorithm_of,
 )
 
-DEFAULTS = AngleParams()
-WINDOW_DEFAULTS = WindowParams()
+# The parameters that change the strokes of a recording get an option: the simplifier's and
+# the grid's; the canvas is the recording's, and clearing on a press is the page's.
+CLI_PANELS = ("simplifier", "sleeve")
+# A number option's placeholder, by its unit.
+_METAVARS = {"ms": "MS", "°": "DEG", "grid units": "UNITS", "fps": "FPS", "px": "PX"}
 
 
 def register(subparsers: Any) -> None:
@@ -37,7 +41,9 @@ def register(subparsers: Any) -> None:
         description=(
             "Run a recording (JSON: canvas size and pointer samples per path; see "
             "docs/research.md) through a simplifier, exactly as the drawing client would, "
-            "and show the strokes it sends and the ones it drops."
+            "and show the strokes it sends and the ones it drops. An option not given takes "
+            "the recording's value (its simplifier's settings, its sleeve's grid), else its "
+            "default."
         ),
     )
     parser.add_argument("recording", metavar="RECORDING", help="a recording JSON file")
@@ -54,103 +60,49 @@ def register(subparsers: Any) -> None:
         help="the paper's settings: the angle simplifier at its appendix B.1 values "
         "(the same as --algorithm angle)",
     )
-    _option(
-        parser,
-        "--max-error",
-        float,
-        "E",
-        "window: farthest a drawn point may lie from its stroke, grid units",
-        WINDOW_DEFAULTS.max_error,
-    )
-    _option(
-        parser,
-        "--max-window",
-        int,
-        "N",
-        "window: longest stroke in samples after its start (bounds the work)",
-        WINDOW_DEFAULTS.max_window,
-    )
-    _option(
-        parser,
-        "--max-stroke-ms",
-        float,
-        "MS",
-        "window: longest stroke in ms of drawing, so a long line is felt before it ends; "
-        "0 = no limit",
-        WINDOW_DEFAULTS.max_stroke_ms,
-    )
-    _option(
-        parser, "--check-frames", int, "N", "angle: frames between checks", DEFAULTS.check_frames
-    )
-    _option(
-        parser,
-        "--max-angle-deg",
-        float,
-        "A",
-        "angle: largest turn that continues a line, degrees",
-        DEFAULTS.max_angle_deg,
-    )
-    _option(
-        parser,
-        "--frame-max",
-        int,
-        "N",
-        "angle: longest line in frames, 0 = no limit",
-        DEFAULTS.frame_max,
-    )
-    _option(
-        parser, "--fps", float, "F", "angle: frames per second of the drawing loop", DEFAULTS.fps
-    )
-    parser.add_argument(
-        "--no-recover",
-        dest="recover",
-        action="store_false",
-        default=None,
-        help="angle: start a new line at the pointer after a failed check, leaving gaps "
-        "(default: recover, start it at the last check)",
-    )
-    _option(
-        parser,
-        "--min-duration-ms",
-        float,
-        "D",
-        "shortest stroke sent, ms",
-        DEFAULTS.min_duration_ms,
-    )
-    _option(
-        parser, "--min-length", float, "L", "shortest stroke sent, grid units", DEFAULTS.min_length
-    )
-    _option(
-        parser,
-        "--rows",
-        int,
-        "R",
-        "actuator rows (default: the recording's sleeve, else",
-        DEFAULTS.rows,
-    )
-    _option(
-        parser,
-        "--columns",
-        int,
-        "C",
-        "actuator columns (default: the recording's sleeve, else",
-        DEFAULTS.columns,
-    )
-    parser.add_argument(
-        "--stretch",
-        action="store_true",
-        default=None,
-        help="stretch the canvas onto the grid as the paper did (default: keep the aspect ratio)",
-    )
+    for spec in PARAMETERS.values():
+        if spec.panel in CLI_PANELS:
+            _option(parser, spec)
     parser.add_argument("--json", action="store_true", help="print the strokes as JSON")
     parser.set_defaults(handler=functools.partial(run, parser=parser))
 
 
-def _option(
-    parser: argparse.ArgumentParser, flag: str, kind: type, metavar: str, text: str, default: object
-) -> None:
-    suffix = f" {default})" if text.endswith("else") else f" (default: {default})"
-    parser.add_argument(flag, type=kind, metavar=metavar, default=None, help=text + suffix)
+def option_flag(name: str) -> str:
+    """``min_length`` -> ``--min-length``."""
+    return "--" + name.replace("_", "-")
+
+
+def _option(parser: argparse.ArgumentParser, spec: ParamSpec) -> None:
+    """The option of one parameter, its help and range from its declaration; None when absent,
+    so the recording's value or the default applies."""
+    owners = OWNERS[spec.name]
+    prefix = f"{owners[0]}: " if len(owners) == 1 else ""
+    flag = option_flag(spec.name)
+    if spec.kind is bool:
+        default = "on" if spec.default else "off"
+        parser.add_argument(
+            flag,
+            action=argparse.BooleanOptionalAction,
+            default=None,
+            help=_escape(f"{prefix}{spec.help} (default: {default})"),
+        )
+        return
+    allowed = f"{_bound(spec.minimum)} to {_bound(spec.maximum)}"
+    parser.add_argument(
+        flag,
+        type=spec.kind,
+        metavar="N" if spec.kind is int else _METAVARS.get(spec.unit or "", "X"),
+        default=None,
+        help=_escape(f"{prefix}{spec.help} ({allowed}; default: {spec.default:g})"),
+    )
+
+
+def _bound(value: float | None) -> str:
+    return "unbounded" if value is None else f"{value:g}"
+
+
+def _escape(text: str) -> str:
+    return text.replace("%", "%%")
 
 
 def params_from_args(args: argparse.Namespace, recording: Recording) -> Params:
@@ -222,8 +174,9 @@ def _check_usage(
             f"--paper is the {PAPER_ALGORITHM} simplifier: drop --algorithm {args.algorithm}"
         )
     for name, owner in ONLY_FOR.items():
-        if owner != algorithm and getattr(args, name, None) is not None and parser:
-            flag = "--no-recover" if name == "recover" else "--" + name.replace("_", "-")
+        value = getattr(args, name, None)
+        if owner != algorithm and value is not None and parser:
+            flag = option_flag(name if value is not False else f"no_{name}")
             parser.error(f"{flag} only applies to --algorithm {owner}")
 
 
@@ -256,7 +209,7 @@ def describe(result: list[PathSegment], params: Params, source: str) -> str:
     sent = [r for r in result if r.segment.dropped is None]
     lines = [
         f"{source}: {len({r.path for r in result})} path(s) -> {len(sent)} stroke(s) sent, "
-        f"{len(result) - len(sent)} dropped ({_settings(params)}; "
+        f"{len(result) - len(sent)} dropped ({algorithm_of(params).describe(params)}; "
         f"{params.rows} x {params.columns} grid)",
         "",
         f"{'path':>4}  {'start':>15}  {'end':>15}  {'ms':>8}  {'emitted at':>10}  note",
@@ -269,18 +222,6 @@ def describe(result: list[PathSegment], params: Params, source: str) -> str:
             f"{s.emitted_at_ms:>10.1f}  {note}"
         )
     return "\n".join(lines)
-
-
-def _settings(params: Params) -> str:
-    if isinstance(params, WindowParams):
-        cap = f"{params.max_stroke_ms:g} ms" if params.max_stroke_ms else "no limit"
-        return (
-            f"window: max error {params.max_error:g} grid units, every sample, longest stroke {cap}"
-        )
-    return (
-        f"angle: check every {params.check_frames} frames, max {params.max_angle_deg:g} deg, "
-        f"{params.fps:g} fps"
-    )
 
 
 def _p(point: tuple[float, float]) -> str:

@@ -23,6 +23,7 @@ import matplotlib.ticker as ticker
 import numpy as np
 
 from feelmysign.research.evaluate import Row
+from feelmysign.research.sweep import SHORT_NAMES
 
 DPI = 120
 COLOURS = {"angle": "tab:blue", "window": "tab:orange"}
@@ -138,12 +139,11 @@ def _mean(values: Sequence[float]) -> float:
 
 
 def _short(setting: str) -> str:
-    """``max_angle_deg=20 check_frames=5`` -> ``angle 20, check 5`` style, to fit a plot."""
-    words = {"max_angle_deg": "deg", "check_frames": "chk", "max_error": "err", "frame_max": "fmax"}
+    """``check_frames=5 frame_max=60`` -> ``chk 5, fmax 60`` style, to fit a plot."""
     parts = []
     for item in setting.split():
         name, _, value = item.partition("=")
-        parts.append(f"{words.get(name, name)} {value}" if value else name)
+        parts.append(f"{SHORT_NAMES.get(name, name)} {value}" if value else name)
     return ", ".join(parts)
 
 

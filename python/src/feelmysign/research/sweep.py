@@ -15,15 +15,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from feelmysign.errors import FeelMySignError
-from feelmysign.simplify.registry import Algorithm
+from feelmysign.simplify.registry import ALGORITHMS, PAPER_ALGORITHM, PARAMETERS, Algorithm
 
-# Around the paper's defaults (check 5 frames, 20 degrees; window 0.1 grid units),
-# which are in every grid, and small enough for all 210 LASA demonstrations in a
-# minute or two.
-DEFAULT_SWEEPS: dict[str, tuple[str, ...]] = {
-    "angle": ("max_angle_deg=10:40:10", "check_frames=5:15:5"),
-    "window": ("max_error=0.05:0.3:0.05",),
-}
+# Each algorithm's own (see ``Algorithm.sweeps``).
+DEFAULT_SWEEPS: dict[str, tuple[str, ...]] = {a.name: a.sweeps for a in ALGORITHMS.values()}
+# The swept parameters as plots name them, to fit a legend.
+SHORT_NAMES: dict[str, str] = {s.name: s.short for s in PARAMETERS.values() if s.short}
 MAX_VALUES = 1000  # a typo in STEP should not start a week of work
 # Only decimal noise of FROM + k * STEP is rounded away.
 DIGITS = 9
@@ -44,7 +41,9 @@ def parse_sweep(text: str) -> Sweep:
     name, sep, spec = text.partition("=")
     name = name.strip().replace("-", "_")
     if not sep or not name:
-        raise SweepError(f"--sweep {text!r}: write NAME=FROM:TO:STEP, e.g. max_angle_deg=10:40:10")
+        raise SweepError(
+            f"--sweep {text!r}: write NAME=FROM:TO:STEP, e.g. {DEFAULT_SWEEPS[PAPER_ALGORITHM][0]}"
+        )
     parts = spec.split(":")
     try:
         numbers = [float(p) for p in parts]
@@ -91,5 +90,5 @@ def check_names(sweeps: Sequence[Sweep], algorithms: Sequence[Algorithm]) -> Non
 
 
 def label(overrides: dict[str, Any]) -> str:
-    """A short name for a parameter set: ``max_angle_deg=20 check_frames=5``, or ``defaults``."""
+    """A short name for a parameter set: ``check_frames=5 fps=60``, or ``defaults``."""
     return " ".join(f"{k}={v:g}" for k, v in overrides.items()) or "defaults"

@@ -28,48 +28,83 @@ import math
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
-from feelmysign.simplify.params import FRAME_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
+from feelmysign.simplify.params import ParamSpec, SharedParams, param, specs_of
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 
 # Movements shorter than this (pixels) have no direction.
 STILL_PX = 1e-9
 
-ANGLE_PARAMS: dict[str, ParamSpec] = {
-    s.name: s
-    for s in (
-        ParamSpec(
-            "check_frames", int, 2, 600, "frames between two checks (the paper's checkFrame)"
-        ),
-        ParamSpec(
-            "max_angle_deg", float, 1, 179, "largest turn, in degrees, that continues a line"
-        ),
-        ParamSpec("frame_max", int, 0, 36_000, "longest line in frames; 0 = no limit"),
-        ParamSpec("recover", bool, None, None, "start a new line at the last check (no gaps)"),
-        *FRAME_AND_GRID_SPECS,
+
+@dataclass(frozen=True)
+class _AngleOwn:
+    """The paper's own parameters of its algorithm (appendix B.1), with its defaults."""
+
+    check_frames: int = param(
+        5,
+        2,
+        600,
+        help="frames between two checks (the paper's checkFrame)",
+        label="Check frames",
+        unit="frames",
+        paper="checkFrame",
+        short="chk",
     )
-}
+    max_angle_deg: float = param(
+        20.0,
+        1,
+        179,
+        help="largest turn, in degrees, that continues a line",
+        label="Max angle",
+        unit="°",
+        paper="maxAngleDifDeg",
+        detail_levels=(60, 45, 30, 20, 12),
+        short="deg",
+    )
+    frame_max: int = param(
+        0,
+        0,
+        36_000,
+        help="longest line in frames; 0 = no limit",
+        label="Frame max",
+        unit="frames",
+        paper="frameMax",
+        short="fmax",
+    )
+    fps: float = param(
+        60.0,
+        1,
+        1000,
+        help="frames per second of the drawing loop",
+        label="Frames per second",
+        unit="fps",
+        paper="fps",
+    )
+    recover: bool = param(
+        True,
+        help="start a new line at the last check (no gaps)",
+        label="Recover",
+        paper="recover",
+    )
 
 
 @dataclass(frozen=True)
-class AngleParams(FrameAndGrid):
+class AngleParams(SharedParams, _AngleOwn):
     """The paper's parameters (appendix B.1) with its defaults, named with their units."""
 
-    check_frames: int = 5
-    max_angle_deg: float = 20.0
-    frame_max: int = 0
-    fps: float = 60.0
-    recover: bool = True
-    clear_on_press: bool = True
-    min_duration_ms: float = 6.1
-    min_length: float = 0.1
-    rows: int = 3
-    columns: int = 4
-    canvas_width_px: float = 1920.0
-    canvas_height_px: float = 1080.0
-    stretch: bool = False
 
-    def __post_init__(self) -> None:
-        check_all(self, ANGLE_PARAMS)
+ANGLE_PARAMS: dict[str, ParamSpec] = specs_of(AngleParams)
+
+# The grid ``feelmysign evaluate`` sweeps without --sweep: around the paper's defaults (check 5
+# frames, 20 degrees), small enough for all 210 LASA demonstrations in a minute or two.
+SWEEPS = ("max_angle_deg=10:40:10", "check_frames=5:15:5")
+
+
+def describe(params: AngleParams) -> str:
+    """The settings that shape the strokes, in a few words."""
+    return (
+        f"angle: check every {params.check_frames} frames, max {params.max_angle_deg:g} deg, "
+        f"{params.fps:g} fps"
+    )
 
 
 @dataclass

@@ -1,26 +1,62 @@
-"""Parameters of the simplifiers: defaults, allowed ranges, units, help — one table.
+"""Parameters of the simplifiers, each declared once: default, allowed range, unit, help, label.
 
-The same table is written to ``testdata/angle/params.json`` so that the
-browser's settings panel validates with exactly these ranges.
+A parameter is a field of its simplifier's parameter dataclass, declared with
+``param`` (its default, range, unit, help, the paper's name for it, and where
+the page's settings panel shows it). The parameters every simplifier has (the
+canvas, the sleeve's grid, the shortest stroke to send) are the fields of
+``SharedParams``, declared here once; each simplifier declares its own beside
+its code (``angle.py``, ``window.py``). ``specs_of`` reads the declarations
+back as ``ParamSpec`` rows, and everything else is derived from them:
+
+- every parameter dataclass checks its values against them (``check_all``);
+- ``feelmysign simplify`` builds its options, help and ranges from them;
+- ``testdata/generate.py`` writes them as the language-neutral table
+  ``testdata/params/params.json`` (the clients in other languages read it), as
+  each simplifier's ``testdata/<algorithm>/params.json``, and as the page's
+  types and settings rows, ``web/src/simplify/params.generated.ts``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
-from typing import Any
+import typing
+from dataclasses import dataclass, field, fields
+from typing import Any, Literal, TypeVar
 
 from feelmysign.errors import ParameterError
 from feelmysign.simplify.mapping import CanvasMapping
 
+# Where the page's settings panel shows a parameter: "drawing" (how the page treats a
+# drawing, not how it is cut), "simplifier" (how it is cut), "sleeve" (the grid); None: the
+# page sets it itself (the canvas is the drawing area).
+Panel = Literal["drawing", "simplifier", "sleeve"]
+
+_KINDS: dict[type, str] = {bool: "boolean", int: "integer", float: "number"}
+_DECLARATION = "feelmysign.param"
+
+T = TypeVar("T", bool, int, float)
+
 
 @dataclass(frozen=True)
 class ParamSpec:
+    """One parameter: its name, type, default, allowed range and how people see it."""
+
     name: str
     kind: type
+    default: bool | int | float
     minimum: float | None
     maximum: float | None
     help: str
+    # What a person reads: the settings panel's label, and the unit after a value.
+    label: str
+    unit: str | None = None
+    # Its name in the paper's appendix B.1 (its sleeveX and sleeveY count from 0).
+    paper: str | None = None
+    panel: Panel | None = "simplifier"
+    # The values of the page's one "detail" control, coarse to fine, for the parameter it sets.
+    detail_levels: tuple[float, ...] = ()
+    # A few letters for plot legends (``feelmysign evaluate``), where the name is too long.
+    short: str | None = None
 
     def check(self, value: Any) -> None:
         if self.kind is bool:
@@ -42,14 +78,38 @@ class ParamSpec:
     def range_text(self) -> str:
         return f"[{_fmt(self.minimum)}, {_fmt(self.maximum)}]"
 
-    def to_json(self, default: Any) -> dict[str, Any]:
+    @property
+    def type_name(self) -> str:
+        """``boolean``, ``integer`` or ``number``: the type as the JSON tables name it."""
+        return _KINDS[self.kind]
+
+    def to_json(self) -> dict[str, Any]:
+        """The row of one simplifier's table (``testdata/<algorithm>/params.json``)."""
         return {
             "name": self.name,
-            "type": {bool: "boolean", int: "integer", float: "number"}[self.kind],
-            "default": default,
+            "type": self.type_name,
+            "default": self.default,
             "minimum": self.minimum,
             "maximum": self.maximum,
             "help": self.help,
+        }
+
+    def to_table(self, algorithms: list[str]) -> dict[str, Any]:
+        """The row of the language-neutral table (``testdata/params/params.json``)."""
+        return {
+            "name": self.name,
+            "algorithms": algorithms,
+            "paper": self.paper,
+            "type": self.type_name,
+            "default": self.default,
+            "minimum": self.minimum,
+            "maximum": self.maximum,
+            "unit": self.unit,
+            "label": self.label,
+            "help": self.help,
+            "panel": self.panel,
+            "detail_levels": list(self.detail_levels) or None,
+            "short": self.short,
         }
 
 
@@ -57,41 +117,163 @@ def _fmt(bound: float | None) -> str:
     return "unbounded" if bound is None else f"{bound:g}"
 
 
-def check_all(params: object, specs: dict[str, ParamSpec]) -> None:
+@dataclass(frozen=True)
+class _Declaration:
+    """What ``param`` keeps of a field; its name and type are the field's own."""
+
+    minimum: float | None
+    maximum: float | None
+    help: str
+    label: str
+    unit: str | None
+    paper: str | None
+    panel: Panel | None
+    detail_levels: tuple[float, ...]
+    short: str | None
+
+
+def param(
+    default: T,
+    minimum: float | None = None,
+    maximum: float | None = None,
+    *,
+    help: str,
+    label: str,
+    unit: str | None = None,
+    paper: str | None = None,
+    panel: Panel | None = "simplifier",
+    detail_levels: tuple[float, ...] = (),
+    short: str | None = None,
+) -> T:
+    """A parameter field with its default and its declaration (read back by ``specs_of``)."""
+    declaration = _Declaration(
+        minimum, maximum, help, label, unit, paper, panel, detail_levels, short
+    )
+    # field() is typed as the default's type, so the dataclass field keeps its own type.
+    return field(default=default, metadata={_DECLARATION: declaration})
+
+
+_SPECS: dict[type, dict[str, ParamSpec]] = {}
+
+
+def specs_of(params_class: type) -> dict[str, ParamSpec]:
+    """The parameters of a parameter dataclass, by name, in its field order."""
+    if params_class not in _SPECS:
+        _SPECS[params_class] = _read_specs(params_class)
+    return _SPECS[params_class]
+
+
+def _read_specs(params_class: type) -> dict[str, ParamSpec]:
+    hints = typing.get_type_hints(params_class)
+    specs: dict[str, ParamSpec] = {}
+    for item in fields(params_class):
+        declared: _Declaration = item.metadata[_DECLARATION]
+        kind = hints[item.name]
+        # Exactly the field's type: a default of 20 for a float would be written as 20, not 20.0.
+        if not isinstance(item.default, (bool, int, float)) or type(item.default) is not kind:
+            raise TypeError(f"{params_class.__name__}.{item.name}: the default is not a {kind}")
+        specs[item.name] = ParamSpec(
+            item.name,
+            kind,
+            item.default,
+            declared.minimum,
+            declared.maximum,
+            declared.help,
+            declared.label,
+            declared.unit,
+            declared.paper,
+            declared.panel,
+            declared.detail_levels,
+            declared.short,
+        )
+    return specs
+
+
+def check_all(params: object) -> None:
     """Raise ParameterError for the first field of a params dataclass outside its range."""
-    for field in fields(params):  # type: ignore[arg-type]
-        specs[field.name].check(getattr(params, field.name))
+    for spec in specs_of(type(params)).values():
+        spec.check(getattr(params, spec.name))
 
 
-# The drop and grid settings every simplifier has (beside its own).
-DROP_AND_GRID_SPECS = (
-    ParamSpec("clear_on_press", bool, None, None, "a new press clears the drawing"),
-    ParamSpec("min_duration_ms", float, 0, 10_000, "shortest stroke to send, in ms"),
-    ParamSpec("min_length", float, 0, 100, "shortest stroke to send, in grid units"),
-    ParamSpec("rows", int, 1, 64, "actuator rows of the sleeve"),
-    ParamSpec("columns", int, 1, 64, "actuator columns of the sleeve"),
-    ParamSpec("canvas_width_px", float, 1, 100_000, "drawing area width in pixels"),
-    ParamSpec("canvas_height_px", float, 1, 100_000, "drawing area height in pixels"),
-    ParamSpec("stretch", bool, None, None, "stretch the canvas onto the grid (the paper's)"),
-)
-# A simplifier that sees animation frames has their rate too.
-FRAME_AND_GRID_SPECS = (
-    ParamSpec("fps", float, 1, 1000, "frames per second of the drawing loop"),
-    *DROP_AND_GRID_SPECS,
-)
+@dataclass(frozen=True)
+class SharedParams:
+    """The parameters every simplifier has: which strokes it drops, the grid and the canvas.
 
+    A simplifier's parameters are ``class XParams(SharedParams, XOwn)``: a dataclass
+    lists the fields of its last base first, so its own parameters come first and these
+    after them, the order of every table and vector. The defaults are the paper's
+    (appendix B.1).
+    """
 
-class FrameAndGrid:
-    """The canvas-to-grid mapping of a simplifier's parameters (their grid and canvas fields)."""
+    clear_on_press: bool = param(
+        True,
+        help="a new press clears the drawing",
+        label="Clear on press",
+        paper="clickClear",
+        panel="drawing",
+    )
+    min_duration_ms: float = param(
+        6.1,
+        0,
+        10_000,
+        help="shortest stroke to send, in ms",
+        label="Min duration",
+        unit="ms",
+        paper="minimumDuration",
+    )
+    min_length: float = param(
+        0.1,
+        0,
+        100,
+        help="shortest stroke to send, in grid units",
+        label="Min length",
+        unit="grid units",
+        paper="minimumSize",
+    )
+    rows: int = param(
+        3, 1, 64, help="actuator rows of the sleeve", label="Rows", paper="sleeveY", panel="sleeve"
+    )
+    columns: int = param(
+        4,
+        1,
+        64,
+        help="actuator columns of the sleeve",
+        label="Columns",
+        paper="sleeveX",
+        panel="sleeve",
+    )
+    canvas_width_px: float = param(
+        1920.0,
+        1,
+        100_000,
+        help="drawing area width in pixels",
+        label="Canvas width",
+        unit="px",
+        paper="screenX",
+        panel=None,
+    )
+    canvas_height_px: float = param(
+        1080.0,
+        1,
+        100_000,
+        help="drawing area height in pixels",
+        label="Canvas height",
+        unit="px",
+        paper="screenY",
+        panel=None,
+    )
+    stretch: bool = param(
+        False,
+        help="stretch the canvas onto the grid (the paper's)",
+        label="Stretch to the grid",
+    )
 
-    rows: int
-    columns: int
-    canvas_width_px: float
-    canvas_height_px: float
-    stretch: bool
+    def __post_init__(self) -> None:
+        check_all(self)
 
     @property
     def mapping(self) -> CanvasMapping:
+        """The canvas-to-grid mapping of these parameters (their grid and canvas fields)."""
         return CanvasMapping(
             self.canvas_width_px, self.canvas_height_px, self.columns, self.rows, self.stretch
         )

@@ -2,8 +2,9 @@
 
 ``ALGORITHMS`` is the registry every caller (CLI, vectors, research tools)
 chooses from by name: each algorithm's parameter class, its streaming
-simplifier and its parameter table. ``ONLY_FOR`` follows from the tables: the
-parameters that only one algorithm has (giving one to the other is an error).
+simplifier and its parameter table. ``PARAMETERS``, ``OWNERS`` and ``ONLY_FOR``
+follow from the tables: every parameter once, the algorithms that have it, and
+the parameters that only one algorithm has (giving one to the other is an error).
 """
 
 from __future__ import annotations
@@ -13,10 +14,14 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from feelmysign.simplify.angle import ANGLE_PARAMS, AngleParams, AngleSimplifier
+from feelmysign.simplify.angle import SWEEPS as ANGLE_SWEEPS
+from feelmysign.simplify.angle import describe as describe_angle
 from feelmysign.simplify.frames import frames_from_samples
 from feelmysign.simplify.params import ParamSpec
 from feelmysign.simplify.segment import Sample, Segment
+from feelmysign.simplify.window import SWEEPS as WINDOW_SWEEPS
 from feelmysign.simplify.window import WINDOW_PARAMS, WindowParams, WindowSimplifier
+from feelmysign.simplify.window import describe as describe_window
 
 Params = AngleParams | WindowParams
 
@@ -41,6 +46,10 @@ class Algorithm:
     specs: dict[str, ParamSpec]
     summary: str
     input: str
+    # The settings that shape the strokes, in a few words (``feelmysign simplify``'s summary).
+    describe: Callable[[Any], str]
+    # The parameter grid ``feelmysign evaluate`` sweeps without --sweep (NAME=FROM:TO:STEP).
+    sweeps: tuple[str, ...]
 
     def inputs(self, params: Any, samples: Sequence[Sample]) -> list[Sample]:
         """What this simplifier is fed for one path drawn as ``samples``."""
@@ -57,6 +66,8 @@ ALGORITHMS: dict[str, Algorithm] = {
         ANGLE_PARAMS,
         "the paper's turn-angle rule",
         "frames",
+        describe_angle,
+        ANGLE_SWEEPS,
     ),
     "window": Algorithm(
         "window",
@@ -65,24 +76,43 @@ ALGORITHMS: dict[str, Algorithm] = {
         WINDOW_PARAMS,
         "error-bounded, cut at features",
         "samples",
+        describe_window,
+        WINDOW_SWEEPS,
     ),
 }
-
-
-def _only_for() -> dict[str, str]:
-    owners: dict[str, list[str]] = {}
-    for algorithm in ALGORITHMS.values():
-        for name in algorithm.specs:
-            owners.setdefault(name, []).append(algorithm.name)
-    return {name: names[0] for name, names in owners.items() if len(names) == 1}
 
 
 # The project's choice (see docs/research.md, "Default settings"), and the paper's.
 DEFAULT_ALGORITHM = "window"
 PAPER_ALGORITHM = "angle"
 
+
+def _owners() -> dict[str, list[str]]:
+    """Every parameter -> the algorithms that have it: the default algorithm's own first, then
+    the others' own, then the shared ones (the order of the CLI's options and the page's panel).
+    """
+    order = [DEFAULT_ALGORITHM, *(name for name in ALGORITHMS if name != DEFAULT_ALGORITHM)]
+    owners: dict[str, list[str]] = {}
+    for algorithm in (ALGORITHMS[name] for name in order):
+        for name in algorithm.specs:
+            owners.setdefault(name, [])
+    for algorithm in ALGORITHMS.values():
+        for name in algorithm.specs:
+            owners[name].append(algorithm.name)
+    shared = [name for name, names in owners.items() if len(names) > 1]
+    return {name: owners[name] for name in [*(n for n in owners if n not in shared), *shared]}
+
+
+# Parameter name -> the algorithms that have it, in the order above.
+OWNERS: dict[str, list[str]] = _owners()
+
+# Every parameter of every algorithm, by name, in the order above.
+PARAMETERS: dict[str, ParamSpec] = {
+    name: ALGORITHMS[names[0]].specs[name] for name, names in OWNERS.items()
+}
+
 # Parameter name -> the one algorithm that has it.
-ONLY_FOR: dict[str, str] = _only_for()
+ONLY_FOR: dict[str, str] = {name: names[0] for name, names in OWNERS.items() if len(names) == 1}
 
 
 def algorithm_of(params: Params) -> Algorithm:

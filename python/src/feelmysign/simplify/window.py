@@ -58,7 +58,7 @@ import math
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
-from feelmysign.simplify.params import DROP_AND_GRID_SPECS, FrameAndGrid, ParamSpec, check_all
+from feelmysign.simplify.params import ParamSpec, SharedParams, param, specs_of
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.stroke import Point
 
@@ -79,38 +79,10 @@ LINE_SHARE = 0.25
 # compute above it.
 ROUNDING_SLACK = 1e-9
 
-WINDOW_PARAMS: dict[str, ParamSpec] = {
-    s.name: s
-    for s in (
-        ParamSpec(
-            "max_error",
-            float,
-            0.001,
-            100,
-            "farthest a drawn point may lie from its stroke, in grid units",
-        ),
-        ParamSpec(
-            "max_window",
-            int,
-            1,
-            10_000,
-            "longest stroke in samples after its start (bounds the work per sample)",
-        ),
-        ParamSpec(
-            "max_stroke_ms",
-            float,
-            0,
-            60_000,
-            "longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
-        ),
-        *DROP_AND_GRID_SPECS,
-    )
-}
-
 
 @dataclass(frozen=True)
-class WindowParams(FrameAndGrid):
-    """The error bound, the caps, then the same drop and grid settings as angle.
+class _WindowOwn:
+    """The error bound and the caps.
 
     The defaults are the project's (docs/research.md, "Default settings"):
     ``max_error`` 0.25 grid units is 7.5 mm on the paper's sleeve (3 cm
@@ -119,20 +91,50 @@ class WindowParams(FrameAndGrid):
     second of the pen.
     """
 
-    max_error: float = 0.25
-    max_window: int = 256
-    max_stroke_ms: float = 300.0
-    clear_on_press: bool = True
-    min_duration_ms: float = 6.1
-    min_length: float = 0.1
-    rows: int = 3
-    columns: int = 4
-    canvas_width_px: float = 1920.0
-    canvas_height_px: float = 1080.0
-    stretch: bool = False
+    max_error: float = param(
+        0.25,
+        0.001,
+        100,
+        help="farthest a drawn point may lie from its stroke, in grid units",
+        label="Max error",
+        unit="grid units",
+        detail_levels=(0.4, 0.25, 0.15, 0.1, 0.05),
+        short="err",
+    )
+    max_window: int = param(
+        256,
+        1,
+        10_000,
+        help="longest stroke in samples after its start (bounds the work per sample)",
+        label="Window cap",
+        unit="samples",
+    )
+    max_stroke_ms: float = param(
+        300.0,
+        0,
+        60_000,
+        help="longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
+        label="Longest stroke",
+        unit="ms",
+    )
 
-    def __post_init__(self) -> None:
-        check_all(self, WINDOW_PARAMS)
+
+@dataclass(frozen=True)
+class WindowParams(SharedParams, _WindowOwn):
+    """The error bound, the caps, then the same drop and grid settings as angle."""
+
+
+WINDOW_PARAMS: dict[str, ParamSpec] = specs_of(WindowParams)
+
+# The grid ``feelmysign evaluate`` sweeps without --sweep: around 0.1 grid units, small enough
+# for all 210 LASA demonstrations in a minute or two.
+SWEEPS = ("max_error=0.05:0.3:0.05",)
+
+
+def describe(params: WindowParams) -> str:
+    """The settings that shape the strokes, in a few words."""
+    cap = f"{params.max_stroke_ms:g} ms" if params.max_stroke_ms else "no limit"
+    return f"window: max error {params.max_error:g} grid units, every sample, longest stroke {cap}"
 
 
 @dataclass
