@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pytest
 
-from feelmysign.cli._drawing_log import LEGACY_DRAWING, DrawingSummaries
 from feelmysign.events import Adjusted, Cancelled, Played, Rejected, Safety
+from feelmysign.services.drawing_log import LEGACY_DRAWING, DrawingSummaries
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
 # The import names of python/pyproject.toml's [research] extra, which 'make up' leaves out.
