@@ -429,6 +429,9 @@ class Sleeve:
             return
         result = parse(payload, self._layout, format="legacy" if legacy else "json")
         if not isinstance(result, Accepted):
+            # Named when its drawing and seq could be read: its sender finds which stroke it was.
+            named = (("drawing", result.drawing), ("seq", result.seq))
+            info.update({k: v for k, v in named if v is not None})
             self._reject(result.reason, result.message, info, received_wall_ms, ack)
             return
         stroke = result.stroke

@@ -12,8 +12,11 @@ waited at the broker or on the way, the sleeve offline or the network slow.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
 of the strokes queued before it) to its first motor: the sleeve's own lateness,
-not the wait behind a drawing sent all at once. Strokes without a drawing id
-(the legacy text format) count as one drawing per quiet spell. The summary is
+not the wait behind a drawing sent all at once. A stroke cut short by a stop
+was played: it counts once, as played (and cut short). A stroke the duty-cycle
+cap kept from playing counts as rejected (``duty_cycle``), like any refusal.
+Strokes without a drawing id (the legacy text format, JSON that leaves it out,
+a message the sleeve could not read) count as one drawing per quiet spell. The summary is
 built by ``DrawingSummaries`` (pure: events and a clock in, lines out);
 ``DrawingLog`` is its MQTT listener.
 """
@@ -36,6 +39,7 @@ from feelmysign.events import (
     EventError,
     Played,
     Rejected,
+    Safety,
     event_from_json,
 )
 from feelmysign.topics import telemetry_topic
@@ -45,7 +49,7 @@ if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign
 
 QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted and put down
 CHECK_INTERVAL_S = 0.25
-LEGACY_DRAWING = "Legacy strokes"
+NO_DRAWING = "Strokes without a drawing id"
 SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one session
 # Felt this long after it was sent (less its wait behind other strokes), a stroke is late: the
 # page's rule too (web/src/ui/sleeve-says.ts, LATE_MS).
@@ -57,16 +61,19 @@ class _Drawing:
     last_event_s: float
     played: int = 0
     slowed: int = 0
-    cancelled: int = 0
+    cut_short: int = 0  # played, then stopped by a control message: counted in played only
+    cancelled: int = 0  # dropped by a control message before it played
     rejected: Counter[str] = field(default_factory=Counter)
     delays_ms: list[float] = field(default_factory=list)
     late_ms: list[float] = field(default_factory=list)
 
     def line(self, name: str) -> str:
-        shown = name if name == LEGACY_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
+        shown = name if name == NO_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
         parts = [f"{self.played} stroke{'s' if self.played != 1 else ''} played"]
-        if self.slowed:
-            parts[0] += f" ({self.slowed} slowed to be felt)"
+        notes = [f"{self.slowed} slowed to be felt"] if self.slowed else []
+        notes += [f"{self.cut_short} cut short"] if self.cut_short else []
+        if notes:
+            parts[0] += f" ({', '.join(notes)})"
         if self.late_ms:
             parts.append(f"{len(self.late_ms)} played late (by {_seconds(max(self.late_ms))}")
             parts[-1] += " at most)" if len(self.late_ms) > 1 else ")"
@@ -97,9 +104,11 @@ class DrawingSummaries:
         self._drawings: dict[str, _Drawing] = {}
 
     def add(self, event: Event, now_s: float) -> None:
-        if not isinstance(event, Played | Rejected | Cancelled):
-            return  # safety and error events are logged by the sleeve itself
-        name = event.drawing or LEGACY_DRAWING
+        if isinstance(event, Safety) and event.received_at_ms is None:
+            return  # a motor protected outside any stroke (off_failed): the sleeve logs it
+        if not isinstance(event, Played | Rejected | Cancelled | Safety):
+            return  # error events are logged by the sleeve itself
+        name = event.drawing or NO_DRAWING
         drawing = self._drawings.setdefault(name, _Drawing(now_s))
         drawing.last_event_s = now_s
         if isinstance(event, Played):
@@ -110,8 +119,10 @@ class DrawingSummaries:
                 late_ms = event.first_command_at_ms - event.sent_at_ms - event.queued_ms
                 if late_ms > LATE_MS:
                     drawing.late_ms.append(late_ms)
-        elif isinstance(event, Rejected):
+        elif isinstance(event, Rejected | Safety):  # Safety here: a stroke the cap refused
             drawing.rejected[event.reason] += 1
+        elif event.started:  # its played event counted it already
+            drawing.cut_short += 1
         else:
             drawing.cancelled += 1
 
