@@ -92,14 +92,14 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     assert summaries.finished(2.1, all_of_them=True) == [
         f"{NO_DRAWING}: 1 stroke played, 1 cancelled; start delay median 1 ms, max 1 ms"
     ]
-    # Felt 1.6 s and 0.7 s after they were sent (none of it behind other strokes): late; felt
-    # 2 s after it was sent, 1.9 s of that behind the strokes before it: not late.
+    # Felt 1.6 s and 0.7 s after they were sent (none of it behind other strokes): delayed; felt
+    # 2 s after it was sent, 1.9 s of that behind the strokes before it: not delayed.
     late = "bbbbbbbb-2222"
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 1600.0), now_s=3.0)
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 700.0), now_s=3.0)
     summaries.add(_played(late, 1903.0, 1900.0, sent_at_ms=2903.0 - 2000.0), now_s=3.0)
     assert summaries.finished(4.6) == [
-        "Drawing bbbbbbbb: 3 strokes played, 2 played late (by 1.6 s at most); "
+        "Drawing bbbbbbbb: 3 strokes played, 2 delayed on the way (by 1.6 s at most); "
         "start delay median 3 ms, max 3 ms"
     ]
     assert summaries.finished(100.0, all_of_them=True) == []

@@ -3,12 +3,14 @@
 ``up`` listens on ``feelmysign/<id>/events`` like any page does (with the
 sender's account) and, once a drawing has been quiet for ``QUIET_S``, prints::
 
-    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 played late (by 1.6 s),
-    1 rejected (outside_grid); start delay median 3 ms, max 9 ms        (on one line)
+    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 delayed on the way
+    (by 1.6 s), 1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
 
-A stroke played late was felt more than ``LATE_MS`` after its sender sent it, not
-counting its wait behind the strokes before it (the page marks the same ones): it
-waited at the broker or on the way, the sleeve offline or the network slow.
+A stroke delayed on the way was felt more than ``events.DELAYED_MS`` after its
+sender sent it, not counting its wait behind the strokes before it
+(``events.is_delayed``; the page marks the same ones): it waited at the broker or
+on the way, the sleeve offline or the network slow. It was played; a stroke the
+sleeve skipped for being too far behind is a ``late`` refusal, under rejected.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
 of the strokes queued before it) to its first motor: the sleeve's own lateness,
@@ -40,7 +42,9 @@ from feelmysign.events import (
     Played,
     Rejected,
     Safety,
+    delivery_delay_ms,
     event_from_json,
+    is_delayed,
 )
 from feelmysign.topics import telemetry_topic
 
@@ -51,9 +55,6 @@ QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted
 CHECK_INTERVAL_S = 0.25
 NO_DRAWING = "Strokes without a drawing id"
 SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one session
-# Felt this long after it was sent (less its wait behind other strokes), a stroke is late: the
-# page's rule too (web/src/ui/sleeve-says.ts, LATE_MS).
-LATE_MS = 500.0
 
 
 @dataclass
@@ -65,7 +66,7 @@ class _Drawing:
     cancelled: int = 0  # dropped by a control message before it played
     rejected: Counter[str] = field(default_factory=Counter)
     delays_ms: list[float] = field(default_factory=list)
-    late_ms: list[float] = field(default_factory=list)
+    delays_on_the_way_ms: list[float] = field(default_factory=list)  # of the delayed ones
 
     def line(self, name: str) -> str:
         shown = name if name == NO_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
@@ -74,9 +75,9 @@ class _Drawing:
         notes += [f"{self.cut_short} cut short"] if self.cut_short else []
         if notes:
             parts[0] += f" ({', '.join(notes)})"
-        if self.late_ms:
-            parts.append(f"{len(self.late_ms)} played late (by {_seconds(max(self.late_ms))}")
-            parts[-1] += " at most)" if len(self.late_ms) > 1 else ")"
+        if delayed := self.delays_on_the_way_ms:
+            parts.append(f"{len(delayed)} delayed on the way (by {_seconds(max(delayed))}")
+            parts[-1] += " at most)" if len(delayed) > 1 else ")"
         if self.rejected:
             reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in self.rejected.items())
             parts.append(f"{sum(self.rejected.values())} rejected ({reasons})")
@@ -115,10 +116,9 @@ class DrawingSummaries:
             drawing.played += 1
             drawing.slowed += isinstance(event, Adjusted)
             drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
-            if event.sent_at_ms is not None:
-                late_ms = event.first_command_at_ms - event.sent_at_ms - event.queued_ms
-                if late_ms > LATE_MS:
-                    drawing.late_ms.append(late_ms)
+            delay_ms = delivery_delay_ms(event)
+            if delay_ms is not None and is_delayed(event):
+                drawing.delays_on_the_way_ms.append(delay_ms)
         elif isinstance(event, Rejected | Safety):  # Safety here: a stroke the cap refused
             drawing.rejected[event.reason] += 1
         elif event.started:  # its played event counted it already
