@@ -148,7 +148,7 @@ describe("drawing with a mouse on a desktop", () => {
     await screenshot(page, "desktop-after");
   });
 
-  it("keeps adjustments under 5% quiet, names a larger one, and marks a late stroke with how late", async () => {
+  it("keeps adjustments under 5% quiet, names a larger one, and marks a stroke delayed on its way with by how much", async () => {
     const drawing = stroke0Drawing(sleeve.strokes());
     const before = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-played"));
     const now = Date.now();
