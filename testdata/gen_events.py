@@ -6,6 +6,10 @@
 - ``status/<name>.json``: the same for the retained status;
 - ``invalid/<name>.json``: ``kind`` (``event`` or ``status``) and a ``wire`` value that
   is not one, with the ``field`` at fault (``null`` when it is the whole message).
+- ``delay/<name>.json``: a played or adjusted event's ``wire``, its ``delay_ms`` (sent ->
+  first motor command, less its wait behind the strokes before it; ``null`` without a
+  ``sent_at_ms``) and whether it was ``delayed`` (``events.DELAYED_MS``, kept as
+  ``delayed_ms``): the page marks the same strokes as the terminal of ``feelmysign up``.
 
 Every expected value is computed here by feelmysign.events; a case that the
 reference reads differently from what it is meant to show stops generation.
@@ -16,7 +20,15 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from feelmysign.events import EventError, Status, event_from_json
+from feelmysign.events import (
+    DELAYED_MS,
+    EventError,
+    Played,
+    Status,
+    delivery_delay_ms,
+    event_from_json,
+    is_delayed,
+)
 
 TIMING = {
     "received_at_ms": 1795326267664.25,
@@ -262,6 +274,46 @@ INVALID: dict[str, tuple[str, str, Any]] = {
 }
 
 
+SENT_MS = 1795326267000.0
+
+
+def _delay_case(first_after_sent_ms: float, queued_ms: float, **extra: Any) -> dict[str, Any]:
+    """A played event felt ``first_after_sent_ms`` after it was sent, ``queued_ms`` of it in
+    the queue behind the strokes before it."""
+    first_ms = SENT_MS + first_after_sent_ms
+    timing = {**TIMING, "queued_ms": queued_ms, "first_command_at_ms": first_ms}
+    return {"type": "played", **STROKE, "sent_at_ms": SENT_MS, **timing, **extra}
+
+
+# Delivery delays, around DELAYED_MS (500 ms): what the page and 'up' mark as delayed.
+DELAYS: dict[str, tuple[str, dict[str, Any]]] = {
+    "on-time": ("felt 64.5 ms after it was sent: not delayed", _delay_case(64.5, 0)),
+    "delayed": ("felt 1.6 s after it was sent, none of it queued", _delay_case(1600.25, 0)),
+    "queued-not-delayed": (
+        "felt 2 s after it was sent, 1.9 s of it behind the strokes before it: not delayed",
+        _delay_case(2000.0, 1900.0),
+    ),
+    "queued-and-delayed": (
+        "felt 2.7 s after it was sent, 1.9 s of it queued: delayed by 0.8 s",
+        _delay_case(2700.5, 1900.25),
+    ),
+    "at-the-threshold": ("a delay of exactly 500 ms is not delayed", _delay_case(500.0, 0)),
+    "just-above": ("a delay of 500.25 ms is delayed", _delay_case(500.25, 0)),
+    "sender-clock-ahead": (
+        "the sender's clock runs ahead of the sleeve's: a negative delay, not delayed",
+        _delay_case(-250.0, 0),
+    ),
+    "no-sent-at": (
+        "a stroke without sent_at_ms has no delivery delay",
+        {"type": "played", "topic": "deviceOne/line", **TIMING},
+    ),
+    "adjusted-delayed": (
+        "an adjusted stroke is delayed by the same rule",
+        _delay_case(900.0, 100.0, type="adjusted", reason="too_fast", requested_duration_ms=50),
+    ),
+}
+
+
 def _typed(value: Any) -> dict[str, Any]:
     return dataclasses.asdict(value)
 
@@ -285,6 +337,16 @@ def cases() -> dict[str, dict[str, Any]]:
             "wire": wire,
             "typed": _typed(status),
             "json": status.to_json(),
+        }
+    for name, (description, wire) in DELAYS.items():
+        played = event_from_json(wire)
+        assert isinstance(played, Played), name
+        out[f"delay/{name}.json"] = {
+            "description": description,
+            "wire": wire,
+            "delayed_ms": DELAYED_MS,
+            "delay_ms": delivery_delay_ms(played),
+            "delayed": is_delayed(played),
         }
     for name, (kind, description, wire) in INVALID.items():
         try:

@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from feelmysign.cli._lan_options import default_route_address
+from feelmysign.cli.options.lan import default_route_address
 from feelmysign.errors import BrokerError
 
 

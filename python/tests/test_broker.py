@@ -32,9 +32,15 @@ import pytest
 from paho.mqtt.enums import CallbackAPIVersion
 from paho.mqtt.reasoncodes import ReasonCode
 
-from feelmysign.broker import Account, Broker, BrokerError, Credentials, load_credentials
-from feelmysign.broker._config import hash_password
-from feelmysign.broker._process import find_mosquitto
+from feelmysign.broker import (
+    Account,
+    Broker,
+    BrokerError,
+    Credentials,
+    find_mosquitto,
+    hash_password,
+    load_credentials,
+)
 from feelmysign.broker.credentials import new_password
 from feelmysign.connection import probe_login
 

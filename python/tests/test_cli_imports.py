@@ -64,7 +64,7 @@ def test_building_the_parser_imports_no_heavy_module() -> None:
 
 EARLY_PROBE = """
 import sys
-import feelmysign.cli._early_off as early  # what importing feelmysign.cli imports anyway
+import feelmysign.early_off as early  # what importing feelmysign.cli imports anyway
 
 seen = []
 open_bus, switch_off = early._open_bus, early.switch_off

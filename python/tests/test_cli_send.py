@@ -26,7 +26,7 @@ from paho.mqtt.reasoncodes import ReasonCode
 
 from feelmysign.broker import Broker, BrokerError, Credentials
 from feelmysign.cli import main
-from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.connection import BrokerConnectionError, parse_broker_url
 from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.protocol import Accepted, parse

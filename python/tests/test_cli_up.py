@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pytest
 
-from feelmysign.cli._drawing_log import LEGACY_DRAWING, DrawingSummaries
 from feelmysign.events import Adjusted, Cancelled, Played, Rejected, Safety
+from feelmysign.services.drawing_log import NO_DRAWING, DrawingSummaries
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
 # The import names of python/pyproject.toml's [research] extra, which 'make up' leaves out.
@@ -90,19 +90,62 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     cancelled = Cancelled(message="m", received_at_ms=1.0, cancelled_at_ms=2.0, started=False)
     summaries.add(cancelled, now_s=2.0)
     assert summaries.finished(2.1, all_of_them=True) == [
-        f"{LEGACY_DRAWING}: 1 stroke played, 1 cancelled; start delay median 1 ms, max 1 ms"
+        f"{NO_DRAWING}: 1 stroke played, 1 cancelled; start delay median 1 ms, max 1 ms"
     ]
-    # Felt 1.6 s and 0.7 s after they were sent (none of it behind other strokes): late; felt
-    # 2 s after it was sent, 1.9 s of that behind the strokes before it: not late.
+    # Felt 1.6 s and 0.7 s after they were sent (none of it behind other strokes): delayed; felt
+    # 2 s after it was sent, 1.9 s of that behind the strokes before it: not delayed.
     late = "bbbbbbbb-2222"
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 1600.0), now_s=3.0)
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 700.0), now_s=3.0)
     summaries.add(_played(late, 1903.0, 1900.0, sent_at_ms=2903.0 - 2000.0), now_s=3.0)
     assert summaries.finished(4.6) == [
-        "Drawing bbbbbbbb: 3 strokes played, 2 played late (by 1.6 s at most); "
+        "Drawing bbbbbbbb: 3 strokes played, 2 delayed on the way (by 1.6 s at most); "
         "start delay median 3 ms, max 3 ms"
     ]
     assert summaries.finished(100.0, all_of_them=True) == []
+
+
+def test_a_stroke_cut_short_is_counted_once_as_played() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5)
+    drawing = "cccccccc-3333"
+    summaries.add(_played(drawing, 2.0), now_s=0.0)
+    summaries.add(_played(drawing, 4.0), now_s=0.1)
+    cut = Cancelled(
+        message="m", drawing=drawing, seq=1, received_at_ms=1, cancelled_at_ms=2, started=True
+    )
+    dropped = Cancelled(
+        message="m", drawing=drawing, seq=2, received_at_ms=1, cancelled_at_ms=2, started=False
+    )
+    summaries.add(cut, now_s=0.2)
+    summaries.add(dropped, now_s=0.2)
+    assert summaries.finished(10.0) == [
+        "Drawing cccccccc: 2 strokes played (1 cut short), 1 cancelled; "
+        "start delay median 3 ms, max 4 ms"
+    ]
+
+
+def test_a_stroke_the_duty_cycle_cap_refused_is_counted_in_its_drawing() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5)
+    drawing = "dddddddd-4444"
+    summaries.add(_played(drawing, 2.0), now_s=0.0)
+    capped = Safety(reason="duty_cycle", row=0, column=1, drawing=drawing, seq=1, received_at_ms=1)
+    summaries.add(capped, now_s=0.1)
+    summaries.add(Safety(reason="off_failed", row=0, column=1), now_s=0.1)  # about no stroke
+    assert summaries.finished(10.0) == [
+        "Drawing dddddddd: 1 stroke played, 1 rejected (duty_cycle); "
+        "start delay median 2 ms, max 2 ms"
+    ]
+
+
+def test_strokes_without_a_drawing_id_are_not_called_legacy() -> None:
+    # JSON v1 may leave the drawing out, and a message the sleeve could not read has none.
+    summaries = DrawingSummaries(quiet_s=1.5)
+    summaries.add(_played(None, 2.0), now_s=0.0)
+    summaries.add(Rejected(reason="not_json", message="m", received_at_ms=1), now_s=0.0)
+    assert summaries.finished(10.0) == [
+        f"{NO_DRAWING}: 1 stroke played, 1 rejected (not_json); start delay median 2 ms, max 2 ms"
+    ]
+    assert "legacy" not in NO_DRAWING.lower()
 
 
 def _lines(stream: object) -> queue.Queue[str]:

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from feelmysign.cli import main
-from feelmysign.cli._options import LAYOUT_ENV
+from feelmysign.cli.options.layout import LAYOUT_ENV
 
 FEELMYSIGN = Path(sys.executable).with_name("feelmysign")  # the installed console script
 PAPER_FILE = Path(__file__).resolve().parents[2] / "deploy" / "layouts" / "paper-sleeve.toml"

@@ -20,12 +20,14 @@ from vectors import load
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.control import Cancel, format_control
 from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.errors import FeelMySignError
-from feelmysign.events import event_from_json
+from feelmysign.events import Cancelled, Rejected, event_from_json
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.protocol import format_json
+from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.stroke import Stroke
 from feelmysign.topics import sleeve_topic as topic
 
@@ -381,3 +383,35 @@ def test_strokes_still_waiting_at_stop_are_reported(broker: Broker) -> None:
     sender.loop_stop()
     reasons = [e.get("reason") for e in events if e["type"] == "rejected"]
     assert reasons.count("stopped") == 2
+
+
+def test_a_drawing_with_a_refused_stroke_and_one_cut_short_is_one_terminal_line(
+    running: Running, broker: Broker
+) -> None:
+    # What a page sends (JSON v1, each stroke named by its drawing and seq), read back from the
+    # sleeve's own events as 'feelmysign up' prints them.
+    sender = _sender(broker.credentials)
+    sid = broker.credentials.sleeve_id
+    drawing = str(uuid.uuid4())
+    sent_ms = time.time() * 1000
+    strokes = [
+        Stroke((0.0, 0.0), (0.0, 1.0), 120.0, 0.8, drawing, 0, sent_ms),
+        Stroke((0.0, 0.0), (0.0, 9.0), 120.0, 0.8, drawing, 1, sent_ms),  # outside the grid
+        Stroke((0.0, 0.0), (3.0, 2.0), 3000.0, 0.8, drawing, 2, sent_ms),  # long
+    ]
+    for stroke in strokes:
+        sender.publish(topic(sid, "strokes"), format_json(stroke), qos=1).wait_for_publish(5)
+    running.wait_events(3)  # two played, one rejected
+    sender.publish(topic(sid, "control"), format_control(Cancel(drawing)), qos=1)
+    events = [event_from_json(e) for e in running.wait_events(4)]
+    refused = next(e for e in events if isinstance(e, Rejected))
+    assert (refused.reason, refused.drawing, refused.seq) == ("outside_grid", drawing, 1)
+    assert any(isinstance(e, Cancelled) and e.started and e.seq == 2 for e in events)
+    summaries = DrawingSummaries()
+    for event in events:
+        summaries.add(event, now_s=0.0)
+    [line] = summaries.finished(100.0)
+    assert line.startswith(
+        f"Drawing {drawing[:8]}: 2 strokes played (1 cut short), 1 rejected (outside_grid); "
+    ), line
+    sender.loop_stop()

@@ -19,7 +19,7 @@ import feelmysign.layout
 from feelmysign.backends import all_off
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_state import drive_levels, open_state_bus, state_of
-from feelmysign.cli._early_off import switch_off_early
+from feelmysign.early_off import switch_off_early
 from feelmysign.layout import Layout, load_layout
 
 REPO = Path(__file__).resolve().parents[2]
@@ -298,7 +298,7 @@ def test_a_chip_that_does_not_answer_on_the_raw_bus_is_named_and_the_rest_go_on(
 def test_a_bug_in_the_early_pass_does_not_keep_the_start_up_from_its_own_all_off(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], debug: str
 ) -> None:
-    import feelmysign.cli._early_off as early
+    import feelmysign.early_off as early
 
     def broken(layout_path: str, state_path: str | None) -> list[str]:
         raise RuntimeError("a bug")

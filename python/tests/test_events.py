@@ -16,17 +16,20 @@ from feelmysign.events import (
     Played,
     Rejected,
     Status,
+    delivery_delay_ms,
     event_from_json,
+    is_delayed,
 )
 
 CASES = load("events")
 EVENTS = [(name, case) for name, case in CASES if name.startswith("event/")]
 STATUSES = [(name, case) for name, case in CASES if name.startswith("status/")]
 INVALID = [(name, case) for name, case in CASES if name.startswith("invalid/")]
+DELAYS = [(name, case) for name, case in CASES if name.startswith("delay/")]
 
 
 def test_every_group_has_vectors() -> None:
-    assert EVENTS and STATUSES and INVALID
+    assert EVENTS and STATUSES and INVALID and DELAYS
 
 
 @pytest.mark.parametrize(("name", "case"), EVENTS, ids=[n for n, _ in EVENTS])
@@ -52,6 +55,21 @@ def test_invalid_vectors(name: str, case: dict[str, Any]) -> None:
     with pytest.raises(EventError) as caught:
         read(case["wire"])
     assert caught.value.field == case["field"]
+
+
+@pytest.mark.parametrize(("name", "case"), DELAYS, ids=[n for n, _ in DELAYS])
+def test_delay_vectors(name: str, case: dict[str, Any]) -> None:
+    played = Played.from_json(case["wire"])
+    assert delivery_delay_ms(played) == case["delay_ms"]
+    assert is_delayed(played, threshold_ms=case["delayed_ms"]) is case["delayed"]
+
+
+def test_the_vectors_show_both_sides_of_the_delayed_threshold() -> None:
+    # Delayed and not, with a delay exactly at the threshold among the not delayed.
+    delayed = {case["delayed"] for _, case in DELAYS}
+    assert delayed == {True, False}
+    at = [case for _, case in DELAYS if case["delay_ms"] == case["delayed_ms"]]
+    assert at and not any(case["delayed"] for case in at)
 
 
 def test_a_class_reads_only_its_own_type() -> None:

@@ -356,3 +356,16 @@ def test_json_numbers_read_back_as_the_same_double(value: float) -> None:
     written = text.split('"sent_at_ms":')[1].rstrip("}")
     assert float(written) == value
     assert not written.endswith(".0")
+
+
+def test_a_stroke_refused_for_its_values_is_named_by_its_drawing_and_seq() -> None:
+    # The sleeve's event names it, so its sender's page and terminal find which stroke it was.
+    outside = '{"v":1,"drawing":"d-1","seq":7,"start":[0,0],"end":[0,9],"duration_ms":300}'
+    refused = parse(outside, PAPER)
+    assert isinstance(refused, Rejected) and refused.reason == "outside_grid"
+    assert (refused.drawing, refused.seq) == ("d-1", 7)
+    # Not when the name is what is wrong: the event then carries no id it could be matched by.
+    bad_seq = '{"v":1,"drawing":"d-1","seq":-1,"start":[0,0],"end":[0,1],"duration_ms":300}'
+    refused = parse(bad_seq, PAPER)
+    assert isinstance(refused, Rejected) and refused.field == "seq"
+    assert (refused.drawing, refused.seq) == (None, None)

@@ -148,7 +148,7 @@ describe("drawing with a mouse on a desktop", () => {
     await screenshot(page, "desktop-after");
   });
 
-  it("keeps adjustments under 5% quiet, names a larger one, and marks a late stroke with how late", async () => {
+  it("keeps adjustments under 5% quiet, names a larger one, and marks a stroke delayed on its way with by how much", async () => {
     const drawing = stroke0Drawing(sleeve.strokes());
     const before = Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-played"));
     const now = Date.now();
@@ -164,9 +164,9 @@ describe("drawing with a mouse on a desktop", () => {
       duration_ms: 600,
       requested_duration_ms: 417,
     });
-    // Sent 1.5 s before it was felt, none of it waiting behind other strokes: late by 1.5 s.
+    // Sent 1.5 s before it was felt, none of it waiting behind other strokes: delayed by 1.5 s.
     await sleeve.publish("events", { type: "played", drawing, seq: 2, ...played, sent_at_ms: now - 1500 });
-    // Sent as long before, but all of that behind the strokes before it (played back to back): not late.
+    // Sent as long before, but all of that behind the strokes before it (played back to back): not delayed.
     await sleeve.publish("events", {
       type: "played",
       drawing,
@@ -177,14 +177,14 @@ describe("drawing with a mouse on a desktop", () => {
     });
     // All four taken in (an adjusted stroke was played too), then what the card says of them.
     await waitForData(page, '[data-testid="played-summary"]', "played", String(before + 4));
-    await waitForData(page, '[data-testid="played-summary"]', "late", "1");
+    await waitForData(page, '[data-testid="played-summary"]', "delayed", "1");
     const log = await page.locator('[data-testid="event-log"]').innerText();
     expect(log).toContain("Stroke 1 played in 600 ms instead of 417 ms (min duration).");
-    expect(log).toContain("Stroke 2 played 1.5 s late");
+    expect(log).toContain("Stroke 2 delayed 1.5 s on the way");
     expect(log).not.toContain("Stroke 0 played in");
     expect(log).not.toContain("Stroke 3 played");
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
-      "1 late (last by 1.5 s)",
+      "1 delayed on the way (last by 1.5 s)",
     );
   });
 

@@ -389,7 +389,7 @@ export class App {
     const event = parseEvent(payload);
     if (event === null) return;
     const reading = interpretEvent(event, this.#session.drawing?.id ?? null);
-    for (const what of reading.counts) this.#says.count(what, reading.lateMs);
+    for (const what of reading.counts) this.#says.count(what, reading.delayMs);
     if (reading.played !== null) this.#felt.played(reading.played);
     if (reading.cancelled !== null) this.#felt.cancelled(reading.cancelled);
     if (reading.refusedSeq !== null) this.#session.refused(reading.refusedSeq);

@@ -289,13 +289,17 @@ export function statusToJson(status: SleeveStatus): Record<string, unknown> {
 
 // ---- what an event means for the drawing on the page ------------------------------------------
 
-/** A stroke started this long after it was sent (less its queueing) is marked late: felt that much later. */
-export const LATE_MS = 500;
+/**
+ * A played stroke whose delivery delay is above this was "delayed" on its way: the page marks it, as
+ * the terminal of `feelmysign up` does (Python `events.DELAYED_MS`). Not the sleeve's `late`
+ * refusal, which skips a stroke; a delayed stroke was played.
+ */
+export const DELAYED_MS = 500;
 /** Adjustments smaller than this share of the duration asked for are not worth a line. */
 export const NOTABLE_ADJUSTMENT = 0.05;
 
 /** What the "Sleeve says" card counts. */
-export type EventCount = "played" | "late" | "refused" | "cancelled" | "cut";
+export type EventCount = "played" | "delayed" | "refused" | "cancelled" | "cut";
 /** A line of the "Sleeve says" log: a refusal, a stroke played otherwise than asked, an error, news. */
 export type NoteKind = "rejected" | "adjusted" | "error" | "info";
 
@@ -307,8 +311,8 @@ export interface Note {
 export interface EventReading {
   /** What to count, in order (a cut stroke is counted cancelled and cut). */
   readonly counts: readonly EventCount[];
-  /** How late, when `counts` has "late". */
-  readonly lateMs: number;
+  /** Its delivery delay, when `counts` has "delayed". */
+  readonly delayMs: number;
   readonly notes: readonly Note[];
   /** A stroke of the drawing was played: where it is in time. */
   readonly played: PlayedEvent | AdjustedEvent | null;
@@ -320,7 +324,7 @@ export interface EventReading {
 
 const NOTHING: EventReading = {
   counts: [],
-  lateMs: 0,
+  delayMs: 0,
   notes: [],
   played: null,
   cancelled: null,
@@ -328,12 +332,19 @@ const NOTHING: EventReading = {
 };
 
 /**
- * How late a played stroke was felt: sent -> felt, less the wait behind the strokes before it
- * (playing back to back is the design, not lateness). What remains is the network, the broker
- * holding it, the sleeve. 0 when the stroke carried no sent time.
+ * How long a played stroke was held on its way: sent -> its first motor command, less its wait
+ * behind the strokes before it (playing a drawing back to back is the design, not a delay). What
+ * remains is the network, the broker holding it, the sleeve offline. Null when the stroke carried
+ * no sent time. Python's `events.delivery_delay_ms`; testdata/events/delay keeps the two equal.
  */
-export function feltLateMs(event: PlayedEvent | AdjustedEvent): number {
-  return event.sent_at_ms === null ? 0 : event.first_command_at_ms - event.sent_at_ms - event.queued_ms;
+export function deliveryDelayMs(event: PlayedEvent | AdjustedEvent): number | null {
+  return event.sent_at_ms === null ? null : event.first_command_at_ms - event.sent_at_ms - event.queued_ms;
+}
+
+/** Whether a played stroke was delayed on its way (see `deliveryDelayMs`). */
+export function isDelayed(event: PlayedEvent | AdjustedEvent, thresholdMs = DELAYED_MS): boolean {
+  const delayMs = deliveryDelayMs(event);
+  return delayMs !== null && delayMs > thresholdMs;
 }
 
 /** What `event` means for the page whose current drawing is `drawingId` (null: none). */
@@ -347,12 +358,12 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
       if (!ours) return NOTHING;
       const counts: EventCount[] = ["played"];
       const notes: Note[] = [];
-      const late = feltLateMs(event);
-      if (late > LATE_MS) {
-        counts.push("late");
+      const delayMs = deliveryDelayMs(event) ?? 0;
+      if (isDelayed(event)) {
+        counts.push("delayed");
         notes.push({
           kind: "adjusted",
-          text: `${label} played ${seconds(late)} late (it waited at the broker or on the way).`,
+          text: `${label} delayed ${seconds(delayMs)} on the way (held at the broker or by the network).`,
         });
       }
       if (event.type === "adjusted") {
@@ -366,7 +377,7 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
           });
         }
       }
-      return { ...NOTHING, counts, lateMs: late, notes, played: event };
+      return { ...NOTHING, counts, delayMs, notes, played: event };
     }
     case "rejected": {
       // A refusal of no drawing in particular (a message the sleeve could not read) is shown too.

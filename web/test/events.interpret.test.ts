@@ -1,8 +1,8 @@
 /** What the sleeve's events mean for the drawing on the page: the vectors of testdata/events, read. */
 import { describe, expect, it } from "vitest";
 import {
-  LATE_MS,
-  feltLateMs,
+  DELAYED_MS,
+  deliveryDelayMs,
   interpretEvent,
   parseEvent,
   seconds,
@@ -75,19 +75,19 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     expect(interpretEvent(small, DRAWING).notes).toEqual([]);
   });
 
-  it("marks a stroke felt late, but not one that waited behind the strokes before it", () => {
+  it("marks a stroke delayed on its way, but not one that waited behind the strokes before it", () => {
     const played = vector("played-with-sent-at") as PlayedEvent;
     const sentAtMs = played.first_command_at_ms - 1500;
-    const late = interpretEvent({ ...played, sent_at_ms: sentAtMs }, DRAWING);
-    expect(late.counts).toEqual(["played", "late"]);
-    expect(late.lateMs).toBeCloseTo(1500, 6);
-    expect(late.notes.map((note) => note.text)).toEqual([
-      "Stroke 3 played 1.5 s late (it waited at the broker or on the way).",
+    const delayed = interpretEvent({ ...played, sent_at_ms: sentAtMs }, DRAWING);
+    expect(delayed.counts).toEqual(["played", "delayed"]);
+    expect(delayed.delayMs).toBeCloseTo(1500, 6);
+    expect(delayed.notes.map((note) => note.text)).toEqual([
+      "Stroke 3 delayed 1.5 s on the way (held at the broker or by the network).",
     ]);
     const queued = interpretEvent({ ...played, sent_at_ms: sentAtMs, queued_ms: 1500 }, DRAWING);
     expect(queued.counts).toEqual(["played"]);
     // The vector's own stroke: 64.5 ms from sent to felt, far under the limit.
-    expect(feltLateMs(played)).toBeLessThan(LATE_MS);
+    expect(deliveryDelayMs(played)).toBeLessThan(DELAYED_MS);
     expect(interpretEvent(played, DRAWING).counts).toEqual(["played"]);
   });
 

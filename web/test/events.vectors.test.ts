@@ -1,6 +1,16 @@
 /** The sleeve's events and status, read and written as the Python reference does (testdata/events). */
 import { describe, expect, it } from "vitest";
-import { eventToJson, parseEvent, parseStatus, readEvent, readStatus, statusToJson } from "../src/events";
+import {
+  DELAYED_MS,
+  deliveryDelayMs,
+  eventToJson,
+  isDelayed,
+  parseEvent,
+  parseStatus,
+  readEvent,
+  readStatus,
+  statusToJson,
+} from "../src/events";
 import { hasVectors, vectors } from "./testdata";
 
 interface ValidVector {
@@ -16,16 +26,40 @@ interface InvalidVector {
   wire: unknown;
 }
 
+/** A played event's delivery delay, as the terminal of `feelmysign up` computes it. */
+interface DelayVector {
+  description: string;
+  wire: unknown;
+  delayed_ms: number;
+  delay_ms: number | null;
+  delayed: boolean;
+}
+
 const present = hasVectors("events");
 const events = present ? (vectors("events", "event") as [string, ValidVector][]) : [];
 const statuses = present ? (vectors("events", "status") as [string, ValidVector][]) : [];
 const invalid = present ? (vectors("events", "invalid") as [string, InvalidVector][]) : [];
+const delays = present ? (vectors("events", "delay") as [string, DelayVector][]) : [];
 
 describe.skipIf(!present)("event and status vectors", () => {
   it("finds every group", () => {
     expect(events.length).toBeGreaterThan(0);
     expect(statuses.length).toBeGreaterThan(0);
     expect(invalid.length).toBeGreaterThan(0);
+    expect(delays.length).toBeGreaterThan(0);
+  });
+
+  it("marks delayed strokes at the threshold the terminal uses", () => {
+    expect(delays.every(([, vector]) => vector.delayed_ms === DELAYED_MS)).toBe(true);
+  });
+
+  it.each(delays)("delay %s", (_name, vector) => {
+    const event = parseEvent(JSON.stringify(vector.wire));
+    if (event === null || (event.type !== "played" && event.type !== "adjusted")) {
+      throw new Error("a delay vector is a played or adjusted event");
+    }
+    expect(deliveryDelayMs(event)).toBe(vector.delay_ms);
+    expect(isDelayed(event)).toBe(vector.delayed);
   });
 
   it.each(events)("%s", (_name, vector) => {

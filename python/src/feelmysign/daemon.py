@@ -56,6 +56,7 @@ from feelmysign.events import (
     Safety,
     Status,
     StatusLayout,
+    delivery_delay_ms,
 )
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS, PacePolicy
@@ -83,8 +84,9 @@ RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
 # the broker kept for a sleeve that was away is not rate-limited on its return.
 BURST = MAX_PENDING
 KEEPALIVE_S = 15
-# A stroke felt this long after it was sent (beyond its wait in the queue) is reported as late.
-LATE_MS = 1000.0
+# A stroke delayed on its way by more than this (events.delivery_delay_ms) is logged: a higher
+# bar than the page's and the terminal's (events.DELAYED_MS), to keep the sleeve's journal quiet.
+LOG_DELAYED_MS = 1000.0
 # Cancelled drawings remembered, so that their later strokes do not start them again.
 REMEMBERED_CANCELS = 64
 NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disconnect
@@ -429,6 +431,9 @@ class Sleeve:
             return
         result = parse(payload, self._layout, format="legacy" if legacy else "json")
         if not isinstance(result, Accepted):
+            # Named when its drawing and seq could be read: its sender finds which stroke it was.
+            named = (("drawing", result.drawing), ("seq", result.seq))
+            info.update({k: v for k, v in named if v is not None})
             self._reject(result.reason, result.message, info, received_wall_ms, ack)
             return
         stroke = result.stroke
@@ -548,7 +553,7 @@ class Sleeve:
         """
         if isinstance(event, Played):
             self._count("played")
-            self._say_if_late(event)
+            self._say_if_delayed(event)
         elif isinstance(event, Cancelled):
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":
@@ -562,20 +567,18 @@ class Sleeve:
         if ack is not None:
             self._outbox.put(ack)
 
-    def _say_if_late(self, event: Played) -> None:
+    def _say_if_delayed(self, event: Played) -> None:
         """A stroke felt long after it was sent (held by the broker, a slow network): logged, with
-        how late. Waiting behind the strokes before it is how a drawing plays, not lateness."""
-        if event.sent_at_ms is None:
-            return
-        late_ms = event.first_command_at_ms - event.sent_at_ms - event.queued_ms
-        if late_ms > LATE_MS:
+        its delay. Not ``late``, the refusal of a stroke the sleeve is too far behind for."""
+        delay_ms = delivery_delay_ms(event)
+        if delay_ms is not None and delay_ms > LOG_DELAYED_MS:
             log.warning(
-                "sleeve %s: stroke %s of drawing %s played %.1f s late (it waited at the broker "
+                "sleeve %s: stroke %s of drawing %s delayed by %.1f s (it waited at the broker "
                 "or on the way)",
                 self._id,
                 event.seq,
                 event.drawing,
-                late_ms / 1000,
+                delay_ms / 1000,
             )
 
     def _count(self, *names: str) -> None:

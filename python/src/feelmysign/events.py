@@ -305,6 +305,32 @@ def event_from_json(data: object) -> Event:
     return event
 
 
+# --- what a played event means for its sender --------------------------------------------
+
+# A stroke whose delivery delay is above this was "delayed": the page and the terminal of
+# 'feelmysign up' mark it. Not the sleeve's `late` refusal (docs/protocol.md, pace), which
+# skips a stroke; a delayed stroke was played.
+DELAYED_MS = 500.0
+
+
+def delivery_delay_ms(event: Played) -> float | None:
+    """How long a played stroke was held on its way: sent -> its first motor command, less
+    its wait behind the strokes before it (playing a drawing back to back is the design, not
+    a delay). What remains is the network, the broker holding it, the sleeve offline. None
+    when the stroke carried no ``sent_at_ms`` (the two clocks are the sender's and the
+    sleeve's: their offset is part of the figure). web/src/events.ts computes the same, and
+    ``testdata/events/delay`` keeps the two equal."""
+    if event.sent_at_ms is None:
+        return None
+    return event.first_command_at_ms - event.sent_at_ms - event.queued_ms
+
+
+def is_delayed(event: Played, *, threshold_ms: float = DELAYED_MS) -> bool:
+    """Whether ``event``'s stroke was delayed on its way (see ``delivery_delay_ms``)."""
+    delay_ms = delivery_delay_ms(event)
+    return delay_ms is not None and delay_ms > threshold_ms
+
+
 # The order the sleeve publishes the layout's keys in.
 _LAYOUT_ORDER = (
     "name",

@@ -19,7 +19,7 @@ import difflib
 import json
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from decimal import ROUND_HALF_UP, Context, Decimal
 from typing import Any, Literal
 
@@ -110,6 +110,10 @@ class Rejected:
     reason: str
     message: str
     field: str | None = None
+    # The stroke's drawing and seq, when they were read and valid and something else was wrong:
+    # the sleeve's event carries them, so the sender's page and log know which stroke it was.
+    drawing: str | None = None
+    seq: int | None = None
 
 
 def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accepted | Rejected:
@@ -136,8 +140,15 @@ def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accept
         return stroke
     checked = validate_stroke(stroke, layout)
     if isinstance(checked, Rejected):
-        return checked
+        return _named(checked, stroke)
     return Accepted(checked, chosen)
+
+
+def _named(problem: Rejected, stroke: Stroke) -> Rejected:
+    """``problem`` with the stroke's drawing and seq, unless one of them is the problem."""
+    if problem.field in ("drawing", "seq"):
+        return problem
+    return replace(problem, drawing=stroke.drawing, seq=stroke.seq)
 
 
 def _detect(body: str) -> WireFormat:

@@ -1,6 +1,6 @@
 /**
  * The "Sleeve says" card for the current drawing: its name, what became of
- * its strokes (played, refused, cancelled, dropped, late), and the latest
+ * its strokes (played, refused, cancelled, dropped, delayed), and the latest
  * notes. Reset with every new drawing, so nothing of an old drawing lingers.
  */
 import { seconds } from "../events";
@@ -14,8 +14,9 @@ export interface Counts {
   cut: number;
   /** Not sent: cancelled before they left, or dropped by the timing policy. */
   dropped: number;
-  late: number;
-  latestLateMs: number;
+  /** Played, but held on the way (events.ts `isDelayed`): not the sleeve's `late` refusal. */
+  delayed: number;
+  latestDelayMs: number;
 }
 
 const zero = (): Counts => ({
@@ -24,8 +25,8 @@ const zero = (): Counts => ({
   cancelled: 0,
   cut: 0,
   dropped: 0,
-  late: 0,
-  latestLateMs: 0,
+  delayed: 0,
+  latestDelayMs: 0,
 });
 
 export class SleeveSays {
@@ -61,9 +62,9 @@ export class SleeveSays {
     this.#render();
   }
 
-  count(what: Exclude<keyof Counts, "latestLateMs">, late_ms = 0): void {
+  count(what: Exclude<keyof Counts, "latestDelayMs">, delayMs = 0): void {
     this.#counts[what]++;
-    if (what === "late") this.#counts.latestLateMs = late_ms;
+    if (what === "delayed") this.#counts.latestDelayMs = delayMs;
     this.#render();
   }
 
@@ -82,14 +83,14 @@ export class SleeveSays {
   }
 
   #render(): void {
-    const { played, refused, cancelled, cut, dropped, late, latestLateMs } = this.#counts;
+    const { played, refused, cancelled, cut, dropped, delayed, latestDelayMs } = this.#counts;
     const summary = this.#summary;
     summary.dataset["played"] = String(played);
     summary.dataset["sent"] = String(this.#sent);
     summary.dataset["refused"] = String(refused);
     summary.dataset["cancelled"] = String(cancelled);
     summary.dataset["dropped"] = String(dropped);
-    summary.dataset["late"] = String(late);
+    summary.dataset["delayed"] = String(delayed);
     if (this.#sent === 0 && dropped === 0) {
       summary.textContent = "No strokes sent yet.";
       return;
@@ -100,7 +101,7 @@ export class SleeveSays {
     if (cut > 0) parts.push(`${cut} cut short by Stop`);
     if (cancelled > cut) parts.push(`${cancelled - cut} cancelled before playing`);
     if (dropped > 0) parts.push(`${dropped} dropped unsent`);
-    if (late > 0) parts.push(`${late} late (last by ${seconds(latestLateMs)})`);
+    if (delayed > 0) parts.push(`${delayed} delayed on the way (last by ${seconds(latestDelayMs)})`);
     summary.textContent = `${parts.join(", ")}.`;
   }
 }

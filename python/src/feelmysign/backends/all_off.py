@@ -3,7 +3,7 @@
 A DRV2605L in RTP mode drives its motor at RTP_INPUT until told otherwise, also
 after the process that set it was killed. A sleeve restarted after a crash
 therefore switches the chips off before it imports anything else (see
-``feelmysign.cli._early_off``), and this module is what it may import for that:
+``feelmysign.early_off``), and this module is what it may import for that:
 the few registers it writes, the off sequence, and ``/dev/i2c-N`` through the
 kernel's plain read/write interface (Documentation/i2c/dev-interface.rst),
 without smbus2 and the ctypes it loads. On the wire, a two-byte write is the

@@ -50,8 +50,8 @@ from feelmysign.broker import Broker
 from feelmysign.broker.credentials import Account, Credentials, reuse_or_create
 from feelmysign.broker.nats_cluster import NatsCluster
 from feelmysign.broker.sleeves import add_sleeve
-from feelmysign.cli._inputs import whole_number
-from feelmysign.cli._parser import CliParser
+from feelmysign.cli.options.parser import CliParser
+from feelmysign.cli.options.values import whole_number
 from feelmysign.connection import new_client, parse_broker_url
 from feelmysign.player import SPIN_MS
 from feelmysign.topics import telemetry_topic

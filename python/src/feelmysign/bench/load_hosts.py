@@ -66,7 +66,7 @@ def stroke_key(payload: bytes) -> str | None:
 
 
 def _quiet() -> None:
-    # The sleeves' own log lines (a stroke played late, ...) would bury the figures.
+    # The sleeves' own log lines (a stroke delayed on the way, ...) would bury the figures.
     logging.getLogger("feelmysign").setLevel(logging.ERROR)
 
 

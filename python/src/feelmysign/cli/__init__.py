@@ -3,7 +3,7 @@
 Each subcommand module defines ``register(subparsers)``, which adds its parser
 and sets ``handler`` to a function ``(args) -> int``. Errors a person can act on
 print one ``Error: ...`` line on stderr and exit 1; usage errors exit 2 (one
-``Error:`` line too, see ``_parser``). Anything else that escapes a command is
+``Error:`` line too, see ``options.parser``). Anything else that escapes a command is
 a bug: it still gets one ``Error:`` line, with a request to report it, and exit
 70 (EX_SOFTWARE); ``FEELMYSIGN_DEBUG=1`` shows its traceback instead.
 """
@@ -15,7 +15,7 @@ import sys
 
 # Nothing else at module level: a sleeve restarted after a crash imports this
 # package, then switches its motors off (main), before any other import.
-from feelmysign.cli._early_off import switch_off_early
+from feelmysign.early_off import switch_off_early
 
 TYPE_CHECKING = False  # typing itself costs a start-up import; mypy reads this name as True
 if TYPE_CHECKING:
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from typing import Any, TextIO
 
-    from feelmysign.cli._parser import CliParser
+    from feelmysign.cli.options.parser import CliParser
 
 DEBUG_ENV = "FEELMYSIGN_DEBUG"
 BUG_EXIT = 70  # EX_SOFTWARE (sysexits.h): an internal error, not the user's
@@ -52,7 +52,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     import importlib
 
     from feelmysign import __version__
-    from feelmysign.cli._parser import CliParser
+    from feelmysign.cli.options.parser import CliParser
 
     parser = CliParser(
         prog="feelmysign",

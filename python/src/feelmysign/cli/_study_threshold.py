@@ -11,7 +11,7 @@ import random
 from pathlib import Path
 from typing import Any
 
-from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.errors import StudyError
 from feelmysign.study.choices import DIMENSIONS, DIRECTIONS
 

@@ -24,7 +24,7 @@ from feelmysign.broker import (
     default_state_dir,
 )
 from feelmysign.cli._join import run_add_sleeve, run_nats_accounts
-from feelmysign.cli._lan_options import add_lan_options, lan_from_args
+from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 # How often the CLI notices a stop request or a Mosquitto that died.

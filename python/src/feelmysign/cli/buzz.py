@@ -19,11 +19,11 @@ import time
 from feelmysign.backends.base import check_actuator
 from feelmysign.backends.factory import BACKEND_NAMES, open_backend
 from feelmysign.backends.sim import SimBackend
-from feelmysign.cli._emulation import add_emulate_state_option
-from feelmysign.cli._options import add_layout_options, layout_from_args
-from feelmysign.cli._signals import interrupt_on_stop_signals
+from feelmysign.cli.options.emulation import add_emulate_state_option
+from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
+from feelmysign.services.stop_signals import interrupt_on_stop_signals
 
 DEFAULT_DURATION_MS = 1000.0  # long enough to feel and to find by touch which motor it is
 

@@ -49,7 +49,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from feelmysign.cli._inputs import not_empty, output_folder, whole_number
+from feelmysign.cli.options.values import not_empty, output_folder, whole_number
 from feelmysign.cli.simplify import load
 from feelmysign.errors import FeelMySignError
 from feelmysign.simplify.recording import Recording

@@ -19,8 +19,8 @@ import os
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_state import open_state_bus
 from feelmysign.backends.i2c import I2CBus
-from feelmysign.cli._emulation import add_emulate_state_option
-from feelmysign.cli._options import LAYOUT_ENV
+from feelmysign.cli.options.emulation import add_emulate_state_option
+from feelmysign.cli.options.layout import LAYOUT_ENV
 from feelmysign.errors import HardwareError, LayoutError
 from feelmysign.layout import load_layout
 

@@ -7,10 +7,10 @@ import json
 from dataclasses import replace
 from typing import Any
 
-from feelmysign.cli._inputs import number
-from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._picture import LEGEND, grid_picture
-from feelmysign.cli._stroke_input import strokes_from
+from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.strokes import strokes_from
+from feelmysign.cli.options.values import number
 from feelmysign.layout import MAX_MIN_BURST_MS, MIN_BURST_MS, Layout
 from feelmysign.planner import MERGE_DISTANCE, plan
 from feelmysign.schedule import Schedule, schedule_to_json

@@ -29,8 +29,8 @@ import uuid
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli import simplify
-from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
-from feelmysign.cli._inputs import MAX_TIMEOUT_S, number
+from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.values import MAX_TIMEOUT_S, number
 from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout

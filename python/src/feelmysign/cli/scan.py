@@ -25,9 +25,9 @@ from feelmysign.backends.emulated_state import open_state_bus
 from feelmysign.backends.i2c import I2CBus, open_smbus
 from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
-from feelmysign.cli._emulation import add_emulate_state_option
-from feelmysign.cli._inputs import MAX_LAYOUT_BYTES, check_input_file, not_empty
-from feelmysign.cli._options import LAYOUT_ENV
+from feelmysign.cli.options.emulation import add_emulate_state_option
+from feelmysign.cli.options.layout import LAYOUT_ENV
+from feelmysign.cli.options.values import MAX_LAYOUT_BYTES, check_input_file, not_empty
 from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
 

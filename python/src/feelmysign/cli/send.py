@@ -21,9 +21,9 @@ import uuid
 from collections.abc import Iterator
 from dataclasses import replace
 
-from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
-from feelmysign.cli._inputs import MAX_TIMEOUT_S, number, stdin_lines, topic
-from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.values import MAX_TIMEOUT_S, number, stdin_lines, topic
 from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, Layout

@@ -8,7 +8,7 @@ import json
 from dataclasses import asdict, fields, replace
 from typing import Any
 
-from feelmysign.cli._inputs import MAX_RECORDING_BYTES, check_input_file
+from feelmysign.cli.options.values import MAX_RECORDING_BYTES, check_input_file
 from feelmysign.simplify import (
     ALGORITHMS,
     PathSegment,

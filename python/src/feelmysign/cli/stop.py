@@ -7,8 +7,8 @@ import threading
 import uuid
 from typing import TYPE_CHECKING, Any
 
-from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
-from feelmysign.cli._inputs import MAX_TIMEOUT_S, number
+from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.values import MAX_TIMEOUT_S, number
 from feelmysign.connection import DEFAULT_TIMEOUT_S, connect_client
 from feelmysign.control import CANCEL_ALL, Cancel, format_control
 from feelmysign.errors import BrokerConnectionError, ParameterError

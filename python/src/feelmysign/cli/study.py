@@ -20,8 +20,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-from feelmysign.cli._broker_options import add_broker_options, broker_settings_from_args
 from feelmysign.cli._study_threshold import add_threshold_parser
+from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.errors import StudyError
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 

@@ -17,15 +17,15 @@ from feelmysign.broker import (
     Broker,
     Credentials,
 )
-from feelmysign.cli._drawing_log import DrawingLog
-from feelmysign.cli._inputs import output_file, port, sleeve_id
-from feelmysign.cli._lan_options import add_lan_options, lan_from_args
-from feelmysign.cli._options import add_layout_options, layout_from_args
 from feelmysign.cli._page_server import page_server, qr_text
-from feelmysign.cli._signals import call_on_stop_signals
-from feelmysign.cli._watchdog import Watchdog
+from feelmysign.cli.options.lan import add_lan_options, lan_from_args
+from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.values import output_file, port, sleeve_id
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.services.drawing_log import DrawingLog
+from feelmysign.services.stop_signals import call_on_stop_signals
+from feelmysign.services.watchdog import Watchdog
 from feelmysign.webserver import WEB_DIST, Api
 
 DEFAULT_HTTP_PORT = 8000

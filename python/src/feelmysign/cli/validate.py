@@ -16,8 +16,8 @@ import json
 import os
 from typing import Any
 
-from feelmysign.cli._inputs import read_stdin
-from feelmysign.cli._options import add_layout_options, layout_from_args
+from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.values import read_stdin
 from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, Rejected, parse, stroke_to_dict
 

@@ -24,7 +24,12 @@ from pathlib import Path
 
 from feelmysign.broker import DEFAULT_SLEEVE_ID, default_state_dir
 from feelmysign.broker.credentials import Role, check_sleeve_id, load_login
-from feelmysign.cli._inputs import MAX_CREDENTIALS_BYTES, check_input_file, not_empty, sleeve_id
+from feelmysign.cli.options.values import (
+    MAX_CREDENTIALS_BYTES,
+    check_input_file,
+    not_empty,
+    sleeve_id,
+)
 from feelmysign.connection import DEFAULT_BROKER_URL, BrokerSettings, parse_broker_url
 from feelmysign.connection.join_token import default_trust_dir, join_settings
 from feelmysign.connection.settings import PASSWORD_ENV, USERNAME_ENV

@@ -44,7 +44,7 @@ if TYPE_CHECKING:
 # The commands that drive motors, and their --backend default ("scan" only reads).
 # "off" has no --backend: it always drives the chips.
 EARLY_COMMANDS = {"sleeve": "sim", "buzz": "drv2605", "off": "drv2605"}
-LAYOUT_ENV = "FEELMYSIGN_LAYOUT"  # as cli/_options.py reads it
+LAYOUT_ENV = "FEELMYSIGN_LAYOUT"  # as cli/options/layout.py reads it
 DEBUG_ENV = "FEELMYSIGN_DEBUG"  # as cli/__init__.py reads it: a bug here is then printed
 # The memo's first line: a memo another version of feelmysign wrote is a miss (its reader
 # of the layout may have differed).

@@ -16,7 +16,7 @@ import re
 import sys
 from typing import NoReturn
 
-from feelmysign.cli._inputs import decimal_float_option, decimal_int_option
+from feelmysign.cli.options.values import decimal_float_option, decimal_int_option
 
 USAGE_ERROR_EXIT = 2
 # '-' then a digit, or '-.' then a digit: a number or a stroke, never one of our options.

@@ -13,7 +13,7 @@ import os
 from collections.abc import Sequence
 from typing import Any
 
-from feelmysign.cli._inputs import (
+from feelmysign.cli.options.values import (
     MAX_LAYOUT_BYTES,
     check_input_file,
     not_empty,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from feelmysign.cli._inputs import MAX_STATE_BYTES, existing_or_new_file
+from feelmysign.cli.options.values import MAX_STATE_BYTES, existing_or_new_file
 
 
 def add_emulate_state_option(parser: argparse.ArgumentParser) -> None:

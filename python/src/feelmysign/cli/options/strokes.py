@@ -17,7 +17,7 @@ import json
 from collections.abc import Iterator
 from typing import Any
 
-from feelmysign.cli._inputs import read_stdin
+from feelmysign.cli.options.values import read_stdin
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, parse

@@ -3,17 +3,22 @@
 ``up`` listens on ``feelmysign/<id>/events`` like any page does (with the
 sender's account) and, once a drawing has been quiet for ``QUIET_S``, prints::
 
-    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 played late (by 1.6 s),
-    1 rejected (outside_grid); start delay median 3 ms, max 9 ms        (on one line)
+    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 delayed on the way
+    (by 1.6 s), 1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
 
-A stroke played late was felt more than ``LATE_MS`` after its sender sent it, not
-counting its wait behind the strokes before it (the page marks the same ones): it
-waited at the broker or on the way, the sleeve offline or the network slow.
+A stroke delayed on the way was felt more than ``events.DELAYED_MS`` after its
+sender sent it, not counting its wait behind the strokes before it
+(``events.is_delayed``; the page marks the same ones): it waited at the broker or
+on the way, the sleeve offline or the network slow. It was played; a stroke the
+sleeve skipped for being too far behind is a ``late`` refusal, under rejected.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
 of the strokes queued before it) to its first motor: the sleeve's own lateness,
-not the wait behind a drawing sent all at once. Strokes without a drawing id
-(the legacy text format) count as one drawing per quiet spell. The summary is
+not the wait behind a drawing sent all at once. A stroke cut short by a stop
+was played: it counts once, as played (and cut short). A stroke the duty-cycle
+cap kept from playing counts as rejected (``duty_cycle``), like any refusal.
+Strokes without a drawing id (the legacy text format, JSON that leaves it out,
+a message the sleeve could not read) count as one drawing per quiet spell. The summary is
 built by ``DrawingSummaries`` (pure: events and a clock in, lines out);
 ``DrawingLog`` is its MQTT listener.
 """
@@ -36,7 +41,10 @@ from feelmysign.events import (
     EventError,
     Played,
     Rejected,
+    Safety,
+    delivery_delay_ms,
     event_from_json,
+    is_delayed,
 )
 from feelmysign.topics import telemetry_topic
 
@@ -45,11 +53,8 @@ if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign
 
 QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted and put down
 CHECK_INTERVAL_S = 0.25
-LEGACY_DRAWING = "Legacy strokes"
+NO_DRAWING = "Strokes without a drawing id"
 SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one session
-# Felt this long after it was sent (less its wait behind other strokes), a stroke is late: the
-# page's rule too (web/src/ui/sleeve-says.ts, LATE_MS).
-LATE_MS = 500.0
 
 
 @dataclass
@@ -57,19 +62,22 @@ class _Drawing:
     last_event_s: float
     played: int = 0
     slowed: int = 0
-    cancelled: int = 0
+    cut_short: int = 0  # played, then stopped by a control message: counted in played only
+    cancelled: int = 0  # dropped by a control message before it played
     rejected: Counter[str] = field(default_factory=Counter)
     delays_ms: list[float] = field(default_factory=list)
-    late_ms: list[float] = field(default_factory=list)
+    delays_on_the_way_ms: list[float] = field(default_factory=list)  # of the delayed ones
 
     def line(self, name: str) -> str:
-        shown = name if name == LEGACY_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
+        shown = name if name == NO_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
         parts = [f"{self.played} stroke{'s' if self.played != 1 else ''} played"]
-        if self.slowed:
-            parts[0] += f" ({self.slowed} slowed to be felt)"
-        if self.late_ms:
-            parts.append(f"{len(self.late_ms)} played late (by {_seconds(max(self.late_ms))}")
-            parts[-1] += " at most)" if len(self.late_ms) > 1 else ")"
+        notes = [f"{self.slowed} slowed to be felt"] if self.slowed else []
+        notes += [f"{self.cut_short} cut short"] if self.cut_short else []
+        if notes:
+            parts[0] += f" ({', '.join(notes)})"
+        if delayed := self.delays_on_the_way_ms:
+            parts.append(f"{len(delayed)} delayed on the way (by {_seconds(max(delayed))}")
+            parts[-1] += " at most)" if len(delayed) > 1 else ")"
         if self.rejected:
             reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in self.rejected.items())
             parts.append(f"{sum(self.rejected.values())} rejected ({reasons})")
@@ -97,21 +105,24 @@ class DrawingSummaries:
         self._drawings: dict[str, _Drawing] = {}
 
     def add(self, event: Event, now_s: float) -> None:
-        if not isinstance(event, Played | Rejected | Cancelled):
-            return  # safety and error events are logged by the sleeve itself
-        name = event.drawing or LEGACY_DRAWING
+        if isinstance(event, Safety) and event.received_at_ms is None:
+            return  # a motor protected outside any stroke (off_failed): the sleeve logs it
+        if not isinstance(event, Played | Rejected | Cancelled | Safety):
+            return  # error events are logged by the sleeve itself
+        name = event.drawing or NO_DRAWING
         drawing = self._drawings.setdefault(name, _Drawing(now_s))
         drawing.last_event_s = now_s
         if isinstance(event, Played):
             drawing.played += 1
             drawing.slowed += isinstance(event, Adjusted)
             drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
-            if event.sent_at_ms is not None:
-                late_ms = event.first_command_at_ms - event.sent_at_ms - event.queued_ms
-                if late_ms > LATE_MS:
-                    drawing.late_ms.append(late_ms)
-        elif isinstance(event, Rejected):
+            delay_ms = delivery_delay_ms(event)
+            if delay_ms is not None and is_delayed(event):
+                drawing.delays_on_the_way_ms.append(delay_ms)
+        elif isinstance(event, Rejected | Safety):  # Safety here: a stroke the cap refused
             drawing.rejected[event.reason] += 1
+        elif event.started:  # its played event counted it already
+            drawing.cut_short += 1
         else:
             drawing.cancelled += 1
 
