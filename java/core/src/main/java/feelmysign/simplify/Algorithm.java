@@ -1,15 +1,15 @@
 package feelmysign.simplify;
 
-import java.util.ArrayList;
 import java.util.Collections;
+import java.util.EnumMap;
 import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Map;
 
 /**
  * The simplifiers by name, as the reference's registry: each one's parameters in their order,
- * with defaults and ranges, and what it is fed ({@code frames} resampled at {@code fps}, or
- * every pointer {@code samples}).
+ * with defaults and ranges (from the generated {@link ParamTable}), and what it is fed
+ * ({@code frames} resampled at {@code fps}, or every pointer {@code samples}).
  */
 public enum Algorithm {
   /** The paper's turn-angle rule (section 4.4, appendix B.4), fed animation frames. */
@@ -17,8 +17,8 @@ public enum Algorithm {
   /** Error-bounded, cut at features, fed every pointer sample. */
   WINDOW("window", "error-bounded, cut at features", false);
 
-  /** The project's choice (docs/research.md, "Default settings"). */
-  public static final Algorithm DEFAULT = WINDOW;
+  /** The project's choice (docs/research.md, "Default settings"): the table's default. */
+  public static final Algorithm DEFAULT = named(ParamTable.DEFAULT_ALGORITHM);
   /** The paper's. */
   public static final Algorithm PAPER = ANGLE;
 
@@ -58,12 +58,12 @@ public enum Algorithm {
 
   /** Its parameters in their order (the reference's dataclass fields), with their defaults. */
   public Map<String, Object> defaults() {
-    return this == ANGLE ? Tables.ANGLE_DEFAULTS : Tables.WINDOW_DEFAULTS;
+    return Tables.DEFAULTS.get(this);
   }
 
   /** Its parameter table, by name. */
   public Map<String, ParamSpec> specs() {
-    return this == ANGLE ? Tables.ANGLE_SPECS : Tables.WINDOW_SPECS;
+    return Tables.SPECS.get(this);
   }
 
   /** A new streaming simplifier with these parameters. */
@@ -88,125 +88,46 @@ public enum Algorithm {
     return Tables.ONLY_FOR;
   }
 
-  /** The tables, built once. */
+  /**
+   * The tables, built once from the generated {@link ParamTable} (the reference's declarations):
+   * each algorithm's parameters in its order, with defaults and ranges.
+   */
   static final class Tables {
     private Tables() {}
 
-    // The drop and grid settings every simplifier has (beside its own).
-    static final List<ParamSpec> DROP_AND_GRID =
-        List.of(
-            ParamSpec.bool("clear_on_press", "a new press clears the drawing"),
-            ParamSpec.number("min_duration_ms", 0, 10_000, "shortest stroke to send, in ms"),
-            ParamSpec.number("min_length", 0, 100, "shortest stroke to send, in grid units"),
-            ParamSpec.integer("rows", 1, 64, "actuator rows of the sleeve"),
-            ParamSpec.integer("columns", 1, 64, "actuator columns of the sleeve"),
-            ParamSpec.number("canvas_width_px", 1, 100_000, "drawing area width in pixels"),
-            ParamSpec.number("canvas_height_px", 1, 100_000, "drawing area height in pixels"),
-            ParamSpec.bool("stretch", "stretch the canvas onto the grid (the paper's)"));
+    static final Map<Algorithm, Map<String, ParamSpec>> SPECS = new EnumMap<>(Algorithm.class);
+    static final Map<Algorithm, Map<String, Object>> DEFAULTS = new EnumMap<>(Algorithm.class);
+    // In the table's order, as the reference's ONLY_FOR (the first one given is the one told).
+    static final Map<String, Algorithm> ONLY_FOR;
 
-    static final Map<String, ParamSpec> ANGLE_SPECS =
-        table(
-            List.of(
-                ParamSpec.integer(
-                    "check_frames", 2, 600, "frames between two checks (the paper's checkFrame)"),
-                ParamSpec.number(
-                    "max_angle_deg", 1, 179, "largest turn, in degrees, that continues a line"),
-                ParamSpec.integer("frame_max", 0, 36_000, "longest line in frames; 0 = no limit"),
-                ParamSpec.bool("recover", "start a new line at the last check (no gaps)"),
-                ParamSpec.number("fps", 1, 1000, "frames per second of the drawing loop")),
-            DROP_AND_GRID);
-
-    static final Map<String, ParamSpec> WINDOW_SPECS =
-        table(
-            List.of(
-                ParamSpec.number(
-                    "max_error",
-                    0.001,
-                    100,
-                    "farthest a drawn point may lie from its stroke, in grid units"),
-                ParamSpec.integer(
-                    "max_window",
-                    1,
-                    10_000,
-                    "longest stroke in samples after its start (bounds the work per sample)"),
-                ParamSpec.number(
-                    "max_stroke_ms",
-                    0,
-                    60_000,
-                    "longest stroke in ms of drawing, so a long line is felt before it ends; "
-                        + "0 = no limit")),
-            DROP_AND_GRID);
-
-    static final Map<String, Object> ANGLE_DEFAULTS =
-        ordered(
-            "check_frames", 5L,
-            "max_angle_deg", 20.0,
-            "frame_max", 0L,
-            "fps", 60.0,
-            "recover", true,
-            "clear_on_press", true,
-            "min_duration_ms", 6.1,
-            "min_length", 0.1,
-            "rows", 3L,
-            "columns", 4L,
-            "canvas_width_px", 1920.0,
-            "canvas_height_px", 1080.0,
-            "stretch", false);
-
-    // The project's defaults (docs/research.md, "Default settings"): max_error 0.25 grid units
-    // is 7.5 mm on the paper's sleeve, well below the forearm's two-point threshold; strokes of
-    // at most 300 ms keep the felt drawing within about a third of a second of the pen.
-    static final Map<String, Object> WINDOW_DEFAULTS =
-        ordered(
-            "max_error", 0.25,
-            "max_window", 256L,
-            "max_stroke_ms", 300.0,
-            "clear_on_press", true,
-            "min_duration_ms", 6.1,
-            "min_length", 0.1,
-            "rows", 3L,
-            "columns", 4L,
-            "canvas_width_px", 1920.0,
-            "canvas_height_px", 1080.0,
-            "stretch", false);
-
-    static final Map<String, Algorithm> ONLY_FOR = onlyForTable();
-
-    private static Map<String, ParamSpec> table(List<ParamSpec> own, List<ParamSpec> shared) {
-      Map<String, ParamSpec> out = new LinkedHashMap<>();
-      for (ParamSpec spec : own) {
-        out.put(spec.name(), spec);
+    static {
+      Map<String, ParamTable.Row> rows = new LinkedHashMap<>();
+      for (ParamTable.Row row : ParamTable.PARAMETERS) {
+        rows.put(row.name(), row);
       }
-      for (ParamSpec spec : shared) {
-        out.put(spec.name(), spec);
+      for (Algorithm algorithm : values()) {
+        List<String> names = ParamTable.ALGORITHMS.get(algorithm.wireName);
+        if (names == null) {
+          throw new IllegalStateException("ParamTable has no " + algorithm.wireName);
+        }
+        Map<String, ParamSpec> specs = new LinkedHashMap<>();
+        Map<String, Object> defaults = new LinkedHashMap<>();
+        for (String name : names) {
+          ParamTable.Row row = rows.get(name);
+          specs.put(
+              name, new ParamSpec(name, row.kind(), row.minimum(), row.maximum(), row.help()));
+          defaults.put(name, row.defaultValue());
+        }
+        SPECS.put(algorithm, Collections.unmodifiableMap(specs));
+        DEFAULTS.put(algorithm, Collections.unmodifiableMap(defaults));
       }
-      return Collections.unmodifiableMap(out);
-    }
-
-    private static Map<String, Object> ordered(Object... pairs) {
-      Map<String, Object> out = new LinkedHashMap<>();
-      for (int i = 0; i < pairs.length; i += 2) {
-        out.put((String) pairs[i], pairs[i + 1]);
-      }
-      return Collections.unmodifiableMap(out);
-    }
-
-    private static Map<String, Algorithm> onlyForTable() {
-      Map<String, List<Algorithm>> owners = new LinkedHashMap<>();
-      for (Map<String, ParamSpec> specs : List.of(ANGLE_SPECS, WINDOW_SPECS)) {
-        Algorithm algorithm = specs == ANGLE_SPECS ? ANGLE : WINDOW;
-        for (String name : specs.keySet()) {
-          owners.computeIfAbsent(name, k -> new ArrayList<>()).add(algorithm);
+      Map<String, Algorithm> onlyFor = new LinkedHashMap<>();
+      for (ParamTable.Row row : ParamTable.PARAMETERS) {
+        if (row.algorithms().size() == 1) {
+          onlyFor.put(row.name(), named(row.algorithms().get(0)));
         }
       }
-      Map<String, Algorithm> out = new LinkedHashMap<>();
-      owners.forEach(
-          (name, list) -> {
-            if (list.size() == 1) {
-              out.put(name, list.get(0));
-            }
-          });
-      return Collections.unmodifiableMap(out);
+      ONLY_FOR = Collections.unmodifiableMap(onlyFor);
     }
   }
 }

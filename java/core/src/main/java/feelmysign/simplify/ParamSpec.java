@@ -5,7 +5,8 @@ import java.math.BigInteger;
 
 /**
  * One parameter of a simplifier: its name, kind, allowed range (inclusive; null: unbounded)
- * and help, as the reference's {@code ParamSpec} (written to {@code testdata/*}/params.json).
+ * and help, as the reference's {@code ParamSpec} (written to {@code testdata/*}/params.json);
+ * {@link Algorithm} makes them from the generated {@link ParamTable}.
  */
 public record ParamSpec(String name, Kind kind, Double minimum, Double maximum, String help) {
 
@@ -25,18 +26,6 @@ public record ParamSpec(String name, Kind kind, Double minimum, Double maximum, 
     public String jsonName() {
       return jsonName;
     }
-  }
-
-  static ParamSpec bool(String name, String help) {
-    return new ParamSpec(name, Kind.BOOLEAN, null, null, help);
-  }
-
-  static ParamSpec integer(String name, double minimum, double maximum, String help) {
-    return new ParamSpec(name, Kind.INTEGER, minimum, maximum, help);
-  }
-
-  static ParamSpec number(String name, double minimum, double maximum, String help) {
-    return new ParamSpec(name, Kind.NUMBER, minimum, maximum, help);
   }
 
   /**

@@ -1,7 +1,9 @@
 package feelmysign.simplify;
 
+import java.util.ArrayList;
 import java.util.Collections;
 import java.util.LinkedHashMap;
+import java.util.List;
 import java.util.Map;
 
 /**
@@ -10,7 +12,9 @@ import java.util.Map;
  * names, defaults, ranges and error sentences, and a value keeps the kind it was given (5 stays
  * the integer 5, 5.0 the float 5.0), as Python's dataclasses keep it.
  *
- * <p>Besides the reference's names, the paper's appendix B.1 names are understood:
+ * <p>Every name, default and range comes from the generated {@link ParamTable}, the reference's
+ * declarations. Besides the reference's names, the paper's appendix B.1 names (the table's
+ * {@code paper} column) are understood:
  * {@code frameMax}, {@code checkFrame}, {@code maxAngleDifDeg}, {@code fps}, {@code clickClear},
  * {@code recover}, {@code sleeveX} and {@code sleeveY} (the last actuator's index, counted from
  * 0, so one less than the columns and rows), {@code screenX}, {@code screenY},
@@ -92,14 +96,12 @@ public final class Params {
 
   public Object get(String name) {
     Alias alias = Alias.of(name);
-    if (alias != null) {
-      Object value = values.get(alias.canonical);
-      return alias.fromCanonical(value);
-    }
-    if (!values.containsKey(name)) {
+    String canonical = alias == null ? name : alias.canonical;
+    if (!values.containsKey(canonical)) {
       throw unknown(algorithm, name);
     }
-    return values.get(name);
+    Object value = values.get(canonical);
+    return alias == null ? value : alias.fromCanonical(value);
   }
 
   public double number(String name) {
@@ -143,7 +145,8 @@ public final class Params {
   }
 
   private static IllegalArgumentException unknown(Algorithm algorithm, String name) {
-    Algorithm owner = Algorithm.onlyFor().get(name);
+    Alias alias = Alias.of(name);
+    Algorithm owner = Algorithm.onlyFor().get(alias == null ? name : alias.canonical);
     if (owner != null && owner != algorithm) {
       return new IllegalArgumentException(
           name + " only applies to the " + owner.wireName() + " simplifier");
@@ -156,7 +159,7 @@ public final class Params {
             + "; its parameters are "
             + String.join(", ", algorithm.defaults().keySet())
             + " (or the paper's names: "
-            + String.join(", ", Alias.NAMES.keySet())
+            + String.join(", ", Alias.namesOf(algorithm))
             + ")");
   }
 
@@ -175,22 +178,20 @@ public final class Params {
     return algorithm.wireName() + " " + values;
   }
 
-  /** A name of the paper's appendix B.1, and the reference parameter it stands for. */
+  /**
+   * A name of the paper's appendix B.1 that is not the reference's, and the reference parameter
+   * it stands for: the {@code paper} column of the generated {@link ParamTable}.
+   */
   private static final class Alias {
     static final Map<String, Alias> NAMES = new LinkedHashMap<>();
 
     static {
-      add("frameMax", "frame_max", 0);
-      add("checkFrame", "check_frames", 0);
-      add("maxAngleDifDeg", "max_angle_deg", 0);
-      add("clickClear", "clear_on_press", 0);
-      // The paper counts the sleeve's actuators from 0: sleeveX 3 is 4 columns.
-      add("sleeveX", "columns", 1);
-      add("sleeveY", "rows", 1);
-      add("screenX", "canvas_width_px", 0);
-      add("screenY", "canvas_height_px", 0);
-      add("minimumDuration", "min_duration_ms", 0);
-      add("minimumSize", "min_length", 0);
+      for (ParamTable.Row row : ParamTable.PARAMETERS) {
+        // fps and recover are named as the paper names them: nothing to translate.
+        if (row.paper() != null && !row.paper().equals(row.name())) {
+          NAMES.put(row.paper(), new Alias(row.paper(), row.name(), row.paperOffset()));
+        }
+      }
     }
 
     final String name;
@@ -203,12 +204,19 @@ public final class Params {
       this.offset = offset;
     }
 
-    private static void add(String name, String canonical, long offset) {
-      NAMES.put(name, new Alias(name, canonical, offset));
-    }
-
     static Alias of(String name) {
       return NAMES.get(name);
+    }
+
+    /** The paper's names of {@code algorithm}'s parameters, in the table's order. */
+    static List<String> namesOf(Algorithm algorithm) {
+      List<String> out = new ArrayList<>();
+      for (Alias alias : NAMES.values()) {
+        if (algorithm.specs().containsKey(alias.canonical)) {
+          out.add(alias.name);
+        }
+      }
+      return out;
     }
 
     ParamSpec spec(Algorithm algorithm) {

@@ -1,6 +1,7 @@
 package feelmysign.simplify;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 
@@ -8,8 +9,10 @@ import com.fasterxml.jackson.databind.JsonNode;
 import feelmysign.Vectors;
 import feelmysign.json.Numbers;
 import java.util.ArrayList;
+import java.util.HashSet;
 import java.util.List;
 import java.util.Map;
+import java.util.Set;
 import java.util.stream.Stream;
 import org.junit.jupiter.api.Test;
 import org.junit.jupiter.params.ParameterizedTest;
@@ -17,11 +20,109 @@ import org.junit.jupiter.params.provider.Arguments;
 import org.junit.jupiter.params.provider.MethodSource;
 
 /**
- * The parameter tables against the reference's (testdata/angle/params.json and
+ * The generated {@link ParamTable} against the language-neutral table it is generated from
+ * (testdata/params/params.json): every row and column, and each algorithm's order. The
+ * parameter tables against the reference's (testdata/angle/params.json and
  * testdata/window/params.json): every name in order, kind, default (an integer stays one),
  * range and help; and the refusals of values outside them, in the reference's words.
  */
 class ParamTableTest {
+  private static final JsonNode NEUTRAL =
+      Vectors.read(Vectors.testdata().resolve("params/params.json"));
+
+  private static String textOrNull(JsonNode node) {
+    return node.isNull() ? null : node.asText();
+  }
+
+  private static Double numberOrNull(JsonNode node) {
+    return node.isNull() ? null : node.asDouble();
+  }
+
+  private static List<String> texts(JsonNode array) {
+    List<String> out = new ArrayList<>();
+    array.forEach(item -> out.add(item.asText()));
+    return out;
+  }
+
+  @Test
+  void theGeneratedTableIsTheLanguageNeutralOne() {
+    assertEquals(NEUTRAL.get("default_algorithm").asText(), ParamTable.DEFAULT_ALGORITHM);
+    assertEquals(Algorithm.named(ParamTable.DEFAULT_ALGORITHM), Algorithm.DEFAULT);
+    List<String> algorithms = new ArrayList<>();
+    NEUTRAL.get("algorithms").fieldNames().forEachRemaining(algorithms::add);
+    assertEquals(algorithms, new ArrayList<>(ParamTable.ALGORITHMS.keySet()), "algorithms");
+    for (String name : algorithms) {
+      List<String> order = texts(NEUTRAL.get("algorithms").get(name));
+      assertEquals(order, ParamTable.ALGORITHMS.get(name), name + " order");
+      assertEquals(order, new ArrayList<>(Algorithm.named(name).defaults().keySet()), name);
+    }
+    List<JsonNode> rows = new ArrayList<>();
+    NEUTRAL.get("parameters").forEach(rows::add);
+    assertEquals(
+        rows.stream().map(row -> row.get("name").asText()).toList(),
+        ParamTable.PARAMETERS.stream().map(ParamTable.Row::name).toList(),
+        "every parameter once, in the table's order");
+    Set<String> columns =
+        Set.of(
+            "name", "algorithms", "paper", "type", "default", "minimum", "maximum", "unit",
+            "label", "help", "panel", "detail_levels", "short");
+    for (int i = 0; i < rows.size(); i++) {
+      JsonNode json = rows.get(i);
+      ParamTable.Row row = ParamTable.PARAMETERS.get(i);
+      String name = row.name();
+      Set<String> keys = new HashSet<>();
+      json.fieldNames().forEachRemaining(keys::add);
+      assertEquals(columns, keys, name + ": a column the Java table does not hold");
+      assertEquals(texts(json.get("algorithms")), row.algorithms(), name + " algorithms");
+      assertEquals(textOrNull(json.get("paper")), row.paper(), name + " paper");
+      assertEquals(json.get("type").asText(), row.kind().jsonName(), name + " type");
+      assertEquals(Vectors.plain(json.get("default")), row.defaultValue(), name + " default");
+      assertEquals(numberOrNull(json.get("minimum")), row.minimum(), name + " minimum");
+      assertEquals(numberOrNull(json.get("maximum")), row.maximum(), name + " maximum");
+      assertEquals(textOrNull(json.get("unit")), row.unit(), name + " unit");
+      assertEquals(json.get("label").asText(), row.label(), name + " label");
+      assertEquals(json.get("help").asText(), row.help(), name + " help");
+      assertEquals(textOrNull(json.get("panel")), row.panel(), name + " panel");
+      List<Double> levels = null;
+      if (!json.get("detail_levels").isNull()) {
+        levels = new ArrayList<>();
+        for (JsonNode level : json.get("detail_levels")) {
+          levels.add(level.asDouble());
+        }
+      }
+      assertEquals(levels, row.detailLevels(), name + " detail levels");
+      assertEquals(textOrNull(json.get("short")), row.shortName(), name + " short");
+    }
+  }
+
+  @Test
+  void everyPaperNameOfTheTableStandsForItsParameter() {
+    int aliases = 0;
+    for (ParamTable.Row row : ParamTable.PARAMETERS) {
+      if (row.paper() == null) {
+        assertEquals(0, row.paperOffset(), row.name());
+        continue;
+      }
+      for (String wireName : row.algorithms()) {
+        Params defaults = Params.of(Algorithm.named(wireName), Map.of());
+        Object ours = defaults.get(row.name());
+        Object papers = defaults.get(row.paper());
+        if (row.kind() == ParamSpec.Kind.BOOLEAN) {
+          assertEquals(ours, papers, row.paper());
+        } else {
+          assertEquals(ours.getClass(), papers.getClass(), row.paper() + " keeps the kind");
+          assertEquals(
+              ParamSpec.toDouble(ours) - row.paperOffset(),
+              ParamSpec.toDouble(papers),
+              row.paper());
+        }
+        assertEquals(defaults, defaults.with(row.paper(), papers), row.paper() + " round trip");
+      }
+      aliases += row.paper().equals(row.name()) ? 0 : 1;
+    }
+    assertTrue(aliases >= 10, "appendix B.1 names most parameters: " + aliases);
+  }
+
   static Stream<Arguments> tables() {
     return Stream.of(
         Arguments.of(Algorithm.ANGLE, "angle/params.json"),
@@ -139,7 +240,16 @@ class ParamTableTest {
 
   @Test
   void theParametersOfTheOtherAlgorithmAreRefused() {
-    assertThrows(IllegalArgumentException.class, () -> Params.window().with("checkFrame", 5));
-    assertThrows(IllegalArgumentException.class, () -> Params.window().with("colour", 5));
+    IllegalArgumentException paper =
+        assertThrows(IllegalArgumentException.class, () -> Params.window().with("checkFrame", 5));
+    assertEquals("checkFrame only applies to the angle simplifier", paper.getMessage());
+    IllegalArgumentException read =
+        assertThrows(IllegalArgumentException.class, () -> Params.window().get("checkFrame"));
+    assertEquals("checkFrame only applies to the angle simplifier", read.getMessage());
+    IllegalArgumentException unknown =
+        assertThrows(IllegalArgumentException.class, () -> Params.window().with("colour", 5));
+    assertTrue(unknown.getMessage().startsWith("the window simplifier has no parameter colour;"));
+    assertTrue(unknown.getMessage().contains("sleeveX"), unknown.getMessage());
+    assertFalse(unknown.getMessage().contains("checkFrame"), "the angle's paper names");
   }
 }
