@@ -29,6 +29,7 @@ and skips those the sleeve is too late for after a stall (``late``).
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import hmac
 import json
@@ -236,6 +237,9 @@ class Sleeve:
             # Our own handle on paho's network thread: see _stop_network.
             self._network = self._client._thread
             log.info("sleeve %s: connecting to %s", self._id, self._settings.urls)
+            # What start-up made stays for the sleeve's life: kept out of the collector's
+            # scans, so a full collection during a stroke's receipt is short.
+            gc.freeze()
             self._stopped.wait()
             if self._fatal is not None:
                 raise self._fatal
