@@ -292,3 +292,51 @@ def test_a_crash_on_the_submitting_thread_switches_every_motor_off_and_stops_the
     assert any(change.intensity > 0 for change in backend.changes)  # it did start
     assert refusal is not None and refusal.reason == "player_stopped"
     backend.close()
+
+
+class _HungBus(SimBackend):
+    """The simulator whose first motor write hangs until ``release`` (a bus that stopped
+    answering mid-write), counting the all-offs asked of it."""
+
+    def __init__(self, layout: Layout) -> None:
+        super().__init__(layout)
+        self.hanging = threading.Event()
+        self.release = threading.Event()
+        self.all_offs = 0
+
+    def set_intensity(self, row: int, column: int, intensity: float) -> None:
+        if intensity > 0 and not self.release.is_set():
+            self.hanging.set()
+            self.release.wait()
+        super().set_intensity(row, column, intensity)
+
+    def all_off(self) -> None:
+        self.all_offs += 1
+        super().all_off()
+
+
+def test_stop_switches_every_motor_off_while_a_write_on_the_submitting_thread_hangs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The submitting thread holds the player's lock while it writes a stroke's first
+    command; a write that never returns must not keep stop from switching every motor off."""
+    monkeypatch.setattr("feelmysign.player.STOP_WAIT_S", 0.1)
+    backend = _HungBus(PAPER)
+    player = Player(backend, PAPER)
+    player.start()
+    _wait_idle(player)
+    opened_offs = backend.all_offs
+    submitter = threading.Thread(
+        target=player.submit, args=(_planned(0, 0, 3, 0, 300, drawing="hung", seq=0),)
+    )
+    submitter.start()
+    try:
+        assert backend.hanging.wait(10.0), "the first write never started"
+        player.stop()
+        offs_while_hung = backend.all_offs - opened_offs
+    finally:
+        backend.release.set()
+        submitter.join(10.0)
+    assert offs_while_hung >= 1
+    assert not submitter.is_alive()
+    backend.close()

@@ -56,6 +56,7 @@ SPIN_MS = 0.5  # spin, not sleep, for the last half millisecond: sleep wakes up 
 # thread blocks or this interval passes (5 ms by default): far too long when a
 # stroke's first command should follow its message within a millisecond.
 SWITCH_INTERVAL_S = 0.0002
+STOP_WAIT_S = 5.0  # how long stop waits for a write under way before every motor goes off
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
 MAX_PENDING = 256
 MAX_BACKLOG_MS = 30_000.0
@@ -348,11 +349,16 @@ class Player:
         self._running = False
         self._wake.set()
         if self._thread is not None:
-            self._thread.join(timeout=5.0)
+            self._thread.join(timeout=STOP_WAIT_S)
         # After any write a submitting thread is making (it saw the player running): that
         # thread checks _running under this lock, so nothing is written after this all-off.
-        with self._play_lock:
+        # A thread stuck in a write (a hung bus) must not keep the motors from going off.
+        locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
+        try:
             self._backend.all_off()
+        finally:
+            if locked:
+                self._play_lock.release()
         with self._lock:
             unplayed = list(self._inbox) + [
                 tag for tag in self._timeline.unstarted() if isinstance(tag, PlannedStroke)
@@ -392,11 +398,15 @@ class Player:
             self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
+            # After a write a submitting thread may be making (see stop).
+            locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
             try:
-                with self._play_lock:  # after a write a submitting thread may be making
-                    self._backend.all_off()
+                self._backend.all_off()
             except Exception as error:  # a lost chip: stop() tries again and says so
                 log.warning("all motors off as the player stops: %s", error)
+            finally:
+                if locked:
+                    self._play_lock.release()
 
     def _take_inbox(self) -> None:
         now = self._clock()
