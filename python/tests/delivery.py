@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import threading
@@ -69,6 +70,13 @@ class SleeveProcess(Closing):
 
     def close(self) -> None:
         self.stop()
+
+    def started(self) -> int:
+        """How many strokes the stopped sleeve started, by its own count (the line it prints as
+        it stops): one per start, however many copies of each event a watcher received."""
+        found = re.findall(r"stopped, every motor off \((\d+) played", self.log.read_text())
+        assert found, f"the sleeve did not say what it played as it stopped: see {self.log}"
+        return int(found[-1])
 
     def changes(self) -> list[dict[str, Any]]:
         if not self.record.exists():
@@ -193,15 +201,29 @@ def by_seq(events: list[dict[str, Any]], drawing: str) -> dict[int, list[dict[st
     return found
 
 
-def plays(events: list[dict[str, Any]], drawing: str) -> dict[int, int]:
-    """How many times each stroke of ``drawing`` started. A watcher may receive one event
-    twice across a broker restart (QoS 1 is at least once): such copies say the same
-    ``first_command_at_ms``, and count once."""
-    starts: dict[int, set[float]] = {}
+def starts(events: list[dict[str, Any]], drawing: str) -> dict[int, set[float]]:
+    """When each stroke of ``drawing`` started (its ``first_command_at_ms``), by seq.
+
+    A watcher may receive one event twice across a broker restart: events are QoS 1, at
+    least once, and a broker killed after it passed an event on, before it recorded the
+    acknowledgement (the sleeve's to it, or the watcher's), sends the event again. Such
+    copies say the same ``first_command_at_ms``: one start. Two starts are two clock readings.
+    """
+    found: dict[int, set[float]] = {}
     for event in played(events):
         if event.get("drawing") == drawing:
-            starts.setdefault(event["seq"], set()).add(event["first_command_at_ms"])
-    return {seq: len(times) for seq, times in starts.items()}
+            found.setdefault(event["seq"], set()).add(event["first_command_at_ms"])
+    return found
+
+
+def plays(events: list[dict[str, Any]], drawing: str) -> dict[int, int]:
+    """How many times each stroke of ``drawing`` started (see ``starts``)."""
+    return {seq: len(times) for seq, times in starts(events, drawing).items()}
+
+
+def felt_more_than_once(events: list[dict[str, Any]], drawing: str) -> dict[int, list[float]]:
+    """The strokes of ``drawing`` that started more than once, with their start times."""
+    return {seq: sorted(times) for seq, times in starts(events, drawing).items() if len(times) > 1}
 
 
 def played(events: list[dict[str, Any]]) -> list[dict[str, Any]]:

@@ -7,6 +7,10 @@ sleeve's session. Restarted on the same state, it delivers what the sleeve had n
 acknowledged, and the sleeve drops what it had already played (by
 ``drawing``/``seq``). Both orders of return: the sender first (its strokes must
 wait in the sleeve's saved session) and the sleeve first.
+
+"Felt once" is counted by starts, not by events: events are QoS 1 too, and a copy of
+one that the restarted broker delivers again is the same start (see ``delivery.starts``).
+The sleeve's own count of the strokes it started must be the drawing's length.
 """
 
 from __future__ import annotations
@@ -19,7 +23,16 @@ from pathlib import Path
 
 import pytest
 from conftest import StartBroker
-from delivery import Sender, SleeveProcess, Watcher, by_seq, delivery, played, stroke, wait_for
+from delivery import (
+    Sender,
+    SleeveProcess,
+    Watcher,
+    delivery,
+    felt_more_than_once,
+    played,
+    stroke,
+    wait_for,
+)
 
 from feelmysign.broker import Broker
 
@@ -49,10 +62,32 @@ def test_every_stroke_the_broker_acknowledged_is_felt_once_after_a_sigkill(
             f"every acknowledged stroke to play (broker killed at stroke {kill_at})",
         )
         sleeve.stop()  # a copy still on its way would be played before the sleeve stops
-        events = by_seq(played(watcher.snapshot()), sender.drawing)
-        twice = {seq: len(group) for seq, group in events.items() if len(group) > 1}
+        twice = felt_more_than_once(watcher.snapshot(), sender.drawing)
         assert not twice, f"played more than once (broker killed at stroke {kill_at}): {twice}"
+        assert sleeve.started() == STROKES, f"broker killed at stroke {kill_at}"
         assert any(change["intensity"] > 0 for change in sleeve.changes())
+
+
+def test_a_played_event_the_broker_sends_again_is_one_start_and_two_starts_are_two() -> None:
+    """What a watcher received in a run where the broker was killed just after the sleeve's
+    played event of stroke 37 went out: the event twice, the same bytes (QoS 1: the broker
+    died before an acknowledgement of the event was recorded, and it came again after the
+    restart), for a stroke the sleeve started once. A second start has a first command of
+    its own, and counts."""
+    drawing = "fe2e1a7e-6b17-4fb8-a81b-7f3301b55e25"
+    event = {
+        "type": "played",
+        "drawing": drawing,
+        "seq": 37,
+        "received_at_ms": 1795684435817.3193,
+        "first_command_at_ms": 1795684435856.3828,
+    }
+    other = {**event, "seq": 36, "first_command_at_ms": 1795684435756.1}
+    assert felt_more_than_once([other, event, dict(event)], drawing) == {}
+    again = {**event, "type": "adjusted", "first_command_at_ms": 1795684436012.5}
+    assert felt_more_than_once([other, event, dict(event), again], drawing) == {
+        37: [1795684435856.3828, 1795684436012.5]
+    }
 
 
 def _kill_and_restart(

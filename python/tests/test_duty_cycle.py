@@ -169,3 +169,39 @@ def test_energy_counts_intensity_squared_and_forgets_what_left_the_window() -> N
 def test_a_meaningless_cap_is_refused(window_ms: float, duty: float) -> None:
     with pytest.raises(ValueError, match="window_ms must be above 0"):
         DutyCycle(window_ms, duty)
+
+
+_drives = st.lists(
+    st.tuples(
+        st.integers(0, 2),  # actuator row (one column): few actuators, so drives pile up
+        st.floats(0, 1_000),  # start, ms after the one before
+        st.floats(1, 3_000),  # length, ms
+        st.floats(0.05, 1.0),  # intensity
+        st.booleans(),  # committed (a stroke admitted, not over) or written (the past)
+    ),
+    max_size=40,
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(_drives, st.floats(0, 12_000), st.floats(0, 2_000))
+def test_what_surely_fits_is_admitted(
+    drives: list[tuple[int, float, float, float, bool]], energy_ms: float, after_ms: float
+) -> None:
+    """surely_fits answers from totals and one bound for every actuator: whenever it says
+    yes, the exact check admits a stroke of that energy on any one actuator."""
+    duty = DutyCycle(window_ms=20_000.0, max_duty_cycle=0.5)
+    t_ms = 0.0
+    for actuator_row, gap_ms, length_ms, intensity, committed in drives:
+        t_ms += gap_ms
+        actuator = (actuator_row, 0)
+        if committed:
+            duty.commit({actuator: [Drive(t_ms, t_ms + length_ms, intensity**2)]}, t_ms)
+        else:
+            duty.output(actuator, t_ms, intensity)
+            duty.output(actuator, t_ms + length_ms, 0.0)
+    now_ms = t_ms + after_ms
+    if duty.surely_fits(energy_ms, now_ms):
+        for row in range(3):
+            stroke = {(row, 0): [Drive(now_ms, now_ms + energy_ms, 1.0)]}
+            assert duty.check(stroke, now_ms) is None

@@ -212,3 +212,131 @@ def test_the_loop_goes_round_at_least_once_an_idle_wait_during_a_long_command() 
         player.stop()
         backend.close()
     assert max(t for t in waits.timeouts if t is not None) <= IDLE_WAIT_S
+
+
+class _ThreadsSeen(SimBackend):
+    """The simulator, keeping which thread wrote each command."""
+
+    def __init__(self, layout: Layout) -> None:
+        super().__init__(layout)
+        self.writers: list[int] = []
+
+    def set_intensity(self, row: int, column: int, intensity: float) -> None:
+        self.writers.append(threading.get_ident())
+        super().set_intensity(row, column, intensity)
+
+
+def test_a_stroke_for_an_idle_player_starts_on_the_thread_that_submits_it() -> None:
+    """No thread switch between a stroke's receipt and its first motor; the player's thread
+    plays the rest, and the stroke plays as it would have."""
+    backend = _ThreadsSeen(PAPER)
+    events = Events()
+    player = Player(backend, PAPER, on_event=events)
+    player.start()
+    try:
+        _wait_idle(player)
+        threading.Event().wait(0.05)  # the player's thread is asleep, between rounds
+        assert player.submit(_planned(0, 0, 3, 0, 300, drawing="here", seq=0)) is None
+        first_writer = backend.writers[0] if backend.writers else None
+        (event,) = events.wait_for(1)
+        _wait_idle(player)
+        last_writer = backend.writers[-1]  # its last off
+    finally:
+        player.stop()
+    assert first_writer == threading.get_ident()
+    assert event["type"] == "played" and event["seq"] == 0
+    assert last_writer != threading.get_ident()  # written by the player's thread
+    assert backend.snapshot() == [[0.0] * 4 for _ in range(3)]
+    reference = SimBackend(PAPER)  # the same stroke, played by the player's thread alone
+    alone = Player(reference, PAPER)
+    alone._play_lock.acquire()  # as when the player's thread is in a round
+    alone.start()
+    try:
+        assert alone.submit(_planned(0, 0, 3, 0, 300, drawing="there", seq=0)) is None
+        alone._play_lock.release()
+        _wait_idle(alone)
+    finally:
+        alone.stop()
+    written = [(c.row, c.column, c.intensity) for c in backend.changes]
+    assert written == [(c.row, c.column, c.intensity) for c in reference.changes]
+    backend.close()
+    reference.close()
+
+
+def test_a_crash_on_the_submitting_thread_switches_every_motor_off_and_stops_the_player(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from feelmysign.timeline import Timeline
+
+    backend = SimBackend(PAPER)
+    events = Events()
+    player = Player(backend, PAPER, on_event=events)
+    real_complete = Timeline.complete
+
+    def complete_then_crash(self: Timeline) -> None:
+        if any(any(row) for row in backend.snapshot()):  # a motor is on: now crash
+            raise RuntimeError("a bug in the player")
+        real_complete(self)
+
+    monkeypatch.setattr(Timeline, "complete", complete_then_crash)
+    player.start()
+    try:
+        _wait_idle(player)
+        assert player.submit(_planned(0, 0, 3, 0, 2000, drawing="crash", seq=0)) is None
+        (told,) = events.wait_for(1)
+        assert backend.snapshot() == [[0.0] * 4 for _ in range(3)]  # off before submit returned
+        refusal = player.submit(_planned(0, 0, 3, 0, 2000, drawing="crash", seq=1))
+    finally:
+        player.stop()
+    assert told["type"] == "error" and told["reason"] == "player_crashed"
+    assert any(change.intensity > 0 for change in backend.changes)  # it did start
+    assert refusal is not None and refusal.reason == "player_stopped"
+    backend.close()
+
+
+class _HungBus(SimBackend):
+    """The simulator whose first motor write hangs until ``release`` (a bus that stopped
+    answering mid-write), counting the all-offs asked of it."""
+
+    def __init__(self, layout: Layout) -> None:
+        super().__init__(layout)
+        self.hanging = threading.Event()
+        self.release = threading.Event()
+        self.all_offs = 0
+
+    def set_intensity(self, row: int, column: int, intensity: float) -> None:
+        if intensity > 0 and not self.release.is_set():
+            self.hanging.set()
+            self.release.wait()
+        super().set_intensity(row, column, intensity)
+
+    def all_off(self) -> None:
+        self.all_offs += 1
+        super().all_off()
+
+
+def test_stop_switches_every_motor_off_while_a_write_on_the_submitting_thread_hangs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The submitting thread holds the player's lock while it writes a stroke's first
+    command; a write that never returns must not keep stop from switching every motor off."""
+    monkeypatch.setattr("feelmysign.player.STOP_WAIT_S", 0.1)
+    backend = _HungBus(PAPER)
+    player = Player(backend, PAPER)
+    player.start()
+    _wait_idle(player)
+    opened_offs = backend.all_offs
+    submitter = threading.Thread(
+        target=player.submit, args=(_planned(0, 0, 3, 0, 300, drawing="hung", seq=0),)
+    )
+    submitter.start()
+    try:
+        assert backend.hanging.wait(10.0), "the first write never started"
+        player.stop()
+        offs_while_hung = backend.all_offs - opened_offs
+    finally:
+        backend.release.set()
+        submitter.join(10.0)
+    assert offs_while_hung >= 1
+    assert not submitter.is_alive()
+    backend.close()

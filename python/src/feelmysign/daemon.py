@@ -29,6 +29,7 @@ and skips those the sleeve is too late for after a stall (``late``).
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import hmac
 import json
@@ -207,6 +208,7 @@ class Sleeve:
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         self._client = self._make_client()
         self._network: threading.Thread | None = None
+        self._control_topic = control_topic(self._id)  # compared with every message's topic
 
     @property
     def player(self) -> Player:
@@ -238,6 +240,9 @@ class Sleeve:
             # Our own handle on paho's network thread: see _stop_network.
             self._network = self._client._thread
             log.info("sleeve %s: connecting to %s", self._id, self._settings.urls)
+            # What start-up made stays for the sleeve's life: kept out of the collector's
+            # scans, so a full collection during a stroke's receipt is short.
+            gc.freeze()
             self._stopped.wait()
             if self._fatal is not None:
                 raise self._fatal
@@ -393,6 +398,12 @@ class Sleeve:
 
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
         received_at_ms, received_wall_ms = monotonic_ms(), wall_ms()
+        # The garbage collector can wait until the stroke's first motor command is out: a
+        # collection that a message's allocations would set off in the middle of its
+        # receipt runs when the handler returns instead (collecting is never skipped).
+        collecting = gc.isenabled()
+        if collecting:
+            gc.disable()
         info: dict[str, Any] = {"topic": message.topic}
         ack = _Ack(message.mid, self._connection) if message.qos > 0 else None
         try:
@@ -402,6 +413,9 @@ class Sleeve:
             self._reject(
                 "internal_error", f"unexpected error: {error}", info, received_wall_ms, ack
             )
+        finally:
+            if collecting:
+                gc.enable()
 
     def _handle(
         self,
@@ -412,7 +426,7 @@ class Sleeve:
         received_wall_ms: float,
     ) -> None:
         self._count("received")
-        name = message.topic
+        name = info["topic"]
         legacy = name == self._options.legacy_topic
         if message.retain:
             # A stroke kept by the broker would play again at every start.
@@ -426,7 +440,7 @@ class Sleeve:
             )
             return
         payload = message.payload
-        if name == control_topic(self._id):
+        if name == self._control_topic:
             self._control(payload, info, received_wall_ms, ack)
             return
         result = parse(payload, self._layout, format="legacy" if legacy else "json")
@@ -437,12 +451,12 @@ class Sleeve:
             self._reject(result.reason, result.message, info, received_wall_ms, ack)
             return
         stroke = result.stroke
-        known = (
-            ("drawing", stroke.drawing),
-            ("seq", stroke.seq),
-            ("sent_at_ms", stroke.sent_at_ms),
-        )
-        info.update({k: v for k, v in known if v is not None})
+        if stroke.drawing is not None:
+            info["drawing"] = stroke.drawing
+        if stroke.seq is not None:
+            info["seq"] = stroke.seq
+        if stroke.sent_at_ms is not None:
+            info["sent_at_ms"] = stroke.sent_at_ms
         if stroke.drawing is not None and stroke.drawing in self._cancelled:
             # A stroke of a cancelled drawing (one the broker held, or sent just after the cancel).
             cancelled_at_ms = self._cancelled[stroke.drawing]
@@ -493,8 +507,10 @@ class Sleeve:
             start_wall_ms=received_wall_ms + self._player.wait_ms(received_at_ms),
             duration_ms=schedule.duration_ms,
         )
-        figures = (("age_ms", verdict.age_ms), ("lag_ms", verdict.lag_ms))
-        info.update({k: round(v, 1) for k, v in figures if v is not None})
+        if verdict.age_ms is not None:
+            info["age_ms"] = round(verdict.age_ms, 1)
+        if verdict.lag_ms is not None:
+            info["lag_ms"] = round(verdict.lag_ms, 1)
         if verdict.reason is not None:
             self._reject(verdict.reason, verdict.message, info, received_wall_ms, ack)
             return

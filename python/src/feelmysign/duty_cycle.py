@@ -71,6 +71,8 @@ class DutyCycle:
         self._past_total: dict[Actuator, float] = {}
         self._level: dict[Actuator, tuple[float, float]] = {}  # actuator -> (since_ms, energy)
         self._committed: dict[Actuator, list[Drive]] = {}
+        # Per actuator, the energy of its committed drives whole: kept as they are committed.
+        self._committed_total: dict[Actuator, float] = {}
 
     def output(self, actuator: Actuator, t_ms: float, intensity: float) -> None:
         """The actuator's output changed to ``intensity`` at ``t_ms``."""
@@ -116,6 +118,18 @@ class DutyCycle:
         limit = self.budget_ms * (1 - SURE_MARGIN) - SURE_MARGIN_MS
         if energy_ms * (1 + SURE_MARGIN) > limit:
             return False
+        # First the largest past and the largest committed total, whichever actuators hold
+        # them, and every level held: above any one actuator's load. Mostly enough, and it
+        # asks nothing per actuator (this runs before a stroke's first motor command).
+        bound = (
+            energy_ms * (1 + SURE_MARGIN)
+            + max(self._past_total.values(), default=0.0)
+            + max(self._committed_total.values(), default=0.0)
+        )
+        for since_ms, energy in self._level.values():
+            bound += energy * max(0.0, now_ms - since_ms)
+        if bound <= limit:
+            return True
         for actuator in {*self._past_total, *self._level, *self._committed}:
             load = self._past_total.get(actuator, 0.0)
             level = self._level.get(actuator)
@@ -131,11 +145,16 @@ class DutyCycle:
         """The stroke with ``drives`` started: its drive counts until it is over."""
         for actuator, planned in drives.items():
             kept = [d for d in self._committed.get(actuator, ()) if d.end_ms > now_ms]
-            self._committed[actuator] = kept + list(planned)
+            committed = self._committed[actuator] = kept + list(planned)
+            total = 0.0
+            for drive in committed:  # summed as surely_fits sums them
+                total += drive.energy * (drive.end_ms - drive.start_ms)
+            self._committed_total[actuator] = total
 
     def clear(self) -> None:
         """Nothing committed any more (the plan was dropped); the past stays: it heated."""
         self._committed.clear()
+        self._committed_total.clear()
 
     def _forget(self, actuator: Actuator, now_ms: float) -> None:
         past = self._past.get(actuator)

@@ -22,6 +22,11 @@ was drawn is no longer the sender's.
 Timing: the thread sleeps until just before the next change and spins the last
 ``spin_ms``, so writes land within a fraction of a millisecond of the plan;
 each write's lateness is kept for ``timing_errors_ms``.
+
+A stroke due at once (an idle sleeve) does not wait for the player's thread to
+wake: the thread that submits it writes its first commands itself, through the
+same steps under the same lock, and the player's thread plays the rest. Waking a
+thread costs tens of microseconds at best and milliseconds on a loaded machine.
 """
 
 from __future__ import annotations
@@ -51,6 +56,7 @@ SPIN_MS = 0.5  # spin, not sleep, for the last half millisecond: sleep wakes up 
 # thread blocks or this interval passes (5 ms by default): far too long when a
 # stroke's first command should follow its message within a millisecond.
 SWITCH_INTERVAL_S = 0.0002
+STOP_WAIT_S = 5.0  # how long stop waits for a write under way before every motor goes off
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
 MAX_PENDING = 256
 MAX_BACKLOG_MS = 30_000.0
@@ -170,6 +176,11 @@ class Player:
         self._max_backlog_ms = max_backlog_ms
         self._spin_ms = spin_ms
         self._lock = threading.Lock()
+        # Held while the timeline is read or changed and while motors are written: by the
+        # player's thread for each round of its loop (never while it sleeps), and by a
+        # thread that submits a stroke due at once, which then writes its first commands
+        # itself (see submit). One writer at a time, so the writes keep their order.
+        self._play_lock = threading.Lock()
         self._wake = threading.Event()
         self._inbox: deque[PlannedStroke] = deque()
         self._pending = 0
@@ -209,8 +220,37 @@ class Player:
             self._tail_ms = stroke.start_ms + stroke.schedule.duration_ms
             self._pending += 1
             self._inbox.append(stroke)
-        self._wake.set()
+            due_now = stroke.start_ms <= stroke.received_at_ms
+        if due_now:
+            self._play_due()
+        self._wake.set()  # the player plans its next wake-up (and plays the stroke if we did not)
         return None
+
+    def _play_due(self) -> None:
+        """On the submitting thread: what is due now, written as the player's thread would
+        (same steps, same order), so a stroke for an idle sleeve needs no thread switch to
+        start. Only when the player is between rounds: when its thread holds the timeline
+        (a round, or the spin before a change), it plays the stroke itself right after."""
+        if not self._play_lock.acquire(blocking=False):
+            return
+        try:
+            if not self._running:
+                return  # stopping: stop() switches every motor off under this lock
+            self._take_inbox()
+            self._apply_cancels()
+            next_ms = self._timeline.next_ms()
+            if next_ms is not None and next_ms <= self._clock():
+                self._play()
+        except Exception:  # as in the player's thread: every motor off, and the player stops
+            log.exception("player stopped by an unexpected error; all motors off")
+            self._running = False
+            self._on_event(ErrorEvent(reason="player_crashed"))
+            try:
+                self._backend.all_off()
+            except Exception as error:  # a lost chip: stop() tries again and says so
+                log.warning("all motors off as the player stops: %s", error)
+        finally:
+            self._play_lock.release()
 
     def hold(self, drawing: object, seq: object, acknowledge: Callable[[], None]) -> bool:
         """A copy of a stroke accepted and not yet played: True, and ``acknowledge`` is called
@@ -309,8 +349,16 @@ class Player:
         self._running = False
         self._wake.set()
         if self._thread is not None:
-            self._thread.join(timeout=5.0)
-        self._backend.all_off()
+            self._thread.join(timeout=STOP_WAIT_S)
+        # After any write a submitting thread is making (it saw the player running): that
+        # thread checks _running under this lock, so nothing is written after this all-off.
+        # A thread stuck in a write (a hung bus) must not keep the motors from going off.
+        locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
+        try:
+            self._backend.all_off()
+        finally:
+            if locked:
+                self._play_lock.release()
         with self._lock:
             unplayed = list(self._inbox) + [
                 tag for tag in self._timeline.unstarted() if isinstance(tag, PlannedStroke)
@@ -337,18 +385,28 @@ class Player:
             while self._running:
                 self._beat_s = time.monotonic()
                 self._wake.clear()
-                self._take_inbox()
-                self._apply_cancels()
-                self._step()
+                with self._play_lock:
+                    if not self._running:
+                        break
+                    self._take_inbox()
+                    self._apply_cancels()
+                    wait_s = self._step()
+                if wait_s is not None:
+                    self._wake.wait(wait_s)
         except Exception:  # the thread must never die with motors on
             log.exception("player stopped by an unexpected error; all motors off")
             self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
+            # After a write a submitting thread may be making (see stop).
+            locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
             try:
                 self._backend.all_off()
             except Exception as error:  # a lost chip: stop() tries again and says so
                 log.warning("all motors off as the player stops: %s", error)
+            finally:
+                if locked:
+                    self._play_lock.release()
 
     def _take_inbox(self) -> None:
         now = self._clock()
@@ -405,18 +463,22 @@ class Player:
                         if acknowledge is not None:
                             acknowledge()
 
-    def _step(self) -> None:
+    def _step(self) -> float | None:
+        """Play what is due; else how long to sleep (s) before looking again."""
         next_ms = self._timeline.next_ms()
         if next_ms is None:
-            self._wake.wait(IDLE_WAIT_S)
-            return
+            return IDLE_WAIT_S
         wait_ms = next_ms - self._clock() - self._spin_ms
         if wait_ms > 0:
             # Never longer than when idle: the service's watchdog needs the loop to go round.
-            self._wake.wait(min(wait_ms / 1000.0, IDLE_WAIT_S))
-            return  # new strokes may have come in: look again
+            return min(wait_ms / 1000.0, IDLE_WAIT_S)  # new strokes may come in: look again
         while self._clock() < next_ms:
             time.sleep(0)  # let the network thread take the interpreter meanwhile
+        self._play()
+        return None
+
+    def _play(self) -> None:
+        """Write everything due now, then plan the rest of the strokes that started."""
         due = self._timeline.pop_due(self._clock())
         written_at_ms = self._clock()  # the first command of a stroke goes out now
         lost = self._write(due.changes)

@@ -103,22 +103,31 @@ class _Stroke:
 _Kind = Literal["on", "off", "start"]
 
 
-@dataclass(order=True)
+@dataclass(slots=True)
 class _Event:
     t_ms: float
     order: int
-    kind: _Kind = field(compare=False)
-    actuator: Actuator = field(compare=False, default=(0, 0))
-    command: int = field(compare=False, default=0)
-    energy: float = field(compare=False, default=0.0)
-    tag: object = field(compare=False, default=None)
-    stroke: _Stroke | None = field(compare=False, default=None)  # on a start event only
+    kind: _Kind
+    actuator: Actuator = (0, 0)
+    command: int = 0
+    energy: float = 0.0
+    tag: object = None
+    stroke: _Stroke | None = None  # on a start event only
+
+
+# The heap holds (t_ms, order, event): tuples compare in C, where a dataclass's ordering
+# would run Python code for every comparison of the heap, on the way to a stroke's first command.
+_Entry = tuple[float, int, _Event]
+
+
+def _when(event: _Event) -> tuple[float, int]:
+    return (event.t_ms, event.order)
 
 
 class Timeline:
     def __init__(self, layout: Layout) -> None:
         self._layout = layout
-        self._events: list[_Event] = []
+        self._events: list[_Entry] = []
         self._order = itertools.count()
         self._commands = itertools.count()
         self._active: dict[Actuator, dict[int, float]] = {}
@@ -188,10 +197,10 @@ class Timeline:
     def next_ms(self) -> float | None:
         """When the next thing is due, or None when nothing is planned."""
         if self._incomplete and (
-            not self._events or self._events[0].t_ms > self._incomplete[0].start_ms
+            not self._events or self._events[0][0] > self._incomplete[0].start_ms
         ):
             self.complete()  # started: its rest may be due first
-        return self._events[0].t_ms if self._events else None
+        return self._events[0][0] if self._events else None
 
     @property
     def busy(self) -> bool:
@@ -201,14 +210,14 @@ class Timeline:
     def pop_due(self, now_ms: float) -> Due:
         """Everything due at or before ``now_ms``, in time order; only real changes are listed."""
         due = Due()
-        while self._events and self._events[0].t_ms <= now_ms:
-            t_ms = self._events[0].t_ms
+        while self._events and self._events[0][0] <= now_ms:
+            t_ms = self._events[0][0]
             if self._incomplete and t_ms > self._incomplete[0].start_ms:
                 self.complete()  # its rest may be due before this
                 continue
             touched: dict[Actuator, object] = {}  # each actuator, and the stroke that last moved it
-            while self._events and self._events[0].t_ms == t_ms:
-                self._apply(heapq.heappop(self._events), touched, due)
+            while self._events and self._events[0][0] == t_ms:
+                self._apply(heapq.heappop(self._events)[2], touched, due)
             for actuator in sorted(touched):
                 self._settle(actuator, t_ms, due, touched[actuator])
         return due
@@ -217,16 +226,16 @@ class Timeline:
         """Drop everything still planned for the strokes whose tag ``match``es; their motors go
         off at ``now_ms`` (a motor another stroke also drives keeps that stroke's intensity)."""
         self.complete()
-        dropped = [e for e in self._events if e.tag is not None and match(e.tag)]
+        dropped = [e for _, _, e in self._events if e.tag is not None and match(e.tag)]
         if not dropped:
             return Cut()
         gone = {id(e) for e in dropped}
         # A stroke the duty-cycle cap refused was never played (and was reported): not "cut".
         refused = [e.tag for e in dropped if e.kind != "start" and e.command in self._dropped]
         self._dropped -= {e.command for e in dropped}
-        self._events = [e for e in self._events if id(e) not in gone]
+        self._events = [entry for entry in self._events if id(entry[2]) not in gone]
         heapq.heapify(self._events)
-        dropped.sort()
+        dropped.sort(key=_when)
         unstarted = [e.tag for e in dropped if e.kind == "start"]
         started: list[object] = []
         for tag in (e.tag for e in dropped):
@@ -248,14 +257,14 @@ class Timeline:
         """The tags of strokes with anything still planned, each once."""
         self.complete()
         seen: dict[int, object] = {}
-        for event in self._events:
+        for _, _, event in self._events:
             if event.tag is not None:
                 seen.setdefault(id(event.tag), event.tag)
         return list(seen.values())
 
     def unstarted(self) -> list[object]:
         """The tags of strokes added but not yet started."""
-        return [e.stroke.tag for e in sorted(self._events) if e.stroke is not None]
+        return [e.stroke.tag for _, _, e in sorted(self._events) if e.stroke is not None]
 
     def clear(self) -> list[Change]:
         """Drop everything planned; the changes that switch every running actuator off."""
@@ -270,7 +279,7 @@ class Timeline:
 
     def _push(self, event: _Event) -> None:
         event.order = next(self._order)  # ties at one time keep the order they were added in
-        heapq.heappush(self._events, event)
+        heapq.heappush(self._events, (event.t_ms, event.order, event))
 
     def _apply(self, event: _Event, touched: dict[Actuator, object], due: Due) -> None:
         if event.stroke is not None:

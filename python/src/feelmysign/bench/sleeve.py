@@ -336,3 +336,8 @@ def report() -> list[str]:
                     )
                 )
     return lines
+
+
+if __name__ == "__main__":  # python -m feelmysign.bench.sleeve: this group alone
+    for line in report():
+        print(line, flush=True)
