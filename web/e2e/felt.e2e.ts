@@ -228,7 +228,8 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
 
   it("loads a saved recording back, shows what would be felt, and plays it again", async () => {
     await page.locator('[data-testid="new-button"]').click();
-    await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.5, 0.85), at(0.2, 0.2)]);
+    // Timed by the clock (the replay plays it at its own pace), however slowly frames come.
+    await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.5, 0.85), at(0.2, 0.2)], { legMs: 700 });
     const original = await drawingId(page);
     const strokes = Number(await dataOf(page, "timeline", "strokes"));
     await watcher.waitFor("the triangle played", () => watcher.of(original, "played").length >= strokes);
