@@ -78,9 +78,13 @@ vectors-check: $(STAMP)
 # The ten slowest tests are listed before pytest's summary, to keep an eye on what makes
 # `make test` long; e.g. make pytest PYTEST_ARGS="-x tests/test_planner.py".
 PYTEST_ARGS ?= --durations=10
+# pytest's processes (pytest-xdist; 0: pytest alone). Most slow tests wait on a sleeve that
+# plays in real time or a broker that restarts, so two overlap on two cores; each idle one
+# takes the next test (worksteal), every test with its own ports and temporary state.
+PYTEST_WORKERS ?= 2
 
 pytest: $(STAMP) system
-	cd python && ../$(BIN)/pytest $(PYTEST_ARGS)
+	cd python && ../$(BIN)/pytest -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS)
 
 # Everything `make test` installs; independent of each other, so `make -j` runs them at once.
 install: system $(STAMP)

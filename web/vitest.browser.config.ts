@@ -4,6 +4,8 @@ import { defineConfig } from "vitest/config";
 export default defineConfig({
   test: {
     include: ["e2e/**/*.e2e.ts"],
+    // A temporary $XDG_STATE_HOME for every process the tests start.
+    globalSetup: ["e2e/global-setup.ts"],
     environment: "node",
     // One browser and one broker at a time: the machine has two cores.
     fileParallelism: false,

@@ -21,6 +21,10 @@
 
 A test that uses any of them is marked ``broker`` automatically (``pytest -m "not broker"``
 skips it); a missing Mosquitto fails it with the command that installs it.
+
+Every test, and every process it starts, keeps its state (``$XDG_STATE_HOME``: a broker's
+default state directory, the sleeve's wiring memos) in a temporary directory of the test
+session, never in the home directory of whoever runs the tests.
 """
 
 from __future__ import annotations
@@ -48,6 +52,15 @@ settings.load_profile("feelmysign")
 BROKER_FIXTURES = frozenset({"broker", "broker_credentials", "start_broker"})
 
 StartBroker = Callable[..., Broker]
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _state_home(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """``$XDG_STATE_HOME`` for the whole session (a test may still set its own)."""
+    state_home = tmp_path_factory.mktemp("xdg-state")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("XDG_STATE_HOME", str(state_home))
+        yield state_home
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -27,7 +27,7 @@ import json, sys
 from feelmysign.cli import build_parser
 build_parser()
 parsed = sorted(sys.modules)
-import feelmysign.study.threshold  # the probe sees an import: numpy, questplus, research
+import feelmysign.study.analysis  # the probe sees an import: numpy, scipy, the study
 print(json.dumps({"parser": parsed, "after": sorted(sys.modules)}))
 """
 
@@ -47,8 +47,8 @@ def test_building_the_parser_imports_no_heavy_module() -> None:
         [sys.executable, "-c", PROBE], capture_output=True, text=True, timeout=120, check=True
     )
     modules = json.loads(done.stdout)
-    # The probe can see a heavy import: the study's threshold module brings numpy and questplus.
-    assert {"numpy", "questplus", "feelmysign.study.threshold"} <= set(heavy(modules["after"]))
+    # The probe can see a heavy import: the study's analysis brings numpy and scipy.
+    assert {"numpy", "scipy", "feelmysign.study.analysis"} <= set(heavy(modules["after"]))
     loaded = heavy(modules["parser"])
     assert not loaded, (
         f"building the parser imported {loaded[:10]}: import them in the subcommand's handler; "

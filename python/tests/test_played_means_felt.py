@@ -39,8 +39,9 @@ TIGHT_SAFETY = (
 
 
 def _strokes(count: int, seed: int, *, spot: bool) -> list[Stroke]:
-    """Strokes with an intensity each: short and soft all over the grid (0.3, 0.303, ...), or
-    long and strong around one spot (0.85, 0.853, ...), so that one motor works hard."""
+    """Strokes with an intensity each: short all over the grid, from soft to strong (0.3 up
+    to 0.9, whatever their count), or long and strong around one spot (0.85, 0.853, ...), so
+    that one motor works hard."""
     rng = random.Random(seed)
     strokes = []
     for seq in range(count):
@@ -51,7 +52,7 @@ def _strokes(count: int, seed: int, *, spot: bool) -> list[Stroke]:
         else:
             start = (rng.uniform(0, 3), rng.uniform(0, 2))
             end = (rng.uniform(0, 3), rng.uniform(0, 2))
-            duration_ms, intensity = rng.uniform(80, 120), 0.3 + 0.003 * seq
+            duration_ms, intensity = rng.uniform(80, 120), 0.3 + 0.6 * seq / count
         strokes.append(Stroke(start, end, duration_ms, round(intensity, 3), "felt", seq))
     return strokes
 
@@ -126,7 +127,9 @@ def _play_paced(
 def test_strokes_paced_in_real_time_are_played_exactly_when_felt(
     broker: Broker, tmp_path: Path
 ) -> None:
-    strokes = _strokes(200, seed=8, spot=False)
+    # Tens of strokes over the grid, a dozen seconds of drawing: each one a check of the
+    # played event against the record.
+    strokes = _strokes(80, seed=8, spot=False)
     told, felt = _play_paced(broker, tmp_path, PAPER, strokes)
     played = {e["seq"] for e in told if e["type"] in ("played", "adjusted")}
     assert played == felt
@@ -141,7 +144,8 @@ def test_strokes_the_duty_cycle_cap_refuses_are_reported_and_never_called_played
     paper = PAPER.read_text()
     safety = paper[paper.index("[safety]") : paper.index("[i2c]")]
     layout_file.write_text(paper.replace(safety, TIGHT_SAFETY + "\n"))
-    strokes = _strokes(40, seed=9, spot=True)
+    # Ten seconds on one spot: the 2 s window fills, refuses, empties and plays again.
+    strokes = _strokes(20, seed=9, spot=True)
     told, felt = _play_paced(broker, tmp_path, layout_file, strokes)
     played = {e["seq"] for e in told if e["type"] in ("played", "adjusted")}
     capped = [e for e in told if e["type"] == "safety"]

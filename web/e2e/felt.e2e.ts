@@ -17,6 +17,8 @@ import { DESKTOP, Processes } from "./processes";
 type Point = readonly [number, number];
 /** The bound: every motor off this soon after the sleeve received the cancel. */
 const OFF_WITHIN_MS = 20;
+/** How long each leg of the long drawing takes to draw, and so its stroke to play: seconds. */
+const LEG_MS = 2_000;
 
 interface RecordLine {
   t_ms: number;
@@ -154,11 +156,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     // leg took to draw: seconds, however slowly this machine answers the Esc.
     await setLongestStroke(page, "0");
     await page.locator('[data-testid="new-button"]').click();
-    // A slow zigzag: each leg takes seconds to draw, so its stroke plays that long. Not too
-    // slow: a leg drawn in over 10 s makes a stroke the sleeve refuses as too long, and a
-    // loaded machine took 8 to 10 s a leg at 4 px a pointer step; 8 px halves that.
+    // A slow zigzag: each leg takes seconds to draw, so its stroke plays that long. Timed by
+    // the clock, not by pointer steps: a loaded machine took 8 to 10 s a leg at 4 px a step,
+    // near the 10 s of a stroke the sleeve refuses as too long.
     const legs: Point[] = [at(0.05, 0.1), at(0.3, 0.9), at(0.55, 0.1), at(0.8, 0.9), at(0.95, 0.1)];
-    await drawWithMouse(page, legs, { stepPx: 8 });
+    await drawWithMouse(page, legs, { legMs: LEG_MS });
     const drawing = await drawingId(page);
     // Mid-way: the last stroke has started (it lasts as long as its leg took to draw, over a second).
     const last = Number(await dataOf(page, "timeline", "strokes")) - 1;
@@ -226,7 +228,8 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
 
   it("loads a saved recording back, shows what would be felt, and plays it again", async () => {
     await page.locator('[data-testid="new-button"]').click();
-    await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.5, 0.85), at(0.2, 0.2)]);
+    // Timed by the clock (the replay plays it at its own pace), however slowly frames come.
+    await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.5, 0.85), at(0.2, 0.2)], { legMs: 700 });
     const original = await drawingId(page);
     const strokes = Number(await dataOf(page, "timeline", "strokes"));
     await watcher.waitFor("the triangle played", () => watcher.of(original, "played").length >= strokes);
@@ -253,7 +256,14 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0", 30_000);
     await page.locator('[data-testid="replay-button"]').click();
     const again = await drawingId(page);
-    await watcher.waitFor("the replay played", () => watcher.of(again, "played").length >= strokes);
+    // The replay keeps the drawing's own pace: it plays as long as the triangle took to draw,
+    // which a loaded machine makes longer.
+    const drawnMs = watcher.of(original, "played").reduce((sum, e) => sum + (e["duration_ms"] as number), 0);
+    await watcher.waitFor(
+      "the replay played",
+      () => watcher.of(again, "played").length >= strokes,
+      30_000 + drawnMs,
+    );
     const sent = watcher.of(again, "played").map((e) => e["seq"]);
     expect(sent).toEqual([...Array(strokes).keys()]);
     await waitForData(page, '[data-testid="played-summary"]', "played", String(strokes), 30_000);

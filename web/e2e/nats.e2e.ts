@@ -28,7 +28,8 @@ import { screenshot, waitForData } from "./page";
 import { drawSquare } from "./strokes";
 
 const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
-const READY_TIMEOUT_MS = 90_000;
+/** Longer than the cluster's own limit for settling (120 s), so that its error, with the logs, is what fails. */
+const READY_TIMEOUT_MS = 150_000;
 /** The sleeve's pace limits on a cluster (docs/deploy.md): a failover may hold strokes ~10 s. */
 const CLUSTER_PACE = ["--max-lag-ms", "30000", "--max-age-ms", "60000"];
 

@@ -72,19 +72,37 @@ export function walk(points: readonly (readonly [number, number])[], stepPx: num
   return out;
 }
 
-/** Mouse: press at the first point, move along the polyline one step per frame, release. */
+/**
+ * Mouse: press at the first point, move along the polyline one step per frame, release.
+ * With `legMs`, each leg (from one point to the next) takes that long by the clock, however
+ * slowly a loaded machine gives frames: each frame's step goes where the leg is at that time
+ * (fewer, longer steps on a slow machine), so a stroke lasts as long as its leg was meant to.
+ */
 export async function drawWithMouse(
   page: Page,
   points: readonly (readonly [number, number])[],
-  options: { stepPx?: number; beforeRelease?: () => Promise<void> } = {},
+  options: { stepPx?: number; legMs?: number; beforeRelease?: () => Promise<void> } = {},
 ): Promise<void> {
   const [x0, y0] = points[0]!;
   await page.mouse.move(x0, y0);
   await page.mouse.down();
   await nextFrame(page);
-  for (const [x, y] of walk(points, options.stepPx ?? 5)) {
-    await page.mouse.move(x, y);
-    await nextFrame(page);
+  if (options.legMs === undefined) {
+    for (const [x, y] of walk(points, options.stepPx ?? 5)) {
+      await page.mouse.move(x, y);
+      await nextFrame(page);
+    }
+  } else {
+    for (let i = 1; i < points.length; i++) {
+      const [ax, ay] = points[i - 1]!;
+      const [bx, by] = points[i]!;
+      const startMs = performance.now();
+      for (let done = 0; done < 1;) {
+        done = Math.min(1, (performance.now() - startMs) / options.legMs);
+        await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
+        await nextFrame(page);
+      }
+    }
   }
   await options.beforeRelease?.();
   await page.mouse.up();

@@ -13,10 +13,15 @@ themselves. The same figures come from
 
 The simulated gesture recordings in ``research/gestures`` follow, as ratios
 only. ``python -m feelmysign.bench.simplifier_timing`` prints this group alone.
+
+Nothing here is timed (playback is simulated), so its parts run in two processes at once:
+the default simplifier in one, the paper's and the gestures in the other.
 """
 
 from __future__ import annotations
 
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -51,26 +56,35 @@ def sources() -> tuple[list[Source], Recogniser]:
 
 
 def report() -> list[str]:
-    found, recogniser = sources()
     lines = [
         "Felt drawing against the pen (210 LASA drawings as drawn and at three speeds; "
         "skin = time on the skin / drawing time)"
     ]
-    for label, name in (("default", DEFAULT_ALGORITHM), ("paper", PAPER_ALGORITHM)):
-        rows = evaluate(
-            found, [Run(ALGORITHMS[name], {})], recogniser=recogniser, shape_metrics=False
-        )
-        for entry in summarize(rows):
-            lines.append(
-                f"  {label} ({name}) {entry['set']:<6}: skin mean {entry['skin_ratio_mean']:.3f}, "
-                f"p95 {entry['skin_ratio_p95']:.3f}; release to felt end p95 "
-                f"{entry['release_to_felt_end_p95_ms']:.0f} ms; pen to skin p95 "
-                f"{entry['pen_to_skin_p95_ms']:.0f} ms; recognised "
-                f"{entry['recognised_sent_pct']:.1f} % sent / "
-                f"{entry['recognised_drawn_pct']:.1f} % drawn; {entry['strokes_mean']:.2f} strokes"
-            )
-    lines += gesture_report()
+    # Two processes, about as much work in each (the window simplifier costs the most).
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        default = pool.submit(lasa_lines, "default", DEFAULT_ALGORITHM)
+        paper_and_gestures = pool.submit(_paper_and_gestures)
+        lines += default.result() + paper_and_gestures.result()
     return lines
+
+
+def lasa_lines(label: str, name: str) -> list[str]:
+    """The LASA figures of simplifier ``name`` at its defaults, labelled ``label``."""
+    found, recogniser = sources()
+    rows = evaluate(found, [Run(ALGORITHMS[name], {})], recogniser=recogniser, shape_metrics=False)
+    return [
+        f"  {label} ({name}) {entry['set']:<6}: skin mean {entry['skin_ratio_mean']:.3f}, "
+        f"p95 {entry['skin_ratio_p95']:.3f}; release to felt end p95 "
+        f"{entry['release_to_felt_end_p95_ms']:.0f} ms; pen to skin p95 "
+        f"{entry['pen_to_skin_p95_ms']:.0f} ms; recognised "
+        f"{entry['recognised_sent_pct']:.1f} % sent / "
+        f"{entry['recognised_drawn_pct']:.1f} % drawn; {entry['strokes_mean']:.2f} strokes"
+        for entry in summarize(rows)
+    ]
+
+
+def _paper_and_gestures() -> list[str]:
+    return lasa_lines("paper", PAPER_ALGORITHM) + gesture_report()
 
 
 # The simulated gesture recordings (research/gestures), when run from the repository.

@@ -15,10 +15,19 @@ with ``tls=`` (a certificate for 127.0.0.1 from ``broker.tls.ensure_local_ca``)
 (``mqtts://``, ``wss://``; a route only with a certificate from the same CA).
 ``python -m feelmysign.broker.nats_cluster DIR``
 runs one until Ctrl-C and prints its URLs and accounts as JSON (the browser tests use it).
+
+A started cluster is settled, however busy the machine: JetStream has a meta leader that
+sees the other two nodes current, every node has taken an MQTT login (the first one
+creates the MQTT streams, with three replicas) and every node's share of those streams is
+current (its ``/healthz`` on the monitoring port, ``NatsNode.monitor_port``). Each is a
+condition waited for, never a fixed time: on a loaded machine an MQTT login that comes
+before the meta leader hangs for seconds, and one that comes before the leader has heard
+from every node is refused ("no suitable peers for placement"), and is tried again.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -26,8 +35,12 @@ import signal
 import subprocess
 import sys
 import time
+import urllib.error
+import urllib.request
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from feelmysign.broker import _process as process_
 from feelmysign.broker.credentials import (
@@ -51,9 +64,15 @@ TLS_CONF, LOOPBACK_CONF = "node.conf", "node-loopback.conf"
 NATS_SERVER_ENV = "FEELMYSIGN_NATS_SERVER"
 DEFAULT_NATS_SERVER = REPO / ".cache" / "go-bin" / "nats-server"
 NODE_NAMES = ("a", "b", "c")
-# JetStream elects its meta leader and creates the MQTT streams (R3) after the routes are up.
-READY_TIMEOUT_S = 60.0
+# JetStream elects its meta leader and creates the MQTT streams (R3) after the routes are up:
+# seconds on an idle machine; the limit is for a machine busy with other work, which only
+# a failure waits for.
+READY_TIMEOUT_S = 120.0
 READY_POLL_S = 0.2
+# One MQTT login of the readiness check: the first creates the MQTT streams, each a request
+# to JetStream that times out after 5 s (nats-server's default for MQTT).
+PROBE_TIMEOUT_S = 10.0
+MONITOR_TIMEOUT_S = 5.0
 STOP_TIMEOUT_S = 10.0
 
 
@@ -65,6 +84,8 @@ class NatsNode:
     mqtt_port: int
     ws_port: int
     tls: bool = False
+    # nats-server's HTTP monitoring (/healthz, /jsz) on 127.0.0.1; None: not served
+    monitor_port: int | None = None
 
     @property
     def mqtt_url(self) -> str:
@@ -125,13 +146,13 @@ class NatsCluster(Started):
                 free("127.0.0.1"),
                 free("127.0.0.1"),
                 tls=self.tls is not None,
+                monitor_port=free("127.0.0.1"),
             )
             for name in NODE_NAMES
         ]
         try:
             self._processes = [self._spawn(executable, node) for node in self.nodes]
-            for index in range(len(self.nodes)):
-                self._wait_ready(index)
+            self._wait_ready()
         except BaseException:
             self.stop()
             raise
@@ -171,6 +192,8 @@ class NatsCluster(Started):
             env |= {"TLS_CERT": cert, "TLS_KEY": key, "ROUTE_CERT": cert, "ROUTE_KEY": key}
             env["ROUTE_CA"] = str(tls.ca)
         conf = TLS_CONF if tls is not None else LOOPBACK_CONF
+        if node.monitor_port is not None:
+            args = ("-m", str(node.monitor_port), *args)  # on the node's host, 127.0.0.1
         log = (self.state_dir / f"{node.name}.log").open("ab")
         with log:
             return subprocess.Popen(
@@ -184,28 +207,87 @@ class NatsCluster(Started):
                 preexec_fn=process_._parent_death_signal(os.getpid()),
             )
 
-    def _wait_ready(self, index: int) -> None:
-        """Until node ``index`` accepts an MQTT login (possible only once JetStream is up)."""
+    def _wait_ready(self) -> None:
+        """Until the cluster is settled (see the top of this module), each step a condition."""
+        deadline = time.monotonic() + READY_TIMEOUT_S
+        indexes = range(len(self.nodes))
+        self._until(
+            deadline,
+            self._meta_settled,
+            "JetStream has no meta leader that sees every node current",
+        )
+        for index in indexes:
+            self._until(
+                deadline,
+                functools.partial(self._accepts_login, index),
+                f"nats-server {self.nodes[index].name} took no MQTT login",
+            )
+        self._until(
+            deadline,
+            lambda: all(self._monitor(index, "healthz") is not None for index in indexes),
+            "the MQTT streams are not current on every node",
+        )
+
+    def _until(self, deadline: float, condition: Callable[[], bool], what: str) -> None:
+        while True:
+            for index, process in enumerate(self._processes):
+                if process is not None and process.poll() is not None:
+                    raise BrokerError(
+                        "start-failed",
+                        f"nats-server {self.nodes[index].name} exited: {self.log(index)}",
+                    )
+            if condition():
+                return
+            if time.monotonic() > deadline:
+                logs = "\n".join(
+                    f"--- {node.name}.log:\n{self.log(index)}"
+                    for index, node in enumerate(self.nodes)
+                )
+                raise BrokerError(
+                    "start-failed", f"{what} after {READY_TIMEOUT_S:g} s; the logs end:\n{logs}"
+                )
+            time.sleep(READY_POLL_S)
+
+    def _monitor(self, index: int, endpoint: str) -> dict[str, Any] | None:
+        """Node ``index``'s answer on its monitoring port; None unless 200 OK (``/healthz``
+        answers 503 while the node is not current)."""
+        url = f"http://127.0.0.1:{self.nodes[index].monitor_port}/{endpoint}"
+        try:
+            with urllib.request.urlopen(url, timeout=MONITOR_TIMEOUT_S) as reply:
+                answer = json.load(reply)
+        except (OSError, ValueError):  # not listening yet, 503, a timeout, half an answer
+            return None
+        return answer if isinstance(answer, dict) else None
+
+    def _meta_settled(self) -> bool:
+        """Every node is current with one meta leader, and that leader has heard from the
+        other nodes (by name) and sees them current: streams can be placed on all three."""
+        indexes = range(len(self.nodes))
+        if not all(self._monitor(i, "healthz?js-meta-only=true") is not None for i in indexes):
+            return False
+        for index in indexes:
+            jsz = self._monitor(index, "jsz?leader-only=true")
+            if jsz is None:
+                continue  # not the leader (or gone): it answers 400
+            meta = jsz.get("meta_cluster") or {}
+            others = meta.get("replicas") or []
+            names = {peer.get("name") for peer in others}
+            return (
+                len(others) == len(self.nodes) - 1
+                and names <= set(NODE_NAMES)
+                and all(peer.get("current") and not peer.get("offline") for peer in others)
+            )
+        return False
+
+    def _accepts_login(self, index: int) -> bool:
+        """Whether node ``index`` takes an MQTT login (the first one creates the MQTT streams;
+        a refused one is tried again)."""
         node = self.nodes[index]
         sender = replace(self.credentials, mqtt_url=node.mqtt_url).settings("sender")
         if self.tls is not None:
             sender = replace(sender, ca_file=str(self.tls.ca) if self.tls.ca else None)
         probe_id = f"ready-{os.getpid()}"
-        deadline = time.monotonic() + READY_TIMEOUT_S
-        while time.monotonic() < deadline:
-            process = self._processes[index]
-            if process is not None and process.poll() is not None:
-                raise BrokerError(
-                    "start-failed", f"nats-server {node.name} exited: {self.log(index)}"
-                )
-            if probe_login(sender, client_id=probe_id, timeout_s=2.0, poll_s=0.1):
-                return
-            time.sleep(READY_POLL_S)
-        raise BrokerError(
-            "start-failed",
-            f"nats-server {node.name} did not accept MQTT logins within {READY_TIMEOUT_S:g} s: "
-            f"{self.log(index)}",
-        )
+        return bool(probe_login(sender, client_id=probe_id, timeout_s=PROBE_TIMEOUT_S, poll_s=0.1))
 
     def log(self, index: int) -> str:
         path = self.state_dir / f"{self.nodes[index].name}.log"

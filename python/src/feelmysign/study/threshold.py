@@ -25,7 +25,6 @@ import random
 from dataclasses import dataclass
 
 import numpy as np
-import questplus
 
 from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
@@ -82,6 +81,8 @@ class Procedure:
         self.thresholds = np.geomspace(
             grid.minimum, grid.maximum, (grid.steps - 1) * THRESHOLD_GRID_FACTOR + 1
         )
+        import questplus  # scipy, xarray: seconds to import, and a design check needs none
+
         self._quest = questplus.QuestPlus(
             stim_domain={"intensity": self.values},
             param_domain={
