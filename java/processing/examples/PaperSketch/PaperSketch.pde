@@ -11,6 +11,7 @@ import feelmysign.processing.*;
 String BROKER = "mqtt://127.0.0.1:1883";
 String USER = "sender";
 String PASSWORD = "";   // from the broker's credentials.json
+String SLEEVE = "sleeve1";  // whose events (played, rejected, ...) the sketch hears
 
 FeelMySign sleeve;
 
@@ -20,6 +21,7 @@ void setup() {
   sleeve = new FeelMySign(this)
     .broker(BROKER)
     .login(USER, PASSWORD)
+    .sleeve(SLEEVE)
     .angle()             // frameMax 40, checkFrame 10, maxAngleDifDeg 20, ...: B.1
     .set("screenX", 1920)
     .set("screenY", 1080)

@@ -107,7 +107,8 @@ public class FeelMySign {
 
   /** User and password (from credentials.json of {@code feelmysign broker}). */
   public FeelMySign login(String user, String pass) {
-    this.username = user;
+    // An empty user is no login: a broker that lets anyone in.
+    this.username = user == null || user.isEmpty() ? null : user;
     this.password = pass;
     return this;
   }
@@ -260,7 +261,9 @@ public class FeelMySign {
     requireStarted();
     client.newDrawing();
     if (params.flag("clear_on_press")) {
-      sent.clear();
+      synchronized (sent) {
+        sent.clear();
+      }
     }
     for (Stroke stroke : strokes) {
       send(stroke);
@@ -282,14 +285,18 @@ public class FeelMySign {
     return client == null ? 0 : client.unsent();
   }
 
-  /** The strokes sent, oldest first (at most {@link #HISTORY_STROKES}). */
+  /** The strokes sent, oldest first (at most {@link #HISTORY_STROKES}); any thread may ask. */
   public List<Stroke> sent() {
-    return new ArrayList<>(sent);
+    synchronized (sent) {
+      return new ArrayList<>(sent);
+    }
   }
 
   /** The sleeve's latest events, oldest first (at most {@link #EVENT_HISTORY}). */
   public List<SleeveEvent> events() {
-    return new ArrayList<>(events);
+    synchronized (events) {
+      return new ArrayList<>(events);
+    }
   }
 
   /** The canvas x of a grid column (the inverse of the simplifier's mapping). */
@@ -325,7 +332,7 @@ public class FeelMySign {
 
   /** Draws the strokes sent (the paper's "previously sent vectors") in the current stroke style. */
   public void drawSent() {
-    for (Stroke s : sent) {
+    for (Stroke s : sent()) {
       parent.line(canvasX(s.startX()), canvasY(s.startY()), canvasX(s.endX()), canvasY(s.endY()));
     }
   }
@@ -344,7 +351,7 @@ public class FeelMySign {
    * current drawing (the sleeve's own account, not what was sent).
    */
   public void drawPlayed() {
-    for (SleeveEvent e : events) {
+    for (SleeveEvent e : events()) {
       if (!(SleeveEvent.PLAYED.equals(e.type()) || SleeveEvent.ADJUSTED.equals(e.type()))) {
         continue;
       }
@@ -389,8 +396,12 @@ public class FeelMySign {
       release(line.isEmpty() ? sample : line.get(line.size() - 1));
     }
     if (params.flag("clear_on_press")) {
-      sent.clear();
-      events.clear();
+      synchronized (sent) {
+        sent.clear();
+      }
+      synchronized (events) {
+        events.clear();
+      }
     }
     client.newDrawing();
     line.clear();
@@ -445,20 +456,24 @@ public class FeelMySign {
   }
 
   private void remember(Stroke stroke) {
-    if (sent.size() >= HISTORY_STROKES) {
-      sent.removeFirst();
+    synchronized (sent) {
+      if (sent.size() >= HISTORY_STROKES) {
+        sent.removeFirst();
+      }
+      sent.addLast(stroke);
     }
-    sent.addLast(stroke);
   }
 
   /** Processing's hook, after the sketch's draw(): the network's news, on the sketch's thread. */
   public void draw() {
     for (Object item; (item = inbox.poll()) != null; ) {
       if (item instanceof SleeveEvent event) {
-        if (events.size() >= EVENT_HISTORY) {
-          events.removeFirst();
+        synchronized (events) {
+          if (events.size() >= EVENT_HISTORY) {
+            events.removeFirst();
+          }
+          events.addLast(event);
         }
-        events.addLast(event);
         call(eventMethod, event);
       } else if (item instanceof BrokerNews news) {
         connected = news.state == SleeveClient.State.CONNECTED;
