@@ -82,19 +82,23 @@ public class FeelMySign {
   private final BlockingQueue<Object> inbox = new ArrayBlockingQueue<>(EVENT_QUEUE);
   private final AtomicLong overflowed = new AtomicLong();
   private long overflowTold;
-  private String lastSaid;
+  /** Sentences said since the broker was last connected: each is said once, not per retry. */
+  private final java.util.Set<String> said = new java.util.LinkedHashSet<>();
+  private final Relay relay = new Relay();
   private String status = "not started";
   private boolean connected;
 
   private final Deque<Stroke> sent = new ArrayDeque<>();
   private final Deque<SleeveEvent> events = new ArrayDeque<>();
   private final List<Sample> line = new ArrayList<>();
-  private Method eventMethod;
-  private Method statusMethod;
+  private final Method eventMethod;
+  private final Method statusMethod;
 
   /** The library for {@code parent}; configure it, then {@link #start()} it in setup(). */
   public FeelMySign(PApplet parent) {
     this.parent = parent;
+    this.eventMethod = sketchMethod("sleeveEvent", SleeveEvent.class);
+    this.statusMethod = sketchMethod("sleeveStatus", String.class);
   }
 
   // ---- configuration (before start) ----
@@ -211,10 +215,8 @@ public class FeelMySign {
       params = params.with("canvas_width_px", parent.width).with("canvas_height_px", parent.height);
     }
     simplifier = params.algorithm().make(params);
-    eventMethod = sketchMethod("sleeveEvent", SleeveEvent.class);
-    statusMethod = sketchMethod("sleeveStatus", String.class);
     SleeveClient.Builder builder =
-        SleeveClient.builder(brokerUrl).sleeveId(sleeveId).format(format).listener(new Relay());
+        SleeveClient.builder(brokerUrl).sleeveId(sleeveId).format(format).listener(relay);
     if (username != null) {
       builder.login(username, password);
     }
@@ -478,8 +480,10 @@ public class FeelMySign {
       } else if (item instanceof BrokerNews news) {
         connected = news.state == SleeveClient.State.CONNECTED;
         status = news.detail;
-        if (!news.detail.equals(lastSaid)) {
-          lastSaid = news.detail;
+        if (connected) {
+          said.clear();
+        }
+        if (said.size() < 50 && said.add(news.detail)) {
           PApplet.println("feelmysign: " + news.detail);
           call(statusMethod, news.detail);
         }
@@ -528,6 +532,11 @@ public class FeelMySign {
       PApplet.println("feelmysign: " + method.getName() + "() failed: " + cause);
       cause.printStackTrace();
     }
+  }
+
+  /** The network thread's side, for tests. */
+  SleeveClient.Listener relay() {
+    return relay;
   }
 
   private record BrokerNews(SleeveClient.State state, String detail) {}

@@ -152,7 +152,8 @@ class PaperSketchIT {
         + "public void settings() { " + size + " }\n" + body + "}\n";
   }
 
-  private PApplet compileAndRun(String name, Map<String, String> constants) throws Exception {
+  /** Compiles an example as the PDE would; returns where its class is. */
+  private Path compile(String name, Map<String, String> constants) throws Exception {
     Path pde = Path.of("examples", name, name + ".pde");
     String source = sketchSource(Files.readString(pde), name, constants);
     Path src = state.resolve("sketch/" + name + ".java");
@@ -164,6 +165,18 @@ class PaperSketchIT {
     int rc = javac.run(null, null, null, "-proc:none", "-d", classes.toString(),
         "-cp", System.getProperty("java.class.path"), src.toString());
     assertEquals(0, rc, "the example " + name + " does not compile:\n" + source);
+    return classes;
+  }
+
+  @Test
+  void everyExampleCompilesAgainstTheLibrary() throws Exception {
+    for (String name : List.of("PaperSketch", "ModernSketch", "StudyShape")) {
+      assertTrue(Files.exists(compile(name, Map.of()).resolve(name + ".class")), name);
+    }
+  }
+
+  private PApplet compileAndRun(String name, Map<String, String> constants) throws Exception {
+    Path classes = compile(name, constants);
     URLClassLoader loader = new URLClassLoader(new URL[] {classes.toUri().toURL()},
         getClass().getClassLoader());
     PApplet applet = (PApplet) loader.loadClass(name).getDeclaredConstructor().newInstance();
