@@ -219,6 +219,7 @@ class PaperSketchIT {
     Map<String, Object> sender = (Map<String, Object>) credentials.get("sender");
     // The sleeve's events, heard as any other sender hears them.
     List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
+    List<String> statuses = new CopyOnWriteArrayList<>();
     SleeveClient listener = SleeveClient.builder((String) credentials.get("mqtt_url"))
         .login((String) sender.get("username"), (String) sender.get("password"))
         .sleeveId(SLEEVE)
@@ -226,6 +227,11 @@ class PaperSketchIT {
           @Override
           public void event(SleeveEvent event) {
             heard.add(event);
+          }
+
+          @Override
+          public void status(String payload) {
+            statuses.add(payload);
           }
         })
         .build();
@@ -240,7 +246,9 @@ class PaperSketchIT {
       java.lang.reflect.Field field = sketch.getClass().getDeclaredField("sleeve");
       field.setAccessible(true); // a sketch's fields are package-private, as the PDE makes them
       FeelMySign library = (FeelMySign) field.get(sketch);
-      waitFor(() -> library.connected() && listener.connected(), "connection to the broker");
+      // The sleeve's retained status: the listener's subscriptions are in place, the sleeve is up.
+      waitFor(() -> library.connected() && statuses.stream().anyMatch(p -> !p.isEmpty()),
+          "connection to the broker and the sleeve's status");
 
       List<long[]> path = squarePath();
       for (int i = 0; i < path.size(); i++) {
