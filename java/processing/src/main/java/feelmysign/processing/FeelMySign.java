@@ -91,6 +91,8 @@ public class FeelMySign {
   private final Deque<Stroke> sent = new ArrayDeque<>();
   private final Deque<SleeveEvent> events = new ArrayDeque<>();
   private final List<Sample> line = new ArrayList<>();
+  private int tooShort;
+  private int tooBrief;
   private final Method eventMethod;
   private final Method statusMethod;
 
@@ -439,6 +441,27 @@ public class FeelMySign {
       emit(s);
     }
     line.clear();
+    tellDropped();
+  }
+
+  /**
+   * The paper's NotEnoughDistance and NotEnoughDuration (its B.3.1 and B.3.2): pieces of the
+   * line the sleeve could not render leave gaps. Said once per line, with what to tune.
+   */
+  private void tellDropped() {
+    if (tooShort + tooBrief > 0) {
+      String sentence = "this line has " + (tooShort + tooBrief) + " gap(s): " + tooShort
+          + " piece(s) shorter than minimumSize (" + params.number("min_length")
+          + " grid units) and " + tooBrief + " briefer than minimumDuration ("
+          + params.number("min_duration_ms") + " ms) were not sent. Draw larger or slower, "
+          + "or tune checkFrame and maxAngleDifDeg (or minimumSize and minimumDuration for your"
+          + " sleeve).";
+      if (!inbox.offer(sentence)) {
+        overflowed.incrementAndGet();
+      }
+    }
+    tooShort = 0;
+    tooBrief = 0;
   }
 
   private void feed(List<Sample> inputs) {
@@ -451,6 +474,11 @@ public class FeelMySign {
 
   private void emit(Segment s) {
     if (!s.sent()) {
+      if (Segment.NOT_ENOUGH_DISTANCE.equals(s.dropped())) {
+        tooShort++;
+      } else {
+        tooBrief++;
+      }
       return;
     }
     Stroke stroke = new Stroke(s.startX(), s.startY(), s.endX(), s.endY(), s.durationMs());

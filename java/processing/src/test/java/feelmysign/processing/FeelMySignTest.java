@@ -89,6 +89,15 @@ class FeelMySignTest {
       assertFalse(library.connected());
       assertTrue(library.sent().size() >= 4, "a square is four strokes or more");
       assertEquals(library.sent().size(), library.unsent(), "every stroke waits in the outbox");
+      // A tap: too short to feel (the paper's NotEnoughDistance), said with what to tune.
+      int before = library.sent().size();
+      post(library, MouseEvent.PRESS, t + 500, 700, 500);
+      post(library, MouseEvent.RELEASE, t + 600, 700, 500);
+      library.draw();
+      assertTrue(sketch.statuses.stream().anyMatch(
+          s -> s.contains("gap") && s.contains("shorter than minimumSize")), sketch.statuses.toString());
+      assertEquals(0, library.sent().size(), "the tap cleared the drawing (clickClear) and sent nothing");
+      assertTrue(before > 0);
       assertEquals(new HashSet<>(sketch.statuses).size(), sketch.statuses.size(),
           "a sentence said twice: " + sketch.statuses);
       for (Thread thread : sketch.threads) {
