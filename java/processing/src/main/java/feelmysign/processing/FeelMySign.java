@@ -2,6 +2,9 @@ package feelmysign.processing;
 
 import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
+import feelmysign.protocol.Layout;
+import feelmysign.protocol.ParseResult;
+import feelmysign.protocol.Protocol;
 import feelmysign.protocol.Stroke;
 import feelmysign.protocol.StrokeException;
 import feelmysign.protocol.WireFormat;
@@ -252,9 +255,23 @@ public class FeelMySign {
     }
   }
 
-  /** Sends a stroke of your own (grid units, ms) in the current drawing. */
+  /**
+   * Sends a stroke of your own (grid units, ms) in the current drawing; one the sleeve would
+   * refuse (outside the grid, too long) is said on the console and to sleeveStatus instead.
+   *
+   * @return the stroke as sent, or null when it was not
+   */
   public Stroke send(Stroke stroke) {
     requireStarted();
+    // Checked as the sleeve will (the paper's "point not in grid", A.3.1): said, not sent.
+    Layout layout =
+        new Layout(params.rows(), params.columns(), Layout.PAPER.maxStrokeDurationMs());
+    if (Protocol.validateStroke(stroke, layout) instanceof ParseResult.Rejected rejected) {
+      if (!inbox.offer("a stroke was not sent: " + rejected.message())) {
+        overflowed.incrementAndGet();
+      }
+      return null;
+    }
     Stroke out = client.send(stroke);
     remember(out);
     return out;
@@ -270,7 +287,9 @@ public class FeelMySign {
       }
     }
     for (Stroke stroke : strokes) {
-      send(stroke);
+      if (send(stroke) == null) {
+        return; // said; the rest of the drawing would not make sense without it
+      }
     }
   }
 

@@ -98,6 +98,11 @@ class FeelMySignTest {
           s -> s.contains("gap") && s.contains("shorter than minimumSize")), sketch.statuses.toString());
       assertEquals(0, library.sent().size(), "the tap cleared the drawing (clickClear) and sent nothing");
       assertTrue(before > 0);
+      // A stroke of the sketch's own outside the grid (the paper's A.3.1): said, not sent.
+      assertEquals(null, library.send(new feelmysign.protocol.Stroke(0, 0, 9, 0, 500)));
+      library.draw();
+      assertTrue(sketch.statuses.stream().anyMatch(s -> s.startsWith("a stroke was not sent: end (9, 0)"
+          + " is outside the 3-row x 4-column grid")), sketch.statuses.toString());
       assertEquals(new HashSet<>(sketch.statuses).size(), sketch.statuses.size(),
           "a sentence said twice: " + sketch.statuses);
       for (Thread thread : sketch.threads) {
