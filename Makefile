@@ -39,6 +39,7 @@ help:
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 	@echo "make java-build  build the Java port (java/bin/feelmysign-java); make java-test tests it"
+	@echo "make processing-library  the Processing library: java/processing/target/dist/feelmysign.zip"
 
 $(RUN_STAMP): python/pyproject.toml
 	@echo "==> Python packages to run feelmysign (python/pyproject.toml: dependencies) into $(VENV):"
@@ -221,8 +222,10 @@ MVN := mvn -B -q -Dstyle.color=never -Dmaven.repo.local=$(CURDIR)/.cache/m2 -f $
 JAVA_POMS := $(JAVA_DIR)/pom.xml $(wildcard $(JAVA_DIR)/*/pom.xml)
 JAVA_STAMP := .cache/m2/.installed-stamp
 SYSTEM_PACKAGES += maven openjdk-17-jdk-headless
+# Xvfb (and xauth, for xvfb-run): the Processing library's example sketch runs on a virtual screen.
+SYSTEM_PACKAGES += xvfb xauth
 
-.PHONY: java-build java-test java-bench java-clean
+.PHONY: java-build java-test java-bench java-clean processing-library
 
 # Resolves every dependency and plugin (a build without tests) once per change of a pom.
 $(JAVA_STAMP): $(JAVA_POMS) | system
@@ -237,10 +240,12 @@ java-build: $(JAVA_STAMP)
 # Compiles once and runs every JUnit test (one JVM per module): the shared vectors, the client
 # against a real Mosquitto and sleeve simulator, and the command line against the Python
 # reference (both from the .venv). Maven is quiet; the totals of Surefire's reports follow it.
+# The Processing library's tests (failsafe, after its zip is built) run an example sketch on
+# Xvfb's virtual screen, started by xvfb-run for the whole build.
 java-test: $(JAVA_STAMP) $(STAMP) system
-	rm -rf $(JAVA_DIR)/*/target/surefire-reports
-	$(MVN) verify
-	@cat $(JAVA_DIR)/*/target/surefire-reports/*.txt | awk '/^Tests run:/ { \
+	rm -rf $(JAVA_DIR)/*/target/surefire-reports $(JAVA_DIR)/*/target/failsafe-reports
+	xvfb-run -a -s "-screen 0 1920x1080x24" $(MVN) verify
+	@cat $(JAVA_DIR)/*/target/surefire-reports/*.txt $(JAVA_DIR)/*/target/failsafe-reports/*.txt | awk '/^Tests run:/ { \
 	  gsub(",", ""); run += $$3; failed += $$5 + $$7; skipped += $$9 } \
 	  END { printf "java: %d passed, %d failed, %d skipped\n", run - failed - skipped, failed, skipped }'
 
@@ -248,6 +253,11 @@ java-test: $(JAVA_STAMP) $(STAMP) system
 # measured in the same JVM run.
 java-bench: java-build $(LASA_FRAMES)
 	java -cp $(JAVA_DIR)/cli/target/feelmysign-java.jar feelmysign.cli.Bench $(LASA_FRAMES)
+
+# The Processing library for Processing 4's Contribution Manager (docs/processing.md):
+# java/processing/target/dist/feelmysign.zip and feelmysign.txt beside it.
+processing-library: $(JAVA_STAMP)
+	$(MVN) -DskipTests package
 
 java-clean:
 	rm -rf $(JAVA_DIR)/*/target

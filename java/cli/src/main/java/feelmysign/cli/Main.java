@@ -24,9 +24,10 @@ public final class Main {
   public static int run(String[] args, PrintStream out, PrintStream err) {
     if (args.length == 0 || args[0].equals("-h") || args[0].equals("--help")) {
       PrintStream to = args.length == 0 ? err : out;
-      to.println("usage: " + PROG + " {simplify} ...");
+      to.println("usage: " + PROG + " {simplify,send} ...");
       to.println();
       to.println("  simplify  cut a recorded drawing into the strokes a sender would send");
+      to.println("  send      send strokes, a shape or a recording to a sleeve");
       return args.length == 0 ? 2 : 0;
     }
     String command = args[0];
@@ -35,10 +36,13 @@ public final class Main {
       if (command.equals("simplify")) {
         return SimplifyCommand.run(rest, out, err);
       }
+      if (command.equals("send")) {
+        return SendCommand.run(rest, out, err);
+      }
       err.println(
           "Error: command: invalid choice: '"
               + command
-              + "' (choose from 'simplify'). See '"
+              + "' (choose from 'simplify', 'send'). See '"
               + PROG
               + " --help'.");
       return 2;

@@ -113,6 +113,8 @@ public final class SleeveClient implements AutoCloseable {
   private boolean connected;
   private boolean loginRefused;
   private String lastCertificateProblem;
+  /** Whether the broker being out of reach has been told since the last connection. */
+  private boolean outageTold;
   private String drawing;
   private long nextSeq;
 
@@ -288,6 +290,7 @@ public final class SleeveClient implements AutoCloseable {
       current = client;
       connected = true;
       lastCertificateProblem = null;
+      outageTold = false;
     }
     listener.broker(
         State.CONNECTED,
@@ -363,7 +366,14 @@ public final class SleeveClient implements AutoCloseable {
               + " s. Give the broker's CA (caCertificate) or its fingerprint (caFingerprint).");
       return;
     }
-    if (wasConnected || context.getReconnector().getAttempts() == 0) {
+    // Told once per outage, not per retry. (HiveMQ counts the first attempt as 1, so its
+    // attempt count cannot say which failure is the first.)
+    boolean tell;
+    synchronized (lock) {
+      tell = wasConnected || !outageTold;
+      outageTold = true;
+    }
+    if (tell) {
       listener.broker(
           State.OFFLINE,
           "No connection to "

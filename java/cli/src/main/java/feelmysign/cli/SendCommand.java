@@ -1,0 +1,317 @@
+package feelmysign.cli;
+
+import feelmysign.client.SleeveClient;
+import feelmysign.json.PyJson;
+import feelmysign.protocol.Layout;
+import feelmysign.protocol.ParseResult;
+import feelmysign.protocol.Protocol;
+import feelmysign.protocol.Stroke;
+import feelmysign.protocol.WireFormat;
+import feelmysign.shapes.Shapes;
+import feelmysign.simplify.Params;
+import feelmysign.simplify.PathSegment;
+import feelmysign.simplify.Recording;
+import feelmysign.simplify.Simplify;
+import java.io.IOException;
+import java.io.PrintStream;
+import java.io.UncheckedIOException;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.Map;
+
+/**
+ * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
+ * feelmysign send} does (its flags where they apply): every stroke checked first, one drawing,
+ * QoS 1, and the command returns once the broker has acknowledged every stroke (exit 0), or
+ * says why not (exit 1). Strokes go out at once (the reference's "burst" pace).
+ */
+final class SendCommand {
+  private SendCommand() {}
+
+  static final String PROG = Main.PROG + " send";
+  static final String USAGE =
+      "usage: " + PROG + " [-h] [--shape {circle,square,triangle,star,heart,line}]\n"
+          + "       [--segments N] [--duration-ms D] [--margin M] [--recording FILE [--paper]]\n"
+          + "       [--intensity A] [--legacy] [--legacy-topic TOPIC] [--timeout-s S]\n"
+          + "       [--broker URL] [--id ID] [--username U] [--password P]\n"
+          + "       [--credentials FILE] [--ca FILE] [--ca-fingerprint SHA256]\n"
+          + "       [--rows R] [--columns C] [--spacing-cm S] [STROKE ...]";
+  static final String HELP = USAGE + "\n\n"
+      + "Send strokes (startX,startY,endX,endY,duration in grid units and ms), a shape of the\n"
+      + "study's library (--shape, --segments), or a recording cut by the simplifier\n"
+      + "(--recording; the window simplifier, --paper for the paper's angle one) to a sleeve,\n"
+      + "and wait until the broker has them. Broker settings: the option, else\n"
+      + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
+      + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
+
+  static int run(String[] args, PrintStream out, PrintStream err) {
+    String shape = null;
+    Integer segments = null;
+    Double durationMs = null;
+    double margin = 0;
+    String recording = null;
+    boolean paper = false;
+    Double intensity = null;
+    boolean legacy = false;
+    String legacyTopic = null;
+    double timeoutS = 10;
+    String broker = null;
+    String sleeveId = null;
+    String username = null;
+    String password = null;
+    String credentials = null;
+    String ca = null;
+    String caFingerprint = null;
+    int rows = 3;
+    int columns = 4;
+    double spacingCm = 3.0;
+    List<String> strokeArgs = new ArrayList<>();
+    for (int i = 0; i < args.length; i++) {
+      String a = args[i];
+      switch (a) {
+        case "-h", "--help" -> {
+          out.print(HELP);
+          return 0;
+        }
+        case "--shape" -> shape = value(args, ++i, a);
+        case "--segments" -> segments = (int) integer(value(args, ++i, a), a);
+        case "--duration-ms" -> durationMs = number(value(args, ++i, a), a);
+        case "--margin" -> margin = number(value(args, ++i, a), a);
+        case "--recording" -> recording = value(args, ++i, a);
+        case "--paper" -> paper = true;
+        case "--intensity" -> intensity = number(value(args, ++i, a), a);
+        case "--legacy" -> legacy = true;
+        case "--legacy-topic" -> legacyTopic = value(args, ++i, a);
+        case "--timeout-s" -> timeoutS = number(value(args, ++i, a), a);
+        case "--broker" -> broker = value(args, ++i, a);
+        case "--id" -> sleeveId = value(args, ++i, a);
+        case "--username" -> username = value(args, ++i, a);
+        case "--password" -> password = value(args, ++i, a);
+        case "--credentials" -> credentials = value(args, ++i, a);
+        case "--ca" -> ca = value(args, ++i, a);
+        case "--ca-fingerprint" -> caFingerprint = value(args, ++i, a);
+        case "--rows" -> rows = (int) integer(value(args, ++i, a), a);
+        case "--columns" -> columns = (int) integer(value(args, ++i, a), a);
+        case "--spacing-cm" -> spacingCm = number(value(args, ++i, a), a);
+        default -> {
+          if (a.startsWith("--")) {
+            throw new Main.UsageException(PROG, USAGE, "unrecognized arguments: " + a);
+          }
+          strokeArgs.add(a);
+        }
+      }
+    }
+    int given = (shape != null ? 1 : 0) + (recording != null ? 1 : 0)
+        + (strokeArgs.isEmpty() ? 0 : 1);
+    if (given != 1) {
+      throw new Main.UsageException(PROG, USAGE,
+          "give one of: STROKE ..., --shape NAME or --recording FILE");
+    }
+    if (intensity != null && !(intensity >= 0 && intensity <= 1)) {
+      throw new IllegalArgumentException("intensity = " + intensity
+          + " is not allowed; it must be a number in [0, 1], or None for the default");
+    }
+    if (!(timeoutS > 0 && Double.isFinite(timeoutS))) {
+      throw new IllegalArgumentException(
+          "--timeout-s = " + timeoutS + " is not allowed; it must be a number of seconds above 0");
+    }
+    Layout layout = new Layout(rows, columns, Layout.PAPER.maxStrokeDurationMs());
+
+    List<Stroke> strokes = new ArrayList<>();
+    if (shape != null) {
+      strokes.addAll(Shapes.strokes(shape, rows, columns, spacingCm,
+          layout.maxStrokeDurationMs(), segments, durationMs, margin));
+    } else if (recording != null) {
+      strokes.addAll(fromRecording(Path.of(recording), paper, rows, columns));
+    } else {
+      for (String text : strokeArgs) {
+        strokes.add(parseStroke(text));
+      }
+    }
+    if (strokes.isEmpty()) {
+      throw new IllegalArgumentException("nothing to send: the recording gave no strokes");
+    }
+    if (intensity != null) {
+      List<Stroke> with = new ArrayList<>();
+      for (Stroke s : strokes) {
+        with.add(new Stroke(s.startX(), s.startY(), s.endX(), s.endY(), s.durationMs(),
+            intensity, null, null, null));
+      }
+      strokes = with;
+    }
+    // Every stroke checked as the sleeve will, before anything is sent.
+    for (int i = 0; i < strokes.size(); i++) {
+      if (Protocol.validateStroke(strokes.get(i), layout) instanceof ParseResult.Rejected r) {
+        String why = r.message().endsWith(".") ? r.message() : r.message() + ".";
+        throw new IllegalArgumentException("stroke " + (i + 1) + ": " + why + " Nothing was sent.");
+      }
+    }
+
+    // Broker settings: option, else credentials file, else default.
+    if (credentials != null) {
+      Map<String, Object> document = readCredentials(Path.of(credentials));
+      if (broker == null && document.get("mqtt_url") instanceof String url) {
+        broker = url;
+      }
+      if (sleeveId == null && document.get("sleeve") instanceof Map<?, ?> sleeve
+          && sleeve.get("id") instanceof String id) {
+        sleeveId = id;
+      }
+      if (document.get("sender") instanceof Map<?, ?> sender) {
+        if (username == null && sender.get("username") instanceof String u) {
+          username = u;
+        }
+        if (password == null && sender.get("password") instanceof String p) {
+          password = p;
+        }
+      }
+      if (caFingerprint == null && ca == null && document.get("ca_fingerprint") instanceof String f) {
+        caFingerprint = f;
+      }
+    }
+    SleeveClient.Builder builder = SleeveClient.builder(broker == null ? "mqtt://127.0.0.1:1883" : broker)
+        .sleeveId(sleeveId == null ? "sleeve1" : sleeveId);
+    if (username != null) {
+      builder.login(username, password == null ? "" : password);
+    }
+    if (legacy) {
+      builder.format(WireFormat.LEGACY);
+      if (legacyTopic != null) {
+        builder.legacyTopic(legacyTopic);
+      }
+    }
+    if (ca != null) {
+      builder.caCertificate(Path.of(ca));
+    }
+    if (caFingerprint != null) {
+      builder.caFingerprint(caFingerprint);
+    }
+    String[] lastSaid = {"no answer"};
+    builder.listener(new SleeveClient.Listener() {
+      @Override
+      public void broker(SleeveClient.State state, String detail) {
+        synchronized (lastSaid) {
+          lastSaid[0] = detail;
+        }
+      }
+    });
+    try (SleeveClient client = builder.build()) {
+      client.connect();
+      client.newDrawing();
+      for (Stroke s : strokes) {
+        client.send(s);
+      }
+      long deadline = System.nanoTime() + (long) (timeoutS * 1e9);
+      while (client.unsent() > 0 && !client.loginRefused() && System.nanoTime() < deadline) {
+        try {
+          Thread.sleep(10);
+        } catch (InterruptedException stop) {
+          Thread.currentThread().interrupt();
+          break;
+        }
+      }
+      if (client.loginRefused()) {
+        err.println("Error: the broker refused the login of '" + username
+            + "': fix --username and --password, or give --credentials; nothing was sent");
+        return 1;
+      }
+      if (client.unsent() > 0) {
+        synchronized (lastSaid) {
+          err.println("Error: " + client.unsent() + " of " + strokes.size()
+              + " strokes did not reach the broker within " + timeoutS + " s: " + lastSaid[0]);
+        }
+        return 1;
+      }
+      out.println("Sent " + strokes.size() + " stroke" + (strokes.size() == 1 ? "" : "s")
+          + (legacy ? " as legacy text" : " to sleeve '" + (sleeveId == null ? "sleeve1" : sleeveId)
+              + "' (drawing " + client.drawing() + ")") + "; the broker has them.");
+      return 0;
+    }
+  }
+
+  private static List<Stroke> fromRecording(Path file, boolean paper, int rows, int columns) {
+    String text;
+    try {
+      text = Files.readString(file);
+    } catch (IOException error) {
+      throw new UncheckedIOException("cannot read the recording " + file + ": " + error.getMessage(),
+          error);
+    }
+    Recording rec = Recording.parse(text, file.toString());
+    Params params = (paper ? Params.angle() : Params.window())
+        .with("canvas_width_px", rec.widthPx()).with("canvas_height_px", rec.heightPx())
+        .with("rows", rec.rows() == null ? rows : rec.rows())
+        .with("columns", rec.columns() == null ? columns : rec.columns());
+    List<Stroke> strokes = new ArrayList<>();
+    for (PathSegment p : Simplify.paths(params, rec.paths())) {
+      var s = p.segment();
+      if (s.sent()) {
+        strokes.add(new Stroke(s.startX(), s.startY(), s.endX(), s.endY(), s.durationMs()));
+      }
+    }
+    return strokes;
+  }
+
+  private static Stroke parseStroke(String text) {
+    String[] parts = text.split(",", -1);
+    if (parts.length != 5) {
+      throw new IllegalArgumentException("STROKE " + text
+          + " is not allowed; it must be startX,startY,endX,endY,duration (grid units, ms)");
+    }
+    double[] v = new double[5];
+    for (int i = 0; i < 5; i++) {
+      try {
+        v[i] = Double.parseDouble(parts[i].strip());
+      } catch (NumberFormatException notANumber) {
+        throw new IllegalArgumentException("STROKE " + text
+            + " is not allowed; it must be startX,startY,endX,endY,duration (grid units, ms)");
+      }
+    }
+    return new Stroke(v[0], v[1], v[2], v[3], v[4]);
+  }
+
+  @SuppressWarnings("unchecked")
+  private static Map<String, Object> readCredentials(Path file) {
+    try {
+      Object document = PyJson.loads(Files.readString(file));
+      if (document instanceof Map<?, ?> map) {
+        return (Map<String, Object>) map;
+      }
+    } catch (IOException error) {
+      throw new UncheckedIOException("cannot read the credentials " + file + ": "
+          + error.getMessage(), error);
+    } catch (RuntimeException bad) {
+      // fall through: not JSON
+    }
+    throw new IllegalArgumentException("the credentials " + file
+        + " are not the JSON object 'feelmysign broker' writes");
+  }
+
+  private static String value(String[] args, int i, String flag) {
+    if (i >= args.length) {
+      throw new Main.UsageException(PROG, USAGE, "argument " + flag + ": expected one argument");
+    }
+    return args[i];
+  }
+
+  private static double number(String text, String flag) {
+    try {
+      return Double.parseDouble(text);
+    } catch (NumberFormatException e) {
+      throw new Main.UsageException(PROG, USAGE,
+          "argument " + flag + ": invalid float value: '" + text + "'");
+    }
+  }
+
+  private static long integer(String text, String flag) {
+    try {
+      return Long.parseLong(text);
+    } catch (NumberFormatException e) {
+      throw new Main.UsageException(PROG, USAGE,
+          "argument " + flag + ": invalid int value: '" + text + "'");
+    }
+  }
+
+}

@@ -1,0 +1,162 @@
+package feelmysign.cli;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+import static org.junit.jupiter.api.Assertions.fail;
+
+import feelmysign.client.SleeveClient;
+import feelmysign.client.SleeveEvent;
+import java.io.BufferedReader;
+import java.io.ByteArrayOutputStream;
+import java.io.InputStreamReader;
+import java.io.PrintStream;
+import java.nio.charset.StandardCharsets;
+import java.nio.file.Files;
+import java.nio.file.Path;
+import java.util.List;
+import java.util.Map;
+import java.util.concurrent.CopyOnWriteArrayList;
+import java.util.concurrent.TimeUnit;
+import org.junit.jupiter.api.AfterAll;
+import org.junit.jupiter.api.BeforeAll;
+import org.junit.jupiter.api.Test;
+import org.junit.jupiter.api.TestInstance;
+import org.junit.jupiter.api.io.TempDir;
+
+/** feelmysign-java send against a real broker and sleeve simulator from the .venv. */
+@TestInstance(TestInstance.Lifecycle.PER_CLASS)
+class SendCommandTest {
+  private static final long WAIT_S = 60;
+  private Path credentials;
+  private Process broker;
+  private Process sleeve;
+
+  private record Result(int code, String out, String err) {}
+
+  private static Result send(String... args) {
+    ByteArrayOutputStream out = new ByteArrayOutputStream();
+    ByteArrayOutputStream err = new ByteArrayOutputStream();
+    String[] all = new String[args.length + 1];
+    all[0] = "send";
+    System.arraycopy(args, 0, all, 1, args.length);
+    int code = Main.run(all, new PrintStream(out, true, StandardCharsets.UTF_8),
+        new PrintStream(err, true, StandardCharsets.UTF_8));
+    return new Result(code, out.toString(StandardCharsets.UTF_8), err.toString(StandardCharsets.UTF_8));
+  }
+
+  private static Path repository() {
+    for (Path dir = Path.of("").toAbsolutePath(); dir != null; dir = dir.getParent()) {
+      if (Files.isDirectory(dir.resolve("testdata")) && Files.isDirectory(dir.resolve("python"))) {
+        return dir;
+      }
+    }
+    throw new IllegalStateException("not inside the feelmysign repository");
+  }
+
+  @BeforeAll
+  void start(@TempDir Path state) throws Exception {
+    String feelmysign = repository().resolve(".venv/bin/feelmysign").toString();
+    broker = new ProcessBuilder(feelmysign, "broker", "--state-dir", state.toString(),
+            "--port", "0", "--ws-port", "0", "--sleeve-id", "send-test")
+        .redirectErrorStream(true).start();
+    BufferedReader out = new BufferedReader(
+        new InputStreamReader(broker.getInputStream(), StandardCharsets.UTF_8));
+    for (String line; (line = out.readLine()) != null && !line.startsWith("Ready."); ) {
+      // until the broker is ready
+    }
+    Thread drain = new Thread(() -> {
+      try {
+        out.lines().forEach(line -> {});
+      } catch (java.io.UncheckedIOException closed) {
+        // The broker stopped.
+      }
+    });
+    drain.setDaemon(true);
+    drain.start();
+    credentials = state.resolve("credentials.json");
+    assertTrue(Files.exists(credentials), "feelmysign broker did not start");
+    sleeve = new ProcessBuilder(feelmysign, "sleeve", "--credentials", credentials.toString(),
+            "--backend", "sim", "--log-level", "warning")
+        .redirectErrorStream(true).redirectOutput(state.resolve("sleeve.log").toFile()).start();
+  }
+
+  @AfterAll
+  void stop() throws InterruptedException {
+    for (Process p : new Process[] {sleeve, broker}) {
+      if (p != null) {
+        p.destroy();
+        if (!p.waitFor(WAIT_S, TimeUnit.SECONDS)) {
+          p.destroyForcibly();
+        }
+      }
+    }
+  }
+
+  @Test
+  void aShapeAtAChosenResolutionIsPlayedByTheSleeve() throws Exception {
+    @SuppressWarnings("unchecked")
+    Map<String, Object> doc = (Map<String, Object>) feelmysign.json.PyJson.loads(
+        Files.readString(credentials));
+    @SuppressWarnings("unchecked")
+    Map<String, Object> sender = (Map<String, Object>) doc.get("sender");
+    List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
+    List<String> statuses = new CopyOnWriteArrayList<>();
+    try (SleeveClient listener = SleeveClient.builder((String) doc.get("mqtt_url"))
+        .login((String) sender.get("username"), (String) sender.get("password"))
+        .sleeveId("send-test")
+        .listener(new SleeveClient.Listener() {
+          @Override
+          public void event(SleeveEvent event) {
+            heard.add(event);
+          }
+
+          @Override
+          public void status(String payload) {
+            statuses.add(payload);
+          }
+        }).build()) {
+      listener.connect();
+      long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
+      // The sleeve's retained status arrives once the listener's subscriptions are in place.
+      while (statuses.stream().noneMatch(p -> !p.isEmpty())) {
+        if (System.nanoTime() > deadline) {
+          fail("the listener heard no status from the sleeve");
+        }
+        Thread.sleep(20);
+      }
+      Result result = send("--credentials", credentials.toString(), "--shape", "square",
+          "--segments", "4", "--duration-ms", "1200", "--timeout-s", "60");
+      assertEquals(0, result.code(), result.err());
+      assertTrue(result.out().startsWith("Sent 4 strokes to sleeve 'send-test'"), result.out());
+      while (heard.stream().filter(e -> "played".equals(e.type())
+          || "adjusted".equals(e.type())).count() < 4) {
+        if (System.nanoTime() > deadline) {
+          fail("the sleeve did not play the square: " + heard);
+        }
+        Thread.sleep(20);
+      }
+    }
+  }
+
+  @Test
+  void aWrongPasswordIsSaidAndNothingSent() {
+    Result result = send("--credentials", credentials.toString(), "--password", "wrong",
+        "--timeout-s", "60", "0,0,2,0,500");
+    assertEquals(1, result.code());
+    assertTrue(result.err().startsWith("Error: the broker refused the login of"), result.err());
+  }
+
+  @Test
+  void badInputIsRefusedBeforeAnythingIsSent() {
+    Result outside = send("--broker", "mqtt://127.0.0.1:1", "0,0,9,0,500");
+    assertEquals(1, outside.code());
+    assertTrue(outside.err().contains("outside the 3-row x 4-column grid")
+        && outside.err().contains("Nothing was sent."), outside.err());
+    Result segments = send("--shape", "square", "--segments", "6");
+    assertEquals(1, segments.code());
+    assertEquals("Error: segments of a square = 6 is not allowed; it must be a multiple of 4"
+        + " from 4 to 64 (each of its 4 sides split into equal strokes)\n", segments.err());
+    Result both = send("--shape", "circle", "0,0,1,0,500");
+    assertEquals(2, both.code());
+  }
+}

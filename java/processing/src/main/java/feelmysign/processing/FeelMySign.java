@@ -1,0 +1,619 @@
+package feelmysign.processing;
+
+import feelmysign.client.SleeveClient;
+import feelmysign.client.SleeveEvent;
+import feelmysign.protocol.Layout;
+import feelmysign.protocol.ParseResult;
+import feelmysign.protocol.Protocol;
+import feelmysign.protocol.Stroke;
+import feelmysign.protocol.StrokeException;
+import feelmysign.protocol.WireFormat;
+import feelmysign.simplify.Algorithm;
+import feelmysign.simplify.Params;
+import feelmysign.simplify.Sample;
+import feelmysign.simplify.Segment;
+import feelmysign.simplify.Simplifier;
+import java.lang.reflect.Method;
+import java.nio.file.Path;
+import java.util.ArrayDeque;
+import java.util.ArrayList;
+import java.util.Deque;
+import java.util.List;
+import java.util.concurrent.ArrayBlockingQueue;
+import java.util.concurrent.BlockingQueue;
+import java.util.concurrent.atomic.AtomicLong;
+import processing.core.PApplet;
+import processing.event.MouseEvent;
+
+/**
+ * feelmysign for a Processing sketch: draw with the mouse, feel it on a sleeve.
+ *
+ * <pre>
+ * import feelmysign.processing.*;
+ * FeelMySign sleeve;
+ * void setup() {
+ *   size(1920, 1080);
+ *   sleeve = new FeelMySign(this).broker("mqtt://127.0.0.1:1883").login("sender", "...").start();
+ * }
+ * void draw() {
+ *   background(255);
+ *   sleeve.drawSent();   // the strokes sent so far
+ *   sleeve.drawLine();   // the line being drawn
+ * }
+ * </pre>
+ *
+ * <p>The library registers its own {@code mouseEvent}, {@code draw} and {@code dispose} hooks:
+ * a press starts a drawing, each drag goes through the simplifier, each stroke it lets go is
+ * sent. The sleeve's events and the broker's news are queued by the network thread and handed
+ * to the sketch on its own thread, at the end of each {@code draw()}: to {@code void
+ * sleeveEvent(SleeveEvent event)} and {@code void sleeveStatus(String sentence)} when the sketch
+ * has them. Nothing the network does throws into {@code draw()}: a broker out of reach, a wrong
+ * password or a certificate that does not match is said once, on the console and to {@code
+ * sleeveStatus}, and the sketch keeps drawing; strokes drawn meanwhile wait in the client's
+ * outbox (or are dropped after {@link #lateLimitMs}, the page's policies). Queues and histories
+ * are bounded, so a sketch can draw for hours.
+ */
+public class FeelMySign {
+  /** The library's version, as library.properties' prettyVersion. */
+  public static final String VERSION = "0.1.0";
+  /** Strokes kept for {@link #drawSent} and {@link #sent}: the oldest go first. */
+  public static final int HISTORY_STROKES = 500;
+  /** Events waiting for the sketch's next frame; beyond this the oldest are counted, not kept. */
+  public static final int EVENT_QUEUE = 1000;
+  /** Events kept for {@link #drawPlayed} and {@link #events}. */
+  public static final int EVENT_HISTORY = 200;
+
+  private final PApplet parent;
+  private String brokerUrl = "mqtt://127.0.0.1:1883";
+  private String username;
+  private String password;
+  private String sleeveId = "sleeve1";
+  private WireFormat format = WireFormat.JSON;
+  private String legacyTopic;
+  private Path caCertificate;
+  private String caFingerprint;
+  private Long lateLimitMs;
+  private Params params = Params.window();
+  private boolean canvasGiven;
+
+  private SleeveClient client;
+  private Simplifier simplifier;
+  private LiveFrames frames;
+  private boolean started;
+
+  /** Network thread to sketch thread. */
+  private final BlockingQueue<Object> inbox = new ArrayBlockingQueue<>(EVENT_QUEUE);
+  private final AtomicLong overflowed = new AtomicLong();
+  private long overflowTold;
+  /** Sentences said since the broker was last connected: each is said once, not per retry. */
+  private final java.util.Set<String> said = new java.util.LinkedHashSet<>();
+  private final Relay relay = new Relay();
+  private String status = "not started";
+  private boolean connected;
+
+  private final Deque<Stroke> sent = new ArrayDeque<>();
+  private final Deque<SleeveEvent> events = new ArrayDeque<>();
+  private final List<Sample> line = new ArrayList<>();
+  private int tooShort;
+  private int tooBrief;
+  private final Method eventMethod;
+  private final Method statusMethod;
+
+  /** The library for {@code parent}; configure it, then {@link #start()} it in setup(). */
+  public FeelMySign(PApplet parent) {
+    this.parent = parent;
+    this.eventMethod = sketchMethod("sleeveEvent", SleeveEvent.class);
+    this.statusMethod = sketchMethod("sleeveStatus", String.class);
+  }
+
+  // ---- configuration (before start) ----
+
+  /** The broker: mqtt://, mqtts://, ws:// or wss:// (default mqtt://127.0.0.1:1883). */
+  public FeelMySign broker(String url) {
+    this.brokerUrl = url;
+    return this;
+  }
+
+  /** User and password (from credentials.json of {@code feelmysign broker}). */
+  public FeelMySign login(String user, String pass) {
+    // An empty user is no login: a broker that lets anyone in.
+    this.username = user == null || user.isEmpty() ? null : user;
+    this.password = pass;
+    return this;
+  }
+
+  /** The sleeve's id (default sleeve1): strokes go to feelmysign/&lt;id&gt;/strokes. */
+  public FeelMySign sleeve(String id) {
+    this.sleeveId = id;
+    return this;
+  }
+
+  /** For mqtts:// and wss://: trust the CA of {@code feelmysign up --lan} (its PEM file). */
+  public FeelMySign caCertificate(String pemPath) {
+    this.caCertificate = Path.of(pemPath);
+    return this;
+  }
+
+  /** For mqtts:// and wss://: trust the broker's CA by its SHA-256 fingerprint. */
+  public FeelMySign caFingerprint(String sha256) {
+    this.caFingerprint = sha256;
+    return this;
+  }
+
+  /** The paper's legacy text on deviceOne/line instead of JSON v1. */
+  public FeelMySign legacy() {
+    this.format = WireFormat.LEGACY;
+    return this;
+  }
+
+  /** The legacy text on this topic. */
+  public FeelMySign legacy(String topic) {
+    this.format = WireFormat.LEGACY;
+    this.legacyTopic = topic;
+    return this;
+  }
+
+  /** Strokes that waited longer than this while offline are dropped, not sent late. */
+  public FeelMySign lateLimitMs(long limitMs) {
+    this.lateLimitMs = limitMs;
+    return this;
+  }
+
+  /** The paper's angle simplifier at its appendix B.1 defaults. */
+  public FeelMySign angle() {
+    return algorithm("angle");
+  }
+
+  /** The window simplifier (error-bounded, cut at features) at its defaults. */
+  public FeelMySign window() {
+    return algorithm("window");
+  }
+
+  /** A simplifier by name (angle or window) at its defaults; parameters set before are kept. */
+  public FeelMySign algorithm(String name) {
+    Algorithm algorithm = Algorithm.named(name);
+    Params fresh = algorithm == Algorithm.ANGLE ? Params.angle() : Params.window();
+    for (var entry : params.values().entrySet()) {
+      if (!entry.getKey().equals("algorithm") && fresh.values().containsKey(entry.getKey())) {
+        fresh = fresh.with(entry.getKey(), entry.getValue());
+      }
+    }
+    this.params = fresh;
+    return this;
+  }
+
+  /**
+   * One parameter, by the reference's name ({@code max_error}) or the paper's B.1 name
+   * ({@code frameMax}, {@code screenX}, ...).
+   *
+   * @throws IllegalArgumentException naming the parameter, the value and the allowed range
+   */
+  public FeelMySign set(String name, Object value) {
+    this.params = params.with(name, value);
+    if (name.equals("screenX") || name.equals("screenY") || name.startsWith("canvas_")) {
+      canvasGiven = true;
+    }
+    return this;
+  }
+
+  /** Every parameter at once. */
+  public FeelMySign params(Params given) {
+    this.params = given;
+    canvasGiven = true;
+    return this;
+  }
+
+  /** The simplifier's parameters in use. */
+  public Params params() {
+    return params;
+  }
+
+  /**
+   * Starts: the canvas is the sketch's (unless set), the client connects (in the background:
+   * this returns at once) and the hooks are registered. Call it in setup(), after size().
+   */
+  public FeelMySign start() {
+    if (started) {
+      return this;
+    }
+    if (!canvasGiven) {
+      params = params.with("canvas_width_px", parent.width).with("canvas_height_px", parent.height);
+    }
+    simplifier = params.algorithm().make(params);
+    SleeveClient.Builder builder =
+        SleeveClient.builder(brokerUrl).sleeveId(sleeveId).format(format).listener(relay);
+    if (username != null) {
+      builder.login(username, password);
+    }
+    if (legacyTopic != null) {
+      builder.legacyTopic(legacyTopic);
+    }
+    if (caCertificate != null) {
+      builder.caCertificate(caCertificate);
+    }
+    if (caFingerprint != null) {
+      builder.caFingerprint(caFingerprint);
+    }
+    if (lateLimitMs != null) {
+      builder.lateLimitMs(lateLimitMs);
+    }
+    client = builder.build();
+    parent.registerMethod("mouseEvent", this);
+    parent.registerMethod("draw", this);
+    parent.registerMethod("dispose", this);
+    started = true;
+    client.connect();
+    return this;
+  }
+
+  // ---- what a sketch calls ----
+
+  /** Stop: the sleeve stops playing this drawing and drops the rest of it. */
+  public void stop() {
+    if (client != null) {
+      client.stop();
+    }
+  }
+
+  /**
+   * Sends a stroke of your own (grid units, ms) in the current drawing; one the sleeve would
+   * refuse (outside the grid, too long) is said on the console and to sleeveStatus instead.
+   *
+   * @return the stroke as sent, or null when it was not
+   */
+  public Stroke send(Stroke stroke) {
+    requireStarted();
+    // Checked as the sleeve will (the paper's "point not in grid", A.3.1): said, not sent.
+    Layout layout =
+        new Layout(params.rows(), params.columns(), Layout.PAPER.maxStrokeDurationMs());
+    if (Protocol.validateStroke(stroke, layout) instanceof ParseResult.Rejected rejected) {
+      if (!inbox.offer("a stroke was not sent: " + rejected.message())) {
+        overflowed.incrementAndGet();
+      }
+      return null;
+    }
+    Stroke out = client.send(stroke);
+    remember(out);
+    return out;
+  }
+
+  /** Sends strokes as one new drawing (e.g. a shape), in order. */
+  public void sendDrawing(List<Stroke> strokes) {
+    requireStarted();
+    client.newDrawing();
+    if (params.flag("clear_on_press")) {
+      synchronized (sent) {
+        sent.clear();
+      }
+    }
+    for (Stroke stroke : strokes) {
+      if (send(stroke) == null) {
+        return; // said; the rest of the drawing would not make sense without it
+      }
+    }
+  }
+
+  /** Whether the broker is connected now. */
+  public boolean connected() {
+    return connected;
+  }
+
+  /** The broker's news as a sentence (what is wrong and what to do, when something is). */
+  public String status() {
+    return status;
+  }
+
+  /** Strokes the sleeve may not have yet (queued while offline or awaiting the broker). */
+  public int unsent() {
+    return client == null ? 0 : client.unsent();
+  }
+
+  /** The strokes sent, oldest first (at most {@link #HISTORY_STROKES}); any thread may ask. */
+  public List<Stroke> sent() {
+    synchronized (sent) {
+      return new ArrayList<>(sent);
+    }
+  }
+
+  /** The sleeve's latest events, oldest first (at most {@link #EVENT_HISTORY}). */
+  public List<SleeveEvent> events() {
+    synchronized (events) {
+      return new ArrayList<>(events);
+    }
+  }
+
+  /** The canvas x of a grid column (the inverse of the simplifier's mapping). */
+  public float canvasX(double gridX) {
+    int columns = params.columns();
+    double w = params.number("canvas_width_px");
+    double h = params.number("canvas_height_px");
+    if (columns <= 1) {
+      return (float) (w / 2);
+    }
+    if (params.flag("stretch")) {
+      return (float) (gridX * w / (columns - 1));
+    }
+    double scale = params.mapping().scale();
+    double offset = ((columns - 1) - w * scale) / 2;
+    return scale == 0 ? (float) (w / 2) : (float) ((gridX - offset) / scale);
+  }
+
+  /** The canvas y of a grid row. */
+  public float canvasY(double gridY) {
+    int rows = params.rows();
+    double h = params.number("canvas_height_px");
+    if (rows <= 1) {
+      return (float) (h / 2);
+    }
+    if (params.flag("stretch")) {
+      return (float) (gridY * h / (rows - 1));
+    }
+    double scale = params.mapping().scale();
+    double offset = ((rows - 1) - h * scale) / 2;
+    return scale == 0 ? (float) (h / 2) : (float) ((gridY - offset) / scale);
+  }
+
+  /** Draws the strokes sent (the paper's "previously sent vectors") in the current stroke style. */
+  public void drawSent() {
+    for (Stroke s : sent()) {
+      parent.line(canvasX(s.startX()), canvasY(s.startY()), canvasX(s.endX()), canvasY(s.endY()));
+    }
+  }
+
+  /** Draws the line being drawn, from where the current stroke starts to the pointer. */
+  public void drawLine() {
+    for (int i = 1; i < line.size(); i++) {
+      Sample a = line.get(i - 1);
+      Sample b = line.get(i);
+      parent.line((float) a.x(), (float) a.y(), (float) b.x(), (float) b.y());
+    }
+  }
+
+  /**
+   * Draws what the sleeve played, from its events: each played or adjusted stroke of the
+   * current drawing (the sleeve's own account, not what was sent).
+   */
+  public void drawPlayed() {
+    for (SleeveEvent e : events()) {
+      if (!(SleeveEvent.PLAYED.equals(e.type()) || SleeveEvent.ADJUSTED.equals(e.type()))) {
+        continue;
+      }
+      Object stroke = e.fields().get("stroke");
+      if (stroke instanceof java.util.Map<?, ?> m
+          && m.get("start") instanceof List<?> start
+          && m.get("end") instanceof List<?> end
+          && start.size() == 2
+          && end.size() == 2) {
+        parent.line(
+            canvasX(number(start.get(0))), canvasY(number(start.get(1))),
+            canvasX(number(end.get(0))), canvasY(number(end.get(1))));
+      }
+    }
+  }
+
+  private static double number(Object value) {
+    return value instanceof Number n ? n.doubleValue() : Double.NaN;
+  }
+
+  // ---- the hooks Processing calls (public, for registerMethod) ----
+
+  /** Processing's hook: mouse presses, drags and releases go through the simplifier. */
+  public void mouseEvent(MouseEvent event) {
+    double x = clamp(event.getX(), params.number("canvas_width_px"));
+    double y = clamp(event.getY(), params.number("canvas_height_px"));
+    Sample sample = new Sample(event.getMillis(), x, y);
+    switch (event.getAction()) {
+      case MouseEvent.PRESS -> press(sample);
+      case MouseEvent.DRAG -> move(sample);
+      case MouseEvent.RELEASE -> release(sample);
+      default -> {}
+    }
+  }
+
+  private static double clamp(double v, double max) {
+    return Math.max(0, Math.min(max, v));
+  }
+
+  private void press(Sample sample) {
+    if (simplifier.drawing()) {
+      release(line.isEmpty() ? sample : line.get(line.size() - 1));
+    }
+    if (params.flag("clear_on_press")) {
+      synchronized (sent) {
+        sent.clear();
+      }
+      synchronized (events) {
+        events.clear();
+      }
+    }
+    client.newDrawing();
+    line.clear();
+    line.add(sample);
+    if (params.algorithm().takesFrames()) {
+      frames = new LiveFrames(params.fps());
+      feed(frames.press(sample));
+    } else {
+      feed(List.of(sample));
+    }
+  }
+
+  private void move(Sample sample) {
+    if (!simplifier.drawing()) {
+      return; // a drag that began outside the sketch
+    }
+    if (line.size() >= 10_000) {
+      line.remove(1); // bounded: the on-screen line of a path drawn for minutes
+    }
+    line.add(sample);
+    feed(params.algorithm().takesFrames() ? frames.move(sample) : List.of(sample));
+  }
+
+  private void release(Sample sample) {
+    if (!simplifier.drawing()) {
+      return;
+    }
+    move(sample);
+    if (params.algorithm().takesFrames()) {
+      feed(frames.release());
+    }
+    for (Segment s : simplifier.end()) {
+      emit(s);
+    }
+    line.clear();
+    tellDropped();
+  }
+
+  /**
+   * The paper's NotEnoughDistance and NotEnoughDuration (its B.3.1 and B.3.2): pieces of the
+   * line the sleeve could not render leave gaps. Said once per line, with what to tune.
+   */
+  private void tellDropped() {
+    if (tooShort + tooBrief > 0) {
+      String sentence = "this line has " + (tooShort + tooBrief) + " gap(s): " + tooShort
+          + " piece(s) shorter than minimumSize (" + params.number("min_length")
+          + " grid units) and " + tooBrief + " briefer than minimumDuration ("
+          + params.number("min_duration_ms") + " ms) were not sent. Draw larger or slower, "
+          + "or tune checkFrame and maxAngleDifDeg (or minimumSize and minimumDuration for your"
+          + " sleeve).";
+      if (!inbox.offer(sentence)) {
+        overflowed.incrementAndGet();
+      }
+    }
+    tooShort = 0;
+    tooBrief = 0;
+  }
+
+  private void feed(List<Sample> inputs) {
+    for (Sample input : inputs) {
+      for (Segment s : simplifier.push(input)) {
+        emit(s);
+      }
+    }
+  }
+
+  private void emit(Segment s) {
+    if (!s.sent()) {
+      if (Segment.NOT_ENOUGH_DISTANCE.equals(s.dropped())) {
+        tooShort++;
+      } else {
+        tooBrief++;
+      }
+      return;
+    }
+    Stroke stroke = new Stroke(s.startX(), s.startY(), s.endX(), s.endY(), s.durationMs());
+    remember(client.send(stroke));
+  }
+
+  private void remember(Stroke stroke) {
+    synchronized (sent) {
+      if (sent.size() >= HISTORY_STROKES) {
+        sent.removeFirst();
+      }
+      sent.addLast(stroke);
+    }
+  }
+
+  /** Processing's hook, after the sketch's draw(): the network's news, on the sketch's thread. */
+  public void draw() {
+    for (Object item; (item = inbox.poll()) != null; ) {
+      if (item instanceof SleeveEvent event) {
+        synchronized (events) {
+          if (events.size() >= EVENT_HISTORY) {
+            events.removeFirst();
+          }
+          events.addLast(event);
+        }
+        call(eventMethod, event);
+      } else if (item instanceof BrokerNews news) {
+        connected = news.state == SleeveClient.State.CONNECTED;
+        status = news.detail;
+        if (connected) {
+          said.clear();
+        }
+        if (said.size() < 50 && said.add(news.detail)) {
+          PApplet.println("feelmysign: " + news.detail);
+          call(statusMethod, news.detail);
+        }
+      } else if (item instanceof String said) {
+        PApplet.println("feelmysign: " + said);
+        call(statusMethod, said);
+      }
+    }
+    long lost = overflowed.get();
+    if (lost != overflowTold) {
+      overflowTold = lost;
+      PApplet.println("feelmysign: " + lost + " events came faster than the sketch drew and were not kept");
+    }
+  }
+
+  /** Processing's hook when the sketch ends: the client closes (the sleeve is not stopped). */
+  public void dispose() {
+    if (client != null) {
+      client.close();
+    }
+  }
+
+  private void requireStarted() {
+    if (!started) {
+      throw new IllegalStateException("feelmysign is not started: call start() in setup() first");
+    }
+  }
+
+  private Method sketchMethod(String name, Class<?> argument) {
+    try {
+      return parent.getClass().getMethod(name, argument);
+    } catch (NoSuchMethodException absent) {
+      return null;
+    }
+  }
+
+  private void call(Method method, Object argument) {
+    if (method == null) {
+      return;
+    }
+    try {
+      method.invoke(parent, argument);
+    } catch (ReflectiveOperationException error) {
+      // The sketch's own callback failed: say so, as Processing does, and keep drawing.
+      Throwable cause = error.getCause() == null ? error : error.getCause();
+      PApplet.println("feelmysign: " + method.getName() + "() failed: " + cause);
+      cause.printStackTrace();
+    }
+  }
+
+  /** The network thread's side, for tests. */
+  SleeveClient.Listener relay() {
+    return relay;
+  }
+
+  private record BrokerNews(SleeveClient.State state, String detail) {}
+
+  /** Runs on the network thread: only queues, never blocks, never throws. */
+  private final class Relay implements SleeveClient.Listener {
+    private void offer(Object item) {
+      if (!inbox.offer(item)) {
+        overflowed.incrementAndGet();
+      }
+    }
+
+    @Override
+    public void broker(SleeveClient.State state, String detail) {
+      offer(new BrokerNews(state, detail == null ? state.toString().toLowerCase() : detail));
+    }
+
+    @Override
+    public void event(SleeveEvent event) {
+      offer(event);
+    }
+
+    @Override
+    public void refused(Stroke stroke, StrokeException error) {
+      offer("a stroke was not sent: " + error.getMessage());
+    }
+
+    @Override
+    public void late(List<Stroke> strokes) {
+      offer(strokes.size() + " strokes waited too long while offline and were dropped");
+    }
+  }
+}

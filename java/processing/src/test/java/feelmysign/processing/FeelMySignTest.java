@@ -1,0 +1,176 @@
+package feelmysign.processing;
+
+import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
+import static org.junit.jupiter.api.Assertions.assertSame;
+import static org.junit.jupiter.api.Assertions.assertThrows;
+import static org.junit.jupiter.api.Assertions.assertTrue;
+import static org.junit.jupiter.api.Assertions.fail;
+
+import feelmysign.client.SleeveEvent;
+import java.io.IOException;
+import java.net.ServerSocket;
+import java.util.ArrayList;
+import java.util.HashSet;
+import java.util.List;
+import java.util.concurrent.TimeUnit;
+import org.junit.jupiter.api.Test;
+import processing.core.PApplet;
+import processing.core.PConstants;
+import processing.event.MouseEvent;
+
+/**
+ * The library without a screen: its hooks are called as Processing calls them (a sketch that
+ * is not run), against a broker that is not there.
+ */
+class FeelMySignTest {
+  /** A sketch with the library's two optional callbacks, recording where they ran. */
+  public static class Sketch extends PApplet {
+    final List<String> statuses = new ArrayList<>();
+    final List<SleeveEvent> events = new ArrayList<>();
+    final List<Thread> threads = new ArrayList<>();
+
+    public void sleeveStatus(String sentence) {
+      statuses.add(sentence);
+      threads.add(Thread.currentThread());
+    }
+
+    public void sleeveEvent(SleeveEvent event) {
+      events.add(event);
+      threads.add(Thread.currentThread());
+    }
+  }
+
+  private static int unusedPort() throws IOException {
+    try (ServerSocket socket = new ServerSocket(0)) {
+      return socket.getLocalPort();
+    }
+  }
+
+  private static void post(FeelMySign library, int action, long millis, int x, int y) {
+    library.mouseEvent(new MouseEvent(null, millis, action, 0, x, y, PConstants.LEFT, 1));
+  }
+
+  @Test
+  void aBrokerOutOfReachIsSaidOnceAndStrokesWaitInTheOutbox() throws Exception {
+    Sketch sketch = new Sketch();
+    sketch.width = 1920;
+    sketch.height = 1080;
+    FeelMySign library =
+        new FeelMySign(sketch).broker("mqtt://127.0.0.1:" + unusedPort()).angle().start();
+    try {
+      // Nothing reaches the sketch until its draw(): the hook, called here as Processing does.
+      long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(60);
+      while (sketch.statuses.stream().noneMatch(s -> s.contains("retrying"))) {
+        if (System.nanoTime() > deadline) {
+          fail("the broker's absence was not said: " + sketch.statuses);
+        }
+        library.draw();
+        Thread.sleep(20);
+      }
+      // A square drawn meanwhile: its strokes are kept for when the broker is back.
+      long t = 0;
+      post(library, MouseEvent.PRESS, t, 200, 200);
+      int[][] corners = {{1400, 200}, {1400, 900}, {200, 900}, {200, 200}};
+      int x = 200;
+      int y = 200;
+      for (int[] c : corners) {
+        for (int k = 1; k <= 40; k++) {
+          t += 16;
+          post(library, MouseEvent.DRAG, t, x + (c[0] - x) * k / 40, y + (c[1] - y) * k / 40);
+        }
+        x = c[0];
+        y = c[1];
+      }
+      post(library, MouseEvent.RELEASE, t, x, y);
+      for (int i = 0; i < 10; i++) {
+        library.draw();
+      }
+      assertFalse(library.connected());
+      assertTrue(library.sent().size() >= 4, "a square is four strokes or more");
+      assertEquals(library.sent().size(), library.unsent(), "every stroke waits in the outbox");
+      // A tap: too short to feel (the paper's NotEnoughDistance), said with what to tune.
+      int before = library.sent().size();
+      post(library, MouseEvent.PRESS, t + 500, 700, 500);
+      post(library, MouseEvent.RELEASE, t + 600, 700, 500);
+      library.draw();
+      assertTrue(sketch.statuses.stream().anyMatch(
+          s -> s.contains("gap") && s.contains("shorter than minimumSize")), sketch.statuses.toString());
+      assertEquals(0, library.sent().size(), "the tap cleared the drawing (clickClear) and sent nothing");
+      assertTrue(before > 0);
+      // A stroke of the sketch's own outside the grid (the paper's A.3.1): said, not sent.
+      assertEquals(null, library.send(new feelmysign.protocol.Stroke(0, 0, 9, 0, 500)));
+      library.draw();
+      assertTrue(sketch.statuses.stream().anyMatch(s -> s.startsWith("a stroke was not sent: end (9, 0)"
+          + " is outside the 3-row x 4-column grid")), sketch.statuses.toString());
+      assertEquals(new HashSet<>(sketch.statuses).size(), sketch.statuses.size(),
+          "a sentence said twice: " + sketch.statuses);
+      for (Thread thread : sketch.threads) {
+        assertSame(Thread.currentThread(), thread, "a callback ran off the sketch's thread");
+      }
+    } finally {
+      library.dispose();
+    }
+  }
+
+  @Test
+  void eventsFromTheNetworkThreadReachTheSketchOnlyInsideDraw() throws Exception {
+    Sketch sketch = new Sketch();
+    // Not started: no connection, so only these events are queued.
+    FeelMySign library = new FeelMySign(sketch);
+    try {
+      Thread network = new Thread(() -> {
+        for (int i = 0; i < FeelMySign.EVENT_QUEUE + 50; i++) {
+          library.relay().event(SleeveEvent.parse(
+              "{\"type\": \"played\", \"drawing\": \"d\", \"seq\": " + i + "}"));
+        }
+      });
+      network.start();
+      network.join();
+      assertTrue(sketch.events.isEmpty(), "an event was delivered outside draw()");
+      library.draw();
+      // Bounded: what came faster than the sketch drew is counted, not kept.
+      assertEquals(FeelMySign.EVENT_QUEUE, sketch.events.size());
+      assertEquals(FeelMySign.EVENT_HISTORY, library.events().size());
+      assertEquals(0L, sketch.events.get(0).seq());
+      for (Thread thread : sketch.threads) {
+        assertSame(Thread.currentThread(), thread);
+      }
+    } finally {
+      library.dispose();
+    }
+  }
+
+  @Test
+  void aParameterOutOfRangeSaysWhichAndTheRange() {
+    FeelMySign library = new FeelMySign(new Sketch()).angle();
+    IllegalArgumentException error =
+        assertThrows(IllegalArgumentException.class, () -> library.set("checkFrame", 1));
+    assertTrue(error.getMessage().contains("1 is not allowed; it must be in [2, 600]"),
+        error.getMessage());
+  }
+
+  @Test
+  void livingFramesAreTheFramesOfARecording() {
+    // The same samples, all at once (Frames.fromSamples) and one by one (LiveFrames).
+    java.util.Random random = new java.util.Random(7);
+    for (int trial = 0; trial < 200; trial++) {
+      List<feelmysign.simplify.Sample> samples = new ArrayList<>();
+      double t = random.nextInt(1000);
+      int n = 1 + random.nextInt(40);
+      for (int i = 0; i < n; i++) {
+        samples.add(new feelmysign.simplify.Sample(t, random.nextInt(500), random.nextInt(500)));
+        t += random.nextInt(4) == 0 ? 0 : random.nextInt(60);
+      }
+      double fps = new double[] {60, 30, 24, 7.5}[random.nextInt(4)];
+      LiveFrames live = new LiveFrames(fps);
+      List<feelmysign.simplify.Sample> got = new ArrayList<>(live.press(samples.get(0)));
+      for (int i = 1; i < n; i++) {
+        got.addAll(live.move(samples.get(i)));
+      }
+      got.addAll(live.release());
+      assertEquals(feelmysign.simplify.Frames.fromSamples(samples, fps), got,
+          "trial " + trial + " at " + fps + " fps: " + samples);
+    }
+  }
+}
