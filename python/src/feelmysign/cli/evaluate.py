@@ -337,7 +337,7 @@ def _table(
         "",
         f"{'set':<6} {'algorithm':<9} {'parameters':<30} {'strokes':>7} {'DP':>6} "
         f"{'max dev':>8} {'worst':>6} {'Fréchet':>7} {'skin':>5} {'p95':>5} "
-        f"{'felt end p95':>12} {'pen p95':>8} {'recognised':>16}",
+        f"{'felt end p95':>12} {'pen p95':>8} {'recognised':>17}",
     ]
     for s in summary:
         lines.append(
@@ -347,7 +347,7 @@ def _table(
             f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
             f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
             f"{_num(s['pen_to_skin_p95_ms'], '.0f', ' ms'):>8} "
-            f"{_recognised(s):>16}"
+            f"{_recognised(s):>17}"
         )
     lines += ["", f"Wrote results.csv, frontier.csv, summary.json and 3 plots to {out}/"]
     return "\n".join(lines)
