@@ -101,6 +101,7 @@ def test_the_table_without_json(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert main(["evaluate", *argv, "--out", str(tmp_path / "o")]) == 0
     out = capsys.readouterr().out
     assert "window    max_error=0.2" in out and "Wrote results.csv" in out
+    assert "recognised: $1 on the drawings / strokes sent / felt path" in out
 
 
 @pytest.mark.parametrize(
@@ -155,6 +156,7 @@ def test_lasa_at_three_speeds_gives_timing_and_recognition(
         assert entry["pen_to_skin_p95_ms"] > 0
         assert 0 <= entry["recognised_sent_pct"] <= 100
         assert 0 <= entry["recognised_drawn_pct"] <= 100
+        assert 0 <= entry["recognised_felt_pct"] <= 100
     # The drawings themselves are the same shapes at every speed.
     drawn = {s["recognised_drawn_pct"] for s in summary}
     assert len(drawn) == 1
@@ -218,10 +220,12 @@ def test_a_folder_of_gesture_logs_is_recognised_per_speed(
         # Each drawing is named among the other three of its speed: the other person's.
         assert entry["recognised_drawn_pct"] == 100.0
         assert entry["recognised_sent_pct"] == 100.0
+        assert entry["recognised_felt_pct"] == 100.0
         assert entry["skin_ratio_mean"] > 0
     with (out / "results.csv").open() as handle:
         rows = list(csv.DictReader(handle))
     assert {r["group"] for r in rows} == {"circle", "caret"}
+    assert {r["recognised_felt"] for r in rows} == {"1"}
     # Times from the first point: a fast gesture lasts 40 x 8 ms.
     fast = [r for r in rows if r["set"] == "fast"]
     assert {float(r["drawing_ms"]) for r in fast} == {320.0}
@@ -240,6 +244,7 @@ def test_a_gesture_alone_in_its_set_is_not_recognised(
         str(tmp_path / "o"),
     )
     assert document["summary"][0]["recognised_sent_pct"] is None
+    assert document["summary"][0]["recognised_felt_pct"] is None
 
 
 @pytest.mark.parametrize(
@@ -299,6 +304,7 @@ def test_a_templates_file_in_the_folder_is_what_drawings_are_named_against(
     for entry in document["summary"]:
         assert entry["recognised_drawn_pct"] == expected_pct
         assert entry["recognised_sent_pct"] == expected_pct
+        assert entry["recognised_felt_pct"] == expected_pct
 
 
 def test_templates_given_elsewhere_name_a_gesture_without_its_own_template_nothing(
@@ -314,8 +320,9 @@ def test_templates_given_elsewhere_name_a_gesture_without_its_own_template_nothi
     with (tmp_path / "o" / "results.csv").open() as handle:
         rows = list(csv.DictReader(handle))
     # Carets have no template here: evaluated, not recognised; circles are named "ring".
-    assert {r["recognised_sent"] for r in rows if r["group"] == "caret"} == {""}
-    assert {r["recognised_sent"] for r in rows if r["group"] == "circle"} == {"1"}
+    for column in ("recognised_sent", "recognised_felt"):
+        assert {r[column] for r in rows if r["group"] == "caret"} == {""}
+        assert {r[column] for r in rows if r["group"] == "circle"} == {"1"}
 
 
 @pytest.mark.parametrize(

@@ -42,6 +42,8 @@ def test_strokes_play_back_to_back_and_the_felt_end_follows_the_last() -> None:
     assert played.pen_to_skin_ms == pytest.approx((400.0, 400.0, 400.0))
     (release,) = played.release_to_felt_end_ms
     assert 400.0 <= release <= 400.0 + 60.0  # the last stroke, and its last burst's tail
+    # Their schedules, in the order they play: what the felt path is read from.
+    assert [s.stroke.start for s in played.schedules] == [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]
 
 
 def test_a_slowed_stroke_delays_the_ones_after_it() -> None:

@@ -22,9 +22,11 @@ polyline, strokes sent and dropped, the emission lag of each stroke, and the
 strokes offline Douglas-Peucker needs at the same error; in time, with every
 stroke planned as the sleeve plans it and played back to back as the sleeve
 plays them: time on the skin / drawing time, release to felt end, pen to skin;
-and whether the $1 recogniser names the shape from the drawing and from the
-strokes sent: on LASA against its demonstrations, on recordings against the
-other drawings of their set (the drawing's own left out; see docs/research.md).
+and whether the $1 recogniser names the shape from the drawing, from the
+strokes sent and from the felt path (the phantom point the planned strokes
+render over time: the energy-weighted position of the actuators on): on LASA
+against its demonstrations, on recordings against the other drawings of their
+set (the drawing's own left out; see docs/research.md).
 
 A folder is searched for recordings (*.json) and $1 gesture logs (*.xml, as
 s01/fast/arrow01.xml: <Gesture Name= Speed=><Point X= Y= T=/>...). A drawing's
@@ -330,12 +332,12 @@ def _table(
     lines = [
         f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units;",
         "skin: time on the skin / drawing time; felt end: release to the end of the last stroke;",
-        "pen: pen to skin; recognised: $1 on the drawings / on the strokes sent"
+        "pen: pen to skin; recognised: $1 on the drawings / strokes sent / felt path"
         + (f", against {against}" if against else ""),
         "",
         f"{'set':<6} {'algorithm':<9} {'parameters':<30} {'strokes':>7} {'DP':>6} "
         f"{'max dev':>8} {'worst':>6} {'Fréchet':>7} {'skin':>5} {'p95':>5} "
-        f"{'felt end p95':>12} {'pen p95':>8} {'recognised':>11}",
+        f"{'felt end p95':>12} {'pen p95':>8} {'recognised':>17}",
     ]
     for s in summary:
         lines.append(
@@ -345,7 +347,7 @@ def _table(
             f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
             f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
             f"{_num(s['pen_to_skin_p95_ms'], '.0f', ' ms'):>8} "
-            f"{_recognised(s):>11}"
+            f"{_recognised(s):>17}"
         )
     lines += ["", f"Wrote results.csv, frontier.csv, summary.json and 3 plots to {out}/"]
     return "\n".join(lines)
@@ -356,5 +358,5 @@ def _num(value: float | None, spec: str, unit: str = "") -> str:
 
 
 def _recognised(s: dict[str, Any]) -> str:
-    drawn, sent = s["recognised_drawn_pct"], s["recognised_sent_pct"]
-    return "-" if drawn is None else f"{drawn:.1f}/{sent:.1f}"
+    drawn, sent, felt = (s[f"recognised_{k}_pct"] for k in ("drawn", "sent", "felt"))
+    return "-" if drawn is None else f"{drawn:.1f}/{sent:.1f}/{felt:.1f}"

@@ -12,8 +12,10 @@ Each row measures the shape (deviation of every drawn sample, Fréchet
 distance, strokes against Douglas-Peucker at the same error), the timing as
 the sleeve would play it (``playback``: time on the skin against drawing time,
 release to felt end, pen to skin) and, when the recording is a LASA shape,
-whether the $1 recogniser (``dollar``) names the shape from the drawing and
-from the polyline of the strokes sent.
+whether the $1 recogniser (``dollar``) names the shape from the drawing, from
+the polyline of the strokes sent, and from the felt path (``felt``: the
+phantom point the planned schedules render over time). A shape can survive
+the simplifier and still be lost in the planner; the last two tell where.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from numpy.typing import NDArray
 
 from feelmysign.layout import PAPER_SLEEVE, Layout, grid_layout
 from feelmysign.research import dollar, metrics
+from feelmysign.research.felt import felt_path
 from feelmysign.research.playback import simulate
 from feelmysign.research.rerun import rerun
 from feelmysign.research.sweep import label
@@ -98,6 +101,7 @@ class Row:
     pen_to_skin_ms: tuple[float, ...] = field(default=(), repr=False)
     recognised_drawn: bool | None = None
     recognised_sent: bool | None = None
+    recognised_felt: bool | None = None
 
     @property
     def skin_ratio(self) -> float:
@@ -128,6 +132,7 @@ class Row:
             "pen_to_skin_max_ms": _round(max(self.pen_to_skin_ms)) if self.pen_to_skin_ms else "",
             "recognised_drawn": _flag(self.recognised_drawn),
             "recognised_sent": _flag(self.recognised_sent),
+            "recognised_felt": _flag(self.recognised_felt),
         }
 
 
@@ -312,6 +317,9 @@ def evaluate_one(
         pen_to_skin_ms=playback.pen_to_skin_ms,
         recognised_drawn=recogniser.drawn(source, drawn) if recogniser else None,
         recognised_sent=recogniser.names(source, sent_polyline(segments)) if recogniser else None,
+        recognised_felt=recogniser.names(source, felt_path(playback.schedules))
+        if recogniser
+        else None,
     )
 
 
@@ -366,6 +374,7 @@ def summarize(rows: Sequence[Row]) -> list[dict[str, Any]]:
                 "pen_to_skin_p95_ms": _percentile(pen),
                 "recognised_drawn_pct": _percent([r.recognised_drawn for r in members]),
                 "recognised_sent_pct": _percent([r.recognised_sent for r in members]),
+                "recognised_felt_pct": _percent([r.recognised_felt for r in members]),
             }
         )
     return summary

@@ -12,7 +12,8 @@ the real planner on the sleeve's layout. From that:
 - release to felt end: from the pointer's release to the end of the last
   motor command of the path's last stroke;
 - pen to skin: for each stroke, from the moment its start was drawn to the
-  moment the sleeve starts it.
+  moment the sleeve starts it;
+- the schedules played, in order: what ``felt`` reads the felt path from.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from dataclasses import dataclass
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
+from feelmysign.schedule import Schedule
 from feelmysign.simplify.registry import PathSegment
 from feelmysign.simplify.segment import Sample
 from feelmysign.stroke import Stroke
@@ -35,6 +37,7 @@ class Playback:
     release_to_felt_end_ms: tuple[float, ...]  # one per path that sent a stroke
     pen_to_skin_ms: tuple[float, ...]  # one per stroke played
     refused: int  # strokes the planner refused (too long for the sleeve)
+    schedules: tuple[Schedule, ...] = ()  # of the strokes played, in the order they play
 
     @property
     def skin_ratio(self) -> float:
@@ -50,6 +53,7 @@ def simulate(
     skin_ms = 0.0
     felt_end: dict[int, float] = {}
     pen_to_skin: list[float] = []
+    schedules: list[Schedule] = []
     refused = 0
     for item in segments:
         segment = item.segment
@@ -66,7 +70,10 @@ def simulate(
         felt_end[item.path] = start_ms + max(schedule.duration_ms, last_command_ms)
         skin_ms += schedule.duration_ms
         pen_to_skin.append(start_ms - segment.start_ms)
+        schedules.append(schedule)
     release = [
         felt_end[index] - paths[index][-1].t_ms for index in sorted(felt_end) if paths[index]
     ]
-    return Playback(drawing_ms, skin_ms, tuple(release), tuple(pen_to_skin), refused)
+    return Playback(
+        drawing_ms, skin_ms, tuple(release), tuple(pen_to_skin), refused, tuple(schedules)
+    )
