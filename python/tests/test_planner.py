@@ -14,7 +14,7 @@ from vectors import load
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.errors import StrokeError
 from feelmysign.layout import MIN_BURST_MS, Layout, grid_layout
-from feelmysign.overlaps import merge_commands
+from feelmysign.overlaps import _energy_pieces, _two_pieces, merge_commands
 from feelmysign.planner import overrun_allowance_ms, plan, render_point, virtual_actuators
 from feelmysign.schedule import Burst, Command, Schedule, schedule_to_json
 from feelmysign.stroke import Stroke
@@ -187,6 +187,22 @@ def test_short_overlap_piece_joins_its_neighbour_keeping_energy() -> None:
     assert merged[0].start_ms == 0 and merged[-1].end_ms == 195
     energy = sum(c.intensity**2 * c.duration_ms for c in merged)
     assert energy == pytest.approx(sum(c.intensity**2 * c.duration_ms for c in inputs))
+
+
+def test_two_spans_merge_as_the_general_sweep_does() -> None:
+    # The pair of spans a stroke's bursts put on one actuator is merged by a
+    # written-out case analysis; it must give the sweep's pieces, bit for bit,
+    # for every order of the four ends and intensities close, equal or capped.
+    times = (0.0, 20.0, 20.000000000000004, 50.0, 80.0)
+    levels = (1e-200, 1e-6, 0.5, 0.6, 0.6000000001, 0.9999999, 1.0)
+    spans = list(itertools.product(times, times, levels))
+    compared = 0
+    for first, second in itertools.product(spans, spans):
+        fast = _two_pieces([first, second])
+        if fast is not None:
+            assert fast == _energy_pieces([first, second]), (first, second)
+            compared += 1
+    assert compared > 500  # every case of the analysis, not a few
 
 
 # --- properties over random strokes and grids --------------------------------

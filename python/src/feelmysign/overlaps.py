@@ -43,17 +43,27 @@ def commands_from_spans(
     """Each actuator's spans merged, as commands sorted by start, then row, then column."""
     # One actuator's pieces never share a start, so sorting these tuples whole
     # orders them exactly as that key does.
-    pieces = []
+    pieces: list[tuple[float, int, int, float, float]] = []
+    append = pieces.append
     sqrt = math.sqrt
     for (row, column), spans in by_actuator.items():
-        if len(spans) == 1:  # most actuators of a stroke render one burst: _lone_piece inline
+        if len(spans) == 1:  # most actuators of a stroke render one burst: _energy_pieces inline
             start, end, intensity = spans[0]
             energy = intensity**2
             if not energy <= 0 and start < end:
-                pieces.append((start, row, column, end, min(1.0, sqrt(energy))))
+                intensity = sqrt(energy)  # min(1.0, ...) without the builtin call, as below
+                append((start, row, column, end, intensity if intensity < 1.0 else 1.0))
             continue
-        for start, end, intensity in _join_short(_energy_pieces(spans), min_command_ms):
-            pieces.append((start, row, column, end, intensity))
+        actuator_pieces = _two_pieces(spans) if len(spans) == 2 else None
+        if actuator_pieces is None:
+            actuator_pieces = _energy_pieces(spans)
+        # _join_short's own first test, here: most actuators have no short piece.
+        for start, end, _ in actuator_pieces:
+            if end - start < min_command_ms:
+                actuator_pieces = _join_short(actuator_pieces, min_command_ms)
+                break
+        for start, end, intensity in actuator_pieces:
+            append((start, row, column, end, intensity))
     pieces.sort()
     return tuple(
         [
@@ -63,11 +73,45 @@ def commands_from_spans(
     )
 
 
-def _actuator_pieces(spans: list[Span], min_command_ms: float) -> list[Piece]:
-    """What one actuator does: its spans' energies summed, short pieces joined."""
-    if len(spans) == 1:
-        return _lone_piece(*spans[0])  # most actuators of a stroke render one burst
-    return _join_short(_energy_pieces(spans), min_command_ms)
+def _two_pieces(spans: list[Span]) -> list[Piece] | None:
+    """``_energy_pieces`` of two spans, the second starting inside or after the first.
+
+    That is how a stroke's bursts reach an actuator (in stroke order, onsets
+    rising); the few cases there are, written out, cost a fraction of the
+    general sweep. None for any other pair: the sweep handles it. The same
+    floats: a sum of one energy is that energy, of two their float sum.
+    """
+    (s1, t1, i1), (s2, t2, i2) = spans
+    e1, e2 = i1**2, i2**2
+    if not (s1 < s2 and s1 < t1 and s2 < t2 and e1 > 0 and e2 > 0):
+        return None
+    first, second = math.sqrt(e1), math.sqrt(e2)
+    first = first if first < 1.0 else 1.0
+    second = second if second < 1.0 else 1.0
+    if t1 < s2:  # apart: the gap between them has no energy
+        return [(s1, t1, first), (s2, t2, second)]
+    if t1 == s2:  # touching: one piece if their intensities are close
+        if math.isclose(first, second):
+            return [(s1, t2, first)]
+        return [(s1, t1, first), (s2, t2, second)]
+    both = math.sqrt(e1 + e2)
+    both = both if both < 1.0 else 1.0
+    # Overlapping: the first alone, both, then whichever runs on (if either
+    # does); each piece touches the one before, so a close intensity extends it.
+    overlap_end = t1 if t1 < t2 else t2
+    if math.isclose(first, both):
+        pieces = [(s1, overlap_end, first)]
+    else:
+        pieces = [(s1, s2, first), (s2, overlap_end, both)]
+    if t1 == t2:
+        return pieces
+    last, end = (second, t2) if t1 < t2 else (first, t1)
+    before = pieces[-1]
+    if math.isclose(before[2], last):
+        pieces[-1] = (before[0], end, before[2])
+    else:
+        pieces.append((overlap_end, end, last))
+    return pieces
 
 
 def _energy_pieces(spans: list[Span]) -> list[Piece]:
@@ -89,14 +133,6 @@ def _energy_pieces(spans: list[Span]) -> list[Piece]:
                 pieces.append((start, end, intensity))
         start = end
     return pieces
-
-
-def _lone_piece(start: float, end: float, intensity: float) -> list[Piece]:
-    """``_energy_pieces`` of a single span (which ``_join_short`` leaves alone)."""
-    energy = intensity**2
-    if energy <= 0 or not start < end:  # underflow, or a span shorter than its start's ulp
-        return []
-    return [(start, end, min(1.0, math.sqrt(energy)))]
 
 
 def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
