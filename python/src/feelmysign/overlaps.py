@@ -54,7 +54,7 @@ def commands_from_spans(
                 intensity = sqrt(energy)  # min(1.0, ...) without the builtin call, as below
                 append((start, row, column, end, intensity if intensity < 1.0 else 1.0))
             continue
-        actuator_pieces = _two_pieces(spans) if len(spans) == 2 else None
+        actuator_pieces = _two_pieces(spans) if len(spans) == 2 else _chained_pieces(spans)
         if actuator_pieces is None:
             actuator_pieces = _energy_pieces(spans)
         # _join_short's own first test, here: most actuators have no short piece.
@@ -65,12 +65,25 @@ def commands_from_spans(
         for start, end, intensity in actuator_pieces:
             append((start, row, column, end, intensity))
     pieces.sort()
-    return tuple(
-        [
-            Command(row, column, start, end - start, intensity)
-            for start, row, column, end, intensity in pieces
-        ]
-    )
+    # Command(row, column, start, end - start, intensity), without its __init__
+    # call: the same fields in one dict, for the dozen commands of a stroke.
+    new, set_fields = object.__new__, object.__setattr__
+    commands = []
+    for start, row, column, end, intensity in pieces:
+        command = new(Command)
+        set_fields(
+            command,
+            "__dict__",
+            {
+                "row": row,
+                "column": column,
+                "start_ms": start,
+                "duration_ms": end - start,
+                "intensity": intensity,
+            },
+        )
+        commands.append(command)
+    return tuple(commands)
 
 
 def _two_pieces(spans: list[Span]) -> list[Piece] | None:
@@ -111,6 +124,47 @@ def _two_pieces(spans: list[Span]) -> list[Piece] | None:
         pieces[-1] = (before[0], end, before[2])
     else:
         pieces.append((overlap_end, end, last))
+    return pieces
+
+
+def _chained_pieces(spans: list[Span]) -> list[Piece] | None:
+    """``_energy_pieces`` of spans each starting after the one before, by one sweep.
+
+    That is how a stroke's bursts reach an actuator. At each bound the spans
+    ending there leave and those starting there join the ones on, kept in the
+    spans' order, so the energies summed on each piece are the very list the
+    general sweep sums: the same floats, without a search per piece. None for
+    spans in any other order, or empty ones: the general sweep handles them.
+    """
+    before = -math.inf
+    for start, end, _ in spans:
+        if not before < start < end:
+            return None
+        before = start
+    bounds = sorted({t for start, end, _ in spans for t in (start, end)})
+    ends: list[float] = []  # of the spans on, in the spans' order
+    energies: list[float] = []  # their energies, in the same order
+    pieces: list[Piece] = []
+    waiting = iter(spans)
+    next_start, next_end, next_intensity = next(waiting)
+    start = bounds[0]
+    for end in itertools.islice(bounds, 1, None):
+        if start in ends:
+            kept = [i for i, t in enumerate(ends) if t != start]
+            ends, energies = [ends[i] for i in kept], [energies[i] for i in kept]
+        if next_start == start:  # starts differ: at most one span joins at a bound
+            ends.append(next_end)
+            energies.append(next_intensity**2)
+            next_start, next_end, next_intensity = next(waiting, (math.inf, math.inf, 0.0))
+        energy = sum(energies)
+        if not energy <= 0:
+            intensity = math.sqrt(energy)
+            intensity = intensity if intensity < 1.0 else 1.0
+            if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
+                pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
+            else:
+                pieces.append((start, end, intensity))
+        start = end
     return pieces
 
 

@@ -204,7 +204,7 @@ class Outline:
                 commands_from_spans(spans, self.min_command_ms),
                 self.duration_ms,
                 self.adjusted,
-                tuple([Burst(x, y, p, s, d, intensity) for x, y, p, s, d in self.bursts]),
+                _bursts_of(self.bursts, intensity),
                 self.thinned,
             )
         return self._schedule
@@ -455,6 +455,29 @@ def _bursts(
     start_ms = onset_a * t + onset_b
     bursts.append((x, y, fractions[last] * t, start_ms, t - start_ms))
     return bursts
+
+
+def _bursts_of(bursts: list[RawBurst], intensity: float) -> tuple[Burst, ...]:
+    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, without its __init__
+    call: the same fields in one dict, as ``commands_from_spans`` makes its commands."""
+    new, set_fields = object.__new__, object.__setattr__
+    result = []
+    for x, y, peak_ms, start_ms, duration_ms in bursts:
+        burst = new(Burst)
+        set_fields(
+            burst,
+            "__dict__",
+            {
+                "x": x,
+                "y": y,
+                "peak_ms": peak_ms,
+                "start_ms": start_ms,
+                "duration_ms": duration_ms,
+                "intensity": intensity,
+            },
+        )
+        result.append(burst)
+    return tuple(result)
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
