@@ -149,9 +149,9 @@ def _chained_pieces(spans: list[Span]) -> list[Piece] | None:
     next_start, next_end, next_intensity = next(waiting)
     start = bounds[0]
     for end in itertools.islice(bounds, 1, None):
-        if start in ends:
-            kept = [i for i, t in enumerate(ends) if t != start]
-            ends, energies = [ends[i] for i in kept], [energies[i] for i in kept]
+        while start in ends:  # the spans ending here leave; the rest keep their order
+            i = ends.index(start)
+            del ends[i], energies[i]
         if next_start == start:  # starts differ: at most one span joins at a bound
             ends.append(next_end)
             energies.append(next_intensity**2)
