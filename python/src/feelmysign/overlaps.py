@@ -197,17 +197,18 @@ def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
         return pieces  # none short: the common case, answered without looking for neighbours
     pieces = list(pieces)
     while True:
-        short = [
-            i
-            for i, (s, e, _) in enumerate(pieces)
-            if e - s < min_command_ms and _neighbour(pieces, i) is not None
-        ]
-        if not short:
+        # The shortest short piece with a neighbour (the first of equals), and
+        # that neighbour: one pass, no list of candidates.
+        shortest, neighbour, shortest_ms = -1, -1, math.inf
+        for i, (start, end, _) in enumerate(pieces):
+            length_ms = end - start
+            if length_ms < min_command_ms and (shortest < 0 or length_ms < shortest_ms):
+                j = _neighbour(pieces, i)
+                if j is not None:
+                    shortest, neighbour, shortest_ms = i, j, length_ms
+        if shortest < 0:
             return pieces
-        i = min(short, key=lambda k: pieces[k][1] - pieces[k][0])
-        j = _neighbour(pieces, i)
-        assert j is not None
-        a, b = sorted((i, j))
+        a, b = (shortest, neighbour) if shortest < neighbour else (neighbour, shortest)
         pieces[a : b + 1] = [_joined(pieces[a], pieces[b])]
 
 
