@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import random
 from typing import Any
 
 import pytest
@@ -14,7 +15,7 @@ from vectors import load
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.errors import StrokeError
 from feelmysign.layout import MIN_BURST_MS, Layout, grid_layout
-from feelmysign.overlaps import merge_commands
+from feelmysign.overlaps import _chained_pieces, _energy_pieces, _two_pieces, merge_commands
 from feelmysign.planner import overrun_allowance_ms, plan, render_point, virtual_actuators
 from feelmysign.schedule import Burst, Command, Schedule, schedule_to_json
 from feelmysign.stroke import Stroke
@@ -187,6 +188,54 @@ def test_short_overlap_piece_joins_its_neighbour_keeping_energy() -> None:
     assert merged[0].start_ms == 0 and merged[-1].end_ms == 195
     energy = sum(c.intensity**2 * c.duration_ms for c in merged)
     assert energy == pytest.approx(sum(c.intensity**2 * c.duration_ms for c in inputs))
+
+
+def test_planned_commands_and_bursts_are_as_their_constructors_make_them() -> None:
+    # The planner fills their fields directly (no __init__ call per command):
+    # every field must be there, as a constructed one has it.
+    schedule = plan(Stroke((0.2, 0.3), (2.7, 1.6), 400.0), PAPER)
+    assert schedule.commands and schedule.bursts
+    for c in schedule.commands:
+        made = Command(c.row, c.column, c.start_ms, c.duration_ms, c.intensity)
+        assert vars(c) == vars(made) and c == made and hash(c) == hash(made)
+    for b in schedule.bursts:
+        made_burst = Burst(b.x, b.y, b.peak_ms, b.start_ms, b.duration_ms, b.intensity)
+        assert vars(b) == vars(made_burst) and b == made_burst
+
+
+def test_two_spans_merge_as_the_general_sweep_does() -> None:
+    # The pair of spans a stroke's bursts put on one actuator is merged by a
+    # written-out case analysis; it must give the sweep's pieces, bit for bit,
+    # for every order of the four ends and intensities close, equal or capped.
+    times = (0.0, 20.0, 20.000000000000004, 50.0, 80.0)
+    levels = (1e-200, 1e-6, 0.5, 0.6, 0.6000000001, 0.9999999, 1.0)
+    spans = list(itertools.product(times, times, levels))
+    compared = 0
+    for first, second in itertools.product(spans, spans):
+        fast = _two_pieces([first, second])
+        if fast is not None:
+            assert fast == _energy_pieces([first, second]), (first, second)
+            compared += 1
+    assert compared > 500  # every case of the analysis, not a few
+
+
+def test_spans_in_a_chain_merge_as_the_general_sweep_does() -> None:
+    # Spans each starting after the one before (how a stroke's bursts reach an
+    # actuator) are merged by one sweep; it must give the general sweep's pieces.
+    rng = random.Random(5)
+    times = (0.0, 20.0, 20.000000000000004, 35.0, 50.0, 80.0, 95.0)
+    levels = (1e-200, 1e-6, 0.5, 0.6, 0.6000000001, 0.9999999, 1.0)
+    compared = 0
+    for _ in range(20_000):
+        spans = [
+            (rng.choice(times), rng.choice(times), rng.choice(levels))
+            for _ in range(rng.randint(1, 5))
+        ]
+        fast = _chained_pieces(spans)
+        if fast is not None:
+            assert fast == _energy_pieces(spans), spans
+            compared += 1
+    assert compared > 1000  # chains of every length, not a few
 
 
 # --- properties over random strokes and grids --------------------------------

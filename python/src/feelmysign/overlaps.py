@@ -43,31 +43,129 @@ def commands_from_spans(
     """Each actuator's spans merged, as commands sorted by start, then row, then column."""
     # One actuator's pieces never share a start, so sorting these tuples whole
     # orders them exactly as that key does.
-    pieces = []
+    pieces: list[tuple[float, int, int, float, float]] = []
+    append = pieces.append
     sqrt = math.sqrt
     for (row, column), spans in by_actuator.items():
-        if len(spans) == 1:  # most actuators of a stroke render one burst: _lone_piece inline
+        if len(spans) == 1:  # most actuators of a stroke render one burst: _energy_pieces inline
             start, end, intensity = spans[0]
             energy = intensity**2
             if not energy <= 0 and start < end:
-                pieces.append((start, row, column, end, min(1.0, sqrt(energy))))
+                intensity = sqrt(energy)  # min(1.0, ...) without the builtin call, as below
+                append((start, row, column, end, intensity if intensity < 1.0 else 1.0))
             continue
-        for start, end, intensity in _join_short(_energy_pieces(spans), min_command_ms):
-            pieces.append((start, row, column, end, intensity))
+        actuator_pieces = _two_pieces(spans) if len(spans) == 2 else _chained_pieces(spans)
+        if actuator_pieces is None:
+            actuator_pieces = _energy_pieces(spans)
+        # _join_short's own first test, here: most actuators have no short piece.
+        for start, end, _ in actuator_pieces:
+            if end - start < min_command_ms:
+                actuator_pieces = _join_short(actuator_pieces, min_command_ms)
+                break
+        for start, end, intensity in actuator_pieces:
+            append((start, row, column, end, intensity))
     pieces.sort()
-    return tuple(
-        [
-            Command(row, column, start, end - start, intensity)
-            for start, row, column, end, intensity in pieces
-        ]
-    )
+    # Command(row, column, start, end - start, intensity), without its __init__
+    # call: the same fields in one dict, for the dozen commands of a stroke.
+    new, set_fields = object.__new__, object.__setattr__
+    commands = []
+    for start, row, column, end, intensity in pieces:
+        command = new(Command)
+        set_fields(
+            command,
+            "__dict__",
+            {
+                "row": row,
+                "column": column,
+                "start_ms": start,
+                "duration_ms": end - start,
+                "intensity": intensity,
+            },
+        )
+        commands.append(command)
+    return tuple(commands)
 
 
-def _actuator_pieces(spans: list[Span], min_command_ms: float) -> list[Piece]:
-    """What one actuator does: its spans' energies summed, short pieces joined."""
-    if len(spans) == 1:
-        return _lone_piece(*spans[0])  # most actuators of a stroke render one burst
-    return _join_short(_energy_pieces(spans), min_command_ms)
+def _two_pieces(spans: list[Span]) -> list[Piece] | None:
+    """``_energy_pieces`` of two spans, the second starting inside or after the first.
+
+    That is how a stroke's bursts reach an actuator (in stroke order, onsets
+    rising); the few cases there are, written out, cost a fraction of the
+    general sweep. None for any other pair: the sweep handles it. The same
+    floats: a sum of one energy is that energy, of two their float sum.
+    """
+    (s1, t1, i1), (s2, t2, i2) = spans
+    e1, e2 = i1**2, i2**2
+    if not (s1 < s2 and s1 < t1 and s2 < t2 and e1 > 0 and e2 > 0):
+        return None
+    first, second = math.sqrt(e1), math.sqrt(e2)
+    first = first if first < 1.0 else 1.0
+    second = second if second < 1.0 else 1.0
+    if t1 < s2:  # apart: the gap between them has no energy
+        return [(s1, t1, first), (s2, t2, second)]
+    if t1 == s2:  # touching: one piece if their intensities are close
+        if math.isclose(first, second):
+            return [(s1, t2, first)]
+        return [(s1, t1, first), (s2, t2, second)]
+    both = math.sqrt(e1 + e2)
+    both = both if both < 1.0 else 1.0
+    # Overlapping: the first alone, both, then whichever runs on (if either
+    # does); each piece touches the one before, so a close intensity extends it.
+    overlap_end = t1 if t1 < t2 else t2
+    if math.isclose(first, both):
+        pieces = [(s1, overlap_end, first)]
+    else:
+        pieces = [(s1, s2, first), (s2, overlap_end, both)]
+    if t1 == t2:
+        return pieces
+    last, end = (second, t2) if t1 < t2 else (first, t1)
+    before = pieces[-1]
+    if math.isclose(before[2], last):
+        pieces[-1] = (before[0], end, before[2])
+    else:
+        pieces.append((overlap_end, end, last))
+    return pieces
+
+
+def _chained_pieces(spans: list[Span]) -> list[Piece] | None:
+    """``_energy_pieces`` of spans each starting after the one before, by one sweep.
+
+    That is how a stroke's bursts reach an actuator. At each bound the spans
+    ending there leave and those starting there join the ones on, kept in the
+    spans' order, so the energies summed on each piece are the very list the
+    general sweep sums: the same floats, without a search per piece. None for
+    spans in any other order, or empty ones: the general sweep handles them.
+    """
+    before = -math.inf
+    for start, end, _ in spans:
+        if not before < start < end:
+            return None
+        before = start
+    bounds = sorted({t for start, end, _ in spans for t in (start, end)})
+    ends: list[float] = []  # of the spans on, in the spans' order
+    energies: list[float] = []  # their energies, in the same order
+    pieces: list[Piece] = []
+    waiting = iter(spans)
+    next_start, next_end, next_intensity = next(waiting)
+    start = bounds[0]
+    for end in itertools.islice(bounds, 1, None):
+        while start in ends:  # the spans ending here leave; the rest keep their order
+            i = ends.index(start)
+            del ends[i], energies[i]
+        if next_start == start:  # starts differ: at most one span joins at a bound
+            ends.append(next_end)
+            energies.append(next_intensity**2)
+            next_start, next_end, next_intensity = next(waiting, (math.inf, math.inf, 0.0))
+        energy = sum(energies)
+        if not energy <= 0:
+            intensity = math.sqrt(energy)
+            intensity = intensity if intensity < 1.0 else 1.0
+            if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
+                pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
+            else:
+                pieces.append((start, end, intensity))
+        start = end
+    return pieces
 
 
 def _energy_pieces(spans: list[Span]) -> list[Piece]:
@@ -91,14 +189,6 @@ def _energy_pieces(spans: list[Span]) -> list[Piece]:
     return pieces
 
 
-def _lone_piece(start: float, end: float, intensity: float) -> list[Piece]:
-    """``_energy_pieces`` of a single span (which ``_join_short`` leaves alone)."""
-    energy = intensity**2
-    if energy <= 0 or not start < end:  # underflow, or a span shorter than its start's ulp
-        return []
-    return [(start, end, min(1.0, math.sqrt(energy)))]
-
-
 def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
     """Join pieces shorter than the minimum to an adjacent piece of the same on-period."""
     if len(pieces) < 2:
@@ -107,17 +197,18 @@ def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
         return pieces  # none short: the common case, answered without looking for neighbours
     pieces = list(pieces)
     while True:
-        short = [
-            i
-            for i, (s, e, _) in enumerate(pieces)
-            if e - s < min_command_ms and _neighbour(pieces, i) is not None
-        ]
-        if not short:
+        # The shortest short piece with a neighbour (the first of equals), and
+        # that neighbour: one pass, no list of candidates.
+        shortest, neighbour, shortest_ms = -1, -1, math.inf
+        for i, (start, end, _) in enumerate(pieces):
+            length_ms = end - start
+            if length_ms < min_command_ms and (shortest < 0 or length_ms < shortest_ms):
+                j = _neighbour(pieces, i)
+                if j is not None:
+                    shortest, neighbour, shortest_ms = i, j, length_ms
+        if shortest < 0:
             return pieces
-        i = min(short, key=lambda k: pieces[k][1] - pieces[k][0])
-        j = _neighbour(pieces, i)
-        assert j is not None
-        a, b = sorted((i, j))
+        a, b = (shortest, neighbour) if shortest < neighbour else (neighbour, shortest)
         pieces[a : b + 1] = [_joined(pieces[a], pieces[b])]
 
 

@@ -38,7 +38,13 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
 
-from feelmysign.apparent_motion import Timing, fits, shortest_planned_ms, thinned, timings
+from feelmysign.apparent_motion import (
+    Timing,
+    fitting_timings,
+    shortest_planned_ms,
+    thinned,
+    timings,
+)
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
 from feelmysign.overlaps import Actuator, Span, commands_from_spans
@@ -112,10 +118,20 @@ def outline(
     its ``schedule()`` is the one ``plan`` returns, and ``head()`` the first of
     its commands, computed without the rest (see ``Outline``).
     """
-    start, end = _checked_stroke(stroke, layout)
-    intensity = layout.default_intensity if stroke.intensity is None else stroke.intensity
+    given = _plain_stroke(stroke, layout)
+    if given is None:  # clamped onto the grid, or a StrokeError saying what is wrong
+        start, end = _checked_stroke(stroke, layout)
+        stroke = _canonical(stroke, start, end)
+    else:
+        start, end = given
+    intensity = stroke.intensity
+    if intensity is None:
+        intensity = layout.default_intensity
     min_ms = layout.shortest_burst_ms if min_command_ms is None else min_command_ms
-    duration_ms, adjusted = _kept_duration(stroke, start, end, min_ms, strict=strict)
+    duration_ms = stroke.duration_ms
+    adjusted = None
+    if not duration_ms >= shortest_planned_ms(min_ms):  # _kept_duration's first test, inline
+        duration_ms, adjusted = _kept_duration(stroke, start, end, min_ms, strict=strict)
     if duration_ms > layout.max_stroke_duration_ms:
         raise StrokeError(
             "duration_too_long",
@@ -123,15 +139,14 @@ def outline(
             f"{layout.max_stroke_duration_ms:g} ms; send a slower, shorter stroke",
         )
     points, fractions = virtual_actuators(start, end, merge_distance=merge_distance)
-    burst_timings = timings(fractions)
     left_out = 0
-    if not fits(burst_timings, duration_ms, min_ms):
+    burst_timings = fitting_timings(fractions, duration_ms, min_ms)
+    if burst_timings is None:
         kept = thinned(fractions, duration_ms, min_ms)
         left_out = len(fractions) - len(kept)
         points, fractions = [points[i] for i in kept], [fractions[i] for i in kept]
         burst_timings = timings(fractions)
     bursts = _bursts(points, fractions, burst_timings, duration_ms)
-    stroke = _canonical(stroke, start, end)
     return Outline(stroke, layout, duration_ms, adjusted, intensity, min_ms, bursts, left_out)
 
 
@@ -189,7 +204,7 @@ class Outline:
                 commands_from_spans(spans, self.min_command_ms),
                 self.duration_ms,
                 self.adjusted,
-                tuple([Burst(x, y, p, s, d, intensity) for x, y, p, s, d in self.bursts]),
+                _bursts_of(self.bursts, intensity),
                 self.thinned,
             )
         return self._schedule
@@ -256,6 +271,43 @@ def _kept_duration(
     return needed_ms, Adjustment(TOO_FAST, stroke.duration_ms, needed_ms)
 
 
+def _plain_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point] | None:
+    """The stroke's endpoints when it is plainly valid as it is, else None.
+
+    Plainly valid: float coordinates on the grid, a finite positive float
+    duration, an intensity in [0, 1] or none; ``_checked_stroke`` passes it
+    unchanged and ``_canonical`` keeps it. Anything else (None) goes through
+    them, for the clamping or the error. Most strokes, parsed from the
+    protocol, are plain, and this costs a fraction of those checks.
+    """
+    try:
+        (x0, y0), (x1, y1) = start, end = stroke.start, stroke.end
+    except (TypeError, ValueError):
+        return None  # _checked_stroke says what is wrong
+    x_max, y_max = layout.columns - 1, layout.rows - 1
+    duration_ms = stroke.duration_ms
+    if not (
+        type(x0) is float
+        and type(y0) is float
+        and type(x1) is float
+        and type(y1) is float
+        and type(duration_ms) is float
+        # Comparisons fail for NaN, so these also say every number is finite.
+        and 0.0 <= x0 <= x_max
+        and 0.0 <= x1 <= x_max
+        and 0.0 <= y0 <= y_max
+        and 0.0 <= y1 <= y_max
+        and 0.0 < duration_ms < math.inf
+    ):
+        return None
+    intensity = stroke.intensity
+    # Last, as _checked_stroke tests it after the numbers (a TypeError for a
+    # string here is the one it would raise).
+    if intensity is not None and not 0.0 <= intensity <= 1.0:
+        return None
+    return start, end
+
+
 def _checked_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point]:
     """The stroke's endpoints clamped onto the grid, or StrokeError saying what is wrong."""
     values = (*stroke.start, *stroke.end, stroke.duration_ms)
@@ -309,26 +361,40 @@ def virtual_actuators(
     if length <= ON_LINE_EPSILON:
         return [start], [0.0]
     (x0, y0), (x1, y1) = start, end
-    crossings = sorted({*_line_crossings(x0, x1), *_line_crossings(y0, y1)})
+    crossings = _line_crossings(x0, x1)
+    crossings += _line_crossings(y0, y1)
+    if len(crossings) > 1:
+        crossings = sorted(set(crossings))  # a stroke through an actuator crosses both lines there
     fractions = _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
-    points = []
+    points: list[Point] = []
+    append = points.append
+    dx, dy = x1 - x0, y1 - y0
     for f in fractions:
         if f == 0.0:
-            points.append(start)
+            append(start)
         elif f == 1.0:
-            points.append(end)
+            append(end)
         else:
-            points.append((_snap(x0 + (x1 - x0) * f), _snap(y0 + (y1 - y0) * f)))
+            # _snap of each coordinate, inline: a stroke's every crossing is snapped.
+            x, y = x0 + dx * f, y0 + dy * f
+            nearest = round(x)
+            if abs(x - nearest) <= ON_LINE_EPSILON:
+                x = float(nearest)
+            nearest = round(y)
+            if abs(y - nearest) <= ON_LINE_EPSILON:
+                y = float(nearest)
+            append((x, y))
     return points, fractions
 
 
 def _line_crossings(a: float, b: float) -> list[float]:
     """Fractions in (0, 1) where the coordinate goes from a to b through an integer."""
-    if abs(b - a) <= ON_LINE_EPSILON:
+    step = b - a
+    if abs(step) <= ON_LINE_EPSILON:
         return []
     low, high = (a, b) if a < b else (b, a)
     first, last = math.ceil(low - ON_LINE_EPSILON), math.floor(high + ON_LINE_EPSILON)
-    return [f for k in range(first, last + 1) if 0.0 < (f := (k - a) / (b - a)) < 1.0]
+    return [f for k in range(first, last + 1) if 0.0 < (f := (k - a) / step) < 1.0]
 
 
 def _merged_fractions(fractions: list[float], merge_fraction: float) -> list[float]:
@@ -337,16 +403,20 @@ def _merged_fractions(fractions: list[float], merge_fraction: float) -> list[flo
     A group is represented by its midpoint, unless it holds an endpoint, which wins.
     """
     merged: list[float] = []
+    append = merged.append
     first = last = fractions[0]  # of the group being gathered; only they decide its point
     for f in itertools.islice(fractions, 1, None):
         if f - first < merge_fraction:
             last = f
+        elif first == last:  # a group of one: its own point (what the midpoint gives)
+            append(first)
+            first = last = f
         else:
-            merged.append(0.0 if first == 0.0 else 1.0 if last == 1.0 else (first + last) / 2)
+            append(0.0 if first == 0.0 else 1.0 if last == 1.0 else (first + last) / 2)
             first = last = f
     if not merged:
         return [0.0, 1.0]  # shorter than the merge distance: just its two endpoints
-    merged.append(0.0 if first == 0.0 else 1.0 if last == 1.0 else (first + last) / 2)
+    append(0.0 if first == 0.0 else 1.0 if last == 1.0 else (first + last) / 2)
     return merged
 
 
@@ -385,6 +455,29 @@ def _bursts(
     start_ms = onset_a * t + onset_b
     bursts.append((x, y, fractions[last] * t, start_ms, t - start_ms))
     return bursts
+
+
+def _bursts_of(bursts: list[RawBurst], intensity: float) -> tuple[Burst, ...]:
+    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, without its __init__
+    call: the same fields in one dict, as ``commands_from_spans`` makes its commands."""
+    new, set_fields = object.__new__, object.__setattr__
+    result = []
+    for x, y, peak_ms, start_ms, duration_ms in bursts:
+        burst = new(Burst)
+        set_fields(
+            burst,
+            "__dict__",
+            {
+                "x": x,
+                "y": y,
+                "peak_ms": peak_ms,
+                "start_ms": start_ms,
+                "duration_ms": duration_ms,
+                "intensity": intensity,
+            },
+        )
+        result.append(burst)
+    return tuple(result)
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
@@ -437,15 +530,35 @@ def _spans_by_actuator(
 ) -> dict[Actuator, list[Span]]:
     """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
     by_actuator: dict[Actuator, list[Span]] = {}
-    columns, rows = layout.columns, layout.rows
-    sqrt = math.sqrt
+    last_column, last_row = layout.columns - 1, layout.rows - 1
+    sqrt, floor = math.sqrt, math.floor
     for x, y, _, span_start, length_ms in bursts:
         if length_ms <= 0:
             continue
         span_end = span_start + length_ms  # as Command.end_ms computes it
-        column_weights = _axis_weights(x, columns)
-        # _funneled, unrolled into this loop: no list per burst on the planning path.
-        for row, wy in _axis_weights(y, rows):
+        # _axis_weights of x and of y, and _funneled, unrolled into this loop:
+        # no call and no list per burst on the planning path.
+        low = floor(x)
+        if low > last_column:
+            low = last_column
+        fraction = x - low
+        if fraction <= ON_LINE_EPSILON:
+            column_weights: tuple[tuple[int, float], ...] = ((low, 1.0),)
+        elif fraction >= _OFF_LINE:
+            column_weights = ((low + 1, 1.0),)
+        else:
+            column_weights = ((low, 1.0 - fraction), (low + 1, fraction))
+        low = floor(y)
+        if low > last_row:
+            low = last_row
+        fraction = y - low
+        if fraction <= ON_LINE_EPSILON:
+            row_weights: tuple[tuple[int, float], ...] = ((low, 1.0),)
+        elif fraction >= _OFF_LINE:
+            row_weights = ((low + 1, 1.0),)
+        else:
+            row_weights = ((low, 1.0 - fraction), (low + 1, fraction))
+        for row, wy in row_weights:
             for column, wx in column_weights:
                 value = intensity * sqrt(wx * wy)
                 if value > 0:

@@ -97,6 +97,25 @@ class Schedule:
     bursts: tuple[Burst, ...] = ()
     thinned: int = 0
 
+    def __init__(
+        self,
+        stroke: Stroke,
+        commands: tuple[Command, ...],
+        duration_ms: float,
+        adjusted: Adjustment | None = None,
+        bursts: tuple[Burst, ...] = (),
+        thinned: int = 0,
+    ) -> None:
+        # As Command's: one dict update instead of a frozen dataclass's setattr per field.
+        self.__dict__.update(
+            stroke=stroke,
+            commands=commands,
+            duration_ms=duration_ms,
+            adjusted=adjusted,
+            bursts=bursts,
+            thinned=thinned,
+        )
+
 
 def stroke_to_json(stroke: Stroke) -> dict[str, object]:
     """A stroke as the JSON the CLI and the vectors use (optional fields only when set)."""
