@@ -165,11 +165,7 @@ def strokes_to_send(result: Rerun, params: Params) -> tuple[list[Stroke], list[f
         stroke = Stroke(segment.start, segment.end, segment.duration_ms, drawing=drawing, seq=seq)
         checked = validate_stroke(stroke, layout)
         if isinstance(checked, Rejected):
-            raise StrokeError(
-                checked.reason,
-                f"Stroke {seq + 1} of the replay would be rejected by the sleeve "
-                f"({checked.reason}): {checked.message} Nothing was sent.",
-            )
+            raise checked.as_error(f"Stroke {seq + 1} of the replay", then=" Nothing was sent.")
         strokes.append(checked)
         at_ms.append(segment.emitted_at_ms - origin_ms)
     if not strokes:

@@ -191,11 +191,7 @@ def _strokes(args: argparse.Namespace, layout: Layout) -> list[Stroke]:
     for seq, (where, text) in enumerate(_stroke_texts(args.strokes)):
         result = parse(text, layout, format="legacy")
         if not isinstance(result, Accepted):
-            raise StrokeError(
-                result.reason,
-                f"{where} {text!r} would be rejected by the sleeve ({result.reason}): "
-                f"{result.message} Nothing was sent.",
-            )
+            raise result.as_error(f"{where} {text!r}", then=" Nothing was sent.")
         strokes.append(replace(result.stroke, intensity=args.intensity, drawing=drawing, seq=seq))
     if not strokes:
         raise StrokeError("empty", "Standard input held no stroke; nothing was sent.")
