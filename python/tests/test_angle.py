@@ -10,7 +10,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from simplifier_checks import (
-    assert_dropped_say_why,
     assert_joined_from_press_to_release,
     check_vector,
     random_walk,
@@ -133,15 +132,6 @@ def test_segments_join_and_keep_the_path_ends(case: tuple[AngleParams, list[Samp
     assert_joined_from_press_to_release(params, samples)
 
 
-@settings(max_examples=150, deadline=None)
-@given(paths())
-def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
-    case: tuple[AngleParams, list[Sample]],
-) -> None:
-    params, samples = case
-    assert_dropped_say_why(params, samples)
-
-
 @settings(max_examples=100, deadline=None)
 @given(paths())
 def test_without_recover_strokes_still_start_and_end_on_the_path(
@@ -153,10 +143,3 @@ def test_without_recover_strokes_still_start_and_end_on_the_path(
     on_path = {params.mapping.to_grid(s.x, s.y) for s in samples}
     assert all(s.start in on_path and s.end in on_path for s in segments)
     assert all(a.end_ms <= b.start_ms for a, b in itertools.pairwise(segments))
-
-
-@settings(max_examples=100, deadline=None)
-@given(paths())
-def test_replay_is_deterministic(case: tuple[AngleParams, list[Sample]]) -> None:
-    params, samples = case
-    assert run(params, [samples]) == run(params, [samples])

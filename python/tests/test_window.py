@@ -13,7 +13,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from simplifier_checks import (
-    assert_dropped_say_why,
     assert_joined_from_press_to_release,
     check_vector,
     random_walk,
@@ -396,22 +395,6 @@ def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
             short = math.dist(segment.start, before) < params.min_length
             assert last - first == 1 or short
         assert segment.emitted_at_ms in times and segment.emitted_at_ms >= segment.end_ms
-
-
-@settings(max_examples=150, deadline=None)
-@given(paths())
-def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
-    case: tuple[WindowParams, list[Sample]],
-) -> None:
-    params, samples = case
-    assert_dropped_say_why(params, samples)
-
-
-@settings(max_examples=100, deadline=None)
-@given(paths())
-def test_replay_is_deterministic(case: tuple[WindowParams, list[Sample]]) -> None:
-    params, samples = case
-    assert run(params, [samples]) == run(params, [samples])
 
 
 # ---- The same strokes, to the last bit, as the simplifier first written (window_reference) ----
