@@ -8,7 +8,9 @@ join from the press to the release, and a dropped one says why.
 from __future__ import annotations
 
 import itertools
+import json
 import math
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -99,3 +101,27 @@ def assert_dropped_say_why(params: SimplifierParams, samples: list[Sample]) -> N
             assert segment.dropped == NOT_ENOUGH_DURATION
             assert segment.duration_ms < params.min_duration_ms
         assert segment.emitted_at_ms >= segment.end_ms
+
+
+def write_recording(case: dict[str, Any], path: Path) -> Path:
+    """A vector's paths, canvas and sleeve written as a recording for ``feelmysign simplify``."""
+    params = case["params"]
+    document = {
+        "canvas": {"width_px": params["canvas_width_px"], "height_px": params["canvas_height_px"]},
+        "paths": [
+            [{"t_ms": t, "x": x, "y": y, "pressure": p} for t, x, y, p in samples]
+            for samples in case["paths"]
+        ],
+        "sleeve": {"rows": params["rows"], "columns": params["columns"]},
+    }
+    path.write_text(json.dumps(document))
+    return path
+
+
+def simplify_flags(algorithm: str, params: dict[str, Any], numbers: tuple[str, ...]) -> list[str]:
+    """The ``feelmysign simplify`` options that ask for a vector's parameters: the ``numbers``
+    named, and --stretch when the vector stretches."""
+    flags = ["--algorithm", algorithm]
+    for name in numbers:
+        flags += ["--" + name.replace("_", "-"), repr(params[name])]
+    return flags + (["--stretch"] if params["stretch"] else [])

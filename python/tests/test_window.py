@@ -17,6 +17,8 @@ from simplifier_checks import (
     check_vector,
     random_walk,
     run,
+    simplify_flags,
+    write_recording,
 )
 from vectors import load
 from window_reference import ReferenceWindowSimplifier
@@ -219,25 +221,9 @@ def test_a_tap_gives_one_dropped_segment() -> None:
 # --- the command line ---------------------------------------------------------
 
 
-def _recording(case: dict[str, Any], path: Path) -> Path:
-    params = case["params"]
-    document = {
-        "canvas": {"width_px": params["canvas_width_px"], "height_px": params["canvas_height_px"]},
-        "paths": [
-            [{"t_ms": t, "x": x, "y": y, "pressure": p} for t, x, y, p in samples]
-            for samples in case["paths"]
-        ],
-        "sleeve": {"rows": params["rows"], "columns": params["columns"]},
-    }
-    path.write_text(json.dumps(document))
-    return path
-
-
 def _flags(params: dict[str, Any]) -> list[str]:
-    flags = ["--algorithm", "window"]
-    for name in ("max_error", "max_window", "max_stroke_ms", "min_duration_ms", "min_length"):
-        flags += ["--" + name.replace("_", "-"), repr(params[name])]
-    return flags + (["--stretch"] if params["stretch"] else [])
+    numbers = ("max_error", "max_window", "max_stroke_ms", "min_duration_ms", "min_length")
+    return simplify_flags("window", params, numbers)
 
 
 @pytest.mark.parametrize(
@@ -248,7 +234,7 @@ def test_cli_reproduces_the_vectors(
     name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     case = WINDOW[name]
-    recording = _recording(case, tmp_path / "drawing.json")
+    recording = write_recording(case, tmp_path / "drawing.json")
     assert main(["simplify", str(recording), "--json", *_flags(case["params"])]) == 0
     result = json.loads(capsys.readouterr().out)
     assert result["algorithm"] == "window" and result["params"] == case["params"]
@@ -264,7 +250,7 @@ def test_cli_reproduces_the_vectors(
 
 
 def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    recording = _recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
+    recording = write_recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0.05"]) == 0
     assert "window: max error 0.05 grid units" in capsys.readouterr().out
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"]) == 1
@@ -291,7 +277,7 @@ def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_cli_uses_the_recordings_algorithm_and_parameters(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    path = _recording(WINDOW["circle/max-error-0.02"], tmp_path / "w.json")
+    path = write_recording(WINDOW["circle/max-error-0.02"], tmp_path / "w.json")
     document = json.loads(path.read_text())
     path.write_text(
         json.dumps(
