@@ -7,7 +7,8 @@
  */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
-import { SHARED_PARAM_ARBS, expectDropRule, mapping, pointerPathArb } from "./simplifier-arbitraries";
+import { CanvasMapping } from "../src/simplify/mapping";
+import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
 import { AngleSimplifier } from "../src/simplify/angle";
 import { framesFromSamples } from "../src/simplify/frames";
 import { DEFAULT_ANGLE_PARAMS, type AngleParams } from "../src/simplify/params";
@@ -63,7 +64,7 @@ describe("angle simplifier properties", () => {
     fc.assert(
       fc.property(paramsArb, pathArb, (params, samples) => {
         const { frames, segments } = runPath(params, samples);
-        const grid = mapping(params);
+        const grid = CanvasMapping.fromParams(params);
         const first = frames[0]!;
         const last = frames[frames.length - 1]!;
         expect(segments.length).toBeGreaterThanOrEqual(1);

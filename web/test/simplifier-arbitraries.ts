@@ -1,11 +1,10 @@
 /**
  * What the property tests of both simplifiers draw from: random pointer paths,
- * the parameters every simplifier shares, the canvas mapping those give, and
- * the drop rule every simplifier applies through segment.ts.
+ * the parameters every simplifier shares, and the drop rule every simplifier
+ * applies through segment.ts.
  */
 import fc from "fast-check";
 import { expect } from "vitest";
-import { CanvasMapping } from "../src/simplify/mapping";
 import {
   NOT_ENOUGH_DISTANCE,
   NOT_ENOUGH_DURATION,
@@ -75,16 +74,6 @@ interface SharedParams {
   canvas_width_px: number;
   canvas_height_px: number;
   stretch: boolean;
-}
-
-export function mapping(params: SharedParams): CanvasMapping {
-  return new CanvasMapping({
-    width_px: params.canvas_width_px,
-    height_px: params.canvas_height_px,
-    columns: params.columns,
-    rows: params.rows,
-    stretch: params.stretch,
-  });
 }
 
 /** A dropped segment carries the reason its size gives (distance first), and a kept one is big enough. */

@@ -10,7 +10,8 @@
  */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
-import { SHARED_PARAM_ARBS, expectDropRule, mapping, pointerPathArb } from "./simplifier-arbitraries";
+import { CanvasMapping } from "../src/simplify/mapping";
+import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
 import { type Point, type Sample, type Segment } from "../src/simplify/segment";
 import { LINE_SHARE, WindowSimplifier } from "../src/simplify/window";
 import type { WindowParams } from "../src/simplify/window-params";
@@ -54,7 +55,7 @@ function covered(params: WindowParams, samples: readonly Sample[]) {
   const simplifier = new WindowSimplifier(params);
   const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
   segments.push(...simplifier.end());
-  const map = mapping(params);
+  const map = CanvasMapping.fromParams(params);
   // An end is its sample, or within LINE_SHARE x max_error of it going on along a line the
   // latency cap cut.
   const moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE;
