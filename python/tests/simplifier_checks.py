@@ -125,3 +125,25 @@ def simplify_flags(algorithm: str, params: dict[str, Any], numbers: tuple[str, .
     for name in numbers:
         flags += ["--" + name.replace("_", "-"), repr(params[name])]
     return flags + (["--stretch"] if params["stretch"] else [])
+
+
+# A square on a 900 x 600 canvas, corner to corner, closed.
+SQUARE_CORNERS_PX = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
+
+
+def square_path(sample_ms: float) -> list[Sample]:
+    """The square drawn with 40 samples a side, ``sample_ms`` apart, ending on its first corner."""
+    points = [
+        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
+        for (x0, y0), (x1, y1) in itertools.pairwise(SQUARE_CORNERS_PX)
+        for k in range(40)
+    ] + [SQUARE_CORNERS_PX[-1]]
+    return [Sample(i * sample_ms, x, y) for i, (x, y) in enumerate(points)]
+
+
+def assert_four_strokes_on_the_corners(params: SimplifierParams, segments: list[Segment]) -> None:
+    """The square's four sides, all sent, each from one corner to the next."""
+    grid = [params.mapping.to_grid(x, y) for x, y in SQUARE_CORNERS_PX]
+    assert [s.dropped for s in segments] == [None] * 4
+    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
+        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)

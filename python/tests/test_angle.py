@@ -10,10 +10,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from simplifier_checks import (
+    assert_four_strokes_on_the_corners,
     assert_joined_from_press_to_release,
     check_vector,
     random_walk,
     run,
+    square_path,
 )
 from vectors import load
 
@@ -71,19 +73,9 @@ def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: o
 
 def test_square_is_four_strokes_with_its_corners() -> None:
     params = AngleParams(canvas_width_px=900, canvas_height_px=600)
-    corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
     # One sample per frame, 40 frames a side: every corner falls on a check.
-    points = [
-        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
-        for (x0, y0), (x1, y1) in itertools.pairwise(corners)
-        for k in range(40)
-    ] + [corners[-1]]
-    path = [Sample(i * 1000 / 60, x, y) for i, (x, y) in enumerate(points)]
-    segments = [s for _, s in run(params, [path])]
-    grid = [params.mapping.to_grid(x, y) for x, y in corners]
-    assert [s.dropped for s in segments] == [None] * 4
-    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
-        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+    segments = [s for _, s in run(params, [square_path(1000 / 60)])]
+    assert_four_strokes_on_the_corners(params, segments)
 
 
 @pytest.mark.parametrize("gap_px", [0.0, 1.0])

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from dataclasses import asdict
@@ -13,11 +12,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from simplifier_checks import (
+    assert_four_strokes_on_the_corners,
     assert_joined_from_press_to_release,
     check_vector,
     random_walk,
     run,
     simplify_flags,
+    square_path,
     write_recording,
 )
 from vectors import load
@@ -92,18 +93,8 @@ def test_square_is_four_strokes_with_its_corners() -> None:
     params = WindowParams(
         canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000, max_stroke_ms=0
     )
-    corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
-    points = [
-        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
-        for (x0, y0), (x1, y1) in itertools.pairwise(corners)
-        for k in range(40)
-    ] + [corners[-1]]
-    path = [Sample(i * 8.0, x, y) for i, (x, y) in enumerate(points)]
-    segments = [s for _, s in run(params, [path])]
-    grid = [params.mapping.to_grid(x, y) for x, y in corners]
-    assert [s.dropped for s in segments] == [None] * 4
-    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
-        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+    segments = [s for _, s in run(params, [square_path(8.0)])]
+    assert_four_strokes_on_the_corners(params, segments)
     # Each corner is found one sample later, when the next sample leaves the line.
     assert [s.emitted_at_ms - s.end_ms for s in segments[:3]] == pytest.approx([8.0] * 3)
 
