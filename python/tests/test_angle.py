@@ -9,6 +9,14 @@ from typing import Any
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from simplifier_checks import (
+    assert_four_strokes_on_the_corners,
+    assert_joined_from_press_to_release,
+    check_vector,
+    random_walk,
+    run,
+    square_path,
+)
 from vectors import load
 
 from feelmysign.errors import ParameterError
@@ -16,46 +24,19 @@ from feelmysign.simplify import (
     AngleParams,
     CanvasMapping,
     Sample,
-    Segment,
     frames_from_samples,
-    simplify_paths,
 )
-from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
 
 VECTORS = [(n, c) for n, c in load("angle") if n != "params"]
 PARAMS_TABLE = dict(load("angle"))["params"]
-
-
-def _run(params: AngleParams, paths: list[list[Sample]]) -> list[tuple[int, Segment]]:
-    return [(p.path, p.segment) for p in simplify_paths(params, paths)]
 
 
 @pytest.mark.parametrize(("name", "case"), VECTORS, ids=[n for n, _ in VECTORS])
 def test_vector(name: str, case: dict[str, Any]) -> None:
     params = AngleParams(**case["params"])
     paths = [[Sample(*s) for s in path] for path in case["paths"]]
-    tolerance = case["tolerance"]
     assert [len(frames_from_samples(p, params.fps)) for p in paths] == case["expected"]["inputs"]
-    actual = _run(params, paths)
-    expected = case["expected"]["segments"]
-    assert len(actual) == len(expected), name
-    for (path, segment), want in zip(actual, expected, strict=True):
-        assert path == want["path"] and segment.dropped == want["dropped"]
-        got = [
-            *segment.start,
-            *segment.end,
-            segment.start_ms,
-            segment.end_ms,
-            segment.emitted_at_ms,
-        ]
-        wanted = [
-            *want["start"],
-            *want["end"],
-            want["start_ms"],
-            want["end_ms"],
-            want["emitted_at_ms"],
-        ]
-        assert got == pytest.approx(wanted, abs=tolerance)
+    check_vector(name, case, params, paths)
 
 
 def test_parameter_table_matches_the_defaults() -> None:
@@ -92,19 +73,9 @@ def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: o
 
 def test_square_is_four_strokes_with_its_corners() -> None:
     params = AngleParams(canvas_width_px=900, canvas_height_px=600)
-    corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
     # One sample per frame, 40 frames a side: every corner falls on a check.
-    points = [
-        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
-        for (x0, y0), (x1, y1) in itertools.pairwise(corners)
-        for k in range(40)
-    ] + [corners[-1]]
-    path = [Sample(i * 1000 / 60, x, y) for i, (x, y) in enumerate(points)]
-    segments = [s for _, s in _run(params, [path])]
-    grid = [params.mapping.to_grid(x, y) for x, y in corners]
-    assert [s.dropped for s in segments] == [None] * 4
-    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
-        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+    segments = [s for _, s in run(params, [square_path(1000 / 60)])]
+    assert_four_strokes_on_the_corners(params, segments)
 
 
 @pytest.mark.parametrize("gap_px", [0.0, 1.0])
@@ -113,7 +84,7 @@ def test_a_line_flicked_back_onto_its_start_is_two_strokes(gap_px: float) -> Non
     params = AngleParams(canvas_width_px=1200, canvas_height_px=800)
     out = [Sample(k * 8.0, 300.0 + 800.0 * k / 75, 400.0) for k in range(76)]
     back = [Sample(600.0 + 8.0 * k, 1100.0 - (800.0 - gap_px) * k / 5, 400.0) for k in range(1, 6)]
-    segments = [s for _, s in _run(params, [out + back])]
+    segments = [s for _, s in run(params, [out + back])]
     assert [s.dropped for s in segments] == [None, None]
     assert segments[0].length > 1.5 and segments[1].length > 1.5
 
@@ -142,19 +113,7 @@ def paths(draw: st.DrawFn) -> tuple[AngleParams, list[Sample]]:
         canvas_width_px=800,
         canvas_height_px=600,
     )
-    count = draw(st.integers(1, 150))
-    steps = draw(
-        st.lists(
-            st.tuples(st.floats(-40, 40), st.floats(-40, 40), st.floats(0, 30)),
-            min_size=count,
-            max_size=count,
-        )
-    )
-    x, y, t_ms = draw(st.floats(0, 800)), draw(st.floats(0, 600)), 0.0
-    samples = [Sample(t_ms, x, y)]
-    for dx, dy, dt in steps:
-        x, y, t_ms = min(max(x + dx, 0), 800), min(max(y + dy, 0), 600), t_ms + dt
-        samples.append(Sample(t_ms, x, y))
+    samples = random_walk(draw, margin_px=0)
     return params, samples
 
 
@@ -162,32 +121,7 @@ def paths(draw: st.DrawFn) -> tuple[AngleParams, list[Sample]]:
 @given(paths())
 def test_segments_join_and_keep_the_path_ends(case: tuple[AngleParams, list[Sample]]) -> None:
     params, samples = case
-    segments = [s for _, s in _run(params, [samples])]
-    assert segments, "a path always gives at least one segment (sent or dropped)"
-    mapping = params.mapping
-    assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
-    assert segments[-1].end == mapping.to_grid(samples[-1].x, samples[-1].y)
-    assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
-    for before, after in itertools.pairwise(segments):
-        assert after.start == before.end and after.start_ms == before.end_ms
-
-
-@settings(max_examples=150, deadline=None)
-@given(paths())
-def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
-    case: tuple[AngleParams, list[Sample]],
-) -> None:
-    params, samples = case
-    for _, segment in _run(params, [samples]):
-        if segment.dropped is None:
-            assert segment.length >= params.min_length
-            assert segment.duration_ms >= params.min_duration_ms
-        elif segment.dropped == NOT_ENOUGH_DISTANCE:
-            assert segment.length < params.min_length
-        else:
-            assert segment.dropped == NOT_ENOUGH_DURATION
-            assert segment.duration_ms < params.min_duration_ms
-        assert segment.emitted_at_ms >= segment.end_ms
+    assert_joined_from_press_to_release(params, samples)
 
 
 @settings(max_examples=100, deadline=None)
@@ -197,14 +131,7 @@ def test_without_recover_strokes_still_start_and_end_on_the_path(
 ) -> None:
     params, samples = case
     params = AngleParams(**{**params.__dict__, "recover": False})
-    segments = [s for _, s in _run(params, [samples])]
+    segments = [s for _, s in run(params, [samples])]
     on_path = {params.mapping.to_grid(s.x, s.y) for s in samples}
     assert all(s.start in on_path and s.end in on_path for s in segments)
     assert all(a.end_ms <= b.start_ms for a, b in itertools.pairwise(segments))
-
-
-@settings(max_examples=100, deadline=None)
-@given(paths())
-def test_replay_is_deterministic(case: tuple[AngleParams, list[Sample]]) -> None:
-    params, samples = case
-    assert _run(params, [samples]) == _run(params, [samples])

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from cli_environment import clean_cli_environment
 from test_cli_send import Sleeve
 
 from feelmysign.broker import Broker
@@ -16,21 +17,12 @@ from feelmysign.research.rerun import mismatch, rerun, run_frames
 from feelmysign.simplify import AngleParams, Sample, frames_from_samples, load_recording
 from feelmysign.simplify.recording import RecordedStroke
 
-ENVIRONMENT = (
-    "FEELMYSIGN_BROKER",
-    "FEELMYSIGN_SLEEVE_ID",
-    "FEELMYSIGN_USERNAME",
-    "FEELMYSIGN_PASSWORD",
-    "FEELMYSIGN_CREDENTIALS",
-)
 CANVAS = {"width_px": 1200, "height_px": 800}
 
 
 @pytest.fixture(autouse=True)
 def clean_environment(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    for name in ENVIRONMENT:
-        monkeypatch.delenv(name, raising=False)
-    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    clean_cli_environment(monkeypatch, tmp_path)
 
 
 def spiral_samples() -> list[Sample]:

@@ -21,6 +21,7 @@ from typing import Any
 
 import paho.mqtt.client as mqtt
 import pytest
+from cli_environment import clean_cli_environment
 from paho.mqtt.enums import CallbackAPIVersion
 from paho.mqtt.reasoncodes import ReasonCode
 
@@ -34,22 +35,12 @@ from feelmysign.shapes import shape_strokes
 
 WAIT_S = 10.0
 LEGACY_TOPIC = "deviceOne/line"
-ENVIRONMENT = (
-    "FEELMYSIGN_BROKER",
-    "FEELMYSIGN_SLEEVE_ID",
-    "FEELMYSIGN_USERNAME",
-    "FEELMYSIGN_PASSWORD",
-    "FEELMYSIGN_CREDENTIALS",
-    "FEELMYSIGN_LAYOUT",
-)
 
 
 @pytest.fixture(autouse=True)
 def clean_environment(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """No FEELMYSIGN_* from the developer's shell, and no local broker's credentials file."""
-    for name in ENVIRONMENT:
-        monkeypatch.delenv(name, raising=False)
-    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    clean_cli_environment(monkeypatch, tmp_path)
 
 
 class Sleeve:

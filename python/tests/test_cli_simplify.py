@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from simplifier_checks import simplify_flags, write_recording
 from vectors import load
 
 from feelmysign.cli import main
@@ -14,42 +15,10 @@ from feelmysign.cli import main
 ANGLE = dict(load("angle"))
 
 
-def _recording(case: dict[str, Any], path: Path) -> Path:
-    params = case["params"]
-    document = {
-        "canvas": {"width_px": params["canvas_width_px"], "height_px": params["canvas_height_px"]},
-        "paths": [
-            [{"t_ms": t, "x": x, "y": y, "pressure": p} for t, x, y, p in p_]
-            for p_ in case["paths"]
-        ],
-        "sleeve": {"rows": params["rows"], "columns": params["columns"]},
-    }
-    path.write_text(json.dumps(document))
-    return path
-
-
 def _flags(params: dict[str, Any]) -> list[str]:
-    flags = [
-        "--algorithm",
-        "angle",
-        "--check-frames",
-        str(params["check_frames"]),
-        "--max-angle-deg",
-        repr(params["max_angle_deg"]),
-        "--frame-max",
-        str(params["frame_max"]),
-        "--fps",
-        repr(params["fps"]),
-        "--min-duration-ms",
-        repr(params["min_duration_ms"]),
-        "--min-length",
-        repr(params["min_length"]),
-    ]
-    if not params["recover"]:
-        flags.append("--no-recover")
-    if params["stretch"]:
-        flags.append("--stretch")
-    return flags
+    numbers = ("check_frames", "max_angle_deg", "frame_max", "fps", "min_duration_ms", "min_length")
+    flags = simplify_flags("angle", params, numbers)
+    return flags + ([] if params["recover"] else ["--no-recover"])
 
 
 @pytest.mark.parametrize(
@@ -67,7 +36,7 @@ def test_cli_reproduces_the_vectors(
     name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     case = ANGLE[name]
-    recording = _recording(case, tmp_path / "drawing.json")
+    recording = write_recording(case, tmp_path / "drawing.json")
     assert main(["simplify", str(recording), "--json", *_flags(case["params"])]) == 0
     result = json.loads(capsys.readouterr().out)
     expected = case["expected"]["segments"]
@@ -85,7 +54,7 @@ def test_cli_reproduces_the_vectors(
 
 
 def test_readable_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    recording = _recording(ANGLE["right-angle/defaults"], tmp_path / "r.json")
+    recording = write_recording(ANGLE["right-angle/defaults"], tmp_path / "r.json")
     assert main(["simplify", str(recording)]) == 0
     out = capsys.readouterr().out
     assert "stroke(s) sent" in out and "path" in out
@@ -122,6 +91,6 @@ def test_bad_recordings_say_what_is_wrong(
 def test_missing_file_and_bad_parameter(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["simplify", str(tmp_path / "absent.json")]) == 1
     assert "cannot read recording" in capsys.readouterr().err
-    recording = _recording(ANGLE["circle/defaults"], tmp_path / "c.json")
+    recording = write_recording(ANGLE["circle/defaults"], tmp_path / "c.json")
     assert main(["simplify", str(recording), "--paper", "--check-frames", "1"]) == 1
     assert "check_frames" in capsys.readouterr().err

@@ -75,6 +75,16 @@ def _desk_call(api: StudyApi, method: str, path: str, body: dict[str, Any]) -> t
     return status, json.loads(payload)
 
 
+def _answer_as_simulated(api: StudyApi, base: str, run: dict[str, Any]) -> tuple[int, Any]:
+    """Answers the trial just sent as the simulated participant would."""
+    answer = {
+        "dimension": "length",
+        "position": run["next"]["position"],
+        "response": run["simulated_answer"],
+    }
+    return _desk_call(api, "POST", f"{base}/threshold-answer", answer)
+
+
 def test_the_page_runs_the_procedure_step_by_step_and_resumes_after_a_restart(
     tmp_path: Path,
 ) -> None:
@@ -96,13 +106,7 @@ def test_the_page_runs_the_procedure_step_by_step_and_resumes_after_a_restart(
         run = state["dimensions"]["length"]["run"]
         assert status == 200 and run["next"]["sent"] and "direction" not in run["next"]
         assert run["last_send"]["played"] == 1
-        answer = {"dimension": "length", "position": run["next"]["position"]}
-        status, state = _desk_call(
-            page,
-            "POST",
-            f"{base}/threshold-answer",
-            {**answer, "response": run["simulated_answer"]},
-        )
+        status, state = _answer_as_simulated(page, base, run)
         assert status == 200
     before = state["dimensions"]["length"]["run"]
     assert len(before["trials"]) == 5 and before["estimate"]["low"] < before["estimate"]["high"]
@@ -113,19 +117,16 @@ def test_the_page_runs_the_procedure_step_by_step_and_resumes_after_a_restart(
     assert after["dimensions"]["length"]["run"]["next"] == {**before["next"], "sent": False}
     assert after["dimensions"]["length"]["run"]["estimate"] == pytest.approx(before["estimate"])
     status, refused = _desk_call(
-        page, "POST", f"{base}/threshold-answer", {**answer, "position": 5, "response": "up"}
+        page,
+        "POST",
+        f"{base}/threshold-answer",
+        {"dimension": "length", "position": 5, "response": "up"},
     )
     assert status == 400  # sent before the restart only: send it again
     while after["dimensions"]["length"]["run"] is not None:
         _, after = _desk_call(page, "POST", f"{base}/threshold-send", {"dimension": "length"})
         run = after["dimensions"]["length"]["run"]
-        answer = {"dimension": "length", "position": run["next"]["position"]}
-        _, after = _desk_call(
-            page,
-            "POST",
-            f"{base}/threshold-answer",
-            {**answer, "response": run["simulated_answer"]},
-        )
+        _, after = _answer_as_simulated(page, base, run)
     (finished,) = after["dimensions"]["length"]["finished_runs"]
     assert finished["trials"] == store.design.threshold.trials
     assert finished["low"] <= finished["threshold"] <= finished["high"]

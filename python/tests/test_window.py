@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from dataclasses import asdict
@@ -12,6 +11,16 @@ from typing import Any
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from simplifier_checks import (
+    assert_four_strokes_on_the_corners,
+    assert_joined_from_press_to_release,
+    check_vector,
+    random_walk,
+    run,
+    simplify_flags,
+    square_path,
+    write_recording,
+)
 from vectors import load
 from window_reference import ReferenceWindowSimplifier
 
@@ -22,9 +31,8 @@ from feelmysign.simplify import (
     Segment,
     WindowParams,
     WindowSimplifier,
-    simplify_paths,
 )
-from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
+from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE
 from feelmysign.simplify.window import LINE_SHARE
 from feelmysign.stroke import Point
 
@@ -34,10 +42,6 @@ PARAMS_TABLE = WINDOW["params"]
 # The bound is tested on the reference's own float arithmetic; a different
 # formula for the same distance may differ in the last bits.
 FLOAT_TOLERANCE = 1e-12
-
-
-def _run(params: WindowParams, paths: list[list[Sample]]) -> list[tuple[int, Segment]]:
-    return [(p.path, p.segment) for p in simplify_paths(params, paths)]
 
 
 def _distance(point: Point, start: Point, end: Point) -> float:
@@ -53,18 +57,8 @@ def _distance(point: Point, start: Point, end: Point) -> float:
 def test_vector(name: str, case: dict[str, Any]) -> None:
     params = WindowParams(**case["params"])
     paths = [[Sample(*s) for s in path] for path in case["paths"]]
-    tolerance = case["tolerance"]
     assert [len(p) for p in paths] == case["expected"]["inputs"]
-    actual = _run(params, paths)
-    expected = case["expected"]["segments"]
-    assert len(actual) == len(expected), name
-    for (path, segment), want in zip(actual, expected, strict=True):
-        assert path == want["path"] and segment.dropped == want["dropped"]
-        got = [*segment.start, *segment.end, segment.start_ms, segment.end_ms]
-        wanted = [*want["start"], *want["end"], want["start_ms"], want["end_ms"]]
-        assert [*got, segment.emitted_at_ms] == pytest.approx(
-            [*wanted, want["emitted_at_ms"]], abs=tolerance
-        )
+    check_vector(name, case, params, paths)
 
 
 def test_parameter_table_matches_the_defaults() -> None:
@@ -99,18 +93,8 @@ def test_square_is_four_strokes_with_its_corners() -> None:
     params = WindowParams(
         canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000, max_stroke_ms=0
     )
-    corners = [(150, 100), (750, 100), (750, 500), (150, 500), (150, 100)]
-    points = [
-        (x0 + (x1 - x0) * k / 40, y0 + (y1 - y0) * k / 40)
-        for (x0, y0), (x1, y1) in itertools.pairwise(corners)
-        for k in range(40)
-    ] + [corners[-1]]
-    path = [Sample(i * 8.0, x, y) for i, (x, y) in enumerate(points)]
-    segments = [s for _, s in _run(params, [path])]
-    grid = [params.mapping.to_grid(x, y) for x, y in corners]
-    assert [s.dropped for s in segments] == [None] * 4
-    for segment, (a, b) in zip(segments, itertools.pairwise(grid), strict=True):
-        assert segment.start == pytest.approx(a) and segment.end == pytest.approx(b)
+    segments = [s for _, s in run(params, [square_path(8.0)])]
+    assert_four_strokes_on_the_corners(params, segments)
     # Each corner is found one sample later, when the next sample leaves the line.
     assert [s.emitted_at_ms - s.end_ms for s in segments[:3]] == pytest.approx([8.0] * 3)
 
@@ -121,7 +105,7 @@ def test_a_straight_line_the_latency_cap_cuts_stays_one_straight_line() -> None:
     # samples but points on the line of the first, so the felt line does not bend.
     params = WindowParams()
     path = [Sample(i * 8.0, 100 + 12.0 * i, 540 + (0.6 if i % 2 else -0.6)) for i in range(126)]
-    segments = [s for _, s in _run(params, [path]) if s.dropped is None]
+    segments = [s for _, s in run(params, [path]) if s.dropped is None]
     assert len(segments) >= 4
     (x0, y0), (x1, y1) = segments[0].start, segments[0].end
     for segment in segments[1:]:
@@ -147,7 +131,7 @@ def test_the_cut_goes_on_the_feature_not_where_the_bound_first_breaks() -> None:
     )
     up = [Sample(8.0 * k, 5.0 * k, 100 - 0.6 * k) for k in range(21)]
     down = [Sample(8.0 * (20 + k), 100 + 5.0 * k, 88 + 0.6 * k) for k in range(1, 41)]
-    segments = [s for _, s in _run(params, [up + down])]
+    segments = [s for _, s in run(params, [up + down])]
     tip = params.mapping.to_grid(up[-1].x, up[-1].y)
     assert segments[0].end == tip and segments[0].end_ms == up[-1].t_ms
     assert segments[0].emitted_at_ms > up[-1].t_ms + 8.0  # found later, cut back on the tip
@@ -157,7 +141,7 @@ def test_the_cut_goes_on_the_feature_not_where_the_bound_first_breaks() -> None:
 def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
     params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=100)
     line = [Sample(8.0 * k, 1.0 * k, 100) for k in range(76)]  # 600 ms, straight
-    segments = [s for _, s in _run(params, [line])]
+    segments = [s for _, s in run(params, [line])]
     assert all(s.duration_ms <= 100 for s in segments)
     # Samples 8 ms apart: each stroke covers 12 of them (96 ms), the seventh the rest.
     assert [s.duration_ms for s in segments] == [96.0] * 6 + [24.0]
@@ -180,11 +164,11 @@ def test_the_latency_cap_cuts_at_a_feature_of_the_strokes_second_half_only() -> 
     # A bump 0.2 high (within the bound) 40 ms in: cutting there would leave a 40 ms
     # stroke, too brief to be felt in its drawn time; the line after it is straight, so
     # the cap cuts at the last sample it allows.
-    early = [s for _, s in _run(params, [_bumped_line(params, 40.0, 0.2)])]
+    early = [s for _, s in run(params, [_bumped_line(params, 40.0, 0.2)])]
     assert [s.dropped for s in early] == [None, None]
     assert (early[0].start_ms, early[0].end_ms) == (0.0, 296.0)
     # The same bump 200 ms in lies in the stroke's second half: the cut is on it.
-    late = [s for _, s in _run(params, [_bumped_line(params, 200.0, 0.2)])]
+    late = [s for _, s in run(params, [_bumped_line(params, 200.0, 0.2)])]
     assert (late[0].start_ms, late[0].end_ms) == (0.0, 200.0)
     assert late[-1].end_ms == 400.0
 
@@ -194,7 +178,7 @@ def test_a_release_a_rounding_error_after_a_frame_still_reaches_the_end() -> Non
     samples = [Sample(k * 8.0, 200.0 + 6.0 * k, 300.0 + 2.0 * k) for k in range(63)]
     release = Sample(500.0 + 0.0003, 200.0 + 6.0 * 63, 300.0 + 2.0 * 63)
     params = WindowParams(canvas_width_px=1200, canvas_height_px=800, max_stroke_ms=0)
-    segments = [s for _, s in _run(params, [[*samples, release]])]
+    segments = [s for _, s in run(params, [[*samples, release]])]
     assert [s.dropped for s in segments] == [None]
     assert segments[-1].end == params.mapping.to_grid(release.x, release.y)
 
@@ -228,25 +212,9 @@ def test_a_tap_gives_one_dropped_segment() -> None:
 # --- the command line ---------------------------------------------------------
 
 
-def _recording(case: dict[str, Any], path: Path) -> Path:
-    params = case["params"]
-    document = {
-        "canvas": {"width_px": params["canvas_width_px"], "height_px": params["canvas_height_px"]},
-        "paths": [
-            [{"t_ms": t, "x": x, "y": y, "pressure": p} for t, x, y, p in samples]
-            for samples in case["paths"]
-        ],
-        "sleeve": {"rows": params["rows"], "columns": params["columns"]},
-    }
-    path.write_text(json.dumps(document))
-    return path
-
-
 def _flags(params: dict[str, Any]) -> list[str]:
-    flags = ["--algorithm", "window"]
-    for name in ("max_error", "max_window", "max_stroke_ms", "min_duration_ms", "min_length"):
-        flags += ["--" + name.replace("_", "-"), repr(params[name])]
-    return flags + (["--stretch"] if params["stretch"] else [])
+    numbers = ("max_error", "max_window", "max_stroke_ms", "min_duration_ms", "min_length")
+    return simplify_flags("window", params, numbers)
 
 
 @pytest.mark.parametrize(
@@ -257,7 +225,7 @@ def test_cli_reproduces_the_vectors(
     name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     case = WINDOW[name]
-    recording = _recording(case, tmp_path / "drawing.json")
+    recording = write_recording(case, tmp_path / "drawing.json")
     assert main(["simplify", str(recording), "--json", *_flags(case["params"])]) == 0
     result = json.loads(capsys.readouterr().out)
     assert result["algorithm"] == "window" and result["params"] == case["params"]
@@ -273,7 +241,7 @@ def test_cli_reproduces_the_vectors(
 
 
 def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    recording = _recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
+    recording = write_recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0.05"]) == 0
     assert "window: max error 0.05 grid units" in capsys.readouterr().out
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"]) == 1
@@ -300,7 +268,7 @@ def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_cli_uses_the_recordings_algorithm_and_parameters(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    path = _recording(WINDOW["circle/max-error-0.02"], tmp_path / "w.json")
+    path = write_recording(WINDOW["circle/max-error-0.02"], tmp_path / "w.json")
     document = json.loads(path.read_text())
     path.write_text(
         json.dumps(
@@ -332,20 +300,8 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
         canvas_width_px=800,
         canvas_height_px=600,
     )
-    count = draw(st.integers(1, 150))
-    steps = draw(
-        st.lists(
-            st.tuples(st.floats(-40, 40), st.floats(-40, 40), st.floats(min_step_ms, 30)),
-            min_size=count,
-            max_size=count,
-        )
-    )
     # Starting and stepping past the canvas exercises the clamping onto the grid.
-    x, y, t_ms = draw(st.floats(-50, 850)), draw(st.floats(-50, 650)), 0.0
-    samples = [Sample(t_ms, x, y)]
-    for dx, dy, dt in steps:
-        x, y, t_ms = min(max(x + dx, -50), 850), min(max(y + dy, -50), 650), t_ms + dt
-        samples.append(Sample(t_ms, x, y))
+    samples = random_walk(draw, margin_px=50, min_step_ms=min_step_ms)
     return params, samples
 
 
@@ -357,7 +313,7 @@ def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int
     point or, going on along a line the latency cap cut, within LINE_SHARE x
     max_error of it.
     """
-    segments = [s for _, s in _run(params, [samples])]
+    segments = [s for _, s in run(params, [samples])]
     mapping = params.mapping
     moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE
     covered: list[tuple[int, int, Segment]] = []
@@ -395,15 +351,9 @@ def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
 @given(paths())
 def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sample]]) -> None:
     params, samples = case
-    segments = [s for _, s in _run(params, [samples])]
-    assert segments, "a path always gives at least one segment (sent or dropped)"
-    mapping = params.mapping
-    assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
-    release = mapping.to_grid(samples[-1].x, samples[-1].y)
-    assert math.dist(segments[-1].end, release) <= LINE_SHARE * params.max_error + FLOAT_TOLERANCE
-    assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
-    for before, after in itertools.pairwise(segments):
-        assert after.start == before.end and after.start_ms == before.end_ms
+    assert_joined_from_press_to_release(
+        params, samples, release_within=LINE_SHARE * params.max_error + FLOAT_TOLERANCE
+    )
 
 
 @settings(max_examples=150, deadline=None)
@@ -422,31 +372,6 @@ def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
             short = math.dist(segment.start, before) < params.min_length
             assert last - first == 1 or short
         assert segment.emitted_at_ms in times and segment.emitted_at_ms >= segment.end_ms
-
-
-@settings(max_examples=150, deadline=None)
-@given(paths())
-def test_sent_strokes_meet_the_minimums_and_dropped_say_why(
-    case: tuple[WindowParams, list[Sample]],
-) -> None:
-    params, samples = case
-    for _, segment in _run(params, [samples]):
-        if segment.dropped is None:
-            assert segment.length >= params.min_length
-            assert segment.duration_ms >= params.min_duration_ms
-        elif segment.dropped == NOT_ENOUGH_DISTANCE:
-            assert segment.length < params.min_length
-        else:
-            assert segment.dropped == NOT_ENOUGH_DURATION
-            assert segment.duration_ms < params.min_duration_ms
-        assert segment.emitted_at_ms >= segment.end_ms
-
-
-@settings(max_examples=100, deadline=None)
-@given(paths())
-def test_replay_is_deterministic(case: tuple[WindowParams, list[Sample]]) -> None:
-    params, samples = case
-    assert _run(params, [samples]) == _run(params, [samples])
 
 
 # ---- The same strokes, to the last bit, as the simplifier first written (window_reference) ----
@@ -604,6 +529,6 @@ def test_a_drawing_along_the_edges_gives_strokes_on_the_grid(
     # drawn sample on it: a line going on along a stroke the cap ended must not leave it.
     params, samples = case
     x_max, y_max = params.columns - 1, params.rows - 1
-    for _, segment in _run(params, [samples]):
+    for _, segment in run(params, [samples]):
         for x, y in (segment.start, segment.end):
             assert 0.0 <= x <= x_max and 0.0 <= y <= y_max, segment

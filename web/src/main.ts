@@ -2,6 +2,7 @@
 import "./styles.css";
 import { App } from "./app";
 import { fetchConfig } from "./config";
+import { memoryStorage } from "./memory-storage";
 import { buildToolbar } from "./ui/toolbar";
 
 declare global {
@@ -19,17 +20,7 @@ function settingsStorage(): Storage {
     localStorage.removeItem(probe);
     return localStorage;
   } catch {
-    const data = new Map<string, string>();
-    return {
-      get length() {
-        return data.size;
-      },
-      clear: () => data.clear(),
-      getItem: (key) => data.get(key) ?? null,
-      key: (index) => [...data.keys()][index] ?? null,
-      removeItem: (key) => void data.delete(key),
-      setItem: (key, value) => void data.set(key, value),
-    };
+    return memoryStorage();
   }
 }
 

@@ -7,51 +7,15 @@
  */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
+import { CanvasMapping } from "../src/simplify/mapping";
+import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
 import { AngleSimplifier } from "../src/simplify/angle";
 import { framesFromSamples } from "../src/simplify/frames";
-import { CanvasMapping } from "../src/simplify/mapping";
 import { DEFAULT_ANGLE_PARAMS, type AngleParams } from "../src/simplify/params";
 import { simplifyPaths } from "../src/simplify/registry";
-import {
-  NOT_ENOUGH_DISTANCE,
-  NOT_ENOUGH_DURATION,
-  segmentLength,
-  type Sample,
-  type Segment,
-} from "../src/simplify/segment";
+import { type Sample, type Segment } from "../src/simplify/segment";
 
-const WIDTH_PX = 900;
-const HEIGHT_PX = 600;
-
-/** A pointer path: a random walk inside (and a little outside) the canvas, times increasing. */
-const pathArb = fc
-  .record({
-    x0: fc.double({ min: -20, max: WIDTH_PX + 20, noNaN: true }),
-    y0: fc.double({ min: -20, max: HEIGHT_PX + 20, noNaN: true }),
-    steps: fc.array(
-      fc.record({
-        dt: fc.double({ min: 0, max: 40, noNaN: true }),
-        dx: fc.double({ min: -60, max: 60, noNaN: true }),
-        dy: fc.double({ min: -60, max: 60, noNaN: true }),
-        pressure: fc.double({ min: 0, max: 1, noNaN: true }),
-      }),
-      // "max": long paths, with many checks; fast-check favours tiny arrays otherwise.
-      { minLength: 0, maxLength: 200, size: "max" },
-    ),
-  })
-  .map(({ x0, y0, steps }) => {
-    const samples: Sample[] = [{ t_ms: 0, x: x0, y: y0, pressure: 0.5 }];
-    for (const step of steps) {
-      const last = samples[samples.length - 1]!;
-      samples.push({
-        t_ms: last.t_ms + step.dt,
-        x: last.x + step.dx,
-        y: last.y + step.dy,
-        pressure: step.pressure,
-      });
-    }
-    return samples;
-  });
+const pathArb = pointerPathArb({ minStepMs: 0, randomPressure: true });
 
 const paramsArb: fc.Arbitrary<AngleParams> = fc.record({
   algorithm: fc.constant("angle" as const),
@@ -60,14 +24,7 @@ const paramsArb: fc.Arbitrary<AngleParams> = fc.record({
   frame_max: fc.oneof(fc.constant(0), fc.integer({ min: 1, max: 120 })),
   fps: fc.double({ min: 10, max: 240, noNaN: true }),
   recover: fc.boolean(),
-  clear_on_press: fc.boolean(),
-  min_duration_ms: fc.double({ min: 0, max: 100, noNaN: true }),
-  min_length: fc.double({ min: 0, max: 1, noNaN: true }),
-  rows: fc.integer({ min: 2, max: 8 }),
-  columns: fc.integer({ min: 2, max: 8 }),
-  canvas_width_px: fc.constant(WIDTH_PX),
-  canvas_height_px: fc.constant(HEIGHT_PX),
-  stretch: fc.boolean(),
+  ...SHARED_PARAM_ARBS,
 });
 
 function runPath(params: AngleParams, samples: readonly Sample[]): { frames: Sample[]; segments: Segment[] } {
@@ -76,16 +33,6 @@ function runPath(params: AngleParams, samples: readonly Sample[]): { frames: Sam
   const segments = frames.flatMap((frame) => simplifier.push(frame));
   segments.push(...simplifier.end());
   return { frames, segments };
-}
-
-function mapping(params: AngleParams): CanvasMapping {
-  return new CanvasMapping({
-    width_px: params.canvas_width_px,
-    height_px: params.canvas_height_px,
-    columns: params.columns,
-    rows: params.rows,
-    stretch: params.stretch,
-  });
 }
 
 describe("angle simplifier properties", () => {
@@ -117,7 +64,7 @@ describe("angle simplifier properties", () => {
     fc.assert(
       fc.property(paramsArb, pathArb, (params, samples) => {
         const { frames, segments } = runPath(params, samples);
-        const grid = mapping(params);
+        const grid = CanvasMapping.fromParams(params);
         const first = frames[0]!;
         const last = frames[frames.length - 1]!;
         expect(segments.length).toBeGreaterThanOrEqual(1);
@@ -132,20 +79,7 @@ describe("angle simplifier properties", () => {
   it("a dropped segment carries the reason its size gives, and a kept one is big enough", () => {
     fc.assert(
       fc.property(paramsArb, pathArb, (params, samples) => {
-        for (const segment of runPath(params, samples).segments) {
-          const length = segmentLength(segment);
-          const duration = segment.end_ms - segment.start_ms;
-          if (segment.dropped === NOT_ENOUGH_DISTANCE) {
-            expect(length).toBeLessThan(params.min_length);
-          } else if (segment.dropped === NOT_ENOUGH_DURATION) {
-            expect(length).toBeGreaterThanOrEqual(params.min_length);
-            expect(duration).toBeLessThan(params.min_duration_ms);
-          } else {
-            expect(segment.dropped).toBeNull();
-            expect(length).toBeGreaterThanOrEqual(params.min_length);
-            expect(duration).toBeGreaterThanOrEqual(params.min_duration_ms);
-          }
-        }
+        for (const segment of runPath(params, samples).segments) expectDropRule(segment, params);
       }),
     );
   });

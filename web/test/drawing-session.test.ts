@@ -99,6 +99,11 @@ const L: readonly (readonly [number, number])[] = [
   [280, 20],
   [280, 180],
 ];
+/** A second line, drawn after L into the same drawing. */
+const DIAGONAL: readonly (readonly [number, number])[] = [
+  [20, 180],
+  [150, 100],
+];
 
 /** Presses at the first sample, moves through the rest a frame each, and (unless told) releases. */
 function drawPath(session: DrawingSession, samples: readonly Sample[], release = true): void {
@@ -140,30 +145,12 @@ describe("a drawing session", () => {
     drawPath(session, along(L));
     const first = session.drawing!;
     const count = sent.length;
-    drawPath(
-      session,
-      along(
-        [
-          [20, 180],
-          [150, 100],
-        ],
-        5000,
-      ),
-    );
+    drawPath(session, along(DIAGONAL, 5000));
     expect(session.drawing).toBe(first);
     expect(first.paths).toHaveLength(2);
     expect(sent[count]!.seq).toBe(count);
     session.close();
-    drawPath(
-      session,
-      along(
-        [
-          [20, 180],
-          [150, 100],
-        ],
-        9000,
-      ),
-    );
+    drawPath(session, along(DIAGONAL, 9000));
     const second = session.drawing!;
     expect(second).not.toBe(first);
     const fresh = sent.filter((stroke) => stroke.drawing === second.id);
@@ -196,16 +183,7 @@ describe("a drawing session", () => {
     const { session, view, sent } = setup();
     drawPath(session, along(L));
     const drawing = session.drawing!;
-    drawPath(
-      session,
-      along(
-        [
-          [20, 180],
-          [150, 100],
-        ],
-        5000,
-      ),
-    );
+    drawPath(session, along(DIAGONAL, 5000));
     session.refused(0);
     session.acked(sent[0]!);
     const first = drawing.bySeq(0)!;
@@ -220,16 +198,7 @@ describe("a drawing session", () => {
   it("takes back the last path, and clears the canvas with the first", () => {
     const { session, changes } = setup();
     drawPath(session, along(L));
-    drawPath(
-      session,
-      along(
-        [
-          [20, 180],
-          [150, 100],
-        ],
-        5000,
-      ),
-    );
+    drawPath(session, along(DIAGONAL, 5000));
     expect(session.undo()).toBe(true);
     expect(session.drawing!.paths).toHaveLength(1);
     expect(session.undo()).toBe(true);
@@ -262,16 +231,7 @@ describe("a drawing session", () => {
     expect(released()).toBe(1);
     expect(waiting).toHaveLength(0);
     // The next press draws again, into the same drawing (Stop's close() is the page's to call).
-    drawPath(
-      session,
-      along(
-        [
-          [20, 180],
-          [150, 100],
-        ],
-        9000,
-      ),
-    );
+    drawPath(session, along(DIAGONAL, 9000));
     expect(session.drawing).toBe(drawing);
     expect(drawing.paths).toHaveLength(2);
     expect(sent.length).toBeGreaterThan(sentAtStop);

@@ -1,6 +1,7 @@
 /** Settings: validated with exactly the ranges of testdata/angle/params.json, persisted, reset. */
 import { describe, expect, it } from "vitest";
 import type { ServerConfig } from "../src/config";
+import { memoryStorage } from "../src/memory-storage";
 import {
   DEFAULT_SETTINGS,
   FIELDS,
@@ -29,20 +30,6 @@ const table = (
 const settingKeys = new Set<string>(FIELDS.map((field) => field.key));
 /** The parameters the settings panel offers (the canvas size comes from the page). */
 const offered = table.filter((row) => settingKeys.has(row.name));
-
-function memoryStorage(initial: Record<string, string> = {}): Storage {
-  const data = new Map(Object.entries(initial));
-  return {
-    get length() {
-      return data.size;
-    },
-    clear: () => data.clear(),
-    getItem: (key) => data.get(key) ?? null,
-    key: (index) => [...data.keys()][index] ?? null,
-    removeItem: (key) => void data.delete(key),
-    setItem: (key, value) => void data.set(key, value),
-  };
-}
 
 function errorsFor(key: SettingKey, value: unknown): string | undefined {
   return validateSettings({ ...DEFAULT_SETTINGS, [key]: value })[key];

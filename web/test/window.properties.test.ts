@@ -11,47 +11,18 @@
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
 import { CanvasMapping } from "../src/simplify/mapping";
-import {
-  NOT_ENOUGH_DISTANCE,
-  NOT_ENOUGH_DURATION,
-  segmentLength,
-  type Point,
-  type Sample,
-  type Segment,
-} from "../src/simplify/segment";
+import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
+import { type Point, type Sample, type Segment } from "../src/simplify/segment";
 import { LINE_SHARE, WindowSimplifier } from "../src/simplify/window";
 import type { WindowParams } from "../src/simplify/window-params";
 
-const WIDTH_PX = 900;
-const HEIGHT_PX = 600;
 /** Room for a distance computed another way than the simplifier's (last bits only). */
 const FLOAT_TOLERANCE = 1e-12;
 /** Hundreds of random paths: generous, for a loaded machine (the work is bounded, not timed). */
 const PROPERTY_TIMEOUT_MS = 120_000;
 
-/** A pointer path: a random walk inside (and a little outside) the canvas, times increasing. */
-const pathArb = fc
-  .record({
-    x0: fc.double({ min: -20, max: WIDTH_PX + 20, noNaN: true }),
-    y0: fc.double({ min: -20, max: HEIGHT_PX + 20, noNaN: true }),
-    steps: fc.array(
-      fc.record({
-        // Every sample its own time, so each stroke's samples are known from its times.
-        dt: fc.double({ min: 0.01, max: 40, noNaN: true }),
-        dx: fc.double({ min: -60, max: 60, noNaN: true }),
-        dy: fc.double({ min: -60, max: 60, noNaN: true }),
-      }),
-      { minLength: 0, maxLength: 200, size: "max" },
-    ),
-  })
-  .map(({ x0, y0, steps }) => {
-    const samples: Sample[] = [{ t_ms: 0, x: x0, y: y0, pressure: 0.5 }];
-    for (const step of steps) {
-      const last = samples[samples.length - 1]!;
-      samples.push({ t_ms: last.t_ms + step.dt, x: last.x + step.dx, y: last.y + step.dy, pressure: 0.5 });
-    }
-    return samples;
-  });
+// Every sample its own time, so each stroke's samples are known from its times.
+const pathArb = pointerPathArb({ minStepMs: 0.01, randomPressure: false });
 
 const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   algorithm: fc.constant("window" as const),
@@ -61,25 +32,8 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   ),
   max_window: fc.oneof(fc.constantFrom(1, 2, 64), fc.integer({ min: 1, max: 300 })),
   max_stroke_ms: fc.constantFrom(0, 50, 300),
-  clear_on_press: fc.boolean(),
-  min_duration_ms: fc.double({ min: 0, max: 100, noNaN: true }),
-  min_length: fc.double({ min: 0, max: 1, noNaN: true }),
-  rows: fc.integer({ min: 2, max: 8 }),
-  columns: fc.integer({ min: 2, max: 8 }),
-  canvas_width_px: fc.constant(WIDTH_PX),
-  canvas_height_px: fc.constant(HEIGHT_PX),
-  stretch: fc.boolean(),
+  ...SHARED_PARAM_ARBS,
 });
-
-function mapping(params: WindowParams): CanvasMapping {
-  return new CanvasMapping({
-    width_px: params.canvas_width_px,
-    height_px: params.canvas_height_px,
-    columns: params.columns,
-    rows: params.rows,
-    stretch: params.stretch,
-  });
-}
 
 /** Distance from a point to the segment start -> end (not its line). */
 function distance(point: Point, start: Point, end: Point): number {
@@ -101,7 +55,7 @@ function covered(params: WindowParams, samples: readonly Sample[]) {
   const simplifier = new WindowSimplifier(params);
   const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
   segments.push(...simplifier.end());
-  const map = mapping(params);
+  const map = CanvasMapping.fromParams(params);
   // An end is its sample, or within LINE_SHARE x max_error of it going on along a line the
   // latency cap cut.
   const moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE;
@@ -183,16 +137,7 @@ describe("window simplifier invariants", () => {
       fc.assert(
         fc.property(paramsArb, pathArb, (params, samples) => {
           for (const segment of covered(params, samples).segments) {
-            const duration = segment.end_ms - segment.start_ms;
-            if (segment.dropped === null) {
-              expect(segmentLength(segment)).toBeGreaterThanOrEqual(params.min_length);
-              expect(duration).toBeGreaterThanOrEqual(params.min_duration_ms);
-            } else if (segment.dropped === NOT_ENOUGH_DISTANCE) {
-              expect(segmentLength(segment)).toBeLessThan(params.min_length);
-            } else {
-              expect(segment.dropped).toBe(NOT_ENOUGH_DURATION);
-              expect(duration).toBeLessThan(params.min_duration_ms);
-            }
+            expectDropRule(segment, params);
             expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
           }
         }),

@@ -38,10 +38,13 @@ import math
 import sys
 from dataclasses import dataclass, fields
 from os import PathLike
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from feelmysign.errors import LayoutError
 from feelmysign.input_files import MAX_LAYOUT_BYTES, read_text
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -172,17 +175,27 @@ def load_layout(path: str | PathLike[str]) -> Layout:
     return parse_layout(text, source)
 
 
+def loads_toml(
+    text: str,
+    source: str,
+    error: Callable[[str, list[str]], Exception],
+    *,
+    nesting: str,
+) -> dict[str, Any]:
+    """The TOML document in ``text``, or ``error(source, [why])`` raised: not TOML, or nested
+    too deeply for Python's stack (``nesting`` says how deep the file's kind goes)."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as problem:
+        raise error(source, [f"not valid TOML: {problem}"]) from None
+    except RecursionError:
+        raise error(source, [f"nested too deeply to read; {nesting}"]) from None
+
+
 def parse_layout(text: str, source: str = "<string>") -> Layout:
     """Validate a layout given as TOML text; ``source`` names it in error messages."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise LayoutError(source, [f"not valid TOML: {error}"]) from None
-    except RecursionError:
-        raise LayoutError(
-            source, ["nested too deeply to read; a layout nests arrays and tables 2 levels deep"]
-        ) from None
-    return _build(data, source)
+    nesting = "a layout nests arrays and tables 2 levels deep"
+    return _build(loads_toml(text, source, LayoutError, nesting=nesting), source)
 
 
 def grid_layout(

@@ -115,6 +115,14 @@ class Rejected:
     drawing: str | None = None
     seq: int | None = None
 
+    def as_error(self, what: str, *, then: str = "") -> StrokeError:
+        """The error for a stroke of ours the sleeve would refuse: ``what`` names the stroke,
+        ``then`` (a sentence) says what was not done because of it."""
+        return StrokeError(
+            self.reason,
+            f"{what} would be rejected by the sleeve ({self.reason}): {self.message}{then}",
+        )
+
 
 def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accepted | Rejected:
     """Parse and validate one stroke message against ``layout``'s grid and duration cap.

@@ -40,13 +40,7 @@ export class AngleSimplifier {
     this.params = params;
     // Python's math.radians multiplies by pi/180 computed first.
     this.#cosMax = Math.cos(params.max_angle_deg * (Math.PI / 180));
-    this.#mapping = new CanvasMapping({
-      width_px: params.canvas_width_px,
-      height_px: params.canvas_height_px,
-      columns: params.columns,
-      rows: params.rows,
-      stretch: params.stretch,
-    });
+    this.#mapping = CanvasMapping.fromParams(params);
   }
 
   /** True between the first frame of a path and `end`. */

@@ -42,6 +42,23 @@ export class CanvasMapping {
     this.#offsetY = (this.#yExtent - options.height_px * this.scale) / 2;
   }
 
+  /** The mapping a simplifier's parameters ask for (their canvas, grid and stretch). */
+  static fromParams(params: {
+    readonly canvas_width_px: number;
+    readonly canvas_height_px: number;
+    readonly columns: number;
+    readonly rows: number;
+    readonly stretch: boolean;
+  }): CanvasMapping {
+    return new CanvasMapping({
+      width_px: params.canvas_width_px,
+      height_px: params.canvas_height_px,
+      columns: params.columns,
+      rows: params.rows,
+      stretch: params.stretch,
+    });
+  }
+
   /** Grid point (x = column, y = row) of a canvas pixel, clamped onto the grid. */
   toGrid(xPx: number, yPx: number): Point {
     return [this.gridX(xPx), this.gridY(yPx)];

@@ -145,13 +145,7 @@ export class WindowSimplifier {
     this.#reachLimit = params.max_error - ROUNDING_SLACK;
     this.#xExtent = params.columns - 1;
     this.#yExtent = params.rows - 1;
-    this.#mapping = new CanvasMapping({
-      width_px: params.canvas_width_px,
-      height_px: params.canvas_height_px,
-      columns: params.columns,
-      rows: params.rows,
-      stretch: params.stretch,
-    });
+    this.#mapping = CanvasMapping.fromParams(params);
     this.#window = new Samples();
   }
 

@@ -7,6 +7,7 @@
  */
 import type { ActuatorFrame } from "../telemetry";
 import { drawSleeveTop, setSleeveTransform } from "./canvas";
+import { FrameRequest, fitToDevicePixels } from "./canvas-frame";
 import type { GridSize } from "./geometry";
 
 /** Turned, the strip along the sleeve's top edge (its right on the screen) for its marker. */
@@ -21,7 +22,7 @@ export class SleevePreview {
   readonly #ctx: CanvasRenderingContext2D;
   #grid: GridSize = { rows: 3, columns: 4 };
   #frame: ActuatorFrame | null = null;
-  #scheduled = false;
+  readonly #redraw = new FrameRequest(() => this.#draw());
   #framesSeen = 0;
   #online = false;
   #turned = false;
@@ -32,8 +33,8 @@ export class SleevePreview {
     const ctx = canvas.getContext("2d");
     if (ctx === null) throw new Error("This browser cannot draw on a canvas (no 2D context).");
     this.#ctx = ctx;
-    new ResizeObserver(() => this.#schedule()).observe(canvas);
-    this.#schedule();
+    new ResizeObserver(() => this.#redraw.request()).observe(canvas);
+    this.#redraw.request();
   }
 
   /**
@@ -49,14 +50,14 @@ export class SleevePreview {
     const down = Math.max(turned ? grid.columns : grid.rows, 1);
     this.#canvas.style.aspectRatio = `${across} / ${down}`;
     this.#canvas.dataset["turned"] = String(turned);
-    this.#schedule();
+    this.#redraw.request();
   }
 
   show(frame: ActuatorFrame): void {
     this.#frame = frame;
     this.#framesSeen++;
     this.setGrid({ rows: frame.rows, columns: frame.columns });
-    this.#schedule();
+    this.#redraw.request();
   }
 
   /**
@@ -67,28 +68,13 @@ export class SleevePreview {
     if (!online) this.#frame = null;
     this.#online = online;
     this.#caption.textContent = message;
-    this.#schedule();
-  }
-
-  #schedule(): void {
-    if (this.#scheduled) return;
-    this.#scheduled = true;
-    requestAnimationFrame(() => {
-      this.#scheduled = false;
-      this.#draw();
-    });
+    this.#redraw.request();
   }
 
   #draw(): void {
     const canvas = this.#canvas;
-    const dpr = window.devicePixelRatio || 1;
-    const width = canvas.clientWidth;
-    const height = canvas.clientHeight;
+    const { width, height, dpr } = fitToDevicePixels(canvas);
     if (width === 0 || height === 0) return;
-    if (canvas.width !== Math.round(width * dpr) || canvas.height !== Math.round(height * dpr)) {
-      canvas.width = Math.round(width * dpr);
-      canvas.height = Math.round(height * dpr);
-    }
     const ctx = this.#ctx;
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     ctx.clearRect(0, 0, width, height);

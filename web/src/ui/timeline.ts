@@ -9,6 +9,7 @@
  */
 import { totalMs, type Grid, type PlacedStroke } from "../felt";
 import type { FeltPlacement } from "../felt-placement";
+import { FrameRequest, fitToDevicePixels } from "./canvas-frame";
 import { PlacementRaster, type LaneRaster } from "./felt-raster";
 
 const LABEL_WIDTH_PX = 34;
@@ -39,7 +40,10 @@ export class TimelineView {
   #column = new Float32Array(0);
   #image: ImageData | null = null;
   #cursorMs: number | null = null;
-  #scheduled = false;
+  readonly #redraw = new FrameRequest(() => {
+    this.#draw();
+    this.#drawCursor();
+  });
 
   constructor(canvas: HTMLCanvasElement, cursor: HTMLCanvasElement, caption: HTMLElement) {
     this.#canvas = canvas;
@@ -47,7 +51,7 @@ export class TimelineView {
     this.#caption = caption;
     this.#ctx = context(canvas);
     this.#cursorCtx = context(cursor);
-    new ResizeObserver(() => this.#schedule()).observe(canvas);
+    new ResizeObserver(() => this.#redraw.request()).observe(canvas);
   }
 
   /** The drawing to show (A), and the one to compare it with (B) or null. */
@@ -63,7 +67,7 @@ export class TimelineView {
     this.#canvas.dataset["strokes"] = String(a.placed.length);
     this.#canvas.dataset["compare"] = b === null ? "off" : String(b.length);
     this.#canvas.dataset["totalMs"] = String(Math.round(this.totalMs));
-    this.#schedule();
+    this.#redraw.request();
   }
 
   get totalMs(): number {
@@ -82,27 +86,6 @@ export class TimelineView {
     this.#caption.textContent = text;
   }
 
-  #schedule(): void {
-    if (this.#scheduled) return;
-    this.#scheduled = true;
-    requestAnimationFrame(() => {
-      this.#scheduled = false;
-      this.#draw();
-      this.#drawCursor();
-    });
-  }
-
-  #size(canvas: HTMLCanvasElement): { width: number; height: number; dpr: number } {
-    const dpr = window.devicePixelRatio || 1;
-    const width = canvas.clientWidth;
-    const height = canvas.clientHeight;
-    if (canvas.width !== Math.round(width * dpr) || canvas.height !== Math.round(height * dpr)) {
-      canvas.width = Math.round(width * dpr);
-      canvas.height = Math.round(height * dpr);
-    }
-    return { width, height, dpr };
-  }
-
   #lane(row: number, column: number, height: number): { top: number; height: number } {
     const lanes = this.#grid.rows * this.#grid.columns;
     const laneHeight = (height - AXIS_HEIGHT_PX) / Math.max(lanes, 1);
@@ -110,7 +93,7 @@ export class TimelineView {
   }
 
   #draw(): void {
-    const { width, height, dpr } = this.#size(this.#canvas);
+    const { width, height, dpr } = fitToDevicePixels(this.#canvas);
     if (width === 0 || height === 0) return;
     const ctx = this.#ctx;
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
@@ -207,7 +190,7 @@ export class TimelineView {
   }
 
   #drawCursor(): void {
-    const { width, height, dpr } = this.#size(this.#cursorCanvas);
+    const { width, height, dpr } = fitToDevicePixels(this.#cursorCanvas);
     const ctx = this.#cursorCtx;
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     ctx.clearRect(0, 0, width, height);

@@ -112,23 +112,13 @@ def _intensity(requested: float | None, layout: Layout) -> tuple[float, str]:
         requested = layout.default_intensity
     if not (math.isfinite(requested) and 0.0 <= requested <= 1.0):
         raise ParameterError("--intensity", requested, "a number in [0, 1]")
-    if requested > layout.max_intensity:
-        return layout.max_intensity, (
-            f"Intensity {requested:g} capped at the layout's safety.max_intensity "
-            f"{layout.max_intensity:g}."
-        )
-    return requested, ""
+    return _capped("Intensity", requested, "max_intensity", layout.max_intensity)
 
 
 def _duration_ms(requested: float, layout: Layout) -> tuple[float, str]:
     if not (math.isfinite(requested) and requested > 0):
         raise ParameterError("--duration-ms", requested, "a number of milliseconds above 0")
-    if requested > layout.max_on_time_ms:
-        return layout.max_on_time_ms, (
-            f"Duration {requested:g} ms capped at the layout's safety.max_on_time_ms "
-            f"{layout.max_on_time_ms:g} ms."
-        )
-    return requested, ""
+    return _capped("Duration", requested, "max_on_time_ms", layout.max_on_time_ms, unit=" ms")
 
 
 def _where(args: argparse.Namespace, layout: Layout) -> str:
@@ -141,3 +131,13 @@ def _where(args: argparse.Namespace, layout: Layout) -> str:
     elif args.emulate:
         bus = "an emulated I2C bus"
     return f" (DRV2605L on multiplexer 0x{wire.multiplexer:02X} channel {wire.channel}, {bus})"
+
+
+def _capped(
+    what: str, requested: float, limit_name: str, limit: float, *, unit: str = ""
+) -> tuple[float, str]:
+    """``requested`` held to the layout's safety limit, with the note saying so when it was."""
+    if requested > limit:
+        note = f"{what} {requested:g}{unit} capped at the layout's safety.{limit_name}"
+        return limit, f"{note} {limit:g}{unit}."
+    return requested, ""

@@ -29,9 +29,13 @@ import uuid
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli import simplify
-from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
-from feelmysign.cli.options.values import MAX_TIMEOUT_S, number
-from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
+from feelmysign.cli.options.broker import (
+    add_broker_options,
+    add_broker_timeout_option,
+    broker_settings_from_args,
+)
+from feelmysign.cli.options.values import number
+from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
@@ -77,13 +81,7 @@ def register(subparsers: Any) -> None:
         metavar="X",
         help="with --send, send X times faster than drawn (default: 1, as drawn)",
     )
-    group.add_argument(
-        "--timeout-s",
-        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
-        default=DEFAULT_TIMEOUT_S,
-        metavar="S",
-        help=f"with --send, longest wait for the broker, seconds (default: {DEFAULT_TIMEOUT_S:g})",
-    )
+    add_broker_timeout_option(group, help_start="with --send, longest wait for the broker, seconds")
     add_broker_options(parser, role="sender")
     parser.set_defaults(handler=functools.partial(run, parser=parser))
 
@@ -167,11 +165,7 @@ def strokes_to_send(result: Rerun, params: Params) -> tuple[list[Stroke], list[f
         stroke = Stroke(segment.start, segment.end, segment.duration_ms, drawing=drawing, seq=seq)
         checked = validate_stroke(stroke, layout)
         if isinstance(checked, Rejected):
-            raise StrokeError(
-                checked.reason,
-                f"Stroke {seq + 1} of the replay would be rejected by the sleeve "
-                f"({checked.reason}): {checked.message} Nothing was sent.",
-            )
+            raise checked.as_error(f"Stroke {seq + 1} of the replay", then=" Nothing was sent.")
         strokes.append(checked)
         at_ms.append(segment.emitted_at_ms - origin_ms)
     if not strokes:

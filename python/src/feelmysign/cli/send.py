@@ -21,10 +21,14 @@ import uuid
 from collections.abc import Iterator
 from dataclasses import replace
 
-from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.broker import (
+    add_broker_options,
+    add_broker_timeout_option,
+    broker_settings_from_args,
+)
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
-from feelmysign.cli.options.values import MAX_TIMEOUT_S, number, stdin_lines, topic
-from feelmysign.connection import DEFAULT_TIMEOUT_S, BrokerSettings, connect_client
+from feelmysign.cli.options.values import number, stdin_lines, topic
+from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, Layout
 from feelmysign.protocol import Accepted, parse
@@ -122,13 +126,7 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
         "like a person drawing; burst: all at once (default: realtime for --shape, burst for "
         "STROKEs)",
     )
-    group.add_argument(
-        "--timeout-s",
-        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
-        default=DEFAULT_TIMEOUT_S,
-        metavar="S",
-        help=f"longest wait for the broker to answer, in seconds (default: {DEFAULT_TIMEOUT_S:g})",
-    )
+    add_broker_timeout_option(group, help_start="longest wait for the broker to answer, in seconds")
     group.add_argument(
         "--json", action="store_true", help="print one JSON object per message sent, for programs"
     )
@@ -193,11 +191,7 @@ def _strokes(args: argparse.Namespace, layout: Layout) -> list[Stroke]:
     for seq, (where, text) in enumerate(_stroke_texts(args.strokes)):
         result = parse(text, layout, format="legacy")
         if not isinstance(result, Accepted):
-            raise StrokeError(
-                result.reason,
-                f"{where} {text!r} would be rejected by the sleeve ({result.reason}): "
-                f"{result.message} Nothing was sent.",
-            )
+            raise result.as_error(f"{where} {text!r}", then=" Nothing was sent.")
         strokes.append(replace(result.stroke, intensity=args.intensity, drawing=drawing, seq=seq))
     if not strokes:
         raise StrokeError("empty", "Standard input held no stroke; nothing was sent.")

@@ -7,9 +7,12 @@ import threading
 import uuid
 from typing import TYPE_CHECKING, Any
 
-from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
-from feelmysign.cli.options.values import MAX_TIMEOUT_S, number
-from feelmysign.connection import DEFAULT_TIMEOUT_S, connect_client
+from feelmysign.cli.options.broker import (
+    add_broker_options,
+    add_broker_timeout_option,
+    broker_settings_from_args,
+)
+from feelmysign.connection import connect_client
 from feelmysign.control import CANCEL_ALL, Cancel, format_control
 from feelmysign.errors import BrokerConnectionError, ParameterError
 from feelmysign.protocol import MAX_DRAWING_ID_CHARS, is_drawing_id
@@ -38,13 +41,7 @@ def register(subparsers: Any) -> None:
         metavar="DRAWING",
         help='the drawing id to cancel (as in the strokes\' "drawing"; default: everything)',
     )
-    parser.add_argument(
-        "--timeout-s",
-        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
-        default=DEFAULT_TIMEOUT_S,
-        metavar="S",
-        help=f"how long to wait for the broker, seconds (default: {DEFAULT_TIMEOUT_S:g})",
-    )
+    add_broker_timeout_option(parser, help_start="how long to wait for the broker, seconds")
     add_broker_options(parser, role="sender")
     parser.set_defaults(handler=run)
 

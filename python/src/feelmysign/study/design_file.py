@@ -9,13 +9,13 @@ shapes.
 
 from __future__ import annotations
 
-import sys
 import uuid
 from pathlib import Path
 from typing import Any
 
 from feelmysign.errors import DesignError, FeelMySignError
 from feelmysign.input_files import MAX_DESIGN_BYTES, read_text
+from feelmysign.layout import loads_toml
 from feelmysign.shapes import SHAPES
 from feelmysign.simplify.registry import ALGORITHMS
 from feelmysign.study.coding import normalise
@@ -34,11 +34,6 @@ from feelmysign.study.design import (
 from feelmysign.study.problems import MISSING, Problems
 from feelmysign.study.stimulus import recorded_strokes, stimulus_layout
 from feelmysign.study.threshold import check_fits
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 MAX_SHAPES = 24
 MAX_LEVELS = 12
@@ -65,14 +60,8 @@ def load_design(path: str | Path) -> Design:
 
 
 def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path(".")) -> Design:
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise DesignError(source, [f"not valid TOML: {error}"]) from error
-    except RecursionError:
-        raise DesignError(
-            source, ["nested too deeply to read; a design nests arrays and tables 3 levels deep"]
-        ) from None
+    nesting = "a design nests arrays and tables 3 levels deep"
+    data = loads_toml(text, source, DesignError, nesting=nesting)
     problems = Problems(source)
     problems.unknown("", data, _TOP)
     study = problems.table("study", data.get("study", MISSING), required=True)

@@ -11,7 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from feelmysign.errors import ParameterError, StrokeError
+from feelmysign.errors import ParameterError
 from feelmysign.layout import PAPER_SLEEVE, Layout, load_layout
 from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.research.rerun import rerun
@@ -83,10 +83,8 @@ def recorded_strokes(
         )
         checked = validate_stroke(stroke, layout)
         if isinstance(checked, Rejected):
-            raise StrokeError(
-                checked.reason,
-                f"{recording_path}: stroke {len(strokes) + 1} with {simplifier} {settings} "
-                f"would be rejected by the sleeve ({checked.reason}): {checked.message}",
+            raise checked.as_error(
+                f"{recording_path}: stroke {len(strokes) + 1} with {simplifier} {settings}"
             )
         strokes.append(replace(checked, drawing=drawing, seq=len(strokes)))
     if not strokes:

@@ -26,11 +26,18 @@ from feelmysign.broker import DEFAULT_SLEEVE_ID, default_state_dir
 from feelmysign.broker.credentials import Role, check_sleeve_id, load_login
 from feelmysign.cli.options.values import (
     MAX_CREDENTIALS_BYTES,
+    MAX_TIMEOUT_S,
     check_input_file,
     not_empty,
+    number,
     sleeve_id,
 )
-from feelmysign.connection import DEFAULT_BROKER_URL, BrokerSettings, parse_broker_url
+from feelmysign.connection import (
+    DEFAULT_BROKER_URL,
+    DEFAULT_TIMEOUT_S,
+    BrokerSettings,
+    parse_broker_url,
+)
 from feelmysign.connection.join_token import default_trust_dir, join_settings
 from feelmysign.connection.settings import PASSWORD_ENV, USERNAME_ENV
 from feelmysign.errors import BrokerConnectionError
@@ -39,6 +46,19 @@ BROKER_ENV = "FEELMYSIGN_BROKER"
 SLEEVE_ID_ENV = "FEELMYSIGN_SLEEVE_ID"
 CREDENTIALS_ENV = "FEELMYSIGN_CREDENTIALS"
 JOIN_ENV = "FEELMYSIGN_JOIN"
+
+
+def add_broker_timeout_option(
+    parser: argparse.ArgumentParser | argparse._ArgumentGroup, *, help_start: str
+) -> None:
+    """Add --timeout-s, the longest wait for the broker; ``help_start`` says what is awaited."""
+    parser.add_argument(
+        "--timeout-s",
+        type=number(0, MAX_TIMEOUT_S, unit="s", above_low=True),
+        default=DEFAULT_TIMEOUT_S,
+        metavar="S",
+        help=f"{help_start} (default: {DEFAULT_TIMEOUT_S:g})",
+    )
 
 
 def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:

@@ -73,20 +73,17 @@ def add_layout_options(parser: argparse.ArgumentParser) -> None:
         help=f"sleeve layout TOML file, e.g. deploy/layouts/paper-sleeve.toml "
         f"(default: ${LAYOUT_ENV}, if set)",
     )
-    group.add_argument(
-        "--rows",
-        metavar="R",
-        type=whole_number(1, MAX_GRID_SIDE),
-        action=_Exclusive,
-        help=f"number of actuator rows, 1 to 64 (default: {PAPER_SLEEVE.rows})",
-    )
-    group.add_argument(
-        "--columns",
-        metavar="C",
-        type=whole_number(1, MAX_GRID_SIDE),
-        action=_Exclusive,
-        help=f"number of actuator columns, 1 to 64 (default: {PAPER_SLEEVE.columns})",
-    )
+    for side, metavar, default in (
+        ("rows", "R", PAPER_SLEEVE.rows),
+        ("columns", "C", PAPER_SLEEVE.columns),
+    ):
+        group.add_argument(
+            f"--{side}",
+            metavar=metavar,
+            type=whole_number(1, MAX_GRID_SIDE),
+            action=_Exclusive,
+            help=f"number of actuator {side}, 1 to 64 (default: {default})",
+        )
     group.add_argument(
         "--spacing-cm",
         metavar="S",
