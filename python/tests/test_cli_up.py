@@ -18,11 +18,12 @@ import subprocess
 import sys
 import threading
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
-from feelmysign.events import Adjusted, Cancelled, Played, Rejected, Safety
+from feelmysign.events import Adjusted, Cancelled, EventCopies, Played, Rejected, Safety
 from feelmysign.services.drawing_log import NO_DRAWING, DrawingSummaries
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
@@ -103,6 +104,32 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
         "start delay median 3 ms, max 3 ms"
     ]
     assert summaries.finished(100.0, all_of_them=True) == []
+
+
+def test_a_copy_of_an_event_after_a_broker_restart_is_counted_once() -> None:
+    # Events are published at QoS 1: a restarted broker may deliver one again, equal in
+    # every field. Two strokes' events, each delivered twice, are two strokes.
+    summaries = DrawingSummaries(quiet_s=1.5)
+    drawing = "dddddddd-4444"
+    first = replace(_played(drawing, 2.0), seq=0)
+    second = replace(_played(drawing, 2.0), seq=1)
+    refused = Rejected(reason="outside_grid", message="m", drawing=drawing, seq=2, received_at_ms=1)
+    for event in (first, first, second, refused, second, refused):
+        summaries.add(event, now_s=0.0)
+    assert summaries.finished(10.0) == [
+        "Drawing dddddddd: 2 strokes played, 1 rejected (outside_grid); "
+        "start delay median 2 ms, max 2 ms"
+    ]
+
+
+def test_events_that_name_no_stroke_are_never_taken_for_copies() -> None:
+    copies = EventCopies(capacity=2)
+    legacy = _played(None, 1.0)
+    assert [copies.is_copy(legacy), copies.is_copy(legacy)] == [False, False]
+    strokes = [replace(_played("d", 1.0), seq=seq) for seq in range(3)]
+    assert [copies.is_copy(event) for event in strokes] == [False, False, False]
+    # Capacity 2: the first is forgotten, the last is still remembered.
+    assert [copies.is_copy(strokes[0]), copies.is_copy(strokes[2])] == [False, True]
 
 
 def test_a_stroke_cut_short_is_counted_once_as_played() -> None:

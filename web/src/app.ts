@@ -8,7 +8,7 @@ import { CANCEL_ALL } from "./control";
 import type { ServerConfig } from "./config";
 import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
-import { interpretEvent, parseEvent } from "./events";
+import { EventCopies, interpretEvent, parseEvent } from "./events";
 import { StrokeSender, type BrokerState } from "./mqtt/sender";
 import { buildRecording, recordingFileName } from "./recording";
 import { drawingFromRecording, parseRecording } from "./recording-load";
@@ -44,6 +44,8 @@ export class App {
   readonly #preview: SleevePreview;
   readonly #status: StatusBar;
   readonly #says: SleeveSays;
+  /** Copies of events a broker restart delivers again: each stroke counted once. */
+  readonly #copies = new EventCopies();
   readonly #panel: SettingsPanel;
   readonly #picker: SleevePicker;
   readonly #sender: StrokeSender;
@@ -387,7 +389,7 @@ export class App {
 
   #onEvent(payload: string): void {
     const event = parseEvent(payload);
-    if (event === null) return;
+    if (event === null || this.#copies.isCopy(payload, event)) return;
     const reading = interpretEvent(event, this.#session.drawing?.id ?? null);
     for (const what of reading.counts) this.#says.count(what, reading.delayMs);
     if (reading.played !== null) this.#felt.played(reading.played);

@@ -251,6 +251,39 @@ export function parseEvent(text: string): SleeveEvent | null {
   return readEvent(parseText(text));
 }
 
+/** Stroke events remembered to tell a copy from a new event: far more than one drawing sends. */
+export const REMEMBERED_EVENTS = 4096;
+
+/**
+ * Tells a copy of a stroke's event from a new one. The sleeve publishes events at QoS 1,
+ * so after a broker restart a reader may get the same event twice; counting it twice
+ * would show a stroke played twice that was felt once. A stroke's event carries its
+ * times, so a copy has exactly the same text, and two real events never do. Events that
+ * name no stroke (errors, a message the sleeve could not read) are never held back.
+ */
+export class EventCopies {
+  readonly #seen = new Set<string>();
+  readonly #order: string[] = [];
+  #next = 0;
+
+  constructor(readonly capacity = REMEMBERED_EVENTS) {}
+
+  /** True when `text` is a copy of a stroke's event already seen (and then remembered). */
+  isCopy(text: string, event: SleeveEvent): boolean {
+    if (!("seq" in event) || event.seq === null || event.drawing == null) return false;
+    if (this.#seen.has(text)) return true;
+    if (this.#order.length < this.capacity) {
+      this.#order.push(text);
+    } else {
+      this.#seen.delete(this.#order[this.#next]!);
+      this.#order[this.#next] = text;
+      this.#next = (this.#next + 1) % this.capacity;
+    }
+    this.#seen.add(text);
+    return false;
+  }
+}
+
 /** The event as the sleeve publishes it: optional fields left out. */
 export function eventToJson(event: SleeveEvent): Record<string, unknown> {
   return { type: event.type, ...writeFields(event, EVENT_FIELDS[event.type]) };

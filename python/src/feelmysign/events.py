@@ -313,6 +313,39 @@ def event_from_json(data: object) -> Event:
 DELAYED_MS = 500.0
 
 
+# Stroke events remembered to tell a copy from a new event: far more than one drawing sends.
+REMEMBERED_EVENTS = 4096
+
+
+class EventCopies:
+    """Tells a copy of a stroke's event from a new one.
+
+    The sleeve publishes events at QoS 1, so after a broker restart a reader may get
+    the same event twice; counting it twice would report a stroke played twice that was
+    felt once. A stroke's event carries its times, so a copy is equal in every field and
+    two real events never are. Events that name no stroke (errors, a message the sleeve
+    could not read) are never held back. The page does the same (``EventCopies`` in
+    web/src/events.ts).
+    """
+
+    def __init__(self, capacity: int = REMEMBERED_EVENTS) -> None:
+        from collections import OrderedDict
+
+        self._capacity = capacity
+        self._seen: OrderedDict[Event, None] = OrderedDict()
+
+    def is_copy(self, event: Event) -> bool:
+        """True when ``event`` is a copy of a stroke's event already seen (else remembered)."""
+        if getattr(event, "drawing", None) is None or getattr(event, "seq", None) is None:
+            return False
+        if event in self._seen:
+            return True
+        self._seen[event] = None
+        if len(self._seen) > self._capacity:
+            self._seen.popitem(last=False)
+        return False
+
+
 def delivery_delay_ms(event: Played) -> float | None:
     """How long a played stroke was held on its way: sent -> its first motor command, less
     its wait behind the strokes before it (playing a drawing back to back is the design, not

@@ -38,6 +38,7 @@ from feelmysign.events import (
     Adjusted,
     Cancelled,
     Event,
+    EventCopies,
     EventError,
     Played,
     Rejected,
@@ -103,8 +104,11 @@ class DrawingSummaries:
     def __init__(self, *, quiet_s: float = QUIET_S) -> None:
         self._quiet_s = quiet_s
         self._drawings: dict[str, _Drawing] = {}
+        self._copies = EventCopies()  # a broker restart may deliver an event again
 
     def add(self, event: Event, now_s: float) -> None:
+        if self._copies.is_copy(event):
+            return
         if isinstance(event, Safety) and event.received_at_ms is None:
             return  # a motor protected outside any stroke (off_failed): the sleeve logs it
         if not isinstance(event, Played | Rejected | Cancelled | Safety):
