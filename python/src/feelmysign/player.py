@@ -119,6 +119,10 @@ class Refusal:
     message: str
 
 
+def _duplicate(drawing: object, seq: object) -> Refusal:
+    return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already played or refused")
+
+
 class Player:
     """Call ``start`` once, ``submit`` from any thread, ``stop`` to end with every motor off."""
 
@@ -173,15 +177,20 @@ class Player:
         if not self._running:
             return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
         with self._lock:
-            refusal = self._check_repeat(drawing, seq) or self._check_room(stroke)
+            if self._queue.seen(drawing, seq):
+                return _duplicate(drawing, seq)
+            refusal = self._check_room(stroke)
             if refusal:
                 return refusal
+            duration_ms = stroke.schedule.duration_ms
             if isinstance(drawing, str) and isinstance(seq, int):
-                self._queue.remember(drawing, seq)
                 self._unplayed[(drawing, seq)] = stroke
+                start_ms = self._queue.place(stroke.received_at_ms, duration_ms, drawing, seq)
+            else:
+                start_ms = self._queue.place(stroke.received_at_ms, duration_ms)
+            stroke.start_ms = start_ms
             stroke.number = self._accepted
             self._accepted += 1
-            stroke.start_ms = self._queue.place(stroke.received_at_ms, stroke.schedule.duration_ms)
             self._pending += 1
             self._inbox.append(stroke)
             due_now = stroke.start_ms <= stroke.received_at_ms
@@ -243,13 +252,13 @@ class Player:
     def wait_ms(self, now_ms: float) -> float:
         """How long a stroke submitted at ``now_ms`` would wait for the strokes before it."""
         with self._lock:
-            return self._queue.wait_ms(now_ms)
+            return max(0.0, self._queue.tail_ms - now_ms)
 
     def repeat(self, drawing: object, seq: object) -> Refusal | None:
         """A ``duplicate`` refusal when this stroke was accepted or settled before, else None:
         for checking a copy before anything else counts it (the rate limit, the pace rules)."""
         with self._lock:
-            return self._check_repeat(drawing, seq)
+            return _duplicate(drawing, seq) if self._queue.seen(drawing, seq) else None
 
     def remember(self, drawing: object, seq: object) -> None:
         """A stroke settled without playing (refused and acknowledged): a copy of it the broker
@@ -258,15 +267,8 @@ class Player:
             with self._lock:
                 self._queue.remember(drawing, seq)
 
-    def _check_repeat(self, drawing: object, seq: object) -> Refusal | None:
-        if not self._queue.seen(drawing, seq):
-            return None
-        return Refusal(
-            "duplicate", f"stroke {seq} of drawing {drawing} was already played or refused"
-        )
-
     def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
-        backlog_ms = self._queue.wait_ms(stroke.received_at_ms)
+        backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
         if self._pending >= self._max_pending or backlog_ms > self._max_backlog_ms:
             return Refusal(
                 "queue_full",

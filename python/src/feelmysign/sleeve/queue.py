@@ -99,9 +99,20 @@ class Queue:
         self.tail_ms = NEVER_MS
         self._seen: OrderedDict[str, SeenSeqs] = OrderedDict()
 
-    def place(self, arrival_ms: float, duration_ms: float) -> float:
-        """Queue a stroke: when it starts (and the tail moves to its end)."""
-        start = max(arrival_ms, self.tail_ms)  # start_ms(), written out: on every stroke's path
+    def place(
+        self, arrival_ms: float, duration_ms: float, drawing: str | None = None, seq: int = 0
+    ) -> float:
+        """Queue a stroke: when it starts (and the tail moves to its end). With a ``drawing``,
+        its ``seq`` is remembered as :meth:`remember` does (in one call: this is on the path
+        from a stroke's message to its first command)."""
+        if drawing is not None:
+            seqs = self._seen.get(drawing)
+            if seqs is None:
+                seqs = self._new_drawing(drawing)
+            else:
+                self._seen.move_to_end(drawing)
+            seqs.add(seq)
+        start = max(arrival_ms, self.tail_ms)  # start_ms(), written out: one call less
         self.tail_ms = start + duration_ms
         return start
 
@@ -121,13 +132,19 @@ class Queue:
         return seqs is not None and seq in seqs
 
     def remember(self, drawing: str, seq: int) -> None:
+        """A seq of a drawing settled without being placed: a copy of it is seen too."""
         seqs = self._seen.get(drawing)
         if seqs is None:
-            seqs = self._seen[drawing] = SeenSeqs()
-            while len(self._seen) > REMEMBERED_DRAWINGS:
-                self._seen.popitem(last=False)
-        self._seen.move_to_end(drawing)
+            seqs = self._new_drawing(drawing)
+        else:
+            self._seen.move_to_end(drawing)
         seqs.add(seq)
+
+    def _new_drawing(self, drawing: str) -> SeenSeqs:
+        seqs = self._seen[drawing] = SeenSeqs()
+        while len(self._seen) > REMEMBERED_DRAWINGS:
+            self._seen.popitem(last=False)
+        return seqs
 
 
 @dataclass(frozen=True)
@@ -184,8 +201,9 @@ def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
             outcomes.append(Outcome(HELD if waiting else DUPLICATE))
             continue
         if step.drawing is not None and step.seq is not None:
-            queue.remember(step.drawing, step.seq)
-        start = queue.place(step.arrival_ms, step.duration_ms)
+            start = queue.place(step.arrival_ms, step.duration_ms, step.drawing, step.seq)
+        else:
+            start = queue.place(step.arrival_ms, step.duration_ms)
         planned[len(outcomes)] = (start, step.duration_ms, step.drawing, step.seq)
         outcomes.append(None)
     for index, (start, duration, _, _) in planned.items():
