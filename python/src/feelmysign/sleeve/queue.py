@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 NEVER_MS = float("-inf")  # the tail of an empty queue: the next stroke starts when it arrives
 REMEMBERED_DRAWINGS = 64  # drawings whose seqs are kept, for dropping redeliveries
+REMEMBERED_CANCELS = 64  # cancelled drawings kept, for refusing their later strokes
 
 # Outcomes of replay.
 PLAYED = "played"  # started and played whole
@@ -147,6 +148,20 @@ class Queue:
         return seqs
 
 
+class CancelledDrawings(OrderedDict[str, float]):
+    """The drawings cancelled lately, each with when its cancel came: a stroke of one that
+    comes later (the broker held it, or it was sent just after) is ``cancelled`` too.
+
+    A dict, so that the check on every stroke (``drawing in cancelled``) stays one lookup.
+    """
+
+    def cancel(self, drawing: str, at_ms: float) -> None:
+        self[drawing] = at_ms
+        self.move_to_end(drawing)
+        while len(self) > REMEMBERED_CANCELS:
+            self.popitem(last=False)
+
+
 @dataclass(frozen=True)
 class Arrival:
     """A stroke reaching the sleeve at ``arrival_ms`` (``drawing`` and ``seq`` may be None)."""
@@ -183,12 +198,12 @@ def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
     outcomes: list[Outcome | None] = []
     # Accepted and not cancelled: index -> (start, duration, drawing, seq).
     planned: dict[int, tuple[float, float, str | None, int | None]] = {}
-    cancelled: set[str] = set()
+    cancelled = CancelledDrawings()
     for step in steps:
         if isinstance(step, CancelAt):
             _cancel(step, queue, planned, outcomes)
             if step.drawing is not None:
-                cancelled.add(step.drawing)
+                cancelled.cancel(step.drawing, step.at_ms)
             continue
         if step.drawing is not None and step.drawing in cancelled:
             outcomes.append(Outcome(CANCELLED))
