@@ -12,7 +12,8 @@ from feelmysign.backends.sim import SimBackend
 from feelmysign.events import Event
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
-from feelmysign.player import PlannedStroke, Player, SeenSeqs, monotonic_ms, wall_ms
+from feelmysign.player import PlannedStroke, Player, monotonic_ms, wall_ms
+from feelmysign.sleeve.queue import SeenSeqs
 from feelmysign.stroke import Stroke
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)

@@ -15,6 +15,7 @@
  * Pure: no DOM, no clock.
  */
 import type { FeltStroke, PlacedStroke } from "./felt";
+import { EMPTY_TAIL_MS, queueStartMs } from "./sleeve-queue";
 
 export class FeltPlacement {
   /** Shifted strokes (arrival relative to the first stroke's), in seq order. */
@@ -164,10 +165,10 @@ export class FeltPlacement {
   /** The first reported stroke and the sleeve's clock offset against the page's estimate of it. */
   #reanchor(): void {
     this.#anchor = null;
-    let tail = Number.NEGATIVE_INFINITY;
+    let tail = EMPTY_TAIL_MS;
     for (let index = 0; index < this.#strokes.length; index++) {
       const stroke = this.#strokes[index]!;
-      const estimateMs = Math.max(stroke.arrives_ms, tail);
+      const estimateMs = queueStartMs(stroke.arrives_ms, tail);
       const reported = this.#startedAt.get(stroke.seq);
       if (reported !== undefined) {
         this.#anchor = { index, offsetMs: reported - estimateMs };
@@ -193,7 +194,7 @@ export class FeltPlacement {
       this.#descents = 0;
     }
     const previous = this.#placed[from - 1];
-    let tail = previous === undefined ? Number.NEGATIVE_INFINITY : previous.start_ms + previous.played_ms;
+    let tail = previous === undefined ? EMPTY_TAIL_MS : previous.start_ms + previous.played_ms;
     let dirtyMs = Number.POSITIVE_INFINITY;
     const offset = this.#anchor?.offsetMs;
     let stop = this.#strokes.length;
@@ -201,7 +202,7 @@ export class FeltPlacement {
       const stroke = this.#strokes[i]!;
       const reportedAt = offset === undefined ? undefined : this.#startedAt.get(stroke.seq);
       const known = reportedAt === undefined ? undefined : reportedAt - offset!;
-      const start_ms = known ?? Math.max(stroke.arrives_ms, tail);
+      const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
       const played_ms = this.#playedMs(stroke);
       tail = start_ms + played_ms;
       const old = this.#placed[i];

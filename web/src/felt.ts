@@ -8,10 +8,12 @@
  * by the apparent-motion model): it shows where and when the touch is.
  *
  * Times: where the sleeve told when it played a stroke, that time; otherwise
- * the sleeve's own rule (docs/protocol.md, "Playback"): a stroke starts when
- * it arrives, or when the one before it ends if that is later.
+ * the sleeve's own rule (docs/protocol.md, "Playback"; `queueStartMs` in
+ * sleeve-queue.ts, pinned by testdata/queue): a stroke starts when it arrives,
+ * or when the one before it ends if that is later.
  */
 import type { Point } from "./simplify/segment";
+import { EMPTY_TAIL_MS, queueStartMs } from "./sleeve-queue";
 
 export interface FeltStroke {
   readonly seq: number;
@@ -55,10 +57,10 @@ export function placeStrokes(
   cut: ReadonlyMap<number, number> = new Map(),
 ): PlacedStroke[] {
   const placed: PlacedStroke[] = [];
-  let tail = Number.NEGATIVE_INFINITY;
+  let tail = EMPTY_TAIL_MS;
   for (const stroke of [...strokes].sort((a, b) => a.seq - b.seq)) {
     const known = reported.get(stroke.seq);
-    const start_ms = known ?? Math.max(stroke.arrives_ms, tail);
+    const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
     const played_ms = Math.min(stroke.duration_ms, Math.max(0, cut.get(stroke.seq) ?? stroke.duration_ms));
     tail = start_ms + played_ms;
     placed.push({ ...stroke, start_ms, reported: known !== undefined, played_ms });

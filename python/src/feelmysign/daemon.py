@@ -37,7 +37,7 @@ import logging
 import queue
 import threading
 import time
-from collections import Counter, OrderedDict
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
@@ -73,6 +73,7 @@ from feelmysign.player import (
 )
 from feelmysign.protocol import Accepted, parse
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
+from feelmysign.sleeve.queue import CancelledDrawings
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
@@ -89,7 +90,6 @@ KEEPALIVE_S = 15
 # bar than the page's and the terminal's (events.DELAYED_MS), to keep the sleeve's journal quiet.
 LOG_DELAYED_MS = 1000.0
 # Cancelled drawings remembered, so that their later strokes do not start them again.
-REMEMBERED_CANCELS = 64
 NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disconnect
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
 # "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
@@ -203,7 +203,7 @@ class Sleeve:
         self._stopped = threading.Event()
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
-        self._cancelled: OrderedDict[str, float] = OrderedDict()  # drawing -> cancelled at (wall)
+        self._cancelled = CancelledDrawings()  # drawing -> cancelled at (wall)
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         self._client = self._make_client()
@@ -529,10 +529,7 @@ class Sleeve:
             self._reject(result.reason, result.message, info, received_wall_ms, ack)
             return
         if not result.everything:
-            self._cancelled[result.drawing] = received_wall_ms
-            self._cancelled.move_to_end(result.drawing)
-            while len(self._cancelled) > REMEMBERED_CANCELS:
-                self._cancelled.popitem(last=False)
+            self._cancelled.cancel(result.drawing, received_wall_ms)
         what = "every drawing" if result.everything else f"drawing {result.drawing}"
         log.info("sleeve %s: cancel %s", self._id, what)
         self._player.cancel(result, received_wall_ms)

@@ -13,7 +13,8 @@ format) is never refused by them:
 - **late**: a stroke that would start more than ``max_lag_ms`` after it was due
   is skipped. When a stroke is due is the sender's own time line: its
   ``sent_at_ms``, but never before the stroke before it in the same drawing has
-  ended (a drawing sent all at once is due back to back). How late it starts is
+  ended (a drawing sent all at once is due back to back): the queue's start-time
+  rule (:func:`feelmysign.sleeve.queue.start_ms`) on the sender's clock. How late it starts is
   measured against the smallest delay seen in that drawing, so a constant
   clock difference between sender and sleeve cancels out. After a stall (the
   network or the broker away for 10 s) the backlog arrives at once: the sleeve
@@ -34,6 +35,8 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 
+from feelmysign.sleeve.queue import REMEMBERED_DRAWINGS, start_ms
+
 # Strokes older than this are refused. Long enough for a sender's clock a few seconds off
 # and for a broker restart; short enough that a drawing is not felt long after the fact.
 MAX_AGE_MS = 10_000.0
@@ -43,7 +46,6 @@ MAX_LAG_MS = 1_000.0
 # Once skipping, skip down to this much behind: strokes of a drawing play back to back, so
 # the lag left when skipping stops stays for the rest of the drawing.
 CATCH_UP_FRACTION = 0.25
-REMEMBERED_DRAWINGS = 64  # drawings whose time line is kept (the player remembers as many)
 
 STALE = "stale"
 LATE = "late"
@@ -96,7 +98,8 @@ class PacePolicy:
             line = _TimeLine(line.smallest_delay_ms, sent_at_ms)  # on its own, not kept
         elif seq is not None:
             line.last_seq = seq
-        due_ms = max(sent_at_ms, line.due_end_ms)
+        # The sleeve's queue rule, on the sender's time line.
+        due_ms = start_ms(sent_at_ms, line.due_end_ms)
         line.due_end_ms = due_ms + duration_ms
         if age_ms > self.max_age_ms:
             return Verdict(

@@ -31,12 +31,11 @@ thread costs tens of microseconds at best and milliseconds on a loaded machine.
 
 from __future__ import annotations
 
-import bisect
 import logging
 import sys
 import threading
 import time
-from collections import OrderedDict, deque
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -47,6 +46,7 @@ from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Sa
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline
 from feelmysign.schedule import Schedule
+from feelmysign.sleeve.queue import Queue
 from feelmysign.timeline import Capped, Change, Timeline
 
 log = logging.getLogger(__name__)
@@ -60,7 +60,6 @@ STOP_WAIT_S = 5.0  # how long stop waits for a write under way before every moto
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
 MAX_PENDING = 256
 MAX_BACKLOG_MS = 30_000.0
-REMEMBERED_DRAWINGS = 64  # drawings whose seqs are kept, for dropping redeliveries
 TIMING_SAMPLES = 100_000
 
 
@@ -120,38 +119,8 @@ class Refusal:
     message: str
 
 
-class SeenSeqs:
-    """The seqs of one drawing seen so far, as sorted disjoint ranges [low, high): a drawing
-    sent in order is one range whatever its length, each gap adds one."""
-
-    def __init__(self) -> None:
-        self._lows: list[int] = []
-        self._highs: list[int] = []
-
-    def __contains__(self, seq: int) -> bool:
-        i = bisect.bisect_right(self._lows, seq) - 1
-        return i >= 0 and seq < self._highs[i]
-
-    def add(self, seq: int) -> None:
-        if seq in self:
-            return
-        i = bisect.bisect_right(self._lows, seq)  # the range after seq, if any
-        joins_before = i > 0 and self._highs[i - 1] == seq
-        joins_after = i < len(self._lows) and self._lows[i] == seq + 1
-        if joins_before and joins_after:
-            self._highs[i - 1] = self._highs[i]
-            del self._lows[i], self._highs[i]
-        elif joins_before:
-            self._highs[i - 1] = seq + 1
-        elif joins_after:
-            self._lows[i] = seq
-        else:
-            self._lows.insert(i, seq)
-            self._highs.insert(i, seq + 1)
-
-    @property
-    def ranges(self) -> int:
-        return len(self._lows)
+def _duplicate(drawing: object, seq: object) -> Refusal:
+    return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already played or refused")
 
 
 class Player:
@@ -184,9 +153,9 @@ class Player:
         self._wake = threading.Event()
         self._inbox: deque[PlannedStroke] = deque()
         self._pending = 0
-        self._tail_ms = float("-inf")
-        # Per drawing, the seqs accepted or settled (see remember): a copy of one is a duplicate.
-        self._seen: OrderedDict[str, SeenSeqs] = OrderedDict()
+        # When each stroke starts, and per drawing the seqs accepted or settled (see
+        # remember): a copy of one is a duplicate.
+        self._queue = Queue()
         # Accepted, with a drawing and seq, and not yet started, refused or dropped: what a
         # redelivered copy must wait for (see hold).
         self._unplayed: dict[tuple[str, int], PlannedStroke] = {}
@@ -208,16 +177,20 @@ class Player:
         if not self._running:
             return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
         with self._lock:
-            refusal = self._check_repeat(drawing, seq) or self._check_room(stroke)
+            if self._queue.seen(drawing, seq):
+                return _duplicate(drawing, seq)
+            refusal = self._check_room(stroke)
             if refusal:
                 return refusal
+            duration_ms = stroke.schedule.duration_ms
             if isinstance(drawing, str) and isinstance(seq, int):
-                self._remember(drawing, seq)
                 self._unplayed[(drawing, seq)] = stroke
+                start_ms = self._queue.place(stroke.received_at_ms, duration_ms, drawing, seq)
+            else:
+                start_ms = self._queue.place(stroke.received_at_ms, duration_ms)
+            stroke.start_ms = start_ms
             stroke.number = self._accepted
             self._accepted += 1
-            stroke.start_ms = max(stroke.received_at_ms, self._tail_ms)
-            self._tail_ms = stroke.start_ms + stroke.schedule.duration_ms
             self._pending += 1
             self._inbox.append(stroke)
             due_now = stroke.start_ms <= stroke.received_at_ms
@@ -279,42 +252,23 @@ class Player:
     def wait_ms(self, now_ms: float) -> float:
         """How long a stroke submitted at ``now_ms`` would wait for the strokes before it."""
         with self._lock:
-            return max(0.0, self._tail_ms - now_ms)
+            return max(0.0, self._queue.tail_ms - now_ms)
 
     def repeat(self, drawing: object, seq: object) -> Refusal | None:
         """A ``duplicate`` refusal when this stroke was accepted or settled before, else None:
         for checking a copy before anything else counts it (the rate limit, the pace rules)."""
         with self._lock:
-            return self._check_repeat(drawing, seq)
+            return _duplicate(drawing, seq) if self._queue.seen(drawing, seq) else None
 
     def remember(self, drawing: object, seq: object) -> None:
         """A stroke settled without playing (refused and acknowledged): a copy of it the broker
         delivers again is a ``duplicate`` too, not a second verdict."""
         if isinstance(drawing, str) and isinstance(seq, int):
             with self._lock:
-                self._remember(drawing, seq)
-
-    def _remember(self, drawing: str, seq: int) -> None:
-        seen = self._seen.get(drawing)
-        if seen is None:
-            seen = self._seen[drawing] = SeenSeqs()
-            while len(self._seen) > REMEMBERED_DRAWINGS:
-                self._seen.popitem(last=False)
-        self._seen.move_to_end(drawing)
-        seen.add(seq)
-
-    def _check_repeat(self, drawing: object, seq: object) -> Refusal | None:
-        if not isinstance(drawing, str) or not isinstance(seq, int):
-            return None
-        seen = self._seen.get(drawing)
-        if seen is None or seq not in seen:
-            return None
-        return Refusal(
-            "duplicate", f"stroke {seq} of drawing {drawing} was already played or refused"
-        )
+                self._queue.remember(drawing, seq)
 
     def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
-        backlog_ms = max(0.0, self._tail_ms - stroke.received_at_ms)
+        backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
         if self._pending >= self._max_pending or backlog_ms > self._max_backlog_ms:
             return Refusal(
                 "queue_full",
@@ -445,13 +399,10 @@ class Player:
                     for tag in cut.unstarted
                     if isinstance(tag, PlannedStroke)
                 }
-                self._tail_ms = max(
-                    (
-                        tag.start_ms + tag.schedule.duration_ms
-                        for tag in [*self._timeline.tags(), *self._inbox]
-                        if isinstance(tag, PlannedStroke)
-                    ),
-                    default=float("-inf"),
+                self._queue.replan(
+                    tag.start_ms + tag.schedule.duration_ms
+                    for tag in [*self._timeline.tags(), *self._inbox]
+                    if isinstance(tag, PlannedStroke)
                 )
             for tags, started in ((cut.started, True), (cut.unstarted, False)):
                 for tag in tags:

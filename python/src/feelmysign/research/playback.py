@@ -2,8 +2,8 @@
 
 The sleeve's player starts a stroke when it arrives or when the one before
 it has finished, whichever is later, and the stroke then lasts its planned
-duration (``Player.submit``: ``start = max(received, tail)``, ``tail = start +
-schedule.duration_ms``). Here a stroke arrives when the simplifier let it go
+duration: the sleeve's queue (:class:`feelmysign.sleeve.queue.Queue`), used
+here as the player uses it. Here a stroke arrives when the simplifier let it go
 (``emitted_at_ms``; the network is taken as instant), and each is planned by
 the real planner on the sleeve's layout. From that:
 
@@ -27,6 +27,7 @@ from feelmysign.planner import plan
 from feelmysign.schedule import Schedule
 from feelmysign.simplify.registry import PathSegment
 from feelmysign.simplify.segment import Sample
+from feelmysign.sleeve.queue import Queue
 from feelmysign.stroke import Stroke
 
 
@@ -49,7 +50,7 @@ def simulate(
 ) -> Playback:
     """Plan and play the sent segments of one recording, in the order they were let go."""
     drawing_ms = sum(path[-1].t_ms - path[0].t_ms for path in paths if path)
-    tail_ms = float("-inf")
+    queue = Queue()
     skin_ms = 0.0
     felt_end: dict[int, float] = {}
     pen_to_skin: list[float] = []
@@ -64,8 +65,7 @@ def simulate(
         except StrokeError:
             refused += 1
             continue
-        start_ms = max(segment.emitted_at_ms, tail_ms)
-        tail_ms = start_ms + schedule.duration_ms
+        start_ms = queue.place(segment.emitted_at_ms, schedule.duration_ms)
         last_command_ms = max((c.end_ms for c in schedule.commands), default=0.0)
         felt_end[item.path] = start_ms + max(schedule.duration_ms, last_command_ms)
         skin_ms += schedule.duration_ms

@@ -1,0 +1,245 @@
+"""The sleeve's queue: when each stroke starts, the seqs seen per drawing, and cancels.
+
+The start-time rule: strokes play back to back, in the order they arrive. A
+stroke starts when it arrives, or when the stroke before it ends if that is
+later::
+
+    start = max(arrival, tail)      tail = start + duration
+
+so the strokes of a drawing sent faster than they play feel like one continuous
+touch, and a stroke that arrives to an idle sleeve starts at once. The pace rule
+(:mod:`feelmysign.pace`) times the sender's own time line by the same rule, on
+``sent_at_ms``: :func:`start_ms` is the one place it is written.
+
+A cancel drops the strokes of its drawing (or all) accepted before it: one not
+yet started is dropped, one playing is cut where the cancel came. The tail is
+then the end of the latest stroke still planned (none: the next stroke starts
+when it arrives). A stroke of a cancelled drawing that comes later is refused
+as ``cancelled``.
+
+Each ``seq`` of a drawing plays once: a copy of one accepted before is
+``held`` while the original waits to play (its acknowledgement waits for it)
+and a ``duplicate`` after. A gap never waits for the missing seq, and a
+missing one that comes after later ones still plays.
+
+Pure (numbers in, numbers out; no clock, no thread, no I/O): the player keeps
+one :class:`Queue` under its lock, and :func:`replay` runs a whole sequence of
+arrivals and cancels at once, for the simulations and the vectors in
+``testdata/queue/`` (which the page's ``web/src/sleeve-queue.ts`` reproduces).
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections import OrderedDict
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+NEVER_MS = float("-inf")  # the tail of an empty queue: the next stroke starts when it arrives
+REMEMBERED_DRAWINGS = 64  # drawings whose seqs are kept, for dropping redeliveries
+REMEMBERED_CANCELS = 64  # cancelled drawings kept, for refusing their later strokes
+
+# Outcomes of replay.
+PLAYED = "played"  # started and played whole
+CUT = "cut"  # started, cut short by a cancel
+CANCELLED = (
+    "cancelled"  # accepted, dropped by a cancel before it started; or of a cancelled drawing
+)
+HELD = "held"  # a copy of a stroke still waiting to play: nothing new is queued
+DUPLICATE = "duplicate"  # a copy of a stroke that started (or was dropped) before
+
+
+def start_ms(arrival_ms: float, tail_ms: float) -> float:
+    """When a stroke that arrives at ``arrival_ms`` starts behind a queue ending at ``tail_ms``."""
+    return max(arrival_ms, tail_ms)
+
+
+class SeenSeqs:
+    """The seqs of one drawing seen so far, as sorted disjoint ranges [low, high): a drawing
+    sent in order is one range whatever its length, each gap adds one."""
+
+    def __init__(self) -> None:
+        self._lows: list[int] = []
+        self._highs: list[int] = []
+
+    def __contains__(self, seq: int) -> bool:
+        i = bisect.bisect_right(self._lows, seq) - 1
+        return i >= 0 and seq < self._highs[i]
+
+    def add(self, seq: int) -> None:
+        if seq in self:
+            return
+        i = bisect.bisect_right(self._lows, seq)  # the range after seq, if any
+        joins_before = i > 0 and self._highs[i - 1] == seq
+        joins_after = i < len(self._lows) and self._lows[i] == seq + 1
+        if joins_before and joins_after:
+            self._highs[i - 1] = self._highs[i]
+            del self._lows[i], self._highs[i]
+        elif joins_before:
+            self._highs[i - 1] = seq + 1
+        elif joins_after:
+            self._lows[i] = seq
+        else:
+            self._lows.insert(i, seq)
+            self._highs.insert(i, seq + 1)
+
+    @property
+    def ranges(self) -> int:
+        return len(self._lows)
+
+
+class Queue:
+    """The tail of the strokes accepted so far and the seqs seen per drawing.
+
+    Not thread-safe: the player calls it under its lock.
+    """
+
+    __slots__ = ("_seen", "tail_ms")
+
+    def __init__(self) -> None:
+        self.tail_ms = NEVER_MS
+        self._seen: OrderedDict[str, SeenSeqs] = OrderedDict()
+
+    def place(
+        self, arrival_ms: float, duration_ms: float, drawing: str | None = None, seq: int = 0
+    ) -> float:
+        """Queue a stroke: when it starts (and the tail moves to its end). With a ``drawing``,
+        its ``seq`` is remembered as :meth:`remember` does (in one call: this is on the path
+        from a stroke's message to its first command)."""
+        if drawing is not None:
+            seqs = self._seen.get(drawing)
+            if seqs is None:
+                seqs = self._new_drawing(drawing)
+            else:
+                self._seen.move_to_end(drawing)
+            seqs.add(seq)
+        start = max(arrival_ms, self.tail_ms)  # start_ms(), written out: one call less
+        self.tail_ms = start + duration_ms
+        return start
+
+    def wait_ms(self, now_ms: float) -> float:
+        """How long a stroke arriving at ``now_ms`` would wait for the strokes before it."""
+        return max(0.0, self.tail_ms - now_ms)
+
+    def replan(self, ends_ms: Iterable[float]) -> None:
+        """After a cancel: the tail is the end of the latest stroke still planned."""
+        self.tail_ms = max(ends_ms, default=NEVER_MS)
+
+    def seen(self, drawing: object, seq: object) -> bool:
+        """Whether this seq of this drawing was accepted or settled before."""
+        if not isinstance(drawing, str) or not isinstance(seq, int):
+            return False
+        seqs = self._seen.get(drawing)
+        return seqs is not None and seq in seqs
+
+    def remember(self, drawing: str, seq: int) -> None:
+        """A seq of a drawing settled without being placed: a copy of it is seen too."""
+        seqs = self._seen.get(drawing)
+        if seqs is None:
+            seqs = self._new_drawing(drawing)
+        else:
+            self._seen.move_to_end(drawing)
+        seqs.add(seq)
+
+    def _new_drawing(self, drawing: str) -> SeenSeqs:
+        seqs = self._seen[drawing] = SeenSeqs()
+        while len(self._seen) > REMEMBERED_DRAWINGS:
+            self._seen.popitem(last=False)
+        return seqs
+
+
+class CancelledDrawings(OrderedDict[str, float]):
+    """The drawings cancelled lately, each with when its cancel came: a stroke of one that
+    comes later (the broker held it, or it was sent just after) is ``cancelled`` too.
+
+    A dict, so that the check on every stroke (``drawing in cancelled``) stays one lookup.
+    """
+
+    def cancel(self, drawing: str, at_ms: float) -> None:
+        self[drawing] = at_ms
+        self.move_to_end(drawing)
+        while len(self) > REMEMBERED_CANCELS:
+            self.popitem(last=False)
+
+
+@dataclass(frozen=True)
+class Arrival:
+    """A stroke reaching the sleeve at ``arrival_ms`` (``drawing`` and ``seq`` may be None)."""
+
+    arrival_ms: float
+    duration_ms: float
+    drawing: str | None = None
+    seq: int | None = None
+
+
+@dataclass(frozen=True)
+class CancelAt:
+    """A cancel of ``drawing`` (None: every drawing) reaching the sleeve at ``at_ms``."""
+
+    at_ms: float
+    drawing: str | None = None
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What became of one arrival. ``start_ms`` and ``played_ms`` are None unless it started
+    (``played`` or ``cut``); ``played_ms`` is how long it played before a cancel cut it."""
+
+    outcome: str
+    start_ms: float | None = None
+    played_ms: float | None = None
+
+
+def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
+    """The sleeve's queue over a whole sequence, in the order the steps reach it (their
+    times never decrease): one outcome per arrival, in order. Every stroke here plays
+    (no planner, no pace, rate or duty-cycle rules: those are admission's)."""
+    queue = Queue()
+    outcomes: list[Outcome | None] = []
+    # Accepted and not cancelled: index -> (start, duration, drawing, seq).
+    planned: dict[int, tuple[float, float, str | None, int | None]] = {}
+    cancelled = CancelledDrawings()
+    for step in steps:
+        if isinstance(step, CancelAt):
+            _cancel(step, queue, planned, outcomes)
+            if step.drawing is not None:
+                cancelled.cancel(step.drawing, step.at_ms)
+            continue
+        if step.drawing is not None and step.drawing in cancelled:
+            outcomes.append(Outcome(CANCELLED))
+            continue
+        if queue.seen(step.drawing, step.seq):
+            waiting = any(
+                drawing == step.drawing and seq == step.seq and start > step.arrival_ms
+                for start, _, drawing, seq in planned.values()
+            )
+            outcomes.append(Outcome(HELD if waiting else DUPLICATE))
+            continue
+        if step.drawing is not None and step.seq is not None:
+            start = queue.place(step.arrival_ms, step.duration_ms, step.drawing, step.seq)
+        else:
+            start = queue.place(step.arrival_ms, step.duration_ms)
+        planned[len(outcomes)] = (start, step.duration_ms, step.drawing, step.seq)
+        outcomes.append(None)
+    for index, (start, duration, _, _) in planned.items():
+        outcomes[index] = Outcome(PLAYED, start, duration)
+    return [o for o in outcomes if o is not None]
+
+
+def _cancel(
+    cancel: CancelAt,
+    queue: Queue,
+    planned: dict[int, tuple[float, float, str | None, int | None]],
+    outcomes: list[Outcome | None],
+) -> None:
+    now = cancel.at_ms
+    for index, (start, duration, drawing, _) in list(planned.items()):
+        if start + duration <= now or (cancel.drawing is not None and drawing != cancel.drawing):
+            continue  # over already, or another drawing's
+        del planned[index]
+        if start <= now:
+            outcomes[index] = Outcome(CUT, start, now - start)
+        else:
+            outcomes[index] = Outcome(CANCELLED)
+    # What still plays (and what played already, ending before now) sets the tail.
+    queue.replan(start + duration for start, duration, _, _ in planned.values())
