@@ -25,7 +25,6 @@ broker add-sleeve`` does. Latencies are wall clock on one machine.
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 import multiprocessing
 import os
@@ -53,6 +52,7 @@ from feelmysign.broker.sleeves import add_sleeve
 from feelmysign.cli.options.parser import CliParser
 from feelmysign.cli.options.values import whole_number
 from feelmysign.connection import new_client, parse_broker_url
+from feelmysign.events import Cancelled, EventError, Played, Rejected, Safety, event_from_json
 from feelmysign.player import SPIN_MS
 from feelmysign.topics import telemetry_topic
 
@@ -303,13 +303,16 @@ class _Watcher:
         key = stroke_key(payload)
         if key is None:
             return
-        event = json.loads(payload)
+        try:
+            event = event_from_json(payload)
+        except EventError:
+            return  # not a sleeve event: its stroke stays unsettled, and is counted lost
         with self._lock:
-            if event.get("type") in ("played", "adjusted"):
+            if isinstance(event, Played):  # adjusted ones too
                 self.played.setdefault(key, set()).add(payload)
-                self.first_command_ms.setdefault(key, float(event["first_command_at_ms"]))
-            elif event.get("type") in ("rejected", "cancelled", "safety"):
-                self.refused.setdefault(key, str(event.get("reason")))
+                self.first_command_ms.setdefault(key, float(event.first_command_at_ms))
+            elif isinstance(event, Rejected | Cancelled | Safety):
+                self.refused.setdefault(key, event.reason)
 
     def settled(self, keys: dict[str, float]) -> int:
         with self._lock:

@@ -32,7 +32,7 @@ import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import paho.mqtt.client as mqtt
 
@@ -41,10 +41,13 @@ from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.control import Cancel, format_control
 from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.events import Cancelled, Event, Played, event_from_json
 from feelmysign.layout import Layout
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import control_topic, strokes_topic, telemetry_topic
+
+_E = TypeVar("_E", bound=Event)
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 # 1 cm and 10 cm on the paper's 3 cm grid.
@@ -92,25 +95,25 @@ class _Inbox:
             self.items.append((time.time_ns() / 1e6, bytes(message.payload)))
             self.cond.notify_all()
 
-    def wait_played(self, count: int, timeout_s: float = 30.0) -> list[dict[str, Any]]:
+    def wait_played(self, count: int, timeout_s: float = 30.0) -> list[Played]:
         """The first ``count`` played (or adjusted) events; safety events and others skipped."""
 
-        def played() -> list[dict[str, Any]]:
-            events = (json.loads(payload) for _, payload in self.items)
-            return [e for e in events if e.get("type") in ("played", "adjusted")]
+        def played() -> list[Played]:
+            events = (event_from_json(payload) for _, payload in self.items)
+            return [e for e in events if isinstance(e, Played)]
 
         with self.cond:
             if not self.cond.wait_for(lambda: len(played()) >= count, timeout_s):
                 raise TimeoutError(f"{len(played())} of {count} strokes were played")
             return played()[:count]
 
-    def wait_event(self, kind: str, drawing: str, timeout_s: float) -> dict[str, Any] | None:
-        """The first event of type ``kind`` about a stroke of ``drawing``; None if none came."""
+    def wait_event(self, kind: type[_E], drawing: str, timeout_s: float) -> _E | None:
+        """The first event of class ``kind`` about a stroke of ``drawing``; None if none came."""
 
-        def found() -> dict[str, Any] | None:
+        def found() -> _E | None:
             for _, payload in self.items:
-                event: dict[str, Any] = json.loads(payload)
-                if event.get("type") == kind and event.get("drawing") == drawing:
+                event = event_from_json(payload)
+                if isinstance(event, kind) and getattr(event, "drawing", None) == drawing:
                     return event
             return None
 
@@ -184,7 +187,7 @@ def _sleeve(c: Credentials) -> Iterator[Sleeve]:
         backend.close()
 
 
-def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[dict[str, Any]]:
+def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[tuple[float, Played]]:
     """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event.
 
     Each stroke (a drawing of its own) is cancelled once its played event is out, i.e. after
@@ -203,16 +206,15 @@ def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[dict[str, A
         published_ms = time.time_ns() / 1e6
         sender.publish(strokes_topic(c.sleeve_id), format_json(stroke), qos=1)
         event = inbox.wait_played(1)[-1]
-        if event.get("drawing") != drawing:
+        if event.drawing != drawing:
             raise RuntimeError(f"expected a played event of {drawing}, got {event}")
-        event["published_at_ms"] = published_ms
-        results.append(event)
+        results.append((published_ms, event))
         sender.publish(control_topic(c.sleeve_id), format_control(Cancel(drawing)), qos=1)
         time.sleep(PAUSE_S)
         # Its motors are off once it is reported cancelled (mostly during the pause); a stroke
         # that ended before the cancel came is not reported: wait no longer than its end.
-        end_ms = event["first_command_at_ms"] + event["duration_ms"] + 100.0
-        inbox.wait_event("cancelled", drawing, max(0.0, end_ms - time.time_ns() / 1e6) / 1000)
+        end_ms = event.first_command_at_ms + event.duration_ms + 100.0
+        inbox.wait_event(Cancelled, drawing, max(0.0, end_ms - time.time_ns() / 1e6) / 1000)
     for client in (watcher, sender):
         client.loop_stop()
         client.disconnect()
@@ -275,9 +277,9 @@ def drawing_gaps(c: Credentials, shape: Any, strokes: int) -> list[float]:
         client.loop_stop()
         client.disconnect()
     return [
-        after["first_command_at_ms"] - (before["first_command_at_ms"] + before["duration_ms"])
+        after.first_command_at_ms - (before.first_command_at_ms + before.duration_ms)
         for before, after in itertools.pairwise(events)
-        if after["queued_ms"] > 0
+        if after.queued_ms > 0
     ]
 
 
@@ -294,14 +296,14 @@ def _latency_lines(
 ) -> list[str]:
     stroke_latencies(c, shape, WARM_UP)
     events = stroke_latencies(c, shape, count)
-    end_to_end = [e["first_command_at_ms"] - e["published_at_ms"] for e in events]
+    end_to_end = [e.first_command_at_ms - published_ms for published_ms, e in events]
     ratio = percentile(end_to_end, 99) / percentile(bare, 99)
     return [
         _figures(f"{label}: publish -> first actuator command", end_to_end)
         + f"   {ratio:.2f}x baseline p99",
         _figures(
             f"{label}: sleeve's share (receive -> first command)",
-            [e["latency_ms"] for e in events],
+            [e.latency_ms for _, e in events],
         ),
     ]
 

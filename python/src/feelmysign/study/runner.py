@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 from feelmysign.errors import FeelMySignError, StudyError
+from feelmysign.events import Adjusted, Event, EventError, Played, Rejected, event_from_json
 from feelmysign.layout import Layout
 from feelmysign.schedule import stroke_to_json
 from feelmysign.stroke import Stroke
@@ -42,18 +43,27 @@ def stroke_from_json(data: dict[str, Any]) -> Stroke:
     )
 
 
+def sleeve_events(events: list[dict[str, Any]]) -> list[Event]:
+    """The sleeve's events among ``events`` (as stored); anything else is left out."""
+    typed: list[Event] = []
+    for data in events:
+        try:
+            typed.append(event_from_json(data))
+        except EventError:
+            continue  # not a sleeve event: nothing in the summary counts it
+    return typed
+
+
 def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]:
-    played = [e for e in events if e.get("type") in ("played", "adjusted")]
-    latencies = [
-        float(e["latency_ms"]) for e in played if isinstance(e.get("latency_ms"), (int, float))
-    ]
+    typed = sleeve_events(events)
+    played = [e for e in typed if isinstance(e, Played)]  # adjusted ones were played too
     return {
         "strokes": strokes,
         "played": len(played),
-        "adjusted": sum(1 for e in events if e.get("type") == "adjusted"),
-        "rejected": [str(e.get("reason")) for e in events if e.get("type") == "rejected"],
-        "latency_ms_max": round(max(latencies), 3) if latencies else None,
-        "felt_duration_ms": round(sum(float(e.get("duration_ms", 0)) for e in played), 1),
+        "adjusted": sum(1 for e in typed if isinstance(e, Adjusted)),
+        "rejected": [e.reason for e in typed if isinstance(e, Rejected)],
+        "latency_ms_max": round(max(e.latency_ms for e in played), 3) if played else None,
+        "felt_duration_ms": round(sum(float(e.duration_ms) for e in played), 1),
     }
 
 

@@ -8,9 +8,11 @@ dry run's study file has the same shape as a real one.
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 from feelmysign.errors import StrokeError
+from feelmysign.events import Adjusted, Event, Played, Rejected
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.stroke import Stroke
@@ -19,25 +21,43 @@ from feelmysign.study.runner import Play
 
 def offline_player(layout: Layout) -> Play:
     def play(strokes: list[Stroke]) -> list[dict[str, Any]]:
+        # Every stroke is received now and played at once, so each starts as it arrives:
+        # no latency, no queue, no start error (the figures a dry run reports as 0).
+        received_at_ms = round(time.time() * 1000, 3)
         events: list[dict[str, Any]] = []
         for stroke in strokes:
-            base = {"drawing": stroke.drawing, "seq": stroke.seq, "simulated": True}
+            base: dict[str, Any] = {
+                "drawing": stroke.drawing,
+                "seq": stroke.seq,
+                "sent_at_ms": stroke.sent_at_ms,
+                "received_at_ms": received_at_ms,
+            }
+            event: Event
             try:
                 schedule = plan(stroke, layout)
             except StrokeError as error:
-                events.append({"type": "rejected", **base, "reason": error.reason})
+                event = Rejected(reason=error.reason, message=error.message, **base)
+                events.append(event.to_json())
                 continue
-            event: dict[str, Any] = {
-                "type": "adjusted" if schedule.adjusted else "played",
+            played: dict[str, Any] = {
                 **base,
+                "start_at_ms": received_at_ms,
+                "first_command_at_ms": received_at_ms,
                 "latency_ms": 0.0,
+                "start_error_ms": 0.0,
+                "queued_ms": 0.0,
                 "duration_ms": schedule.duration_ms,
                 "commands": len(schedule.commands),
             }
             if schedule.adjusted:
-                event["reason"] = schedule.adjusted.reason
-                event["requested_duration_ms"] = schedule.adjusted.requested_duration_ms
-            events.append(event)
+                event = Adjusted(
+                    **played,
+                    reason=schedule.adjusted.reason,
+                    requested_duration_ms=schedule.adjusted.requested_duration_ms,
+                )
+            else:
+                event = Played(**played)
+            events.append(event.to_json())
         return events
 
     return play

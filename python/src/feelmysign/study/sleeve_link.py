@@ -18,13 +18,13 @@ from typing import Any
 import paho.mqtt.client as mqtt
 
 from feelmysign.connection import BrokerSettings, connect_client
+from feelmysign.events import Event, EventError, Played, Rejected, event_from_json
 from feelmysign.sending import OutgoingStroke, StrokeSender
 from feelmysign.stroke import Stroke
 from feelmysign.topics import telemetry_topic
 
 # Beyond the drawing's own duration: the sleeve's queue, its latency and the event's trip.
 EVENTS_GRACE_S = 5.0
-FINAL_TYPES = ("played", "adjusted", "rejected")
 MAX_FELT_WAIT_S = 30.0  # the sleeve's own cap on queued strokes
 
 
@@ -33,27 +33,33 @@ class _Events:
 
     def __init__(self) -> None:
         self._condition = threading.Condition()
-        self._by_drawing: dict[str, list[dict[str, Any]]] = {}
+        # Each event typed, and as it came: the study file stores what the sleeve said.
+        self._by_drawing: dict[str, list[tuple[Event, dict[str, Any]]]] = {}
 
     def on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
         try:
-            event = json.loads(message.payload)
-        except ValueError:
-            return  # not ours to judge: the sleeve's events are JSON
-        if not isinstance(event, dict) or not isinstance(event.get("drawing"), str):
-            return
+            data = json.loads(message.payload)
+            event = event_from_json(data)
+        except (ValueError, EventError):
+            return  # not ours to judge: not one of the sleeve's events
+        drawing = getattr(event, "drawing", None)
+        if drawing is None:
+            return  # about no stroke (an error): no trial waits for it
         with self._condition:
-            self._by_drawing.setdefault(event["drawing"], []).append(event)
+            self._by_drawing.setdefault(drawing, []).append((event, data))
             self._condition.notify_all()
 
-    def wait(self, drawing: str, count: int, timeout_s: float) -> list[dict[str, Any]]:
-        """The drawing's events once each of its ``count`` strokes has a final one (or timeout)."""
+    def wait(
+        self, drawing: str, count: int, timeout_s: float
+    ) -> list[tuple[Event, dict[str, Any]]]:
+        """The drawing's events once each of its ``count`` strokes has a final one (or timeout):
+        played (or adjusted) or rejected."""
 
         def done() -> bool:
             seen = {
-                e.get("seq")
-                for e in self._by_drawing.get(drawing, ())
-                if e.get("type") in FINAL_TYPES
+                e.seq
+                for e, _ in self._by_drawing.get(drawing, ())
+                if isinstance(e, Played | Rejected)
             }
             return len(seen) >= count
 
@@ -102,18 +108,13 @@ class SleeveLink:
             total_s = sum(s.duration_ms for s in strokes) / 1000
             left_s = max(0.0, started_s + total_s - time.monotonic()) + EVENTS_GRACE_S
             events = self._events.wait(drawing, len(strokes), left_s)
-            _until_felt(events)
-            return events
+            _until_felt([event for event, _ in events])
+            return [data for _, data in events]
 
 
-def _until_felt(events: list[dict[str, Any]]) -> None:
+def _until_felt(events: list[Event]) -> None:
     """Return once the last stroke has finished on the skin, not when it started: the
     participant is asked only after the whole shape was felt."""
-    ends_ms = [
-        float(e["first_command_at_ms"]) + float(e["duration_ms"])
-        for e in events
-        if isinstance(e.get("first_command_at_ms"), (int, float))
-        and isinstance(e.get("duration_ms"), (int, float))
-    ]
+    ends_ms = [e.first_command_at_ms + e.duration_ms for e in events if isinstance(e, Played)]
     if ends_ms:
         time.sleep(min(MAX_FELT_WAIT_S, max(0.0, max(ends_ms) / 1000 - time.time())))

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from feelmysign.errors import StudyError
+from feelmysign.events import EventError, event_from_json
 from feelmysign.input_files import UnusableFile, check_kind
 from feelmysign.study.design import Design
 from feelmysign.study.design_file import parse_design
@@ -281,7 +282,7 @@ class StudyStore:
                     "requested_duration_ms, reason, json) VALUES (?,?,?,?,?,?,?,?)",
                     (
                         send_id,
-                        str(event.get("type", "")),
+                        _event_type(event),
                         event.get("seq"),
                         event.get("latency_ms"),
                         event.get("duration_ms"),
@@ -476,3 +477,12 @@ class StudyStore:
                 "stop_reason = ? WHERE id = ?",
                 (now_ms(), threshold, low, high, stop_reason, run_id),
             )
+
+
+def _event_type(event: dict[str, Any]) -> str:
+    """The events table's type column: the sleeve event's type, empty for anything else
+    (only the sleeve's events reach the store: the sleeve link reads no other)."""
+    try:
+        return event_from_json(event).kind
+    except EventError:
+        return ""
