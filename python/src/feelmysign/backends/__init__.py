@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     )
     from feelmysign.backends.sim import Change, SimBackend
     from feelmysign.backends.tca9548a import Multiplexers, MuxChannel
-    from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry, monotonic_ms
+    from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 
 _WHERE = {
     "Backend": "base",
@@ -64,7 +64,6 @@ _WHERE = {
     "MuxChannel": "tca9548a",
     "ActuatorFrame": "telemetry",
     "ActuatorTelemetry": "telemetry",
-    "monotonic_ms": "telemetry",
 }
 __all__ = [
     "DRV2605L",
@@ -91,7 +90,6 @@ __all__ = [
     "check_intensity",
     "check_wiring",
     "compare_with_layout",
-    "monotonic_ms",
     "open_smbus",
     "rtp_level",
 ]

@@ -22,7 +22,6 @@ from __future__ import annotations
 import json
 import os
 import threading
-import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,7 +29,8 @@ from pathlib import Path
 from typing import TextIO
 
 from feelmysign.backends.base import GridBackend
-from feelmysign.backends.telemetry import ActuatorTelemetry, monotonic_ms
+from feelmysign.backends.telemetry import ActuatorTelemetry
+from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
 
@@ -71,7 +71,7 @@ class SimBackend(GridBackend):
         record: str | os.PathLike[str] | None = None,
         telemetry: ActuatorTelemetry | None = None,
         keep_changes: int | None = DEFAULT_KEEP_CHANGES,
-        wall_clock: Callable[[], float] = lambda: time.time() * 1000.0,
+        wall_clock: Callable[[], float] = wall_ms,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
         if keep_changes is not None and keep_changes < 0:
