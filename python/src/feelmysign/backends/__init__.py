@@ -33,7 +33,7 @@ if TYPE_CHECKING:
         WireCheck,
         compare_with_layout,
     )
-    from feelmysign.backends.sim import Change, SimBackend
+    from feelmysign.backends.sim import RecordedChange, SimBackend
     from feelmysign.backends.tca9548a import Multiplexers, MuxChannel
     from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 
@@ -58,7 +58,7 @@ _WHERE = {
     "ScanResult": "scan",
     "WireCheck": "scan",
     "compare_with_layout": "scan",
-    "Change": "sim",
+    "RecordedChange": "sim",
     "SimBackend": "sim",
     "Multiplexers": "tca9548a",
     "MuxChannel": "tca9548a",
@@ -71,7 +71,6 @@ __all__ = [
     "ActuatorTelemetry",
     "Backend",
     "BusConflictError",
-    "Change",
     "ChannelScan",
     "Drv2605Backend",
     "EmulatedDRV2605L",
@@ -82,6 +81,7 @@ __all__ = [
     "LayoutReport",
     "Multiplexers",
     "MuxChannel",
+    "RecordedChange",
     "ScanResult",
     "SimBackend",
     "Transaction",

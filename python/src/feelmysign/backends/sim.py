@@ -39,8 +39,15 @@ _T_DECIMALS = 3  # microseconds: finer than any clock the player is measured aga
 
 
 @dataclass(frozen=True)
-class Change:
-    """One actuator's intensity changed at ``t_ms`` after the backend was opened."""
+class RecordedChange:
+    """One actuator's intensity changed at ``t_ms`` after the backend was opened.
+
+    What the sleeve did, as the simulator saw it: not :class:`feelmysign.timeline.Change`,
+    the player's order to change an intensity at a planned time on its own clock (with the
+    stroke that ordered it). A recorded change is measured from the backend's opening, so
+    its time includes the player's lateness; the two stay apart so that a record is never
+    mistaken for the plan it is compared with.
+    """
 
     t_ms: float
     row: int
@@ -79,7 +86,7 @@ class SimBackend(GridBackend):
         self._clock = clock
         self._record_path = Path(record) if record is not None else None
         self._record: TextIO | None = None
-        self._changes: deque[Change] = deque(maxlen=keep_changes)
+        self._changes: deque[RecordedChange] = deque(maxlen=keep_changes)
         self._changes_lock = threading.Lock()
         self._start_ms = 0.0
         self._wall_clock = wall_clock
@@ -91,7 +98,7 @@ class SimBackend(GridBackend):
         return self._record_path
 
     @property
-    def changes(self) -> list[Change]:
+    def changes(self) -> list[RecordedChange]:
         """The recorded changes, oldest first (at most ``keep_changes``)."""
         with self._changes_lock:
             return list(self._changes)
@@ -105,7 +112,7 @@ class SimBackend(GridBackend):
 
     def _write(self, row: int, column: int, intensity: float) -> None:
         t_ms = round(self._clock() - self._start_ms, _T_DECIMALS)
-        change = Change(t_ms, row, column, intensity)
+        change = RecordedChange(t_ms, row, column, intensity)
         with self._changes_lock:
             self._changes.append(change)
         if self._record is not None:
