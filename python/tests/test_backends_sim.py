@@ -12,7 +12,7 @@ from feelmysign.backends import (
     ActuatorFrame,
     ActuatorTelemetry,
     Backend,
-    Change,
+    RecordedChange,
     SimBackend,
 )
 from feelmysign.layout import Layout
@@ -47,9 +47,9 @@ def test_sim_records_each_change_relative_to_its_start() -> None:
         clock.advance(50.0)
         sim.set_intensity(0, 3, 0.0)
         assert sim.changes == [
-            Change(12.5, 0, 3, 0.8),
-            Change(112.5, 2, 0, 0.25),
-            Change(162.5, 0, 3, 0.0),
+            RecordedChange(12.5, 0, 3, 0.8),
+            RecordedChange(112.5, 2, 0, 0.25),
+            RecordedChange(162.5, 0, 3, 0.0),
         ]
         assert sim.snapshot() == [[0.0, 0.0, 0.0, 0.0], [0.0] * 4, [0.25, 0.0, 0.0, 0.0]]
 

@@ -17,6 +17,7 @@ from feelmysign.errors import StrokeError
 from feelmysign.layout import MIN_BURST_MS, Layout, grid_layout
 from feelmysign.overlaps import _chained_pieces, _energy_pieces, _two_pieces, merge_commands
 from feelmysign.planner import overrun_allowance_ms, plan, render_point, virtual_actuators
+from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.schedule import Burst, Command, Schedule, schedule_to_json
 from feelmysign.stroke import Stroke
 
@@ -155,7 +156,27 @@ def test_out_of_grid_message_names_the_range() -> None:
     with pytest.raises(StrokeError) as error:
         plan(Stroke((0, 0), (5, 5), 1000), PAPER)
     assert error.value.reason == "outside_grid"
-    assert "[0, 3]" in error.value.message and "[0, 2]" in error.value.message
+    assert "0..3" in error.value.message and "0..2" in error.value.message
+
+
+@pytest.mark.parametrize(
+    "stroke",
+    [
+        Stroke((0, 0), (5, 5), 1000),
+        Stroke((0, 0), (3 + 1e-7, 2), 1000),  # past the sleeve's tolerance
+        Stroke((0, 0), (1, 1), 0),
+        Stroke((0, 0), (1, 1), math.nan),
+        Stroke((0, 0), (1, 1), 1000, 1.5),
+        Stroke((0, 0), (1, 1), 20_000.0),
+        Stroke((0.0, 0.0), (1.0, 1.0), 20_000.0),  # plainly valid but for the duration cap
+    ],
+)
+def test_a_refused_stroke_gets_the_sleeves_reason_and_message(stroke: Stroke) -> None:
+    refused = validate_stroke(stroke, PAPER)
+    assert isinstance(refused, Rejected)
+    with pytest.raises(StrokeError) as error:
+        plan(stroke, PAPER)
+    assert (error.value.reason, error.value.message) == (refused.reason, refused.message)
 
 
 def test_slowed_stroke_longer_than_the_cap_is_refused() -> None:

@@ -9,10 +9,11 @@ from typing import Any
 import pytest
 
 from feelmysign.backends.sim import SimBackend
+from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.events import Event
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
-from feelmysign.player import PlannedStroke, Player, monotonic_ms, wall_ms
+from feelmysign.player import PlannedStroke, Player
 from feelmysign.sleeve.queue import SeenSeqs
 from feelmysign.stroke import Stroke
 

@@ -45,6 +45,7 @@ from typing import TYPE_CHECKING, Any
 from feelmysign import __version__
 from feelmysign.backends.base import Backend
 from feelmysign.backends.telemetry import ActuatorTelemetry
+from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
 from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError, StrokeError
@@ -68,8 +69,6 @@ from feelmysign.player import (
     PlannedStroke,
     Player,
     cancelled,
-    monotonic_ms,
-    wall_ms,
 )
 from feelmysign.protocol import Accepted, parse
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder

@@ -36,7 +36,6 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import replace
 
 from feelmysign.apparent_motion import (
     Timing,
@@ -48,6 +47,7 @@ from feelmysign.apparent_motion import (
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
 from feelmysign.overlaps import Actuator, Span, commands_from_spans
+from feelmysign.protocol import playable
 from feelmysign.schedule import Adjustment, Burst, Command, Schedule
 from feelmysign.stroke import Point, Stroke
 
@@ -119,9 +119,9 @@ def outline(
     its commands, computed without the rest (see ``Outline``).
     """
     given = _plain_stroke(stroke, layout)
-    if given is None:  # clamped onto the grid, or a StrokeError saying what is wrong
-        start, end = _checked_stroke(stroke, layout)
-        stroke = _canonical(stroke, start, end)
+    if given is None:  # clamped onto the grid, or the sleeve's StrokeError saying what is wrong
+        stroke = playable(stroke, layout)
+        start, end = stroke.start, stroke.end
     else:
         start, end = given
     intensity = stroke.intensity
@@ -133,7 +133,9 @@ def outline(
     if not duration_ms >= shortest_planned_ms(min_ms):  # _kept_duration's first test, inline
         duration_ms, adjusted = _kept_duration(stroke, start, end, min_ms, strict=strict)
     if duration_ms > layout.max_stroke_duration_ms:
-        raise StrokeError(
+        if adjusted is None:  # too long as sent: the protocol's refusal, as the sleeve words it
+            playable(stroke, layout)
+        raise StrokeError(  # too long once slowed: the layout's shortest burst made it so
             "duration_too_long",
             f"stroke needs {duration_ms:.3f} ms, more than the sleeve's maximum of "
             f"{layout.max_stroke_duration_ms:g} ms; send a slower, shorter stroke",
@@ -275,15 +277,16 @@ def _plain_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point] | None:
     """The stroke's endpoints when it is plainly valid as it is, else None.
 
     Plainly valid: float coordinates on the grid, a finite positive float
-    duration, an intensity in [0, 1] or none; ``_checked_stroke`` passes it
-    unchanged and ``_canonical`` keeps it. Anything else (None) goes through
-    them, for the clamping or the error. Most strokes, parsed from the
-    protocol, are plain, and this costs a fraction of those checks.
+    duration, an intensity in [0, 1] or none; ``protocol.playable`` would pass
+    it and its clamping keep its values. Anything else (None) goes through
+    ``playable``, for the clamping or the sleeve's error (the duration cap is
+    checked once the duration is known, after any slowing). Most strokes,
+    parsed from the protocol, are plain, and this costs a fraction of those checks.
     """
     try:
         (x0, y0), (x1, y1) = start, end = stroke.start, stroke.end
     except (TypeError, ValueError):
-        return None  # _checked_stroke says what is wrong
+        return None  # playable says what is wrong
     x_max, y_max = layout.columns - 1, layout.rows - 1
     duration_ms = stroke.duration_ms
     if not (
@@ -301,51 +304,11 @@ def _plain_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point] | None:
     ):
         return None
     intensity = stroke.intensity
-    # Last, as _checked_stroke tests it after the numbers (a TypeError for a
-    # string here is the one it would raise).
+    # Last, as playable tests it after the numbers (a TypeError for a string
+    # here is the one it would raise).
     if intensity is not None and not 0.0 <= intensity <= 1.0:
         return None
     return start, end
-
-
-def _checked_stroke(stroke: Stroke, layout: Layout) -> tuple[Point, Point]:
-    """The stroke's endpoints clamped onto the grid, or StrokeError saying what is wrong."""
-    values = (*stroke.start, *stroke.end, stroke.duration_ms)
-    if not all(map(math.isfinite, values)):
-        raise StrokeError("not_finite", f"stroke has a non-finite number: {values}")
-    if stroke.duration_ms <= 0:
-        raise StrokeError(
-            "duration_not_positive",
-            f"duration_ms must be more than 0, got {stroke.duration_ms:g}",
-        )
-    if stroke.intensity is not None and not 0.0 <= stroke.intensity <= 1.0:
-        raise StrokeError(
-            "intensity_out_of_range", f"intensity must be in [0, 1], got {stroke.intensity:g}"
-        )
-    return _on_grid(stroke.start, "start", layout), _on_grid(stroke.end, "end", layout)
-
-
-def _on_grid(point: Point, name: str, layout: Layout) -> Point:
-    x_max, y_max = layout.columns - 1, layout.rows - 1
-    x, y = point
-    tolerance = 1e-6
-    if not (-tolerance <= x <= x_max + tolerance and -tolerance <= y <= y_max + tolerance):
-        raise StrokeError(
-            "outside_grid",
-            f"{name} point ({x:g}, {y:g}) is outside the {layout.rows} x {layout.columns} grid: "
-            f"x (column) must be in [0, {x_max}] and y (row) in [0, {y_max}]",
-        )
-    return (min(max(float(x), 0.0), float(x_max)), min(max(float(y), 0.0), float(y_max)))
-
-
-def _canonical(stroke: Stroke, start: Point, end: Point) -> Stroke:
-    """The stroke with its clamped float endpoints (itself when they already are)."""
-    # dataclasses.replace costs as much as a tenth of a short stroke's plan, and
-    # most strokes arrive already on the grid as floats.
-    given = (*stroke.start, *stroke.end)
-    if (*start, *end) == given and all(type(v) is float for v in given):
-        return stroke
-    return replace(stroke, start=start, end=end)
 
 
 def virtual_actuators(

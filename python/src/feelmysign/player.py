@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from feelmysign.backends.base import Backend
+from feelmysign.clock import monotonic_ms
 from feelmysign.control import Cancel
 from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
@@ -71,14 +72,6 @@ _STROKE_FIELDS = (
     "age_ms",
     "lag_ms",
 )  # of PlannedStroke.info
-
-
-def monotonic_ms() -> float:
-    return time.monotonic_ns() / 1e6
-
-
-def wall_ms() -> float:
-    return time.time_ns() / 1e6
 
 
 @dataclass

@@ -170,6 +170,21 @@ def validate_stroke(stroke: Stroke, layout: Layout) -> Stroke | Rejected:
     problem = _first_problem(stroke, layout)
     if problem is not None:
         return problem
+    return _clamped(stroke, layout)
+
+
+def playable(stroke: Stroke, layout: Layout) -> Stroke:
+    """``stroke`` with its points clamped into the grid when the sleeve would play what it
+    draws (its points, duration and intensity), else StrokeError with the sleeve's reason and
+    message. The planner's check: a stroke's drawing, seq and sending time do not change what
+    is felt, so they are the protocol's alone."""
+    problem = _motion_problem(stroke, layout)
+    if problem is not None:
+        raise StrokeError(problem.reason, problem.message)
+    return _clamped(stroke, layout)
+
+
+def _clamped(stroke: Stroke, layout: Layout) -> Stroke:
     # As dataclasses.replace makes it, without its look at every field.
     return Stroke(
         _clamp(stroke.start, layout),
@@ -516,13 +531,20 @@ def _first_problem(stroke: Stroke, layout: Layout | None) -> Rejected | None:
     checks = (
         _check_drawing(stroke.drawing),
         _check_seq(stroke.seq),
-        _check_point(stroke.start, "start", layout),
-        _check_point(stroke.end, "end", layout),
-        _check_duration(stroke.duration_ms, layout),
-        _check_intensity(stroke.intensity),
+        _motion_problem(stroke, layout),
         _check_sent_at(stroke.sent_at_ms),
     )
     return next((problem for problem in checks if problem is not None), None)
+
+
+def _motion_problem(stroke: Stroke, layout: Layout | None) -> Rejected | None:
+    """The first problem with what the stroke draws: its points, duration and intensity."""
+    return (
+        _check_point(stroke.start, "start", layout)
+        or _check_point(stroke.end, "end", layout)
+        or _check_duration(stroke.duration_ms, layout)
+        or _check_intensity(stroke.intensity)
+    )
 
 
 def _check_drawing(drawing: str | None) -> Rejected | None:

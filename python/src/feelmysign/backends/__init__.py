@@ -33,9 +33,9 @@ if TYPE_CHECKING:
         WireCheck,
         compare_with_layout,
     )
-    from feelmysign.backends.sim import Change, SimBackend
+    from feelmysign.backends.sim import RecordedChange, SimBackend
     from feelmysign.backends.tca9548a import Multiplexers, MuxChannel
-    from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry, monotonic_ms
+    from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 
 _WHERE = {
     "Backend": "base",
@@ -58,13 +58,12 @@ _WHERE = {
     "ScanResult": "scan",
     "WireCheck": "scan",
     "compare_with_layout": "scan",
-    "Change": "sim",
+    "RecordedChange": "sim",
     "SimBackend": "sim",
     "Multiplexers": "tca9548a",
     "MuxChannel": "tca9548a",
     "ActuatorFrame": "telemetry",
     "ActuatorTelemetry": "telemetry",
-    "monotonic_ms": "telemetry",
 }
 __all__ = [
     "DRV2605L",
@@ -72,7 +71,6 @@ __all__ = [
     "ActuatorTelemetry",
     "Backend",
     "BusConflictError",
-    "Change",
     "ChannelScan",
     "Drv2605Backend",
     "EmulatedDRV2605L",
@@ -83,6 +81,7 @@ __all__ = [
     "LayoutReport",
     "Multiplexers",
     "MuxChannel",
+    "RecordedChange",
     "ScanResult",
     "SimBackend",
     "Transaction",
@@ -91,7 +90,6 @@ __all__ = [
     "check_intensity",
     "check_wiring",
     "compare_with_layout",
-    "monotonic_ms",
     "open_smbus",
     "rtp_level",
 ]

@@ -22,7 +22,6 @@ from __future__ import annotations
 import json
 import os
 import threading
-import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,7 +29,8 @@ from pathlib import Path
 from typing import TextIO
 
 from feelmysign.backends.base import GridBackend
-from feelmysign.backends.telemetry import ActuatorTelemetry, monotonic_ms
+from feelmysign.backends.telemetry import ActuatorTelemetry
+from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
 
@@ -39,8 +39,15 @@ _T_DECIMALS = 3  # microseconds: finer than any clock the player is measured aga
 
 
 @dataclass(frozen=True)
-class Change:
-    """One actuator's intensity changed at ``t_ms`` after the backend was opened."""
+class RecordedChange:
+    """One actuator's intensity changed at ``t_ms`` after the backend was opened.
+
+    What the sleeve did, as the simulator saw it: not :class:`feelmysign.timeline.Change`,
+    the player's order to change an intensity at a planned time on its own clock (with the
+    stroke that ordered it). A recorded change is measured from the backend's opening, so
+    its time includes the player's lateness; the two stay apart so that a record is never
+    mistaken for the plan it is compared with.
+    """
 
     t_ms: float
     row: int
@@ -71,7 +78,7 @@ class SimBackend(GridBackend):
         record: str | os.PathLike[str] | None = None,
         telemetry: ActuatorTelemetry | None = None,
         keep_changes: int | None = DEFAULT_KEEP_CHANGES,
-        wall_clock: Callable[[], float] = lambda: time.time() * 1000.0,
+        wall_clock: Callable[[], float] = wall_ms,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
         if keep_changes is not None and keep_changes < 0:
@@ -79,7 +86,7 @@ class SimBackend(GridBackend):
         self._clock = clock
         self._record_path = Path(record) if record is not None else None
         self._record: TextIO | None = None
-        self._changes: deque[Change] = deque(maxlen=keep_changes)
+        self._changes: deque[RecordedChange] = deque(maxlen=keep_changes)
         self._changes_lock = threading.Lock()
         self._start_ms = 0.0
         self._wall_clock = wall_clock
@@ -91,7 +98,7 @@ class SimBackend(GridBackend):
         return self._record_path
 
     @property
-    def changes(self) -> list[Change]:
+    def changes(self) -> list[RecordedChange]:
         """The recorded changes, oldest first (at most ``keep_changes``)."""
         with self._changes_lock:
             return list(self._changes)
@@ -105,7 +112,7 @@ class SimBackend(GridBackend):
 
     def _write(self, row: int, column: int, intensity: float) -> None:
         t_ms = round(self._clock() - self._start_ms, _T_DECIMALS)
-        change = Change(t_ms, row, column, intensity)
+        change = RecordedChange(t_ms, row, column, intensity)
         with self._changes_lock:
             self._changes.append(change)
         if self._record is not None:

@@ -23,21 +23,16 @@ from __future__ import annotations
 import logging
 import math
 import threading
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from feelmysign.clock import monotonic_ms
 from feelmysign.errors import ParameterError
 from feelmysign.lifecycle import Started
 
 _log = logging.getLogger(__name__)
 
 DEFAULT_RATE_HZ = 20.0  # one frame every 50 ms: smooth enough for a preview, cheap on MQTT
-
-
-def monotonic_ms() -> float:
-    """The default clock of the backends: a monotonic time in milliseconds."""
-    return time.monotonic_ns() / 1e6
 
 
 @dataclass(frozen=True)
