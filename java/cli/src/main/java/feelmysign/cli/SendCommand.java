@@ -25,7 +25,10 @@ import java.util.Map;
  * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
  * feelmysign send} does (its flags where they apply): every stroke checked first, one drawing,
  * QoS 1, and the command returns once the broker has acknowledged every stroke (exit 0), or
- * says why not (exit 1). Strokes go out at once (the reference's "burst" pace).
+ * says why not (exit 1). A shape or a recording goes out at the pace it plays ({@code --pace
+ * realtime}: each stroke once the one before would have finished), so a second send right after
+ * it is not queued behind it and refused as late; strokes given one by one go out at once
+ * ({@code --pace burst}), as the reference does.
  */
 final class SendCommand {
   private SendCommand() {}
@@ -34,7 +37,8 @@ final class SendCommand {
   static final String USAGE =
       "usage: " + PROG + " [-h] [--shape {circle,square,triangle,star,heart,line}]\n"
           + "       [--segments N] [--duration-ms D] [--margin M] [--recording FILE [--paper]]\n"
-          + "       [--intensity A] [--legacy] [--legacy-topic TOPIC] [--timeout-s S]\n"
+          + "       [--intensity A] [--legacy] [--legacy-topic TOPIC]\n"
+          + "       [--pace {realtime,burst}] [--timeout-s S]\n"
           + "       [--broker URL] [--id ID] [--username U] [--password P]\n"
           + "       [--credentials FILE] [--ca FILE] [--ca-fingerprint SHA256]\n"
           + "       [--rows R] [--columns C] [--spacing-cm S] [STROKE ...]";
@@ -42,7 +46,10 @@ final class SendCommand {
       + "Send strokes (startX,startY,endX,endY,duration in grid units and ms), a shape of the\n"
       + "study's library (--shape, --segments), or a recording cut by the simplifier\n"
       + "(--recording; the window simplifier, --paper for the paper's angle one) to a sleeve,\n"
-      + "and wait until the broker has them. Broker settings: the option, else\n"
+      + "and wait until the broker has them. --pace realtime (the default for --shape and\n"
+      + "--recording) sends each stroke when the previous one would have finished playing, like\n"
+      + "a person drawing, so the command lasts as long as the drawing plays; --pace burst (the\n"
+      + "default for STROKEs) sends them all at once. Broker settings: the option, else\n"
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
       + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
 
@@ -57,6 +64,7 @@ final class SendCommand {
     boolean legacy = false;
     String legacyTopic = null;
     double timeoutS = 10;
+    String pace = null;
     String broker = null;
     String sleeveId = null;
     String username = null;
@@ -84,6 +92,13 @@ final class SendCommand {
         case "--intensity" -> intensity = number(value(args, ++i, a), a);
         case "--legacy" -> legacy = true;
         case "--legacy-topic" -> legacyTopic = value(args, ++i, a);
+        case "--pace" -> {
+          pace = value(args, ++i, a);
+          if (!pace.equals("realtime") && !pace.equals("burst")) {
+            throw new Main.UsageException(PROG, USAGE, "argument --pace: invalid choice: '" + pace
+                + "' (choose from 'realtime', 'burst')");
+          }
+        }
         case "--timeout-s" -> timeoutS = number(value(args, ++i, a), a);
         case "--broker" -> broker = value(args, ++i, a);
         case "--id" -> sleeveId = value(args, ++i, a);
@@ -197,20 +212,28 @@ final class SendCommand {
         }
       }
     });
+    boolean realtime = pace == null ? shape != null || recording != null : pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
       client.newDrawing();
-      for (Stroke s : strokes) {
-        client.send(s);
-      }
-      long deadline = System.nanoTime() + (long) (timeoutS * 1e9);
-      while (client.unsent() > 0 && !client.loginRefused() && System.nanoTime() < deadline) {
-        try {
-          Thread.sleep(10);
-        } catch (InterruptedException stop) {
-          Thread.currentThread().interrupt();
-          break;
+      if (realtime) {
+        // Each stroke when the one before would have finished playing, once the broker has the
+        // one before: the sleeve's queue stays short, as when a person draws.
+        long startNs = System.nanoTime();
+        double offsetMs = 0;
+        for (Stroke s : strokes) {
+          sleepUntil(startNs + (long) (offsetMs * 1e6));
+          client.send(s);
+          if (!awaitBroker(client, timeoutS)) {
+            break;
+          }
+          offsetMs += s.durationMs();
         }
+      } else {
+        for (Stroke s : strokes) {
+          client.send(s);
+        }
+        awaitBroker(client, timeoutS);
       }
       if (client.loginRefused()) {
         err.println("Error: the broker refused the login of '" + username
@@ -228,6 +251,32 @@ final class SendCommand {
           + (legacy ? " as legacy text" : " to sleeve '" + (sleeveId == null ? "sleeve1" : sleeveId)
               + "' (drawing " + client.drawing() + ")") + "; the broker has them.");
       return 0;
+    }
+  }
+
+  /** Waits until the broker has every stroke sent; false when it refused or timed out. */
+  private static boolean awaitBroker(SleeveClient client, double timeoutS) {
+    long deadline = System.nanoTime() + (long) (timeoutS * 1e9);
+    while (client.unsent() > 0 && !client.loginRefused() && System.nanoTime() < deadline) {
+      try {
+        Thread.sleep(5);
+      } catch (InterruptedException stop) {
+        Thread.currentThread().interrupt();
+        return false;
+      }
+    }
+    return client.unsent() == 0;
+  }
+
+  private static void sleepUntil(long dueNs) {
+    long waitNs;
+    while ((waitNs = dueNs - System.nanoTime()) > 0) {
+      try {
+        Thread.sleep(waitNs / 1_000_000, (int) (waitNs % 1_000_000));
+      } catch (InterruptedException stop) {
+        Thread.currentThread().interrupt();
+        return;
+      }
     }
   }
 

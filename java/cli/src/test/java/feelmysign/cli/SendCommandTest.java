@@ -139,6 +139,56 @@ class SendCommandTest {
   }
 
   @Test
+  void twoShapesInARowArePlayedWithoutAStrokeLate() throws Exception {
+    @SuppressWarnings("unchecked")
+    Map<String, Object> doc = (Map<String, Object>) feelmysign.json.PyJson.loads(
+        Files.readString(credentials));
+    @SuppressWarnings("unchecked")
+    Map<String, Object> sender = (Map<String, Object>) doc.get("sender");
+    List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
+    List<String> statuses = new CopyOnWriteArrayList<>();
+    try (SleeveClient listener = SleeveClient.builder((String) doc.get("mqtt_url"))
+        .login((String) sender.get("username"), (String) sender.get("password"))
+        .sleeveId("send-test")
+        .listener(new SleeveClient.Listener() {
+          @Override
+          public void event(SleeveEvent event) {
+            heard.add(event);
+          }
+
+          @Override
+          public void status(String payload) {
+            statuses.add(payload);
+          }
+        }).build()) {
+      listener.connect();
+      long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
+      while (statuses.stream().noneMatch(p -> !p.isEmpty())) {
+        if (System.nanoTime() > deadline) {
+          fail("the listener heard no status from the sleeve");
+        }
+        Thread.sleep(20);
+      }
+      // Sent all at once, the second square would wait 2.4 s behind the first: late.
+      for (int i = 0; i < 2; i++) {
+        Result result = send("--credentials", credentials.toString(), "--shape", "square",
+            "--segments", "4", "--duration-ms", "2400", "--timeout-s", "60");
+        assertEquals(0, result.code(), result.err());
+      }
+      java.util.function.Predicate<SleeveEvent> answered = e -> "played".equals(e.type())
+          || "adjusted".equals(e.type()) || "rejected".equals(e.type());
+      while (heard.stream().filter(answered).count() < 8) {
+        if (System.nanoTime() > deadline) {
+          fail("the sleeve did not answer every stroke: " + heard);
+        }
+        Thread.sleep(20);
+      }
+      assertEquals(List.of(), heard.stream().filter(e -> "rejected".equals(e.type()))
+          .map(SleeveEvent::fields).toList());
+    }
+  }
+
+  @Test
   void aWrongPasswordIsSaidAndNothingSent() {
     Result result = send("--credentials", credentials.toString(), "--password", "wrong",
         "--timeout-s", "60", "0,0,2,0,500");
