@@ -12,10 +12,16 @@ import feelmysign.simplify.Params;
 import feelmysign.simplify.PathSegment;
 import feelmysign.simplify.Recording;
 import feelmysign.simplify.Simplify;
+import feelmysign.client.BrokerUrl;
 import java.io.IOException;
 import java.io.PrintStream;
 import java.io.UncheckedIOException;
+import java.net.ConnectException;
+import java.net.InetSocketAddress;
+import java.net.Socket;
+import java.net.UnknownHostException;
 import java.nio.file.Files;
+import java.nio.file.NoSuchFileException;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
@@ -212,6 +218,8 @@ final class SendCommand {
         }
       }
     });
+    String url = broker == null ? "mqtt://127.0.0.1:1883" : broker;
+    refuseWhenNobodyListens(url);
     boolean realtime = pace == null ? shape != null || recording != null : pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
@@ -236,8 +244,11 @@ final class SendCommand {
         awaitBroker(client, timeoutS);
       }
       if (client.loginRefused()) {
-        err.println("Error: the broker refused the login of '" + username
-            + "': fix --username and --password, or give --credentials; nothing was sent");
+        err.println("Error: the broker refused "
+            + (username == null ? "a login without a user name" : "the login of '" + username + "'")
+            + ": give --username and --password, or --credentials FILE, the credentials.json"
+            + " that 'feelmysign broker' writes in its state directory (its sender's login);"
+            + " nothing was sent");
         return 1;
       }
       if (client.unsent() > 0) {
@@ -321,21 +332,72 @@ final class SendCommand {
     return new Stroke(v[0], v[1], v[2], v[3], v[4]);
   }
 
+  /**
+   * Nothing listening at the broker's address is said at once, as {@code feelmysign send} says
+   * it, rather than after {@code --timeout-s} of retries. Anything else (no answer, a slow
+   * network) is left to the client, which retries until the timeout.
+   */
+  private static void refuseWhenNobodyListens(String url) {
+    BrokerUrl where;
+    try {
+      where = BrokerUrl.parse(url);
+    } catch (RuntimeException bad) {
+      return; // the client says what is wrong with the URL
+    }
+    try (Socket probe = new Socket()) {
+      probe.connect(new InetSocketAddress(where.host(), where.port()), 2000);
+    } catch (ConnectException refused) {
+      throw new IllegalArgumentException("Nothing accepts connections at " + url
+          + " (connection refused): " + START_HINT + ".");
+    } catch (UnknownHostException unknown) {
+      throw new IllegalArgumentException("Cannot find the host '" + where.host() + "' of " + url
+          + ": check the host name in --broker.");
+    } catch (IOException other) {
+      // No answer yet: the client keeps trying until --timeout-s.
+    }
+  }
+
+  private static final String START_HINT =
+      "start one with 'feelmysign broker' or 'make up', or give the right --broker URL";
+
+  /** A credentials.json of 'feelmysign broker', checked as the reference checks it. */
   @SuppressWarnings("unchecked")
   private static Map<String, Object> readCredentials(Path file) {
+    Object document;
     try {
-      Object document = PyJson.loads(Files.readString(file));
-      if (document instanceof Map<?, ?> map) {
-        return (Map<String, Object>) map;
-      }
-    } catch (IOException error) {
-      throw new UncheckedIOException("cannot read the credentials " + file + ": "
-          + error.getMessage(), error);
-    } catch (RuntimeException bad) {
-      // fall through: not JSON
+      document = PyJson.loads(Files.readString(file));
+    } catch (NoSuchFileException absent) {
+      throw new IllegalArgumentException("No credentials file at " + file + "; start the broker"
+          + " first ('feelmysign broker') or pass the file it wrote (STATE_DIR/credentials.json,"
+          + " or STATE_DIR/sleeve-credentials.json for a sleeve).");
+    } catch (IOException | RuntimeException unreadable) {
+      throw badCredentials(file, "it cannot be read as JSON (" + unreadable.getMessage() + ")");
     }
-    throw new IllegalArgumentException("the credentials " + file
-        + " are not the JSON object 'feelmysign broker' writes");
+    if (document instanceof Map<?, ?> map && !map.containsKey("sender")
+        && map.containsKey("sleeve")) {
+      throw badCredentials(file, "it holds only a sleeve's login (a sleeve-credentials.json); to"
+          + " send, use the broker's credentials.json");
+    }
+    if (!(document instanceof Map<?, ?> map
+        && map.get("mqtt_url") instanceof String
+        && map.get("ws_url") instanceof String
+        && map.get("sleeve") instanceof Map<?, ?> sleeve
+        && sleeve.get("id") instanceof String
+        && sleeve.get("username") instanceof String
+        && sleeve.get("password") instanceof String
+        && map.get("sender") instanceof Map<?, ?> sender
+        && sender.get("username") instanceof String
+        && sender.get("password") instanceof String)) {
+      throw badCredentials(file,
+          "it lacks mqtt_url, ws_url, sleeve{id, username, password} or sender{...}");
+    }
+    return (Map<String, Object>) map;
+  }
+
+  private static IllegalArgumentException badCredentials(Path file, String problem) {
+    return new IllegalArgumentException("The credentials file " + file + " is not usable: "
+        + problem + ". Fix it, or delete it to have the broker generate new passwords (every"
+        + " sleeve and sender must then use the new file).");
   }
 
   private static String value(String[] args, int i, String flag) {

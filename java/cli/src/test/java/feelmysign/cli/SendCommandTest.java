@@ -8,6 +8,7 @@ import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
 import java.io.BufferedReader;
 import java.io.ByteArrayOutputStream;
+import java.io.IOException;
 import java.io.InputStreamReader;
 import java.io.PrintStream;
 import java.nio.charset.StandardCharsets;
@@ -194,6 +195,55 @@ class SendCommandTest {
         "--timeout-s", "60", "0,0,2,0,500");
     assertEquals(1, result.code());
     assertTrue(result.err().startsWith("Error: the broker refused the login of"), result.err());
+  }
+
+  @Test
+  void credentialsAndBrokerProblemsAreSaidAsTheReferenceSaysThem(@TempDir Path dir)
+      throws IOException {
+    Path missing = dir.resolve("nowhere.json");
+    Result absent = send("--credentials", missing.toString(), "0,0,2,0,500");
+    assertEquals(1, absent.code());
+    assertEquals("Error: No credentials file at " + missing + "; start the broker first"
+        + " ('feelmysign broker') or pass the file it wrote (STATE_DIR/credentials.json, or"
+        + " STATE_DIR/sleeve-credentials.json for a sleeve).\n", absent.err());
+    Path other = dir.resolve("other.json");
+    Files.writeString(other, "{\"canvas\": {\"width_px\": 10}}");
+    Result notCredentials = send("--credentials", other.toString(), "0,0,2,0,500");
+    assertEquals(1, notCredentials.code());
+    assertTrue(notCredentials.err().startsWith("Error: The credentials file " + other
+        + " is not usable: it lacks mqtt_url, ws_url, sleeve{id, username, password} or"
+        + " sender{...}. Fix it,"), notCredentials.err());
+    Path text = dir.resolve("notes.txt");
+    Files.writeString(text, "not json");
+    Result notJson = send("--credentials", text.toString(), "0,0,2,0,500");
+    assertEquals(1, notJson.code());
+    assertTrue(notJson.err().startsWith("Error: The credentials file " + text
+        + " is not usable: it cannot be read as JSON"), notJson.err());
+    // Nothing listening: said at once, not after --timeout-s.
+    int port;
+    try (java.net.ServerSocket socket = new java.net.ServerSocket(0)) {
+      port = socket.getLocalPort();
+    }
+    Result nobody = send("--broker", "mqtt://127.0.0.1:" + port, "--timeout-s", "600", "0,0,2,0,500");
+    assertEquals(1, nobody.code());
+    assertEquals("Error: Nothing accepts connections at mqtt://127.0.0.1:" + port
+        + " (connection refused): start one with 'feelmysign broker' or 'make up', or give the"
+        + " right --broker URL.\n", nobody.err());
+  }
+
+  @Test
+  void aLoginRefusedWithoutAUserNameSaysSoAndWhereThePasswordIs() {
+    @SuppressWarnings("unchecked")
+    Map<String, Object> doc;
+    try {
+      doc = (Map<String, Object>) feelmysign.json.PyJson.loads(Files.readString(credentials));
+    } catch (IOException error) {
+      throw new java.io.UncheckedIOException(error);
+    }
+    Result result = send("--broker", (String) doc.get("mqtt_url"), "--timeout-s", "60", "0,0,2,0,500");
+    assertEquals(1, result.code());
+    assertTrue(result.err().contains("without a user name") && result.err().contains("credentials.json")
+        && !result.err().contains("null"), result.err());
   }
 
   @Test
