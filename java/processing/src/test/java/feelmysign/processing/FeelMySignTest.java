@@ -187,6 +187,22 @@ class FeelMySignTest {
   }
 
   @Test
+  void thePaperSketchSaysTheAngleSimplifiersDefaults() throws IOException {
+    String sketch = java.nio.file.Files.readString(
+        java.nio.file.Path.of("examples/PaperSketch/PaperSketch.pde"));
+    feelmysign.simplify.Params defaults = feelmysign.simplify.Params.angle();
+    String[][] named = {
+      {"frameMax", "frame_max"}, {"checkFrame", "check_frames"}, {"maxAngleDifDeg", "max_angle_deg"}
+    };
+    for (String[] name : named) {
+      java.util.regex.Matcher said =
+          java.util.regex.Pattern.compile("\\b" + name[0] + " (\\d+(?:\\.\\d+)?)").matcher(sketch);
+      assertTrue(said.find(), name[0] + " is not in the sketch's comment");
+      assertEquals(defaults.number(name[1]), Double.parseDouble(said.group(1)), name[0]);
+    }
+  }
+
+  @Test
   void aParameterOutOfRangeSaysWhichAndTheRange() {
     FeelMySign library = new FeelMySign(new Sketch()).angle();
     IllegalArgumentException error =
