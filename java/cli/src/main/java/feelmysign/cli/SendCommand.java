@@ -292,14 +292,14 @@ final class SendCommand {
   }
 
   private static List<Stroke> fromRecording(Path file, boolean paper, int rows, int columns) {
-    String text;
+    byte[] data;
     try {
-      text = Files.readString(file);
+      data = Files.readAllBytes(file);
     } catch (IOException error) {
       throw new UncheckedIOException("cannot read the recording " + file + ": " + error.getMessage(),
           error);
     }
-    Recording rec = Recording.parse(text, file.toString());
+    Recording rec = Recording.parse(Recording.decode(data, file.toString()), file.toString());
     Params params = (paper ? Params.angle() : Params.window())
         .with("canvas_width_px", rec.widthPx()).with("canvas_height_px", rec.heightPx())
         .with("rows", rec.rows() == null ? rows : rec.rows())
