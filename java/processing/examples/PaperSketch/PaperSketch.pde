@@ -22,7 +22,7 @@ void setup() {
     .broker(BROKER)
     .login(USER, PASSWORD)
     .sleeve(SLEEVE)
-    .angle()             // frameMax 40, checkFrame 10, maxAngleDifDeg 20, ...: B.1
+    .angle()             // B.1's defaults: frameMax 0 (no limit), checkFrame 5, maxAngleDifDeg 20, ...
     .set("screenX", 1920)
     .set("screenY", 1080)
     .legacy()            // "startX,startY,endX,endY,duration" on deviceOne/line

@@ -215,6 +215,14 @@ def main_(outdir: Path) -> None:
     case("text output, angle", [first, "--paper", "--stretch"])
     for name, text in BROKEN.items():
         case(name, [str(save(name, text)), "--json"])
+    # Not UTF-8 (a Latin-1 "é" after a valid start, then a lone continuation byte): the
+    # sentence names the first bad byte's offset.
+    binary = folder / "latin1.json"
+    binary.write_bytes(b'{"canvas": {"width_px": 100, "height_px": 100}, "note": "caf\xe9"}')
+    case("not UTF-8", [str(binary), "--json"])
+    continuation = folder / "continuation.json"
+    continuation.write_bytes(b"\x80{}")
+    case("not UTF-8 at the start", [str(continuation), "--json"])
     case("missing file", [str(folder / "absent.json"), "--json"])
     case("a folder", [str(folder), "--json"])
     for arguments in USAGE_ERRORS:

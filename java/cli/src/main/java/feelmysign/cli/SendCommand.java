@@ -12,10 +12,16 @@ import feelmysign.simplify.Params;
 import feelmysign.simplify.PathSegment;
 import feelmysign.simplify.Recording;
 import feelmysign.simplify.Simplify;
+import feelmysign.client.BrokerUrl;
 import java.io.IOException;
 import java.io.PrintStream;
 import java.io.UncheckedIOException;
+import java.net.ConnectException;
+import java.net.InetSocketAddress;
+import java.net.Socket;
+import java.net.UnknownHostException;
 import java.nio.file.Files;
+import java.nio.file.NoSuchFileException;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
@@ -25,7 +31,10 @@ import java.util.Map;
  * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
  * feelmysign send} does (its flags where they apply): every stroke checked first, one drawing,
  * QoS 1, and the command returns once the broker has acknowledged every stroke (exit 0), or
- * says why not (exit 1). Strokes go out at once (the reference's "burst" pace).
+ * says why not (exit 1). A shape or a recording goes out at the pace it plays ({@code --pace
+ * realtime}: each stroke once the one before would have finished), so a second send right after
+ * it is not queued behind it and refused as late; strokes given one by one go out at once
+ * ({@code --pace burst}), as the reference does.
  */
 final class SendCommand {
   private SendCommand() {}
@@ -34,7 +43,8 @@ final class SendCommand {
   static final String USAGE =
       "usage: " + PROG + " [-h] [--shape {circle,square,triangle,star,heart,line}]\n"
           + "       [--segments N] [--duration-ms D] [--margin M] [--recording FILE [--paper]]\n"
-          + "       [--intensity A] [--legacy] [--legacy-topic TOPIC] [--timeout-s S]\n"
+          + "       [--intensity A] [--legacy] [--legacy-topic TOPIC]\n"
+          + "       [--pace {realtime,burst}] [--timeout-s S]\n"
           + "       [--broker URL] [--id ID] [--username U] [--password P]\n"
           + "       [--credentials FILE] [--ca FILE] [--ca-fingerprint SHA256]\n"
           + "       [--rows R] [--columns C] [--spacing-cm S] [STROKE ...]";
@@ -42,7 +52,10 @@ final class SendCommand {
       + "Send strokes (startX,startY,endX,endY,duration in grid units and ms), a shape of the\n"
       + "study's library (--shape, --segments), or a recording cut by the simplifier\n"
       + "(--recording; the window simplifier, --paper for the paper's angle one) to a sleeve,\n"
-      + "and wait until the broker has them. Broker settings: the option, else\n"
+      + "and wait until the broker has them. --pace realtime (the default for --shape and\n"
+      + "--recording) sends each stroke when the previous one would have finished playing, like\n"
+      + "a person drawing, so the command lasts as long as the drawing plays; --pace burst (the\n"
+      + "default for STROKEs) sends them all at once. Broker settings: the option, else\n"
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
       + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
 
@@ -57,6 +70,7 @@ final class SendCommand {
     boolean legacy = false;
     String legacyTopic = null;
     double timeoutS = 10;
+    String pace = null;
     String broker = null;
     String sleeveId = null;
     String username = null;
@@ -84,6 +98,13 @@ final class SendCommand {
         case "--intensity" -> intensity = number(value(args, ++i, a), a);
         case "--legacy" -> legacy = true;
         case "--legacy-topic" -> legacyTopic = value(args, ++i, a);
+        case "--pace" -> {
+          pace = value(args, ++i, a);
+          if (!pace.equals("realtime") && !pace.equals("burst")) {
+            throw new Main.UsageException(PROG, USAGE, "argument --pace: invalid choice: '" + pace
+                + "' (choose from 'realtime', 'burst')");
+          }
+        }
         case "--timeout-s" -> timeoutS = number(value(args, ++i, a), a);
         case "--broker" -> broker = value(args, ++i, a);
         case "--id" -> sleeveId = value(args, ++i, a);
@@ -197,24 +218,37 @@ final class SendCommand {
         }
       }
     });
+    String url = broker == null ? "mqtt://127.0.0.1:1883" : broker;
+    refuseWhenNobodyListens(url);
+    boolean realtime = pace == null ? shape != null || recording != null : pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
       client.newDrawing();
-      for (Stroke s : strokes) {
-        client.send(s);
-      }
-      long deadline = System.nanoTime() + (long) (timeoutS * 1e9);
-      while (client.unsent() > 0 && !client.loginRefused() && System.nanoTime() < deadline) {
-        try {
-          Thread.sleep(10);
-        } catch (InterruptedException stop) {
-          Thread.currentThread().interrupt();
-          break;
+      if (realtime) {
+        // Each stroke when the one before would have finished playing, once the broker has the
+        // one before: the sleeve's queue stays short, as when a person draws.
+        long startNs = System.nanoTime();
+        double offsetMs = 0;
+        for (Stroke s : strokes) {
+          sleepUntil(startNs + (long) (offsetMs * 1e6));
+          client.send(s);
+          if (!awaitBroker(client, timeoutS)) {
+            break;
+          }
+          offsetMs += s.durationMs();
         }
+      } else {
+        for (Stroke s : strokes) {
+          client.send(s);
+        }
+        awaitBroker(client, timeoutS);
       }
       if (client.loginRefused()) {
-        err.println("Error: the broker refused the login of '" + username
-            + "': fix --username and --password, or give --credentials; nothing was sent");
+        err.println("Error: the broker refused "
+            + (username == null ? "a login without a user name" : "the login of '" + username + "'")
+            + ": give --username and --password, or --credentials FILE, the credentials.json"
+            + " that 'feelmysign broker' writes in its state directory (its sender's login);"
+            + " nothing was sent");
         return 1;
       }
       if (client.unsent() > 0) {
@@ -231,15 +265,41 @@ final class SendCommand {
     }
   }
 
+  /** Waits until the broker has every stroke sent; false when it refused or timed out. */
+  private static boolean awaitBroker(SleeveClient client, double timeoutS) {
+    long deadline = System.nanoTime() + (long) (timeoutS * 1e9);
+    while (client.unsent() > 0 && !client.loginRefused() && System.nanoTime() < deadline) {
+      try {
+        Thread.sleep(5);
+      } catch (InterruptedException stop) {
+        Thread.currentThread().interrupt();
+        return false;
+      }
+    }
+    return client.unsent() == 0;
+  }
+
+  private static void sleepUntil(long dueNs) {
+    long waitNs;
+    while ((waitNs = dueNs - System.nanoTime()) > 0) {
+      try {
+        Thread.sleep(waitNs / 1_000_000, (int) (waitNs % 1_000_000));
+      } catch (InterruptedException stop) {
+        Thread.currentThread().interrupt();
+        return;
+      }
+    }
+  }
+
   private static List<Stroke> fromRecording(Path file, boolean paper, int rows, int columns) {
-    String text;
+    byte[] data;
     try {
-      text = Files.readString(file);
+      data = Files.readAllBytes(file);
     } catch (IOException error) {
       throw new UncheckedIOException("cannot read the recording " + file + ": " + error.getMessage(),
           error);
     }
-    Recording rec = Recording.parse(text, file.toString());
+    Recording rec = Recording.parse(Recording.decode(data, file.toString()), file.toString());
     Params params = (paper ? Params.angle() : Params.window())
         .with("canvas_width_px", rec.widthPx()).with("canvas_height_px", rec.heightPx())
         .with("rows", rec.rows() == null ? rows : rec.rows())
@@ -272,21 +332,72 @@ final class SendCommand {
     return new Stroke(v[0], v[1], v[2], v[3], v[4]);
   }
 
+  /**
+   * Nothing listening at the broker's address is said at once, as {@code feelmysign send} says
+   * it, rather than after {@code --timeout-s} of retries. Anything else (no answer, a slow
+   * network) is left to the client, which retries until the timeout.
+   */
+  private static void refuseWhenNobodyListens(String url) {
+    BrokerUrl where;
+    try {
+      where = BrokerUrl.parse(url);
+    } catch (RuntimeException bad) {
+      return; // the client says what is wrong with the URL
+    }
+    try (Socket probe = new Socket()) {
+      probe.connect(new InetSocketAddress(where.host(), where.port()), 2000);
+    } catch (ConnectException refused) {
+      throw new IllegalArgumentException("Nothing accepts connections at " + url
+          + " (connection refused): " + START_HINT + ".");
+    } catch (UnknownHostException unknown) {
+      throw new IllegalArgumentException("Cannot find the host '" + where.host() + "' of " + url
+          + ": check the host name in --broker.");
+    } catch (IOException other) {
+      // No answer yet: the client keeps trying until --timeout-s.
+    }
+  }
+
+  private static final String START_HINT =
+      "start one with 'feelmysign broker' or 'make up', or give the right --broker URL";
+
+  /** A credentials.json of 'feelmysign broker', checked as the reference checks it. */
   @SuppressWarnings("unchecked")
   private static Map<String, Object> readCredentials(Path file) {
+    Object document;
     try {
-      Object document = PyJson.loads(Files.readString(file));
-      if (document instanceof Map<?, ?> map) {
-        return (Map<String, Object>) map;
-      }
-    } catch (IOException error) {
-      throw new UncheckedIOException("cannot read the credentials " + file + ": "
-          + error.getMessage(), error);
-    } catch (RuntimeException bad) {
-      // fall through: not JSON
+      document = PyJson.loads(Files.readString(file));
+    } catch (NoSuchFileException absent) {
+      throw new IllegalArgumentException("No credentials file at " + file + "; start the broker"
+          + " first ('feelmysign broker') or pass the file it wrote (STATE_DIR/credentials.json,"
+          + " or STATE_DIR/sleeve-credentials.json for a sleeve).");
+    } catch (IOException | RuntimeException unreadable) {
+      throw badCredentials(file, "it cannot be read as JSON (" + unreadable.getMessage() + ")");
     }
-    throw new IllegalArgumentException("the credentials " + file
-        + " are not the JSON object 'feelmysign broker' writes");
+    if (document instanceof Map<?, ?> map && !map.containsKey("sender")
+        && map.containsKey("sleeve")) {
+      throw badCredentials(file, "it holds only a sleeve's login (a sleeve-credentials.json); to"
+          + " send, use the broker's credentials.json");
+    }
+    if (!(document instanceof Map<?, ?> map
+        && map.get("mqtt_url") instanceof String
+        && map.get("ws_url") instanceof String
+        && map.get("sleeve") instanceof Map<?, ?> sleeve
+        && sleeve.get("id") instanceof String
+        && sleeve.get("username") instanceof String
+        && sleeve.get("password") instanceof String
+        && map.get("sender") instanceof Map<?, ?> sender
+        && sender.get("username") instanceof String
+        && sender.get("password") instanceof String)) {
+      throw badCredentials(file,
+          "it lacks mqtt_url, ws_url, sleeve{id, username, password} or sender{...}");
+    }
+    return (Map<String, Object>) map;
+  }
+
+  private static IllegalArgumentException badCredentials(Path file, String problem) {
+    return new IllegalArgumentException("The credentials file " + file + " is not usable: "
+        + problem + ". Fix it, or delete it to have the broker generate new passwords (every"
+        + " sleeve and sender must then use the new file).");
   }
 
   private static String value(String[] args, int i, String flag) {

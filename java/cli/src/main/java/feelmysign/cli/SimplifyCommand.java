@@ -14,10 +14,6 @@ import java.io.IOException;
 import java.io.PrintStream;
 import java.math.BigDecimal;
 import java.math.RoundingMode;
-import java.nio.ByteBuffer;
-import java.nio.charset.CharacterCodingException;
-import java.nio.charset.CodingErrorAction;
-import java.nio.charset.StandardCharsets;
 import java.nio.file.AccessDeniedException;
 import java.nio.file.Files;
 import java.nio.file.LinkOption;
@@ -312,20 +308,7 @@ final class SimplifyCommand {
     } catch (IOException error) {
       throw new RecordingException("cannot read recording " + path + ": " + error.getMessage());
     }
-    String text;
-    try {
-      text =
-          StandardCharsets.UTF_8
-              .newDecoder()
-              .onMalformedInput(CodingErrorAction.REPORT)
-              .onUnmappableCharacter(CodingErrorAction.REPORT)
-              .decode(ByteBuffer.wrap(data))
-              .toString();
-    } catch (CharacterCodingException error) {
-      throw new RecordingException(
-          path + ": not UTF-8 text; save the recording as UTF-8 JSON");
-    }
-    return Recording.parse(text, path);
+    return Recording.parse(Recording.decode(data, path), path);
   }
 
   private static String fileKind(Path file) {

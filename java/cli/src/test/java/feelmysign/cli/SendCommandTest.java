@@ -8,6 +8,7 @@ import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
 import java.io.BufferedReader;
 import java.io.ByteArrayOutputStream;
+import java.io.IOException;
 import java.io.InputStreamReader;
 import java.io.PrintStream;
 import java.nio.charset.StandardCharsets;
@@ -139,11 +140,110 @@ class SendCommandTest {
   }
 
   @Test
+  void twoShapesInARowArePlayedWithoutAStrokeLate() throws Exception {
+    @SuppressWarnings("unchecked")
+    Map<String, Object> doc = (Map<String, Object>) feelmysign.json.PyJson.loads(
+        Files.readString(credentials));
+    @SuppressWarnings("unchecked")
+    Map<String, Object> sender = (Map<String, Object>) doc.get("sender");
+    List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
+    List<String> statuses = new CopyOnWriteArrayList<>();
+    try (SleeveClient listener = SleeveClient.builder((String) doc.get("mqtt_url"))
+        .login((String) sender.get("username"), (String) sender.get("password"))
+        .sleeveId("send-test")
+        .listener(new SleeveClient.Listener() {
+          @Override
+          public void event(SleeveEvent event) {
+            heard.add(event);
+          }
+
+          @Override
+          public void status(String payload) {
+            statuses.add(payload);
+          }
+        }).build()) {
+      listener.connect();
+      long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
+      while (statuses.stream().noneMatch(p -> !p.isEmpty())) {
+        if (System.nanoTime() > deadline) {
+          fail("the listener heard no status from the sleeve");
+        }
+        Thread.sleep(20);
+      }
+      // Sent all at once, the second square would wait 2.4 s behind the first: late.
+      for (int i = 0; i < 2; i++) {
+        Result result = send("--credentials", credentials.toString(), "--shape", "square",
+            "--segments", "4", "--duration-ms", "2400", "--timeout-s", "60");
+        assertEquals(0, result.code(), result.err());
+      }
+      java.util.function.Predicate<SleeveEvent> answered = e -> "played".equals(e.type())
+          || "adjusted".equals(e.type()) || "rejected".equals(e.type());
+      while (heard.stream().filter(answered).count() < 8) {
+        if (System.nanoTime() > deadline) {
+          fail("the sleeve did not answer every stroke: " + heard);
+        }
+        Thread.sleep(20);
+      }
+      assertEquals(List.of(), heard.stream().filter(e -> "rejected".equals(e.type()))
+          .map(SleeveEvent::fields).toList());
+    }
+  }
+
+  @Test
   void aWrongPasswordIsSaidAndNothingSent() {
     Result result = send("--credentials", credentials.toString(), "--password", "wrong",
         "--timeout-s", "60", "0,0,2,0,500");
     assertEquals(1, result.code());
     assertTrue(result.err().startsWith("Error: the broker refused the login of"), result.err());
+  }
+
+  @Test
+  void credentialsAndBrokerProblemsAreSaidAsTheReferenceSaysThem(@TempDir Path dir)
+      throws IOException {
+    Path missing = dir.resolve("nowhere.json");
+    Result absent = send("--credentials", missing.toString(), "0,0,2,0,500");
+    assertEquals(1, absent.code());
+    assertEquals("Error: No credentials file at " + missing + "; start the broker first"
+        + " ('feelmysign broker') or pass the file it wrote (STATE_DIR/credentials.json, or"
+        + " STATE_DIR/sleeve-credentials.json for a sleeve).\n", absent.err());
+    Path other = dir.resolve("other.json");
+    Files.writeString(other, "{\"canvas\": {\"width_px\": 10}}");
+    Result notCredentials = send("--credentials", other.toString(), "0,0,2,0,500");
+    assertEquals(1, notCredentials.code());
+    assertTrue(notCredentials.err().startsWith("Error: The credentials file " + other
+        + " is not usable: it lacks mqtt_url, ws_url, sleeve{id, username, password} or"
+        + " sender{...}. Fix it,"), notCredentials.err());
+    Path text = dir.resolve("notes.txt");
+    Files.writeString(text, "not json");
+    Result notJson = send("--credentials", text.toString(), "0,0,2,0,500");
+    assertEquals(1, notJson.code());
+    assertTrue(notJson.err().startsWith("Error: The credentials file " + text
+        + " is not usable: it cannot be read as JSON"), notJson.err());
+    // Nothing listening: said at once, not after --timeout-s.
+    int port;
+    try (java.net.ServerSocket socket = new java.net.ServerSocket(0)) {
+      port = socket.getLocalPort();
+    }
+    Result nobody = send("--broker", "mqtt://127.0.0.1:" + port, "--timeout-s", "600", "0,0,2,0,500");
+    assertEquals(1, nobody.code());
+    assertEquals("Error: Nothing accepts connections at mqtt://127.0.0.1:" + port
+        + " (connection refused): start one with 'feelmysign broker' or 'make up', or give the"
+        + " right --broker URL.\n", nobody.err());
+  }
+
+  @Test
+  void aLoginRefusedWithoutAUserNameSaysSoAndWhereThePasswordIs() {
+    @SuppressWarnings("unchecked")
+    Map<String, Object> doc;
+    try {
+      doc = (Map<String, Object>) feelmysign.json.PyJson.loads(Files.readString(credentials));
+    } catch (IOException error) {
+      throw new java.io.UncheckedIOException(error);
+    }
+    Result result = send("--broker", (String) doc.get("mqtt_url"), "--timeout-s", "60", "0,0,2,0,500");
+    assertEquals(1, result.code());
+    assertTrue(result.err().contains("without a user name") && result.err().contains("credentials.json")
+        && !result.err().contains("null"), result.err());
   }
 
   @Test

@@ -338,11 +338,12 @@ public final class SleeveClient implements AutoCloseable {
             State.OFFLINE,
             "The broker at "
                 + url
-                + " refused the login of '"
-                + username
-                + "' ("
+                + (username == null
+                    ? " refused a login without a user name ("
+                    : " refused the login of '" + username + "' (")
                 + code
-                + "). Fix the username or password.");
+                + "). Give the sender's username and password from the credentials.json that"
+                + " 'feelmysign broker' writes in its state directory.");
         return;
       }
     }

@@ -313,4 +313,21 @@ class RoundTripTest {
       assertTrue(!client.connected());
     }
   }
+
+  @Test
+  void aLoginWithoutAUserNameIsSaidSoWithWhereTheLoginIs() throws InterruptedException {
+    Heard heard = new Heard();
+    try (SleeveClient client =
+        SleeveClient.builder(mqttUrl).sleeveId(SLEEVE).listener(heard).build()) {
+      client.connect();
+      heard.next(SleeveClient.State.class, s -> s == SleeveClient.State.OFFLINE, "offline");
+      assertTrue(client.loginRefused());
+      synchronized (heard.brokerSaid) {
+        assertTrue(heard.brokerSaid.stream().anyMatch(s -> s.contains("refused a login without a"
+            + " user name") && s.contains("credentials.json")), heard.brokerSaid.toString());
+        assertTrue(heard.brokerSaid.stream().noneMatch(s -> s.contains("'null'")),
+            heard.brokerSaid.toString());
+      }
+    }
+  }
 }

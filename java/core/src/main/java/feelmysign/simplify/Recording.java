@@ -32,6 +32,28 @@ public record Recording(
     Integer columns,
     Map<String, Object> simplifier) {
 
+  /**
+   * A recording file's bytes as text: UTF-8, or a RecordingException naming the offset of the
+   * first byte that is not (as the reference's {@code load_recording} says it).
+   */
+  public static String decode(byte[] data, String source) {
+    var decoder = java.nio.charset.StandardCharsets.UTF_8.newDecoder()
+        .onMalformedInput(java.nio.charset.CodingErrorAction.REPORT)
+        .onUnmappableCharacter(java.nio.charset.CodingErrorAction.REPORT);
+    java.nio.ByteBuffer in = java.nio.ByteBuffer.wrap(data);
+    java.nio.CharBuffer out = java.nio.CharBuffer.allocate(data.length);
+    java.nio.charset.CoderResult result = decoder.decode(in, out, true);
+    if (!result.isError()) {
+      result = decoder.flush(out);
+    }
+    if (result.isError()) {
+      // The decoder stops at the first byte of the malformed sequence, as Python's start.
+      throw new RecordingException(source + ": not UTF-8 text (byte " + in.position()
+          + "); a recording is JSON saved as UTF-8");
+    }
+    return out.flip().toString();
+  }
+
   /** Read a recording's text; {@code source} names it in messages. */
   public static Recording parse(String text, String source) {
     Object data;

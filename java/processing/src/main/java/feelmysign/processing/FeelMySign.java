@@ -370,29 +370,33 @@ public class FeelMySign {
   }
 
   /**
-   * Draws what the sleeve played, from its events: each played or adjusted stroke of the
-   * current drawing (the sleeve's own account, not what was sent).
+   * Draws what the sleeve played: each stroke sent (of those kept for {@link #drawSent}) whose
+   * {@code played} or {@code adjusted} event arrived. The sleeve's events name a stroke by its
+   * drawing and seq only, so the geometry is the library's record of what it sent.
    */
   public void drawPlayed() {
+    java.util.Map<String, Stroke> byId = new java.util.HashMap<>();
+    for (Stroke s : sent()) {
+      if (s.drawing() != null && s.seq() != null) {
+        byId.put(strokeId(s.drawing(), s.seq()), s);
+      }
+    }
     for (SleeveEvent e : events()) {
-      if (!(SleeveEvent.PLAYED.equals(e.type()) || SleeveEvent.ADJUSTED.equals(e.type()))) {
+      if (!(SleeveEvent.PLAYED.equals(e.type()) || SleeveEvent.ADJUSTED.equals(e.type()))
+          || e.drawing() == null
+          || e.seq() == null) {
         continue;
       }
-      Object stroke = e.fields().get("stroke");
-      if (stroke instanceof java.util.Map<?, ?> m
-          && m.get("start") instanceof List<?> start
-          && m.get("end") instanceof List<?> end
-          && start.size() == 2
-          && end.size() == 2) {
-        parent.line(
-            canvasX(number(start.get(0))), canvasY(number(start.get(1))),
-            canvasX(number(end.get(0))), canvasY(number(end.get(1))));
+      // remove: a stroke is drawn once even if its event came twice.
+      Stroke s = byId.remove(strokeId(e.drawing(), e.seq()));
+      if (s != null) {
+        parent.line(canvasX(s.startX()), canvasY(s.startY()), canvasX(s.endX()), canvasY(s.endY()));
       }
     }
   }
 
-  private static double number(Object value) {
-    return value instanceof Number n ? n.doubleValue() : Double.NaN;
+  private static String strokeId(String drawing, long seq) {
+    return seq + "/" + drawing;
   }
 
   // ---- the hooks Processing calls (public, for registerMethod) ----

@@ -141,6 +141,67 @@ class FeelMySignTest {
     }
   }
 
+  /** A sketch that records the lines it is asked to draw instead of drawing them. */
+  public static class LineSketch extends PApplet {
+    final List<float[]> lines = new ArrayList<>();
+
+    @Override
+    public void line(float x1, float y1, float x2, float y2) {
+      lines.add(new float[] {x1, y1, x2, y2});
+    }
+  }
+
+  @Test
+  void drawPlayedDrawsTheSentStrokesWhosePlayedEventArrived() throws Exception {
+    LineSketch sketch = new LineSketch();
+    sketch.width = 400;
+    sketch.height = 300;
+    FeelMySign library = new FeelMySign(sketch)
+        .broker("mqtt://127.0.0.1:" + unusedPort()).set("stretch", true).start();
+    try {
+      var first = library.send(new feelmysign.protocol.Stroke(0, 0, 3, 0, 500));
+      var second = library.send(new feelmysign.protocol.Stroke(3, 0, 3, 2, 500));
+      var third = library.send(new feelmysign.protocol.Stroke(3, 2, 0, 2, 500));
+      assertTrue(first.drawing() != null && first.seq() != null, "sent without drawing or seq");
+      // The sleeve's events carry no geometry: only the drawing and seq of what it played.
+      library.relay().event(SleeveEvent.parse("{\"type\": \"played\", \"drawing\": \""
+          + first.drawing() + "\", \"seq\": " + first.seq() + "}"));
+      library.relay().event(SleeveEvent.parse("{\"type\": \"adjusted\", \"drawing\": \""
+          + third.drawing() + "\", \"seq\": " + third.seq() + ", \"reason\": \"too_fast\"}"));
+      library.relay().event(SleeveEvent.parse("{\"type\": \"rejected\", \"drawing\": \""
+          + second.drawing() + "\", \"seq\": " + second.seq() + ", \"reason\": \"late\"}"));
+      library.relay().event(SleeveEvent.parse(
+          "{\"type\": \"played\", \"drawing\": \"another\", \"seq\": " + second.seq() + "}"));
+      library.draw();
+      sketch.lines.clear();
+      library.drawPlayed();
+      List<List<Float>> drawn = new ArrayList<>();
+      for (float[] l : sketch.lines) {
+        drawn.add(List.of(l[0], l[1], l[2], l[3]));
+      }
+      // Stretched: column 3 of 4 is x 400, row 2 of 3 is y 300.
+      assertEquals(List.of(List.of(0f, 0f, 400f, 0f), List.of(400f, 300f, 0f, 300f)), drawn);
+    } finally {
+      library.dispose();
+    }
+  }
+
+  @Test
+  void thePaperSketchSaysTheAngleSimplifiersDefaults() throws IOException {
+    String sketch = java.nio.file.Files.readString(
+        java.nio.file.Path.of("examples/PaperSketch/PaperSketch.pde"));
+    feelmysign.simplify.Params defaults = feelmysign.simplify.Params.angle();
+    String[][] named = {
+      {"frameMax", "frame_max"}, {"checkFrame", "check_frames"}, {"maxAngleDifDeg", "max_angle_deg"}
+    };
+    for (String[] name : named) {
+      java.util.regex.Matcher said =
+          java.util.regex.Pattern.compile("\\b" + name[0] + " (\\d+(?:\\.\\d+)?)").matcher(sketch);
+      assertTrue(said.find(), name[0] + " is not in the sketch's comment");
+      assertEquals(defaults.number(name[1]), Double.parseDouble(said.group(1)), name[0]);
+    }
+  }
+
   @Test
   void aParameterOutOfRangeSaysWhichAndTheRange() {
     FeelMySign library = new FeelMySign(new Sketch()).angle();
