@@ -251,7 +251,9 @@ java-test: $(JAVA_STAMP) $(STAMP) system
 
 # The Java simplifiers' throughput on the LASA frames of the web bench, beside a baseline
 # measured in the same JVM run.
-java-bench: java-build $(LASA_FRAMES)
+# Only the command line's jar is built for it (not the Processing library's zip and javadoc).
+java-bench: $(JAVA_STAMP) $(LASA_FRAMES)
+	$(MVN) -DskipTests -pl cli -am package
 	java -cp $(JAVA_DIR)/cli/target/feelmysign-java.jar feelmysign.cli.Bench $(LASA_FRAMES)
 
 # The Processing library for Processing 4's Contribution Manager (docs/processing.md):

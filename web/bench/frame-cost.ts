@@ -39,7 +39,7 @@ async function unusedPort(): Promise<number> {
 }
 
 /** Measured drawings per phase; the least scripting time is kept (other work on the machine only adds). */
-const REPEATS = 3;
+const REPEATS = 2;
 /** No further repeat once a phase has taken this long (the old page took seconds per frame). */
 const PHASE_LIMIT_MS = 20_000;
 

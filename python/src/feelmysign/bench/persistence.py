@@ -27,7 +27,7 @@ from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic
 
 STROKES = 300
-ROUNDS = 5
+ROUNDS = 3
 WAIT_S = 10.0
 
 
