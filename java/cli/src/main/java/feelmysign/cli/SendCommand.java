@@ -101,7 +101,7 @@ final class SendCommand {
         case "--pace" -> {
           pace = value(args, ++i, a);
           if (!pace.equals("realtime") && !pace.equals("burst")) {
-            throw new Main.UsageException(PROG, USAGE, "argument --pace: invalid choice: '" + pace
+            throw new Main.UsageException(PROG, "argument --pace: invalid choice: '" + pace
                 + "' (choose from 'realtime', 'burst')");
           }
         }
@@ -118,7 +118,7 @@ final class SendCommand {
         case "--spacing-cm" -> spacingCm = number(value(args, ++i, a), a);
         default -> {
           if (a.startsWith("--")) {
-            throw new Main.UsageException(PROG, USAGE, "unrecognized arguments: " + a);
+            throw new Main.UsageException(PROG, "unrecognized arguments: " + a);
           }
           strokeArgs.add(a);
         }
@@ -127,7 +127,7 @@ final class SendCommand {
     int given = (shape != null ? 1 : 0) + (recording != null ? 1 : 0)
         + (strokeArgs.isEmpty() ? 0 : 1);
     if (given != 1) {
-      throw new Main.UsageException(PROG, USAGE,
+      throw new Main.UsageException(PROG,
           "give one of: STROKE ..., --shape NAME or --recording FILE");
     }
     if (intensity != null && !(intensity >= 0 && intensity <= 1)) {
@@ -402,7 +402,7 @@ final class SendCommand {
 
   private static String value(String[] args, int i, String flag) {
     if (i >= args.length) {
-      throw new Main.UsageException(PROG, USAGE, "argument " + flag + ": expected one argument");
+      throw new Main.UsageException(PROG, "argument " + flag + ": expected one argument");
     }
     return args[i];
   }
@@ -411,7 +411,7 @@ final class SendCommand {
     try {
       return Double.parseDouble(text);
     } catch (NumberFormatException e) {
-      throw new Main.UsageException(PROG, USAGE,
+      throw new Main.UsageException(PROG,
           "argument " + flag + ": invalid float value: '" + text + "'");
     }
   }
@@ -420,7 +420,7 @@ final class SendCommand {
     try {
       return Long.parseLong(text);
     } catch (NumberFormatException e) {
-      throw new Main.UsageException(PROG, USAGE,
+      throw new Main.UsageException(PROG,
           "argument " + flag + ": invalid int value: '" + text + "'");
     }
   }
