@@ -285,28 +285,21 @@ final class SimplifyCommand {
         }
         return value;
       }
-      case INT -> {
-        Long number = PythonNumbers.parseInt(value);
-        if (number == null) {
-          throw usage(
-              "argument "
-                  + option.action()
-                  + ": "
-                  + PyRepr.of(value)
-                  + " is not a whole decimal number; write it with the digits 0-9, e.g. 3");
-        }
-        return number;
-      }
       default -> {
-        Double number = PythonNumbers.parseFloat(value);
+        boolean whole = option.kind() == Kind.INT;
+        // Not a conditional expression: it would make a Long a Double (numeric promotion).
+        Object number;
+        if (whole) {
+          number = PythonNumbers.parseInt(value);
+        } else {
+          number = PythonNumbers.parseFloat(value);
+        }
         if (number == null) {
-          throw usage(
-              "argument "
-                  + option.action()
-                  + ": "
-                  + PyRepr.of(value)
-                  + " is not a decimal number; write it with the digits 0-9, e.g. 0.25, 12 or "
-                  + "2e-3");
+          String wanted =
+              whole
+                  ? "a whole decimal number; write it with the digits 0-9, e.g. 3"
+                  : "a decimal number; write it with the digits 0-9, e.g. 0.25, 12 or 2e-3";
+          throw usage("argument " + option.action() + ": " + PyRepr.of(value) + " is not " + wanted);
         }
         return number;
       }

@@ -6,6 +6,7 @@ import static org.junit.jupiter.api.Assertions.fail;
 
 import com.fasterxml.jackson.databind.JsonNode;
 import com.fasterxml.jackson.databind.ObjectMapper;
+import feelmysign.testing.LiveSleeve;
 import java.io.ByteArrayOutputStream;
 import java.io.IOException;
 import java.io.PrintStream;
@@ -29,18 +30,9 @@ import org.junit.jupiter.api.io.TempDir;
 class SimplifyAgainstReferenceTest {
   @TempDir Path work;
 
-  private static Path repository() {
-    for (Path dir = Path.of("").toAbsolutePath(); dir != null; dir = dir.getParent()) {
-      if (Files.isDirectory(dir.resolve("testdata")) && Files.isDirectory(dir.resolve("python"))) {
-        return dir;
-      }
-    }
-    throw new IllegalStateException("not inside the feelmysign repository");
-  }
-
   @Test
   void printsWhatTheReferencePrints() throws IOException, InterruptedException {
-    Path repo = repository();
+    Path repo = LiveSleeve.repository();
     Path python = repo.resolve(".venv/bin/python");
     if (!Files.isExecutable(python)) {
       fail(python + " is missing: run 'make .venv/.installed-stamp' (make java-test does)");
