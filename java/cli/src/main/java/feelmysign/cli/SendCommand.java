@@ -13,6 +13,7 @@ import feelmysign.simplify.PathSegment;
 import feelmysign.simplify.Recording;
 import feelmysign.simplify.Simplify;
 import feelmysign.client.BrokerUrl;
+import feelmysign.client.ConnectFailure;
 import java.io.IOException;
 import java.io.PrintStream;
 import java.io.UncheckedIOException;
@@ -344,19 +345,15 @@ final class SendCommand {
     try (Socket probe = new Socket()) {
       probe.connect(new InetSocketAddress(where.host(), where.port()), 2000);
     } catch (ConnectException refused) {
-      throw new IllegalArgumentException("Nothing accepts connections at " + url
-          + " (connection refused): " + START_HINT + ".");
+      throw new IllegalArgumentException(ConnectFailure.refused(url, "--broker URL"));
     } catch (UnknownHostException unknown) {
-      throw new IllegalArgumentException("Cannot find the host '" + where.host() + "' of " + url
-          + ": check the host name in --broker.");
+      throw new IllegalArgumentException(
+          ConnectFailure.unknownHost(url, where.host(), "--broker"));
     } catch (IOException other) {
       // No answer yet: the client keeps trying until --timeout-s.
     }
   }
 
-
-  private static final String START_HINT =
-      "start one with 'feelmysign broker' or 'make up', or give the right --broker URL";
 
   /** A credentials.json of 'feelmysign broker', checked as the reference checks it. */
   @SuppressWarnings("unchecked")
