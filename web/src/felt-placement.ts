@@ -14,8 +14,8 @@
  *
  * Pure: no DOM, no clock.
  */
-import type { FeltStroke, PlacedStroke } from "./felt";
-import { EMPTY_TAIL_MS, queueStartMs } from "./sleeve-queue";
+import { feltEndMs, playedMs, type FeltStroke, type PlacedStroke } from "./felt";
+import { QueueTail } from "./sleeve-queue";
 
 export class FeltPlacement {
   /** Shifted strokes (arrival relative to the first stroke's), in seq order. */
@@ -23,6 +23,8 @@ export class FeltPlacement {
   readonly #placed: PlacedStroke[] = [];
   /** The largest end (start + played) of strokes 0..i: what is over by then. */
   readonly #prefixEndMs: number[] = [];
+  /** The sleeve's queue tail after stroke i: where stroke i + 1 is placed from. */
+  readonly #tailMs: number[] = [];
   readonly #indexBySeq = new Map<number, number>();
   /** seq -> start reported by the sleeve, on the sleeve's clock. */
   readonly #startedAt = new Map<number, number>();
@@ -165,21 +167,16 @@ export class FeltPlacement {
   /** The first reported stroke and the sleeve's clock offset against the page's estimate of it. */
   #reanchor(): void {
     this.#anchor = null;
-    let tail = EMPTY_TAIL_MS;
+    const queue = new QueueTail();
     for (let index = 0; index < this.#strokes.length; index++) {
       const stroke = this.#strokes[index]!;
-      const estimateMs = queueStartMs(stroke.arrives_ms, tail);
+      const estimateMs = queue.place(stroke.arrives_ms, playedMs(stroke, this.#cut));
       const reported = this.#startedAt.get(stroke.seq);
       if (reported !== undefined) {
         this.#anchor = { index, offsetMs: reported - estimateMs };
         return;
       }
-      tail = estimateMs + this.#playedMs(stroke);
     }
-  }
-
-  #playedMs(stroke: FeltStroke): number {
-    return Math.min(stroke.duration_ms, Math.max(0, this.#cut.get(stroke.seq) ?? stroke.duration_ms));
   }
 
   /**
@@ -190,11 +187,11 @@ export class FeltPlacement {
     if (all) {
       this.#placed.length = 0;
       this.#prefixEndMs.length = 0;
+      this.#tailMs.length = 0;
       this.#reported = 0;
       this.#descents = 0;
     }
-    const previous = this.#placed[from - 1];
-    let tail = previous === undefined ? EMPTY_TAIL_MS : previous.start_ms + previous.played_ms;
+    const queue = new QueueTail(this.#tailMs[from - 1]);
     let dirtyMs = Number.POSITIVE_INFINITY;
     const offset = this.#anchor?.offsetMs;
     let stop = this.#strokes.length;
@@ -202,9 +199,8 @@ export class FeltPlacement {
       const stroke = this.#strokes[i]!;
       const reportedAt = offset === undefined ? undefined : this.#startedAt.get(stroke.seq);
       const known = reportedAt === undefined ? undefined : reportedAt - offset!;
-      const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
-      const played_ms = this.#playedMs(stroke);
-      tail = start_ms + played_ms;
+      const played_ms = playedMs(stroke, this.#cut);
+      const start_ms = queue.place(stroke.arrives_ms, played_ms, known);
       const old = this.#placed[i];
       const placed: PlacedStroke = { ...stroke, start_ms, reported: known !== undefined, played_ms };
       if (
@@ -227,12 +223,16 @@ export class FeltPlacement {
       this.#descents += this.#descends(i) + this.#descends(i + 1);
       if (placed.reported) this.#reported++;
       dirtyMs = Math.min(dirtyMs, start_ms);
-      this.#prefixEndMs[i] = Math.max(this.#prefixEndMs[i - 1] ?? Number.NEGATIVE_INFINITY, tail);
+      this.#tailMs[i] = queue.tailMs;
+      this.#prefixEndMs[i] = Math.max(
+        this.#prefixEndMs[i - 1] ?? Number.NEGATIVE_INFINITY,
+        feltEndMs(placed),
+      );
     }
     // Strokes kept after the last re-placed one: their prefix ends follow, until one stays.
     for (let i = Math.max(stop, 1); i < this.#placed.length; i++) {
       const placed = this.#placed[i]!;
-      const value = Math.max(this.#prefixEndMs[i - 1]!, placed.start_ms + placed.played_ms);
+      const value = Math.max(this.#prefixEndMs[i - 1]!, feltEndMs(placed));
       if (value === this.#prefixEndMs[i]) break;
       this.#prefixEndMs[i] = value;
     }

@@ -8,12 +8,12 @@
  * by the apparent-motion model): it shows where and when the touch is.
  *
  * Times: where the sleeve told when it played a stroke, that time; otherwise
- * the sleeve's own rule (docs/protocol.md, "Playback"; `queueStartMs` in
+ * the sleeve's own rule (docs/protocol.md, "Playback"; `QueueTail` in
  * sleeve-queue.ts, pinned by testdata/queue): a stroke starts when it arrives,
  * or when the one before it ends if that is later.
  */
 import type { Point } from "./simplify/segment";
-import { EMPTY_TAIL_MS, queueStartMs } from "./sleeve-queue";
+import { QueueTail } from "./sleeve-queue";
 
 export interface FeltStroke {
   readonly seq: number;
@@ -57,15 +57,24 @@ export function placeStrokes(
   cut: ReadonlyMap<number, number> = new Map(),
 ): PlacedStroke[] {
   const placed: PlacedStroke[] = [];
-  let tail = EMPTY_TAIL_MS;
+  const queue = new QueueTail();
   for (const stroke of [...strokes].sort((a, b) => a.seq - b.seq)) {
     const known = reported.get(stroke.seq);
-    const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
-    const played_ms = Math.min(stroke.duration_ms, Math.max(0, cut.get(stroke.seq) ?? stroke.duration_ms));
-    tail = start_ms + played_ms;
+    const played_ms = playedMs(stroke, cut);
+    const start_ms = queue.place(stroke.arrives_ms, played_ms, known);
     placed.push({ ...stroke, start_ms, reported: known !== undefined, played_ms });
   }
   return placed;
+}
+
+/** How long `stroke` plays: whole, or up to where a cancel cut it (`cut`: seq -> ms into it). */
+export function playedMs(stroke: FeltStroke, cut: ReadonlyMap<number, number>): number {
+  return Math.min(stroke.duration_ms, Math.max(0, cut.get(stroke.seq) ?? stroke.duration_ms));
+}
+
+/** When the touch of a placed stroke ends. */
+export function feltEndMs(stroke: PlacedStroke): number {
+  return stroke.start_ms + stroke.played_ms;
 }
 
 /** Where the brush is `t_ms` into the stroke (clamped to its ends). */
@@ -119,5 +128,5 @@ export function playingAt(
 
 /** When the last stroke ends (0 for none). */
 export function totalMs(placed: readonly PlacedStroke[]): number {
-  return placed.reduce((end, stroke) => Math.max(end, stroke.start_ms + stroke.played_ms), 0);
+  return placed.reduce((end, stroke) => Math.max(end, feltEndMs(stroke)), 0);
 }
