@@ -96,6 +96,15 @@ describe("the drawing area's marks", () => {
     return sent;
   }
 
+  /** A new drawing of one line across the middle, from `u0` to `u1` of the width, sent: its ends. */
+  async function newLine(u0: number, u1: number): Promise<[Point, Point]> {
+    await page.locator('[data-testid="new-button"]').click();
+    const ends: [Point, Point] = [await at(u0, 0.5), await at(u1, 0.5)];
+    await draw(ends);
+    await allSent(await drawingId());
+    return ends;
+  }
+
   /**
    * Along the row at viewport y `y`, from x0 to x1: how many pixel columns of the ink canvas show
    * the colour `rgb` within two pixels of the row.
@@ -188,10 +197,7 @@ describe("the drawing area's marks", () => {
   });
 
   it("takes a refused stroke out of the felt timeline, and marks one the duty-cycle cap kept from playing", async () => {
-    await page.locator('[data-testid="new-button"]').click();
-    const [left, right] = [await at(0.1, 0.5), await at(0.9, 0.5)];
-    await draw([left, right]);
-    await allSent(await drawingId());
+    const [left, right] = await newLine(0.1, 0.9);
     // Played again: every stroke reaches the sleeve at once, so the timeline plays them back to back.
     await page.locator('[data-testid="replay-button"]').click();
     const drawing = await drawingId();
@@ -235,10 +241,7 @@ describe("the drawing area's marks", () => {
   });
 
   it("lays the A/B comparison on the drawing it compares: a straight line on itself", async () => {
-    await page.locator('[data-testid="new-button"]').click();
-    const [left, right] = [await at(0.15, 0.5), await at(0.85, 0.5)];
-    await draw([left, right]);
-    await allSent(await drawingId());
+    const [left, right] = await newLine(0.15, 0.85);
     await page.locator('[data-testid="compare-toggle"]').check();
     await nextFrame(page);
     // Every layer of the stage covers it exactly.

@@ -116,16 +116,17 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
   });
 
   it("refuses a stroke the duty-cycle cap kept from playing: counted, marked, nothing felt of it", () => {
-    const reading = interpretEvent(vector("safety-duty-cycle"), DRAWING);
-    expect(reading.counts).toEqual(["refused"]);
-    expect(reading.refusedSeq).toBe(3);
-    expect(reading.unplayed).toEqual({ seq: 3, why: "capped" });
-    expect(reading.notes).toEqual([
-      {
-        kind: "rejected",
-        text: "Stroke 3 refused by the duty-cycle cap: not played: the motor would have been driven 52% of the last 60 s",
-      },
-    ]);
+    expect(interpretEvent(vector("safety-duty-cycle"), DRAWING)).toMatchObject({
+      counts: ["refused"],
+      refusedSeq: 3,
+      unplayed: { seq: 3, why: "capped" },
+      notes: [
+        {
+          kind: "rejected",
+          text: "Stroke 3 refused by the duty-cycle cap: not played: the motor would have been driven 52% of the last 60 s",
+        },
+      ],
+    });
     // Another drawing's: a safety note, nothing counted or marked.
     const other = interpretEvent(vector("safety-duty-cycle"), "another");
     expect(other).toMatchObject({ counts: [], refusedSeq: null, unplayed: null });
