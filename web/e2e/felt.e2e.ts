@@ -11,7 +11,7 @@ import mqtt, { type MqttClient } from "mqtt";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { RESULTS_DIR, type Credentials } from "./harness";
-import { drawingArea, drawWithMouse, openAdvanced, screenshot, waitForData, type Area } from "./page";
+import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
 import { DESKTOP, Processes } from "./processes";
 
 type Point = readonly [number, number];
@@ -82,15 +82,6 @@ async function dataOf(page: Page, testid: string, key: string): Promise<string> 
   return page
     .locator(`[data-testid="${testid}"]`)
     .evaluate((el, k) => (el as HTMLElement).dataset[k] ?? "", key);
-}
-
-/** Settings → Advanced → Longest stroke (ms of drawing; 0 = no limit), saved. */
-async function setLongestStroke(page: Page, ms: string): Promise<void> {
-  await page.locator('[data-testid="settings-button"]').click();
-  await openAdvanced(page);
-  await page.locator('[data-testid="setting-max_stroke_ms"]').fill(ms);
-  await page.locator('[data-testid="settings-save"]').click();
-  await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
 }
 
 describe("the felt drawing, served by feelmysign up with the simulated sleeve", () => {
