@@ -6,12 +6,11 @@
  */
 import { readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
-import mqtt from "mqtt";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { REPO_DIR } from "./harness";
+import { EventWatcher, REPO_DIR } from "./harness";
 import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
-import { DESKTOP, Processes } from "./processes";
+import { Processes } from "./processes";
 
 type Point = readonly [number, number];
 /** The sleeve's longest stroke on this layout, and how long the slow leg takes to draw: ms. */
@@ -25,7 +24,7 @@ describe("a stroke the sleeve refuses", () => {
   const processes = new Processes();
   let page: Page;
   let area: Area;
-  const events: Record<string, unknown>[] = [];
+  let watcher: EventWatcher;
   const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
 
   beforeAll(async () => {
@@ -38,17 +37,9 @@ describe("a stroke the sleeve refuses", () => {
     expect(short).not.toBe(paper);
     writeFileSync(layout, short);
     const up = await processes.up("refused", { args: ["--layout", layout] });
-    const client = await mqtt.connectAsync(up.credentials.mqtt_url, {
-      username: up.credentials.sender.username,
-      password: up.credentials.sender.password,
-      clientId: `test-refused-${process.pid}-${Date.now()}`,
-    });
-    processes.add(() => client.endAsync(true));
-    client.on("message", (_topic, payload) => events.push(JSON.parse(payload.toString("utf8"))));
-    await client.subscribeAsync(`feelmysign/${up.credentials.sleeve.id}/events`, { qos: 1 });
-    page = await processes.page(up.url, { ...DESKTOP, deviceScaleFactor: 1 });
-    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
-    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
+    watcher = await EventWatcher.connect(up.credentials);
+    processes.add(() => watcher.client.endAsync(true));
+    page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });
 
@@ -64,20 +55,20 @@ describe("a stroke the sleeve refuses", () => {
     const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
     const sent = Number(await page.locator(SUMMARY).getAttribute("data-sent"));
     expect(sent).toBeGreaterThanOrEqual(4);
-    const ours = () => events.filter((e) => e["drawing"] === drawing);
-    const deadline = Date.now() + 60_000;
-    while (ours().filter((e) => e["type"] !== "cancelled").length < sent) {
-      if (Date.now() > deadline) throw new Error(`the sleeve answered ${JSON.stringify(ours())}`);
-      await new Promise((wake) => setTimeout(wake, 50));
-    }
-    const refused = ours().filter((e) => e["type"] === "rejected");
-    expect(refused.map((e) => e["reason"])).toEqual(["duration_too_long"]);
-    await waitForData(page, SUMMARY, "refused", "1");
-    // The refused stroke is not on the timeline: the others are.
-    await waitForData(page, TIMELINE, "strokes", String(sent - 1));
-    await expect(page.locator('[data-testid="event-log"]').innerText()).resolves.toContain(
-      `Stroke ${refused[0]!["seq"]} refused`,
+    await watcher.waitFor(
+      "every stroke answered",
+      () => watcher.of(drawing).filter((e) => e["type"] !== "cancelled").length >= sent,
+      60_000,
     );
+    // The slow leg's stroke at least (a loaded machine may draw a fast leg slowly too).
+    const refused = watcher.of(drawing, "rejected");
+    expect(refused.length).toBeGreaterThanOrEqual(1);
+    expect(new Set(refused.map((e) => e["reason"]))).toEqual(new Set(["duration_too_long"]));
+    await waitForData(page, SUMMARY, "refused", String(refused.length));
+    // The refused strokes are not on the timeline: the others are.
+    await waitForData(page, TIMELINE, "strokes", String(sent - refused.length));
+    const log = await page.locator('[data-testid="event-log"]').innerText();
+    for (const event of refused) expect(log).toContain(`Stroke ${event["seq"]} refused`);
     await screenshot(page, "refused-by-the-sleeve");
   });
 });
