@@ -2,8 +2,10 @@
  * The sleeve's queue, as the sleeve runs it (python feelmysign.sleeve.queue, pinned by
  * the vectors in testdata/queue): strokes play back to back in the order they arrive,
  * each starting when it arrives or when the stroke before it ends, whichever is later.
- * `queueStartMs` is the page's one copy of that rule; `replayQueue` runs it over arrivals,
- * copies and cancels as the sleeve does, so the vectors check it.
+ * `queueStartMs` is the page's one copy of that rule and `QueueTail` the one copy of how
+ * the tail moves; `replayQueue` runs them over arrivals, copies and cancels as the sleeve
+ * does, so the vectors check them, and the felt timeline (felt.ts, felt-placement.ts)
+ * places its strokes with the same `QueueTail`.
  *
  * Pure: no DOM, no clock.
  */
@@ -14,6 +16,35 @@ export const EMPTY_TAIL_MS = Number.NEGATIVE_INFINITY;
 /** When a stroke that arrives at `arrivalMs` starts behind a queue that ends at `tailMs`. */
 export function queueStartMs(arrivalMs: number, tailMs: number): number {
   return Math.max(arrivalMs, tailMs);
+}
+
+/**
+ * The tail of the queue, stroke by stroke, as the sleeve's `Queue.place` moves it: a stroke
+ * starts by `queueStartMs` and holds the queue until it ends.
+ */
+export class QueueTail {
+  /** When the last stroke queued ends: the earliest the next one can start. */
+  tailMs: number;
+
+  /** A queue ending at `tailMs` (by default empty: the next stroke starts when it arrives). */
+  constructor(tailMs: number = EMPTY_TAIL_MS) {
+    this.tailMs = tailMs;
+  }
+
+  /**
+   * Queues a stroke that arrives at `arrivalMs` and holds the queue `heldMs` from its start: when it
+   * starts. `startedMs`, when the sleeve said when it started, is taken over the rule.
+   */
+  place(arrivalMs: number, heldMs: number, startedMs: number = queueStartMs(arrivalMs, this.tailMs)): number {
+    this.tailMs = startedMs + heldMs;
+    return startedMs;
+  }
+
+  /** After a cancel: the tail is the end of the latest stroke still planned. */
+  replan(endsMs: Iterable<number>): void {
+    this.tailMs = EMPTY_TAIL_MS;
+    for (const endMs of endsMs) this.tailMs = Math.max(this.tailMs, endMs);
+  }
 }
 
 /** A stroke reaching the sleeve (drawing and seq absent in the legacy format). */
@@ -39,6 +70,7 @@ export type QueueOutcome =
 interface Planned {
   readonly index: number;
   readonly start_ms: number;
+  readonly end_ms: number;
   readonly duration_ms: number;
   readonly drawing: string | undefined;
   readonly seq: number | undefined;
@@ -50,20 +82,19 @@ export function replayQueue(steps: readonly QueueStep[]): QueueOutcome[] {
   const planned = new Map<number, Planned>();
   const seen = new Set<string>();
   const cancelled = new Set<string>();
-  let tail = EMPTY_TAIL_MS;
+  const queue = new QueueTail();
   for (const step of steps) {
     if ("cancel" in step) {
       const now = step.at_ms;
       for (const [index, p] of planned) {
-        if (p.start_ms + p.duration_ms <= now || (step.cancel !== "*" && p.drawing !== step.cancel)) continue;
+        if (p.end_ms <= now || (step.cancel !== "*" && p.drawing !== step.cancel)) continue;
         planned.delete(index);
         outcomes[index] =
           p.start_ms <= now
             ? { outcome: "cut", start_ms: p.start_ms, played_ms: now - p.start_ms }
             : { outcome: "cancelled" };
       }
-      tail = EMPTY_TAIL_MS;
-      for (const p of planned.values()) tail = Math.max(tail, p.start_ms + p.duration_ms);
+      queue.replan([...planned.values()].map((p) => p.end_ms));
       if (step.cancel !== "*") cancelled.add(step.cancel);
       continue;
     }
@@ -81,11 +112,11 @@ export function replayQueue(steps: readonly QueueStep[]): QueueOutcome[] {
       continue;
     }
     if (key !== null) seen.add(key);
-    const start_ms = queueStartMs(step.arrival_ms, tail);
-    tail = start_ms + step.duration_ms;
+    const start_ms = queue.place(step.arrival_ms, step.duration_ms);
     planned.set(outcomes.length, {
       index: outcomes.length,
       start_ms,
+      end_ms: queue.tailMs,
       duration_ms: step.duration_ms,
       drawing,
       seq,

@@ -24,6 +24,21 @@ describe("placeStrokes", () => {
     expect(totalMs(placed)).toBe(600);
   });
 
+  it("feels nothing of a stroke the duty-cycle cap kept from playing, and keeps its turn", () => {
+    const placed = placeStrokes(
+      [stroke(0, 0), stroke(1, 0), stroke(2, 0)],
+      new Map(),
+      new Map(),
+      new Set([1]),
+    );
+    expect(placed.map((s) => [s.start_ms, s.played_ms, s.capped])).toEqual([
+      [0, 100, false],
+      [100, 0, true],
+      [200, 100, false],
+    ]);
+    expect(playingAt(placed, 150)).toBeNull();
+  });
+
   it("takes the sleeve's reported start over its own estimate, and the cut length", () => {
     const placed = placeStrokes([stroke(0, 0), stroke(1, 0)], new Map([[0, 30]]), new Map([[0, 40]]));
     expect(placed.map((s) => [s.start_ms, s.played_ms, s.reported])).toEqual([
