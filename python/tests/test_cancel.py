@@ -7,11 +7,12 @@ import subprocess
 import sys
 import time
 import uuid
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
 from test_daemon import Running, _sender
-from test_player import Events, _planned
+from test_player import Events, _planned, started_player
 
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker
@@ -77,14 +78,9 @@ def test_cancel_of_nothing_changes_nothing() -> None:
 
 
 @pytest.fixture
-def player() -> Any:
-    backend = SimBackend(PAPER)
-    events = Events()
-    player = Player(backend, PAPER, on_event=events)
-    player.start()
-    yield player, backend, events
-    player.stop()
-    backend.close()
+def player() -> Iterator[tuple[Player, SimBackend, Events]]:
+    with started_player() as started:
+        yield started
 
 
 def _wait(condition: Any, what: str) -> None:
