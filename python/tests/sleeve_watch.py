@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import json
 import queue
+import signal
+import subprocess
 import sys
 import threading
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -90,6 +93,24 @@ def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:
         str(credentials_path),
         *extra,
     ]
+
+
+@contextmanager
+def reaped(process: subprocess.Popen[str]) -> Iterator[subprocess.Popen[str]]:
+    """``process``, killed and waited for on the way out, however the test ends: no sleeve
+    outlives its test to drive a motor of the next."""
+    try:
+        yield process
+    finally:
+        process.kill()
+        process.wait(WAIT_S)
+
+
+def exit_code_after(process: subprocess.Popen[str], sent: signal.Signals) -> int:
+    """Send ``sent`` and wait for the process to end: its exit code, or minus the number of
+    the signal that ended it."""
+    process.send_signal(sent)
+    return process.wait(WAIT_S)
 
 
 def online(name: str, body: dict[str, Any]) -> bool:
