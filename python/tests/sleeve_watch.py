@@ -7,12 +7,10 @@ import json
 import queue
 import signal
 import subprocess
-import sys
 import threading
 import uuid
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from pathlib import Path
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -80,19 +78,6 @@ def subscribe_all(
 def subscribe(client: mqtt.Client, topic: str, *, wait_s: float = WAIT_S) -> Inbox:
     """Every message on ``topic`` that ``client`` receives from now on, once subscribed."""
     return subscribe_all(client, [topic], wait_s=wait_s)[0]
-
-
-def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:
-    """``feelmysign sleeve`` as its own process, logged in with ``credentials_path``."""
-    return [
-        sys.executable,
-        "-m",
-        "feelmysign",
-        "sleeve",
-        "--credentials",
-        str(credentials_path),
-        *extra,
-    ]
 
 
 @contextmanager
