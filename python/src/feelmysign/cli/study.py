@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.parser import add_command
 from feelmysign.errors import StudyError
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 
@@ -45,11 +46,11 @@ REQUIRES = (
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
+    parser = add_command(
+        subparsers,
         "study",
         help="run the paper's recognition study (design, sessions, coding, analysis, thresholds)",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="study_command", metavar="STEP", required=True)
 
