@@ -51,7 +51,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import not_empty, output_folder, whole_number
 from feelmysign.cli.simplify import load
 from feelmysign.errors import FeelMySignError
@@ -66,7 +66,7 @@ if TYPE_CHECKING:
 DEFAULT_OUT_ROOT = Path("evaluations")
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "evaluate",

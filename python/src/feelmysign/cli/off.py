@@ -21,12 +21,12 @@ from feelmysign.backends.emulated_state import open_state_bus
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import LAYOUT_ENV
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.errors import HardwareError, LayoutError
 from feelmysign.layout import load_layout
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "off",

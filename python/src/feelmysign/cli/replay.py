@@ -34,7 +34,7 @@ from feelmysign.cli.options.broker import (
     add_broker_timeout_option,
     broker_settings_from_args,
 )
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
@@ -61,7 +61,7 @@ def _simplify_options() -> argparse.ArgumentParser:
     return parser
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "replay",

@@ -27,7 +27,7 @@ from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layo
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import LAYOUT_ENV
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import MAX_LAYOUT_BYTES, check_input_file, not_empty
 from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
@@ -65,7 +65,7 @@ class ChannelRow:
         }
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "scan",

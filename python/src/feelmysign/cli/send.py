@@ -27,7 +27,7 @@ from feelmysign.cli.options.broker import (
     broker_settings_from_args,
 )
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
@@ -51,7 +51,7 @@ def _epilog() -> str:
     )
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "send",

@@ -7,13 +7,13 @@ import logging
 import sys
 from collections import Counter
 from collections.abc import Callable
-from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import number, output_file, topic
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
@@ -30,7 +30,7 @@ MIN_RATE_PER_S = 0.1  # one stroke in 10 s: slower is a sleeve that refuses ever
 MAX_RATE_PER_S = 10_000.0  # far above what a person draws; the planner is the limit
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = subparsers.add_parser(
         "sleeve",
         help="run the sleeve: play every stroke sent to it",

@@ -18,11 +18,11 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.errors import StudyError
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 
@@ -45,7 +45,7 @@ REQUIRES = (
 # step that runs, not by 'feelmysign --help'.
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "study",

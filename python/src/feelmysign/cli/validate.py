@@ -17,7 +17,7 @@ import os
 from typing import Any
 
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
-from feelmysign.cli.options.parser import add_command
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import read_stdin
 from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, Rejected, parse, stroke_to_dict
@@ -30,7 +30,7 @@ see docs/protocol.md for every field, range and reason code.
 """
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = add_command(
         subparsers,
         "validate",

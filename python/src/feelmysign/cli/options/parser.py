@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 import re
 import sys
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TypeAlias
 
 from feelmysign.cli.options.values import decimal_float_option, decimal_int_option
 
@@ -42,10 +42,13 @@ class CliParser(argparse.ArgumentParser):
         sys.exit(USAGE_ERROR_EXIT)
 
 
-def add_command(subparsers: Any, name: str, **options: Any) -> argparse.ArgumentParser:
+# What ``register(subparsers)`` of each subcommand module receives: the parser's subcommands.
+Subcommands: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
+
+
+def add_command(subparsers: Subcommands, name: str, **options: Any) -> argparse.ArgumentParser:
     """A ``feelmysign`` subcommand whose --help prints its description (most often its
     module's docstring) as written: paragraphs, lists and examples kept, not re-wrapped."""
-    parser: argparse.ArgumentParser = subparsers.add_parser(
+    return subparsers.add_parser(
         name, formatter_class=argparse.RawDescriptionHelpFormatter, **options
     )
-    return parser
