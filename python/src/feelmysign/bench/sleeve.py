@@ -221,6 +221,19 @@ def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[tuple[float
     return results
 
 
+def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:
+    """``feelmysign sleeve`` as its own process, logged in with ``credentials_path``."""
+    return [
+        sys.executable,
+        "-m",
+        "feelmysign",
+        "sleeve",
+        "--credentials",
+        str(credentials_path),
+        *extra,
+    ]
+
+
 @contextmanager
 def _sleeve_process(
     c: Credentials, credentials_path: Path, grid: tuple[str, ...] = ()
@@ -229,19 +242,7 @@ def _sleeve_process(
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "status"))
     process = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "feelmysign",
-            "sleeve",
-            "--credentials",
-            str(credentials_path),
-            "--rate-per-s",
-            "10000",
-            "--log-level",
-            "warning",
-            *grid,
-        ],
+        sleeve_command(credentials_path, "--rate-per-s", "10000", "--log-level", "warning", *grid),
         stdout=subprocess.DEVNULL,
     )
     try:
