@@ -1,0 +1,3 @@
+import { benchScribble } from "./scribble";
+const s = await benchScribble();
+console.log(JSON.stringify(s));
