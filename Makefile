@@ -34,7 +34,8 @@ help:
 	@echo "make test    install what is needed, then lint, type-check and run every test,"
 	@echo "             side by side (TEST_JOBS=3 lanes; each part's output printed whole when it ends)"
 	@echo "make check   the same parts one at a time"
-	@echo "make bench   print performance figures (a few minutes)"
+	@echo "make bench   print performance figures (at most 5 minutes on a quiet 2-core machine: what they"
+	@echo "             need built side by side, then one timed part at a time)"
 	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
 	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
@@ -112,6 +113,8 @@ test:
 # times, not timings); then every timed part one after another (`bench-timed`), so that no
 # two timings share the cores. The total wall time is printed at the end.
 bench: $(STAMP) system
+	@echo "==> make bench: what the figures need, side by side (each part's output printed whole when it"
+	@echo "    ends); then the timed parts one at a time. Load average now: $$(cut -d' ' -f1-3 /proc/loadavg)"
 	@started=$$(date +%s); \
 	$(MAKE) --no-print-directory -j3 --output-sync=target bench-prepare \
 	  && $(MAKE) --no-print-directory -j1 bench-timed; status=$$?; \
