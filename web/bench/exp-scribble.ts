@@ -1,3 +1,0 @@
-import { benchScribble } from "./scribble";
-const s = await benchScribble();
-console.log(JSON.stringify(s));
