@@ -206,7 +206,11 @@ STATUSES: dict[str, tuple[str, dict[str, Any]]] = {
     ),
     "floor": (
         "the sleeve's floor: the shortest stroke it plays unslowed (ERM), the shortest felt",
-        {"online": True, "layout": LAYOUT, "floor": {"min_duration_ms": 73.701, "min_length": 0.05}},
+        {
+            "online": True,
+            "layout": LAYOUT,
+            "floor": {"min_duration_ms": 73.701, "min_length": 0.05},
+        },
     ),
     "floor-wearer": (
         "the floor raised to a wearer's measured limits",

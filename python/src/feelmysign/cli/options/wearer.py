@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from feelmysign.wearer import Wearer, read_wearer
+if TYPE_CHECKING:  # the planner's constants: not imported by 'feelmysign --help'
+    from feelmysign.wearer import Wearer
 
 
 def add_wearer_option(parser: argparse.ArgumentParser) -> None:
@@ -18,4 +20,6 @@ def add_wearer_option(parser: argparse.ArgumentParser) -> None:
 
 def wearer_from_args(args: argparse.Namespace) -> Wearer | None:
     """The wearer file's limits, checked before the sleeve starts; None without --wearer."""
+    from feelmysign.wearer import read_wearer
+
     return None if args.wearer is None else read_wearer(args.wearer)
