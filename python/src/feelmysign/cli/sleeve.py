@@ -158,6 +158,15 @@ def run(args: argparse.Namespace) -> int:
         f"{options.backend_name} backend, broker {settings.url}; Ctrl-C to stop",
         flush=True,
     )
+    if wearer is not None:
+        from feelmysign.wearer import sleeve_floor
+
+        floor = sleeve_floor(layout, wearer)
+        print(
+            f"Wearer {wearer.name}: its status asks senders for strokes of at least "
+            f"{floor.min_duration_ms:g} ms and {floor.min_length:g} grid units",
+            flush=True,
+        )
     counts = run_sleeve(
         settings,
         layout,
