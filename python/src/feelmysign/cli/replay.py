@@ -17,7 +17,9 @@ With --send the strokes go to the sleeve as JSON v1 (one new drawing id, seq
 0..n-1), each at the moment the simplifier let it go in the drawing (its
 emitted_at_ms from the first frame, divided by --speed; durations unchanged),
 and each is acknowledged by the broker before the next (QoS 1). Every stroke
-is checked against the sleeve's rules before connecting.
+is checked against the sleeve's rules before connecting. The sleeve's retained
+status is read first (up to 2.5 s): its floor raises the simplifier's
+min_duration_ms and min_length (never lowers them), said on stderr.
 """
 
 from __future__ import annotations

@@ -10,7 +10,9 @@ sent (a bad one: nothing is sent, exit 1). JSON v1 goes to
 ``feelmysign/<id>/strokes`` with one fresh drawing id, ``seq`` 0..n-1 and
 ``sent_at_ms``; ``--legacy`` sends the original text format to the legacy
 topic. Each message is published with QoS 1, and the command returns once the
-broker has acknowledged every one (exit 0), or says why not (exit 1).
+broker has acknowledged every one (exit 0), or says why not (exit 1). When the
+sleeve's retained status advertises a floor, one line on stderr says how many
+strokes are below it (they are sent as given).
 """
 
 from __future__ import annotations
