@@ -74,6 +74,11 @@ def test_save_keeps_the_other_dimension_and_reads_back(tmp_path: Path) -> None:
     assert read_wearer(path) == Wearer("P01", 0.7, 118.4)
 
 
+def test_save_says_when_it_cannot_write(tmp_path: Path) -> None:
+    with pytest.raises(WearerError, match=r"cannot write the wearer file .*give a writable path"):
+        save_wearer(tmp_path / "missing-folder" / "wearer.json", "P01", "length", 0.62)
+
+
 def test_save_refuses_another_wearers_file(tmp_path: Path) -> None:
     path = tmp_path / "wearer.json"
     save_wearer(path, "P01", "length", 0.62)

@@ -146,11 +146,18 @@ def save_wearer(path: str | os.PathLike[str], name: str, dimension: str, value: 
     else:
         wearer = Wearer(name, kept.min_length, value)
     wearer_from_json(wearer.to_json(), os.fspath(path))  # in range, or said before writing
-    temporary = f"{os.fspath(path)}.tmp"
-    with open(temporary, "w", encoding="utf-8") as file:
-        json.dump(wearer.to_json(), file, indent=1)
-        file.write("\n")
-    os.replace(temporary, path)
+    temporary = f"{os.fspath(path)}.tmp"  # replaced at once: never a half-written file
+    try:
+        with open(temporary, "w", encoding="utf-8") as file:
+            json.dump(wearer.to_json(), file, indent=1)
+            file.write("\n")
+        os.replace(temporary, path)
+    except OSError as error:
+        raise WearerError(
+            f"cannot write the wearer file {os.fspath(path)} ({error.strerror or error}); the "
+            f"threshold is in the study file: give a writable path, or write {wearer.to_json()} "
+            "into a file by hand"
+        ) from None
     return wearer
 
 
