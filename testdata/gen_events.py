@@ -3,7 +3,8 @@
 - ``event/<name>.json``: ``wire`` (a message as received), ``typed`` (every field of the
   event it reads as, ``null`` when absent) and ``json`` (what ``to_json`` writes back:
   optional fields left out, unknown keys dropped, keys in publishing order);
-- ``status/<name>.json``: the same for the retained status;
+- ``status/<name>.json``: the same for the retained status (``typed`` holds ``floor`` only
+  when the status has one);
 - ``invalid/<name>.json``: ``kind`` (``event`` or ``status``) and a ``wire`` value that
   is not one, with the ``field`` at fault (``null`` when it is the whole message).
 - ``delay/<name>.json``: a played or adjusted event's ``wire``, its ``delay_ms`` (sent ->
@@ -203,6 +204,24 @@ STATUSES: dict[str, tuple[str, dict[str, Any]]] = {
         "a layout with only its grid",
         {"online": True, "layout": {"rows": 4, "columns": 6}},
     ),
+    "floor": (
+        "the sleeve's floor: the shortest stroke it plays unslowed (ERM), the shortest felt",
+        {
+            "online": True,
+            "layout": LAYOUT,
+            "floor": {"min_duration_ms": 73.701, "min_length": 0.05},
+        },
+    ),
+    "floor-wearer": (
+        "the floor raised to a wearer's measured limits",
+        {
+            "online": True,
+            "sleeve_id": "sleeve1",
+            "layout": LAYOUT,
+            "at_ms": 1795326267664,
+            "floor": {"min_duration_ms": 118.4, "min_length": 0.62, "wearer": "P01"},
+        },
+    ),
 }
 
 INVALID: dict[str, tuple[str, str, Any]] = {
@@ -266,6 +285,16 @@ INVALID: dict[str, tuple[str, str, Any]] = {
         "a grid side outside 1..64",
         {"online": True, "layout": {"rows": 0, "columns": 4}},
     ),
+    "status-floor-negative": (
+        "status",
+        "a floor below 0",
+        {"online": True, "floor": {"min_duration_ms": -1, "min_length": 0.05}},
+    ),
+    "status-floor-no-length": (
+        "status",
+        "a floor without its length",
+        {"online": True, "floor": {"min_duration_ms": 73.701}},
+    ),
     "status-layout-not-object": (
         "status",
         "layout must be an object",
@@ -318,6 +347,15 @@ def _typed(value: Any) -> dict[str, Any]:
     return dataclasses.asdict(value)
 
 
+def typed_status(status: Status) -> dict[str, Any]:
+    """A status's fields; ``floor``, added after the others, only when the status has one (the
+    vectors of statuses without it were written before it)."""
+    typed = _typed(status)
+    if typed["floor"] is None:
+        del typed["floor"]
+    return typed
+
+
 def cases() -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     for name, (description, wire) in EVENTS.items():
@@ -335,7 +373,7 @@ def cases() -> dict[str, dict[str, Any]]:
         out[f"status/{name}.json"] = {
             "description": description,
             "wire": wire,
-            "typed": _typed(status),
+            "typed": typed_status(status),
             "json": status.to_json(),
         }
     for name, (description, wire) in DELAYS.items():

@@ -45,7 +45,10 @@ def test_event_vectors(name: str, case: dict[str, Any]) -> None:
 @pytest.mark.parametrize(("name", "case"), STATUSES, ids=[n for n, _ in STATUSES])
 def test_status_vectors(name: str, case: dict[str, Any]) -> None:
     status = Status.from_json(json.dumps(case["wire"]))
-    assert dataclasses.asdict(status) == case["typed"]
+    typed = dataclasses.asdict(status)
+    if "floor" not in case["typed"]:  # vectors older than the floor leave it out
+        assert typed.pop("floor") is None
+    assert typed == case["typed"]
     assert status.to_json() == case["json"]
 
 

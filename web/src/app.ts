@@ -14,6 +14,7 @@ import { buildRecording, recordingFileName } from "./recording";
 import { drawingFromRecording, parseRecording } from "./recording-load";
 import { LATE_LIMIT_MS, loadSettings, saveSettings, withServerBroker, type Settings } from "./settings";
 import { lateLimitMs, senderTarget, settingsChange } from "./settings-diff";
+import { withFloor } from "./sleeve-floor";
 import { offlineAdvice, SleeveWatch } from "./sleeve-state";
 import { parseActuators } from "./telemetry";
 import { DrawingView } from "./ui/canvas";
@@ -100,7 +101,8 @@ export class App {
     this.#compareToggle = byId<HTMLInputElement>(doc, "compare-toggle");
     this.#compareDetail = byId<HTMLInputElement>(doc, "compare-detail");
     this.#session = new DrawingSession(this.#view, {
-      settings: () => this.#settings,
+      // The simplifier keeps every stroke at or above the sleeve's floor (its status).
+      settings: () => withFloor(this.#settings, this.#sleeve.status?.floor),
       grid: () => this.#grid(),
       send: (stroke) => this.#sender.send(stroke),
       changed: (drawing) => this.#drawingChanged(drawing),
@@ -184,6 +186,7 @@ export class App {
         config: this.#config,
         sleeveGrid: this.#sleeve.status?.layout ?? null,
         spacingCm: this.#sleeve.status?.layout?.spacing_cm ?? null,
+        floor: this.#sleeve.status?.floor ?? null,
       }),
     );
     doc.addEventListener("keydown", (event) => {

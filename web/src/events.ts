@@ -112,6 +112,19 @@ export interface SleeveStatus {
   readonly legacy_topic: string | null;
   readonly layout: StatusLayout | null;
   readonly at_ms: number | null;
+  /** Came later than the other fields: absent from an older sleeve's status. */
+  readonly floor?: SleeveFloor;
+}
+
+/**
+ * The least a stroke should be for the sleeve to play it as sent and its wearer to feel it
+ * (Python `StatusFloor`): a sender raises its simplifier's minimums to at least these.
+ */
+export interface SleeveFloor {
+  readonly min_duration_ms: number;
+  readonly min_length: number;
+  /** Whose measured limits are in it, when any. */
+  readonly wearer: string | null;
 }
 
 // ---- the field tables: names in publishing order, as in events.py -----------------------------
@@ -187,6 +200,11 @@ const STATUS_FIELDS: readonly Field[] = [
   ["version", "text", false],
   ["backend", "text", false],
   ["legacy_topic", "text", false],
+];
+const FLOOR_FIELDS: readonly Field[] = [
+  ["min_duration_ms", "number", true],
+  ["min_length", "number", true],
+  ["wearer", "text", false],
 ];
 /** A grid side the page will draw: the layout file's own limit. */
 const MAX_GRID_SIDE = 64;
@@ -299,14 +317,26 @@ function readLayout(value: unknown): StatusLayout | null | undefined {
   return fields as unknown as StatusLayout;
 }
 
+function readFloor(value: unknown): SleeveFloor | null | undefined {
+  if (value === null || value === undefined) return null;
+  const data = asObject(value);
+  const fields = data === null ? null : readFields(data, FLOOR_FIELDS);
+  if (fields === null) return undefined;
+  const { min_duration_ms, min_length } = fields as { min_duration_ms: number; min_length: number };
+  if (min_duration_ms < 0 || min_length < 0) return undefined;
+  return fields as unknown as SleeveFloor;
+}
+
 export function readStatus(value: unknown): SleeveStatus | null {
   const data = asObject(value);
   if (data === null) return null;
   const fields = readFields(data, STATUS_FIELDS);
   const layout = readLayout(data["layout"]);
   const atMs = readValue(data["at_ms"], "number");
-  if (fields === null || layout === undefined || atMs === undefined) return null;
-  return { ...fields, layout, at_ms: atMs } as unknown as SleeveStatus;
+  const floor = readFloor(data["floor"]);
+  if (fields === null || layout === undefined || atMs === undefined || floor === undefined) return null;
+  const status = { ...fields, layout, at_ms: atMs };
+  return (floor === null ? status : { ...status, floor }) as unknown as SleeveStatus;
 }
 
 export function parseStatus(text: string): SleeveStatus | null {
@@ -317,6 +347,7 @@ export function statusToJson(status: SleeveStatus): Record<string, unknown> {
   const out = writeFields(status, STATUS_FIELDS);
   if (status.layout !== null) out["layout"] = writeFields(status.layout, LAYOUT_FIELDS);
   if (status.at_ms !== null) out["at_ms"] = status.at_ms;
+  if (status.floor !== undefined) out["floor"] = writeFields(status.floor, FLOOR_FIELDS);
   return out;
 }
 

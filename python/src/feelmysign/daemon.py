@@ -74,6 +74,7 @@ from feelmysign.protocol import Accepted, parse
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.sleeve.queue import CancelledDrawings
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
+from feelmysign.wearer import Wearer, sleeve_floor
 
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
     import paho.mqtt.client as mqtt
@@ -172,6 +173,8 @@ class SleeveOptions:
     # timing on a machine of its own; 0 where many sleeves share the processors (the load
     # bench), which cannot all spin.
     spin_ms: float = SPIN_MS
+    # The wearer's measured limits (feelmysign.wearer), advertised in the status's floor.
+    wearer: Wearer | None = None
 
 
 class Sleeve:
@@ -645,4 +648,5 @@ class Sleeve:
                 max_stroke_duration_ms=layout.max_stroke_duration_ms,
             ),
             at_ms=round(time.time() * 1000),
+            floor=sleeve_floor(layout, self._options.wearer),
         ).dumps()

@@ -413,8 +413,42 @@ class StatusLayout:
 
 
 @dataclass(frozen=True, kw_only=True)
+class StatusFloor:
+    """The least a stroke should be for this sleeve to play it as sent and its wearer to feel it.
+
+    ``min_duration_ms``: the shortest stroke the sleeve plays without slowing it (its
+    layout's two end bursts, ``apparent_motion.shortest_planned_ms``), or the wearer's
+    measured limit when that is longer; ``min_length``: the shortest stroke felt as moving
+    (grid units), likewise. ``wearer``: whose measured limits are in it, when any. A sender
+    raises its simplifier's ``min_duration_ms`` and ``min_length`` to at least these.
+    """
+
+    min_duration_ms: float
+    min_length: float
+    wearer: str | None = None
+
+    @classmethod
+    def from_json(cls, data: object) -> StatusFloor:
+        r = _Reader(data, "floor")
+        min_duration_ms, min_length = r.number("min_duration_ms"), r.number("min_length")
+        if min_duration_ms < 0 or min_length < 0:
+            raise EventError("floor min_duration_ms and min_length must be 0 or more", "floor")
+        return cls(
+            min_duration_ms=min_duration_ms,
+            min_length=min_length,
+            wearer=r.text("wearer", required=False),
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        return _wire(None, asdict(self))
+
+
+@dataclass(frozen=True, kw_only=True)
 class Status:
-    """The retained ``status``: ``online`` is all a last will must carry."""
+    """The retained ``status``: ``online`` is all a last will must carry.
+
+    ``floor`` came later than the other fields: absent from an older sleeve's status, and
+    an older reader ignores it."""
 
     online: bool
     sleeve_id: str | None = None
@@ -423,6 +457,7 @@ class Status:
     legacy_topic: str | None = None
     layout: StatusLayout | None = None
     at_ms: float | None = None
+    floor: StatusFloor | None = None
 
     @classmethod
     def from_json(cls, data: object) -> Status:
@@ -433,6 +468,7 @@ class Status:
                 raise EventError(f"not JSON: {error}") from None
         r = _Reader(data, "a status")
         layout = r.obj("layout")
+        floor = r.obj("floor")
         return cls(
             online=r.flag("online"),
             sleeve_id=r.text("sleeve_id", required=False),
@@ -441,6 +477,7 @@ class Status:
             legacy_topic=r.text("legacy_topic", required=False),
             layout=None if layout is None else StatusLayout.from_json(layout),
             at_ms=r.number("at_ms", required=False),
+            floor=None if floor is None else StatusFloor.from_json(floor),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -455,6 +492,7 @@ class Status:
                 "legacy_topic": self.legacy_topic,
                 "layout": None if self.layout is None else self.layout.to_json(),
                 "at_ms": self.at_ms,
+                "floor": None if self.floor is None else self.floor.to_json(),
             },
         )
         return wire

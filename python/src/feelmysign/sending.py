@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from feelmysign.connection import BrokerSettings
 from feelmysign.errors import BrokerConnectionError
+from feelmysign.events import StatusFloor
 from feelmysign.protocol import format_json, format_legacy
 from feelmysign.stroke import Stroke
 
@@ -193,3 +194,39 @@ def printer(*, json_lines: bool, total: int) -> Callable[[OutgoingStroke, str], 
         print(line, flush=True)
 
     return report
+
+
+# A sleeve that listens has its retained status at the broker, sent right after the
+# subscription; none within this, none is known (the page waits as long: STATUS_WAIT_MS).
+STATUS_WAIT_S = 2.5
+
+
+def sleeve_floor_from_status(
+    client: mqtt.Client, settings: BrokerSettings, *, wait_s: float = STATUS_WAIT_S
+) -> StatusFloor | None:
+    """The floor the sleeve advertises in its retained status (docs/protocol.md), read on a
+    connected ``client``; None when the broker holds no status, or one without a floor (an
+    older sleeve), within ``wait_s``."""
+    from feelmysign.events import EventError, Status
+    from feelmysign.topics import telemetry_topic
+
+    topic = telemetry_topic(settings.sleeve_id, "status")
+    arrived = threading.Event()
+    read: list[Status | None] = []
+
+    def on_status(_client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        try:
+            read.append(Status.from_json(message.payload) if message.payload else None)
+        except EventError:
+            read.append(None)  # not understood: no floor, as from an older sleeve
+        arrived.set()
+
+    client.message_callback_add(topic, on_status)
+    try:
+        client.subscribe(topic, qos=1)
+        arrived.wait(wait_s)
+        client.unsubscribe(topic)
+    finally:
+        client.message_callback_remove(topic)
+    status = read[0] if read else None
+    return None if status is None else status.floor

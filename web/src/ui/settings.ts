@@ -5,6 +5,8 @@
  * Save is possible only when every field is valid; Reset fills in the defaults.
  */
 import type { ServerConfig } from "../config";
+import type { SleeveFloor } from "../events";
+import { floorNote, type Minimums } from "../sleeve-floor";
 import {
   FIELDS,
   defaultSettings,
@@ -45,6 +47,8 @@ export interface SettingsPanelContext {
   readonly sleeveGrid: GridSize | null;
   /** The sleeve's actuator spacing: what one grid unit is on the skin. */
   readonly spacingCm?: number | null;
+  /** The sleeve's floor (its status): the simplifier's minimums are raised to it. */
+  readonly floor?: SleeveFloor | null;
 }
 
 export class SettingsPanel {
@@ -62,6 +66,7 @@ export class SettingsPanel {
   #gridNote: HTMLElement | null = null;
   #brokerNote: HTMLElement | null = null;
   #unitNote: HTMLElement | null = null;
+  #floorNote: HTMLElement | null = null;
   #detail: HTMLInputElement | null = null;
   #detailText: HTMLElement | null = null;
 
@@ -122,7 +127,9 @@ export class SettingsPanel {
       if (section.note !== undefined) fieldset.append(paragraph("section-note", section.note));
       if (section.id === "simplifier") {
         this.#unitNote = paragraph("section-note", "");
-        fieldset.append(this.#unitNote);
+        this.#floorNote = paragraph("section-note", "");
+        this.#floorNote.dataset["testid"] = "floor-note";
+        fieldset.append(this.#unitNote, this.#floorNote);
       }
       if (section.id === "sleeve") {
         this.#gridNote = paragraph("section-note", "");
@@ -332,7 +339,12 @@ export class SettingsPanel {
       this.#rows.get(key)!.dataset["disabled"] = String(disabled);
       for (const input of this.#inputs.get(key) ?? []) input.disabled = disabled;
     }
-    const { config, sleeveGrid, spacingCm } = this.#context;
+    const { config, sleeveGrid, spacingCm, floor } = this.#context;
+    if (this.#floorNote) {
+      const note = floorNote(candidateMinimums(candidate), floor);
+      this.#floorNote.textContent = note ?? "";
+      this.#floorNote.hidden = note === null;
+    }
     if (this.#unitNote) {
       this.#unitNote.textContent =
         "Lengths are in grid units: 1 grid unit is the spacing between two neighbouring actuators" +
@@ -368,6 +380,13 @@ export class SettingsPanel {
     this.#onSave(saved as unknown as Settings);
     this.#dialog.close();
   }
+}
+
+/** The minimums being edited, as numbers (a half-typed value counts as 0: the floor applies). */
+function candidateMinimums(candidate: Candidate): Minimums {
+  const number = (value: unknown): number =>
+    typeof value === "number" && Number.isFinite(value) ? value : 0;
+  return { min_duration_ms: number(candidate.min_duration_ms), min_length: number(candidate.min_length) };
 }
 
 function helpText(field: FieldSpec): string {

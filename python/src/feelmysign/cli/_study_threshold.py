@@ -34,6 +34,14 @@ def add_threshold_parser(commands: Any) -> None:
         help="dry run: a simulated wearer whose threshold is T (grid units or ms)",
     )
     parser.add_argument("--seed", type=int, default=0, help="the simulated wearer's seed")
+    parser.add_argument(
+        "--save",
+        type=Path,
+        metavar="FILE",
+        help="also write the threshold into this wearer file (JSON; the other dimension's "
+        "value, if the file has one for the same participant, is kept), for "
+        "'feelmysign sleeve --wearer FILE'",
+    )
     add_broker_options(parser, role="sender")
     parser.set_defaults(handler=run)
 
@@ -54,6 +62,10 @@ def run(args: argparse.Namespace) -> int:
     from feelmysign.study.threshold import SimulatedObserver
     from feelmysign.study.threshold_run import run_threshold
 
+    if args.save is not None:
+        from feelmysign.wearer import wearer_to_update
+
+        wearer_to_update(args.save, args.participant)  # a bad file is said before the run
     store = StudyStore(args.study)
     layout = stimulus_layout(store.design.stimulus, store.base_dir)
     unit = "grid units" if args.dimension == "length" else "ms"
@@ -85,4 +97,12 @@ def run(args: argparse.Namespace) -> int:
         f"Threshold ({args.dimension}): {estimate.threshold:.3g} {unit}, 95% interval "
         f"{estimate.low:.3g} to {estimate.high:.3g}, after {estimate.trials} trials."
     )
+    if args.save is not None:
+        from feelmysign.wearer import save_wearer
+
+        wearer = save_wearer(args.save, args.participant, args.dimension, estimate.threshold)
+        print(
+            f"Saved to {args.save}: {wearer.to_json()}; run the sleeve with "
+            f"'feelmysign sleeve --wearer {args.save}' (or 'feelmysign up --wearer {args.save}')."
+        )
     return 0

@@ -17,7 +17,9 @@ With --send the strokes go to the sleeve as JSON v1 (one new drawing id, seq
 0..n-1), each at the moment the simplifier let it go in the drawing (its
 emitted_at_ms from the first frame, divided by --speed; durations unchanged),
 and each is acknowledged by the broker before the next (QoS 1). Every stroke
-is checked against the sleeve's rules before connecting.
+is checked against the sleeve's rules before connecting. The sleeve's retained
+status is read first (up to 2.5 s): its floor raises the simplifier's
+min_duration_ms and min_length (never lowers them), said on stderr.
 """
 
 from __future__ import annotations
@@ -25,7 +27,9 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import sys
 import uuid
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli import simplify
@@ -40,12 +44,14 @@ from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
-from feelmysign.sending import OutgoingStroke, StrokeSender, printer
+from feelmysign.sending import OutgoingStroke, StrokeSender, printer, sleeve_floor_from_status
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import DEFAULT_ALGORITHM, Params
 from feelmysign.stroke import Stroke
 
 if TYPE_CHECKING:
+    import paho.mqtt.client as mqtt
+
     from feelmysign.research.rerun import Rerun
 
 MAX_SPEED = 1000.0  # a minute of drawing in 60 ms: faster is a burst, not a pace
@@ -95,11 +101,19 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     algorithm = simplify.chosen_algorithm(args, recording)
     simplify._check_usage(args, algorithm, parser)  # another algorithm's option: exit 2
     params = simplify.params_from_args(args, recording)
-    result = rerun(recording, params)
-    compared = recording.strokes is not None and algorithm == _recorded_algorithm(recording)
-    difference = mismatch(result.segments, recording.strokes or ()) if compared else None
-    if args.send:
-        _send(args, result, params)
+    client = _connect(args) if args.send else None
+    try:
+        if client is not None:
+            params = _respect_floor(client, broker_settings_from_args(args, "sender"), params)
+        result = rerun(recording, params)
+        compared = recording.strokes is not None and algorithm == _recorded_algorithm(recording)
+        difference = mismatch(result.segments, recording.strokes or ()) if compared else None
+        if client is not None:
+            _send(args, client, result, params)
+    finally:
+        if client is not None:
+            client.disconnect()
+            client.loop_stop()
     if args.json:
         print(json.dumps(_document(result, params, compared, difference)))
     else:
@@ -178,7 +192,28 @@ def strokes_to_send(result: Rerun, params: Params) -> tuple[list[Stroke], list[f
     return strokes, at_ms
 
 
-def _send(args: argparse.Namespace, result: Rerun, params: Params) -> None:
+def _connect(args: argparse.Namespace) -> mqtt.Client:
+    settings: BrokerSettings = broker_settings_from_args(args, "sender")
+    return connect_client(
+        settings, f"feelmysign-replay-{uuid.uuid4().hex[:12]}", timeout_s=args.timeout_s
+    )
+
+
+def _respect_floor(client: mqtt.Client, settings: BrokerSettings, params: Params) -> Params:
+    """The simplifier's minimums raised to the floor the sleeve advertises (never lowered), said
+    on stderr (stdout may be JSON for a program)."""
+    from feelmysign.wearer import respect_floor  # the planner's constants: not by --help
+
+    floor = sleeve_floor_from_status(client, settings)
+    min_duration_ms, min_length, note = respect_floor(
+        params.min_duration_ms, params.min_length, floor
+    )
+    if note is not None:
+        print(note, file=sys.stderr, flush=True)
+    return replace(params, min_duration_ms=min_duration_ms, min_length=min_length)
+
+
+def _send(args: argparse.Namespace, client: mqtt.Client, result: Rerun, params: Params) -> None:
     strokes, at_ms = strokes_to_send(result, params)
     settings: BrokerSettings = broker_settings_from_args(args, "sender")
     speed = args.speed or 1.0
@@ -186,14 +221,7 @@ def _send(args: argparse.Namespace, result: Rerun, params: Params) -> None:
         OutgoingStroke(i, settings.strokes_topic, stroke, legacy=False)
         for i, stroke in enumerate(strokes)
     ]
-    client = connect_client(
-        settings, f"feelmysign-replay-{uuid.uuid4().hex[:12]}", timeout_s=args.timeout_s
-    )
-    try:
-        # The same publish, acknowledgement wait and report as 'send'.
-        report = printer(json_lines=args.json, total=len(messages))
-        sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
-        sender.send_at(messages, [offset_ms / speed for offset_ms in at_ms])
-    finally:
-        client.disconnect()
-        client.loop_stop()
+    # The same publish, acknowledgement wait and report as 'send'.
+    report = printer(json_lines=args.json, total=len(messages))
+    sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
+    sender.send_at(messages, [offset_ms / speed for offset_ms in at_ms])

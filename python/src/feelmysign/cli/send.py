@@ -10,13 +10,17 @@ sent (a bad one: nothing is sent, exit 1). JSON v1 goes to
 ``feelmysign/<id>/strokes`` with one fresh drawing id, ``seq`` 0..n-1 and
 ``sent_at_ms``; ``--legacy`` sends the original text format to the legacy
 topic. Each message is published with QoS 1, and the command returns once the
-broker has acknowledged every one (exit 0), or says why not (exit 1).
+broker has acknowledged every one (exit 0), or says why not (exit 1). When the
+sleeve's retained status advertises a floor, one line on stderr says how many
+strokes are below it (they are sent as given).
 """
 
 from __future__ import annotations
 
 import argparse
 import functools
+import math
+import sys
 import uuid
 from collections.abc import Iterator
 from dataclasses import replace
@@ -31,9 +35,16 @@ from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
+from feelmysign.events import StatusFloor
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, Layout
 from feelmysign.protocol import Accepted, parse
-from feelmysign.sending import OutgoingStroke, Pace, StrokeSender, printer
+from feelmysign.sending import (
+    OutgoingStroke,
+    Pace,
+    StrokeSender,
+    printer,
+    sleeve_floor_from_status,
+)
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
 from feelmysign.stroke import Stroke
 from feelmysign.topics import LEGACY_TOPIC
@@ -144,6 +155,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     client_id = f"feelmysign-send-{uuid.uuid4().hex[:12]}"
     client = connect_client(settings, client_id, timeout_s=args.timeout_s)
     try:
+        _say_floor(sleeve_floor_from_status(client, settings, wait_s=FLOOR_WAIT_S), strokes)
         report = printer(json_lines=args.json, total=len(messages))
         StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report).send(
             messages, pace=pace
@@ -154,6 +166,35 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     if not args.json:
         print(_summary(args, settings, strokes), flush=True)
     return 0
+
+
+# The retained status comes right after the subscription; on a LAN far within this.
+FLOOR_WAIT_S = 1.0
+
+
+def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
+    """One line on stderr (stdout may be JSON for a program): the floor the sleeve advertises and
+    how many of the strokes, sent as given (no simplifier here), are below it."""
+    if floor is None:
+        return
+    below = sum(
+        1
+        for s in strokes
+        if s.duration_ms < floor.min_duration_ms or math.dist(s.start, s.end) < floor.min_length
+    )
+    whose = f" with wearer {floor.wearer}'s limits" if floor.wearer else ""
+    verdict = (
+        f"{below} of the {len(strokes)} strokes are below it (the sleeve slows a briefer one; "
+        "a shorter one may not be felt)"
+        if below
+        else "every stroke is at or above it"
+    )
+    print(
+        f"The sleeve's floor{whose}: strokes of at least {floor.min_duration_ms:g} ms and "
+        f"{floor.min_length:g} grid units; {verdict}.",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:

@@ -15,6 +15,7 @@ from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import number, output_file, topic
+from feelmysign.cli.options.wearer import add_wearer_option, wearer_from_args
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
 from feelmysign.layout import Layout
@@ -44,6 +45,7 @@ def register(subparsers: Subcommands) -> None:
     )
     add_broker_options(parser, role="sleeve")
     add_layout_options(parser)
+    add_wearer_option(parser)
     parser.add_argument(
         "--backend",
         choices=BACKEND_NAMES,
@@ -138,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
     if args.record is not None:
         output_file(args.record, option="--record")
     layout = layout_from_args(args)
+    wearer = wearer_from_args(args)
     settings = broker_settings_from_args(args, "sleeve")
     options = SleeveOptions(
         sleeve_id=settings.sleeve_id,
@@ -148,12 +151,22 @@ def run(args: argparse.Namespace) -> int:
         + (" (emulated bus)" if args.emulate or args.emulate_state else ""),
         max_age_ms=args.max_age_ms,
         max_lag_ms=args.max_lag_ms,
+        wearer=wearer,
     )
     print(
         f"Sleeve {options.sleeve_id}: {layout.rows} x {layout.columns} actuators, "
         f"{options.backend_name} backend, broker {settings.url}; Ctrl-C to stop",
         flush=True,
     )
+    if wearer is not None:
+        from feelmysign.wearer import sleeve_floor
+
+        floor = sleeve_floor(layout, wearer)
+        print(
+            f"Wearer {wearer.name}: its status asks senders for strokes of at least "
+            f"{floor.min_duration_ms:g} ms and {floor.min_length:g} grid units",
+            flush=True,
+        )
     counts = run_sleeve(
         settings,
         layout,

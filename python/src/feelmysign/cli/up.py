@@ -21,6 +21,7 @@ from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import output_file, port, sleeve_id
+from feelmysign.cli.options.wearer import add_wearer_option, wearer_from_args
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.services.drawing_log import DrawingLog
@@ -100,6 +101,7 @@ def register(subparsers: Subcommands) -> None:
         "'feelmysign study new DESIGN.toml --out FILE')",
     )
     add_layout_options(parser)
+    add_wearer_option(parser)
     add_lan_options(parser)
     parser.set_defaults(handler=run)
 
@@ -108,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
     if args.record is not None:
         output_file(args.record, option="--record")
     layout = layout_from_args(args)
+    wearer = wearer_from_args(args)
     port = _port_or_free(args.port, DEFAULT_MQTT_PORT, "MQTT")
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
     broker = Broker(
@@ -125,7 +128,9 @@ def run(args: argparse.Namespace) -> int:
         )
         with server:
             settings = c.settings("sleeve")
-            options = SleeveOptions(sleeve_id=c.sleeve_id, backend_name=args.sleeve_backend)
+            options = SleeveOptions(
+                sleeve_id=c.sleeve_id, backend_name=args.sleeve_backend, wearer=wearer
+            )
 
             sender = c.settings("sender")
 

@@ -1,0 +1,25 @@
+"""``--wearer FILE``: the wearer's measured limits, for the subcommands that run a sleeve."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the planner's constants: not imported by 'feelmysign --help'
+    from feelmysign.wearer import Wearer
+
+
+def add_wearer_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--wearer",
+        metavar="FILE",
+        help="the wearer's shortest felt stroke (JSON, written by 'feelmysign study threshold "
+        "--save'): the sleeve advertises it in its status, and senders keep strokes above it",
+    )
+
+
+def wearer_from_args(args: argparse.Namespace) -> Wearer | None:
+    """The wearer file's limits, checked before the sleeve starts; None without --wearer."""
+    from feelmysign.wearer import read_wearer
+
+    return None if args.wearer is None else read_wearer(args.wearer)
