@@ -146,6 +146,13 @@ def test_a_sender_raises_its_minimums_and_never_lowers_them() -> None:
     assert respect_floor(6.1, 0.1, None) == (6.1, 0.1, None)
 
 
+def test_the_motors_floor_alone_leaves_a_senders_minimums_alone() -> None:
+    # Without a wearer's limits the simplifier would drop the brief strokes the sleeve can
+    # slow and catch up after; only a wearer's measured limits are kept to.
+    floor = StatusFloor(min_duration_ms=73.701, min_length=0.05, wearer=None)
+    assert respect_floor(6.1, 0.01, floor) == (6.1, 0.01, None)
+
+
 # ---- the loop ----------------------------------------------------------------------------
 
 

@@ -13,7 +13,10 @@ export interface Minimums {
 
 /** `settings` with its minimums raised to `floor` (the same object when nothing is raised). */
 export function withFloor<T extends Minimums>(settings: T, floor: SleeveFloor | null | undefined): T {
-  if (floor == null) return settings;
+  // Only a wearer's measured limits are kept to (as Python's respect_floor): the motors' floor
+  // alone would make the simplifier drop brief strokes, which costs more of the shape than the
+  // sleeve's slowing them and catching up afterwards.
+  if (floor == null || !floor.wearer) return settings;
   const minDurationMs = Math.max(settings.min_duration_ms, floor.min_duration_ms);
   const minLength = Math.max(settings.min_length, floor.min_length);
   if (minDurationMs === settings.min_duration_ms && minLength === settings.min_length) return settings;
@@ -23,6 +26,9 @@ export function withFloor<T extends Minimums>(settings: T, floor: SleeveFloor | 
 /** One sentence for the settings panel: what the floor makes the simplifier use; null without one. */
 export function floorNote(settings: Minimums, floor: SleeveFloor | null | undefined): string | null {
   if (floor == null) return null;
+  if (!floor.wearer) {
+    return `The sleeve plays strokes briefer than ${round(floor.min_duration_ms)} ms slowed to that, and catches up after them; a wearer file (feelmysign sleeve --wearer) sets limits the page keeps to.`;
+  }
   const whose = floor.wearer
     ? `the sleeve's floor with wearer ${floor.wearer}'s limits`
     : "the sleeve's floor";

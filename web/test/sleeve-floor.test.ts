@@ -6,8 +6,16 @@ const user = { min_duration_ms: 6.1, min_length: 0.1, other: "kept" };
 const floor = { min_duration_ms: 73.701, min_length: 0.05, wearer: null };
 
 describe("withFloor", () => {
-  it("raises a minimum below the floor and keeps one above it", () => {
-    expect(withFloor(user, floor)).toEqual({ min_duration_ms: 73.701, min_length: 0.1, other: "kept" });
+  it("raises a minimum below a wearer's floor and keeps one above it", () => {
+    expect(withFloor(user, { ...floor, wearer: "P01" })).toEqual({
+      min_duration_ms: 73.701,
+      min_length: 0.1,
+      other: "kept",
+    });
+  });
+
+  it("keeps the settings under the motors' floor alone (the sleeve slows and catches up)", () => {
+    expect(withFloor(user, floor)).toBe(user);
   });
 
   it("never lowers a user's higher setting", () => {
@@ -29,9 +37,12 @@ describe("floorNote", () => {
         "min duration and min length raised to it.",
     );
     expect(floorNote(user, floor)).toBe(
-      "At least 73.7 ms and 0.05 grid units per stroke: the sleeve's floor; min duration raised to it.",
+      "The sleeve plays strokes briefer than 73.7 ms slowed to that, and catches up after them; " +
+        "a wearer file (feelmysign sleeve --wearer) sets limits the page keeps to.",
     );
-    expect(floorNote({ min_duration_ms: 100, min_length: 1 }, floor)).toContain("your settings are above it");
+    expect(floorNote({ min_duration_ms: 100, min_length: 1 }, { ...floor, wearer: "P01" })).toContain(
+      "your settings are above it",
+    );
   });
 
   it("says nothing without a floor", () => {

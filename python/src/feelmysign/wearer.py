@@ -179,8 +179,14 @@ def respect_floor(
     min_duration_ms: float, min_length: float, floor: StatusFloor | None
 ) -> tuple[float, float, str | None]:
     """A simplifier's minimums raised to the sleeve's floor (never lowered), and one line that
-    says what was raised (None when nothing was)."""
-    if floor is None:
+    says what was raised (None when nothing was).
+
+    Only a floor with a wearer's measured limits is kept to. The motors' own floor alone is
+    not: the simplifier drops a stroke below its minimums rather than merging it into its
+    neighbour, and on people's gestures dropping the strokes briefer than the ERM floor
+    (73.7 ms) costs more recognitions than the sleeve's slowing them does (it catches up
+    afterwards; docs/research.md)."""
+    if floor is None or not floor.wearer:
         return min_duration_ms, min_length, None
     raised: list[str] = []
     if floor.min_duration_ms > min_duration_ms:
