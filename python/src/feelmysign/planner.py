@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections import defaultdict
 from collections.abc import Iterable, Sequence
 
 from feelmysign.apparent_motion import (
@@ -421,26 +422,10 @@ def _bursts(
 
 
 def _bursts_of(bursts: list[RawBurst], intensity: float) -> tuple[Burst, ...]:
-    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, without its __init__
-    call: the same fields in one dict, as ``commands_from_spans`` makes its commands."""
-    new, set_fields = object.__new__, object.__setattr__
-    result = []
-    for x, y, peak_ms, start_ms, duration_ms in bursts:
-        burst = new(Burst)
-        set_fields(
-            burst,
-            "__dict__",
-            {
-                "x": x,
-                "y": y,
-                "peak_ms": peak_ms,
-                "start_ms": start_ms,
-                "duration_ms": duration_ms,
-                "intensity": intensity,
-            },
-        )
-        result.append(burst)
-    return tuple(result)
+    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, made in C as
+    ``commands_from_spans`` makes its commands (the named tuple's __new__ is Python)."""
+    new = tuple.__new__
+    return tuple([new(Burst, (*burst, intensity)) for burst in bursts])
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
@@ -492,42 +477,72 @@ def _spans_by_actuator(
     bursts: Iterable[RawBurst], intensity: float, layout: Layout
 ) -> dict[Actuator, list[Span]]:
     """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
-    by_actuator: dict[Actuator, list[Span]] = {}
+    if not intensity >= _LEAST_SAFE_INTENSITY:
+        return _spans_by_actuator_checked(bursts, intensity, layout)
+    by_actuator: defaultdict[Actuator, list[Span]] = defaultdict(list)
     last_column, last_row = layout.columns - 1, layout.rows - 1
     sqrt, floor = math.sqrt, math.floor
     for x, y, _, span_start, length_ms in bursts:
         if length_ms <= 0:
             continue
         span_end = span_start + length_ms  # as Command.end_ms computes it
-        # _axis_weights of x and of y, and _funneled, unrolled into this loop:
-        # no call and no list per burst on the planning path.
-        low = floor(x)
-        if low > last_column:
-            low = last_column
-        fraction = x - low
-        if fraction <= ON_LINE_EPSILON:
-            column_weights: tuple[tuple[int, float], ...] = ((low, 1.0),)
-        elif fraction >= _OFF_LINE:
-            column_weights = ((low + 1, 1.0),)
-        else:
-            column_weights = ((low, 1.0 - fraction), (low + 1, fraction))
-        low = floor(y)
-        if low > last_row:
-            low = last_row
-        fraction = y - low
-        if fraction <= ON_LINE_EPSILON:
-            row_weights: tuple[tuple[int, float], ...] = ((low, 1.0),)
-        elif fraction >= _OFF_LINE:
-            row_weights = ((low + 1, 1.0),)
-        else:
-            row_weights = ((low, 1.0 - fraction), (low + 1, fraction))
-        for row, wy in row_weights:
-            for column, wx in column_weights:
-                value = intensity * sqrt(wx * wy)
-                if value > 0:
-                    spans = by_actuator.get((row, column))
-                    if spans is None:
-                        by_actuator[(row, column)] = [(span_start, span_end, value)]
-                    else:
-                        spans.append((span_start, span_end, value))
+        # _funneled, unrolled for each case of _axis_weights of x and of y: no call,
+        # no list and no loop per burst on the planning path. A weight of 1.0 leaves
+        # intensity * sqrt(wx * wy) as it is (times 1.0 and sqrt(1.0) are exact).
+        column = floor(x)
+        if column > last_column:
+            column = last_column
+        fx = x - column
+        row = floor(y)
+        if row > last_row:
+            row = last_row
+        fy = y - row
+        if fx <= ON_LINE_EPSILON or fx >= _OFF_LINE:  # on a column line
+            if fx > ON_LINE_EPSILON:
+                column += 1
+            if fy <= ON_LINE_EPSILON or fy >= _OFF_LINE:  # on an actuator
+                if fy > ON_LINE_EPSILON:
+                    row += 1
+                by_actuator[(row, column)].append((span_start, span_end, intensity))
+            else:  # between two rows
+                by_actuator[(row, column)].append(
+                    (span_start, span_end, intensity * sqrt(1.0 - fy))
+                )
+                by_actuator[(row + 1, column)].append((span_start, span_end, intensity * sqrt(fy)))
+        elif fy <= ON_LINE_EPSILON or fy >= _OFF_LINE:  # on a row line, between two columns
+            if fy > ON_LINE_EPSILON:
+                row += 1
+            by_actuator[(row, column)].append((span_start, span_end, intensity * sqrt(1.0 - fx)))
+            by_actuator[(row, column + 1)].append((span_start, span_end, intensity * sqrt(fx)))
+        else:  # inside a cell: its four corners
+            wx = 1.0 - fx
+            wy = 1.0 - fy
+            by_actuator[(row, column)].append((span_start, span_end, intensity * sqrt(wx * wy)))
+            by_actuator[(row, column + 1)].append((span_start, span_end, intensity * sqrt(fx * wy)))
+            by_actuator[(row + 1, column)].append((span_start, span_end, intensity * sqrt(wx * fy)))
+            by_actuator[(row + 1, column + 1)].append(
+                (span_start, span_end, intensity * sqrt(fx * fy))
+            )
+    return by_actuator
+
+
+# Above this, intensity times a funneling weight (at least 1e-9, see
+# ON_LINE_EPSILON) is never 0: no span of a stroke so intense is empty.
+_LEAST_SAFE_INTENSITY = 1e-280
+
+
+def _spans_by_actuator_checked(
+    bursts: Iterable[RawBurst], intensity: float, layout: Layout
+) -> dict[Actuator, list[Span]]:
+    """``_spans_by_actuator`` for a stroke so faint (or off) that a span may be 0: left out."""
+    by_actuator: dict[Actuator, list[Span]] = {}
+    for x, y, _, span_start, length_ms in bursts:
+        if length_ms <= 0:
+            continue
+        burst = Burst(x, y, 0.0, span_start, length_ms, intensity)
+        for row, column, value in _funneled(burst, layout):
+            if value > 0:
+                by_actuator.setdefault((row, column), []).append(
+                    (span_start, span_start + length_ms, value)
+                )
     return by_actuator

@@ -3,13 +3,19 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from feelmysign.stroke import Stroke
 
 
-@dataclass(frozen=True)
-class Command:
-    """One physical actuator on at a constant intensity, times relative to the stroke's start."""
+class Command(NamedTuple):
+    """One physical actuator on at a constant intensity, times relative to the stroke's start.
+
+    A named tuple: a planned stroke makes a dozen commands before its first motor
+    starts, and the planner makes each in one C call (``tuple.__new__``), with no
+    __init__ and no __dict__ (a frozen dataclass's setattr per field took a
+    quarter of planning a stroke).
+    """
 
     row: int
     column: int
@@ -17,31 +23,16 @@ class Command:
     duration_ms: float
     intensity: float
 
-    def __init__(
-        self, row: int, column: int, start_ms: float, duration_ms: float, intensity: float
-    ) -> None:
-        # The generated __init__ of a frozen dataclass sets each field through
-        # object.__setattr__: a planned stroke makes a dozen commands, and that
-        # took a quarter of planning it. One dict update sets the same fields.
-        self.__dict__.update(
-            row=row,
-            column=column,
-            start_ms=start_ms,
-            duration_ms=duration_ms,
-            intensity=intensity,
-        )
-
     @property
     def end_ms(self) -> float:
         return self.start_ms + self.duration_ms
 
 
-@dataclass(frozen=True)
-class Burst:
+class Burst(NamedTuple):
     """One virtual actuator of a stroke: a point in grid units felt around its peak time.
 
     ``start_ms`` and ``duration_ms`` are the burst's onset and length, shared by
-    the physical actuators that render it (funneling).
+    the physical actuators that render it (funneling). A named tuple, as Command.
     """
 
     x: float
@@ -50,25 +41,6 @@ class Burst:
     start_ms: float
     duration_ms: float
     intensity: float
-
-    def __init__(
-        self,
-        x: float,
-        y: float,
-        peak_ms: float,
-        start_ms: float,
-        duration_ms: float,
-        intensity: float,
-    ) -> None:
-        # As Command's: one dict update instead of a frozen dataclass's setattr per field.
-        self.__dict__.update(
-            x=x,
-            y=y,
-            peak_ms=peak_ms,
-            start_ms=start_ms,
-            duration_ms=duration_ms,
-            intensity=intensity,
-        )
 
 
 @dataclass(frozen=True)
