@@ -318,9 +318,9 @@ class Outline:
         if self._bursts is not None:
             return sum(energy * d for _, _, _, _, d in self._bursts if d > 0)
         burst_timings = self._way[3]
-        total_ms = self.duration_ms * sum(map(_LENGTH_A, burst_timings)) + sum(
-            map(_LENGTH_B, burst_timings)
-        )
+        slopes: float = sum(map(_LENGTH_A, burst_timings))
+        intercepts_ms: float = sum(map(_LENGTH_B, burst_timings))
+        total_ms = self.duration_ms * slopes + intercepts_ms
         margin_ms = _BOUND_MARGIN_MS * len(burst_timings)
         return energy * (total_ms * (1 + _BOUND_MARGIN) + margin_ms)
 
