@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import math
 import random
+from collections import Counter
 from typing import Any
 
 import pytest
@@ -15,7 +16,13 @@ from vectors import load
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.errors import StrokeError
 from feelmysign.layout import MIN_BURST_MS, Layout, grid_layout
-from feelmysign.overlaps import _chained_pieces, _energy_pieces, _two_pieces, merge_commands
+from feelmysign.overlaps import (
+    _chained_pieces,
+    _energy_pieces,
+    _paired_pieces,
+    _two_pieces,
+    merge_commands,
+)
 from feelmysign.planner import overrun_allowance_ms, plan, render_point, virtual_actuators
 from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.schedule import Burst, Command, Schedule, schedule_to_json
@@ -212,16 +219,17 @@ def test_short_overlap_piece_joins_its_neighbour_keeping_energy() -> None:
 
 
 def test_planned_commands_and_bursts_are_as_their_constructors_make_them() -> None:
-    # The planner fills their fields directly (no __init__ call per command):
-    # every field must be there, as a constructed one has it.
+    # The planner makes them with tuple.__new__ (no __new__ call of the named tuple per
+    # command): each must be of its class, with every field, as a constructed one is.
     schedule = plan(Stroke((0.2, 0.3), (2.7, 1.6), 400.0), PAPER)
     assert schedule.commands and schedule.bursts
     for c in schedule.commands:
         made = Command(c.row, c.column, c.start_ms, c.duration_ms, c.intensity)
-        assert vars(c) == vars(made) and c == made and hash(c) == hash(made)
+        assert type(c) is Command and c._asdict() == made._asdict()
+        assert c == made and hash(c) == hash(made)
     for b in schedule.bursts:
         made_burst = Burst(b.x, b.y, b.peak_ms, b.start_ms, b.duration_ms, b.intensity)
-        assert vars(b) == vars(made_burst) and b == made_burst
+        assert type(b) is Burst and b._asdict() == made_burst._asdict() and b == made_burst
 
 
 def test_two_spans_merge_as_the_general_sweep_does() -> None:
@@ -257,6 +265,27 @@ def test_spans_in_a_chain_merge_as_the_general_sweep_does() -> None:
             assert fast == _energy_pieces(spans), spans
             compared += 1
     assert compared > 1000  # chains of every length, not a few
+
+
+def test_spans_on_two_at_a_time_merge_as_the_general_sweep_does() -> None:
+    # Spans each overlapping at most the next (how most actuators get three bursts
+    # or more) are merged by a walk along them; it must give the general sweep's
+    # pieces: apart, touching, overlapping, one inside the one before, ending together.
+    rng = random.Random(6)
+    starts = (0.0, 20.0, 20.000000000000004, 35.0, 50.0, 65.0, 80.0, 95.0, 110.0)
+    lengths = (5.0, 15.0, 20.0, 30.0, 30.000000000000004, 45.0, 60.0)
+    levels = (1e-200, 1e-6, 0.5, 0.6, 0.6000000001, 0.9999999, 1.0)
+    compared = Counter[int]()
+    for _ in range(20_000):
+        spans = [
+            (start, start + rng.choice(lengths), rng.choice(levels))
+            for start in sorted(rng.sample(starts, rng.randint(1, 5)))
+        ]
+        fast = _paired_pieces(spans)
+        if fast is not None:
+            assert fast == _energy_pieces(spans), spans
+            compared[len(spans)] += 1
+    assert min(compared[count] for count in range(1, 6)) > 100  # walks of every length
 
 
 # --- properties over random strokes and grids --------------------------------

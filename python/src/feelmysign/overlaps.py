@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import operator
 from collections.abc import Iterable
 
 from feelmysign.schedule import Command
@@ -41,20 +42,29 @@ def commands_from_spans(
     by_actuator: dict[Actuator, list[Span]], min_command_ms: float
 ) -> tuple[Command, ...]:
     """Each actuator's spans merged, as commands sorted by start, then row, then column."""
-    # One actuator's pieces never share a start, so sorting these tuples whole
-    # orders them exactly as that key does.
-    pieces: list[tuple[float, int, int, float, float]] = []
-    append = pieces.append
+    commands: list[Command] = []
+    append = commands.append
     sqrt = math.sqrt
+    # Command(row, column, start, end - start, intensity), without the named tuple's
+    # __new__ (a Python function): the same tuple, made in C.
+    new = tuple.__new__
     for (row, column), spans in by_actuator.items():
         if len(spans) == 1:  # most actuators of a stroke render one burst: _energy_pieces inline
             start, end, intensity = spans[0]
             energy = intensity**2
             if not energy <= 0 and start < end:
                 intensity = sqrt(energy)  # min(1.0, ...) without the builtin call, as below
-                append((start, row, column, end, intensity if intensity < 1.0 else 1.0))
+                append(
+                    new(
+                        Command,
+                        (row, column, start, end - start, intensity if intensity < 1.0 else 1.0),
+                    )
+                )
             continue
-        actuator_pieces = _two_pieces(spans) if len(spans) == 2 else _chained_pieces(spans)
+        if len(spans) == 2:
+            actuator_pieces = _two_pieces(spans)
+        else:
+            actuator_pieces = _paired_pieces(spans) or _chained_pieces(spans)
         if actuator_pieces is None:
             actuator_pieces = _energy_pieces(spans)
         # _join_short's own first test, here: most actuators have no short piece.
@@ -63,27 +73,14 @@ def commands_from_spans(
                 actuator_pieces = _join_short(actuator_pieces, min_command_ms)
                 break
         for start, end, intensity in actuator_pieces:
-            append((start, row, column, end, intensity))
-    pieces.sort()
-    # Command(row, column, start, end - start, intensity), without its __init__
-    # call: the same fields in one dict, for the dozen commands of a stroke.
-    new, set_fields = object.__new__, object.__setattr__
-    commands = []
-    for start, row, column, end, intensity in pieces:
-        command = new(Command)
-        set_fields(
-            command,
-            "__dict__",
-            {
-                "row": row,
-                "column": column,
-                "start_ms": start,
-                "duration_ms": end - start,
-                "intensity": intensity,
-            },
-        )
-        commands.append(command)
+            append(new(Command, (row, column, start, end - start, intensity)))
+    # One actuator's pieces never share a start, so start, row and column order
+    # the commands totally (no two compare equal).
+    commands.sort(key=_START_ROW_COLUMN)
     return tuple(commands)
+
+
+_START_ROW_COLUMN = operator.itemgetter(2, 0, 1)  # of a Command: a sort key made in C
 
 
 def _two_pieces(spans: list[Span]) -> list[Piece] | None:
@@ -124,6 +121,74 @@ def _two_pieces(spans: list[Span]) -> list[Piece] | None:
         pieces[-1] = (before[0], end, before[2])
     else:
         pieces.append((overlap_end, end, last))
+    return pieces
+
+
+def _paired_pieces(spans: list[Span]) -> list[Piece] | None:
+    """``_energy_pieces`` of spans on at most two at a time, by one walk along them.
+
+    That is how most actuators driven by three bursts or more of a stroke get
+    them: each burst overlaps the next, and is over before the one after next
+    starts. So each interval is one span alone or two (summed in the spans'
+    order, as the sweep sums them: ``sum`` of one or two floats is that float,
+    or their float sum), and the walk finds each from the spans' order, without
+    sorting their bounds. None (for the sweeps) unless each span starts after
+    the one before, ends after it starts, and at or before the one after next
+    starts, and has an energy above 0.
+    """
+    energies: list[float] = []
+    before_start = before_end = last_end = -math.inf  # of the span before, of the one before it
+    for start, end, intensity in spans:
+        energy = intensity**2
+        if not (before_start < start < end and before_end <= start and energy > 0):
+            return None
+        energies.append(energy)
+        before_start, before_end, last_end = start, last_end, end
+    # The intervals, each (start, end, energy): one span on alone, or two.
+    intervals: list[Piece] = []
+    add = intervals.append
+    count = len(spans)
+    now, alone_end, _ = spans[0]
+    alone_energy = energies[0]
+    j = 1  # the next span to start
+    while j < count:
+        next_start, next_end, _ = spans[j]
+        next_energy = energies[j]
+        if alone_end <= next_start:  # over before the next starts (or as it starts)
+            add((now, alone_end, alone_energy))
+            now, alone_end, alone_energy = next_start, next_end, next_energy
+            j += 1
+            continue
+        if now < next_start:
+            add((now, next_start, alone_energy))
+        both = alone_energy + next_energy
+        if next_end < alone_end:  # the next one ends first: alone again after it
+            add((next_start, next_end, both))
+            now = next_end
+            j += 1
+        elif alone_end < next_end:  # the next one goes on alone
+            add((next_start, alone_end, both))
+            now, alone_end, alone_energy = alone_end, next_end, next_energy
+            j += 1
+        else:  # both end together: the one after starts at or after that
+            add((next_start, next_end, both))
+            if j + 1 == count:
+                break
+            now, alone_end, _ = spans[j + 1]
+            alone_energy = energies[j + 1]
+            j += 2
+    else:
+        add((now, alone_end, alone_energy))
+    # As the sweeps merge: a piece touching the one before with a close intensity extends it.
+    pieces: list[Piece] = []
+    sqrt, isclose = math.sqrt, math.isclose
+    for start, end, energy in intervals:
+        intensity = sqrt(energy)
+        intensity = intensity if intensity < 1.0 else 1.0
+        if pieces and pieces[-1][1] == start and isclose(pieces[-1][2], intensity):
+            pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
+        else:
+            pieces.append((start, end, intensity))
     return pieces
 
 

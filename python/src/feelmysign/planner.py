@@ -35,7 +35,9 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+import operator
+from collections import defaultdict
+from collections.abc import Iterable, Iterator, Sequence
 
 from feelmysign.apparent_motion import (
     Timing,
@@ -140,33 +142,46 @@ def outline(
             f"stroke needs {duration_ms:.3f} ms, more than the sleeve's maximum of "
             f"{layout.max_stroke_duration_ms:g} ms; send a slower, shorter stroke",
         )
-    points, fractions = virtual_actuators(start, end, merge_distance=merge_distance)
+    # The fractions and timings of every burst: whether they all fit decides which are
+    # kept. Their points and bursts are made when asked for (``Outline.bursts``), or only
+    # the first few of them (``Outline.head``).
+    fractions = _fractions(start, end, merge_distance)
     left_out = 0
     burst_timings = fitting_timings(fractions, duration_ms, min_ms)
     if burst_timings is None:
         kept = thinned(fractions, duration_ms, min_ms)
         left_out = len(fractions) - len(kept)
-        points, fractions = [points[i] for i in kept], [fractions[i] for i in kept]
+        fractions = [fractions[i] for i in kept]
         burst_timings = timings(fractions)
-    bursts = _bursts(points, fractions, burst_timings, duration_ms)
-    return Outline(stroke, layout, duration_ms, adjusted, intensity, min_ms, bursts, left_out)
+    return Outline(
+        stroke,
+        layout,
+        duration_ms,
+        adjusted,
+        intensity,
+        min_ms,
+        (start, end, fractions, burst_timings),
+        left_out,
+    )
 
 
 class Outline:
     """A stroke planned up to its bursts, each ``(x, y, peak_ms, start_ms, duration_ms)``.
 
     What admitting a stroke needs (its duration, whether it was slowed) is
-    here; the commands are not yet. ``schedule()`` makes all of them (what
-    ``plan`` returns); ``head(before_ms)`` only those that start before
-    ``before_ms``, exactly as ``schedule()`` has them, from the few bursts
-    around the actuators they drive: a sleeve starts a long stroke's first
-    motors without planning the rest first.
+    here; the commands are not yet, nor the bursts: only each burst's fraction
+    of the way and timing. ``schedule()`` makes all of them (what ``plan``
+    returns); ``head(before_ms)`` only the commands that start before
+    ``before_ms``, exactly as ``schedule()`` has them, from the few first
+    bursts around the actuators they drive: a sleeve starts a long stroke's
+    first motors without planning the rest first.
     """
 
     __slots__ = (
+        "_bursts",
         "_schedule",
+        "_way",
         "adjusted",
-        "bursts",
         "duration_ms",
         "intensity",
         "layout",
@@ -183,7 +198,7 @@ class Outline:
         adjusted: Adjustment | None,
         intensity: float,
         min_command_ms: float,
-        bursts: list[RawBurst],
+        way: tuple[Point, Point, list[float], list[Timing]],
         thinned: int,
     ) -> None:
         self.stroke = stroke
@@ -192,21 +207,33 @@ class Outline:
         self.adjusted = adjusted
         self.intensity = intensity
         self.min_command_ms = min_command_ms
-        self.bursts = bursts
+        # Start, end, and each burst's fraction of the way and timing (apparent_motion.Timing).
+        self._way = way
         self.thinned = thinned
+        self._bursts: list[RawBurst] | None = None
         self._schedule: Schedule | None = None
+
+    @property
+    def bursts(self) -> list[RawBurst]:
+        """Every burst, in stroke order (made once)."""
+        if self._bursts is None:
+            start, end, fractions, burst_timings = self._way
+            points = _points(start, end, fractions)
+            self._bursts = _bursts(points, fractions, burst_timings, self.duration_ms)
+        return self._bursts
 
     def schedule(self) -> Schedule:
         """The whole schedule (made once)."""
         if self._schedule is None:
             intensity = self.intensity
-            spans = _spans_by_actuator(self.bursts, intensity, self.layout)
+            bursts = self.bursts
+            spans = _spans_by_actuator(bursts, intensity, self.layout)
             self._schedule = Schedule(
                 self.stroke,
                 commands_from_spans(spans, self.min_command_ms),
                 self.duration_ms,
                 self.adjusted,
-                _bursts_of(self.bursts, intensity),
+                _bursts_of(bursts, intensity),
                 self.thinned,
             )
         return self._schedule
@@ -220,34 +247,90 @@ class Outline:
         grid unit of it, and the stroke moves away monotonically along each
         axis, so the bursts are read in order until one lies two grid units or
         more from each of these actuators along some axis: no burst after it
-        comes back.
+        comes back. Bursts start in order (each at least an SOA, 35.8 ms, after
+        the one before), so those starting before ``before_ms`` come first; only
+        the bursts read are made.
         """
         if self._schedule is not None:
             return tuple(c for c in self._schedule.commands if c.start_ms < before_ms)
-        bursts = self.bursts
-        last_early = max((i for i, b in enumerate(bursts) if b[3] < before_ms), default=-1)
         early: set[Actuator] = set()
         spans: dict[Actuator, list[Span]] = {}
-        for i, burst in enumerate(bursts):
-            if i > last_early and _far_from(burst, early):
+        starting = True  # still reading bursts that start before before_ms
+        for burst in self._each_burst():
+            if starting and not burst[3] < before_ms:
+                starting = False
+            if not starting and _far_from(burst, early):
                 break
             drives = _spans_by_actuator([burst], self.intensity, self.layout)
             for actuator, actuator_spans in drives.items():
                 spans.setdefault(actuator, []).extend(actuator_spans)
-                if i <= last_early and burst[3] < before_ms:
+                if starting:
                     early.add(actuator)
         commands = commands_from_spans({a: spans[a] for a in early}, self.min_command_ms)
         return tuple(c for c in commands if c.start_ms < before_ms)
+
+    def _each_burst(self) -> Iterator[RawBurst]:
+        """The bursts in order, each made as ``bursts`` makes it, as they are asked for."""
+        if self._bursts is not None:
+            yield from self._bursts
+            return
+        start, end, fractions, burst_timings = self._way
+        t = self.duration_ms
+        latest_end = t + overrun_allowance_ms(t)
+        last = len(fractions) - 1
+        (x0, y0), (x1, y1) = start, end
+        dx, dy = x1 - x0, y1 - y0
+        for i, f in enumerate(fractions):
+            if f == 0.0:  # _points, for one fraction
+                x, y = start
+            elif f == 1.0:
+                x, y = end
+            else:
+                x, y = x0 + dx * f, y0 + dy * f
+                nearest = round(x)
+                if abs(x - nearest) <= ON_LINE_EPSILON:
+                    x = float(nearest)
+                nearest = round(y)
+                if abs(y - nearest) <= ON_LINE_EPSILON:
+                    y = float(nearest)
+            onset_a, onset_b, length_a, length_b = burst_timings[i]
+            start_ms = onset_a * t + onset_b
+            if i < last:  # as _bursts makes them
+                length_ms = length_a * t + length_b
+                if start_ms + length_ms > latest_end:
+                    length_ms = latest_end - start_ms
+            else:
+                length_ms = t - start_ms
+            yield (x, y, f * t, start_ms, length_ms)
 
     def energy_bound_ms(self) -> float:
         """At least the energy (intensity squared x ms) any one actuator gets from the stroke.
 
         Funneling splits a burst's energy among its actuators, overlaps add
         energies (capped at full drive) and a join keeps them: so no actuator
-        gets more than the bursts' energy together.
+        gets more than the bursts' energy together. Before the bursts are made
+        (a stroke's first motors start before that), from their timings: the
+        sum of their lengths before any is cut at the overrun allowance (a cut
+        only shortens a burst), as ``T * sum(a) + sum(b)`` (summed in C, not per
+        burst), with a margin far above its rounding.
         """
         energy = self.intensity**2
-        return sum(energy * d for _, _, _, _, d in self.bursts if d > 0)
+        if self._bursts is not None:
+            return sum(energy * d for _, _, _, _, d in self._bursts if d > 0)
+        burst_timings = self._way[3]
+        slopes: float = sum(map(_LENGTH_A, burst_timings))
+        intercepts_ms: float = sum(map(_LENGTH_B, burst_timings))
+        total_ms = self.duration_ms * slopes + intercepts_ms
+        margin_ms = _BOUND_MARGIN_MS * len(burst_timings)
+        return energy * (total_ms * (1 + _BOUND_MARGIN) + margin_ms)
+
+
+# Of a burst's timing (apparent_motion.Timing): its length's coefficients, length = a T + b.
+_LENGTH_A, _LENGTH_B = operator.itemgetter(2), operator.itemgetter(3)
+# The rounding of a sum of lengths computed two ways is about 1e-16 of it: far below these.
+# A length may also fall short of 0 by a rounding when the shortest burst is 0 ms.
+_BOUND_MARGIN = 1e-9
+_BOUND_MARGIN_MS = 1e-6
 
 
 def overrun_allowance_ms(duration_ms: float) -> float:
@@ -320,17 +403,29 @@ def virtual_actuators(
     ``merge_distance`` become one (an endpoint wins; otherwise their midpoint,
     which still lies on the stroke). A stroke of zero length has one point.
     """
+    fractions = _fractions(start, end, merge_distance)
+    return _points(start, end, fractions), fractions
+
+
+def _fractions(start: Point, end: Point, merge_distance: float) -> list[float]:
+    """The fractions of the way of ``virtual_actuators``."""
     length = math.dist(start, end)
     if length <= ON_LINE_EPSILON:
-        return [start], [0.0]
+        return [0.0]
     (x0, y0), (x1, y1) = start, end
     crossings = _line_crossings(x0, x1)
     crossings += _line_crossings(y0, y1)
     if len(crossings) > 1:
         crossings = sorted(set(crossings))  # a stroke through an actuator crosses both lines there
-    fractions = _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
+    return _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
+
+
+def _points(start: Point, end: Point, fractions: Iterable[float]) -> list[Point]:
+    """The points of the way at these fractions: the endpoints themselves at 0 and 1, each
+    crossing snapped onto the grid line it crosses."""
     points: list[Point] = []
     append = points.append
+    (x0, y0), (x1, y1) = start, end
     dx, dy = x1 - x0, y1 - y0
     for f in fractions:
         if f == 0.0:
@@ -347,7 +442,7 @@ def virtual_actuators(
             if abs(y - nearest) <= ON_LINE_EPSILON:
                 y = float(nearest)
             append((x, y))
-    return points, fractions
+    return points
 
 
 def _line_crossings(a: float, b: float) -> list[float]:
@@ -421,26 +516,10 @@ def _bursts(
 
 
 def _bursts_of(bursts: list[RawBurst], intensity: float) -> tuple[Burst, ...]:
-    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, without its __init__
-    call: the same fields in one dict, as ``commands_from_spans`` makes its commands."""
-    new, set_fields = object.__new__, object.__setattr__
-    result = []
-    for x, y, peak_ms, start_ms, duration_ms in bursts:
-        burst = new(Burst)
-        set_fields(
-            burst,
-            "__dict__",
-            {
-                "x": x,
-                "y": y,
-                "peak_ms": peak_ms,
-                "start_ms": start_ms,
-                "duration_ms": duration_ms,
-                "intensity": intensity,
-            },
-        )
-        result.append(burst)
-    return tuple(result)
+    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, made in C as
+    ``commands_from_spans`` makes its commands (the named tuple's __new__ is Python)."""
+    new = tuple.__new__
+    return tuple([new(Burst, (*burst, intensity)) for burst in bursts])
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
@@ -492,42 +571,72 @@ def _spans_by_actuator(
     bursts: Iterable[RawBurst], intensity: float, layout: Layout
 ) -> dict[Actuator, list[Span]]:
     """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
-    by_actuator: dict[Actuator, list[Span]] = {}
+    if not intensity >= _LEAST_SAFE_INTENSITY:
+        return _spans_by_actuator_checked(bursts, intensity, layout)
+    by_actuator: defaultdict[Actuator, list[Span]] = defaultdict(list)
     last_column, last_row = layout.columns - 1, layout.rows - 1
     sqrt, floor = math.sqrt, math.floor
     for x, y, _, span_start, length_ms in bursts:
         if length_ms <= 0:
             continue
         span_end = span_start + length_ms  # as Command.end_ms computes it
-        # _axis_weights of x and of y, and _funneled, unrolled into this loop:
-        # no call and no list per burst on the planning path.
-        low = floor(x)
-        if low > last_column:
-            low = last_column
-        fraction = x - low
-        if fraction <= ON_LINE_EPSILON:
-            column_weights: tuple[tuple[int, float], ...] = ((low, 1.0),)
-        elif fraction >= _OFF_LINE:
-            column_weights = ((low + 1, 1.0),)
-        else:
-            column_weights = ((low, 1.0 - fraction), (low + 1, fraction))
-        low = floor(y)
-        if low > last_row:
-            low = last_row
-        fraction = y - low
-        if fraction <= ON_LINE_EPSILON:
-            row_weights: tuple[tuple[int, float], ...] = ((low, 1.0),)
-        elif fraction >= _OFF_LINE:
-            row_weights = ((low + 1, 1.0),)
-        else:
-            row_weights = ((low, 1.0 - fraction), (low + 1, fraction))
-        for row, wy in row_weights:
-            for column, wx in column_weights:
-                value = intensity * sqrt(wx * wy)
-                if value > 0:
-                    spans = by_actuator.get((row, column))
-                    if spans is None:
-                        by_actuator[(row, column)] = [(span_start, span_end, value)]
-                    else:
-                        spans.append((span_start, span_end, value))
+        # _funneled, unrolled for each case of _axis_weights of x and of y: no call,
+        # no list and no loop per burst on the planning path. A weight of 1.0 leaves
+        # intensity * sqrt(wx * wy) as it is (times 1.0 and sqrt(1.0) are exact).
+        column = floor(x)
+        if column > last_column:
+            column = last_column
+        fx = x - column
+        row = floor(y)
+        if row > last_row:
+            row = last_row
+        fy = y - row
+        if fx <= ON_LINE_EPSILON or fx >= _OFF_LINE:  # on a column line
+            if fx > ON_LINE_EPSILON:
+                column += 1
+            if fy <= ON_LINE_EPSILON or fy >= _OFF_LINE:  # on an actuator
+                if fy > ON_LINE_EPSILON:
+                    row += 1
+                by_actuator[(row, column)].append((span_start, span_end, intensity))
+            else:  # between two rows
+                by_actuator[(row, column)].append(
+                    (span_start, span_end, intensity * sqrt(1.0 - fy))
+                )
+                by_actuator[(row + 1, column)].append((span_start, span_end, intensity * sqrt(fy)))
+        elif fy <= ON_LINE_EPSILON or fy >= _OFF_LINE:  # on a row line, between two columns
+            if fy > ON_LINE_EPSILON:
+                row += 1
+            by_actuator[(row, column)].append((span_start, span_end, intensity * sqrt(1.0 - fx)))
+            by_actuator[(row, column + 1)].append((span_start, span_end, intensity * sqrt(fx)))
+        else:  # inside a cell: its four corners
+            wx = 1.0 - fx
+            wy = 1.0 - fy
+            by_actuator[(row, column)].append((span_start, span_end, intensity * sqrt(wx * wy)))
+            by_actuator[(row, column + 1)].append((span_start, span_end, intensity * sqrt(fx * wy)))
+            by_actuator[(row + 1, column)].append((span_start, span_end, intensity * sqrt(wx * fy)))
+            by_actuator[(row + 1, column + 1)].append(
+                (span_start, span_end, intensity * sqrt(fx * fy))
+            )
+    return by_actuator
+
+
+# Above this, intensity times a funneling weight (at least 1e-9, see
+# ON_LINE_EPSILON) is never 0: no span of a stroke so intense is empty.
+_LEAST_SAFE_INTENSITY = 1e-280
+
+
+def _spans_by_actuator_checked(
+    bursts: Iterable[RawBurst], intensity: float, layout: Layout
+) -> dict[Actuator, list[Span]]:
+    """``_spans_by_actuator`` for a stroke so faint (or off) that a span may be 0: left out."""
+    by_actuator: dict[Actuator, list[Span]] = {}
+    for x, y, _, span_start, length_ms in bursts:
+        if length_ms <= 0:
+            continue
+        burst = Burst(x, y, 0.0, span_start, length_ms, intensity)
+        for row, column, value in _funneled(burst, layout):
+            if value > 0:
+                by_actuator.setdefault((row, column), []).append(
+                    (span_start, span_start + length_ms, value)
+                )
     return by_actuator

@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from feelmysign.frozen_init import dict_init
 from feelmysign.stroke import Stroke
 
 
-@dict_init
-@dataclass(frozen=True)
-class Command:
-    """One physical actuator on at a constant intensity, times relative to the stroke's start."""
+class Command(NamedTuple):
+    """One physical actuator on at a constant intensity, times relative to the stroke's start.
+
+    A named tuple: a planned stroke makes a dozen commands before its first motor
+    starts, and the planner makes each in one C call (``tuple.__new__``), with no
+    __init__ and no __dict__ (a frozen dataclass's setattr per field took a
+    quarter of planning a stroke).
+    """
 
     row: int
     column: int
@@ -24,13 +29,11 @@ class Command:
         return self.start_ms + self.duration_ms
 
 
-@dict_init
-@dataclass(frozen=True)
-class Burst:
+class Burst(NamedTuple):
     """One virtual actuator of a stroke: a point in grid units felt around its peak time.
 
     ``start_ms`` and ``duration_ms`` are the burst's onset and length, shared by
-    the physical actuators that render it (funneling).
+    the physical actuators that render it (funneling). A named tuple, as Command.
     """
 
     x: float
