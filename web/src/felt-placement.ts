@@ -15,7 +15,7 @@
  * Pure: no DOM, no clock.
  */
 import type { FeltStroke, PlacedStroke } from "./felt";
-import { EMPTY_TAIL_MS, queueStartMs } from "./sleeve-queue";
+import { EMPTY_TAIL_MS, queueCatchUpMs, queueStartMs, SLEEVE_FLOOR_MS } from "./sleeve-queue";
 
 export class FeltPlacement {
   /** Shifted strokes (arrival relative to the first stroke's), in seq order. */
@@ -37,6 +37,9 @@ export class FeltPlacement {
   #descents = 0;
   /** The earliest time (ms) whose picture changed since `takeDirty`; "all" after a rebuild. */
   #dirty: number | "all" | null = "all";
+
+  /** `floorMs`: the sleeve's floor, down to which a stroke that waits catches up. */
+  constructor(readonly floorMs: number = SLEEVE_FLOOR_MS) {}
 
   /** Every stroke again (a new drawing, an undo, another arrival): placed from scratch. */
   reset(strokes: readonly FeltStroke[] = []): void {
@@ -174,12 +177,17 @@ export class FeltPlacement {
         this.#anchor = { index, offsetMs: reported - estimateMs };
         return;
       }
-      tail = estimateMs + this.#playedMs(stroke);
+      tail = estimateMs + this.#playedMs(stroke, this.#durationMs(stroke, tail));
     }
   }
 
-  #playedMs(stroke: FeltStroke): number {
-    return Math.min(stroke.duration_ms, Math.max(0, this.#cut.get(stroke.seq) ?? stroke.duration_ms));
+  /** How long the sleeve plays the stroke behind a queue ending at `tailMs` (it catches up). */
+  #durationMs(stroke: FeltStroke, tailMs: number): number {
+    return queueCatchUpMs(stroke.arrives_ms, tailMs, stroke.duration_ms, this.floorMs);
+  }
+
+  #playedMs(stroke: FeltStroke, durationMs: number): number {
+    return Math.min(durationMs, Math.max(0, this.#cut.get(stroke.seq) ?? durationMs));
   }
 
   /**
@@ -203,14 +211,22 @@ export class FeltPlacement {
       const reportedAt = offset === undefined ? undefined : this.#startedAt.get(stroke.seq);
       const known = reportedAt === undefined ? undefined : reportedAt - offset!;
       const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
-      const played_ms = this.#playedMs(stroke);
+      const duration_ms = this.#durationMs(stroke, tail);
+      const played_ms = this.#playedMs(stroke, duration_ms);
       tail = start_ms + played_ms;
       const old = this.#placed[i];
-      const placed: PlacedStroke = { ...stroke, start_ms, reported: known !== undefined, played_ms };
+      const placed: PlacedStroke = {
+        ...stroke,
+        duration_ms,
+        start_ms,
+        reported: known !== undefined,
+        played_ms,
+      };
       if (
         i > from &&
         old !== undefined &&
         old.start_ms === start_ms &&
+        old.duration_ms === duration_ms &&
         old.played_ms === played_ms &&
         old.reported === placed.reported
       ) {

@@ -10,10 +10,12 @@
  * Times: where the sleeve told when it played a stroke, that time; otherwise
  * the sleeve's own rule (docs/protocol.md, "Playback"; `queueStartMs` in
  * sleeve-queue.ts, pinned by testdata/queue): a stroke starts when it arrives,
- * or when the one before it ends if that is later.
+ * or when the one before it ends if that is later, and one that waits plays
+ * faster to catch up, down to the sleeve's floor (`queueCatchUpMs`): the strokes
+ * placed here are one drawing's.
  */
 import type { Point } from "./simplify/segment";
-import { EMPTY_TAIL_MS, queueStartMs } from "./sleeve-queue";
+import { EMPTY_TAIL_MS, queueCatchUpMs, queueStartMs, SLEEVE_FLOOR_MS } from "./sleeve-queue";
 
 export interface FeltStroke {
   readonly seq: number;
@@ -25,6 +27,7 @@ export interface FeltStroke {
   readonly arrives_ms: number;
 }
 
+/** `duration_ms` of a placed stroke is how long the sleeve plays it: shorter when it caught up. */
 export interface PlacedStroke extends FeltStroke {
   /** When it plays, ms on the timeline's clock. */
   readonly start_ms: number;
@@ -48,22 +51,26 @@ export interface Drive {
 
 /**
  * Places strokes in time: a reported start wins; otherwise arrival, or the end
- * of the stroke before, whichever is later. `reported` maps seq -> start (ms);
- * `cut` maps seq -> ms after its start when a cancel stopped it.
+ * of the stroke before, whichever is later. A stroke arriving before the one
+ * before it ends plays faster, down to `floorMs` (the sleeve's catch-up rule).
+ * `reported` maps seq -> start (ms); `cut` maps seq -> ms after its start when
+ * a cancel stopped it.
  */
 export function placeStrokes(
   strokes: readonly FeltStroke[],
   reported: ReadonlyMap<number, number> = new Map(),
   cut: ReadonlyMap<number, number> = new Map(),
+  floorMs: number = SLEEVE_FLOOR_MS,
 ): PlacedStroke[] {
   const placed: PlacedStroke[] = [];
   let tail = EMPTY_TAIL_MS;
   for (const stroke of [...strokes].sort((a, b) => a.seq - b.seq)) {
     const known = reported.get(stroke.seq);
     const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
-    const played_ms = Math.min(stroke.duration_ms, Math.max(0, cut.get(stroke.seq) ?? stroke.duration_ms));
+    const duration_ms = queueCatchUpMs(stroke.arrives_ms, tail, stroke.duration_ms, floorMs);
+    const played_ms = Math.min(duration_ms, Math.max(0, cut.get(stroke.seq) ?? duration_ms));
     tail = start_ms + played_ms;
-    placed.push({ ...stroke, start_ms, reported: known !== undefined, played_ms });
+    placed.push({ ...stroke, duration_ms, start_ms, reported: known !== undefined, played_ms });
   }
   return placed;
 }

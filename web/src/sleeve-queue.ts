@@ -2,8 +2,11 @@
  * The sleeve's queue, as the sleeve runs it (python feelmysign.sleeve.queue, pinned by
  * the vectors in testdata/queue): strokes play back to back in the order they arrive,
  * each starting when it arrives or when the stroke before it ends, whichever is later.
- * `queueStartMs` is the page's one copy of that rule; `replayQueue` runs it over arrivals,
- * copies and cancels as the sleeve does, so the vectors check it.
+ * `queueStartMs` is the page's one copy of that rule. A stroke that arrives behind a stroke of
+ * its own drawing plays faster, by as much as the sleeve is behind, down to the sleeve's floor
+ * and never slower than it came (docs/protocol.md, "Playback"): `queueCatchUpMs` is the
+ * page's one copy of that rule. `replayQueue` runs both over arrivals, copies and cancels as
+ * the sleeve does, so the vectors check them.
  *
  * Pure: no DOM, no clock.
  */
@@ -14,6 +17,28 @@ export const EMPTY_TAIL_MS = Number.NEGATIVE_INFINITY;
 /** When a stroke that arrives at `arrivalMs` starts behind a queue that ends at `tailMs`. */
 export function queueStartMs(arrivalMs: number, tailMs: number): number {
   return Math.max(arrivalMs, tailMs);
+}
+
+/**
+ * The paper sleeve's floor: the shortest stroke its ERM motors play without slowing it (two
+ * end bursts of 20 ms in apparent motion, python `shortest_planned_ms`). Catching up stops here.
+ */
+export const SLEEVE_FLOOR_MS = 73.701;
+
+/**
+ * How long a stroke of `durationMs` plays when it arrives at `arrivalMs` behind strokes of its
+ * drawing that end at `tailMs`: shorter by how far the sleeve is behind, down to `floorMs`,
+ * never longer than it came.
+ */
+export function queueCatchUpMs(
+  arrivalMs: number,
+  tailMs: number,
+  durationMs: number,
+  floorMs: number,
+): number {
+  const behindMs = tailMs - arrivalMs;
+  if (behindMs <= 0 || durationMs <= floorMs) return durationMs;
+  return Math.max(floorMs, durationMs - behindMs);
 }
 
 /** A stroke reaching the sleeve (drawing and seq absent in the legacy format). */
@@ -44,13 +69,18 @@ interface Planned {
   readonly seq: number | undefined;
 }
 
-/** What becomes of each stroke of `steps` (in the order they reach the sleeve): one outcome per stroke. */
-export function replayQueue(steps: readonly QueueStep[]): QueueOutcome[] {
+/**
+ * What becomes of each stroke of `steps` (in the order they reach the sleeve): one outcome per
+ * stroke. Strokes behind their own drawing catch up down to `floorMs`.
+ */
+export function replayQueue(steps: readonly QueueStep[], floorMs: number): QueueOutcome[] {
   const outcomes: (QueueOutcome | null)[] = [];
   const planned = new Map<number, Planned>();
   const seen = new Set<string>();
   const cancelled = new Set<string>();
   let tail = EMPTY_TAIL_MS;
+  // The drawing of the stroke ending at the tail (only a stroke with drawing and seq has one).
+  let tailDrawing: string | undefined = undefined;
   for (const step of steps) {
     if ("cancel" in step) {
       const now = step.at_ms;
@@ -63,7 +93,13 @@ export function replayQueue(steps: readonly QueueStep[]): QueueOutcome[] {
             : { outcome: "cancelled" };
       }
       tail = EMPTY_TAIL_MS;
-      for (const p of planned.values()) tail = Math.max(tail, p.start_ms + p.duration_ms);
+      tailDrawing = undefined;
+      for (const p of planned.values()) {
+        if (p.start_ms + p.duration_ms > tail) {
+          tail = p.start_ms + p.duration_ms;
+          tailDrawing = p.drawing;
+        }
+      }
       if (step.cancel !== "*") cancelled.add(step.cancel);
       continue;
     }
@@ -81,12 +117,17 @@ export function replayQueue(steps: readonly QueueStep[]): QueueOutcome[] {
       continue;
     }
     if (key !== null) seen.add(key);
+    const behindOwn = key !== null && drawing === tailDrawing;
+    const duration_ms = behindOwn
+      ? queueCatchUpMs(step.arrival_ms, tail, step.duration_ms, floorMs)
+      : step.duration_ms;
     const start_ms = queueStartMs(step.arrival_ms, tail);
-    tail = start_ms + step.duration_ms;
+    tail = start_ms + duration_ms;
+    tailDrawing = key !== null ? drawing : undefined;
     planned.set(outcomes.length, {
       index: outcomes.length,
       start_ms,
-      duration_ms: step.duration_ms,
+      duration_ms,
       drawing,
       seq,
     });

@@ -1,6 +1,7 @@
 /** The incremental placement gives what placing every stroke again from scratch gives. */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
+import { SLEEVE_FLOOR_MS } from "../src/sleeve-queue";
 import { placeStrokes, playingAt, totalMs, type FeltStroke, type PlacedStroke } from "../src/felt";
 import { FeltPlacement } from "../src/felt-placement";
 
@@ -99,8 +100,10 @@ describe("FeltPlacement", () => {
     const all = new FeltPlacement();
     all.reset([...strokes].reverse());
     expect(all.placed).toEqual(one.placed);
-    expect(all.placed.map((s) => s.start_ms)).toEqual([0, 100, 200, 300]);
-    expect(all.bySeq(2)?.start_ms).toBe(200);
+    // Each waits behind the one before, so plays at the sleeve's floor.
+    const F = SLEEVE_FLOOR_MS;
+    expect(all.placed.map((s) => s.start_ms)).toEqual([0, 100, 100 + F, 100 + F + F]);
+    expect(all.bySeq(2)?.start_ms).toBe(100 + F);
   });
 
   it("says from when the picture changed, and everything after a reset", () => {
