@@ -7,6 +7,10 @@ import threading
 from typing import Any
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from vectors import load
+
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.backends.sim import SimBackend
 from feelmysign.events import Event, Played
@@ -26,9 +30,6 @@ from feelmysign.sleeve.queue import (
     start_ms,
 )
 from feelmysign.stroke import Stroke
-from hypothesis import given
-from hypothesis import strategies as st
-from vectors import load
 
 CASES = load("queue")
 
