@@ -226,3 +226,16 @@ def test_the_player_plays_a_stroke_behind_its_drawing_faster_and_says_so() -> No
             schedule.duration_ms
         )
         assert all(c.start_ms >= 0 and c.duration_ms > 0 for c in schedule.commands)
+
+
+def test_a_stroke_planned_faster_before_the_lock_is_planned_again_when_the_queue_moved() -> None:
+    # The player plans a waiting stroke faster before it takes its lock (the queue as it then
+    # stood); when a cancel moved the tail meanwhile, the duration decided under the lock wins.
+    player = Player(SimBackend(PAPER), PAPER)
+    stroke = PlannedStroke(outline(Stroke((0.0, 0.0), (3.0, 2.0), 600.0), PAPER), 0.0, 0.0, {})
+    stale = outline(Stroke((0.0, 0.0), (3.0, 2.0), 100.0), PAPER)
+    assert player._catch_up(stroke, 250.0, stale) == 250.0
+    assert stroke.schedule.duration_ms == 250.0 and stroke.compressed_ms == 350.0
+    fresh = outline(Stroke((0.0, 0.0), (3.0, 2.0), 200.0), PAPER)
+    again = PlannedStroke(outline(Stroke((0.0, 0.0), (3.0, 2.0), 600.0), PAPER), 0.0, 0.0, {})
+    assert player._catch_up(again, 200.0, fresh) == 200.0 and again.schedule is fresh

@@ -181,6 +181,10 @@ class Player:
         drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
         if not self._running:
             return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
+        # A stroke that will wait may play faster (catch up): planned before the lock, so the
+        # player's thread is not held up meanwhile; checked under the lock (a cancel may have
+        # moved the tail since). An idle sleeve's stroke pays one comparison here.
+        faster = self._faster(stroke) if self._queue.tail_ms > stroke.received_at_ms else None
         with self._lock:
             if self._queue.seen(drawing, seq):
                 return _duplicate(drawing, seq)
@@ -193,7 +197,7 @@ class Player:
                     stroke.received_at_ms, duration_ms, self._floor_ms, drawing
                 )
                 if fast_ms < duration_ms:  # behind its drawing: it waits, so no first command
-                    duration_ms = self._catch_up(stroke, fast_ms)
+                    duration_ms = self._catch_up(stroke, fast_ms, faster)
                 self._unplayed[(drawing, seq)] = stroke
                 start_ms = self._queue.place(stroke.received_at_ms, duration_ms, drawing, seq)
             else:
@@ -209,11 +213,25 @@ class Player:
         self._wake.set()  # the player plans its next wake-up (and plays the stroke if we did not)
         return None
 
-    def _catch_up(self, stroke: PlannedStroke, duration_ms: float) -> float:
-        """Under the lock: the stroke planned again to play in ``duration_ms``; the duration
-        it now plays in."""
+    def _faster(self, stroke: PlannedStroke) -> Outline | None:
+        """Outside the lock: the stroke planned to catch up with its drawing as the queue stands
+        now (a hint: the tail is read without the lock), or None."""
+        drawing, given = stroke.info.get("drawing"), stroke.schedule
+        if not isinstance(drawing, str):
+            return None
+        fast_ms = self._queue.catch_up_ms(
+            stroke.received_at_ms, given.duration_ms, self._floor_ms, drawing
+        )
+        return caught_up(given, fast_ms, self._layout) if fast_ms < given.duration_ms else None
+
+    def _catch_up(self, stroke: PlannedStroke, duration_ms: float, hint: Outline | None) -> float:
+        """Under the lock: the stroke planned again to play in ``duration_ms`` (``hint`` when it
+        was planned so before the lock, else now); the duration it now plays in."""
         given = stroke.schedule
-        faster = caught_up(given, duration_ms, self._layout)
+        if hint is not None and hint.duration_ms == duration_ms:
+            faster: Outline | None = hint
+        else:
+            faster = caught_up(given, duration_ms, self._layout)
         if faster is None:
             return given.duration_ms
         stroke.schedule = faster
