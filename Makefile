@@ -26,6 +26,7 @@ SYSTEM_PACKAGES := mosquitto mosquitto-clients
 TEST_JOBS ?= 3
 
 .PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study system clean
+.PHONY: bench-prepare bench-timed bench-prepare-python bench-timed-python
 
 help:
 	@echo "make up      set up and start everything (broker, sleeve simulator, drawing client);"
@@ -33,7 +34,8 @@ help:
 	@echo "make test    install what is needed, then lint, type-check and run every test,"
 	@echo "             side by side (TEST_JOBS=3 lanes; each part's output printed whole when it ends)"
 	@echo "make check   the same parts one at a time"
-	@echo "make bench   print performance figures (a few minutes)"
+	@echo "make bench   print performance figures (at most 5 minutes on a quiet 2-core machine: what they"
+	@echo "             need built side by side, then one timed part at a time)"
 	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
 	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
@@ -106,8 +108,25 @@ test:
 	  || { echo "==> make test: FAILED (the parts marked Error above)" >&2; exit 1; }
 	@echo "==> make test: every part passed"
 
+# make bench: first what the figures need, built side by side (`bench-prepare`: the page,
+# the LASA frames, the Java jar, and the felt-drawing group, whose figures are simulated
+# times, not timings); then every timed part one after another (`bench-timed`), so that no
+# two timings share the cores. The total wall time is printed at the end.
 bench: $(STAMP) system
-	$(PY) -m feelmysign.bench
+	@echo "==> make bench: what the figures need, side by side (each part's output printed whole when it"
+	@echo "    ends); then the timed parts one at a time. Load average now: $$(cut -d' ' -f1-3 /proc/loadavg)"
+	@started=$$(date +%s); \
+	$(MAKE) --no-print-directory -j3 --output-sync=target bench-prepare \
+	  && $(MAKE) --no-print-directory -j1 bench-timed; status=$$?; \
+	echo "make bench: $$(( $$(date +%s) - started )) s in all (load average now: $$(cut -d' ' -f1-3 /proc/loadavg))"; \
+	exit $$status
+
+# The Python groups, untimed first (bench-prepare), then the timed ones (bench-timed).
+bench-prepare-python: $(STAMP)
+	$(PY) -m feelmysign.bench simplifier_timing
+
+bench-timed-python: $(STAMP) system
+	$(PY) -m feelmysign.bench --without simplifier_timing
 
 # The study analysis's coverage over many seeded simulated studies (python -m
 # feelmysign.bench.study_recovery; about 50 minutes at 400 runs), apart from make bench.
@@ -136,6 +155,7 @@ NPM_QUIET := --no-audit --no-fund --loglevel=error
 SYSTEM_PACKAGES += chromium
 
 .PHONY: web-build web-test web-typecheck web-format-check web-unit web-browser-test web-bench web-clean
+.PHONY: bench-timed-web
 
 $(WEB_STAMP): $(WEB)/package.json $(WEB)/package-lock.json
 	@command -v npm >/dev/null || { echo "Error: npm not found; install Node.js 20.19 or newer with npm, then run make again." >&2; exit 1; }
@@ -168,8 +188,14 @@ LASA_FRAMES := $(WEB)/bench/.lasa-frames.json
 $(LASA_FRAMES): $(STAMP) python/src/feelmysign/bench/lasa_points.py python/src/feelmysign/research/lasa.py python/src/feelmysign/simplify/frames.py
 	$(PY) -m feelmysign.bench.lasa_points $@
 
+WEB_BENCH := cd $(WEB) && $(WEB_BIN)/tsx bench/run.ts
+
 web-bench: web-build system $(LASA_FRAMES)
-	cd $(WEB) && $(WEB_BIN)/tsx bench/run.ts
+	$(WEB_BENCH)
+
+# In make bench: built in bench-prepare, run in bench-timed.
+bench-timed-web:
+	$(WEB_BENCH)
 
 web-clean:
 	rm -rf $(WEB)/node_modules $(WEB)/dist $(WEB)/test-results
@@ -177,7 +203,8 @@ web-clean:
 # The web client joins the project-wide targets (extra prerequisites; their recipes stay above).
 install: $(WEB_STAMP)
 check: web-test
-bench: web-bench
+bench: $(WEB_STAMP)
+bench-prepare: web-build $(LASA_FRAMES)
 up: web-build
 clean: web-clean
 # ==== end of web ===========================================================================
@@ -225,7 +252,7 @@ SYSTEM_PACKAGES += maven openjdk-17-jdk-headless
 # Xvfb (and xauth, for xvfb-run): the Processing library's example sketch runs on a virtual screen.
 SYSTEM_PACKAGES += xvfb xauth
 
-.PHONY: java-build java-test java-bench java-clean processing-library
+.PHONY: java-build java-test java-bench java-clean processing-library java-bench-jar bench-timed-java
 
 # Resolves every dependency and plugin (a build without tests) once per change of a pom.
 $(JAVA_STAMP): $(JAVA_POMS) | system
@@ -252,9 +279,17 @@ java-test: $(JAVA_STAMP) $(STAMP) system
 # The Java simplifiers' throughput on the LASA frames of the web bench, beside a baseline
 # measured in the same JVM run.
 # Only the command line's jar is built for it (not the Processing library's zip and javadoc).
-java-bench: $(JAVA_STAMP) $(LASA_FRAMES)
+JAVA_BENCH := java -cp $(JAVA_DIR)/cli/target/feelmysign-java.jar feelmysign.cli.Bench $(LASA_FRAMES)
+
+java-bench: java-bench-jar $(LASA_FRAMES)
+	$(JAVA_BENCH)
+
+java-bench-jar: $(JAVA_STAMP)
 	$(MVN) -DskipTests -pl cli -am package
-	java -cp $(JAVA_DIR)/cli/target/feelmysign-java.jar feelmysign.cli.Bench $(LASA_FRAMES)
+
+# In make bench: built in bench-prepare, run in bench-timed.
+bench-timed-java:
+	$(JAVA_BENCH)
 
 # The Processing library for Processing 4's Contribution Manager (docs/processing.md):
 # java/processing/target/dist/feelmysign.zip and feelmysign.txt beside it.
@@ -265,6 +300,12 @@ java-clean:
 	rm -rf $(JAVA_DIR)/*/target
 
 install: $(JAVA_STAMP)
-bench: java-bench
+bench: $(JAVA_STAMP)
+bench-prepare: java-bench-jar
 clean: java-clean
 # ==== end of Java ==========================================================================
+
+# ==== make bench, all parts together (see the bench target at the top) ======================
+# bench-prepare's parts are listed with each part above; the timed ones run in this order.
+bench-prepare: bench-prepare-python
+bench-timed: bench-timed-web bench-timed-java bench-timed-python

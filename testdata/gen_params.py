@@ -104,12 +104,27 @@ def typescript() -> str:
         *(_member(s) for s in PARAMETERS.values() if s.panel is not None),
         "}",
     ]
+    # The shared parameters once, after each simplifier's own (a dataclass lists its last
+    # base's fields first), so the lists do not repeat them.
+    shared_list = [f.name for f in shared]
+    lines += [
+        "",
+        "/** The parameters every simplifier has, in the reference's order (after its own). */",
+        *_array("export const SHARED_PARAM_NAMES = ", shared_list, " as const;"),
+    ]
     for algorithm in ALGORITHMS.values():
         names = [f.name for f in fields(algorithm.params)]
+        own = names[: len(names) - len(shared_list)]
+        if own + shared_list != names:
+            raise ValueError(f"{algorithm.name}: its shared parameters are not its last ones")
         lines += [
             "",
             f"/** The {algorithm.name} simplifier's parameters, in the reference's order. */",
-            *_array(f"export const {algorithm.name.upper()}_PARAM_NAMES = ", names, " as const;"),
+            *_array(
+                f"export const {algorithm.name.upper()}_PARAM_NAMES = ",
+                [*own, _Spread("SHARED_PARAM_NAMES")],
+                " as const;",
+            ),
         ]
     lines += [
         "",
@@ -141,8 +156,17 @@ def _array(head: str, values: list[Any], tail: str) -> list[str]:
     return [f"{head}[", *(f"{indent}{item}," for item in items), f"{indent[:-2]}]{tail}"]
 
 
+@dataclass(frozen=True)
+class _Spread:
+    """``...name`` in an array literal."""
+
+    name: str
+
+
 def _literal(value: Any) -> str:
     """A JSON value as a TypeScript literal; a whole number without its ``.0`` (as JS prints it)."""
+    if isinstance(value, _Spread):
+        return f"...{value.name}"
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return json.dumps(value, ensure_ascii=False)
@@ -210,18 +234,27 @@ def java() -> str:
         f"  public static final String DEFAULT_ALGORITHM = {_java(DEFAULT_ALGORITHM)};",
         "",
     ]
+    # Each order as one string of names (a list literal a name a line would repeat the shared
+    # parameters in every simplifier's list).
     algorithms = _Call(
         "ordered",
         [
             _Call(
                 "Map.entry",
-                [_java(a.name), _Call("List.of", [_java(f.name) for f in fields(a.params)])],
+                [
+                    _java(a.name),
+                    _Call("names", [_java(" ".join(f.name for f in fields(a.params)))]),
+                ],
             )
             for a in ALGORITHMS.values()
         ],
     )
     rows = _Call("List.of", [_java_row(name, spec) for name, spec in PARAMETERS.items()])
     footer = [
+        "",
+        "  private static List<String> names(String spaced) {",
+        '    return List.of(spaced.split(" "));',
+        "  }",
         "",
         "  @SafeVarargs",
         "  private static <V> Map<String, V> ordered(Map.Entry<String, V>... entries) {",

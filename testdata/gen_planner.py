@@ -22,162 +22,99 @@ LRA = {**WIDE, "actuator_type": "LRA"}
 # from 83 ms to 1,865 ms, with a burst running 603 ms past its end.
 NEAR_CROSSINGS = (2.0429, 0.1643, 0.9571, 0.8214, 83.3333)
 
-# name -> (description, layout, stroke (x0, y0, x1, y1, T[, intensity]), options)
-CASES: dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]] = {
-    "worked/two-actuators": (
-        "tactile-brush.md: two points, T = 1000",
-        PAPER,
-        (0, 0, 1, 0, 1000),
-        {},
+# A case: its description, layout, stroke (x0, y0, x1, y1, T[, intensity]) and planner options.
+Case = tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]
+
+
+def case(
+    description: str, stroke: tuple[float, ...], *, layout: dict[str, Any] = PAPER, **options: Any
+) -> Case:
+    """A case on the paper's sleeve (unless ``layout`` says otherwise) with the planner's
+    default options, but for those given."""
+    return (description, layout, stroke, options)
+
+
+CASES: dict[str, Case] = {
+    "worked/two-actuators": case("tactile-brush.md: two points, T = 1000", (0, 0, 1, 0, 1000)),
+    "worked/three-actuators": case("tactile-brush.md: (0,0)->(2,0), T = 1000", (0, 0, 2, 0, 1000)),
+    "worked/diagonal": case(
+        "tactile-brush.md: (0,0)->(3,2), T = 1500, overlaps merged", (0, 0, 3, 2, 1500)
     ),
-    "worked/three-actuators": (
-        "tactile-brush.md: (0,0)->(2,0), T = 1000",
-        PAPER,
-        (0, 0, 2, 0, 1000),
-        {},
+    "interior/both-ends": case(
+        "both endpoints inside cells: four-actuator rendering", (0.5, 0.5, 2.5, 1.5, 800)
     ),
-    "worked/diagonal": (
-        "tactile-brush.md: (0,0)->(3,2), T = 1500, overlaps merged",
-        PAPER,
-        (0, 0, 3, 2, 1500),
-        {},
+    "interior/crossing-cells": case(
+        "interior endpoints, up and to the right", (0.3, 1.7, 2.2, 0.4, 1200)
     ),
-    "interior/both-ends": (
-        "both endpoints inside cells: four-actuator rendering",
-        PAPER,
-        (0.5, 0.5, 2.5, 1.5, 800),
-        {},
+    "interior/point": case("a stroke of zero length: one point held", (1.5, 0.5, 1.5, 0.5, 300)),
+    "interior/on-row-line": case(
+        "endpoints on a row line between actuators", (0.25, 1, 2.75, 1, 900)
     ),
-    "interior/crossing-cells": (
-        "interior endpoints, up and to the right",
-        PAPER,
-        (0.3, 1.7, 2.2, 0.4, 1200),
-        {},
+    "merge/through-actuator": case(
+        "crosses a row and a column at the same actuator", (0, 0, 2, 2, 1000)
     ),
-    "interior/point": (
-        "a stroke of zero length: one point held",
-        PAPER,
-        (1.5, 0.5, 1.5, 0.5, 300),
-        {},
+    "merge/near-corner": case(
+        "a row and a column crossing 0.014 apart become one", (0, 0, 2.02, 2, 1000)
     ),
-    "interior/on-row-line": (
-        "endpoints on a row line between actuators",
-        PAPER,
-        (0.25, 1, 2.75, 1, 900),
-        {},
-    ),
-    "merge/through-actuator": (
-        "crosses a row and a column at the same actuator",
-        PAPER,
-        (0, 0, 2, 2, 1000),
-        {},
-    ),
-    "merge/near-corner": (
-        "a row and a column crossing 0.014 apart become one",
-        PAPER,
-        (0, 0, 2.02, 2, 1000),
-        {},
-    ),
-    "merge/no-merge": (
+    "merge/no-merge": case(
         "the same stroke with merging off keeps both crossings",
-        PAPER,
         (0, 0, 2.02, 2, 4000),
-        {"merge_distance": 0.0},
+        merge_distance=0.0,
     ),
-    "feasible/too-fast": (
-        "9 cm at 50 ms: too fast even for two end phantoms; slowed to 73.701 ms",
-        PAPER,
-        (0, 0, 3, 0, 50),
-        {},
+    "feasible/too-fast": case(
+        "9 cm at 50 ms: too fast even for two end phantoms; slowed to 73.701 ms", (0, 0, 3, 0, 50)
     ),
-    "feasible/too-fast-diagonal": ("the diagonal at 50 ms: slowed", PAPER, (0, 0, 3, 2, 50), {}),
-    "feasible/too-fast-point": (
-        "a point at 30 ms: held as long as the shortest stroke",
-        PAPER,
-        (1.5, 0.5, 1.5, 0.5, 30),
-        {},
+    "feasible/too-fast-diagonal": case("the diagonal at 50 ms: slowed", (0, 0, 3, 2, 50)),
+    "feasible/too-fast-point": case(
+        "a point at 30 ms: held as long as the shortest stroke", (1.5, 0.5, 1.5, 0.5, 30)
     ),
-    "feasible/strict": (
-        "too fast for two end phantoms, with strict: rejected",
-        PAPER,
-        (0, 0, 3, 2, 50),
-        {"strict": True},
+    "feasible/strict": case(
+        "too fast for two end phantoms, with strict: rejected", (0, 0, 3, 2, 50), strict=True
     ),
-    "feasible/strict-thinned": (
-        "the diagonal at 100 ms with strict: thinned, not rejected",
-        PAPER,
-        (0, 0, 3, 2, 100),
-        {"strict": True},
+    "feasible/strict-thinned": case(
+        "the diagonal at 100 ms with strict: thinned, not rejected", (0, 0, 3, 2, 100), strict=True
     ),
-    "feasible/min-40": (
+    "feasible/min-40": case(
         "a longer minimum burst thins a stroke that was fine",
-        PAPER,
         (0, 0, 3, 0, 300),
-        {"min_command_ms": 40.0},
+        min_command_ms=40.0,
     ),
-    "feasible/min-0": (
-        "minimum 0: only negative bursts are infeasible",
-        PAPER,
-        (0, 0, 3, 0, 100),
-        {"min_command_ms": 0.0},
+    "feasible/min-0": case(
+        "minimum 0: only negative bursts are infeasible", (0, 0, 3, 0, 100), min_command_ms=0.0
     ),
-    "thin/straight": (
-        "9 cm at 100 ms: the two crossings left out, time kept",
-        PAPER,
-        (0, 0, 3, 0, 100),
-        {},
+    "thin/straight": case(
+        "9 cm at 100 ms: the two crossings left out, time kept", (0, 0, 3, 0, 100)
     ),
-    "thin/diagonal": (
-        "the diagonal at 200 ms: the crossings closest in time left out",
-        PAPER,
-        (0, 0, 3, 2, 200),
-        {},
+    "thin/diagonal": case(
+        "the diagonal at 200 ms: the crossings closest in time left out", (0, 0, 3, 2, 200)
     ),
-    "thin/near-crossings": (
-        "crossings 0.05 to 0.15 apart: thinned, played in its 83.3 ms",
-        PAPER,
-        NEAR_CROSSINGS,
-        {},
+    "thin/near-crossings": case(
+        "crossings 0.05 to 0.15 apart: thinned, played in its 83.3 ms", NEAR_CROSSINGS
     ),
-    "thin/near-crossings-moved": (
-        "the same with the start moved by 0.003: the same duration",
-        PAPER,
-        (2.04, *NEAR_CROSSINGS[1:]),
-        {},
+    "thin/near-crossings-moved": case(
+        "the same with the start moved by 0.003: the same duration", (2.04, *NEAR_CROSSINGS[1:])
     ),
-    "thin/near-crossings-merged": (
-        "the same with merge distance 0.15: the same duration",
-        PAPER,
-        NEAR_CROSSINGS,
-        {"merge_distance": 0.15},
+    "thin/near-crossings-merged": case(
+        "the same with merge distance 0.15: the same duration", NEAR_CROSSINGS, merge_distance=0.15
     ),
-    "overrun/near-crossings-slow": (
+    "overrun/near-crossings-slow": case(
         "that stroke at 1,865 ms: the burst before the last is cut 186.5 ms after the end",
-        PAPER,
         (*NEAR_CROSSINGS[:4], 1865.349),
-        {},
     ),
-    "overrun/long": (
-        "9 cm in 10 s: the burst before the last is cut 1 s after the end",
-        PAPER,
-        (0, 0, 3, 0, 10000),
-        {},
+    "overrun/long": case(
+        "9 cm in 10 s: the burst before the last is cut 1 s after the end", (0, 0, 3, 0, 10000)
     ),
-    "grid/outside": ("(0,0)->(5,5) on 3 x 4: outside the grid", PAPER, (0, 0, 5, 5, 1000), {}),
-    "grid/negative": ("a negative coordinate", PAPER, (-0.5, 0, 1, 0, 1000), {}),
-    "grid/zero-duration": ("duration 0", PAPER, (0, 0, 1, 0, 0), {}),
-    "grid/wide-sleeve": (
-        "a 4 x 6 sleeve with default intensity 0.7",
-        WIDE,
-        (0.5, 3, 5, 0.25, 2000),
-        {},
+    "grid/outside": case("(0,0)->(5,5) on 3 x 4: outside the grid", (0, 0, 5, 5, 1000)),
+    "grid/negative": case("a negative coordinate", (-0.5, 0, 1, 0, 1000)),
+    "grid/zero-duration": case("duration 0", (0, 0, 1, 0, 0)),
+    "grid/wide-sleeve": case(
+        "a 4 x 6 sleeve with default intensity 0.7", (0.5, 3, 5, 0.25, 2000), layout=WIDE
     ),
-    "grid/intensity": ("an explicit intensity", PAPER, (0, 2, 3, 0.5, 1500, 0.4), {}),
-    "grid/lra": (
+    "grid/intensity": case("an explicit intensity", (0, 2, 3, 0.5, 1500, 0.4)),
+    "grid/lra": case(
         "linear resonant actuators: 10 ms bursts, so 61 ms fit two end phantoms",
-        LRA,
         (0, 0, 5, 3, 61),
-        {},
+        layout=LRA,
     ),
 }
 
@@ -193,14 +130,11 @@ DIRECTIONS = {
 }
 
 
-def _all_cases() -> dict[str, tuple[str, dict[str, Any], tuple[float, ...], dict[str, Any]]]:
+def _all_cases() -> dict[str, Case]:
     cases = dict(CASES)
     for name, (x, y) in DIRECTIONS.items():
-        cases[f"direction/{name}"] = (
-            f"from the actuator (1, 1) to the {name}",
-            PAPER,
-            (1, 1, x, y, 600),
-            {},
+        cases[f"direction/{name}"] = case(
+            f"from the actuator (1, 1) to the {name}", (1, 1, x, y, 600)
         )
     return cases
 

@@ -49,6 +49,14 @@ class Case:
     format: Format = "auto"
 
 
+def expect(outcome: str, *rows: tuple[str, str, Any], **options: Any) -> list[Case]:
+    """Cases meant to show one ``outcome``, from (name, description, payload) rows; ``options``
+    (``layout``, ``format``) apply to each of them."""
+    return [
+        Case(name, description, payload, outcome, **options) for name, description, payload in rows
+    ]
+
+
 def js(*fields: str) -> str:
     """A JSON v1 object from ``"key":value`` parts, written compactly."""
     return "{" + ",".join(['"v":1', *fields]) + "}"
@@ -71,103 +79,94 @@ def valid_cases() -> list[Case]:
     pretty = '{\n  "v": 1,\n  "start": [0, 0],\n  "end": [3, 2],\n  "duration_ms": 800\n}\n'
     unknown = js(START, END, DUR, '"colour":"red"', '"extra":{"nested":[1,2,{"a":null}]}')
     nulls = js(START, END, DUR, '"drawing":null', '"seq":null', '"intensity":null')
-    a = ACCEPTED
     return [
-        Case("legacy-integers", "the simplest legacy stroke", "0,0,2,0,1000", a),
-        Case("legacy-decimals", "decimals as senders write them", "0.5,1.25,3,2,420.5", a),
-        Case("legacy-corner-to-corner", "both extreme corners", "0,0,3,2,1000", a),
-        Case("legacy-reverse", "right to left, bottom to top", "3,2,0,0,250", a),
-        Case("legacy-point", "start = end: a tap", "1,1,1,1,300", a),
-        Case("legacy-whitespace", "whitespace around the payload", " 0,0,2,0,1000\r\n", a),
-        Case("legacy-field-spaces", "spaces around fields", "0, 0 ,2,\t0, 1000", a),
-        Case("legacy-sign-exponent", "plus sign and exponents", "+1,0,2e0,0,1.5E3", a),
-        Case("legacy-bare-points", "'.5' and '1.' are numbers", ".5,1.,2,0,100", a),
-        Case("legacy-negative-zero", "-0 is read as 0", "-0,-0.0,2,0,100", a),
-        Case(
-            "legacy-tolerance-high",
-            "within 1e-9 above the grid: clamped to the edge",
-            "3.0000000001,2.0000000005,0,0,100",
-            a,
+        *expect(
+            ACCEPTED,
+            ("legacy-integers", "the simplest legacy stroke", "0,0,2,0,1000"),
+            ("legacy-decimals", "decimals as senders write them", "0.5,1.25,3,2,420.5"),
+            ("legacy-corner-to-corner", "both extreme corners", "0,0,3,2,1000"),
+            ("legacy-reverse", "right to left, bottom to top", "3,2,0,0,250"),
+            ("legacy-point", "start = end: a tap", "1,1,1,1,300"),
+            ("legacy-whitespace", "whitespace around the payload", " 0,0,2,0,1000\r\n"),
+            ("legacy-field-spaces", "spaces around fields", "0, 0 ,2,\t0, 1000"),
+            ("legacy-sign-exponent", "plus sign and exponents", "+1,0,2e0,0,1.5E3"),
+            ("legacy-bare-points", "'.5' and '1.' are numbers", ".5,1.,2,0,100"),
+            ("legacy-negative-zero", "-0 is read as 0", "-0,-0.0,2,0,100"),
+            (
+                "legacy-tolerance-high",
+                "within 1e-9 above the grid: clamped to the edge",
+                "3.0000000001,2.0000000005,0,0,100",
+            ),
+            (
+                "legacy-tolerance-low",
+                "within 1e-9 below 0: clamped to 0",
+                "-0.0000000001,0,0,-1e-10,100",
+            ),
+            ("legacy-max-duration", "exactly the maximum duration", "0,0,2,0,10000"),
+            ("legacy-tiny-duration", "a tiny positive duration", "0,0,2,0,0.0001"),
+            (
+                "legacy-many-decimals",
+                "more decimals than senders write: read in full",
+                "0.123456789,1.99999,2.5,0.3333333333333333,123.456789",
+            ),
+            ("legacy-bytes", "bytes, as MQTT delivers them", b"0,0,2,0,1000"),
+            ("legacy-bom", "a UTF-8 byte-order mark is dropped", b"\xef\xbb\xbf1,1,2,2,500"),
         ),
-        Case(
-            "legacy-tolerance-low",
-            "within 1e-9 below 0: clamped to 0",
-            "-0.0000000001,0,0,-1e-10,100",
-            a,
+        *expect(
+            ACCEPTED,
+            ("legacy-forced", "format=legacy", "0,1,3,1,900"),
+            format="legacy",
         ),
-        Case("legacy-max-duration", "exactly the maximum duration", "0,0,2,0,10000", a),
-        Case("legacy-tiny-duration", "a tiny positive duration", "0,0,2,0,0.0001", a),
-        Case(
-            "legacy-many-decimals",
-            "more decimals than senders write: read in full",
-            "0.123456789,1.99999,2.5,0.3333333333333333,123.456789",
-            a,
+        *expect(
+            ACCEPTED,
+            ("legacy-larger-grid", "a 4 x 6 sleeve", "5,3,0,0,8000"),
+            layout=LRA,
         ),
-        Case("legacy-bytes", "bytes, as MQTT delivers them", b"0,0,2,0,1000", a),
-        Case(
-            "legacy-bom",
-            "a UTF-8 byte-order mark is dropped",
-            b"\xef\xbb\xbf1,1,2,2,500",
-            a,
+        *expect(
+            ACCEPTED,
+            ("json-full", "every field of JSON v1", full),
+            ("json-minimal", "only the required fields", minimal()),
+            ("json-pretty", "indented over several lines", pretty),
+            ("json-unknown-keys", "unknown keys are ignored", unknown),
+            ("json-null-optionals", "null optional fields = absent", nulls),
+            (
+                "json-integral-floats",
+                "1.0 and 3.0 are integers (JavaScript cannot tell them apart)",
+                js('"v":1.0', '"seq":3.0', START, END, DUR),
+            ),
+            ("json-intensity-zero", "intensity 0 (off)", minimal('"intensity":0')),
+            ("json-intensity-one", "intensity 1", minimal('"intensity":1')),
+            (
+                "json-tolerance",
+                "within 1e-9 of the grid: clamped",
+                js('"start":[3.0000000001,-1e-10]', END, DUR),
+            ),
+            (
+                "json-duplicate-key",
+                "a repeated key: the last one counts, as in JSON.parse",
+                js('"start":[9,9]', START, END, DUR),
+            ),
+            ("json-seq-max", "the largest seq", minimal('"seq":9007199254740991')),
+            ("json-drawing-64", "a 64-character drawing id", minimal(f'"drawing":"{"d" * 64}"')),
+            (
+                "json-escaped-drawing",
+                "JSON escapes in the drawing id",
+                minimal('"drawing":"a\\u002db\\"c\\\\"'),
+            ),
+            (
+                "json-utf8-bytes",
+                "UTF-8 bytes with non-ASCII text in an ignored key",
+                minimal('"note":"héllo ✍"').encode("utf-8"),
+            ),
         ),
-        Case("legacy-forced", "format=legacy", "0,1,3,1,900", a, format="legacy"),
-        Case("legacy-larger-grid", "a 4 x 6 sleeve", "5,3,0,0,8000", a, layout=LRA),
-        Case("json-full", "every field of JSON v1", full, a),
-        Case("json-minimal", "only the required fields", minimal(), a),
-        Case("json-pretty", "indented over several lines", pretty, a),
-        Case("json-unknown-keys", "unknown keys are ignored", unknown, a),
-        Case("json-null-optionals", "null optional fields = absent", nulls, a),
-        Case(
-            "json-integral-floats",
-            "1.0 and 3.0 are integers (JavaScript cannot tell them apart)",
-            js('"v":1.0', '"seq":3.0', START, END, DUR),
-            a,
-        ),
-        Case("json-intensity-zero", "intensity 0 (off)", minimal('"intensity":0'), a),
-        Case("json-intensity-one", "intensity 1", minimal('"intensity":1'), a),
-        Case(
-            "json-tolerance",
-            "within 1e-9 of the grid: clamped",
-            js('"start":[3.0000000001,-1e-10]', END, DUR),
-            a,
-        ),
-        Case(
-            "json-duplicate-key",
-            "a repeated key: the last one counts, as in JSON.parse",
-            js('"start":[9,9]', START, END, DUR),
-            a,
-        ),
-        Case("json-seq-max", "the largest seq", minimal('"seq":9007199254740991'), a),
-        Case(
-            "json-drawing-64",
-            "a 64-character drawing id",
-            minimal(f'"drawing":"{"d" * 64}"'),
-            a,
-        ),
-        Case(
-            "json-escaped-drawing",
-            "JSON escapes in the drawing id",
-            minimal('"drawing":"a\\u002db\\"c\\\\"'),
-            a,
-        ),
-        Case(
-            "json-utf8-bytes",
-            "UTF-8 bytes with non-ASCII text in an ignored key",
-            minimal('"note":"héllo ✍"').encode("utf-8"),
-            a,
-        ),
-        Case(
-            "json-forced",
-            "format=json with leading whitespace",
-            "\n " + minimal(),
-            a,
+        *expect(
+            ACCEPTED,
+            ("json-forced", "format=json with leading whitespace", "\n " + minimal()),
             format="json",
         ),
-        Case(
-            "json-larger-grid",
-            "a 4 x 6 sleeve",
-            js('"start":[5,3]', END, DUR),
-            a,
+        *expect(
+            ACCEPTED,
+            ("json-larger-grid", "a 4 x 6 sleeve", js('"start":[5,3]', END, DUR)),
             layout=LRA,
         ),
     ]
@@ -176,331 +175,237 @@ def valid_cases() -> list[Case]:
 def payload_cases() -> list[Case]:
     """Rejected before any format is chosen: type, size, encoding, emptiness."""
     return [
-        Case(
-            "not-text-invalid-utf8",
-            "bytes that are not UTF-8",
-            b"\xff\xfe0,0",
+        *expect(
             "not_text",
+            ("not-text-invalid-utf8", "bytes that are not UTF-8", b"\xff\xfe0,0"),
+            ("not-text-latin1", "Latin-1 bytes", b"0,0,2,0,1000 \xe9"),
+            ("not-text-overlong", "an overlong UTF-8 sequence", b"\xc0\xaf"),
+            ("not-text-truncated-utf8", "a cut UTF-8 sequence", b"0,0,2,0,1\xe2\x82"),
+            ("not-text-null", "null instead of text", None),
+            ("not-text-number", "a number instead of text", 5),
+            ("not-text-list", "a list instead of text", [0, 0, 2, 0, 1000]),
+            (
+                "not-text-object",
+                "an already-parsed object instead of text",
+                {"v": 1, "start": [0, 0], "end": [2, 0], "duration_ms": 1000},
+            ),
         ),
-        Case("not-text-latin1", "Latin-1 bytes", b"0,0,2,0,1000 \xe9", "not_text"),
-        Case("not-text-overlong", "an overlong UTF-8 sequence", b"\xc0\xaf", "not_text"),
-        Case(
-            "not-text-truncated-utf8",
-            "a cut UTF-8 sequence",
-            b"0,0,2,0,1\xe2\x82",
-            "not_text",
-        ),
-        Case("not-text-null", "null instead of text", None, "not_text"),
-        Case("not-text-number", "a number instead of text", 5, "not_text"),
-        Case("not-text-list", "a list instead of text", [0, 0, 2, 0, 1000], "not_text"),
-        Case(
-            "not-text-object",
-            "an already-parsed object instead of text",
-            {"v": 1, "start": [0, 0], "end": [2, 0], "duration_ms": 1000},
-            "not_text",
-        ),
-        Case("too-long-legacy", "513 bytes", "0,0,2,0," + "1" * 505, "too_long"),
-        Case(
-            "too-long-multibyte",
-            "257 characters, 514 UTF-8 bytes",
-            "é" * 257,
+        *expect(
             "too_long",
+            ("too-long-legacy", "513 bytes", "0,0,2,0," + "1" * 505),
+            ("too-long-multibyte", "257 characters, 514 UTF-8 bytes", "é" * 257),
+            ("too-long-whitespace", "600 spaces: size is checked first", " " * 600),
+            ("too-long-json", "padded JSON", minimal(f'"pad":"{"x" * 480}"')),
         ),
-        Case(
-            "too-long-whitespace",
-            "600 spaces: size is checked first",
-            " " * 600,
-            "too_long",
+        *expect(
+            "empty",
+            ("empty-string", "nothing", ""),
+            ("empty-whitespace", "only whitespace", " \t\r\n "),
+            ("empty-bytes", "no bytes", b""),
+            ("empty-bom", "only a byte-order mark", b"\xef\xbb\xbf"),
         ),
-        Case("too-long-json", "padded JSON", minimal(f'"pad":"{"x" * 480}"'), "too_long"),
-        Case("empty-string", "nothing", "", "empty"),
-        Case("empty-whitespace", "only whitespace", " \t\r\n ", "empty"),
-        Case("empty-bytes", "no bytes", b"", "empty"),
-        Case("empty-bom", "only a byte-order mark", b"\xef\xbb\xbf", "empty"),
     ]
 
 
 def legacy_cases() -> list[Case]:
-    def bad(name: str, description: str, payload: str, reason: str) -> Case:
-        return Case(name, description, payload, reason)
-
-    wrong, nan = "wrong_field_count", "not_a_number"
     return [
-        bad("four-fields", "no duration", "0,0,2,0", wrong),
-        bad("six-fields", "an intensity appended", "0,0,2,0,1000,0.8", wrong),
-        bad("trailing-comma", "a sixth, empty field", "0,0,2,0,1000,", wrong),
-        bad("semicolons", "';' as separator", "0;0;2;0;1000", wrong),
-        bad("space-separated", "spaces as separator", "0 0 2 0 1000", wrong),
-        bad("decimal-commas", "',' as decimal point", "0,5,1,0,2,0,1,0,1000", wrong),
-        Case(
-            "json-as-legacy",
-            "JSON with format=legacy",
-            minimal(),
-            wrong,
+        *expect(
+            "wrong_field_count",
+            ("four-fields", "no duration", "0,0,2,0"),
+            ("six-fields", "an intensity appended", "0,0,2,0,1000,0.8"),
+            ("trailing-comma", "a sixth, empty field", "0,0,2,0,1000,"),
+            ("semicolons", "';' as separator", "0;0;2;0;1000"),
+            ("space-separated", "spaces as separator", "0 0 2 0 1000"),
+            ("decimal-commas", "',' as decimal point", "0,5,1,0,2,0,1,0,1000"),
+        ),
+        *expect(
+            "wrong_field_count",
+            ("json-as-legacy", "JSON with format=legacy", minimal()),
             format="legacy",
         ),
-        bad("letters", "a word", "a,0,2,0,1000", nan),
-        bad("empty-field", "nothing between commas", "0,,2,0,1000", nan),
-        bad("underscore", "'1_000' (Python's float() takes it)", "0,0,2,0,1_000", nan),
-        bad("unit-suffix", "a unit after the number", "0,0,2,0,1000ms", nan),
-        bad("hex", "a hexadecimal number", "0x1,0,2,0,1000", nan),
-        bad("arabic-digits", "non-ASCII digits", "0,0,2,0,١٠٠٠", nan),
-        bad("fullwidth-digits", "fullwidth digits", "０,0,2,0,1000", nan),
-        bad("double-point", "two decimal points", "1..2,0,2,0,1000", nan),
-        bad("bare-exponent", "an exponent without digits", "1e,0,2,0,1000", nan),
-        bad("bare-sign", "a sign alone", "-,0,2,0,1000", nan),
-        bad("inner-space", "a space inside a number", "1 0,0,2,0,1000", nan),
-        bad("nan", "NaN", "nan,0,2,0,1000", "not_finite"),
-        bad("inf", "inf", "0,0,2,0,inf", "not_finite"),
-        bad("infinity", "-Infinity", "0,-Infinity,2,0,1000", "not_finite"),
-        bad("overflow", "too large for a double", "1e999,0,2,0,1000", "not_finite"),
+        *expect(
+            "not_a_number",
+            ("letters", "a word", "a,0,2,0,1000"),
+            ("empty-field", "nothing between commas", "0,,2,0,1000"),
+            ("underscore", "'1_000' (Python's float() takes it)", "0,0,2,0,1_000"),
+            ("unit-suffix", "a unit after the number", "0,0,2,0,1000ms"),
+            ("hex", "a hexadecimal number", "0x1,0,2,0,1000"),
+            ("arabic-digits", "non-ASCII digits", "0,0,2,0,١٠٠٠"),
+            ("fullwidth-digits", "fullwidth digits", "０,0,2,0,1000"),
+            ("double-point", "two decimal points", "1..2,0,2,0,1000"),
+            ("bare-exponent", "an exponent without digits", "1e,0,2,0,1000"),
+            ("bare-sign", "a sign alone", "-,0,2,0,1000"),
+            ("inner-space", "a space inside a number", "1 0,0,2,0,1000"),
+        ),
+        *expect(
+            "not_finite",
+            ("nan", "NaN", "nan,0,2,0,1000"),
+            ("inf", "inf", "0,0,2,0,inf"),
+            ("infinity", "-Infinity", "0,-Infinity,2,0,1000"),
+            ("overflow", "too large for a double", "1e999,0,2,0,1000"),
+        ),
     ]
 
 
 def json_syntax_cases() -> list[Case]:
-    bad_json, not_object = "invalid_json", "not_an_object"
     return [
-        Case("json-truncated", "cut short", '{"v":1,"start":[0,0]', bad_json),
-        Case("json-open-brace", "a lone brace", "{", bad_json),
-        Case("json-trailing-comma", "a trailing comma", minimal()[:-1] + ",}", bad_json),
-        Case(
-            "json-nan-literal",
-            "NaN is not JSON",
-            js('"start":[NaN,0]', END, DUR),
-            bad_json,
+        *expect(
+            "invalid_json",
+            ("json-truncated", "cut short", '{"v":1,"start":[0,0]'),
+            ("json-open-brace", "a lone brace", "{"),
+            ("json-trailing-comma", "a trailing comma", minimal()[:-1] + ",}"),
+            ("json-nan-literal", "NaN is not JSON", js('"start":[NaN,0]', END, DUR)),
+            (
+                "json-infinity-literal",
+                "Infinity is not JSON",
+                js(START, END, '"duration_ms":Infinity'),
+            ),
+            ("json-single-quotes", "single quotes", "{'v':1}"),
+            ("json-unquoted-keys", "unquoted keys", "{v:1}"),
+            ("json-comment", "a comment", '{"v":1 /* one */}'),
+            ("json-extra-data", "text after the object", minimal() + " 0,0,2,0,1000"),
+            ("json-two-objects", "two objects", minimal() + minimal()),
+            (
+                "json-control-character",
+                "a raw control character in a string",
+                minimal('"drawing":"a\tb"'),
+            ),
         ),
-        Case(
-            "json-infinity-literal",
-            "Infinity is not JSON",
-            js(START, END, '"duration_ms":Infinity'),
-            bad_json,
-        ),
-        Case("json-single-quotes", "single quotes", "{'v':1}", bad_json),
-        Case("json-unquoted-keys", "unquoted keys", "{v:1}", bad_json),
-        Case("json-comment", "a comment", '{"v":1 /* one */}', bad_json),
-        Case(
-            "json-extra-data",
-            "text after the object",
-            minimal() + " 0,0,2,0,1000",
-            bad_json,
-        ),
-        Case("json-two-objects", "two objects", minimal() + minimal(), bad_json),
-        Case(
-            "json-control-character",
-            "a raw control character in a string",
-            minimal('"drawing":"a\tb"'),
-            bad_json,
-        ),
-        Case(
-            "legacy-as-json",
-            "legacy text, format=json",
-            "0,0,2,0,1000",
-            bad_json,
+        *expect(
+            "invalid_json",
+            ("legacy-as-json", "legacy text, format=json", "0,0,2,0,1000"),
             format="json",
         ),
-        Case("json-array", "a JSON array", "[0,0,2,0,1000]", not_object),
-        Case("json-string", "a JSON string", '"0,0,2,0,1000"', not_object, format="json"),
-        Case("json-number", "a JSON number", "42", not_object, format="json"),
-        Case("json-null", "JSON null", "null", not_object, format="json"),
-        Case("json-true", "JSON true", "true", not_object, format="json"),
+        *expect(
+            "not_an_object",
+            ("json-array", "a JSON array", "[0,0,2,0,1000]"),
+        ),
+        *expect(
+            "not_an_object",
+            ("json-string", "a JSON string", '"0,0,2,0,1000"'),
+            ("json-number", "a JSON number", "42"),
+            ("json-null", "JSON null", "null"),
+            ("json-true", "JSON true", "true"),
+            format="json",
+        ),
     ]
 
 
 def json_field_cases() -> list[Case]:
-    missing, wrong = "missing_field", "wrong_type"
     return [
-        Case(
-            "missing-v",
-            "no version",
-            '{"start":[0,0],"end":[2,0],"duration_ms":1}',
-            missing,
+        *expect(
+            "missing_field",
+            ("missing-v", "no version", '{"start":[0,0],"end":[2,0],"duration_ms":1}'),
+            ("missing-start", "no start", js(END, DUR)),
+            ("missing-end", "no end", js(START, DUR)),
+            ("missing-duration", "'duration' for 'duration_ms'", js(START, END, '"duration":5')),
+            ("missing-everything", "an empty object", "{}"),
         ),
-        Case("missing-start", "no start", js(END, DUR), missing),
-        Case("missing-end", "no end", js(START, DUR), missing),
-        Case(
-            "missing-duration",
-            "'duration' for 'duration_ms'",
-            js(START, END, '"duration":5'),
-            missing,
-        ),
-        Case("missing-everything", "an empty object", "{}", missing),
-        Case(
-            "version-2",
-            "a future version",
-            minimal().replace('"v":1', '"v":2'),
+        *expect(
             "unknown_version",
+            ("version-2", "a future version", minimal().replace('"v":1', '"v":2')),
+            ("version-0", "version 0", minimal().replace('"v":1', '"v":0')),
+            ("version-fraction", "version 1.5", minimal().replace('"v":1', '"v":1.5')),
         ),
-        Case(
-            "version-0",
-            "version 0",
-            minimal().replace('"v":1', '"v":0'),
-            "unknown_version",
+        *expect(
+            "wrong_type",
+            ("version-string", 'v "1"', minimal().replace('"v":1', '"v":"1"')),
+            ("version-boolean", "v true", minimal().replace('"v":1', '"v":true')),
+            ("version-null", "v null", minimal().replace('"v":1', '"v":null')),
+            ("start-string", 'start "0,0"', js('"start":"0,0"', END, DUR)),
+            ("start-one-number", "start [0]", js('"start":[0]', END, DUR)),
+            ("start-three-numbers", "start [0,0,0]", js('"start":[0,0,0]', END, DUR)),
+            ("start-boolean", "true is not a number", js('"start":[true,0]', END, DUR)),
+            ("start-nested", "start [[0],0]", js('"start":[[0],0]', END, DUR)),
+            ("start-object", 'start {"x":0,"y":0}', js('"start":{"x":0,"y":0}', END, DUR)),
+            ("start-null", "a required field null", js('"start":null', END, DUR)),
+            ("end-number", "end 2", js(START, '"end":2', DUR)),
+            ("duration-string", 'duration_ms "1000"', js(START, END, '"duration_ms":"1000"')),
+            ("duration-boolean", "duration_ms true", js(START, END, '"duration_ms":true')),
+            ("duration-null", "duration_ms null", js(START, END, '"duration_ms":null')),
+            ("intensity-string", 'intensity "high"', minimal('"intensity":"high"')),
+            ("intensity-boolean", "intensity false", minimal('"intensity":false')),
+            ("seq-fraction", "seq 1.5", minimal('"seq":1.5')),
+            ("seq-string", 'seq "3"', minimal('"seq":"3"')),
+            ("seq-boolean", "seq true", minimal('"seq":true')),
+            ("drawing-number", "drawing 5", minimal('"drawing":5')),
+            ("sent-at-string", 'sent_at_ms "now"', minimal('"sent_at_ms":"now"')),
         ),
-        Case(
-            "version-fraction",
-            "version 1.5",
-            minimal().replace('"v":1', '"v":1.5'),
-            "unknown_version",
-        ),
-        Case("version-string", 'v "1"', minimal().replace('"v":1', '"v":"1"'), wrong),
-        Case("version-boolean", "v true", minimal().replace('"v":1', '"v":true'), wrong),
-        Case("version-null", "v null", minimal().replace('"v":1', '"v":null'), wrong),
-        Case("start-string", 'start "0,0"', js('"start":"0,0"', END, DUR), wrong),
-        Case("start-one-number", "start [0]", js('"start":[0]', END, DUR), wrong),
-        Case(
-            "start-three-numbers",
-            "start [0,0,0]",
-            js('"start":[0,0,0]', END, DUR),
-            wrong,
-        ),
-        Case(
-            "start-boolean",
-            "true is not a number",
-            js('"start":[true,0]', END, DUR),
-            wrong,
-        ),
-        Case("start-nested", "start [[0],0]", js('"start":[[0],0]', END, DUR), wrong),
-        Case(
-            "start-object",
-            'start {"x":0,"y":0}',
-            js('"start":{"x":0,"y":0}', END, DUR),
-            wrong,
-        ),
-        Case("start-null", "a required field null", js('"start":null', END, DUR), wrong),
-        Case("end-number", "end 2", js(START, '"end":2', DUR), wrong),
-        Case(
-            "duration-string",
-            'duration_ms "1000"',
-            js(START, END, '"duration_ms":"1000"'),
-            wrong,
-        ),
-        Case(
-            "duration-boolean",
-            "duration_ms true",
-            js(START, END, '"duration_ms":true'),
-            wrong,
-        ),
-        Case(
-            "duration-null",
-            "duration_ms null",
-            js(START, END, '"duration_ms":null'),
-            wrong,
-        ),
-        Case("intensity-string", 'intensity "high"', minimal('"intensity":"high"'), wrong),
-        Case("intensity-boolean", "intensity false", minimal('"intensity":false'), wrong),
-        Case("seq-fraction", "seq 1.5", minimal('"seq":1.5'), wrong),
-        Case("seq-string", 'seq "3"', minimal('"seq":"3"'), wrong),
-        Case("seq-boolean", "seq true", minimal('"seq":true'), wrong),
-        Case("drawing-number", "drawing 5", minimal('"drawing":5'), wrong),
-        Case("sent-at-string", 'sent_at_ms "now"', minimal('"sent_at_ms":"now"'), wrong),
     ]
 
 
 def json_value_cases() -> list[Case]:
-    drawing, seq = "bad_drawing_id", "seq_out_of_range"
     return [
-        Case("drawing-empty", "an empty drawing id", minimal('"drawing":""'), drawing),
-        Case("drawing-65", "65 characters", minimal(f'"drawing":"{"d" * 65}"'), drawing),
-        Case("drawing-space", "a space", minimal('"drawing":"my drawing"'), drawing),
-        Case("drawing-non-ascii", "non-ASCII", minimal('"drawing":"dessin-é"'), drawing),
-        Case(
-            "drawing-control",
-            "an escaped control character",
-            minimal('"drawing":"a\\u0001"'),
-            drawing,
+        *expect(
+            "bad_drawing_id",
+            ("drawing-empty", "an empty drawing id", minimal('"drawing":""')),
+            ("drawing-65", "65 characters", minimal(f'"drawing":"{"d" * 65}"')),
+            ("drawing-space", "a space", minimal('"drawing":"my drawing"')),
+            ("drawing-non-ascii", "non-ASCII", minimal('"drawing":"dessin-é"')),
+            ("drawing-control", "an escaped control character", minimal('"drawing":"a\\u0001"')),
         ),
-        Case("seq-negative", "seq -1", minimal('"seq":-1'), seq),
-        Case("seq-too-large", "seq 2^53", minimal('"seq":9007199254740992'), seq),
-        Case("seq-huge-float", "seq 1e300", minimal('"seq":1e300'), seq),
-        Case(
-            "json-overflow-point",
-            "1e400 in start",
-            js('"start":[1e400,0]', END, DUR),
+        *expect(
+            "seq_out_of_range",
+            ("seq-negative", "seq -1", minimal('"seq":-1')),
+            ("seq-too-large", "seq 2^53", minimal('"seq":9007199254740992')),
+            ("seq-huge-float", "seq 1e300", minimal('"seq":1e300')),
+        ),
+        *expect(
             "not_finite",
+            ("json-overflow-point", "1e400 in start", js('"start":[1e400,0]', END, DUR)),
+            (
+                "json-overflow-integer",
+                "a 400-digit duration",
+                js(START, END, '"duration_ms":' + "9" * 400),
+            ),
+            ("json-overflow-intensity", "intensity 1e999", minimal('"intensity":1e999')),
+            ("json-overflow-sent-at", "sent_at_ms -1e999", minimal('"sent_at_ms":-1e999')),
         ),
-        Case(
-            "json-overflow-integer",
-            "a 400-digit duration",
-            js(START, END, '"duration_ms":' + "9" * 400),
-            "not_finite",
-        ),
-        Case(
-            "json-overflow-intensity",
-            "intensity 1e999",
-            minimal('"intensity":1e999'),
-            "not_finite",
-        ),
-        Case(
-            "json-overflow-sent-at",
-            "sent_at_ms -1e999",
-            minimal('"sent_at_ms":-1e999'),
-            "not_finite",
-        ),
-        Case(
-            "intensity-above",
-            "intensity 1.2",
-            minimal('"intensity":1.2'),
+        *expect(
             "intensity_out_of_range",
+            ("intensity-above", "intensity 1.2", minimal('"intensity":1.2')),
+            ("intensity-below", "intensity -0.1", minimal('"intensity":-0.1')),
+            ("intensity-barely-above", "intensity 1.0000001", minimal('"intensity":1.0000001')),
         ),
-        Case(
-            "intensity-below",
-            "intensity -0.1",
-            minimal('"intensity":-0.1'),
-            "intensity_out_of_range",
-        ),
-        Case(
-            "intensity-barely-above",
-            "intensity 1.0000001",
-            minimal('"intensity":1.0000001'),
-            "intensity_out_of_range",
-        ),
-        Case(
-            "sent-at-negative",
-            "sent_at_ms -1",
-            minimal('"sent_at_ms":-1'),
+        *expect(
             "sent_at_out_of_range",
+            ("sent-at-negative", "sent_at_ms -1", minimal('"sent_at_ms":-1')),
         ),
     ]
 
 
 def grid_cases() -> list[Case]:
-    out, zero, long = "outside_grid", "duration_not_positive", "duration_too_long"
     return [
-        Case("x-equals-columns", "x = 4 on 4 columns (off by one)", "4,0,2,0,1000", out),
-        Case("y-equals-rows", "y = 3 on 3 rows", "0,3,2,0,1000", out),
-        Case("negative-x", "x = -0.5", "-0.5,0,2,0,1000", out),
-        Case("end-outside", "end x = 3.0001", "0,0,3.0001,0,1000", out),
-        Case("beyond-tolerance", "2e-9 beyond the edge", "3.000000002,0,0,0,1000", out),
-        Case("json-end-outside", "end [0,-1]", js(START, '"end":[0,-1]', DUR), out),
-        Case(
-            "larger-grid-outside",
-            "x = 6 on a 4 x 6 sleeve",
-            "6,0,0,0,1000",
-            out,
+        *expect(
+            "outside_grid",
+            ("x-equals-columns", "x = 4 on 4 columns (off by one)", "4,0,2,0,1000"),
+            ("y-equals-rows", "y = 3 on 3 rows", "0,3,2,0,1000"),
+            ("negative-x", "x = -0.5", "-0.5,0,2,0,1000"),
+            ("end-outside", "end x = 3.0001", "0,0,3.0001,0,1000"),
+            ("beyond-tolerance", "2e-9 beyond the edge", "3.000000002,0,0,0,1000"),
+            ("json-end-outside", "end [0,-1]", js(START, '"end":[0,-1]', DUR)),
+        ),
+        *expect(
+            "outside_grid",
+            ("larger-grid-outside", "x = 6 on a 4 x 6 sleeve", "6,0,0,0,1000"),
             layout=LRA,
         ),
-        Case("duration-zero", "duration 0", "0,0,2,0,0", zero),
-        Case("duration-negative", "duration -5", "0,0,2,0,-5", zero),
-        Case("duration-negative-zero", "duration -0", "0,0,2,0,-0", zero),
-        Case("duration-underflow", "1e-400 is 0 as a double", "0,0,2,0,1e-400", zero),
-        Case(
-            "json-duration-zero",
-            "duration_ms 0",
-            js(START, END, '"duration_ms":0'),
-            zero,
+        *expect(
+            "duration_not_positive",
+            ("duration-zero", "duration 0", "0,0,2,0,0"),
+            ("duration-negative", "duration -5", "0,0,2,0,-5"),
+            ("duration-negative-zero", "duration -0", "0,0,2,0,-0"),
+            ("duration-underflow", "1e-400 is 0 as a double", "0,0,2,0,1e-400"),
+            ("json-duration-zero", "duration_ms 0", js(START, END, '"duration_ms":0')),
         ),
-        Case("duration-just-over", "10000.0001 ms", "0,0,2,0,10000.0001", long),
-        Case(
-            "json-duration-minute",
-            "a minute",
-            js(START, END, '"duration_ms":60000'),
-            long,
+        *expect(
+            "duration_too_long",
+            ("duration-just-over", "10000.0001 ms", "0,0,2,0,10000.0001"),
+            ("json-duration-minute", "a minute", js(START, END, '"duration_ms":60000')),
         ),
-        Case(
-            "larger-grid-too-long",
-            "8000.5 ms, cap 8000",
-            "0,0,2,0,8000.5",
-            long,
+        *expect(
+            "duration_too_long",
+            ("larger-grid-too-long", "8000.5 ms, cap 8000", "0,0,2,0,8000.5"),
             layout=LRA,
         ),
     ]

@@ -18,8 +18,9 @@ from typing import Any, NamedTuple
 
 import paho.mqtt.client as mqtt
 from conftest import StartBroker
-from sleeve_watch import SleeveWatch, settings, sleeve_command
+from sleeve_watch import SleeveWatch, settings
 
+from feelmysign.bench.sleeve import sleeve_command
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import new_client
 from feelmysign.lifecycle import Closing

@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import json
 import queue
-import sys
+import signal
+import subprocess
 import threading
 import uuid
-from collections.abc import Callable
-from pathlib import Path
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -79,17 +80,22 @@ def subscribe(client: mqtt.Client, topic: str, *, wait_s: float = WAIT_S) -> Inb
     return subscribe_all(client, [topic], wait_s=wait_s)[0]
 
 
-def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:
-    """``feelmysign sleeve`` as its own process, logged in with ``credentials_path``."""
-    return [
-        sys.executable,
-        "-m",
-        "feelmysign",
-        "sleeve",
-        "--credentials",
-        str(credentials_path),
-        *extra,
-    ]
+@contextmanager
+def reaped(process: subprocess.Popen[str]) -> Iterator[subprocess.Popen[str]]:
+    """``process``, killed and waited for on the way out, however the test ends: no sleeve
+    outlives its test to drive a motor of the next."""
+    try:
+        yield process
+    finally:
+        process.kill()
+        process.wait(WAIT_S)
+
+
+def exit_code_after(process: subprocess.Popen[str], sent: signal.Signals) -> int:
+    """Send ``sent`` and wait for the process to end: its exit code, or minus the number of
+    the signal that ended it."""
+    process.send_signal(sent)
+    return process.wait(WAIT_S)
 
 
 def online(name: str, body: dict[str, Any]) -> bool:

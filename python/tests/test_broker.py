@@ -256,22 +256,29 @@ def test_sleeve_telemetry_reaches_the_sender(broker: Broker, connect: Connect) -
         assert sender.next_message().topic == topic
 
 
-def test_sleeve_cannot_publish_strokes(broker: Broker, connect: Connect) -> None:
-    sleeve, sender = connect("sleeve"), connect("sender")
-    topic = strokes_topic(broker.credentials)
-    sleeve.subscribe(topic)
-    assert sleeve.publish(topic, b"forged") == NOT_AUTHORIZED
-    sender.publish(topic, b"marker")
-    assert sleeve.next_message().payload == b"marker"
-
-
-def test_sender_cannot_publish_status(broker: Broker, connect: Connect) -> None:
-    sleeve, sender = connect("sleeve"), connect("sender")
-    topic = status_topic(broker.credentials)
-    sender.subscribe(topic)
-    assert sender.publish(topic, b'{"online":true}') == NOT_AUTHORIZED
-    sleeve.publish(topic, b"marker")
-    assert sender.next_message().payload == b"marker"
+@pytest.mark.parametrize(
+    ("forger", "owner", "topic_of", "forged"),
+    [
+        ("sleeve", "sender", strokes_topic, b"forged"),
+        ("sender", "sleeve", status_topic, b'{"online":true}'),
+    ],
+    ids=["sleeve-cannot-publish-strokes", "sender-cannot-publish-status"],
+)
+def test_only_the_owner_of_a_topic_publishes_on_it(
+    broker: Broker,
+    connect: Connect,
+    forger: str,
+    owner: str,
+    topic_of: Callable[[Credentials], str],
+    forged: bytes,
+) -> None:
+    clients = {"sleeve": connect("sleeve"), "sender": connect("sender")}
+    topic = topic_of(broker.credentials)
+    clients[forger].subscribe(topic)
+    assert clients[forger].publish(topic, forged) == NOT_AUTHORIZED
+    # The owner's message after it arrives, the forged one never did.
+    clients[owner].publish(topic, b"marker")
+    assert clients[forger].next_message().payload == b"marker"
 
 
 def test_sleeve_cannot_read_another_sleeves_strokes(broker: Broker, connect: Connect) -> None:

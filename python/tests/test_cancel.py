@@ -7,11 +7,13 @@ import subprocess
 import sys
 import time
 import uuid
+from collections.abc import Iterator
 from typing import Any
 
+import paho.mqtt.client as mqtt
 import pytest
 from test_daemon import Running, _sender
-from test_player import Events, _planned
+from test_player import Events, _planned, started_player
 
 from feelmysign.backends.sim import SimBackend
 from feelmysign.broker import Broker
@@ -77,14 +79,9 @@ def test_cancel_of_nothing_changes_nothing() -> None:
 
 
 @pytest.fixture
-def player() -> Any:
-    backend = SimBackend(PAPER)
-    events = Events()
-    player = Player(backend, PAPER, on_event=events)
-    player.start()
-    yield player, backend, events
-    player.stop()
-    backend.close()
+def player() -> Iterator[tuple[Player, SimBackend, Events]]:
+    with started_player() as started:
+        yield started
 
 
 def _wait(condition: Any, what: str) -> None:
@@ -129,72 +126,76 @@ def test_strokes_accepted_after_a_cancel_are_not_touched(player: Any) -> None:
 
 # --- the sleeve, through the broker ----------------------------------------------------------
 
+ThroughBroker = tuple[Running, mqtt.Client, str]
 
-def test_a_control_message_stops_the_sleeve_and_later_strokes_stay_cancelled(
-    broker: Broker,
-) -> None:
+
+@pytest.fixture
+def through_broker(broker: Broker) -> Iterator[ThroughBroker]:
+    """A sleeve on a thread and a sender, both logged in to ``broker``, and the sleeve's id."""
     running = Running(broker.credentials)
     sender = _sender(broker.credentials)
-    sid = broker.credentials.sleeve_id
-    drawing = str(uuid.uuid4())
     try:
-        for seq in range(3):
-            stroke = Stroke((0.0, 0.0), (3.0, 2.0), 3000.0, 0.8, drawing, seq)
-            sender.publish(strokes_topic(sid), format_json(stroke), qos=1).wait_for_publish(5)
-        running.wait_events(1)
-        control = format_control(Cancel(drawing))
-        sender.publish(control_topic(sid), control, qos=1).wait_for_publish(5)
-        events = running.wait_events(4)
-        cancelled = [e for e in events if e["type"] == "cancelled"]
-        assert [(e["seq"], e["started"]) for e in cancelled] == [(0, True), (1, False), (2, False)]
-        _wait(lambda: running.sleeve.player.idle, "the sleeve still plays after the cancel")
-        assert running.backend.snapshot() == [[0.0] * 4 for _ in range(3)]
-        # A stroke of that drawing arriving later (held by the broker, say) is cancelled too.
-        late = Stroke((0.0, 0.0), (1.0, 0.0), 300.0, 0.8, drawing, 3)
-        sender.publish(strokes_topic(sid), format_json(late), qos=1).wait_for_publish(5)
-        (after,) = running.wait_events(5)[4:]
-        assert (after["type"], after["seq"], after["started"]) == ("cancelled", 3, False)
-        # A control message the sleeve cannot read is rejected like a stroke.
-        sender.publish(control_topic(sid), '{"v":1}', qos=1).wait_for_publish(5)
-        (refused,) = running.wait_events(6)[5:]
-        assert (refused["type"], refused["reason"]) == ("rejected", "missing_field")
-        assert refused["topic"] == control_topic(sid)
+        yield running, sender, broker.credentials.sleeve_id
     finally:
         sender.loop_stop()
         running.stop()
+
+
+def test_a_control_message_stops_the_sleeve_and_later_strokes_stay_cancelled(
+    through_broker: ThroughBroker,
+) -> None:
+    running, sender, sid = through_broker
+    drawing = str(uuid.uuid4())
+    for seq in range(3):
+        stroke = Stroke((0.0, 0.0), (3.0, 2.0), 3000.0, 0.8, drawing, seq)
+        sender.publish(strokes_topic(sid), format_json(stroke), qos=1).wait_for_publish(5)
+    running.wait_events(1)
+    control = format_control(Cancel(drawing))
+    sender.publish(control_topic(sid), control, qos=1).wait_for_publish(5)
+    events = running.wait_events(4)
+    cancelled = [e for e in events if e["type"] == "cancelled"]
+    assert [(e["seq"], e["started"]) for e in cancelled] == [(0, True), (1, False), (2, False)]
+    _wait(lambda: running.sleeve.player.idle, "the sleeve still plays after the cancel")
+    assert running.backend.snapshot() == [[0.0] * 4 for _ in range(3)]
+    # A stroke of that drawing arriving later (held by the broker, say) is cancelled too.
+    late = Stroke((0.0, 0.0), (1.0, 0.0), 300.0, 0.8, drawing, 3)
+    sender.publish(strokes_topic(sid), format_json(late), qos=1).wait_for_publish(5)
+    (after,) = running.wait_events(5)[4:]
+    assert (after["type"], after["seq"], after["started"]) == ("cancelled", 3, False)
+    # A control message the sleeve cannot read is rejected like a stroke.
+    sender.publish(control_topic(sid), '{"v":1}', qos=1).wait_for_publish(5)
+    (refused,) = running.wait_events(6)[5:]
+    assert (refused["type"], refused["reason"]) == ("rejected", "missing_field")
+    assert refused["topic"] == control_topic(sid)
 
 
 # --- feelmysign stop ----------------------------------------------------------------------------
 
 
-def test_feelmysign_stop_cancels_through_the_broker(broker: Broker) -> None:
-    running = Running(broker.credentials)
-    sender = _sender(broker.credentials)
-    sid = broker.credentials.sleeve_id
-    try:
-        stroke = Stroke((0.0, 0.0), (3.0, 0.0), 5000.0, 0.8, "drawn-by-cli", 0)
-        sender.publish(strokes_topic(sid), format_json(stroke), qos=1).wait_for_publish(5)
-        running.wait_events(1)
-        command = [
-            sys.executable,
-            "-m",
-            "feelmysign",
-            "stop",
-            "--credentials",
-            str(broker.credentials_path),
-        ]
-        done = subprocess.run(command, capture_output=True, text=True, timeout=60, check=False)
-        assert done.returncode == 0, done.stderr
-        assert f"Stop sent to sleeve {sid}: everything." in done.stdout
-        (event,) = running.wait_events(2)[1:]
-        assert (event["type"], event["drawing"], event["started"]) == (
-            "cancelled",
-            "drawn-by-cli",
-            True,
-        )
-    finally:
-        sender.loop_stop()
-        running.stop()
+def test_feelmysign_stop_cancels_through_the_broker(
+    broker: Broker, through_broker: ThroughBroker
+) -> None:
+    running, sender, sid = through_broker
+    stroke = Stroke((0.0, 0.0), (3.0, 0.0), 5000.0, 0.8, "drawn-by-cli", 0)
+    sender.publish(strokes_topic(sid), format_json(stroke), qos=1).wait_for_publish(5)
+    running.wait_events(1)
+    command = [
+        sys.executable,
+        "-m",
+        "feelmysign",
+        "stop",
+        "--credentials",
+        str(broker.credentials_path),
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=60, check=False)
+    assert done.returncode == 0, done.stderr
+    assert f"Stop sent to sleeve {sid}: everything." in done.stdout
+    (event,) = running.wait_events(2)[1:]
+    assert (event["type"], event["drawing"], event["started"]) == (
+        "cancelled",
+        "drawn-by-cli",
+        True,
+    )
 
 
 def test_feelmysign_stop_refuses_a_bad_drawing_id() -> None:
@@ -210,21 +211,15 @@ def test_feelmysign_stop_refuses_a_bad_drawing_id() -> None:
 
 
 def test_a_stroke_felt_long_after_it_was_sent_is_logged_as_delayed(
-    broker: Broker, caplog: pytest.LogCaptureFixture
+    through_broker: ThroughBroker, caplog: pytest.LogCaptureFixture
 ) -> None:
-    running = Running(broker.credentials)
-    sender = _sender(broker.credentials)
-    sid = broker.credentials.sleeve_id
-    try:
-        with caplog.at_level("WARNING", logger="feelmysign.daemon"):
-            # Sent 5 s ago by the sender's clock: held at the broker while the sleeve was away.
-            sent_at_ms = time.time() * 1000 - 5000
-            stroke = Stroke((0.0, 0.0), (1.0, 0.0), 200.0, 0.8, "held", 0, sent_at_ms)
-            sender.publish(strokes_topic(sid), format_json(stroke), qos=1).wait_for_publish(5)
-            running.wait_events(1)
-        # Delayed on the way, not "late" (the refusal of a stroke the sleeve is too far behind for).
-        said = [r.getMessage() for r in caplog.records if "delayed" in r.getMessage()]
-        assert len(said) == 1 and "stroke 0 of drawing held delayed by 5." in said[0], said
-    finally:
-        sender.loop_stop()
-        running.stop()
+    running, sender, sid = through_broker
+    with caplog.at_level("WARNING", logger="feelmysign.daemon"):
+        # Sent 5 s ago by the sender's clock: held at the broker while the sleeve was away.
+        sent_at_ms = time.time() * 1000 - 5000
+        stroke = Stroke((0.0, 0.0), (1.0, 0.0), 200.0, 0.8, "held", 0, sent_at_ms)
+        sender.publish(strokes_topic(sid), format_json(stroke), qos=1).wait_for_publish(5)
+        running.wait_events(1)
+    # Delayed on the way, not "late" (the refusal of a stroke the sleeve is too far behind for).
+    said = [r.getMessage() for r in caplog.records if "delayed" in r.getMessage()]
+    assert len(said) == 1 and "stroke 0 of drawing held delayed by 5." in said[0], said

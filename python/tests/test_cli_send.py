@@ -30,6 +30,7 @@ from feelmysign.cli import main
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.connection import BrokerConnectionError, parse_broker_url
 from feelmysign.layout import PAPER_SLEEVE
+from feelmysign.lifecycle import Closing
 from feelmysign.protocol import Accepted, parse
 from feelmysign.shapes import shape_strokes
 
@@ -43,7 +44,7 @@ def clean_environment(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     clean_cli_environment(monkeypatch, tmp_path)
 
 
-class Sleeve:
+class Sleeve(Closing):
     """A client logged in with the sleeve's account, subscribed to its strokes and legacy topics."""
 
     def __init__(self, credentials: Credentials) -> None:
@@ -78,9 +79,8 @@ class Sleeve:
 
 @pytest.fixture
 def sleeve(broker: Broker) -> Iterator[Sleeve]:
-    client = Sleeve(broker.credentials)
-    yield client
-    client.close()
+    with Sleeve(broker.credentials) as client:
+        yield client
 
 
 def send(broker: Broker, *argv: str) -> int:

@@ -9,6 +9,7 @@ import math
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from timelines import TIGHT_WINDOW_MS, Played, tight_layout
 
 from feelmysign.duty_cycle import Drive, DutyCycle
 from feelmysign.errors import StrokeError
@@ -18,16 +19,8 @@ from feelmysign.schedule import Command, Schedule
 from feelmysign.stroke import Stroke
 from feelmysign.timeline import Change, Timeline
 
-WINDOW_MS = 2000.0
-TIGHT = Layout(
-    rows=3,
-    columns=4,
-    spacing_cm=3.0,
-    max_stroke_duration_ms=1000,
-    max_on_time_ms=1000,
-    duty_cycle_window_ms=WINDOW_MS,
-    max_duty_cycle=0.5,
-)
+WINDOW_MS = TIGHT_WINDOW_MS
+TIGHT = tight_layout(max_duty_cycle=0.5)
 BUDGET_MS = WINDOW_MS * 0.5
 
 strokes = st.lists(
@@ -50,15 +43,7 @@ def _play(
 ) -> tuple[list[Change], list[object], list[object]]:
     for index, (schedule, start_ms) in enumerate(planned):
         timeline.add(schedule, start_ms, tag=index)
-    changes: list[Change] = []
-    started: list[object] = []
-    capped: list[object] = []
-    while (t := timeline.next_ms()) is not None:
-        due = timeline.pop_due(t)
-        changes += due.changes
-        started += due.started
-        capped += [c.tag for c in due.capped]
-    return changes, started, capped
+    return Played().play_out(timeline)
 
 
 def _levels(changes: list[Change]) -> dict[tuple[int, int], list[tuple[float, float]]]:

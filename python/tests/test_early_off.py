@@ -45,6 +45,14 @@ def _left_on(path: Path, *actuators: tuple[int, int]) -> None:
     assert max(drive_levels(path).values()) == 1.0
 
 
+def _editable_paper_layout(tmp_path: Path) -> tuple[Path, Path, list[str]]:
+    """A copy of the paper's layout to edit, an emulated bus, and the options naming both."""
+    layout_path = tmp_path / "layout.toml"
+    layout_path.write_text(PAPER_TEXT)
+    state = tmp_path / "bus.json"
+    return layout_path, state, ["--layout", str(layout_path), "--emulate-state", str(state)]
+
+
 def _memos(home: Path) -> list[Path]:
     return sorted((home / "feelmysign" / "wiring").glob("*.txt"))
 
@@ -144,10 +152,7 @@ def test_a_first_start_switches_off_every_channel_of_every_multiplexer_named(
 def test_after_an_edit_the_chips_the_old_layout_wired_are_switched_off_too(
     tmp_path: Path, state_home: Path
 ) -> None:
-    layout_path = tmp_path / "layout.toml"
-    layout_path.write_text(PAPER_TEXT)
-    state = tmp_path / "bus.json"
-    arguments = ["--layout", str(layout_path), "--emulate-state", str(state)]
+    layout_path, state, arguments = _editable_paper_layout(tmp_path)
     _left_on(state)
     switch_off_early("buzz", arguments)  # the memo of the layout as it was
     _left_on(state)  # 0x71/2, which the old layout wires
@@ -189,10 +194,7 @@ def test_an_unreadable_memo_is_a_miss_and_is_replaced(
 def test_a_memo_of_another_text_is_not_used(
     tmp_path: Path, state_home: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    layout_path = tmp_path / "layout.toml"
-    layout_path.write_text(PAPER_TEXT)
-    state = tmp_path / "bus.json"
-    arguments = ["--layout", str(layout_path), "--emulate-state", str(state)]
+    layout_path, state, arguments = _editable_paper_layout(tmp_path)
     _left_on(state)
     switch_off_early("buzz", arguments)
     layout_path.write_text(PAPER_TEXT + "\n# an edit that changes nothing but the text\n")

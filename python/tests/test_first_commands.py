@@ -13,6 +13,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from timelines import Played, tight_layout
 
 from feelmysign.layout import Layout
 from feelmysign.planner import outline, plan
@@ -23,15 +24,7 @@ PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 WIDE = Layout(rows=3, columns=12, spacing_cm=3.0)
 LRA = Layout(rows=4, columns=6, spacing_cm=2.5, actuator_type="LRA")
 # A 2 s window with a third of it at full drive: reached within a few strokes.
-TIGHT = Layout(
-    rows=3,
-    columns=4,
-    spacing_cm=3.0,
-    max_stroke_duration_ms=1000,
-    max_on_time_ms=1000,
-    duty_cycle_window_ms=2000,
-    max_duty_cycle=0.3,
-)
+TIGHT = tight_layout(max_duty_cycle=0.3)
 LAYOUTS = (PAPER, WIDE, LRA, TIGHT)
 
 
@@ -79,15 +72,10 @@ def _play(
     """Every change, started and capped tag, strokes arriving as the player takes them:
     each at the end of the one before (or after a gap), popped at its start, then on."""
     timeline = Timeline(layout)
-    changes: list[Change] = []
-    started: list[object] = []
-    capped: list[object] = []
+    played = Played()
 
     def pop(now_ms: float) -> None:
-        due = timeline.pop_due(now_ms)
-        changes.extend(due.changes)
-        started.extend(due.started)
-        capped.extend(c.tag for c in due.capped)
+        played.take(timeline.pop_due(now_ms))
 
     start_ms = 1000.0
     for k, (stroke, gap_ms) in enumerate(zip(strokes, gaps_ms, strict=True)):
@@ -100,9 +88,7 @@ def _play(
             timeline.add(plan(stroke, layout), start_ms, tag=k)
             pop(start_ms)
         start_ms += plan(stroke, layout).duration_ms + gap_ms
-    while (t_ms := timeline.next_ms()) is not None:
-        pop(t_ms)
-    return changes, started, capped
+    return played.play_out(timeline)
 
 
 @settings(max_examples=300, deadline=None)

@@ -15,6 +15,7 @@ from feelmysign.layout import (
     MUX_ADDRESSES,
     MUX_CHANNELS,
     PAPER_SLEEVE,
+    TOP_KEYS,
     Layout,
     Wire,
     check_layout,
@@ -300,16 +301,7 @@ TOML_LITERALS = st.sampled_from(
         "0.5",
     ]
 )
-KEYS = [
-    "name",
-    "rows",
-    "columns",
-    "spacing_cm",
-    "actuator_type",
-    "min_burst_ms",
-    "default_intensity",
-    "colour",
-]
+KEYS = [*TOP_KEYS, "colour"]  # every top-level key, and one a layout may not have
 
 
 @given(st.dictionaries(st.sampled_from(KEYS), TOML_LITERALS))

@@ -19,8 +19,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from sleeve_watch import SleeveWatch, online, sleeve_command
+from sleeve_watch import SleeveWatch, online
 
+from feelmysign.bench.sleeve import sleeve_command
 from feelmysign.broker import Broker
 from feelmysign.layout import Layout, load_layout
 from feelmysign.planner import plan

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import itertools
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import pytest
@@ -51,15 +53,29 @@ def _planned(
     return PlannedStroke(schedule, received_at_ms, received_wall_ms, dict(info))
 
 
-@pytest.fixture
-def running() -> Any:
+def new_player() -> tuple[Player, SimBackend, Events]:
+    """A player on the paper sleeve's simulator, recording its events; not started yet."""
     backend = SimBackend(PAPER)
     events = Events()
-    player = Player(backend, PAPER, on_event=events)
+    return Player(backend, PAPER, on_event=events), backend, events
+
+
+@contextmanager
+def started_player() -> Iterator[tuple[Player, SimBackend, Events]]:
+    """A :func:`new_player`, started; stopped and its simulator closed after."""
+    player, backend, events = new_player()
     player.start()
-    yield player, backend, events
-    player.stop()
-    backend.close()
+    try:
+        yield player, backend, events
+    finally:
+        player.stop()
+        backend.close()
+
+
+@pytest.fixture
+def running() -> Iterator[tuple[Player, SimBackend, Events]]:
+    with started_player() as started:
+        yield started
 
 
 def test_strokes_of_a_drawing_play_back_to_back(running: Any) -> None:
@@ -175,9 +191,7 @@ def test_a_player_that_crashes_mid_stroke_switches_every_motor_off_first(
 ) -> None:
     from feelmysign.timeline import Timeline
 
-    backend = SimBackend(PAPER)
-    events = Events()
-    player = Player(backend, PAPER, on_event=events)
+    player, backend, events = new_player()
     real_pop_due = Timeline.pop_due
 
     def pop_due_then_crash(self: Timeline, now_ms: float) -> Any:
@@ -290,9 +304,7 @@ def test_a_crash_on_the_submitting_thread_switches_every_motor_off_and_stops_the
 ) -> None:
     from feelmysign.timeline import Timeline
 
-    backend = SimBackend(PAPER)
-    events = Events()
-    player = Player(backend, PAPER, on_event=events)
+    player, backend, events = new_player()
     real_complete = Timeline.complete
 
     def complete_then_crash(self: Timeline) -> None:

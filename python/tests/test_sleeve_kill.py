@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
-from sleeve_watch import SleeveWatch, online, settings
+from sleeve_watch import SleeveWatch, exit_code_after, online, reaped, settings
 
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
@@ -61,16 +61,11 @@ def wait_until(condition: Callable[[], bool]) -> None:
 
 def kill_mid_stroke(broker: Broker, watcher: SleeveWatch, state: Path) -> dict[str, float]:
     """Start a sleeve, send it a long stroke, SIGKILL it while a motor is on; what it left."""
-    sleeve = start_sleeve(broker, state)
-    try:
+    with reaped(start_sleeve(broker, state)) as sleeve:
         watcher.next(online, "the sleeve online")
         watcher.send(restart_off.LONG_STROKE)  # row 1, 8 s
         wait_until(lambda: any(level > 0 for level in drive_levels(state).values()))
-        sleeve.send_signal(signal.SIGKILL)
-        assert sleeve.wait(WAIT_S) == -signal.SIGKILL
-    finally:
-        sleeve.kill()
-        sleeve.wait(WAIT_S)
+        assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
     left = drive_levels(state)
     # Nothing ran after SIGKILL: the chips still drive what they drove. Without
     # this the rest of the test would prove nothing.
@@ -101,8 +96,7 @@ def test_a_restart_after_sigkill_mid_stroke_switches_every_motor_off_before_goin
     kill_mid_stroke(broker, watcher, state)
     forget_sleeve_session(broker)
 
-    restarted = start_sleeve(broker, state)
-    try:
+    with reaped(start_sleeve(broker, state)) as restarted:
         status = watcher.next(online, "the sleeve online")
         # Online is said only after the backend opened, so the off came first.
         assert status["backend"] == "drv2605 (emulated bus)"
@@ -115,11 +109,7 @@ def test_a_restart_after_sigkill_mid_stroke_switches_every_motor_off_before_goin
             "the stroke after the restart played",
         )
         assert played["seq"] == 0
-        restarted.send_signal(signal.SIGTERM)
-        assert restarted.wait(WAIT_S) == 0
-    finally:
-        restarted.kill()
-        restarted.wait(WAIT_S)
+        assert exit_code_after(restarted, signal.SIGTERM) == 0
     assert set(drive_levels(state).values()) == {0.0}
 
 

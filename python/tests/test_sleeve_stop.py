@@ -13,9 +13,10 @@ from typing import Any
 
 import paho.mqtt.client as mqtt
 import pytest
-from sleeve_watch import SleeveWatch, online, settings, sleeve_command
+from sleeve_watch import SleeveWatch, online, settings
 
 from feelmysign.backends.sim import SimBackend
+from feelmysign.bench.sleeve import sleeve_command
 from feelmysign.broker import Broker
 from feelmysign.connection import new_client
 from feelmysign.daemon import NETWORK_STOP_S, Sleeve, SleeveOptions

@@ -25,7 +25,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from sleeve_watch import SleeveWatch, online
+from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
 
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
@@ -94,8 +94,7 @@ def test_a_stopped_sleeve_stops_pinging_and_the_watchdog_restart_switches_every_
     watchdog_s = float(unit_setting("WatchdogSec"))
     state = tmp_path / "bus.json"
     with SleeveWatch(broker.credentials, "status", "events") as watcher:
-        sleeve = start_sleeve(broker, state, notify)
-        try:
+        with reaped(start_sleeve(broker, state, notify)) as sleeve:
             notify.expect("READY=1")
             watcher.next(online, "the sleeve online")
             notify.expect("WATCHDOG=1")
@@ -115,11 +114,8 @@ def test_a_stopped_sleeve_stops_pinging_and_the_watchdog_restart_switches_every_
                 assert time.monotonic() < deadline, "a stopped sleeve kept pinging"
             # Stopped, the sleeve left its motor on: what the watchdog is for.
             assert any(level > 0 for level in drive_levels(state).values())
-            sleeve.send_signal(signal.SIGKILL)  # WatchdogSignal
-            assert sleeve.wait(WAIT_S) == -signal.SIGKILL
-        finally:
-            sleeve.kill()
-            sleeve.wait(WAIT_S)
+            # WatchdogSignal
+            assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
 
         # ExecStopPost: every motor off at once, before the restart.
         command = [sys.executable, "-m", "feelmysign", "off", "--layout", str(restart_off.PAPER)]
@@ -133,16 +129,11 @@ def test_a_stopped_sleeve_stops_pinging_and_the_watchdog_restart_switches_every_
         assert set(drive_levels(state).values()) == {0.0}
 
         # Restart=: the sleeve comes back, ready, its motors still off.
-        restarted = start_sleeve(broker, state, notify)
-        try:
+        with reaped(start_sleeve(broker, state, notify)) as restarted:
             notify.expect("READY=1")
             watcher.next(online, "the restarted sleeve online")
             notify.expect("WATCHDOG=1")
-            restarted.send_signal(signal.SIGTERM)
-            assert restarted.wait(WAIT_S) == 0
-        finally:
-            restarted.kill()
-            restarted.wait(WAIT_S)
+            assert exit_code_after(restarted, signal.SIGTERM) == 0
     assert set(drive_levels(state).values()) == {0.0}
 
 

@@ -7,6 +7,7 @@ import math
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from timelines import Played, tight_layout
 
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
@@ -16,15 +17,7 @@ from feelmysign.timeline import Change, Timeline
 
 PAPER = Layout(rows=3, columns=4, spacing_cm=3.0)
 # A 2 s window with half of it at full drive: 1000 ms of budget, quick to reach.
-TIGHT = Layout(
-    rows=3,
-    columns=4,
-    spacing_cm=3.0,
-    max_stroke_duration_ms=1000,
-    max_on_time_ms=1000,
-    duty_cycle_window_ms=2000,
-    max_duty_cycle=0.5,
-)
+TIGHT = tight_layout(max_duty_cycle=0.5)
 
 
 def _schedule(*commands: Command, duration_ms: float = 100.0) -> Schedule:
@@ -69,24 +62,12 @@ def test_writes_only_on_change() -> None:
     assert [(c.t_ms, c.intensity) for c in _drain(timeline)] == [(0.0, 0.5), (200.0, 0.0)]
 
 
-def _run(timeline: Timeline) -> tuple[list[Change], list[object], list[object]]:
-    changes: list[Change] = []
-    started: list[object] = []
-    capped: list[object] = []
-    while (t := timeline.next_ms()) is not None:
-        due = timeline.pop_due(t)
-        changes += due.changes
-        started += due.started
-        capped += [c.tag for c in due.capped]
-    return changes, started, capped
-
-
 def test_a_stroke_over_the_duty_cycle_budget_plays_not_at_all_and_a_rest_restores_it() -> None:
     timeline = Timeline(TIGHT)
     for k in range(4):  # back-to-back strokes keeping one motor at full drive
         timeline.add(_schedule(Command(2, 3, 0, 500, 1.0), duration_ms=500), k * 500.0, tag=k)
     timeline.add(_schedule(Command(2, 3, 0, 100, 1.0)), 3000.0, tag="rested")
-    changes, started, capped = _run(timeline)
+    changes, started, capped = Played().play_out(timeline)
     # 0 and 1 fill the 1000 ms budget exactly; 2 and 3 would exceed it: not a single command.
     assert started == [0, 1, "rested"] and capped == [2, 3]
     assert [(c.t_ms, c.intensity) for c in changes] == [
@@ -113,7 +94,7 @@ def test_short_gaps_are_rests_in_proportion_not_resets() -> None:
     timeline = Timeline(TIGHT)
     for k in range(6):  # 400 ms on, 1 ms off: the motor hardly rests
         timeline.add(_schedule(Command(1, 1, 0, 400, 1.0), duration_ms=400), k * 401.0, tag=k)
-    _, started, capped = _run(timeline)
+    _, started, capped = Played().play_out(timeline)
     assert started == [0, 1] and capped == [2, 3, 4, 5]
 
 
@@ -121,7 +102,7 @@ def test_a_motor_used_a_fifth_of_the_time_is_never_refused() -> None:
     timeline = Timeline(PAPER)  # the defaults: a minute, half of it
     for k in range(600):  # ten minutes of 200 ms at full drive every second
         timeline.add(_schedule(Command(0, 1, 0, 200, 1.0), duration_ms=200), k * 1000.0, tag=k)
-    _, started, capped = _run(timeline)
+    _, started, capped = Played().play_out(timeline)
     assert capped == [] and len(started) == 600
 
 
@@ -203,7 +184,7 @@ def test_a_stroke_that_takes_over_the_motors_left_on_changes_nothing_until_it_mo
     timeline = Timeline(PAPER)
     timeline.add(first, 0.0, tag="first")
     timeline.add(second, first.duration_ms, tag="second")
-    changes, started, _ = _run(timeline)
+    changes, started, _ = Played().play_out(timeline)
     assert started == ["first", "second"]
     at_joint = [c for c in changes if c.t_ms == first.duration_ms]
     assert at_joint == []  # (0, 1) stays on: now the second stroke's

@@ -4,17 +4,25 @@ A reference for the property test that the simplifier in ``feelmysign.simplify.w
 keeps its samples in flat lists and skips tests a bound proves needless, gives the same strokes
 to the last bit. It is the simplifier as of its straight-line rule (a line's end kept on the
 grid), with the canvas-to-grid mapping computed in full for every sample (``_to_grid``). Kept
-in the tests, not in the package.
+in the tests, not in the package. Its point-to-segment distance and direction are the
+simplifier's own: what the two must agree on is which samples are tested where, and the
+simplifier's inlined loops must equal that distance to the last bit.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
-from feelmysign.simplify.window import CAP_FEATURE_SHARE, LINE_SHARE, STRAIGHT, WindowParams
+from feelmysign.simplify.window import (
+    CAP_FEATURE_SHARE,
+    LINE_SHARE,
+    STRAIGHT,
+    WindowParams,
+    segment_distance_sq,
+    unit_direction,
+)
 from feelmysign.stroke import Point
 
 
@@ -147,7 +155,7 @@ class ReferenceWindowSimplifier:
         )
         cut = self._feature(window, window[-1].point, first)
         straight = STRAIGHT * self.params.max_error
-        far_sq = _distance_sq(window[cut].point, anchor.point, window[-1].point)
+        far_sq = segment_distance_sq(window[cut].point, anchor.point, window[-1].point)
         bends = far_sq > straight * straight
         return cut if bends and self._sendable(anchor, window[cut]) else len(window) - 1
 
@@ -176,7 +184,7 @@ class ReferenceWindowSimplifier:
         if not (0.0 <= end.point[0] <= x_extent and 0.0 <= end.point[1] <= y_extent):
             return at  # off the grid: the sleeve would refuse it
         limit = LINE_SHARE * self.params.max_error
-        if _distance_sq(at.point, end.point, end.point) > limit * limit:  # a bend, not noise
+        if segment_distance_sq(at.point, end.point, end.point) > limit * limit:  # a bend, not noise
             return at
         if not self._sendable(window[0], end) or not self._fits(window, 1, cut + 1, end.point):
             return at
@@ -190,9 +198,9 @@ class ReferenceWindowSimplifier:
         limit = LINE_SHARE * self.params.max_error
         anchor = window[0].point
         for index in range(1, cut + 1):
-            if _distance_sq(window[index].point, anchor, end.point) > limit * limit:
+            if segment_distance_sq(window[index].point, anchor, end.point) > limit * limit:
                 return None
-        return _direction(anchor, end.point)
+        return unit_direction(anchor, end.point)
 
     def _sendable(self, start: _Point, end: _Point) -> bool:
         """Whether start -> end is long enough to send (the cap never cuts off a dropped stroke)."""
@@ -208,7 +216,7 @@ class ReferenceWindowSimplifier:
         anchor = window[0].point
         ranked = sorted(
             range(first, len(window)),
-            key=lambda i: (_distance_sq(window[i].point, anchor, end), i),
+            key=lambda i: (segment_distance_sq(window[i].point, anchor, end), i),
             reverse=True,
         )
         for index in ranked:
@@ -220,7 +228,7 @@ class ReferenceWindowSimplifier:
         """Whether window[first:stop] all lie within max_error of window[0] -> end."""
         anchor = window[0].point
         for index in range(first, stop):
-            if _distance_sq(window[index].point, anchor, end) > self._max_error_sq:
+            if segment_distance_sq(window[index].point, anchor, end) > self._max_error_sq:
                 return False
         return True
 
@@ -235,23 +243,3 @@ class ReferenceWindowSimplifier:
             min_length=self.params.min_length,
             min_duration_ms=self.params.min_duration_ms,
         )
-
-
-def _direction(start: Point, end: Point) -> tuple[float, float] | None:
-    """The unit vector from ``start`` to ``end`` (None if they coincide)."""
-    dx, dy = end[0] - start[0], end[1] - start[1]
-    length = math.sqrt(dx * dx + dy * dy)
-    return (dx / length, dy / length) if length > 0.0 else None
-
-
-def _distance_sq(point: Point, start: Point, end: Point) -> float:
-    """Squared distance from ``point`` to the segment start -> end (its nearest point)."""
-    ax, ay = start
-    dx, dy = end[0] - ax, end[1] - ay
-    qx, qy = point[0] - ax, point[1] - ay
-    length_sq = dx * dx + dy * dy
-    if length_sq > 0.0:
-        # The nearest point of the segment: the projection, clamped onto it.
-        t = min(max((qx * dx + qy * dy) / length_sq, 0.0), 1.0)
-        qx, qy = qx - t * dx, qy - t * dy
-    return qx * qx + qy * qy

@@ -35,7 +35,8 @@ function phase(label: string, figures: FramePhase): string {
   return (
     `  ${label.padEnd(22)} ${figures.scriptMsPerFrame.toFixed(3)} ms/frame scripting` +
     ` (the page's own frame work: mean ${figures.pageWorkMeanMs.toFixed(3)} ms, p95 ${figures.pageWorkP95Ms.toFixed(3)} ms;` +
-    ` ${figures.frames} frames, ${figures.strokes} strokes on the canvas)`
+    ` ${figures.frames} frames, least of ${figures.drawings} drawings, ${figures.strokes} strokes on the canvas)` +
+    (figures.capped ? ` [more frames than the page keeps (${figures.frames}): per frame overstated]` : "")
   );
 }
 

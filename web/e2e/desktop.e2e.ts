@@ -29,6 +29,7 @@ import {
   drawWithMouse,
   nextFrame,
   screenshot,
+  showActuators,
   toGrid,
   waitForData,
   walk,
@@ -111,17 +112,12 @@ describe("drawing with a mouse on a desktop", () => {
   it("lights the preview from the sleeve's actuator telemetry", async () => {
     const preview = '[data-testid="sleeve-preview"]';
     expect(await page.locator(preview).getAttribute("data-lit")).toBe("0");
-    await sleeve.publish("actuators", {
-      t_ms: 1200,
-      rows: 3,
-      columns: 4,
-      intensities: [
-        [0, 0.9, 0.4, 0],
-        [0, 0.2, 0, 0],
-        [0, 0, 0, 0],
-      ],
-    });
-    await waitForData(page, preview, "lit", "3");
+    const frame = [
+      [0, 0.9, 0.4, 0],
+      [0, 0.2, 0, 0],
+      [0, 0, 0, 0],
+    ];
+    await showActuators(page, sleeve, frame, 1200); // three on: the preview lights three
     expect(await page.locator(preview).getAttribute("data-max-intensity")).toBe("0.900");
   });
 

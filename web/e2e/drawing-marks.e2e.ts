@@ -1,13 +1,15 @@
 /**
  * What the drawing area shows, read from its pixels in real Chromium: Esc with
  * the pen down ends the path there; a stroke the sleeve refused stays marked
- * refused, whatever is redrawn; the A/B comparison lies on the drawing it is
- * compared with.
+ * refused, whatever is redrawn; one refused leaves the felt timeline and one the
+ * duty-cycle cap kept from playing is marked refused too; the A/B comparison
+ * lies on the drawing it is compared with.
  */
 import { readFileSync } from "node:fs";
+import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { FakeSleeve } from "./harness";
+import { FakeSleeve, REPO_DIR } from "./harness";
 import { drawingArea, nextFrame, screenshot, waitForData, walk } from "./page";
 import { DESKTOP, Processes } from "./processes";
 
@@ -21,6 +23,13 @@ const COMPARE_RGB = [0x5e, 0xc8, 0xff] as const;
 
 type Point = readonly [number, number];
 type Rgb = readonly [number, number, number];
+
+/** An event as the sleeve publishes it (testdata/events/event/<name>.json), about stroke `seq` of `drawing`. */
+function sleeveEvent(name: string, drawing: string | null, seq: number): object {
+  const path = join(REPO_DIR, "testdata", "events", "event", `${name}.json`);
+  const { wire } = JSON.parse(readFileSync(path, "utf8")) as { wire: object };
+  return { ...wire, drawing, seq, received_at_ms: Date.now() };
+}
 
 describe("the drawing area's marks", () => {
   const processes = new Processes();
@@ -85,6 +94,15 @@ describe("the drawing area's marks", () => {
     await nextFrame(page);
     await nextFrame(page);
     return sent;
+  }
+
+  /** A new drawing of one line across the middle, from `u0` to `u1` of the width, sent: its ends. */
+  async function newLine(u0: number, u1: number): Promise<[Point, Point]> {
+    await page.locator('[data-testid="new-button"]').click();
+    const ends: [Point, Point] = [await at(u0, 0.5), await at(u1, 0.5)];
+    await draw(ends);
+    await allSent(await drawingId());
+    return ends;
   }
 
   /**
@@ -178,11 +196,52 @@ describe("the drawing area's marks", () => {
     expect(await columnsOf("ink", REFUSED_RGB, y, x0, x1)).toBeGreaterThan(0);
   });
 
+  it("takes a refused stroke out of the felt timeline, and marks one the duty-cycle cap kept from playing", async () => {
+    const [left, right] = await newLine(0.1, 0.9);
+    // Played again: every stroke reaches the sleeve at once, so the timeline plays them back to back.
+    await page.locator('[data-testid="replay-button"]').click();
+    const drawing = await drawingId();
+    const strokes = await allSent(drawing);
+    expect(strokes, "a line long enough for three strokes or more").toBeGreaterThanOrEqual(3);
+    const durationMs = new Map(
+      sleeveStrokes(drawing).map((stroke) => [stroke["seq"] as number, stroke["duration_ms"] as number]),
+    );
+    const timeline = '[data-testid="timeline"]';
+    const totalMs = async () => Number(await page.locator(timeline).getAttribute("data-total-ms"));
+    const before = await totalMs();
+    const red = () => columnsOf("ink", REFUSED_RGB, left[1], left[0], right[0]);
+    // Bits too short to feel, dropped by the simplifier, are dashed red already.
+    const dropped = await red();
+
+    // Refused: never in the sleeve's queue, so never felt, and the strokes after it move up.
+    await sleeve.publish("events", sleeveEvent("rejected", drawing, 0));
+    await waitForData(page, SUMMARY, "refused", "1");
+    await waitForData(page, timeline, "strokes", String(strokes - 1));
+    expect(Math.abs((await totalMs()) - (before - durationMs.get(0)!))).toBeLessThanOrEqual(1);
+    await nextFrame(page);
+    const refusedColumns = await red();
+    expect(refusedColumns).toBeGreaterThan(dropped);
+
+    // Kept from playing by the duty-cycle cap when its turn came: marked refused on the canvas and
+    // counted so; its turn passed in silence, so the strokes after it stay where they were.
+    await sleeve.publish("events", sleeveEvent("safety-duty-cycle", drawing, 1));
+    await waitForData(page, SUMMARY, "refused", "2");
+    await nextFrame(page);
+    await nextFrame(page);
+    expect(await red()).toBeGreaterThan(refusedColumns);
+    expect(await page.locator(timeline).getAttribute("data-strokes")).toBe(String(strokes - 1));
+    expect(Math.abs((await totalMs()) - (before - durationMs.get(0)!))).toBeLessThanOrEqual(1);
+    await expect(page.locator('[data-testid="event-log"] li').first().innerText()).resolves.toContain(
+      "Stroke 1 refused by the duty-cycle cap",
+    );
+    await expect(page.locator('[data-testid="timeline-caption"]').innerText()).resolves.toContain(
+      "1 not felt (the sleeve's duty-cycle cap kept it from playing)",
+    );
+    await screenshot(page, "refused-and-capped");
+  });
+
   it("lays the A/B comparison on the drawing it compares: a straight line on itself", async () => {
-    await page.locator('[data-testid="new-button"]').click();
-    const [left, right] = [await at(0.15, 0.5), await at(0.85, 0.5)];
-    await draw([left, right]);
-    await allSent(await drawingId());
+    const [left, right] = await newLine(0.15, 0.85);
     await page.locator('[data-testid="compare-toggle"]').check();
     await nextFrame(page);
     // Every layer of the stage covers it exactly.

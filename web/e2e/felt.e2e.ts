@@ -7,12 +7,11 @@
  */
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
-import mqtt, { type MqttClient } from "mqtt";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { RESULTS_DIR, type Credentials } from "./harness";
-import { drawingArea, drawWithMouse, openAdvanced, screenshot, waitForData, type Area } from "./page";
-import { DESKTOP, Processes } from "./processes";
+import { EventWatcher, RESULTS_DIR } from "./harness";
+import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
+import { Processes } from "./processes";
 
 type Point = readonly [number, number];
 /** How long each leg of the long drawing takes to draw, and so its stroke to play: seconds. */
@@ -34,46 +33,6 @@ function readRecord(path: string): RecordLine[] {
     .map((line) => JSON.parse(line) as RecordLine);
 }
 
-/** Everything the sleeve says on its events topic, read with the sender's account. */
-class EventWatcher {
-  readonly events: Record<string, unknown>[] = [];
-  readonly client: MqttClient;
-
-  private constructor(client: MqttClient) {
-    this.client = client;
-    client.on("message", (_topic, payload) => this.events.push(JSON.parse(payload.toString("utf8"))));
-  }
-
-  static async connect(credentials: Credentials): Promise<EventWatcher> {
-    const client = await mqtt.connectAsync(credentials.mqtt_url, {
-      username: credentials.sender.username,
-      password: credentials.sender.password,
-      clientId: `test-events-${process.pid}-${Date.now()}`,
-    });
-    const watcher = new EventWatcher(client);
-    await client.subscribeAsync(`feelmysign/${credentials.sleeve.id}/events`, { qos: 1 });
-    return watcher;
-  }
-
-  async waitFor(
-    what: string,
-    test: (events: Record<string, unknown>[]) => boolean,
-    timeoutMs = 30_000,
-  ): Promise<Record<string, unknown>[]> {
-    const deadline = Date.now() + timeoutMs;
-    while (!test(this.events)) {
-      if (Date.now() > deadline)
-        throw new Error(`no ${what} after ${timeoutMs} ms: ${JSON.stringify(this.events.slice(-5))}`);
-      await new Promise((wake) => setTimeout(wake, 20));
-    }
-    return this.events;
-  }
-
-  of(drawing: string, type?: string): Record<string, unknown>[] {
-    return this.events.filter((e) => e["drawing"] === drawing && (type === undefined || e["type"] === type));
-  }
-}
-
 async function drawingId(page: Page): Promise<string> {
   return page.evaluate(() => window.feelmysign?.drawingId ?? "");
 }
@@ -82,15 +41,6 @@ async function dataOf(page: Page, testid: string, key: string): Promise<string> 
   return page
     .locator(`[data-testid="${testid}"]`)
     .evaluate((el, k) => (el as HTMLElement).dataset[k] ?? "", key);
-}
-
-/** Settings → Advanced → Longest stroke (ms of drawing; 0 = no limit), saved. */
-async function setLongestStroke(page: Page, ms: string): Promise<void> {
-  await page.locator('[data-testid="settings-button"]').click();
-  await openAdvanced(page);
-  await page.locator('[data-testid="setting-max_stroke_ms"]').fill(ms);
-  await page.locator('[data-testid="settings-save"]').click();
-  await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
 }
 
 describe("the felt drawing, served by feelmysign up with the simulated sleeve", () => {
@@ -106,9 +56,7 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     const up = await processes.up("felt", { args: ["--record", recordPath] });
     watcher = await EventWatcher.connect(up.credentials);
     processes.add(() => watcher.client.endAsync(true));
-    page = await processes.page(up.url, { ...DESKTOP, deviceScaleFactor: 1 });
-    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
-    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
+    page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });
 

@@ -372,3 +372,43 @@ export class FakeSleeve {
     await this.client.endAsync(true);
   }
 }
+
+/** Everything the sleeve says on its events topic, read with the sender's account. */
+export class EventWatcher {
+  readonly events: Record<string, unknown>[] = [];
+  readonly client: MqttClient;
+
+  private constructor(client: MqttClient) {
+    this.client = client;
+    client.on("message", (_topic, payload) => this.events.push(JSON.parse(payload.toString("utf8"))));
+  }
+
+  static async connect(credentials: Credentials): Promise<EventWatcher> {
+    const client = await mqtt.connectAsync(credentials.mqtt_url, {
+      username: credentials.sender.username,
+      password: credentials.sender.password,
+      clientId: `test-events-${process.pid}-${Date.now()}`,
+    });
+    const watcher = new EventWatcher(client);
+    await client.subscribeAsync(`feelmysign/${credentials.sleeve.id}/events`, { qos: 1 });
+    return watcher;
+  }
+
+  async waitFor(
+    what: string,
+    test: (events: Record<string, unknown>[]) => boolean,
+    timeoutMs = 30_000,
+  ): Promise<Record<string, unknown>[]> {
+    const deadline = Date.now() + timeoutMs;
+    while (!test(this.events)) {
+      if (Date.now() > deadline)
+        throw new Error(`no ${what} after ${timeoutMs} ms: ${JSON.stringify(this.events.slice(-5))}`);
+      await new Promise((wake) => setTimeout(wake, 20));
+    }
+    return this.events;
+  }
+
+  of(drawing: string, type?: string): Record<string, unknown>[] {
+    return this.events.filter((e) => e["drawing"] === drawing && (type === undefined || e["type"] === type));
+  }
+}

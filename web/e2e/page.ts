@@ -3,7 +3,7 @@ import { mkdirSync } from "node:fs";
 import { join } from "node:path";
 import type { CDPSession, Page } from "playwright-core";
 import { CanvasMapping } from "../src/simplify/mapping";
-import { RESULTS_DIR } from "./harness";
+import { RESULTS_DIR, type FakeSleeve } from "./harness";
 
 export interface Area {
   /** The drawing area's top-left corner in viewport CSS pixels. */
@@ -165,6 +165,22 @@ export async function waitForData(
   }
 }
 
+/**
+ * `sleeve` publishes an actuator frame (its telemetry) of `intensities`, one array per row of
+ * the grid; resolves once the page's preview lights as many actuators as are on.
+ */
+export async function showActuators(
+  page: Page,
+  sleeve: FakeSleeve,
+  intensities: readonly (readonly number[])[],
+  tMs = 0,
+): Promise<void> {
+  const [rows, columns] = [intensities.length, intensities[0]?.length ?? 0];
+  await sleeve.publish("actuators", { t_ms: tMs, rows, columns, intensities });
+  const lit = intensities.flat().filter((intensity) => intensity > 0).length;
+  await waitForData(page, '[data-testid="sleeve-preview"]', "lit", String(lit));
+}
+
 /** Waits until the sleeve has played at least one stroke of the page's current drawing. */
 export async function waitForPlayed(page: Page, timeoutMs = 30_000): Promise<void> {
   await page.waitForFunction(
@@ -180,4 +196,13 @@ export async function openAdvanced(page: Page): Promise<void> {
   await page.locator('[data-testid="settings-advanced"]').evaluate((details) => {
     (details as HTMLDetailsElement).open = true;
   });
+}
+
+/** Settings → Advanced → Longest stroke (ms of drawing; 0 = no limit), saved. */
+export async function setLongestStroke(page: Page, ms: string): Promise<void> {
+  await page.locator('[data-testid="settings-button"]').click();
+  await openAdvanced(page);
+  await page.locator('[data-testid="setting-max_stroke_ms"]').fill(ms);
+  await page.locator('[data-testid="settings-save"]').click();
+  await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
 }

@@ -13,6 +13,7 @@ import {
   nextFrame,
   openAdvanced,
   screenshot,
+  showActuators,
   waitForData,
   type Area,
 } from "./page";
@@ -96,17 +97,16 @@ describe("drawing with a finger on a phone", () => {
     expect(sent).toBeGreaterThanOrEqual(2);
     const strokes = await sleeve.waitForStrokes(sent);
     expectStrokesFollow(strokes, points, area, await strokeBounds(page, area), 4);
-    await sleeve.publish("actuators", {
-      t_ms: 10,
-      rows: 3,
-      columns: 4,
-      intensities: [
+    await showActuators(
+      page,
+      sleeve,
+      [
         [0, 0, 0, 0],
         [0.7, 0, 0, 0],
         [1, 0.5, 0, 0],
       ],
-    });
-    await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "3");
+      10,
+    );
     await screenshot(page, "phone");
   });
 

@@ -19,6 +19,7 @@ import {
   type BrowserOptions,
   type Credentials,
 } from "./harness";
+import { waitForData } from "./page";
 
 /** A desktop browser window. */
 export const DESKTOP: BrowserOptions = { viewport: { width: 1280, height: 800 } };
@@ -88,6 +89,14 @@ export class Processes {
   async page(url: string, options: BrowserOptions = DESKTOP): Promise<Page> {
     const page = await (await this.browser(options)).newPage();
     await page.goto(url);
+    return page;
+  }
+
+  /** A page on `url` in a fresh desktop Chromium (one pixel per CSS pixel), once it is connected and sees the sleeve online. */
+  async onlinePage(url: string): Promise<Page> {
+    const page = await this.page(url, { ...DESKTOP, deviceScaleFactor: 1 });
+    await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
+    await waitForData(page, '[data-testid="sleeve-status"]', "state", "online");
     return page;
   }
 

@@ -395,6 +395,7 @@ export class App {
     if (reading.played !== null) this.#felt.played(reading.played);
     if (reading.cancelled !== null) this.#felt.cancelled(reading.cancelled);
     if (reading.refusedSeq !== null) this.#session.refused(reading.refusedSeq);
+    if (reading.unplayed !== null) this.#felt.unplayed(reading.unplayed);
     for (const note of reading.notes) this.#says.add(note.kind, note.text);
   }
 

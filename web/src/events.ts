@@ -354,9 +354,26 @@ export interface EventReading {
   readonly played: PlayedEvent | AdjustedEvent | null;
   /** A stroke of the drawing was cancelled: where it stopped. */
   readonly cancelled: CancelledEvent | null;
-  /** The seq of a stroke of the drawing the sleeve refused. */
+  /** The seq of a stroke of the drawing the sleeve refused, or kept from playing: marked on the canvas. */
   readonly refusedSeq: number | null;
+  /** A stroke of the drawing the sleeve will never play: what the felt timeline leaves out of it. */
+  readonly unplayed: Unplayed | null;
 }
+
+/**
+ * A stroke the sleeve will never play. `refused`: refused on arrival, it never entered the sleeve's
+ * queue. `capped`: the duty-cycle cap kept it from playing when its turn came, and the sleeve let
+ * its turn pass in silence (the strokes after it keep their starts).
+ */
+export interface Unplayed {
+  readonly seq: number;
+  readonly why: "refused" | "capped";
+}
+
+/** The refusal of a copy of a stroke already played or refused: it says nothing of that stroke's touch. */
+export const DUPLICATE_REASON = "duplicate";
+/** The safety event of a stroke the duty-cycle cap kept from playing. */
+export const DUTY_CYCLE_REASON = "duty_cycle";
 
 const NOTHING: EventReading = {
   counts: [],
@@ -365,6 +382,7 @@ const NOTHING: EventReading = {
   played: null,
   cancelled: null,
   refusedSeq: null,
+  unplayed: null,
 };
 
 /**
@@ -418,11 +436,14 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
     case "rejected": {
       // A refusal of no drawing in particular (a message the sleeve could not read) is shown too.
       const shown = ours || ref?.drawing == null;
+      // A copy's refusal leaves the stroke where the sleeve put it (played, or refused before).
+      const unplayed = ours && event.reason !== DUPLICATE_REASON;
       return {
         ...NOTHING,
         counts: ours ? ["refused"] : [],
         notes: shown ? [{ kind: "rejected", text: `${label} refused: ${describe(event)}` }] : [],
         refusedSeq: ours ? event.seq : null,
+        unplayed: unplayed ? { seq: event.seq!, why: "refused" } : null,
       };
     }
     case "cancelled":
@@ -439,6 +460,16 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
         cancelled: event,
       };
     case "safety":
+      if (ours && event.reason === DUTY_CYCLE_REASON) {
+        // Refused when its turn came: counted and marked as a refusal, as `up`'s terminal counts it.
+        return {
+          ...NOTHING,
+          counts: ["refused"],
+          notes: [{ kind: "rejected", text: `${label} refused by the duty-cycle cap: ${describe(event)}` }],
+          refusedSeq: event.seq,
+          unplayed: { seq: event.seq!, why: "capped" },
+        };
+      }
       return {
         ...NOTHING,
         notes: [

@@ -6,16 +6,19 @@
  * stroke and per sleeve event does not grow with the drawing. Gives the same
  * placement as the full computation (felt-panel's former `#place`):
  *
+ *   - a stroke the sleeve refused on arrival is left out: it never entered the
+ *     sleeve's queue, so it is not felt and holds no later stroke back;
  *   - times start at the first stroke's arrival (the shift);
- *   - the page's estimate is placeStrokes with the cuts;
+ *   - the page's estimate is placeStrokes with the cuts and the strokes the
+ *     duty-cycle cap kept from playing;
  *   - once the sleeve reported a stroke, its clock is anchored on the first
  *     stroke (in seq order) it reported: every reported start, less that
  *     offset, replaces the estimate.
  *
  * Pure: no DOM, no clock.
  */
-import type { FeltStroke, PlacedStroke } from "./felt";
-import { EMPTY_TAIL_MS, queueCatchUpMs, queueStartMs, SLEEVE_FLOOR_MS } from "./sleeve-queue";
+import { caughtUp, feltEndMs, turnOf, type FeltStroke, type PlacedStroke } from "./felt";
+import { QueueTail, SLEEVE_FLOOR_MS } from "./sleeve-queue";
 
 export class FeltPlacement {
   /** Shifted strokes (arrival relative to the first stroke's), in seq order. */
@@ -23,16 +26,24 @@ export class FeltPlacement {
   readonly #placed: PlacedStroke[] = [];
   /** The largest end (start + played) of strokes 0..i: what is over by then. */
   readonly #prefixEndMs: number[] = [];
+  /** The sleeve's queue tail after stroke i: where stroke i + 1 is placed from. */
+  readonly #tailMs: number[] = [];
   readonly #indexBySeq = new Map<number, number>();
   /** seq -> start reported by the sleeve, on the sleeve's clock. */
   readonly #startedAt = new Map<number, number>();
   /** seq -> ms into the stroke at which a cancel cut it. */
   readonly #cut = new Map<number, number>();
+  /** Seqs the duty-cycle cap kept from playing. */
+  readonly #capped = new Set<number>();
+  /** Seqs the sleeve refused on arrival: never placed. */
+  readonly #refused = new Set<number>();
   /** Arrival (unshifted) of the first stroke: the timeline's zero. */
   #shiftMs = 0;
   /** Index of the first stroke the sleeve reported, and its clock's offset; null before any. */
   #anchor: { index: number; offsetMs: number } | null = null;
+  /** Strokes whose start the sleeve reported, and strokes its duty-cycle cap kept from playing. */
   #reported = 0;
+  #cappedCount = 0;
   /** Pairs (i - 1, i) whose start goes back in time: the fast search needs none. */
   #descents = 0;
   /** The earliest time (ms) whose picture changed since `takeDirty`; "all" after a rebuild. */
@@ -45,7 +56,7 @@ export class FeltPlacement {
   reset(strokes: readonly FeltStroke[] = []): void {
     this.#strokes.length = 0;
     this.#indexBySeq.clear();
-    const sorted = [...strokes].sort((a, b) => a.seq - b.seq);
+    const sorted = strokes.filter((s) => !this.#refused.has(s.seq)).sort((a, b) => a.seq - b.seq);
     this.#shiftMs =
       sorted.length === 0
         ? 0
@@ -58,6 +69,7 @@ export class FeltPlacement {
 
   /** A new stroke at the end (seq after every one placed, arrival unshifted). */
   append(stroke: FeltStroke): void {
+    if (this.#refused.has(stroke.seq)) return;
     const last = this.#strokes[this.#strokes.length - 1];
     const first = this.#strokes.length === 0;
     if (!first && (stroke.seq <= last!.seq || stroke.arrives_ms < this.#shiftMs)) {
@@ -98,12 +110,54 @@ export class FeltPlacement {
     }
   }
 
+  /** The sleeve's duty-cycle cap kept stroke `seq` from playing: nothing felt, its turn kept. */
+  cap(seq: number): void {
+    if (this.#capped.has(seq)) return;
+    this.#capped.add(seq);
+    const index = this.#indexBySeq.get(seq);
+    // Its turn holds the queue as if it played: no estimate moves, the anchor's neither.
+    if (index !== undefined) this.#placeFrom(index, false);
+  }
+
+  /** The sleeve refused stroke `seq` on arrival: never felt, it gives its place to the strokes after it. */
+  refuse(seq: number): void {
+    if (this.#refused.has(seq)) return;
+    this.#refused.add(seq);
+    const index = this.#indexBySeq.get(seq);
+    if (index === undefined) return;
+    if (index === 0 || (this.#anchor !== null && index <= this.#anchor.index)) {
+      // The timeline's zero, or the estimate the sleeve's clock is anchored on, moves.
+      this.reset(this.#unshifted());
+      return;
+    }
+    const removed = this.#placed[index]!;
+    this.#descents -= this.#descends(index) + this.#descends(index + 1);
+    for (const list of [this.#strokes, this.#placed, this.#prefixEndMs, this.#tailMs]) list.splice(index, 1);
+    this.#descents += this.#descends(index);
+    this.#indexBySeq.delete(seq);
+    for (let i = index; i < this.#strokes.length; i++) this.#indexBySeq.set(this.#strokes[i]!.seq, i);
+    if (this.#anchor !== null && this.#anchor.index > index) {
+      this.#anchor = { ...this.#anchor, index: this.#anchor.index - 1 };
+    }
+    this.#count(removed, -1);
+    this.#markDirty(removed.start_ms);
+    if (index < this.#strokes.length) {
+      this.#placeFrom(index, false);
+    }
+  }
+
   get placed(): readonly PlacedStroke[] {
     return this.#placed;
   }
 
+  /** How many strokes the sleeve reported it played (with their start). */
   get reportedCount(): number {
     return this.#reported;
+  }
+
+  /** How many strokes the sleeve's duty-cycle cap kept from playing. */
+  get cappedCount(): number {
+    return this.#cappedCount;
   }
 
   /** When the last stroke ends (0 for none), as felt.ts's totalMs. */
@@ -168,26 +222,17 @@ export class FeltPlacement {
   /** The first reported stroke and the sleeve's clock offset against the page's estimate of it. */
   #reanchor(): void {
     this.#anchor = null;
-    let tail = EMPTY_TAIL_MS;
+    const queue = new QueueTail();
     for (let index = 0; index < this.#strokes.length; index++) {
       const stroke = this.#strokes[index]!;
-      const estimateMs = queueStartMs(stroke.arrives_ms, tail);
+      const played = caughtUp(stroke, queue.tailMs, this.floorMs);
+      const estimateMs = queue.place(stroke.arrives_ms, turnOf(played, this.#cut, this.#capped).held_ms);
       const reported = this.#startedAt.get(stroke.seq);
       if (reported !== undefined) {
         this.#anchor = { index, offsetMs: reported - estimateMs };
         return;
       }
-      tail = estimateMs + this.#playedMs(stroke, this.#durationMs(stroke, tail));
     }
-  }
-
-  /** How long the sleeve plays the stroke behind a queue ending at `tailMs` (it catches up). */
-  #durationMs(stroke: FeltStroke, tailMs: number): number {
-    return queueCatchUpMs(stroke.arrives_ms, tailMs, stroke.duration_ms, this.floorMs);
-  }
-
-  #playedMs(stroke: FeltStroke, durationMs: number): number {
-    return Math.min(durationMs, Math.max(0, this.#cut.get(stroke.seq) ?? durationMs));
   }
 
   /**
@@ -198,11 +243,12 @@ export class FeltPlacement {
     if (all) {
       this.#placed.length = 0;
       this.#prefixEndMs.length = 0;
+      this.#tailMs.length = 0;
       this.#reported = 0;
+      this.#cappedCount = 0;
       this.#descents = 0;
     }
-    const previous = this.#placed[from - 1];
-    let tail = previous === undefined ? EMPTY_TAIL_MS : previous.start_ms + previous.played_ms;
+    const queue = new QueueTail(this.#tailMs[from - 1]);
     let dirtyMs = Number.POSITIVE_INFINITY;
     const offset = this.#anchor?.offsetMs;
     let stop = this.#strokes.length;
@@ -210,25 +256,19 @@ export class FeltPlacement {
       const stroke = this.#strokes[i]!;
       const reportedAt = offset === undefined ? undefined : this.#startedAt.get(stroke.seq);
       const known = reportedAt === undefined ? undefined : reportedAt - offset!;
-      const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
-      const duration_ms = this.#durationMs(stroke, tail);
-      const played_ms = this.#playedMs(stroke, duration_ms);
-      tail = start_ms + played_ms;
+      const played = caughtUp(stroke, queue.tailMs, this.floorMs);
+      const turn = turnOf(played, this.#cut, this.#capped);
+      const start_ms = queue.place(stroke.arrives_ms, turn.held_ms, known);
       const old = this.#placed[i];
-      const placed: PlacedStroke = {
-        ...stroke,
-        duration_ms,
-        start_ms,
-        reported: known !== undefined,
-        played_ms,
-      };
+      const placed: PlacedStroke = { ...played, start_ms, reported: known !== undefined, ...turn.felt };
       if (
         i > from &&
         old !== undefined &&
         old.start_ms === start_ms &&
-        old.duration_ms === duration_ms &&
-        old.played_ms === played_ms &&
-        old.reported === placed.reported
+        old.duration_ms === placed.duration_ms &&
+        old.played_ms === placed.played_ms &&
+        old.reported === placed.reported &&
+        old.capped === placed.capped
       ) {
         stop = i;
         break;
@@ -236,24 +276,39 @@ export class FeltPlacement {
       // Descents are counted over the array as it stands: the two pairs this stroke is in.
       this.#descents -= this.#descends(i) + this.#descends(i + 1);
       if (old !== undefined) {
-        if (old.reported) this.#reported--;
+        this.#count(old, -1);
         dirtyMs = Math.min(dirtyMs, old.start_ms);
       }
       this.#placed[i] = placed;
       this.#descents += this.#descends(i) + this.#descends(i + 1);
-      if (placed.reported) this.#reported++;
+      this.#count(placed, 1);
       dirtyMs = Math.min(dirtyMs, start_ms);
-      this.#prefixEndMs[i] = Math.max(this.#prefixEndMs[i - 1] ?? Number.NEGATIVE_INFINITY, tail);
+      this.#tailMs[i] = queue.tailMs;
+      this.#prefixEndMs[i] = Math.max(
+        this.#prefixEndMs[i - 1] ?? Number.NEGATIVE_INFINITY,
+        feltEndMs(placed),
+      );
     }
     // Strokes kept after the last re-placed one: their prefix ends follow, until one stays.
     for (let i = Math.max(stop, 1); i < this.#placed.length; i++) {
       const placed = this.#placed[i]!;
-      const value = Math.max(this.#prefixEndMs[i - 1]!, placed.start_ms + placed.played_ms);
+      const value = Math.max(this.#prefixEndMs[i - 1]!, feltEndMs(placed));
       if (value === this.#prefixEndMs[i]) break;
       this.#prefixEndMs[i] = value;
     }
-    if (dirtyMs !== Number.POSITIVE_INFINITY && this.#dirty !== "all") {
-      this.#dirty = this.#dirty === null ? dirtyMs : Math.min(this.#dirty, dirtyMs);
+    this.#markDirty(dirtyMs);
+  }
+
+  /** Counts a placed stroke in (+1) or out (-1). */
+  #count(stroke: PlacedStroke, sign: 1 | -1): void {
+    if (stroke.reported) this.#reported += sign;
+    if (stroke.capped) this.#cappedCount += sign;
+  }
+
+  /** The picture changed from `fromMs` on. */
+  #markDirty(fromMs: number): void {
+    if (fromMs !== Number.POSITIVE_INFINITY && this.#dirty !== "all") {
+      this.#dirty = this.#dirty === null ? fromMs : Math.min(this.#dirty, fromMs);
     }
   }
 

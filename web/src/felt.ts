@@ -8,14 +8,14 @@
  * by the apparent-motion model): it shows where and when the touch is.
  *
  * Times: where the sleeve told when it played a stroke, that time; otherwise
- * the sleeve's own rule (docs/protocol.md, "Playback"; `queueStartMs` in
+ * the sleeve's own rule (docs/protocol.md, "Playback"; `QueueTail` in
  * sleeve-queue.ts, pinned by testdata/queue): a stroke starts when it arrives,
  * or when the one before it ends if that is later, and one that waits plays
  * faster to catch up, down to the sleeve's floor (`queueCatchUpMs`): the strokes
  * placed here are one drawing's.
  */
 import type { Point } from "./simplify/segment";
-import { EMPTY_TAIL_MS, queueCatchUpMs, queueStartMs, SLEEVE_FLOOR_MS } from "./sleeve-queue";
+import { queueCatchUpMs, QueueTail, SLEEVE_FLOOR_MS } from "./sleeve-queue";
 
 export interface FeltStroke {
   readonly seq: number;
@@ -35,6 +35,11 @@ export interface PlacedStroke extends FeltStroke {
   readonly reported: boolean;
   /** Cut short (or dropped) by a cancel: it ends at `start_ms + played_ms`. */
   readonly played_ms: number;
+  /**
+   * Kept from playing by the sleeve's duty-cycle cap when its turn came: nothing felt
+   * (`played_ms` 0), and its turn passes in silence (the sleeve does not move the strokes after it).
+   */
+  readonly capped: boolean;
 }
 
 export interface Grid {
@@ -54,25 +59,56 @@ export interface Drive {
  * of the stroke before, whichever is later. A stroke arriving before the one
  * before it ends plays faster, down to `floorMs` (the sleeve's catch-up rule).
  * `reported` maps seq -> start (ms); `cut` maps seq -> ms after its start when
- * a cancel stopped it.
+ * a cancel stopped it; `capped` holds the seqs the duty-cycle cap kept from playing.
+ * A stroke the sleeve refused on arrival never entered its queue: leave it out of `strokes`.
  */
 export function placeStrokes(
   strokes: readonly FeltStroke[],
   reported: ReadonlyMap<number, number> = new Map(),
   cut: ReadonlyMap<number, number> = new Map(),
+  capped: ReadonlySet<number> = new Set(),
   floorMs: number = SLEEVE_FLOOR_MS,
 ): PlacedStroke[] {
   const placed: PlacedStroke[] = [];
-  let tail = EMPTY_TAIL_MS;
+  const queue = new QueueTail();
   for (const stroke of [...strokes].sort((a, b) => a.seq - b.seq)) {
     const known = reported.get(stroke.seq);
-    const start_ms = known ?? queueStartMs(stroke.arrives_ms, tail);
-    const duration_ms = queueCatchUpMs(stroke.arrives_ms, tail, stroke.duration_ms, floorMs);
-    const played_ms = Math.min(duration_ms, Math.max(0, cut.get(stroke.seq) ?? duration_ms));
-    tail = start_ms + played_ms;
-    placed.push({ ...stroke, duration_ms, start_ms, reported: known !== undefined, played_ms });
+    const played = caughtUp(stroke, queue.tailMs, floorMs);
+    const turn = turnOf(played, cut, capped);
+    const start_ms = queue.place(stroke.arrives_ms, turn.held_ms, known);
+    placed.push({ ...played, start_ms, reported: known !== undefined, ...turn.felt });
   }
   return placed;
+}
+
+/**
+ * The stroke as the sleeve plays it behind a queue ending at `tailMs`: faster when it waits, down to
+ * `floorMs` (`queueCatchUpMs`). The strokes placed here are one drawing's, so every stroke that waits
+ * is behind its own drawing and catches up.
+ */
+export function caughtUp(stroke: FeltStroke, tailMs: number, floorMs: number): FeltStroke {
+  const duration_ms = queueCatchUpMs(stroke.arrives_ms, tailMs, stroke.duration_ms, floorMs);
+  return duration_ms === stroke.duration_ms ? stroke : { ...stroke, duration_ms };
+}
+
+/**
+ * What a stroke's turn is: how long it holds the sleeve's queue (whole, or until a cancel cut it;
+ * `cut`: seq -> ms into it), and what of it is felt (nothing, when the duty-cycle cap kept it from
+ * playing: `capped`).
+ */
+export function turnOf(
+  stroke: FeltStroke,
+  cut: ReadonlyMap<number, number>,
+  capped: ReadonlySet<number>,
+): { held_ms: number; felt: { played_ms: number; capped: boolean } } {
+  const held_ms = Math.min(stroke.duration_ms, Math.max(0, cut.get(stroke.seq) ?? stroke.duration_ms));
+  const isCapped = capped.has(stroke.seq);
+  return { held_ms, felt: { played_ms: isCapped ? 0 : held_ms, capped: isCapped } };
+}
+
+/** When the touch of a placed stroke ends. */
+export function feltEndMs(stroke: PlacedStroke): number {
+  return stroke.start_ms + stroke.played_ms;
 }
 
 /** Where the brush is `t_ms` into the stroke (clamped to its ends). */
@@ -126,5 +162,5 @@ export function playingAt(
 
 /** When the last stroke ends (0 for none). */
 export function totalMs(placed: readonly PlacedStroke[]): number {
-  return placed.reduce((end, stroke) => Math.max(end, stroke.start_ms + stroke.played_ms), 0);
+  return placed.reduce((end, stroke) => Math.max(end, feltEndMs(stroke)), 0);
 }

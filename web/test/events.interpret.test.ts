@@ -91,10 +91,11 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     expect(interpretEvent(played, DRAWING).counts).toEqual(["played"]);
   });
 
-  it("counts a refused stroke of the drawing and names it for the canvas", () => {
+  it("counts a refused stroke of the drawing and names it for the canvas and the timeline", () => {
     const reading = interpretEvent(vector("rejected"), DRAWING);
     expect(reading.counts).toEqual(["refused"]);
     expect(reading.refusedSeq).toBe(3);
+    expect(reading.unplayed).toEqual({ seq: 3, why: "refused" });
     expect(reading.notes).toEqual([
       { kind: "rejected", text: "Stroke 3 refused: start (4, 0) is outside the grid" },
     ]);
@@ -107,11 +108,37 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     expect(reading.notes).toEqual([{ kind: "rejected", text: "A stroke refused: not JSON" }]);
   });
 
+  it("leaves the timeline alone for the refusal of a copy: the stroke itself was played or refused before", () => {
+    const rejected = vector("rejected");
+    if (rejected.type !== "rejected") throw new Error("the rejected vector is not one");
+    const copy = interpretEvent({ ...rejected, reason: "duplicate", message: "already played" }, DRAWING);
+    expect(copy.unplayed).toBeNull();
+  });
+
+  it("refuses a stroke the duty-cycle cap kept from playing: counted, marked, nothing felt of it", () => {
+    expect(interpretEvent(vector("safety-duty-cycle"), DRAWING)).toMatchObject({
+      counts: ["refused"],
+      refusedSeq: 3,
+      unplayed: { seq: 3, why: "capped" },
+      notes: [
+        {
+          kind: "rejected",
+          text: "Stroke 3 refused by the duty-cycle cap: not played: the motor would have been driven 52% of the last 60 s",
+        },
+      ],
+    });
+    // Another drawing's: a safety note, nothing counted or marked.
+    const other = interpretEvent(vector("safety-duty-cycle"), "another");
+    expect(other).toMatchObject({ counts: [], refusedSeq: null, unplayed: null });
+    expect(other.notes.map((note) => note.kind)).toEqual(["error"]);
+  });
+
   it("says nothing of another drawing's refusal", () => {
     expect(interpretEvent(vector("rejected"), "another")).toMatchObject({
       counts: [],
       notes: [],
       refusedSeq: null,
+      unplayed: null,
     });
   });
 

@@ -10,21 +10,27 @@ function placeFromScratch(
   strokes: readonly FeltStroke[],
   startedAt: ReadonlyMap<number, number>,
   cut: ReadonlyMap<number, number>,
+  capped: ReadonlySet<number> = new Set(),
+  refused: ReadonlySet<number> = new Set(),
 ): PlacedStroke[] {
-  const start = Math.min(...strokes.map((s) => s.arrives_ms));
-  const shifted = strokes.map((s) => ({ ...s, arrives_ms: s.arrives_ms - start }));
-  const estimate = placeStrokes(shifted, new Map(), cut);
+  const kept = strokes.filter((s) => !refused.has(s.seq));
+  if (kept.length === 0) return [];
+  const start = Math.min(...kept.map((s) => s.arrives_ms));
+  const shifted = kept.map((s) => ({ ...s, arrives_ms: s.arrives_ms - start }));
+  const estimate = placeStrokes(shifted, new Map(), cut, capped);
   const first = estimate.find((s) => startedAt.has(s.seq));
   if (first === undefined) return estimate;
   const offset = startedAt.get(first.seq)! - first.start_ms;
   const reported = new Map([...startedAt].map(([seq, at]) => [seq, at - offset]));
-  return placeStrokes(shifted, reported, cut);
+  return placeStrokes(shifted, reported, cut, capped);
 }
 
 type Step =
   | { kind: "append"; gap_ms: number; duration_ms: number }
   | { kind: "report"; pick: number; at_ms: number }
-  | { kind: "cut"; pick: number; cut_ms: number };
+  | { kind: "cut"; pick: number; cut_ms: number }
+  | { kind: "cap"; pick: number }
+  | { kind: "refuse"; pick: number };
 
 const step: fc.Arbitrary<Step> = fc.oneof(
   fc.record({
@@ -38,16 +44,20 @@ const step: fc.Arbitrary<Step> = fc.oneof(
     at_ms: fc.integer({ min: 0, max: 20_000 }),
   }),
   fc.record({ kind: fc.constant("cut" as const), pick: fc.nat(), cut_ms: fc.integer({ min: 0, max: 300 }) }),
+  fc.record({ kind: fc.constant("cap" as const), pick: fc.nat() }),
+  fc.record({ kind: fc.constant("refuse" as const), pick: fc.nat() }),
 );
 
 describe("FeltPlacement", () => {
-  it("after every new stroke, report and cut, places as the full computation does", () => {
+  it("after every new stroke, report, cut, cap and refusal, places as the full computation does", () => {
     fc.assert(
       fc.property(fc.integer({ min: 0, max: 5000 }), fc.array(step, { maxLength: 60 }), (origin, steps) => {
         const placement = new FeltPlacement();
         const strokes: FeltStroke[] = [];
         const startedAt = new Map<number, number>();
         const cut = new Map<number, number>();
+        const capped = new Set<number>();
+        const refused = new Set<number>();
         let arrives = origin;
         for (const s of steps) {
           if (s.kind === "append") {
@@ -67,16 +77,24 @@ describe("FeltPlacement", () => {
             if (s.kind === "report") {
               startedAt.set(seq, s.at_ms);
               placement.report(seq, s.at_ms);
-            } else {
+            } else if (s.kind === "cut") {
               cut.set(seq, s.cut_ms);
               placement.cut(seq, s.cut_ms);
+            } else if (s.kind === "cap") {
+              capped.add(seq);
+              placement.cap(seq);
+            } else {
+              refused.add(seq);
+              placement.refuse(seq);
             }
           }
           if (strokes.length === 0) continue;
-          const expected = placeFromScratch(strokes, startedAt, cut);
+          const expected = placeFromScratch(strokes, startedAt, cut, capped, refused);
           expect(placement.placed).toEqual(expected);
           expect(placement.totalMs).toBe(totalMs(expected));
           expect(placement.reportedCount).toBe(expected.filter((p) => p.reported).length);
+          expect(placement.cappedCount).toBe(expected.filter((p) => p.capped).length);
+          for (const seq of refused) expect(placement.bySeq(seq)).toBeUndefined();
           for (const t of [0, 17, 150, 333, 1000, 4000, 12_000, totalMs(expected)]) {
             expect(placement.playingAt(t)).toEqual(playingAt(expected, t));
           }
@@ -104,6 +122,26 @@ describe("FeltPlacement", () => {
     const F = SLEEVE_FLOOR_MS;
     expect(all.placed.map((s) => s.start_ms)).toEqual([0, 100, 100 + F, 100 + F + F]);
     expect(all.bySeq(2)?.start_ms).toBe(100 + F);
+  });
+
+  it("leaves a refused stroke out: the strokes after it move up into its place", () => {
+    const placement = new FeltPlacement();
+    for (const seq of [0, 1, 2, 3]) {
+      placement.append({ seq, start: [0, 0], end: [1, 0], duration_ms: 100, intensity: 1, arrives_ms: 10 });
+    }
+    placement.refuse(1);
+    // Each waits behind the one before, so plays at the sleeve's floor.
+    const F = SLEEVE_FLOOR_MS;
+    expect(placement.placed.map((s) => [s.seq, s.start_ms])).toEqual([
+      [0, 0],
+      [2, 100],
+      [3, 100 + F],
+    ]);
+    expect(placement.totalMs).toBe(100 + F + F);
+    // Refused before it is drawn (the event came first): never placed.
+    placement.refuse(4);
+    placement.append({ seq: 4, start: [0, 0], end: [1, 0], duration_ms: 100, intensity: 1, arrives_ms: 20 });
+    expect(placement.placed.map((s) => s.seq)).toEqual([0, 2, 3]);
   });
 
   it("says from when the picture changed, and everything after a reset", () => {

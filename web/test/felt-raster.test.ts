@@ -87,6 +87,8 @@ const step = fc.oneof(
     at_ms: fc.integer({ min: 0, max: 60_000 }),
   }),
   fc.record({ kind: fc.constant("cut" as const), pick: fc.nat(), cut_ms: fc.integer({ min: 0, max: 800 }) }),
+  fc.record({ kind: fc.constant("cap" as const), pick: fc.nat() }),
+  fc.record({ kind: fc.constant("refuse" as const), pick: fc.nat() }),
 );
 
 describe("PlacementRaster", () => {
@@ -113,7 +115,9 @@ describe("PlacementRaster", () => {
           } else if (seqs.length > 0) {
             const seq = seqs[s.pick % seqs.length]!;
             if (s.kind === "report") placement.report(seq, s.at_ms);
-            else placement.cut(seq, s.cut_ms);
+            else if (s.kind === "cut") placement.cut(seq, s.cut_ms);
+            else if (s.kind === "cap") placement.cap(seq);
+            else placement.refuse(seq);
           }
           kept.sync(placement, GRID);
           const whole = new LaneRaster(GRID.rows * GRID.columns, kept.raster.capacity, kept.raster.msPerBin);
@@ -138,6 +142,7 @@ describe("PlacementRaster", () => {
       start_ms: 0,
       reported: false,
       played_ms: 30 * STEP_MS,
+      capped: false,
     };
     paintStroke(raster, GRID, stroke, alpha);
     // Along row 0 from column 0 to 3: lane 0 first, lane 3 last, row 1 never.

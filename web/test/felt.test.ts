@@ -25,6 +25,23 @@ describe("placeStrokes", () => {
     expect(totalMs(placed)).toBe(600);
   });
 
+  it("feels nothing of a stroke the duty-cycle cap kept from playing, and keeps its turn", () => {
+    const placed = placeStrokes(
+      [stroke(0, 0), stroke(1, 0), stroke(2, 0)],
+      new Map(),
+      new Map(),
+      new Set([1]),
+    );
+    // The two that wait catch up to the sleeve's floor; the capped one's turn is its caught-up one.
+    const F = SLEEVE_FLOOR_MS;
+    expect(placed.map((s) => [s.start_ms, s.played_ms, s.capped])).toEqual([
+      [0, 100, false],
+      [100, 0, true],
+      [100 + F, F, false],
+    ]);
+    expect(playingAt(placed, 150)).toBeNull();
+  });
+
   it("takes the sleeve's reported start over its own estimate, and the cut length", () => {
     const placed = placeStrokes([stroke(0, 0), stroke(1, 0)], new Map([[0, 30]]), new Map([[0, 40]]));
     // The second waits 70 ms behind the first, so it catches up: down to the sleeve's floor.

@@ -125,7 +125,8 @@ class Layout:
 
 
 _DEFAULTS = Layout(rows=1, columns=MIN_ACTUATORS, spacing_cm=1.0)
-_TOP_KEYS = (
+# The keys at the top of a layout file, before its [safety] and [i2c] tables.
+TOP_KEYS = (
     "name",
     "rows",
     "columns",
@@ -247,7 +248,7 @@ def default_layout() -> Layout:
 
 def _build(data: dict[str, Any], source: str) -> Layout:
     problems = _Problems()
-    problems.unknown_keys("", data, (*_TOP_KEYS, "safety", "i2c"))
+    problems.unknown_keys("", data, (*TOP_KEYS, "safety", "i2c"))
     geometry = _read_geometry(problems, data)
     caps = _read_caps(problems, data)
     hardware = _read_i2c(problems, data.get("i2c", {}), geometry["rows"], geometry["columns"])
@@ -463,7 +464,7 @@ def _to_data(layout: Layout) -> dict[str, Any]:
     """A layout as the dictionary its TOML file would give, so one validator checks both."""
     wires = [{f.name: getattr(w, f.name) for f in fields(w)} for w in layout.wiring]
     # None is no TOML value: an unset optional key is simply absent from the file.
-    top = {key: getattr(layout, key) for key in _TOP_KEYS}
+    top = {key: getattr(layout, key) for key in TOP_KEYS}
     return {
         **{key: value for key, value in top.items() if value is not None},
         "safety": {key: getattr(layout, key) for key in _SAFETY_KEYS},

@@ -156,14 +156,7 @@ def _chained_pieces(spans: list[Span]) -> list[Piece] | None:
             ends.append(next_end)
             energies.append(next_intensity**2)
             next_start, next_end, next_intensity = next(waiting, (math.inf, math.inf, 0.0))
-        energy = sum(energies)
-        if not energy <= 0:
-            intensity = math.sqrt(energy)
-            intensity = intensity if intensity < 1.0 else 1.0
-            if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
-                pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
-            else:
-                pieces.append((start, end, intensity))
+        _add_piece(pieces, start, end, sum(energies))
         start = end
     return pieces
 
@@ -178,15 +171,22 @@ def _energy_pieces(spans: list[Span]) -> list[Piece]:
         # The energies on [start, end), summed in the spans' order. A span covers
         # it when it starts at or before its start and ends after it (every span
         # starts and ends on a bound).
-        energy = sum([e for s, t, e in energies if s <= start < t])
-        if not energy <= 0:
-            intensity = min(1.0, math.sqrt(energy))
-            if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
-                pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
-            else:
-                pieces.append((start, end, intensity))
+        _add_piece(pieces, start, end, sum([e for s, t, e in energies if s <= start < t]))
         start = end
     return pieces
+
+
+def _add_piece(pieces: list[Piece], start: float, end: float, energy: float) -> None:
+    """Add [start, end) at the intensity of ``energy`` (capped at 1) after ``pieces``, by
+    extending the last piece when it ends at ``start`` with a close intensity. No energy
+    adds nothing: the actuator is off there."""
+    if not energy <= 0:
+        intensity = math.sqrt(energy)
+        intensity = intensity if intensity < 1.0 else 1.0
+        if pieces and pieces[-1][1] == start and math.isclose(pieces[-1][2], intensity):
+            pieces[-1] = (pieces[-1][0], end, pieces[-1][2])
+        else:
+            pieces.append((start, end, intensity))
 
 
 def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from feelmysign.frozen_init import dict_init
 from feelmysign.stroke import Stroke
 
 
+@dict_init
 @dataclass(frozen=True)
 class Command:
     """One physical actuator on at a constant intensity, times relative to the stroke's start."""
@@ -17,25 +19,12 @@ class Command:
     duration_ms: float
     intensity: float
 
-    def __init__(
-        self, row: int, column: int, start_ms: float, duration_ms: float, intensity: float
-    ) -> None:
-        # The generated __init__ of a frozen dataclass sets each field through
-        # object.__setattr__: a planned stroke makes a dozen commands, and that
-        # took a quarter of planning it. One dict update sets the same fields.
-        self.__dict__.update(
-            row=row,
-            column=column,
-            start_ms=start_ms,
-            duration_ms=duration_ms,
-            intensity=intensity,
-        )
-
     @property
     def end_ms(self) -> float:
         return self.start_ms + self.duration_ms
 
 
+@dict_init
 @dataclass(frozen=True)
 class Burst:
     """One virtual actuator of a stroke: a point in grid units felt around its peak time.
@@ -51,25 +40,6 @@ class Burst:
     duration_ms: float
     intensity: float
 
-    def __init__(
-        self,
-        x: float,
-        y: float,
-        peak_ms: float,
-        start_ms: float,
-        duration_ms: float,
-        intensity: float,
-    ) -> None:
-        # As Command's: one dict update instead of a frozen dataclass's setattr per field.
-        self.__dict__.update(
-            x=x,
-            y=y,
-            peak_ms=peak_ms,
-            start_ms=start_ms,
-            duration_ms=duration_ms,
-            intensity=intensity,
-        )
-
 
 @dataclass(frozen=True)
 class Adjustment:
@@ -80,6 +50,7 @@ class Adjustment:
     duration_ms: float
 
 
+@dict_init
 @dataclass(frozen=True)
 class Schedule:
     """The commands of one stroke, sorted by start time, then row, then column.
@@ -96,25 +67,6 @@ class Schedule:
     adjusted: Adjustment | None = None
     bursts: tuple[Burst, ...] = ()
     thinned: int = 0
-
-    def __init__(
-        self,
-        stroke: Stroke,
-        commands: tuple[Command, ...],
-        duration_ms: float,
-        adjusted: Adjustment | None = None,
-        bursts: tuple[Burst, ...] = (),
-        thinned: int = 0,
-    ) -> None:
-        # As Command's: one dict update instead of a frozen dataclass's setattr per field.
-        self.__dict__.update(
-            stroke=stroke,
-            commands=commands,
-            duration_ms=duration_ms,
-            adjusted=adjusted,
-            bursts=bursts,
-            thinned=thinned,
-        )
 
 
 def stroke_to_json(stroke: Stroke) -> dict[str, object]:

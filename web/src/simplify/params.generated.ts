@@ -54,13 +54,8 @@ export interface PanelParams {
   readonly stretch: boolean;
 }
 
-/** The angle simplifier's parameters, in the reference's order. */
-export const ANGLE_PARAM_NAMES = [
-  "check_frames",
-  "max_angle_deg",
-  "frame_max",
-  "fps",
-  "recover",
+/** The parameters every simplifier has, in the reference's order (after its own). */
+export const SHARED_PARAM_NAMES = [
   "clear_on_press",
   "min_duration_ms",
   "min_length",
@@ -71,19 +66,22 @@ export const ANGLE_PARAM_NAMES = [
   "stretch",
 ] as const;
 
+/** The angle simplifier's parameters, in the reference's order. */
+export const ANGLE_PARAM_NAMES = [
+  "check_frames",
+  "max_angle_deg",
+  "frame_max",
+  "fps",
+  "recover",
+  ...SHARED_PARAM_NAMES,
+] as const;
+
 /** The window simplifier's parameters, in the reference's order. */
 export const WINDOW_PARAM_NAMES = [
   "max_error",
   "max_window",
   "max_stroke_ms",
-  "clear_on_press",
-  "min_duration_ms",
-  "min_length",
-  "rows",
-  "columns",
-  "canvas_width_px",
-  "canvas_height_px",
-  "stretch",
+  ...SHARED_PARAM_NAMES,
 ] as const;
 
 /** Every parameter once: the language-neutral table (testdata/params/params.json). */

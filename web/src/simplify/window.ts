@@ -375,24 +375,14 @@ export class WindowSimplifier {
     // The farthest, found as the distances are: nearly always the cut, so no second pass.
     let farthest = -1;
     let farthestDistance = -1;
-    // `distanceSq` inlined as in `#farthestSq` (the same distances to the last bit).
+    // The chord's terms computed once, as in `#farthestSq`.
     const dx = endX - ax;
     const dy = endY - ay;
     const lengthSq = dx * dx + dy * dy;
     for (let i = first; i < count; i++) {
-      let qx = xs[i]! - ax;
-      let qy = ys[i]! - ay;
-      if (lengthSq > 0) {
-        const t = (qx * dx + qy * dy) / lengthSq;
-        if (t >= 1) {
-          qx = qx - dx;
-          qy = qy - dy;
-        } else if (!(t <= 0)) {
-          qx = qx - t * dx;
-          qy = qy - t * dy;
-        }
-      }
-      const d = qx * qx + qy * qy;
+      const qx = xs[i]! - ax;
+      const qy = ys[i]! - ay;
+      const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
       distances[i] = d;
       if (Number.isNaN(d)) finite = false;
       else if (d >= farthestDistance) {
@@ -402,12 +392,7 @@ export class WindowSimplifier {
     }
     if (!finite) return this.#featureSorted(count, first);
     if (farthest < 0) return count - 1; // unreachable: the last sample fits by construction
-    if (
-      this.#reaches[farthest]! <= this.#reachLimit ||
-      this.#within(farthest, xs[farthest]!, ys[farthest]!, this.#maxErrorSq)
-    ) {
-      return farthest;
-    }
+    if (this.#fits(farthest)) return farthest;
     distances[farthest] = -1;
     // Farthest first and, at equal distances, the later sample first: the order of a sort by
     // (distance, index) descending, taken one at a time since the farthest nearly always fits.
@@ -422,12 +407,7 @@ export class WindowSimplifier {
         }
       }
       if (best < 0) return count - 1; // unreachable: the last sample fits by construction
-      if (
-        this.#reaches[best]! <= this.#reachLimit ||
-        this.#within(best, xs[best]!, ys[best]!, this.#maxErrorSq)
-      ) {
-        return best;
-      }
+      if (this.#fits(best)) return best;
       distances[best] = -1;
     }
   }
@@ -437,19 +417,22 @@ export class WindowSimplifier {
    * of a sort with the same comparator, which a NaN makes inconsistent, so the sort itself.
    */
   #featureSorted(count: number, first: number): number {
-    const { xs, ys } = this.#window;
     const ranked: { index: number; distanceSq: number }[] = [];
     for (let i = first; i < count; i++) ranked.push({ index: i, distanceSq: this.#distances[i]! });
     ranked.sort((a, b) => b.distanceSq - a.distanceSq || b.index - a.index);
     for (const { index } of ranked) {
-      if (
-        this.#reaches[index]! <= this.#reachLimit ||
-        this.#within(index, xs[index]!, ys[index]!, this.#maxErrorSq)
-      ) {
-        return index;
-      }
+      if (this.#fits(index)) return index;
     }
     return count - 1; // unreachable: the last sample fits by construction
+  }
+
+  /** Whether window[index] can end the stroke: every sample before it within the bound of its own chord. */
+  #fits(index: number): boolean {
+    const { xs, ys } = this.#window;
+    return (
+      this.#reaches[index]! <= this.#reachLimit ||
+      this.#within(index, xs[index]!, ys[index]!, this.#maxErrorSq)
+    );
   }
 
   /** Whether window[1..stop) all lie within sqrt(limitSq) of window[0] -> (endX, endY). */
@@ -460,10 +443,7 @@ export class WindowSimplifier {
   /**
    * The greatest squared distance of window[1..stop) to window[0] -> (endX, endY) (0 if none,
    * NaN counting as none), or -1 as soon as one exceeds limitSq: the inner loop of every
-   * sample. `distanceSq` inlined, its chord terms computed once and its float operations in its
-   * order, so every distance is the same to the last bit: t <= 0 leaves q as it is (q - 0 * d
-   * is q; a zero's sign is squared away), t >= 1 subtracts d itself (1 * d is d), and a NaN t
-   * falls to the projection as through Math.max and Math.min.
+   * sample: its chord terms computed once (`chordDistanceSq`).
    */
   #farthestSq(stop: number, endX: number, endY: number, limitSq: number): number {
     const { xs, ys } = this.#window;
@@ -475,17 +455,7 @@ export class WindowSimplifier {
     let farthest = 0;
     if (lengthSq > 0) {
       for (let i = 1; i < stop; i++) {
-        let qx = xs[i]! - ax;
-        let qy = ys[i]! - ay;
-        const t = (qx * dx + qy * dy) / lengthSq;
-        if (t >= 1) {
-          qx = qx - dx;
-          qy = qy - dy;
-        } else if (!(t <= 0)) {
-          qx = qx - t * dx;
-          qy = qy - t * dy;
-        }
-        const d = qx * qx + qy * qy;
+        const d = chordDistanceSq(xs[i]! - ax, ys[i]! - ay, dx, dy, lengthSq);
         if (d > limitSq) return -1;
         if (d > farthest) farthest = d;
       }
@@ -519,12 +489,26 @@ function direction(start: Point, end: Point): Point | null {
 function distanceSq(px: number, py: number, ax: number, ay: number, ex: number, ey: number): number {
   const dx = ex - ax;
   const dy = ey - ay;
-  let qx = px - ax;
-  let qy = py - ay;
+  const qx = px - ax;
+  const qy = py - ay;
   const lengthSq = dx * dx + dy * dy;
-  if (lengthSq > 0) {
-    // The nearest point of the segment: the projection, clamped onto it.
-    const t = Math.min(Math.max((qx * dx + qy * dy) / lengthSq, 0), 1);
+  return lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
+}
+
+/**
+ * Squared distance from q (relative to a chord's start) to the chord d of squared length
+ * `lengthSq` > 0, at its nearest point: the projection, clamped onto the chord. Its chord terms
+ * computed once by the caller, for the inner loops. The clamp is written out, not with Math.max
+ * and Math.min, with the same result to the last bit: t <= 0 leaves q as it is (q - 0 * d is q;
+ * a zero's sign is squared away), t >= 1 subtracts d itself (1 * d is d), and a NaN t falls to
+ * the projection as through Math.max and Math.min.
+ */
+function chordDistanceSq(qx: number, qy: number, dx: number, dy: number, lengthSq: number): number {
+  const t = (qx * dx + qy * dy) / lengthSq;
+  if (t >= 1) {
+    qx = qx - dx;
+    qy = qy - dy;
+  } else if (!(t <= 0)) {
     qx = qx - t * dx;
     qy = qy - t * dy;
   }

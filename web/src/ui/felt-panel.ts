@@ -1,14 +1,15 @@
 /**
  * The felt drawing, kept in step with the sleeve: the current drawing's
  * strokes placed in time (felt.ts) from the sleeve's `played` and `cancelled`
- * events (its own estimate until they come), the timeline with a cursor
+ * events (its own estimate until they come), without the strokes it refused
+ * and with nothing felt of those its duty-cycle cap kept from playing, the timeline with a cursor
  * moving at the moment being felt, a marker on the canvas where the brush is,
  * and an A/B comparison with the same paths simplified under other settings.
  * A new stroke or a sleeve event costs the same however long the drawing is:
  * the placement is kept (felt-placement.ts), only the new strokes added.
  */
 import type { Drawing, DrawnSegment } from "../drawing";
-import type { CancelledEvent, AdjustedEvent, PlayedEvent } from "../events";
+import type { CancelledEvent, AdjustedEvent, PlayedEvent, Unplayed } from "../events";
 import { brushAt, placeStrokes, type FeltStroke, type Grid, type PlacedStroke } from "../felt";
 import { FeltPlacement } from "../felt-placement";
 import { simplifyPaths, type SimplifierParams } from "../simplify/registry";
@@ -64,16 +65,11 @@ export class FeltPanel {
     this.#timeline.show(this.#grid, placement, this.#b?.placed ?? null);
     const count = placement.placed.length;
     const seconds = (placement.totalMs / 1000).toFixed(1);
-    const reported = placement.reportedCount;
     this.#timeline.setCaption(
       count === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
         : `${count} stroke${count === 1 ? "" : "s"}, ${seconds} s` +
-            (reported === count
-              ? ", as the sleeve played them."
-              : reported > 0
-                ? `; ${reported} as the sleeve played them, the rest as it would.`
-                : ": what would be felt, played back to back as the sleeve does."),
+            timelineCaption(count, placement.reportedCount, placement.cappedCount),
     );
   }
 
@@ -100,6 +96,14 @@ export class FeltPanel {
       event.seq,
       event.started && started !== undefined ? event.cancelled_at_ms - started : 0,
     );
+    this.refresh();
+  }
+
+  /** The sleeve will never play a stroke of this drawing: refused, it leaves the timeline; capped, nothing of it is felt. */
+  unplayed({ seq, why }: Unplayed): void {
+    this.#sync();
+    if (why === "refused") this.#placement.refuse(seq);
+    else this.#placement.cap(seq);
     this.refresh();
   }
 
@@ -194,4 +198,20 @@ export class FeltPanel {
     };
     requestAnimationFrame(step);
   }
+}
+
+/** What the timeline's times are: the sleeve's, the page's estimate, or both; and what was not felt. */
+export function timelineCaption(count: number, reported: number, capped: number): string {
+  if (reported === 0 && capped === 0) return ": what would be felt, played back to back as the sleeve does.";
+  const estimated = count - reported - capped;
+  const said: string[] = [];
+  if (reported > 0)
+    said.push(reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`);
+  if (capped > 0) {
+    said.push(
+      `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,
+    );
+  }
+  if (estimated > 0) said.push("the rest as it would");
+  return `${reported === count ? ", " : "; "}${said.join(", ")}.`;
 }

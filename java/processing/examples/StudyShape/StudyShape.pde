@@ -9,6 +9,7 @@ import java.util.List;
 String BROKER = "mqtt://127.0.0.1:1883";
 String USER = "sender";
 String PASSWORD = "";   // from the broker's credentials.json
+String SLEEVE = "sleeve1";
 int ROWS = 3;           // the paper's sleeve: 3 x 4 actuators, 3 cm apart
 int COLUMNS = 4;
 
@@ -24,6 +25,7 @@ void setup() {
   sleeve = new FeelMySign(this)
     .broker(BROKER)
     .login(USER, PASSWORD)
+    .sleeve(SLEEVE)
     .set("rows", ROWS)
     .set("columns", COLUMNS)
     .start();

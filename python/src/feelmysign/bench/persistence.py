@@ -20,6 +20,7 @@ import time
 import uuid
 from pathlib import Path
 
+from feelmysign.bench._mqtt import close
 from feelmysign.broker import Broker
 from feelmysign.connection import new_client
 from feelmysign.protocol import format_json
@@ -60,9 +61,7 @@ def _round_trips_ms(broker: Broker, strokes: int) -> list[float]:
             times_ms.append((time.perf_counter_ns() - start_ns) / 1e6)
         return times_ms
     finally:
-        for client in (sender, sleeve):
-            client.loop_stop()
-            client.disconnect()
+        close(sender, sleeve)
 
 
 def measure(strokes: int = STROKES, rounds: int = ROUNDS) -> dict[bool, float]:

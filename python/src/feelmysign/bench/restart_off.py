@@ -47,6 +47,7 @@ import paho.mqtt.client as mqtt
 
 import feelmysign
 from feelmysign.backends.emulated_state import drive_levels
+from feelmysign.bench import _mqtt
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import new_client
 from feelmysign.protocol import format_json
@@ -123,8 +124,7 @@ class _Online:
                 self.count += 1
 
     def close(self) -> None:
-        self.client.loop_stop()
-        self.client.disconnect()
+        _mqtt.close(self.client)
 
 
 def _kill_mid_stroke(command: list[str], state: Path, online: _Online, env: dict[str, str]) -> None:

@@ -37,6 +37,7 @@ from typing import Any, TypeVar
 import paho.mqtt.client as mqtt
 
 from feelmysign.backends.sim import SimBackend
+from feelmysign.bench._mqtt import close
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import BrokerSettings, new_client
 from feelmysign.control import Cancel, format_control
@@ -165,9 +166,7 @@ def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = PAUSE_S) 
         inbox.wait(k + 1)
         time.sleep(pause_s)
     received = inbox.wait(count)
-    for client in (receiver, sender):
-        client.loop_stop()
-        client.disconnect()
+    close(receiver, sender)
     return [r - s for (r, _), s in zip(received, sent, strict=True)]
 
 
@@ -215,10 +214,21 @@ def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[tuple[float
         # that ended before the cancel came is not reported: wait no longer than its end.
         end_ms = event.first_command_at_ms + event.duration_ms + 100.0
         inbox.wait_event(Cancelled, drawing, max(0.0, end_ms - time.time_ns() / 1e6) / 1000)
-    for client in (watcher, sender):
-        client.loop_stop()
-        client.disconnect()
+    close(watcher, sender)
     return results
+
+
+def sleeve_command(credentials_path: Path, *extra: str) -> list[str]:
+    """``feelmysign sleeve`` as its own process, logged in with ``credentials_path``."""
+    return [
+        sys.executable,
+        "-m",
+        "feelmysign",
+        "sleeve",
+        "--credentials",
+        str(credentials_path),
+        *extra,
+    ]
 
 
 @contextmanager
@@ -229,19 +239,7 @@ def _sleeve_process(
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "status"))
     process = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "feelmysign",
-            "sleeve",
-            "--credentials",
-            str(credentials_path),
-            "--rate-per-s",
-            "10000",
-            "--log-level",
-            "warning",
-            *grid,
-        ],
+        sleeve_command(credentials_path, "--rate-per-s", "10000", "--log-level", "warning", *grid),
         stdout=subprocess.DEVNULL,
     )
     try:
@@ -254,8 +252,7 @@ def _sleeve_process(
     finally:
         process.send_signal(signal.SIGTERM)
         process.wait(10)
-        watcher.loop_stop()
-        watcher.disconnect()
+        close(watcher)
 
 
 def drawing_gaps(c: Credentials, shape: Any, strokes: int) -> list[float]:
@@ -273,9 +270,7 @@ def drawing_gaps(c: Credentials, shape: Any, strokes: int) -> list[float]:
             qos=1,
         )
     events = inbox.wait_played(strokes, timeout_s=60)
-    for client in (watcher, sender):
-        client.loop_stop()
-        client.disconnect()
+    close(watcher, sender)
     return [
         after.first_command_at_ms - (before.first_command_at_ms + before.duration_ms)
         for before, after in itertools.pairwise(events)

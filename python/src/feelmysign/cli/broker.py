@@ -25,18 +25,19 @@ from feelmysign.broker import (
 )
 from feelmysign.cli._join import run_add_sleeve, run_nats_accounts
 from feelmysign.cli.options.lan import add_lan_options, lan_from_args
+from feelmysign.cli.options.parser import Subcommands, add_command
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 # How often the CLI notices a stop request or a Mosquitto that died.
 WATCH_INTERVAL_S = 0.1
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "broker",
         help="run a local Mosquitto (MQTT and WebSockets on 127.0.0.1) until interrupted",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "--state-dir",

@@ -21,6 +21,7 @@ from feelmysign.backends.factory import BACKEND_NAMES, open_backend
 from feelmysign.backends.sim import SimBackend
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.errors import ParameterError
 from feelmysign.layout import Layout
 from feelmysign.services.stop_signals import interrupt_on_stop_signals
@@ -28,12 +29,12 @@ from feelmysign.services.stop_signals import interrupt_on_stop_signals
 DEFAULT_DURATION_MS = 1000.0  # long enough to feel and to find by touch which motor it is
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "buzz",
         help="switch one motor on for a moment, to check its wiring",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("row", type=int, metavar="ROW", help="the motor's row, from 0")
     parser.add_argument("column", type=int, metavar="COLUMN", help="the motor's column, from 0")

@@ -51,6 +51,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import not_empty, output_folder, whole_number
 from feelmysign.cli.simplify import load
 from feelmysign.errors import FeelMySignError
@@ -65,12 +66,12 @@ if TYPE_CHECKING:
 DEFAULT_OUT_ROOT = Path("evaluations")
 
 
-def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "evaluate",
         help="measure simplifiers (error, strokes, lag) on recordings or LASA, with plots",
         description=(__doc__ or "").replace("{default_sweeps}", _default_sweeps_text()),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "recordings",

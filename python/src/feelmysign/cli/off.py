@@ -21,16 +21,17 @@ from feelmysign.backends.emulated_state import open_state_bus
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import LAYOUT_ENV
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.errors import HardwareError, LayoutError
 from feelmysign.layout import load_layout
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "off",
         help="switch every motor of the sleeve off (after a crash)",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "--layout",

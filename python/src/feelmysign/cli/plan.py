@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 from dataclasses import replace
-from typing import Any
 
 from feelmysign.cli._picture import LEGEND, grid_picture
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.strokes import strokes_from
 from feelmysign.cli.options.values import number
 from feelmysign.layout import MAX_MIN_BURST_MS, MIN_BURST_MS, Layout
@@ -19,7 +19,7 @@ from feelmysign.stroke import Stroke
 MAX_MERGE_DISTANCE = 0.5  # beyond half a cell, merging would move crossings off their lines
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = subparsers.add_parser(
         "plan",
         help="show the actuator commands the sleeve would play for strokes",

@@ -34,6 +34,7 @@ from feelmysign.cli.options.broker import (
     add_broker_timeout_option,
     broker_settings_from_args,
 )
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
@@ -60,12 +61,12 @@ def _simplify_options() -> argparse.ArgumentParser:
     return parser
 
 
-def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "replay",
         help="re-run a recording through a simplifier, exactly, and optionally send it",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
         parents=[_simplify_options()],
         conflict_handler="resolve",  # both have -h
     )

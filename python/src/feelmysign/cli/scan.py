@@ -27,6 +27,7 @@ from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layo
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import LAYOUT_ENV
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import MAX_LAYOUT_BYTES, check_input_file, not_empty
 from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import MAX_I2C_BUS, PAPER_SLEEVE, Layout, Wire, load_layout
@@ -64,12 +65,12 @@ class ChannelRow:
         }
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "scan",
         help="check which DRV2605L answers on each multiplexer channel, against the layout",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "--layout",
@@ -114,13 +115,28 @@ def run(args: argparse.Namespace) -> int:
     finally:
         bus.close()
     report = compare_with_layout(result, layout)
-    rows = channel_rows(result, layout)
-    ok = report.ok and bool(layout.wiring)
+    scanned = _Scanned(layout, bus_number, result, report, channel_rows(result, layout))
     if args.json:
-        print(json.dumps(_as_json(args, layout, bus_number, result, report, rows, ok)))
+        print(json.dumps(_as_json(args, scanned)))
     else:
-        print(_describe(args, layout, bus_number, result, report, rows), flush=True)
-    return 0 if ok else 1
+        print(_describe(args, scanned), flush=True)
+    return 0 if scanned.ok else 1
+
+
+@dataclass(frozen=True)
+class _Scanned:
+    """A scan and what it means for the layout: what the text and the JSON both report."""
+
+    layout: Layout
+    bus_number: int
+    result: ScanResult
+    report: LayoutReport
+    rows: list[ChannelRow]
+
+    @property
+    def ok(self) -> bool:
+        """Every wired actuator answers, and the layout wires some."""
+        return self.report.ok and bool(self.layout.wiring)
 
 
 def _open_bus(bus_number: int) -> I2CBus:
@@ -180,15 +196,9 @@ def _found_and_status(
     return found, "ok" if right_chip else "WRONG CHIP"
 
 
-def _describe(
-    args: argparse.Namespace,
-    layout: Layout,
-    bus_number: int,
-    result: ScanResult,
-    report: LayoutReport,
-    rows: list[ChannelRow],
-) -> str:
-    where = f"/dev/i2c-{bus_number}"
+def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
+    layout, result, report, rows = scanned.layout, scanned.result, scanned.report, scanned.rows
+    where = f"/dev/i2c-{scanned.bus_number}"
     if args.emulate_state:
         where = f"the emulated bus in {args.emulate_state}"
     elif args.emulate:
@@ -265,22 +275,15 @@ def _main_bus_line(result: ScanResult, layout: Layout) -> str:
     return line
 
 
-def _as_json(
-    args: argparse.Namespace,
-    layout: Layout,
-    bus_number: int,
-    result: ScanResult,
-    report: LayoutReport,
-    rows: list[ChannelRow],
-    ok: bool,
-) -> dict[str, Any]:
+def _as_json(args: argparse.Namespace, scanned: _Scanned) -> dict[str, Any]:
+    layout, result, report = scanned.layout, scanned.result, scanned.report
     return {
-        "ok": ok,
+        "ok": scanned.ok,
         "emulated": bool(args.emulate or args.emulate_state),
-        "bus": None if args.emulate or args.emulate_state else bus_number,
+        "bus": None if args.emulate or args.emulate_state else scanned.bus_number,
         "layout": layout.name,
         "main_bus": [f"0x{a:02X}" for a in result.main_bus],
         "missing_multiplexers": [f"0x{a:02X}" for a in result.missing_multiplexers],
-        "channels": [row.as_dict() for row in rows],
+        "channels": [row.as_dict() for row in scanned.rows],
         "problems": report.problems() if layout.wiring else ["the layout wires no actuator"],
     }

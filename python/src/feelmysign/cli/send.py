@@ -27,6 +27,7 @@ from feelmysign.cli.options.broker import (
     broker_settings_from_args,
 )
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import ParameterError, StrokeError
@@ -50,13 +51,13 @@ def _epilog() -> str:
     )
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "send",
         help="send strokes or a shape to a sleeve over MQTT, acknowledged by the broker",
         description=__doc__,
         epilog=_epilog(),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "strokes",

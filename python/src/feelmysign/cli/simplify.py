@@ -8,6 +8,7 @@ import json
 from dataclasses import asdict, fields, replace
 from typing import Any
 
+from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import MAX_RECORDING_BYTES, check_input_file
 from feelmysign.simplify import (
     ALGORITHMS,
@@ -34,7 +35,7 @@ CLI_PANELS = ("simplifier", "sleeve")
 _METAVARS = {"ms": "MS", "°": "DEG", "grid units": "UNITS", "fps": "FPS", "px": "PX"}
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = subparsers.add_parser(
         "simplify",
         help="cut a recorded drawing into the strokes a sender would send",

@@ -7,13 +7,13 @@ import logging
 import sys
 from collections import Counter
 from collections.abc import Callable
-from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import number, output_file, topic
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
@@ -30,7 +30,7 @@ MIN_RATE_PER_S = 0.1  # one stroke in 10 s: slower is a sleeve that refuses ever
 MAX_RATE_PER_S = 10_000.0  # far above what a person draws; the planner is the limit
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = subparsers.add_parser(
         "sleeve",
         help="run the sleeve: play every stroke sent to it",
@@ -83,22 +83,22 @@ def register(subparsers: Any) -> None:
         metavar="R",
         help=f"strokes accepted per second on average (default: {RATE_PER_S:g}; bursts of {BURST})",
     )
-    parser.add_argument(
+    _add_limit_ms(
+        parser,
         "--max-age-ms",
-        type=number(*MAX_AGE_RANGE_MS, unit="milliseconds"),
-        default=MAX_AGE_MS,
-        metavar="MS",
-        help="refuse strokes sent longer ago than this, by the sender's clock (reason stale; "
-        f"default: {MAX_AGE_MS:g}, in [{MAX_AGE_RANGE_MS[0]:g}, {MAX_AGE_RANGE_MS[1]:g}])",
+        MAX_AGE_MS,
+        MAX_AGE_RANGE_MS,
+        "refuse strokes sent longer ago than this, by the sender's clock",
+        reason="stale",
     )
-    parser.add_argument(
+    _add_limit_ms(
+        parser,
         "--max-lag-ms",
-        type=number(*MAX_LAG_RANGE_MS, unit="milliseconds"),
-        default=MAX_LAG_MS,
-        metavar="MS",
-        help="skip strokes that would start later than this after they were due, to catch up "
-        f"after a stall (reason late; default: {MAX_LAG_MS:g}, in "
-        f"[{MAX_LAG_RANGE_MS[0]:g}, {MAX_LAG_RANGE_MS[1]:g}])",
+        MAX_LAG_MS,
+        MAX_LAG_RANGE_MS,
+        "skip strokes that would start later than this after they were due, to catch up after "
+        "a stall",
+        reason="late",
     )
     parser.add_argument(
         "--log-level",
@@ -107,6 +107,26 @@ def register(subparsers: Any) -> None:
         help="how much to log on stderr (default: info)",
     )
     parser.set_defaults(handler=run)
+
+
+def _add_limit_ms(
+    parser: argparse.ArgumentParser,
+    flag: str,
+    default_ms: float,
+    range_ms: tuple[float, float],
+    what: str,
+    *,
+    reason: str,
+) -> None:
+    """A limit in milliseconds, its help ending with the refusal's reason, default and range."""
+    low_ms, high_ms = range_ms
+    parser.add_argument(
+        flag,
+        type=number(low_ms, high_ms, unit="milliseconds"),
+        default=default_ms,
+        metavar="MS",
+        help=f"{what} (reason {reason}; default: {default_ms:g}, in [{low_ms:g}, {high_ms:g}])",
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -12,6 +12,7 @@ from feelmysign.cli.options.broker import (
     add_broker_timeout_option,
     broker_settings_from_args,
 )
+from feelmysign.cli.options.parser import Subcommands
 from feelmysign.connection import connect_client
 from feelmysign.control import CANCEL_ALL, Cancel, format_control
 from feelmysign.errors import BrokerConnectionError, ParameterError
@@ -23,7 +24,7 @@ if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign
     from paho.mqtt.reasoncodes import ReasonCode
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = subparsers.add_parser(
         "stop",
         help="stop a drawing on the sleeve, or everything it plays",

@@ -18,12 +18,16 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.errors import StudyError
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
+
+if TYPE_CHECKING:
+    from feelmysign.study.store import StudyStore
 
 # Checked (not imported) when the parser is built: without them 'study' is listed as not installed.
 REQUIRES = (
@@ -41,12 +45,12 @@ REQUIRES = (
 # step that runs, not by 'feelmysign --help'.
 
 
-def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "study",
         help="run the paper's recognition study (design, sessions, coding, analysis, thresholds)",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="study_command", metavar="STEP", required=True)
 
@@ -147,10 +151,15 @@ def _new(args: argparse.Namespace) -> int:
     return 0
 
 
-def _status(args: argparse.Namespace) -> int:
+def _store(args: argparse.Namespace) -> StudyStore:
+    """The study named on the command line (``STUDY``), opened."""
     from feelmysign.study.store import StudyStore
 
-    store = StudyStore(args.study)
+    return StudyStore(args.study)
+
+
+def _status(args: argparse.Namespace) -> int:
+    store = _store(args)
     codings = store.latest_codings()
     print(f"{args.study}: {store.design.name}")
     for row in store.participants():
@@ -173,9 +182,8 @@ def _simulate(args: argparse.Namespace) -> int:
     if not 1 <= args.participants <= 500:
         raise StudyError(f"--participants must be 1 to 500; got {args.participants}")
     from feelmysign.study.dry_run import dry_run
-    from feelmysign.study.store import StudyStore
 
-    store = StudyStore(args.study)
+    store = _store(args)
     codes = dry_run(
         store,
         args.participants,
@@ -192,27 +200,24 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from feelmysign.study.store import StudyStore
     from feelmysign.study.terminal import run_in_terminal
 
-    store = StudyStore(args.study)
+    store = _store(args)
     settings = broker_settings_from_args(args, "sender")
     return run_in_terminal(store, settings, args.participant)
 
 
 def _review(args: argparse.Namespace) -> int:
-    from feelmysign.study.store import StudyStore
     from feelmysign.study.terminal import review_in_terminal
 
-    return review_in_terminal(StudyStore(args.study))
+    return review_in_terminal(_store(args))
 
 
 def _export(args: argparse.Namespace) -> int:
     from feelmysign.study.export import export_study
-    from feelmysign.study.store import StudyStore
 
     out = _out_dir(args)
-    for path in export_study(StudyStore(args.study), out):
+    for path in export_study(_store(args), out):
         print(path)
     return 0
 
@@ -221,10 +226,9 @@ def _analyse(args: argparse.Namespace) -> int:
     if not 50 <= args.bootstrap <= 100_000:
         raise StudyError(f"--bootstrap must be 50 to 100000; got {args.bootstrap}")
     from feelmysign.study.analysis import analyse_study
-    from feelmysign.study.store import StudyStore
 
     out = _out_dir(args)
-    analysis = analyse_study(StudyStore(args.study), out, samples=args.bootstrap)
+    analysis = analyse_study(_store(args), out, samples=args.bootstrap)
     print(
         f"{analysis.participants} participants, {analysis.trials} trials, "
         f"{analysis.unclear} awaiting review."

@@ -7,7 +7,6 @@ import socket
 import threading
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
-from typing import Any
 
 from feelmysign.backends.factory import BACKEND_NAMES
 from feelmysign.broker import (
@@ -20,6 +19,7 @@ from feelmysign.broker import (
 from feelmysign.cli._page_server import page_server, qr_text
 from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import output_file, port, sleeve_id
 from feelmysign.cli.sleeve import run_sleeve
 from feelmysign.daemon import Sleeve, SleeveOptions
@@ -31,7 +31,7 @@ from feelmysign.webserver import WEB_DIST, Api
 DEFAULT_HTTP_PORT = 8000
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Subcommands) -> None:
     parser = subparsers.add_parser(
         "up",
         help="start the broker, a sleeve and the drawing client, all on this machine",

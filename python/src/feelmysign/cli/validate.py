@@ -17,6 +17,7 @@ import os
 from typing import Any
 
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import read_stdin
 from feelmysign.layout import Layout
 from feelmysign.protocol import Accepted, Rejected, parse, stroke_to_dict
@@ -29,14 +30,14 @@ see docs/protocol.md for every field, range and reason code.
 """
 
 
-def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    parser = subparsers.add_parser(
+def register(subparsers: Subcommands) -> None:
+    parser = add_command(
+        subparsers,
         "validate",
         help="check a stroke message the way the sleeve would",
         description="Say whether the sleeve would accept a stroke message, and if not, why.\n"
         "Exit status 0 if accepted, 1 if rejected.",
         epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "payload",

@@ -336,7 +336,7 @@ class WindowSimplifier:
         first = next((i for i in range(1, last + 1) if times[i] >= earliest), last)
         cut = self._feature(points, points[last], first)
         straight = STRAIGHT * self.params.max_error
-        far_sq = _distance_sq(points[cut], anchor, points[last])
+        far_sq = segment_distance_sq(points[cut], anchor, points[last])
         bends = far_sq > straight * straight
         return cut if bends and self._sendable(anchor, points[cut]) else last
 
@@ -368,7 +368,7 @@ class WindowSimplifier:
         if not (0.0 <= end[0] <= self._x_extent and 0.0 <= end[1] <= self._y_extent):
             return at
         limit = LINE_SHARE * self.params.max_error
-        if _distance_sq(at, end, end) > limit * limit:  # a bend, not noise
+        if segment_distance_sq(at, end, end) > limit * limit:  # a bend, not noise
             return at
         if not self._sendable(points[0], end):
             return at
@@ -387,7 +387,7 @@ class WindowSimplifier:
         certain = self._reaches_near(points, cut, end, limit - ROUNDING_SLACK)
         if not certain and not _within(points, cut + 1, end, limit * limit):
             return None
-        return _direction(points[0], end)
+        return unit_direction(points[0], end)
 
     def _sendable(self, start: Point, end: Point) -> bool:
         """Whether start -> end is long enough to send (the cap never cuts off a dropped stroke)."""
@@ -426,7 +426,7 @@ class WindowSimplifier:
         )
 
 
-def _direction(start: Point, end: Point) -> tuple[float, float] | None:
+def unit_direction(start: Point, end: Point) -> tuple[float, float] | None:
     """The unit vector from ``start`` to ``end`` (None if they coincide)."""
     dx, dy = end[0] - start[0], end[1] - start[1]
     length = math.sqrt(dx * dx + dy * dy)
@@ -434,12 +434,12 @@ def _direction(start: Point, end: Point) -> tuple[float, float] | None:
 
 
 # The squared distance from a point to a segment start -> end (its nearest point), as
-# ``_distance_sq`` computes it, is the inner loop of the simplifier: ``_farthest_sq`` and
+# ``segment_distance_sq`` computes it, is the inner loop of the simplifier: ``_farthest_sq`` and
 # ``_distances_sq`` inline it over a stroke's samples, with the chord's terms computed once. The
-# float operations are ``_distance_sq``'s, in its order, so every result is the same to the last
-# bit: max(t, 0.0) and min(t, 1.0) are written as the comparisons Python's max and min make (a
-# NaN stays NaN), t <= 0 leaves q as it is (q - 0 * d is q; a zero's sign is squared away) and
-# t == 1 subtracts d itself (1.0 * d is d).
+# float operations are ``segment_distance_sq``'s, in its order, so every result is the same to
+# the last bit: max(t, 0.0) and min(t, 1.0) are written as the comparisons Python's max and min
+# make (a NaN stays NaN), t <= 0 leaves q as it is (q - 0 * d is q; a zero's sign is squared
+# away) and t == 1 subtracts d itself (1.0 * d is d).
 
 
 def _within(points: list[Point], stop: int, end: Point, limit_sq: float) -> bool:
@@ -486,7 +486,7 @@ def _farthest_sq(points: list[Point], stop: int, end: Point, limit_sq: float) ->
 def _distances_sq(
     points: list[Point], first: int, stop: int, start: Point, end: Point
 ) -> list[float]:
-    """``_distance_sq`` of points[first:stop] to the segment start -> end."""
+    """``segment_distance_sq`` of points[first:stop] to the segment start -> end."""
     ax, ay = start
     dx, dy = end[0] - ax, end[1] - ay
     length_sq = dx * dx + dy * dy
@@ -509,7 +509,7 @@ def _distances_sq(
     return out
 
 
-def _distance_sq(point: Point, start: Point, end: Point) -> float:
+def segment_distance_sq(point: Point, start: Point, end: Point) -> float:
     """Squared distance from ``point`` to the segment start -> end (its nearest point)."""
     ax, ay = start
     dx, dy = end[0] - ax, end[1] - ay

@@ -9,6 +9,7 @@ line run in this process. The Java test runs the same arguments and compares.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import json
@@ -18,13 +19,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from feelmysign.cli import main
+from feelmysign.cli import build_parser, main
 from feelmysign.research.gestures import load_gesture_log
 from feelmysign.research.lasa import load_lasa
 from feelmysign.simplify.recording import Recording
 
 REPO = Path(__file__).resolve().parents[5]
 SEED = 20261126
+JAVA_PROG = "feelmysign-java simplify"
 
 
 def recording_json(recording: Recording) -> dict[str, Any]:
@@ -156,6 +158,12 @@ USAGE_ERRORS = [
     ["--rows", "2.5"],
     ["--max-error", "abc"],
     ["--bogus"],
+    ["--no", "--json"],
+    ["--recover"],
+    ["--algorithm", "window", "--no-recover"],
+    ["--stretch=yes"],
+    ["--max-e=abc"],
+    ["--max-window", "2.5"],
 ]
 
 
@@ -167,6 +175,16 @@ def run(arguments: list[str]) -> tuple[int, str, str]:
         except SystemExit as stop:  # argparse's usage errors
             code = stop.code if isinstance(stop.code, int) else 1
     return code, out.getvalue(), err.getvalue()
+
+
+def help_as(prog: str) -> str:
+    """The reference's ``simplify --help`` under the Java port's name: argparse wraps the usage
+    after the program's name, so the two are compared under the same one."""
+    parser = build_parser("simplify")
+    subcommands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    simplify = subcommands.choices["simplify"]
+    simplify.prog = prog
+    return simplify.format_help()
 
 
 def main_(outdir: Path) -> None:
@@ -227,6 +245,17 @@ def main_(outdir: Path) -> None:
     case("a folder", [str(folder), "--json"])
     for arguments in USAGE_ERRORS:
         case(" ".join(arguments), [first, *arguments, "--json"])
+    java_help = help_as(JAVA_PROG)
+    for arguments in (["--help"], ["-h"], ["--he"], [first, "--json", "--help"]):
+        cases.append(
+            {
+                "name": " ".join(arguments),
+                "args": arguments,
+                "code": 0,
+                "stdout": java_help,
+                "stderr": "",
+            }
+        )
     (outdir / "cases.json").write_text(json.dumps(cases), encoding="utf-8")
     print(f"{len(cases)} cases, {len(recordings)} recordings in {outdir}")
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 from feelmysign.cli.options.values import (
@@ -25,7 +26,7 @@ from feelmysign.layout import (
     MAX_SPACING_CM,
     PAPER_SLEEVE,
     Layout,
-    grid_layout,
+    check_layout,
     load_layout,
 )
 
@@ -98,21 +99,12 @@ def layout_from_args(args: argparse.Namespace) -> Layout:
     """The layout the options ask for; raises LayoutError (exit 1) for a bad file or grid."""
     if args.layout is not None:
         return _load(args.layout)
-    grid = {dest: getattr(args, dest) for dest in _GRID_DESTS}
-    if any(value is not None for value in grid.values()):
-        # Same caps as the paper's sleeve: only the geometry was asked to change.
-        return grid_layout(
-            grid["rows"] if grid["rows"] is not None else PAPER_SLEEVE.rows,
-            grid["columns"] if grid["columns"] is not None else PAPER_SLEEVE.columns,
-            grid["spacing_cm"] if grid["spacing_cm"] is not None else PAPER_SLEEVE.spacing_cm,
-            name="grid",
-            default_intensity=PAPER_SLEEVE.default_intensity,
-            max_intensity=PAPER_SLEEVE.max_intensity,
-            max_stroke_duration_ms=PAPER_SLEEVE.max_stroke_duration_ms,
-            max_on_time_ms=PAPER_SLEEVE.max_on_time_ms,
-            duty_cycle_window_ms=PAPER_SLEEVE.duty_cycle_window_ms,
-            max_duty_cycle=PAPER_SLEEVE.max_duty_cycle,
-        )
+    asked = {dest: getattr(args, dest) for dest in _GRID_DESTS}
+    geometry = {dest: value for dest, value in asked.items() if value is not None}
+    if geometry:
+        # The paper's sleeve, caps and all: only the geometry was asked to change.
+        grid = replace(PAPER_SLEEVE, name="grid", **geometry)
+        return check_layout(grid, f"grid {grid.rows} x {grid.columns}")
     from_env = os.environ.get(LAYOUT_ENV, "")
     if from_env:
         return _load(from_env)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 import re
 import sys
-from typing import NoReturn
+from typing import Any, NoReturn, TypeAlias
 
 from feelmysign.cli.options.values import decimal_float_option, decimal_int_option
 
@@ -40,3 +40,15 @@ class CliParser(argparse.ArgumentParser):
         text = _ARGUMENT_PREFIX.sub("", text)
         sys.stderr.write(f"Error: {text}. See '{self.prog} --help'.\n")
         sys.exit(USAGE_ERROR_EXIT)
+
+
+# What ``register(subparsers)`` of each subcommand module receives: the parser's subcommands.
+Subcommands: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
+
+
+def add_command(subparsers: Subcommands, name: str, **options: Any) -> argparse.ArgumentParser:
+    """A ``feelmysign`` subcommand whose --help prints its description (most often its
+    module's docstring) as written: paragraphs, lists and examples kept, not re-wrapped."""
+    return subparsers.add_parser(
+        name, formatter_class=argparse.RawDescriptionHelpFormatter, **options
+    )

@@ -73,13 +73,11 @@ public final class Main {
   /** A usage error: the command line itself is wrong (exit 2). */
   static final class UsageException extends RuntimeException {
     private static final long serialVersionUID = 1L;
-    final String usage;
     final String prog;
 
-    UsageException(String prog, String usage, String message) {
+    UsageException(String prog, String message) {
       super(message);
       this.prog = prog;
-      this.usage = usage;
     }
   }
 }

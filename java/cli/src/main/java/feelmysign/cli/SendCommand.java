@@ -13,6 +13,7 @@ import feelmysign.simplify.PathSegment;
 import feelmysign.simplify.Recording;
 import feelmysign.simplify.Simplify;
 import feelmysign.client.BrokerUrl;
+import feelmysign.client.ConnectFailure;
 import java.io.IOException;
 import java.io.PrintStream;
 import java.io.UncheckedIOException;
@@ -24,8 +25,10 @@ import java.nio.file.Files;
 import java.nio.file.NoSuchFileException;
 import java.nio.file.Path;
 import java.util.ArrayList;
+import java.util.HashMap;
 import java.util.List;
 import java.util.Map;
+import java.util.Set;
 
 /**
  * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
@@ -59,75 +62,64 @@ final class SendCommand {
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
       + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
 
-  static int run(String[] args, PrintStream out, PrintStream err) {
-    String shape = null;
-    Integer segments = null;
-    Double durationMs = null;
-    double margin = 0;
-    String recording = null;
-    boolean paper = false;
-    Double intensity = null;
-    boolean legacy = false;
-    String legacyTopic = null;
-    double timeoutS = 10;
-    String pace = null;
-    String broker = null;
-    String sleeveId = null;
-    String username = null;
-    String password = null;
-    String credentials = null;
-    String ca = null;
-    String caFingerprint = null;
-    int rows = 3;
-    int columns = 4;
-    double spacingCm = 3.0;
-    List<String> strokeArgs = new ArrayList<>();
+  // The options that take a value, by the kind of value; --paper and --legacy take none.
+  private static final Set<String> WHOLE = Set.of("--segments", "--rows", "--columns");
+  private static final Set<String> DECIMAL =
+      Set.of("--duration-ms", "--margin", "--intensity", "--timeout-s", "--spacing-cm");
+  private static final Set<String> TEXT =
+      Set.of("--shape", "--recording", "--legacy-topic", "--pace", "--broker", "--id",
+          "--username", "--password", "--credentials", "--ca", "--ca-fingerprint");
+
+  /**
+   * The options given, by flag: a String, a Long, a Double, or TRUE for --paper and --legacy,
+   * each converted where it stands, as the reference's parser does; the rest, the strokes, into
+   * {@code strokeArgs}. Null for --help.
+   */
+  private static Map<String, Object> parse(String[] args, List<String> strokeArgs) {
+    Map<String, Object> given = new HashMap<>();
     for (int i = 0; i < args.length; i++) {
       String a = args[i];
-      switch (a) {
-        case "-h", "--help" -> {
-          out.print(HELP);
-          return 0;
-        }
-        case "--shape" -> shape = value(args, ++i, a);
-        case "--segments" -> segments = (int) integer(value(args, ++i, a), a);
-        case "--duration-ms" -> durationMs = number(value(args, ++i, a), a);
-        case "--margin" -> margin = number(value(args, ++i, a), a);
-        case "--recording" -> recording = value(args, ++i, a);
-        case "--paper" -> paper = true;
-        case "--intensity" -> intensity = number(value(args, ++i, a), a);
-        case "--legacy" -> legacy = true;
-        case "--legacy-topic" -> legacyTopic = value(args, ++i, a);
-        case "--pace" -> {
-          pace = value(args, ++i, a);
-          if (!pace.equals("realtime") && !pace.equals("burst")) {
-            throw new Main.UsageException(PROG, USAGE, "argument --pace: invalid choice: '" + pace
-                + "' (choose from 'realtime', 'burst')");
-          }
-        }
-        case "--timeout-s" -> timeoutS = number(value(args, ++i, a), a);
-        case "--broker" -> broker = value(args, ++i, a);
-        case "--id" -> sleeveId = value(args, ++i, a);
-        case "--username" -> username = value(args, ++i, a);
-        case "--password" -> password = value(args, ++i, a);
-        case "--credentials" -> credentials = value(args, ++i, a);
-        case "--ca" -> ca = value(args, ++i, a);
-        case "--ca-fingerprint" -> caFingerprint = value(args, ++i, a);
-        case "--rows" -> rows = (int) integer(value(args, ++i, a), a);
-        case "--columns" -> columns = (int) integer(value(args, ++i, a), a);
-        case "--spacing-cm" -> spacingCm = number(value(args, ++i, a), a);
-        default -> {
-          if (a.startsWith("--")) {
-            throw new Main.UsageException(PROG, USAGE, "unrecognized arguments: " + a);
-          }
-          strokeArgs.add(a);
-        }
+      if (a.equals("-h") || a.equals("--help")) {
+        return null;
+      } else if (a.equals("--paper") || a.equals("--legacy")) {
+        given.put(a, Boolean.TRUE);
+      } else if (WHOLE.contains(a)) {
+        given.put(a, integer(value(args, ++i, a), a));
+      } else if (DECIMAL.contains(a)) {
+        given.put(a, number(value(args, ++i, a), a));
+      } else if (TEXT.contains(a)) {
+        given.put(a, value(args, ++i, a));
+      } else if (a.startsWith("--")) {
+        throw new Main.UsageException(PROG, "unrecognized arguments: " + a);
+      } else {
+        strokeArgs.add(a);
       }
     }
-    int given = (shape != null ? 1 : 0) + (recording != null ? 1 : 0)
+    Object pace = given.get("--pace");
+    if (pace != null && !pace.equals("realtime") && !pace.equals("burst")) {
+      throw new Main.UsageException(PROG, "argument --pace: invalid choice: '" + pace
+          + "' (choose from 'realtime', 'burst')");
+    }
+    return given;
+  }
+
+  static int run(String[] args, PrintStream out, PrintStream err) {
+    List<String> strokeArgs = new ArrayList<>();
+    Map<String, Object> given = parse(args, strokeArgs);
+    if (given == null) {
+      out.print(HELP);
+      return 0;
+    }
+    String shape = (String) given.get("--shape");
+    String recording = (String) given.get("--recording");
+    Double intensity = (Double) given.get("--intensity");
+    double timeoutS = (Double) given.getOrDefault("--timeout-s", 10.0);
+    int rows = ((Long) given.getOrDefault("--rows", 3L)).intValue();
+    int columns = ((Long) given.getOrDefault("--columns", 4L)).intValue();
+    int sources = (shape != null ? 1 : 0) + (recording != null ? 1 : 0)
         + (strokeArgs.isEmpty() ? 0 : 1);
-    if (given != 1) {
-      throw new Main.UsageException(PROG, USAGE,
+    if (sources != 1) {
+      throw new Main.UsageException(PROG,
           "give one of: STROKE ..., --shape NAME or --recording FILE");
     }
     if (intensity != null && !(intensity >= 0 && intensity <= 1)) {
@@ -142,10 +134,14 @@ final class SendCommand {
 
     List<Stroke> strokes = new ArrayList<>();
     if (shape != null) {
-      strokes.addAll(Shapes.strokes(shape, rows, columns, spacingCm,
-          layout.maxStrokeDurationMs(), segments, durationMs, margin));
+      Long segments = (Long) given.get("--segments");
+      strokes.addAll(Shapes.strokes(shape, rows, columns,
+          (Double) given.getOrDefault("--spacing-cm", 3.0), layout.maxStrokeDurationMs(),
+          segments == null ? null : segments.intValue(), (Double) given.get("--duration-ms"),
+          (Double) given.getOrDefault("--margin", 0.0)));
     } else if (recording != null) {
-      strokes.addAll(fromRecording(Path.of(recording), paper, rows, columns));
+      strokes.addAll(
+          fromRecording(Path.of(recording), given.containsKey("--paper"), rows, columns));
     } else {
       for (String text : strokeArgs) {
         strokes.add(parseStroke(text));
@@ -171,43 +167,46 @@ final class SendCommand {
     }
 
     // Broker settings: option, else credentials file, else default.
-    if (credentials != null) {
+    if (given.get("--credentials") instanceof String credentials) {
       Map<String, Object> document = readCredentials(Path.of(credentials));
-      if (broker == null && document.get("mqtt_url") instanceof String url) {
-        broker = url;
+      if (document.get("mqtt_url") instanceof String url) {
+        given.putIfAbsent("--broker", url);
       }
-      if (sleeveId == null && document.get("sleeve") instanceof Map<?, ?> sleeve
+      if (document.get("sleeve") instanceof Map<?, ?> sleeve
           && sleeve.get("id") instanceof String id) {
-        sleeveId = id;
+        given.putIfAbsent("--id", id);
       }
       if (document.get("sender") instanceof Map<?, ?> sender) {
-        if (username == null && sender.get("username") instanceof String u) {
-          username = u;
+        if (sender.get("username") instanceof String u) {
+          given.putIfAbsent("--username", u);
         }
-        if (password == null && sender.get("password") instanceof String p) {
-          password = p;
+        if (sender.get("password") instanceof String p) {
+          given.putIfAbsent("--password", p);
         }
       }
-      if (caFingerprint == null && ca == null && document.get("ca_fingerprint") instanceof String f) {
-        caFingerprint = f;
+      if (!given.containsKey("--ca") && document.get("ca_fingerprint") instanceof String f) {
+        given.putIfAbsent("--ca-fingerprint", f);
       }
     }
-    SleeveClient.Builder builder = SleeveClient.builder(broker == null ? "mqtt://127.0.0.1:1883" : broker)
-        .sleeveId(sleeveId == null ? "sleeve1" : sleeveId);
+    String url = (String) given.getOrDefault("--broker", "mqtt://127.0.0.1:1883");
+    String sleeveId = (String) given.getOrDefault("--id", "sleeve1");
+    String username = (String) given.get("--username");
+    SleeveClient.Builder builder = SleeveClient.builder(url).sleeveId(sleeveId);
     if (username != null) {
-      builder.login(username, password == null ? "" : password);
+      builder.login(username, (String) given.getOrDefault("--password", ""));
     }
+    boolean legacy = given.containsKey("--legacy");
     if (legacy) {
       builder.format(WireFormat.LEGACY);
-      if (legacyTopic != null) {
-        builder.legacyTopic(legacyTopic);
+      if (given.get("--legacy-topic") instanceof String topic) {
+        builder.legacyTopic(topic);
       }
     }
-    if (ca != null) {
+    if (given.get("--ca") instanceof String ca) {
       builder.caCertificate(Path.of(ca));
     }
-    if (caFingerprint != null) {
-      builder.caFingerprint(caFingerprint);
+    if (given.get("--ca-fingerprint") instanceof String fingerprint) {
+      builder.caFingerprint(fingerprint);
     }
     String[] lastSaid = {"no answer"};
     builder.listener(new SleeveClient.Listener() {
@@ -218,8 +217,8 @@ final class SendCommand {
         }
       }
     });
-    String url = broker == null ? "mqtt://127.0.0.1:1883" : broker;
     refuseWhenNobodyListens(url);
+    Object pace = given.get("--pace");
     boolean realtime = pace == null ? shape != null || recording != null : pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
@@ -259,8 +258,7 @@ final class SendCommand {
         return 1;
       }
       out.println("Sent " + strokes.size() + " stroke" + (strokes.size() == 1 ? "" : "s")
-          + (legacy ? " as legacy text" : " to sleeve '" + (sleeveId == null ? "sleeve1" : sleeveId)
-              + "' (drawing " + client.drawing() + ")") + "; the broker has them.");
+          + (legacy ? " as legacy text" : " to sleeve '" + sleeveId + "' (drawing " + client.drawing() + ")") + "; the broker has them.");
       return 0;
     }
   }
@@ -347,18 +345,15 @@ final class SendCommand {
     try (Socket probe = new Socket()) {
       probe.connect(new InetSocketAddress(where.host(), where.port()), 2000);
     } catch (ConnectException refused) {
-      throw new IllegalArgumentException("Nothing accepts connections at " + url
-          + " (connection refused): " + START_HINT + ".");
+      throw new IllegalArgumentException(ConnectFailure.refused(url, "--broker URL"));
     } catch (UnknownHostException unknown) {
-      throw new IllegalArgumentException("Cannot find the host '" + where.host() + "' of " + url
-          + ": check the host name in --broker.");
+      throw new IllegalArgumentException(
+          ConnectFailure.unknownHost(url, where.host(), "--broker"));
     } catch (IOException other) {
       // No answer yet: the client keeps trying until --timeout-s.
     }
   }
 
-  private static final String START_HINT =
-      "start one with 'feelmysign broker' or 'make up', or give the right --broker URL";
 
   /** A credentials.json of 'feelmysign broker', checked as the reference checks it. */
   @SuppressWarnings("unchecked")
@@ -402,7 +397,7 @@ final class SendCommand {
 
   private static String value(String[] args, int i, String flag) {
     if (i >= args.length) {
-      throw new Main.UsageException(PROG, USAGE, "argument " + flag + ": expected one argument");
+      throw new Main.UsageException(PROG, "argument " + flag + ": expected one argument");
     }
     return args[i];
   }
@@ -411,7 +406,7 @@ final class SendCommand {
     try {
       return Double.parseDouble(text);
     } catch (NumberFormatException e) {
-      throw new Main.UsageException(PROG, USAGE,
+      throw new Main.UsageException(PROG,
           "argument " + flag + ": invalid float value: '" + text + "'");
     }
   }
@@ -420,7 +415,7 @@ final class SendCommand {
     try {
       return Long.parseLong(text);
     } catch (NumberFormatException e) {
-      throw new Main.UsageException(PROG, USAGE,
+      throw new Main.UsageException(PROG,
           "argument " + flag + ": invalid int value: '" + text + "'");
     }
   }

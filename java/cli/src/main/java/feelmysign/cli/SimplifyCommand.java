@@ -4,6 +4,8 @@ import feelmysign.json.Numbers;
 import feelmysign.json.PyDumps;
 import feelmysign.json.PyRepr;
 import feelmysign.simplify.Algorithm;
+import feelmysign.simplify.ParamSpec;
+import feelmysign.simplify.ParamTable;
 import feelmysign.simplify.Params;
 import feelmysign.simplify.PathSegment;
 import feelmysign.simplify.Recording;
@@ -40,74 +42,118 @@ final class SimplifyCommand {
   /** An hour of drawing at 240 samples a second is ~60 MiB. */
   static final long MAX_RECORDING_BYTES = 64L * 1024 * 1024;
 
-  /** A flag: its name, the parameter it sets (null for the others) and its kind. */
-  private record Option(String flag, String dest, Kind kind, String metavar, String help) {}
-
+  /** What a flag does: takes a number, a whole number or a choice, or sets true or false. */
   private enum Kind {
     FLOAT,
     INT,
+    CHOICE,
     TRUE,
     FALSE,
-    CHOICE
+    HELP
   }
 
-  private static final List<Option> OPTIONS =
-      List.of(
-          new Option("--algorithm", "algorithm", Kind.CHOICE, "{angle,window}",
-              "the simplifier: angle (the paper's) or window (error-bounded, cut at features);"
-                  + " default: the recording's, else window"),
-          new Option("--paper", "paper", Kind.TRUE, null,
-              "the paper's settings: the angle simplifier at its appendix B.1 values"),
-          new Option("--max-error", "max_error", Kind.FLOAT, "E",
-              "window: farthest a drawn point may lie from its stroke, grid units"),
-          new Option("--max-window", "max_window", Kind.INT, "N",
-              "window: longest stroke in samples after its start (bounds the work)"),
-          new Option("--max-stroke-ms", "max_stroke_ms", Kind.FLOAT, "MS",
-              "window: longest stroke in ms of drawing; 0 = no limit"),
-          new Option("--check-frames", "check_frames", Kind.INT, "N",
-              "angle: frames between checks"),
-          new Option("--max-angle-deg", "max_angle_deg", Kind.FLOAT, "A",
-              "angle: largest turn that continues a line, degrees"),
-          new Option("--frame-max", "frame_max", Kind.INT, "N",
-              "angle: longest line in frames, 0 = no limit"),
-          new Option("--fps", "fps", Kind.FLOAT, "F", "angle: frames per second of the drawing loop"),
-          new Option("--no-recover", "recover", Kind.FALSE, null,
-              "angle: start a new line at the pointer after a failed check, leaving gaps"),
-          new Option("--min-duration-ms", "min_duration_ms", Kind.FLOAT, "D",
-              "shortest stroke sent, ms"),
-          new Option("--min-length", "min_length", Kind.FLOAT, "L",
-              "shortest stroke sent, grid units"),
-          new Option("--rows", "rows", Kind.INT, "R",
-              "actuator rows (default: the recording's sleeve, else 3)"),
-          new Option("--columns", "columns", Kind.INT, "C",
-              "actuator columns (default: the recording's sleeve, else 4)"),
-          new Option("--stretch", "stretch", Kind.TRUE, null,
-              "stretch the canvas onto the grid as the paper did"),
-          new Option("--json", "json", Kind.TRUE, null, "print the strokes as JSON"),
-          new Option("--help", "help", Kind.TRUE, null, "show this help and exit"));
+  /** One name of an option: the parameter it sets and how, and the option's name in errors
+   * (its names joined by '/', as argparse names it). */
+  private record Flag(String flag, String dest, Kind kind, String action) {}
 
-  static final String USAGE =
-      "usage: "
-          + PROG
-          + " [-h] [--algorithm {angle,window}] [--paper] [--max-error E]\n"
-          + "       [--max-window N] [--max-stroke-ms MS] [--check-frames N]\n"
-          + "       [--max-angle-deg A] [--frame-max N] [--fps F] [--no-recover]\n"
-          + "       [--min-duration-ms D] [--min-length L] [--rows R] [--columns C]\n"
-          + "       [--stretch] [--json]\n"
-          + "       RECORDING\n";
+  // The parameters that change the strokes of a recording get an option, as in the reference:
+  // the simplifier's and the grid's; the canvas is the recording's, clearing on a press the page's.
+  private static final Set<String> CLI_PANELS = Set.of("simplifier", "sleeve");
+  // A number option's placeholder, by its unit, as the reference's.
+  private static final Map<String, String> METAVARS =
+      Map.of("ms", "MS", "\u00b0", "DEG", "grid units", "UNITS", "fps", "FPS", "px", "PX");
+  private static final String DESCRIPTION =
+      "Run a recording (JSON: canvas size and pointer samples per path; see docs/research.md)"
+          + " through a simplifier, exactly as the drawing client would, and show the strokes it"
+          + " sends and the ones it drops. An option not given takes the recording's value (its"
+          + " simplifier's settings, its sleeve's grid), else its default.";
+
+  private static final List<ArgparseHelp.Argument> ARGUMENTS = new ArrayList<>();
+  private static final List<Flag> FLAGS = new ArrayList<>();
+
+  static {
+    flags(Kind.HELP, "help", null, "show this help message and exit", "-h", "--help");
+    String choices = "{" + String.join(",", ParamTable.ALGORITHMS.keySet()) + "}";
+    flags(
+        Kind.CHOICE,
+        "algorithm",
+        choices,
+        "the simplifier: angle (the paper's) or window (error-bounded, cut at features);"
+            + " default: the recording's, else "
+            + ParamTable.DEFAULT_ALGORITHM,
+        "--algorithm");
+    flags(
+        Kind.TRUE,
+        "paper",
+        null,
+        "the paper's settings: the angle simplifier at its appendix B.1 values (the same as"
+            + " --algorithm "
+            + Algorithm.PAPER.wireName()
+            + ")",
+        "--paper");
+    for (ParamTable.Row row : ParamTable.PARAMETERS) {
+      if (row.panel() != null && CLI_PANELS.contains(row.panel())) {
+        parameter(row);
+      }
+    }
+    flags(Kind.TRUE, "json", null, "print the strokes as JSON", "--json");
+    ARGUMENTS.add(
+        new ArgparseHelp.Argument("RECORDING", "RECORDING", "a recording JSON file", true));
+  }
+
+  /** The option of one parameter, its help and range from the table, as the reference's. */
+  private static void parameter(ParamTable.Row row) {
+    String prefix = row.algorithms().size() == 1 ? row.algorithms().get(0) + ": " : "";
+    String flag = "--" + row.name().replace('_', '-');
+    if (row.kind() == ParamSpec.Kind.BOOLEAN) {
+      String onOff = Boolean.TRUE.equals(row.defaultValue()) ? "on" : "off";
+      String help = prefix + row.help() + " (default: " + onOff + ")";
+      // argparse's BooleanOptionalAction: --recover and --no-recover, listed together.
+      String no = "--no-" + flag.substring(2);
+      ARGUMENTS.add(
+          new ArgparseHelp.Argument(flag + ", " + no, "[" + flag + " | " + no + "]", help, false));
+      FLAGS.add(new Flag(flag, row.name(), Kind.TRUE, flag + "/" + no));
+      FLAGS.add(new Flag(no, row.name(), Kind.FALSE, flag + "/" + no));
+      return;
+    }
+    boolean whole = row.kind() == ParamSpec.Kind.INTEGER;
+    String metavar = whole ? "N" : METAVARS.getOrDefault(row.unit() == null ? "" : row.unit(), "X");
+    String help =
+        prefix
+            + row.help()
+            + " ("
+            + bound(row.minimum())
+            + " to "
+            + bound(row.maximum())
+            + "; default: "
+            + Numbers.pythonG(((Number) row.defaultValue()).doubleValue())
+            + ")";
+    flags(whole ? Kind.INT : Kind.FLOAT, row.name(), metavar, help, flag);
+  }
+
+  private static String bound(Double value) {
+    return value == null ? "unbounded" : Numbers.pythonG(value);
+  }
+
+  /** An option of one or more names (listed together), taking {@code metavar} or nothing. */
+  private static void flags(Kind kind, String dest, String metavar, String help, String... names) {
+    String argument = metavar == null ? "" : " " + metavar;
+    List<String> invocations = new ArrayList<>();
+    for (String name : names) {
+      invocations.add(name + argument);
+      FLAGS.add(new Flag(name, dest, kind, String.join("/", names)));
+    }
+    ARGUMENTS.add(
+        new ArgparseHelp.Argument(
+            String.join(", ", invocations), "[" + names[0] + argument + "]", help, false));
+  }
+
+  private static final ArgparseHelp HELP = new ArgparseHelp(PROG, DESCRIPTION, ARGUMENTS);
 
   static int run(String[] args, PrintStream out, PrintStream err) {
     Map<String, Object> given = parse(args);
     if (given.containsKey("help")) {
-      out.print(USAGE);
-      out.println();
-      out.println("Run a recording through a simplifier, exactly as the drawing client would,");
-      out.println("and show the strokes it sends and the ones it drops.");
-      out.println();
-      for (Option option : OPTIONS) {
-        String name = option.flag() + (option.metavar() == null ? "" : " " + option.metavar());
-        out.printf("  %-26s %s%n", name, option.help());
-      }
+      out.print(HELP.help());
       return 0;
     }
     String path = (String) given.get("recording");
@@ -127,7 +173,7 @@ final class SimplifyCommand {
   // --- the command line, as argparse reads it ----------------------------------------------
 
   private static Main.UsageException usage(String message) {
-    return new Main.UsageException(PROG, USAGE, message);
+    return new Main.UsageException(PROG, message);
   }
 
   private static Map<String, Object> parse(String[] args) {
@@ -145,10 +191,6 @@ final class SimplifyCommand {
         onlyPositionals = true;
         continue;
       }
-      if (arg.equals("-h")) {
-        given.put("help", true);
-        continue;
-      }
       String name = arg;
       String explicit = null;
       int equals = arg.indexOf('=');
@@ -156,18 +198,21 @@ final class SimplifyCommand {
         name = arg.substring(0, equals);
         explicit = arg.substring(equals + 1);
       }
-      Option option = find(name);
+      Flag option = find(name, arg);
       if (option == null) {
         unrecognized.add(arg);
         continue;
       }
       switch (option.kind()) {
-        case TRUE, FALSE -> {
+        case TRUE, FALSE, HELP -> {
           if (explicit != null) {
             throw usage(
-                "argument " + option.flag() + ": ignored explicit argument " + PyRepr.of(explicit));
+                "argument "
+                    + option.action()
+                    + ": ignored explicit argument "
+                    + PyRepr.of(explicit));
           }
-          given.put(option.dest(), option.kind() == Kind.TRUE);
+          given.put(option.dest(), option.kind() != Kind.FALSE);
         }
         default -> {
           String value = explicit;
@@ -176,7 +221,7 @@ final class SimplifyCommand {
                 || (args[i + 1].startsWith("-")
                     && !args[i + 1].equals("-")
                     && !isNegativeNumber(args[i + 1]))) {
-              throw usage("argument " + option.flag() + ": expected one argument");
+              throw usage("argument " + option.action() + ": expected one argument");
             }
             value = args[++i];
           }
@@ -206,62 +251,55 @@ final class SimplifyCommand {
     return arg.matches("^-\\.?\\d.*") || (arg.startsWith("-") && arg.contains(" "));
   }
 
-  /** An option by its name or a unique prefix of it, as argparse allows. */
-  private static Option find(String name) {
-    if (!name.startsWith("--")) {
-      return null;
-    }
-    List<Option> matches = new ArrayList<>();
-    for (Option option : OPTIONS) {
-      if (option.flag().equals(name)) {
-        return option;
+  /** An option by its name or a unique prefix of it ({@code arg} as given), as argparse allows. */
+  private static Flag find(String name, String arg) {
+    List<Flag> matches = new ArrayList<>();
+    for (Flag flag : FLAGS) {
+      if (flag.flag().equals(name)) {
+        return flag;
       }
-      if (option.flag().startsWith(name)) {
-        matches.add(option);
+      if (name.startsWith("--") && flag.flag().startsWith(name)) {
+        matches.add(flag);
       }
     }
     if (matches.size() > 1) {
-      List<String> flags = matches.stream().map(Option::flag).toList();
-      throw usage("ambiguous option: " + name + " could match " + String.join(", ", flags));
+      List<String> flags = matches.stream().map(Flag::flag).toList();
+      throw usage("ambiguous option: " + arg + " could match " + String.join(", ", flags));
     }
     return matches.isEmpty() ? null : matches.get(0);
   }
 
-  private static Object convert(Option option, String value) {
+  private static Object convert(Flag option, String value) {
     switch (option.kind()) {
       case CHOICE -> {
         if (Algorithm.named(value) == null) {
           throw usage(
               "argument "
-                  + option.flag()
+                  + option.action()
                   + ": invalid choice: "
                   + PyRepr.of(value)
-                  + " (choose from 'angle', 'window')");
+                  + " (choose from "
+                  + String.join(
+                      ", ", ParamTable.ALGORITHMS.keySet().stream().map(PyRepr::of).toList())
+                  + ")");
         }
         return value;
       }
-      case INT -> {
-        Long number = PythonNumbers.parseInt(value);
-        if (number == null) {
-          throw usage(
-              "argument "
-                  + option.flag()
-                  + ": "
-                  + PyRepr.of(value)
-                  + " is not a whole decimal number; write it with the digits 0-9, e.g. 3");
-        }
-        return number;
-      }
       default -> {
-        Double number = PythonNumbers.parseFloat(value);
+        boolean whole = option.kind() == Kind.INT;
+        // Not a conditional expression: it would make a Long a Double (numeric promotion).
+        Object number;
+        if (whole) {
+          number = PythonNumbers.parseInt(value);
+        } else {
+          number = PythonNumbers.parseFloat(value);
+        }
         if (number == null) {
-          throw usage(
-              "argument "
-                  + option.flag()
-                  + ": "
-                  + PyRepr.of(value)
-                  + " is not a decimal number; write it with the digits 0-9, e.g. 0.25, 12 or "
-                  + "2e-3");
+          String wanted =
+              whole
+                  ? "a whole decimal number; write it with the digits 0-9, e.g. 3"
+                  : "a decimal number; write it with the digits 0-9, e.g. 0.25, 12 or 2e-3";
+          throw usage("argument " + option.action() + ": " + PyRepr.of(value) + " is not " + wanted);
         }
         return number;
       }
@@ -377,7 +415,7 @@ final class SimplifyCommand {
     for (Map.Entry<String, Algorithm> only : Algorithm.onlyFor().entrySet()) {
       String name = only.getKey();
       if (only.getValue() != algorithm && given.containsKey(name)) {
-        String flag = name.equals("recover") ? "--no-recover" : "--" + name.replace('_', '-');
+        String flag = (Boolean.FALSE.equals(given.get(name)) ? "--no-" : "--") + name.replace('_', '-');
         throw usage(flag + " only applies to --algorithm " + only.getValue().wireName());
       }
     }

@@ -2,22 +2,17 @@ package feelmysign.cli;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertTrue;
-import static org.junit.jupiter.api.Assertions.fail;
 
-import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
-import java.io.BufferedReader;
+import feelmysign.testing.LiveSleeve;
 import java.io.ByteArrayOutputStream;
 import java.io.IOException;
-import java.io.InputStreamReader;
 import java.io.PrintStream;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.List;
 import java.util.Map;
-import java.util.concurrent.CopyOnWriteArrayList;
-import java.util.concurrent.TimeUnit;
 import org.junit.jupiter.api.AfterAll;
 import org.junit.jupiter.api.BeforeAll;
 import org.junit.jupiter.api.Test;
@@ -27,10 +22,8 @@ import org.junit.jupiter.api.io.TempDir;
 /** feelmysign-java send against a real broker and sleeve simulator from the .venv. */
 @TestInstance(TestInstance.Lifecycle.PER_CLASS)
 class SendCommandTest {
-  private static final long WAIT_S = 60;
+  private LiveSleeve live;
   private Path credentials;
-  private Process broker;
-  private Process sleeve;
 
   private record Result(int code, String out, String err) {}
 
@@ -45,148 +38,50 @@ class SendCommandTest {
     return new Result(code, out.toString(StandardCharsets.UTF_8), err.toString(StandardCharsets.UTF_8));
   }
 
-  private static Path repository() {
-    for (Path dir = Path.of("").toAbsolutePath(); dir != null; dir = dir.getParent()) {
-      if (Files.isDirectory(dir.resolve("testdata")) && Files.isDirectory(dir.resolve("python"))) {
-        return dir;
-      }
-    }
-    throw new IllegalStateException("not inside the feelmysign repository");
-  }
-
   @BeforeAll
   void start(@TempDir Path state) throws Exception {
-    String feelmysign = repository().resolve(".venv/bin/feelmysign").toString();
-    broker = new ProcessBuilder(feelmysign, "broker", "--state-dir", state.toString(),
-            "--port", "0", "--ws-port", "0", "--sleeve-id", "send-test")
-        .redirectErrorStream(true).start();
-    BufferedReader out = new BufferedReader(
-        new InputStreamReader(broker.getInputStream(), StandardCharsets.UTF_8));
-    for (String line; (line = out.readLine()) != null && !line.startsWith("Ready."); ) {
-      // until the broker is ready
-    }
-    Thread drain = new Thread(() -> {
-      try {
-        out.lines().forEach(line -> {});
-      } catch (java.io.UncheckedIOException closed) {
-        // The broker stopped.
-      }
-    });
-    drain.setDaemon(true);
-    drain.start();
-    credentials = state.resolve("credentials.json");
-    assertTrue(Files.exists(credentials), "feelmysign broker did not start");
-    sleeve = new ProcessBuilder(feelmysign, "sleeve", "--credentials", credentials.toString(),
-            "--backend", "sim", "--log-level", "warning")
-        .redirectErrorStream(true).redirectOutput(state.resolve("sleeve.log").toFile()).start();
+    live = LiveSleeve.start(state, "send-test", List.of(), List.of());
+    credentials = live.credentials();
   }
 
   @AfterAll
   void stop() throws InterruptedException {
-    for (Process p : new Process[] {sleeve, broker}) {
-      if (p != null) {
-        p.destroy();
-        if (!p.waitFor(WAIT_S, TimeUnit.SECONDS)) {
-          p.destroyForcibly();
-        }
-      }
+    if (live != null) {
+      live.close();
     }
   }
 
   @Test
   void aShapeAtAChosenResolutionIsPlayedByTheSleeve() throws Exception {
-    @SuppressWarnings("unchecked")
-    Map<String, Object> doc = (Map<String, Object>) feelmysign.json.PyJson.loads(
-        Files.readString(credentials));
-    @SuppressWarnings("unchecked")
-    Map<String, Object> sender = (Map<String, Object>) doc.get("sender");
-    List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
-    List<String> statuses = new CopyOnWriteArrayList<>();
-    try (SleeveClient listener = SleeveClient.builder((String) doc.get("mqtt_url"))
-        .login((String) sender.get("username"), (String) sender.get("password"))
-        .sleeveId("send-test")
-        .listener(new SleeveClient.Listener() {
-          @Override
-          public void event(SleeveEvent event) {
-            heard.add(event);
-          }
-
-          @Override
-          public void status(String payload) {
-            statuses.add(payload);
-          }
-        }).build()) {
-      listener.connect();
-      long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
-      // The sleeve's retained status arrives once the listener's subscriptions are in place.
-      while (statuses.stream().noneMatch(p -> !p.isEmpty())) {
-        if (System.nanoTime() > deadline) {
-          fail("the listener heard no status from the sleeve");
-        }
-        Thread.sleep(20);
-      }
+    try (LiveSleeve.Listening sleeve = live.listen()) {
       Result result = send("--credentials", credentials.toString(), "--shape", "square",
           "--segments", "4", "--duration-ms", "1200", "--timeout-s", "60");
       assertEquals(0, result.code(), result.err());
       assertTrue(result.out().startsWith("Sent 4 strokes to sleeve 'send-test'"), result.out());
-      while (heard.stream().filter(e -> "played".equals(e.type())
-          || "adjusted".equals(e.type())).count() < 4) {
-        if (System.nanoTime() > deadline) {
-          fail("the sleeve did not play the square: " + heard);
-        }
-        Thread.sleep(20);
-      }
+      LiveSleeve.waitFor(() -> sleeve.played() >= 4, "the square played: " + sleeve.events);
     }
   }
 
   @Test
   void twoShapesInARowArePlayedWithoutAStrokeLate() throws Exception {
-    @SuppressWarnings("unchecked")
-    Map<String, Object> doc = (Map<String, Object>) feelmysign.json.PyJson.loads(
-        Files.readString(credentials));
-    @SuppressWarnings("unchecked")
-    Map<String, Object> sender = (Map<String, Object>) doc.get("sender");
-    List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
-    List<String> statuses = new CopyOnWriteArrayList<>();
-    try (SleeveClient listener = SleeveClient.builder((String) doc.get("mqtt_url"))
-        .login((String) sender.get("username"), (String) sender.get("password"))
-        .sleeveId("send-test")
-        .listener(new SleeveClient.Listener() {
-          @Override
-          public void event(SleeveEvent event) {
-            heard.add(event);
-          }
-
-          @Override
-          public void status(String payload) {
-            statuses.add(payload);
-          }
-        }).build()) {
-      listener.connect();
-      long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
-      while (statuses.stream().noneMatch(p -> !p.isEmpty())) {
-        if (System.nanoTime() > deadline) {
-          fail("the listener heard no status from the sleeve");
-        }
-        Thread.sleep(20);
-      }
+    try (LiveSleeve.Listening sleeve = live.listen()) {
       // Sent all at once, the second square would wait 2.4 s behind the first: late.
       for (int i = 0; i < 2; i++) {
         Result result = send("--credentials", credentials.toString(), "--shape", "square",
             "--segments", "4", "--duration-ms", "2400", "--timeout-s", "60");
         assertEquals(0, result.code(), result.err());
       }
-      java.util.function.Predicate<SleeveEvent> answered = e -> "played".equals(e.type())
-          || "adjusted".equals(e.type()) || "rejected".equals(e.type());
-      while (heard.stream().filter(answered).count() < 8) {
-        if (System.nanoTime() > deadline) {
-          fail("the sleeve did not answer every stroke: " + heard);
-        }
-        Thread.sleep(20);
-      }
-      assertEquals(List.of(), heard.stream().filter(e -> "rejected".equals(e.type()))
-          .map(SleeveEvent::fields).toList());
+      LiveSleeve.waitFor(
+          () -> sleeve.played() + rejected(sleeve).size() >= 8, "an answer to every stroke");
+      assertEquals(List.of(), rejected(sleeve));
     }
+  }
+
+  private static List<Map<String, Object>> rejected(LiveSleeve.Listening sleeve) {
+    return sleeve.events.stream()
+        .filter(e -> SleeveEvent.REJECTED.equals(e.type()))
+        .map(SleeveEvent::fields)
+        .toList();
   }
 
   @Test
@@ -233,14 +128,7 @@ class SendCommandTest {
 
   @Test
   void aLoginRefusedWithoutAUserNameSaysSoAndWhereThePasswordIs() {
-    @SuppressWarnings("unchecked")
-    Map<String, Object> doc;
-    try {
-      doc = (Map<String, Object>) feelmysign.json.PyJson.loads(Files.readString(credentials));
-    } catch (IOException error) {
-      throw new java.io.UncheckedIOException(error);
-    }
-    Result result = send("--broker", (String) doc.get("mqtt_url"), "--timeout-s", "60", "0,0,2,0,500");
+    Result result = send("--broker", live.mqttUrl(), "--timeout-s", "60", "0,0,2,0,500");
     assertEquals(1, result.code());
     assertTrue(result.err().contains("without a user name") && result.err().contains("credentials.json")
         && !result.err().contains("null"), result.err());

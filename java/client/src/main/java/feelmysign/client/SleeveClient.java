@@ -377,13 +377,10 @@ public final class SleeveClient implements AutoCloseable {
     if (tell) {
       listener.broker(
           State.OFFLINE,
-          "No connection to "
-              + url
-              + " ("
-              + (cause == null ? "closed" : cause.getMessage())
-              + "); retrying every "
+          ConnectFailure.sentence(url, cause)
+              + " Retrying every "
               + RECONNECT_PERIOD_MS / 1000
-              + " s. Is the broker running? ('make up' starts it.)");
+              + " s.");
     }
   }
 

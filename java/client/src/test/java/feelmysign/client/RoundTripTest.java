@@ -5,17 +5,12 @@ import static org.junit.jupiter.api.Assertions.assertNotNull;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 import static org.junit.jupiter.api.Assertions.fail;
 
-import feelmysign.json.PyJson;
 import feelmysign.protocol.Stroke;
-import java.io.BufferedReader;
+import feelmysign.testing.LiveSleeve;
 import java.io.IOException;
-import java.io.InputStreamReader;
-import java.nio.charset.StandardCharsets;
-import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
-import java.util.Map;
 import java.util.concurrent.BlockingQueue;
 import java.util.concurrent.LinkedBlockingQueue;
 import java.util.concurrent.TimeUnit;
@@ -33,103 +28,31 @@ import org.junit.jupiter.api.io.TempDir;
  */
 @TestInstance(TestInstance.Lifecycle.PER_CLASS)
 class RoundTripTest {
-  private static final long WAIT_S = 60; // generous: the machine running the tests may be busy
+  private static final long WAIT_S = LiveSleeve.WAIT_S;
   private static final String SLEEVE = "java-test";
 
-  private Path state;
-  private Process broker;
-  private Process sleeve;
-  private String mqttUrl;
-  private String mqttsUrl;
-  private String caFingerprint;
-  private String senderUser;
-  private String senderPassword;
-
-  private static Path repository() {
-    for (Path dir = Path.of("").toAbsolutePath(); dir != null; dir = dir.getParent()) {
-      if (Files.isDirectory(dir.resolve("testdata")) && Files.isDirectory(dir.resolve("python"))) {
-        return dir;
-      }
-    }
-    throw new IllegalStateException("not inside the feelmysign repository");
-  }
+  private LiveSleeve live;
 
   @BeforeAll
-  void startBrokerAndSleeve(@TempDir Path dir) throws IOException, InterruptedException {
-    state = dir;
-    Path feelmysign = repository().resolve(".venv/bin/feelmysign");
-    if (!Files.isExecutable(feelmysign)) {
-      fail(feelmysign + " is missing: run 'make .venv/.installed-stamp' (make java-test does)");
-    }
-    broker =
-        new ProcessBuilder(
-                feelmysign.toString(), "broker", "--state-dir", state.toString(),
-                "--port", "0", "--ws-port", "0", "--sleeve-id", SLEEVE,
-                // TLS too, on loopback, with the broker's own CA: the --lan set-up.
-                "--host", "127.0.0.1", "--tls-port", "0")
-            .redirectErrorStream(true)
-            .start();
-    BufferedReader out =
-        new BufferedReader(new InputStreamReader(broker.getInputStream(), StandardCharsets.UTF_8));
-    long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
-    StringBuilder said = new StringBuilder();
-    for (String line; (line = out.readLine()) != null; ) {
-      said.append(line).append('\n');
-      if (line.startsWith("Ready.")) {
-        break;
-      }
-      if (System.nanoTime() > deadline) {
-        fail("feelmysign broker did not get ready:\n" + said);
-      }
-    }
-    assertTrue(said.toString().contains("Ready."), "feelmysign broker failed:\n" + said);
-    // Keep draining its output, so that it never blocks on a full pipe.
-    Thread drain =
-        new Thread(
-            () -> {
-              try {
-                out.lines().forEach(line -> {});
-              } catch (java.io.UncheckedIOException closed) {
-                // The broker stopped.
-              }
-            },
-            "broker-output");
-    drain.setDaemon(true);
-    drain.start();
-    Path credentials = state.resolve("credentials.json");
-    @SuppressWarnings("unchecked")
-    Map<String, Object> document =
-        (Map<String, Object>) PyJson.loads(Files.readString(credentials));
-    mqttUrl = (String) document.get("mqtt_url");
-    mqttsUrl = (String) document.get("mqtts_url");
-    caFingerprint = (String) document.get("ca_fingerprint");
-    @SuppressWarnings("unchecked")
-    Map<String, Object> sender = (Map<String, Object>) document.get("sender");
-    senderUser = (String) sender.get("username");
-    senderPassword = (String) sender.get("password");
-    sleeve =
-        new ProcessBuilder(
-                feelmysign.toString(), "sleeve", "--credentials", credentials.toString(),
-                "--backend", "sim", "--no-legacy", "--log-level", "warning")
-            .redirectErrorStream(true)
-            .redirectOutput(state.resolve("sleeve.log").toFile())
-            .start();
+  void startBrokerAndSleeve(@TempDir Path state) throws IOException {
+    // TLS too, on loopback, with the broker's own CA: the --lan set-up.
+    live =
+        LiveSleeve.start(
+            state,
+            SLEEVE,
+            List.of("--host", "127.0.0.1", "--tls-port", "0"),
+            List.of("--no-legacy"));
   }
 
   @AfterAll
   void stopThem() throws InterruptedException {
-    for (Process process : new Process[] {sleeve, broker}) {
-      if (process != null) {
-        process.destroy(); // SIGTERM: the sleeve stops with every motor off
-        if (!process.waitFor(WAIT_S, TimeUnit.SECONDS)) {
-          process.destroyForcibly();
-        }
-      }
+    if (live != null) {
+      live.close();
     }
   }
 
   /** Everything the client tells, in order, to wait on. */
-  private static final class Heard implements SleeveClient.Listener {
+  private static final class Heard extends LiveSleeve.Listening {
     final BlockingQueue<Object> all = new LinkedBlockingQueue<>();
     final List<String> brokerSaid = new ArrayList<>();
 
@@ -142,13 +65,8 @@ class RoundTripTest {
     }
 
     @Override
-    public void status(String payload) {
-      all.add("status " + payload);
-    }
-
-    @Override
-    public void event(SleeveEvent event) {
-      all.add(event);
+    protected void heard(Object eventOrStatus) {
+      all.add(eventOrStatus);
     }
 
     @Override
@@ -172,11 +90,18 @@ class RoundTripTest {
   }
 
   private SleeveClient client(Heard heard, String password) {
-    return SleeveClient.builder(mqttUrl)
-        .login(senderUser, password)
-        .sleeveId(SLEEVE)
-        .listener(heard)
-        .build();
+    return live.client(password).listener(heard).build();
+  }
+
+  /** A client over TLS, trusting what {@code trust} sets (a CA file or fingerprint). */
+  private SleeveClient tlsClient(
+      Heard heard, java.util.function.UnaryOperator<SleeveClient.Builder> trust) {
+    SleeveClient.Builder builder =
+        SleeveClient.builder(live.mqttsUrl())
+            .login(live.senderUser(), live.senderPassword())
+            .sleeveId(SLEEVE)
+            .listener(heard);
+    return trust.apply(builder).build();
   }
 
   /** One stroke over the connection {@code client} makes: it comes back played. */
@@ -194,13 +119,7 @@ class RoundTripTest {
   @Test
   void overTlsWithTheBrokersCa() throws InterruptedException {
     Heard heard = new Heard();
-    try (SleeveClient client =
-        SleeveClient.builder(mqttsUrl)
-            .login(senderUser, senderPassword)
-            .sleeveId(SLEEVE)
-            .caCertificate(state.resolve("tls/ca.pem"))
-            .listener(heard)
-            .build()) {
+    try (SleeveClient client = tlsClient(heard, b -> b.caCertificate(live.caCertificate()))) {
       playsOneStroke(client, heard);
     }
   }
@@ -208,13 +127,7 @@ class RoundTripTest {
   @Test
   void overTlsWithTheCasFingerprint() throws InterruptedException {
     Heard heard = new Heard();
-    try (SleeveClient client =
-        SleeveClient.builder(mqttsUrl)
-            .login(senderUser, senderPassword)
-            .sleeveId(SLEEVE)
-            .caFingerprint(caFingerprint)
-            .listener(heard)
-            .build()) {
+    try (SleeveClient client = tlsClient(heard, b -> b.caFingerprint(live.caFingerprint()))) {
       playsOneStroke(client, heard);
     }
   }
@@ -223,13 +136,7 @@ class RoundTripTest {
   void aCertificateThatDoesNotMatchIsToldAndRetried() throws InterruptedException {
     Heard heard = new Heard();
     String other = "0".repeat(64);
-    try (SleeveClient client =
-        SleeveClient.builder(mqttsUrl)
-            .login(senderUser, senderPassword)
-            .sleeveId(SLEEVE)
-            .caFingerprint(other)
-            .listener(heard)
-            .build()) {
+    try (SleeveClient client = tlsClient(heard, b -> b.caFingerprint(other))) {
       client.connect();
       heard.next(SleeveClient.State.class, s -> s == SleeveClient.State.OFFLINE, "offline");
       Thread.sleep(3 * SleeveClient.RECONNECT_PERIOD_MS);
@@ -253,7 +160,7 @@ class RoundTripTest {
   @Test
   void strokesSentFromJavaArePlayed() throws InterruptedException {
     Heard heard = new Heard();
-    try (SleeveClient client = client(heard, senderPassword)) {
+    try (SleeveClient client = client(heard, live.senderPassword())) {
       client.connect();
       heard.next(String.class, s -> s.contains("\"online\": true"), "the sleeve online");
       String drawing = client.newDrawing();
@@ -276,7 +183,7 @@ class RoundTripTest {
   @Test
   void stopCancelsTheDrawingMidway() throws InterruptedException {
     Heard heard = new Heard();
-    try (SleeveClient client = client(heard, senderPassword)) {
+    try (SleeveClient client = client(heard, live.senderPassword())) {
       client.connect();
       heard.next(String.class, s -> s.contains("\"online\": true"), "the sleeve online");
       String drawing = client.newDrawing();
@@ -301,7 +208,7 @@ class RoundTripTest {
   @Test
   void aWrongPasswordIsToldOnceAndNotRetried() throws InterruptedException {
     Heard heard = new Heard();
-    try (SleeveClient client = client(heard, senderPassword + "x")) {
+    try (SleeveClient client = client(heard, live.senderPassword() + "x")) {
       client.connect();
       heard.next(SleeveClient.State.class, s -> s == SleeveClient.State.OFFLINE, "offline");
       assertTrue(client.loginRefused());
@@ -318,7 +225,7 @@ class RoundTripTest {
   void aLoginWithoutAUserNameIsSaidSoWithWhereTheLoginIs() throws InterruptedException {
     Heard heard = new Heard();
     try (SleeveClient client =
-        SleeveClient.builder(mqttUrl).sleeveId(SLEEVE).listener(heard).build()) {
+        SleeveClient.builder(live.mqttUrl()).sleeveId(SLEEVE).listener(heard).build()) {
       client.connect();
       heard.next(SleeveClient.State.class, s -> s == SleeveClient.State.OFFLINE, "offline");
       assertTrue(client.loginRefused());

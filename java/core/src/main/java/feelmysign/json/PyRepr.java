@@ -9,6 +9,29 @@ import java.util.Map;
 public final class PyRepr {
   private PyRepr() {}
 
+  /** Python's {@code type(value).__name__} of a JSON-like value: "int", "str", "dict"... */
+  public static String typeName(Object value) {
+    if (value == null) {
+      return "NoneType";
+    }
+    if (value instanceof Long || value instanceof Integer || value instanceof BigInteger) {
+      return "int";
+    }
+    if (value instanceof Double || value instanceof Float) {
+      return "float";
+    }
+    if (value instanceof Boolean) {
+      return "bool";
+    }
+    if (value instanceof String) {
+      return "str";
+    }
+    if (value instanceof List) {
+      return "list";
+    }
+    return value instanceof Map ? "dict" : value.getClass().getSimpleName();
+  }
+
   /** Python's repr of a JSON-like value: True, 1.0, 'text', [1, 2], {'a': None}. */
   public static String of(Object value) {
     if (value == null) {

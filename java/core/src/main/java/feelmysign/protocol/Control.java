@@ -29,19 +29,6 @@ public final class Control {
   public static final String CANCEL_ALL = "*";
   private static final String EXAMPLE = "{\"v\":1,\"cancel\":\"*\"}";
 
-  /** Every reason a control message can be refused with (a subset of the stroke reasons). */
-  public static final List<String> REASONS =
-      List.of(
-          NOT_TEXT,
-          TOO_LONG,
-          EMPTY,
-          INVALID_JSON,
-          NOT_AN_OBJECT,
-          MISSING_FIELD,
-          WRONG_TYPE,
-          UNKNOWN_VERSION,
-          BAD_DRAWING_ID);
-
   /** Cancel the strokes of {@code drawing}, or of every drawing when it is {@code "*"}. */
   public record Cancel(String drawing) {
     public boolean everything() {

@@ -6,6 +6,7 @@ import feelmysign.json.JsonDecodeException;
 import feelmysign.json.NonFiniteLiteralException;
 import feelmysign.json.Numbers;
 import feelmysign.json.PyDumps;
+import feelmysign.json.PyRepr;
 import feelmysign.json.PyJson;
 import feelmysign.protocol.ParseResult.Accepted;
 import feelmysign.protocol.ParseResult.Rejected;
@@ -219,7 +220,7 @@ public final class Protocol {
     } else if (payload instanceof byte[] bytes) {
       data = bytes;
     } else {
-      String kind = payload == null ? "None" : "of type " + pythonTypeName(payload);
+      String kind = payload == null ? "None" : "of type " + PyRepr.typeName(payload);
       return new Rejected(
           NOT_TEXT,
           "The payload is "
@@ -285,26 +286,6 @@ public final class Protocol {
       i++;
     }
     return -1;
-  }
-
-  /** The name Python gives the type of a value that reached the sleeve instead of text. */
-  static String pythonTypeName(Object value) {
-    if (value instanceof Integer || value instanceof Long || value instanceof BigInteger) {
-      return "int";
-    }
-    if (value instanceof Double || value instanceof Float) {
-      return "float";
-    }
-    if (value instanceof Boolean) {
-      return "bool";
-    }
-    if (value instanceof List) {
-      return "list";
-    }
-    if (value instanceof Map) {
-      return "dict";
-    }
-    return value.getClass().getSimpleName();
   }
 
   static String strip(String text) {

@@ -1,6 +1,7 @@
 package feelmysign.protocol;
 
 import feelmysign.json.PyDumps;
+import feelmysign.json.PyRepr;
 import java.math.BigInteger;
 import java.util.List;
 import java.util.Map;
@@ -39,22 +40,14 @@ final class Text {
   }
 
   static String jsonKind(Object value) {
-    if (value == null) {
-      return "null";
-    }
-    if (value instanceof Map) {
-      return "an object";
-    }
-    if (value instanceof List) {
-      return "an array";
-    }
-    if (value instanceof String) {
-      return "a string";
-    }
-    if (value instanceof Boolean) {
-      return "a boolean";
-    }
-    return "a number";
+    return switch (PyRepr.typeName(value)) {
+      case "NoneType" -> "null";
+      case "dict" -> "an object";
+      case "list" -> "an array";
+      case "str" -> "a string";
+      case "bool" -> "a boolean";
+      default -> "a number";
+    };
   }
 
   /** Python's {@code str()} of a JSON number: "2", "2.5", "1e+16". */

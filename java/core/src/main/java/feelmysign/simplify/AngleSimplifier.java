@@ -143,15 +143,16 @@ public final class AngleSimplifier implements Simplifier {
   }
 
   private Segment finish(Sample start, Sample end) {
-    return Segment.finish(
-        mapping.gridX(start.x()),
-        mapping.gridY(start.y()),
-        mapping.gridX(end.x()),
-        mapping.gridY(end.y()),
-        start.tMs(),
-        end.tMs(),
-        pointer != null ? pointer.tMs() : end.tMs(),
-        minLength,
-        minDurationMs);
+    double emittedAtMs = pointer != null ? pointer.tMs() : end.tMs();
+    return new Segment(
+            mapping.gridX(start.x()),
+            mapping.gridY(start.y()),
+            mapping.gridX(end.x()),
+            mapping.gridY(end.y()),
+            start.tMs(),
+            end.tMs(),
+            emittedAtMs,
+            null)
+        .checked(minLength, minDurationMs);
   }
 }

@@ -61,34 +61,14 @@ public final class ParamTable {
       ordered(
           Map.entry(
               "angle",
-              List.of(
-                  "check_frames",
-                  "max_angle_deg",
-                  "frame_max",
-                  "fps",
-                  "recover",
-                  "clear_on_press",
-                  "min_duration_ms",
-                  "min_length",
-                  "rows",
-                  "columns",
-                  "canvas_width_px",
-                  "canvas_height_px",
-                  "stretch")),
+              names(
+                  "check_frames max_angle_deg frame_max fps recover clear_on_press min_duration_ms "
+                      + "min_length rows columns canvas_width_px canvas_height_px stretch")),
           Map.entry(
               "window",
-              List.of(
-                  "max_error",
-                  "max_window",
-                  "max_stroke_ms",
-                  "clear_on_press",
-                  "min_duration_ms",
-                  "min_length",
-                  "rows",
-                  "columns",
-                  "canvas_width_px",
-                  "canvas_height_px",
-                  "stretch")));
+              names(
+                  "max_error max_window max_stroke_ms clear_on_press min_duration_ms min_length "
+                      + "rows columns canvas_width_px canvas_height_px stretch")));
 
   /** Every parameter once. */
   public static final List<Row> PARAMETERS =
@@ -334,6 +314,10 @@ public final class ParamTable {
               "simplifier",
               null,
               null));
+
+  private static List<String> names(String spaced) {
+    return List.of(spaced.split(" "));
+  }
 
   @SafeVarargs
   private static <V> Map<String, V> ordered(Map.Entry<String, V>... entries) {

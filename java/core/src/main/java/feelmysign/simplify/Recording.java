@@ -125,32 +125,9 @@ public record Recording(
     if (object ? !(value instanceof Map) : !(value instanceof List)) {
       String wanted = object ? "an object" : "a list";
       throw new RecordingException(
-          source + ": '" + key + "' must be " + wanted + ", got " + typeName(value));
+          source + ": '" + key + "' must be " + wanted + ", got " + PyRepr.typeName(value));
     }
     return value;
-  }
-
-  /** Python's {@code type(value).__name__} for a JSON value. */
-  static String typeName(Object value) {
-    if (value == null) {
-      return "NoneType";
-    }
-    if (value instanceof Boolean) {
-      return "bool";
-    }
-    if (value instanceof Long || value instanceof BigInteger) {
-      return "int";
-    }
-    if (value instanceof Double) {
-      return "float";
-    }
-    if (value instanceof String) {
-      return "str";
-    }
-    if (value instanceof List) {
-      return "list";
-    }
-    return "dict";
   }
 
   private static double positive(Map<?, ?> data, String key, String source) {

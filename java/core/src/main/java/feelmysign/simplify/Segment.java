@@ -38,29 +38,18 @@ public record Segment(
   }
 
   /**
-   * A finished piece of a path: sent, or dropped as too short (first) or too brief to feel.
-   * Length is tested first, as the paper does: a tap is "not enough distance".
+   * This piece, finished: sent, or dropped as too short (first) or too brief to feel. Length is
+   * tested first, as the paper does: a tap is "not enough distance".
    */
-  static Segment finish(
-      double startX,
-      double startY,
-      double endX,
-      double endY,
-      double startMs,
-      double endMs,
-      double emittedAtMs,
-      double minLength,
-      double minDurationMs) {
-    Segment segment =
-        new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, null);
-    String dropped = null;
-    if (segment.length() < minLength) {
-      dropped = NOT_ENOUGH_DISTANCE;
-    } else if (segment.durationMs() < minDurationMs) {
-      dropped = NOT_ENOUGH_DURATION;
+  Segment checked(double minLength, double minDurationMs) {
+    String reason = null;
+    if (length() < minLength) {
+      reason = NOT_ENOUGH_DISTANCE;
+    } else if (durationMs() < minDurationMs) {
+      reason = NOT_ENOUGH_DURATION;
     }
-    return dropped == null
-        ? segment
-        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, dropped);
+    return reason == null
+        ? this
+        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, reason);
   }
 }

@@ -348,19 +348,7 @@ public final class WindowSimplifier implements Simplifier {
     double dy = endY - ay;
     double lengthSq = dx * dx + dy * dy;
     for (int i = first; i < n; i++) {
-      double qx = xs[i] - ax;
-      double qy = ys[i] - ay;
-      if (lengthSq > 0) {
-        double t = (qx * dx + qy * dy) / lengthSq;
-        if (t >= 1) {
-          qx = qx - dx;
-          qy = qy - dy;
-        } else if (!(t <= 0)) {
-          qx = qx - t * dx;
-          qy = qy - t * dy;
-        }
-      }
-      double d = qx * qx + qy * qy;
+      double d = offsetSq(xs[i] - ax, ys[i] - ay, dx, dy, lengthSq);
       distances[i] = d;
       if (Double.isNaN(d)) {
         finite = false;
@@ -427,8 +415,7 @@ public final class WindowSimplifier implements Simplifier {
 
   /**
    * The greatest squared distance of window[1..stop) to window[0] -> (endX, endY) (0 if none,
-   * NaN counting as none), or -1 as soon as one exceeds limitSq: {@link #distanceSq} inlined,
-   * its float operations in its order, so every distance is the same to the last bit.
+   * NaN counting as none), or -1 as soon as one exceeds limitSq (see {@link #offsetSq}).
    */
   private double farthestSq(int stop, double endX, double endY, double limitSq) {
     double ax = xs[0];
@@ -437,37 +424,13 @@ public final class WindowSimplifier implements Simplifier {
     double dy = endY - ay;
     double lengthSq = dx * dx + dy * dy;
     double farthest = 0;
-    if (lengthSq > 0) {
-      for (int i = 1; i < stop; i++) {
-        double qx = xs[i] - ax;
-        double qy = ys[i] - ay;
-        double t = (qx * dx + qy * dy) / lengthSq;
-        if (t >= 1) {
-          qx = qx - dx;
-          qy = qy - dy;
-        } else if (!(t <= 0)) {
-          qx = qx - t * dx;
-          qy = qy - t * dy;
-        }
-        double d = qx * qx + qy * qy;
-        if (d > limitSq) {
-          return -1;
-        }
-        if (d > farthest) {
-          farthest = d;
-        }
+    for (int i = 1; i < stop; i++) {
+      double d = offsetSq(xs[i] - ax, ys[i] - ay, dx, dy, lengthSq);
+      if (d > limitSq) {
+        return -1;
       }
-    } else {
-      for (int i = 1; i < stop; i++) {
-        double qx = xs[i] - ax;
-        double qy = ys[i] - ay;
-        double d = qx * qx + qy * qy;
-        if (d > limitSq) {
-          return -1;
-        }
-        if (d > farthest) {
-          farthest = d;
-        }
+      if (d > farthest) {
+        farthest = d;
       }
     }
     return farthest;
@@ -476,16 +439,28 @@ public final class WindowSimplifier implements Simplifier {
   private Segment finish(
       double startX, double startY, double startMs, double endX, double endY, double endMs) {
     emittedInPath = true;
-    return Segment.finish(
-        startX,
-        startY,
-        endX,
-        endY,
-        startMs,
-        endMs,
-        pointer != null ? pointer.tMs() : endMs,
-        minLength,
-        minDurationMs);
+    double emittedAtMs = pointer != null ? pointer.tMs() : endMs;
+    return new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, null)
+        .checked(minLength, minDurationMs);
+  }
+
+  /**
+   * Squared distance of q (a sample less the anchor) to the segment anchor -> anchor + d, whose
+   * squared length is lengthSq: {@link #distanceSq} with its float operations in its order, so
+   * every distance is the same to the last bit (t = 1 and t = 0 need no multiplication).
+   */
+  private static double offsetSq(double qx, double qy, double dx, double dy, double lengthSq) {
+    if (lengthSq > 0) {
+      double t = (qx * dx + qy * dy) / lengthSq;
+      if (t >= 1) {
+        qx = qx - dx;
+        qy = qy - dy;
+      } else if (!(t <= 0)) {
+        qx = qx - t * dx;
+        qy = qy - t * dy;
+      }
+    }
+    return qx * qx + qy * qy;
   }
 
   /** Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey) (its nearest point). */

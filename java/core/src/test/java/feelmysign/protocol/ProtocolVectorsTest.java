@@ -5,6 +5,7 @@ import static org.junit.jupiter.api.Assertions.assertInstanceOf;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 
 import com.fasterxml.jackson.databind.JsonNode;
+import feelmysign.VectorFiles;
 import feelmysign.Vectors;
 import feelmysign.protocol.ParseResult.Accepted;
 import feelmysign.protocol.ParseResult.Rejected;
@@ -19,18 +20,6 @@ import org.junit.jupiter.params.provider.MethodSource;
  * (reason, field and the reference's exact sentence) and the exact bytes of both formats.
  */
 class ProtocolVectorsTest {
-  static Stream<Arguments> valid() {
-    return Vectors.cases("protocol/valid");
-  }
-
-  static Stream<Arguments> invalid() {
-    return Vectors.cases("protocol/invalid");
-  }
-
-  static Stream<Arguments> format() {
-    return Vectors.cases("protocol/format");
-  }
-
   private static Object payload(JsonNode vector) {
     String encoding = vector.get("payload_encoding").asText();
     JsonNode payload = vector.get("payload");
@@ -68,7 +57,7 @@ class ProtocolVectorsTest {
   }
 
   @ParameterizedTest(name = "{0}")
-  @MethodSource("valid")
+  @VectorFiles("protocol/valid")
   void acceptsAsTheReference(String name, JsonNode vector) {
     JsonNode expected = vector.get("expected");
     Accepted accepted = assertInstanceOf(Accepted.class, parse(vector), name);
@@ -77,7 +66,7 @@ class ProtocolVectorsTest {
   }
 
   @ParameterizedTest(name = "{0}")
-  @MethodSource("invalid")
+  @VectorFiles("protocol/invalid")
   void refusesAsTheReference(String name, JsonNode vector) {
     JsonNode expected = vector.get("expected");
     Rejected rejected = assertInstanceOf(Rejected.class, parse(vector), name);
@@ -90,7 +79,7 @@ class ProtocolVectorsTest {
   }
 
   @ParameterizedTest(name = "{0}")
-  @MethodSource("format")
+  @VectorFiles("protocol/format")
   void formatsTheSameBytes(String name, JsonNode vector) {
     Stroke stroke = stroke(vector.get("stroke"));
     assertEquals(vector.get("json").asText(), Protocol.formatJson(stroke));

@@ -6,11 +6,10 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 
 import com.fasterxml.jackson.databind.JsonNode;
 import com.fasterxml.jackson.databind.ObjectMapper;
+import feelmysign.Vectors;
 import feelmysign.protocol.Stroke;
 import feelmysign.simplify.ParameterException;
 import java.nio.charset.StandardCharsets;
-import java.nio.file.Files;
-import java.nio.file.Path;
 import java.util.List;
 import org.junit.jupiter.api.Test;
 
@@ -30,19 +29,10 @@ class ShapesTest {
           + " t.end[1], t.duration_ms] for t in s]])",
       "print(json.dumps(out))");
 
-  private static Path repository() {
-    for (Path dir = Path.of("").toAbsolutePath(); dir != null; dir = dir.getParent()) {
-      if (Files.isDirectory(dir.resolve("testdata")) && Files.isDirectory(dir.resolve("python"))) {
-        return dir;
-      }
-    }
-    throw new IllegalStateException("not inside the feelmysign repository");
-  }
-
   @Test
   void everyShapeAtEveryResolutionIsTheReferences() throws Exception {
     Process python = new ProcessBuilder(
-            repository().resolve(".venv/bin/python").toString(), "-c", SCRIPT)
+            Vectors.testdata().resolveSibling(".venv/bin/python").toString(), "-c", SCRIPT)
         .redirectError(ProcessBuilder.Redirect.INHERIT)
         .start();
     String text = new String(python.getInputStream().readAllBytes(), StandardCharsets.UTF_8);

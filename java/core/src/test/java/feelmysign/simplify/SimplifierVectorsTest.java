@@ -3,15 +3,13 @@ package feelmysign.simplify;
 import static org.junit.jupiter.api.Assertions.assertEquals;
 
 import com.fasterxml.jackson.databind.JsonNode;
+import feelmysign.VectorFiles;
 import feelmysign.Vectors;
 import java.util.ArrayList;
 import java.util.LinkedHashMap;
 import java.util.List;
 import java.util.Map;
-import java.util.stream.Stream;
 import org.junit.jupiter.params.ParameterizedTest;
-import org.junit.jupiter.params.provider.Arguments;
-import org.junit.jupiter.params.provider.MethodSource;
 
 /**
  * Both simplifiers against every vector of testdata/angle and testdata/window: the inputs fed
@@ -19,22 +17,14 @@ import org.junit.jupiter.params.provider.MethodSource;
  * tolerance.
  */
 class SimplifierVectorsTest {
-  static Stream<Arguments> angle() {
-    return Vectors.cases("angle");
-  }
-
-  static Stream<Arguments> window() {
-    return Vectors.cases("window");
-  }
-
   @ParameterizedTest(name = "{0}")
-  @MethodSource("angle")
+  @VectorFiles("angle")
   void angleReproducesTheReference(String name, JsonNode vector) {
     check(Algorithm.ANGLE, vector);
   }
 
   @ParameterizedTest(name = "{0}")
-  @MethodSource("window")
+  @VectorFiles("window")
   void windowReproducesTheReference(String name, JsonNode vector) {
     check(Algorithm.WINDOW, vector);
   }

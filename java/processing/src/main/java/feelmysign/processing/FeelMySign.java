@@ -477,8 +477,8 @@ public class FeelMySign {
           + " piece(s) shorter than minimumSize (" + params.number("min_length")
           + " grid units) and " + tooBrief + " briefer than minimumDuration ("
           + params.number("min_duration_ms") + " ms) were not sent. Draw larger or slower, "
-          + "or tune checkFrame and maxAngleDifDeg (or minimumSize and minimumDuration for your"
-          + " sleeve).";
+          + "or tune " + (params.algorithm() == Algorithm.ANGLE ? "checkFrame and maxAngleDifDeg"
+              : "max_error") + " (or minimumSize and minimumDuration for your sleeve).";
       if (!inbox.offer(sentence)) {
         overflowed.incrementAndGet();
       }

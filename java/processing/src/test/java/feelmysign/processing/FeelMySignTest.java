@@ -56,12 +56,17 @@ class FeelMySignTest {
     Sketch sketch = new Sketch();
     sketch.width = 1920;
     sketch.height = 1080;
-    FeelMySign library =
-        new FeelMySign(sketch).broker("mqtt://127.0.0.1:" + unusedPort()).angle().start();
+    String url = "mqtt://127.0.0.1:" + unusedPort();
+    FeelMySign library = new FeelMySign(sketch).broker(url).angle().start();
+    // The reference's sentence, not the network library's exception.
+    String told =
+        "Nothing accepts connections at " + url + " (connection refused): start one with"
+            + " 'feelmysign broker' or 'make up', or give the right broker URL. Retrying every"
+            + " 2 s.";
     try {
       // Nothing reaches the sketch until its draw(): the hook, called here as Processing does.
       long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(60);
-      while (sketch.statuses.stream().noneMatch(s -> s.contains("retrying"))) {
+      while (!sketch.statuses.contains(told)) {
         if (System.nanoTime() > deadline) {
           fail("the broker's absence was not said: " + sketch.statuses);
         }

@@ -2,19 +2,17 @@ package feelmysign.processing;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
 import static org.junit.jupiter.api.Assertions.assertTrue;
+import static feelmysign.testing.LiveSleeve.waitFor;
 import static org.junit.jupiter.api.Assertions.fail;
 
-import feelmysign.client.SleeveClient;
-import feelmysign.client.SleeveEvent;
 import feelmysign.json.PyJson;
 import feelmysign.protocol.Protocol;
 import feelmysign.protocol.Stroke;
+import feelmysign.testing.LiveSleeve;
 import java.awt.Rectangle;
 import java.awt.Robot;
-import java.io.BufferedReader;
 import java.io.File;
 import java.io.IOException;
-import java.io.InputStreamReader;
 import java.net.URL;
 import java.net.URLClassLoader;
 import java.nio.charset.StandardCharsets;
@@ -23,9 +21,6 @@ import java.nio.file.Path;
 import java.util.ArrayList;
 import java.util.List;
 import java.util.Map;
-import java.util.concurrent.CopyOnWriteArrayList;
-import java.util.concurrent.TimeUnit;
-import java.util.function.BooleanSupplier;
 import java.util.regex.Matcher;
 import java.util.regex.Pattern;
 import javax.imageio.ImageIO;
@@ -38,36 +33,26 @@ import org.junit.jupiter.api.TestInstance;
 import org.junit.jupiter.api.io.TempDir;
 import processing.core.PApplet;
 import processing.core.PConstants;
+import processing.event.KeyEvent;
 import processing.event.MouseEvent;
 
 /**
  * The paper's sketch example (examples/PaperSketch) as a user runs it, on Xvfb's screen, with
  * Processing's core from Maven Central: a scripted mouse draws a square; the strokes it sends
  * are the legacy text {@code feelmysign simplify --paper} computes from the same mouse path,
- * and a real {@code feelmysign sleeve --backend sim} plays them (played events come back).
- * make java-test runs it under xvfb-run; a screenshot is left in target/.
+ * and a real {@code feelmysign sleeve --backend sim} plays them (played events come back). The
+ * two other examples too: ModernSketch sends a square drawn with the mouse as JSON v1, StudyShape
+ * the library's square of 8 strokes on Enter, and the sleeve plays every stroke of each. make
+ * java-test runs it under xvfb-run; a screenshot of the paper's sketch is left in target/.
  */
 @TestInstance(TestInstance.Lifecycle.PER_CLASS)
 class PaperSketchIT {
-  private static final long WAIT_S = 60; // generous: the machine may be busy
   private static final String SLEEVE = "sketch-test";
   static final Path SCREENSHOT = Path.of("target/paper-sketch-under-xvfb.png").toAbsolutePath();
 
   private Path state;
-  private Path repository;
-  private Process broker;
-  private Process sleeve;
-  private Map<String, Object> credentials;
-  private PApplet sketch;
-
-  private static Path repository() {
-    for (Path dir = Path.of("").toAbsolutePath(); dir != null; dir = dir.getParent()) {
-      if (Files.isDirectory(dir.resolve("testdata")) && Files.isDirectory(dir.resolve("python"))) {
-        return dir;
-      }
-    }
-    throw new IllegalStateException("not inside the feelmysign repository");
-  }
+  private LiveSleeve live;
+  private final List<PApplet> sketches = new ArrayList<>();
 
   @BeforeAll
   void startBrokerAndSleeve(@TempDir Path dir) throws Exception {
@@ -75,54 +60,17 @@ class PaperSketchIT {
       fail("no X display: run 'make java-test', which starts Xvfb (xvfb-run) for this test");
     }
     state = dir;
-    repository = repository();
-    Path feelmysign = repository.resolve(".venv/bin/feelmysign");
-    broker = new ProcessBuilder(feelmysign.toString(), "broker", "--state-dir", state.toString(),
-            "--port", "0", "--ws-port", "0", "--sleeve-id", SLEEVE)
-        .redirectErrorStream(true).start();
-    BufferedReader out = new BufferedReader(
-        new InputStreamReader(broker.getInputStream(), StandardCharsets.UTF_8));
-    StringBuilder said = new StringBuilder();
-    for (String line; (line = out.readLine()) != null; ) {
-      said.append(line).append('\n');
-      if (line.startsWith("Ready.")) {
-        break;
-      }
-    }
-    assertTrue(said.toString().contains("Ready."), "feelmysign broker failed:\n" + said);
-    Thread drain = new Thread(() -> {
-      try {
-        out.lines().forEach(line -> {});
-      } catch (java.io.UncheckedIOException closed) {
-        // The broker stopped.
-      }
-    }, "broker-output");
-    drain.setDaemon(true);
-    drain.start();
-    Path file = state.resolve("credentials.json");
-    @SuppressWarnings("unchecked")
-    Map<String, Object> document = (Map<String, Object>) PyJson.loads(Files.readString(file));
-    credentials = document;
     // The sleeve with its legacy topic (deviceOne/line), as the paper's sketch sends.
-    sleeve = new ProcessBuilder(feelmysign.toString(), "sleeve", "--credentials", file.toString(),
-            "--backend", "sim", "--log-level", "warning")
-        .redirectErrorStream(true).redirectOutput(state.resolve("sleeve.log").toFile()).start();
+    live = LiveSleeve.start(state, SLEEVE, List.of(), List.of());
   }
 
   @AfterAll
   void stopThem() throws InterruptedException {
-    if (sketch != null) {
-      sketch.noLoop();
-      sketch.getSurface().setVisible(false);
-      sketch.dispose(); // the library's dispose hook closes its client (exit() would end the JVM)
+    for (PApplet sketch : new ArrayList<>(sketches)) {
+      retire(sketch);
     }
-    for (Process process : new Process[] {sleeve, broker}) {
-      if (process != null) {
-        process.destroy();
-        if (!process.waitFor(WAIT_S, TimeUnit.SECONDS)) {
-          process.destroyForcibly();
-        }
-      }
+    if (live != null) {
+      live.close();
     }
   }
 
@@ -180,17 +128,101 @@ class PaperSketchIT {
     URLClassLoader loader = new URLClassLoader(new URL[] {classes.toUri().toURL()},
         getClass().getClassLoader());
     PApplet applet = (PApplet) loader.loadClass(name).getDeclaredConstructor().newInstance();
+    sketches.add(applet);
     PApplet.runSketch(new String[] {"--location=0,0", name}, applet);
     return applet;
   }
 
-  private static void waitFor(BooleanSupplier condition, String what) throws InterruptedException {
-    long deadline = System.nanoTime() + TimeUnit.SECONDS.toNanos(WAIT_S);
-    while (!condition.getAsBoolean()) {
-      if (System.nanoTime() > deadline) {
-        fail("no " + what + " within " + WAIT_S + " s");
+  /** A sketch's window closed and its client with it (exit() would end the JVM). */
+  private void retire(PApplet sketch) {
+    sketch.noLoop();
+    sketch.getSurface().setVisible(false);
+    sketch.dispose(); // the library's dispose hook closes its client
+    sketches.remove(sketch);
+  }
+
+  /** An example run against the live sleeve, logged in as its sender; its library once connected. */
+  private FeelMySign runConnected(String name) throws Exception {
+    PApplet sketch = compileAndRun(name, Map.of(
+        "BROKER", live.mqttUrl(),
+        "USER", live.senderUser(),
+        "PASSWORD", live.senderPassword(),
+        "SLEEVE", SLEEVE));
+    waitFor(() -> sketch.frameCount > 3, "frames drawn by " + name);
+    java.lang.reflect.Field field = sketch.getClass().getDeclaredField("sleeve");
+    field.setAccessible(true); // a sketch's fields are package-private, as the PDE makes them
+    FeelMySign library = (FeelMySign) field.get(sketch);
+    waitFor(library::connected, name + "'s connection to the broker");
+    return library;
+  }
+
+  /** The mouse drawing {@code path} on {@code sketch}: press, drags, release. */
+  private static void draw(PApplet sketch, List<long[]> path) {
+    for (int i = 0; i < path.size(); i++) {
+      long[] p = path.get(i);
+      int action = i == 0 ? MouseEvent.PRESS
+          : i == path.size() - 1 ? MouseEvent.RELEASE : MouseEvent.DRAG;
+      sketch.postEvent(new MouseEvent(null, p[0], action, 0, (int) p[1], (int) p[2],
+          PConstants.LEFT, 1));
+    }
+  }
+
+  /** Waits until the sleeve has played (or played adjusted) every stroke {@code library} sent. */
+  private static void awaitPlayed(LiveSleeve.Listening listener, FeelMySign library)
+      throws InterruptedException {
+    waitFor(() -> library.unsent() == 0, "the broker's PUBACK of every stroke");
+    java.util.Set<String> drawings = new java.util.HashSet<>();
+    library.sent().forEach(s -> drawings.add(s.drawing()));
+    int count = library.sent().size();
+    waitFor(() -> listener.events.stream()
+            .filter(e -> drawings.contains(e.drawing()))
+            .filter(e -> "played".equals(e.type()) || "adjusted".equals(e.type()))
+            .count() >= count,
+        count + " played events from the sleeve: " + listener.events);
+    // And the sketch got them too, inside its draw(), on its own thread.
+    waitFor(() -> library.events().stream().filter(e -> drawings.contains(e.drawing())).count()
+        >= count, "events handed to the sketch");
+  }
+
+  @Test
+  void theModernSketchSendsADrawnSquareAsJsonAndTheSleevePlaysIt() throws Exception {
+    try (LiveSleeve.Listening listener = live.listen()) {
+      FeelMySign library = runConnected("ModernSketch");
+      PApplet sketch = sketches.get(sketches.size() - 1);
+      List<long[]> path = new ArrayList<>();
+      for (long[] p : squarePath()) {
+        path.add(new long[] {p[0], p[1] * 3 / 5, p[2] * 3 / 5}); // onto its 1280 x 720 canvas
       }
-      Thread.sleep(20);
+      draw(sketch, path);
+      waitFor(() -> library.sent().size() >= 4, "a square's strokes sent");
+      for (Stroke stroke : library.sent()) {
+        assertTrue(stroke.drawing() != null && stroke.seq() != null, "JSON v1: " + stroke);
+      }
+      awaitPlayed(listener, library);
+      retire(sketch);
+    }
+  }
+
+  @Test
+  void theStudySketchSendsTheChosenShapeAndTheSleevePlaysIt() throws Exception {
+    try (LiveSleeve.Listening listener = live.listen()) {
+      FeelMySign library = runConnected("StudyShape");
+      PApplet sketch = sketches.get(sketches.size() - 1);
+      // 2: the square, at the sketch's 8 strokes; Enter sends it.
+      sketch.postEvent(new KeyEvent(null, 1, KeyEvent.PRESS, 0, '2', '2'));
+      sketch.postEvent(new KeyEvent(null, 2, KeyEvent.PRESS, 0, PConstants.ENTER, 10));
+      List<Stroke> square =
+          feelmysign.shapes.Shapes.strokes("square", 3, 4, 3.0, 10000, 8, null, 0);
+      waitFor(() -> library.sent().size() >= square.size(), square.size() + " strokes sent");
+      List<String> sent = new ArrayList<>();
+      for (Stroke stroke : library.sent()) {
+        sent.add(Protocol.formatLegacy(stroke));
+      }
+      List<String> expected = new ArrayList<>();
+      square.forEach(stroke -> expected.add(Protocol.formatLegacy(stroke)));
+      assertEquals(expected, sent, "the library's square of 8 strokes");
+      awaitPlayed(listener, library);
+      retire(sketch);
     }
   }
 
@@ -215,49 +247,11 @@ class PaperSketchIT {
 
   @Test
   void aSquareDrawnWithTheMouseIsSentAsSimplifyPaperSaysAndPlayed() throws Exception {
-    @SuppressWarnings("unchecked")
-    Map<String, Object> sender = (Map<String, Object>) credentials.get("sender");
     // The sleeve's events, heard as any other sender hears them.
-    List<SleeveEvent> heard = new CopyOnWriteArrayList<>();
-    List<String> statuses = new CopyOnWriteArrayList<>();
-    SleeveClient listener = SleeveClient.builder((String) credentials.get("mqtt_url"))
-        .login((String) sender.get("username"), (String) sender.get("password"))
-        .sleeveId(SLEEVE)
-        .listener(new SleeveClient.Listener() {
-          @Override
-          public void event(SleeveEvent event) {
-            heard.add(event);
-          }
-
-          @Override
-          public void status(String payload) {
-            statuses.add(payload);
-          }
-        })
-        .build();
-    listener.connect();
-    try {
-      sketch = compileAndRun("PaperSketch", Map.of(
-          "BROKER", (String) credentials.get("mqtt_url"),
-          "USER", (String) sender.get("username"),
-          "PASSWORD", (String) sender.get("password"),
-          "SLEEVE", SLEEVE));
-      waitFor(() -> sketch.frameCount > 3, "frames drawn by the sketch");
-      java.lang.reflect.Field field = sketch.getClass().getDeclaredField("sleeve");
-      field.setAccessible(true); // a sketch's fields are package-private, as the PDE makes them
-      FeelMySign library = (FeelMySign) field.get(sketch);
-      // The sleeve's retained status: the listener's subscriptions are in place, the sleeve is up.
-      waitFor(() -> library.connected() && statuses.stream().anyMatch(p -> !p.isEmpty()),
-          "connection to the broker and the sleeve's status");
-
+    try (LiveSleeve.Listening listener = live.listen()) {
+      FeelMySign library = runConnected("PaperSketch");
       List<long[]> path = squarePath();
-      for (int i = 0; i < path.size(); i++) {
-        long[] p = path.get(i);
-        int action = i == 0 ? MouseEvent.PRESS
-            : i == path.size() - 1 ? MouseEvent.RELEASE : MouseEvent.DRAG;
-        sketch.postEvent(new MouseEvent(null, p[0], action, 0, (int) p[1], (int) p[2],
-            PConstants.LEFT, 1));
-      }
+      draw(sketches.get(sketches.size() - 1), path);
 
       List<String> expected = referenceLegacyStrokes(path);
       assertTrue(expected.size() >= 4, "a square is at least four strokes: " + expected);
@@ -269,8 +263,7 @@ class PaperSketchIT {
       assertEquals(expected, sent, "the sketch's legacy strokes and simplify --paper's");
       waitFor(() -> library.unsent() == 0, "the broker's PUBACK of every stroke");
 
-      waitFor(() -> heard.stream().filter(e -> SleeveEvent.PLAYED.equals(e.type())
-              || SleeveEvent.ADJUSTED.equals(e.type())).count() >= expected.size(),
+      waitFor(() -> listener.played() >= expected.size(),
           expected.size() + " played events from the sleeve");
       // And the sketch got them too, inside its draw(), on its own thread.
       waitFor(() -> library.events().size() >= expected.size(), "events handed to the sketch");
@@ -279,8 +272,6 @@ class PaperSketchIT {
       ImageIO.write(robot.createScreenCapture(new Rectangle(0, 0, 1920, 1080)), "png",
           SCREENSHOT.toFile());
       assertTrue(Files.size(SCREENSHOT) > 0);
-    } finally {
-      listener.close();
     }
   }
 
@@ -297,7 +288,7 @@ class PaperSketchIT {
     recording.append("]]}");
     Path file = state.resolve("square.json");
     Files.writeString(file, recording);
-    Process simplify = new ProcessBuilder(repository.resolve(".venv/bin/feelmysign").toString(),
+    Process simplify = new ProcessBuilder(LiveSleeve.feelmysign().toString(),
             "simplify", file.toString(), "--paper", "--json")
         .redirectError(ProcessBuilder.Redirect.INHERIT).start();
     String out = new String(simplify.getInputStream().readAllBytes(), StandardCharsets.UTF_8);
