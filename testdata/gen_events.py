@@ -74,6 +74,10 @@ EVENTS: dict[str, tuple[str, dict[str, Any]]] = {
             **TIMING,
         },
     ),
+    "played-compressed": (
+        "a stroke played faster to catch up with its drawing, by compressed_ms",
+        {"type": "played", **STROKE, **TIMING, "queued_ms": 180.5, "compressed_ms": 126.299},
+    ),
     "rejected-late": (
         "a stroke skipped to catch up after a stall",
         {

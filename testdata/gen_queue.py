@@ -1,12 +1,15 @@
-"""Vectors for the sleeve's queue (feelmysign.sleeve.queue): when each stroke starts.
+"""Vectors for the sleeve's queue (feelmysign.sleeve.queue): when each stroke starts, and
+how long it plays once the sleeve catches up.
 
-``<name>.json``: ``steps``, in the order they reach the sleeve (times never
+``<name>.json``: ``floor_ms``, the sleeve's floor (the paper sleeve's: the shortest
+stroke it plays without slowing it, down to which a stroke behind its drawing is
+played faster); ``steps``, in the order they reach the sleeve (times never
 decrease), each a stroke ``{"arrival_ms", "duration_ms"}`` (with ``drawing``
 and ``seq`` when it has them) or a cancel ``{"cancel": drawing or "*",
 "at_ms"}``; and ``outcomes``, one per stroke in order: ``{"outcome"}`` (one of
 ``played``, ``cut``, ``cancelled``, ``held``, ``duplicate``) with ``start_ms``
 and ``played_ms`` for a stroke that started (``played_ms`` is less than its
-duration when a cancel cut it).
+duration when a cancel cut it, or when it played faster to catch up).
 
 Each case names the outcomes it is meant to show; generation stops if the
 reference disagrees.
@@ -16,7 +19,13 @@ from __future__ import annotations
 
 from typing import Any
 
+from feelmysign.apparent_motion import shortest_planned_ms
+from feelmysign.layout import Layout
 from feelmysign.sleeve.queue import Arrival, CancelAt, Outcome, replay
+
+# The paper sleeve's floor (73.701 ms for its 20 ms bursts).
+FLOOR_MS = shortest_planned_ms(Layout(rows=3, columns=4, spacing_cm=3.0).shortest_burst_ms)
+F = FLOOR_MS
 
 Step = dict[str, Any]
 
@@ -51,14 +60,15 @@ DUPLICATE = Outcome("duplicate")
 CASES: dict[str, tuple[str, list[Step], list[Outcome]]] = {
     "idle": ("a stroke to an idle sleeve starts when it arrives", [s(40, 300)], [played(40, 300)]),
     "back-to-back": (
-        "strokes sent faster than they play start as the one before ends",
+        "strokes sent faster than they play start as the one before ends, caught up to the floor",
         [s(0, 300, "d1", 0), s(10, 300, "d1", 1), s(20, 250.5, "d1", 2)],
-        [played(0, 300), played(300, 300), played(600, 250.5)],
+        [played(0, 300), played(300, F), played(300 + F, F)],
     ),
     "gaps": (
-        "a stroke after a pause starts when it arrives; one in the middle of a stroke waits",
+        "a stroke after a pause starts when it arrives; one in the middle of a stroke waits, "
+        "caught up (50 ms behind) but not below the floor",
         [s(0, 100, "d1", 0), s(500, 100, "d1", 1), s(550, 100, "d1", 2)],
-        [played(0, 100), played(500, 100), played(600, 100)],
+        [played(0, 100), played(500, 100), played(600, F)],
     ),
     "touching": (
         "a stroke arriving as the one before ends starts then",
@@ -78,17 +88,17 @@ CASES: dict[str, tuple[str, list[Step], list[Outcome]]] = {
     "seq-gap": (
         "a gap in the seqs never waits for the missing one",
         [s(0, 100, "d1", 0), s(20, 100, "d1", 3)],
-        [played(0, 100), played(100, 100)],
+        [played(0, 100), played(100, F)],
     ),
     "out-of-order": (
         "a seq that comes after later ones still plays, in the order it arrives",
         [s(0, 300, "d1", 0), s(10, 300, "d1", 2), s(20, 300, "d1", 1)],
-        [played(0, 300), played(300, 300), played(600, 300)],
+        [played(0, 300), played(300, F), played(300 + F, F)],
     ),
     "redelivery-waiting": (
         "a copy of a stroke still waiting to play is held, and queues nothing",
         [s(0, 300, "d1", 0), s(10, 300, "d1", 1), s(20, 300, "d1", 1), s(30, 300, "d1", 2)],
-        [played(0, 300), played(300, 300), HELD, played(600, 300)],
+        [played(0, 300), played(300, F), HELD, played(300 + F, F)],
     ),
     "redelivery-played": (
         "a copy of a stroke that started is a duplicate, and queues nothing",
@@ -118,7 +128,8 @@ CASES: dict[str, tuple[str, list[Step], list[Outcome]]] = {
         [cut(0, 50), CANCELLED, CANCELLED],
     ),
     "cancel-one-drawing": (
-        "a cancel of one drawing leaves the others where they were planned",
+        "a cancel of one drawing leaves the others where they were planned; the next stroke "
+        "of one behind its drawing catches up",
         [
             s(0, 200, "a", 0),
             s(10, 200, "b", 0),
@@ -126,7 +137,7 @@ CASES: dict[str, tuple[str, list[Step], list[Outcome]]] = {
             c(100, "a"),
             s(150, 200, "b", 1),
         ],
-        [cut(0, 100), played(200, 200), CANCELLED, played(400, 200)],
+        [cut(0, 100), played(200, 200), CANCELLED, played(400, F)],
     ),
     "cancel-everything": (
         "a cancel of everything drops every drawing's strokes; new strokes still play",
@@ -148,6 +159,42 @@ CASES: dict[str, tuple[str, list[Step], list[Outcome]]] = {
         "a copy of a stroke dropped by a cancel of everything is a duplicate",
         [s(0, 100, "d1", 0), s(10, 100, "d1", 1), c(50, "*"), s(60, 100, "d1", 1)],
         [cut(0, 50), CANCELLED, DUPLICATE],
+    ),
+    "catch-up": (
+        "a stroke behind its drawing plays shorter by as much as the sleeve is behind; one "
+        "that arrives when the sleeve has caught up plays as it came",
+        [s(0, 300, "d1", 0), s(200, 300, "d1", 1), s(600, 300, "d1", 2)],
+        [played(0, 300), played(300, 200), played(600, 300)],
+    ),
+    "catch-up-floor": (
+        "catching up stops at the floor; a stroke at or below the floor is never lengthened",
+        [s(0, 300, "d1", 0), s(10, 300, "d1", 1), s(20, 50, "d1", 2), s(30, 73, "d1", 3)],
+        [played(0, 300), played(300, F), played(300 + F, 50), played(350 + F, 73)],
+    ),
+    "catch-up-other-drawing": (
+        "a stroke waiting behind another drawing plays as it came; the next of its own "
+        "drawing, behind it, catches up",
+        [s(0, 300, "a", 0), s(100, 300, "b", 0), s(200, 300, "b", 1)],
+        [played(0, 300), played(300, 300), played(600, F)],
+    ),
+    "catch-up-after-cancel": (
+        "after a cancel the tail is the latest stroke still planned, and its drawing: a stroke "
+        "of that drawing catches up, and after a cancel of everything nothing is behind",
+        [
+            s(0, 300, "a", 0),
+            s(10, 300, "b", 0),
+            s(20, 300, "a", 1),
+            c(100, "a"),
+            s(150, 300, "b", 1),
+            c(620, "*"),
+            s(630, 300, "b", 2),
+        ],
+        [cut(0, 100), played(300, 300), CANCELLED, cut(600, 20), played(630, 300)],
+    ),
+    "catch-up-legacy": (
+        "strokes without a drawing (the legacy format) are never caught up",
+        [s(0, 300), s(10, 300), s(20, 300)],
+        [played(0, 300), played(300, 300), played(600, 300)],
     ),
 }
 
@@ -177,10 +224,11 @@ def _outcome(outcome: Outcome) -> dict[str, Any]:
 def cases() -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     for name, (description, steps, expected) in CASES.items():
-        outcomes = replay(_steps(steps))
+        outcomes = replay(_steps(steps), FLOOR_MS)
         assert outcomes == expected, (name, outcomes)
         out[f"{name}.json"] = {
             "description": description,
+            "floor_ms": FLOOR_MS,
             "steps": steps,
             "outcomes": [_outcome(o) for o in outcomes],
         }

@@ -31,6 +31,11 @@ from feelmysign.topics import strokes_topic
 WAIT_S = 60.0  # generous: the machine running the tests may be busy
 
 
+# The paper sleeve's floor (docs/protocol.md, catching up): a stroke this short plays as sent,
+# never faster, so a drawing of n such strokes sent at once plays for n x FLOOR_MS.
+FLOOR_MS = 73.701
+
+
 def wait_for(condition: Callable[[], bool], what: str, timeout_s: float = WAIT_S) -> None:
     deadline = time.monotonic() + timeout_s
     while not condition():

@@ -12,10 +12,12 @@ from contextlib import ExitStack
 from pathlib import Path
 
 from conftest import StartBroker
-from delivery import SleeveProcess, by_seq, delivery, played, stroke, wait_for
+from delivery import FLOOR_MS, SleeveProcess, by_seq, delivery, played, stroke, wait_for
 
-STROKES = 20
-DURATION_MS = 300.0  # 20 strokes: 6 s of playing, so most are still waiting at the kill
+# Sent at once, strokes longer than the floor would catch up: 80 at the floor are 5.9 s of
+# playing, so most are still waiting at the kill.
+STROKES = 80
+DURATION_MS = FLOOR_MS
 KILL_AFTER_PLAYED = 4
 
 

@@ -57,6 +57,37 @@ def test_a_slowed_stroke_delays_the_ones_after_it() -> None:
     assert played.pen_to_skin_ms[1] > played.pen_to_skin_ms[0]
 
 
+def test_a_stroke_behind_its_drawing_plays_faster_and_the_felt_end_catches_up() -> None:
+    # The first stroke is let go 100 ms after it was drawn and plays until 900; the second,
+    # let go at 820, is 80 ms behind: it plays in 320 ms instead of 400.
+    segments = [
+        PathSegment(0, Segment((0.0, 0.0), (1.0, 0.0), 0.0, 400.0, 500.0)),
+        PathSegment(0, Segment((1.0, 0.0), (2.0, 0.0), 400.0, 800.0, 820.0)),
+    ]
+    path = [Sample(0.0, 0, 0), Sample(800.0, 0, 0)]
+    played = simulate(segments, [path], PAPER_SLEEVE)
+    assert played.compressed == 1
+    assert played.compressed_ms == pytest.approx(80.0)
+    assert (played.skipped, played.skipped_ms) == (0, 0.0)
+    assert played.skin_ms == pytest.approx(720.0)
+    assert [s.duration_ms for s in played.schedules] == pytest.approx([400.0, 320.0])
+    assert played.pen_to_skin_ms == pytest.approx((500.0, 500.0))  # 900 - 400
+    (release,) = played.release_to_felt_end_ms
+    assert 1220.0 - 800.0 <= release <= 1220.0 - 800.0 + 60.0
+
+
+def test_strokes_let_go_at_once_catch_up_to_the_floor_and_none_is_skipped() -> None:
+    # Forty 300 ms strokes let go at once: all but the first play at the floor, ahead of the
+    # sender's time line (back to back at 300 ms), so the pace rule skips none.
+    segments = [
+        PathSegment(0, Segment((0.0, 0.0), (1.0, 0.0), 0.0, 300.0, 300.0)) for _ in range(40)
+    ]
+    played = simulate(segments, [[Sample(0.0, 0, 0), Sample(300.0, 0, 0)]], PAPER_SLEEVE)
+    assert played.compressed == 39 and played.skipped == 0
+    assert [s.duration_ms for s in played.schedules[1:]] == [73.701] * 39
+    assert played.compressed_ms == pytest.approx(39 * (300.0 - 73.701))
+
+
 def test_dollar_recognises_a_rotated_scaled_copy_and_tells_shapes_apart() -> None:
     t = np.linspace(0, 2 * math.pi, 80)
     circle = np.stack([np.cos(t), np.sin(t)], axis=1)

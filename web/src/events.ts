@@ -34,6 +34,8 @@ interface Timing {
   readonly queued_ms: number;
   readonly duration_ms: number;
   readonly commands: number;
+  /** How much shorter it played to catch up with its drawing (null: as planned). */
+  readonly compressed_ms: number | null;
 }
 
 export interface PlayedEvent extends StrokeRef, Timing {
@@ -149,6 +151,7 @@ const TIMING: readonly Field[] = [
   ["queued_ms", "number", true],
   ["duration_ms", "number", true],
   ["commands", "index", true],
+  ["compressed_ms", "number", false],
 ];
 const REASON_MESSAGE: readonly Field[] = [
   ["reason", "text", true],

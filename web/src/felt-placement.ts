@@ -17,8 +17,8 @@
  *
  * Pure: no DOM, no clock.
  */
-import { feltEndMs, turnOf, type FeltStroke, type PlacedStroke } from "./felt";
-import { QueueTail } from "./sleeve-queue";
+import { caughtUp, feltEndMs, turnOf, type FeltStroke, type PlacedStroke } from "./felt";
+import { QueueTail, SLEEVE_FLOOR_MS } from "./sleeve-queue";
 
 export class FeltPlacement {
   /** Shifted strokes (arrival relative to the first stroke's), in seq order. */
@@ -48,6 +48,9 @@ export class FeltPlacement {
   #descents = 0;
   /** The earliest time (ms) whose picture changed since `takeDirty`; "all" after a rebuild. */
   #dirty: number | "all" | null = "all";
+
+  /** `floorMs`: the sleeve's floor, down to which a stroke that waits catches up. */
+  constructor(readonly floorMs: number = SLEEVE_FLOOR_MS) {}
 
   /** Every stroke again (a new drawing, an undo, another arrival): placed from scratch. */
   reset(strokes: readonly FeltStroke[] = []): void {
@@ -222,7 +225,8 @@ export class FeltPlacement {
     const queue = new QueueTail();
     for (let index = 0; index < this.#strokes.length; index++) {
       const stroke = this.#strokes[index]!;
-      const estimateMs = queue.place(stroke.arrives_ms, turnOf(stroke, this.#cut, this.#capped).held_ms);
+      const played = caughtUp(stroke, queue.tailMs, this.floorMs);
+      const estimateMs = queue.place(stroke.arrives_ms, turnOf(played, this.#cut, this.#capped).held_ms);
       const reported = this.#startedAt.get(stroke.seq);
       if (reported !== undefined) {
         this.#anchor = { index, offsetMs: reported - estimateMs };
@@ -252,14 +256,16 @@ export class FeltPlacement {
       const stroke = this.#strokes[i]!;
       const reportedAt = offset === undefined ? undefined : this.#startedAt.get(stroke.seq);
       const known = reportedAt === undefined ? undefined : reportedAt - offset!;
-      const turn = turnOf(stroke, this.#cut, this.#capped);
+      const played = caughtUp(stroke, queue.tailMs, this.floorMs);
+      const turn = turnOf(played, this.#cut, this.#capped);
       const start_ms = queue.place(stroke.arrives_ms, turn.held_ms, known);
       const old = this.#placed[i];
-      const placed: PlacedStroke = { ...stroke, start_ms, reported: known !== undefined, ...turn.felt };
+      const placed: PlacedStroke = { ...played, start_ms, reported: known !== undefined, ...turn.felt };
       if (
         i > from &&
         old !== undefined &&
         old.start_ms === start_ms &&
+        old.duration_ms === placed.duration_ms &&
         old.played_ms === placed.played_ms &&
         old.reported === placed.reported &&
         old.capped === placed.capped

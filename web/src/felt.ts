@@ -10,10 +10,12 @@
  * Times: where the sleeve told when it played a stroke, that time; otherwise
  * the sleeve's own rule (docs/protocol.md, "Playback"; `QueueTail` in
  * sleeve-queue.ts, pinned by testdata/queue): a stroke starts when it arrives,
- * or when the one before it ends if that is later.
+ * or when the one before it ends if that is later, and one that waits plays
+ * faster to catch up, down to the sleeve's floor (`queueCatchUpMs`): the strokes
+ * placed here are one drawing's.
  */
 import type { Point } from "./simplify/segment";
-import { QueueTail } from "./sleeve-queue";
+import { queueCatchUpMs, QueueTail, SLEEVE_FLOOR_MS } from "./sleeve-queue";
 
 export interface FeltStroke {
   readonly seq: number;
@@ -25,6 +27,7 @@ export interface FeltStroke {
   readonly arrives_ms: number;
 }
 
+/** `duration_ms` of a placed stroke is how long the sleeve plays it: shorter when it caught up. */
 export interface PlacedStroke extends FeltStroke {
   /** When it plays, ms on the timeline's clock. */
   readonly start_ms: number;
@@ -53,26 +56,39 @@ export interface Drive {
 
 /**
  * Places strokes in time: a reported start wins; otherwise arrival, or the end
- * of the stroke before, whichever is later. `reported` maps seq -> start (ms);
- * `cut` maps seq -> ms after its start when a cancel stopped it; `capped` holds the
- * seqs the duty-cycle cap kept from playing. A stroke the sleeve refused on arrival
- * never entered its queue: leave it out of `strokes`.
+ * of the stroke before, whichever is later. A stroke arriving before the one
+ * before it ends plays faster, down to `floorMs` (the sleeve's catch-up rule).
+ * `reported` maps seq -> start (ms); `cut` maps seq -> ms after its start when
+ * a cancel stopped it; `capped` holds the seqs the duty-cycle cap kept from playing.
+ * A stroke the sleeve refused on arrival never entered its queue: leave it out of `strokes`.
  */
 export function placeStrokes(
   strokes: readonly FeltStroke[],
   reported: ReadonlyMap<number, number> = new Map(),
   cut: ReadonlyMap<number, number> = new Map(),
   capped: ReadonlySet<number> = new Set(),
+  floorMs: number = SLEEVE_FLOOR_MS,
 ): PlacedStroke[] {
   const placed: PlacedStroke[] = [];
   const queue = new QueueTail();
   for (const stroke of [...strokes].sort((a, b) => a.seq - b.seq)) {
     const known = reported.get(stroke.seq);
-    const turn = turnOf(stroke, cut, capped);
+    const played = caughtUp(stroke, queue.tailMs, floorMs);
+    const turn = turnOf(played, cut, capped);
     const start_ms = queue.place(stroke.arrives_ms, turn.held_ms, known);
-    placed.push({ ...stroke, start_ms, reported: known !== undefined, ...turn.felt });
+    placed.push({ ...played, start_ms, reported: known !== undefined, ...turn.felt });
   }
   return placed;
+}
+
+/**
+ * The stroke as the sleeve plays it behind a queue ending at `tailMs`: faster when it waits, down to
+ * `floorMs` (`queueCatchUpMs`). The strokes placed here are one drawing's, so every stroke that waits
+ * is behind its own drawing and catches up.
+ */
+export function caughtUp(stroke: FeltStroke, tailMs: number, floorMs: number): FeltStroke {
+  const duration_ms = queueCatchUpMs(stroke.arrives_ms, tailMs, stroke.duration_ms, floorMs);
+  return duration_ms === stroke.duration_ms ? stroke : { ...stroke, duration_ms };
 }
 
 /**

@@ -1,6 +1,7 @@
 /** The incremental placement gives what placing every stroke again from scratch gives. */
 import fc from "fast-check";
 import { describe, expect, it } from "vitest";
+import { SLEEVE_FLOOR_MS } from "../src/sleeve-queue";
 import { placeStrokes, playingAt, totalMs, type FeltStroke, type PlacedStroke } from "../src/felt";
 import { FeltPlacement } from "../src/felt-placement";
 
@@ -117,8 +118,10 @@ describe("FeltPlacement", () => {
     const all = new FeltPlacement();
     all.reset([...strokes].reverse());
     expect(all.placed).toEqual(one.placed);
-    expect(all.placed.map((s) => s.start_ms)).toEqual([0, 100, 200, 300]);
-    expect(all.bySeq(2)?.start_ms).toBe(200);
+    // Each waits behind the one before, so plays at the sleeve's floor.
+    const F = SLEEVE_FLOOR_MS;
+    expect(all.placed.map((s) => s.start_ms)).toEqual([0, 100, 100 + F, 100 + F + F]);
+    expect(all.bySeq(2)?.start_ms).toBe(100 + F);
   });
 
   it("leaves a refused stroke out: the strokes after it move up into its place", () => {
@@ -127,12 +130,14 @@ describe("FeltPlacement", () => {
       placement.append({ seq, start: [0, 0], end: [1, 0], duration_ms: 100, intensity: 1, arrives_ms: 10 });
     }
     placement.refuse(1);
+    // Each waits behind the one before, so plays at the sleeve's floor.
+    const F = SLEEVE_FLOOR_MS;
     expect(placement.placed.map((s) => [s.seq, s.start_ms])).toEqual([
       [0, 0],
       [2, 100],
-      [3, 200],
+      [3, 100 + F],
     ]);
-    expect(placement.totalMs).toBe(300);
+    expect(placement.totalMs).toBe(100 + F + F);
     // Refused before it is drawn (the event came first): never placed.
     placement.refuse(4);
     placement.append({ seq: 4, start: [0, 0], end: [1, 0], duration_ms: 100, intensity: 1, arrives_ms: 20 });

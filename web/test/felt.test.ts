@@ -10,6 +10,7 @@ import {
   totalMs,
   type FeltStroke,
 } from "../src/felt";
+import { SLEEVE_FLOOR_MS } from "../src/sleeve-queue";
 
 const GRID = { rows: 3, columns: 4 };
 
@@ -31,20 +32,41 @@ describe("placeStrokes", () => {
       new Map(),
       new Set([1]),
     );
+    // The two that wait catch up to the sleeve's floor; the capped one's turn is its caught-up one.
+    const F = SLEEVE_FLOOR_MS;
     expect(placed.map((s) => [s.start_ms, s.played_ms, s.capped])).toEqual([
       [0, 100, false],
       [100, 0, true],
-      [200, 100, false],
+      [100 + F, F, false],
     ]);
     expect(playingAt(placed, 150)).toBeNull();
   });
 
   it("takes the sleeve's reported start over its own estimate, and the cut length", () => {
     const placed = placeStrokes([stroke(0, 0), stroke(1, 0)], new Map([[0, 30]]), new Map([[0, 40]]));
+    // The second waits 70 ms behind the first, so it catches up: down to the sleeve's floor.
     expect(placed.map((s) => [s.start_ms, s.played_ms, s.reported])).toEqual([
       [30, 40, true],
-      [70, 100, false],
+      [70, SLEEVE_FLOOR_MS, false],
     ]);
+  });
+
+  it("plays a stroke that waits faster by its wait, down to the floor, never slower", () => {
+    const placed = placeStrokes([
+      stroke(0, 0, 300),
+      stroke(1, 100, 300),
+      stroke(2, 120, 50),
+      stroke(3, 900, 300),
+    ]);
+    expect(placed.map((s) => [s.start_ms, s.duration_ms])).toEqual([
+      [0, 300],
+      [300, 100], // 200 ms behind
+      [400, 50], // below the floor: as it came
+      [900, 300], // not behind
+    ]);
+    // The brush crosses a stroke that caught up in its shorter time.
+    expect(brushAt(placed[1]!, 50)).toEqual([1, 0]);
+    expect(placeStrokes([stroke(0, 0, 300), stroke(1, 10, 300)])[1]!.duration_ms).toBe(SLEEVE_FLOOR_MS);
   });
 });
 

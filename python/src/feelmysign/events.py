@@ -142,6 +142,8 @@ class Played(_Event):
     queued_ms: float  # waiting for the strokes before it
     duration_ms: float
     commands: int
+    # Played faster to catch up with its drawing (docs/protocol.md, "Playback"): by this much.
+    compressed_ms: float | None = None
 
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
@@ -154,6 +156,7 @@ class Played(_Event):
             "queued_ms": r.number("queued_ms"),
             "duration_ms": r.number("duration_ms"),
             "commands": r.index("commands"),
+            "compressed_ms": r.number("compressed_ms", required=False),
         }
 
 

@@ -14,6 +14,13 @@ stroke still waiting to play (the broker sends again what was not acknowledged
 when a connection dropped) is not dropped but ``hold``: its acknowledgement
 waits for the stroke, so the broker keeps it until it is felt.
 
+A stroke that arrives while the sleeve is behind its own drawing is played
+faster, down to the sleeve's floor, so the drawing catches up with the pen
+(``catch_up_ms`` in :mod:`feelmysign.sleeve.queue`): it is planned again with
+the shorter duration (same path, fewer crossings if they no longer fit), and its
+``played`` event says by how much (``compressed_ms``). Such a stroke waits by
+definition, so this is never on the path to a first command.
+
 The queue is bounded: a stroke that would start more than ``max_backlog_ms``
 from now, or beyond ``max_pending`` strokes not yet started, is refused
 (``queue_full``) rather than played late: a touch felt half a minute after it
@@ -37,15 +44,16 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
+from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.backends.base import Backend
 from feelmysign.clock import monotonic_ms
 from feelmysign.control import Cancel
 from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
-from feelmysign.planner import Outline
+from feelmysign.planner import Outline, outline
 from feelmysign.schedule import Schedule
 from feelmysign.sleeve.queue import Queue
 from feelmysign.timeline import Capped, Change, Timeline
@@ -91,6 +99,7 @@ class PlannedStroke:
     # duty-cycle cap, cancelled): the daemon then acknowledges the message to the broker.
     acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
+    compressed_ms: float | None = None  # how much shorter it plays to catch up, if it does
 
     def planned(self) -> Schedule:
         """The whole schedule (planned now if it was an outline)."""
@@ -149,6 +158,9 @@ class Player:
         # When each stroke starts, and per drawing the seqs accepted or settled (see
         # remember): a copy of one is a duplicate.
         self._queue = Queue()
+        self._layout = layout
+        # The shortest stroke played without slowing it: catching up stops there.
+        self._floor_ms = shortest_planned_ms(layout.shortest_burst_ms)
         # Accepted, with a drawing and seq, and not yet started, refused or dropped: what a
         # redelivered copy must wait for (see hold).
         self._unplayed: dict[tuple[str, int], PlannedStroke] = {}
@@ -169,6 +181,10 @@ class Player:
         drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
         if not self._running:
             return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
+        # A stroke that will wait may play faster (catch up): planned before the lock, so the
+        # player's thread is not held up meanwhile; checked under the lock (a cancel may have
+        # moved the tail since). An idle sleeve's stroke pays one comparison here.
+        faster = self._faster(stroke) if self._queue.tail_ms > stroke.received_at_ms else None
         with self._lock:
             if self._queue.seen(drawing, seq):
                 return _duplicate(drawing, seq)
@@ -177,6 +193,11 @@ class Player:
                 return refusal
             duration_ms = stroke.schedule.duration_ms
             if isinstance(drawing, str) and isinstance(seq, int):
+                fast_ms = self._queue.catch_up_ms(
+                    stroke.received_at_ms, duration_ms, self._floor_ms, drawing
+                )
+                if fast_ms < duration_ms:  # behind its drawing: it waits, so no first command
+                    duration_ms = self._catch_up(stroke, fast_ms, faster)
                 self._unplayed[(drawing, seq)] = stroke
                 start_ms = self._queue.place(stroke.received_at_ms, duration_ms, drawing, seq)
             else:
@@ -191,6 +212,31 @@ class Player:
             self._play_due()
         self._wake.set()  # the player plans its next wake-up (and plays the stroke if we did not)
         return None
+
+    def _faster(self, stroke: PlannedStroke) -> Outline | None:
+        """Outside the lock: the stroke planned to catch up with its drawing as the queue stands
+        now (a hint: the tail is read without the lock), or None."""
+        drawing, given = stroke.info.get("drawing"), stroke.schedule
+        if not isinstance(drawing, str):
+            return None
+        fast_ms = self._queue.catch_up_ms(
+            stroke.received_at_ms, given.duration_ms, self._floor_ms, drawing
+        )
+        return caught_up(given, fast_ms, self._layout) if fast_ms < given.duration_ms else None
+
+    def _catch_up(self, stroke: PlannedStroke, duration_ms: float, hint: Outline | None) -> float:
+        """Under the lock: the stroke planned again to play in ``duration_ms`` (``hint`` when it
+        was planned so before the lock, else now); the duration it now plays in."""
+        given = stroke.schedule
+        if hint is not None and hint.duration_ms == duration_ms:
+            faster: Outline | None = hint
+        else:
+            faster = caught_up(given, duration_ms, self._layout)
+        if faster is None:
+            return given.duration_ms
+        stroke.schedule = faster
+        stroke.compressed_ms = round(given.duration_ms - faster.duration_ms, 3)
+        return faster.duration_ms
 
     def _play_due(self) -> None:
         """On the submitting thread: what is due now, written as the player's thread would
@@ -393,7 +439,7 @@ class Player:
                     if isinstance(tag, PlannedStroke)
                 }
                 self._queue.replan(
-                    tag.start_ms + tag.schedule.duration_ms
+                    (tag.start_ms + tag.schedule.duration_ms, tag.info.get("drawing"))
                     for tag in [*self._timeline.tags(), *self._inbox]
                     if isinstance(tag, PlannedStroke)
                 )
@@ -567,6 +613,7 @@ class Player:
             "queued_ms": stroke.start_ms - stroke.received_at_ms,
             "duration_ms": schedule.duration_ms,
             "commands": len(schedule.commands),
+            "compressed_ms": stroke.compressed_ms,
         }
         event: Played
         if schedule.adjusted:
@@ -580,6 +627,17 @@ class Player:
         self._on_event(event)
         if acknowledge is not None:
             acknowledge()
+
+
+def caught_up(given: Schedule | Outline, duration_ms: float, layout: Layout) -> Outline | None:
+    """``given`` planned again to play in ``duration_ms`` (shorter, at or above the floor), on
+    the same path: crossings that no longer fit are thinned as for any stroke. None when that
+    would not be shorter, or would be slowed (below the floor of ``given``'s own bursts)."""
+    min_ms = given.min_command_ms if isinstance(given, Outline) else None
+    faster = outline(replace(given.stroke, duration_ms=duration_ms), layout, min_command_ms=min_ms)
+    if faster.adjusted is not None or faster.duration_ms >= given.duration_ms:
+        return None
+    return faster
 
 
 def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Callable[[], None]:

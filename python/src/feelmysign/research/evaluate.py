@@ -11,7 +11,8 @@ used are not applied).
 Each row measures the shape (deviation of every drawn sample, Fréchet
 distance, strokes against Douglas-Peucker at the same error), the timing as
 the sleeve would play it (``playback``: time on the skin against drawing time,
-release to felt end, pen to skin) and, when the recording is a LASA shape,
+release to felt end, pen to skin, and how much the sleeve caught up by playing
+strokes faster and how much it skipped as ``late``) and, when the recording is a LASA shape,
 whether the $1 recogniser (``dollar``) names the shape from the drawing, from
 the polyline of the strokes sent, and from the felt path (``felt``: the
 phantom point the planned schedules render over time). A shape can survive
@@ -102,10 +103,19 @@ class Row:
     recognised_drawn: bool | None = None
     recognised_sent: bool | None = None
     recognised_felt: bool | None = None
+    compressed: int = 0  # strokes played faster to catch up with the drawing
+    compressed_ms: float = 0.0  # by how much, added up
+    skipped: int = 0  # strokes skipped as late
+    skipped_ms: float = 0.0  # their planned durations, added up
 
     @property
     def skin_ratio(self) -> float:
         return self.skin_ms / self.drawing_ms if self.drawing_ms > 0 else float("nan")
+
+    @property
+    def played(self) -> int:
+        """Strokes played (one pen-to-skin time each)."""
+        return len(self.pen_to_skin_ms)
 
     def csv_fields(self) -> dict[str, Any]:
         lags = np.array(self.lags_ms)
@@ -130,6 +140,10 @@ class Row:
             "skin_ratio": _round(self.skin_ratio),
             "release_to_felt_end_ms": _round(max(self.release_ms)) if self.release_ms else "",
             "pen_to_skin_max_ms": _round(max(self.pen_to_skin_ms)) if self.pen_to_skin_ms else "",
+            "compressed": self.compressed,
+            "compressed_ms": _round(self.compressed_ms),
+            "skipped": self.skipped,
+            "skipped_ms": _round(self.skipped_ms),
             "recognised_drawn": _flag(self.recognised_drawn),
             "recognised_sent": _flag(self.recognised_sent),
             "recognised_felt": _flag(self.recognised_felt),
@@ -320,6 +334,10 @@ def evaluate_one(
         recognised_felt=recogniser.names(source, felt_path(playback.schedules))
         if recogniser
         else None,
+        compressed=playback.compressed,
+        compressed_ms=playback.compressed_ms,
+        skipped=playback.skipped,
+        skipped_ms=playback.skipped_ms,
     )
 
 
@@ -351,6 +369,9 @@ def summarize(rows: Sequence[Row]) -> list[dict[str, Any]]:
         ratios = np.array([r.skin_ratio for r in members if r.drawing_ms > 0])
         release = np.array([v for r in members for v in r.release_ms])
         pen = np.array([v for r in members for v in r.pen_to_skin_ms])
+        # The time the strokes would have played without catching up (skipped ones too).
+        planned_ms = sum(r.skin_ms + r.compressed_ms + r.skipped_ms for r in members)
+        played = sum(r.played for r in members)
         summary.append(
             {
                 "set": source_set,
@@ -372,6 +393,22 @@ def summarize(rows: Sequence[Row]) -> list[dict[str, Any]]:
                 "release_to_felt_end_median_ms": _percentile(release, 50),
                 "release_to_felt_end_p95_ms": _percentile(release),
                 "pen_to_skin_p95_ms": _percentile(pen),
+                "compressed_strokes_pct": round(
+                    100.0 * sum(r.compressed for r in members) / played, 2
+                )
+                if played
+                else None,
+                "compressed_time_pct": round(
+                    100.0 * sum(r.compressed_ms for r in members) / planned_ms, 2
+                )
+                if planned_ms
+                else None,
+                "skipped_total": sum(r.skipped for r in members),
+                "skipped_time_pct": round(
+                    100.0 * sum(r.skipped_ms for r in members) / planned_ms, 2
+                )
+                if planned_ms
+                else None,
                 "recognised_drawn_pct": _percent([r.recognised_drawn for r in members]),
                 "recognised_sent_pct": _percent([r.recognised_sent for r in members]),
                 "recognised_felt_pct": _percent([r.recognised_felt for r in members]),

@@ -11,6 +11,24 @@ touch, and a stroke that arrives to an idle sleeve starts at once. The pace rule
 (:mod:`feelmysign.pace`) times the sender's own time line by the same rule, on
 ``sent_at_ms``: :func:`start_ms` is the one place it is written.
 
+The catch-up rule: a stroke that arrives while the sleeve is behind its own
+drawing (the tail is a stroke of the same drawing, ``behind = tail - arrival >
+0``) is played faster, by as much as the sleeve is behind, but never below the
+sleeve's floor (the shortest stroke it plays without slowing it) and never
+slower than it came::
+
+    duration = max(floor, duration - behind)   (only when behind > 0 and duration > floor)
+
+so a drawing that queues (fast drawing, short strokes slowed to the floor, a
+slow network) gets back to the pen within a stroke or two, keeping its shape:
+only durations change, never where a stroke goes. Only the strokes of one
+drawing are caught up: a stroke waiting behind another drawing (another sender,
+or a new drawing after a pen lift) is not behind its own pen, and the strokes
+without a drawing (the legacy format) play as they came. :func:`catch_up_ms` is
+the one place it is written; ``Queue.catch_up_ms`` applies it to the queue's
+tail. Skipping (``late``, :mod:`feelmysign.pace`) stays the last resort, for a
+sleeve so far behind that even strokes at the floor cannot catch up.
+
 A cancel drops the strokes of its drawing (or all) accepted before it: one not
 yet started is dropped, one playing is cut where the cancel came. The tail is
 then the end of the latest stroke still planned (none: the next stroke starts
@@ -54,6 +72,17 @@ def start_ms(arrival_ms: float, tail_ms: float) -> float:
     return max(arrival_ms, tail_ms)
 
 
+def catch_up_ms(arrival_ms: float, tail_ms: float, duration_ms: float, floor_ms: float) -> float:
+    """The duration to play a stroke of ``duration_ms`` with, arriving at ``arrival_ms`` behind
+    strokes of its drawing that end at ``tail_ms``: shorter by how far the sleeve is behind,
+    down to ``floor_ms`` and never longer than it came (a stroke at or below the floor, or one
+    that does not wait, keeps its duration)."""
+    behind_ms = tail_ms - arrival_ms
+    if behind_ms <= 0.0 or duration_ms <= floor_ms:
+        return duration_ms
+    return max(floor_ms, duration_ms - behind_ms)
+
+
 class SeenSeqs:
     """The seqs of one drawing seen so far, as sorted disjoint ranges [low, high): a drawing
     sent in order is one range whatever its length, each gap adds one."""
@@ -94,10 +123,11 @@ class Queue:
     Not thread-safe: the player calls it under its lock.
     """
 
-    __slots__ = ("_seen", "tail_ms")
+    __slots__ = ("_seen", "tail_drawing", "tail_ms")
 
     def __init__(self) -> None:
         self.tail_ms = NEVER_MS
+        self.tail_drawing: str | None = None  # the drawing of the stroke that ends at the tail
         self._seen: OrderedDict[str, SeenSeqs] = OrderedDict()
 
     def place(
@@ -115,15 +145,26 @@ class Queue:
             seqs.add(seq)
         start = max(arrival_ms, self.tail_ms)  # start_ms(), written out: one call less
         self.tail_ms = start + duration_ms
+        self.tail_drawing = drawing
         return start
+
+    def catch_up_ms(
+        self, arrival_ms: float, duration_ms: float, floor_ms: float, drawing: str | None
+    ) -> float:
+        """The duration to place a stroke of ``drawing`` with (:func:`catch_up_ms`): shorter
+        only when it waits behind a stroke of the same drawing."""
+        if drawing is None or drawing != self.tail_drawing:
+            return duration_ms
+        return catch_up_ms(arrival_ms, self.tail_ms, duration_ms, floor_ms)
 
     def wait_ms(self, now_ms: float) -> float:
         """How long a stroke arriving at ``now_ms`` would wait for the strokes before it."""
         return max(0.0, self.tail_ms - now_ms)
 
-    def replan(self, ends_ms: Iterable[float]) -> None:
-        """After a cancel: the tail is the end of the latest stroke still planned."""
-        self.tail_ms = max(ends_ms, default=NEVER_MS)
+    def replan(self, ends: Iterable[tuple[float, str | None]]) -> None:
+        """After a cancel: the tail is the end of the latest stroke still planned, each given
+        as ``(end_ms, drawing)``."""
+        self.tail_ms, self.tail_drawing = max(ends, default=(NEVER_MS, None), key=_end_ms)
 
     def seen(self, drawing: object, seq: object) -> bool:
         """Whether this seq of this drawing was accepted or settled before."""
@@ -146,6 +187,10 @@ class Queue:
         while len(self._seen) > REMEMBERED_DRAWINGS:
             self._seen.popitem(last=False)
         return seqs
+
+
+def _end_ms(end: tuple[float, str | None]) -> float:
+    return end[0]
 
 
 class CancelledDrawings(OrderedDict[str, float]):
@@ -190,10 +235,12 @@ class Outcome:
     played_ms: float | None = None
 
 
-def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
+def replay(steps: Sequence[Arrival | CancelAt], floor_ms: float) -> list[Outcome]:
     """The sleeve's queue over a whole sequence, in the order the steps reach it (their
-    times never decrease): one outcome per arrival, in order. Every stroke here plays
-    (no planner, no pace, rate or duty-cycle rules: those are admission's)."""
+    times never decrease): one outcome per arrival, in order. Strokes behind their own
+    drawing are caught up down to ``floor_ms`` (the sleeve's shortest unslowed stroke), as
+    the player does; a ``played`` outcome's ``played_ms`` is then below its duration. Every
+    stroke here plays (no planner, no pace, rate or duty-cycle rules: those are admission's)."""
     queue = Queue()
     outcomes: list[Outcome | None] = []
     # Accepted and not cancelled: index -> (start, duration, drawing, seq).
@@ -215,11 +262,12 @@ def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
             )
             outcomes.append(Outcome(HELD if waiting else DUPLICATE))
             continue
+        duration = queue.catch_up_ms(step.arrival_ms, step.duration_ms, floor_ms, step.drawing)
         if step.drawing is not None and step.seq is not None:
-            start = queue.place(step.arrival_ms, step.duration_ms, step.drawing, step.seq)
+            start = queue.place(step.arrival_ms, duration, step.drawing, step.seq)
         else:
-            start = queue.place(step.arrival_ms, step.duration_ms)
-        planned[len(outcomes)] = (start, step.duration_ms, step.drawing, step.seq)
+            start = queue.place(step.arrival_ms, duration)
+        planned[len(outcomes)] = (start, duration, step.drawing, step.seq)
         outcomes.append(None)
     for index, (start, duration, _, _) in planned.items():
         outcomes[index] = Outcome(PLAYED, start, duration)
@@ -242,4 +290,4 @@ def _cancel(
         else:
             outcomes[index] = Outcome(CANCELLED)
     # What still plays (and what played already, ending before now) sets the tail.
-    queue.replan(start + duration for start, duration, _, _ in planned.values())
+    queue.replan((start + duration, drawing) for start, duration, drawing, _ in planned.values())
