@@ -46,7 +46,9 @@ from feelmysign.control import Cancel
 from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline
+from feelmysign.protocol import DUPLICATE, PLAYER_STOPPED, QUEUE_FULL
 from feelmysign.schedule import Schedule
+from feelmysign.sleeve.admission import MAX_BACKLOG_MS, MAX_PENDING, duplicate_message, queue_full
 from feelmysign.sleeve.queue import Queue
 from feelmysign.timeline import Capped, Change, Timeline
 
@@ -59,8 +61,6 @@ SPIN_MS = 0.5  # spin, not sleep, for the last half millisecond: sleep wakes up 
 SWITCH_INTERVAL_S = 0.0002
 STOP_WAIT_S = 5.0  # how long stop waits for a write under way before every motor goes off
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
-MAX_PENDING = 256
-MAX_BACKLOG_MS = 30_000.0
 TIMING_SAMPLES = 100_000
 
 
@@ -113,7 +113,7 @@ class Refusal:
 
 
 def _duplicate(drawing: object, seq: object) -> Refusal:
-    return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already played or refused")
+    return Refusal(DUPLICATE, duplicate_message(drawing, seq))
 
 
 class Player:
@@ -168,7 +168,7 @@ class Player:
         """Queue a stroke; None when accepted, else why not (nothing is queued then)."""
         drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
         if not self._running:
-            return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
+            return Refusal(PLAYER_STOPPED, "the sleeve's player has stopped; restart the sleeve")
         with self._lock:
             if self._queue.seen(drawing, seq):
                 return _duplicate(drawing, seq)
@@ -247,11 +247,19 @@ class Player:
         with self._lock:
             return max(0.0, self._queue.tail_ms - now_ms)
 
-    def repeat(self, drawing: object, seq: object) -> Refusal | None:
-        """A ``duplicate`` refusal when this stroke was accepted or settled before, else None:
-        for checking a copy before anything else counts it (the rate limit, the pace rules)."""
+    def waiting(self, drawing: object, seq: object, now_ms: float) -> bool:
+        """Accepted and not yet started (nor refused or dropped): a copy of it can be held
+        (see ``hold``). ``now_ms`` is not needed: the player's thread knows what started."""
+        if not isinstance(drawing, str) or not isinstance(seq, int):
+            return False
         with self._lock:
-            return _duplicate(drawing, seq) if self._queue.seen(drawing, seq) else None
+            return (drawing, seq) in self._unplayed
+
+    def seen(self, drawing: object, seq: object) -> bool:
+        """Accepted or settled before: a copy of it is a duplicate. For checking a copy
+        before anything else counts it (the rate limit, the pace rules)."""
+        with self._lock:
+            return self._queue.seen(drawing, seq)
 
     def remember(self, drawing: object, seq: object) -> None:
         """A stroke settled without playing (refused and acknowledged): a copy of it the broker
@@ -262,14 +270,8 @@ class Player:
 
     def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
         backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
-        if self._pending >= self._max_pending or backlog_ms > self._max_backlog_ms:
-            return Refusal(
-                "queue_full",
-                f"{self._pending} strokes ({backlog_ms / 1000:.1f} s) are waiting to play; the "
-                f"sleeve keeps at most {self._max_pending} strokes or "
-                f"{self._max_backlog_ms / 1000:g} s: send more slowly",
-            )
-        return None
+        message = queue_full(self._pending, backlog_ms, self._max_pending, self._max_backlog_ms)
+        return None if message is None else Refusal(QUEUE_FULL, message)
 
     def cancel(self, cancel: Cancel, received_wall_ms: float) -> None:
         """Cancel the strokes of a drawing (or all) accepted so far, from any thread.

@@ -35,18 +35,17 @@ from collections import OrderedDict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from feelmysign import protocol
+
 NEVER_MS = float("-inf")  # the tail of an empty queue: the next stroke starts when it arrives
 REMEMBERED_DRAWINGS = 64  # drawings whose seqs are kept, for dropping redeliveries
 REMEMBERED_CANCELS = 64  # cancelled drawings kept, for refusing their later strokes
 
-# Outcomes of replay.
-PLAYED = "played"  # started and played whole
-CUT = "cut"  # started, cut short by a cancel
-CANCELLED = (
-    "cancelled"  # accepted, dropped by a cancel before it started; or of a cancelled drawing
-)
-HELD = "held"  # a copy of a stroke still waiting to play: nothing new is queued
-DUPLICATE = "duplicate"  # a copy of a stroke that started (or was dropped) before
+# Outcomes of replay: played whole, cut short by a cancel, or one of admission's reasons
+# (cancelled, held, duplicate).
+PLAYED = "played"
+CUT = "cut"
+CANCELLED, HELD, DUPLICATE = protocol.CANCELLED, protocol.HELD, protocol.DUPLICATE
 
 
 def start_ms(arrival_ms: float, tail_ms: float) -> float:
@@ -190,56 +189,77 @@ class Outcome:
     played_ms: float | None = None
 
 
+class Simulation:
+    """A sleeve's queue played out at once, with no player thread: the strokes placed and not
+    cancelled, each with its start. It answers admission's questions
+    (:class:`feelmysign.sleeve.admission.QueueState`) for an arrival at any time."""
+
+    def __init__(self) -> None:
+        self.queue = Queue()
+        # Placed and not cancelled: key -> (start, duration, drawing, seq).
+        self.planned: dict[int, tuple[float, float, str | None, int | None]] = {}
+
+    def place(
+        self, key: int, arrival_ms: float, duration_ms: float, drawing: str | None, seq: int | None
+    ) -> float:
+        """Queue a stroke under ``key``: when it starts."""
+        if drawing is not None and seq is not None:
+            start = self.queue.place(arrival_ms, duration_ms, drawing, seq)
+        else:
+            start = self.queue.place(arrival_ms, duration_ms)
+        self.planned[key] = (start, duration_ms, drawing, seq)
+        return start
+
+    def cancel(self, cancel: CancelAt) -> dict[int, Outcome]:
+        """The strokes ``cancel`` cuts or drops, by key: each leaves the queue."""
+        now = cancel.at_ms
+        cut: dict[int, Outcome] = {}
+        for key, (start, duration, drawing, _) in list(self.planned.items()):
+            over = start + duration <= now
+            if over or (cancel.drawing is not None and drawing != cancel.drawing):
+                continue  # over already, or another drawing's
+            del self.planned[key]
+            cut[key] = Outcome(CUT, start, now - start) if start <= now else Outcome(CANCELLED)
+        # What still plays (and what played already, ending before now) sets the tail.
+        self.queue.replan(start + duration for start, duration, _, _ in self.planned.values())
+        return cut
+
+    def waiting(self, drawing: object, seq: object, now_ms: float) -> bool:
+        return any(
+            d == drawing and s == seq and start > now_ms for start, _, d, s in self.planned.values()
+        )
+
+    def seen(self, drawing: object, seq: object) -> bool:
+        return self.queue.seen(drawing, seq)
+
+    def wait_ms(self, now_ms: float) -> float:
+        return self.queue.wait_ms(now_ms)
+
+
 def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
     """The sleeve's queue over a whole sequence, in the order the steps reach it (their
-    times never decrease): one outcome per arrival, in order. Every stroke here plays
-    (no planner, no pace, rate or duty-cycle rules: those are admission's)."""
-    queue = Queue()
+    times never decrease): one outcome per arrival, in order. Copies and strokes of a
+    cancelled drawing meet admission's rules; every other stroke plays (no planner, no
+    pace, rate or duty-cycle rules here)."""
+    # Here, not at the top: admission keeps its cancelled drawings in this module.
+    from feelmysign.sleeve.admission import copy_of
+
+    simulation = Simulation()
     outcomes: list[Outcome | None] = []
-    # Accepted and not cancelled: index -> (start, duration, drawing, seq).
-    planned: dict[int, tuple[float, float, str | None, int | None]] = {}
     cancelled = CancelledDrawings()
     for step in steps:
         if isinstance(step, CancelAt):
-            _cancel(step, queue, planned, outcomes)
+            for index, outcome in simulation.cancel(step).items():
+                outcomes[index] = outcome
             if step.drawing is not None:
                 cancelled.cancel(step.drawing, step.at_ms)
             continue
-        if step.drawing is not None and step.drawing in cancelled:
-            outcomes.append(Outcome(CANCELLED))
+        copy = copy_of(step.drawing, step.seq, {}, step.arrival_ms, True, cancelled, simulation)
+        if copy is not None:
+            outcomes.append(Outcome(copy.reason))
             continue
-        if queue.seen(step.drawing, step.seq):
-            waiting = any(
-                drawing == step.drawing and seq == step.seq and start > step.arrival_ms
-                for start, _, drawing, seq in planned.values()
-            )
-            outcomes.append(Outcome(HELD if waiting else DUPLICATE))
-            continue
-        if step.drawing is not None and step.seq is not None:
-            start = queue.place(step.arrival_ms, step.duration_ms, step.drawing, step.seq)
-        else:
-            start = queue.place(step.arrival_ms, step.duration_ms)
-        planned[len(outcomes)] = (start, step.duration_ms, step.drawing, step.seq)
+        simulation.place(len(outcomes), step.arrival_ms, step.duration_ms, step.drawing, step.seq)
         outcomes.append(None)
-    for index, (start, duration, _, _) in planned.items():
+    for index, (start, duration, _, _) in simulation.planned.items():
         outcomes[index] = Outcome(PLAYED, start, duration)
     return [o for o in outcomes if o is not None]
-
-
-def _cancel(
-    cancel: CancelAt,
-    queue: Queue,
-    planned: dict[int, tuple[float, float, str | None, int | None]],
-    outcomes: list[Outcome | None],
-) -> None:
-    now = cancel.at_ms
-    for index, (start, duration, drawing, _) in list(planned.items()):
-        if start + duration <= now or (cancel.drawing is not None and drawing != cancel.drawing):
-            continue  # over already, or another drawing's
-        del planned[index]
-        if start <= now:
-            outcomes[index] = Outcome(CUT, start, now - start)
-        else:
-            outcomes[index] = Outcome(CANCELLED)
-    # What still plays (and what played already, ending before now) sets the tail.
-    queue.replan(start + duration for start, duration, _, _ in planned.values())
