@@ -10,7 +10,7 @@ import pytest
 
 from feelmysign.backends.sim import SimBackend
 from feelmysign.clock import monotonic_ms, wall_ms
-from feelmysign.events import Event
+from feelmysign.events import Event, StrokeRef
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.player import PlannedStroke, Player
@@ -48,7 +48,9 @@ def _planned(
     """The stroke, planned, received now or at ``received`` (monotonic ms, wall-clock ms)."""
     schedule = plan(Stroke((x0, y0), (x1, y1), duration_ms), PAPER)
     received_at_ms, received_wall_ms = received or (monotonic_ms(), wall_ms())
-    return PlannedStroke(schedule, received_at_ms, received_wall_ms, dict(info))
+    return PlannedStroke(
+        schedule, received_at_ms, StrokeRef(**info, received_at_ms=received_wall_ms)
+    )
 
 
 @pytest.fixture

@@ -10,7 +10,7 @@ import pytest
 from vectors import load
 
 from feelmysign.backends.sim import SimBackend
-from feelmysign.events import Event
+from feelmysign.events import Event, StrokeRef
 from feelmysign.layout import Layout
 from feelmysign.player import PlannedStroke, Player
 from feelmysign.schedule import Schedule
@@ -102,7 +102,7 @@ def test_the_player_starts_strokes_as_the_vectors_say(name: str, case: dict[str,
             if player.hold(info.get("drawing"), info.get("seq"), lambda: None):
                 outcomes.append(Outcome("held"))
                 continue
-            planned = PlannedStroke(schedule, step["arrival_ms"], 0.0, info)
+            planned = PlannedStroke(schedule, step["arrival_ms"], StrokeRef(**info))
             refusal = player.submit(planned)
             if refusal is not None:
                 outcomes.append(Outcome(refusal.reason))

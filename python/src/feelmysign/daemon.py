@@ -57,6 +57,7 @@ from feelmysign.events import (
     Safety,
     Status,
     StatusLayout,
+    StrokeRef,
     delivery_delay_ms,
 )
 from feelmysign.layout import Layout
@@ -230,12 +231,8 @@ class Sleeve:
         try:
             unplayed = self._player.stop()  # motors off first, whatever happens to the network
             for stroke in unplayed:
-                self._reject(
-                    "stopped",
-                    "the sleeve stopped before this stroke could play",
-                    stroke.info,
-                    stroke.received_wall_ms,
-                )
+                message = "the sleeve stopped before this stroke could play"
+                self._reject("stopped", message, stroke.ref)
         finally:
             if self._telemetry is not None:
                 # Every motor is off: that frame goes out (after any older one) before the
@@ -376,15 +373,13 @@ class Sleeve:
         collecting = gc.isenabled()
         if collecting:
             gc.disable()
-        info: dict[str, Any] = {"topic": message.topic}
         ack = _Ack(message.mid, self._connection) if message.qos > 0 else None
         try:
-            self._handle(message, info, ack, received_at_ms, received_wall_ms)
+            self._handle(message, ack, received_at_ms, received_wall_ms)
         except Exception as error:  # the handler must never take the sleeve down
             log.exception("sleeve %s: unexpected error handling a message", self._id)
-            self._reject(
-                "internal_error", f"unexpected error: {error}", info, received_wall_ms, ack
-            )
+            ref = StrokeRef(message.topic, received_at_ms=received_wall_ms)
+            self._reject("internal_error", f"unexpected error: {error}", ref, ack)
         finally:
             if collecting:
                 gc.enable()
@@ -392,47 +387,48 @@ class Sleeve:
     def _handle(
         self,
         message: mqtt.MQTTMessage,
-        info: dict[str, Any],
         ack: _Ack | None,
         received_at_ms: float,
         received_wall_ms: float,
     ) -> None:
         self._count("received")
-        name = info["topic"]
+        name = message.topic
         if name == self._control_topic and not message.retain:
-            self._control(message.payload, info, received_wall_ms, ack)
+            ref = StrokeRef(name, received_at_ms=received_wall_ms)
+            self._control(message.payload, ref, received_wall_ms, ack)
             return
-        verdict = self._admission.admit(
+        verdict = self._admission.admit(  # positional: one keyword less to match each
             message.payload,
-            info,
-            legacy=name == self._options.legacy_topic,
-            retained=message.retain,
-            holdable=ack is not None,
-            received_at_ms=received_at_ms,
-            received_wall_ms=received_wall_ms,
-            queue=self._player,
+            name,
+            name == self._options.legacy_topic,  # legacy
+            message.retain,  # retained
+            ack is not None,  # holdable: acknowledged later
+            received_at_ms,
+            received_wall_ms,
+            self._player,  # the queue
         )
         if not isinstance(verdict, Refused):
-            planned = PlannedStroke(verdict, received_at_ms, received_wall_ms, info)
+            outline, ref = verdict
+            planned = PlannedStroke(outline, received_at_ms, ref)
             if ack is not None:
                 planned.acknowledge = lambda: self._outbox.put(ack)
             refusal = self._player.submit(planned)
             if refusal is not None:
-                self._reject(refusal.reason, refusal.message, info, received_wall_ms, ack)
-        elif verdict.reason == CANCELLED and verdict.cancelled_at_ms is not None:
-            event = cancelled(info, received_wall_ms, verdict.cancelled_at_ms, started=False)
-            self._event(event, ack)
+                self._reject(refusal.reason, refusal.message, ref, ack)
+            return
+        ref = verdict.ref
+        if verdict.reason == CANCELLED and verdict.cancelled_at_ms is not None:
+            self._event(cancelled(ref, verdict.cancelled_at_ms, started=False), ack)
         elif verdict.reason != HELD:
-            self._reject(verdict.reason, verdict.message, info, received_wall_ms, ack)
-        elif not self._hold(info, ack):
+            self._reject(verdict.reason, verdict.message, ref, ack)
+        elif not self._hold(ref, ack):
             # The original started (or was dropped) since: this copy is a duplicate.
-            drawing, seq = info.get("drawing"), info.get("seq")
-            self._reject(DUPLICATE, duplicate_message(drawing, seq), info, received_wall_ms, ack)
+            self._reject(DUPLICATE, duplicate_message(ref.drawing, ref.seq), ref, ack)
 
-    def _hold(self, info: dict[str, Any], ack: _Ack | None) -> bool:
+    def _hold(self, ref: StrokeRef, ack: _Ack | None) -> bool:
         """The copy waits with its original, acknowledged when that one plays: False when the
         original is no longer waiting (it started meanwhile)."""
-        drawing, seq = info.get("drawing"), info.get("seq")
+        drawing, seq = ref.drawing, ref.seq
         if ack is None or not self._player.hold(drawing, seq, lambda: self._outbox.put(ack)):
             return False
         self._count("redelivered")
@@ -445,11 +441,11 @@ class Sleeve:
         return True
 
     def _control(
-        self, payload: object, info: dict[str, Any], received_wall_ms: float, ack: _Ack | None
+        self, payload: object, ref: StrokeRef, received_wall_ms: float, ack: _Ack | None
     ) -> None:
         result = parse_control(payload)
         if not isinstance(result, Cancel):
-            self._reject(result.reason, result.message, info, received_wall_ms, ack)
+            self._reject(result.reason, result.message, ref, ack)
             return
         if not result.everything:
             self._admission.cancelled.cancel(result.drawing, received_wall_ms)
@@ -461,24 +457,17 @@ class Sleeve:
 
     # --- what the sleeve tells the world -----------------------------------------------
 
-    def _reject(
-        self,
-        reason: str,
-        message: str,
-        info: dict[str, Any],
-        received_wall_ms: float,
-        ack: _Ack | None = None,
-    ) -> None:
+    def _reject(self, reason: str, message: str, ref: StrokeRef, ack: _Ack | None = None) -> None:
         """Report a stroke that will not play; acknowledge it after the event unless the
         sleeve is only going away (then the broker must deliver it again)."""
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
-        rejected = Rejected(reason=reason, message=message, **info, received_at_ms=received_wall_ms)
+        rejected = Rejected(reason=reason, message=message, stroke=ref)
         if reason in NOT_ACKNOWLEDGED:
             ack = None
         elif ack is not None:
             # Settled: a copy the broker delivers again gets no second verdict.
-            self._player.remember(info.get("drawing"), info.get("seq"))
+            self._player.remember(ref.drawing, ref.seq)
         self._event(rejected, ack)
 
     def _event(self, event: Event, ack: _Ack | None = None) -> None:

@@ -80,16 +80,16 @@ class PacePolicy:
 
     def check(
         self,
-        *,
         drawing: str | None,
-        seq: int | None = None,
         sent_at_ms: float | None,
         received_wall_ms: float,
         start_wall_ms: float,
         duration_ms: float,
+        seq: int | None = None,
     ) -> Verdict:
         """The verdict on a stroke received at ``received_wall_ms`` that would start at
-        ``start_wall_ms`` (both on the sleeve's wall clock) and last ``duration_ms``."""
+        ``start_wall_ms`` (both on the sleeve's wall clock) and last ``duration_ms``.
+        (Positional too: the sleeve calls it on the path from a message to its first command.)"""
         if sent_at_ms is None:
             return Verdict()
         age_ms = received_wall_ms - sent_at_ms

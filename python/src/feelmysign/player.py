@@ -37,13 +37,22 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from feelmysign.backends.base import Backend
 from feelmysign.clock import monotonic_ms
 from feelmysign.control import Cancel
-from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
+from feelmysign.events import (
+    NO_STROKE,
+    Adjusted,
+    Cancelled,
+    ErrorEvent,
+    Event,
+    Played,
+    Safety,
+    StrokeRef,
+)
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline
 from feelmysign.protocol import DUPLICATE, PLAYER_STOPPED, QUEUE_FULL
@@ -64,16 +73,6 @@ IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests al
 TIMING_SAMPLES = 100_000
 
 
-_STROKE_FIELDS = (
-    "topic",
-    "drawing",
-    "seq",
-    "sent_at_ms",
-    "age_ms",
-    "lag_ms",
-)  # of PlannedStroke.info
-
-
 @dataclass
 class PlannedStroke:
     """A stroke ready to play, with what the events report about it."""
@@ -82,15 +81,17 @@ class PlannedStroke:
     # gets its first motors on before the rest of it is planned.
     schedule: Schedule | Outline
     received_at_ms: float  # player clock (monotonic)
-    received_wall_ms: float
-    info: dict[str, Any] = field(
-        default_factory=dict
-    )  # e.g. drawing, seq, topic: copied into events
+    ref: StrokeRef  # which stroke it is, received when by the wall clock: named in its events
     start_ms: float = 0.0
     # Called once the event saying what became of the stroke is out (played, refused by the
     # duty-cycle cap, cancelled): the daemon then acknowledges the message to the broker.
     acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
+
+    @property
+    def received_wall_ms(self) -> float:
+        received = self.ref.received_at_ms
+        return 0.0 if received is None else received
 
     def planned(self) -> Schedule:
         """The whole schedule (planned now if it was an outline)."""
@@ -166,15 +167,16 @@ class Player:
 
     def submit(self, stroke: PlannedStroke) -> Refusal | None:
         """Queue a stroke; None when accepted, else why not (nothing is queued then)."""
-        drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        drawing, seq = stroke.ref.drawing, stroke.ref.seq
         if not self._running:
             return Refusal(PLAYER_STOPPED, "the sleeve's player has stopped; restart the sleeve")
         with self._lock:
             if self._queue.seen(drawing, seq):
                 return _duplicate(drawing, seq)
-            refusal = self._check_room(stroke)
-            if refusal:
-                return refusal
+            backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
+            full = queue_full(self._pending, backlog_ms, self._max_pending, self._max_backlog_ms)
+            if full is not None:
+                return Refusal(QUEUE_FULL, full)
             duration_ms = stroke.schedule.duration_ms
             if isinstance(drawing, str) and isinstance(seq, int):
                 self._unplayed[(drawing, seq)] = stroke
@@ -237,7 +239,7 @@ class Player:
 
     def _done(self, stroke: PlannedStroke) -> Callable[[], None] | None:
         """Under the lock: the stroke leaves the unplayed ones; its acknowledgement, to call."""
-        drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        drawing, seq = stroke.ref.drawing, stroke.ref.seq
         if isinstance(drawing, str) and isinstance(seq, int):
             self._unplayed.pop((drawing, seq), None)
         return stroke.acknowledge
@@ -267,11 +269,6 @@ class Player:
         if isinstance(drawing, str) and isinstance(seq, int):
             with self._lock:
                 self._queue.remember(drawing, seq)
-
-    def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
-        backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
-        message = queue_full(self._pending, backlog_ms, self._max_pending, self._max_backlog_ms)
-        return None if message is None else Refusal(QUEUE_FULL, message)
 
     def cancel(self, cancel: Cancel, received_wall_ms: float) -> None:
         """Cancel the strokes of a drawing (or all) accepted so far, from any thread.
@@ -380,7 +377,7 @@ class Player:
                 return (
                     isinstance(tag, PlannedStroke)
                     and tag.number < before
-                    and cancel.matches(tag.info.get("drawing"))
+                    and cancel.matches(tag.ref.drawing)
                 )
 
             cut = self._timeline.cancel(chosen, self._clock())
@@ -403,7 +400,7 @@ class Player:
                 for tag in tags:
                     if isinstance(tag, PlannedStroke):
                         at_ms = request.received_wall_ms
-                        event = cancelled(tag.info, tag.received_wall_ms, at_ms, started=started)
+                        event = cancelled(tag.ref, at_ms, started=started)
                         self._on_event(event)
                         acknowledge = acknowledgements.get(id(tag))  # a started one was
                         if acknowledge is not None:
@@ -449,8 +446,8 @@ class Player:
             self.timing_errors_ms.append(self._clock() - change.t_ms)
             try:
                 if note is not None:
-                    info = change.tag.info if isinstance(change.tag, PlannedStroke) else {}
-                    note(info.get("drawing"), info.get("seq"))
+                    ref = change.tag.ref if isinstance(change.tag, PlannedStroke) else NO_STROKE
+                    note(ref.drawing, ref.seq)
                 self._backend.set_intensity(change.row, change.column, change.intensity)
             except Exception as error:  # a motor that fails must not stop the others
                 log.warning("actuator (%d, %d): %s", change.row, change.column, error)
@@ -500,8 +497,7 @@ class Player:
                     row=change.row,
                     column=change.column,
                     message=f"cut {when}: {error} Every motor was switched off.",
-                    **{k: v for k, v in stroke.info.items() if k in _STROKE_FIELDS},
-                    received_at_ms=stroke.received_wall_ms,
+                    stroke=stroke.ref,
                 )
             )
             if acknowledge is not None:
@@ -531,8 +527,7 @@ class Player:
         refusal = capped.refusal
         row, column = refusal.actuator
         window_s = refusal.window_ms / 1000
-        info = capped.tag.info if isinstance(capped.tag, PlannedStroke) else {}
-        received = capped.tag.received_wall_ms if isinstance(capped.tag, PlannedStroke) else None
+        ref = capped.tag.ref if isinstance(capped.tag, PlannedStroke) else NO_STROKE
         self._on_event(
             Safety(
                 reason="duty_cycle",
@@ -543,8 +538,7 @@ class Player:
                     f"{refusal.duty_cycle:.0%} of the last {window_s:g} s at full drive, above "
                     f"the layout's max_duty_cycle {refusal.max_duty_cycle:.0%}; it needs a rest"
                 ),
-                **{k: v for k, v in info.items() if k in _STROKE_FIELDS},
-                received_at_ms=received,
+                stroke=ref,
                 duty_cycle=round(refusal.duty_cycle, 4),
                 max_duty_cycle=refusal.max_duty_cycle,
                 window_ms=refusal.window_ms,
@@ -559,9 +553,8 @@ class Player:
             acknowledge = self._done(stroke)
         self.played += 1
         schedule = stroke.planned()
-        timing = {
-            **stroke.info,
-            "received_at_ms": stroke.received_wall_ms,
+        timing: dict[str, Any] = {
+            "stroke": stroke.ref,
             "start_at_ms": stroke.received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
             "first_command_at_ms": stroke.received_wall_ms + (now - stroke.received_at_ms),
             "latency_ms": now - stroke.received_at_ms,
@@ -595,17 +588,14 @@ def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Calla
     return both
 
 
-def cancelled(
-    info: dict[str, Any], received_wall_ms: float, cancelled_at_ms: float, *, started: bool
-) -> Cancelled:
-    """The event for a stroke (``info``: topic, drawing, seq, sent_at_ms) that a control
-    message received at ``cancelled_at_ms`` cancelled."""
+def cancelled(stroke: StrokeRef, cancelled_at_ms: float, *, started: bool) -> Cancelled:
+    """The event for a stroke that a control message received at ``cancelled_at_ms``
+    cancelled."""
     return Cancelled(
         message="cut short by a control message"
         if started
         else "dropped by a control message before it played",
-        **info,
-        received_at_ms=received_wall_ms,
+        stroke=stroke,
         cancelled_at_ms=cancelled_at_ms,
         started=started,
     )

@@ -29,9 +29,10 @@ its lock, a simulation from its own :class:`feelmysign.sleeve.queue.Queue`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, NamedTuple, Protocol
+from typing import NamedTuple, Protocol
 
 from feelmysign.errors import StrokeError
+from feelmysign.events import StrokeRef
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS, PacePolicy
 from feelmysign.planner import Outline, outline
@@ -76,8 +77,9 @@ class QueueState(Protocol):
 
 
 # Play it: the stroke's outline (the player plans the rest of it once its first commands are
-# out); what the events say about it is in the ``info`` admission filled in.
-Admitted = Outline
+# out) and what its events name it by. A plain pair: it is made on the path from a stroke's
+# message to its first command, and a named tuple's constructor is a Python call.
+Admitted = tuple[Outline, StrokeRef]
 
 
 class Refused(NamedTuple):
@@ -86,7 +88,7 @@ class Refused(NamedTuple):
 
     reason: str
     message: str
-    info: dict[str, Any]
+    ref: StrokeRef
     cancelled_at_ms: float | None = None
 
 
@@ -110,6 +112,10 @@ class TokenBucket:
         return False
 
 
+CANCELLED_MESSAGE = "dropped by a control message before it played"
+HELD_MESSAGE = "a copy of a stroke waiting to play: it waits with it"
+
+
 def duplicate_message(drawing: object, seq: object) -> str:
     return f"stroke {seq} of drawing {drawing} was already played or refused"
 
@@ -117,28 +123,26 @@ def duplicate_message(drawing: object, seq: object) -> str:
 def copy_of(
     drawing: str | None,
     seq: int | None,
-    info: dict[str, Any],
     now_ms: float,
     holdable: bool,
     cancelled: Mapping[str, float],
     queue: QueueState,
-) -> Refused | None:
+) -> str | None:
     """Rules 3 to 5, on the identity of a stroke arriving at ``now_ms``: ``cancelled``,
-    ``held`` (when ``holdable``), ``duplicate``; None for a stroke met for the first time.
+    ``held`` (when ``holdable``) or ``duplicate``; None for a stroke met for the first time.
     (Positional: this is on the path from a stroke's message to its first command.)"""
     if drawing is not None and drawing in cancelled:
         # A stroke of a cancelled drawing (one the broker held, or sent just after the cancel).
-        message = "dropped by a control message before it played"
-        return Refused(CANCELLED, message, info, cancelled[drawing])
+        return CANCELLED
     if holdable and queue.waiting(drawing, seq, now_ms):
         # The broker's copy of a stroke still waiting to play (the connection dropped before
         # it was acknowledged): acknowledged when the stroke plays, not now, and not checked
         # again (the pace rules and the rate limit took the original).
-        return Refused(HELD, "a copy of a stroke waiting to play: it waits with it", info)
+        return HELD
     if queue.seen(drawing, seq):
         # A copy of a stroke played or refused before, whose acknowledgement was lost (a
         # dropped connection, a failed server).
-        return Refused(DUPLICATE, duplicate_message(drawing, seq), info)
+        return DUPLICATE
     return None
 
 
@@ -181,65 +185,67 @@ class Admission:
     def admit(
         self,
         payload: object,
-        info: dict[str, Any],
-        *,
-        legacy: bool = False,
-        retained: bool = False,
-        holdable: bool = True,
+        topic: str | None,
+        legacy: bool,
+        retained: bool,
+        holdable: bool,
         received_at_ms: float,
         received_wall_ms: float,
         queue: QueueState,
     ) -> Admitted | Refused:
-        """The verdict on a message received at ``received_at_ms`` (the queue's clock) and
-        ``received_wall_ms`` (the wall clock the pace compares with the sender's). ``info``
-        (what the events say about the stroke: its topic to start with) is filled in as the
-        rules learn it (drawing, seq, sent_at_ms, age_ms, lag_ms), so that it names the stroke
-        as far as it was read whatever happens. ``holdable``: the message can be acknowledged
-        later (QoS 1), so a copy of a stroke waiting to play can wait with it."""
+        """The verdict on a message received on ``topic`` at ``received_at_ms`` (the queue's
+        clock) and ``received_wall_ms`` (the wall clock the pace compares with the sender's).
+        ``legacy``: the payload is read as the legacy format. ``retained``: the broker kept the
+        message. ``holdable``: the message can be acknowledged later (QoS 1), so a copy of a
+        stroke waiting to play can wait with it. (Positional too: the sleeve calls it on the
+        path from a message to its first command.)"""
         if retained:
-            return Refused(RETAINED, RETAINED_MESSAGE, info)
+            return Refused(
+                RETAINED, RETAINED_MESSAGE, StrokeRef(topic, received_at_ms=received_wall_ms)
+            )
         result = parse(payload, self.layout, format="legacy" if legacy else "json")
         if not isinstance(result, Accepted):
             # Named when its drawing and seq could be read: its sender finds which stroke it was.
-            if result.drawing is not None:
-                info["drawing"] = result.drawing
-            if result.seq is not None:
-                info["seq"] = result.seq
-            return Refused(result.reason, result.message, info)
+            ref = StrokeRef(topic, result.drawing, result.seq, received_at_ms=received_wall_ms)
+            return Refused(result.reason, result.message, ref)
         stroke = result.stroke
-        drawing, seq = stroke.drawing, stroke.seq
-        if drawing is not None:
-            info["drawing"] = drawing
-        if seq is not None:
-            info["seq"] = seq
-        if stroke.sent_at_ms is not None:
-            info["sent_at_ms"] = stroke.sent_at_ms
-        copy = copy_of(drawing, seq, info, received_at_ms, holdable, self.cancelled, queue)
+        drawing, seq, sent_at_ms = stroke.drawing, stroke.seq, stroke.sent_at_ms
+        copy = copy_of(drawing, seq, received_at_ms, holdable, self.cancelled, queue)
         if copy is not None:
-            return copy
+            ref = StrokeRef(topic, drawing, seq, sent_at_ms, received_at_ms=received_wall_ms)
+            if copy == CANCELLED and drawing is not None:
+                return Refused(CANCELLED, CANCELLED_MESSAGE, ref, self.cancelled[drawing])
+            if copy == HELD:
+                return Refused(HELD, HELD_MESSAGE, ref)
+            return Refused(DUPLICATE, duplicate_message(drawing, seq), ref)
         if not self._bucket.take(received_at_ms):
             message = (
                 f"more than {self.rate_per_s:g} strokes per second (bursts of {self.burst}); "
                 "send more slowly"
             )
-            return Refused(RATE_LIMITED, message, info)
+            ref = StrokeRef(topic, drawing, seq, sent_at_ms, received_at_ms=received_wall_ms)
+            return Refused(RATE_LIMITED, message, ref)
         try:
             # Its bursts only: the commands are planned by the player, the first ones first.
             planned = outline(stroke, self.layout, strict=self.strict)
         except StrokeError as error:
-            return Refused(error.reason, error.message, info)
+            ref = StrokeRef(topic, drawing, seq, sent_at_ms, received_at_ms=received_wall_ms)
+            return Refused(error.reason, error.message, ref)
+        start_wall_ms = received_wall_ms + queue.wait_ms(received_at_ms)
         verdict = self._pace.check(
-            drawing=drawing,
-            seq=seq,
-            sent_at_ms=stroke.sent_at_ms,
-            received_wall_ms=received_wall_ms,
-            start_wall_ms=received_wall_ms + queue.wait_ms(received_at_ms),
-            duration_ms=planned.duration_ms,
+            drawing, sent_at_ms, received_wall_ms, start_wall_ms, planned.duration_ms, seq
         )
-        if verdict.age_ms is not None:
-            info["age_ms"] = round(verdict.age_ms, 1)
-        if verdict.lag_ms is not None:
-            info["lag_ms"] = round(verdict.lag_ms, 1)
+        age_ms, lag_ms = verdict.age_ms, verdict.lag_ms
+        # Positional: this one is on the path from a stroke's message to its first command.
+        ref = StrokeRef(
+            topic,
+            drawing,
+            seq,
+            sent_at_ms,
+            None if age_ms is None else round(age_ms, 1),
+            None if lag_ms is None else round(lag_ms, 1),
+            received_wall_ms,
+        )
         if verdict.reason is not None:
-            return Refused(verdict.reason, verdict.message, info)
-        return planned
+            return Refused(verdict.reason, verdict.message, ref)
+        return planned, ref

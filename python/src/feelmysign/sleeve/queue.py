@@ -254,9 +254,9 @@ def replay(steps: Sequence[Arrival | CancelAt]) -> list[Outcome]:
             if step.drawing is not None:
                 cancelled.cancel(step.drawing, step.at_ms)
             continue
-        copy = copy_of(step.drawing, step.seq, {}, step.arrival_ms, True, cancelled, simulation)
+        copy = copy_of(step.drawing, step.seq, step.arrival_ms, True, cancelled, simulation)
         if copy is not None:
-            outcomes.append(Outcome(copy.reason))
+            outcomes.append(Outcome(copy))
             continue
         simulation.place(len(outcomes), step.arrival_ms, step.duration_ms, step.drawing, step.seq)
         outcomes.append(None)

@@ -12,7 +12,7 @@ import time
 from typing import Any
 
 from feelmysign.errors import StrokeError
-from feelmysign.events import Adjusted, Event, Played, Rejected
+from feelmysign.events import Adjusted, Event, Played, Rejected, StrokeRef
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.stroke import Stroke
@@ -26,21 +26,21 @@ def offline_player(layout: Layout) -> Play:
         received_at_ms = round(time.time() * 1000, 3)
         events: list[dict[str, Any]] = []
         for stroke in strokes:
-            base: dict[str, Any] = {
-                "drawing": stroke.drawing,
-                "seq": stroke.seq,
-                "sent_at_ms": stroke.sent_at_ms,
-                "received_at_ms": received_at_ms,
-            }
+            ref = StrokeRef(
+                drawing=stroke.drawing,
+                seq=stroke.seq,
+                sent_at_ms=stroke.sent_at_ms,
+                received_at_ms=received_at_ms,
+            )
             event: Event
             try:
                 schedule = plan(stroke, layout)
             except StrokeError as error:
-                event = Rejected(reason=error.reason, message=error.message, **base)
+                event = Rejected(reason=error.reason, message=error.message, stroke=ref)
                 events.append(event.to_json())
                 continue
             played: dict[str, Any] = {
-                **base,
+                "stroke": ref,
                 "start_at_ms": received_at_ms,
                 "first_command_at_ms": received_at_ms,
                 "latency_ms": 0.0,
