@@ -552,29 +552,33 @@ class Player:
             self._pending -= 1
             acknowledge = self._done(stroke)
         self.played += 1
-        schedule = stroke.planned()
-        timing: dict[str, Any] = {
-            "stroke": stroke.ref,
-            "start_at_ms": stroke.received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
-            "first_command_at_ms": stroke.received_wall_ms + (now - stroke.received_at_ms),
-            "latency_ms": now - stroke.received_at_ms,
-            "start_error_ms": now - stroke.start_ms,
-            "queued_ms": stroke.start_ms - stroke.received_at_ms,
-            "duration_ms": schedule.duration_ms,
-            "commands": len(schedule.commands),
-        }
-        event: Played
-        if schedule.adjusted:
-            event = Adjusted(
-                **timing,
-                reason=schedule.adjusted.reason,
-                requested_duration_ms=schedule.adjusted.requested_duration_ms,
-            )
-        else:
-            event = Played(**timing)
-        self._on_event(event)
+        self._on_event(played_event(stroke, now))
         if acknowledge is not None:
             acknowledge()
+
+
+def played_event(stroke: PlannedStroke, written_at_ms: float) -> Played:
+    """The ``played`` event (``adjusted`` when the planner slowed it) of a stroke whose first
+    command went out at ``written_at_ms`` (the player's clock, as ``received_at_ms``)."""
+    schedule = stroke.planned()
+    received_wall_ms = stroke.received_wall_ms
+    timing: dict[str, Any] = {
+        "stroke": stroke.ref,
+        "start_at_ms": received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
+        "first_command_at_ms": received_wall_ms + (written_at_ms - stroke.received_at_ms),
+        "latency_ms": written_at_ms - stroke.received_at_ms,
+        "start_error_ms": written_at_ms - stroke.start_ms,
+        "queued_ms": stroke.start_ms - stroke.received_at_ms,
+        "duration_ms": schedule.duration_ms,
+        "commands": len(schedule.commands),
+    }
+    if schedule.adjusted:
+        return Adjusted(
+            **timing,
+            reason=schedule.adjusted.reason,
+            requested_duration_ms=schedule.adjusted.requested_duration_ms,
+        )
+    return Played(**timing)
 
 
 def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Callable[[], None]:
