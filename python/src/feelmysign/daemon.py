@@ -540,22 +540,12 @@ class Sleeve:
             log.warning("sleeve %s: could not acknowledge a stroke: %s", self._id, error)
 
     def _status(self, *, online: bool) -> str:
-        layout = self._layout
         return Status(
             online=online,
             sleeve_id=self._id,
             version=__version__,
             backend=self._options.backend_name,
             legacy_topic=self._options.legacy_topic,
-            layout=StatusLayout(
-                name=layout.name,
-                rows=layout.rows,
-                columns=layout.columns,
-                spacing_cm=layout.spacing_cm,
-                actuator_type=layout.actuator_type,
-                default_intensity=layout.default_intensity,
-                max_intensity=layout.max_intensity,
-                max_stroke_duration_ms=layout.max_stroke_duration_ms,
-            ),
+            layout=StatusLayout.of(self._layout),
             at_ms=round(time.time() * 1000),
         ).dumps()

@@ -16,9 +16,12 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import asdict, dataclass, fields
-from typing import Any, ClassVar, Literal, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeVar
 
 from feelmysign.input_files import loads_json
+
+if TYPE_CHECKING:
+    from feelmysign.layout import Layout
 
 EventType = Literal["played", "adjusted", "rejected", "cancelled", "safety", "error"]
 
@@ -453,6 +456,11 @@ class StatusLayout:
     default_intensity: float | None = None
     max_intensity: float | None = None
     max_stroke_duration_ms: float | None = None
+
+    @classmethod
+    def of(cls, layout: Layout) -> StatusLayout:
+        """What the status tells of ``layout``."""
+        return cls(**{name: getattr(layout, name) for name in _LAYOUT_ORDER})
 
     @classmethod
     def from_json(cls, data: object) -> StatusLayout:

@@ -103,8 +103,8 @@ class Queue:
         self, arrival_ms: float, duration_ms: float, drawing: str | None = None, seq: int = 0
     ) -> float:
         """Queue a stroke: when it starts (and the tail moves to its end). With a ``drawing``,
-        its ``seq`` is remembered as :meth:`remember` does (in one call: this is on the path
-        from a stroke's message to its first command)."""
+        its ``seq`` is remembered (written out here, not a call to :meth:`remember`: this is
+        on the path from a stroke's message to its first command)."""
         if drawing is not None:
             seqs = self._seen.get(drawing)
             if seqs is None:
@@ -132,13 +132,9 @@ class Queue:
         return seqs is not None and seq in seqs
 
     def remember(self, drawing: str, seq: int) -> None:
-        """A seq of a drawing settled without being placed: a copy of it is seen too."""
-        seqs = self._seen.get(drawing)
-        if seqs is None:
-            seqs = self._new_drawing(drawing)
-        else:
-            self._seen.move_to_end(drawing)
-        seqs.add(seq)
+        """A seq of a drawing settled without being placed: a copy of it is seen too. Placed
+        as a stroke of no duration at the tail, which leaves the tail where it is."""
+        self.place(self.tail_ms, 0.0, drawing, seq)
 
     def _new_drawing(self, drawing: str) -> SeenSeqs:
         seqs = self._seen[drawing] = SeenSeqs()
