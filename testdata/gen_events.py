@@ -365,7 +365,7 @@ def cases() -> dict[str, dict[str, Any]]:
     for name, (description, wire) in EVENTS.items():
         event = event_from_json(wire)
         assert event.kind == wire["type"], name
-        typed = {"type": event.kind, **_typed(event)}
+        typed = {"type": event.kind, **event.typed()}
         out[f"event/{name}.json"] = {
             "description": description,
             "wire": wire,

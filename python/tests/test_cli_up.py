@@ -23,7 +23,15 @@ from pathlib import Path
 
 import pytest
 
-from feelmysign.events import Adjusted, Cancelled, EventCopies, Played, Rejected, Safety
+from feelmysign.events import (
+    Adjusted,
+    Cancelled,
+    EventCopies,
+    Played,
+    Rejected,
+    Safety,
+    StrokeRef,
+)
 from feelmysign.services.drawing_log import NO_DRAWING, DrawingSummaries
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
@@ -53,8 +61,10 @@ WAIT_S = 60.0  # start-up of Mosquitto, the sleeve and the web server on a loade
 def _played(
     drawing: str | None, latency_ms: float, queued_ms: float = 0.0, **extra: object
 ) -> Played:
+    sent_at_ms = extra.pop("sent_at_ms", None)
+    assert sent_at_ms is None or isinstance(sent_at_ms, float)
     times = {
-        "received_at_ms": 1000.0,
+        "stroke": StrokeRef(drawing=drawing, sent_at_ms=sent_at_ms, received_at_ms=1000.0),
         "start_at_ms": 1001.0,
         "first_command_at_ms": 1000.0 + latency_ms,
         "latency_ms": latency_ms,
@@ -63,10 +73,13 @@ def _played(
         "duration_ms": 500.0,
         "commands": 3,
     }
-    sent = {"sent_at_ms": extra.pop("sent_at_ms")} if "sent_at_ms" in extra else {}
     if extra:
-        return Adjusted(drawing=drawing, **times, **sent, **extra)  # type: ignore[arg-type]
-    return Played(drawing=drawing, **times, **sent)  # type: ignore[arg-type]
+        return Adjusted(**times, **extra)  # type: ignore[arg-type]
+    return Played(**times)  # type: ignore[arg-type]
+
+
+def _with_seq(event: Played, seq: int) -> Played:
+    return replace(event, stroke=replace(event.stroke, seq=seq))
 
 
 def test_one_line_per_drawing_once_it_is_quiet() -> None:
@@ -77,7 +90,9 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     slowed = _played(drawing, 509.0, 500.0, reason="too_fast", requested_duration_ms=50)
     summaries.add(slowed, now_s=0.2)
     rejected = Rejected(
-        reason="outside_grid", message="m", drawing="aaaaaaaa-1111", received_at_ms=1
+        reason="outside_grid",
+        message="m",
+        stroke=StrokeRef(drawing="aaaaaaaa-1111", received_at_ms=1),
     )
     summaries.add(rejected, now_s=0.4)
     summaries.add(_played(None, 1.0), now_s=0.5)
@@ -88,7 +103,9 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
         "Drawing aaaaaaaa: 2 strokes played (1 slowed to be felt), 1 rejected (outside_grid); "
         "start delay median 6 ms, max 9 ms"
     ]
-    cancelled = Cancelled(message="m", received_at_ms=1.0, cancelled_at_ms=2.0, started=False)
+    cancelled = Cancelled(
+        message="m", stroke=StrokeRef(received_at_ms=1.0), cancelled_at_ms=2.0, started=False
+    )
     summaries.add(cancelled, now_s=2.0)
     assert summaries.finished(2.1, all_of_them=True) == [
         f"{NO_DRAWING}: 1 stroke played, 1 cancelled; start delay median 1 ms, max 1 ms"
@@ -111,9 +128,12 @@ def test_a_copy_of_an_event_after_a_broker_restart_is_counted_once() -> None:
     # every field. Two strokes' events, each delivered twice, are two strokes.
     summaries = DrawingSummaries(quiet_s=1.5)
     drawing = "dddddddd-4444"
-    first = replace(_played(drawing, 2.0), seq=0)
-    second = replace(_played(drawing, 2.0), seq=1)
-    refused = Rejected(reason="outside_grid", message="m", drawing=drawing, seq=2, received_at_ms=1)
+    first, second = (_with_seq(_played(drawing, 2.0), seq) for seq in (0, 1))
+    refused = Rejected(
+        reason="outside_grid",
+        message="m",
+        stroke=StrokeRef(drawing=drawing, seq=2, received_at_ms=1),
+    )
     for event in (first, first, second, refused, second, refused):
         summaries.add(event, now_s=0.0)
     assert summaries.finished(10.0) == [
@@ -126,7 +146,7 @@ def test_events_that_name_no_stroke_are_never_taken_for_copies() -> None:
     copies = EventCopies(capacity=2)
     legacy = _played(None, 1.0)
     assert [copies.is_copy(legacy), copies.is_copy(legacy)] == [False, False]
-    strokes = [replace(_played("d", 1.0), seq=seq) for seq in range(3)]
+    strokes = [_with_seq(_played("d", 1.0), seq) for seq in range(3)]
     assert [copies.is_copy(event) for event in strokes] == [False, False, False]
     # Capacity 2: the first is forgotten, the last is still remembered.
     assert [copies.is_copy(strokes[0]), copies.is_copy(strokes[2])] == [False, True]
@@ -138,10 +158,16 @@ def test_a_stroke_cut_short_is_counted_once_as_played() -> None:
     summaries.add(_played(drawing, 2.0), now_s=0.0)
     summaries.add(_played(drawing, 4.0), now_s=0.1)
     cut = Cancelled(
-        message="m", drawing=drawing, seq=1, received_at_ms=1, cancelled_at_ms=2, started=True
+        message="m",
+        stroke=StrokeRef(drawing=drawing, seq=1, received_at_ms=1),
+        cancelled_at_ms=2,
+        started=True,
     )
     dropped = Cancelled(
-        message="m", drawing=drawing, seq=2, received_at_ms=1, cancelled_at_ms=2, started=False
+        message="m",
+        stroke=StrokeRef(drawing=drawing, seq=2, received_at_ms=1),
+        cancelled_at_ms=2,
+        started=False,
     )
     summaries.add(cut, now_s=0.2)
     summaries.add(dropped, now_s=0.2)
@@ -155,7 +181,12 @@ def test_a_stroke_the_duty_cycle_cap_refused_is_counted_in_its_drawing() -> None
     summaries = DrawingSummaries(quiet_s=1.5)
     drawing = "dddddddd-4444"
     summaries.add(_played(drawing, 2.0), now_s=0.0)
-    capped = Safety(reason="duty_cycle", row=0, column=1, drawing=drawing, seq=1, received_at_ms=1)
+    capped = Safety(
+        reason="duty_cycle",
+        row=0,
+        column=1,
+        stroke=StrokeRef(drawing=drawing, seq=1, received_at_ms=1),
+    )
     summaries.add(capped, now_s=0.1)
     summaries.add(Safety(reason="off_failed", row=0, column=1), now_s=0.1)  # about no stroke
     assert summaries.finished(10.0) == [
@@ -168,7 +199,8 @@ def test_strokes_without_a_drawing_id_are_not_called_legacy() -> None:
     # JSON v1 may leave the drawing out, and a message the sleeve could not read has none.
     summaries = DrawingSummaries(quiet_s=1.5)
     summaries.add(_played(None, 2.0), now_s=0.0)
-    summaries.add(Rejected(reason="not_json", message="m", received_at_ms=1), now_s=0.0)
+    not_json = Rejected(reason="not_json", message="m", stroke=StrokeRef(received_at_ms=1))
+    summaries.add(not_json, now_s=0.0)
     assert summaries.finished(10.0) == [
         f"{NO_DRAWING}: 1 stroke played, 1 rejected (not_json); start delay median 2 ms, max 2 ms"
     ]

@@ -12,7 +12,7 @@ import pytest
 
 from feelmysign.backends.sim import SimBackend
 from feelmysign.clock import monotonic_ms, wall_ms
-from feelmysign.events import Event
+from feelmysign.events import Event, StrokeRef
 from feelmysign.layout import Layout
 from feelmysign.planner import plan
 from feelmysign.player import PlannedStroke, Player
@@ -50,7 +50,9 @@ def _planned(
     """The stroke, planned, received now or at ``received`` (monotonic ms, wall-clock ms)."""
     schedule = plan(Stroke((x0, y0), (x1, y1), duration_ms), PAPER)
     received_at_ms, received_wall_ms = received or (monotonic_ms(), wall_ms())
-    return PlannedStroke(schedule, received_at_ms, received_wall_ms, dict(info))
+    return PlannedStroke(
+        schedule, received_at_ms, StrokeRef(**info, received_at_ms=received_wall_ms)
+    )
 
 
 def new_player() -> tuple[Player, SimBackend, Events]:
@@ -114,7 +116,7 @@ def test_copies_are_refused_gaps_never_wait_and_a_stroke_after_later_ones_still_
     assert player.submit(_planned(2, 0, 3, 0, 100, drawing="d", seq=3)) is None
     duplicate = player.submit(_planned(1, 0, 2, 0, 100, drawing="d", seq=2))
     assert duplicate is not None and duplicate.reason == "duplicate"
-    assert player.repeat("d", 0) is not None and player.repeat("d", 1) is None
+    assert player.seen("d", 0) and not player.seen("d", 1)
     # Stroke 1 comes after 2 and 3 (a broker that failed over delivers it again): it was
     # delivered as far as its sender knows, so it plays, once.
     assert player.submit(_planned(0, 0, 1, 0, 100, drawing="d", seq=1)) is None
@@ -131,7 +133,7 @@ def test_a_stroke_settled_without_playing_is_a_duplicate_when_it_comes_again(
     refusal = player.submit(_planned(0, 0, 1, 0, 100, drawing="d", seq=7))
     assert refusal is not None and refusal.reason == "duplicate"
     assert "already played or refused" in refusal.message
-    assert player.repeat("d", 6) is None and player.repeat("e", 7) is None
+    assert not player.seen("d", 6) and not player.seen("e", 7)
 
 
 def test_the_seqs_seen_are_kept_as_ranges() -> None:

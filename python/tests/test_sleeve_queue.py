@@ -13,7 +13,7 @@ from vectors import load
 
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.backends.sim import SimBackend
-from feelmysign.events import Event, Played
+from feelmysign.events import Event, Played, StrokeRef
 from feelmysign.layout import Layout
 from feelmysign.planner import outline
 from feelmysign.player import PlannedStroke, Player
@@ -109,7 +109,7 @@ def test_the_player_starts_strokes_as_the_vectors_say(name: str, case: dict[str,
             if player.hold(info.get("drawing"), info.get("seq"), lambda: None):
                 outcomes.append(Outcome("held"))
                 continue
-            planned = PlannedStroke(schedule, step["arrival_ms"], 0.0, info)
+            planned = PlannedStroke(schedule, step["arrival_ms"], StrokeRef(**info))
             refusal = player.submit(planned)
             if refusal is not None:
                 outcomes.append(Outcome(refusal.reason))
@@ -192,13 +192,19 @@ def test_the_player_plays_a_stroke_behind_its_drawing_faster_and_says_so() -> No
     stroke = Stroke((0.0, 0.0), (3.0, 2.0), 600.0)
     player.start()
     try:
-        first = PlannedStroke(outline(stroke, PAPER), 0.0, 0.0, {"drawing": "d", "seq": 0})
+        first = PlannedStroke(
+            outline(stroke, PAPER), 0.0, StrokeRef(drawing="d", seq=0, received_at_ms=0.0)
+        )
         assert player.submit(first) is None
         now_ms[0] = 10.0  # 590 ms behind: down to the floor
-        second = PlannedStroke(outline(stroke, PAPER), 10.0, 10.0, {"drawing": "d", "seq": 1})
+        second = PlannedStroke(
+            outline(stroke, PAPER), 10.0, StrokeRef(drawing="d", seq=1, received_at_ms=10.0)
+        )
         assert player.submit(second) is None
         now_ms[0] = 650.0  # 23.701 ms behind: shorter by that
-        third = PlannedStroke(outline(stroke, PAPER), 650.0, 650.0, {"drawing": "d", "seq": 2})
+        third = PlannedStroke(
+            outline(stroke, PAPER), 650.0, StrokeRef(drawing="d", seq=2, received_at_ms=650.0)
+        )
         assert player.submit(third) is None
         now_ms[0] = 10_000.0
         player._wake.set()
@@ -232,10 +238,14 @@ def test_a_stroke_planned_faster_before_the_lock_is_planned_again_when_the_queue
     # The player plans a waiting stroke faster before it takes its lock (the queue as it then
     # stood); when a cancel moved the tail meanwhile, the duration decided under the lock wins.
     player = Player(SimBackend(PAPER), PAPER)
-    stroke = PlannedStroke(outline(Stroke((0.0, 0.0), (3.0, 2.0), 600.0), PAPER), 0.0, 0.0, {})
+    stroke = PlannedStroke(
+        outline(Stroke((0.0, 0.0), (3.0, 2.0), 600.0), PAPER), 0.0, StrokeRef(received_at_ms=0.0)
+    )
     stale = outline(Stroke((0.0, 0.0), (3.0, 2.0), 100.0), PAPER)
     assert player._catch_up(stroke, 250.0, stale) == 250.0
     assert stroke.schedule.duration_ms == 250.0 and stroke.compressed_ms == 350.0
     fresh = outline(Stroke((0.0, 0.0), (3.0, 2.0), 200.0), PAPER)
-    again = PlannedStroke(outline(Stroke((0.0, 0.0), (3.0, 2.0), 600.0), PAPER), 0.0, 0.0, {})
+    again = PlannedStroke(
+        outline(Stroke((0.0, 0.0), (3.0, 2.0), 600.0), PAPER), 0.0, StrokeRef(received_at_ms=0.0)
+    )
     assert player._catch_up(again, 200.0, fresh) == 200.0 and again.schedule is fresh

@@ -38,7 +38,6 @@ import queue
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -48,7 +47,7 @@ from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
 from feelmysign.control import Cancel, parse_control
-from feelmysign.errors import FeelMySignError, StrokeError
+from feelmysign.errors import FeelMySignError
 from feelmysign.events import (
     Cancelled,
     ErrorEvent,
@@ -58,21 +57,15 @@ from feelmysign.events import (
     Safety,
     Status,
     StatusLayout,
+    StrokeRef,
     delivery_delay_ms,
 )
 from feelmysign.layout import Layout
-from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS, PacePolicy
-from feelmysign.planner import outline
-from feelmysign.player import (
-    MAX_PENDING,
-    SPIN_MS,
-    PlannedStroke,
-    Player,
-    cancelled,
-)
-from feelmysign.protocol import Accepted, parse
+from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
+from feelmysign.player import SPIN_MS, PlannedStroke, Player, cancelled
+from feelmysign.protocol import CANCELLED, DUPLICATE, HELD
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
-from feelmysign.sleeve.queue import CancelledDrawings
+from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -81,10 +74,6 @@ if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign
 
 log = logging.getLogger(__name__)
 
-RATE_PER_S = 30.0  # sustained strokes per second; a fast drawing sends about 10
-# Strokes accepted at once: as many as the player may hold, so that a drawing
-# the broker kept for a sleeve that was away is not rate-limited on its return.
-BURST = MAX_PENDING
 KEEPALIVE_S = 15
 # A stroke delayed on its way by more than this (events.delivery_delay_ms) is logged: a higher
 # bar than the page's and the terminal's (events.DELAYED_MS), to keep the sleeve's journal quiet.
@@ -139,26 +128,6 @@ class _Publish:
 _Outgoing = _Publish | _Ack
 
 
-class TokenBucket:
-    """At most ``rate_per_s`` on average, ``burst`` at once."""
-
-    def __init__(self, rate_per_s: float, burst: float, clock: Callable[[], float]) -> None:
-        self._rate_per_ms = rate_per_s / 1000.0
-        self._burst = burst
-        self._tokens = burst
-        self._clock = clock
-        self._last_ms = clock()
-
-    def take(self) -> bool:
-        now = self._clock()
-        self._tokens = min(self._burst, self._tokens + (now - self._last_ms) * self._rate_per_ms)
-        self._last_ms = now
-        if self._tokens >= 1.0:
-            self._tokens -= 1.0
-            return True
-        return False
-
-
 @dataclass(frozen=True)
 class SleeveOptions:
     sleeve_id: str
@@ -199,13 +168,18 @@ class Sleeve:
         self._player = player or Player(
             backend, layout, on_event=self._event, spin_ms=options.spin_ms
         )
-        self._bucket = TokenBucket(options.rate_per_s, options.burst, monotonic_ms)
-        self._pace = PacePolicy(max_age_ms=options.max_age_ms, max_lag_ms=options.max_lag_ms)
+        self._admission = Admission(
+            layout,
+            strict=options.strict,
+            rate_per_s=options.rate_per_s,
+            burst=options.burst,
+            max_age_ms=options.max_age_ms,
+            max_lag_ms=options.max_lag_ms,
+        )
         self._connection = 0  # counts connections: an acknowledgement is valid on its own only
         self._stopped = threading.Event()
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
-        self._cancelled = CancelledDrawings()  # drawing -> cancelled at (wall)
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         self._client = self._make_client()
@@ -260,12 +234,8 @@ class Sleeve:
         try:
             unplayed = self._player.stop()  # motors off first, whatever happens to the network
             for stroke in unplayed:
-                self._reject(
-                    "stopped",
-                    "the sleeve stopped before this stroke could play",
-                    stroke.info,
-                    stroke.received_wall_ms,
-                )
+                message = "the sleeve stopped before this stroke could play"
+                self._reject("stopped", message, stroke.ref)
         finally:
             if self._telemetry is not None:
                 # Every motor is off: that frame goes out (after any older one) before the
@@ -406,15 +376,13 @@ class Sleeve:
         collecting = gc.isenabled()
         if collecting:
             gc.disable()
-        info: dict[str, Any] = {"topic": message.topic}
         ack = _Ack(message.mid, self._connection) if message.qos > 0 else None
         try:
-            self._handle(message, info, ack, received_at_ms, received_wall_ms)
+            self._handle(message, ack, received_at_ms, received_wall_ms)
         except Exception as error:  # the handler must never take the sleeve down
             log.exception("sleeve %s: unexpected error handling a message", self._id)
-            self._reject(
-                "internal_error", f"unexpected error: {error}", info, received_wall_ms, ack
-            )
+            ref = StrokeRef(message.topic, received_at_ms=received_wall_ms)
+            self._reject("internal_error", f"unexpected error: {error}", ref, ack)
         finally:
             if collecting:
                 gc.enable()
@@ -422,116 +390,68 @@ class Sleeve:
     def _handle(
         self,
         message: mqtt.MQTTMessage,
-        info: dict[str, Any],
         ack: _Ack | None,
         received_at_ms: float,
         received_wall_ms: float,
     ) -> None:
         self._count("received")
-        name = info["topic"]
-        legacy = name == self._options.legacy_topic
-        if message.retain:
-            # A stroke kept by the broker would play again at every start.
-            self._reject(
-                "retained",
-                "a retained stroke is not played: publish strokes without "
-                "the retain flag, and clear this one with an empty retained message",
-                info,
-                received_wall_ms,
-                ack,
-            )
+        name = message.topic
+        if name == self._control_topic and not message.retain:
+            ref = StrokeRef(name, received_at_ms=received_wall_ms)
+            self._control(message.payload, ref, received_wall_ms, ack)
             return
-        payload = message.payload
-        if name == self._control_topic:
-            self._control(payload, info, received_wall_ms, ack)
-            return
-        result = parse(payload, self._layout, format="legacy" if legacy else "json")
-        if not isinstance(result, Accepted):
-            # Named when its drawing and seq could be read: its sender finds which stroke it was.
-            named = (("drawing", result.drawing), ("seq", result.seq))
-            info.update({k: v for k, v in named if v is not None})
-            self._reject(result.reason, result.message, info, received_wall_ms, ack)
-            return
-        stroke = result.stroke
-        if stroke.drawing is not None:
-            info["drawing"] = stroke.drawing
-        if stroke.seq is not None:
-            info["seq"] = stroke.seq
-        if stroke.sent_at_ms is not None:
-            info["sent_at_ms"] = stroke.sent_at_ms
-        if stroke.drawing is not None and stroke.drawing in self._cancelled:
-            # A stroke of a cancelled drawing (one the broker held, or sent just after the cancel).
-            cancelled_at_ms = self._cancelled[stroke.drawing]
-            self._event(cancelled(info, received_wall_ms, cancelled_at_ms, started=False), ack)
-            return
-        if ack is not None and self._player.hold(
-            stroke.drawing, stroke.seq, lambda: self._outbox.put(ack)
-        ):
-            # The broker's copy of a stroke still waiting to play (the connection dropped
-            # before it was acknowledged): acknowledged when the stroke plays, not now, and
-            # not checked again (the pace rules and the rate limit took the original).
-            self._count("redelivered")
-            log.info(
-                "sleeve %s: stroke %s of drawing %s came again while it waits to play",
-                self._id,
-                stroke.seq,
-                stroke.drawing,
-            )
-            return
-        repeat = self._player.repeat(stroke.drawing, stroke.seq)
-        if repeat is not None:
-            # A copy of a stroke played or refused before, whose acknowledgement was lost
-            # (a dropped connection, a failed server): dropped before the rate limit and the
-            # pace rules see it, so it is reported as what it is and changes nothing.
-            self._reject(repeat.reason, repeat.message, info, received_wall_ms, ack)
-            return
-        if not self._bucket.take():
-            self._reject(
-                "rate_limited",
-                f"more than {self._options.rate_per_s:g} strokes per second "
-                f"(bursts of {self._options.burst}); send more slowly",
-                info,
-                received_wall_ms,
-                ack,
-            )
-            return
-        try:
-            # Its bursts only: the commands are planned by the player, the first ones first.
-            schedule = outline(stroke, self._layout, strict=self._options.strict)
-        except StrokeError as error:
-            self._reject(error.reason, error.message, info, received_wall_ms, ack)
-            return
-        verdict = self._pace.check(
-            drawing=stroke.drawing,
-            seq=stroke.seq,
-            sent_at_ms=stroke.sent_at_ms,
-            received_wall_ms=received_wall_ms,
-            start_wall_ms=received_wall_ms + self._player.wait_ms(received_at_ms),
-            duration_ms=schedule.duration_ms,
+        verdict = self._admission.admit(  # positional: one keyword less to match each
+            message.payload,
+            name,
+            name == self._options.legacy_topic,  # legacy
+            message.retain,  # retained
+            ack is not None,  # holdable: acknowledged later
+            received_at_ms,
+            received_wall_ms,
+            self._player,  # the queue
         )
-        if verdict.age_ms is not None:
-            info["age_ms"] = round(verdict.age_ms, 1)
-        if verdict.lag_ms is not None:
-            info["lag_ms"] = round(verdict.lag_ms, 1)
-        if verdict.reason is not None:
-            self._reject(verdict.reason, verdict.message, info, received_wall_ms, ack)
+        if not isinstance(verdict, Refused):
+            outline, ref = verdict
+            planned = PlannedStroke(outline, received_at_ms, ref)
+            if ack is not None:
+                planned.acknowledge = lambda: self._outbox.put(ack)
+            refusal = self._player.submit(planned)
+            if refusal is not None:
+                self._reject(refusal.reason, refusal.message, ref, ack)
             return
-        planned = PlannedStroke(schedule, received_at_ms, received_wall_ms, info)
-        if ack is not None:
-            planned.acknowledge = lambda: self._outbox.put(ack)
-        refusal = self._player.submit(planned)
-        if refusal is not None:
-            self._reject(refusal.reason, refusal.message, info, received_wall_ms, ack)
+        ref = verdict.ref
+        if verdict.reason == CANCELLED and verdict.cancelled_at_ms is not None:
+            self._event(cancelled(ref, verdict.cancelled_at_ms, started=False), ack)
+        elif verdict.reason != HELD:
+            self._reject(verdict.reason, verdict.message, ref, ack)
+        elif not self._hold(ref, ack):
+            # The original started (or was dropped) since: this copy is a duplicate.
+            self._reject(DUPLICATE, duplicate_message(ref.drawing, ref.seq), ref, ack)
+
+    def _hold(self, ref: StrokeRef, ack: _Ack | None) -> bool:
+        """The copy waits with its original, acknowledged when that one plays: False when the
+        original is no longer waiting (it started meanwhile)."""
+        drawing, seq = ref.drawing, ref.seq
+        if ack is None or not self._player.hold(drawing, seq, lambda: self._outbox.put(ack)):
+            return False
+        self._count("redelivered")
+        log.info(
+            "sleeve %s: stroke %s of drawing %s came again while it waits to play",
+            self._id,
+            seq,
+            drawing,
+        )
+        return True
 
     def _control(
-        self, payload: object, info: dict[str, Any], received_wall_ms: float, ack: _Ack | None
+        self, payload: object, ref: StrokeRef, received_wall_ms: float, ack: _Ack | None
     ) -> None:
         result = parse_control(payload)
         if not isinstance(result, Cancel):
-            self._reject(result.reason, result.message, info, received_wall_ms, ack)
+            self._reject(result.reason, result.message, ref, ack)
             return
         if not result.everything:
-            self._cancelled.cancel(result.drawing, received_wall_ms)
+            self._admission.cancelled.cancel(result.drawing, received_wall_ms)
         what = "every drawing" if result.everything else f"drawing {result.drawing}"
         log.info("sleeve %s: cancel %s", self._id, what)
         self._player.cancel(result, received_wall_ms)
@@ -540,24 +460,17 @@ class Sleeve:
 
     # --- what the sleeve tells the world -----------------------------------------------
 
-    def _reject(
-        self,
-        reason: str,
-        message: str,
-        info: dict[str, Any],
-        received_wall_ms: float,
-        ack: _Ack | None = None,
-    ) -> None:
+    def _reject(self, reason: str, message: str, ref: StrokeRef, ack: _Ack | None = None) -> None:
         """Report a stroke that will not play; acknowledge it after the event unless the
         sleeve is only going away (then the broker must deliver it again)."""
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
-        rejected = Rejected(reason=reason, message=message, **info, received_at_ms=received_wall_ms)
+        rejected = Rejected(reason=reason, message=message, stroke=ref)
         if reason in NOT_ACKNOWLEDGED:
             ack = None
         elif ack is not None:
             # Settled: a copy the broker delivers again gets no second verdict.
-            self._player.remember(info.get("drawing"), info.get("seq"))
+            self._player.remember(ref.drawing, ref.seq)
         self._event(rejected, ack)
 
     def _event(self, event: Event, ack: _Ack | None = None) -> None:
@@ -630,23 +543,13 @@ class Sleeve:
             log.warning("sleeve %s: could not acknowledge a stroke: %s", self._id, error)
 
     def _status(self, *, online: bool) -> str:
-        layout = self._layout
         return Status(
             online=online,
             sleeve_id=self._id,
             version=__version__,
             backend=self._options.backend_name,
             legacy_topic=self._options.legacy_topic,
-            layout=StatusLayout(
-                name=layout.name,
-                rows=layout.rows,
-                columns=layout.columns,
-                spacing_cm=layout.spacing_cm,
-                actuator_type=layout.actuator_type,
-                default_intensity=layout.default_intensity,
-                max_intensity=layout.max_intensity,
-                max_stroke_duration_ms=layout.max_stroke_duration_ms,
-            ),
+            layout=StatusLayout.of(self._layout),
             at_ms=round(time.time() * 1000),
-            floor=sleeve_floor(layout, self._options.wearer),
+            floor=sleeve_floor(self._layout, self._options.wearer),
         ).dumps()

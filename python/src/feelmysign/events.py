@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass
-from typing import Any, ClassVar, Literal, TypeVar
+from dataclasses import asdict, dataclass, fields
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeVar
 
 from feelmysign.input_files import loads_json
+
+if TYPE_CHECKING:
+    from feelmysign.layout import Layout
 
 EventType = Literal["played", "adjusted", "rejected", "cancelled", "safety", "error"]
 
@@ -90,12 +93,65 @@ def _wire(type_name: str | None, values: dict[str, Any]) -> dict[str, Any]:
 _E = TypeVar("_E", bound="_Event")
 
 
+@dataclass(frozen=True)
+class StrokeRef:
+    """What names the stroke an event is about: the topic it came in on, its drawing and
+    seq, when it was sent (the sender's wall clock) and received (the sleeve's), and the
+    pace's figures. Every stroke event embeds one; on the wire its fields stand among the
+    event's own, in this order (docs/protocol.md)."""
+
+    topic: str | None = None
+    drawing: str | None = None
+    seq: int | None = None
+    sent_at_ms: float | None = None
+    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
+    lag_ms: float | None = None  # how much later than due it starts
+    received_at_ms: float | None = None
+
+    def __init__(
+        self,
+        topic: str | None = None,
+        drawing: str | None = None,
+        seq: int | None = None,
+        sent_at_ms: float | None = None,
+        age_ms: float | None = None,
+        lag_ms: float | None = None,
+        received_at_ms: float | None = None,
+    ) -> None:
+        # As Stroke's: a frozen dataclass's own __init__ sets each field through
+        # object.__setattr__, and the sleeve makes one per stroke before its first command.
+        self.__dict__.update(
+            topic=topic,
+            drawing=drawing,
+            seq=seq,
+            sent_at_ms=sent_at_ms,
+            age_ms=age_ms,
+            lag_ms=lag_ms,
+            received_at_ms=received_at_ms,
+        )
+
+
+NO_STROKE = StrokeRef()  # an event about no stroke (a motor's safety off)
+
+
 @dataclass(frozen=True, kw_only=True)
 class _Event:
     kind: ClassVar[EventType]
 
+    def typed(self) -> dict[str, Any]:
+        """Every field by its name on the wire, in publishing order, None where absent: the
+        embedded stroke's fields stand in its place."""
+        values: dict[str, Any] = {}
+        for field in fields(self):
+            value = getattr(self, field.name)
+            if isinstance(value, StrokeRef):
+                values.update(value.__dict__)  # set in field order (see its __init__)
+            else:
+                values[field.name] = value
+        return values
+
     def to_json(self) -> dict[str, Any]:
-        return _wire(self.kind, asdict(self))
+        return _wire(self.kind, self.typed())
 
     def dumps(self) -> str:
         return json.dumps(self.to_json())
@@ -111,30 +167,59 @@ class _Event:
 
 
 def _read_stroke(r: _Reader, *, received_required: bool = True) -> dict[str, Any]:
-    """The fields that name the stroke an event is about, shared by every stroke event."""
-    return {
-        "topic": r.text("topic", required=False),
-        "drawing": r.text("drawing", required=False),
-        "seq": r.index("seq", required=False),
-        "sent_at_ms": r.number("sent_at_ms", required=False),
-        "age_ms": r.number("age_ms", required=False),
-        "lag_ms": r.number("lag_ms", required=False),
-        "received_at_ms": r.number("received_at_ms", required=received_required),
-    }
+    """The stroke an event is about, as the ``stroke`` argument of its class."""
+    stroke = StrokeRef(
+        topic=r.text("topic", required=False),
+        drawing=r.text("drawing", required=False),
+        seq=r.index("seq", required=False),
+        sent_at_ms=r.number("sent_at_ms", required=False),
+        age_ms=r.number("age_ms", required=False),
+        lag_ms=r.number("lag_ms", required=False),
+        received_at_ms=r.number("received_at_ms", required=received_required),
+    )
+    return {"stroke": stroke}
+
+
+class _AboutAStroke:
+    """An event's stroke fields read as its own (``event.drawing``), as on the wire."""
+
+    stroke: StrokeRef
+
+    @property
+    def topic(self) -> str | None:
+        return self.stroke.topic
+
+    @property
+    def drawing(self) -> str | None:
+        return self.stroke.drawing
+
+    @property
+    def seq(self) -> int | None:
+        return self.stroke.seq
+
+    @property
+    def sent_at_ms(self) -> float | None:
+        return self.stroke.sent_at_ms
+
+    @property
+    def age_ms(self) -> float | None:
+        return self.stroke.age_ms
+
+    @property
+    def lag_ms(self) -> float | None:
+        return self.stroke.lag_ms
+
+    @property
+    def received_at_ms(self) -> float | None:
+        return self.stroke.received_at_ms
 
 
 @dataclass(frozen=True, kw_only=True)
-class Played(_Event):
+class Played(_AboutAStroke, _Event):
     """The stroke's first command went out (times ``*_at_ms``: the sleeve's wall clock)."""
 
     kind: ClassVar[EventType] = "played"
-    topic: str | None = None
-    drawing: str | None = None
-    seq: int | None = None
-    sent_at_ms: float | None = None
-    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
-    lag_ms: float | None = None  # how much later than due it starts
-    received_at_ms: float
+    stroke: StrokeRef  # with received_at_ms
     start_at_ms: float  # planned start
     first_command_at_ms: float
     latency_ms: float  # receive -> first command
@@ -177,19 +262,13 @@ class Adjusted(Played):
 
 
 @dataclass(frozen=True, kw_only=True)
-class Rejected(_Event):
+class Rejected(_AboutAStroke, _Event):
     """The stroke will not be played: ``reason`` is a code of docs/protocol.md."""
 
     kind: ClassVar[EventType] = "rejected"
     reason: str
     message: str
-    topic: str | None = None
-    drawing: str | None = None
-    seq: int | None = None
-    sent_at_ms: float | None = None
-    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
-    lag_ms: float | None = None  # how much later than due it starts
-    received_at_ms: float
+    stroke: StrokeRef  # with received_at_ms
 
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
@@ -201,20 +280,14 @@ class Rejected(_Event):
 
 
 @dataclass(frozen=True, kw_only=True)
-class Cancelled(_Event):
+class Cancelled(_AboutAStroke, _Event):
     """A control message cancelled the stroke: ``started`` when it was cut short while playing
     (it had its ``played`` event), not when it was dropped before it started."""
 
     kind: ClassVar[EventType] = "cancelled"
     reason: str = "cancelled"
     message: str
-    topic: str | None = None
-    drawing: str | None = None
-    seq: int | None = None
-    sent_at_ms: float | None = None
-    age_ms: float | None = None  # received minus sent_at_ms (docs/protocol.md, pace)
-    lag_ms: float | None = None  # how much later than due it starts
-    received_at_ms: float
+    stroke: StrokeRef  # with received_at_ms
     cancelled_at_ms: float
     started: bool
 
@@ -230,7 +303,7 @@ class Cancelled(_Event):
 
 
 @dataclass(frozen=True, kw_only=True)
-class Safety(_Event):
+class Safety(_AboutAStroke, _Event):
     """A motor was protected: a stroke the duty-cycle cap kept from playing (``duty_cycle``:
     the stroke's fields, the motor's would-be duty cycle and the limit), or an off that
     failed twice, so every motor was switched off (``off_failed``)."""
@@ -240,13 +313,7 @@ class Safety(_Event):
     row: int
     column: int
     message: str | None = None
-    topic: str | None = None
-    drawing: str | None = None
-    seq: int | None = None
-    sent_at_ms: float | None = None
-    age_ms: float | None = None
-    lag_ms: float | None = None
-    received_at_ms: float | None = None
+    stroke: StrokeRef = NO_STROKE
     duty_cycle: float | None = None  # what the window would have held, 0..1 of full drive
     max_duty_cycle: float | None = None
     window_ms: float | None = None
@@ -392,6 +459,11 @@ class StatusLayout:
     default_intensity: float | None = None
     max_intensity: float | None = None
     max_stroke_duration_ms: float | None = None
+
+    @classmethod
+    def of(cls, layout: Layout) -> StatusLayout:
+        """What the status tells of ``layout``."""
+        return cls(**{name: getattr(layout, name) for name in _LAYOUT_ORDER})
 
     @classmethod
     def from_json(cls, data: object) -> StatusLayout:

@@ -35,7 +35,10 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 
+from feelmysign.protocol import LATE, STALE
 from feelmysign.sleeve.queue import REMEMBERED_DRAWINGS, start_ms
+
+__all__ = ["LATE", "MAX_AGE_MS", "MAX_LAG_MS", "STALE", "PacePolicy", "Verdict"]
 
 # Strokes older than this are refused. Long enough for a sender's clock a few seconds off
 # and for a broker restart; short enough that a drawing is not felt long after the fact.
@@ -46,9 +49,6 @@ MAX_LAG_MS = 1_000.0
 # Once skipping, skip down to this much behind: strokes of a drawing play back to back, so
 # the lag left when skipping stops stays for the rest of the drawing.
 CATCH_UP_FRACTION = 0.25
-
-STALE = "stale"
-LATE = "late"
 
 
 @dataclass(frozen=True)
@@ -80,16 +80,16 @@ class PacePolicy:
 
     def check(
         self,
-        *,
         drawing: str | None,
-        seq: int | None = None,
         sent_at_ms: float | None,
         received_wall_ms: float,
         start_wall_ms: float,
         duration_ms: float,
+        seq: int | None = None,
     ) -> Verdict:
         """The verdict on a stroke received at ``received_wall_ms`` that would start at
-        ``start_wall_ms`` (both on the sleeve's wall clock) and last ``duration_ms``."""
+        ``start_wall_ms`` (both on the sleeve's wall clock) and last ``duration_ms``.
+        (Positional too: the sleeve calls it on the path from a message to its first command.)"""
         if sent_at_ms is None:
             return Verdict()
         age_ms = received_wall_ms - sent_at_ms

@@ -44,17 +44,28 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.backends.base import Backend
 from feelmysign.clock import monotonic_ms
 from feelmysign.control import Cancel
-from feelmysign.events import Adjusted, Cancelled, ErrorEvent, Event, Played, Safety
+from feelmysign.events import (
+    NO_STROKE,
+    Adjusted,
+    Cancelled,
+    ErrorEvent,
+    Event,
+    Played,
+    Safety,
+    StrokeRef,
+)
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline, outline
+from feelmysign.protocol import DUPLICATE, PLAYER_STOPPED, QUEUE_FULL
 from feelmysign.schedule import Schedule
+from feelmysign.sleeve.admission import MAX_BACKLOG_MS, MAX_PENDING, duplicate_message, queue_full
 from feelmysign.sleeve.queue import Queue
 from feelmysign.timeline import Capped, Change, Timeline
 
@@ -67,19 +78,7 @@ SPIN_MS = 0.5  # spin, not sleep, for the last half millisecond: sleep wakes up 
 SWITCH_INTERVAL_S = 0.0002
 STOP_WAIT_S = 5.0  # how long stop waits for a write under way before every motor goes off
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
-MAX_PENDING = 256
-MAX_BACKLOG_MS = 30_000.0
 TIMING_SAMPLES = 100_000
-
-
-_STROKE_FIELDS = (
-    "topic",
-    "drawing",
-    "seq",
-    "sent_at_ms",
-    "age_ms",
-    "lag_ms",
-)  # of PlannedStroke.info
 
 
 @dataclass
@@ -90,16 +89,18 @@ class PlannedStroke:
     # gets its first motors on before the rest of it is planned.
     schedule: Schedule | Outline
     received_at_ms: float  # player clock (monotonic)
-    received_wall_ms: float
-    info: dict[str, Any] = field(
-        default_factory=dict
-    )  # e.g. drawing, seq, topic: copied into events
+    ref: StrokeRef  # which stroke it is, received when by the wall clock: named in its events
     start_ms: float = 0.0
     # Called once the event saying what became of the stroke is out (played, refused by the
     # duty-cycle cap, cancelled): the daemon then acknowledges the message to the broker.
     acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
     compressed_ms: float | None = None  # how much shorter it plays to catch up, if it does
+
+    @property
+    def received_wall_ms(self) -> float:
+        received = self.ref.received_at_ms
+        return 0.0 if received is None else received
 
     def planned(self) -> Schedule:
         """The whole schedule (planned now if it was an outline)."""
@@ -122,7 +123,7 @@ class Refusal:
 
 
 def _duplicate(drawing: object, seq: object) -> Refusal:
-    return Refusal("duplicate", f"stroke {seq} of drawing {drawing} was already played or refused")
+    return Refusal(DUPLICATE, duplicate_message(drawing, seq))
 
 
 class Player:
@@ -178,9 +179,9 @@ class Player:
 
     def submit(self, stroke: PlannedStroke) -> Refusal | None:
         """Queue a stroke; None when accepted, else why not (nothing is queued then)."""
-        drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        drawing, seq = stroke.ref.drawing, stroke.ref.seq
         if not self._running:
-            return Refusal("player_stopped", "the sleeve's player has stopped; restart the sleeve")
+            return Refusal(PLAYER_STOPPED, "the sleeve's player has stopped; restart the sleeve")
         # A stroke that will wait may play faster (catch up): planned before the lock, so the
         # player's thread is not held up meanwhile; checked under the lock (a cancel may have
         # moved the tail since). An idle sleeve's stroke pays one comparison here.
@@ -188,9 +189,10 @@ class Player:
         with self._lock:
             if self._queue.seen(drawing, seq):
                 return _duplicate(drawing, seq)
-            refusal = self._check_room(stroke)
-            if refusal:
-                return refusal
+            backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
+            full = queue_full(self._pending, backlog_ms, self._max_pending, self._max_backlog_ms)
+            if full is not None:
+                return Refusal(QUEUE_FULL, full)
             duration_ms = stroke.schedule.duration_ms
             if isinstance(drawing, str) and isinstance(seq, int):
                 fast_ms = self._queue.catch_up_ms(
@@ -216,7 +218,7 @@ class Player:
     def _faster(self, stroke: PlannedStroke) -> Outline | None:
         """Outside the lock: the stroke planned to catch up with its drawing as the queue stands
         now (a hint: the tail is read without the lock), or None."""
-        drawing, given = stroke.info.get("drawing"), stroke.schedule
+        drawing, given = stroke.ref.drawing, stroke.schedule
         if not isinstance(drawing, str):
             return None
         fast_ms = self._queue.catch_up_ms(
@@ -283,7 +285,7 @@ class Player:
 
     def _done(self, stroke: PlannedStroke) -> Callable[[], None] | None:
         """Under the lock: the stroke leaves the unplayed ones; its acknowledgement, to call."""
-        drawing, seq = stroke.info.get("drawing"), stroke.info.get("seq")
+        drawing, seq = stroke.ref.drawing, stroke.ref.seq
         if isinstance(drawing, str) and isinstance(seq, int):
             self._unplayed.pop((drawing, seq), None)
         return stroke.acknowledge
@@ -293,11 +295,19 @@ class Player:
         with self._lock:
             return max(0.0, self._queue.tail_ms - now_ms)
 
-    def repeat(self, drawing: object, seq: object) -> Refusal | None:
-        """A ``duplicate`` refusal when this stroke was accepted or settled before, else None:
-        for checking a copy before anything else counts it (the rate limit, the pace rules)."""
+    def waiting(self, drawing: object, seq: object, now_ms: float) -> bool:
+        """Accepted and not yet started (nor refused or dropped): a copy of it can be held
+        (see ``hold``). ``now_ms`` is not needed: the player's thread knows what started."""
+        if not isinstance(drawing, str) or not isinstance(seq, int):
+            return False
         with self._lock:
-            return _duplicate(drawing, seq) if self._queue.seen(drawing, seq) else None
+            return (drawing, seq) in self._unplayed
+
+    def seen(self, drawing: object, seq: object) -> bool:
+        """Accepted or settled before: a copy of it is a duplicate. For checking a copy
+        before anything else counts it (the rate limit, the pace rules)."""
+        with self._lock:
+            return self._queue.seen(drawing, seq)
 
     def remember(self, drawing: object, seq: object) -> None:
         """A stroke settled without playing (refused and acknowledged): a copy of it the broker
@@ -305,17 +315,6 @@ class Player:
         if isinstance(drawing, str) and isinstance(seq, int):
             with self._lock:
                 self._queue.remember(drawing, seq)
-
-    def _check_room(self, stroke: PlannedStroke) -> Refusal | None:
-        backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
-        if self._pending >= self._max_pending or backlog_ms > self._max_backlog_ms:
-            return Refusal(
-                "queue_full",
-                f"{self._pending} strokes ({backlog_ms / 1000:.1f} s) are waiting to play; the "
-                f"sleeve keeps at most {self._max_pending} strokes or "
-                f"{self._max_backlog_ms / 1000:g} s: send more slowly",
-            )
-        return None
 
     def cancel(self, cancel: Cancel, received_wall_ms: float) -> None:
         """Cancel the strokes of a drawing (or all) accepted so far, from any thread.
@@ -424,7 +423,7 @@ class Player:
                 return (
                     isinstance(tag, PlannedStroke)
                     and tag.number < before
-                    and cancel.matches(tag.info.get("drawing"))
+                    and cancel.matches(tag.ref.drawing)
                 )
 
             cut = self._timeline.cancel(chosen, self._clock())
@@ -439,7 +438,7 @@ class Player:
                     if isinstance(tag, PlannedStroke)
                 }
                 self._queue.replan(
-                    (tag.start_ms + tag.schedule.duration_ms, tag.info.get("drawing"))
+                    (tag.start_ms + tag.schedule.duration_ms, tag.ref.drawing)
                     for tag in [*self._timeline.tags(), *self._inbox]
                     if isinstance(tag, PlannedStroke)
                 )
@@ -447,7 +446,7 @@ class Player:
                 for tag in tags:
                     if isinstance(tag, PlannedStroke):
                         at_ms = request.received_wall_ms
-                        event = cancelled(tag.info, tag.received_wall_ms, at_ms, started=started)
+                        event = cancelled(tag.ref, at_ms, started=started)
                         self._on_event(event)
                         acknowledge = acknowledgements.get(id(tag))  # a started one was
                         if acknowledge is not None:
@@ -493,8 +492,8 @@ class Player:
             self.timing_errors_ms.append(self._clock() - change.t_ms)
             try:
                 if note is not None:
-                    info = change.tag.info if isinstance(change.tag, PlannedStroke) else {}
-                    note(info.get("drawing"), info.get("seq"))
+                    ref = change.tag.ref if isinstance(change.tag, PlannedStroke) else NO_STROKE
+                    note(ref.drawing, ref.seq)
                 self._backend.set_intensity(change.row, change.column, change.intensity)
             except Exception as error:  # a motor that fails must not stop the others
                 log.warning("actuator (%d, %d): %s", change.row, change.column, error)
@@ -544,8 +543,7 @@ class Player:
                     row=change.row,
                     column=change.column,
                     message=f"cut {when}: {error} Every motor was switched off.",
-                    **{k: v for k, v in stroke.info.items() if k in _STROKE_FIELDS},
-                    received_at_ms=stroke.received_wall_ms,
+                    stroke=stroke.ref,
                 )
             )
             if acknowledge is not None:
@@ -575,8 +573,7 @@ class Player:
         refusal = capped.refusal
         row, column = refusal.actuator
         window_s = refusal.window_ms / 1000
-        info = capped.tag.info if isinstance(capped.tag, PlannedStroke) else {}
-        received = capped.tag.received_wall_ms if isinstance(capped.tag, PlannedStroke) else None
+        ref = capped.tag.ref if isinstance(capped.tag, PlannedStroke) else NO_STROKE
         self._on_event(
             Safety(
                 reason="duty_cycle",
@@ -587,8 +584,7 @@ class Player:
                     f"{refusal.duty_cycle:.0%} of the last {window_s:g} s at full drive, above "
                     f"the layout's max_duty_cycle {refusal.max_duty_cycle:.0%}; it needs a rest"
                 ),
-                **{k: v for k, v in info.items() if k in _STROKE_FIELDS},
-                received_at_ms=received,
+                stroke=ref,
                 duty_cycle=round(refusal.duty_cycle, 4),
                 max_duty_cycle=refusal.max_duty_cycle,
                 window_ms=refusal.window_ms,
@@ -602,29 +598,7 @@ class Player:
             self._pending -= 1
             acknowledge = self._done(stroke)
         self.played += 1
-        schedule = stroke.planned()
-        timing = {
-            **stroke.info,
-            "received_at_ms": stroke.received_wall_ms,
-            "start_at_ms": stroke.received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
-            "first_command_at_ms": stroke.received_wall_ms + (now - stroke.received_at_ms),
-            "latency_ms": now - stroke.received_at_ms,
-            "start_error_ms": now - stroke.start_ms,
-            "queued_ms": stroke.start_ms - stroke.received_at_ms,
-            "duration_ms": schedule.duration_ms,
-            "commands": len(schedule.commands),
-            "compressed_ms": stroke.compressed_ms,
-        }
-        event: Played
-        if schedule.adjusted:
-            event = Adjusted(
-                **timing,
-                reason=schedule.adjusted.reason,
-                requested_duration_ms=schedule.adjusted.requested_duration_ms,
-            )
-        else:
-            event = Played(**timing)
-        self._on_event(event)
+        self._on_event(played_event(stroke, now))
         if acknowledge is not None:
             acknowledge()
 
@@ -640,6 +614,31 @@ def caught_up(given: Schedule | Outline, duration_ms: float, layout: Layout) -> 
     return faster
 
 
+def played_event(stroke: PlannedStroke, written_at_ms: float) -> Played:
+    """The ``played`` event (``adjusted`` when the planner slowed it) of a stroke whose first
+    command went out at ``written_at_ms`` (the player's clock, as ``received_at_ms``)."""
+    schedule = stroke.planned()
+    received_wall_ms = stroke.received_wall_ms
+    timing: dict[str, Any] = {
+        "stroke": stroke.ref,
+        "start_at_ms": received_wall_ms + (stroke.start_ms - stroke.received_at_ms),
+        "first_command_at_ms": received_wall_ms + (written_at_ms - stroke.received_at_ms),
+        "latency_ms": written_at_ms - stroke.received_at_ms,
+        "start_error_ms": written_at_ms - stroke.start_ms,
+        "queued_ms": stroke.start_ms - stroke.received_at_ms,
+        "duration_ms": schedule.duration_ms,
+        "commands": len(schedule.commands),
+        "compressed_ms": stroke.compressed_ms,
+    }
+    if schedule.adjusted:
+        return Adjusted(
+            **timing,
+            reason=schedule.adjusted.reason,
+            requested_duration_ms=schedule.adjusted.requested_duration_ms,
+        )
+    return Played(**timing)
+
+
 def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Callable[[], None]:
     if first is None:
         return second
@@ -651,17 +650,14 @@ def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Calla
     return both
 
 
-def cancelled(
-    info: dict[str, Any], received_wall_ms: float, cancelled_at_ms: float, *, started: bool
-) -> Cancelled:
-    """The event for a stroke (``info``: topic, drawing, seq, sent_at_ms) that a control
-    message received at ``cancelled_at_ms`` cancelled."""
+def cancelled(stroke: StrokeRef, cancelled_at_ms: float, *, started: bool) -> Cancelled:
+    """The event for a stroke that a control message received at ``cancelled_at_ms``
+    cancelled."""
     return Cancelled(
         message="cut short by a control message"
         if started
         else "dropped by a control message before it played",
-        **info,
-        received_at_ms=received_wall_ms,
+        stroke=stroke,
         cancelled_at_ms=cancelled_at_ms,
         started=started,
     )

@@ -57,6 +57,17 @@ DURATION_NOT_POSITIVE = "duration_not_positive"
 DURATION_TOO_LONG = "duration_too_long"
 INTENSITY_OUT_OF_RANGE = "intensity_out_of_range"
 SENT_AT_OUT_OF_RANGE = "sent_at_out_of_range"
+# The sleeve's own reasons, for a stroke it could read (feelmysign.sleeve.admission, in the
+# order it checks them; docs/protocol.md, "What the sleeve publishes").
+RETAINED = "retained"
+CANCELLED = "cancelled"
+HELD = "held"  # a copy waiting with its original: no event, acknowledged when it plays
+DUPLICATE = "duplicate"
+RATE_LIMITED = "rate_limited"
+STALE = "stale"
+LATE = "late"
+QUEUE_FULL = "queue_full"
+PLAYER_STOPPED = "player_stopped"
 
 REASONS: dict[str, str] = {
     NOT_TEXT: "the payload is not a string or bytes, or its bytes are not UTF-8",

@@ -17,10 +17,11 @@ from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import number, output_file, topic
 from feelmysign.cli.options.wearer import add_wearer_option, wearer_from_args
 from feelmysign.connection import BrokerSettings
-from feelmysign.daemon import BURST, RATE_PER_S, Sleeve, SleeveOptions
+from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.services.stop_signals import call_on_stop_signals
+from feelmysign.sleeve.admission import BURST, RATE_PER_S
 from feelmysign.topics import LEGACY_TOPIC
 
 TELEMETRY_RATE_HZ = 20.0  # previews look smooth at 20 frames a second; more only costs traffic

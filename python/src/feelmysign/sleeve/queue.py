@@ -53,18 +53,17 @@ from collections import OrderedDict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from feelmysign import protocol
+
 NEVER_MS = float("-inf")  # the tail of an empty queue: the next stroke starts when it arrives
 REMEMBERED_DRAWINGS = 64  # drawings whose seqs are kept, for dropping redeliveries
 REMEMBERED_CANCELS = 64  # cancelled drawings kept, for refusing their later strokes
 
-# Outcomes of replay.
-PLAYED = "played"  # started and played whole
-CUT = "cut"  # started, cut short by a cancel
-CANCELLED = (
-    "cancelled"  # accepted, dropped by a cancel before it started; or of a cancelled drawing
-)
-HELD = "held"  # a copy of a stroke still waiting to play: nothing new is queued
-DUPLICATE = "duplicate"  # a copy of a stroke that started (or was dropped) before
+# Outcomes of replay: played whole, cut short by a cancel, or one of admission's reasons
+# (cancelled, held, duplicate).
+PLAYED = "played"
+CUT = "cut"
+CANCELLED, HELD, DUPLICATE = protocol.CANCELLED, protocol.HELD, protocol.DUPLICATE
 
 
 def start_ms(arrival_ms: float, tail_ms: float) -> float:
@@ -134,8 +133,8 @@ class Queue:
         self, arrival_ms: float, duration_ms: float, drawing: str | None = None, seq: int = 0
     ) -> float:
         """Queue a stroke: when it starts (and the tail moves to its end). With a ``drawing``,
-        its ``seq`` is remembered as :meth:`remember` does (in one call: this is on the path
-        from a stroke's message to its first command)."""
+        its ``seq`` is remembered (written out here, not a call to :meth:`remember`: this is
+        on the path from a stroke's message to its first command)."""
         if drawing is not None:
             seqs = self._seen.get(drawing)
             if seqs is None:
@@ -174,13 +173,9 @@ class Queue:
         return seqs is not None and seq in seqs
 
     def remember(self, drawing: str, seq: int) -> None:
-        """A seq of a drawing settled without being placed: a copy of it is seen too."""
-        seqs = self._seen.get(drawing)
-        if seqs is None:
-            seqs = self._new_drawing(drawing)
-        else:
-            self._seen.move_to_end(drawing)
-        seqs.add(seq)
+        """A seq of a drawing settled without being placed: a copy of it is seen too. Placed
+        as a stroke of no duration at the tail, which leaves the tail where it is."""
+        self.place(self.tail_ms, 0.0, drawing, seq)
 
     def _new_drawing(self, drawing: str) -> SeenSeqs:
         seqs = self._seen[drawing] = SeenSeqs()
@@ -235,59 +230,87 @@ class Outcome:
     played_ms: float | None = None
 
 
+class Simulation:
+    """A sleeve's queue played out at once, with no player thread: the strokes placed and not
+    cancelled, each with its start. It answers admission's questions
+    (:class:`feelmysign.sleeve.admission.QueueState`) for an arrival at any time."""
+
+    def __init__(self, floor_ms: float | None = None) -> None:
+        self.queue = Queue()
+        # The sleeve's floor: strokes behind their own drawing catch up down to it (None: not).
+        self.floor_ms = floor_ms
+        # Placed and not cancelled: key -> (start, duration, drawing, seq).
+        self.planned: dict[int, tuple[float, float, str | None, int | None]] = {}
+
+    def place(
+        self, key: int, arrival_ms: float, duration_ms: float, drawing: str | None, seq: int | None
+    ) -> float:
+        """Queue a stroke under ``key``: when it starts."""
+        if self.floor_ms is not None:
+            duration_ms = self.queue.catch_up_ms(arrival_ms, duration_ms, self.floor_ms, drawing)
+        if drawing is not None and seq is not None:
+            start = self.queue.place(arrival_ms, duration_ms, drawing, seq)
+        else:
+            start = self.queue.place(arrival_ms, duration_ms)
+        self.planned[key] = (start, duration_ms, drawing, seq)
+        return start
+
+    def cancel(self, cancel: CancelAt) -> dict[int, Outcome]:
+        """The strokes ``cancel`` cuts or drops, by key: each leaves the queue."""
+        now = cancel.at_ms
+        cut: dict[int, Outcome] = {}
+        for key, (start, duration, drawing, _) in list(self.planned.items()):
+            over = start + duration <= now
+            if over or (cancel.drawing is not None and drawing != cancel.drawing):
+                continue  # over already, or another drawing's
+            del self.planned[key]
+            cut[key] = Outcome(CUT, start, now - start) if start <= now else Outcome(CANCELLED)
+        # What still plays (and what played already, ending before now) sets the tail.
+        self.queue.replan(
+            (start + duration, drawing) for start, duration, drawing, _ in self.planned.values()
+        )
+        return cut
+
+    def waiting(self, drawing: object, seq: object, now_ms: float) -> bool:
+        if drawing is None or seq is None:
+            return False  # a legacy stroke has no identity: never a copy (as the player)
+        return any(
+            d == drawing and s == seq and start > now_ms for start, _, d, s in self.planned.values()
+        )
+
+    def seen(self, drawing: object, seq: object) -> bool:
+        return self.queue.seen(drawing, seq)
+
+    def wait_ms(self, now_ms: float) -> float:
+        return self.queue.wait_ms(now_ms)
+
+
 def replay(steps: Sequence[Arrival | CancelAt], floor_ms: float) -> list[Outcome]:
     """The sleeve's queue over a whole sequence, in the order the steps reach it (their
-    times never decrease): one outcome per arrival, in order. Strokes behind their own
-    drawing are caught up down to ``floor_ms`` (the sleeve's shortest unslowed stroke), as
-    the player does; a ``played`` outcome's ``played_ms`` is then below its duration. Every
-    stroke here plays (no planner, no pace, rate or duty-cycle rules: those are admission's)."""
-    queue = Queue()
+    times never decrease): one outcome per arrival, in order. Copies and strokes of a
+    cancelled drawing meet admission's rules; every other stroke plays (no planner, no
+    pace, rate or duty-cycle rules here). Strokes behind their own drawing are caught up
+    down to ``floor_ms`` (the sleeve's shortest unslowed stroke), as the player does; a
+    ``played`` outcome's ``played_ms`` is then below its duration."""
+    # Here, not at the top: admission keeps its cancelled drawings in this module.
+    from feelmysign.sleeve.admission import copy_of
+
+    simulation = Simulation(floor_ms)
     outcomes: list[Outcome | None] = []
-    # Accepted and not cancelled: index -> (start, duration, drawing, seq).
-    planned: dict[int, tuple[float, float, str | None, int | None]] = {}
     cancelled = CancelledDrawings()
     for step in steps:
         if isinstance(step, CancelAt):
-            _cancel(step, queue, planned, outcomes)
+            for index, outcome in simulation.cancel(step).items():
+                outcomes[index] = outcome
             if step.drawing is not None:
                 cancelled.cancel(step.drawing, step.at_ms)
             continue
-        if step.drawing is not None and step.drawing in cancelled:
-            outcomes.append(Outcome(CANCELLED))
+        copy = copy_of(step.drawing, step.seq, step.arrival_ms, True, cancelled, simulation)
+        if copy is not None:
+            outcomes.append(Outcome(copy))
             continue
-        if queue.seen(step.drawing, step.seq):
-            waiting = any(
-                drawing == step.drawing and seq == step.seq and start > step.arrival_ms
-                for start, _, drawing, seq in planned.values()
-            )
-            outcomes.append(Outcome(HELD if waiting else DUPLICATE))
-            continue
-        duration = queue.catch_up_ms(step.arrival_ms, step.duration_ms, floor_ms, step.drawing)
-        if step.drawing is not None and step.seq is not None:
-            start = queue.place(step.arrival_ms, duration, step.drawing, step.seq)
-        else:
-            start = queue.place(step.arrival_ms, duration)
-        planned[len(outcomes)] = (start, duration, step.drawing, step.seq)
+        simulation.place(len(outcomes), step.arrival_ms, step.duration_ms, step.drawing, step.seq)
         outcomes.append(None)
-    for index, (start, duration, _, _) in planned.items():
+    for index, (start, duration, _, _) in simulation.planned.items():
         outcomes[index] = Outcome(PLAYED, start, duration)
     return [o for o in outcomes if o is not None]
-
-
-def _cancel(
-    cancel: CancelAt,
-    queue: Queue,
-    planned: dict[int, tuple[float, float, str | None, int | None]],
-    outcomes: list[Outcome | None],
-) -> None:
-    now = cancel.at_ms
-    for index, (start, duration, drawing, _) in list(planned.items()):
-        if start + duration <= now or (cancel.drawing is not None and drawing != cancel.drawing):
-            continue  # over already, or another drawing's
-        del planned[index]
-        if start <= now:
-            outcomes[index] = Outcome(CUT, start, now - start)
-        else:
-            outcomes[index] = Outcome(CANCELLED)
-    # What still plays (and what played already, ending before now) sets the tail.
-    queue.replan((start + duration, drawing) for start, duration, drawing, _ in planned.values())
