@@ -176,3 +176,37 @@ def test_up_refuses_its_config_to_a_foreign_host_header(tmp_path: Path) -> None:
     assert answers[f"127.0.0.1:{port}"][0] == 200 and password
     status, body = answers["attacker.example"]
     assert status == 403 and password.encode() not in body
+
+
+def _send_line(tmp_path: Path) -> str:
+    """``feelmysign send --shape line`` with up's credentials; the drawing id it sent."""
+    credentials = str(tmp_path / "state" / "credentials.json")
+    command = [sys.executable, "-m", "feelmysign", "send", "--credentials", credentials]
+    command += ["--shape", "line", "--pace", "burst"]
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    sent = subprocess.run(
+        command, capture_output=True, text=True, timeout=WAIT_S, env=env, check=True
+    )
+    return sent.stdout.rsplit("(drawing ", 1)[1].split(")")[0]
+
+
+def test_up_prints_its_drawing_lines_again_after_a_broker_restart(tmp_path: Path) -> None:
+    """The drawing log listens again on the restarted broker: a clean session forgets
+    subscriptions, so a drawing sent after "Back:" still gets its "Drawing" line."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        before = _send_line(tmp_path)
+        _wait_for(lines, f"Drawing {before[:8]}: ", seen)
+        (mosquitto,) = _mosquitto_children(process.pid)
+        os.kill(mosquitto, signal.SIGKILL)
+        _wait_for(lines, "Back: the broker is running again on", seen)
+        after = _send_line(tmp_path)
+        _wait_for(lines, f"Drawing {after[:8]}: ", seen)
+    finally:
+        code = _interrupt(process)
+    assert code == 0, "".join(seen)
+    (line,) = [line for line in seen if line.startswith(f"Drawing {after[:8]}: ")]
+    assert " played" in line and "rejected" not in line, line

@@ -166,6 +166,7 @@ class DrawingLog:
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._client: mqtt.Client | None = None
+        self._subscribed = threading.Event()  # the broker acknowledged the subscription
         self._ticker = threading.Thread(
             target=self._tick, name="feelmysign-drawing-log", daemon=True
         )
@@ -179,6 +180,11 @@ class DrawingLog:
             self._emit(f"No per-drawing log: cannot listen to the sleeve's events ({error}).")
             return self
         client.on_message = self._on_message
+        client.on_subscribe = lambda *_: self._subscribed.set()
+        client.on_disconnect = lambda *_: self._subscribed.clear()
+        # Subscribed again on every reconnection: a clean session (and a broker started
+        # again) forgets subscriptions, and the log would go silent after a broker restart.
+        client.on_connect = self._on_connect
         client.subscribe(self._topic, qos=1)
         self._client = client
         self._ticker.start()
@@ -194,6 +200,16 @@ class DrawingLog:
             lines = self._summaries.finished(self._clock(), all_of_them=True)
         for line in lines:
             self._emit(line)
+
+    def listening(self) -> bool:
+        """Whether events reach the log now; True when it never could (said once already)."""
+        return self._client is None or self._subscribed.is_set()
+
+    def _on_connect(
+        self, client: mqtt.Client, _userdata: Any, _flags: Any, code: Any, _props: Any
+    ) -> None:
+        if not code.is_failure:
+            client.subscribe(self._topic, qos=1)
 
     def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
         try:
