@@ -24,7 +24,7 @@ from pathlib import Path
 import pytest
 
 from feelmysign.events import Adjusted, Cancelled, EventCopies, Played, Rejected, Safety
-from feelmysign.services.drawing_log import NO_DRAWING, DrawingSummaries
+from feelmysign.services.drawing_log import IDLE_S, NO_DRAWING, DrawingSummaries
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
 # The import names of python/pyproject.toml's [research] extra, which 'make up' leaves out.
@@ -99,11 +99,42 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 1600.0), now_s=3.0)
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 700.0), now_s=3.0)
     summaries.add(_played(late, 1903.0, 1900.0, sent_at_ms=2903.0 - 2000.0), now_s=3.0)
-    assert summaries.finished(4.6) == [
+    assert summaries.finished(4.6) == []  # quiet, but no other drawing started: resting
+    assert summaries.finished(3.0 + IDLE_S) == [
         "Drawing bbbbbbbb: 3 strokes played, 2 delayed on the way (by 1.6 s at most); "
         "start delay median 3 ms, max 3 ms"
     ]
     assert summaries.finished(100.0, all_of_them=True) == []
+
+
+def test_a_pen_resting_longer_than_a_quiet_spell_keeps_one_line_per_drawing() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5, idle_s=10.0)
+    drawing, following = "aaaaaaaa-1111", "eeeeeeee-5555"
+    summaries.add(replace(_played(drawing, 2.0), seq=0), now_s=0.0)
+    assert summaries.finished(1.6) == [] and summaries.finished(5.0) == []  # the pen rests
+    summaries.add(replace(_played(drawing, 4.0), seq=1), now_s=5.0)
+    summaries.add(replace(_played(following, 3.0), seq=0), now_s=5.5)
+    # The next drawing started: the first is over once it has been quiet for a spell.
+    assert summaries.finished(6.4) == []
+    assert summaries.finished(6.6) == [
+        "Drawing aaaaaaaa: 2 strokes played; start delay median 3 ms, max 4 ms"
+    ]
+    assert summaries.finished(7.1) == []  # the next one rests: no other drawing after it
+
+
+def test_a_drawing_that_goes_on_after_its_line_is_printed_again_with_all_of_it() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5, idle_s=10.0)
+    drawing = "aaaaaaaa-1111"
+    summaries.add(replace(_played(drawing, 2.0), seq=0), now_s=0.0)
+    assert summaries.finished(10.0) == [
+        "Drawing aaaaaaaa: 1 stroke played; start delay median 2 ms, max 2 ms"
+    ]
+    refused = Rejected(reason="outside_grid", message="m", drawing=drawing, seq=1, received_at_ms=1)
+    summaries.add(refused, now_s=30.0)
+    assert summaries.finished(50.0) == [
+        "Drawing aaaaaaaa (updated): 1 stroke played, 1 rejected (outside_grid); "
+        "start delay median 2 ms, max 2 ms"
+    ]
 
 
 def test_a_copy_of_an_event_after_a_broker_restart_is_counted_once() -> None:
@@ -145,7 +176,7 @@ def test_a_stroke_cut_short_is_counted_once_as_played() -> None:
     )
     summaries.add(cut, now_s=0.2)
     summaries.add(dropped, now_s=0.2)
-    assert summaries.finished(10.0) == [
+    assert summaries.finished(100.0) == [
         "Drawing cccccccc: 2 strokes played (1 cut short), 1 cancelled; "
         "start delay median 3 ms, max 4 ms"
     ]
@@ -158,7 +189,7 @@ def test_a_stroke_the_duty_cycle_cap_refused_is_counted_in_its_drawing() -> None
     capped = Safety(reason="duty_cycle", row=0, column=1, drawing=drawing, seq=1, received_at_ms=1)
     summaries.add(capped, now_s=0.1)
     summaries.add(Safety(reason="off_failed", row=0, column=1), now_s=0.1)  # about no stroke
-    assert summaries.finished(10.0) == [
+    assert summaries.finished(100.0) == [
         "Drawing dddddddd: 1 stroke played, 1 rejected (duty_cycle); "
         "start delay median 2 ms, max 2 ms"
     ]

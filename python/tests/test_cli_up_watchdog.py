@@ -15,11 +15,19 @@ import subprocess
 import sys
 import threading
 import time
+import uuid
 from pathlib import Path
 from typing import IO
 
 import pytest
 from host_header import get
+
+from feelmysign.broker.credentials import load_login
+from feelmysign.connection import connect_client
+from feelmysign.protocol import format_json
+from feelmysign.services.drawing_log import QUIET_S
+from feelmysign.stroke import Stroke
+from feelmysign.topics import sleeve_topic
 
 WAIT_S = 60.0
 
@@ -210,3 +218,42 @@ def test_up_prints_its_drawing_lines_again_after_a_broker_restart(tmp_path: Path
     assert code == 0, "".join(seen)
     (line,) = [line for line in seen if line.startswith(f"Drawing {after[:8]}: ")]
     assert " played" in line and "rejected" not in line, line
+
+
+def test_up_prints_one_line_for_a_drawing_whose_pen_rested(tmp_path: Path) -> None:
+    """A stroke, a rest longer than a quiet spell, a stroke of the same drawing, then the
+    next drawing: one "Drawing" line for the first, with both strokes."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    resting, following = str(uuid.uuid4()), str(uuid.uuid4())
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        sender = connect_client(
+            load_login(tmp_path / "state" / "credentials.json", "sender"), "test-rested-pen"
+        )
+        strokes_topic = sleeve_topic("sleeve1", "strokes")
+
+        def send(drawing: str, seq: int) -> None:
+            stroke = Stroke((0.0, 0.0), (0.0, 1.0), 120.0, 0.8, drawing, seq, time.time() * 1000)
+            sender.publish(strokes_topic, format_json(stroke), qos=1).wait_for_publish(WAIT_S)
+
+        try:
+            send(resting, 0)
+            time.sleep(QUIET_S + 1.0)  # the pen rests: longer than a quiet spell
+            send(resting, 1)
+            send(following, 0)
+            _wait_for(lines, f"Drawing {resting[:8]}", seen)
+        finally:
+            sender.disconnect()
+            sender.loop_stop()
+    finally:
+        code = _interrupt(process)
+    while True:  # what up printed up to its end (Ctrl-C prints what is left)
+        try:
+            seen.append(lines.get(timeout=2.0))
+        except queue.Empty:
+            break
+    assert code == 0, "".join(seen)
+    (line,) = [line for line in seen if line.startswith(f"Drawing {resting[:8]}")]
+    assert line.startswith(f"Drawing {resting[:8]}: 2 strokes played;"), line
