@@ -322,3 +322,33 @@ def test_a_research_command_says_what_to_install(tmp_path: Path) -> None:
     assert done.returncode == 1 and "Traceback" not in done.stderr
     assert done.stderr.startswith("Error: feelmysign study needs the research tools")
     assert "python[research]" in done.stderr
+
+
+# What 'up --study' serves its page without: the analysis, the simulated participants'
+# templates and the threshold staircase import these only when they are first used.
+DEFERRED_FOR_THE_STUDY_PAGE = ("numpy", "scipy", "pandas", "statsmodels", "matplotlib")
+
+
+def test_the_study_page_is_served_without_the_analysis_packages(tmp_path: Path) -> None:
+    study = tmp_path / "quick.db"
+    design = REPO / "deploy" / "studies" / "quick.toml"  # a recorded shape among its shapes
+    subprocess.run(
+        [FEELMYSIGN, "study", "new", str(design), "--out", str(study)],
+        capture_output=True,
+        timeout=WAIT_S,
+        check=True,
+    )
+    # What 'up --study' builds before it serves the page, minus the broker connection.
+    script = (
+        "import sys\n"
+        "from feelmysign.study.api import StudyApi\n"
+        "from feelmysign.study.runner import Session\n"
+        "from feelmysign.study.store import StudyStore\n"
+        f"store = StudyStore({str(study)!r})\n"
+        f"StudyApi(Session(store, None), {str(tmp_path / 'results')!r})\n"
+        f"print(' '.join(m for m in {DEFERRED_FOR_THE_STUDY_PAGE!r} if m in sys.modules))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_S, check=True
+    )
+    assert done.stdout.split() == [], done.stdout
