@@ -427,11 +427,18 @@ def order_cases() -> list[Case]:
             "not_a_number",
         ),
         Case(
-            "order-missing-before-version",
-            "v 2 and no duration_ms",
+            "order-version-before-missing",
+            "v 2 and no duration_ms: the version first, another version may need other fields",
             '{"v":2,"start":[0,0],"end":[1,0]}',
+            "unknown_version",
+        ),
+        Case(
+            "order-missing-version-first",
+            "no v and no start",
+            '{"end":[1,0],"duration_ms":100}',
             "missing_field",
         ),
+        Case("order-version-only", "only a future version", '{"v":2}', "unknown_version"),
         Case(
             "order-types-before-values",
             "start outside the grid and seq a string",

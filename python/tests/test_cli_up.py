@@ -32,7 +32,7 @@ from feelmysign.events import (
     Safety,
     StrokeRef,
 )
-from feelmysign.services.drawing_log import NO_DRAWING, DrawingSummaries
+from feelmysign.services.drawing_log import IDLE_S, NO_DRAWING, DrawingSummaries
 
 FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
 # The import names of python/pyproject.toml's [research] extra, which 'make up' leaves out.
@@ -59,12 +59,16 @@ WAIT_S = 60.0  # start-up of Mosquitto, the sleeve and the web server on a loade
 
 
 def _played(
-    drawing: str | None, latency_ms: float, queued_ms: float = 0.0, **extra: object
+    drawing: str | None,
+    latency_ms: float,
+    queued_ms: float = 0.0,
+    seq: int | None = None,
+    **extra: object,
 ) -> Played:
     sent_at_ms = extra.pop("sent_at_ms", None)
     assert sent_at_ms is None or isinstance(sent_at_ms, float)
     times = {
-        "stroke": StrokeRef(drawing=drawing, sent_at_ms=sent_at_ms, received_at_ms=1000.0),
+        "stroke": StrokeRef(drawing=drawing, seq=seq, sent_at_ms=sent_at_ms, received_at_ms=1000.0),
         "start_at_ms": 1001.0,
         "first_command_at_ms": 1000.0 + latency_ms,
         "latency_ms": latency_ms,
@@ -116,11 +120,46 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 1600.0), now_s=3.0)
     summaries.add(_played(late, 3.0, sent_at_ms=1003.0 - 700.0), now_s=3.0)
     summaries.add(_played(late, 1903.0, 1900.0, sent_at_ms=2903.0 - 2000.0), now_s=3.0)
-    assert summaries.finished(4.6) == [
+    assert summaries.finished(4.6) == []  # quiet, but no other drawing started: resting
+    assert summaries.finished(3.0 + IDLE_S) == [
         "Drawing bbbbbbbb: 3 strokes played, 2 delayed on the way (by 1.6 s at most); "
         "start delay median 3 ms, max 3 ms"
     ]
     assert summaries.finished(100.0, all_of_them=True) == []
+
+
+def test_a_pen_resting_longer_than_a_quiet_spell_keeps_one_line_per_drawing() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5, idle_s=10.0)
+    drawing, following = "aaaaaaaa-1111", "eeeeeeee-5555"
+    summaries.add(_played(drawing, 2.0, seq=0), now_s=0.0)
+    assert summaries.finished(1.6) == [] and summaries.finished(5.0) == []  # the pen rests
+    summaries.add(_played(drawing, 4.0, seq=1), now_s=5.0)
+    summaries.add(_played(following, 3.0, seq=0), now_s=5.5)
+    # The next drawing started: the first is over once it has been quiet for a spell.
+    assert summaries.finished(6.4) == []
+    assert summaries.finished(6.6) == [
+        "Drawing aaaaaaaa: 2 strokes played; start delay median 3 ms, max 4 ms"
+    ]
+    assert summaries.finished(7.1) == []  # the next one rests: no other drawing after it
+
+
+def test_a_drawing_that_goes_on_after_its_line_is_printed_again_with_all_of_it() -> None:
+    summaries = DrawingSummaries(quiet_s=1.5, idle_s=10.0)
+    drawing = "aaaaaaaa-1111"
+    summaries.add(_played(drawing, 2.0, seq=0), now_s=0.0)
+    assert summaries.finished(10.0) == [
+        "Drawing aaaaaaaa: 1 stroke played; start delay median 2 ms, max 2 ms"
+    ]
+    refused = Rejected(
+        reason="outside_grid",
+        message="m",
+        stroke=StrokeRef(drawing=drawing, seq=1, received_at_ms=1),
+    )
+    summaries.add(refused, now_s=30.0)
+    assert summaries.finished(50.0) == [
+        "Drawing aaaaaaaa (updated): 1 stroke played, 1 rejected (outside_grid); "
+        "start delay median 2 ms, max 2 ms"
+    ]
 
 
 def test_a_copy_of_an_event_after_a_broker_restart_is_counted_once() -> None:
@@ -171,7 +210,7 @@ def test_a_stroke_cut_short_is_counted_once_as_played() -> None:
     )
     summaries.add(cut, now_s=0.2)
     summaries.add(dropped, now_s=0.2)
-    assert summaries.finished(10.0) == [
+    assert summaries.finished(100.0) == [
         "Drawing cccccccc: 2 strokes played (1 cut short), 1 cancelled; "
         "start delay median 3 ms, max 4 ms"
     ]
@@ -189,7 +228,7 @@ def test_a_stroke_the_duty_cycle_cap_refused_is_counted_in_its_drawing() -> None
     )
     summaries.add(capped, now_s=0.1)
     summaries.add(Safety(reason="off_failed", row=0, column=1), now_s=0.1)  # about no stroke
-    assert summaries.finished(10.0) == [
+    assert summaries.finished(100.0) == [
         "Drawing dddddddd: 1 stroke played, 1 rejected (duty_cycle); "
         "start delay median 2 ms, max 2 ms"
     ]
@@ -323,3 +362,33 @@ def test_a_research_command_says_what_to_install(tmp_path: Path) -> None:
     assert done.returncode == 1 and "Traceback" not in done.stderr
     assert done.stderr.startswith("Error: feelmysign study needs the research tools")
     assert "python[research]" in done.stderr
+
+
+# What 'up --study' serves its page without: the analysis, the simulated participants'
+# templates and the threshold staircase import these only when they are first used.
+DEFERRED_FOR_THE_STUDY_PAGE = ("numpy", "scipy", "pandas", "statsmodels", "matplotlib")
+
+
+def test_the_study_page_is_served_without_the_analysis_packages(tmp_path: Path) -> None:
+    study = tmp_path / "quick.db"
+    design = REPO / "deploy" / "studies" / "quick.toml"  # a recorded shape among its shapes
+    subprocess.run(
+        [FEELMYSIGN, "study", "new", str(design), "--out", str(study)],
+        capture_output=True,
+        timeout=WAIT_S,
+        check=True,
+    )
+    # What 'up --study' builds before it serves the page, minus the broker connection.
+    script = (
+        "import sys\n"
+        "from feelmysign.study.api import StudyApi\n"
+        "from feelmysign.study.runner import Session\n"
+        "from feelmysign.study.store import StudyStore\n"
+        f"store = StudyStore({str(study)!r})\n"
+        f"StudyApi(Session(store, None), {str(tmp_path / 'results')!r})\n"
+        f"print(' '.join(m for m in {DEFERRED_FOR_THE_STUDY_PAGE!r} if m in sys.modules))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_S, check=True
+    )
+    assert done.stdout.split() == [], done.stdout

@@ -15,11 +15,19 @@ import subprocess
 import sys
 import threading
 import time
+import uuid
 from pathlib import Path
 from typing import IO
 
 import pytest
 from host_header import get
+
+from feelmysign.broker.credentials import load_login
+from feelmysign.connection import connect_client
+from feelmysign.protocol import format_json
+from feelmysign.services.drawing_log import QUIET_S
+from feelmysign.stroke import Stroke
+from feelmysign.topics import sleeve_topic
 
 WAIT_S = 60.0
 
@@ -176,3 +184,76 @@ def test_up_refuses_its_config_to_a_foreign_host_header(tmp_path: Path) -> None:
     assert answers[f"127.0.0.1:{port}"][0] == 200 and password
     status, body = answers["attacker.example"]
     assert status == 403 and password.encode() not in body
+
+
+def _send_line(tmp_path: Path) -> str:
+    """``feelmysign send --shape line`` with up's credentials; the drawing id it sent."""
+    credentials = str(tmp_path / "state" / "credentials.json")
+    command = [sys.executable, "-m", "feelmysign", "send", "--credentials", credentials]
+    command += ["--shape", "line", "--pace", "burst"]
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    sent = subprocess.run(
+        command, capture_output=True, text=True, timeout=WAIT_S, env=env, check=True
+    )
+    return sent.stdout.rsplit("(drawing ", 1)[1].split(")")[0]
+
+
+def test_up_prints_its_drawing_lines_again_after_a_broker_restart(tmp_path: Path) -> None:
+    """The drawing log listens again on the restarted broker: a clean session forgets
+    subscriptions, so a drawing sent after "Back:" still gets its "Drawing" line."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        before = _send_line(tmp_path)
+        _wait_for(lines, f"Drawing {before[:8]}: ", seen)
+        (mosquitto,) = _mosquitto_children(process.pid)
+        os.kill(mosquitto, signal.SIGKILL)
+        _wait_for(lines, "Back: the broker is running again on", seen)
+        after = _send_line(tmp_path)
+        _wait_for(lines, f"Drawing {after[:8]}: ", seen)
+    finally:
+        code = _interrupt(process)
+    assert code == 0, "".join(seen)
+    (line,) = [line for line in seen if line.startswith(f"Drawing {after[:8]}: ")]
+    assert " played" in line and "rejected" not in line, line
+
+
+def test_up_prints_one_line_for_a_drawing_whose_pen_rested(tmp_path: Path) -> None:
+    """A stroke, a rest longer than a quiet spell, a stroke of the same drawing, then the
+    next drawing: one "Drawing" line for the first, with both strokes."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    resting, following = str(uuid.uuid4()), str(uuid.uuid4())
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        sender = connect_client(
+            load_login(tmp_path / "state" / "credentials.json", "sender"), "test-rested-pen"
+        )
+        strokes_topic = sleeve_topic("sleeve1", "strokes")
+
+        def send(drawing: str, seq: int) -> None:
+            stroke = Stroke((0.0, 0.0), (0.0, 1.0), 120.0, 0.8, drawing, seq, time.time() * 1000)
+            sender.publish(strokes_topic, format_json(stroke), qos=1).wait_for_publish(WAIT_S)
+
+        try:
+            send(resting, 0)
+            time.sleep(QUIET_S + 1.0)  # the pen rests: longer than a quiet spell
+            send(resting, 1)
+            send(following, 0)
+            _wait_for(lines, f"Drawing {resting[:8]}", seen)
+        finally:
+            sender.disconnect()
+            sender.loop_stop()
+    finally:
+        code = _interrupt(process)
+    while True:  # what up printed up to its end (Ctrl-C prints what is left)
+        try:
+            seen.append(lines.get(timeout=2.0))
+        except queue.Empty:
+            break
+    assert code == 0, "".join(seen)
+    (line,) = [line for line in seen if line.startswith(f"Drawing {resting[:8]}")]
+    assert line.startswith(f"Drawing {resting[:8]}: 2 strokes played;"), line

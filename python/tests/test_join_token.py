@@ -25,6 +25,13 @@ def test_a_token_round_trips_and_gives_tls_settings() -> None:
     assert (settings.username, settings.ca_file) == ("sleeve-arm2", "/tmp/ca.pem")
 
 
+@pytest.mark.parametrize("url", ["mqtt://127.0.0.1:1883", "ws://localhost:9001", "mqtt://[::1]:1"])
+def test_a_token_for_a_sleeve_on_the_broker_s_machine_may_be_plain(url: str) -> None:
+    token = JoinToken(url, "arm2", "sleeve-arm2", "pw-123456")
+    assert decode_join_token(token.encode()) == token
+    assert token.settings().tls is False
+
+
 @pytest.mark.parametrize(
     ("text", "problem"),
     [
@@ -32,7 +39,8 @@ def test_a_token_round_trips_and_gives_tls_settings() -> None:
         ("fms1.%%%", "not base64 JSON"),
         (JoinToken("mqtts://h:1", "a", "u", "p", FINGERPRINT).encode()[:-9], "cut or mistyped"),
         (JoinToken("mqtts://h:1", "a", "u", "p", "12").encode(), "not 64 hex digits"),
-        (JoinToken("mqtt://h:1883", "a", "u", "p").encode(), "a sleeve joins over TLS only"),
+        (JoinToken("mqtt://h:1883", "a", "u", "p").encode(), "a sleeve joins over TLS unless"),
+        (JoinToken("ws://10.0.0.2:80", "a", "u", "p").encode(), "a sleeve joins over TLS unless"),
     ],
 )
 def test_a_damaged_token_says_what_is_wrong(text: str, problem: str) -> None:

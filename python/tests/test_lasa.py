@@ -7,9 +7,9 @@ import pytest
 from scipy.io import loadmat
 
 from feelmysign.research import lasa, metrics
-from feelmysign.research.evaluate import grid_points, params_for
+from feelmysign.research.evaluate import grid_points
 from feelmysign.research.rerun import rerun
-from feelmysign.simplify.registry import ALGORITHMS
+from feelmysign.simplify.registry import ALGORITHMS, params_for
 
 
 @pytest.fixture(scope="module")

@@ -15,12 +15,13 @@ import pytest
 from feelmysign.cli import main
 from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.research import dollar, metrics
-from feelmysign.research.evaluate import Row, Run, Source, evaluate_one, grid_points, params_for
+from feelmysign.research.evaluate import Row, Run, Source, evaluate_one, grid_points
 from feelmysign.research.lasa import load_lasa
 from feelmysign.research.playback import simulate
 from feelmysign.research.speeds import retimed
 from feelmysign.simplify import ALGORITHMS, PathSegment, Sample, Segment
 from feelmysign.simplify.recording import Recording
+from feelmysign.simplify.registry import params_for
 
 
 def _stroke(start: tuple[float, float], end: tuple[float, float], t0: float, t1: float) -> Segment:

@@ -421,11 +421,15 @@ def _json_error_text(error: Exception) -> str:
 
 
 def _stroke_from_object(document: dict[str, Any]) -> Stroke | Rejected:
-    for key in ("v", "start", "end", "duration_ms"):
-        if key not in document:
-            return Rejected(MISSING_FIELD, _missing_message(key, document), key)
+    if "v" not in document:
+        return Rejected(MISSING_FIELD, _missing_message("v", document), "v")
     try:
+        # The version before the other fields: another version may need other fields,
+        # so "no start" would send its sender looking for the wrong problem.
         _check_version(document["v"])
+        for key in ("start", "end", "duration_ms"):
+            if key not in document:
+                return Rejected(MISSING_FIELD, _missing_message(key, document), key)
         # Read in wire order, so the first problem reported is the same in every port.
         drawing = _read_drawing(document.get("drawing"))
         seq = _read_seq(document.get("seq"))

@@ -22,10 +22,10 @@ from feelmysign.bench._timing import Rate, best_rate, row
 from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.planner import plan
 from feelmysign.protocol import format_legacy, parse
-from feelmysign.research.evaluate import params_for
 from feelmysign.research.lasa import LasaDemo, load_lasa
 from feelmysign.research.rerun import rerun
 from feelmysign.simplify import ALGORITHMS
+from feelmysign.simplify.registry import params_for
 from feelmysign.stroke import Stroke
 
 PERCENTILE = 95

@@ -22,17 +22,17 @@ def run_add_sleeve(args: argparse.Namespace) -> int:
     files = StateFiles(Path(args.state_dir or default_state_dir()).absolute())
     credentials = load_credentials(files.credentials)
     sleeve_id = check_sleeve_id(args.new_sleeve_id)
-    url = args.url or credentials.mqtts_url
-    if url is None:
+    # No TLS listener: the plain loopback listener, as 'up' itself uses, for a second
+    # sleeve on this machine (a password may go in clear text on loopback only).
+    url = args.url or credentials.mqtts_url or credentials.mqtt_url
+    settings = parse_broker_url(url)
+    if not settings.tls and not settings.on_loopback:
         raise BrokerError(
             "bad-option",
-            "This broker has no TLS listener for a sleeve on another machine: start it with "
-            "'feelmysign up --lan' (or 'feelmysign broker --lan') first, or give the URL the "
-            "sleeve reaches it by with --url mqtts://HOST:PORT.",
-        )
-    if not parse_broker_url(url).tls:
-        raise BrokerError(
-            "bad-option", f"--url {url} is not mqtts:// or wss://: a sleeve joins over TLS only."
+            f"--url {url} is plain mqtt:// or ws:// to another machine: a sleeve joins over "
+            "TLS (mqtts:// or wss://) unless it runs on this machine (127.0.0.1, ::1 or "
+            "localhost). Start the broker with 'feelmysign up --lan' (or 'feelmysign broker "
+            "--lan') and leave --url out, or give its TLS URL.",
         )
     if sleeve_id == credentials.sleeve_id:
         account = credentials.sleeve
@@ -51,7 +51,12 @@ def run_add_sleeve(args: argparse.Namespace) -> int:
     print(
         f"Sleeve {sleeve_id}: account {account.username}, {where}. On the sleeve run\n"
         f"  feelmysign sleeve --join TOKEN\n"
-        "with the line above as TOKEN (it holds a password: keep it like one).",
+        "with the line above as TOKEN (it holds a password: keep it like one)."
+        + (
+            ""
+            if settings.tls
+            else f"\nIts broker URL {url} is on this machine only: the sleeve must run here too."
+        ),
         file=sys.stderr,
         flush=True,
     )

@@ -132,18 +132,18 @@ def run(args: argparse.Namespace) -> int:
                 sleeve_id=c.sleeve_id, backend_name=args.sleeve_backend, wearer=wearer
             )
 
-            sender = c.settings("sender")
+            log = DrawingLog(c.settings("sender"), c.sleeve_id)  # a line per drawing
 
             def started(sleeve: Sleeve) -> None:
                 _stop_on_signals(sleeve, watchdog)
-                watchdog.watch(sleeve)
+                watchdog.watch(sleeve, log.listening)
                 threading.Thread(
                     target=_announce,
                     args=(sleeve, page_url, broker, api is not None),
                     daemon=True,
                 ).start()
 
-            with DrawingLog(sender, c.sleeve_id):  # one line per drawing, from its events
+            with log:
                 run_sleeve(
                     settings,
                     layout,

@@ -90,8 +90,11 @@ def decode_join_token(text: str) -> JoinToken:
         raise _bad("its CA fingerprint is not 64 hex digits")
     joined = JoinToken(data["url"], data["id"], data["user"], data["pass"], fingerprint)
     settings = joined.settings()  # checks the URL
-    if not settings.tls:
-        raise _bad(f"its URL {joined.url} is not mqtts:// or wss://; a sleeve joins over TLS only")
+    if not settings.tls and not settings.on_loopback:
+        raise _bad(
+            f"its URL {joined.url} is not mqtts:// or wss://; a sleeve joins over TLS "
+            "unless it runs on the broker's machine (a loopback URL)"
+        )
     return joined
 
 

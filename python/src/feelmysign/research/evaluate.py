@@ -25,7 +25,7 @@ import csv
 import itertools
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +39,7 @@ from feelmysign.research.playback import simulate
 from feelmysign.research.rerun import rerun
 from feelmysign.research.sweep import label
 from feelmysign.simplify.recording import Recording
-from feelmysign.simplify.registry import Algorithm, Params
+from feelmysign.simplify.registry import Algorithm, Params, params_for
 from feelmysign.simplify.segment import Sample, Segment
 
 # Errors (grid units) at which the Douglas-Peucker frontier is drawn: from far below
@@ -156,20 +156,6 @@ def _round(value: Any) -> float:
 
 def _flag(value: bool | None) -> int | str:
     return "" if value is None else int(value)
-
-
-def params_for(algorithm: Algorithm, recording: Recording, overrides: dict[str, Any]) -> Params:
-    """The algorithm's defaults on the recording's canvas and sleeve, then ``overrides``."""
-    base = algorithm.params()
-    names = {f.name for f in fields(base)}
-    canvas = {
-        "canvas_width_px": recording.width_px,
-        "canvas_height_px": recording.height_px,
-        "rows": recording.rows or base.rows,
-        "columns": recording.columns or base.columns,
-    }
-    params: Params = replace(base, **{k: v for k, v in canvas.items() if k in names}, **overrides)
-    return params
 
 
 def grid_points(params: Params, frames: Sequence[Sample]) -> metrics.Points:

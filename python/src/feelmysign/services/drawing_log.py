@@ -1,7 +1,7 @@
 """One line per drawing in the terminal of ``feelmysign up``, from the sleeve's own events.
 
 ``up`` listens on ``feelmysign/<id>/events`` like any page does (with the
-sender's account) and, once a drawing has been quiet for ``QUIET_S``, prints::
+sender's account) and prints one line per drawing id once that drawing is over::
 
     Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 delayed on the way
     (by 1.6 s), 1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
@@ -17,8 +17,15 @@ of the strokes queued before it) to its first motor: the sleeve's own lateness,
 not the wait behind a drawing sent all at once. A stroke cut short by a stop
 was played: it counts once, as played (and cut short). A stroke the duty-cycle
 cap kept from playing counts as rejected (``duty_cycle``), like any refusal.
-Strokes without a drawing id (the legacy text format, JSON that leaves it out,
-a message the sleeve could not read) count as one drawing per quiet spell. The summary is
+A drawing is over when it has been quiet for ``QUIET_S`` and an event of another
+drawing has come since (the next drawing started), or once it has been quiet for ``IDLE_S``,
+or when ``up`` stops. A pen that rests a few seconds therefore does not split a
+drawing in two lines. A drawing that goes on after its line was printed (a rest
+longer than ``IDLE_S``) is printed again, marked ``(updated)``, with the totals of
+the whole drawing: the last line about a drawing id is always all of it, and
+replaces the earlier one rather than adding to it. Strokes without a drawing id (the legacy text
+format, JSON that leaves it out, a message the sleeve could not read) cannot be
+told apart: they count as one drawing per quiet spell of ``QUIET_S``. The summary is
 built by ``DrawingSummaries`` (pure: events and a clock in, lines out);
 ``DrawingLog`` is its MQTT listener.
 """
@@ -28,7 +35,7 @@ from __future__ import annotations
 import statistics
 import threading
 import uuid
-from collections import Counter
+from collections import Counter, OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -52,7 +59,9 @@ from feelmysign.topics import telemetry_topic
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
     import paho.mqtt.client as mqtt
 
-QUIET_S = 1.5  # a drawing is over when its strokes stop this long: a pen lifted and put down
+QUIET_S = 1.5  # a pen lifted: the drawing is over if another one has started since
+IDLE_S = 10.0  # a drawing quiet this long is over, even if no other one started
+UPDATABLE_DRAWINGS = 256  # printed drawings whose later strokes are added to their totals
 CHECK_INTERVAL_S = 0.25
 NO_DRAWING = "Strokes without a drawing id"
 SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one session
@@ -61,6 +70,8 @@ SHOWN_ID_CHARS = 8  # a uuid's first 8 characters tell drawings apart in one ses
 @dataclass
 class _Drawing:
     last_event_s: float
+    last_event_index: int = 0  # the summaries' event count at its last event
+    printed: bool = False  # its line was printed: the next one says "(updated)"
     played: int = 0
     slowed: int = 0
     cut_short: int = 0  # played, then stopped by a control message: counted in played only
@@ -71,6 +82,8 @@ class _Drawing:
 
     def line(self, name: str) -> str:
         shown = name if name == NO_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
+        if self.printed:
+            shown += " (updated)"
         parts = [f"{self.played} stroke{'s' if self.played != 1 else ''} played"]
         notes = [f"{self.slowed} slowed to be felt"] if self.slowed else []
         notes += [f"{self.cut_short} cut short"] if self.cut_short else []
@@ -99,11 +112,14 @@ def _seconds(ms: float) -> str:
 
 
 class DrawingSummaries:
-    """Events in, one summary line per drawing out once it has been quiet for ``quiet_s``."""
+    """Events in, one summary line per drawing out once it is over (see the module)."""
 
-    def __init__(self, *, quiet_s: float = QUIET_S) -> None:
+    def __init__(self, *, quiet_s: float = QUIET_S, idle_s: float = IDLE_S) -> None:
         self._quiet_s = quiet_s
+        self._idle_s = idle_s
         self._drawings: dict[str, _Drawing] = {}
+        self._printed: OrderedDict[str, _Drawing] = OrderedDict()  # oldest first
+        self._events = 0  # counted: "another drawing sent since" compares these
         self._copies = EventCopies()  # a broker restart may deliver an event again
 
     def add(self, event: Event, now_s: float) -> None:
@@ -114,8 +130,12 @@ class DrawingSummaries:
         if not isinstance(event, Played | Rejected | Cancelled | Safety):
             return  # error events are logged by the sleeve itself
         name = event.drawing or NO_DRAWING
+        if name not in self._drawings and name in self._printed:
+            self._drawings[name] = self._printed.pop(name)  # goes on: its totals go on too
         drawing = self._drawings.setdefault(name, _Drawing(now_s))
+        self._events += 1
         drawing.last_event_s = now_s
+        drawing.last_event_index = self._events
         if isinstance(event, Played):
             drawing.played += 1
             drawing.slowed += isinstance(event, Adjusted)
@@ -130,14 +150,31 @@ class DrawingSummaries:
         else:
             drawing.cancelled += 1
 
+    def _is_over(self, name: str, drawing: _Drawing, now_s: float) -> bool:
+        quiet_s = now_s - drawing.last_event_s
+        if quiet_s >= self._idle_s:
+            return True
+        # Without an id, drawings cannot be told apart: a quiet spell ends one.
+        next_started = name == NO_DRAWING or self._events > drawing.last_event_index
+        return quiet_s >= self._quiet_s and next_started
+
     def finished(self, now_s: float, *, all_of_them: bool = False) -> list[str]:
-        """The lines of the drawings quiet since ``quiet_s`` (or of every one), oldest first."""
+        """The lines of the drawings that are over (or of every one), oldest first."""
         done = [
             name
             for name, drawing in self._drawings.items()
-            if all_of_them or now_s - drawing.last_event_s >= self._quiet_s
+            if all_of_them or self._is_over(name, drawing, now_s)
         ]
-        return [self._drawings.pop(name).line(name) for name in done]
+        lines = []
+        for name in done:
+            drawing = self._drawings.pop(name)
+            lines.append(drawing.line(name))
+            if name != NO_DRAWING:
+                drawing.printed = True
+                self._printed[name] = drawing
+                if len(self._printed) > UPDATABLE_DRAWINGS:
+                    self._printed.popitem(last=False)
+        return lines
 
 
 class DrawingLog:
@@ -166,6 +203,7 @@ class DrawingLog:
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._client: mqtt.Client | None = None
+        self._subscribed = threading.Event()  # the broker acknowledged the subscription
         self._ticker = threading.Thread(
             target=self._tick, name="feelmysign-drawing-log", daemon=True
         )
@@ -179,6 +217,11 @@ class DrawingLog:
             self._emit(f"No per-drawing log: cannot listen to the sleeve's events ({error}).")
             return self
         client.on_message = self._on_message
+        client.on_subscribe = lambda *_: self._subscribed.set()
+        client.on_disconnect = lambda *_: self._subscribed.clear()
+        # Subscribed again on every reconnection: a clean session (and a broker started
+        # again) forgets subscriptions, and the log would go silent after a broker restart.
+        client.on_connect = self._on_connect
         client.subscribe(self._topic, qos=1)
         self._client = client
         self._ticker.start()
@@ -194,6 +237,16 @@ class DrawingLog:
             lines = self._summaries.finished(self._clock(), all_of_them=True)
         for line in lines:
             self._emit(line)
+
+    def listening(self) -> bool:
+        """Whether events reach the log now; True when it never could (said once already)."""
+        return self._client is None or self._subscribed.is_set()
+
+    def _on_connect(
+        self, client: mqtt.Client, _userdata: Any, _flags: Any, code: Any, _props: Any
+    ) -> None:
+        if not code.is_failure:
+            client.subscribe(self._topic, qos=1)
 
     def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
         try:

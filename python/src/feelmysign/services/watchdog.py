@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Callable
 
 from feelmysign.broker import Broker
 from feelmysign.daemon import CONNECTION_STATE, Sleeve
@@ -34,6 +35,7 @@ class Watchdog(Started):
         self._stopping = threading.Event()
         self._wake = threading.Event()  # set by a stop of either kind: no waiting out the interval
         self._sleeve: Sleeve | None = None
+        self._listening: Callable[[], bool] = lambda: True
         self._thread = threading.Thread(target=self._run, name="feelmysign-watchdog", daemon=True)
 
     def start(self) -> None:
@@ -48,8 +50,12 @@ class Watchdog(Started):
         self._broker.stop()  # a broker started here again is stopped here too
         logging.getLogger(Sleeve.__module__).removeFilter(self._reported_here)
 
-    def watch(self, sleeve: Sleeve) -> None:
+    def watch(self, sleeve: Sleeve, listening: Callable[[], bool] | None = None) -> None:
+        """Report on ``sleeve``; "Back:" also waits for ``listening()`` (the drawing log):
+        a drawing sent after that line is then in the terminal too."""
         self._sleeve = sleeve
+        if listening is not None:
+            self._listening = listening
         logging.getLogger(Sleeve.__module__).addFilter(self._reported_here)
 
     def _reported_here(self, record: logging.LogRecord) -> bool:
@@ -106,7 +112,7 @@ class Watchdog(Started):
             if sleeve is None:
                 continue
             now = sleeve.counts["connections"]
-            if lost and now > connections and sleeve.connected.is_set():
+            if lost and now > connections and sleeve.connected.is_set() and self._listening():
                 lost = False
                 if restarted_on:
                     print(

@@ -10,8 +10,8 @@ the parameters that only one algorithm has (giving one to the other is an error)
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Any, Protocol
+from dataclasses import dataclass, fields, replace
+from typing import TYPE_CHECKING, Any, Protocol
 
 from feelmysign.simplify.angle import ANGLE_PARAMS, AngleParams, AngleSimplifier
 from feelmysign.simplify.angle import SWEEPS as ANGLE_SWEEPS
@@ -22,6 +22,9 @@ from feelmysign.simplify.segment import Sample, Segment
 from feelmysign.simplify.window import SWEEPS as WINDOW_SWEEPS
 from feelmysign.simplify.window import WINDOW_PARAMS, WindowParams, WindowSimplifier
 from feelmysign.simplify.window import describe as describe_window
+
+if TYPE_CHECKING:
+    from feelmysign.simplify.recording import Recording
 
 Params = AngleParams | WindowParams
 
@@ -144,3 +147,17 @@ def simplify_paths(params: Params, paths: Sequence[Sequence[Sample]]) -> list[Pa
             out += [PathSegment(index, s) for s in simplifier.push(item)]
         out += [PathSegment(index, s) for s in simplifier.end()]
     return out
+
+
+def params_for(algorithm: Algorithm, recording: Recording, overrides: dict[str, Any]) -> Params:
+    """The algorithm's defaults on the recording's canvas and sleeve, then ``overrides``."""
+    base = algorithm.params()
+    names = {f.name for f in fields(base)}
+    canvas = {
+        "canvas_width_px": recording.width_px,
+        "canvas_height_px": recording.height_px,
+        "rows": recording.rows or base.rows,
+        "columns": recording.columns or base.columns,
+    }
+    params: Params = replace(base, **{k: v for k, v in canvas.items() if k in names}, **overrides)
+    return params

@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import Any
 
 from feelmysign.errors import FeelMySignError, StudyError
-from feelmysign.study.analysis import analyse_study
 from feelmysign.study.runner import Session
 from feelmysign.study.threshold_desk import ThresholdDesk, dimension_of
 
@@ -209,6 +208,10 @@ class StudyApi:
         if not self._analysing.acquire(blocking=False):
             raise StudyError("an analysis is already running; wait for it")
         try:
+            # Imported here: the analysis needs pandas, statsmodels and matplotlib (seconds
+            # to import), and serving the study page needs none of them until this button.
+            from feelmysign.study.analysis import analyse_study
+
             out = self.results_dir / time.strftime("%Y%m%d-%H%M%S")
             analysis = analyse_study(self.store, out, samples=self._bootstrap)
             self._latest = out

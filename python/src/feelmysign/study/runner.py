@@ -11,6 +11,7 @@ offline ``simulated_sleeve.play_offline`` for dry runs without a sleeve).
 
 from __future__ import annotations
 
+import functools
 import json
 import sqlite3
 import uuid
@@ -21,9 +22,8 @@ from feelmysign.errors import FeelMySignError, StudyError
 from feelmysign.events import Adjusted, Event, EventError, Played, Rejected, event_from_json
 from feelmysign.layout import Layout
 from feelmysign.schedule import stroke_to_json
-from feelmysign.stroke import Stroke
+from feelmysign.stroke import Point, Stroke
 from feelmysign.study.coding import code_answer
-from feelmysign.study.simulated import SimulatedParticipant, templates
 from feelmysign.study.stimulus import stimulus_layout, trial_strokes
 from feelmysign.study.store import StudyStore
 
@@ -74,8 +74,16 @@ class Session:
         self.store = store
         self._play = play
         self.layout: Layout = stimulus_layout(store.design.stimulus, store.base_dir)
-        self._templates = templates(store.design, self.layout, store.base_dir)
         self._simulation_seed = simulation_seed
+
+    @functools.cached_property
+    def _templates(self) -> dict[str, list[Point]]:
+        """The shapes' outlines a simulated participant compares with: made when one first
+        answers, since they import numpy and plan every shape (seconds on a Pi) and a
+        study with real participants only never needs them."""
+        from feelmysign.study.simulated import templates
+
+        return templates(self.store.design, self.layout, self.store.base_dir)
 
     @property
     def player(self) -> Play | None:
@@ -237,6 +245,8 @@ class Session:
         if not sends:
             raise StudyError("send the shape first: the simulated participant answers what it felt")
         strokes = [stroke_from_json(s) for s in json.loads(sends[-1]["strokes_json"])]
+        from feelmysign.study.simulated import SimulatedParticipant
+
         participant = SimulatedParticipant(seed=self._simulation_seed + int(row["number"]))
         result = participant.answer(
             strokes, self.layout, self.store.design, self._templates, f"{row['code']}:{trial['id']}"

@@ -17,7 +17,7 @@ from feelmysign.protocol import Rejected, validate_stroke
 from feelmysign.research.rerun import rerun
 from feelmysign.shapes import shape_strokes
 from feelmysign.simplify.recording import load_recording
-from feelmysign.simplify.registry import ALGORITHMS
+from feelmysign.simplify.registry import ALGORITHMS, params_for
 from feelmysign.stroke import Stroke
 from feelmysign.study.design import Design, Stimulus
 
@@ -61,10 +61,6 @@ def recorded_strokes(
     what the simplifier gave, which is this level's resolution.
     """
     # Drawn on the study's sleeve, whatever sleeve the recording was made for.
-    # Here, not at the top: research.evaluate's metrics import scipy and pandas, seconds that
-    # a study's design check, status or export never needs.
-    from feelmysign.research.evaluate import params_for
-
     recording = replace(load_recording(recording_path), rows=layout.rows, columns=layout.columns)
     params = params_for(ALGORITHMS[simplifier], recording, settings)
     result = rerun(recording, params)

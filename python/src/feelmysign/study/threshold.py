@@ -24,8 +24,6 @@ import math
 import random
 from dataclasses import dataclass
 
-import numpy as np
-
 from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
 from feelmysign.stroke import Stroke
@@ -76,6 +74,10 @@ class Procedure:
     def __init__(self, threshold: Threshold, dimension: Dimension) -> None:
         self.settings = threshold
         self.dimension = dimension
+        # numpy here, not at the top: the design check (check_fits, at every start of
+        # 'up --study') needs none of it, and it takes a good part of a second to import.
+        import numpy as np
+
         grid = dimension_settings(threshold, dimension)
         self.values = np.geomspace(grid.minimum, grid.maximum, grid.steps)
         self.thresholds = np.geomspace(
@@ -103,6 +105,8 @@ class Procedure:
         return float(self._quest.next_stim["intensity"])
 
     def update(self, value: float, correct: bool) -> None:
+        import numpy as np
+
         nearest = float(self.values[np.argmin(np.abs(self.values - value))])
         self._quest.update(
             stim={"intensity": nearest}, outcome={"response": "Correct" if correct else "Incorrect"}
@@ -110,6 +114,8 @@ class Procedure:
         self.trials += 1
 
     def estimate(self) -> Estimate:
+        import numpy as np
+
         marginal = np.asarray(self._quest.marginal_posterior["threshold"], dtype=float)
         cumulative = np.cumsum(marginal) / marginal.sum()
         tail = (1 - CREDIBLE) / 2

@@ -104,8 +104,9 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
             metavar="TOKEN",
             type=not_empty("join token"),
             help=f"the one-line token of 'feelmysign broker add-sleeve ID': broker URL (TLS), "
-            f"its CA's fingerprint, this sleeve's id and login; replaces the other broker "
-            f"options (default: ${JOIN_ENV})",
+            f"its CA's fingerprint, this sleeve's id and login; not to be given with "
+            f"--broker, --id, --username, --password or --credentials (default: ${JOIN_ENV}, "
+            "which wins over their environment variables)",
         )
     group.add_argument(
         "--credentials",
@@ -132,6 +133,9 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
     env = os.environ
     token = getattr(args, "join", None) or (env.get(JOIN_ENV) if role == "sleeve" else None)
     if token:
+        _check_nothing_beside_the_token(
+            "--join" if getattr(args, "join", None) else f"${JOIN_ENV}", args
+        )
         return join_settings(token, default_trust_dir())
     url = args.broker or env.get(BROKER_ENV) or None
     username = args.username or env.get(USERNAME_ENV) or None
@@ -160,6 +164,34 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
     return parse_broker_url(
         url or DEFAULT_BROKER_URL, username=username, password=password, sleeve_id=sleeve_id
     )
+
+
+# What a join token holds, as options.
+_IN_A_TOKEN = (
+    ("broker", "--broker"),
+    ("sleeve_id", "--id"),
+    ("username", "--username"),
+    ("password", "--password"),
+    ("credentials", "--credentials"),
+)
+
+
+def _check_nothing_beside_the_token(token_from: str, args: argparse.Namespace) -> None:
+    """A join token is the broker URL, sleeve id and login: one of these options beside
+    it is a conflict, refused rather than silently overruled.
+
+    Their environment variables are not: the systemd unit sets $FEELMYSIGN_CREDENTIALS
+    for every sleeve, and a token in sleeve.env wins over it, as the unit says.
+    """
+    given = [option for key, option in _IN_A_TOKEN if getattr(args, key, None)]
+    if given:
+        also = " and ".join(given)
+        raise BrokerConnectionError(
+            "bad-option",
+            f"{token_from} (a join token) holds the broker URL, the sleeve id and its login, "
+            f"and would win over {also}: give one or the other. Leave {also} out to join "
+            f"with the token, or leave {token_from} out to use {also}.",
+        )
 
 
 def _login(path: str | None, url: str | None, role: Role) -> BrokerSettings | None:

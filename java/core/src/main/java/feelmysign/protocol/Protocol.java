@@ -442,13 +442,18 @@ public final class Protocol {
   }
 
   private static Object strokeFromObject(Map<String, Object> document) {
-    for (String key : new String[] {"v", "start", "end", "duration_ms"}) {
-      if (!document.containsKey(key)) {
-        return new Rejected(MISSING_FIELD, missingMessage(key, document), key);
-      }
+    if (!document.containsKey("v")) {
+      return new Rejected(MISSING_FIELD, missingMessage("v", document), "v");
     }
     try {
+      // The version before the other fields: another version may need other fields,
+      // so "no start" would send its sender looking for the wrong problem.
       checkVersion(document.get("v"));
+      for (String key : new String[] {"start", "end", "duration_ms"}) {
+        if (!document.containsKey(key)) {
+          return new Rejected(MISSING_FIELD, missingMessage(key, document), key);
+        }
+      }
       // Read in wire order, so the first problem reported is the same in every port.
       String drawing = readDrawing(document.get("drawing"));
       BigInteger seq = readSeq(document.get("seq"));
