@@ -276,7 +276,7 @@ java-soak: $(JAVA_STAMP) $(STAMP) system
 	  feelmysign.processing.SoakSketches $(SOAK_MINUTES) target/soak.csv
 
 java-clean:
-	rm -rf $(JAVA_DIR)/*/target
+	rm -rf $(JAVA_DIR)/*/target $(JAVA_DIR)/target
 
 install: $(JAVA_STAMP)
 bench: java-bench
