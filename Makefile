@@ -252,7 +252,7 @@ SYSTEM_PACKAGES += maven openjdk-17-jdk-headless
 # Xvfb (and xauth, for xvfb-run): the Processing library's example sketch runs on a virtual screen.
 SYSTEM_PACKAGES += xvfb xauth
 
-.PHONY: java-build java-test java-bench java-clean processing-library java-bench-jar bench-timed-java
+.PHONY: java-build java-test java-bench java-soak java-clean processing-library java-bench-jar bench-timed-java
 
 # Resolves every dependency and plugin (a build without tests) once per change of a pom.
 $(JAVA_STAMP): $(JAVA_POMS) | system
@@ -296,8 +296,22 @@ bench-timed-java:
 processing-library: $(JAVA_STAMP)
 	$(MVN) -DskipTests package
 
+# A long session (docs/processing.md, "Long sessions"): ModernSketch and PaperSketch under Xvfb,
+# a scripted mouse drawing path after path to a real broker and sleeve simulator for
+# SOAK_MINUTES; a CSV row a minute (heap after GC, RSS, draw() time, frame interval, strokes)
+# in java/processing/target/soak.csv, then the last five minutes against the first five.
+# Not part of test or bench: it takes an hour by default. Run nice'd: it shares the machine.
+SOAK_MINUTES ?= 60
+java-soak: $(JAVA_STAMP) $(STAMP) system
+	$(MVN) -DskipTests -pl processing -am package dependency:build-classpath \
+	  -Dmdep.outputFile=target/soak-classpath.txt -Dmdep.includeScope=test
+	cd $(JAVA_DIR)/processing && nice -n 10 xvfb-run -a -s "-screen 0 1920x1080x24" \
+	  java -Djava.awt.headless=false -Xmx512m \
+	  -cp "target/test-classes:target/classes:$$(cat target/soak-classpath.txt)" \
+	  feelmysign.processing.SoakSketches $(SOAK_MINUTES) target/soak.csv
+
 java-clean:
-	rm -rf $(JAVA_DIR)/*/target
+	rm -rf $(JAVA_DIR)/*/target $(JAVA_DIR)/target
 
 install: $(JAVA_STAMP)
 bench: $(JAVA_STAMP)

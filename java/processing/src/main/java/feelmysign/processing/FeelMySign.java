@@ -62,6 +62,11 @@ public class FeelMySign {
   public static final int EVENT_QUEUE = 1000;
   /** Events kept for {@link #drawPlayed} and {@link #events}. */
   public static final int EVENT_HISTORY = 200;
+  /**
+   * Samples kept for {@link #drawLine} (about 2.7 minutes of one drag at 60 fps): beyond this the
+   * oldest after the press go first, so the line keeps its start and its latest stretch.
+   */
+  public static final int LINE_SAMPLES = 10_000;
 
   private final PApplet parent;
   private String brokerUrl = "mqtt://127.0.0.1:1883";
@@ -445,7 +450,7 @@ public class FeelMySign {
     if (!simplifier.drawing()) {
       return; // a drag that began outside the sketch
     }
-    if (line.size() >= 10_000) {
+    if (line.size() >= LINE_SAMPLES) {
       line.remove(1); // bounded: the on-screen line of a path drawn for minutes
     }
     line.add(sample);

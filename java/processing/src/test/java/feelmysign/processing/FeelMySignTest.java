@@ -192,6 +192,43 @@ class FeelMySignTest {
   }
 
   @Test
+  void aSketchThatNeverClearsKeepsOnlyTheLatestStrokesAndLine() throws Exception {
+    LineSketch sketch = new LineSketch();
+    sketch.width = 400;
+    sketch.height = 300;
+    // Nothing cleared on press: a session of hours would otherwise keep every stroke it sent.
+    FeelMySign library = new FeelMySign(sketch).broker("mqtt://127.0.0.1:" + unusedPort())
+        .set("clear_on_press", false).set("stretch", true).start();
+    try {
+      int count = FeelMySign.HISTORY_STROKES * 3;
+      feelmysign.protocol.Stroke last = null;
+      for (int i = 0; i < count; i++) {
+        last = library.send(new feelmysign.protocol.Stroke(0, i % 3, 3, 2 - i % 3, 100));
+      }
+      List<feelmysign.protocol.Stroke> kept = library.sent();
+      assertEquals(FeelMySign.HISTORY_STROKES, kept.size());
+      assertEquals(last, kept.get(kept.size() - 1), "the newest stroke is kept");
+      assertEquals((long) count - FeelMySign.HISTORY_STROKES, kept.get(0).seq(),
+          "the oldest go first");
+      sketch.lines.clear();
+      library.drawSent();
+      assertEquals(FeelMySign.HISTORY_STROKES, sketch.lines.size(), "drawSent draws what is kept");
+
+      // One drag of minutes: the on-screen line keeps its start and the latest samples.
+      post(library, MouseEvent.PRESS, 0, 10, 10);
+      for (int i = 1; i <= FeelMySign.LINE_SAMPLES + 500; i++) {
+        post(library, MouseEvent.DRAG, 16L * i, 10 + i % 300, 10 + i % 200);
+      }
+      sketch.lines.clear();
+      library.drawLine();
+      assertEquals(FeelMySign.LINE_SAMPLES - 1, sketch.lines.size());
+      assertEquals(10f, sketch.lines.get(0)[0], "the line starts where the press was");
+    } finally {
+      library.dispose();
+    }
+  }
+
+  @Test
   void thePaperSketchSaysTheAngleSimplifiersDefaults() throws IOException {
     String sketch = java.nio.file.Files.readString(
         java.nio.file.Path.of("examples/PaperSketch/PaperSketch.pde"));
