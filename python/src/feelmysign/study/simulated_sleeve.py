@@ -20,9 +20,10 @@ import time
 from dataclasses import replace
 from typing import Any
 
+from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.events import Event, Rejected
 from feelmysign.layout import Layout
-from feelmysign.player import PlannedStroke, played_event
+from feelmysign.player import PlannedStroke, caught_up, played_event
 from feelmysign.protocol import QUEUE_FULL, format_json
 from feelmysign.sleeve.admission import (
     MAX_BACKLOG_MS,
@@ -58,7 +59,7 @@ def offline_player(layout: Layout) -> Play:
                 received_wall_ms=arrival_ms,
                 queue=simulation,
             )
-            event = _placed(verdict, index, arrival_ms, simulation)
+            event = _placed(verdict, index, arrival_ms, simulation, layout)
             events.append(event.to_json())
         return events
 
@@ -66,10 +67,15 @@ def offline_player(layout: Layout) -> Play:
 
 
 def _placed(
-    verdict: Admitted | Refused, index: int, arrival_ms: float, simulation: Simulation
+    verdict: Admitted | Refused,
+    index: int,
+    arrival_ms: float,
+    simulation: Simulation,
+    layout: Layout,
 ) -> Event:
     """The event for an admitted stroke placed in the queue as the player places it (refused
-    when the queue is full), or for a refused one."""
+    when the queue is full; played faster when it waits behind its drawing, as the player
+    catches up), or for a refused one."""
     if isinstance(verdict, Refused):
         return Rejected(reason=verdict.reason, message=verdict.message, stroke=verdict.ref)
     outline, ref = verdict
@@ -78,6 +84,14 @@ def _placed(
     if full is not None:
         return Rejected(reason=QUEUE_FULL, message=full, stroke=ref)
     stroke = PlannedStroke(outline.schedule(), arrival_ms, ref)
+    floor_ms = shortest_planned_ms(layout.shortest_burst_ms)
+    fast_ms = simulation.queue.catch_up_ms(
+        arrival_ms, stroke.planned().duration_ms, floor_ms, ref.drawing
+    )
+    faster = caught_up(outline, fast_ms, layout) if fast_ms < outline.duration_ms else None
+    if faster is not None:
+        stroke.compressed_ms = round(outline.duration_ms - faster.duration_ms, 3)
+        stroke.schedule = faster.schedule()
     stroke.start_ms = simulation.place(
         index, arrival_ms, stroke.planned().duration_ms, ref.drawing, ref.seq
     )
