@@ -165,8 +165,14 @@ class Sleeve:
         self._options = options
         self._id = options.sleeve_id
         self._outbox: queue.SimpleQueue[_Outgoing | None] = queue.SimpleQueue()
+        # Catching up never plays a stroke briefer than the floor the status advertises: the
+        # motors' own, or the wearer's measured shortest felt duration when that is longer.
         self._player = player or Player(
-            backend, layout, on_event=self._event, spin_ms=options.spin_ms
+            backend,
+            layout,
+            on_event=self._event,
+            spin_ms=options.spin_ms,
+            floor_ms=sleeve_floor(layout, options.wearer).min_duration_ms,
         )
         self._admission = Admission(
             layout,

@@ -139,6 +139,7 @@ class Player:
         max_pending: int = MAX_PENDING,
         max_backlog_ms: float = MAX_BACKLOG_MS,
         spin_ms: float = SPIN_MS,
+        floor_ms: float | None = None,
     ) -> None:
         self._backend = backend
         self._timeline = Timeline(layout)
@@ -160,8 +161,11 @@ class Player:
         # remember): a copy of one is a duplicate.
         self._queue = Queue()
         self._layout = layout
-        # The shortest stroke played without slowing it: catching up stops there.
-        self._floor_ms = shortest_planned_ms(layout.shortest_burst_ms)
+        # The shortest stroke played without slowing it, or the floor the sleeve advertises
+        # (raised to its wearer's measured limits): catching up stops there.
+        self._floor_ms = (
+            shortest_planned_ms(layout.shortest_burst_ms) if floor_ms is None else floor_ms
+        )
         # Accepted, with a drawing and seq, and not yet started, refused or dropped: what a
         # redelivered copy must wait for (see hold).
         self._unplayed: dict[tuple[str, int], PlannedStroke] = {}
