@@ -20,6 +20,8 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     [i2c]
     bus = 1                       # /dev/i2c-1
     multiplexers = [0x70, 0x71]   # TCA9548A addresses
+    # Optional: every DRV2605L's EN pin on one GPIO line, pulled down (docs/sleeve-hardware.md)
+    enable = { chip = "gpiochip0", line = 17 }
     wiring = [
       { row = 0, column = 0, multiplexer = 0x70, channel = 0 },
       ...
@@ -35,6 +37,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import re
 import sys
 from dataclasses import dataclass, fields
 from os import PathLike
@@ -70,6 +73,8 @@ MAX_DURATION_MS = 600_000.0  # 10 minutes; catches microseconds typed as millise
 MUX_ADDRESSES = range(0x70, 0x78)  # TCA9548A: pins A0..A2 select 0x70..0x77
 MUX_CHANNELS = 8  # TCA9548A channels 0..7; one DRV2605L (fixed address 0x5A) per channel
 MAX_I2C_BUS = 255  # the N of /dev/i2c-N
+MAX_GPIO_LINE = 1023  # a line offset on its chip; a Raspberry Pi's gpiochip0 has 54 to 58
+GPIO_CHIP = re.compile(r"(?:/dev/)?gpiochip[0-9]{1,3}")  # as gpiodetect lists them
 MAX_NAME_CHARS = 64
 NAME_FORBIDDEN = "/+#"  # the name may appear in MQTT topics, where these are special
 
@@ -82,6 +87,24 @@ class Wire:
     column: int
     multiplexer: int
     channel: int
+
+
+@dataclass(frozen=True)
+class EnableLine:
+    """The GPIO line every DRV2605L's EN pin hangs on: high lets the chips drive their motors,
+    low (the pull-down, whenever no process drives the line) shuts every one of them down."""
+
+    chip: str  # "gpiochip0", as gpiodetect names it
+    line: int  # the line's offset on that chip (on a Raspberry Pi, the BCM GPIO number)
+
+    @property
+    def path(self) -> str:
+        """The chip's character device, e.g. ``/dev/gpiochip0``."""
+        return self.chip if self.chip.startswith("/dev/") else f"/dev/{self.chip}"
+
+    @property
+    def name(self) -> str:
+        return f"{self.chip} line {self.line}"
 
 
 @dataclass(frozen=True)
@@ -115,6 +138,8 @@ class Layout:
     i2c_bus: int = 1
     multiplexers: tuple[int, ...] = ()
     wiring: tuple[Wire, ...] = ()
+    # None: no enable line, every EN pin tied high (only I2C switches a motor off).
+    enable: EnableLine | None = None
 
     @property
     def shortest_burst_ms(self) -> float:
@@ -143,7 +168,8 @@ _SAFETY_KEYS = (
     "max_duty_cycle",
 )
 MIN_DUTY_WINDOW_MS = 1000.0  # shorter is no longer about heat but about single strokes
-_I2C_KEYS = ("bus", "multiplexers", "wiring")
+_I2C_KEYS = ("bus", "multiplexers", "enable", "wiring")
+_ENABLE_KEYS = ("chip", "line")
 _WIRE_KEYS = ("row", "column", "multiplexer", "channel")
 _MEANINGS = {
     "rows": "the number of actuator rows",
@@ -345,7 +371,54 @@ def _read_i2c(
     bus = problems.integer("i2c.bus", i2c.get("bus", _DEFAULTS.i2c_bus), 0, MAX_I2C_BUS)
     multiplexers = _read_multiplexers(problems, i2c.get("multiplexers", []))
     wiring = _read_wiring(problems, i2c.get("wiring", []), rows, columns, multiplexers)
-    return {"i2c_bus": bus, "multiplexers": multiplexers, "wiring": wiring}
+    enable = None
+    if "enable" in i2c:
+        enable = _read_enable(problems, i2c["enable"], bool(i2c.get("wiring")))
+    return {"i2c_bus": bus, "multiplexers": multiplexers, "wiring": wiring, "enable": enable}
+
+
+def _read_enable(problems: _Problems, value: Any, wired: bool) -> EnableLine | None:
+    """``enable = { chip = "gpiochip0", line = 17 }``: where the chips' EN pins are wired."""
+    example = 'enable = { chip = "gpiochip0", line = 17 }'
+    if not isinstance(value, dict):
+        problems.add("i2c.enable", f"must be a table such as {example}; got {_show(value)}")
+        return None
+    table = problems.table("i2c.enable", value, _ENABLE_KEYS)
+    chip = table.get("chip", _MISSING)
+    if chip is _MISSING:
+        problems.add(
+            "i2c.enable.chip",
+            'missing; the GPIO chip of the line (a name such as "gpiochip0", as gpiodetect '
+            "lists them) is required",
+        )
+        chip = None
+    elif not isinstance(chip, str) or not GPIO_CHIP.fullmatch(chip):
+        problems.add(
+            "i2c.enable.chip",
+            'must be a GPIO chip name such as "gpiochip0" (or its path "/dev/gpiochip0"), as '
+            f"gpiodetect lists them; got {_show(chip)}",
+        )
+        chip = None
+    raw_line = table.get("line", _MISSING)
+    line = None
+    if isinstance(raw_line, str):  # "GPIO17" is a name gpiod also takes, but not the offset
+        problems.add(
+            "i2c.enable.line",
+            f"must be a whole number from 0 to {MAX_GPIO_LINE}, the line's offset (on a "
+            f"Raspberry Pi the BCM GPIO number: 17 for GPIO17, physical pin 11); got "
+            f"{_show(raw_line)}",
+        )
+    else:
+        line = problems.integer("i2c.enable.line", raw_line, 0, MAX_GPIO_LINE)
+    if not wired:
+        problems.add(
+            "i2c.enable",
+            "an enable line needs i2c.wiring: it switches the chips the wiring lists; add the "
+            "wiring or remove enable",
+        )
+    if chip is None or line is None:
+        return None
+    return EnableLine(chip=chip, line=line)
 
 
 def _read_multiplexers(problems: _Problems, value: Any) -> tuple[int, ...]:
@@ -468,7 +541,16 @@ def _to_data(layout: Layout) -> dict[str, Any]:
     return {
         **{key: value for key, value in top.items() if value is not None},
         "safety": {key: getattr(layout, key) for key in _SAFETY_KEYS},
-        "i2c": {"bus": layout.i2c_bus, "multiplexers": list(layout.multiplexers), "wiring": wires},
+        "i2c": {
+            "bus": layout.i2c_bus,
+            "multiplexers": list(layout.multiplexers),
+            "wiring": wires,
+            **(
+                {}
+                if layout.enable is None
+                else {"enable": {"chip": layout.enable.chip, "line": layout.enable.line}}
+            ),
+        },
     }
 
 

@@ -19,6 +19,7 @@ and nothing while an intensity holds.
 from __future__ import annotations
 
 import contextlib
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ParamSpec, TypeVar
@@ -26,6 +27,7 @@ from typing import ParamSpec, TypeVar
 from feelmysign.backends.all_off import DRV2605_ADDRESS as DRV2605_ADDRESS  # re-exported
 from feelmysign.backends.all_off import MODE_STANDBY, REG_MODE, REG_RTP_INPUT
 from feelmysign.backends.base import GridBackend
+from feelmysign.backends.enable import Line
 from feelmysign.backends.i2c import I2CBus, is_no_answer, open_smbus
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES, Multiplexers
 from feelmysign.backends.telemetry import ActuatorTelemetry
@@ -55,6 +57,8 @@ SUPPORTED_DEVICE_IDS = (
 
 _T = TypeVar("_T")
 _P = ParamSpec("_P")
+
+log = logging.getLogger(__name__)
 
 
 def device_id_from_status(status: int) -> int:
@@ -103,6 +107,17 @@ class DRV2605L:
 
     def standby(self) -> None:
         self._i2c.write_byte_data(self.address, _REG_MODE, _MODE_STANDBY)
+
+    def reads_off(self) -> str | None:
+        """None when the registers read back silent (standby, RTP 0); else what they hold.
+
+        With the enable line low the datasheet says the chip may not take writes: before
+        the line goes high, each chip must show that it took its "off"."""
+        mode = self._i2c.read_byte_data(self.address, _REG_MODE)
+        rtp = self._i2c.read_byte_data(self.address, _REG_RTP_INPUT)
+        if mode & _MODE_STANDBY and rtp == 0:
+            return None
+        return f"MODE 0x{mode:02X}, RTP_INPUT 0x{rtp:02X}"
 
     def _update_bits(self, register: int, mask: int, on: bool) -> None:
         # Read-modify-write: the other bits hold calibration and loop settings.
@@ -212,15 +227,50 @@ class Drv2605Backend(GridBackend):
         *,
         bus: I2CBus | None = None,
         telemetry: ActuatorTelemetry | None = None,
+        enable: Line | None = None,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
         self._bus = bus
+        # Every chip's EN pin (layout.enable): low until every chip is off and checked, and
+        # dropped before any I2C "off". None: EN tied high, only I2C switches a motor off.
+        self._enable = enable
+        self._closing = False
+        # Chips that stopped answering and have not taken an "off" since: their motor may be
+        # on (without an enable line). ``retry_lost`` tries them again. key -> what failed.
+        self._lost: dict[tuple[int, int], str] = {}
         self._owned_bus: I2CBus | None = None
         self._multiplexers: Multiplexers | None = None
         self._actuators: dict[tuple[int, int], _Actuator] = {}
         self._rtp_levels: dict[tuple[int, int], int] = {}  # what each chip holds, when known
         self._configured: set[tuple[int, int]] = set()  # chips set up for RTP by start_rtp
         self._playing: set[tuple[int, int]] = set()  # of those, the ones out of standby
+
+    @property
+    def enable(self) -> Line | None:
+        return self._enable
+
+    @property
+    def lost(self) -> dict[tuple[int, int], str]:
+        """(row, column) -> why, for every chip that stopped answering and was not switched
+        off since."""
+        with self._lock:
+            return dict(self._lost)
+
+    @property
+    def silenced(self) -> bool:
+        """Open, with an enable line held low: every motor is off whatever is written to it."""
+        return self._enable is not None and self.is_open and not self._enable.high
+
+    def describe(self, key: tuple[int, int]) -> str:
+        """Where the chip of actuator ``key`` (row, column) hangs, in words."""
+        actuator = self._actuators.get(key)
+        if actuator is None:
+            return f"actuator row {key[0]}, column {key[1]}"
+        return actuator.where
+
+    def wire(self, key: tuple[int, int]) -> Wire | None:
+        actuator = self._actuators.get(key)
+        return None if actuator is None else actuator.wire
 
     def switch_off_unchecked(self) -> list[str]:
         """Before (or instead of) ``open``: every chip that answers off, none checked; what failed.
@@ -231,11 +281,17 @@ class Drv2605Backend(GridBackend):
         with self._lock:
             if self.is_open:
                 return []
+            problems = []
+            if self._enable is not None:
+                try:  # first, before any I2C: every motor off at once, the lost ones included
+                    self._enable.request()
+                except HardwareError as error:
+                    problems.append(str(error))
             try:
                 self._connect()
-                return self._off_problems()
+                return problems + self._off_problems()
             except (HardwareError, LayoutError) as error:
-                return [str(error)]
+                return [*problems, str(error)]
             finally:
                 self._multiplexers = None
                 self._release()
@@ -258,13 +314,21 @@ class Drv2605Backend(GridBackend):
 
     def _open(self) -> None:
         multiplexers = self._connect()
+        line_problem: HardwareError | None = None
         try:
+            if self._enable is not None:
+                try:  # low (shutdown) until every chip is off and checked
+                    self._enable.request()
+                except HardwareError as error:
+                    line_problem = error  # the I2C "off" below goes out all the same
             # Off first, before any check can raise: after a crash a chip may still drive
             # its motor, and a missing or wrong chip elsewhere must not keep it running.
             off_problems = self._off_problems()
-            self._check_chips()
+            self._check_chips(readback=self._enable is not None)
             if off_problems:  # every chip passed the check, yet one could not be switched off
                 raise HardwareError(_off_failed_message(off_problems))
+            if line_problem is not None:
+                raise line_problem
             for key, actuator in self._actuators.items():
                 self._guard(
                     actuator,
@@ -275,18 +339,24 @@ class Drv2605Backend(GridBackend):
                 self._rtp_levels[key] = 0
                 self._configured.add(key)
                 self._playing.add(key)
+            if self._enable is not None:
+                self._enable.set_high(True)  # every chip off, checked and set up: motors may run
         except BaseException:
+            self._drop(release=True)  # low first, whatever failed
             # Leave no channel enabled, so 'feelmysign scan' starts from a clean bus.
             with contextlib.suppress(HardwareError):
                 multiplexers.deselect_all()
             self._release()
             raise
 
-    def _check_chips(self) -> None:
+    def _check_chips(self, *, readback: bool = False) -> None:
+        """Every chip answers and is a DRV2605L (with ``readback``, also reads back "off":
+        before an enable line goes high); HardwareError listing every one that is not."""
         problems = []
         for actuator in self._actuators.values():
             try:
                 device_id = actuator.chip.device_id()
+                held = actuator.chip.reads_off() if readback else None
             except OSError as error:
                 if is_no_answer(error):
                     problems.append(f"No DRV2605L answered on {actuator.where}; {_CHECK_HINT}")
@@ -301,6 +371,11 @@ class Drv2605Backend(GridBackend):
                     f"The chip at 0x{DRV2605_ADDRESS:02X} on {actuator.where} is a "
                     f"{device_name(device_id)}, not a DRV2605L (device id 7) or DRV2605 (id 3); "
                     f"fit a DRV2605L there or {_CHECK_HINT}"
+                )
+            elif held is not None:
+                problems.append(
+                    f'The DRV2605L on {actuator.where} did not take its "off" ({held} read '
+                    "back), so the enable line stays low; power the driver boards off and on"
                 )
         if len(problems) == 1:
             raise HardwareError(f"{problems[0]} {_OTHERS_OFF}")
@@ -329,9 +404,80 @@ class Drv2605Backend(GridBackend):
         self._rtp_levels[key] = level
 
     def _all_off(self) -> None:
+        self._drop()  # first: every motor stops at once, a chip that does not answer included
         problems = self._off_problems()
+        if self._enable is None:
+            if problems:
+                raise HardwareError(_off_failed_message(problems))
+            return
         if problems:
-            raise HardwareError(_off_failed_message(problems))
+            # Not an error: the line holds every motor off. It stays low until they answer.
+            log.warning(
+                "enable line held low: not every chip took the off:\n%s",
+                "\n".join(f"  - {p}" for p in problems),
+            )
+            return
+        self._raise_if_safe()
+
+    def close(self) -> None:
+        with self._lock:
+            self._closing = True  # the all-off on the way out leaves the line low
+        super().close()
+
+    def retry_lost(self) -> list[tuple[int, int]]:
+        """Try "off" again on every chip that stopped answering; the ones that took it.
+
+        A chip that answers again is switched off (RTP 0, standby) at once, so that a motor
+        left on when its wire came loose does not run on when the wire comes back; the next
+        stroke sets it up again. With an enable line held low for a lost chip, the line goes
+        high again only once every chip answers and reads back off."""
+        with self._lock:
+            if not self.is_open or not self._lost or self._multiplexers is None:
+                return []
+            back = []
+            with self._multiplexers.best_effort():
+                for key in list(self._lost):
+                    actuator = self._actuators[key]
+                    try:
+                        self._rtp_zero(key, actuator)
+                        self._standby(key, actuator)
+                    except HardwareError as error:
+                        self._lost[key] = str(error)
+                        continue
+                    self._configured.discard(key)  # it may have reset: set it up again
+                    del self._lost[key]
+                    back.append(key)
+            if back and not self._lost and self._enable is not None:
+                self._all_off()  # every chip off again and checked, then the line goes high
+            return back
+
+    def _drop(self, *, release: bool = False) -> None:
+        """The enable line low (and let go, with ``release``); never raises."""
+        line = self._enable
+        if line is None:
+            return
+        try:
+            if release:
+                line.release()
+            elif line.high:
+                line.set_high(False)
+        except HardwareError as error:
+            log.error("could not drive the enable line low: %s", error)
+
+    def _raise_if_safe(self) -> None:
+        """The enable line high again, once every chip answers and reads back off."""
+        if self._enable is None or self._closing or not self.is_open or self._lost:
+            return
+        try:
+            self._check_chips(readback=True)
+        except HardwareError as error:
+            log.warning("enable line held low: %s", error)
+            return
+        finally:
+            with contextlib.suppress(HardwareError):
+                if self._multiplexers is not None:
+                    self._multiplexers.deselect_all()
+        self._enable.set_high(True)
 
     def _off_problems(self) -> list[str]:
         """Switch every chip that answers off (RTP 0, standby), then deselect every channel.
@@ -352,6 +498,11 @@ class Drv2605Backend(GridBackend):
                         step(key, actuator)
                     except HardwareError as error:
                         problems.setdefault(key, str(error))
+        for key in self._actuators:
+            if key in problems:
+                self._lost[key] = problems[key]
+            else:
+                self._lost.pop(key, None)  # it took the off: its motor is off
         listed = list(problems.values())
         try:
             multiplexers.deselect_all()
@@ -368,6 +519,7 @@ class Drv2605Backend(GridBackend):
         self._guard(actuator, "", actuator.chip.standby)
 
     def _release(self) -> None:
+        self._drop(release=True)  # low, then let go: the pull-down keeps it low
         bus, self._owned_bus = self._owned_bus, None
         if bus is not None:
             bus.close()
@@ -384,7 +536,12 @@ class Drv2605Backend(GridBackend):
         key = (actuator.wire.row, actuator.wire.column)
         try:
             return action(*args, **kwargs)
+        except HardwareError as error:  # its multiplexer did not answer
+            self._lose(key, str(error))
+            raise
         except OSError as error:
+            # First, before anything else: with an enable line, every motor stops now.
+            self._drop()
             # The chip's and the multiplexers' state are unknown now: rewrite them next time.
             self._rtp_levels.pop(key, None)
             self._configured.discard(key)
@@ -392,6 +549,15 @@ class Drv2605Backend(GridBackend):
             if self._multiplexers is not None:
                 self._multiplexers.invalidate()
             when = f" {doing}" if doing else ""
-            raise HardwareError(
+            message = (
                 f"The DRV2605L on {actuator.where} stopped answering{when} ({error}); {_CHECK_HINT}"
-            ) from error
+            )
+            self._lost[key] = message
+            raise HardwareError(message) from error
+
+    def _lose(self, key: tuple[int, int], message: str) -> None:
+        self._drop()
+        self._rtp_levels.pop(key, None)
+        self._configured.discard(key)
+        self._playing.discard(key)
+        self._lost[key] = message

@@ -23,15 +23,37 @@ to survive a power cut)::
                    "registers": "e04000010100..."},
         ...
       },
-      "main_bus_chips": []
+      "main_bus_chips": [],
+      "transactions": 1234,
+      "enable": {"chip": "gpiochip0", "line": 17, "level": 1,
+                 "holder": {"pid": 4242, "start": 987654},
+                 "effective": 1, "changed_at": {"ms": 1764166000123.5, "transaction": 1201}}
     }
+
+``enable`` is present when the layout wires every chip's EN pin to one GPIO line
+(``i2c.enable``), absent or null otherwise (EN tied high). ``level`` is what the
+last process that drove the line drove it to and ``holder`` that process (its
+pid and its start time in clock ticks since boot, /proc/PID/stat field 22, so a
+reused pid does not count). The line models its pull-down: it is high only
+while ``level`` is 1 and the holder still runs, so once the sleeve is gone
+(``kill -9``, a crash) every reader sees it low and every chip's ``drive`` 0,
+though no process was left to write "low". ``effective`` is that level when the
+file was written. A chip whose EN is low drives nothing whatever its registers
+say; with EN high (or no line) it drives what its registers say.
+
+``transactions`` counts the bus transactions tried; a chip found not answering
+gets ``lost_at`` (the wall clock in ms and that count, when a transaction first
+found it so; null while it answers), and the line's ``changed_at`` says when it
+last changed: a test reads from these how soon after a chip was lost every
+motor was off.
 
 Faults are set in the file: leave a chip out of ``chips`` (or set
 ``"connected": false``, a broken wire that keeps the registers) for a missing
 chip; set ``device_id`` (e.g. 4, a DRV2604) for a wrong chip. ``drive`` is
-written for people and tests to read (0..1, what the motor gets) and ignored
-when the file is read back. One process at a time should drive a state file;
-others may read it.
+written for people and tests to read (0..1, what the motor gets when the file
+was written; :func:`drive_levels` works it out again at the time it is read, as
+the enable line may have fallen since) and ignored when the file is read
+back. One process at a time should drive a state file; others may read it.
 """
 
 from __future__ import annotations
@@ -39,7 +61,11 @@ from __future__ import annotations
 import json
 import os
 
-from feelmysign.backends.emulated_i2c import EmulatedDRV2605L, EmulatedI2CBus
+from feelmysign.backends.emulated_i2c import (
+    EmulatedDRV2605L,
+    EmulatedEnableLine,
+    EmulatedI2CBus,
+)
 from feelmysign.errors import FeelMySignError
 from feelmysign.input_files import MAX_STATE_BYTES, loads_json, read_text
 
@@ -91,6 +117,9 @@ def open_state_bus(path: str | os.PathLike[str], layout: Layout | None) -> Emula
             raise EmulatedStateError(
                 state_path, f"cannot be written: {error.strerror or error}"
             ) from error
+    if layout is not None and layout.enable is not None and bus.enable_line is None:
+        # A file made before the layout had a line: the boards are wired to it now.
+        bus.add_enable_line(layout.enable.chip, layout.enable.line)
     write_through = _WriteThrough(state_path)
     bus.on_write = write_through
     bus.before_transaction = write_through.take_faults
@@ -195,7 +224,31 @@ def state_of(bus: EmulatedI2CBus) -> dict[str, Any]:
             for (multiplexer, channel), chip in sorted(bus.chips.items())
         },
         "main_bus_chips": [_chip_state(chip) for chip in bus.main_bus_chips],
+        "transactions": bus.transactions,
+        "enable": None if bus.enable_line is None else _line_state(bus.enable_line),
     }
+
+
+def _line_state(line: EmulatedEnableLine) -> dict[str, Any]:
+    holder = line.holder
+    return {
+        "chip": line.chip,
+        "line": line.line,
+        "level": int(line.level),
+        "holder": None if holder is None else {"pid": holder[0], "start": holder[1]},
+        "effective": int(line.effective_high),
+        "changed_at": _when(line.changed_at),
+    }
+
+
+def _when(at: tuple[float, int] | None) -> dict[str, Any] | None:
+    return None if at is None else {"ms": at[0], "transaction": at[1]}
+
+
+def _read_when(saved: Any) -> tuple[float, int] | None:
+    if saved is None:
+        return None
+    return (float(saved["ms"]), int(saved["transaction"]))
 
 
 def bus_from_state(data: Any) -> EmulatedI2CBus:
@@ -212,6 +265,16 @@ def bus_from_state(data: Any) -> EmulatedI2CBus:
         _restore(bus.attach_chip(int(multiplexer, 16), int(channel)), saved, name)
     for index, saved in enumerate(list(data.get("main_bus_chips", []))):
         _restore(bus.attach_main_bus_chip(), saved, f"main bus chip {index}")
+    bus.transactions = int(data.get("transactions", 0))
+    line = data.get("enable")
+    if line is not None:
+        enable = EmulatedEnableLine(str(line["chip"]), int(line["line"]))
+        enable.level = bool(line.get("level", 0))
+        holder = line.get("holder")
+        enable.holder = None if holder is None else (int(holder["pid"]), int(holder["start"]))
+        enable.changed_at = _read_when(line.get("changed_at"))
+        bus.enable_line = enable
+        bus.add_enable_line(enable.chip, enable.line)  # links it, and every EN follows it
     return bus
 
 
@@ -221,6 +284,7 @@ def _chip_state(chip: EmulatedDRV2605L) -> dict[str, Any]:
         "connected": chip.connected,
         "drive": round(chip.output, 4),
         "registers": chip.registers.hex(),
+        "lost_at": _when(chip.lost_at),
     }
 
 
@@ -230,6 +294,7 @@ def _restore(chip: EmulatedDRV2605L, saved: Any, name: str) -> None:
         raise ValueError(f"chip {name} has {len(registers)} registers, not {len(chip.registers)}")
     chip.registers[:] = registers
     chip.connected = bool(saved.get("connected", True))
+    chip.lost_at = _read_when(saved.get("lost_at"))
     if "device_id" in saved:  # wins over STATUS, so a test can fit a wrong chip by editing one key
         device_id = int(saved["device_id"])
         if not 0 <= device_id <= 7:

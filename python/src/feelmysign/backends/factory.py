@@ -14,6 +14,7 @@ from feelmysign.backends.base import Backend
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
 from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.enable import GpiodLine, Line
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.sim import SimBackend
 from feelmysign.backends.telemetry import ActuatorTelemetry
@@ -64,9 +65,21 @@ def open_backend(
         bus = open_state_bus(emulate_state, layout)
     elif emulate:
         bus = EmulatedI2CBus.for_layout(layout)
-    backend = Drv2605Backend(layout, bus=bus, telemetry=telemetry)
+    backend = Drv2605Backend(
+        layout, bus=bus, telemetry=telemetry, enable=enable_line_for(layout, bus)
+    )
     backend.open()
     return backend
+
+
+def enable_line_for(layout: Layout, bus: I2CBus | None) -> Line | None:
+    """The layout's enable line: the emulated bus's own, or the real GPIO (gpiod is imported
+    only when the line is requested); None for a layout without one."""
+    if layout.enable is None:
+        return None
+    if isinstance(bus, EmulatedI2CBus):
+        return bus.add_enable_line(layout.enable.chip, layout.enable.line)
+    return GpiodLine(layout.enable)
 
 
 def _open_sim(
