@@ -357,6 +357,8 @@ def typed_status(status: Status) -> dict[str, Any]:
     typed = _typed(status)
     if typed["floor"] is None:
         del typed["floor"]
+    if typed["hardware"] is None:  # a later field still: only where a status has it
+        del typed["hardware"]
     return typed
 
 

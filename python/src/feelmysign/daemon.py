@@ -52,10 +52,12 @@ from feelmysign.events import (
     Cancelled,
     ErrorEvent,
     Event,
+    LostChip,
     Played,
     Rejected,
     Safety,
     Status,
+    StatusHardware,
     StatusLayout,
     StrokeRef,
     delivery_delay_ms,
@@ -90,6 +92,8 @@ NOT_ACKNOWLEDGED = frozenset({"stopped", "player_stopped"})
 # that reports these itself in its own words (``feelmysign up``) filters them out.
 CONNECTION_STATE = {"connection_state": True}
 CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
+# Safety events after which the status's ``hardware`` changed: published again with them.
+HARDWARE_EVENTS = frozenset({"chip_lost", "chip_back"})
 
 
 def sleeve_client_id(sleeve_id: str, password: str | None) -> str:
@@ -160,6 +164,7 @@ class Sleeve:
         telemetry: ActuatorTelemetry | None = None,
     ) -> None:
         self._settings = settings
+        self._backend = backend  # its lost chips and enable line go into the status
         self._telemetry = telemetry  # flushed at stop, so previews see the final all-off
         self._layout = layout
         self._options = options
@@ -492,6 +497,16 @@ class Sleeve:
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":
             self._count("capped")
+        elif isinstance(event, Safety) and event.reason in HARDWARE_EVENTS:
+            self._count(event.reason)
+            # After the event: a reader that sees the status change has the event about it.
+            self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+            self._outbox.put(
+                _Publish(telemetry_topic(self._id, "status"), self._status(online=True), 1, True)
+            )
+            if ack is not None:
+                self._outbox.put(ack)
+            return
         if isinstance(event, ErrorEvent) and event.reason == "player_crashed":
             self._fatal = FeelMySignError(
                 "the player stopped on an unexpected error (see the log); every motor is off"
@@ -558,4 +573,29 @@ class Sleeve:
             layout=StatusLayout.of(self._layout),
             at_ms=round(time.time() * 1000),
             floor=sleeve_floor(self._layout, self._options.wearer),
+            hardware=self._hardware() if online else None,
         ).dumps()
+
+    def _hardware(self) -> StatusHardware | None:
+        """The motors' hardware now: chips lost, the enable line (the drv2605 backend only)."""
+        lost: dict[tuple[int, int], str] | None = getattr(self._backend, "lost", None)
+        if lost is None:
+            return None
+        chips = []
+        for row, column in sorted(lost):
+            wire = self._backend.wire((row, column)) if hasattr(self._backend, "wire") else None
+            chips.append(
+                LostChip(
+                    row=row,
+                    column=column,
+                    multiplexer=None if wire is None else f"0x{wire.multiplexer:02X}",
+                    channel=None if wire is None else wire.channel,
+                )
+            )
+        enable = getattr(self._backend, "enable", None)
+        silenced = bool(getattr(self._backend, "silenced", False))
+        return StatusHardware(
+            state="silenced" if silenced else "degraded" if chips else "ok",
+            lost=tuple(chips),
+            enable=None if enable is None else "high" if enable.high else "low",
+        )

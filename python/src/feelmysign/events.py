@@ -487,6 +487,59 @@ class StatusLayout:
         return _wire(None, {name: values[name] for name in _LAYOUT_ORDER})
 
 
+@dataclass(frozen=True)
+class LostChip:
+    """A DRV2605L that stopped answering and has not taken an "off" since."""
+
+    row: int
+    column: int
+    multiplexer: str | None = None  # "0x70"
+    channel: int | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return _wire(None, asdict(self))
+
+
+@dataclass(frozen=True)
+class StatusHardware:
+    """The motors' hardware as the status tells it: ``state`` is ``ok``, ``degraded`` (a chip
+    lost, its motor perhaps still on, the others playing) or ``silenced`` (the enable line held
+    low for a lost chip: nothing plays); ``enable`` is the line's level, None without one."""
+
+    state: str
+    lost: tuple[LostChip, ...] = ()
+    enable: str | None = None  # "high" or "low"
+
+    @classmethod
+    def from_json(cls, data: object) -> StatusHardware:
+        r = _Reader(data, "hardware")
+        raw = data.get("lost", []) if isinstance(data, dict) else []
+        if not isinstance(raw, list):
+            raise EventError("lost must be an array", "lost")
+        lost = []
+        for item in raw:
+            chip = _Reader(item, "hardware.lost")
+            lost.append(
+                LostChip(
+                    row=chip.index("row"),
+                    column=chip.index("column"),
+                    multiplexer=chip.text("multiplexer", required=False),
+                    channel=chip.index("channel", required=False),
+                )
+            )
+        return cls(state=r.text("state"), lost=tuple(lost), enable=r.text("enable", required=False))
+
+    def to_json(self) -> dict[str, Any]:
+        return _wire(
+            None,
+            {
+                "state": self.state,
+                "lost": [chip.to_json() for chip in self.lost],
+                "enable": self.enable,
+            },
+        )
+
+
 @dataclass(frozen=True, kw_only=True)
 class StatusFloor:
     """The least a stroke should be for this sleeve to play it as sent and its wearer to feel it.
@@ -533,6 +586,7 @@ class Status:
     layout: StatusLayout | None = None
     at_ms: float | None = None
     floor: StatusFloor | None = None
+    hardware: StatusHardware | None = None  # the drv2605 backend's only
 
     @classmethod
     def from_json(cls, data: object) -> Status:
@@ -544,6 +598,7 @@ class Status:
         r = _Reader(data, "a status")
         layout = r.obj("layout")
         floor = r.obj("floor")
+        hardware = r.obj("hardware")
         return cls(
             online=r.flag("online"),
             sleeve_id=r.text("sleeve_id", required=False),
@@ -553,6 +608,7 @@ class Status:
             layout=None if layout is None else StatusLayout.from_json(layout),
             at_ms=r.number("at_ms", required=False),
             floor=None if floor is None else StatusFloor.from_json(floor),
+            hardware=None if hardware is None else StatusHardware.from_json(hardware),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -568,6 +624,7 @@ class Status:
                 "layout": None if self.layout is None else self.layout.to_json(),
                 "at_ms": self.at_ms,
                 "floor": None if self.floor is None else self.floor.to_json(),
+                "hardware": None if self.hardware is None else self.hardware.to_json(),
             },
         )
         return wire

@@ -68,6 +68,7 @@ STALE = "stale"
 LATE = "late"
 QUEUE_FULL = "queue_full"
 PLAYER_STOPPED = "player_stopped"
+SILENCED = "silenced"  # the enable line is held low for a chip that does not answer
 
 REASONS: dict[str, str] = {
     NOT_TEXT: "the payload is not a string or bytes, or its bytes are not UTF-8",

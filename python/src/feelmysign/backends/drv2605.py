@@ -258,8 +258,11 @@ class Drv2605Backend(GridBackend):
 
     @property
     def silenced(self) -> bool:
-        """Open, with an enable line held low: every motor is off whatever is written to it."""
-        return self._enable is not None and self.is_open and not self._enable.high
+        """Open, with an enable line held low for a chip that does not answer (or failed its
+        check): every motor is off whatever is written to it, until that chip answers."""
+        # No lock: read on the path of every stroke's receipt, and each name is read whole.
+        enable = self._enable
+        return enable is not None and self.is_open and bool(self._lost) and not enable.high
 
     def describe(self, key: tuple[int, int]) -> str:
         """Where the chip of actuator ``key`` (row, column) hangs, in words."""
@@ -352,40 +355,48 @@ class Drv2605Backend(GridBackend):
     def _check_chips(self, *, readback: bool = False) -> None:
         """Every chip answers and is a DRV2605L (with ``readback``, also reads back "off":
         before an enable line goes high); HardwareError listing every one that is not."""
-        problems = []
-        for actuator in self._actuators.values():
+        problems = list(self._chip_problems(readback=readback).values())
+        others_off = _OTHERS_OFF
+        if self._enable is not None:
+            others_off = f"{_OTHERS_OFF[:-1]}; the {self._enable.description} stays low)"
+        if len(problems) == 1:
+            raise HardwareError(f"{problems[0]} {others_off}")
+        if problems:
+            total = len(self._actuators)
+            listed = "\n".join(f"  - {p}" for p in problems)
+            raise HardwareError(
+                f"{len(problems)} of {total} DRV2605L chips failed the check ({others_off[1:-1]}):"
+                f"\n{listed}"
+            )
+
+    def _chip_problems(self, *, readback: bool) -> dict[tuple[int, int], str]:
+        """(row, column) -> what is wrong, for every chip that fails the check."""
+        problems: dict[tuple[int, int], str] = {}
+        for key, actuator in self._actuators.items():
             try:
                 device_id = actuator.chip.device_id()
                 held = actuator.chip.reads_off() if readback else None
             except OSError as error:
                 if is_no_answer(error):
-                    problems.append(f"No DRV2605L answered on {actuator.where}; {_CHECK_HINT}")
+                    problems[key] = f"No DRV2605L answered on {actuator.where}; {_CHECK_HINT}"
                 else:
-                    problems.append(
+                    problems[key] = (
                         f"I2C error ({error}) reading the DRV2605L on {actuator.where}; "
                         f"{_CHECK_HINT}"
                     )
                 continue
             if device_id not in SUPPORTED_DEVICE_IDS:
-                problems.append(
+                problems[key] = (
                     f"The chip at 0x{DRV2605_ADDRESS:02X} on {actuator.where} is a "
                     f"{device_name(device_id)}, not a DRV2605L (device id 7) or DRV2605 (id 3); "
                     f"fit a DRV2605L there or {_CHECK_HINT}"
                 )
             elif held is not None:
-                problems.append(
+                problems[key] = (
                     f'The DRV2605L on {actuator.where} did not take its "off" ({held} read '
                     "back), so the enable line stays low; power the driver boards off and on"
                 )
-        if len(problems) == 1:
-            raise HardwareError(f"{problems[0]} {_OTHERS_OFF}")
-        if problems:
-            total = len(self._actuators)
-            listed = "\n".join(f"  - {p}" for p in problems)
-            raise HardwareError(
-                f"{len(problems)} of {total} DRV2605L chips failed the check ({_OTHERS_OFF}):"
-                f"\n{listed}"
-            )
+        return problems
 
     def _write(self, row: int, column: int, intensity: float) -> None:
         key = (row, column)
@@ -469,14 +480,15 @@ class Drv2605Backend(GridBackend):
         if self._enable is None or self._closing or not self.is_open or self._lost:
             return
         try:
-            self._check_chips(readback=True)
-        except HardwareError as error:
-            log.warning("enable line held low: %s", error)
-            return
+            problems = self._chip_problems(readback=True)
         finally:
             with contextlib.suppress(HardwareError):
                 if self._multiplexers is not None:
                     self._multiplexers.deselect_all()
+        if problems:  # tried again with the lost chips (retry_lost)
+            self._lost.update(problems)
+            log.warning("enable line held low:\n%s", "\n".join(problems.values()))
+            return
         self._enable.set_high(True)
 
     def _off_problems(self) -> list[str]:

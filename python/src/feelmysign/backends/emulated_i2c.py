@@ -285,6 +285,7 @@ class EmulatedEnableLine:
         self.level = False
         self.holder: tuple[int, int] | None = None
         self.changed_at: tuple[float, int] | None = None
+        self.rises = 0  # how many times it went high, ever: a test sees that it never did
         self._bus: EmulatedI2CBus | None = None
 
     @property
@@ -343,6 +344,8 @@ class EmulatedEnableLine:
     def _change(self, high: bool) -> None:
         bus = self._bus
         transactions = 0 if bus is None else bus.transactions
+        if high and not self.level:
+            self.rises += 1
         self.level = high
         self.changed_at = (round(time.time() * 1000, 3), transactions)
         self._changed()

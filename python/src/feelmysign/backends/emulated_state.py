@@ -27,7 +27,8 @@ to survive a power cut)::
       "transactions": 1234,
       "enable": {"chip": "gpiochip0", "line": 17, "level": 1,
                  "holder": {"pid": 4242, "start": 987654},
-                 "effective": 1, "changed_at": {"ms": 1764166000123.5, "transaction": 1201}}
+                 "effective": 1, "changed_at": {"ms": 1764166000123.5, "transaction": 1201},
+                 "rises": 3}
     }
 
 ``enable`` is present when the layout wires every chip's EN pin to one GPIO line
@@ -38,8 +39,9 @@ reused pid does not count). The line models its pull-down: it is high only
 while ``level`` is 1 and the holder still runs, so once the sleeve is gone
 (``kill -9``, a crash) every reader sees it low and every chip's ``drive`` 0,
 though no process was left to write "low". ``effective`` is that level when the
-file was written. A chip whose EN is low drives nothing whatever its registers
-say; with EN high (or no line) it drives what its registers say.
+file was written; ``rises`` counts the times it ever went high. A chip whose EN
+is low drives nothing whatever its registers say; with EN high (or no line) it
+drives what its registers say.
 
 ``transactions`` counts the bus transactions tried; a chip found not answering
 gets ``lost_at`` (the wall clock in ms and that count, when a transaction first
@@ -238,6 +240,7 @@ def _line_state(line: EmulatedEnableLine) -> dict[str, Any]:
         "holder": None if holder is None else {"pid": holder[0], "start": holder[1]},
         "effective": int(line.effective_high),
         "changed_at": _when(line.changed_at),
+        "rises": line.rises,
     }
 
 
@@ -273,6 +276,7 @@ def bus_from_state(data: Any) -> EmulatedI2CBus:
         holder = line.get("holder")
         enable.holder = None if holder is None else (int(holder["pid"]), int(holder["start"]))
         enable.changed_at = _read_when(line.get("changed_at"))
+        enable.rises = int(line.get("rises", 0))
         bus.enable_line = enable
         bus.add_enable_line(enable.chip, enable.line)  # links it, and every EN follows it
     return bus
