@@ -7,7 +7,9 @@
 Row and column are grid indices (row 0 = y 0, column 0 = x 0; see the layout
 file's drawing). The intensity is capped at the layout's safety.max_intensity
 and the duration at its safety.max_on_time_ms. Every motor is switched off
-afterwards, also on Ctrl-C or an error.
+afterwards, also on Ctrl-C or an error. With an enable line in the layout
+(``i2c.enable``) the line goes high for the buzz, once every chip is off and
+checked, and low again before the "off" goes out over I2C.
 """
 
 from __future__ import annotations
@@ -78,9 +80,12 @@ def run(args: argparse.Namespace) -> int:
         args.backend, layout, emulate=args.emulate, emulate_state=args.emulate_state
     )
     where = _where(args, layout)
+    line = layout.enable
     for note in (intensity_note, duration_note):
         if note:
             print(note, flush=True)
+    if line is not None and args.backend == "drv2605":
+        print(f"Enable line {line.name} high: every chip is off and checked.", flush=True)
     print(
         f"Buzzing row {args.row}, column {args.column}{where} at intensity {intensity:g} "
         f"for {duration_ms:g} ms...",
@@ -97,8 +102,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"Interrupted after {elapsed_ms:.0f} ms.", flush=True)
         raise
     finally:
-        backend.close()  # all off first, then release the bus
-        print("Every motor is off.", flush=True)
+        backend.close()  # all off first (the enable line low before that), then the bus
+        after = (
+            "" if line is None or args.backend != "drv2605" else f" Enable line {line.name} low."
+        )
+        print(f"Every motor is off.{after}", flush=True)
     if isinstance(backend, SimBackend):
         for change in backend.changes:
             print(

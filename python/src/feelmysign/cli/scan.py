@@ -5,7 +5,9 @@
     feelmysign scan --layout deploy/layouts/paper-sleeve.toml --emulate-state bus.json
 
 One line per channel of every multiplexer the layout lists: the actuator the
-layout expects there, what answered, and the verdict. Exit 0 when every wired
+layout expects there, what answered, and the verdict. With an enable line in the
+layout (``i2c.enable``), who holds it and, when nobody does, that it reads low
+(the pull-down): one that reads high with nobody driving it is a problem. Exit 0 when every wired
 actuator's DRV2605L answers and nothing answers where none is wired, 1
 otherwise (also when the layout wires nothing, as then nothing was checked).
 Only reads: no motor is switched on, and every channel is disabled afterwards.
@@ -22,6 +24,7 @@ from typing import Any
 from feelmysign.backends.drv2605 import DRV2605_ADDRESS, SUPPORTED_DEVICE_IDS, device_name
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
 from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.enable import read_free_line
 from feelmysign.backends.i2c import I2CBus, open_smbus
 from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
@@ -112,10 +115,11 @@ def run(args: argparse.Namespace) -> int:
         bus = _open_bus(bus_number)
     try:
         result = scan(bus, addresses)
+        line = _enable_line(layout, bus)
     finally:
         bus.close()
     report = compare_with_layout(result, layout)
-    scanned = _Scanned(layout, bus_number, result, report, channel_rows(result, layout))
+    scanned = _Scanned(layout, bus_number, result, report, channel_rows(result, layout), line)
     if args.json:
         print(json.dumps(_as_json(args, scanned)))
     else:
@@ -132,11 +136,62 @@ class _Scanned:
     result: ScanResult
     report: LayoutReport
     rows: list[ChannelRow]
+    enable: EnableReport | None = None
 
     @property
     def ok(self) -> bool:
-        """Every wired actuator answers, and the layout wires some."""
-        return self.report.ok and bool(self.layout.wiring)
+        """Every wired actuator answers, the layout wires some, and its enable line is sound."""
+        line_ok = self.enable is None or self.enable.problem is None
+        return self.report.ok and bool(self.layout.wiring) and line_ok
+
+
+@dataclass(frozen=True)
+class EnableReport:
+    """The enable line: who holds it, its level when it could be read, what is wrong."""
+
+    name: str
+    holder: str
+    level: bool | None
+    problem: str | None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "line": self.name,
+            "holder": self.holder,
+            "level": None if self.level is None else "high" if self.level else "low",
+            "problem": self.problem,
+        }
+
+    def describe(self) -> str:
+        level = "" if self.level is None else f", reads {'high' if self.level else 'low'}"
+        verdict = f": {self.problem}" if self.problem else ": ok"
+        return f"Enable line {self.name}: {self.holder}{level}{verdict}."
+
+
+def _enable_line(layout: Layout, bus: I2CBus) -> EnableReport | None:
+    """The layout's enable line as it is now (read without driving it); None without one."""
+    enable = layout.enable
+    if enable is None:
+        return None
+    if isinstance(bus, EmulatedI2CBus):
+        line = bus.enable_line
+        if line is None or line.holder is None or not line.holder_alive:
+            holder, level = "free (nobody drives it; the pull-down holds it)", False
+        else:
+            holder, level = f"held by process {line.holder[0]}", line.effective_high
+        return EnableReport(enable.name, holder, level, None)
+    try:
+        holder, read = read_free_line(enable)
+    except HardwareError as error:
+        return EnableReport(enable.name, "not readable", None, str(error))
+    problem = None
+    if read:
+        problem = (
+            "it reads HIGH with nobody driving it, so a crash would leave the motors enabled: "
+            "fit the pull-down (10 kOhm from the line to GND) and check that no driver board "
+            "ties EN high (docs/sleeve-hardware.md)"
+        )
+    return EnableReport(enable.name, holder, read, problem)
 
 
 def _open_bus(bus_number: int) -> I2CBus:
@@ -219,6 +274,8 @@ def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
             "",
         ]
     lines.append(_main_bus_line(result, layout))
+    if scanned.enable is not None:
+        lines.append(scanned.enable.describe())
     if not layout.wiring:
         lines.append(
             f"The layout {layout.name!r} wires no actuator, so nothing was checked: give "
@@ -285,5 +342,9 @@ def _as_json(args: argparse.Namespace, scanned: _Scanned) -> dict[str, Any]:
         "main_bus": [f"0x{a:02X}" for a in result.main_bus],
         "missing_multiplexers": [f"0x{a:02X}" for a in result.missing_multiplexers],
         "channels": [row.as_dict() for row in scanned.rows],
-        "problems": report.problems() if layout.wiring else ["the layout wires no actuator"],
+        "problems": (report.problems() if layout.wiring else ["the layout wires no actuator"])
+        + (
+            [] if scanned.enable is None or not scanned.enable.problem else [scanned.enable.problem]
+        ),
+        "enable": None if scanned.enable is None else scanned.enable.as_dict(),
     }
