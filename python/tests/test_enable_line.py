@@ -144,8 +144,10 @@ def test_a_chip_lost_while_on_mid_drawing_drops_the_line_at_once_and_says_which(
             lambda n, b: b.get("drawing") == "after" and b.get("type") == "played",
             "a stroke played once the chip is back",
         )
+        rises = saved(state)["enable"]["rises"]
         assert exit_code_after(sleeve, signal.SIGTERM) == 0
     assert saved(state)["enable"]["effective"] == 0
+    assert saved(state)["enable"]["rises"] == rises  # low first, and kept low, on the way out
     assert set(drive_levels(state).values()) == {0.0}
     events = watcher.received("events")
     assert not any(e.get("reason") == "player_crashed" for e in events), events

@@ -349,6 +349,7 @@ class Player:
         Returns the strokes accepted but not started, which will never play.
         """
         self._running = False
+        self._hold_low()  # an enable line low at once, before the wait and any I2C "off"
         self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=STOP_WAIT_S)
@@ -402,6 +403,7 @@ class Player:
             self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
+            self._hold_low()
             # After a write a submitting thread may be making (see stop).
             locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
             try:
@@ -545,6 +547,12 @@ class Player:
             log.warning("all motors off %s: %s", when, error)
 
     # --- chips that stopped answering ---------------------------------------------
+
+    def _hold_low(self) -> None:
+        """Stopping: the backend's enable line (if it has one) low, and kept low."""
+        hold_low: Callable[[], None] | None = getattr(self._backend, "hold_low", None)
+        if hold_low is not None:
+            hold_low()
 
     def _lost(self) -> dict[tuple[int, int], str]:
         """(row, column) -> why, for each chip the backend could not switch off (none for a

@@ -431,9 +431,14 @@ class Drv2605Backend(GridBackend):
         self._raise_if_safe()
 
     def close(self) -> None:
-        with self._lock:
-            self._closing = True  # the all-off on the way out leaves the line low
+        self.hold_low()
         super().close()
+
+    def hold_low(self) -> None:
+        """The sleeve is stopping: the enable line low now, and it stays low through the
+        all-offs on the way out. Takes no lock, so a write stuck on the bus cannot delay it."""
+        self._closing = True  # read by _raise_if_safe: no all-off raises the line again
+        self._drop()
 
     def retry_lost(self) -> list[tuple[int, int]]:
         """Try "off" again on every chip that stopped answering; the ones that took it.
