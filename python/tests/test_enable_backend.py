@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -217,3 +219,56 @@ def test_feelmysign_off_drops_the_line_before_any_i2c(tmp_path: Path) -> None:
     line = line_of(other)
     assert line.holder is None and line.rises == line_of(bus).rises  # let go, never raised
     assert all(chip.output == 0 and chip.standby for chip in other.chips.values())
+
+
+# --- the commands -----------------------------------------------------------------------------
+
+
+def feelmysign(tmp_path: Path, *arguments: str) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "XDG_STATE_HOME": str(tmp_path / "state")}
+    return subprocess.run(
+        [*restart_off.feelmysign_command(), *arguments],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+
+
+def test_scan_reports_the_line_and_off_and_buzz_leave_it_low(tmp_path: Path) -> None:
+    layout = tmp_path / "layout.toml"
+    layout.write_text(paper_text('{ chip = "gpiochip0", line = 17 }'))
+    state = tmp_path / "bus.json"
+    where = ["--layout", str(layout), "--emulate-state", str(state)]
+
+    buzz = feelmysign(tmp_path, "buzz", "1", "1", "--duration-ms", "50", *where)
+    assert buzz.returncode == 0, buzz.stderr
+    assert "Enable line gpiochip0 line 17 high" in buzz.stdout
+    assert buzz.stdout.rstrip().endswith("Every motor is off. Enable line gpiochip0 line 17 low.")
+    assert json.loads(state.read_text())["enable"]["rises"] == 1
+
+    scan = feelmysign(tmp_path, "scan", "--json", *where)
+    assert scan.returncode == 0, scan.stderr
+    assert json.loads(scan.stdout)["enable"] == {
+        "line": "gpiochip0 line 17",
+        "holder": "free (nobody drives it; the pull-down holds it)",
+        "level": "low",
+        "problem": None,
+    }
+    off = feelmysign(tmp_path, "off", *where)
+    assert off.returncode == 0, off.stderr
+    assert "the emulated enable line (gpiochip0 line 17) is low" in off.stdout
+    saved = json.loads(state.read_text())["enable"]
+    assert (saved["level"], saved["holder"], saved["rises"]) == (0, None, 1)
+
+
+def test_a_layout_with_a_line_on_a_pi_without_that_gpio_chip_says_what_to_fix(
+    tmp_path: Path,
+) -> None:
+    from feelmysign.backends.enable import GpiodLine
+
+    line = GpiodLine(EnableLine(chip="gpiochip99", line=17))
+    with pytest.raises(HardwareError, match="there is no /dev/gpiochip99; list the GPIO chips"):
+        line.request()
+    assert not line.high
+    line.release()  # never taken: nothing to let go
