@@ -126,7 +126,7 @@ class DrawingSummaries:
         if self._copies.is_copy(event):
             return
         if isinstance(event, Safety) and event.received_at_ms is None:
-            return  # a motor protected outside any stroke (off_failed): the sleeve logs it
+            return  # about a chip, outside any stroke (chip_lost, chip_back): the sleeve logs it
         if not isinstance(event, Played | Rejected | Cancelled | Safety):
             return  # error events are logged by the sleeve itself
         name = event.drawing or NO_DRAWING
