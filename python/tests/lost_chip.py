@@ -49,17 +49,21 @@ def saved(state: Path) -> dict[str, Any]:
     return data
 
 
-def set_connected(state: Path, key: str, connected: bool) -> None:
-    """Set the chip's wire in the file, again if the sleeve's own write raced the edit."""
+def set_connected(state: Path, key: str, connected: bool) -> float:
+    """Set the chip's wire in the file, again if the sleeve's own write raced the edit; the
+    wall clock (ms) of the last edit."""
     deadline = time.monotonic() + WAIT_S
+    edited_ms = 0.0
     while _connected(state, key) != connected:
         assert time.monotonic() < deadline, f"the chip {key} never became connected={connected}"
         data = saved(state)
         data["chips"][key]["connected"] = connected
         edited = state.with_name("edit.json")
         edited.write_text(json.dumps(data))
+        edited_ms = time.time() * 1000
         edited.replace(state)
         time.sleep(0.02)
+    return edited_ms
 
 
 def _connected(state: Path, key: str) -> bool:

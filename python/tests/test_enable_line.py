@@ -8,10 +8,10 @@ a chip whose EN is low drives nothing. A chip's wire comes loose by an edit of t
 
 - a chip lost while its motor is on, then ``kill -9``: every motor at 0 once the sleeve
   is gone, though the lost chip's registers still say "on";
-- a chip lost while its motor is on, mid-drawing: the line falls at the very failure
-  (no bus transaction between), every motor at 0 within 20 ms by the times the file
-  records, a ``safety`` event naming the chip, a ``silenced`` status; the line goes
-  high again once the chip answers, and strokes play again;
+- a chip lost while its motor is on, mid-drawing: every motor at 0 within 20 ms of the
+  wire coming loose, by the times the file records (the sleeve reads the chips whose
+  motors run every 5 ms), a ``safety`` event naming the chip, a ``silenced`` status;
+  the line goes high again once the chip answers, and strokes play again;
 - a restart with a chip missing: the line never goes high, every motor at 0, a clear
   error naming the chip.
 """
@@ -94,7 +94,7 @@ def test_a_chip_lost_while_on_mid_drawing_drops_the_line_at_once_and_says_which(
         key = a_motor_on(state)
         rises = saved(state)["enable"]["rises"]
         print("before the fault:", excerpt(state, key))
-        set_connected(state, key, False)
+        edited_ms = set_connected(state, key, False)
         lost = watcher.next(
             lambda n, b: b.get("type") == "safety" and b.get("reason") == "chip_lost",
             "a safety event for the lost chip",
@@ -108,10 +108,14 @@ def test_a_chip_lost_while_on_mid_drawing_drops_the_line_at_once_and_says_which(
         print("after the fault:", excerpt(state, key))
         line, lost_at = after["enable"], after["chips"][key]["lost_at"]
         assert line["level"] == 0 and line["effective"] == 0, line
-        # The line fell at the failed transaction itself: nothing else on the bus between.
-        assert line["changed_at"]["transaction"] == lost_at["transaction"], (line, lost_at)
+        # lost_at: when the wire came loose for the sleeve (it took the edit of the file);
+        # the line fell after, within MAX_OFF_MS by the clock both were recorded on.
+        assert line["changed_at"]["transaction"] >= lost_at["transaction"], (line, lost_at)
         off_ms = line["changed_at"]["ms"] - lost_at["ms"]
-        print(f"every motor off {off_ms:.3f} ms after the failed transaction")
+        print(
+            f"every motor off {off_ms:.3f} ms after the chip came loose for the sleeve, "
+            f"{line['changed_at']['ms'] - edited_ms:.3f} ms after the test's edit of the file"
+        )
         assert 0 <= off_ms <= MAX_OFF_MS, (line, lost_at)
         assert set(drive_levels(state).values()) == {0.0}
         status = watcher.next(

@@ -82,6 +82,9 @@ TIMING_SAMPLES = 100_000
 # How often a chip that stopped answering is tried again: once it answers, its motor (which
 # may have run on, without an enable line) is off within this, well inside a second.
 RETRY_LOST_S = 0.2
+# How often, with an enable line, the chips whose motors run are read while nothing else is
+# written: a wire that comes loose mid-stroke drops the line within this (plus a read).
+CHECK_DRIVEN_S = 0.005
 
 
 @dataclass
@@ -182,6 +185,7 @@ class Player:
         self.capped = 0
         self.cut = 0  # strokes cut for a chip that stopped answering
         self._retry_at_s = 0.0  # when the lost chips are tried again next
+        self._check_at_s = 0.0  # when the driven chips are read again next
 
     # --- any thread ------------------------------------------------------------
 
@@ -394,6 +398,8 @@ class Player:
                     self._take_inbox()
                     self._apply_cancels()
                     wait_s = self._step()
+                    if wait_s is not None:
+                        wait_s = self._check_driven(wait_s)
                     if self._lost():
                         wait_s = self._retry_lost(wait_s)
                 if wait_s is not None:
@@ -600,6 +606,32 @@ class Player:
                 )
             )
         return RETRY_LOST_S if wait_s is None else min(wait_s, RETRY_LOST_S)
+
+    def _check_driven(self, wait_s: float) -> float:
+        """With nothing due for a while: read the chips whose motors run (a backend with an
+        enable line only), and report one that no longer answers as lost. How long the loop
+        may sleep now."""
+        check: Callable[[], tuple[tuple[int, int], str] | None] | None = getattr(
+            self._backend, "check_driven", None
+        )
+        if check is None or getattr(self._backend, "enable", None) is None:
+            return wait_s
+        if not self._timeline.busy:
+            return wait_s
+        now_s = time.monotonic()
+        if now_s >= self._check_at_s and wait_s * 1000 > self._spin_ms + 1.0:
+            self._check_at_s = now_s + CHECK_DRIVEN_S
+            failed = check()
+            if failed is not None:
+                (row, column), error = failed
+                log.warning("actuator (%d, %d): %s", row, column, error)
+                self._on_event(ErrorEvent(reason="backend", message=error, row=row, column=column))
+                cut = self._cut_playing()
+                self._chip_lost(
+                    Change(self._clock(), row, column, 0.0), error, cut, not_yet_played=[]
+                )
+                return 0.0  # look at the timeline again at once
+        return min(wait_s, max(0.0, self._check_at_s - now_s))
 
     def _refuse_all_silenced(self) -> None:
         """Silenced: every stroke in the timeline is cut and said so, none is called played."""

@@ -440,6 +440,28 @@ class Drv2605Backend(GridBackend):
         self._closing = True  # read by _raise_if_safe: no all-off raises the line again
         self._drop()
 
+    def check_driven(self) -> tuple[tuple[int, int], str] | None:
+        """With an enable line: read STATUS from every chip whose motor is on; the first one
+        that does not answer, and why (the line is low by then). None when all answer.
+
+        A wire that comes loose while its motor runs is otherwise found only at the next
+        write to that chip, which may be seconds later in a slow stroke: the player calls
+        this every few milliseconds while motors run, so the line drops within them. Without
+        a line nothing is gained in time (the motor cannot be stopped), so no bus traffic is
+        spent on it."""
+        with self._lock:
+            if self._enable is None or not self.is_open or not self._enable.high:
+                return None
+            for key, level in self._rtp_levels.items():
+                if level == 0:
+                    continue
+                actuator = self._actuators[key]
+                try:
+                    self._guard(actuator, "while its motor ran", actuator.chip.device_id)
+                except HardwareError as error:
+                    return key, str(error)
+            return None
+
     def retry_lost(self) -> list[tuple[int, int]]:
         """Try "off" again on every chip that stopped answering; the ones that took it.
 

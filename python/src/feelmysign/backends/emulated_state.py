@@ -43,9 +43,10 @@ file was written; ``rises`` counts the times it ever went high. A chip whose EN
 is low drives nothing whatever its registers say; with EN high (or no line) it
 drives what its registers say.
 
-``transactions`` counts the bus transactions tried; a chip found not answering
-gets ``lost_at`` (the wall clock in ms and that count, when a transaction first
-found it so; null while it answers), and the line's ``changed_at`` says when it
+``transactions`` counts the bus transactions tried; a chip that stops answering
+gets ``lost_at`` (the wall clock in ms and that count: when the process driving
+the bus took the edit that disconnected it, or when a transaction first found it
+gone; null while it answers), and the line's ``changed_at`` says when it
 last changed: a test reads from these how soon after a chip was lost every
 motor was off.
 
@@ -62,6 +63,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 
 from feelmysign.backends.emulated_i2c import (
     EmulatedDRV2605L,
@@ -160,7 +162,10 @@ class _WriteThrough:
         except EmulatedStateError:
             return  # half-edited by hand: the next change is looked at again
         for key, chip in bus.chips.items():
-            chip.connected = key in saved and saved[key].connected
+            connected = key in saved and saved[key].connected
+            if chip.connected and not connected:  # the wire comes loose now, for this process
+                chip.lost_at = (round(time.time() * 1000, 3), bus.transactions)
+            chip.connected = connected
 
 
 def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
