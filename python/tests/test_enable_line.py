@@ -80,6 +80,27 @@ def test_a_chip_lost_while_on_then_kill_9_leaves_every_motor_off(
     assert set(drive_levels(state).values()) == {0.0}
 
 
+def test_kill_9_while_the_line_is_high_leaves_every_motor_off_with_no_process_left(
+    broker: Broker, tmp_path: Path
+) -> None:
+    """The dead man's switch alone: the sleeve dies with the line high and a motor on; no
+    process writes "low" or "off", and still nothing is driven once it is gone."""
+    state, layout = tmp_path / "bus.json", paper_with_enable(tmp_path)
+    with (
+        SleeveWatch(broker.credentials, "status", "events") as watcher,
+        reaped(start(broker, state, layout)) as sleeve,
+    ):
+        watcher.next(online, "the sleeve online")
+        watcher.send(restart_off.LONG_STROKE)
+        key = a_motor_on(state)
+        assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+    print("after kill -9 with the line high:", excerpt(state, key))
+    line = saved(state)["enable"]
+    assert (line["level"], line["holder"]["pid"]) == (1, sleeve.pid)  # left high by the dead
+    assert register_drive(state, key) > 0  # and the chip still told to drive
+    assert set(drive_levels(state).values()) == {0.0}
+
+
 def test_a_chip_lost_while_on_mid_drawing_drops_the_line_at_once_and_says_which(
     broker: Broker, tmp_path: Path
 ) -> None:
