@@ -671,6 +671,7 @@ class Player:
                 "Every other motor was switched off; this one cannot be (no enable line): it is "
                 "tried again until it answers."
             )
+        error = error if error.endswith(".") else f"{error}."  # a sentence before the next
         if not cut:
             self._on_event(
                 Safety(

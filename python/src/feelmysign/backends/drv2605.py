@@ -357,7 +357,13 @@ class Drv2605Backend(GridBackend):
         before an enable line goes high); HardwareError listing every one that is not."""
         problems = list(self._chip_problems(readback=readback).values())
         others_off = _OTHERS_OFF
-        if self._enable is not None:
+        if self._enable is None:
+            # A chip that does not answer cannot be switched off: its motor may still run.
+            others_off = (
+                f"{_OTHERS_OFF[:-1]}; a motor on a chip that did not answer may still run: if "
+                "one keeps vibrating, cut the sleeve's power)"
+            )
+        else:
             others_off = f"{_OTHERS_OFF[:-1]}; the {self._enable.description} stays low)"
         if len(problems) == 1:
             raise HardwareError(f"{problems[0]} {others_off}")

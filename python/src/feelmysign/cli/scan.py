@@ -248,7 +248,9 @@ def _found_and_status(
         return found, "UNEXPECTED" if has_driver else "free"
     if not has_driver:
         return found, "MISSING"
-    return found, "ok" if right_chip else "WRONG CHIP"
+    if not right_chip:
+        return found, "WRONG CHIP"
+    return found, "DRIVING" if scanned is not None and scanned.driving else "ok"
 
 
 def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
@@ -283,7 +285,7 @@ def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
         )
         return "\n".join(lines)
     wired = len(report.wires)
-    answering = sum(1 for check in report.wires if check.status == "ok")
+    answering = sum(1 for check in report.wires if check.status in ("ok", "driving"))
     if report.ok:
         lines.append(f"All {wired} actuators answer as the layout says.")
     else:
