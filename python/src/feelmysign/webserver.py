@@ -43,6 +43,7 @@ import ssl
 import sys
 import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -122,6 +123,7 @@ class _Connection:
 
     sock: socket.socket
     peer: str
+    port: int
     idle_since_s: float
     opening: asyncio.Task[None] | None = None
     transport: asyncio.BaseTransport | None = None
@@ -217,7 +219,9 @@ class WebServer:
             )
         self._log.addHandler(self._log_handler)
         self._notices = _Notices()
-        self._connections: dict[tuple[str, int], _Connection] = {}
+        # Least recently active first (moved to the end after each answer): the one to close
+        # at the cap is found at the front, in constant time however many are held.
+        self._connections: OrderedDict[tuple[str, int], _Connection] = OrderedDict()
         # The study API blocks (SQLite, the broker): one thread answers it, away from the loop.
         self._api_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="page-api")
         self._loop = asyncio.new_event_loop()
@@ -319,22 +323,22 @@ class WebServer:
                 continue
             self._make_room()
             peer = (str(address[0]), int(address[1]))
-            connection = _Connection(sock, peer[0], time.monotonic())
+            connection = _Connection(sock, peer[0], peer[1], time.monotonic())
             self._connections[peer] = connection
+            self._connections.move_to_end(peer)  # the address of one closed a moment ago
             connection.opening = loop.create_task(self._open(connection, peer))
 
     def _make_room(self) -> None:
         """Below the cap, by closing the connection idle longest (never refusing a new one)."""
-        for peer, connection in list(self._connections.items()):
-            if connection.closed:
-                del self._connections[peer]
         if len(self._connections) < MAX_CONNECTIONS:
             return
-        idle = [(c.idle_since_s, p) for p, c in self._connections.items() if c.active == 0]
-        if idle:
-            oldest = self._connections.pop(min(idle)[1])
-            self._log.debug("connection cap: closing an idle connection from %s", oldest.peer)
-            oldest.close()
+        for peer, connection in self._connections.items():
+            if connection.closed or connection.active == 0:
+                del self._connections[peer]
+                if not connection.closed:
+                    self._log.debug("connection cap: closed an idle one from %s", peer[0])
+                    connection.close()
+                return
 
     async def _sweep(self) -> None:
         """Close connections that sent no whole request within ``HEADER_TIMEOUT_S``."""
@@ -430,6 +434,9 @@ class WebServer:
             if connection is not None:
                 connection.active -= 1
                 connection.idle_since_s = time.monotonic()
+                peer = (connection.peer, connection.port)
+                if self._connections.get(peer) is connection:
+                    self._connections.move_to_end(peer)
 
     async def _answer_sent(self, request: web.BaseRequest) -> web.StreamResponse:
         """The answer, sent here within the time limit (aiohttp would send it after)."""
