@@ -13,8 +13,11 @@ relay's, not TLS's. The sleeve is a process of its own, as on the Pi.
 from __future__ import annotations
 
 import http.client
+import os
 import socket
 import statistics
+import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -25,6 +28,7 @@ from pathlib import Path
 import paho.mqtt.client as mqtt
 from paho.mqtt.enums import CallbackAPIVersion
 
+from feelmysign.bench._mqtt import close
 from feelmysign.bench.sleeve import (
     MEDIUM,
     WARM_UP,
@@ -35,11 +39,13 @@ from feelmysign.bench.sleeve import (
     stroke_latencies,
 )
 from feelmysign.broker import Broker, Credentials
+from feelmysign.topics import strokes_topic
 from feelmysign.webserver import KEY_COOKIE, WebServer
 
 IDLE_CONNECTIONS = (0, 500, 1000)
 PAGE_LOADS = 20
-STROKES = 100  # each path, after WARM_UP unmeasured ones: enough for a p99
+STROKES = 100
+RELAYED_MESSAGES = 3000  # each path, after WARM_UP unmeasured ones: enough for a p99
 ACCESS_KEY = "bench-key"
 
 
@@ -114,6 +120,53 @@ def _idle_lines(site: Path) -> list[str]:
     return lines
 
 
+# The page server alone in a process, for its CPU time per relayed message.
+_SERVE = """
+import sys
+from pathlib import Path
+from feelmysign.webserver import WebServer
+server = WebServer(port=0, config={}, directory=Path(sys.argv[1]), access_key=sys.argv[3],
+                   mqtt_ws_port=int(sys.argv[2]))
+with server:
+    print(server.url, flush=True)
+    sys.stdin.read()
+"""
+
+
+def _cpu_s(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _relay_cpu_line(c: Credentials, site: Path) -> str:
+    """The page server's CPU time per message relayed (a QoS 1 publish and its PUBACK:
+    one message each way), in a process of its own: immune to the machine's load."""
+    server = subprocess.Popen(
+        [sys.executable, "-c", _SERVE, str(site), str(c.ws_port), ACCESS_KEY],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert server.stdout is not None
+        port = int(server.stdout.readline().strip().rstrip("/").rsplit(":", 1)[1])
+        sender = _websocket_sender(c, port, "/mqtt", f"{KEY_COOKIE}={ACCESS_KEY}")
+        topic = strokes_topic("bench-nobody")  # no sleeve listens: only the relay works
+        for _ in range(WARM_UP * 20):
+            sender.publish(topic, b"warm-up", qos=1).wait_for_publish(10)
+        before_s = _cpu_s(server.pid)
+        for _ in range(RELAYED_MESSAGES):
+            sender.publish(topic, b"x" * 200, qos=1).wait_for_publish(10)
+        per_message_us = (_cpu_s(server.pid) - before_s) / (2 * RELAYED_MESSAGES) * 1e6
+        close(sender)
+    finally:
+        server.communicate("", timeout=30)
+    return (
+        f"  the page server's CPU per relayed MQTT message: {per_message_us:6.1f} us"
+        f"   ({RELAYED_MESSAGES} publishes and their PUBACKs)"
+    )
+
+
 def report() -> list[str]:
     lines = ["Relay (the page's path: real Mosquitto, page server and sleeve process on loopback)"]
     with tempfile.TemporaryDirectory() as state:
@@ -143,6 +196,7 @@ def report() -> list[str]:
                     events = stroke_latencies(c, MEDIUM, STROKES, sender())
                     end_to_end = [e.first_command_at_ms - sent_ms for sent_ms, e in events]
                     lines.append(_line(f"3 cm {name}: publish -> first command", end_to_end, bare))
+            lines.append(_relay_cpu_line(c, site))
         lines += _idle_lines(site)
     return lines
 
