@@ -197,17 +197,13 @@ class CalibrationStore:
         chips = data.get("chips")
         return chips if isinstance(chips, dict) else {}
 
+    def results(self, motor: dict[str, Any]) -> dict[str, Calibration]:
+        """Chip -> its stored results, for the chips calibrated with ``motor``."""
+        found = {chip: _calibration(saved, motor) for chip, saved in self.load().items()}
+        return {chip: result for chip, result in found.items() if result is not None}
+
     def get(self, chip: str, motor: dict[str, Any]) -> Calibration | None:
-        saved = self.load().get(chip)
-        if not isinstance(saved, dict) or saved.get("motor") != motor:
-            return None
-        try:
-            values = [int(saved[key]) for key in ("a_cal_comp", "a_cal_bemf", "bemf_gain")]
-        except (KeyError, TypeError, ValueError):
-            return None
-        if not all(0 <= v <= 0xFF for v in values) or values[2] > BEMF_GAIN_MASK:
-            return None
-        return Calibration(*values)
+        return _calibration(self.load().get(chip), motor)
 
     def put(self, results: dict[str, Calibration], motor: dict[str, Any]) -> None:
         """Keep ``results`` (chip -> calibration); OSError when the file cannot be written."""
@@ -220,3 +216,15 @@ class CalibrationStore:
         with open(temporary, "w", encoding="utf-8") as file:
             file.write(text)
         os.replace(temporary, self.path)  # whole or not at all
+
+
+def _calibration(saved: Any, motor: dict[str, Any]) -> Calibration | None:
+    if not isinstance(saved, dict) or saved.get("motor") != motor:
+        return None
+    try:
+        values = [int(saved[key]) for key in ("a_cal_comp", "a_cal_bemf", "bemf_gain")]
+    except (KeyError, TypeError, ValueError):
+        return None
+    if not all(0 <= v <= 0xFF for v in values) or values[2] > BEMF_GAIN_MASK:
+        return None
+    return Calibration(*values)
