@@ -18,6 +18,7 @@ from feelmysign.backends.drv2605 import (
 )
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.tca9548a import CHANNELS, Multiplexers
+from feelmysign.errors import HardwareError
 from feelmysign.layout import Layout, Wire
 
 # i2cdetect's default range: 0x00-0x07 and 0x78-0x7F are reserved addresses.
@@ -155,3 +156,40 @@ def compare_with_layout(result: ScanResult, layout: Layout) -> LayoutReport:
             "main bus, not behind a multiplexer, and collides with every other DRV2605L"
         )
     return LayoutReport(wires, tuple(unexpected))
+
+
+# The motor settings and auto-calibration results, as their registers hold them.
+MOTOR_REGISTERS = {
+    "rated_voltage": 0x16,
+    "od_clamp": 0x17,
+    "a_cal_comp": 0x18,
+    "a_cal_bemf": 0x19,
+    "feedback_control": 0x1A,
+    "control1": 0x1B,
+}
+
+
+def read_motor_registers(
+    bus: I2CBus, layout: Layout, report: LayoutReport
+) -> dict[tuple[int, int], dict[str, int]]:
+    """(multiplexer, channel) -> register name -> value, for every wired chip that answered.
+
+    Only reads; every channel is disabled afterwards."""
+    muxes = Multiplexers(bus, layout.multiplexers)
+    found: dict[tuple[int, int], dict[str, int]] = {}
+    try:
+        for check in report.wires:
+            if check.status != "ok":
+                continue
+            wire = check.wire
+            try:
+                muxes.select(wire.multiplexer, wire.channel)
+                found[(wire.multiplexer, wire.channel)] = {
+                    name: bus.read_byte_data(DRV2605_ADDRESS, register)
+                    for name, register in MOTOR_REGISTERS.items()
+                }
+            except (OSError, HardwareError):
+                continue  # it answered the scan a moment ago; the table shows it as unread
+    finally:
+        muxes.deselect_all()
+    return found
