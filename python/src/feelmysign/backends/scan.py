@@ -6,6 +6,7 @@ driver is missing, on which multiplexer channel, and what answers instead.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Literal
@@ -170,12 +171,13 @@ MOTOR_REGISTERS = {
 
 
 def read_motor_registers(
-    bus: I2CBus, layout: Layout, report: LayoutReport
+    bus: I2CBus, layout: Layout, result: ScanResult, report: LayoutReport
 ) -> dict[tuple[int, int], dict[str, int]]:
     """(multiplexer, channel) -> register name -> value, for every wired chip that answered.
 
     Only reads; every channel is disabled afterwards."""
-    muxes = Multiplexers(bus, layout.multiplexers)
+    present = [m for m in layout.multiplexers if m not in result.missing_multiplexers]
+    muxes = Multiplexers(bus, present)
     found: dict[tuple[int, int], dict[str, int]] = {}
     try:
         for check in report.wires:
@@ -191,5 +193,6 @@ def read_motor_registers(
             except (OSError, HardwareError):
                 continue  # it answered the scan a moment ago; the table shows it as unread
     finally:
-        muxes.deselect_all()
+        with contextlib.suppress(HardwareError):
+            muxes.deselect_all()
     return found

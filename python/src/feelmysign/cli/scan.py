@@ -153,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
         result = scan(bus, addresses)
         line = _enable_line(layout, bus)
         report = compare_with_layout(result, layout)
-        registers = read_motor_registers(bus, layout, report) if layout.wiring else {}
+        registers = read_motor_registers(bus, layout, result, report) if layout.wiring else {}
     finally:
         bus.close()
     motors = _motor_rows(layout, registers, store)
