@@ -6,6 +6,7 @@ expected value below is derived by hand from the equation in its comment.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
@@ -136,3 +137,15 @@ def test_a_calibration_that_never_ends_is_stopped_and_named(tmp_path: Path) -> N
     assert all(c.output == 0 for c in bus.chips.values())
     # The chips calibrated before it keep their results.
     assert set(store.results(motor_description(layout))) == {"0x70/0", "0x70/1"}
+
+
+def test_a_layout_built_in_code_past_the_checks_is_refused_after_the_off() -> None:
+    layout = dataclasses.replace(parse_layout(GRID + WIRED), rated_voltage_v=9.0)
+    bus = EmulatedI2CBus.for_layout(layout)
+    bus.chips[(0x70, 1)].registers[0x01] = 0x05  # left in RTP mode at full drive by a crash
+    bus.chips[(0x70, 1)].registers[0x02] = 0xFF
+    bus.chips[(0x70, 1)].registers[0x1D] |= 0x08
+    assert bus.chips[(0x70, 1)].output == 1.0
+    with pytest.raises(LayoutError, match="rated voltage 9 V needs register value 425"):
+        Drv2605Backend(layout, bus=bus).open()
+    assert all(c.output == 0 for c in bus.chips.values())

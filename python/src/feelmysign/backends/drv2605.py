@@ -312,7 +312,7 @@ class Drv2605Backend(GridBackend):
         # whatever calibration they hold.
         self._store = calibration
         self._calibrate_all = calibrate
-        self._settings = chip_settings(layout) if layout.wiring else None
+        self._settings: ChipSettings | None = None  # worked out on open, after the off
         self._calibrations: dict[tuple[int, int], Calibration] = {}
         # Every chip's EN pin (layout.enable): low until every chip is off and checked, and
         # dropped before any I2C "off". None: EN tied high, only I2C switches a motor off.
@@ -423,6 +423,7 @@ class Drv2605Backend(GridBackend):
                 raise line_problem
             # Configuration comes after every motor is off and checked: nothing above waits
             # for the calibration file, and nothing here can delay an "off".
+            self._settings = self._chip_settings()
             self._calibrations = self._stored_calibrations()
             for key, actuator in self._actuators.items():
                 self._guard(actuator, "while being set up", self._start_rtp, key, actuator)
@@ -439,6 +440,15 @@ class Drv2605Backend(GridBackend):
                 multiplexers.deselect_all()
             self._release()
             raise
+
+    def _chip_settings(self) -> ChipSettings:
+        try:
+            return chip_settings(self._layout)
+        except ValueError as error:  # a Layout built in code, past the file's checks
+            raise LayoutError(
+                self._layout.name,
+                [f"{error}; set the motor's values from its datasheet (docs/sleeve-hardware.md)"],
+            ) from None
 
     def _start_rtp(self, key: tuple[int, int], actuator: _Actuator) -> None:
         assert self._settings is not None  # opened: the layout is wired
