@@ -160,12 +160,32 @@ def test_a_failed_calibration_names_the_chip_and_leaves_every_motor_off(
     assert saved["0x70/5"]["calibrations"] == 1
     assert bytes.fromhex(saved["0x70/5"]["registers"])[0] & 0x08  # DIAG_RESULT
 
-    # Fixed (the motor wired again): scan --calibrate calibrates and keeps it; the sleeve
-    # then starts without calibrating again.
+    # scan --calibrate says the same, and still shows every chip.
+    failed = scan_calibrate(state, layout)
+    assert failed.returncode == 1
+    assert "Calibration failed: Auto-calibration of the DRV2605L on multiplexer 0x70 channel 5" in (
+        failed.stdout
+    )
+    assert "row 2, column 3" in failed.stdout  # the scan's table is there
+    assert set(drive_levels(state).values()) == {0.0}
+
+    # Fixed (the motor wired again): scan --calibrate calibrates and keeps every result.
     data = json.loads(state.read_text())
     data["chips"]["0x70/5"]["fail_calibration"] = False
     state.write_text(json.dumps(data))
-    scan = subprocess.run(
+    scan = scan_calibrate(state, layout, "--json")
+    assert scan.returncode == 0, scan.stderr
+    motors = json.loads(scan.stdout)["motors"]
+    assert len(motors) == 12
+    assert all(m["calibration_stored"] and m["as_layout"] for m in motors), motors
+    assert {m["rated_voltage"] for m in motors} == {LRA["rated_voltage"]}
+    counts = {name: saved["calibrations"] for name, saved in chips(state).items()}
+    assert counts["0x70/5"] == 3
+    assert set(drive_levels(state).values()) == {0.0}
+
+
+def scan_calibrate(state: Path, layout: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
         [
             *restart_off.feelmysign_command(),
             "scan",
@@ -174,17 +194,9 @@ def test_a_failed_calibration_names_the_chip_and_leaves_every_motor_off(
             "--emulate-state",
             str(state),
             "--calibrate",
-            "--json",
+            *extra,
         ],
         capture_output=True,
         text=True,
         timeout=WAIT_S,
     )
-    assert scan.returncode == 0, scan.stderr
-    motors = json.loads(scan.stdout)["motors"]
-    assert len(motors) == 12
-    assert all(m["calibration_stored"] and m["as_layout"] for m in motors), motors
-    assert {m["rated_voltage"] for m in motors} == {LRA["rated_voltage"]}
-    counts = {name: saved["calibrations"] for name, saved in chips(state).items()}
-    assert counts["0x70/5"] == 2
-    assert set(drive_levels(state).values()) == {0.0}

@@ -17,7 +17,8 @@ what the layout's motor asks for, its auto-calibration results (A_CAL_COMP, A_CA
 BEMF_GAIN) and whether they are kept for the next start. ``--calibrate`` first runs the
 chips' auto-calibration again (each motor buzzes for about a second, one after another)
 and keeps the results: do it after changing a motor; the sleeve calibrates by itself a
-chip that has no result kept.
+chip that has no result kept. Stop the sleeve first (``sudo systemctl stop
+feelmysign-sleeve``): two processes must not drive one bus.
 """
 
 from __future__ import annotations
@@ -125,7 +126,7 @@ def register(subparsers: Subcommands) -> None:
         "--calibrate",
         action="store_true",
         help="first run every chip's auto-calibration again and keep the results (each motor "
-        "buzzes for about a second); after changing a motor",
+        "buzzes for about a second); after changing a motor, with the sleeve stopped",
     )
     parser.add_argument("--json", action="store_true", help="print one JSON object, for programs")
     parser.set_defaults(handler=run)
@@ -147,9 +148,10 @@ def run(args: argparse.Namespace) -> int:
         bus = _open_bus(bus_number)
     # An emulated bus without a file keeps nothing: its calibration is not kept either.
     store = None if args.emulate and not args.emulate_state else _store(layout, args)
+    calibration_problem = None
     try:
         if args.calibrate:
-            _calibrate(layout, bus, store)
+            calibration_problem = _calibrate(layout, bus, store)
         result = scan(bus, addresses)
         line = _enable_line(layout, bus)
         report = compare_with_layout(result, layout)
@@ -158,7 +160,14 @@ def run(args: argparse.Namespace) -> int:
         bus.close()
     motors = _motor_rows(layout, registers, store)
     scanned = _Scanned(
-        layout, bus_number, result, report, channel_rows(result, layout), line, motors
+        layout,
+        bus_number,
+        result,
+        report,
+        channel_rows(result, layout),
+        line,
+        motors,
+        calibration_problem,
     )
     if args.json:
         print(json.dumps(_as_json(args, scanned)))
@@ -178,12 +187,14 @@ class _Scanned:
     rows: list[ChannelRow]
     enable: EnableReport | None = None
     motors: list[MotorRow] | None = None
+    calibration_problem: str | None = None  # --calibrate, when it failed
 
     @property
     def ok(self) -> bool:
         """Every wired actuator answers, the layout wires some, and its enable line is sound."""
         line_ok = self.enable is None or self.enable.problem is None
-        return self.report.ok and bool(self.layout.wiring) and line_ok
+        calibrated = self.calibration_problem is None
+        return self.report.ok and bool(self.layout.wiring) and line_ok and calibrated
 
 
 @dataclass(frozen=True)
@@ -256,14 +267,19 @@ def _store(layout: Layout, args: argparse.Namespace) -> CalibrationStore:
     return calibration_store_for(layout, args.emulate_state)
 
 
-def _calibrate(layout: Layout, bus: I2CBus, store: CalibrationStore | None) -> None:
-    """Every chip switched off, set up and auto-calibrated again; the results kept in ``store``."""
+def _calibrate(layout: Layout, bus: I2CBus, store: CalibrationStore | None) -> str | None:
+    """Every chip switched off, set up and auto-calibrated again, the results kept in ``store``;
+    what went wrong (every motor off then too), or None. The scan runs after it either way."""
     check_wired(layout)
     backend = Drv2605Backend(
         layout, bus=bus, enable=enable_line_for(layout, bus), calibration=store, calibrate=True
     )
-    with backend:
-        pass  # open() calibrates; leaving switches every motor off
+    try:
+        with backend:
+            pass  # open() calibrates; leaving switches every motor off
+    except HardwareError as error:  # open() switched every motor off before it raised
+        return str(error)
+    return None
 
 
 def _motor_rows(
@@ -448,6 +464,8 @@ def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
         return "\n".join(lines)
     if scanned.motors:
         lines += ["", *_motor_lines(layout, scanned.motors), ""]
+    if scanned.calibration_problem is not None:
+        lines += [f"Calibration failed: {scanned.calibration_problem}", ""]
     wired = len(report.wires)
     answering = sum(1 for check in report.wires if check.status == "ok")
     if report.ok:
@@ -514,4 +532,5 @@ def _as_json(args: argparse.Namespace, scanned: _Scanned) -> dict[str, Any]:
         ),
         "enable": None if scanned.enable is None else scanned.enable.as_dict(),
         "motors": [row.as_dict() for row in scanned.motors or []],
+        "calibration_problem": scanned.calibration_problem,
     }
