@@ -8,6 +8,9 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     spacing_cm = 3.0              # centre-to-centre distance between neighbours
     actuator_type = "ERM"         # ERM or LRA
     min_burst_ms = 20             # optional; default by actuator_type (ERM 20, LRA 10)
+    rated_voltage_v = 3.0         # optional; the motor's rated voltage (ERM: average, LRA: RMS)
+    overdrive_voltage_v = 3.6     # optional; the most it may get, peak (its datasheet's maximum)
+    # resonant_frequency_hz = 205 # LRA only, optional; its resonance from its datasheet
     default_intensity = 0.8       # for strokes that do not say, 0..1
 
     [safety]
@@ -65,6 +68,23 @@ ACTUATOR_TYPES: tuple[ActuatorType, ...] = ("ERM", "LRA")
 # Measure your motors and set min_burst_ms when they differ.
 MIN_BURST_MS: dict[ActuatorType, float] = {"ERM": 20.0, "LRA": 10.0}
 MAX_MIN_BURST_MS = 1000.0  # a burst floor of a second already forbids any drawing
+
+# A motor's datasheet values, as the DRV2605L datasheet (SLOS854, 8.5.2) defines them: the
+# rated voltage (ERM: average; LRA: RMS at resonance) is the full-scale drive, the overdrive
+# voltage (peak) bounds the chip's automatic overdrive. Defaults: a common 10 mm coin ERM
+# (3.0 V rated, 3.6 V maximum) and a coin LRA of the 170-235 Hz kind (2.0 V rms rated, its
+# sine's 2.8 V peak as the clamp, 205 Hz: the middle, as the chip tracks the resonance
+# itself in closed loop and the frequency is only its first guess).
+DEFAULT_RATED_VOLTAGE_V: dict[ActuatorType, float] = {"ERM": 3.0, "LRA": 2.0}
+DEFAULT_OVERDRIVE_VOLTAGE_V: dict[ActuatorType, float] = {"ERM": 3.6, "LRA": 2.8}
+DEFAULT_RESONANT_FREQUENCY_HZ = 205.0
+# RATED_VOLTAGE and OD_CLAMP are 8-bit: up to 5.4 V (ERM closed loop) and 5.5 V (ERM open
+# loop, closed-loop clamp 5.6 V); the chip's supply is at most 5.2 V anyway.
+VOLTAGE_RANGE_V = (0.5, 5.0)
+MAX_OVERDRIVE_VOLTAGE_V = 5.5
+# DRIVE_TIME (5 bits, 0.5 to 3.6 ms half periods) covers 139 Hz and up; the closed-loop
+# rated-voltage equation needs (4 x 300 us + 300 us) x f below 1, under 667 Hz.
+RESONANT_FREQUENCY_RANGE_HZ = (140.0, 400.0)
 
 MAX_GRID_SIDE = 64  # rows or columns; 8 multiplexers x 8 channels drive 64 actuators at most
 MIN_ACTUATORS = 2  # a stroke moves between actuators; one cannot draw anything
@@ -135,6 +155,10 @@ class Layout:
     actuator_type: ActuatorType = "ERM"
     # None: the actuator type's MIN_BURST_MS; read it through ``shortest_burst_ms``.
     min_burst_ms: float | None = None
+    # None: the actuator type's default; read them through the properties below.
+    rated_voltage_v: float | None = None
+    overdrive_voltage_v: float | None = None
+    resonant_frequency_hz: float | None = None  # LRA only
     i2c_bus: int = 1
     multiplexers: tuple[int, ...] = ()
     wiring: tuple[Wire, ...] = ()
@@ -148,6 +172,27 @@ class Layout:
             return self.min_burst_ms
         return MIN_BURST_MS[self.actuator_type]
 
+    @property
+    def rated_voltage(self) -> float:
+        """The motor's rated voltage in V (ERM average, LRA RMS): set, or the type's default."""
+        if self.rated_voltage_v is not None:
+            return self.rated_voltage_v
+        return DEFAULT_RATED_VOLTAGE_V[self.actuator_type]
+
+    @property
+    def overdrive_voltage(self) -> float:
+        """The motor's overdrive (peak) voltage in V: set, or the type's default."""
+        if self.overdrive_voltage_v is not None:
+            return self.overdrive_voltage_v
+        return DEFAULT_OVERDRIVE_VOLTAGE_V[self.actuator_type]
+
+    @property
+    def resonance_hz(self) -> float:
+        """An LRA's resonant frequency in Hz: set, or the default."""
+        if self.resonant_frequency_hz is not None:
+            return self.resonant_frequency_hz
+        return DEFAULT_RESONANT_FREQUENCY_HZ
+
 
 _DEFAULTS = Layout(rows=1, columns=MIN_ACTUATORS, spacing_cm=1.0)
 # The keys at the top of a layout file, before its [safety] and [i2c] tables.
@@ -158,6 +203,9 @@ TOP_KEYS = (
     "spacing_cm",
     "actuator_type",
     "min_burst_ms",
+    "rated_voltage_v",
+    "overdrive_voltage_v",
+    "resonant_frequency_hz",
     "default_intensity",
 )
 _SAFETY_KEYS = (
@@ -301,6 +349,7 @@ def _read_geometry(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
         ),
         "actuator_type": problems.actuator_type(data.get("actuator_type", _DEFAULTS.actuator_type)),
         "min_burst_ms": _read_min_burst(problems, data.get("min_burst_ms")),
+        **_read_motor(problems, data),
     }
 
 
@@ -309,6 +358,45 @@ def _read_min_burst(problems: _Problems, value: Any) -> float | None:
     if value is None:
         return None
     return problems.number("min_burst_ms", value, MAX_MIN_BURST_MS)
+
+
+def _read_motor(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
+    """The motor's datasheet values (all optional); the overdrive at least the rated voltage."""
+    kind = data.get("actuator_type", _DEFAULTS.actuator_type)
+    low, high = VOLTAGE_RANGE_V
+    read: dict[str, Any] = {}
+    for key, top, unit in (
+        ("rated_voltage_v", high, "V (ERM: average; LRA: RMS)"),
+        ("overdrive_voltage_v", MAX_OVERDRIVE_VOLTAGE_V, "V peak"),
+    ):
+        value = data.get(key)
+        read[key] = None if value is None else problems.within(key, value, low, top, unit)
+    rated, overdrive = read["rated_voltage_v"], read["overdrive_voltage_v"]
+    if kind in ACTUATOR_TYPES:
+        rated = DEFAULT_RATED_VOLTAGE_V[kind] if rated is None else rated
+        overdrive = DEFAULT_OVERDRIVE_VOLTAGE_V[kind] if overdrive is None else overdrive
+    if rated is not None and overdrive is not None and overdrive < rated:
+        problems.add(
+            "overdrive_voltage_v",
+            f"{overdrive:g} V is below the rated voltage {rated:g} V: the overdrive clamp must "
+            "be at least the rated voltage; take both from the motor's datasheet (its maximum "
+            "or overdrive voltage, and its rated voltage)",
+        )
+    frequency = data.get("resonant_frequency_hz")
+    read["resonant_frequency_hz"] = None
+    if frequency is not None:
+        if kind != "LRA":
+            problems.add(
+                "resonant_frequency_hz",
+                'is for an LRA only (actuator_type = "LRA"); an ERM has no resonance to '
+                "set: remove it, or set actuator_type",
+            )
+        else:
+            low_hz, high_hz = RESONANT_FREQUENCY_RANGE_HZ
+            read["resonant_frequency_hz"] = problems.within(
+                "resonant_frequency_hz", frequency, low_hz, high_hz, "Hz (the LRA's resonance)"
+            )
+    return read
 
 
 def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
@@ -598,6 +686,17 @@ class _Problems:
             self.add(key, f"must be {allowed}; got {_show(value)}")
             return None
         if not (math.isfinite(value) and 0 < value <= high):
+            self.add(key, f"must be {allowed}; got {value}")
+            return None
+        return float(value)
+
+    def within(self, key: str, value: Any, low: float, high: float, unit: str) -> float | None:
+        """A number from ``low`` to ``high`` in ``unit``: a motor's datasheet value."""
+        allowed = f"a number from {low:g} to {high:g} {unit}, from the motor's datasheet"
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            self.add(key, f"must be {allowed}; got {_show(value)}")
+            return None
+        if not (math.isfinite(value) and low <= value <= high):
             self.add(key, f"must be {allowed}; got {value}")
             return None
         return float(value)

@@ -20,10 +20,19 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ParamSpec, TypeVar
 
+from feelmysign.backends.actuator_config import (
+    BEMF_GAIN_MASK,
+    Calibration,
+    CalibrationStore,
+    ChipSettings,
+    chip_settings,
+    motor_description,
+)
 from feelmysign.backends.all_off import DRV2605_ADDRESS as DRV2605_ADDRESS  # re-exported
 from feelmysign.backends.all_off import MODE_STANDBY, REG_MODE, REG_RTP_INPUT
 from feelmysign.backends.base import GridBackend
@@ -32,19 +41,32 @@ from feelmysign.backends.i2c import I2CBus, is_no_answer, open_smbus
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES, Multiplexers
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.errors import HardwareError, LayoutError, ParameterError
-from feelmysign.layout import ActuatorType, Layout, Wire
+from feelmysign.layout import Layout, Wire
 
 # Register map (datasheet names); the ones the all-off writes come from all_off.
 _REG_STATUS = 0x00
 _REG_MODE = REG_MODE
 _REG_RTP_INPUT = REG_RTP_INPUT
+_REG_GO = 0x0C
+_REG_RATED_VOLTAGE = 0x16
+_REG_OD_CLAMP = 0x17
+_REG_A_CAL_COMP = 0x18
+_REG_A_CAL_BEMF = 0x19
 _REG_FEEDBACK_CONTROL = 0x1A
+_REG_CONTROL1 = 0x1B
 _REG_CONTROL3 = 0x1D
 
 _STATUS_DEVICE_ID_SHIFT = 5  # STATUS[7:5] = DEVICE_ID
 _MODE_INTERNAL_TRIGGER = 0x00  # active (STANDBY = 0), plays nothing until GO
 _MODE_REAL_TIME_PLAYBACK = 0x05  # active, output amplitude = RTP_INPUT
+_MODE_AUTO_CALIBRATION = 0x07  # active, runs auto-calibration on GO
 _MODE_STANDBY = MODE_STANDBY
+_STATUS_DIAG_RESULT = 0x08  # STATUS bit 3: 1 = the last calibration (or diagnostic) failed
+_CONTROL1_DRIVE_TIME = 0x1F  # CONTROL1[4:0]
+# Auto-calibration takes 500 to 700 ms at CONTROL4's reset AUTO_CAL_TIME (plus the LRA's
+# settling): far more than that and GO that never clears is a chip or motor problem.
+CALIBRATION_TIMEOUT_S = 2.0
+_CALIBRATION_POLL_S = 0.02
 _FEEDBACK_N_ERM_LRA = 0x80  # N_ERM_LRA (bit 7): 1 = LRA, 0 = ERM
 _CONTROL3_DATA_FORMAT_RTP = 0x08  # DATA_FORMAT_RTP (bit 3): 1 = unsigned, 0x00 off .. 0xFF full
 
@@ -87,15 +109,66 @@ class DRV2605L:
     def device_id(self) -> int:
         return device_id_from_status(self._i2c.read_byte_data(self.address, _REG_STATUS))
 
-    def start_rtp(self, actuator_type: ActuatorType) -> None:
-        """Leave standby, set the motor type and unsigned RTP data, then play RTP at 0 (silent)."""
+    def start_rtp(self, settings: ChipSettings, calibration: Calibration | None = None) -> None:
+        """Leave standby, set the motor (type, voltages, drive time, ``calibration`` when known)
+        and unsigned RTP data, then play RTP at 0 (silent)."""
         self._i2c.write_byte_data(self.address, _REG_MODE, _MODE_INTERNAL_TRIGGER)
         # Zero before entering RTP mode, so a value left by an earlier run never buzzes.
         self._i2c.write_byte_data(self.address, _REG_RTP_INPUT, 0)
-        lra = actuator_type == "LRA"
-        self._update_bits(_REG_FEEDBACK_CONTROL, _FEEDBACK_N_ERM_LRA, lra)
+        self._configure(settings, settings.od_clamp, calibration)
         self._update_bits(_REG_CONTROL3, _CONTROL3_DATA_FORMAT_RTP, True)
         self.play_rtp()
+
+    def _configure(
+        self, settings: ChipSettings, od_clamp: int, calibration: Calibration | None
+    ) -> None:
+        write = self._i2c.write_byte_data
+        write(self.address, _REG_RATED_VOLTAGE, settings.rated_voltage)
+        write(self.address, _REG_OD_CLAMP, od_clamp)
+        feedback = self._i2c.read_byte_data(self.address, _REG_FEEDBACK_CONTROL)
+        wanted = feedback | _FEEDBACK_N_ERM_LRA if settings.lra else feedback & ~_FEEDBACK_N_ERM_LRA
+        if calibration is not None:
+            write(self.address, _REG_A_CAL_COMP, calibration.a_cal_comp)
+            write(self.address, _REG_A_CAL_BEMF, calibration.a_cal_bemf)
+            wanted = (wanted & ~BEMF_GAIN_MASK) | calibration.bemf_gain
+        if wanted & 0xFF != feedback:
+            write(self.address, _REG_FEEDBACK_CONTROL, wanted & 0xFF)
+        control1 = self._i2c.read_byte_data(self.address, _REG_CONTROL1)
+        wanted = (control1 & ~_CONTROL1_DRIVE_TIME & 0xFF) | settings.drive_time
+        if wanted != control1:
+            write(self.address, _REG_CONTROL1, wanted)
+
+    def calibrate(
+        self,
+        settings: ChipSettings,
+        *,
+        timeout_s: float = CALIBRATION_TIMEOUT_S,
+        sleep: Callable[[float], None] = time.sleep,
+    ) -> Calibration | str:
+        """Run the chip's auto-calibration (SLOS854 8.5.6): its results, or what went wrong.
+
+        The chip is left in standby whatever happens, so that a calibration cut short never
+        leaves its motor driven; ``start_rtp`` sets it up again."""
+        write, read = self._i2c.write_byte_data, self._i2c.read_byte_data
+        try:
+            write(self.address, _REG_MODE, _MODE_AUTO_CALIBRATION)
+            self._configure(settings, settings.calibration_od_clamp, None)
+            write(self.address, _REG_GO, 1)
+            deadline = time.monotonic() + timeout_s
+            while read(self.address, _REG_GO) & 1:
+                if time.monotonic() > deadline:
+                    write(self.address, _REG_GO, 0)  # stops it
+                    return f"GO did not clear within {timeout_s:g} s"
+                sleep(_CALIBRATION_POLL_S)
+            if read(self.address, _REG_STATUS) & _STATUS_DIAG_RESULT:
+                return "DIAG_RESULT set in STATUS: the chip found no motor it could calibrate"
+            return Calibration(
+                a_cal_comp=read(self.address, _REG_A_CAL_COMP),
+                a_cal_bemf=read(self.address, _REG_A_CAL_BEMF),
+                bemf_gain=read(self.address, _REG_FEEDBACK_CONTROL) & BEMF_GAIN_MASK,
+            )
+        finally:
+            write(self.address, _REG_MODE, _MODE_STANDBY)
 
     def play_rtp(self) -> None:
         self._i2c.write_byte_data(self.address, _REG_MODE, _MODE_REAL_TIME_PLAYBACK)
@@ -228,9 +301,19 @@ class Drv2605Backend(GridBackend):
         bus: I2CBus | None = None,
         telemetry: ActuatorTelemetry | None = None,
         enable: Line | None = None,
+        calibration: CalibrationStore | None = None,
+        calibrate: bool = False,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
         self._bus = bus
+        # Auto-calibration results: restored from ``calibration`` at every open; a chip without
+        # one there is calibrated on open and its result kept. ``calibrate``: every chip is
+        # calibrated again on open (feelmysign scan --calibrate). With neither, the chips keep
+        # whatever calibration they hold.
+        self._store = calibration
+        self._calibrate_all = calibrate
+        self._settings: ChipSettings | None = None  # worked out on open, after the off
+        self._calibrations: dict[tuple[int, int], Calibration] = {}
         # Every chip's EN pin (layout.enable): low until every chip is off and checked, and
         # dropped before any I2C "off". None: EN tied high, only I2C switches a motor off.
         self._enable = enable
@@ -270,6 +353,12 @@ class Drv2605Backend(GridBackend):
         if actuator is None:
             return f"actuator row {key[0]}, column {key[1]}"
         return actuator.where
+
+    @property
+    def calibrations(self) -> dict[tuple[int, int], Calibration]:
+        """(row, column) -> the calibration results the chip was given (restored or measured)."""
+        with self._lock:
+            return dict(self._calibrations)
 
     def wire(self, key: tuple[int, int]) -> Wire | None:
         actuator = self._actuators.get(key)
@@ -332,18 +421,18 @@ class Drv2605Backend(GridBackend):
                 raise HardwareError(_off_failed_message(off_problems))
             if line_problem is not None:
                 raise line_problem
+            # Configuration comes after every motor is off and checked: nothing above waits
+            # for the calibration file, and nothing here can delay an "off".
+            self._settings = self._chip_settings()
+            self._calibrations = self._stored_calibrations()
             for key, actuator in self._actuators.items():
-                self._guard(
-                    actuator,
-                    "while being set up",
-                    actuator.chip.start_rtp,
-                    self._layout.actuator_type,
-                )
+                self._guard(actuator, "while being set up", self._start_rtp, key, actuator)
                 self._rtp_levels[key] = 0
                 self._configured.add(key)
                 self._playing.add(key)
             if self._enable is not None:
                 self._enable.set_high(True)  # every chip off, checked and set up: motors may run
+            self._calibrate_missing()
         except BaseException:
             self._drop(release=True)  # low first, whatever failed
             # Leave no channel enabled, so 'feelmysign scan' starts from a clean bus.
@@ -351,6 +440,72 @@ class Drv2605Backend(GridBackend):
                 multiplexers.deselect_all()
             self._release()
             raise
+
+    def _chip_settings(self) -> ChipSettings:
+        try:
+            return chip_settings(self._layout)
+        except ValueError as error:  # a Layout built in code, past the file's checks
+            raise LayoutError(
+                self._layout.name,
+                [f"{error}; set the motor's values from its datasheet (docs/sleeve-hardware.md)"],
+            ) from None
+
+    def _start_rtp(self, key: tuple[int, int], actuator: _Actuator) -> None:
+        assert self._settings is not None  # opened: the layout is wired
+        actuator.chip.start_rtp(self._settings, self._calibrations.get(key))
+
+    def _chip_name(self, key: tuple[int, int]) -> str:
+        wire = self._actuators[key].wire
+        return f"0x{wire.multiplexer:02X}/{wire.channel}"
+
+    def _stored_calibrations(self) -> dict[tuple[int, int], Calibration]:
+        if self._store is None:
+            return {}
+        stored = self._store.results(motor_description(self._layout))
+        found = {key: stored.get(self._chip_name(key)) for key in self._actuators}
+        return {key: calibration for key, calibration in found.items() if calibration is not None}
+
+    def _calibrate_missing(self) -> None:
+        """Auto-calibrate every chip without a stored result (all, with ``calibrate``), one at
+        a time (a calibration drives its motor for about a second), and keep the results."""
+        if self._store is None and not self._calibrate_all:
+            return
+        settings = self._settings
+        assert settings is not None
+        todo = [k for k in self._actuators if self._calibrate_all or k not in self._calibrations]
+        measured: dict[str, Calibration] = {}
+        try:
+            for key in todo:
+                actuator = self._actuators[key]
+                self._playing.discard(key)  # in standby once calibrate returns
+                outcome = self._guard(
+                    actuator, "while calibrating", actuator.chip.calibrate, settings
+                )
+                if isinstance(outcome, str):
+                    raise HardwareError(
+                        f"Auto-calibration of the DRV2605L on {actuator.where} failed ({outcome}). "
+                        "Check that its motor is fitted and wired to OUT+ and OUT-, that "
+                        f'actuator_type = "{self._layout.actuator_type}" is the motor\'s kind, and '
+                        "that rated_voltage_v, overdrive_voltage_v (and, for an LRA, "
+                        "resonant_frequency_hz) in the layout match the motor's datasheet; then "
+                        "run 'feelmysign scan --layout FILE --calibrate'"
+                    )
+                self._calibrations[key] = outcome
+                measured[self._chip_name(key)] = outcome
+                self._guard(actuator, "after calibrating", self._start_rtp, key, actuator)
+                self._playing.add(key)
+                log.info("calibrated the DRV2605L on %s: %s", actuator.where, outcome)
+        finally:
+            if measured and self._store is not None:
+                try:
+                    self._store.put(measured, motor_description(self._layout))
+                except OSError as error:
+                    log.warning(
+                        "could not keep the calibration results in %s (%s): the chips "
+                        "calibrate again at the next start",
+                        self._store.path,
+                        error.strerror or error,
+                    )
 
     def _check_chips(self, *, readback: bool = False) -> None:
         """Every chip answers and is a DRV2605L (with ``readback``, also reads back "off":
@@ -411,7 +566,7 @@ class Drv2605Backend(GridBackend):
             return  # a different intensity, the same register value
         actuator = self._actuators[key]
         if key not in self._configured:  # after an I2C error the chip may have reset
-            self._guard(actuator, "", actuator.chip.start_rtp, self._layout.actuator_type)
+            self._guard(actuator, "", self._start_rtp, key, actuator)
             self._configured.add(key)
             self._playing.add(key)
         elif key not in self._playing:  # in standby since all_off

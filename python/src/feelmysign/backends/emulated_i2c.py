@@ -15,6 +15,12 @@ What it models:
   while that channel is enabled. Its register file starts at the datasheet's
   reset values (MODE 0x40: standby); STATUS, VBAT and LRA_RESONANCE_PERIOD are
   read-only; MODE bit 7 (DEV_RESET) restores the reset values.
+- auto-calibration: GO (0x0C) written 1 in MODE 7, out of standby, with EN high, runs
+  it; GO reads 1 for a few reads (the chip is busy), then clears, with DIAG_RESULT
+  (STATUS bit 3) 0 and results in A_CAL_COMP, A_CAL_BEMF and FEEDBACK's BEMF_GAIN
+  worked out from the motor settings (plausible, not physics); with
+  ``fail_calibration`` set (a motor missing), DIAG_RESULT 1 and the results unchanged.
+  ``calibrations`` counts the calibrations run.
 - nobody answering an address raises ``OSError(121, 'Remote I/O error')`` as
   Linux's i2c-dev does; two devices answering one address (two enabled
   channels with a chip each) is a bus conflict: counted, logged and raised as
@@ -102,6 +108,10 @@ _DRV2605L_RESET_VALUES = (
     0x00,  # 0x22 LRA_RESONANCE_PERIOD
 )
 STATUS, MODE, RTP_INPUT, FEEDBACK_CONTROL, CONTROL3 = 0x00, 0x01, 0x02, 0x1A, 0x1D
+GO, RATED_VOLTAGE, OD_CLAMP, A_CAL_COMP, A_CAL_BEMF, CONTROL1 = 0x0C, 0x16, 0x17, 0x18, 0x19, 0x1B
+_MODE_AUTO_CALIBRATION = 0x07
+_STATUS_DIAG_RESULT = 0x08
+_CALIBRATION_BUSY_READS = 3  # GO reads 1 this many times before it clears
 _READ_ONLY = frozenset({STATUS, 0x21, 0x22})
 _MODE_DEV_RESET = 0x80
 _MODE_STANDBY = 0x40
@@ -157,6 +167,9 @@ class EmulatedDRV2605L:
         self.enabled = True  # the EN pin: low is shutdown, the motor driven by nothing
         # When a transaction first found it not answering (ms, bus transaction), since it last did.
         self.lost_at: tuple[float, int] | None = None
+        self.fail_calibration = False  # a fault: the next calibrations set DIAG_RESULT
+        self.calibrations = 0
+        self._busy_reads = 0  # while calibrating: GO reads left before it clears
 
     @property
     def device_id(self) -> int:
@@ -206,6 +219,10 @@ class EmulatedDRV2605L:
         self._check(register)
         self.reads[register] += 1
         self._pointer = register
+        if register == GO and self._busy_reads > 0:
+            self._busy_reads -= 1
+            if self._busy_reads == 0:
+                self._finish_calibration()
         return self.registers[register]
 
     def write(self, register: int, value: int) -> None:
@@ -213,9 +230,34 @@ class EmulatedDRV2605L:
         self.writes[register] += 1
         self._pointer = register
         if register == MODE and value & _MODE_DEV_RESET:
+            self._busy_reads = 0
             self.reset()  # DEV_RESET clears itself once the reset is done
         elif register not in _READ_ONLY:
             self.registers[register] = value
+        if register == GO and value & 1 and self._calibration_mode:
+            self._busy_reads = _CALIBRATION_BUSY_READS
+        elif (register == GO and not value & 1) or (register == MODE and value & _MODE_STANDBY):
+            self._busy_reads = 0  # GO 0 or standby stops a calibration
+            self.registers[GO] = 0
+
+    @property
+    def _calibration_mode(self) -> bool:
+        mode = self.registers[MODE]
+        return self.enabled and not self.standby and (mode & _MODE_FIELD) == _MODE_AUTO_CALIBRATION
+
+    def _finish_calibration(self) -> None:
+        self.calibrations += 1
+        self.registers[GO] = 0
+        if self.fail_calibration:
+            self.registers[STATUS] |= _STATUS_DIAG_RESULT
+            return
+        self.registers[STATUS] &= ~_STATUS_DIAG_RESULT & 0xFF
+        # Plausible values that depend on the settings, so that a test sees them written.
+        rated = self.registers[RATED_VOLTAGE]
+        self.registers[A_CAL_COMP] = 0x0D + rated % 4
+        self.registers[A_CAL_BEMF] = min(0xFF, 0x40 + rated // 2)
+        gain = 3 if self.lra else 1
+        self.registers[FEEDBACK_CONTROL] = (self.registers[FEEDBACK_CONTROL] & 0xFC) | gain
 
     def set_pointer(self, register: int) -> None:
         self._check(register)

@@ -52,7 +52,9 @@ motor was off.
 
 Faults are set in the file: leave a chip out of ``chips`` (or set
 ``"connected": false``, a broken wire that keeps the registers) for a missing
-chip; set ``device_id`` (e.g. 4, a DRV2604) for a wrong chip. ``drive`` is
+chip; set ``device_id`` (e.g. 4, a DRV2604) for a wrong chip; set ``"fail_calibration":
+true`` for a motor the chip cannot calibrate (DIAG_RESULT set; ``calibrations`` counts the
+calibrations a chip ran). ``drive`` is
 written for people and tests to read (0..1, what the motor gets when the file
 was written; :func:`drive_levels` works it out again at the time it is read, as
 the enable line may have fallen since) and ignored when the file is read
@@ -294,6 +296,8 @@ def _chip_state(chip: EmulatedDRV2605L) -> dict[str, Any]:
         "drive": round(chip.output, 4),
         "registers": chip.registers.hex(),
         "lost_at": _when(chip.lost_at),
+        "fail_calibration": chip.fail_calibration,
+        "calibrations": chip.calibrations,
     }
 
 
@@ -304,6 +308,8 @@ def _restore(chip: EmulatedDRV2605L, saved: Any, name: str) -> None:
     chip.registers[:] = registers
     chip.connected = bool(saved.get("connected", True))
     chip.lost_at = _read_when(saved.get("lost_at"))
+    chip.fail_calibration = bool(saved.get("fail_calibration", False))
+    chip.calibrations = int(saved.get("calibrations", 0))
     if "device_id" in saved:  # wins over STATUS, so a test can fit a wrong chip by editing one key
         device_id = int(saved["device_id"])
         if not 0 <= device_id <= 7:

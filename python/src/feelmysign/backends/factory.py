@@ -10,6 +10,12 @@ from __future__ import annotations
 import os
 from typing import Literal
 
+from feelmysign.backends.actuator_config import (
+    CalibrationStore,
+    calibration_path,
+    store_name_for_bus,
+    store_name_for_state_file,
+)
 from feelmysign.backends.base import Backend
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
@@ -66,10 +72,26 @@ def open_backend(
     elif emulate:
         bus = EmulatedI2CBus.for_layout(layout)
     backend = Drv2605Backend(
-        layout, bus=bus, telemetry=telemetry, enable=enable_line_for(layout, bus)
+        layout,
+        bus=bus,
+        telemetry=telemetry,
+        enable=enable_line_for(layout, bus),
+        calibration=calibration_store_for(layout, emulate_state),
+        # An emulated bus without a file starts from reset values every time: a fresh sleeve.
+        calibrate=emulate and emulate_state is None,
     )
     backend.open()
     return backend
+
+
+def calibration_store_for(
+    layout: Layout, emulate_state: str | os.PathLike[str] | None
+) -> CalibrationStore:
+    """Where the chips' auto-calibration results are kept: the sleeve's state directory, one
+    file per I2C bus (an emulated bus kept in a file counts as a bus of its own)."""
+    if emulate_state is not None:
+        return CalibrationStore(calibration_path(store_name_for_state_file(emulate_state)))
+    return CalibrationStore(calibration_path(store_name_for_bus(layout.i2c_bus)))
 
 
 def enable_line_for(layout: Layout, bus: I2CBus | None) -> Line | None:

@@ -6,6 +6,7 @@ driver is missing, on which multiplexer channel, and what answers instead.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Literal
@@ -18,6 +19,7 @@ from feelmysign.backends.drv2605 import (
 )
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.tca9548a import CHANNELS, Multiplexers
+from feelmysign.errors import HardwareError
 from feelmysign.layout import Layout, Wire
 
 # i2cdetect's default range: 0x00-0x07 and 0x78-0x7F are reserved addresses.
@@ -182,3 +184,42 @@ def compare_with_layout(result: ScanResult, layout: Layout) -> LayoutReport:
             "main bus, not behind a multiplexer, and collides with every other DRV2605L"
         )
     return LayoutReport(wires, tuple(unexpected))
+
+
+# The motor settings and auto-calibration results, as their registers hold them.
+MOTOR_REGISTERS = {
+    "rated_voltage": 0x16,
+    "od_clamp": 0x17,
+    "a_cal_comp": 0x18,
+    "a_cal_bemf": 0x19,
+    "feedback_control": 0x1A,
+    "control1": 0x1B,
+}
+
+
+def read_motor_registers(
+    bus: I2CBus, layout: Layout, result: ScanResult, report: LayoutReport
+) -> dict[tuple[int, int], dict[str, int]]:
+    """(multiplexer, channel) -> register name -> value, for every wired chip that answered.
+
+    Only reads; every channel is disabled afterwards."""
+    present = [m for m in layout.multiplexers if m not in result.missing_multiplexers]
+    muxes = Multiplexers(bus, present)
+    found: dict[tuple[int, int], dict[str, int]] = {}
+    try:
+        for check in report.wires:
+            if check.status != "ok":
+                continue
+            wire = check.wire
+            try:
+                muxes.select(wire.multiplexer, wire.channel)
+                found[(wire.multiplexer, wire.channel)] = {
+                    name: bus.read_byte_data(DRV2605_ADDRESS, register)
+                    for name, register in MOTOR_REGISTERS.items()
+                }
+            except (OSError, HardwareError):
+                continue  # it answered the scan a moment ago; the table shows it as unread
+    finally:
+        with contextlib.suppress(HardwareError):
+            muxes.deselect_all()
+    return found
