@@ -14,10 +14,11 @@ rows = 2
 columns = 6
 spacing_cm = 2.5
 actuator_type = "LRA"
-default_intensity = 0.8
+default_intensity = {default_intensity}
 
 [safety]
 max_intensity = {max_intensity}
+max_stroke_duration_ms = {max_stroke_duration_ms}
 duty_cycle_window_ms = {window_ms}
 max_duty_cycle = {max_duty_cycle}
 
@@ -31,7 +32,12 @@ wiring = [
 
 
 def two_by_six_layout(
-    path: Path, *, max_intensity: float = 1.0, window_ms: float = 60000, max_duty_cycle: float = 0.5
+    path: Path,
+    *,
+    max_intensity: float = 1.0,
+    window_ms: float = 60000,
+    max_duty_cycle: float = 0.5,
+    max_stroke_duration_ms: float = 10000,
 ) -> Path:
     """The 2 x 6 layout file: row 0 on multiplexer 0x70, row 1 on 0x71, channels 0..5."""
     wiring = ",\n".join(
@@ -42,8 +48,10 @@ def two_by_six_layout(
     path.write_text(
         TWO_BY_SIX.format(
             max_intensity=max_intensity,
+            default_intensity=min(0.8, max_intensity),
             window_ms=window_ms,
             max_duty_cycle=max_duty_cycle,
+            max_stroke_duration_ms=max_stroke_duration_ms,
             wiring=wiring,
         )
     )
