@@ -204,6 +204,10 @@ class Drv2605Backend(GridBackend):
     ``bus`` is any :class:`~feelmysign.backends.i2c.I2CBus` (the emulated bus in
     tests); without it ``/dev/i2c-<layout.i2c_bus>`` is opened on ``open()`` and
     closed on ``close()``. An injected bus is left open: its owner closes it.
+
+    ``leave_out_missing`` (for ``feelmysign buzz``, to try the motors that are there):
+    a chip that does not answer at ``open`` is left out, named in ``missing``, instead of
+    failing the open; a wrong chip still fails it. Driving a left-out actuator is an error.
     """
 
     def __init__(
@@ -212,8 +216,11 @@ class Drv2605Backend(GridBackend):
         *,
         bus: I2CBus | None = None,
         telemetry: ActuatorTelemetry | None = None,
+        leave_out_missing: bool = False,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
+        self._leave_out_missing = leave_out_missing
+        self.missing: dict[tuple[int, int], str] = {}  # left out at open: actuator -> where
         self._bus = bus
         self._owned_bus: I2CBus | None = None
         self._multiplexers: Multiplexers | None = None
@@ -263,6 +270,8 @@ class Drv2605Backend(GridBackend):
             # its motor, and a missing or wrong chip elsewhere must not keep it running.
             off_problems = self._off_problems()
             self._check_chips()
+            if off_problems and self.missing:  # expected of the chips left out: the rest again
+                off_problems = self._off_problems()
             if off_problems:  # every chip passed the check, yet one could not be switched off
                 raise HardwareError(_off_failed_message(off_problems))
             for key, actuator in self._actuators.items():
@@ -288,7 +297,9 @@ class Drv2605Backend(GridBackend):
             try:
                 device_id = actuator.chip.device_id()
             except OSError as error:
-                if is_no_answer(error):
+                if is_no_answer(error) and self._leave_out_missing:
+                    self.missing[(actuator.wire.row, actuator.wire.column)] = actuator.where
+                elif is_no_answer(error):
                     problems.append(f"No DRV2605L answered on {actuator.where}; {_CHECK_HINT}")
                 else:
                     problems.append(
@@ -302,6 +313,8 @@ class Drv2605Backend(GridBackend):
                     f"{device_name(device_id)}, not a DRV2605L (device id 7) or DRV2605 (id 3); "
                     f"fit a DRV2605L there or {_CHECK_HINT}"
                 )
+        for key in self.missing:
+            del self._actuators[key]
         if len(problems) == 1:
             raise HardwareError(f"{problems[0]} {_OTHERS_OFF}")
         if problems:
@@ -317,6 +330,11 @@ class Drv2605Backend(GridBackend):
         level = rtp_level(intensity)
         if self._rtp_levels.get(key) == level:
             return  # a different intensity, the same register value
+        if key in self.missing:
+            raise HardwareError(
+                f"No DRV2605L answered on {self.missing[key]} when the sleeve was opened; "
+                f"{_CHECK_HINT}"
+            )
         actuator = self._actuators[key]
         if key not in self._configured:  # after an I2C error the chip may have reset
             self._guard(actuator, "", actuator.chip.start_rtp, self._layout.actuator_type)

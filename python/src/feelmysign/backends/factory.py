@@ -32,6 +32,7 @@ def open_backend(
     telemetry: ActuatorTelemetry | None = None,
     emulate: bool = False,
     emulate_state: str | os.PathLike[str] | None = None,
+    leave_out_missing: bool = False,
 ) -> Backend:
     """An open backend for ``layout``, every actuator silent; close it (or use ``with``).
 
@@ -40,9 +41,9 @@ def open_backend(
     with ``emulate``, on an emulated bus wired as the layout says (to try the
     hardware path without hardware); ``emulate_state`` keeps that bus's registers
     in a file across processes (see :mod:`feelmysign.backends.emulated_state`)
-    and implies ``emulate``. Raises ParameterError for a bad choice,
-    LayoutError for a layout without wiring, HardwareError when the chips do not
-    answer (see :meth:`Drv2605Backend.open`).
+    and implies ``emulate``; ``leave_out_missing``: see ``Drv2605Backend``. Raises
+    ParameterError for a bad choice, LayoutError for a layout without wiring,
+    HardwareError when the chips do not answer (see :meth:`Drv2605Backend.open`).
     """
     if name not in BACKEND_NAMES:
         raise ParameterError(
@@ -64,7 +65,9 @@ def open_backend(
         bus = open_state_bus(emulate_state, layout)
     elif emulate:
         bus = EmulatedI2CBus.for_layout(layout)
-    backend = Drv2605Backend(layout, bus=bus, telemetry=telemetry)
+    backend = Drv2605Backend(
+        layout, bus=bus, telemetry=telemetry, leave_out_missing=leave_out_missing
+    )
     backend.open()
     return backend
 
