@@ -168,6 +168,7 @@ def run(args: argparse.Namespace) -> int:
             f"{floor.min_duration_ms:g} ms and {floor.min_length:g} grid units",
             flush=True,
         )
+    _check_clock_meanwhile(settings, options)
     counts = run_sleeve(
         settings,
         layout,
@@ -220,6 +221,22 @@ def run_sleeve(
         on_start(sleeve)
         sleeve.run()
     return sleeve.counts
+
+
+def _check_clock_meanwhile(settings: BrokerSettings, options: SleeveOptions) -> None:
+    """Compare this machine's clock with the broker's (feelmysign.broker_clock), on a thread
+    of its own: the motors and the strokes never wait for it; the log says what it found."""
+    import threading
+
+    from feelmysign.broker_clock import check_clock
+
+    threading.Thread(
+        target=check_clock,
+        args=(settings,),
+        kwargs={"max_age_ms": options.max_age_ms, "sleeve_id": options.sleeve_id},
+        name="feelmysign-clock-check",
+        daemon=True,
+    ).start()
 
 
 def _stop_on_signals(sleeve: Sleeve) -> None:
