@@ -126,6 +126,8 @@ class _Publish:
     payload: str
     qos: int
     retain: bool
+    # An event, for the journal: summed up on the publishing thread, off the player's.
+    event: Event | None = None
 
 
 _Outgoing = _Publish | _Ack
@@ -192,7 +194,8 @@ class Sleeve:
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         # One log line per drawing once it is over (strokes played, refused, start delay):
-        # what the journal shows of a sleeve at work. Events come from two threads.
+        # what the journal shows of a sleeve at work. Kept by the publishing thread (the
+        # lock: the last lines are written at the stop, by whoever stops).
         self._journal = DrawingSummaries()
         self._journal_lock = threading.Lock()
         self._journal_checked_s = 0.0
@@ -501,14 +504,14 @@ class Sleeve:
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":
             self._count("capped")
-        with self._journal_lock:
-            self._journal.add(event, time.monotonic())
         if isinstance(event, ErrorEvent) and event.reason == "player_crashed":
             self._fatal = FeelMySignError(
                 "the player stopped on an unexpected error (see the log); every motor is off"
             )
             self._stopped.set()
-        self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+        self._outbox.put(
+            _Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False, event)
+        )
         if ack is not None:
             self._outbox.put(ack)
 
@@ -564,6 +567,9 @@ class Sleeve:
                 self._client.publish(item.topic, item.payload, qos=item.qos, retain=item.retain)
             except (RuntimeError, ValueError, OSError) as error:
                 log.warning("sleeve %s: could not publish on %s: %s", self._id, item.topic, error)
+            if item.event is not None:
+                with self._journal_lock:
+                    self._journal.add(item.event, time.monotonic())
 
     def _acknowledge(self, ack: _Ack) -> None:
         # Once only: a message id is reused by the broker as soon as it is acknowledged. And
