@@ -212,6 +212,7 @@ def test_a_bus_that_does_not_exist_says_to_enable_i2c_or_use_the_simulator() -> 
         backend.open()
     message = str(error.value)
     assert "/dev/i2c-250" in message and "raspi-config" in message and "--backend sim" in message
+    assert "'bus' in the [i2c] table of the sleeve layout" in message  # the key as the file has it
     assert not backend.is_open
 
 

@@ -175,7 +175,7 @@ class Timeline:
             start_ms = stroke.start_ms
             for command in commands:
                 on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
-                drive = Drive(on_ms, off_ms, command.intensity**2)
+                drive = Drive(on_ms, off_ms, self._driven_energy(command.intensity))
                 drives.setdefault((command.row, command.column), []).append(drive)
             stroke.drives = drives
             if stroke.started_ms is not None:
@@ -189,7 +189,8 @@ class Timeline:
             energy = command.intensity**2
             on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
             if stroke.outline is None:
-                stroke.drives.setdefault(actuator, []).append(Drive(on_ms, off_ms, energy))
+                drive = Drive(on_ms, off_ms, self._driven_energy(command.intensity))
+                stroke.drives.setdefault(actuator, []).append(drive)
             stroke.commands.add(ident)
             self._push(_Event(on_ms, 0, "on", actuator, ident, energy, tag=tag))
             self._push(_Event(off_ms, 0, "off", actuator, ident, tag=tag))
@@ -296,7 +297,11 @@ class Timeline:
 
     def _start(self, stroke: _Stroke, t_ms: float, due: Due) -> None:
         if stroke.outline is not None:
-            if self.duty_cycle.surely_fits(stroke.outline.energy_bound_ms(), t_ms):
+            outline = stroke.outline
+            # No command drives above the cap, so the bound scales down with it.
+            capped = self._driven_energy(outline.intensity) / max(outline.intensity**2, 1e-300)
+            bound_ms = outline.energy_bound_ms() * min(1.0, capped)
+            if self.duty_cycle.surely_fits(bound_ms, t_ms):
                 stroke.started_ms = t_ms  # committed when completed, before anything else
                 due.started.append(stroke.tag)
                 return
@@ -308,6 +313,15 @@ class Timeline:
         else:
             self._dropped.update(stroke.commands)
             due.capped.append(Capped(stroke.tag, refusal))
+
+    def _driven_energy(self, intensity: float) -> float:
+        """The energy a command asking ``intensity`` drives its motor with, alone: as
+        ``_settle`` drives it, capped at full drive and the layout's ``max_intensity``. What
+        the duty-cycle cap counts: the drive that heats the motor, not the drive asked for.
+        (Commands overlapping on one motor add energies and are capped once; counted each
+        capped, they are counted at least at what is driven.)"""
+        driven = min(1.0, intensity, self._layout.max_intensity)
+        return driven * driven
 
     def _settle(self, actuator: Actuator, t_ms: float, due: Due, tag: object = None) -> None:
         active = self._active.get(actuator)

@@ -292,6 +292,10 @@ class Drv2605Backend(GridBackend):
     ``bus`` is any :class:`~feelmysign.backends.i2c.I2CBus` (the emulated bus in
     tests); without it ``/dev/i2c-<layout.i2c_bus>`` is opened on ``open()`` and
     closed on ``close()``. An injected bus is left open: its owner closes it.
+
+    ``leave_out_missing`` (for ``feelmysign buzz``, to try the motors that are there):
+    a chip that does not answer at ``open`` is left out, named in ``missing``, instead of
+    failing the open; a wrong chip still fails it. Driving a left-out actuator is an error.
     """
 
     def __init__(
@@ -303,8 +307,11 @@ class Drv2605Backend(GridBackend):
         enable: Line | None = None,
         calibration: CalibrationStore | None = None,
         calibrate: bool = False,
+        leave_out_missing: bool = False,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
+        self._leave_out_missing = leave_out_missing
+        self.missing: dict[tuple[int, int], str] = {}  # left out at open: actuator -> where
         self._bus = bus
         # Auto-calibration results: restored from ``calibration`` at every open; a chip without
         # one there is calibrated on open and its result kept. ``calibrate``: every chip is
@@ -417,6 +424,8 @@ class Drv2605Backend(GridBackend):
             # its motor, and a missing or wrong chip elsewhere must not keep it running.
             off_problems = self._off_problems()
             self._check_chips(readback=self._enable is not None)
+            if off_problems and self.missing:  # expected of the chips left out: the rest again
+                off_problems = self._off_problems()
             if off_problems:  # every chip passed the check, yet one could not be switched off
                 raise HardwareError(_off_failed_message(off_problems))
             if line_problem is not None:
@@ -430,6 +439,15 @@ class Drv2605Backend(GridBackend):
                 self._rtp_levels[key] = 0
                 self._configured.add(key)
                 self._playing.add(key)
+            if self._enable is not None and self.missing:
+                # One line for every chip: raised, it would wake a missing chip that may
+                # still hold a level. It stays low, and nothing is driven.
+                listed = "; ".join(self.missing.values())
+                raise HardwareError(
+                    f"No DRV2605L answered on {listed}, and the {self._enable.description} "
+                    "switches every chip: it stays low, so no motor can run until that chip "
+                    f"answers; {_CHECK_HINT}"
+                )
             if self._enable is not None:
                 self._enable.set_high(True)  # every chip off, checked and set up: motors may run
             self._calibrate_missing()
@@ -511,6 +529,8 @@ class Drv2605Backend(GridBackend):
         """Every chip answers and is a DRV2605L (with ``readback``, also reads back "off":
         before an enable line goes high); HardwareError listing every one that is not."""
         problems = list(self._chip_problems(readback=readback).values())
+        for key in self.missing:  # left out (leave_out_missing): the rest are driven
+            self._actuators.pop(key, None)
         others_off = _OTHERS_OFF
         if self._enable is None:
             # A chip that does not answer cannot be switched off: its motor may still run.
@@ -538,7 +558,9 @@ class Drv2605Backend(GridBackend):
                 device_id = actuator.chip.device_id()
                 held = actuator.chip.reads_off() if readback else None
             except OSError as error:
-                if is_no_answer(error):
+                if is_no_answer(error) and self._leave_out_missing:
+                    self.missing[key] = actuator.where
+                elif is_no_answer(error):
                     problems[key] = f"No DRV2605L answered on {actuator.where}; {_CHECK_HINT}"
                 else:
                     problems[key] = (
@@ -564,6 +586,11 @@ class Drv2605Backend(GridBackend):
         level = rtp_level(intensity)
         if self._rtp_levels.get(key) == level:
             return  # a different intensity, the same register value
+        if key in self.missing:
+            raise HardwareError(
+                f"No DRV2605L answered on {self.missing[key]} when the sleeve was opened; "
+                f"{_CHECK_HINT}"
+            )
         actuator = self._actuators[key]
         if key not in self._configured:  # after an I2C error the chip may have reset
             self._guard(actuator, "", self._start_rtp, key, actuator)

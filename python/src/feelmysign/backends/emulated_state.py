@@ -154,20 +154,25 @@ class _WriteThrough:
 
         A chip left out of ``chips``, or ``"connected": false``, stops answering at once,
         as a chip whose wire comes loose mid-drawing would (registers kept: its motor runs on).
+        So does a multiplexer set ``"connected": false``, and every chip behind it.
         """
         found = _identity(self._path)
         if found == self._written or found is None:
             return
         self._written = found
         try:
-            saved = dict(read_state(self._path).chips)
+            edited = read_state(self._path)
         except EmulatedStateError:
             return  # half-edited by hand: the next change is looked at again
+        saved = dict(edited.chips)
         for key, chip in bus.chips.items():
             connected = key in saved and saved[key].connected
             if chip.connected and not connected:  # the wire comes loose now, for this process
                 chip.lost_at = (round(time.time() * 1000, 3), bus.transactions)
             chip.connected = connected
+        for address, mux in bus.multiplexers.items():
+            kept = edited.multiplexers.get(address)
+            mux.connected = kept is not None and kept.connected
 
 
 def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:

@@ -39,6 +39,7 @@ def open_backend(
     telemetry: ActuatorTelemetry | None = None,
     emulate: bool = False,
     emulate_state: str | os.PathLike[str] | None = None,
+    leave_out_missing: bool = False,
 ) -> Backend:
     """An open backend for ``layout``, every actuator silent; close it (or use ``with``).
 
@@ -47,9 +48,9 @@ def open_backend(
     with ``emulate``, on an emulated bus wired as the layout says (to try the
     hardware path without hardware); ``emulate_state`` keeps that bus's registers
     in a file across processes (see :mod:`feelmysign.backends.emulated_state`)
-    and implies ``emulate``. Raises ParameterError for a bad choice,
-    LayoutError for a layout without wiring, HardwareError when the chips do not
-    answer (see :meth:`Drv2605Backend.open`).
+    and implies ``emulate``; ``leave_out_missing``: see ``Drv2605Backend``. Raises
+    ParameterError for a bad choice, LayoutError for a layout without wiring,
+    HardwareError when the chips do not answer (see :meth:`Drv2605Backend.open`).
     """
     if name not in BACKEND_NAMES:
         raise ParameterError(
@@ -79,6 +80,7 @@ def open_backend(
         calibration=calibration_store_for(layout, emulate_state),
         # An emulated bus without a file starts from reset values every time: a fresh sleeve.
         calibrate=emulate and emulate_state is None,
+        leave_out_missing=leave_out_missing,
     )
     backend.open()
     return backend

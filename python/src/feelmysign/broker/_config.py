@@ -19,6 +19,7 @@ from feelmysign.broker.credentials import Account, write_private_file
 from feelmysign.errors import BrokerError
 from feelmysign.topics import (
     ANY_SLEEVE,
+    CLOCK_TOPIC,
     TELEMETRY_NAMES,
     control_topic,
     strokes_topic,
@@ -195,6 +196,7 @@ def render_acl(
         f"topic read {strokes_topic(sleeve_id)}",
         f"topic read {control_topic(sleeve_id)}",
         f"topic read {legacy_topic}",
+        f"topic read {CLOCK_TOPIC}",
         *(f"topic write {telemetry_topic(sleeve_id, sub)}" for sub in TELEMETRY_NAMES),
     ]
     for other_id, other_username in other_sleeves:
@@ -203,6 +205,7 @@ def render_acl(
             f"user {other_username}",
             f"topic read {strokes_topic(other_id)}",
             f"topic read {control_topic(other_id)}",
+            f"topic read {CLOCK_TOPIC}",
             *(f"topic write {telemetry_topic(other_id, sub)}" for sub in TELEMETRY_NAMES),
         ]
     sender_lines = [
@@ -210,6 +213,8 @@ def render_acl(
         f"topic write {strokes_topic(ANY_SLEEVE)}",
         f"topic write {control_topic(ANY_SLEEVE)}",
         f"topic write {legacy_topic}",
+        # The broker's clock, published with the sender's login when the broker starts.
+        f"topic write {CLOCK_TOPIC}",
         *(f"topic read {telemetry_topic(ANY_SLEEVE, sub)}" for sub in TELEMETRY_NAMES),
     ]
     return (
