@@ -143,9 +143,10 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--pace",
         choices=("realtime", "burst"),
-        help="realtime: send each stroke when the previous one would have finished playing, "
-        "like a person drawing; burst: all at once (default: realtime for --shape, burst for "
-        "STROKEs)",
+        help="realtime (the default): send each stroke when the previous one would have "
+        "finished playing, like a person drawing; burst: all at once, so the sleeve, catching "
+        "up with a drawing that arrived ahead of it, plays every stroke after the first faster, "
+        "down to its floor (docs/protocol.md, Catching up)",
     )
     group.add_argument(
         "--wait",
@@ -206,7 +207,7 @@ def _send(
     messages: list[OutgoingStroke],
     args: argparse.Namespace,
 ) -> None:
-    pace: Pace = args.pace or ("realtime" if args.shape else "burst")
+    pace: Pace = args.pace or "realtime"
     report = printer(json_lines=args.json, total=len(messages))
     StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report).send(
         messages, pace=pace
@@ -341,7 +342,7 @@ def _await_sleeve(
     args: argparse.Namespace,
     strokes: list[Stroke],
 ) -> int:
-    burst = (args.pace or ("realtime" if args.shape else "burst")) == "burst"
+    burst = (args.pace or "realtime") == "burst"
     drawing_s = (
         sum(s.duration_ms for s in strokes) / 1000 if burst else strokes[-1].duration_ms / 1000
     )

@@ -34,10 +34,11 @@ import java.util.Set;
  * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
  * feelmysign send} does (its flags where they apply): every stroke checked first, one drawing,
  * QoS 1, and the command returns once the broker has acknowledged every stroke (exit 0), or
- * says why not (exit 1). A shape or a recording goes out at the pace it plays ({@code --pace
- * realtime}: each stroke once the one before would have finished), so a second send right after
- * it is not queued behind it and refused as late; strokes given one by one go out at once
- * ({@code --pace burst}), as the reference does.
+ * says why not (exit 1). Strokes go out at the pace they play ({@code --pace realtime}, the
+ * default, as the reference's: each stroke once the one before would have finished), so a
+ * second send right after it is not queued behind it and refused as late, and no stroke arrives
+ * ahead of its drawing (the sleeve would play it faster to catch up, as {@code --pace burst}
+ * asks).
  */
 final class SendCommand {
   private SendCommand() {}
@@ -55,10 +56,11 @@ final class SendCommand {
       + "Send strokes (startX,startY,endX,endY,duration in grid units and ms), a shape of the\n"
       + "study's library (--shape, --segments), or a recording cut by the simplifier\n"
       + "(--recording; the window simplifier, --paper for the paper's angle one) to a sleeve,\n"
-      + "and wait until the broker has them. --pace realtime (the default for --shape and\n"
-      + "--recording) sends each stroke when the previous one would have finished playing, like\n"
-      + "a person drawing, so the command lasts as long as the drawing plays; --pace burst (the\n"
-      + "default for STROKEs) sends them all at once. Broker settings: the option, else\n"
+      + "and wait until the broker has them. --pace realtime (the default) sends each stroke\n"
+      + "when the previous one would have finished playing, like a person drawing, so the\n"
+      + "command lasts as long as the drawing plays; --pace burst sends them all at once, and\n"
+      + "the sleeve then plays every stroke after the first faster, down to its floor, to catch\n"
+      + "up with a drawing that arrived ahead of it. Broker settings: the option, else\n"
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
       + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
 
@@ -219,7 +221,7 @@ final class SendCommand {
     });
     refuseWhenNobodyListens(url);
     Object pace = given.get("--pace");
-    boolean realtime = pace == null ? shape != null || recording != null : pace.equals("realtime");
+    boolean realtime = pace == null || pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
       client.newDrawing();
