@@ -233,6 +233,10 @@ def _analyse(args: argparse.Namespace) -> int:
         f"{analysis.participants} participants, {analysis.trials} trials, "
         f"{analysis.unclear} awaiting review."
     )
+    if analysis.model is not None:
+        from feelmysign.study.analysis.report import shape_test_sentence
+
+        print(shape_test_sentence(analysis.model.test))
     for path in analysis.files:
         print(path)
     return 0

@@ -88,8 +88,8 @@ def analyse_study(
                 seed=seed,
             )
     model = None
-    if len(coded) and coded["shape"].nunique() > 1 and coded["participant"].nunique() > 1:
-        model = shape_differences(coded[["participant", "shape", "segments", "correct"]])
+    if len(coded) and coded["shape"].nunique() > 1:
+        model = shape_differences(coded[["participant", "shape", "segments", "correct"]], seed=seed)
     participants = store.participants()
     analysis = Analysis(
         participants=int(frame["participant"].nunique()) if len(frame) else 0,

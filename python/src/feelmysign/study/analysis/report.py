@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from feelmysign.study.analysis.models import ShapeTest
 from feelmysign.study.store import StudyStore
 
 if TYPE_CHECKING:
@@ -31,6 +32,23 @@ def _interval(low: float, high: float, tested: tuple[float, float]) -> str:
 
 def _p(value: float) -> str:
     return "p < 0.001" if value < 0.001 else f"p = {value:.3f}"
+
+
+def shape_test_sentence(test: ShapeTest) -> str:
+    """What the shape test found, or why there is none: for the report and the terminal."""
+    if test.refused is not None or test.p is None or test.statistic is None:
+        return (
+            f"No test of whether shapes differ is reported: {test.refused}. Run at least "
+            f"{test.participants_needed} participants (8 or more for the calibrated false-positive "
+            "rate in docs/research.md)."
+        )
+    return (
+        f"Test that shapes differ at equal strokes: {test.method} ({test.participants} "
+        f"participants, {test.shapes} shapes; each participant's mean residual per shape "
+        "against a shape-free logistic model of log2(strokes), centred over shapes; statistic: "
+        f"squared length of the mean profile = {test.statistic:.4g}, over {test.flips} sign "
+        f"patterns): {_p(test.p)}."
+    )
 
 
 def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
@@ -105,21 +123,22 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     model = analysis.model
     if model is None:
-        lines.append("Not enough data (two shapes and two participants at least).")
+        lines.append("Not enough data (two shapes with coded answers at least).")
     else:
-        lines += [
-            "Logistic models of a correct answer on shape and log2(strokes). Test: GLM with "
-            "standard errors clustered by participant, Wald test that every shape effect is 0: "
-            f"chi2({model.wald_df}) = {model.wald_chi2:.2f}, {_p(model.wald_p)}.",
-            "",
-            f"Mixed-effects model (participant random intercept; {model.note}): reference shape "
-            f"{model.reference}; slope {model.slope_per_doubling:.2f} log odds per doubling of "
-            f"strokes; participant SD {model.participant_sd:.2f} log odds.",
-            "",
-            "| shape | log odds vs " + model.reference + " | posterior SD |",
-            "|---|---|---|",
-            *(f"| {e.shape} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.mixed),
-        ]
+        lines += [shape_test_sentence(model.test), ""]
+        if model.mixed:
+            lines += [
+                f"Mixed-effects model (participant random intercept; {model.note}; "
+                f"descriptive): reference shape {model.reference}; slope "
+                f"{model.slope_per_doubling:.2f} log odds per doubling of strokes; participant "
+                f"SD {model.participant_sd:.2f} log odds.",
+                "",
+                "| shape | log odds vs " + model.reference + " | posterior SD |",
+                "|---|---|---|",
+                *(f"| {e.shape} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.mixed),
+            ]
+        else:
+            lines.append(f"Mixed-effects model: {model.note}.")
     lines += _threshold_section(analysis)
     lines += [
         "",
