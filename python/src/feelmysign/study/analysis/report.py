@@ -2,32 +2,36 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from feelmysign.study.analysis.models import ShapeTest
+from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
 from feelmysign.study.store import StudyStore
 
 if TYPE_CHECKING:
     from feelmysign.study.analysis.analyse import Analysis
 
 
-def _strokes(value: float, tested: tuple[float, float]) -> str:
-    """A needed resolution, or where it lies when the tested range does not contain it."""
-    if not math.isfinite(value) or value > tested[1]:
-        return f"> {tested[1]:g}"
-    if value < tested[0]:
-        return f"< {tested[0]:g}"
-    return f"{value:.1f}"
+def needed_text(needed: Needed) -> str:
+    """A needed resolution as far as the tested range can say."""
+    if needed.kind == AT_OR_BELOW:
+        return f"≤ {needed.lowest_tested:g} (at or below the lowest tested)"
+    if needed.kind == ABOVE:
+        return f"> {needed.highest_tested:g} (above the highest tested)"
+    assert needed.strokes is not None
+    return f"{needed.strokes:.1f}"
 
 
-def _interval(low: float, high: float, tested: tuple[float, float]) -> str:
-    if high < tested[0]:
-        return f"below the tested range (< {tested[0]:g})"
-    if low > tested[1]:
-        return f"above the tested range (> {tested[1]:g})"
-    return f"{_strokes(low, tested)} - {_strokes(high, tested)}"
+def interval_text(interval: Interval) -> str:
+    """An interval truncated to the tested range; an open end is written ≤ or ≥."""
+    if interval.low_open and interval.high <= interval.low:
+        return f"≤ {interval.low:g}"  # wholly at or below the lowest tested
+    if interval.high_open and interval.low >= interval.high:
+        return f"≥ {interval.high:g}"
+    low = f"≤ {interval.low:g}" if interval.low_open else f"{interval.low:.1f}"
+    high = f"≥ {interval.high:g}" if interval.high_open else f"{interval.high:.1f}"
+    return f"{low} - {high}"
 
 
 def _p(value: float) -> str:
@@ -101,18 +105,19 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "|---|---|---|---|---|---|---|---|",
     ]
     for shape, t in analysis.thresholds.items():
-        rows = analysis.accuracy[shape]
-        tested = (float(rows[0][0]), float(rows[-1][0]))
+        needed = analysis.needed[shape]
         lines.append(
-            f"| {shape} | {_strokes(t.strokes, tested)} | "
-            f"{_interval(t.boot_low, t.boot_high, tested)} | {_interval(t.low, t.high, tested)} | "
-            f"{_interval(t.cluster_low, t.cluster_high, tested)} | {t.fit.slope:.2f} | "
-            f"{t.population.spread:.2f} | {t.dispersion:.2f} |"
+            f"| {shape} | {needed_text(needed)} | {interval_text(needed.interval)} | "
+            f"{interval_text(needed.profile)} | {interval_text(needed.cluster)} | "
+            f"{t.fit.slope:.2f} | {t.population.spread:.2f} | {t.dispersion:.2f} |"
         )
     lines += [
         "",
-        "'< n': every tested resolution was already recognised at the criterion; '> n': not "
-        "even the finest one was.",
+        "A number is given only where the tested resolutions bracket the criterion. "
+        "'≤ n (at or below the lowest tested)': the share correct reached the criterion at "
+        "every tested resolution, so the data say only that n strokes are enough; '> n (above "
+        "the highest tested)': it reached it at none. Intervals are cut at the tested range: "
+        "'≤ n' or '≥ n' at an end means the interval goes on beyond what was tested.",
     ]
     lines += [
         "",
