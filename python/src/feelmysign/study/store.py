@@ -15,7 +15,7 @@ import secrets
 import sqlite3
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -44,6 +44,9 @@ class StudyStore:
         self.path = Path(path)
         self._check_path()
         self._lock = threading.RLock()
+        # The time every row is stamped with: the wall clock, or a dry run's simulated one
+        # (so that a dry run's response times, and so its export, follow from its seed).
+        self.clock: Callable[[], int] = now_ms
         self._db = self._connect(self.path)
         version = self.meta("schema_version")
         if version != str(SCHEMA_VERSION):
@@ -147,7 +150,7 @@ class StudyStore:
             db.execute(
                 "INSERT INTO participants (code, number, created_at_ms, simulated) "
                 "VALUES (?,?,?,?)",
-                (code, number, now_ms(), int(simulated)),
+                (code, number, self.clock(), int(simulated)),
             )
             for position, trial in enumerate(participant_order(self.design, number)):
                 db.execute(
@@ -189,7 +192,7 @@ class StudyStore:
         with self._transaction() as db:
             db.execute(
                 "UPDATE participants SET consent = ?, consent_at_ms = ? WHERE code = ?",
-                (int(consent), now_ms(), code),
+                (int(consent), self.clock(), code),
             )
 
     def record_comfort(self, code: str, answers: list[bool], adjusted: bool) -> None:
@@ -204,7 +207,7 @@ class StudyStore:
         with self._transaction() as db:
             db.execute(
                 "UPDATE participants SET comfort_json = ?, comfort_at_ms = ? WHERE code = ?",
-                (data, now_ms(), row["code"]),
+                (data, self.clock(), row["code"]),
             )
 
     def _require_consent(self, row: sqlite3.Row) -> None:
@@ -226,13 +229,13 @@ class StudyStore:
             if paused:
                 db.execute(
                     "INSERT INTO pauses (participant, paused_at_ms) VALUES (?, ?)",
-                    (row["code"], now_ms()),
+                    (row["code"], self.clock()),
                 )
             else:
                 db.execute(
                     "UPDATE pauses SET resumed_at_ms = ? WHERE participant = ? AND resumed_at_ms "
                     "IS NULL",
-                    (now_ms(), row["code"]),
+                    (self.clock(), row["code"]),
                 )
 
     def withdraw(self, code: str) -> None:
@@ -266,7 +269,7 @@ class StudyStore:
         with self._transaction() as db:
             cursor = db.execute(
                 "INSERT INTO sends (trial, drawing, sent_at_ms, strokes_json) VALUES (?,?,?,?)",
-                (trial_id, drawing, now_ms(), json.dumps(strokes)),
+                (trial_id, drawing, self.clock(), json.dumps(strokes)),
             )
             return int(cursor.lastrowid or 0)
 
@@ -310,7 +313,7 @@ class StudyStore:
         """The answer, once (a second answer to a trial is refused), and its automatic coding."""
         trial = self.trial(trial_id)
         self._require_consent(self.participant(trial["participant"]))
-        at_ms = now_ms()
+        at_ms = self.clock()
         with self._transaction() as db:
             cursor = db.execute(
                 "UPDATE trials SET answer = ?, felt_nothing = ?, confidence = ?, "
@@ -351,7 +354,7 @@ class StudyStore:
             db.execute(
                 "INSERT INTO codings (trial, status, shape, rule, decided_by, decided_at_ms) "
                 "VALUES (?,?,?,?,?,?)",
-                (trial_id, "shape" if shape else "none", shape, rule, "researcher", now_ms()),
+                (trial_id, "shape" if shape else "none", shape, rule, "researcher", self.clock()),
             )
 
     def latest_codings(self) -> dict[int, sqlite3.Row]:
@@ -375,7 +378,7 @@ class StudyStore:
                 f"the questionnaire has {len(items)} item(s), each answered 1..{points}; got "
                 f"{values}"
             )
-        at_ms = now_ms()
+        at_ms = self.clock()
         with self._transaction() as db:
             for item, value in enumerate(values):
                 db.execute(
@@ -399,11 +402,10 @@ class StudyStore:
         count = db.execute("SELECT COUNT(*) FROM questionnaire WHERE participant = ?", (code,))
         return bool(count.fetchone()[0])
 
-    @staticmethod
-    def _finish(db: sqlite3.Connection, code: str) -> None:
+    def _finish(self, db: sqlite3.Connection, code: str) -> None:
         db.execute(
             "UPDATE participants SET finished_at_ms = ? WHERE code = ? AND finished_at_ms IS NULL",
-            (now_ms(), code),
+            (self.clock(), code),
         )
 
     # ---- threshold procedure -----------------------------------------------------------
@@ -415,7 +417,7 @@ class StudyStore:
             cursor = db.execute(
                 "INSERT INTO threshold_runs (participant, dimension, settings_json, started_at_ms) "
                 "VALUES (?,?,?,?)",
-                (row["code"], dimension, json.dumps(settings), now_ms()),
+                (row["code"], dimension, json.dumps(settings), self.clock()),
             )
             return int(cursor.lastrowid or 0)
 
@@ -458,7 +460,7 @@ class StudyStore:
                     response,
                     int(direction == response),
                     json.dumps(events),
-                    now_ms(),
+                    self.clock(),
                 ),
             )
             return int(position)
@@ -475,7 +477,7 @@ class StudyStore:
             db.execute(
                 "UPDATE threshold_runs SET finished_at_ms = ?, threshold = ?, low = ?, high = ?, "
                 "stop_reason = ? WHERE id = ?",
-                (now_ms(), threshold, low, high, stop_reason, run_id),
+                (self.clock(), threshold, low, high, stop_reason, run_id),
             )
 
 
