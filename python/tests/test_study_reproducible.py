@@ -15,7 +15,9 @@ def _dry_run_export(folder: Path, seed: int) -> dict[str, bytes]:
     store = pilot_study(folder)
     dry_run(store, 2, seed=seed)
     files = export_study(store, folder / "export")
-    order = [(t["shape"], t["level"]) for p in store.participants() for t in store.trials(p["code"])]
+    order = [
+        (t["shape"], t["level"]) for p in store.participants() for t in store.trials(p["code"])
+    ]
     store.close()
     return {"order": repr(order).encode()} | {f.name: f.read_bytes() for f in files}
 

@@ -136,6 +136,7 @@ def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
                 {
                     "participant": labels[run["participant"]],
                     "run": run["id"],
+                    "simulated": int(run["simulated"]),
                     "dimension": run["dimension"],
                     "trial": trial["position"] + 1,
                     "value": trial["value"],
@@ -165,6 +166,7 @@ def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
             (
                 "participant",
                 "run",
+                "simulated",
                 "dimension",
                 "trial",
                 "value",

@@ -26,7 +26,7 @@ from feelmysign.input_files import UnusableFile, check_kind
 from feelmysign.study.design import Design
 from feelmysign.study.design_file import parse_design
 from feelmysign.study.order import participant_order
-from feelmysign.study.schema import SCHEMA, SCHEMA_VERSION
+from feelmysign.study.schema import MIGRATIONS, SCHEMA, SCHEMA_VERSION
 
 # Participant codes: 5 characters without look-alikes (0/O, 1/I/L): 28^5 = 17 million.
 CODE_ALPHABET = "23456789ABCDEFGHJKMNPQRSTUVWXYZ"
@@ -47,8 +47,12 @@ class StudyStore:
         # The time every row is stamped with: the wall clock, or a dry run's simulated one
         # (so that a dry run's response times, and so its export, follow from its seed).
         self.clock: Callable[[], int] = now_ms
+        self.migrated_from: Path | None = None  # the backup, when this open migrated the file
         self._db = self._connect(self.path)
         version = self.meta("schema_version")
+        if version is not None and version.isdigit() and int(version) in MIGRATIONS:
+            self._migrate(int(version))
+            version = self.meta("schema_version")
         if version != str(SCHEMA_VERSION):
             raise StudyError(
                 f"{self.path} is not a study file of this version (schema {version!r}, "
@@ -61,6 +65,25 @@ class StudyStore:
             base_dir=base_dir,
         )
         self.base_dir = base_dir
+
+    def _migrate(self, version: int) -> None:
+        """Bring a study file of an earlier version up to this one, after a backup of it
+        beside it (``NAME.schema-V.bak``, every answer as it was), one step at a time."""
+        backup = self.path.with_name(f"{self.path.name}.schema-{version}.bak")
+        if not backup.exists():
+            target = sqlite3.connect(backup)
+            with target:
+                self._db.backup(target)
+            target.close()
+        while version in MIGRATIONS:
+            with self._transaction() as db:
+                for statement in MIGRATIONS[version]:
+                    db.execute(statement)
+                version += 1
+                db.execute(
+                    "UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(version),)
+                )
+        self.migrated_from = backup
 
     def _check_path(self) -> None:
         """A study file is there and is a regular file (``os.stat`` does not block on a fifo)."""
@@ -410,14 +433,24 @@ class StudyStore:
 
     # ---- threshold procedure -----------------------------------------------------------
 
-    def start_threshold_run(self, code: str, dimension: str, settings: dict[str, Any]) -> int:
+    def start_threshold_run(
+        self, code: str, dimension: str, settings: dict[str, Any], *, simulated: bool = False
+    ) -> int:
+        """A new run; ``simulated`` (or a simulated participant's) runs are dry runs, kept
+        apart from measurements in the export and the analysis."""
         row = self.participant(code)
         self._require_consent(row)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO threshold_runs (participant, dimension, settings_json, started_at_ms) "
-                "VALUES (?,?,?,?)",
-                (row["code"], dimension, json.dumps(settings), self.clock()),
+                "INSERT INTO threshold_runs (participant, dimension, settings_json, started_at_ms, "
+                "simulated) VALUES (?,?,?,?,?)",
+                (
+                    row["code"],
+                    dimension,
+                    json.dumps(settings),
+                    self.clock(),
+                    int(simulated or bool(row["simulated"])),
+                ),
             )
             return int(cursor.lastrowid or 0)
 

@@ -125,11 +125,13 @@ def analyse_study(
 
 
 def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
-    """Every threshold run (SQ2.2), anonymised, with its result when it has finished."""
+    """Every threshold run (SQ2.2), anonymised, with its result when it has finished, and
+    whether it is a dry run (``simulated``: the report keeps those apart)."""
     labels = anonymous_labels(store)
     return [
         {
             "participant": labels[run["participant"]],
+            "simulated": bool(run["simulated"]),
             "dimension": run["dimension"],
             "threshold": run["threshold"],
             "low": run["low"],

@@ -47,6 +47,9 @@ def accuracy_plot(
             grid = np.geomspace(strokes.min(), strokes.max(), 100)  # the tested range only
             axes.plot(grid, thresholds[shape].fit.accuracy(grid), color=colour, linewidth=1)
     axes.axhline(criterion, color="grey", linestyle=":", linewidth=1)
+    # The tested range sets the axis, so that a study with no answer yet still has a plot.
+    every = [float(r[0]) for rows in accuracy.values() for r in rows] or [1.0, 2.0]
+    axes.set_xlim(min(every) / 1.2, max(every) * 1.2)
     axes.set_xscale("log", base=2)
     axes.set_xlabel("strokes per shape (log scale)")
     axes.set_ylabel("share named correctly")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from feelmysign.study.analysis.models import ShapeTest
 from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
@@ -156,7 +156,9 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
 
 
 def _threshold_section(analysis: Analysis) -> list[str]:
-    if not analysis.threshold_runs:
+    measured = [run for run in analysis.threshold_runs if not run["simulated"]]
+    simulated = [run for run in analysis.threshold_runs if run["simulated"]]
+    if not measured and not simulated:
         return []
     lines = [
         "",
@@ -165,10 +167,26 @@ def _threshold_section(analysis: Analysis) -> list[str]:
         "QUEST+ on a Weibull function, four directions (25% by chance); threshold = posterior "
         "mean (about 71% correct), interval = 95% credible interval.",
         "",
+    ]
+    lines += _runs_table(measured) if measured else ["No measured run."]
+    if simulated:
+        lines += [
+            "",
+            f"**Simulated runs (dry runs, not measurements): {len(simulated)}.** A simulated "
+            "observer answered these (or the participant is simulated); they are flagged "
+            "`simulated` in threshold.csv and results.json and are not part of the results above.",
+            "",
+            *_runs_table(simulated),
+        ]
+    return lines
+
+
+def _runs_table(runs: list[dict[str, Any]]) -> list[str]:
+    lines = [
         "| participant | varied | threshold | 95% interval | trials | stopped after |",
         "|---|---|---|---|---|---|",
     ]
-    for run in analysis.threshold_runs:
+    for run in runs:
         unit = "grid units" if run["dimension"] == "length" else "ms"
         if run["threshold"] is None:
             lines.append(
