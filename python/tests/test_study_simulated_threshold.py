@@ -22,8 +22,10 @@ def test_a_simulated_observer_run_is_flagged_everywhere(tmp_path: Path) -> None:
     code = store.add_participant()  # a real participant: only the observer is simulated
     store.set_consent(code, True)
     result = subprocess.run(
-        [sys.executable, "-m", "feelmysign", "study", "threshold", str(store.path)]
-        + ["--participant", code, "--dimension", "length", "--simulated-observer", "0.6"],
+        [
+            *(sys.executable, "-m", "feelmysign", "study", "threshold", str(store.path)),
+            *("--participant", code, "--dimension", "length", "--simulated-observer", "0.6"),
+        ],
         capture_output=True,
         text=True,
         timeout=300,
