@@ -1,5 +1,5 @@
 """Export a study: anonymised long-format CSV (one row per trial), the questionnaire, the
-threshold trials, and the design as JSON.
+comfort check, the threshold trials, and the design as JSON.
 
 Anonymised: participant codes are replaced by P01, P02, ... in the order they
 were added (the codes may be on signed consent forms; the export must not link
@@ -127,6 +127,33 @@ def questionnaire_rows(store: StudyStore) -> list[dict[str, Any]]:
     ]
 
 
+COMFORT_COLUMNS = ("participant", "simulated", "item", "question", "answer", "adjusted")
+
+
+def comfort_rows(store: StudyStore) -> list[dict[str, Any]]:
+    """The comfort check (section 6.1 step 2), one row per participant and question: the
+    answer yes/no, and whether the sleeve was adjusted (the same on each of their rows)."""
+    labels = anonymous_labels(store)
+    questions = store.design.comfort
+    out = []
+    for participant in store.participants():
+        if participant["comfort_json"] is None:
+            continue
+        check = json.loads(participant["comfort_json"])
+        for item, answer in enumerate(check["answers"]):
+            out.append(
+                {
+                    "participant": labels[participant["code"]],
+                    "simulated": int(participant["simulated"]),
+                    "item": item + 1,
+                    "question": questions[item] if item < len(questions) else "",
+                    "answer": "yes" if answer else "no",
+                    "adjusted": "yes" if check["adjusted"] else "no",
+                }
+            )
+    return out
+
+
 def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
     labels = anonymous_labels(store)
     out = []
@@ -156,11 +183,13 @@ def _write_csv(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...])
 
 
 def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
-    """Write trials.csv, questionnaire.csv, threshold.csv and design.json into ``out_dir``."""
+    """Write trials.csv, questionnaire.csv, comfort.csv, threshold.csv and design.json into
+    ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {
         "trials.csv": (trial_rows(store), TRIAL_COLUMNS),
         "questionnaire.csv": (questionnaire_rows(store), ("participant", "item", "text", "value")),
+        "comfort.csv": (comfort_rows(store), COMFORT_COLUMNS),
         "threshold.csv": (
             threshold_rows(store),
             (
