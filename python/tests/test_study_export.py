@@ -29,3 +29,37 @@ def test_the_comfort_check_is_exported_as_yes_and_no(tmp_path: Path) -> None:
         ("P02", "1", "Does the sleeve sit comfortably?", "yes", "no"),
         ("P02", "2", "Can you feel every motor?", "yes", "no"),
     ]
+
+
+def test_the_bids_files_read_back_as_the_trials_with_every_column_described(
+    tmp_path: Path,
+) -> None:
+    import json
+
+    import pandas as pd
+
+    from feelmysign.study.dry_run import dry_run
+
+    store = pilot_study(tmp_path)
+    dry_run(store, 2, seed=1)
+    export_study(store, tmp_path / "out")
+    bids = tmp_path / "out" / "bids"
+    description = json.loads((bids / "dataset_description.json").read_text())
+    assert description["BIDSVersion"] and description["Name"] == "Pilot"
+    people = pd.read_csv(bids / "participants.tsv", sep="\t")
+    assert list(people["participant_id"]) == ["sub-01", "sub-02"]
+    trials = pd.read_csv(tmp_path / "out" / "trials.csv", keep_default_na=False, dtype=str)
+    for label, sub in (("P01", "sub-01"), ("P02", "sub-02")):
+        stem = bids / sub / "beh" / f"{sub}_task-shapes_beh"
+        table = pd.read_csv(f"{stem}.tsv", sep="\t", na_values=["n/a"], keep_default_na=False)
+        sidecar = json.loads(Path(f"{stem}.json").read_text())
+        assert sidecar["TaskName"] == "shapes"
+        for column in table.columns:
+            assert sidecar[column]["Description"], column  # every column described
+        mine = trials[trials["participant"] == label]
+        assert len(table) == len(mine) == 16
+        assert list(table["shape"]) == list(mine["shape"])
+        assert list(table["segments"]) == [int(v) for v in mine["segments"]]
+        assert list(table["correct"].fillna(-1)) == [int(v) if v else -1 for v in mine["correct"]]
+        assert list(table["response_time"]) == [float(v) for v in mine["response_time_s"]]
+        assert sidecar["response_time"]["Units"] == "s"

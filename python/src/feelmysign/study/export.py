@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from feelmysign.study.bids import export_bids
 from feelmysign.study.runner import events_summary
 from feelmysign.study.store import StudyStore
 
@@ -206,10 +207,12 @@ def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
         ),
     }
     written = []
+    trials = files["trials.csv"][0]
     for name, (rows, columns) in files.items():
         _write_csv(out_dir / name, rows, columns)
         written.append(out_dir / name)
     design = out_dir / "design.json"
     design.write_text(json.dumps(store.design.to_json(), indent=2) + "\n", encoding="utf-8")
     written.append(design)
+    written += export_bids(store, trials, out_dir / "bids")
     return written
