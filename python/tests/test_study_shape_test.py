@@ -68,3 +68,10 @@ def test_a_two_participant_pilot_is_analysed_without_a_test_and_says_why(tmp_pat
     results = json.loads((tmp_path / "out" / "results.json").read_text())
     test = results["shape_model"]["test"]
     assert test["p"] is None and test["participants_needed"] == MIN_PARTICIPANTS
+    # The per-participant table adds up to the accuracy table.
+    table = results["per_participant"]
+    assert [row["participant"] for row in table] == ["P01", "P02"]
+    for shape, levels in results["accuracy"].items():
+        assert sum(row["by_shape"][shape][0] for row in table) == sum(r["correct"] for r in levels)
+        assert sum(row["by_shape"][shape][1] for row in table) == sum(r["total"] for r in levels)
+    assert "## Per participant" in report and "| P02 | yes | 16 |" in report

@@ -47,6 +47,7 @@ class Analysis:
     criterion: float
     files: list[Path]
     threshold_runs: list[dict[str, Any]]
+    per_participant: list[dict[str, Any]]  # one row per participant (anonymised)
 
 
 def main_trials(store: StudyStore) -> pd.DataFrame:
@@ -114,6 +115,7 @@ def analyse_study(
         criterion=design.criterion,
         files=files,
         threshold_runs=threshold_summaries(store),
+        per_participant=participant_table(frame, [s.name for s in design.shapes]),
     )
     files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
     if needed:
@@ -122,6 +124,35 @@ def analyse_study(
     files.append(_results_json(out_dir / "results.json", analysis))
     files.append(write_report(out_dir / "report.md", store, analysis))
     return analysis
+
+
+def participant_table(frame: pd.DataFrame, shapes: list[str]) -> list[dict[str, Any]]:
+    """Per participant: measured trials answered, how many await review, and the correct
+    ones overall and per shape (of the coded ones)."""
+    if not len(frame):
+        return []
+    rows = []
+    for label, mine in frame.groupby("participant", sort=True):
+        coded = mine[mine["coded_status"] != "unclear"]
+        correct = coded["correct"].astype(int)
+        rows.append(
+            {
+                "participant": str(label),
+                "simulated": bool(int(mine["simulated"].iloc[0])),
+                "trials": len(mine),
+                "unclear": len(mine) - len(coded),
+                "correct": int(correct.sum()),
+                "coded": len(coded),
+                "by_shape": {
+                    shape: [
+                        int(correct[coded["shape"] == shape].sum()),
+                        int((coded["shape"] == shape).sum()),
+                    ]
+                    for shape in shapes
+                },
+            }
+        )
+    return rows
 
 
 def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
@@ -191,6 +222,7 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
         },
         "shape_model": asdict(analysis.model) if analysis.model else None,
         "thresholds": analysis.threshold_runs,
+        "per_participant": analysis.per_participant,
     }
     path.write_text(json.dumps(data, indent=2, default=str) + "\n", encoding="utf-8")
     return path

@@ -80,6 +80,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             for strokes, k, n, low, high in rows
         ]
         lines.append(f"| {shape} | " + " | ".join(cells) + " |")
+    lines += _participant_section(analysis, [shape for shape in analysis.accuracy])
     lines += [
         "",
         "![accuracy](accuracy.png)",
@@ -153,6 +154,33 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     path.write_text("\n".join(lines), encoding="utf-8")
     return path
+
+
+def _participant_section(analysis: Analysis, shapes: list[str]) -> list[str]:
+    if not analysis.per_participant:
+        return []
+    lines = [
+        "",
+        "## Per participant",
+        "",
+        "Measured trials answered, awaiting review, and correct of the coded ones, overall and "
+        "per shape.",
+        "",
+        "| participant | simulated | trials | awaiting review | correct | "
+        + " | ".join(shapes)
+        + " |",
+        "|---|---|---|---|---|" + "---|" * len(shapes),
+    ]
+    for row in analysis.per_participant:
+        share = f"{row['correct'] / row['coded']:.0%}" if row["coded"] else "-"
+        cells = [f"{k}/{n}" if n else "-" for k, n in (row["by_shape"][shape] for shape in shapes)]
+        lines.append(
+            f"| {row['participant']} | {'yes' if row['simulated'] else 'no'} | {row['trials']} | "
+            f"{row['unclear']} | {row['correct']}/{row['coded']} = {share} | "
+            + " | ".join(cells)
+            + " |"
+        )
+    return lines
 
 
 def _threshold_section(analysis: Analysis) -> list[str]:
