@@ -63,3 +63,25 @@ def test_the_bids_files_read_back_as_the_trials_with_every_column_described(
         assert list(table["correct"].fillna(-1)) == [int(v) if v else -1 for v in mine["correct"]]
         assert list(table["response_time"]) == [float(v) for v in mine["response_time_s"]]
         assert sidecar["response_time"]["Units"] == "s"
+
+
+def test_the_response_time_counts_from_the_send_the_answer_follows(tmp_path: Path) -> None:
+    from feelmysign.study.export import trial_rows
+    from feelmysign.study.runner import Session
+    from feelmysign.study.simulated_sleeve import offline_player
+
+    store = pilot_study(tmp_path)
+    now = [1_000_000]
+    store.clock = lambda: now[0]
+    session = Session(store, None)
+    session = Session(store, offline_player(session.layout))
+    code = store.add_participant()
+    session.consent(code, True)
+    session.comfort(code, [True, True], adjusted=False)
+    session.send(code)
+    now[0] += 70_000  # a restart, or a long wait: the shape is sent again
+    session.send(code)
+    now[0] += 4_500
+    session.answer(code, None, answer="circle", felt_nothing=False, confidence=3)
+    (row,) = trial_rows(store)
+    assert row["sends"] == 2 and row["response_time_s"] == 4.5

@@ -34,6 +34,15 @@ def test_a_simulated_observer_run_is_flagged_everywhere(tmp_path: Path) -> None:
     assert "Simulated threshold (a dry run, stored as one)" in result.stdout
     (run,) = store.threshold_runs(code)
     assert run["simulated"] == 1 and run["threshold"] is not None
+    status = subprocess.run(
+        [sys.executable, "-m", "feelmysign", "study", "status", str(store.path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert f"simulated threshold run (dry run) {run['id']} (length): 12 trials, finished" in (
+        status.stdout
+    )
     analyse_study(store, tmp_path / "out", samples=50)
     with (tmp_path / "out" / "threshold.csv").open() as file:
         rows = list(csv.DictReader(file))

@@ -75,7 +75,7 @@ COLUMNS: dict[str, dict[str, Any]] = {
         "Units": "ms",
     },
     "response_time": {
-        "Description": "From the first send of the shape to the recorded answer.",
+        "Description": "From the last send of the shape (the one answered) to the answer.",
         "Units": "s",
     },
     "simulated": {

@@ -79,7 +79,9 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                 else int(coding is not None and coding["shape"] == trial["shape"])
             )
             level = trial["level"]
-            first_sent = sends[0]["sent_at_ms"] if sends else trial["answered_at_ms"]
+            # From the send the answer follows (a repeat send restarts the clock; so does a
+            # restart of the session, which sends again).
+            last_sent = sends[-1]["sent_at_ms"] if sends else trial["answered_at_ms"]
             out.append(
                 {
                     "participant": labels[participant["code"]],
@@ -107,7 +109,7 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                     if summary["latency_ms_max"] is None
                     else summary["latency_ms_max"],
                     "felt_duration_ms": summary["felt_duration_ms"],
-                    "response_time_s": round((trial["answered_at_ms"] - first_sent) / 1000, 3),
+                    "response_time_s": round((trial["answered_at_ms"] - last_sent) / 1000, 3),
                 }
             )
     return out
