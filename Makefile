@@ -25,7 +25,7 @@ SYSTEM_PACKAGES := mosquitto mosquitto-clients
 # cores; pytest and the browser tests each leave much of theirs idle.
 TEST_JOBS ?= 3
 
-.PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study system clean
+.PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study bench-study-calibration system clean
 .PHONY: bench-prepare bench-timed bench-prepare-python bench-timed-python
 
 help:
@@ -38,6 +38,8 @@ help:
 	@echo "             need built side by side, then one timed part at a time)"
 	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
 	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
+	@echo "make bench-study-calibration  the shape test's false-positive rate and the interval"
+	@echo "             coverage at 4, 8, 12, 24 participants (TEST_RUNS=400, COVERAGE_RUNS=100)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 	@echo "make java-build  build the Java port (java/bin/feelmysign-java); make java-test tests it"
@@ -136,6 +138,11 @@ bench-timed-python: $(STAMP) system
 RUNS ?= 400
 bench-study: $(STAMP)
 	$(PY) -m feelmysign.bench.study_recovery $(RUNS)
+
+TEST_RUNS ?= 400
+COVERAGE_RUNS ?= 100
+bench-study-calibration: $(STAMP)
+	$(PY) -m feelmysign.bench.study_calibration $(TEST_RUNS) $(COVERAGE_RUNS)
 
 up: $(RUN_STAMP) system
 	@echo "==> Starting feelmysign up $(ARGS)"

@@ -360,7 +360,13 @@ export class SessionView {
       "div",
       { class: "card" },
       h("h3", {}, "4 · Questionnaire"),
-      h("p", { class: "hint" }, "How comfortable was the sleeve?"),
+      // The design's own items say what is asked; the hint only says how to ask them.
+      h(
+        "p",
+        { class: "hint" },
+        `Read each of the ${items.length} statement(s) to the participant and choose their answer` +
+          ` (1 to ${points}).`,
+      ),
       ...groups,
       submit,
     );

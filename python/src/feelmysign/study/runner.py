@@ -247,10 +247,11 @@ class Session:
         strokes = [stroke_from_json(s) for s in json.loads(sends[-1]["strokes_json"])]
         from feelmysign.study.simulated import SimulatedParticipant
 
+        # The participant's number and the trial's position, not their random code and row
+        # id: the same seed then gives the same answers in every new study file.
         participant = SimulatedParticipant(seed=self._simulation_seed + int(row["number"]))
-        result = participant.answer(
-            strokes, self.layout, self.store.design, self._templates, f"{row['code']}:{trial['id']}"
-        )
+        key = f"{row['number']}:{trial['position']}"
+        result = participant.answer(strokes, self.layout, self.store.design, self._templates, key)
         return {
             "answer": result.answer,
             "felt_nothing": result.felt_nothing,
