@@ -54,6 +54,7 @@ from urllib.parse import parse_qs
 
 import aiohttp
 from aiohttp import web
+from aiohttp.abc import AbstractStreamWriter
 
 from feelmysign.broker.tls import TlsFiles
 from feelmysign.errors import FeelMySignError
@@ -546,7 +547,7 @@ class WebServer:
             return _text(404, "Not Found")
         # A rebuilt client is seen at once; assets/ names carry their content's hash.
         assets = path.startswith("/assets/")
-        return web.FileResponse(target, headers={} if assets else {"Cache-Control": "no-cache"})
+        return _FileResponse(target, headers={} if assets else {"Cache-Control": "no-cache"})
 
     async def _relay(self, request: web.BaseRequest) -> web.StreamResponse:
         """MQTT over WebSockets from the page's own origin: ``/mqtt`` relayed, message by
@@ -663,3 +664,14 @@ def _tls_context(tls: TlsFiles) -> ssl.SSLContext:
     context.minimum_version = ssl.TLSVersion.TLSv1_2
     context.load_cert_chain(tls.cert, tls.key)
     return context
+
+
+class _FileResponse(web.FileResponse):
+    """A file, sent within the time limit by ``_answer_sent``: aiohttp's own prepare after the
+    handler returns is then a no-op, as for any response already sent (FileResponse's would
+    send the file again, and fail on the finished writer, closing the connection)."""
+
+    async def prepare(self, request: web.BaseRequest) -> AbstractStreamWriter | None:
+        if self.prepared:
+            return await web.StreamResponse.prepare(self, request)
+        return await super().prepare(request)
