@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from feelmysign.duty_cycle import Drive, DutyCycle, Refusal
+from feelmysign.frozen_init import dict_init
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline
 from feelmysign.schedule import Command, Schedule
@@ -34,11 +35,13 @@ Actuator = tuple[int, int]
 FIRST_COMMANDS_MS = 1.0
 
 
+@dict_init
 @dataclass(frozen=True)
 class Change:
     """Set an actuator's intensity at a planned time (ms on the player's clock).
 
     ``tag`` is the stroke whose command made this change (for records; not compared).
+    Made with one dict update (``dict_init``): a stroke's first motor command is one.
     """
 
     t_ms: float
@@ -63,6 +66,20 @@ class Due:
     changes: list[Change] = field(default_factory=list)
     started: list[object] = field(default_factory=list)
     capped: list[Capped] = field(default_factory=list)
+
+    def __init__(
+        self,
+        changes: list[Change] | None = None,
+        started: list[object] | None = None,
+        capped: list[Capped] | None = None,
+    ) -> None:
+        # One dict update, not object.__setattr__ and a factory per field: the player asks
+        # for what is due before every stroke's first motor command.
+        self.__dict__.update(
+            changes=[] if changes is None else changes,
+            started=[] if started is None else started,
+            capped=[] if capped is None else capped,
+        )
 
 
 @dataclass(frozen=True)
