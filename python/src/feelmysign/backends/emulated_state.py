@@ -145,9 +145,8 @@ class _WriteThrough:
         self.take_faults(bus)  # an edit made since the last write is not overwritten unseen
         text = _as_text(bus)
         if text != self._last:
-            _replace(self._path, text)
+            self._written = _replace(self._path, text)
             self._last = text
-            self._written = _identity(self._path)
 
     def take_faults(self, bus: EmulatedI2CBus) -> None:
         """A file someone else changed while this process drives it: its faults land now.
@@ -200,13 +199,17 @@ def _as_text(bus: EmulatedI2CBus) -> str:
     return json.dumps(state_of(bus), indent=1) + "\n"
 
 
-def _replace(path: str, text: str) -> None:
-    # A rename replaces the file in one step: readers see the old or the new one.
+def _replace(path: str, text: str) -> tuple[int, int, int] | None:
+    """Writes ``text`` to ``path`` in one step (readers see the old or the new file); the
+    identity of what was written, taken before the rename (which keeps it): an edit renamed
+    over the file just after is then never mistaken for this write, and is seen."""
     folder, name = os.path.split(path)
     temporary = os.path.join(folder, f".{name}.{os.getpid()}.tmp")
     with open(temporary, "w", encoding="utf-8") as file:
         file.write(text)
+    written = _identity(temporary)
     os.replace(temporary, path)
+    return written
 
 
 def _identity(path: str) -> tuple[int, int, int] | None:
