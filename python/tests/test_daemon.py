@@ -412,6 +412,6 @@ def test_a_drawing_with_a_refused_stroke_and_one_cut_short_is_one_terminal_line(
         summaries.add(event, now_s=0.0)
     [line] = summaries.finished(100.0)
     assert line.startswith(
-        f"Drawing {drawing[:8]}: 2 strokes played (1 cut short), 1 rejected (outside_grid); "
+        f"Drawing {drawing[:8]}: 1 stroke played, 1 cut short, 1 rejected (outside_grid); "
     ), line
     sender.loop_stop()

@@ -224,13 +224,23 @@ export class App {
     // A pen still down draws nothing more: its path ends here, before the cancels go out.
     this.#session.endPath();
     const drawing = this.#session.drawing;
-    let dropped = 0;
-    if (drawing !== null) dropped += this.#sender.cancel(drawing.id);
-    dropped += this.#sender.cancel(CANCEL_ALL);
+    const dropped = [
+      ...(drawing === null ? [] : this.#sender.cancel(drawing.id)),
+      ...this.#sender.cancel(CANCEL_ALL),
+    ];
     this.#felt.stopCursor();
     this.#session.close();
-    if (dropped > 0) this.#says.addDropped(dropped);
-    this.#says.add("info", `Stop sent${dropped > 0 ? `; ${dropped} unsent stroke(s) dropped` : ""}.`);
+    // Never sent: marked as such, and counted apart from what the sleeve cancelled.
+    for (const stroke of dropped) {
+      if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
+        this.#session.refused(stroke.seq, "unsent");
+    }
+    if (dropped.length > 0) this.#says.addDropped(dropped.length);
+    this.#says.add(
+      "info",
+      `Stop sent${dropped.length > 0 ? `; ${dropped.length} unsent stroke(s) dropped` : ""}. ` +
+        "Strokes the sleeve had not played yet are cancelled.",
+    );
   }
 
   /** Sends the current drawing's strokes again, as a new drawing (the sleeve plays them back to back). */
@@ -393,12 +403,26 @@ export class App {
   #onEvent(payload: string): void {
     const event = parseEvent(payload);
     if (event === null || this.#copies.isCopy(payload, event)) return;
-    const reading = interpretEvent(event, this.#session.drawing?.id ?? null);
-    for (const what of reading.counts) this.#says.count(what, reading.delayMs);
+    const drawingId = this.#session.drawing?.id ?? null;
+    const reading = interpretEvent(event, drawingId);
+    if (reading.counts.includes("delayed")) this.#says.delayed(reading.delayMs);
+    // What became of the stroke: fates.ts, the rule `up` and the study report from too.
+    const seq = "seq" in event ? event.seq : null;
+    const ours = seq !== null && drawingId !== null && "drawing" in event && event.drawing === drawingId;
+    const fate = ours ? this.#says.fate(event) : null;
+    // A copy's refusal (after a broker restart, or after Stop) of a stroke that was felt.
+    const feltCopy = event.type === "rejected" && (fate === "played" || fate === "cut");
     if (reading.played !== null) this.#felt.played(reading.played);
     if (reading.cancelled !== null) this.#felt.cancelled(reading.cancelled);
-    if (reading.refusedSeq !== null) this.#session.refused(reading.refusedSeq);
-    if (reading.unplayed !== null) this.#felt.unplayed(reading.unplayed);
+    if (ours && (fate === "refused" || fate === "cancelled")) this.#session.refused(seq, fate);
+    if (reading.unplayed !== null && !feltCopy) this.#felt.unplayed(reading.unplayed);
+    if (feltCopy) {
+      this.#says.add(
+        "info",
+        `Stroke ${seq} came again (a reconnect) and was not played twice: it was felt once.`,
+      );
+      return;
+    }
     for (const note of reading.notes) this.#says.add(note.kind, note.text);
   }
 

@@ -228,11 +228,11 @@ export class StrokeSender {
   /**
    * Cancels a drawing (or everything: "*") on the sleeve: its strokes still in
    * the outbox are dropped here, and a control message tells the sleeve to stop
-   * playing and drop the rest. Returns how many unsent strokes were dropped.
+   * playing and drop the rest. Returns the unsent strokes dropped (never sent).
    */
-  cancel(drawing: string): number {
+  cancel(drawing: string): Stroke[] {
     const sleeveId = this.#target?.sleeve_id;
-    if (sleeveId === undefined) return 0;
+    if (sleeveId === undefined) return [];
     const dropped = this.#outbox.dropQueued(
       ({ stroke, sleeveId: to }) => to === sleeveId && (drawing === CANCEL_ALL || stroke.drawing === drawing),
     );
@@ -240,7 +240,7 @@ export class StrokeSender {
       c.drawing === drawing && c.sleeveId === sleeveId;
     this.#cancels = [...this.#cancels.filter((c) => !same(c)), { drawing, sleeveId }];
     this.#flush();
-    return dropped.length;
+    return dropped.map(({ stroke }) => stroke);
   }
 
   /** The timing policy for strokes drawn while the broker is out of reach. */

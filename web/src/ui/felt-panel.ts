@@ -37,6 +37,10 @@ export class FeltPanel {
   /** The cursor runs from `t_ms` at `at` (performance.now()). */
   #anchor: { t_ms: number; at: number } | null = null;
   #running = false;
+  /** Strokes the sleeve dropped at Stop before they started. */
+  readonly #cancelledSeqs = new Set<number>();
+  /** Stop was pressed: what the sleeve has not played yet never will be. */
+  #stopped = false;
 
   constructor(timeline: TimelineView, view: DrawingView) {
     this.#timeline = timeline;
@@ -49,6 +53,8 @@ export class FeltPanel {
     this.#grid = grid;
     this.#arrival = arrival;
     this.#startedAt.clear();
+    this.#cancelledSeqs.clear();
+    this.#stopped = false;
     this.#placement = new FeltPlacement();
     this.#segmentsSeen = 0;
     this.#lastSeen = null;
@@ -69,7 +75,10 @@ export class FeltPanel {
       count === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
         : `${count} stroke${count === 1 ? "" : "s"}, ${seconds} s` +
-            timelineCaption(count, placement.reportedCount, placement.cappedCount),
+            timelineCaption(count, placement.reportedCount, placement.cappedCount, {
+              cancelled: this.#cancelledSeqs.size,
+              stopped: this.#stopped,
+            }),
     );
   }
 
@@ -91,6 +100,7 @@ export class FeltPanel {
   cancelled(event: CancelledEvent): void {
     if (event.seq === null) return;
     const started = this.#startedAt.get(event.seq);
+    if (!event.started) this.#cancelledSeqs.add(event.seq);
     this.#sync();
     this.#placement.cut(
       event.seq,
@@ -110,6 +120,8 @@ export class FeltPanel {
   /** Stop pressed: the cursor stops where it is. */
   stopCursor(): void {
     this.#anchor = null;
+    this.#stopped = true;
+    this.refresh();
   }
 
   /** Compares with the same paths under `params` (null: no comparison). */
@@ -200,10 +212,21 @@ export class FeltPanel {
   }
 }
 
-/** What the timeline's times are: the sleeve's, the page's estimate, or both; and what was not felt. */
-export function timelineCaption(count: number, reported: number, capped: number): string {
-  if (reported === 0 && capped === 0) return ": what would be felt, played back to back as the sleeve does.";
-  const estimated = count - reported - capped;
+/**
+ * What the timeline's times are: the sleeve's, the page's estimate, or both; and what was not felt.
+ * `cancelled`: strokes Stop dropped on the sleeve before they started; `stopped`: Stop was pressed,
+ * so the strokes the sleeve has not reported will not be felt (never "the rest as it would").
+ */
+export function timelineCaption(
+  count: number,
+  reported: number,
+  capped: number,
+  stop: { readonly cancelled: number; readonly stopped: boolean } = { cancelled: 0, stopped: false },
+): string {
+  const { cancelled, stopped } = stop;
+  if (reported === 0 && capped === 0 && cancelled === 0 && !stopped)
+    return ": what would be felt, played back to back as the sleeve does.";
+  const estimated = count - reported - capped - cancelled;
   const said: string[] = [];
   if (reported > 0)
     said.push(reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`);
@@ -212,6 +235,8 @@ export function timelineCaption(count: number, reported: number, capped: number)
       `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,
     );
   }
-  if (estimated > 0) said.push("the rest as it would");
+  if (cancelled > 0)
+    said.push(`${cancelled} cancelled by Stop before ${cancelled === 1 ? "it" : "they"} played`);
+  if (estimated > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");
   return `${reported === count ? ", " : "; "}${said.join(", ")}.`;
 }
