@@ -16,6 +16,7 @@ import { LATE_LIMIT_MS, loadSettings, saveSettings, withServerBroker, type Setti
 import { lateLimitMs, senderTarget, settingsChange } from "./settings-diff";
 import { withFloor } from "./sleeve-floor";
 import { offlineAdvice, SleeveWatch } from "./sleeve-state";
+import { simplifyPaths } from "./simplify/registry";
 import { parseActuators } from "./telemetry";
 import { DrawingView } from "./ui/canvas";
 import { detailParams } from "./ui/detail";
@@ -271,10 +272,15 @@ export class App {
       return false;
     }
     const drawing = drawingFromRecording(recording, newDrawingId(), this.#settings.intensity);
+    // Not sent: Play again will send it, all at once. The timeline shows that, not the drawing's
+    // own pace, so the time it predicts is the time Play again keeps.
+    this.#arrival = "at-once";
     this.#session.adopt(drawing);
     this.#says.add(
       "info",
-      `Loaded ${name}: ${drawing.strokes.length} strokes, not sent. Play again sends them.`,
+      `Loaded ${name}: ${drawing.strokes.length} strokes, not sent. Play again sends them all at once; ` +
+        `the timeline shows them as the sleeve will then play them, back to back and caught up ` +
+        `(${(this.#felt.totalMs / 1000).toFixed(1)} s, where the drawing took ${(drawnMs(drawing) / 1000).toFixed(1)} s).`,
     );
     return true;
   }
@@ -308,8 +314,19 @@ export class App {
     }
     const params = detailParams(drawing.params, level);
     const count = this.#felt.compare(params);
-    byId(this.#doc, "compare-note").textContent =
-      `A (solid): ${drawing.strokes.length} strokes as drawn. B (dashed): ${count} strokes at detail ${level} of 5.`;
+    let note = `A (solid): ${drawing.strokes.length} strokes as drawn. B (dashed): ${count} strokes at detail ${level} of 5.`;
+    // The longest-stroke cap cuts at every detail: say how much of B's count is its doing.
+    if (params.algorithm === "window" && params.max_stroke_ms > 0) {
+      const uncapped = simplifyPaths({ ...params, max_stroke_ms: 0 }, drawing.paths).filter(
+        (piece) => piece.segment.dropped === null,
+      ).length;
+      if (uncapped < count) {
+        note +=
+          ` The longest-stroke cap (${params.max_stroke_ms} ms, Settings → Advanced) cuts ${count - uncapped} of them:` +
+          ` without it, detail ${level} would send ${uncapped}.`;
+      }
+    }
+    byId(this.#doc, "compare-note").textContent = note;
   }
 
   // ---- layout ------------------------------------------------------------------------------
@@ -352,8 +369,10 @@ export class App {
       this.#session.clear();
       this.#fit();
     } else if (change.drawing) {
+      this.#arrival = "at-once"; // not sent: Play again sends it, all at once
       const again = this.#session.recut();
-      if (again !== null) {
+      if (again === null) this.#arrival = "as-drawn";
+      else {
         this.#says.add(
           "info",
           `Re-simplified with the new settings: ${again.strokes.length} strokes, not sent. Play again sends them.`,
@@ -446,4 +465,12 @@ export class App {
   get drawingId(): string | null {
     return this.#session.drawing?.id ?? null;
   }
+}
+
+/** How long the drawing took to draw: its first sample to its last, pen lifts included. */
+function drawnMs(drawing: Drawing): number {
+  const times = drawing.paths.flatMap((path) =>
+    path.length > 0 ? [path[0]!.t_ms, path[path.length - 1]!.t_ms] : [],
+  );
+  return times.length === 0 ? 0 : Math.max(...times) - Math.min(...times);
 }

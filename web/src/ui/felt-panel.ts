@@ -82,6 +82,11 @@ export class FeltPanel {
     );
   }
 
+  /** When the felt drawing ends, ms from its first stroke (as the timeline shows it). */
+  get totalMs(): number {
+    return this.#placement.totalMs;
+  }
+
   /** The sleeve played a stroke of this drawing: its real start, and the cursor from there. */
   played(event: PlayedEvent | AdjustedEvent): void {
     if (event.seq === null) return;
