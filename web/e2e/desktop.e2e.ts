@@ -353,6 +353,11 @@ describe("a broker that goes away", () => {
       expect(await page.locator("#legend").boundingBox()).toEqual(legendBefore);
       await new Promise((wake) => setTimeout(wake, 50));
     }
+    // The notice covers no part of the drawing area: it sits under it, over the legend.
+    const notice = (await page.locator("#notice").boundingBox())!;
+    expect(notice.y, "the notice's top against the area's bottom").toBeGreaterThanOrEqual(
+      stageBefore!.y + stageBefore!.height,
+    );
     const area = await drawingArea(page);
     const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
     await drawWithMouse(page, [at(0.2, 0.2), at(0.2, 0.8), at(0.8, 0.8)]);

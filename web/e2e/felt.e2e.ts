@@ -229,6 +229,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
   it("compares the drawing under a coarser detail, overlaid", async () => {
     await page.locator('[data-testid="compare-toggle"]').check();
     await expect(dataOf(page, "timeline", "compare")).resolves.toMatch(/^\d+$/);
+    // Coarse detail on legs drawn slower than the longest-stroke cap: the note says the cap cuts.
+    await page.locator('[data-testid="compare-detail"]').fill("1");
+    await expect(page.locator("#compare-note").innerText()).resolves.toMatch(
+      /The longest-stroke cap \(300 ms, Settings → Advanced\) cuts \d+ of them: without it, detail 1 would send \d+\./,
+    );
     await screenshot(page, "felt-compare");
     await page.locator('[data-testid="compare-toggle"]').uncheck();
     await expect(dataOf(page, "timeline", "compare")).resolves.toBe("off");

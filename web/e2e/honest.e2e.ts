@@ -167,11 +167,19 @@ describe("honest after faults: the page, up and the study agree with what the sl
       cancelled: counts.cancelled,
       refused: counts.refused,
     }).toEqual(byFate);
-    // up's terminal line, from the same rule.
-    const line = await upLine(drawing);
-    expect(upCounts(line), line).toEqual(byFate);
+    // up's terminal line, from the same rule: its last about the drawing (a line printed while
+    // strokes were still to come is printed again, "(updated)", with all of it).
+    let line = await upLine(drawing);
+    const deadline = Date.now() + LINE_TIMEOUT_MS;
+    while (JSON.stringify(upCounts(line)) !== JSON.stringify(byFate) && Date.now() < deadline) {
+      await new Promise((wake) => setTimeout(wake, 500));
+      line = await upLine(drawing);
+    }
+    expect(upCounts(line), `${line}\n${output}`).toEqual(byFate);
+    console.log(`page: ${JSON.stringify(counts)}\nup: ${line.trim()}`);
     // The study's summary of the same events.
     const study = studySummary(events, counts.sent);
+    console.log(`study: ${JSON.stringify(study)}`);
     expect({
       played: study["played"],
       cut: study["cut_short"],
@@ -181,6 +189,9 @@ describe("honest after faults: the page, up and the study agree with what the sl
     // What the sleeve felt: a motor moved for exactly the strokes called played or cut short.
     const felt = [...fates.fates()].filter(([, fate]) => fate === "played" || fate === "cut").map(([s]) => s);
     expect([...recordedSeqs(recordPath, drawing)].sort((a, b) => a - b)).toEqual(felt);
+    console.log(
+      `record: ${felt.length} strokes moved a motor; page summary: ${await page.locator(SUMMARY).innerText()}`,
+    );
     return byFate;
   }
 
@@ -265,6 +276,42 @@ describe("honest after faults: the page, up and the study agree with what the sl
       expect(caption).not.toContain("the rest as it would");
       expect(caption).toContain("cancelled by Stop");
       await screenshot(page, "honest-after-stop");
+    },
+  );
+  it(
+    "Esc while still drawing, the pen moving on: nothing more is sent, and every stroke is told once",
+    { timeout: 180_000 },
+    async () => {
+      await page.locator('[data-testid="new-button"]').click();
+      const corners: Point[] = [];
+      for (let i = 0; i <= 10; i++) corners.push(at(0.06 + (0.88 * i) / 10, i % 2 === 0 ? 0.25 : 0.75));
+      await page.mouse.move(...corners[0]!);
+      await page.mouse.down();
+      await nextFrame(page);
+      let sentAtStop = 0;
+      for (let i = 1; i < corners.length; i++) {
+        if (i === 5) {
+          await page.keyboard.press("Escape"); // Stop, the pen still down
+          sentAtStop = (await pageCounts(page)).sent;
+        }
+        const [ax, ay] = corners[i - 1]!;
+        const [bx, by] = corners[i]!;
+        const startMs = performance.now();
+        for (let done = 0; done < 1;) {
+          done = Math.min(1, (performance.now() - startMs) / 250);
+          await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
+          await nextFrame(page);
+        }
+      }
+      await page.mouse.up();
+      const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
+      const counts = await waitForEveryStroke(page);
+      // The pen moving on after Stop drew nothing more: no stroke was made, none sent.
+      expect(counts.sent).toBe(sentAtStop);
+      await expectAllAgree(drawing, counts);
+      const caption = await page.locator('[data-testid="timeline-caption"]').innerText();
+      expect(caption).not.toContain("the rest as it would");
+      await screenshot(page, "honest-esc-while-drawing");
     },
   );
 });
