@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import statistics
 import threading
-import uuid
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -196,6 +195,7 @@ class DrawingLog:
 
         self._settings = settings
         self._topic = telemetry_topic(sleeve_id, "events")
+        self._sleeve_id = sleeve_id
         self._emit = emit
         self._clock = clock or time.monotonic
         self._summaries = DrawingSummaries()
@@ -211,7 +211,13 @@ class DrawingLog:
         from feelmysign.errors import FeelMySignError
 
         try:
-            client = connect_client(self._settings, f"feelmysign-up-log-{uuid.uuid4().hex[:12]}")
+            # A persistent session: the broker keeps the log's subscription and the events
+            # published while it reconnects (a broker restarted from its saved state too), so
+            # a drawing's line has all of its strokes. One session per sleeve: up runs the
+            # broker and the sleeve with it, so nothing is queued for it between two runs.
+            client = connect_client(
+                self._settings, f"feelmysign-up-log-{self._sleeve_id}", persistent_session=True
+            )
         except FeelMySignError as error:
             self._emit(f"No per-drawing log: cannot listen to the sleeve's events ({error}).")
             return self
