@@ -139,6 +139,11 @@ export class App {
       acked: (stroke) => this.#session.acked(stroke),
       refused: (_stroke, error) => this.#says.add("error", `A stroke was not sent: ${error.message}`),
       late: (strokes) => {
+        const drawing = this.#session.drawing;
+        for (const stroke of strokes) {
+          if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
+            this.#session.refused(stroke.seq, "unsent");
+        }
         this.#says.addDropped(strokes.length);
         this.#says.add(
           "info",
