@@ -31,5 +31,8 @@ describe("timelineCaption after Stop", () => {
     expect(timelineCaption(4, 3, 0, { cancelled: 1, stopped: true })).toBe(
       "; 3 as the sleeve played them, 1 cancelled by Stop before it played.",
     );
+    expect(timelineCaption(6, 4, 0, { cancelled: 2, cut: 1, stopped: true })).toBe(
+      "; 4 as the sleeve played them (1 cut short by Stop), 2 cancelled by Stop before they played.",
+    );
   });
 });

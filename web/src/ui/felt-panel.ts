@@ -39,6 +39,8 @@ export class FeltPanel {
   #running = false;
   /** Strokes the sleeve dropped at Stop before they started. */
   readonly #cancelledSeqs = new Set<number>();
+  /** Strokes Stop cut short while they played (reported played too). */
+  readonly #cutSeqs = new Set<number>();
   /** Stop was pressed: what the sleeve has not played yet never will be. */
   #stopped = false;
 
@@ -54,6 +56,7 @@ export class FeltPanel {
     this.#arrival = arrival;
     this.#startedAt.clear();
     this.#cancelledSeqs.clear();
+    this.#cutSeqs.clear();
     this.#stopped = false;
     this.#placement = new FeltPlacement();
     this.#segmentsSeen = 0;
@@ -77,6 +80,7 @@ export class FeltPanel {
         : `${count} stroke${count === 1 ? "" : "s"}, ${seconds} s` +
             timelineCaption(count, placement.reportedCount, placement.cappedCount, {
               cancelled: this.#cancelledSeqs.size,
+              cut: this.#cutSeqs.size,
               stopped: this.#stopped,
             }),
     );
@@ -105,7 +109,7 @@ export class FeltPanel {
   cancelled(event: CancelledEvent): void {
     if (event.seq === null) return;
     const started = this.#startedAt.get(event.seq);
-    if (!event.started) this.#cancelledSeqs.add(event.seq);
+    (event.started ? this.#cutSeqs : this.#cancelledSeqs).add(event.seq);
     this.#sync();
     this.#placement.cut(
       event.seq,
@@ -226,15 +230,22 @@ export function timelineCaption(
   count: number,
   reported: number,
   capped: number,
-  stop: { readonly cancelled: number; readonly stopped: boolean } = { cancelled: 0, stopped: false },
+  stop: { readonly cancelled: number; readonly cut?: number; readonly stopped: boolean } = {
+    cancelled: 0,
+    stopped: false,
+  },
 ): string {
   const { cancelled, stopped } = stop;
+  const cut = stop.cut ?? 0;
   if (reported === 0 && capped === 0 && cancelled === 0 && !stopped)
     return ": what would be felt, played back to back as the sleeve does.";
   const estimated = count - reported - capped - cancelled;
   const said: string[] = [];
   if (reported > 0)
-    said.push(reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`);
+    said.push(
+      (reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`) +
+        (cut > 0 ? ` (${cut} cut short by Stop)` : ""),
+    );
   if (capped > 0) {
     said.push(
       `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,
