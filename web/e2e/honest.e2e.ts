@@ -226,6 +226,9 @@ describe("honest after faults: the page, up and the study agree with what the sl
         },
       );
       await waitForData(page, '[data-testid="broker-status"]', "state", "connected", 60_000);
+      // Every stroke answered first: the page's log keeps its last few notes, and strokes held
+      // in the outbox through the outage, played after the copy, would push its note out.
+      const before = await waitForEveryStroke(page);
       // The broker delivers a stroke again that the sleeve has played (its acknowledgement lost
       // with the broker): here sent again by hand, so that it happens on every run.
       await watcher.waitFor("a played stroke", () => watcher.of(drawing, "played").length > 0, 60_000);
@@ -242,11 +245,22 @@ describe("honest after faults: the page, up and the study agree with what the sl
       );
       const duplicate = copy.find((e) => e["drawing"] === drawing && e["reason"] === "duplicate")!;
       expect(duplicate["original_played"]).toBe(true);
+      // The page hears the refusal after the watcher does: its note is waited for, then read.
+      const cameAgain = `Stroke ${playedSeq} came again`;
+      await page
+        .waitForFunction(
+          (text) => document.querySelector('[data-testid="event-log"]')?.textContent?.includes(text) === true,
+          cameAgain,
+          { timeout: 30_000 },
+        )
+        .catch(() => undefined); // the assertion below then shows the log as it is
       const counts = await waitForEveryStroke(page);
+      // The copy changed no count: each stroke still counts once.
+      expect(counts).toEqual(before);
       const byFate = await expectAllAgree(drawing, counts);
       expect(byFate.played).toBeGreaterThan(0);
       const log = await page.locator('[data-testid="event-log"]').innerText();
-      expect(log).toContain(`Stroke ${playedSeq} came again`);
+      expect(log).toContain(cameAgain);
       expect(log).not.toContain(`Stroke ${playedSeq} refused`);
       // The copy counted nothing: the stroke it copies is played, once (checked against up, the
       // study and the record above); refusals are only those of other strokes (late, after the outage).
