@@ -318,6 +318,12 @@ def test_good_broker_urls() -> None:
         (["0,0,1,0,100", "--segments", "4"], "--segments only apply to --shape"),
         (["--shape", "line", "--legacy", "--intensity", "0.5"], "legacy format has no intensity"),
         (["--shape", "line", "--timeout-s", "0"], "--timeout-s: 0 is out of range"),
+        # Nothing would be felt, and the sleeve would report it played: refused, with the range.
+        (
+            ["--shape", "line", "--intensity", "0"],
+            "--intensity: 0 is out of range; give a number "
+            "from 0.01 to 1 (at 0 the sleeve would play strokes no one feels)",
+        ),
         (["--shape", "line", "--id", "a/b"], "--id: the sleeve id 'a/b' cannot be used"),
     ],
 )

@@ -54,6 +54,11 @@ export interface RejectedEvent extends StrokeRef {
   readonly reason: string;
   readonly message: string;
   readonly received_at_ms: number;
+  /**
+   * A `duplicate` only: whether the stroke it is a copy of started playing (felt once, and it stays
+   * played) or not. Null for other reasons and from a sleeve older than the field.
+   */
+  readonly original_played: boolean | null;
 }
 
 /** A control message cancelled it: `started` when it was cut short while playing. */
@@ -163,7 +168,12 @@ const REASON_MESSAGE: readonly Field[] = [
 const EVENT_FIELDS: Record<SleeveEventType, readonly Field[]> = {
   played: [...STROKE, ...TIMING],
   adjusted: [...STROKE, ...TIMING, ["reason", "text", true], ["requested_duration_ms", "number", true]],
-  rejected: [...REASON_MESSAGE, ...STROKE, ["received_at_ms", "number", true]],
+  rejected: [
+    ...REASON_MESSAGE,
+    ...STROKE,
+    ["received_at_ms", "number", true],
+    ["original_played", "flag", false],
+  ],
   cancelled: [
     ...REASON_MESSAGE,
     ...STROKE,

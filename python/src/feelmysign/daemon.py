@@ -486,9 +486,17 @@ class Sleeve:
     def _reject(self, reason: str, message: str, ref: StrokeRef, ack: _Ack | None = None) -> None:
         """Report a stroke that will not play; acknowledge it after the event unless the
         sleeve is only going away (then the broker must deliver it again)."""
+        original_played = None
+        if reason == DUPLICATE:
+            # The copy's sender learns whether the stroke was felt: a copy of a played stroke
+            # leaves it played (once), a copy of a refused one leaves it refused.
+            original_played = self._player.started(ref.drawing, ref.seq)
+            message = duplicate_message(ref.drawing, ref.seq, original_played)
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
-        rejected = Rejected(reason=reason, message=message, stroke=ref)
+        rejected = Rejected(
+            reason=reason, message=message, stroke=ref, original_played=original_played
+        )
         if reason in NOT_ACKNOWLEDGED:
             ack = None
         elif ack is not None:

@@ -269,6 +269,10 @@ class Rejected(_AboutAStroke, _Event):
     reason: str
     message: str
     stroke: StrokeRef  # with received_at_ms
+    # A ``duplicate`` only: whether the stroke it is a copy of started playing (it was felt,
+    # and stays played) or not (refused, capped or cancelled before). Absent from other
+    # reasons, and from a sleeve older than the field.
+    original_played: bool | None = None
 
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
@@ -276,6 +280,7 @@ class Rejected(_AboutAStroke, _Event):
             "reason": r.text("reason"),
             "message": r.text("message"),
             **_read_stroke(r),
+            "original_played": r.flag("original_played", required=False),
         }
 
 

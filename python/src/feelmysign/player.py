@@ -323,6 +323,11 @@ class Player:
         with self._lock:
             return self._queue.seen(drawing, seq)
 
+    def started(self, drawing: object, seq: object) -> bool:
+        """Whether this stroke started playing: a ``duplicate`` refusal of a copy says so."""
+        with self._lock:
+            return self._queue.started(drawing, seq)
+
     def remember(self, drawing: object, seq: object) -> None:
         """A stroke settled without playing (refused and acknowledged): a copy of it the broker
         delivers again is a ``duplicate`` too, not a second verdict."""
@@ -747,6 +752,7 @@ class Player:
         with self._lock:
             self._pending -= 1
             acknowledge = self._done(stroke)
+            self._queue.mark_started(stroke.ref.drawing, stroke.ref.seq)
         self.played += 1
         self._on_event(played_event(stroke, now))
         if acknowledge is not None:

@@ -34,6 +34,12 @@ MAX_PACKET_SIZE_BYTES = 4096
 # A SIGKILL or a power cut loses everything since (strokes acknowledged to their sender
 # included), which is why `feelmysign broker` saves every change instead.
 AUTOSAVE_INTERVAL_S = 60
+# How long Mosquitto keeps a persistent session (its subscriptions and queued QoS 1 events)
+# for a client that never comes back: each page load opens a session of its own (the page
+# resumes it across a broker restart, docs/protocol.md), and a closed tab never ends it, so
+# without a limit the sessions and the events queued for them would pile up forever. An
+# hour is far longer than any reconnection; the sleeve and up's log reconnect within seconds.
+PERSISTENT_CLIENT_EXPIRATION = "1h"
 # The format Mosquitto 2.0 writes by default ("$7$"): PBKDF2-HMAC-SHA512 with
 # 101 iterations, a 12-byte salt and a 64-byte hash, both base64 encoded.
 PBKDF2_ITERATIONS = 101
@@ -155,6 +161,8 @@ set_tcp_nodelay true
 persistence true
 persistence_location {files.persistence_dir}/
 {autosave}
+# A session no client resumed in this long is dropped (one per page load; docs/protocol.md).
+persistent_client_expiration {PERSISTENT_CLIENT_EXPIRATION}
 
 log_dest file {files.log}
 log_timestamp_format %Y-%m-%dT%H:%M:%S

@@ -58,6 +58,10 @@ from feelmysign.topics import LEGACY_TOPIC, telemetry_topic
 if TYPE_CHECKING:
     import paho.mqtt.client as mqtt
 
+# The faintest intensity sent (the page's MIN_INTENSITY): at 0 the sleeve would play, and report
+# as played, a stroke no one feels; so 0 is refused here, with the range to give.
+MIN_INTENSITY = 0.01
+
 
 def _epilog() -> str:
     shapes = "\n".join(
@@ -123,9 +127,10 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("sending")
     group.add_argument(
         "--intensity",
-        type=number(0, 1),
+        type=number(MIN_INTENSITY, 1, unit="(at 0 the sleeve would play strokes no one feels)"),
         metavar="A",
-        help="intensity of every stroke in [0, 1] (default: the sleeve's default intensity)",
+        help=f"intensity of every stroke, from {MIN_INTENSITY:g} to 1 (default: the sleeve's "
+        "default intensity); 0 is refused: the sleeve would report as played what no one feels",
     )
     group.add_argument(
         "--legacy",
@@ -427,8 +432,13 @@ ANY_GRID = replace(
 def _strokes(
     args: argparse.Namespace, layout: Layout, texts: list[tuple[str, str]]
 ) -> list[Stroke]:
-    if args.intensity is not None and not 0.0 <= args.intensity <= 1.0:
-        raise ParameterError("--intensity", args.intensity, "a number in [0, 1]")
+    if args.intensity is not None and not MIN_INTENSITY <= args.intensity <= 1.0:
+        raise ParameterError(
+            "--intensity",
+            args.intensity,
+            f"a number from {MIN_INTENSITY:g} to 1 "
+            "(at 0 the sleeve would play strokes no one feels)",
+        )
     if args.shape:
         return shape_strokes(
             args.shape,

@@ -46,12 +46,12 @@ def _session(store: StudyStore, settings: BrokerSettings, participant: str | Non
             what = trial["resolution"] or "practice"
             print(
                 f"Trial {trial['number']}/{trial['total']}: {trial['shape']}, {what}, "
-                f"{trial['segments']} strokes"
+                f"{_plural(trial['segments'], 'stroke')}"
             )
             input("  Enter sends the shape to the sleeve. ")
             sent = session.send(code)
             print(
-                f"  played {sent['played']}/{sent['strokes']} strokes, "
+                f"  played {sent['played']}/{_plural(sent['strokes'], 'stroke')}, "
                 f"rejected {sent['rejected'] or 'none'}"
             )
             answer = input("  Answer (empty = felt nothing, 'r' = send again): ").strip()
@@ -122,3 +122,8 @@ def review_in_terminal(store: StudyStore) -> int:
         decided += bool(reply)
     print(f"Review done: {decided} decided, {len(waiting) - decided} left for later.")
     return 0
+
+
+def _plural(count: int, noun: str) -> str:
+    """ "1 stroke", "2 strokes"."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
