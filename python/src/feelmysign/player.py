@@ -724,13 +724,6 @@ class Player:
         with self._lock:
             self._pending -= 1
             acknowledge = self._done(capped.tag) if isinstance(capped.tag, PlannedStroke) else None
-            # It plays nothing: a stroke arriving from now on waits only for those still planned,
-            # not for the time this one would have taken (as after a cancel).
-            self._queue.replan(
-                (tag.start_ms + tag.schedule.duration_ms, tag.ref.drawing)
-                for tag in [*self._timeline.tags(), *self._inbox]
-                if isinstance(tag, PlannedStroke) and tag is not capped.tag
-            )
         self.capped += 1
         refusal = capped.refusal
         row, column = refusal.actuator
