@@ -22,6 +22,7 @@ import subprocess
 import sys
 import textwrap
 import threading
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -355,6 +356,28 @@ def test_retained_messages_survive_a_restart(start_broker: StartBroker, tmp_path
         assert (message.payload, message.retain) == (b'{"online":true}', True)
     finally:
         sender.close()
+
+
+def test_the_log_has_no_line_per_save(broker: Broker, connect: Connect) -> None:
+    """The broker saves its database after every change (a stroke, a status): its log keeps
+    the connections and errors, not a line per save, so a sleeve that runs for weeks does not
+    fill its SD card with them."""
+    sender = connect("sender")
+    sleeve = connect("sleeve")
+    database = broker.state_dir / "data" / "mosquitto.db"
+    for index in range(5):
+        saved_before = database.stat().st_mtime_ns if database.exists() else None
+        code = sleeve.publish(status_topic(broker.credentials), b"%d" % index, retain=True)
+        assert not code.is_failure, code
+        # Each retained message is a change: wait until the database on disk has it.
+        deadline_s = time.monotonic() + WAIT_S
+        while (database.stat().st_mtime_ns if database.exists() else None) == saved_before:
+            assert time.monotonic() < deadline_s, "the broker did not save its database"
+            time.sleep(0.02)
+    sender.close()
+    log = broker.log_path.read_text()
+    assert "New client connected" in log, log  # the log is written, with its notices
+    assert "Saving in-memory database" not in log, log
 
 
 def _page_session(credentials: Credentials, client_id: str) -> tuple[mqtt.Client, queue.Queue[Any]]:

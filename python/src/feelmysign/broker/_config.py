@@ -165,6 +165,12 @@ persistence_location {files.persistence_dir}/
 persistent_client_expiration {PERSISTENT_CLIENT_EXPIRATION}
 
 log_dest file {files.log}
+# Errors, warnings and the connection lines only: "information" adds a line at every save of
+# the database, which with a save per change is a line per stroke, and a log that fills a
+# Pi's SD card between two starts (it is rotated only at a start).
+log_type error
+log_type warning
+log_type notice
 log_timestamp_format %Y-%m-%dT%H:%M:%S
 connection_messages true
 """
