@@ -64,6 +64,10 @@ final class SendCommand {
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
       + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
 
+  // The faintest intensity sent (the reference's and the page's): at 0 the sleeve would play,
+  // and report as played, a stroke no one feels.
+  static final double MIN_INTENSITY = 0.01;
+
   // The options that take a value, by the kind of value; --paper and --legacy take none.
   private static final Set<String> WHOLE = Set.of("--segments", "--rows", "--columns");
   private static final Set<String> DECIMAL =
@@ -88,7 +92,14 @@ final class SendCommand {
       } else if (WHOLE.contains(a)) {
         given.put(a, integer(value(args, ++i, a), a));
       } else if (DECIMAL.contains(a)) {
-        given.put(a, number(value(args, ++i, a), a));
+        String text = value(args, ++i, a);
+        double number = number(text, a);
+        if (a.equals("--intensity") && !(number >= MIN_INTENSITY && number <= 1)) {
+          throw new Main.UsageException(PROG, "argument --intensity: " + text
+              + " is out of range; give a number from 0.01 to 1"
+              + " (at 0 the sleeve would play strokes no one feels)");
+        }
+        given.put(a, number);
       } else if (TEXT.contains(a)) {
         given.put(a, value(args, ++i, a));
       } else if (a.startsWith("--")) {
@@ -123,10 +134,6 @@ final class SendCommand {
     if (sources != 1) {
       throw new Main.UsageException(PROG,
           "give one of: STROKE ..., --shape NAME or --recording FILE");
-    }
-    if (intensity != null && !(intensity >= 0 && intensity <= 1)) {
-      throw new IllegalArgumentException("intensity = " + intensity
-          + " is not allowed; it must be a number in [0, 1], or None for the default");
     }
     if (!(timeoutS > 0 && Double.isFinite(timeoutS))) {
       throw new IllegalArgumentException(
