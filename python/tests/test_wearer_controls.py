@@ -18,7 +18,7 @@ from typing import Any
 
 import pytest
 from test_daemon import Running, _sender
-from test_player import Events, _planned, started_player
+from test_player import _planned, started_player
 
 from feelmysign.broker import Broker
 from feelmysign.clock import wall_ms
