@@ -160,7 +160,12 @@ def test_do_not_disturb_ends_by_itself_and_says_so(tmp_path: Path) -> None:
     wearer = controls(tmp_path / "c.json", applied)
     told: list[ControlsState] = []
     ended = threading.Event()
-    wearer.subscribe(lambda state: (told.append(state), ended.set()))
+
+    def tell(state: ControlsState) -> None:
+        told.append(state)
+        ended.set()
+
+    wearer.subscribe(tell)
     until_ms = round(wall_ms()) + 300
     assert wearer.set_do_not_disturb(until_ms, "page").do_not_disturb_until_ms == until_ms
     refusal = wearer.refusal()

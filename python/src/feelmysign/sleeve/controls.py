@@ -127,6 +127,11 @@ class WearerControls:
     def path(self) -> str:
         return self._path
 
+    @property
+    def max_intensity(self) -> float:
+        """The layout's cap: the highest ceiling the wearer may set."""
+        return self._max_intensity
+
     def state(self) -> ControlsState:
         with self._lock:
             return self._state
