@@ -218,3 +218,21 @@ def loudest_until_quiet(state: Path) -> float:
 
     wait_until(quiet, "the stroke over")
     return peak
+
+
+def test_a_button_line_that_cannot_be_had_stops_the_sleeve_at_start_saying_what_to_check(
+    tmp_path: Path,
+) -> None:
+    """The wearer's control is never silently absent: on a machine without that GPIO chip
+    (this one, the sim backend reading the real lines), a clear error and exit 1."""
+    layout = tmp_path / "paper-button.toml"
+    missing = 'pause_button = { chip = "gpiochip99", line = 27 }'
+    layout.write_text(restart_off.PAPER.read_text() + f"\n[controls]\n{missing}\n")
+    command = [*restart_off.feelmysign_command(), "sleeve", "--layout", str(layout)]
+    env = {**os.environ, "XDG_STATE_HOME": str(tmp_path / "s")}
+    done = subprocess.run(command, capture_output=True, text=True, timeout=60, env=env)
+    print(done.stderr)
+    assert done.returncode == 1
+    assert "Traceback" not in done.stderr
+    assert "pause button" in done.stderr and "controls.pause_button.chip" in done.stderr
+    assert "/dev/gpiochip99" in done.stderr and "gpiodetect" in done.stderr

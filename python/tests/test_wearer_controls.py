@@ -20,6 +20,8 @@ import pytest
 from test_daemon import Running, _sender
 from test_player import _planned, started_player
 
+from feelmysign.backends.button import ButtonWatcher
+from feelmysign.backends.emulated_button import EmulatedButton
 from feelmysign.broker import Broker
 from feelmysign.clock import wall_ms
 from feelmysign.events import Status
@@ -31,6 +33,7 @@ from feelmysign.sleeve.controls import (
     ControlsState,
     WearerControls,
 )
+from feelmysign.sleeve.presses import DEBOUNCE_MS
 from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic
 
@@ -244,3 +247,62 @@ def test_the_sleeve_says_its_controls_in_its_status_and_refuses_while_paused(
     finally:
         sender.loop_stop()
         running.stop()
+
+
+# --- the buttons, on their emulated lines ---------------------------------------------------
+
+
+def tap(button: EmulatedButton) -> None:
+    """A finger's short press, let go long enough for the next one to count (presses closer
+    than the debounce window are the bouncing of one)."""
+    button.press()
+    time.sleep(0.05)
+    button.let_go()
+    time.sleep(2 * DEBOUNCE_MS / 1000)
+
+
+def watched(role: str, wearer: WearerControls) -> tuple[EmulatedButton, ButtonWatcher]:
+    button = EmulatedButton("gpiochip0", 27)
+    watcher = ButtonWatcher(button, role, wearer)
+    watcher.start()
+    return button, watcher
+
+
+def test_a_long_press_stops_the_drawing_and_leaves_the_pause_as_it_was(tmp_path: Path) -> None:
+    applied = Applied()
+    wearer = controls(tmp_path / "c.json", applied)
+    button, watcher = watched("pause", wearer)
+    try:
+        for paused_before in (False, True):
+            stops = applied.stops
+            if paused_before:
+                wearer.pause("page")
+            button.press()
+            _wait(lambda s=stops: applied.stops == s + 1, "no stop after a long press")
+            button.let_go()
+            time.sleep(2 * DEBOUNCE_MS / 1000)  # the let-go taken: it must change nothing
+            assert wearer.state().paused is paused_before
+        # A short press while paused resumes.
+        tap(button)
+        _wait(lambda: not wearer.state().paused, "a short press did not resume")
+    finally:
+        watcher.stop()
+
+
+def test_the_turn_down_button_lowers_the_ceiling_a_step_a_press_never_below_the_least(
+    tmp_path: Path,
+) -> None:
+    wearer = controls(tmp_path / "c.json")  # max_intensity 0.9
+    button, watcher = watched("turn_down", wearer)
+    try:
+        seen = []
+        for _ in range(10):
+            before = wearer.state().ceiling
+            tap(button)
+            if before != MIN_CEILING:
+                _wait(lambda b=before: wearer.state().ceiling != b, "the ceiling did not move")
+            seen.append(wearer.state().ceiling)
+        assert seen[:3] == [0.8, 0.7, 0.6]
+        assert seen[-2:] == [MIN_CEILING, MIN_CEILING]
+    finally:
+        watcher.stop()

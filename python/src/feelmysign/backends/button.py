@@ -97,7 +97,7 @@ class GpiodButton:
                 self._button.path, consumer=CONSUMER, config={self._button.line: settings}
             )
         except (OSError, ValueError) as error:
-            what = f"the wearer's {self.description}"
+            what = f"the wearer's {self._button.role.replace('_', '-')} button"
             raise HardwareError(line_error(self._button, error, self._button.key, what)) from error
 
     def pressed(self) -> bool:
