@@ -119,6 +119,11 @@ def test_a_press_mid_drawing_stops_every_motor_at_once_and_the_rest_is_refused_p
         assert _button(state, PAUSE_LINE)["driven_at_press"] > 0  # it came mid-drawing
         assert silent_since is not None and set(drive_levels(state).values()) == {0.0}
         assert silent_since["transaction"] >= pressed_at["transaction"]
+        # One pass of the player, nothing else first: each motor driven at the press needs at
+        # most three transactions to go off (the other multiplexer deselected, its channel
+        # selected, its level written).
+        driven = _button(state, PAUSE_LINE)["driven_at_press"]
+        assert silent_since["transaction"] - pressed_at["transaction"] <= 3 * driven
         off_ms = silent_since["ms"] - pressed_at["ms"]
         print(f"every motor off {off_ms:.3f} ms after the sleeve saw the press")
         assert 0 <= off_ms <= MAX_OFF_MS

@@ -243,7 +243,10 @@ def _watch_buttons(layout: Layout, backend: Backend, sleeve: Sleeve) -> list[But
             watcher = ButtonWatcher(line, button.role, sleeve.controls)
             watcher.start()
             watchers.append(watcher)
-            print(f"The wearer's {line.description}: watched", flush=True)
+            kind = "pause button (press: pause/resume, hold 1 s: stop)"
+            if button.role != "pause":
+                kind = "turn-down button (each press: a step down)"
+            print(f"The wearer's {kind}: {line.description}", flush=True)
     except BaseException:
         for watcher in watchers:
             watcher.stop()
