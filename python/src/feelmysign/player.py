@@ -371,6 +371,10 @@ class Player:
                     Cancel(CANCEL_ALL), self._accepted, received_wall_ms, WEARER, refusal
                 )
                 self._cancels.append(request)
+        if refusal is not None:
+            # The cut on this thread, as a stroke due at once is played (when the player's
+            # thread is between rounds): the motors need not wait for it to wake.
+            self._play_due()
         self._wake.set()
 
     def set_ceiling(self, ceiling: float | None) -> None:

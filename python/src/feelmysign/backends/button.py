@@ -167,6 +167,7 @@ class ButtonWatcher:
                 self._act(press)
 
     def _act(self, press: Press) -> None:
+        log.info("the wearer's %s: %s press", self._line.description, press)
         try:
             if self._role == "pause":
                 self._pause_button(press)
