@@ -205,24 +205,24 @@ class WearerControls:
 
     def _checked_ceiling(self, ceiling: object) -> float:
         top = self._max_intensity
-        number = isinstance(ceiling, int | float) and not isinstance(ceiling, bool)
-        if not number or not math.isfinite(ceiling) or not MIN_CEILING <= ceiling <= top:  # type: ignore[operator, arg-type]
+        value = _finite(ceiling)
+        if value is None or not MIN_CEILING <= value <= top:
             raise ControlsError(
                 f"the intensity ceiling must be a number from {MIN_CEILING:g} to {top:g} (the "
                 f"layout's max_intensity), got {ceiling!r}; choose one in that range, or none "
                 "to remove the ceiling (to stop every stroke, pause instead)"
             )
-        return round(float(ceiling), 4)  # type: ignore[arg-type]
+        return round(value, 4)
 
     def _checked_until(self, until_ms: object) -> int:
         now_ms = self._clock_ms()
-        number = isinstance(until_ms, int | float) and not isinstance(until_ms, bool)
-        if not number or not math.isfinite(until_ms):  # type: ignore[arg-type]
+        value = _finite(until_ms)
+        if value is None:
             raise ControlsError(
                 f'"do not disturb" needs the time it ends, in ms since 1970, got {until_ms!r}; '
                 "give a time within the next 24 hours, or none to end it now"
             )
-        until = round(until_ms)  # type: ignore[call-overload]
+        until = round(value)
         if not now_ms < until <= now_ms + MAX_DO_NOT_DISTURB_MS:
             raise ControlsError(
                 f'"do not disturb" until {_clock_time(until)} is not within the next 24 hours '
@@ -336,6 +336,13 @@ class WearerControls:
             log.info('"do not disturb" ended at %s', _clock_time(until_ms))
             self._timer = None
             self._change(do_not_disturb_until_ms=None)
+
+
+def _finite(value: object) -> float | None:
+    """``value`` as a finite float; None for anything else (a bool, text, NaN)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value) if math.isfinite(value) else None
 
 
 def _check_by(by: str) -> None:
