@@ -133,8 +133,9 @@ class WearerControls:
         return self._max_intensity
 
     def state(self) -> ControlsState:
-        with self._lock:
-            return self._state
+        # No lock: the state is one frozen value, replaced whole; a reader (the status the
+        # player's thread publishes after a lost chip) must never wait for a change's fsync.
+        return self._state
 
     def refusal(self) -> Refusal | None:
         """Why a stroke arriving now is refused (paused, "do not disturb"), or None."""
