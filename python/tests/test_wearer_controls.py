@@ -244,6 +244,20 @@ def test_the_sleeve_says_its_controls_in_its_status_and_refuses_while_paused(
         cut = running.wait_events(7)[6]
         assert (cut["type"], cut["seq"], cut["by"]) == ("cancelled", 4, "wearer")
         assert running.sleeve.controls.state().paused is False
+        # "Do not disturb": refused with the time it ends, until it is ended.
+        until_ms = round(wall_ms()) + 60_000
+        running.sleeve.controls.set_do_not_disturb(until_ms, "page")
+        _wait(
+            lambda: (last_controls() or {}).get("do_not_disturb_until_ms") == until_ms,
+            "no status said do not disturb",
+        )
+        send(5, 200.0)
+        refused = running.wait_events(8)[7]
+        assert (refused["seq"], refused["reason"]) == (5, "do_not_disturb")
+        assert time.strftime("%H:%M:%S UTC", time.gmtime(until_ms / 1000)) in refused["message"]
+        running.sleeve.controls.set_do_not_disturb(None, "page")
+        send(6, 200.0)
+        assert running.wait_events(9)[8]["type"] == "played"
     finally:
         sender.loop_stop()
         running.stop()
