@@ -28,6 +28,7 @@ from typing import Any
 
 from feelmysign.events import (
     DELAYED_MS,
+    Event,
     EventError,
     Played,
     Status,
@@ -163,6 +164,41 @@ EVENTS: dict[str, tuple[str, dict[str, Any]]] = {
             "started": True,
         },
     ),
+    "cancelled-by-wearer": (
+        "the stroke playing when the wearer paused or stopped the sleeve, cut short",
+        {
+            "type": "cancelled",
+            "reason": "cancelled",
+            "message": "cut short by the wearer",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+            "cancelled_at_ms": 1795326268000.5,
+            "started": True,
+            "by": "wearer",
+        },
+    ),
+    "rejected-paused": (
+        "a stroke that came while the wearer had paused the sleeve",
+        {
+            "type": "rejected",
+            "reason": "paused",
+            "message": "the wearer paused the sleeve; it plays again when the wearer presses "
+            "the pause button again, or resumes on the wearer's page",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+        },
+    ),
+    "rejected-do-not-disturb": (
+        'a stroke that came while the wearer\'s "do not disturb" ran',
+        {
+            "type": "rejected",
+            "reason": "do_not_disturb",
+            "message": "the wearer asked not to be disturbed until 2026-11-23 08:00:00 UTC; "
+            "strokes play again after that",
+            **STROKE,
+            "received_at_ms": 1795326267664.25,
+        },
+    ),
     "safety-duty-cycle": (
         "a stroke the duty-cycle cap kept from playing, with the motor and by how much",
         {
@@ -220,6 +256,35 @@ STATUSES: dict[str, tuple[str, dict[str, Any]]] = {
             "online": True,
             "layout": LAYOUT,
             "floor": {"min_duration_ms": 73.701, "min_length": 0.05},
+        },
+    ),
+    "controls-paused": (
+        "the wearer paused the sleeve with its button and set an intensity ceiling",
+        {
+            "online": True,
+            "sleeve_id": "sleeve1",
+            "layout": LAYOUT,
+            "at_ms": 1795326267664,
+            "controls": {
+                "paused": True,
+                "paused_by": "button",
+                "ceiling": 0.6,
+                "do_not_disturb_until_ms": None,
+            },
+        },
+    ),
+    "controls-do-not-disturb": (
+        '"do not disturb" until a time, not paused, no ceiling',
+        {
+            "online": True,
+            "sleeve_id": "sleeve1",
+            "layout": LAYOUT,
+            "controls": {
+                "paused": False,
+                "paused_by": None,
+                "ceiling": None,
+                "do_not_disturb_until_ms": 1795330000000,
+            },
         },
     ),
     "floor-wearer": (
@@ -304,6 +369,34 @@ INVALID: dict[str, tuple[str, str, Any]] = {
         "status",
         "a floor without its length",
         {"online": True, "floor": {"min_duration_ms": 73.701}},
+    ),
+    "status-controls-no-paused": (
+        "status",
+        "the wearer's controls without paused",
+        {"online": True, "controls": {"ceiling": 0.5}},
+    ),
+    "status-controls-ceiling-above-one": (
+        "status",
+        "a ceiling above full drive",
+        {"online": True, "controls": {"paused": False, "ceiling": 1.5}},
+    ),
+    "status-controls-until-fractional": (
+        "status",
+        "do_not_disturb_until_ms is a whole number of ms",
+        {"online": True, "controls": {"paused": False, "do_not_disturb_until_ms": 1.5}},
+    ),
+    "cancelled-by-not-string": (
+        "event",
+        "by must be a string",
+        {
+            "type": "cancelled",
+            "reason": "cancelled",
+            "message": "m",
+            "received_at_ms": 1,
+            "cancelled_at_ms": 2,
+            "started": True,
+            "by": True,
+        },
     ),
     "status-layout-not-object": (
         "status",
@@ -413,6 +506,26 @@ FATES: dict[str, tuple[str, list[dict[str, Any]]]] = {
         "cancelled: the stroke stays played",
         [_played(0), _played(1), _cancelled(1, started=True), _rejected(0, "cancelled")],
     ),
+    "wearer-paused": (
+        "the wearer paused mid-drawing: the stroke playing cut short by the wearer, the one "
+        "waiting and the ones sent after refused as paused, then do-not-disturb refuses one",
+        [
+            _played(0),
+            _played(1),
+            {**EVENTS["cancelled-by-wearer"][1], "seq": 1},
+            _rejected(2, "paused"),
+            _rejected(3, "paused"),
+            _rejected(4, "do_not_disturb"),
+        ],
+    ),
+    "wearer-stop": (
+        "the wearer's stop: cut while playing, dropped before it started, both by the wearer",
+        [
+            _played(0),
+            {**EVENTS["cancelled-by-wearer"][1], "seq": 0},
+            {**EVENTS["cancelled-by-wearer"][1], "seq": 1, "started": False},
+        ],
+    ),
     "chip-lost": (
         "a chip lost while a stroke played cuts it; one cut before its first command is refused",
         [
@@ -436,6 +549,16 @@ def typed_status(status: Status) -> dict[str, Any]:
         del typed["floor"]
     if typed["hardware"] is None:  # a later field still: only where a status has it
         del typed["hardware"]
+    if typed["controls"] is None:  # the wearer's, later again
+        del typed["controls"]
+    return typed
+
+
+def typed_event(event: Event) -> dict[str, Any]:
+    """An event's fields; a cancel's ``by``, added after the others, only when it is set."""
+    typed = {"type": event.kind, **event.typed()}
+    if event.kind == "cancelled" and typed["by"] is None:
+        del typed["by"]
     return typed
 
 
@@ -444,7 +567,7 @@ def cases() -> dict[str, dict[str, Any]]:
     for name, (description, wire) in EVENTS.items():
         event = event_from_json(wire)
         assert event.kind == wire["type"], name
-        typed = {"type": event.kind, **event.typed()}
+        typed = typed_event(event)
         out[f"event/{name}.json"] = {
             "description": description,
             "wire": wire,

@@ -399,3 +399,48 @@ def test_the_duty_cycle_cap_is_read_with_its_defaults_and_checked() -> None:
         with pytest.raises(LayoutError) as error:
             parse_layout(grid + "[safety]\n" + text + "\n")
         assert any(p.startswith(problem) for p in error.value.problems), error.value.problems
+
+
+# --- the wearer's buttons ([controls]) ------------------------------------------------------
+
+_WIRED = Path(__file__).resolve().parents[2] / "deploy" / "layouts" / "paper-sleeve.toml"
+
+
+def test_the_wearers_buttons_are_read_from_their_own_table() -> None:
+    text = _WIRED.read_text() + (
+        '\n[controls]\npause_button = { chip = "gpiochip0", line = 27 }\n'
+        'turn_down_button = { chip = "/dev/gpiochip0", line = 22 }\n'
+    )
+    layout = parse_layout(text)
+    assert layout.pause_button is not None and layout.turn_down_button is not None
+    assert (layout.pause_button.name, layout.pause_button.role) == ("gpiochip0 line 27", "pause")
+    assert (layout.turn_down_button.path, layout.turn_down_button.role) == (
+        "/dev/gpiochip0",
+        "turn_down",
+    )
+    assert check_layout(layout) is layout  # a layout built in code keeps its buttons
+
+
+def test_a_button_in_the_wrong_table_or_on_a_taken_line_says_where_it_belongs() -> None:
+    misplaced = _WIRED.read_text().replace(
+        "[i2c]\n",
+        '[i2c]\nenable = { chip = "gpiochip0", line = 17 }\n'
+        'pause_button = { chip = "gpiochip0", line = 27 }\ncontrols = 1\n',
+        1,
+    )
+    taken = '\n[controls]\nturn_down_button = { chip = "gpiochip0", line = 17 }\n'
+    with pytest.raises(LayoutError) as raised:
+        parse_layout(misplaced + taken)
+    problems = "\n".join(raised.value.problems)
+    assert "i2c.pause_button: unknown key here (it belongs in the [controls] table)" in problems
+    assert "i2c.controls: unknown key here (it is a table of its own, [controls]" in problems
+    assert "controls.turn_down_button: gpiochip0 line 17 is already i2c.enable's" in problems
+
+
+def test_a_button_line_given_by_its_name_is_refused_with_the_offset_to_use() -> None:
+    text = (
+        _WIRED.read_text()
+        + '\n[controls]\npause_button = { chip = "gpiochip0", line = "GPIO27" }\n'
+    )
+    with pytest.raises(LayoutError, match=r"controls\.pause_button\.line: must be a whole number"):
+        parse_layout(text)

@@ -61,7 +61,11 @@ export interface RejectedEvent extends StrokeRef {
   readonly original_played: boolean | null;
 }
 
-/** A control message cancelled it: `started` when it was cut short while playing. */
+/**
+ * A control message cancelled it: `started` when it was cut short while playing. `by` is "wearer"
+ * when the wearer paused or stopped the sleeve; absent for a sender's cancel (and from older
+ * sleeves).
+ */
 export interface CancelledEvent extends StrokeRef {
   readonly type: "cancelled";
   readonly reason: string;
@@ -69,6 +73,7 @@ export interface CancelledEvent extends StrokeRef {
   readonly received_at_ms: number;
   readonly cancelled_at_ms: number;
   readonly started: boolean;
+  readonly by?: string;
 }
 
 /**
@@ -123,7 +128,28 @@ export interface SleeveStatus {
   readonly at_ms: number | null;
   /** Came later than the other fields: absent from an older sleeve's status. */
   readonly floor?: SleeveFloor;
+  /** The wearer's controls; absent from the last will and older sleeves (not paused, no ceiling). */
+  readonly controls?: SleeveControls;
 }
+
+/**
+ * The wearer's controls (Python `StatusControls`): while `paused`, or until
+ * `do_not_disturb_until_ms` (wall clock, ms since 1970), the sleeve refuses every stroke (reasons
+ * `paused`, `do_not_disturb`); no motor is driven above `ceiling`.
+ */
+export interface SleeveControls {
+  readonly paused: boolean;
+  /** "button", "page", "cli" (or "sleeve": it started paused, its controls file unreadable). */
+  readonly paused_by: string | null;
+  readonly ceiling: number | null;
+  readonly do_not_disturb_until_ms: number | null;
+}
+
+/** Refusal reasons of the wearer's controls. */
+export const PAUSED_REASON = "paused";
+export const DO_NOT_DISTURB_REASON = "do_not_disturb";
+/** The `by` of the events of strokes the wearer cut. */
+export const BY_WEARER = "wearer";
 
 /**
  * The least a stroke should be for the sleeve to play it as sent and its wearer to feel it
@@ -180,6 +206,7 @@ const EVENT_FIELDS: Record<SleeveEventType, readonly Field[]> = {
     ["received_at_ms", "number", true],
     ["cancelled_at_ms", "number", true],
     ["started", "flag", true],
+    ["by", "text", false],
   ],
   safety: [
     ["reason", "text", true],
@@ -215,6 +242,12 @@ const STATUS_FIELDS: readonly Field[] = [
   ["version", "text", false],
   ["backend", "text", false],
   ["legacy_topic", "text", false],
+];
+const CONTROLS_FIELDS: readonly Field[] = [
+  ["paused", "flag", true],
+  ["paused_by", "text", false],
+  ["ceiling", "number", false],
+  ["do_not_disturb_until_ms", "index", false],
 ];
 const FLOOR_FIELDS: readonly Field[] = [
   ["min_duration_ms", "number", true],
@@ -277,7 +310,10 @@ export function readEvent(value: unknown): SleeveEvent | null {
   const type = data?.["type"];
   if (data === null || typeof type !== "string" || !Object.hasOwn(EVENT_FIELDS, type)) return null;
   const fields = readFields(data, EVENT_FIELDS[type as SleeveEventType]);
-  return fields === null ? null : ({ type, ...fields } as unknown as SleeveEvent);
+  if (fields === null) return null;
+  // A field later than the others is left out when absent, as the Python reader's typed form does.
+  if (type === "cancelled" && fields["by"] === null) delete fields["by"];
+  return { type, ...fields } as unknown as SleeveEvent;
 }
 
 export function parseEvent(text: string): SleeveEvent | null {
@@ -342,6 +378,16 @@ function readFloor(value: unknown): SleeveFloor | null | undefined {
   return fields as unknown as SleeveFloor;
 }
 
+function readControls(value: unknown): SleeveControls | null | undefined {
+  if (value === null || value === undefined) return null;
+  const data = asObject(value);
+  const fields = data === null ? null : readFields(data, CONTROLS_FIELDS);
+  if (fields === null) return undefined;
+  const ceiling = fields["ceiling"] as number | null;
+  if (ceiling !== null && (ceiling < 0 || ceiling > 1)) return undefined;
+  return fields as unknown as SleeveControls;
+}
+
 export function readStatus(value: unknown): SleeveStatus | null {
   const data = asObject(value);
   if (data === null) return null;
@@ -349,9 +395,13 @@ export function readStatus(value: unknown): SleeveStatus | null {
   const layout = readLayout(data["layout"]);
   const atMs = readValue(data["at_ms"], "number");
   const floor = readFloor(data["floor"]);
+  const controls = readControls(data["controls"]);
   if (fields === null || layout === undefined || atMs === undefined || floor === undefined) return null;
-  const status = { ...fields, layout, at_ms: atMs };
-  return (floor === null ? status : { ...status, floor }) as unknown as SleeveStatus;
+  if (controls === undefined) return null;
+  const status: Record<string, unknown> = { ...fields, layout, at_ms: atMs };
+  if (floor !== null) status["floor"] = floor;
+  if (controls !== null) status["controls"] = controls;
+  return status as unknown as SleeveStatus;
 }
 
 export function parseStatus(text: string): SleeveStatus | null {
@@ -363,6 +413,11 @@ export function statusToJson(status: SleeveStatus): Record<string, unknown> {
   if (status.layout !== null) out["layout"] = writeFields(status.layout, LAYOUT_FIELDS);
   if (status.at_ms !== null) out["at_ms"] = status.at_ms;
   if (status.floor !== undefined) out["floor"] = writeFields(status.floor, FLOOR_FIELDS);
+  // All four keys, null where not set, as the sleeve publishes them.
+  if (status.controls !== undefined) {
+    const controls = status.controls as unknown as Record<string, unknown>;
+    out["controls"] = Object.fromEntries(CONTROLS_FIELDS.map(([name]) => [name, controls[name] ?? null]));
+  }
   return out;
 }
 

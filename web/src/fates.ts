@@ -4,10 +4,12 @@
  * and add up to the strokes answered. `testdata/events/fates` keeps the two equal.
  *
  * - played: its `played` (or `adjusted`) event: felt whole;
- * - cut: cut short by Stop while it played (`cancelled`, started): felt in part, counted here only;
+ * - cut: cut short by Stop (or the wearer's pause or stop, `by` "wearer") while it played
+ *   (`cancelled`, started): felt in part, counted here only;
  * - cancelled: dropped by Stop before it started (`cancelled` not started, or refused as
  *   `cancelled` on arrival);
- * - refused: refused for any other reason, or kept from playing by the duty-cycle cap.
+ * - refused: refused for any other reason (the wearer's `paused` and `do_not_disturb` too: never
+ *   felt), or kept from playing by the duty-cycle cap.
  *
  * A copy the broker delivers again after a restart (or after Stop) is refused (`duplicate`, or
  * `cancelled`): that never changes a fate the stroke has. The stroke's own events rank above any

@@ -46,7 +46,7 @@ from feelmysign.backends.base import Backend
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
-from feelmysign.control import Cancel, parse_control
+from feelmysign.control import CANCEL_ALL, Cancel, parse_control
 from feelmysign.errors import FeelMySignError
 from feelmysign.events import (
     Cancelled,
@@ -64,11 +64,12 @@ from feelmysign.events import (
 )
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
-from feelmysign.player import SPIN_MS, PlannedStroke, Player, cancelled
+from feelmysign.player import SPIN_MS, WEARER, PlannedStroke, Player, cancelled
 from feelmysign.protocol import CANCELLED, DUPLICATE, HELD
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
+from feelmysign.sleeve.controls import ControlsState, WearerControls, controls_path, refusal_for
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -153,6 +154,9 @@ class SleeveOptions:
     spin_ms: float = SPIN_MS
     # The wearer's measured limits (feelmysign.wearer), advertised in the status's floor.
     wearer: Wearer | None = None
+    # Where the wearer's controls are kept (None: the sleeve's state directory, see
+    # feelmysign.sleeve.controls.controls_path).
+    controls_path: str | None = None
 
 
 class Sleeve:
@@ -192,6 +196,15 @@ class Sleeve:
             max_age_ms=options.max_age_ms,
             max_lag_ms=options.max_lag_ms,
         )
+        # The wearer's pause, stop, ceiling and "do not disturb": in force before the player
+        # starts (a sleeve restarted while paused never plays a stroke).
+        self.controls = WearerControls(
+            options.controls_path or controls_path(options.sleeve_id),
+            max_intensity=layout.max_intensity,
+            apply=self._apply_controls,
+            stop=self._wearer_stop,
+        )
+        self.controls.subscribe(self._controls_changed)
         self._connection = 0  # counts connections: an acknowledgement is valid on its own only
         self._stopped = threading.Event()
         self._connected = threading.Event()
@@ -253,6 +266,7 @@ class Sleeve:
         self._stopped.set()
 
     def _shutdown(self, publisher: threading.Thread) -> None:
+        self.controls.close()
         try:
             unplayed = self._player.stop()  # motors off first, whatever happens to the network
             for stroke in unplayed:
@@ -481,6 +495,33 @@ class Sleeve:
         if ack is not None:
             self._outbox.put(ack)
 
+    # --- the wearer's controls ----------------------------------------------------------
+
+    def _apply_controls(self, state: ControlsState) -> None:
+        """The wearer's controls in force: the ceiling on every stroke from now on (planned
+        at it, and no motor driven above it), and a pause or "do not disturb" cuts what
+        plays in the player's next pass and refuses every stroke until it ends."""
+        self._admission.ceiling = state.ceiling
+        self._player.set_ceiling(state.ceiling)
+        received_wall_ms = wall_ms()
+        self._player.refuse(refusal_for(state, received_wall_ms), received_wall_ms)
+
+    def _wearer_stop(self) -> None:
+        self._player.cancel(Cancel(CANCEL_ALL), wall_ms(), by=WEARER)
+
+    def _controls_changed(self, state: ControlsState) -> None:
+        log.info(
+            "sleeve %s: the wearer's controls: paused %s%s, ceiling %s, do not disturb until %s",
+            self._id,
+            state.paused,
+            f" (by {state.paused_by})" if state.paused_by else "",
+            "none" if state.ceiling is None else f"{state.ceiling:g}",
+            state.do_not_disturb_until_ms,
+        )
+        self._outbox.put(
+            _Publish(telemetry_topic(self._id, "status"), self._status(online=True), 1, True)
+        )
+
     # --- what the sleeve tells the world -----------------------------------------------
 
     def _reject(self, reason: str, message: str, ref: StrokeRef, ack: _Ack | None = None) -> None:
@@ -492,7 +533,6 @@ class Sleeve:
             # leaves it played (once), a copy of a refused one leaves it refused.
             original_played = self._player.started(ref.drawing, ref.seq)
             message = duplicate_message(ref.drawing, ref.seq, original_played)
-        self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
         rejected = Rejected(
             reason=reason, message=message, stroke=ref, original_played=original_played
@@ -513,6 +553,8 @@ class Sleeve:
         if isinstance(event, Played):
             self._count("played")
             self._say_if_delayed(event)
+        elif isinstance(event, Rejected):  # by the sleeve, or by the player for a pause
+            self._count("rejected", f"rejected:{event.reason}")
         elif isinstance(event, Cancelled):
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":
@@ -617,6 +659,7 @@ class Sleeve:
             at_ms=round(time.time() * 1000),
             floor=sleeve_floor(self._layout, self._options.wearer),
             hardware=self._hardware() if online else None,
+            controls=self.controls.state() if online else None,
         ).dumps()
 
     def _hardware(self) -> StatusHardware | None:

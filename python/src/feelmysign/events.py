@@ -287,7 +287,9 @@ class Rejected(_AboutAStroke, _Event):
 @dataclass(frozen=True, kw_only=True)
 class Cancelled(_AboutAStroke, _Event):
     """A control message cancelled the stroke: ``started`` when it was cut short while playing
-    (it had its ``played`` event), not when it was dropped before it started."""
+    (it had its ``played`` event), not when it was dropped before it started. ``by`` is
+    ``"wearer"`` when the wearer stopped or paused the sleeve (its button, its page); absent
+    for a sender's control message, and from sleeves older than the field."""
 
     kind: ClassVar[EventType] = "cancelled"
     reason: str = "cancelled"
@@ -295,6 +297,7 @@ class Cancelled(_AboutAStroke, _Event):
     stroke: StrokeRef  # with received_at_ms
     cancelled_at_ms: float
     started: bool
+    by: str | None = None
 
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
@@ -304,6 +307,7 @@ class Cancelled(_AboutAStroke, _Event):
             **_read_stroke(r),
             "cancelled_at_ms": r.number("cancelled_at_ms"),
             "started": r.flag("started"),
+            "by": r.text("by", required=False),
         }
 
 
@@ -578,12 +582,46 @@ class StatusFloor:
         return _wire(None, asdict(self))
 
 
+@dataclass(frozen=True)
+class StatusControls:
+    """The wearer's controls as the status tells them (``feelmysign.sleeve.controls``, where
+    it is also ``ControlsState``): ``paused`` (and by what: ``"button"``, ``"page"`` or
+    ``"cli"``), the wearer's intensity ceiling, and "do not disturb" until a wall-clock time
+    (ms since 1970). The sleeve refuses every stroke while paused (``paused``) or while "do
+    not disturb" runs (``do_not_disturb``); no motor drives above the ceiling."""
+
+    paused: bool = False
+    paused_by: str | None = None
+    ceiling: float | None = None
+    do_not_disturb_until_ms: int | None = None
+
+    @classmethod
+    def from_json(cls, data: object) -> StatusControls:
+        r = _Reader(data, "controls")
+        ceiling = r.number("ceiling", required=False)
+        if ceiling is not None and not 0 <= ceiling <= 1:
+            raise EventError("controls ceiling must be from 0 to 1", "controls")
+        until_ms = r.index("do_not_disturb_until_ms", required=False)
+        return cls(
+            paused=r.flag("paused"),
+            paused_by=r.text("paused_by", required=False),
+            ceiling=ceiling,
+            do_not_disturb_until_ms=until_ms,
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """All four keys, null where not set: a reader tells "not set" from an older sleeve."""
+        return asdict(self)
+
+
 @dataclass(frozen=True, kw_only=True)
 class Status:
     """The retained ``status``: ``online`` is all a last will must carry.
 
     ``floor`` came later than the other fields: absent from an older sleeve's status, and
-    an older reader ignores it."""
+    an older reader ignores it. So did ``controls`` (the wearer's): absent from the last
+    will and from older sleeves, which a reader takes as not paused, no ceiling, no "do
+    not disturb"."""
 
     online: bool
     sleeve_id: str | None = None
@@ -594,6 +632,7 @@ class Status:
     at_ms: float | None = None
     floor: StatusFloor | None = None
     hardware: StatusHardware | None = None  # the drv2605 backend's only
+    controls: StatusControls | None = None
 
     @classmethod
     def from_json(cls, data: object) -> Status:
@@ -606,6 +645,7 @@ class Status:
         layout = r.obj("layout")
         floor = r.obj("floor")
         hardware = r.obj("hardware")
+        controls = r.obj("controls")
         return cls(
             online=r.flag("online"),
             sleeve_id=r.text("sleeve_id", required=False),
@@ -616,6 +656,7 @@ class Status:
             at_ms=r.number("at_ms", required=False),
             floor=None if floor is None else StatusFloor.from_json(floor),
             hardware=None if hardware is None else StatusHardware.from_json(hardware),
+            controls=None if controls is None else StatusControls.from_json(controls),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -632,6 +673,7 @@ class Status:
                 "at_ms": self.at_ms,
                 "floor": None if self.floor is None else self.floor.to_json(),
                 "hardware": None if self.hardware is None else self.hardware.to_json(),
+                "controls": None if self.controls is None else self.controls.to_json(),
             },
         )
         return wire

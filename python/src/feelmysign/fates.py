@@ -6,12 +6,14 @@ Each stroke has one fate, read from the sleeve's events about it (docs/protocol.
 
 - ``played``: its ``played`` (or ``adjusted``) event: felt whole;
 - ``cut``: cut short by a cancel while it played (a ``cancelled`` event with
-  ``started``): felt in part, counted once, here and not under played;
+  ``started``; the sender's, or the wearer's pause or stop, ``by: "wearer"``): felt in
+  part, counted once, here and not under played;
 - ``cancelled``: dropped by a cancel before it started (a ``cancelled`` event
   without ``started``, or refused as ``cancelled`` on arrival: a stroke of a
   drawing stopped before it came);
-- ``refused``: refused on arrival for any other reason, or kept from playing by the
-  duty-cycle cap (a ``safety`` event ``duty_cycle``).
+- ``refused``: refused on arrival for any other reason (the wearer's ``paused`` and
+  ``do_not_disturb`` too: never felt), or kept from playing by the duty-cycle cap (a
+  ``safety`` event ``duty_cycle``).
 
 A broker restart or a Stop makes the sleeve answer some strokes twice: the broker
 delivers again a stroke whose acknowledgement was lost, and the copy is refused

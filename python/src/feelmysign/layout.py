@@ -30,6 +30,12 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
       ...
     ]
 
+    [controls]
+    # Optional: the wearer's buttons, each between a GPIO line and ground, the line pulled
+    # up (docs/sleeve-hardware.md, "The wearer's buttons")
+    pause_button = { chip = "gpiochip0", line = 27 }      # press: pause/resume; hold 1 s: stop
+    turn_down_button = { chip = "gpiochip0", line = 22 }  # each press: intensity down a step
+
 The whole file is checked before anything drives a motor, and every problem is
 reported at once (a ``LayoutError`` with ``problems``), each naming the key, the
 bad value and the allowed range.
@@ -110,9 +116,8 @@ class Wire:
 
 
 @dataclass(frozen=True)
-class EnableLine:
-    """The GPIO line every DRV2605L's EN pin hangs on: high lets the chips drive their motors,
-    low (the pull-down, whenever no process drives the line) shuts every one of them down."""
+class GpioLine:
+    """One GPIO line: its chip and its offset on it."""
 
     chip: str  # "gpiochip0", as gpiodetect names it
     line: int  # the line's offset on that chip (on a Raspberry Pi, the BCM GPIO number)
@@ -125,6 +130,24 @@ class EnableLine:
     @property
     def name(self) -> str:
         return f"{self.chip} line {self.line}"
+
+
+@dataclass(frozen=True)
+class EnableLine(GpioLine):
+    """The GPIO line every DRV2605L's EN pin hangs on: high lets the chips drive their motors,
+    low (the pull-down, whenever no process drives the line) shuts every one of them down."""
+
+
+@dataclass(frozen=True)
+class ButtonLine(GpioLine):
+    """A wearer's button: between the line and ground, the line pulled up (reads low while
+    pressed). ``role``: ``pause`` or ``turn_down`` (feelmysign.backends.button)."""
+
+    role: str = "pause"
+
+    @property
+    def key(self) -> str:
+        return f"controls.{self.role}_button"
 
 
 @dataclass(frozen=True)
@@ -164,6 +187,13 @@ class Layout:
     wiring: tuple[Wire, ...] = ()
     # None: no enable line, every EN pin tied high (only I2C switches a motor off).
     enable: EnableLine | None = None
+    # The wearer's buttons ([controls]); None: not fitted.
+    pause_button: ButtonLine | None = None
+    turn_down_button: ButtonLine | None = None
+
+    @property
+    def buttons(self) -> tuple[ButtonLine, ...]:
+        return tuple(b for b in (self.pause_button, self.turn_down_button) if b is not None)
 
     @property
     def shortest_burst_ms(self) -> float:
@@ -217,6 +247,7 @@ _SAFETY_KEYS = (
 )
 MIN_DUTY_WINDOW_MS = 1000.0  # shorter is no longer about heat but about single strokes
 _I2C_KEYS = ("bus", "multiplexers", "enable", "wiring")
+_CONTROLS_KEYS = ("pause_button", "turn_down_button")
 _ENABLE_KEYS = ("chip", "line")
 _WIRE_KEYS = ("row", "column", "multiplexer", "channel")
 _MEANINGS = {
@@ -322,13 +353,14 @@ def default_layout() -> Layout:
 
 def _build(data: dict[str, Any], source: str) -> Layout:
     problems = _Problems()
-    problems.unknown_keys("", data, (*TOP_KEYS, "safety", "i2c"))
+    problems.unknown_keys("", data, (*TOP_KEYS, "safety", "i2c", "controls"))
     geometry = _read_geometry(problems, data)
     caps = _read_caps(problems, data)
     hardware = _read_i2c(problems, data.get("i2c", {}), geometry["rows"], geometry["columns"])
+    buttons = _read_controls(problems, data.get("controls", {}), hardware["enable"])
     if problems.items:
         raise LayoutError(source, problems.items)
-    return Layout(**geometry, **caps, **hardware)
+    return Layout(**geometry, **caps, **hardware, **buttons)
 
 
 def _read_geometry(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
@@ -467,22 +499,60 @@ def _read_i2c(
 
 def _read_enable(problems: _Problems, value: Any, wired: bool) -> EnableLine | None:
     """``enable = { chip = "gpiochip0", line = 17 }``: where the chips' EN pins are wired."""
-    example = 'enable = { chip = "gpiochip0", line = 17 }'
+    found = _read_gpio_line(problems, "i2c.enable", value, 17)
+    if not wired:
+        problems.add(
+            "i2c.enable",
+            "an enable line needs i2c.wiring: it switches the chips the wiring lists; add the "
+            "wiring or remove enable",
+        )
+    return None if found is None else EnableLine(*found)
+
+
+def _read_controls(problems: _Problems, value: Any, enable: EnableLine | None) -> dict[str, Any]:
+    """The [controls] table: the wearer's buttons, each on a line of its own."""
+    table = problems.table("controls", value, _CONTROLS_KEYS)
+    buttons: dict[str, Any] = {}
+    taken = {} if enable is None else {(enable.chip, enable.line): "i2c.enable"}
+    for key, example_line in (("pause_button", 27), ("turn_down_button", 22)):
+        found = None
+        if key in table:
+            found = _read_gpio_line(problems, f"controls.{key}", table[key], example_line)
+        if found is not None and found in taken:
+            problems.add(
+                f"controls.{key}",
+                f"{found[0]} line {found[1]} is already {taken[found]}'s; a button needs a line "
+                "of its own (see docs/sleeve-hardware.md)",
+            )
+            found = None
+        if found is not None:
+            taken[found] = f"controls.{key}"
+        role = key.removesuffix("_button")
+        buttons[key] = None if found is None else ButtonLine(*found, role=role)
+    return buttons
+
+
+def _read_gpio_line(
+    problems: _Problems, key: str, value: Any, example_line: int
+) -> tuple[str, int] | None:
+    """``{ chip = "gpiochip0", line = N }``: a GPIO line, as gpiodetect and gpioinfo name it."""
+    name = key.rsplit(".", 1)[-1]
+    example = f'{name} = {{ chip = "gpiochip0", line = {example_line} }}'
     if not isinstance(value, dict):
-        problems.add("i2c.enable", f"must be a table such as {example}; got {_show(value)}")
+        problems.add(key, f"must be a table such as {example}; got {_show(value)}")
         return None
-    table = problems.table("i2c.enable", value, _ENABLE_KEYS)
+    table = problems.table(key, value, _ENABLE_KEYS)
     chip = table.get("chip", _MISSING)
     if chip is _MISSING:
         problems.add(
-            "i2c.enable.chip",
+            f"{key}.chip",
             'missing; the GPIO chip of the line (a name such as "gpiochip0", as gpiodetect '
             "lists them) is required",
         )
         chip = None
     elif not isinstance(chip, str) or not GPIO_CHIP.fullmatch(chip):
         problems.add(
-            "i2c.enable.chip",
+            f"{key}.chip",
             'must be a GPIO chip name such as "gpiochip0" (or its path "/dev/gpiochip0"), as '
             f"gpiodetect lists them; got {_show(chip)}",
         )
@@ -491,22 +561,16 @@ def _read_enable(problems: _Problems, value: Any, wired: bool) -> EnableLine | N
     line = None
     if isinstance(raw_line, str):  # "GPIO17" is a name gpiod also takes, but not the offset
         problems.add(
-            "i2c.enable.line",
+            f"{key}.line",
             f"must be a whole number from 0 to {MAX_GPIO_LINE}, the line's offset (on a "
             f"Raspberry Pi the BCM GPIO number: 17 for GPIO17, physical pin 11); got "
             f"{_show(raw_line)}",
         )
     else:
-        line = problems.integer("i2c.enable.line", raw_line, 0, MAX_GPIO_LINE)
-    if not wired:
-        problems.add(
-            "i2c.enable",
-            "an enable line needs i2c.wiring: it switches the chips the wiring lists; add the "
-            "wiring or remove enable",
-        )
+        line = problems.integer(f"{key}.line", raw_line, 0, MAX_GPIO_LINE)
     if chip is None or line is None:
         return None
-    return EnableLine(chip=chip, line=line)
+    return chip, line
 
 
 def _read_multiplexers(problems: _Problems, value: Any) -> tuple[int, ...]:
@@ -639,6 +703,10 @@ def _to_data(layout: Layout) -> dict[str, Any]:
                 else {"enable": {"chip": layout.enable.chip, "line": layout.enable.line}}
             ),
         },
+        "controls": {
+            f"{button.role}_button": {"chip": button.chip, "line": button.line}
+            for button in layout.buttons
+        },
     }
 
 
@@ -757,7 +825,10 @@ class _Problems:
 
 def _suggestion(key: str, allowed: tuple[str, ...]) -> str:
     """A hint for a typo ('colums') or a key put in the wrong table ('max_intensity' at the top)."""
-    for table, keys in (("[safety]", _SAFETY_KEYS), ("[i2c]", _I2C_KEYS)):
+    tables = (("[safety]", _SAFETY_KEYS), ("[i2c]", _I2C_KEYS), ("[controls]", _CONTROLS_KEYS))
+    if key == "controls" and key not in allowed:
+        return " here (it is a table of its own, [controls], at the top of the file)"
+    for table, keys in tables:
         if key in keys and key not in allowed:
             return f" here (it belongs in the {table} table)"
     close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)

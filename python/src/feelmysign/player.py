@@ -50,7 +50,7 @@ from typing import Any
 from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.backends.base import Backend
 from feelmysign.clock import monotonic_ms
-from feelmysign.control import Cancel
+from feelmysign.control import CANCEL_ALL, Cancel
 from feelmysign.events import (
     NO_STROKE,
     Adjusted,
@@ -58,6 +58,7 @@ from feelmysign.events import (
     ErrorEvent,
     Event,
     Played,
+    Rejected,
     Safety,
     StrokeRef,
 )
@@ -85,6 +86,7 @@ RETRY_LOST_S = 0.2
 # How often, with an enable line, the chips whose motors run are read while nothing else is
 # written: a wire that comes loose mid-stroke drops the line within this (plus a read).
 CHECK_DRIVEN_S = 0.005
+WEARER = "wearer"  # the ``by`` of the events of strokes the wearer stopped or paused
 
 
 @dataclass
@@ -116,16 +118,20 @@ class PlannedStroke:
 
 
 @dataclass(frozen=True)
+class Refusal:
+    reason: str
+    message: str
+
+
+@dataclass(frozen=True)
 class _CancelRequest:
     cancel: Cancel
     accepted_before: int  # strokes numbered below this one were accepted before the cancel
     received_wall_ms: float
-
-
-@dataclass(frozen=True)
-class Refusal:
-    reason: str
-    message: str
+    by: str | None = None  # "wearer": the wearer's stop or pause, said in the events
+    # The wearer paused (or "do not disturb"): the strokes not yet started are refused for
+    # this, not cancelled. None: dropped as cancelled.
+    refusal: Refusal | None = None
 
 
 def _duplicate(drawing: object, seq: object) -> Refusal:
@@ -178,6 +184,8 @@ class Player:
         self._running = False
         self._accepted = 0
         self._cancels: list[_CancelRequest] = []
+        # The wearer paused the sleeve (or "do not disturb" runs): every stroke is refused so.
+        self._refusal: Refusal | None = None
         self._thread: threading.Thread | None = None
         self._beat_s = time.monotonic()  # when the player's loop last went round (``alive``)
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
@@ -201,6 +209,8 @@ class Player:
         # moved the tail since). An idle sleeve's stroke pays one comparison here.
         faster = self._faster(stroke) if self._queue.tail_ms > stroke.received_at_ms else None
         with self._lock:
+            if self._refusal is not None:  # under the lock: a pause covers every stroke
+                return self._refusal
             if self._queue.seen(drawing, seq):
                 return _duplicate(drawing, seq)
             backlog_ms = max(0.0, self._queue.tail_ms - stroke.received_at_ms)
@@ -335,15 +345,41 @@ class Player:
             with self._lock:
                 self._queue.remember(drawing, seq)
 
-    def cancel(self, cancel: Cancel, received_wall_ms: float) -> None:
+    def cancel(self, cancel: Cancel, received_wall_ms: float, *, by: str | None = None) -> None:
         """Cancel the strokes of a drawing (or all) accepted so far, from any thread.
 
         The player thread wakes at once, switches their motors off, drops those not started,
-        and reports each one as ``cancelled``; strokes accepted later are not touched.
+        and reports each one as ``cancelled`` (``by`` in the events: ``"wearer"`` for the
+        wearer's stop); strokes accepted later are not touched.
         """
         with self._lock:
-            self._cancels.append(_CancelRequest(cancel, self._accepted, received_wall_ms))
+            self._cancels.append(_CancelRequest(cancel, self._accepted, received_wall_ms, by))
         self._wake.set()
+
+    def refuse(self, refusal: Refusal | None, received_wall_ms: float) -> None:
+        """The wearer paused the sleeve (or set "do not disturb"): from now on every stroke is
+        refused with ``refusal``, and what was accepted before is cut by the next pass of the
+        player as a cancel of everything is (the stroke playing reported ``cancelled`` by
+        the wearer, the ones waiting refused with ``refusal``). None: strokes play again.
+
+        The refusal and the cut are set under one lock, so no stroke slips between them.
+        """
+        with self._lock:
+            self._refusal = refusal
+            if refusal is not None:
+                request = _CancelRequest(
+                    Cancel(CANCEL_ALL), self._accepted, received_wall_ms, WEARER, refusal
+                )
+                self._cancels.append(request)
+        if refusal is not None:
+            # The cut on this thread, as a stroke due at once is played (when the player's
+            # thread is between rounds): the motors need not wait for it to wake.
+            self._play_due()
+        self._wake.set()
+
+    def set_ceiling(self, ceiling: float | None) -> None:
+        """The wearer's intensity ceiling: no motor driven above it from its next change."""
+        self._timeline.set_ceiling(ceiling)
 
     def start(self) -> None:
         sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL_S))
@@ -470,9 +506,7 @@ class Player:
             for tags, started in ((cut.started, True), (cut.unstarted, False)):
                 for tag in tags:
                     if isinstance(tag, PlannedStroke):
-                        at_ms = request.received_wall_ms
-                        event = cancelled(tag.ref, at_ms, started=started)
-                        self._on_event(event)
+                        self._on_event(_cut_event(request, tag.ref, started=started))
                         acknowledge = acknowledgements.get(id(tag))  # a started one was
                         if acknowledge is not None:
                             acknowledge()
@@ -806,14 +840,25 @@ def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Calla
     return both
 
 
-def cancelled(stroke: StrokeRef, cancelled_at_ms: float, *, started: bool) -> Cancelled:
+def cancelled(
+    stroke: StrokeRef, cancelled_at_ms: float, *, started: bool, by: str | None = None
+) -> Cancelled:
     """The event for a stroke that a control message received at ``cancelled_at_ms``
-    cancelled."""
+    cancelled (``by="wearer"``: the wearer's stop or pause, at that time)."""
+    who = "the wearer" if by == WEARER else "a control message"
     return Cancelled(
-        message="cut short by a control message"
-        if started
-        else "dropped by a control message before it played",
+        message=f"cut short by {who}" if started else f"dropped by {who} before it played",
         stroke=stroke,
         cancelled_at_ms=cancelled_at_ms,
         started=started,
+        by=by,
     )
+
+
+def _cut_event(request: _CancelRequest, stroke: StrokeRef, *, started: bool) -> Event:
+    """What a stroke cut by ``request`` is reported as: ``cancelled``, or, not yet started
+    when the wearer paused, refused for the pause."""
+    if not started and request.refusal is not None:
+        refusal = request.refusal
+        return Rejected(reason=refusal.reason, message=refusal.message, stroke=stroke)
+    return cancelled(stroke, request.received_wall_ms, started=started, by=request.by)

@@ -70,6 +70,9 @@ LATE = "late"
 QUEUE_FULL = "queue_full"
 PLAYER_STOPPED = "player_stopped"
 SILENCED = "silenced"  # the enable line is held low for a chip that does not answer
+# The wearer's (feelmysign.sleeve.controls): the sleeve paused, or "do not disturb" running.
+PAUSED = "paused"
+DO_NOT_DISTURB = "do_not_disturb"
 
 REASONS: dict[str, str] = {
     NOT_TEXT: "the payload is not a string or bytes, or its bytes are not UTF-8",

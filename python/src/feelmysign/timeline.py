@@ -152,6 +152,15 @@ class Timeline:
         self._dropped: set[int] = set()  # commands of strokes the cap refused
         self._incomplete: list[_Stroke] = []  # added by their outline, in the order added
         self.duty_cycle = DutyCycle(layout.duty_cycle_window_ms, layout.max_duty_cycle)
+        # No motor is driven above this: the layout's max_intensity, lowered by the wearer's
+        # ceiling (set_ceiling). Read at every change, so a ceiling lowered mid-stroke holds
+        # from the stroke's next change on.
+        self.max_intensity = layout.max_intensity
+
+    def set_ceiling(self, ceiling: float | None) -> None:
+        """The wearer's intensity ceiling (None: none): it only ever lowers the layout's cap."""
+        cap = self._layout.max_intensity
+        self.max_intensity = cap if ceiling is None else min(cap, ceiling)
 
     def add(self, schedule: Schedule, start_ms: float, tag: object = None) -> None:
         """Play ``schedule`` from ``start_ms``; ``tag`` comes back in ``Due.started`` then
@@ -337,7 +346,7 @@ class Timeline:
         the duty-cycle cap counts: the drive that heats the motor, not the drive asked for.
         (Commands overlapping on one motor add energies and are capped once; counted each
         capped, they are counted at least at what is driven.)"""
-        driven = min(1.0, intensity, self._layout.max_intensity)
+        driven = min(1.0, intensity, self.max_intensity)
         return driven * driven
 
     def _settle(self, actuator: Actuator, t_ms: float, due: Due, tag: object = None) -> None:
@@ -345,7 +354,7 @@ class Timeline:
         if not active:
             self._active.pop(actuator, None)
         energy = sum(active.values()) if active else 0.0
-        wanted = min(1.0, math.sqrt(energy), self._layout.max_intensity)
+        wanted = min(1.0, math.sqrt(energy), self.max_intensity)
         if wanted == self._output.get(actuator, 0.0):
             return
         self._output[actuator] = wanted

@@ -395,6 +395,11 @@ class Drv2605Backend(GridBackend):
                 self._multiplexers = None
                 self._release()
 
+    @property
+    def bus(self) -> I2CBus | None:
+        """The bus given at construction (an emulated one), None for the Pi's own."""
+        return self._bus
+
     def _connect(self) -> Multiplexers:
         problems = check_wiring(self._layout)
         if problems:  # before any I2C traffic

@@ -41,6 +41,12 @@ A chip that stops answering records when (``lost_at``: the wall clock in ms and
 the bus's transaction count), and so does the enable line when it changes, so
 a test can read from the state file how soon after a loss every motor was off.
 
+- the wearer's buttons (:class:`feelmysign.backends.emulated_button.EmulatedButton`),
+  each on a GPIO line of its own, which a test presses and lets go. The bus records
+  ``silent_since``: when every motor was last found off (the wall clock in ms and the
+  transaction count; None while a motor is driven), so that a test reads how soon
+  after a press, on the same clock, every motor was off.
+
 ``on_write``, when set, is called after every write the bus applied, while the
 bus is locked: :mod:`feelmysign.backends.emulated_state` uses it to keep the
 registers in a file, so that they outlive the process as a real chip's do.
@@ -61,6 +67,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Literal, NamedTuple
 
+    from feelmysign.backends.emulated_button import EmulatedButton
     from feelmysign.layout import Layout
 
     Operation = Literal["read_byte", "write_byte", "read_byte_data", "write_byte_data"]
@@ -415,6 +422,11 @@ class EmulatedI2CBus:
         self.max_enabled_channels = 0  # the most channels ever enabled at once, all multiplexers
         self.transactions = 0  # every transaction tried, answered or not (kept in a state file)
         self.enable_line: EmulatedEnableLine | None = None
+        self.buttons: dict[tuple[str, int], EmulatedButton] = {}
+        # When every motor was last found off (ms, transaction); None while one is driven.
+        self.silent_since: tuple[float, int] | None = (round(time.time() * 1000, 3), 0)
+        self._driven: set[str] = set()  # the chips whose motors are driven now
+        self.state_path: str | None = None  # the file the bus is kept in, if any
         self.closed = False
         self.on_write: Callable[[EmulatedI2CBus], None] | None = None
         # Called before every transaction, bus locked: a fault injected from outside lands.
@@ -454,6 +466,51 @@ class EmulatedI2CBus:
         high = self.enable_line is None or self.enable_line.effective_high
         for chip in (*self._chips.values(), *self._main_bus_chips):
             chip.enabled = high
+            self._note_drive(chip)
+
+    def _note_drive(self, chip: EmulatedDRV2605L) -> None:
+        """Keeps ``silent_since`` after anything that may have changed ``chip``'s drive."""
+        if chip.output > 0:
+            self._driven.add(chip.name)
+            self.silent_since = None
+        elif chip.name in self._driven:
+            self._driven.discard(chip.name)
+        if not self._driven and self.silent_since is None:
+            self.silent_since = (round(time.time() * 1000, 3), self.transactions)
+
+    def recount_drive(self, silent_since: tuple[float, int] | None) -> None:
+        """After a restore: which motors are driven, and since when all were off if none is."""
+        with self._lock:
+            self._driven = {
+                c.name for c in (*self._chips.values(), *self._main_bus_chips) if c.output > 0
+            }
+            self.silent_since = None if self._driven else silent_since
+            if not self._driven and self.silent_since is None:
+                self.silent_since = (round(time.time() * 1000, 3), self.transactions)
+
+    @property
+    def driven(self) -> int:
+        """How many motors are driven now."""
+        with self._lock:
+            return len(self._driven)
+
+    def add_button(self, chip: str, line: int) -> EmulatedButton:
+        """A wearer's button on GPIO ``chip`` line ``line`` (up until a test presses it)."""
+        from feelmysign.backends.emulated_button import EmulatedButton
+
+        with self._lock:
+            button = self.buttons.setdefault((chip, line), EmulatedButton(chip, line))
+            button._bus = self
+            if self.on_write is not None:
+                self.on_write(self)  # kept with the rest: a test finds it in the file
+            return button
+
+    def button_moved(self, button: EmulatedButton, pressed: bool) -> None:
+        """A button went down or up: recorded, on the bus's clock, and saved."""
+        with self._lock:
+            button.record(pressed, self.transactions, len(self._driven))
+            if self.on_write is not None:
+                self.on_write(self)
 
     # -- building and inspecting ------------------------------------------------------------
 
@@ -475,6 +532,7 @@ class EmulatedI2CBus:
         with self._lock:
             self._chips[(multiplexer, channel)] = chip
             chip.enabled = self.enable_line is None or self.enable_line.effective_high
+            self._note_drive(chip)
         return chip
 
     def attach_main_bus_chip(self, *, device_id: int = DRV2605L_DEVICE_ID) -> EmulatedDRV2605L:
@@ -564,6 +622,8 @@ class EmulatedI2CBus:
             if isinstance(device, EmulatedDRV2605L):
                 device.lost_at = None
             result = self._apply(device, op, register, value)
+            if isinstance(device, EmulatedDRV2605L) and op == "write_byte_data":
+                self._note_drive(device)
             self.log.append(Transaction(op, address, register, value, device.name))
             if self.on_write is not None and op.startswith("write"):
                 self.on_write(self)

@@ -43,6 +43,14 @@ file was written; ``rises`` counts the times it ever went high. A chip whose EN
 is low drives nothing whatever its registers say; with EN high (or no line) it
 drives what its registers say.
 
+``silent_since`` is when every motor was last found off (``{"ms", "transaction"}``,
+null while one is driven). ``buttons`` (present when the layout has wearer's buttons,
+``[controls]``) lists each button's ``chip`` and ``line``, whether it is ``pressed``,
+its ``presses``, when it was last pressed and let go (``pressed_at``, ``released_at``)
+and how many motors were driven at that press (``driven_at_press``): a test presses it
+through the pipe ``FILE.buttons`` (:mod:`feelmysign.backends.emulated_button`) and reads
+here how soon after the press every motor was off.
+
 ``transactions`` counts the bus transactions tried; a chip that stops answering
 gets ``lost_at`` (the wall clock in ms and that count: when the process driving
 the bus took the edit that disconnected it, or when a transaction first found it
@@ -67,6 +75,7 @@ import json
 import os
 import time
 
+from feelmysign.backends.emulated_button import EmulatedButton
 from feelmysign.backends.emulated_i2c import (
     EmulatedDRV2605L,
     EmulatedEnableLine,
@@ -127,6 +136,7 @@ def open_state_bus(path: str | os.PathLike[str], layout: Layout | None) -> Emula
         # A file made before the layout had a line: the boards are wired to it now.
         bus.add_enable_line(layout.enable.chip, layout.enable.line)
     write_through = _WriteThrough(state_path)
+    bus.state_path = state_path
     bus.on_write = write_through
     bus.before_transaction = write_through.take_faults
     return bus
@@ -243,6 +253,20 @@ def state_of(bus: EmulatedI2CBus) -> dict[str, Any]:
         "main_bus_chips": [_chip_state(chip) for chip in bus.main_bus_chips],
         "transactions": bus.transactions,
         "enable": None if bus.enable_line is None else _line_state(bus.enable_line),
+        "silent_since": _when(bus.silent_since),
+        **({"buttons": [_button_state(b) for b in bus.buttons.values()]} if bus.buttons else {}),
+    }
+
+
+def _button_state(button: EmulatedButton) -> dict[str, Any]:
+    return {
+        "chip": button.chip,
+        "line": button.line,
+        "pressed": button.is_pressed,
+        "presses": button.presses,
+        "pressed_at": _when(button.pressed_at),
+        "released_at": _when(button.released_at),
+        "driven_at_press": button.driven_at_press,
     }
 
 
@@ -294,6 +318,15 @@ def bus_from_state(data: Any) -> EmulatedI2CBus:
         enable.rises = int(line.get("rises", 0))
         bus.enable_line = enable
         bus.add_enable_line(enable.chip, enable.line)  # links it, and every EN follows it
+    for saved in list(data.get("buttons", [])):
+        button = bus.add_button(str(saved["chip"]), int(saved["line"]))
+        button.is_pressed = bool(saved.get("pressed", False))
+        button.presses = int(saved.get("presses", 0))
+        button.pressed_at = _read_when(saved.get("pressed_at"))
+        button.released_at = _read_when(saved.get("released_at"))
+        driven = saved.get("driven_at_press")
+        button.driven_at_press = None if driven is None else int(driven)
+    bus.recount_drive(_read_when(data.get("silent_since")))
     return bus
 
 

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from feelmysign.errors import HardwareError
 
 if TYPE_CHECKING:
-    from feelmysign.layout import EnableLine
+    from feelmysign.layout import EnableLine, GpioLine
 
 CONSUMER = "feelmysign"  # what gpioinfo shows as the line's user while the sleeve holds it
 
@@ -104,15 +104,16 @@ class GpiodLine:
             request.release()
 
 
-def import_gpiod() -> Any:
-    """The ``gpiod`` module (libgpiod v2's bindings), or a HardwareError saying how to get it."""
+def import_gpiod(key: str = "i2c.enable") -> Any:
+    """The ``gpiod`` module (libgpiod v2's bindings), or a HardwareError saying how to get it
+    (``key``: the layout's key that asks for a GPIO line)."""
     try:
         import gpiod
     except ImportError as error:
         raise HardwareError(
-            "the layout has an enable line (i2c.enable) and libgpiod's Python bindings are not "
+            f"the layout has a GPIO line ({key}) and libgpiod's Python bindings are not "
             "installed: .venv/bin/pip install 'gpiod>=2.2' (or reinstall feelmysign), or remove "
-            "i2c.enable from the layout"
+            f"{key} from the layout"
         ) from error
     if not hasattr(gpiod, "request_lines"):
         raise HardwareError(
@@ -122,14 +123,16 @@ def import_gpiod() -> Any:
     return gpiod
 
 
-def line_error(enable: EnableLine, error: Exception) -> str:
-    """What went wrong taking or driving ``enable``, and what to do about it."""
-    where = f"the enable line ({enable.name}, from i2c.enable)"
+def line_error(
+    enable: GpioLine, error: Exception, key: str = "i2c.enable", what: str = "the enable line"
+) -> str:
+    """What went wrong taking or driving ``enable`` (the layout's ``key``), and what to do."""
+    where = f"{what} ({enable.name}, from {key})"
     number = getattr(error, "errno", None)
     if number == errno.ENOENT:
         return (
             f"{where}: there is no {enable.path}; list the GPIO chips with 'gpiodetect' and fix "
-            "i2c.enable.chip"
+            f"{key}.chip"
         )
     if number in (errno.EACCES, errno.EPERM):
         return (
@@ -144,7 +147,7 @@ def line_error(enable: EnableLine, error: Exception) -> str:
     if number == errno.EINVAL or isinstance(error, ValueError):
         return (
             f"{where}: {enable.chip} has no line {enable.line} ({error}); list its lines with "
-            f"'gpioinfo {enable.chip}' and fix i2c.enable.line"
+            f"'gpioinfo {enable.chip}' and fix {key}.line"
         )
     return f"{where}: {error}"
 

@@ -8,7 +8,7 @@ layout without wiring for the hardware, options that only one backend has.
 from __future__ import annotations
 
 import os
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from feelmysign.backends.actuator_config import (
     CalibrationStore,
@@ -25,7 +25,10 @@ from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.sim import SimBackend
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.errors import LayoutError, ParameterError
-from feelmysign.layout import Layout
+from feelmysign.layout import ButtonLine, Layout
+
+if TYPE_CHECKING:
+    from feelmysign.backends.button import ButtonInput
 
 BackendName = Literal["sim", "drv2605"]
 BACKEND_NAMES: tuple[BackendName, ...] = ("sim", "drv2605")
@@ -104,6 +107,24 @@ def enable_line_for(layout: Layout, bus: I2CBus | None) -> Line | None:
     if isinstance(bus, EmulatedI2CBus):
         return bus.add_enable_line(layout.enable.chip, layout.enable.line)
     return GpiodLine(layout.enable)
+
+
+def button_inputs(layout: Layout, backend: Backend) -> list[tuple[ButtonLine, ButtonInput]]:
+    """The wearer's buttons of ``layout`` ([controls]), each with its line: the emulated bus's
+    own when ``backend`` drives one (pressed through the pipe next to its state file, if it
+    has one), else the real GPIO line (gpiod is imported when it is requested)."""
+    from feelmysign.backends.button import GpiodButton
+    from feelmysign.backends.emulated_button import ButtonPipe, pipe_path
+
+    bus = getattr(backend, "bus", None)
+    if not isinstance(bus, EmulatedI2CBus):
+        return [(button, GpiodButton(button)) for button in layout.buttons]
+    found: list[tuple[ButtonLine, ButtonInput]] = [
+        (button, bus.add_button(button.chip, button.line)) for button in layout.buttons
+    ]
+    if found and bus.state_path is not None:
+        ButtonPipe(bus, pipe_path(bus.state_path)).open()
+    return found
 
 
 def _open_sim(

@@ -24,6 +24,7 @@ from feelmysign.bench import (
     restart_off,
     simplifier_timing,
     sleeve,
+    wearer_pause,
 )
 
 GROUPS: dict[str, Callable[[], list[str]]] = {
@@ -34,6 +35,7 @@ GROUPS: dict[str, Callable[[], list[str]]] = {
     "sleeve": sleeve.report,
     "relay": relay.report,
     "restart_off": restart_off.report,
+    "wearer_pause": wearer_pause.report,
     "persistence": persistence.report,
 }
 

@@ -7,8 +7,10 @@ import logging
 import sys
 from collections import Counter
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
+from feelmysign.backends.base import Backend
+from feelmysign.backends.factory import BACKEND_NAMES, BackendName, button_inputs, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.cli.options.emulation import add_emulate_state_option
@@ -23,6 +25,9 @@ from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.services.stop_signals import call_on_stop_signals
 from feelmysign.sleeve.admission import BURST, RATE_PER_S
 from feelmysign.topics import LEGACY_TOPIC
+
+if TYPE_CHECKING:
+    from feelmysign.backends.button import ButtonWatcher
 
 TELEMETRY_RATE_HZ = 20.0  # previews look smooth at 20 frames a second; more only costs traffic
 MAX_AGE_RANGE_MS = (100.0, 3_600_000.0)
@@ -217,9 +222,36 @@ def run_sleeve(
     ):
         sleeve = Sleeve(settings, layout, opened, options, telemetry=telemetry)
         sleeves.append(sleeve)
-        on_start(sleeve)
-        sleeve.run()
+        watchers = _watch_buttons(layout, opened, sleeve)
+        try:
+            on_start(sleeve)
+            sleeve.run()
+        finally:
+            for watcher in watchers:
+                watcher.stop()
     return sleeve.counts
+
+
+def _watch_buttons(layout: Layout, backend: Backend, sleeve: Sleeve) -> list[ButtonWatcher]:
+    """The wearer's buttons ([controls]) watched, each on a thread; HardwareError (what to
+    check) for one that cannot be had: the wearer's control is never silently absent."""
+    from feelmysign.backends.button import ButtonWatcher
+
+    watchers: list[ButtonWatcher] = []
+    try:
+        for button, line in button_inputs(layout, backend):
+            watcher = ButtonWatcher(line, button.role, sleeve.controls)
+            watcher.start()
+            watchers.append(watcher)
+            kind = "pause button (press: pause/resume, hold 1 s: stop)"
+            if button.role != "pause":
+                kind = "turn-down button (each press: a step down)"
+            print(f"The wearer's {kind}: {line.description}", flush=True)
+    except BaseException:
+        for watcher in watchers:
+            watcher.stop()
+        raise
+    return watchers
 
 
 def _on_start(sleeve: Sleeve, settings: BrokerSettings, options: SleeveOptions) -> None:

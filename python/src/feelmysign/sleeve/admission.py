@@ -29,6 +29,7 @@ its lock, a simulation from its own :class:`feelmysign.sleeve.queue.Queue`.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import NamedTuple, Protocol
 
 from feelmysign.errors import StrokeError
@@ -186,6 +187,9 @@ class Admission:
         self.cancelled = CancelledDrawings()  # drawing -> when its cancel came (wall clock)
         self._bucket = TokenBucket(rate_per_s, burst)
         self._pace = PacePolicy(max_age_ms=max_age_ms, max_lag_ms=max_lag_ms)
+        # The wearer's intensity ceiling (feelmysign.sleeve.controls): a stroke asking more is
+        # planned at it, so its phantoms keep their proportions below it.
+        self.ceiling: float | None = None
 
     def admit(
         self,
@@ -230,6 +234,9 @@ class Admission:
             )
             ref = StrokeRef(topic, drawing, seq, sent_at_ms, received_at_ms=received_wall_ms)
             return Refused(RATE_LIMITED, message, ref)
+        ceiling = self.ceiling
+        if ceiling is not None and _asks_above(stroke.intensity, self.layout, ceiling):
+            stroke = replace(stroke, intensity=ceiling)
         try:
             # Its bursts only: the commands are planned by the player, the first ones first.
             planned = outline(stroke, self.layout, strict=self.strict)
@@ -254,3 +261,9 @@ class Admission:
         if verdict.reason is not None:
             return Refused(verdict.reason, verdict.message, ref)
         return planned, ref
+
+
+def _asks_above(intensity: float | None, layout: Layout, ceiling: float) -> bool:
+    """Whether a stroke of ``intensity`` (None: the layout's default) asks more than
+    ``ceiling``."""
+    return (layout.default_intensity if intensity is None else intensity) > ceiling

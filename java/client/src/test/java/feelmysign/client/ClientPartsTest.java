@@ -1,6 +1,7 @@
 package feelmysign.client;
 
 import static org.junit.jupiter.api.Assertions.assertEquals;
+import static org.junit.jupiter.api.Assertions.assertFalse;
 import static org.junit.jupiter.api.Assertions.assertNull;
 import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
@@ -55,5 +56,26 @@ class ClientPartsTest {
     assertNull(SleeveEvent.parse("[1]"));
     assertNull(SleeveEvent.parse("{\"type\":5}"));
     assertNull(SleeveEvent.parse("not json"));
+  }
+
+  @Test
+  void theWearersCutsAndRefusalsAreToldApart() {
+    SleeveEvent cut =
+        SleeveEvent.parse(
+            "{\"type\":\"cancelled\",\"reason\":\"cancelled\",\"message\":\"m\",\"seq\":1,"
+                + "\"started\":true,\"by\":\"wearer\"}");
+    assertTrue(cut.byWearer());
+    SleeveEvent stop =
+        SleeveEvent.parse("{\"type\":\"cancelled\",\"reason\":\"cancelled\",\"message\":\"m\"}");
+    assertFalse(stop.byWearer(), "a sender's cancel has no by");
+    for (String reason : List.of(SleeveEvent.PAUSED, SleeveEvent.DO_NOT_DISTURB)) {
+      SleeveEvent refused =
+          SleeveEvent.parse(
+              "{\"type\":\"rejected\",\"reason\":\"" + reason + "\",\"message\":\"m\"}");
+      assertTrue(refused.refusedByWearer(), reason);
+    }
+    assertFalse(
+        SleeveEvent.parse("{\"type\":\"rejected\",\"reason\":\"stale\",\"message\":\"m\"}")
+            .refusedByWearer());
   }
 }
