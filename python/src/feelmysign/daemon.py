@@ -69,6 +69,7 @@ from feelmysign.protocol import CANCELLED, DUPLICATE, HELD
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
+from feelmysign.sleeve.controls import WearerControls
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -191,6 +192,9 @@ class Sleeve:
             burst=options.burst,
             max_age_ms=options.max_age_ms,
             max_lag_ms=options.max_lag_ms,
+        )
+        self.controls = WearerControls(
+            layout.max_intensity, on_stop=lambda: self._player.cancel(Cancel("*"), wall_ms())
         )
         self._connection = 0  # counts connections: an acknowledgement is valid on its own only
         self._stopped = threading.Event()
