@@ -28,6 +28,7 @@ from pathlib import Path
 import pytest
 from sleeve_watch import connected_client, stop_loop
 
+from feelmysign.broker import Broker
 from feelmysign.connection.join_token import decode_join_token
 from feelmysign.connection.settings import parse_broker_url
 
@@ -165,3 +166,16 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
         sent = send(token, tmp_path)
         assert sent.returncode == 0, sent.stdout + sent.stderr
         assert "The sleeve played" in sent.stdout, sent.stdout
+
+
+@pytest.mark.parametrize("name", ["page", "a/b", "", "x" * 65])
+def test_add_sender_refuses_a_name_it_cannot_use(broker: Broker, name: str) -> None:
+    added = subprocess.run(
+        [FEELMYSIGN, "broker", "--state-dir", str(broker.state_dir), "add-sender", "--name", name],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    assert added.returncode == 1, added.stdout + added.stderr
+    assert "1 to 64 letters, digits" in added.stderr and "Traceback" not in added.stderr
+    assert added.stdout == "" and not broker.files.senders.exists()
