@@ -149,9 +149,9 @@ class WearerApi:
         if self._blocking is None:
             raise _Refused(
                 400,
-                "Blocking a sender needs the broker feelmysign runs ('feelmysign up' or "
-                "'feelmysign broker'); this sleeve uses another broker, where its owner "
-                "removes the sender's account.",
+                "Blocking a sender needs the broker feelmysign runs, from its own machine (the "
+                "wearer's page of 'feelmysign up'); this sleeve reaches a broker this page does "
+                "not run: its owner removes the sender's account there.",
             )
         if name == PAGE_SENDER:
             raise _Refused(
