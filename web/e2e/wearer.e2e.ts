@@ -94,6 +94,21 @@ describe("the wearer's page served by feelmysign up", () => {
     expect((await apiState(page)).controls.paused).toBe(false);
   });
 
+  it("works from the keyboard, with its focus shown", async () => {
+    // From the heading (not focusable), Tab goes to the first control: the toggle.
+    await page.locator("h1").click();
+    await page.keyboard.press("Tab");
+    const outline = await page.evaluate(() => {
+      const focused = document.activeElement as HTMLElement;
+      return { testid: focused.dataset["testid"], style: getComputedStyle(focused).outlineStyle };
+    });
+    expect(outline).toEqual({ testid: "pause", style: "solid" });
+    await page.keyboard.press("Space");
+    await waitForData(page, '[data-testid="pause"]', "paused", "true");
+    await page.keyboard.press("Enter");
+    await waitForData(page, '[data-testid="pause"]', "paused", "false");
+  });
+
   it("stops what plays", async () => {
     await page.locator('[data-testid="stop"]').click();
     await page.waitForFunction(() =>
@@ -129,6 +144,24 @@ describe("the wearer's page served by feelmysign up", () => {
     await waitForData(page, '[data-testid="dnd-line"]', "until", "");
     expect((await apiState(page)).controls.do_not_disturb_until_ms).toBeNull();
     expect(await end.isVisible()).toBe(false);
+  });
+
+  it("turns on do not disturb until a time of day", async () => {
+    // Two hours from now, in the browser's own time zone, as the time field takes it.
+    const hhmm = await page.evaluate(() => {
+      const at = new Date(Date.now() + 2 * 3_600_000);
+      return `${String(at.getHours()).padStart(2, "0")}:${String(at.getMinutes()).padStart(2, "0")}`;
+    });
+    await page.locator('[data-testid="dnd-time"]').fill(hhmm);
+    await page.locator('[data-testid="dnd-set"]').click();
+    await page.waitForFunction(() =>
+      document.querySelector('[data-testid="dnd-line"]')!.getAttribute("data-until"),
+    );
+    const until = (await apiState(page)).controls.do_not_disturb_until_ms!;
+    expect(until).toBeGreaterThan(Date.now() + 118 * 60_000);
+    expect(until).toBeLessThanOrEqual(Date.now() + 120 * 60_000);
+    await page.locator('[data-testid="dnd-end"]').click();
+    await waitForData(page, '[data-testid="dnd-line"]', "until", "");
   });
 
   it("blocks a named sender on the broker, and unblocks it", async () => {

@@ -37,7 +37,7 @@ const sendersLine = byId<HTMLParagraphElement>("senders-line");
 const sendersList = byId<HTMLUListElement>("senders");
 
 let state: WearerState | null = null;
-let busy = false; // one change at a time: a second tap waits for the first's answer
+let busy = false; // one change at a time: a second tap is ignored until the first is answered
 let lastSaid = "";
 // A refused change stays on screen until the next change succeeds (a poll does not hide it).
 let changeRefused = false;
@@ -114,7 +114,6 @@ function renderSenders(senders: readonly Sender[]): void {
     button.hidden = !sender.blockable;
     button.textContent = sender.blocked ? "Unblock" : "Block";
     button.setAttribute("aria-label", `${sender.blocked ? "Unblock" : "Block"} ${who}`);
-    button.disabled = busy;
     return item;
   });
   if (
@@ -141,7 +140,9 @@ function summary(s: WearerState): string {
 function render(s: WearerState): void {
   state = s;
   const c = s.controls;
-  const ready = c !== null && !busy;
+  // Not disabled while a change is under way: a disabled button would lose the focus (the
+  // screen reader's place); change() ignores a second press until the first is answered.
+  const ready = c !== null;
   sleeveLine.dataset["state"] = c === null ? "starting" : s.online ? "online" : "offline";
   sleeveLine.textContent =
     c === null
@@ -214,7 +215,6 @@ function showProblem(error: unknown): void {
 async function change(action: Action, body: object = {}): Promise<void> {
   if (busy) return;
   busy = true;
-  if (state !== null) render(state);
   try {
     const next = await act(action, body);
     problem.hidden = true;
