@@ -32,11 +32,13 @@ export default defineConfig({
     outDir: "dist",
     emptyOutDir: true,
     target: "es2022",
-    // Two pages: the drawing client, and the researcher's study page (served at /study).
+    // Three pages: the drawing client, the researcher's study page (served at /study) and the
+    // wearer's page (served at /wearer).
     rollupOptions: {
       input: {
         main: fileURLToPath(new URL("index.html", import.meta.url)),
         study: fileURLToPath(new URL("study.html", import.meta.url)),
+        wearer: fileURLToPath(new URL("wearer.html", import.meta.url)),
       },
     },
   },

@@ -66,6 +66,10 @@ Api = Callable[[str, str, str, bytes, str], tuple[int, str, bytes]]
 MAX_API_BODY_BYTES = 64 * 1024
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 KEY_COOKIE = "feelmysign_key"
+# The wearer's page (/wearer) and its API (/api/wearer/) take the wearer's key, in a cookie of
+# its own: the sender's key does not open them, nor does the wearer's open the broker's login.
+WEARER_COOKIE = "feelmysign_wearer_key"
+WEARER_API_PREFIX = "/api/wearer/"
 
 # A request's line and headers (and its body) within this, from the connection's start
 # or the previous answer: a slow or silent client is closed, not waited for.
@@ -174,6 +178,9 @@ class WebServer:
     ``hosts``: names besides the loopback ones under which pages may read
     ``/config.json`` (e.g. the machine's LAN address, when serving there).
     ``debug_log``: where the details of what peers did wrong go (rotated; none: dropped).
+    ``wearer_api`` and ``wearer_key``: the wearer's page at ``/wearer`` and its API under
+    ``/api/wearer/``, which needs the wearer's key (opened once as ``/wearer?key=KEY``, then
+    a cookie) whether on loopback or not, and a ``Host`` naming this server.
     """
 
     def __init__(
@@ -189,6 +196,8 @@ class WebServer:
         mqtt_ws_port: int | None = None,
         hosts: Iterable[str] = (),
         debug_log: Path | None = None,
+        wearer_api: Api | None = None,
+        wearer_key: str | None = None,
     ) -> None:
         index = directory / "index.html"
         if not index.is_file():
@@ -199,6 +208,10 @@ class WebServer:
         self._root = directory.resolve()
         self._config = json.dumps(config).encode()
         self._api = api
+        if (wearer_api is None) != (wearer_key is None):
+            raise ValueError("the wearer's API and the wearer's key go together")
+        self._wearer_api = wearer_api
+        self._wearer_key = wearer_key
         self._access_key = access_key
         self._mqtt_ws_port = mqtt_ws_port
         self._sock = _listen(host, port)
@@ -458,6 +471,10 @@ class WebServer:
 
     async def _answer(self, request: web.BaseRequest) -> web.StreamResponse:
         path = request.path
+        if self._wearer_api is not None and (
+            path in ("/wearer", "/wearer/") or path.startswith(WEARER_API_PREFIX)
+        ):
+            return await self._wearer(request)
         if self._access_key is not None:
             refused = self._key_checked(request)
             if refused is not None:
@@ -499,6 +516,53 @@ class WebServer:
             return None
         return _text(403, "Forbidden: open the URL that 'feelmysign up' printed (it holds the key)")
 
+    async def _wearer(self, request: web.BaseRequest) -> web.StreamResponse:
+        """The wearer's page and API: only for a Host naming this server (else a page from
+        anywhere could rebind its name to this machine and pause or unblock), and the API
+        only with the wearer's key."""
+        key = self._wearer_key
+        assert key is not None
+        host = (request.headers.get("Host") or "").strip().lower()
+        if host not in self._allowed_hosts:
+            return _text(
+                403,
+                f"Forbidden: the wearer's page is served only at this server's addresses "
+                f"({', '.join(sorted(self._allowed_hosts))}), not to Host {host[:80]!r}. Open "
+                "the wearer's URL that 'feelmysign up' printed.",
+                cache="no-store",
+            )
+        offered = parse_qs(request.query_string).get("key", [None])[0]
+        if offered is not None and hmac.compare_digest(offered.encode(), key.encode()):
+            secure = "Secure; " if self._tls is not None else ""
+            return web.Response(
+                status=303,
+                headers={
+                    "Set-Cookie": f"{WEARER_COOKIE}={key}; {secure}HttpOnly; "
+                    "SameSite=Strict; Path=/",
+                    "Location": "/wearer",
+                    "Cache-Control": "no-store",
+                },
+            )
+        if not request.path.startswith(WEARER_API_PREFIX):
+            if request.method not in ("GET", "HEAD"):
+                return _text(405, f"Unsupported method {request.method!r} for the wearer's page")
+            return self._static("/wearer.html")  # the page is public; its API is not
+        try:
+            cookie = SimpleCookie(request.headers.get("Cookie", ""))
+        except CookieError:
+            cookie = SimpleCookie()
+        held = cookie[WEARER_COOKIE].value if WEARER_COOKIE in cookie else ""
+        if not hmac.compare_digest(held.encode(), key.encode()):
+            return web.json_response(
+                {
+                    "error": "This phone does not hold the wearer's key: open the wearer's URL "
+                    "that 'feelmysign up' printed (or scan its QR code) once."
+                },
+                status=403,
+                headers={"Cache-Control": "no-store"},
+            )
+        return await self._call_api(request, self._wearer_api)
+
     def _config_json(self, request: web.BaseRequest) -> web.StreamResponse:
         host = (request.headers.get("Host") or "").strip().lower()
         if host not in self._allowed_hosts:
@@ -515,8 +579,10 @@ class WebServer:
             headers={"Cache-Control": "no-store"},
         )
 
-    async def _call_api(self, request: web.BaseRequest) -> web.StreamResponse:
-        api = self._api
+    async def _call_api(
+        self, request: web.BaseRequest, api: Api | None = None
+    ) -> web.StreamResponse:
+        api = api or self._api
         assert api is not None
         # At most one byte past the limit: enough for the API to refuse it as too large.
         body = await _read_at_most(request, MAX_API_BODY_BYTES + 1)

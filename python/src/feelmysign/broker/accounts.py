@@ -15,6 +15,7 @@ from pathlib import Path
 from feelmysign.broker import _process as process_
 from feelmysign.broker._config import StateFiles, render_acl, write_password_file
 from feelmysign.broker.credentials import Credentials, write_private_file
+from feelmysign.broker.senders import load_senders
 from feelmysign.broker.sleeves import load_sleeves
 from feelmysign.errors import BrokerError
 
@@ -22,17 +23,19 @@ from feelmysign.errors import BrokerError
 def write_auth_files(
     files: StateFiles, credentials: Credentials, *, legacy_topic: str, mosquitto_dir: str | None
 ) -> None:
-    """passwd and acl for the first sleeve, the sender and every added sleeve."""
+    """passwd and acl for the first sleeve, the sender, every added sleeve and every named
+    sender the wearer has not blocked (a blocked one is in neither: no login, no rights)."""
     others = {
         sleeve_id: account
         for sleeve_id, account in load_sleeves(files.sleeves).items()
         if sleeve_id != credentials.sleeve_id
     }
+    senders = [s.account for s in load_senders(files.senders).values() if not s.blocked]
     dirs = ([mosquitto_dir] if mosquitto_dir else []) + process_.search_dirs()
     passwd_tool = process_.find_executable("mosquitto_passwd", dirs)
     write_password_file(
         files.passwords,
-        [credentials.sleeve, credentials.sender, *others.values()],
+        [credentials.sleeve, credentials.sender, *others.values(), *senders],
         mosquitto_passwd=passwd_tool,
     )
     acl = render_acl(
@@ -41,6 +44,7 @@ def write_auth_files(
         sender_username=credentials.sender.username,
         legacy_topic=legacy_topic,
         other_sleeves=[(sleeve_id, account.username) for sleeve_id, account in others.items()],
+        other_senders=[account.username for account in senders],
     )
     write_private_file(files.acl, acl)
 

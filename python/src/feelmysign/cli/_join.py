@@ -11,6 +11,7 @@ from feelmysign.broker import Credentials, StateFiles, default_state_dir, load_c
 from feelmysign.broker.accounts import reload_running_broker
 from feelmysign.broker.credentials import check_sleeve_id
 from feelmysign.broker.nats_accounts import render_nats_accounts
+from feelmysign.broker.senders import add_sender
 from feelmysign.broker.sleeves import add_sleeve, load_sleeves
 from feelmysign.connection.join_token import JoinToken
 from feelmysign.connection.settings import parse_broker_url
@@ -41,10 +42,21 @@ def run_add_sender(args: argparse.Namespace) -> int:
     url = _join_url(args, credentials, "sender")
     fingerprint = credentials.ca_fingerprint if args.url is None else None
     account = credentials.sender
+    reloaded = ""
+    if args.name is not None:
+        # An account of its own: the wearer can block this sender alone.
+        account = add_sender(files.senders, args.name).account
+        pid = reload_running_broker(files, credentials)
+        reloaded = (
+            f" (its own account: the running broker, pid {pid}, has it now)"
+            if pid
+            else " (its own account: the broker has it at its next start)"
+        )
     token = JoinToken(url, sleeve_id, account.username, account.password, fingerprint, "sender")
     print(token.encode(), flush=True)
     print(
-        f"Sender {account.username}, to sleeve {sleeve_id}. On the sender's machine run\n"
+        f"Sender {account.username}{reloaded}, to sleeve {sleeve_id}. On the sender's machine "
+        "run\n"
         "  feelmysign send --join TOKEN --shape heart\n"
         "with the line above as TOKEN (it holds a password: keep it like one)."
         + (

@@ -16,15 +16,24 @@ import segno
 
 from feelmysign.broker import Broker
 from feelmysign.broker.sleeves import load_sleeves
+from feelmysign.wearer_api import wearer_key
 from feelmysign.webserver import Api, WebServer
 
 ACCESS_KEY_BYTES = 16  # 128 bits: not guessable from the LAN
 
 
 def page_server(
-    broker: Broker, *, http_port: int, directory: Path, api: Api | None = None
-) -> tuple[WebServer, str]:
-    """The server (not yet started) and the URL to open, with its key when off loopback."""
+    broker: Broker,
+    *,
+    http_port: int,
+    directory: Path,
+    api: Api | None = None,
+    wearer_api: Api | None = None,
+) -> tuple[WebServer, str, str | None]:
+    """The server (not yet started), the URL to open, with its key when off loopback, and
+    with ``wearer_api`` the wearer's URL (always with the wearer's key, kept in the state
+    directory so that the wearer's bookmark outlives a restart)."""
+    w_key = wearer_key(broker.state_dir) if wearer_api is not None else None
     c = broker.credentials
     config: dict[str, Any] = {
         "ws_url": c.ws_url,
@@ -37,9 +46,15 @@ def page_server(
     debug_log = broker.state_dir / "page-server.log"
     if broker.lan is None:
         server = WebServer(
-            port=http_port, config=config, directory=directory, api=api, debug_log=debug_log
+            port=http_port,
+            config=config,
+            directory=directory,
+            api=api,
+            debug_log=debug_log,
+            wearer_api=wearer_api,
+            wearer_key=w_key,
         )
-        return server, server.url
+        return server, server.url, _wearer_url(server, w_key)
     key = secrets.token_urlsafe(ACCESS_KEY_BYTES)
     server = WebServer(
         port=http_port,
@@ -51,9 +66,15 @@ def page_server(
         access_key=key,
         mqtt_ws_port=c.ws_port,
         debug_log=debug_log,
+        wearer_api=wearer_api,
+        wearer_key=w_key,
     )
     server.set_config({**config, "ws_url": f"wss://{server.authority}/mqtt"})
-    return server, f"{server.url}?key={key}"
+    return server, f"{server.url}?key={key}", _wearer_url(server, w_key)
+
+
+def _wearer_url(server: WebServer, key: str | None) -> str | None:
+    return f"{server.url}wearer?key={key}" if key is not None else None
 
 
 def qr_text(url: str) -> str:

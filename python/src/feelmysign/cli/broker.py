@@ -3,7 +3,7 @@
     feelmysign broker [--state-dir DIR] [--port P] [--ws-port W] [--sleeve-id ID]
                       [--lan | --host ADDRESS] [--tls-port P] [--tls-cert FILE --tls-key FILE]
     feelmysign broker [--state-dir DIR] add-sleeve ID    # prints the sleeve's join token
-    feelmysign broker [--state-dir DIR] add-sender       # prints a sender's join token
+    feelmysign broker [--state-dir DIR] add-sender [--name NAME]  # a sender's join token
 
 Prints the URLs, the credentials file and the log file, then "Ready." once the broker
 accepts connections. Ctrl-C (SIGINT), SIGTERM or SIGHUP stop Mosquitto and exit 0.
@@ -110,6 +110,13 @@ def register(subparsers: Subcommands) -> None:
         metavar="ID",
         help="the sleeve the token sends to (default: the broker's first sleeve; send --id "
         "may name another)",
+    )
+    sender.add_argument(
+        "--name",
+        metavar="NAME",
+        help="give this sender an account of its own, which the wearer can block on the "
+        "wearer's page (1-64 letters, digits, '_' or '-'; the same name again prints the same "
+        "token); without it, the token holds the sender account every such token shares",
     )
     sender.add_argument(
         "--url",

@@ -7,6 +7,7 @@ import logging
 import sys
 from collections import Counter
 from collections.abc import Callable
+from contextlib import nullcontext
 from typing import TYPE_CHECKING
 
 from feelmysign.backends.base import Backend
@@ -18,8 +19,10 @@ from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.values import number, output_file, topic
 from feelmysign.cli.options.wearer import add_wearer_option, wearer_from_args
+from feelmysign.cli.options.wearer_page import add_wearer_page_options
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.errors import FeelMySignError
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.services.stop_signals import call_on_stop_signals
@@ -52,6 +55,7 @@ def register(subparsers: Subcommands) -> None:
     add_broker_options(parser, role="sleeve")
     add_layout_options(parser)
     add_wearer_option(parser)
+    add_wearer_page_options(parser)
     parser.add_argument(
         "--backend",
         choices=BACKEND_NAMES,
@@ -173,16 +177,35 @@ def run(args: argparse.Namespace) -> int:
             f"{floor.min_duration_ms:g} ms and {floor.min_length:g} grid units",
             flush=True,
         )
-    counts = run_sleeve(
-        settings,
-        layout,
-        options,
-        backend=args.backend,
-        record=args.record,
-        emulate=args.emulate,
-        emulate_state=args.emulate_state,
-        on_start=lambda sleeve: _on_start(sleeve, settings, options),
-    )
+    running: list[Sleeve] = []  # the sleeve once started: the wearer's page controls it
+    page = None
+    if args.wearer_host is not None and args.wearer_page is None:
+        raise FeelMySignError(
+            f"--wearer-host {args.wearer_host} needs --wearer-page [PORT]: add it to serve the "
+            "wearer's page, or leave --wearer-host out."
+        )
+    if args.wearer_page is not None:
+        from feelmysign.cli._wearer_page import wearer_page_server
+
+        page = wearer_page_server(args, options.sleeve_id, layout, running)
+
+    def started(sleeve: Sleeve) -> None:
+        running.append(sleeve)
+        _on_start(sleeve, settings, options)
+
+    with page[0] if page is not None else nullcontext():
+        if page is not None:
+            print(page[1], end="", flush=True)
+        counts = run_sleeve(
+            settings,
+            layout,
+            options,
+            backend=args.backend,
+            record=args.record,
+            emulate=args.emulate,
+            emulate_state=args.emulate_state,
+            on_start=started,
+        )
     print(
         f"Sleeve {options.sleeve_id} stopped, every motor off "
         f"({counts['played']} played, {counts['rejected']} rejected)",

@@ -27,6 +27,7 @@ from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.services.drawing_log import DrawingLog
 from feelmysign.services.stop_signals import call_on_stop_signals
 from feelmysign.services.watchdog import Watchdog
+from feelmysign.wearer_api import Blocking, WearerApi
 from feelmysign.webserver import WEB_DIST, Api
 
 DEFAULT_HTTP_PORT = 8000
@@ -123,8 +124,20 @@ def run(args: argparse.Namespace) -> int:
     watchdog = Watchdog(broker)
     with broker, watchdog, _study_api(args.study, broker.credentials) as api:
         c = broker.credentials
-        server, page_url = page_server(
-            broker, http_port=args.http_port, directory=args.web_dir, api=api
+        running: list[Sleeve] = []  # the sleeve, once started: the wearer's page controls it
+        wearer_api = WearerApi(
+            sleeve_id=c.sleeve_id,
+            max_intensity=layout.max_intensity,
+            controls=lambda: running[0].controls if running else None,
+            online=lambda: bool(running) and running[0].connected.is_set(),
+            blocking=Blocking(broker.files, c),
+        )
+        server, page_url, wearer_url = page_server(
+            broker,
+            http_port=args.http_port,
+            directory=args.web_dir,
+            api=api,
+            wearer_api=wearer_api,
         )
         with server:
             settings = c.settings("sleeve")
@@ -135,11 +148,12 @@ def run(args: argparse.Namespace) -> int:
             log = DrawingLog(c.settings("sender"), c.sleeve_id)  # a line per drawing
 
             def started(sleeve: Sleeve) -> None:
+                running.append(sleeve)
                 _stop_on_signals(sleeve, watchdog)
                 watchdog.watch(sleeve, log.listening)
                 threading.Thread(
                     target=_announce,
-                    args=(sleeve, page_url, broker, api is not None),
+                    args=(sleeve, page_url, broker, api is not None, wearer_url),
                     daemon=True,
                 ).start()
 
@@ -189,7 +203,9 @@ def _port_or_free(asked: int | None, default: int, name: str) -> int:
     return default
 
 
-def _announce(sleeve: Sleeve, url: str, broker: Broker, study: bool = False) -> None:
+def _announce(
+    sleeve: Sleeve, url: str, broker: Broker, study: bool = False, wearer_url: str | None = None
+) -> None:
     if not sleeve.connected.wait(15):
         print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
         return
@@ -208,12 +224,24 @@ def _announce(sleeve: Sleeve, url: str, broker: Broker, study: bool = False) -> 
         f"  Draw here:   {url}\n"
         + (f"  Study:       {url.split('?')[0]}study\n" if study else "")
         + lan
+        + _for_the_wearer(wearer_url, lan=bool(lan))
         + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
         f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"
         f"One line per drawing follows here once it has been played.\n"
         f"Press Ctrl-C to stop.",
         flush=True,
+    )
+
+
+def _for_the_wearer(url: str | None, *, lan: bool) -> str:
+    """The wearer's page: their own URL and key (pause, stop, a ceiling, block a sender)."""
+    if url is None:
+        return ""
+    code = f"{qr_text(url)}" if lan else ""
+    return (
+        f"  For the wearer's phone (pause, stop, a ceiling; keep this key from senders):\n"
+        f"               {url}\n{code}"
     )
 
 

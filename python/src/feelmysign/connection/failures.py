@@ -6,7 +6,7 @@ import socket
 import ssl
 from typing import TYPE_CHECKING
 
-from feelmysign.connection.settings import BrokerSettings
+from feelmysign.connection.settings import SENDER_USERNAME_PREFIX, BrokerSettings
 
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
     from paho.mqtt.reasoncodes import ReasonCode
@@ -74,6 +74,14 @@ def _login_refused_message(settings: BrokerSettings, code: ReasonCode) -> str:
     if code.value not in _LOGIN_REFUSED:
         return f"The broker at {settings.url} refused the connection ({code}, code {code.value})."
     who = f"user {settings.username!r}" if settings.username else "an anonymous login"
+    if settings.username and settings.username.startswith(SENDER_USERNAME_PREFIX):
+        # A sender with an account of its own: the wearer's page may have blocked it.
+        name = settings.username.removeprefix(SENDER_USERNAME_PREFIX)
+        return (
+            f"The broker at {settings.url} refused sender {name!r} ({code}): not authorised. "
+            "The wearer blocked this sender on the wearer's page (or its account was removed); "
+            "ask the wearer to unblock it, or ask for a new join token."
+        )
     return (
         f"The broker at {settings.url} refused {who} ({code}): check the user name and "
         "password, or pass the credentials.json of that broker with --credentials FILE "

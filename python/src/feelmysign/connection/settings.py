@@ -19,6 +19,9 @@ from feelmysign.topics import strokes_topic
 # Here, not in the broker package: the broker's files read URLs with parse_broker_url.
 DEFAULT_MQTT_PORT = 1883  # IANA's MQTT port
 DEFAULT_SLEEVE_ID = "sleeve1"
+# The user names of the senders with an account of their own (broker add-sender --name),
+# which the wearer may block.
+SENDER_USERNAME_PREFIX = "sender-"
 Transport = Literal["tcp", "websockets"]
 # scheme -> (transport, TLS on, default port)
 SCHEMES: dict[str, tuple[Transport, bool, int]] = {

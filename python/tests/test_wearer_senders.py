@@ -1,0 +1,181 @@
+"""The wearer blocks a sender, against real processes: ``feelmysign up`` (its Mosquitto,
+its simulated sleeve, its page server with the wearer's API), ``broker add-sender --name``
+and a real ``feelmysign send --join TOKEN``.
+
+Blocking rewrites the password file and the ACL and reloads Mosquitto: a connected client
+of that account is disconnected (Mosquitto 2.0 checks every client again on SIGHUP) and
+its next login refused, which ``send`` reports in words. Unblocking gives the same token
+back its rights; a block outlives a restart of ``up``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import re
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+from sleeve_watch import connected_client, stop_loop
+
+from feelmysign.broker import Broker
+from feelmysign.connection.join_token import decode_join_token
+from feelmysign.connection.settings import parse_broker_url
+
+FEELMYSIGN = str(Path(sys.executable).parent / "feelmysign")
+WAIT_S = 60.0  # start-up of Mosquitto, the sleeve and the web server on a loaded machine
+WEARER_URL = re.compile(r"(http://127\.0\.0\.1:\d+/)wearer\?key=([\w-]+)")
+
+pytestmark = pytest.mark.broker
+
+
+class Up:
+    """A running ``feelmysign up`` and its wearer's API."""
+
+    def __init__(self, process: subprocess.Popen[str], base: str, key: str) -> None:
+        self.process = process
+        self.base = base
+        self.key = key
+
+    def call(self, action: str, body: dict[str, object] | None = None) -> dict[str, object]:
+        request = urllib.request.Request(
+            f"{self.base}api/wearer/{action}",
+            data=None if body is None else json.dumps(body).encode(),
+            headers={
+                "Cookie": f"feelmysign_wearer_key={self.key}",
+                "Content-Type": "application/json",
+            },
+            method="GET" if body is None else "POST",
+        )
+        with urllib.request.urlopen(request, timeout=WAIT_S) as answer:
+            result: dict[str, object] = json.load(answer)
+            return result
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+@contextmanager
+def running_up(state_dir: Path, mqtt_port: int) -> Iterator[Up]:
+    # The same MQTT port at each start: a join token holds the broker's URL.
+    process = subprocess.Popen(
+        [
+            *(FEELMYSIGN, "up", "--state-dir", str(state_dir)),
+            *("--http-port", "0", "--port", str(mqtt_port), "--ws-port", "0"),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    lines: queue.Queue[str] = queue.Queue()
+    assert process.stdout is not None
+    stdout = process.stdout
+
+    def read() -> None:
+        for line in stdout:
+            lines.put(line)
+
+    threading.Thread(target=read, daemon=True).start()
+    try:
+        seen: list[str] = []
+        while not seen or "Ctrl-C" not in seen[-1]:
+            seen.append(lines.get(timeout=WAIT_S))
+        found = WEARER_URL.search("".join(seen))
+        assert found is not None, "".join(seen)
+        yield Up(process, found[1], found[2])
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(WAIT_S)
+
+
+def add_sender(state_dir: Path, name: str) -> str:
+    added = subprocess.run(
+        [FEELMYSIGN, "broker", "--state-dir", str(state_dir), "add-sender", "--name", name],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    assert added.returncode == 0, added.stderr
+    return added.stdout.strip()
+
+
+def send(token: str, tmp_path: Path) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    env["XDG_STATE_HOME"] = str(tmp_path / "sender-state")
+    return subprocess.run(
+        [FEELMYSIGN, "send", "--join", token, "--shape", "line", "--timeout-s", "20"],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S * 2,
+        env=env,
+    )
+
+
+def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Path) -> None:
+    state_dir = tmp_path / "up"
+    mqtt_port = free_port()
+    with running_up(state_dir, mqtt_port) as up:
+        token = add_sender(state_dir, "alice")
+        assert add_sender(state_dir, "alice") == token  # the same name: the same account
+        login = decode_join_token(token)
+        assert login.username == "sender-alice"
+        senders = up.call("state")["senders"]
+        assert {"name": "alice", "blocked": False, "blockable": True} in senders  # type: ignore[operator]
+
+        sent = send(token, tmp_path)
+        assert sent.returncode == 0, sent.stdout + sent.stderr
+        assert "The sleeve played" in sent.stdout, sent.stdout
+
+        # A client of alice's, connected when the wearer blocks her.
+        client = connected_client(
+            parse_broker_url(login.url, username=login.username, password=login.password)
+        )
+        gone = threading.Event()
+        client.on_disconnect = lambda *_: gone.set()
+        try:
+            state = up.call("block", {"sender": "alice"})
+            assert {"name": "alice", "blocked": True, "blockable": True} in state["senders"]  # type: ignore[operator]
+            assert gone.wait(WAIT_S), "the blocked sender's connection was not cut"
+        finally:
+            stop_loop(client)
+
+        refused = send(token, tmp_path)
+        assert refused.returncode != 0, refused.stdout + refused.stderr
+        assert "The wearer blocked this sender" in refused.stderr, refused.stderr
+        assert "Traceback" not in refused.stderr
+
+    # A restart of up keeps the block.
+    with running_up(state_dir, mqtt_port) as up:
+        assert {"name": "alice", "blocked": True, "blockable": True} in up.call("state")["senders"]  # type: ignore[operator]
+        refused = send(token, tmp_path)
+        assert "The wearer blocked this sender" in refused.stderr, refused.stderr
+        up.call("unblock", {"sender": "alice"})
+        sent = send(token, tmp_path)
+        assert sent.returncode == 0, sent.stdout + sent.stderr
+        assert "The sleeve played" in sent.stdout, sent.stdout
+
+
+@pytest.mark.parametrize("name", ["page", "a/b", "", "x" * 65])
+def test_add_sender_refuses_a_name_it_cannot_use(broker: Broker, name: str) -> None:
+    added = subprocess.run(
+        [FEELMYSIGN, "broker", "--state-dir", str(broker.state_dir), "add-sender", "--name", name],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    assert added.returncode == 1, added.stdout + added.stderr
+    assert "1 to 64 letters, digits" in added.stderr and "Traceback" not in added.stderr
+    assert added.stdout == "" and not broker.files.senders.exists()
