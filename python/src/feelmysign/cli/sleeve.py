@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from feelmysign.backends.factory import BACKEND_NAMES, BackendName, open_backend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
@@ -18,6 +17,7 @@ from feelmysign.cli.options.values import number, output_file, topic
 from feelmysign.cli.options.wearer import add_wearer_option, wearer_from_args
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
+from feelmysign.fates import Fate
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.services.stop_signals import call_on_stop_signals
@@ -168,7 +168,7 @@ def run(args: argparse.Namespace) -> int:
             f"{floor.min_duration_ms:g} ms and {floor.min_length:g} grid units",
             flush=True,
         )
-    counts = run_sleeve(
+    sleeve = run_sleeve(
         settings,
         layout,
         options,
@@ -178,12 +178,21 @@ def run(args: argparse.Namespace) -> int:
         emulate_state=args.emulate_state,
         on_start=lambda sleeve: _on_start(sleeve, settings, options),
     )
-    print(
-        f"Sleeve {options.sleeve_id} stopped, every motor off "
-        f"({counts['played']} played, {counts['rejected']} rejected)",
-        flush=True,
-    )
+    totals = stop_totals(sleeve.stroke_totals())
+    print(f"Sleeve {options.sleeve_id} stopped, every motor off ({totals})", flush=True)
     return 0
+
+
+def stop_totals(totals: Mapping[Fate, int]) -> str:
+    """What the sleeve did with every stroke, by fate (feelmysign.fates, as ``up``'s lines and
+    the page count): played and rejected always, cut short and cancelled when there were any."""
+    parts = [f"{totals['played']} played"]
+    if totals["cut"]:
+        parts.append(f"{totals['cut']} cut short")
+    if totals["cancelled"]:
+        parts.append(f"{totals['cancelled']} cancelled")
+    parts.append(f"{totals['refused']} rejected")
+    return ", ".join(parts)
 
 
 def run_sleeve(
@@ -196,8 +205,9 @@ def run_sleeve(
     emulate: bool = False,
     emulate_state: str | None = None,
     on_start: Callable[[Sleeve], None] = lambda sleeve: None,
-) -> Counter[str]:
-    """Open the backend with its telemetry, run the sleeve until it stops; every motor off after."""
+) -> Sleeve:
+    """Open the backend with its telemetry, run the sleeve until it stops; every motor off after.
+    Returns the stopped sleeve (its counts, its strokes by fate)."""
     sleeves: list[Sleeve] = []
 
     def publish(frame: ActuatorFrame) -> None:
@@ -219,7 +229,7 @@ def run_sleeve(
         sleeves.append(sleeve)
         on_start(sleeve)
         sleeve.run()
-    return sleeve.counts
+    return sleeve
 
 
 def _on_start(sleeve: Sleeve, settings: BrokerSettings, options: SleeveOptions) -> None:
