@@ -147,7 +147,6 @@ export class FeltPanel {
    * as nothing of them can be felt.
    */
   unsent(seqs: readonly number[]): void {
-    if (seqs.length === 0) return;
     this.#sync();
     for (const seq of seqs) this.#placement.refuse(seq);
     this.refresh();
