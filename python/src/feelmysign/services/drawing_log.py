@@ -7,9 +7,10 @@ sender's account) and prints one line per drawing id once that drawing is over::
     (by 1.6 s), 1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
 
 A stroke delayed on the way was felt more than ``events.DELAYED_MS`` after its
-sender sent it, not counting its wait behind the strokes before it
-(``events.is_delayed``; the page marks the same ones): it waited at the broker or
-on the way, the sleeve offline or the network slow. It was played; a stroke the
+sender drew it (its ``sent_at_ms``), not counting its wait behind the strokes before
+it (``events.is_delayed``; the page marks the same ones): it was held on the way, by
+its sender while the broker was out of reach, at the broker while the sleeve was
+offline, or by a slow network. It was played; a stroke the
 sleeve skipped for being too far behind is a ``late`` refusal, under rejected.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
