@@ -109,6 +109,10 @@ def test_a_chip_lost_mid_stroke_cuts_the_stroke_says_which_chip_and_switches_all
             assert "Traceback" not in errors, errors
             assert "Error: Could not switch off every actuator" in errors, errors
             assert f"channel {wire.channel} (actuator row {ROW}, column {LOST_COLUMN})" in errors
+            # Its journal counts by the fates: the stroke the chip cut part-way is cut short,
+            # not played; the one it cut before it was felt is rejected.
+            assert "Drawing bench-ki: 0 strokes played, 1 cut short" in errors, errors
+            assert "Drawing d: 0 strokes played, 1 rejected (chip_lost)" in errors, errors
         finally:
             sleeve.kill()
             sleeve.wait(WAIT_S)

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 
+from feelmysign.cli.sleeve import stop_totals
 from feelmysign.events import (
     Adjusted,
     Cancelled,
@@ -259,6 +260,29 @@ def test_a_stroke_the_duty_cycle_cap_refused_is_counted_in_its_drawing() -> None
         "Drawing dddddddd: 1 stroke played, 1 rejected (duty_cycle); "
         "start delay median 2 ms, max 2 ms"
     ]
+
+
+def test_the_sleeves_stop_line_counts_every_stroke_once_by_its_fate() -> None:
+    # What the sleeve says as it stops: a stroke a lost chip cut after its played event is cut
+    # short, not played; one the duty-cycle cap kept from playing is rejected; a copy after a
+    # broker restart changes nothing; a drawing printed and then going on counts once.
+    summaries = DrawingSummaries(quiet_s=1.5)
+    first, second = "ffffffff-6666", "gggggggg-7777"
+
+    def ref(drawing: str, seq: int) -> StrokeRef:
+        return StrokeRef(drawing=drawing, seq=seq, received_at_ms=1)
+
+    lost = Safety(reason="chip_lost", row=1, column=2, message="m", stroke=ref(first, 1))
+    capped = Safety(reason="duty_cycle", row=0, column=1, stroke=ref(first, 2))
+    copy = Rejected(reason="duplicate", message="m", stroke=ref(first, 0), original_played=True)
+    for event in (_played(first, 2.0, seq=0), _played(first, 2.0, seq=1), lost, capped, copy):
+        summaries.add(event, now_s=0.0)
+    summaries.finished(100.0)  # its line is printed; a stroke that comes later still counts
+    summaries.add(_played(first, 2.0, seq=3), now_s=101.0)
+    stopped = Cancelled(message="m", stroke=ref(second, 0), cancelled_at_ms=2, started=False)
+    summaries.add(stopped, now_s=101.0)
+    assert summaries.totals() == {"played": 2, "cut": 1, "cancelled": 1, "refused": 1}
+    assert stop_totals(summaries.totals()) == "2 played, 1 cut short, 1 cancelled, 1 rejected"
 
 
 def test_strokes_without_a_drawing_id_are_not_called_legacy() -> None:

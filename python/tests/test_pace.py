@@ -63,9 +63,25 @@ def test_after_a_stall_the_backlog_is_skipped_down_to_real_time() -> None:
     played = [v for v in backlog if v.reason is None]
     assert played and all((v.lag_ms or 0.0) <= policy.catch_up_ms for v in played)
     assert "skips strokes" in skipped[0].message
+    assert "held on the way" in skipped[0].message and "queued" not in skipped[0].message
     # And what is drawn after the stall plays on time.
     after = [sleeve.receive(k, 1e6 + k * DURATION_MS, 5.0) for k in range(60, 70)]
     assert all(v.reason is None and (v.lag_ms or 0.0) <= policy.catch_up_ms for v in after)
+
+
+def test_a_stroke_late_behind_another_drawing_is_said_to_be_queued_not_held() -> None:
+    # It came at once, but another drawing holds the sleeve for 3 s: its message says so.
+    verdict = PacePolicy(max_lag_ms=1_000.0).check(
+        drawing="b",
+        seq=0,
+        sent_at_ms=1e6,
+        received_wall_ms=1e6 + 5.0,
+        start_wall_ms=1e6 + 3_005.0,
+        duration_ms=DURATION_MS,
+    )
+    assert verdict.reason == LATE and verdict.lag_ms == pytest.approx(3_000.0)
+    assert "wait 3.00 s behind the strokes queued" in verdict.message
+    assert "held on the way" not in verdict.message
 
 
 def test_strokes_older_than_the_maximum_age_are_stale() -> None:

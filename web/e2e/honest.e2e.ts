@@ -6,19 +6,23 @@
  * while a drawing plays. Every stroke has one fate (fates.ts, Python's feelmysign.fates): the
  * page's counts, `up`'s line and the study's summary must say the same, add up to the strokes
  * drawn, and the strokes the record felt must be exactly those called played or cut short.
+ * The felt timeline's caption counts from the same fates as the card, and leaves out strokes
+ * never sent; and a stroke held while the broker was away carries the time it was drawn, so
+ * one felt late is counted delayed on the page and in `up`'s line alike (or refused as late).
  */
 import { spawnSync } from "node:child_process";
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { readEvent } from "../src/events";
+import { isDelayed, readEvent, type AdjustedEvent, type PlayedEvent } from "../src/events";
 import { DrawingFates, type Fate } from "../src/fates";
 import { collectUntil, EventWatcher, REPO_DIR, type Credentials } from "./harness";
 import { drawingArea, nextFrame, screenshot, waitForData, type Area } from "./page";
 import { Processes, type Up } from "./processes";
 
 const SUMMARY = '[data-testid="played-summary"]';
+const CAPTION = '[data-testid="timeline-caption"]';
 const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
 /** `up` prints a drawing's line once it has been quiet this long (drawing_log.IDLE_S) and more. */
 const LINE_TIMEOUT_MS = 40_000;
@@ -32,6 +36,7 @@ interface PageCounts {
   cancelled: number;
   refused: number;
   dropped: number;
+  delayed: number;
 }
 
 async function pageCounts(page: Page): Promise<PageCounts> {
@@ -44,6 +49,23 @@ async function pageCounts(page: Page): Promise<PageCounts> {
     cancelled: read("cancelled"),
     refused: read("refused"),
     dropped: read("dropped"),
+    delayed: read("delayed"),
+  };
+}
+
+/**
+ * What the felt timeline's caption says became of the strokes, in the card's terms. Its short
+ * form (", as the sleeve played them.") says every stroke was played.
+ */
+function captionCounts(caption: string, sent: number): Omit<PageCounts, "sent" | "delayed"> {
+  const count = (pattern: RegExp) => [...caption.matchAll(pattern)].reduce((n, m) => n + Number(m[1]), 0);
+  const all = /^\d+ strokes?, [\d.]+ s, as the sleeve played them\.$/.test(caption);
+  return {
+    played: all ? sent : count(/(\d+) (?:as the sleeve played them|played \()/g),
+    cut: count(/(\d+) cut short/g),
+    cancelled: count(/(\d+) cancelled by Stop/g),
+    refused: count(/(\d+) (?:refused by the sleeve|not felt \(the sleeve's duty-cycle cap)/g),
+    dropped: count(/(\d+) never sent/g),
   };
 }
 
@@ -68,6 +90,11 @@ function upCounts(line: string): Record<"played" | "cut" | "cancelled" | "refuse
     cancelled: count(/(\d+) cancelled/),
     refused: count(/(\d+) rejected/),
   };
+}
+
+/** How many strokes `up`'s line calls delayed on the way. */
+function upDelayed(line: string): number {
+  return Number(/(\d+) delayed on the way/.exec(line)?.[1] ?? 0);
 }
 
 /** The study's summary of a send (study/runner.py events_summary) over these events. */
@@ -107,11 +134,41 @@ function fatesOf(events: readonly Record<string, unknown>[]): DrawingFates {
   return fates;
 }
 
-function mosquittoOf(up: Up): number {
+/** The Mosquitto `up` runs: none while it is starting one again. */
+function mosquittosOf(up: Up): number[] {
   const found = spawnSync("pgrep", ["-P", String(up.child.pid), "mosquitto"], { encoding: "utf8" });
-  const pids = found.stdout.split(/\s+/).filter(Boolean).map(Number);
+  return found.stdout.split(/\s+/).filter(Boolean).map(Number);
+}
+
+function mosquittoOf(up: Up): number {
+  const pids = mosquittosOf(up);
   if (pids.length !== 1) throw new Error(`expected one mosquitto under up, found ${JSON.stringify(pids)}`);
   return pids[0]!;
+}
+
+/** The played events among `events`, each once. */
+function playedOf(events: readonly Record<string, unknown>[]): (PlayedEvent | AdjustedEvent)[] {
+  const seen = new Set<string>();
+  const played: (PlayedEvent | AdjustedEvent)[] = [];
+  for (const wire of events) {
+    const event = readEvent(wire);
+    const text = JSON.stringify(wire);
+    if (event === null || seen.has(text) || (event.type !== "played" && event.type !== "adjusted")) continue;
+    seen.add(text);
+    played.push(event);
+  }
+  return played;
+}
+
+/**
+ * Strokes held while the broker was away carry the time they were drawn: the first drawn offline
+ * reaches the sleeve over a second after its `sent_at_ms` (whether it then played or was refused).
+ */
+function expectHeldStrokesKeepTheirDrawnTime(events: readonly Record<string, unknown>[]): void {
+  const ages = events
+    .filter((e) => typeof e["sent_at_ms"] === "number" && typeof e["received_at_ms"] === "number")
+    .map((e) => (e["received_at_ms"] as number) - (e["sent_at_ms"] as number));
+  expect(Math.max(...ages), `ages ${JSON.stringify(ages)}`).toBeGreaterThan(1000);
 }
 
 describe("honest after faults: the page, up and the study agree with what the sleeve felt", () => {
@@ -177,6 +234,16 @@ describe("honest after faults: the page, up and the study agree with what the sl
     }
     expect(upCounts(line), `${line}\n${output}`).toEqual(byFate);
     console.log(`page: ${JSON.stringify(counts)}\nup: ${line.trim()}`);
+    // Delayed on the way, by one definition (events.ts isDelayed): the page and up name the same.
+    const delayed = playedOf(events).filter((event) => isDelayed(event)).length;
+    expect(counts.delayed).toBe(delayed);
+    expect(upDelayed(line), line).toBe(delayed);
+    // The felt timeline's caption says what the card says.
+    const caption = await page.locator(CAPTION).innerText();
+    const { sent, delayed: _delayed, ...card } = counts;
+    expect(captionCounts(caption, sent), caption).toEqual(card);
+    expect(caption).not.toContain("the rest"); // every stroke has its fate
+    console.log(`caption: ${caption}`);
     // The study's summary of the same events.
     const study = studySummary(events, counts.sent);
     console.log(`study: ${JSON.stringify(study)}`);
@@ -259,6 +326,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
       expect(counts).toEqual(before);
       const byFate = await expectAllAgree(drawing, counts);
       expect(byFate.played).toBeGreaterThan(0);
+      expectHeldStrokesKeepTheirDrawnTime(watcher.of(drawing));
       const log = await page.locator('[data-testid="event-log"]').innerText();
       expect(log).toContain(cameAgain);
       expect(log).not.toContain(`Stroke ${playedSeq} refused`);
@@ -266,6 +334,70 @@ describe("honest after faults: the page, up and the study agree with what the sl
       // study and the record above); refusals are only those of other strokes (late, after the outage).
       expect(fatesOf(watcher.of(drawing)).fate(playedSeq)).toBe("played");
       await screenshot(page, "honest-after-broker-restart");
+    },
+  );
+
+  it(
+    "a long drawing through repeated broker restarts, Drop late: the caption counts as the card, strokes never sent off the timeline",
+    { timeout: 300_000 },
+    async () => {
+      // Drop late: a stroke the page could not send within 2 s is dropped, never sent.
+      await page.locator('[data-testid="settings-button"]').click();
+      await page.getByText("Drop late").click();
+      await page.locator('[data-testid="settings-save"]').click();
+      await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
+      await page.locator('[data-testid="new-button"]').click();
+      // A zigzag of 28 legs (7 s); the broker is killed three times, pen down: at the first leg
+      // from 3, 12 and 21 on at which up runs one (not while it is starting the next).
+      const legs = 28;
+      const killFrom = [3, 12, 21];
+      const corners: Point[] = [];
+      for (let i = 0; i <= legs; i++) corners.push(at(0.04 + (0.92 * i) / legs, i % 2 === 0 ? 0.2 : 0.8));
+      let kills = 0;
+      await page.mouse.move(...corners[0]!);
+      await page.mouse.down();
+      await nextFrame(page);
+      for (let i = 1; i < corners.length; i++) {
+        const pids = mosquittosOf(up);
+        if (kills < killFrom.length && i >= killFrom[kills]! && pids.length === 1) {
+          process.kill(pids[0]!, "SIGKILL");
+          kills++;
+        }
+        const [ax, ay] = corners[i - 1]!;
+        const [bx, by] = corners[i]!;
+        const startMs = performance.now();
+        for (let done = 0; done < 1;) {
+          done = Math.min(1, (performance.now() - startMs) / 250);
+          await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
+          await nextFrame(page);
+        }
+      }
+      await page.mouse.up();
+      expect(kills).toBeGreaterThanOrEqual(2); // repeated, whatever the machine's pace
+      const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
+      // The broker back for good, the sleeve connected to it, and the page too.
+      const deadline = Date.now() + 60_000;
+      const back = () =>
+        output.lastIndexOf("Back: the broker is running again") >
+        Math.max(output.lastIndexOf("The broker stopped"), output.lastIndexOf("The sleeve lost the broker"));
+      while (mosquittosOf(up).length !== 1 || !back()) {
+        if (Date.now() > deadline) throw new Error(`the broker did not come back:\n${output}`);
+        await new Promise((wake) => setTimeout(wake, 200));
+      }
+      await waitForData(page, '[data-testid="broker-status"]', "state", "connected", 60_000);
+      const counts = await waitForEveryStroke(page);
+      console.log(`${kills} broker kills`);
+      await expectAllAgree(drawing, counts);
+      expectHeldStrokesKeepTheirDrawnTime(watcher.of(drawing));
+      // Strokes never sent, and refused on arrival, are not on the timeline: the rest are.
+      const onTimeline = Number(await page.locator('[data-testid="timeline"]').getAttribute("data-strokes"));
+      expect(onTimeline).toBe(counts.sent - counts.dropped - counts.refused);
+      await screenshot(page, "honest-after-repeated-restarts");
+      // Send late again, as the other tests expect.
+      await page.locator('[data-testid="settings-button"]').click();
+      await page.getByText("Send late").click();
+      await page.locator('[data-testid="settings-save"]').click();
+      await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
     },
   );
 

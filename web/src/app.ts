@@ -10,6 +10,7 @@ import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
 import { EventCopies, interpretEvent, parseEvent } from "./events";
 import { StrokeSender, type BrokerState } from "./mqtt/sender";
+import type { Stroke } from "./protocol";
 import { buildRecording, recordingFileName } from "./recording";
 import { drawingFromRecording, parseRecording } from "./recording-load";
 import { LATE_LIMIT_MS, loadSettings, saveSettings, withServerBroker, type Settings } from "./settings";
@@ -84,7 +85,8 @@ export class App {
       byId<HTMLCanvasElement>(doc, "timeline-cursor"),
       byId(doc, "timeline-caption"),
     );
-    this.#felt = new FeltPanel(timeline, this.#view);
+    // The caption counts from the card: one tally of what became of each stroke (fates.ts).
+    this.#felt = new FeltPanel(timeline, this.#view, this.#says);
     this.#panel = new SettingsPanel(doc, (settings) => this.#applySettings(settings));
     this.#picker = new SleevePicker(
       byId<HTMLSelectElement>(doc, "sleeve-select"),
@@ -139,12 +141,9 @@ export class App {
       acked: (stroke) => this.#session.acked(stroke),
       refused: (_stroke, error) => this.#says.add("error", `A stroke was not sent: ${error.message}`),
       late: (strokes) => {
-        const drawing = this.#session.drawing;
-        for (const stroke of strokes) {
-          if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
-            this.#session.refused(stroke.seq, "unsent");
-        }
+        const unsent = this.#markUnsent(strokes);
         this.#says.addDropped(strokes.length);
+        this.#felt.unsent(unsent);
         this.#says.add(
           "info",
           `${strokes.length} stroke(s) dropped: not sent within ${LATE_LIMIT_MS / 1000} s.`,
@@ -237,16 +236,25 @@ export class App {
     this.#felt.stopCursor();
     this.#session.close();
     // Never sent: marked as such, and counted apart from what the sleeve cancelled.
-    for (const stroke of dropped) {
-      if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
-        this.#session.refused(stroke.seq, "unsent");
-    }
+    const unsent = this.#markUnsent(dropped);
     if (dropped.length > 0) this.#says.addDropped(dropped.length);
+    this.#felt.unsent(unsent);
     this.#says.add(
       "info",
       `Stop sent${dropped.length > 0 ? `; ${dropped.length} unsent stroke(s) dropped` : ""}. ` +
         "Strokes the sleeve had not played yet are cancelled.",
     );
+  }
+
+  /** Marks the current drawing's `strokes` never sent on the canvas; returns their seqs. */
+  #markUnsent(strokes: readonly Stroke[]): number[] {
+    const drawing = this.#session.drawing;
+    const seqs: number[] = [];
+    for (const stroke of strokes) {
+      if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null) seqs.push(stroke.seq);
+    }
+    for (const seq of seqs) this.#session.refused(seq, "unsent");
+    return seqs;
   }
 
   /** Sends the current drawing's strokes again, as a new drawing (the sleeve plays them back to back). */
@@ -440,6 +448,7 @@ export class App {
     if (reading.cancelled !== null) this.#felt.cancelled(reading.cancelled);
     if (ours && (fate === "refused" || fate === "cancelled")) this.#session.refused(seq, fate);
     if (reading.unplayed !== null && !feltCopy) this.#felt.unplayed(reading.unplayed);
+    else if (ours && reading.played === null && reading.cancelled === null) this.#felt.told(seq);
     if (feltCopy) {
       this.#says.add(
         "info",

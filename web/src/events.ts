@@ -515,7 +515,7 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
         counts.push("delayed");
         notes.push({
           kind: "adjusted",
-          text: `${label} delayed ${seconds(delayMs)} on the way (held at the broker or by the network).`,
+          text: `${label} delayed ${seconds(delayMs)} on the way (held while the broker was out of reach, at the broker, or by the network).`,
         });
       }
       if (event.type === "adjusted") {

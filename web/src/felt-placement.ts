@@ -160,6 +160,11 @@ export class FeltPlacement {
     return this.#cappedCount;
   }
 
+  /** Whether the sleeve's duty-cycle cap kept stroke `seq` from playing. */
+  isCapped(seq: number): boolean {
+    return this.#capped.has(seq);
+  }
+
   /** When the last stroke ends (0 for none), as felt.ts's totalMs. */
   get totalMs(): number {
     return Math.max(0, this.#prefixEndMs[this.#prefixEndMs.length - 1] ?? 0);

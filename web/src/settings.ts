@@ -136,7 +136,10 @@ export const FIELDS: readonly FieldSpec[] = [
     key: "late_strokes",
     section: "drawing",
     label: "Timing",
-    help: `strokes drawn while the broker is out of reach: sent when it is back (felt late), or dropped after ${LATE_LIMIT_MS / 1000} s`,
+    help:
+      `strokes drawn while the broker is out of reach: sent when it is back, with the time they were drawn ` +
+      `(the sleeve plays those it is not too late for, counted delayed, and refuses the rest as late), ` +
+      `or dropped after ${LATE_LIMIT_MS / 1000} s`,
     kind: "choice",
     choices: [
       { value: "send", label: "Send late" },

@@ -82,7 +82,7 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     expect(delayed.counts).toEqual(["played", "delayed"]);
     expect(delayed.delayMs).toBeCloseTo(1500, 6);
     expect(delayed.notes.map((note) => note.text)).toEqual([
-      "Stroke 3 delayed 1.5 s on the way (held at the broker or by the network).",
+      "Stroke 3 delayed 1.5 s on the way (held while the broker was out of reach, at the broker, or by the network).",
     ]);
     const queued = interpretEvent({ ...played, sent_at_ms: sentAtMs, queued_ms: 1500 }, DRAWING);
     expect(queued.counts).toEqual(["played"]);

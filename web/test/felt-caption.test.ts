@@ -1,38 +1,186 @@
-/** The felt timeline's caption: whose times it shows, and what of the drawing was not felt. */
-import { describe, expect, it } from "vitest";
-import { timelineCaption } from "../src/ui/felt-panel";
+/**
+ * The felt timeline's caption: whose times it shows, and what became of the strokes, in the
+ * counts of the "Sleeve says" card (fates.ts), so that the two never contradict each other.
+ */
+import { beforeAll, describe, expect, it, vi } from "vitest";
+import { Drawing } from "../src/drawing";
+import { readEvent, type SleeveEvent } from "../src/events";
+import { DrawingFates } from "../src/fates";
+import { DEFAULT_ANGLE_PARAMS } from "../src/simplify/params";
+import type { DrawingView } from "../src/ui/canvas";
+import { FeltPanel, timelineCaption, type Tally, type TallySource } from "../src/ui/felt-panel";
+import type { TimelineView } from "../src/ui/timeline";
+
+const NONE: Tally = { sent: 4, played: 0, cut: 0, cancelled: 0, refused: 0, dropped: 0 };
+const on = (count: number, reported: number, capped = 0) => ({ count, seconds: "1.0", reported, capped });
 
 describe("timelineCaption", () => {
-  it("says the times are the page's own until the sleeve reports", () => {
-    expect(timelineCaption(4, 0, 0)).toBe(": what would be felt, played back to back as the sleeve does.");
+  it("says the times are the page's own until the sleeve answers", () => {
+    expect(timelineCaption(on(4, 0), NONE, false)).toBe(
+      "4 strokes, 1.0 s: what would be felt, played back to back as the sleeve does.",
+    );
   });
 
-  it("says which times are the sleeve's", () => {
-    expect(timelineCaption(4, 4, 0)).toBe(", as the sleeve played them.");
-    expect(timelineCaption(4, 1, 0)).toBe("; 1 as the sleeve played them, the rest as it would.");
+  it("says which times are the sleeve's, in the card's count", () => {
+    expect(timelineCaption(on(4, 4), { ...NONE, played: 4 }, false)).toBe(
+      "4 strokes, 1.0 s, as the sleeve played them.",
+    );
+    expect(timelineCaption(on(4, 1), { ...NONE, played: 1 }, false)).toBe(
+      "4 strokes, 1.0 s; 1 as the sleeve played them, the rest as it would.",
+    );
   });
 
   it("never calls a stroke the duty-cycle cap kept from playing played", () => {
-    expect(timelineCaption(4, 0, 1)).toBe(
-      "; 1 not felt (the sleeve's duty-cycle cap kept it from playing), the rest as it would.",
+    expect(timelineCaption(on(4, 0, 1), { ...NONE, refused: 1 }, false)).toBe(
+      "4 strokes, 1.0 s; 1 not felt (the sleeve's duty-cycle cap kept it from playing), the rest as it would.",
     );
-    expect(timelineCaption(4, 2, 2)).toBe(
-      "; 2 as the sleeve played them, 2 not felt (the sleeve's duty-cycle cap kept them from playing).",
+    expect(timelineCaption(on(4, 2, 2), { ...NONE, played: 2, refused: 2 }, false)).toBe(
+      "4 strokes, 1.0 s; 2 as the sleeve played them, 2 not felt (the sleeve's duty-cycle cap kept them from playing).",
+    );
+  });
+
+  it("counts a played stroke whose report never came as played, and says its time is the page's", () => {
+    expect(timelineCaption(on(4, 3), { ...NONE, played: 4 }, false)).toBe(
+      "4 strokes, 1.0 s; 4 played (the times of 1 are the page's: the sleeve's report of it never came).",
+    );
+  });
+
+  it("says strokes never sent or refused on arrival apart: they are not on the timeline", () => {
+    expect(timelineCaption(on(2, 2), { ...NONE, played: 2, refused: 1, dropped: 1 }, false)).toBe(
+      "2 strokes, 1.0 s; 2 as the sleeve played them, 1 refused by the sleeve (not on the timeline), " +
+        "1 never sent (not on the timeline).",
     );
   });
 });
 
 describe("timelineCaption after Stop", () => {
   it("never says the rest plays as it would once Stop was pressed", () => {
-    expect(timelineCaption(6, 2, 0, { cancelled: 3, stopped: true })).toBe(
-      "; 2 as the sleeve played them, 3 cancelled by Stop before they played, the rest stopped: not felt.",
+    const six = { ...NONE, sent: 6 };
+    expect(timelineCaption(on(6, 2), { ...six, played: 2, cancelled: 3 }, true)).toBe(
+      "6 strokes, 1.0 s; 2 as the sleeve played them, 3 cancelled by Stop before they played, the rest stopped: not felt.",
     );
-    expect(timelineCaption(4, 0, 0, { cancelled: 0, stopped: true })).toBe("; the rest stopped: not felt.");
-    expect(timelineCaption(4, 3, 0, { cancelled: 1, stopped: true })).toBe(
-      "; 3 as the sleeve played them, 1 cancelled by Stop before it played.",
+    expect(timelineCaption(on(4, 0), NONE, true)).toBe("4 strokes, 1.0 s; the rest stopped: not felt.");
+    expect(timelineCaption(on(4, 3), { ...NONE, played: 3, cancelled: 1 }, true)).toBe(
+      "4 strokes, 1.0 s; 3 as the sleeve played them, 1 cancelled by Stop before it played.",
     );
-    expect(timelineCaption(6, 4, 0, { cancelled: 2, cut: 1, stopped: true })).toBe(
-      "; 4 as the sleeve played them (1 cut short by Stop), 2 cancelled by Stop before they played.",
+    expect(timelineCaption(on(6, 4), { ...six, played: 3, cut: 1, cancelled: 2 }, true)).toBe(
+      "6 strokes, 1.0 s; 3 as the sleeve played them, 1 cut short by Stop, 2 cancelled by Stop before they played.",
+    );
+  });
+});
+
+// ---- the panel itself, fed as the page feeds it ------------------------------------------------
+
+const DRAWING = "d-1";
+
+function wire(type: string, seq: number, fields: Record<string, unknown>): SleeveEvent {
+  const event = readEvent({ type, topic: "feelmysign/sleeve1/strokes", drawing: DRAWING, seq, ...fields });
+  if (event === null) throw new Error(`not an event: ${type} ${JSON.stringify(fields)}`);
+  return event;
+}
+
+function played(seq: number, startMs: number): SleeveEvent {
+  const at = { received_at_ms: startMs, start_at_ms: startMs, first_command_at_ms: startMs };
+  return wire("played", seq, {
+    ...at,
+    latency_ms: 0,
+    start_error_ms: 0,
+    queued_ms: 0,
+    duration_ms: 200,
+    commands: 2,
+  });
+}
+
+function duplicate(seq: number, originalPlayed: boolean): SleeveEvent {
+  return wire("rejected", seq, {
+    reason: "duplicate",
+    message: "a copy",
+    received_at_ms: 0,
+    original_played: originalPlayed,
+  });
+}
+
+/** A drawing of `strokes` strokes of 200 ms, drawn back to back. */
+function drawingOf(strokes: number): Drawing {
+  const drawing = new Drawing(DRAWING, {
+    ...DEFAULT_ANGLE_PARAMS,
+    canvas_width_px: 400,
+    canvas_height_px: 300,
+  });
+  drawing.beginPath("mouse");
+  for (let i = 0; i < strokes; i++) {
+    const [start_ms, end_ms] = [i * 200, (i + 1) * 200];
+    const segment = { start: [i % 2, 0], end: [(i + 1) % 2, 1], start_ms, end_ms, duration_ms: 200 } as const;
+    drawing.addSegment({ ...segment, emitted_at_ms: end_ms, dropped: null }, 0.8);
+  }
+  return drawing;
+}
+
+/** The panel with the card's tally (the same fates the card counts), and what it shows. */
+function panelOf(strokes: number) {
+  const fates = new DrawingFates();
+  let dropped = 0;
+  const told: TallySource = {
+    get counts() {
+      return { sent: strokes, ...fates.counts(), dropped };
+    },
+    fateOf: (seq) => fates.fate(seq),
+  };
+  const shown = { caption: "", onTimeline: 0 };
+  const timeline = {
+    show: (_grid: unknown, a: { placed: readonly unknown[] }) => (shown.onTimeline = a.placed.length),
+    setCaption: (text: string) => (shown.caption = text),
+    setCursor: () => undefined,
+  } as unknown as TimelineView;
+  const view = { setCompare: () => undefined, drawMarker: () => undefined } as unknown as DrawingView;
+  const panel = new FeltPanel(timeline, view, told);
+  panel.setDrawing(drawingOf(strokes), { rows: 3, columns: 4 });
+  /** An event, as the page takes it: the card's fate first, then the timeline. */
+  const hear = (event: SleeveEvent) => {
+    fates.add(event);
+    if (event.type === "played" || event.type === "adjusted") panel.played(event);
+    else panel.told("seq" in event ? event.seq : null);
+  };
+  const neverSent = (seqs: number[]) => {
+    dropped += seqs.length;
+    panel.unsent(seqs);
+  };
+  return { fates, shown, hear, neverSent };
+}
+
+describe("the felt panel's caption and the card count from the same fates", () => {
+  // The cursor's animation: no frames here, the caption is what is read.
+  beforeAll(() => vi.stubGlobal("requestAnimationFrame", () => 0));
+
+  it("a stroke whose played event was lost, told played by its copy's refusal: played in both", () => {
+    const { fates, shown, hear } = panelOf(3);
+    hear(played(0, 1000));
+    hear(played(1, 1200));
+    hear(duplicate(2, true)); // its own played event was lost with the broker
+    expect(fates.counts().played).toBe(3);
+    expect(shown.caption).toContain("3 played");
+    expect(shown.caption).not.toContain("the rest as it would");
+  });
+
+  it("strokes never sent leave the timeline and are never said to be felt as it would", () => {
+    const { fates, shown, hear, neverSent } = panelOf(4);
+    hear(played(0, 1000));
+    hear(played(1, 1200));
+    neverSent([2, 3]);
+    expect(fates.counts().played).toBe(2);
+    expect(shown.onTimeline).toBe(2);
+    expect(shown.caption).toMatch(
+      /^2 strokes, [\d.]+ s; 2 as the sleeve played them, 2 never sent \(not on the timeline\)\.$/,
+    );
+  });
+
+  it("a copy's refusal that says its stroke was never felt takes it off the timeline", () => {
+    const { shown, hear } = panelOf(2);
+    hear(played(0, 1000));
+    hear(duplicate(1, false)); // its own refusal was lost: nothing says it was felt
+    expect(shown.onTimeline).toBe(1);
+    expect(shown.caption).toContain(
+      "1 as the sleeve played them, 1 refused by the sleeve (not on the timeline)",
     );
   });
 });

@@ -62,6 +62,7 @@ from feelmysign.events import (
     StrokeRef,
     delivery_delay_ms,
 )
+from feelmysign.fates import Fate
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.player import SPIN_MS, WEARER, PlannedStroke, Player, cancelled
@@ -562,7 +563,10 @@ class Sleeve:
         elif isinstance(event, Safety) and event.reason in HARDWARE_EVENTS:
             self._count(event.reason)
             # After the event: a reader that sees the status change has the event about it.
-            self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+            # The journal takes it too: a stroke a lost chip cut is cut short, not played.
+            self._outbox.put(
+                _Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False, event)
+            )
             self._outbox.put(
                 _Publish(telemetry_topic(self._id, "status"), self._status(online=True), 1, True)
             )
@@ -604,6 +608,13 @@ class Sleeve:
         self._outbox.put(
             _Publish(telemetry_topic(self._id, "actuators"), json.dumps(frame), 0, False)
         )
+
+    def stroke_totals(self) -> dict[Fate, int]:
+        """Every stroke the sleeve answered, by its fate (feelmysign.fates): a stroke counted once,
+        a copy delivered again changing nothing, one cut short (by a stop or a lost chip) not
+        played, one the duty-cycle cap kept from playing refused. What its stop line says."""
+        with self._journal_lock:
+            return self._journal.totals()
 
     def _write_journal(self, *, every_drawing: bool = False) -> None:
         """Log the drawings that are over (every one, at the end)."""

@@ -74,6 +74,22 @@ class _TimeLine:
     last_seq: int | None = None  # the highest seq checked so far
 
 
+def _why_late(held_ms: float, queued_ms: float) -> str:
+    """Why a stroke is late, from the larger of its two parts: ``held_ms``, how much later than
+    the quickest stroke of its drawing it arrived (the sender, the network or the broker held
+    it); ``queued_ms``, how much longer than its own drawing's time line it would wait behind
+    the strokes queued on the sleeve before it (another drawing playing)."""
+    if held_ms >= queued_ms:
+        return (
+            f"it arrived {held_ms / 1000:.2f} s later than its drawing's quickest stroke, held on "
+            "the way (the sender, the network or the broker was away)"
+        )
+    return (
+        f"it would wait {queued_ms / 1000:.2f} s behind the strokes queued on the sleeve before "
+        "it (another drawing playing)"
+    )
+
+
 class PacePolicy:
     """Call ``check`` once per stroke, in the order the strokes arrive (one thread)."""
 
@@ -118,12 +134,13 @@ class PacePolicy:
         lag_ms = start_wall_ms - due_ms - line.smallest_delay_ms
         line.catching_up = lag_ms > (self.catch_up_ms if line.catching_up else self.max_lag_ms)
         if line.catching_up:
+            held_ms = age_ms - line.smallest_delay_ms
             return Verdict(
                 LATE,
-                f"the stroke would start {lag_ms / 1000:.2f} s after it was due; a sleeve more "
-                f"than {self.max_lag_ms / 1000:g} s behind its sender skips strokes until it is "
-                f"within {self.catch_up_ms / 1000:g} s (after a stall of the network, the "
-                "broker or the sleeve)",
+                f"the stroke would start {lag_ms / 1000:.2f} s after it was due: "
+                f"{_why_late(held_ms, lag_ms - held_ms)}; a sleeve more than "
+                f"{self.max_lag_ms / 1000:g} s behind its sender skips strokes until it is "
+                f"within {self.catch_up_ms / 1000:g} s",
                 age_ms=age_ms,
                 lag_ms=lag_ms,
             )

@@ -3,7 +3,11 @@
  * telemetry, over WebSockets with mqtt.js. Strokes wait in an outbox while the
  * broker is out of reach and go out in order when it is back; one leaves the
  * outbox only on the broker's PUBACK, so the count of unsent strokes shown is
- * honest. `sent_at_ms` is stamped when a stroke actually goes out.
+ * honest. `sent_at_ms` is stamped when a stroke is made (drawn), not when it leaves the
+ * outbox: a stroke held while the broker was out of reach carries the moment it was drawn, so
+ * the sleeve's pace rules (docs/protocol.md, "Pace: stale and late strokes") judge it as the
+ * touch it is, refusing one held too long as `late` or `stale`, and one it plays is counted
+ * delayed on the way by the time it was held, on the page and in `up`'s terminal alike.
  *
  * Several sleeves may share the broker. The page hears every sleeve's retained
  * status (for the sleeve picker) and the chosen one's actuators and events.
@@ -263,7 +267,9 @@ export class StrokeSender {
   /** Queues a stroke for the chosen sleeve and sends it now if the broker is connected. */
   send(stroke: Stroke): void {
     if (this.#target === null) throw new Error("send before connect");
-    this.#outbox.add({ stroke, sleeveId: this.#target.sleeve_id });
+    // Stamped now, when it is drawn: kept through an outage and any sending again.
+    const stamped = { ...stroke, sent_at_ms: stroke.sent_at_ms ?? Date.now() };
+    this.#outbox.add({ stroke: stamped, sleeveId: this.#target.sleeve_id });
     this.#flush();
   }
 
@@ -349,7 +355,7 @@ export class StrokeSender {
       }
       return {
         topic: strokesTopic(sleeveId),
-        payload: formatJson({ ...stroke, sent_at_ms: Date.now() }),
+        payload: formatJson(stroke),
       };
     } catch (error) {
       if (error instanceof StrokeError) return error;

@@ -5,11 +5,14 @@
  * and with nothing felt of those its duty-cycle cap kept from playing, the timeline with a cursor
  * moving at the moment being felt, a marker on the canvas where the brush is,
  * and an A/B comparison with the same paths simplified under other settings.
+ * Strokes never sent are not on the timeline. Its caption counts from the card's tally
+ * (sleeve-says.ts, the rule of fates.ts), so the two never say different things.
  * A new stroke or a sleeve event costs the same however long the drawing is:
  * the placement is kept (felt-placement.ts), only the new strokes added.
  */
 import type { Drawing, DrawnSegment } from "../drawing";
 import type { CancelledEvent, AdjustedEvent, PlayedEvent, Unplayed } from "../events";
+import type { Fate } from "../fates";
 import { brushAt, placeStrokes, type FeltStroke, type Grid, type PlacedStroke } from "../felt";
 import { FeltPlacement } from "../felt-placement";
 import { simplifyPaths, type SimplifierParams } from "../simplify/registry";
@@ -20,9 +23,29 @@ import type { TimelineView } from "./timeline";
 /** How the drawing's strokes reach the sleeve: as they were drawn, or all at once (Play again). */
 export type Arrival = "as-drawn" | "at-once";
 
+/** What became of the drawing's strokes, as the "Sleeve says" card counts them (fates.ts). */
+export interface Tally {
+  /** The strokes of the drawing: sent, or dropped before they left. */
+  readonly sent: number;
+  readonly played: number;
+  readonly cut: number;
+  readonly cancelled: number;
+  /** Refused on arrival, or kept from playing by the duty-cycle cap. */
+  readonly refused: number;
+  /** Never sent. */
+  readonly dropped: number;
+}
+
+/** Where the caption reads the tally, and each stroke's fate: the card (SleeveSays). */
+export interface TallySource {
+  readonly counts: Tally;
+  fateOf(seq: number): Fate | null;
+}
+
 export class FeltPanel {
   readonly #timeline: TimelineView;
   readonly #view: DrawingView;
+  readonly #told: TallySource;
   #drawing: Drawing | null = null;
   #arrival: Arrival = "as-drawn";
   #grid: Grid = { rows: 3, columns: 4 };
@@ -37,16 +60,13 @@ export class FeltPanel {
   /** The cursor runs from `t_ms` at `at` (performance.now()). */
   #anchor: { t_ms: number; at: number } | null = null;
   #running = false;
-  /** Strokes the sleeve dropped at Stop before they started. */
-  readonly #cancelledSeqs = new Set<number>();
-  /** Strokes Stop cut short while they played (reported played too). */
-  readonly #cutSeqs = new Set<number>();
   /** Stop was pressed: what the sleeve has not played yet never will be. */
   #stopped = false;
 
-  constructor(timeline: TimelineView, view: DrawingView) {
+  constructor(timeline: TimelineView, view: DrawingView, told: TallySource) {
     this.#timeline = timeline;
     this.#view = view;
+    this.#told = told;
   }
 
   /** A new current drawing (or none): the cursor stops, the sleeve's reports are forgotten. */
@@ -55,8 +75,6 @@ export class FeltPanel {
     this.#grid = grid;
     this.#arrival = arrival;
     this.#startedAt.clear();
-    this.#cancelledSeqs.clear();
-    this.#cutSeqs.clear();
     this.#stopped = false;
     this.#placement = new FeltPlacement();
     this.#segmentsSeen = 0;
@@ -75,14 +93,13 @@ export class FeltPanel {
     const count = placement.placed.length;
     const seconds = (placement.totalMs / 1000).toFixed(1);
     this.#timeline.setCaption(
-      count === 0
+      count === 0 && this.#told.counts.dropped === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
-        : `${count} stroke${count === 1 ? "" : "s"}, ${seconds} s` +
-            timelineCaption(count, placement.reportedCount, placement.cappedCount, {
-              cancelled: this.#cancelledSeqs.size,
-              cut: this.#cutSeqs.size,
-              stopped: this.#stopped,
-            }),
+        : timelineCaption(
+            { count, seconds, reported: placement.reportedCount, capped: placement.cappedCount },
+            this.#told.counts,
+            this.#stopped,
+          ),
     );
   }
 
@@ -109,7 +126,6 @@ export class FeltPanel {
   cancelled(event: CancelledEvent): void {
     if (event.seq === null) return;
     const started = this.#startedAt.get(event.seq);
-    (event.started ? this.#cutSeqs : this.#cancelledSeqs).add(event.seq);
     this.#sync();
     this.#placement.cut(
       event.seq,
@@ -123,6 +139,28 @@ export class FeltPanel {
     this.#sync();
     if (why === "refused") this.#placement.refuse(seq);
     else this.#placement.cap(seq);
+    this.refresh();
+  }
+
+  /**
+   * Strokes never sent (dropped before they left, by Stop or the late limit): off the timeline,
+   * as nothing of them can be felt.
+   */
+  unsent(seqs: readonly number[]): void {
+    this.#sync();
+    for (const seq of seqs) this.#placement.refuse(seq);
+    this.refresh();
+  }
+
+  /**
+   * The card's tally changed without a report the timeline places (a copy's refusal told the
+   * fate): a stroke that now has a fate of not felt, and no report of its own, leaves the timeline.
+   */
+  told(seq: number | null): void {
+    if (seq !== null && this.#told.fateOf(seq) === "refused" && !this.#placement.isCapped(seq)) {
+      this.#sync();
+      this.#placement.refuse(seq);
+    }
     this.refresh();
   }
 
@@ -222,30 +260,43 @@ export class FeltPanel {
 }
 
 /**
- * What the timeline's times are: the sleeve's, the page's estimate, or both; and what was not felt.
- * `cancelled`: strokes Stop dropped on the sleeve before they started; `stopped`: Stop was pressed,
- * so the strokes the sleeve has not reported will not be felt (never "the rest as it would").
+ * The caption: how many strokes over how long, then what became of them, in the card's counts
+ * (`tally`, fates.ts) so the two always agree, and whose times the timeline shows: the sleeve's
+ * for the strokes it reported, the page's estimate for the rest. A stroke with no answer yet is
+ * "as it would" be felt only while it still may be: never once Stop was pressed. `timeline`: the
+ * strokes on it, their length (s), how many the sleeve reported and how many its duty-cycle cap
+ * kept from playing (on the timeline, silent). Strokes refused on arrival and never sent are not
+ * on it, and are said apart.
  */
 export function timelineCaption(
-  count: number,
-  reported: number,
-  capped: number,
-  stop: { readonly cancelled: number; readonly cut?: number; readonly stopped: boolean } = {
-    cancelled: 0,
-    stopped: false,
+  timeline: {
+    readonly count: number;
+    readonly seconds: string;
+    readonly reported: number;
+    readonly capped: number;
   },
+  tally: Tally,
+  stopped: boolean,
 ): string {
-  const { cancelled, stopped } = stop;
-  const cut = stop.cut ?? 0;
-  if (reported === 0 && capped === 0 && cancelled === 0 && !stopped)
-    return ": what would be felt, played back to back as the sleeve does.";
-  const estimated = count - reported - capped - cancelled;
+  const { count, seconds, reported, capped } = timeline;
+  const { played, cut, cancelled, refused, dropped } = tally;
+  const head = `${plural(count, "stroke")}, ${seconds} s`;
+  const waiting = Math.max(0, tally.sent - played - cut - cancelled - refused - dropped);
+  if (waiting === tally.sent && !stopped)
+    return `${head}: what would be felt, played back to back as the sleeve does.`;
+  // Played strokes whose report never came (a copy's refusal told they were felt): the page places them.
+  const placedByPage = Math.max(0, played - Math.max(0, reported - cut));
+  if (played === tally.sent && played === count && placedByPage === 0)
+    return `${head}, as the sleeve played them.`;
   const said: string[] = [];
-  if (reported > 0)
+  if (played > 0) {
     said.push(
-      (reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`) +
-        (cut > 0 ? ` (${cut} cut short by Stop)` : ""),
+      placedByPage === 0
+        ? `${played} as the sleeve played them`
+        : `${played} played (the times of ${placedByPage} are the page's: the sleeve's report of ${placedByPage === 1 ? "it" : "them"} never came)`,
     );
+  }
+  if (cut > 0) said.push(`${cut} cut short by Stop`);
   if (capped > 0) {
     said.push(
       `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,
@@ -253,6 +304,13 @@ export function timelineCaption(
   }
   if (cancelled > 0)
     said.push(`${cancelled} cancelled by Stop before ${cancelled === 1 ? "it" : "they"} played`);
-  if (estimated > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");
-  return `${reported === count ? ", " : "; "}${said.join(", ")}.`;
+  const refusedOff = refused - capped;
+  if (refusedOff > 0) said.push(`${refusedOff} refused by the sleeve (not on the timeline)`);
+  if (dropped > 0) said.push(`${dropped} never sent (not on the timeline)`);
+  if (waiting > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");
+  return `${head}; ${said.join(", ")}.`;
+}
+
+function plural(count: number, noun: string): string {
+  return `${count} ${noun}${count === 1 ? "" : "s"}`;
 }

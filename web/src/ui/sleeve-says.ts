@@ -12,6 +12,8 @@ import { DrawingFates, type Fate } from "../fates";
 import { EventLog, type LogKind } from "./event-log";
 
 export interface Counts {
+  /** The drawing's strokes: sent, or dropped before they left. */
+  sent: number;
   /** Played whole. */
   played: number;
   refused: number;
@@ -47,6 +49,7 @@ export class SleeveSays {
 
   get counts(): Readonly<Counts> {
     return {
+      sent: this.#sent,
       ...this.#fates.counts(),
       dropped: this.#dropped,
       delayed: this.#delayed,
@@ -75,6 +78,11 @@ export class SleeveSays {
     const fate = this.#fates.add(event);
     this.#render();
     return fate;
+  }
+
+  /** Stroke `seq`'s fate so far (fates.ts); null before the sleeve answered it. */
+  fateOf(seq: number): Fate | null {
+    return this.#fates.fate(seq);
   }
 
   /** A played stroke held on the way for `delayMs`. */

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from contextlib import nullcontext
 from typing import TYPE_CHECKING
 
@@ -23,6 +22,7 @@ from feelmysign.cli.options.wearer_page import add_wearer_page_options
 from feelmysign.connection import BrokerSettings
 from feelmysign.daemon import Sleeve, SleeveOptions
 from feelmysign.errors import FeelMySignError
+from feelmysign.fates import Fate
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.services.stop_signals import call_on_stop_signals
@@ -196,7 +196,7 @@ def run(args: argparse.Namespace) -> int:
     with page[0] if page is not None else nullcontext():
         if page is not None:
             print(page[1], end="", flush=True)
-        counts = run_sleeve(
+        sleeve = run_sleeve(
             settings,
             layout,
             options,
@@ -206,12 +206,21 @@ def run(args: argparse.Namespace) -> int:
             emulate_state=args.emulate_state,
             on_start=started,
         )
-    print(
-        f"Sleeve {options.sleeve_id} stopped, every motor off "
-        f"({counts['played']} played, {counts['rejected']} rejected)",
-        flush=True,
-    )
+    totals = stop_totals(sleeve.stroke_totals())
+    print(f"Sleeve {options.sleeve_id} stopped, every motor off ({totals})", flush=True)
     return 0
+
+
+def stop_totals(totals: Mapping[Fate, int]) -> str:
+    """What the sleeve did with every stroke, by fate (feelmysign.fates, as ``up``'s lines and
+    the page count): played and rejected always, cut short and cancelled when there were any."""
+    parts = [f"{totals['played']} played"]
+    if totals["cut"]:
+        parts.append(f"{totals['cut']} cut short")
+    if totals["cancelled"]:
+        parts.append(f"{totals['cancelled']} cancelled")
+    parts.append(f"{totals['refused']} rejected")
+    return ", ".join(parts)
 
 
 def run_sleeve(
@@ -224,8 +233,9 @@ def run_sleeve(
     emulate: bool = False,
     emulate_state: str | None = None,
     on_start: Callable[[Sleeve], None] = lambda sleeve: None,
-) -> Counter[str]:
-    """Open the backend with its telemetry, run the sleeve until it stops; every motor off after."""
+) -> Sleeve:
+    """Open the backend with its telemetry, run the sleeve until it stops; every motor off after.
+    Returns the stopped sleeve (its counts, its strokes by fate)."""
     sleeves: list[Sleeve] = []
 
     def publish(frame: ActuatorFrame) -> None:
@@ -252,7 +262,7 @@ def run_sleeve(
         finally:
             for watcher in watchers:
                 watcher.stop()
-    return sleeve.counts
+    return sleeve
 
 
 def _watch_buttons(layout: Layout, backend: Backend, sleeve: Sleeve) -> list[ButtonWatcher]:

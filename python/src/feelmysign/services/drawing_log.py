@@ -7,9 +7,10 @@ sender's account) and prints one line per drawing id once that drawing is over::
     (by 1.6 s), 1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
 
 A stroke delayed on the way was felt more than ``events.DELAYED_MS`` after its
-sender sent it, not counting its wait behind the strokes before it
-(``events.is_delayed``; the page marks the same ones): it waited at the broker or
-on the way, the sleeve offline or the network slow. It was played; a stroke the
+sender drew it (its ``sent_at_ms``), not counting its wait behind the strokes before
+it (``events.is_delayed``; the page marks the same ones): it was held on the way, by
+its sender while the broker was out of reach, at the broker while the sleeve was
+offline, or by a slow network. It was played; a stroke the
 sleeve skipped for being too far behind is a ``late`` refusal, under rejected.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
@@ -39,7 +40,7 @@ from __future__ import annotations
 
 import statistics
 import threading
-from collections import OrderedDict
+from collections import Counter, OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -58,7 +59,7 @@ from feelmysign.events import (
     event_from_json,
     is_delayed,
 )
-from feelmysign.fates import DrawingFates
+from feelmysign.fates import FATES, DrawingFates, Fate
 from feelmysign.topics import telemetry_topic
 
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
@@ -125,6 +126,8 @@ class DrawingSummaries:
         self._printed: OrderedDict[str, _Drawing] = OrderedDict()  # oldest first
         self._events = 0  # counted: "another drawing sent since" compares these
         self._copies = EventCopies()  # a broker restart may deliver an event again
+        # Every stroke seen, by its fate now: what the sleeve's stop line says.
+        self._totals: Counter[Fate] = Counter()
 
     def add(self, event: Event, now_s: float) -> None:
         if self._copies.is_copy(event):
@@ -140,13 +143,23 @@ class DrawingSummaries:
         self._events += 1
         drawing.last_event_s = now_s
         drawing.last_event_index = self._events
-        drawing.fates.add(event)
+        seq = getattr(event, "seq", None)
+        before = drawing.fates.fate(seq) if seq is not None else None
+        after = drawing.fates.add(event)
+        if after is not None and after != before:
+            if before is not None:
+                self._totals[before] -= 1
+            self._totals[after] += 1
         if isinstance(event, Played):
             drawing.slowed += isinstance(event, Adjusted)
             drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
             delay_ms = delivery_delay_ms(event)
             if delay_ms is not None and is_delayed(event):
                 drawing.delays_on_the_way_ms.append(delay_ms)
+
+    def totals(self) -> dict[Fate, int]:
+        """Every stroke seen, of every drawing, by its fate (feelmysign.fates), 0 included."""
+        return {fate: self._totals[fate] for fate in FATES}
 
     def _is_over(self, name: str, drawing: _Drawing, now_s: float) -> bool:
         quiet_s = now_s - drawing.last_event_s

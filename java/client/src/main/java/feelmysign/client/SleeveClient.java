@@ -37,7 +37,9 @@ import javax.net.ssl.TrustManagerFactory;
  * Sends strokes to one sleeve and hears back from it, as the drawing page does
  * ({@code web/src/mqtt/sender.ts}): MQTT 3.1.1, strokes at QoS 1 on
  * {@code feelmysign/<sleeve>/strokes} (JSON v1, with the drawing's id, {@code seq} counted from
- * 0 and {@code sent_at_ms} stamped as each goes out) or on the legacy topic (the paper's text),
+ * 0 and {@code sent_at_ms} stamped when it is made, kept while it waits for the broker, so the
+ * sleeve's pace rules judge a stroke held offline by when it was drawn) or on the legacy topic (the
+ * paper's text),
  * Stop as the cancel message, the sleeve's {@code status} and {@code events} as callbacks.
  *
  * <p>Strokes wait in an outbox while the broker is out of reach and go out, in order, when it is
@@ -445,6 +447,10 @@ public final class SleeveClient implements AutoCloseable {
       } else {
         addressed = stroke;
       }
+      if (addressed.sentAtMs() == null) {
+        // Stamped now, when it is made: kept through an outage and any sending again.
+        addressed = addressed.withSentAt((double) System.currentTimeMillis());
+      }
       outbox.add(addressed, nowMs());
     }
     flush();
@@ -546,7 +552,7 @@ public final class SleeveClient implements AutoCloseable {
               text = Protocol.formatLegacy(stroke);
             } else {
               topic = Topics.strokesTopic(sleeveId);
-              text = Protocol.formatJson(stroke.withSentAt((double) System.currentTimeMillis()));
+              text = Protocol.formatJson(stroke);
             }
           } catch (StrokeException error) {
             outbox.ack(entry.id());
