@@ -33,7 +33,13 @@ import { byId, StatusBar } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
 import { WearerNotice } from "./ui/wearer-notice";
 import { WearerHoldKeeper } from "./wearer-hold";
-import { ceilingNote, isWearerRefusal, parseWearerControls, wearerRefusalNote } from "./wearer-status";
+import {
+  ceilingNote,
+  holdReason,
+  isWearerRefusal,
+  parseWearerControls,
+  wearerRefusalNote,
+} from "./wearer-status";
 import type { Stroke } from "./protocol";
 
 export interface AppOptions {
@@ -488,7 +494,8 @@ export class App {
     if (this.#wearer.keep(stroke, Date.now())) {
       if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
         this.#session.held(stroke.seq);
-      this.#says.setHeld(this.#wearer.heldCount);
+      const hold = this.#wearer.hold(Date.now());
+      this.#says.setHeld(this.#wearer.heldCount, hold === null ? null : holdReason(hold));
       this.#showWearer();
       return;
     }

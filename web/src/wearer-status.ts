@@ -105,15 +105,20 @@ export function holdHeadline(hold: WearerHold): string {
 
 /** What the page does about it: the strokes drawn now are kept here, not sent. */
 export function holdDetail(hold: WearerHold, heldStrokes: number): string {
-  const when =
-    hold.reason === "paused"
-      ? "until the wearer resumes"
-      : `until ${clockTime(hold.untilMs)} (or until the wearer ends it)`;
   const held =
     heldStrokes === 0
-      ? "Nothing is sent"
-      : `${heldStrokes} stroke${heldStrokes === 1 ? "" : "s"} held on this page, not sent`;
-  return `${held} ${when}: the sleeve would refuse them. You can keep drawing; the page offers to send the held strokes when the wearer is back.`;
+      ? "What you draw is held here, not sent"
+      : `${heldStrokes} stroke${heldStrokes === 1 ? "" : "s"} held here, not sent`;
+  const back =
+    hold.reason === "paused"
+      ? "the wearer resumes"
+      : `${clockTime(hold.untilMs)}, or when the wearer ends it`;
+  return `${held}: the sleeve would refuse them. The page offers to send them when ${back}.`;
+}
+
+/** Why strokes are held, in a few words (the legend, the counts). */
+export function holdReason(hold: WearerHold): string {
+  return hold.reason === "paused" ? "the wearer paused" : "the wearer asked not to be disturbed";
 }
 
 /** The line for a stroke the sleeve refused `paused` or `do_not_disturb` (its status came late). */

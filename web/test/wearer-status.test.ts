@@ -118,11 +118,16 @@ describe("the page's words", () => {
   });
 
   it("says how many strokes are held and that they are not sent", () => {
-    expect(holdDetail({ reason: "paused", sinceMs: null }, 3)).toMatch(
-      /^3 strokes held on this page, not sent until the wearer resumes/,
+    expect(holdDetail({ reason: "paused", sinceMs: null }, 3)).toBe(
+      "3 strokes held here, not sent: the sleeve would refuse them. The page offers to send them when the wearer resumes.",
     );
     expect(holdDetail({ reason: "paused", sinceMs: null }, 1)).toMatch(/^1 stroke held/);
-    expect(holdDetail({ reason: "paused", sinceMs: null }, 0)).toMatch(/^Nothing is sent/);
+    expect(holdDetail({ reason: "paused", sinceMs: null }, 0)).toMatch(
+      /^What you draw is held here, not sent/,
+    );
+    expect(holdDetail({ reason: "do_not_disturb", untilMs: at }, 2)).toContain(
+      "when 14:30, or when the wearer ends it",
+    );
   });
 
   it("says a late refusal is the wearer's pause, with the sleeve's message", () => {

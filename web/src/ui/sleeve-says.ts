@@ -38,6 +38,7 @@ export class SleeveSays {
   #sent = 0;
   /** Kept on the page, not sent, while the wearer paused the sleeve (wearer-hold.ts). */
   #held = 0;
+  #heldWhy = "the wearer paused";
   /** Of the refused: refused `paused` or `do_not_disturb` (the page heard of the pause late). */
   #wearerRefused = 0;
   #drawing: string | null = null;
@@ -100,9 +101,10 @@ export class SleeveSays {
     this.#render();
   }
 
-  /** How many of the drawing's strokes are held on the page now, not sent. */
-  setHeld(held: number): void {
+  /** How many of the drawing's strokes are held on the page now, not sent, and why (`holdReason`). */
+  setHeld(held: number, why: string | null = null): void {
     this.#held = held;
+    if (why !== null) this.#heldWhy = why;
     this.#render();
   }
 
@@ -147,7 +149,7 @@ export class SleeveSays {
         wearer === 0 ? "" : wearer === refused ? " (the wearer paused)" : ` (${wearer} as the wearer paused)`;
       parts.push(`${refused} refused${why}`);
     }
-    if (this.#held > 0) parts.push(`${this.#held} held on this page, not sent (the wearer paused)`);
+    if (this.#held > 0) parts.push(`${this.#held} held on this page, not sent (${this.#heldWhy})`);
     if (dropped > 0) parts.push(`${dropped} never sent`);
     const waiting = this.#sent - played - cut - cancelled - refused - dropped - this.#held;
     if (waiting > 0 && (cut > 0 || cancelled > 0)) parts.push(`${waiting} not answered yet`);

@@ -4,7 +4,7 @@
  * ceiling. The words come from wearer-status.ts; this only puts them on the page.
  */
 import type { WearerView } from "../wearer-hold";
-import { holdDetail, holdHeadline } from "../wearer-status";
+import { holdDetail, holdHeadline, holdReason } from "../wearer-status";
 import { byId } from "./status";
 
 export interface WearerNoticeActions {
@@ -19,6 +19,7 @@ export class WearerNotice {
   readonly #ceiling: HTMLElement;
   readonly #actions: HTMLElement;
   readonly #legend: HTMLElement;
+  readonly #legendWhy: HTMLElement;
 
   constructor(doc: Document, actions: WearerNoticeActions) {
     this.#box = byId(doc, "wearer-notice");
@@ -27,6 +28,7 @@ export class WearerNotice {
     this.#ceiling = byId(doc, "wearer-ceiling");
     this.#actions = byId(doc, "wearer-actions");
     this.#legend = byId(doc, "legend-held");
+    this.#legendWhy = byId(doc, "legend-held-why");
     byId(doc, "send-held-button").addEventListener("click", () => actions.sendHeld());
     byId(doc, "drop-held-button").addEventListener("click", () => actions.dropHeld());
   }
@@ -40,6 +42,7 @@ export class WearerNotice {
     this.#legend.hidden = view.state === "none" || view.held === 0;
     this.#actions.hidden = view.state !== "resumed" || view.held === 0;
     if (view.state === "held") {
+      this.#legendWhy.textContent = holdReason(view.hold);
       this.#set(holdHeadline(view.hold), holdDetail(view.hold, view.held), ceiling);
     } else if (view.state === "resumed") {
       const detail =
