@@ -142,6 +142,15 @@ describe("the sender sees the wearer's choice", () => {
       "the wearer asked not to be disturbed",
     );
     await screenshot(page, "wearer-do-not-disturb-desktop");
+    // A second path, taken back with Undo: its held strokes are no longer offered.
+    await drawWithMouse(page, [at(0.2, 0.8), at(0.8, 0.8)], { legMs: 400 });
+    await page.waitForFunction(
+      ([selector, count]) => Number(document.querySelector<HTMLElement>(selector)?.dataset["held"]) > count,
+      [NOTICE, Number(drawn)] as const,
+    );
+    await page.locator('[data-testid="undo-button"]').click();
+    await waitForData(page, NOTICE, "held", drawn);
+    await waitForData(page, SUMMARY, "held", drawn);
     expect(sleeve.strokes()).toHaveLength(before);
   });
 
@@ -157,6 +166,19 @@ describe("the sender sees the wearer's choice", () => {
     await expect(page.locator('[data-testid="ceiling-note"]').innerText()).resolves.toBe(ceiling);
     await screenshot(page, "wearer-ceiling-settings-desktop");
     await page.locator("#settings-cancel").click();
+  });
+
+  it("Stop drops the held strokes: never sent, and counted so", async () => {
+    await publishControls(sleeve, PAUSED);
+    await waitForData(page, NOTICE, "state", "held");
+    await page.locator('[data-testid="new-button"]').click();
+    await drawWithMouse(page, [at(0.1, 0.1), at(0.9, 0.9)], { legMs: 400 });
+    const drawn = String(await page.locator(SUMMARY).getAttribute("data-sent"));
+    await waitForData(page, SUMMARY, "held", drawn);
+    await page.locator('[data-testid="stop-button"]').click();
+    await waitForData(page, SUMMARY, "held", "0");
+    await waitForData(page, SUMMARY, "dropped", drawn);
+    expect(await page.locator(SUMMARY).innerText()).toContain(`${drawn} never sent`);
   });
 
   it("on a phone: the notice and the held drawing fit the small screen", async () => {

@@ -195,7 +195,16 @@ export class App {
   #wireButtons(): void {
     const doc = this.#doc;
     byId(doc, "new-button").addEventListener("click", () => this.#session.clear());
-    this.#buttons.undo.addEventListener("click", () => this.#session.undo());
+    this.#buttons.undo.addEventListener("click", () => {
+      if (!this.#session.undo()) return;
+      // A held stroke of the path taken back is not sent on resume: it is no longer drawn.
+      const drawing = this.#session.drawing;
+      const gone = this.#wearer.release(
+        (stroke) => drawing !== null && stroke.seq != null && drawing.bySeq(stroke.seq) !== undefined,
+      );
+      if (gone.length > 0) this.#says.setHeld(this.#wearer.heldCount);
+      this.#showWearer();
+    });
     byId(doc, "stop-button").addEventListener("click", () => this.stop());
     this.#buttons.replay.addEventListener("click", () => this.playAgain());
     this.#buttons.record.addEventListener("click", () => this.#download());
@@ -257,6 +266,10 @@ export class App {
       ...this.#sender.cancel(CANCEL_ALL),
     ];
     this.#felt.stopCursor();
+    // Strokes held while the wearer paused are dropped too: Stop means nothing more of this drawing.
+    this.#markNeverSent(this.#wearer.take());
+    this.#says.setHeld(0);
+    this.#showWearer();
     this.#session.close();
     // Never sent: marked as such, and counted apart from what the sleeve cancelled.
     for (const stroke of dropped) {

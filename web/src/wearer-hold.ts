@@ -96,6 +96,13 @@ export class WearerHoldKeeper {
     return strokes;
   }
 
+  /** Keeps held only the strokes `kept` says to (Undo took a path back); returns the others. */
+  release(kept: (stroke: Stroke) => boolean): Stroke[] {
+    const gone = this.#held.filter((stroke) => !kept(stroke));
+    this.#held = this.#held.filter(kept);
+    return gone;
+  }
+
   /** A new drawing: the held strokes of the old one are given back (to count as never sent). */
   newDrawing(): Stroke[] {
     const strokes = this.#held;

@@ -79,3 +79,13 @@ describe("WearerHoldKeeper", () => {
     expect(keeper.keep(stroke(1), T0)).toBe(false);
   });
 });
+
+describe("WearerHoldKeeper.release", () => {
+  it("lets go of the held strokes of a path taken back, keeping the rest in order", () => {
+    const keeper = new WearerHoldKeeper();
+    keeper.onStatus(PAUSED, true, T0, T0);
+    for (const seq of [0, 1, 2, 3]) keeper.keep(stroke(seq), T0);
+    expect(keeper.release((s) => (s.seq ?? 0) < 2).map((s) => s.seq)).toEqual([2, 3]);
+    expect(keeper.take().map((s) => s.seq)).toEqual([0, 1]);
+  });
+});
