@@ -48,7 +48,7 @@ export class WearerNotice {
       const detail =
         view.held === 0
           ? "What you draw now is sent again."
-          : `${plural(view.held, "stroke")} drawn while the sleeve was paused ${view.held === 1 ? "is" : "are"} held here. ` +
+          : `${plural(view.held, "stroke")} drawn meanwhile ${view.held === 1 ? "is" : "are"} held here. ` +
             "Send them to play them now, back to back, or drop them; what you draw now is sent.";
       this.#set("The wearer resumed the sleeve.", detail, ceiling);
     } else if (ceiling !== null) {
