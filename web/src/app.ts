@@ -32,6 +32,16 @@ import { SleeveSays } from "./ui/sleeve-says";
 import { StageSpace } from "./ui/stage-space";
 import { byId, StatusBar } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
+import { WearerNotice } from "./ui/wearer-notice";
+import { WearerHoldKeeper } from "./wearer-hold";
+import {
+  ceilingNote,
+  holdReason,
+  isWearerRefusal,
+  parseWearerControls,
+  wearerRefusalNote,
+} from "./wearer-status";
+import type { Stroke } from "./protocol";
 
 export interface AppOptions {
   readonly config: ServerConfig | null;
@@ -60,6 +70,11 @@ export class App {
   readonly #compareToggle: HTMLInputElement;
   readonly #compareDetail: HTMLInputElement;
   readonly #sleeve: SleeveWatch;
+  /** The wearer's choice (the status's controls): strokes held on the page while paused. */
+  readonly #wearer = new WearerHoldKeeper();
+  readonly #wearerNotice: WearerNotice;
+  /** Wakes the page when a "do not disturb" runs out. */
+  #wearerTimer: ReturnType<typeof setTimeout> | null = null;
   #settings: Settings;
   #refitPending = false;
   #arrival: Arrival = "as-drawn";
@@ -107,7 +122,7 @@ export class App {
       // The simplifier keeps every stroke at or above the sleeve's floor (its status).
       settings: () => withFloor(this.#settings, this.#sleeve.status?.floor),
       grid: () => this.#grid(),
-      send: (stroke) => this.#sender.send(stroke),
+      send: (stroke) => this.#send(stroke),
       changed: (drawing) => this.#drawingChanged(drawing),
       released: () => {
         if (this.#refitPending) this.#fit();
@@ -151,6 +166,10 @@ export class App {
       },
     });
     this.#sender.setLateLimit(lateLimitMs(this.#settings));
+    this.#wearerNotice = new WearerNotice(doc, {
+      sendHeld: () => this.sendHeld(),
+      dropHeld: () => this.#dropHeld(),
+    });
 
     if (loaded.replaced.length > 0) {
       this.#says.add("info", `Saved settings no longer valid were reset: ${loaded.replaced.join(", ")}.`);
@@ -175,7 +194,16 @@ export class App {
   #wireButtons(): void {
     const doc = this.#doc;
     byId(doc, "new-button").addEventListener("click", () => this.#session.clear());
-    this.#buttons.undo.addEventListener("click", () => this.#session.undo());
+    this.#buttons.undo.addEventListener("click", () => {
+      if (!this.#session.undo()) return;
+      // A held stroke of the path taken back is not sent on resume: it is no longer drawn.
+      const drawing = this.#session.drawing;
+      const gone = this.#wearer.release(
+        (stroke) => drawing !== null && stroke.seq != null && drawing.bySeq(stroke.seq) !== undefined,
+      );
+      if (gone.length > 0) this.#says.setHeld(this.#wearer.heldCount);
+      this.#showWearer();
+    });
     byId(doc, "stop-button").addEventListener("click", () => this.stop());
     this.#buttons.replay.addEventListener("click", () => this.playAgain());
     this.#buttons.record.addEventListener("click", () => this.#download());
@@ -192,6 +220,7 @@ export class App {
         sleeveGrid: this.#sleeve.status?.layout ?? null,
         spacingCm: this.#sleeve.status?.layout?.spacing_cm ?? null,
         floor: this.#sleeve.status?.floor ?? null,
+        ceiling: this.#wearer.ceiling,
       }),
     );
     doc.addEventListener("keydown", (event) => {
@@ -206,8 +235,10 @@ export class App {
 
   /** Keeps the buttons, the hint, the card and the timeline in step with the drawing. */
   #drawingChanged(drawing: Drawing | null): void {
+    const another = (drawing?.id ?? null) !== this.#says.drawingId;
     this.#says.reset(drawing?.id ?? null);
     this.#says.setSent(drawing?.strokeCount ?? 0);
+    if (another) this.#newDrawingHeld();
     this.#hint.hidden = drawing !== null;
     const hasPaths = drawing !== null && drawing.paths.length > 0;
     this.#buttons.undo.disabled = !hasPaths;
@@ -234,6 +265,10 @@ export class App {
       ...this.#sender.cancel(CANCEL_ALL),
     ];
     this.#felt.stopCursor();
+    // Strokes held while the wearer paused are dropped too: Stop means nothing more of this drawing.
+    this.#markNeverSent(this.#wearer.take());
+    this.#says.setHeld(0);
+    this.#showWearer();
     this.#session.close();
     // Never sent: marked as such, and counted apart from what the sleeve cancelled.
     const unsent = this.#markUnsent(dropped);
@@ -264,7 +299,7 @@ export class App {
     const copy = drawing.copyAs(newDrawingId());
     this.#arrival = "at-once";
     this.#session.adopt(copy);
-    for (const stroke of copy.strokes) this.#sender.send(stroke);
+    for (const stroke of copy.strokes) this.#send(stroke);
     this.#says.setSent(copy.strokeCount);
   }
 
@@ -376,6 +411,7 @@ export class App {
     const previous = this.#settings;
     this.#settings = withServerBroker(next, this.#config);
     saveSettings(this.#storage, next, this.#config);
+    this.#showWearer(); // the ceiling's line names the intensity
     this.#sender.setLateLimit(lateLimitMs(this.#settings));
     const change = settingsChange(previous, this.#settings);
     if (change.grid) {
@@ -395,6 +431,9 @@ export class App {
     }
     if (change.target) {
       if (change.sleeve) {
+        // The other sleeve's wearer has not said anything yet: its status will.
+        this.#wearer.forgetSleeve();
+        this.#showWearer();
         // Its strokes went to the other sleeve: the next path starts a new drawing for this one.
         this.#session.close();
         this.#picker.setCurrent(this.#settings.sleeve_id);
@@ -420,6 +459,7 @@ export class App {
 
   #onStatus(payload: string): void {
     const read = this.#sleeve.onStatus(payload);
+    this.#onControls(payload);
     if (read === null) return;
     if (read.back && this.#says.counts.played + this.#says.counts.refused > 0) {
       this.#says.add("info", `Sleeve ${this.#settings.sleeve_id} is back.`);
@@ -456,7 +496,113 @@ export class App {
       );
       return;
     }
+    if (event.type === "rejected" && isWearerRefusal(event.reason)) {
+      // The status came after the stroke left: said as the wearer's pause, not a generic refusal.
+      // Shown as the generic refusal would be: for this drawing, or for no drawing in particular.
+      if (ours) this.#says.wearerRefused();
+      if (ours || event.drawing == null) {
+        const label = seq === null ? "A stroke" : `Stroke ${seq}`;
+        this.#says.add("rejected", wearerRefusalNote(label, event.reason, event.message));
+      }
+      return;
+    }
     for (const note of reading.notes) this.#says.add(note.kind, note.text);
+  }
+
+  // ---- the wearer's choice -----------------------------------------------------------------
+
+  /** A stroke drawn (or played again): sent, or held on the page while the wearer paused. */
+  #send(stroke: Stroke): void {
+    const drawing = this.#session.drawing;
+    if (this.#wearer.keep(stroke, Date.now())) {
+      if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
+        this.#session.held(stroke.seq);
+      const hold = this.#wearer.hold(Date.now());
+      this.#says.setHeld(this.#wearer.heldCount, hold === null ? null : holdReason(hold));
+      this.#showWearer();
+      return;
+    }
+    this.#wearer.dismissResumed();
+    this.#showWearer();
+    this.#sender.send(stroke);
+  }
+
+  /** The held strokes go out now, back to back (wearer-hold.ts says why that suits the sleeve's pace). */
+  sendHeld(): void {
+    if (this.#wearer.hold(Date.now()) !== null) return;
+    const strokes = this.#wearer.take();
+    for (const stroke of strokes) {
+      if (stroke.seq != null) this.#session.unhold(stroke.seq);
+      this.#sender.send(stroke);
+    }
+    this.#says.setHeld(0);
+    if (strokes.length > 0) this.#says.add("info", `${strokes.length} held stroke(s) sent.`);
+    this.#showWearer();
+  }
+
+  #dropHeld(): void {
+    const strokes = this.#wearer.take();
+    this.#markNeverSent(strokes);
+    this.#says.setHeld(0);
+    this.#showWearer();
+  }
+
+  /** A new drawing (or none): the strokes held for the old one are never sent. */
+  #newDrawingHeld(): void {
+    this.#markNeverSent(this.#wearer.newDrawing());
+    this.#showWearer();
+  }
+
+  #markNeverSent(strokes: readonly Stroke[]): void {
+    if (strokes.length === 0) return;
+    const drawing = this.#session.drawing;
+    for (const stroke of strokes) {
+      if (stroke.seq == null) continue;
+      this.#session.unhold(stroke.seq);
+      if (drawing !== null && stroke.drawing === drawing.id) this.#session.refused(stroke.seq, "unsent");
+    }
+    if (drawing !== null && strokes.some((stroke) => stroke.drawing === drawing.id))
+      this.#says.addDropped(strokes.length);
+    this.#says.add("info", `${strokes.length} held stroke(s) dropped, never sent.`);
+  }
+
+  #onControls(payload: string): void {
+    const online = this.#sleeve.status?.online === true && payload.trim() !== "";
+    const controls = online ? parseWearerControls(payload) : null;
+    if (online && controls === null) {
+      this.#says.add(
+        "error",
+        "The sleeve's wearer controls (its status, controls) are not understood: the page cannot tell whether the wearer paused.",
+      );
+    }
+    const nowMs = Date.now();
+    const before = this.#wearer.hold(nowMs);
+    if (controls !== null) this.#wearer.onStatus(controls, online, this.#sleeve.status?.at_ms ?? null, nowMs);
+    const after = this.#wearer.hold(nowMs);
+    if (before !== null && after === null) this.#says.add("info", "The wearer resumed the sleeve.");
+    if (before === null && after !== null)
+      this.#says.add("info", "The wearer paused the sleeve: what you draw is held here.");
+    this.#showWearer();
+  }
+
+  #showWearer(): void {
+    const nowMs = Date.now();
+    this.#wearer.tick(nowMs);
+    this.#wearerNotice.show(
+      this.#wearer.view(nowMs),
+      ceilingNote(this.#wearer.ceiling, this.#settings.intensity),
+    );
+    if (this.#wearerTimer !== null) clearTimeout(this.#wearerTimer);
+    this.#wearerTimer = null;
+    const hold = this.#wearer.hold(nowMs);
+    if (hold?.reason === "do_not_disturb") {
+      // setTimeout holds at most 2^31 - 1 ms; a "do not disturb" is at most 24 h.
+      const waitMs = Math.min(hold.untilMs - nowMs + 50, 2 ** 31 - 1);
+      this.#wearerTimer = setTimeout(() => {
+        this.#wearerTimer = null;
+        this.#showWearer();
+      }, waitMs);
+    }
   }
 
   // ---- for the benchmark and the browser tests ---------------------------------------------

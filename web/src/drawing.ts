@@ -35,6 +35,8 @@ export class Drawing {
   readonly #acked = new Set<number>();
   /** Strokes not felt, and why: refused by the sleeve, cancelled by Stop, or never sent. */
   readonly #refused = new Map<number, Unfelt>();
+  /** Strokes kept on the page, not sent, while the wearer paused the sleeve (or asked not to be disturbed). */
+  readonly #held = new Set<number>();
   #nextSeq = 0;
   /** Segments kept as strokes (not dropped) in the paths still in the drawing. */
   #kept = 0;
@@ -113,6 +115,23 @@ export class Drawing {
     const drawn = this.#bySeq.get(seq);
     if (drawn !== undefined) this.#refused.set(seq, why);
     return drawn;
+  }
+
+  /** Stroke `seq` is held on the page, not sent: the wearer paused the sleeve. */
+  markHeld(seq: number): DrawnSegment | undefined {
+    const drawn = this.#bySeq.get(seq);
+    if (drawn !== undefined) this.#held.add(seq);
+    return drawn;
+  }
+
+  /** Stroke `seq` is no longer held (sent after all, or dropped). */
+  unhold(seq: number): DrawnSegment | undefined {
+    this.#held.delete(seq);
+    return this.#bySeq.get(seq);
+  }
+
+  isHeld(drawn: DrawnSegment): boolean {
+    return drawn.stroke?.seq != null && this.#held.has(drawn.stroke.seq);
   }
 
   isRefused(drawn: DrawnSegment): boolean {

@@ -27,6 +27,7 @@ from feelmysign.events import (
     Safety,
     event_from_json,
 )
+from feelmysign.wearer_status import cancelled_by_wearer
 
 if TYPE_CHECKING:
     import paho.mqtt.client as mqtt
@@ -42,6 +43,9 @@ class StrokeOutcome:
     cut_reason: str | None = None
     # When the played event arrived (monotonic s): the stroke ends on the skin duration later.
     played_seen_s: float | None = None
+    # Cut or dropped by the wearer's pause or stop (a ``cancelled`` event ``"by": "wearer"``),
+    # not by a sender's control message.
+    by_wearer: bool = False
 
     @property
     def final(self) -> bool:
@@ -77,6 +81,12 @@ class DrawingOutcome:
             if self._copies.is_copy(event):
                 return
             told = self._record(self.strokes[seq], event)
+            if (
+                told
+                and isinstance(event, Cancelled)
+                and cancelled_by_wearer(bytes(message.payload))
+            ):
+                self.strokes[seq].by_wearer = True
             self._condition.notify_all()
         if told and self._on_event is not None:
             self._on_event(seq, self.strokes[seq], event)

@@ -216,18 +216,27 @@ def sleeve_status(
 ) -> Status | None:
     """The sleeve's retained status (its layout, floor, online), read on a connected
     ``client``; None when the broker holds none, or one not understood, within ``wait_s``."""
+    return sleeve_status_and_payload(client, settings, wait_s=wait_s)[0]
+
+
+def sleeve_status_and_payload(
+    client: mqtt.Client, settings: BrokerSettings, *, wait_s: float = STATUS_WAIT_S
+) -> tuple[Status | None, bytes | None]:
+    """``sleeve_status``, and the status's payload as it came (for fields read apart, such as
+    the wearer's ``controls``, wearer_status.py); (None, None) when none came within ``wait_s``."""
     from feelmysign.events import EventError
     from feelmysign.topics import telemetry_topic
 
     topic = telemetry_topic(settings.sleeve_id, "status")
     arrived = threading.Event()
-    read: list[Status | None] = []
+    read: list[tuple[Status | None, bytes | None]] = []
 
     def on_status(_client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        payload = bytes(message.payload)
         try:
-            read.append(Status.from_json(message.payload) if message.payload else None)
+            read.append((Status.from_json(payload) if payload else None, payload or None))
         except EventError:
-            read.append(None)  # not understood: as from no sleeve
+            read.append((None, payload))  # not understood: as from no sleeve
         arrived.set()
 
     client.message_callback_add(topic, on_status)
@@ -237,4 +246,4 @@ def sleeve_status(
         client.unsubscribe(topic)
     finally:
         client.message_callback_remove(topic)
-    return read[0] if read else None
+    return read[0] if read else (None, None)

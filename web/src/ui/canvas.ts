@@ -46,6 +46,8 @@ const COLORS = {
   rejected: "#ff6b6b",
   /** Cancelled by Stop, or never sent: not felt, but nothing went wrong. */
   cancelled: "rgba(143, 160, 178, 0.7)",
+  /** Held on the page while the wearer paused: not sent yet, may be sent on resume. */
+  held: "#c792ea",
   topEdge: "rgba(255, 138, 91, 0.75)",
   /** The stage's own colour (--surface): a refused stroke is first wiped out with it. */
   erase: "#151d26",
@@ -257,7 +259,10 @@ export class DrawingView {
     this.#acked.push(drawn);
   }
 
-  /** A stroke the sleeve refused (`Drawing.markRefused`): marked on the next flush, and kept so. */
+  /**
+   * A stroke the sleeve refused (`Drawing.markRefused`), or one held on the page (`Drawing.markHeld`):
+   * marked on the next flush, and kept so.
+   */
   markRejected(drawn: DrawnSegment): void {
     this.#rejected.push(drawn);
   }
@@ -282,11 +287,12 @@ export class DrawingView {
     const drawnBefore = this.#segmentsDrawn;
     for (; this.#segmentsDrawn < segments.length; this.#segmentsDrawn++) {
       const drawn = segments[this.#segmentsDrawn]!;
-      if (drawing.isRefused(drawn)) this.#drawRejected(ctx, drawn);
+      if (drawing.isRefused(drawn) || drawing.isHeld(drawn)) this.#drawRejected(ctx, drawn);
       else this.#drawSegment(ctx, drawn, drawing.isAcked(drawn));
     }
     for (const drawn of this.#acked.splice(0)) {
       // A refused stroke stays marked refused, whenever the broker's acknowledgement comes.
+      // A held stroke sent on resume is drawn over its narrower held dashes.
       if (drawn.index < drawnBefore && !drawing.isRefused(drawn)) this.#drawSegment(ctx, drawn, true);
     }
     for (const drawn of this.#rejected.splice(0)) {
@@ -472,11 +478,11 @@ export class DrawingView {
     ctx.restore();
   }
 
-  #drawRejected(ctx: CanvasRenderingContext2D, drawn: DrawnSegment): void {
+  /** Paints the stage's own colour over a stroke: what is drawn next replaces its mark. */
+  #wipe(ctx: CanvasRenderingContext2D, drawn: DrawnSegment): void {
     const ends = this.#segmentEnds(drawn);
     if (ends === null) return;
     const [[x0, y0], [x1, y1]] = ends;
-    const refused = this.#drawing?.unfelt(drawn) === "refused";
     ctx.save();
     ctx.strokeStyle = COLORS.erase;
     ctx.lineWidth = SENT_WIDTH_PX + 2;
@@ -484,6 +490,28 @@ export class DrawingView {
     ctx.moveTo(x0, y0);
     ctx.lineTo(x1, y1);
     ctx.stroke();
+    ctx.restore();
+  }
+
+  #drawRejected(ctx: CanvasRenderingContext2D, drawn: DrawnSegment): void {
+    const ends = this.#segmentEnds(drawn);
+    if (ends === null) return;
+    const [[x0, y0], [x1, y1]] = ends;
+    const refused = this.#drawing?.unfelt(drawn) === "refused";
+    this.#wipe(ctx, drawn);
+    ctx.save();
+    if (this.#drawing?.isHeld(drawn) === true && !refused) {
+      // Held while the wearer paused: violet dashes, as the legend's "held, not sent".
+      ctx.strokeStyle = COLORS.held;
+      ctx.lineWidth = SENT_WIDTH_PX - 1;
+      ctx.setLineDash([9, 6]);
+      ctx.beginPath();
+      ctx.moveTo(x0, y0);
+      ctx.lineTo(x1, y1);
+      ctx.stroke();
+      ctx.restore();
+      return;
+    }
     if (!refused) {
       // Cancelled by Stop or never sent: dotted grey, no cross (the sleeve refused nothing).
       ctx.strokeStyle = COLORS.cancelled;

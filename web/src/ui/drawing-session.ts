@@ -184,6 +184,19 @@ export class DrawingSession {
     this.#scheduleFlush();
   }
 
+  /** Stroke `seq` of this drawing is held on the page, not sent (the wearer paused): marked so. */
+  held(seq: number): void {
+    const drawn = this.#drawing?.markHeld(seq);
+    if (drawn === undefined) return;
+    this.#view.markRejected(drawn);
+    this.#scheduleFlush();
+  }
+
+  /** Stroke `seq` is no longer held: sent after all (drawn sent once acknowledged) or dropped. */
+  unhold(seq: number): void {
+    this.#drawing?.unhold(seq);
+  }
+
   /**
    * The drawing's paths cut again under the settings now, as a new drawing shown at once (not
    * sent: Play again sends it); null when there is nothing to cut, or while drawing.

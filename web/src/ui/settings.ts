@@ -7,6 +7,7 @@
 import type { ServerConfig } from "../config";
 import type { SleeveFloor } from "../events";
 import { floorNote, type Minimums } from "../sleeve-floor";
+import { ceilingNote } from "../wearer-status";
 import {
   FIELDS,
   defaultSettings,
@@ -49,6 +50,8 @@ export interface SettingsPanelContext {
   readonly spacingCm?: number | null;
   /** The sleeve's floor (its status): the simplifier's minimums are raised to it. */
   readonly floor?: SleeveFloor | null;
+  /** The wearer's intensity ceiling (the status's controls): the sleeve plays no stronger. */
+  readonly ceiling?: number | null;
 }
 
 export class SettingsPanel {
@@ -67,6 +70,7 @@ export class SettingsPanel {
   #brokerNote: HTMLElement | null = null;
   #unitNote: HTMLElement | null = null;
   #floorNote: HTMLElement | null = null;
+  #ceilingNote: HTMLElement | null = null;
   #detail: HTMLInputElement | null = null;
   #detailText: HTMLElement | null = null;
   #detailLimit: HTMLElement | null = null;
@@ -110,7 +114,14 @@ export class SettingsPanel {
     const basic = document.createElement("fieldset");
     const basicLegend = document.createElement("legend");
     basicLegend.textContent = "Basic";
-    basic.append(basicLegend, this.#fieldRow(FIELDS.find((f) => f.key === "intensity")!), this.#detailRow());
+    this.#ceilingNote = paragraph("section-note", "");
+    this.#ceilingNote.dataset["testid"] = "ceiling-note";
+    basic.append(
+      basicLegend,
+      this.#fieldRow(FIELDS.find((f) => f.key === "intensity")!),
+      this.#ceilingNote,
+      this.#detailRow(),
+    );
     for (const field of FIELDS.filter((f) => BASIC.includes(f.key) && f.key !== "intensity"))
       basic.append(this.#fieldRow(field));
     this.#body.append(basic);
@@ -346,7 +357,13 @@ export class SettingsPanel {
       this.#rows.get(key)!.dataset["disabled"] = String(disabled);
       for (const input of this.#inputs.get(key) ?? []) input.disabled = disabled;
     }
-    const { config, sleeveGrid, spacingCm, floor } = this.#context;
+    const { config, sleeveGrid, spacingCm, floor, ceiling } = this.#context;
+    if (this.#ceilingNote) {
+      const intensity = candidate.intensity;
+      const note = typeof intensity === "number" ? ceilingNote(ceiling ?? null, intensity) : null;
+      this.#ceilingNote.textContent = note ?? "";
+      this.#ceilingNote.hidden = note === null;
+    }
     if (this.#floorNote) {
       const note = floorNote(candidateMinimums(candidate), floor);
       this.#floorNote.textContent = note ?? "";

@@ -38,6 +38,11 @@ export class SleeveSays {
   #delayed = 0;
   #latestDelayMs = 0;
   #sent = 0;
+  /** Kept on the page, not sent, while the wearer paused the sleeve (wearer-hold.ts). */
+  #held = 0;
+  #heldWhy = "the wearer paused";
+  /** Of the refused: refused `paused` or `do_not_disturb` (the page heard of the pause late). */
+  #wearerRefused = 0;
   #drawing: string | null = null;
 
   constructor(title: HTMLElement, list: HTMLOListElement, summary: HTMLElement) {
@@ -57,6 +62,11 @@ export class SleeveSays {
     };
   }
 
+  /** The drawing the card is about (null: none). */
+  get drawingId(): string | null {
+    return this.#drawing;
+  }
+
   /** A new drawing (or none): counts and notes start again. */
   reset(drawing: string | null): void {
     if (drawing === this.#drawing) return;
@@ -66,6 +76,8 @@ export class SleeveSays {
     this.#delayed = 0;
     this.#latestDelayMs = 0;
     this.#sent = 0;
+    this.#held = 0;
+    this.#wearerRefused = 0;
     this.#list.replaceChildren();
     this.#title.textContent =
       drawing === null ? "Sleeve says" : `Sleeve says · drawing ${drawing.slice(0, 8)}`;
@@ -97,6 +109,19 @@ export class SleeveSays {
     this.#render();
   }
 
+  /** How many of the drawing's strokes are held on the page now, not sent, and why (`holdReason`). */
+  setHeld(held: number, why: string | null = null): void {
+    this.#held = held;
+    if (why !== null) this.#heldWhy = why;
+    this.#render();
+  }
+
+  /** A stroke of this drawing was refused because the wearer paused (also counted by `fate`). */
+  wearerRefused(): void {
+    this.#wearerRefused++;
+    this.#render();
+  }
+
   setSent(sent: number): void {
     this.#sent = sent;
     this.#render();
@@ -116,6 +141,8 @@ export class SleeveSays {
     summary.dataset["cancelled"] = String(cancelled);
     summary.dataset["dropped"] = String(dropped);
     summary.dataset["delayed"] = String(delayed);
+    summary.dataset["held"] = String(this.#held);
+    summary.dataset["wearerRefused"] = String(this.#wearerRefused);
     if (this.#sent === 0 && dropped === 0) {
       summary.textContent = "No strokes sent yet.";
       return;
@@ -124,9 +151,15 @@ export class SleeveSays {
     const parts = [`${played} of ${plural(this.#sent, "stroke")} played`];
     if (cut > 0) parts.push(`${cut} cut short by Stop`);
     if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
-    if (refused > 0) parts.push(`${refused} refused`);
+    if (refused > 0) {
+      const wearer = Math.min(this.#wearerRefused, refused);
+      const why =
+        wearer === 0 ? "" : wearer === refused ? " (the wearer paused)" : ` (${wearer} as the wearer paused)`;
+      parts.push(`${refused} refused${why}`);
+    }
+    if (this.#held > 0) parts.push(`${this.#held} held on this page, not sent (${this.#heldWhy})`);
     if (dropped > 0) parts.push(`${dropped} never sent`);
-    const waiting = this.#sent - played - cut - cancelled - refused - dropped;
+    const waiting = this.#sent - played - cut - cancelled - refused - dropped - this.#held;
     if (waiting > 0 && (cut > 0 || cancelled > 0)) parts.push(`${waiting} not answered yet`);
     if (delayed > 0) parts.push(`${delayed} delayed on the way (last by ${seconds(latestDelayMs)})`);
     summary.textContent = `${parts.join(", ")}.`;

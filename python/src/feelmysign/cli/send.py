@@ -13,6 +13,19 @@ topic. Each message is published with QoS 1, and the command returns once the
 broker has acknowledged every one (exit 0), or says why not (exit 1). When the
 sleeve's retained status advertises a floor, one line on stderr says how many
 strokes are below it (they are sent as given).
+
+The wearer's choice wins over the sender's. When the sleeve's status says the
+wearer paused it, or asked not to be disturbed, one line on stderr says so and
+until when, nothing is sent, and the exit code is 3: wait for the wearer to
+resume, then send again. With --wait, strokes the sleeve refused because the
+wearer paused during the drawing (or cut by the wearer's pause) are named, and
+the exit code is 3 too. A ceiling the wearer set is said in one line: it caps
+every stroke's intensity.
+
+Exit codes: 0 sent (and with --wait, every stroke played); 1 an error, or with
+--wait a stroke refused, cut or unanswered; 2 a usage error; 3 the wearer
+paused the sleeve or asked not to be disturbed (nothing sent, or with --wait
+strokes refused or cut for it).
 """
 
 from __future__ import annotations
@@ -39,7 +52,7 @@ from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
-from feelmysign.events import Event, Status, StatusFloor
+from feelmysign.events import Event, EventError, Status, StatusFloor
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
 from feelmysign.outcome import DrawingOutcome, StrokeOutcome
 from feelmysign.protocol import Accepted, parse
@@ -49,11 +62,19 @@ from feelmysign.sending import (
     Pace,
     StrokeSender,
     printer,
-    sleeve_status,
+    sleeve_status_and_payload,
 )
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
 from feelmysign.stroke import Stroke
 from feelmysign.topics import LEGACY_TOPIC, telemetry_topic
+from feelmysign.wearer_status import (
+    NO_CONTROLS,
+    WEARER_REASONS,
+    WearerControls,
+    ceiling_sentence,
+    controls_from_status,
+    hold_sentence,
+)
 
 if TYPE_CHECKING:
     import paho.mqtt.client as mqtt
@@ -61,6 +82,9 @@ if TYPE_CHECKING:
 # The faintest intensity sent (the page's MIN_INTENSITY): at 0 the sleeve would play, and report
 # as played, a stroke no one feels; so 0 is refused here, with the range to give.
 MIN_INTENSITY = 0.01
+# The exit code when the wearer's choice (paused, do not disturb) kept the drawing from the skin:
+# apart from 1 (an error to fix), since what to do is wait, not change the command.
+WEARER_HOLD_EXIT = 3
 
 
 def _epilog() -> str:
@@ -159,7 +183,8 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="wait for the sleeve's events for the strokes sent, print what it played or "
         "refused, and exit 1 when any stroke was refused, cut or not answered within "
-        "--timeout-s after the drawing; returns once the last stroke has been felt (default: "
+        "--timeout-s after the drawing (3 when the wearer paused the sleeve or asked not to "
+        "be disturbed); returns once the last stroke has been felt (default: "
         "--wait for --shape, --no-wait for STROKEs; not with --legacy)",
     )
     add_broker_timeout_option(
@@ -186,11 +211,17 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     client_id = f"feelmysign-send-{uuid.uuid4().hex[:12]}"
     client = connect_client(settings, client_id, timeout_s=args.timeout_s)
     try:
-        status = sleeve_status(client, settings, wait_s=STATUS_WAIT_S)
+        status, payload = sleeve_status_and_payload(client, settings, wait_s=STATUS_WAIT_S)
         if layout is None:
             layout = _layout_of_sleeve(status, settings)
             strokes = _strokes(args, layout, texts)
         _say_offline(status, settings, wait=wait)
+        controls = _wearer_controls(status, payload)
+        hold = controls.hold()
+        if hold is not None:
+            print(f"Error: {hold_sentence(hold, settings.sleeve_id)}", file=sys.stderr, flush=True)
+            return WEARER_HOLD_EXIT
+        _say_ceiling(controls, strokes, layout)
         _say_floor(None if status is None else status.floor, strokes)
         topic = args.legacy_topic if args.legacy else settings.strokes_topic
         messages = [OutgoingStroke(i, topic, s, args.legacy) for i, s in enumerate(strokes)]
@@ -285,6 +316,32 @@ def _say_offline(status: Status | None, settings: BrokerSettings, *, wait: bool)
     )
 
 
+def _wearer_controls(status: Status | None, payload: bytes | None) -> WearerControls:
+    """The wearer's choice in the sleeve's status; none for no status or an offline one (the
+    last will carries none). Controls not understood are said, and the sleeve still enforces
+    them: its refusals then say what holds it."""
+    if status is None or payload is None or not status.online:
+        return NO_CONTROLS
+    try:
+        return controls_from_status(payload)
+    except EventError as error:
+        print(
+            f"The sleeve's status has wearer controls this command does not understand ({error}); "
+            "sending anyway: the sleeve refuses strokes if its wearer paused it.",
+            file=sys.stderr,
+            flush=True,
+        )
+        return NO_CONTROLS
+
+
+def _say_ceiling(controls: WearerControls, strokes: list[Stroke], layout: Layout) -> None:
+    """One line on stderr: the wearer's ceiling caps every stroke's intensity."""
+    if controls.ceiling is None:
+        return
+    asked = [layout.default_intensity if s.intensity is None else s.intensity for s in strokes]
+    print(ceiling_sentence(controls.ceiling, asked), file=sys.stderr, flush=True)
+
+
 def _watch_events(
     client: mqtt.Client, settings: BrokerSettings, strokes: list[Stroke], args: argparse.Namespace
 ) -> DrawingOutcome:
@@ -371,8 +428,39 @@ def _await_sleeve(
         if not args.json:
             print(f"{line}.", flush=True)
         return 0
-    print(f"Error: {line}.", file=sys.stderr, flush=True)
-    return 1
+    wearer = _wearer_line(outcome)
+    print(f"Error: {line}.{wearer or ''}", file=sys.stderr, flush=True)
+    return 1 if wearer is None else WEARER_HOLD_EXIT
+
+
+def _wearer_line(outcome: DrawingOutcome) -> str | None:
+    """The strokes the wearer's choice kept from the skin, named, and what to do; None when the
+    wearer had no part in it."""
+    refused = {
+        reason: [i + 1 for i, s in enumerate(outcome.strokes) if s.refused_reason == reason]
+        for reason in sorted(WEARER_REASONS)
+    }
+    cut = [i + 1 for i, s in enumerate(outcome.strokes) if s.by_wearer]
+    if not any(refused.values()) and not cut:
+        return None
+    parts = []
+    if refused["paused"]:
+        parts.append(
+            f"the wearer paused the sleeve: stroke(s) {_numbers(refused['paused'])} refused"
+        )
+    if refused["do_not_disturb"]:
+        parts.append(
+            "the wearer asked not to be disturbed: stroke(s) "
+            f"{_numbers(refused['do_not_disturb'])} refused"
+        )
+    if cut:
+        parts.append(f"the wearer's pause or stop cut or dropped stroke(s) {_numbers(cut)}")
+    text = "; ".join(parts)
+    return f" {text[0].upper()}{text[1:]}. Send again once the wearer has resumed."
+
+
+def _numbers(numbers: list[int]) -> str:
+    return ", ".join(str(n) for n in numbers)
 
 
 def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:

@@ -11,6 +11,9 @@ import com.hivemq.client.mqtt.mqtt3.Mqtt3ClientBuilder;
 import com.hivemq.client.mqtt.mqtt3.exceptions.Mqtt3ConnAckException;
 import com.hivemq.client.mqtt.mqtt3.message.connect.connack.Mqtt3ConnAckReturnCode;
 import com.hivemq.client.mqtt.mqtt3.message.publish.Mqtt3Publish;
+import feelmysign.json.JsonDecodeException;
+import feelmysign.json.NonFiniteLiteralException;
+import feelmysign.json.PyJson;
 import feelmysign.protocol.Control;
 import feelmysign.protocol.Protocol;
 import feelmysign.protocol.Stroke;
@@ -28,6 +31,7 @@ import java.security.cert.Certificate;
 import java.security.cert.CertificateFactory;
 import java.util.ArrayList;
 import java.util.List;
+import java.util.Map;
 import java.util.UUID;
 import java.util.concurrent.ThreadLocalRandom;
 import java.util.concurrent.TimeUnit;
@@ -77,6 +81,14 @@ public final class SleeveClient implements AutoCloseable {
 
     /** The sleeve's retained status (JSON; "" when it was cleared). */
     default void status(String payload) {}
+
+    /**
+     * The wearer's choice (paused, ceiling, "do not disturb"), typed, right after each online
+     * {@link #status} that carries it or none ({@link WearerState#NONE}: an older sleeve). Not
+     * after an offline status: the last will carries no controls, and the wearer's choice is kept
+     * on the sleeve. A status whose {@code controls} is not understood is not passed on.
+     */
+    default void wearer(WearerState state) {}
 
     /** One event of the sleeve: played, adjusted, rejected, cancelled, safety, error. */
     default void event(SleeveEvent event) {}
@@ -406,12 +418,29 @@ public final class SleeveClient implements AutoCloseable {
     String text = new String(publish.getPayloadAsBytes(), StandardCharsets.UTF_8);
     if (topic.equals(Topics.telemetryTopic(sleeveId, Topics.STATUS))) {
       listener.status(text);
+      WearerState wearer = onlineWearer(text);
+      if (wearer != null) {
+        listener.wearer(wearer);
+      }
     } else if (topic.equals(Topics.telemetryTopic(sleeveId, Topics.EVENTS))) {
       SleeveEvent event = SleeveEvent.parse(text);
       if (event != null) {
         listener.event(event);
       }
     }
+  }
+
+  /** The wearer's state in an online status; null for an offline one or one not understood. */
+  static WearerState onlineWearer(String statusPayload) {
+    try {
+      if (!(PyJson.loads(statusPayload) instanceof Map<?, ?> status)
+          || !Boolean.TRUE.equals(status.get("online"))) {
+        return null;
+      }
+    } catch (JsonDecodeException | NonFiniteLiteralException error) {
+      return null;
+    }
+    return WearerState.parse(statusPayload);
   }
 
   /** Starts a new drawing: a new id (a random UUID), its strokes counted from 0. */

@@ -94,6 +94,29 @@ public final class LiveSleeve implements AutoCloseable {
     }
   }
 
+  /**
+   * Starts a broker only, keeping its state in {@code state}: no sleeve, so the test publishes
+   * the sleeve's messages itself with {@link #sleeveUser()} and {@link #sleevePassword()}.
+   */
+  public static LiveSleeve brokerOnly(Path state, String sleeveId) throws IOException {
+    Process broker =
+        new ProcessBuilder(
+                feelmysign().toString(), "broker", "--state-dir", state.toString(),
+                "--port", "0", "--ws-port", "0", "--sleeve-id", sleeveId)
+            .redirectErrorStream(true)
+            .start();
+    try {
+      awaitReady(broker);
+      @SuppressWarnings("unchecked")
+      Map<String, Object> document =
+          (Map<String, Object>) PyJson.loads(Files.readString(state.resolve("credentials.json")));
+      return new LiveSleeve(state, sleeveId, broker, null, document);
+    } catch (IOException | RuntimeException error) {
+      stop(broker);
+      throw error;
+    }
+  }
+
   private LiveSleeve(
       Path state, String sleeveId, Process broker, Process sleeve, Map<String, Object> document) {
     this.state = state;
@@ -171,6 +194,15 @@ public final class LiveSleeve implements AutoCloseable {
     return (Map<?, ?>) document.get("sender");
   }
 
+  /** The sleeve's own account: what the sleeve logs in with to publish its status. */
+  public String sleeveUser() {
+    return (String) ((Map<?, ?>) document.get("sleeve")).get("username");
+  }
+
+  public String sleevePassword() {
+    return (String) ((Map<?, ?>) document.get("sleeve")).get("password");
+  }
+
   /** A sender's client to this sleeve over plain MQTT, not yet connected. */
   public SleeveClient.Builder client(String password) {
     return SleeveClient.builder(mqttUrl()).login(senderUser(), password).sleeveId(sleeveId);
@@ -237,7 +269,9 @@ public final class LiveSleeve implements AutoCloseable {
 
   @Override
   public void close() throws InterruptedException {
-    stop(sleeve);
+    if (sleeve != null) {
+      stop(sleeve);
+    }
     stop(broker);
   }
 

@@ -2,6 +2,7 @@ package feelmysign.processing;
 
 import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
+import feelmysign.client.WearerState;
 import feelmysign.protocol.Layout;
 import feelmysign.protocol.ParseResult;
 import feelmysign.protocol.Protocol;
@@ -15,6 +16,7 @@ import feelmysign.simplify.Segment;
 import feelmysign.simplify.Simplifier;
 import java.lang.reflect.Method;
 import java.nio.file.Path;
+import java.time.ZoneId;
 import java.util.ArrayDeque;
 import java.util.ArrayList;
 import java.util.Deque;
@@ -46,8 +48,9 @@ import processing.event.MouseEvent;
  * a press starts a drawing, each drag goes through the simplifier, each stroke it lets go is
  * sent. The sleeve's events and the broker's news are queued by the network thread and handed
  * to the sketch on its own thread, at the end of each {@code draw()}: to {@code void
- * sleeveEvent(SleeveEvent event)} and {@code void sleeveStatus(String sentence)} when the sketch
- * has them. Nothing the network does throws into {@code draw()}: a broker out of reach, a wrong
+ * sleeveEvent(SleeveEvent event)}, {@code void sleeveStatus(String sentence)} and {@code void
+ * sleeveWearer(WearerState wearer)} (the wearer paused the sleeve, set a ceiling, or asked not to
+ * be disturbed; also said to {@code sleeveStatus}) when the sketch has them. Nothing the network does throws into {@code draw()}: a broker out of reach, a wrong
  * password or a certificate that does not match is said once, on the console and to {@code
  * sleeveStatus}, and the sketch keeps drawing; strokes drawn meanwhile wait in the client's
  * outbox (or are dropped after {@link #lateLimitMs}, the page's policies). Queues and histories
@@ -103,12 +106,16 @@ public class FeelMySign {
   private int tooBrief;
   private final Method eventMethod;
   private final Method statusMethod;
+  private final Method wearerMethod;
+  /** The wearer's choice, from the sleeve's last online status (sketch thread). */
+  private WearerState wearer = WearerState.NONE;
 
   /** The library for {@code parent}; configure it, then {@link #start()} it in setup(). */
   public FeelMySign(PApplet parent) {
     this.parent = parent;
     this.eventMethod = sketchMethod("sleeveEvent", SleeveEvent.class);
     this.statusMethod = sketchMethod("sleeveStatus", String.class);
+    this.wearerMethod = sketchMethod("sleeveWearer", WearerState.class);
   }
 
   // ---- configuration (before start) ----
@@ -543,6 +550,8 @@ public class FeelMySign {
           PApplet.println("feelmysign: " + news.detail);
           call(statusMethod, news.detail);
         }
+      } else if (item instanceof WearerState state) {
+        wearerChanged(state);
       } else if (item instanceof String said) {
         PApplet.println("feelmysign: " + said);
         call(statusMethod, said);
@@ -553,6 +562,38 @@ public class FeelMySign {
       overflowTold = lost;
       PApplet.println("feelmysign: " + lost + " events came faster than the sketch drew and were not kept");
     }
+  }
+
+  /**
+   * The wearer's choice changed: said once on the console and to {@code sleeveStatus} (what the
+   * wearer chose, or that the sleeve plays again), and handed typed to {@code sleeveWearer}.
+   */
+  private void wearerChanged(WearerState state) {
+    if (state.equals(wearer)) {
+      return; // a status republished for another reason
+    }
+    long nowMs = System.currentTimeMillis();
+    boolean wasHeld = wearer.holds(nowMs);
+    wearer = state;
+    String sentence = state.sentence(nowMs, ZoneId.systemDefault());
+    if (sentence == null && wasHeld) {
+      sentence = "the wearer resumed the sleeve: strokes play again";
+    }
+    if (sentence != null) {
+      PApplet.println("feelmysign: " + sentence);
+      call(statusMethod, sentence);
+    }
+    call(wearerMethod, state);
+  }
+
+  /**
+   * The wearer's choice (paused, ceiling, "do not disturb") from the sleeve's last online status;
+   * {@link WearerState#NONE} before one came, or from an older sleeve. While {@code
+   * wearer().holds(millis)} the sleeve refuses every stroke drawn ({@code rejected}, reason
+   * {@code paused} or {@code do_not_disturb}).
+   */
+  public WearerState wearer() {
+    return wearer;
   }
 
   /** Processing's hook when the sketch ends: the client closes (the sleeve is not stopped). */
@@ -613,6 +654,11 @@ public class FeelMySign {
     @Override
     public void event(SleeveEvent event) {
       offer(event);
+    }
+
+    @Override
+    public void wearer(WearerState state) {
+      offer(state);
     }
 
     @Override

@@ -8,6 +8,7 @@ import static org.junit.jupiter.api.Assertions.assertTrue;
 import static org.junit.jupiter.api.Assertions.fail;
 
 import feelmysign.client.SleeveEvent;
+import feelmysign.client.WearerState;
 import java.io.IOException;
 import java.net.ServerSocket;
 import java.util.ArrayList;
@@ -28,6 +29,7 @@ class FeelMySignTest {
   public static class Sketch extends PApplet {
     final List<String> statuses = new ArrayList<>();
     final List<SleeveEvent> events = new ArrayList<>();
+    final List<WearerState> wearers = new ArrayList<>();
     final List<Thread> threads = new ArrayList<>();
 
     public void sleeveStatus(String sentence) {
@@ -37,6 +39,11 @@ class FeelMySignTest {
 
     public void sleeveEvent(SleeveEvent event) {
       events.add(event);
+      threads.add(Thread.currentThread());
+    }
+
+    public void sleeveWearer(WearerState wearer) {
+      wearers.add(wearer);
       threads.add(Thread.currentThread());
     }
   }
@@ -49,6 +56,36 @@ class FeelMySignTest {
 
   private static void post(FeelMySign library, int action, long millis, int x, int y) {
     library.mouseEvent(new MouseEvent(null, millis, action, 0, x, y, PConstants.LEFT, 1));
+  }
+
+  @Test
+  void theWearersChoiceReachesTheSketchTypedAndSaidOnItsOwnThread() throws Exception {
+    Sketch sketch = new Sketch();
+    FeelMySign library = new FeelMySign(sketch);
+    assertEquals(WearerState.NONE, library.wearer());
+    WearerState paused = new WearerState(true, "button", 0.6, null);
+    Thread network =
+        new Thread(
+            () -> {
+              library.relay().wearer(paused);
+              library.relay().wearer(paused); // republished for another reason: said once
+              library.relay().wearer(WearerState.NONE);
+            });
+    network.start();
+    network.join();
+    assertTrue(sketch.wearers.isEmpty(), "nothing before the sketch's draw()");
+    library.draw();
+    assertEquals(List.of(paused, WearerState.NONE), sketch.wearers);
+    assertEquals(
+        List.of(
+            "the wearer paused the sleeve: strokes are refused until the wearer resumes it; wait"
+                + " for the wearer (and a ceiling of 60 %)",
+            "the wearer resumed the sleeve: strokes play again"),
+        sketch.statuses);
+    assertEquals(WearerState.NONE, library.wearer());
+    for (Thread thread : sketch.threads) {
+      assertSame(Thread.currentThread(), thread, "a callback ran off the sketch's thread");
+    }
   }
 
   @Test
