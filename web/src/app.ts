@@ -41,7 +41,6 @@ import {
   parseWearerControls,
   wearerRefusalNote,
 } from "./wearer-status";
-import type { Stroke } from "./protocol";
 
 export interface AppOptions {
   readonly config: ServerConfig | null;
