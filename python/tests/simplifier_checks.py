@@ -37,6 +37,7 @@ def check_vector(
     assert len(actual) == len(expected), name
     for (path, segment), want in zip(actual, expected, strict=True):
         assert path == want["path"] and segment.dropped == want["dropped"]
+        assert segment.merged == want.get("merged", 0), name
         got = [
             *segment.start,
             *segment.end,

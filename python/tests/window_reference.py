@@ -11,6 +11,7 @@ simplifier's inlined loops must equal that distance to the last bit.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from feelmysign.simplify.mapping import CanvasMapping
@@ -125,7 +126,8 @@ class ReferenceWindowSimplifier:
                     self._window = [vertex]
                     continue
                 window = self._window = [vertex]
-            if not self._fits(window, 1, len(window), item.point):
+            bound_sq = self._bend_sq(window, item.point)
+            if not self._fits(window, 1, len(window), item.point, bound_sq):
                 cut = self._feature(window, item.point)
                 out.append(self._finish(window[0], window[cut]))
                 self._line = None
@@ -224,11 +226,26 @@ class ReferenceWindowSimplifier:
                 return index
         return len(window) - 1  # unreachable: the last sample fits by construction
 
-    def _fits(self, window: list[_Point], first: int, stop: int, end: Point) -> bool:
-        """Whether window[first:stop] all lie within max_error of window[0] -> end."""
+    def _bend_sq(self, window: list[_Point], end: Point) -> float:
+        """The squared bound a stroke window[0] -> end grows under: max_error's, or the bend
+        rule's (max_bend x its length, never under bend_floor) when that is less."""
+        bend = self.params.max_bend
+        if bend <= 0.0 or len(window) == 1:
+            return self._max_error_sq
         anchor = window[0].point
+        cx, cy = end[0] - anchor[0], end[1] - anchor[1]
+        limit = max(bend * math.sqrt(cx * cx + cy * cy), self.params.bend_floor)
+        return limit * limit if limit < self.params.max_error else self._max_error_sq
+
+    def _fits(
+        self, window: list[_Point], first: int, stop: int, end: Point, limit_sq: float | None = None
+    ) -> bool:
+        """Whether window[first:stop] all lie within max_error (or sqrt(limit_sq)) of
+        window[0] -> end."""
+        anchor = window[0].point
+        bound_sq = self._max_error_sq if limit_sq is None else limit_sq
         for index in range(first, stop):
-            if segment_distance_sq(window[index].point, anchor, end) > self._max_error_sq:
+            if segment_distance_sq(window[index].point, anchor, end) > bound_sq:
                 return False
         return True
 

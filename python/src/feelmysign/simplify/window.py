@@ -54,12 +54,19 @@ at the earlier one's time, so times never run backwards.
 
 from __future__ import annotations
 
+import bisect
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import ParamSpec, SharedParams, param, specs_of
-from feelmysign.simplify.segment import Sample, Segment, finish_segment
+from feelmysign.simplify.segment import (
+    NOT_ENOUGH_DISTANCE,
+    NOT_ENOUGH_DURATION,
+    Sample,
+    Segment,
+    finish_segment,
+)
 from feelmysign.stroke import Point
 
 # The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
@@ -87,8 +94,11 @@ class _WindowOwn:
     The defaults are the project's (docs/research.md, "Default settings"):
     ``max_error`` 0.25 grid units is 7.5 mm on the paper's sleeve (3 cm
     spacing), well below the forearm's two-point threshold (about 35 mm);
-    strokes of at most 300 ms keep the felt drawing within about a third of a
-    second of the pen.
+    strokes of at most 200 ms, with the sleeve catching up queued strokes, end
+    the felt drawing about a quarter second after the pen on people's fast and
+    medium gestures. The bend rule (``max_bend`` 0.1, ``bend_floor`` 0.1) cuts a
+    round shape where its chord strays more than a tenth of its length;
+    ``floor_ms`` is the sleeve's own (73.7 ms on ERM motors).
     """
 
     max_error: float = param(
@@ -110,11 +120,37 @@ class _WindowOwn:
         unit="samples",
     )
     max_stroke_ms: float = param(
-        300.0,
+        200.0,
         0,
         60_000,
         help="longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
         label="Longest stroke",
+        unit="ms",
+    )
+    max_bend: float = param(
+        0.1,
+        0,
+        1,
+        help="farthest a drawn point may lie from its stroke as a share of the stroke's length "
+        "(never under bend_floor), so round shapes stay round; 0 = no limit",
+        label="Max bend",
+        unit="of the stroke's length",
+    )
+    bend_floor: float = param(
+        0.1,
+        0,
+        100,
+        help="least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
+        label="Bend floor",
+        unit="grid units",
+    )
+    floor_ms: float = param(
+        73.7,
+        0,
+        10_000,
+        help="shortest stroke the sleeve plays without slowing it, in ms (its status says); "
+        "a briefer piece merges into a neighbour where the error bound allows",
+        label="Sleeve floor",
         unit="ms",
     )
 
@@ -138,7 +174,10 @@ def describe(params: WindowParams) -> str:
 
 
 @dataclass
-class WindowSimplifier:
+class WindowCore:
+    """The window itself: strokes cut by the error bound, the bend rule and the caps, before
+    too-short pieces are merged (``WindowSimplifier`` merges them)."""
+
     params: WindowParams = field(default_factory=WindowParams)
     # The stroke being drawn, its anchor first, then every sample since, as three parallel lists:
     # the points in grid units, their times and their samples. Plain lists of floats and tuples,
@@ -190,6 +229,14 @@ class WindowSimplifier:
     def line_start(self) -> Sample | None:
         """Where the stroke being drawn starts (canvas pixels); None between paths."""
         return self._samples[0] if self._samples else None
+
+    def last_sample(self) -> tuple[float, Point]:
+        """The last sample taken, as taken: its time (never before the one before) and point."""
+        return self._times[-1], self._points[-1]
+
+    def pointer_ms(self) -> float:
+        """The time of the last sample pushed, as taken (0 before any)."""
+        return self._pointer.t_ms if self._pointer else 0.0
 
     def push(self, sample: Sample) -> list[Segment]:
         """One pointer sample while the pointer is down; the first of a path is the press."""
@@ -298,10 +345,21 @@ class WindowSimplifier:
         if len(points) == 1:
             self._reach = 0.0
             return True
+        reach_limit = self._reach_limit
+        bend = self.params.max_bend
+        if bend > 0.0:
+            # The bend rule: a round shape is cut before its chord strays farther than a share of
+            # the chord's length, never under the floor, never over max_error.
+            ax, ay = points[0]
+            cx, cy = point[0] - ax, point[1] - ay
+            limit = max(bend * math.sqrt(cx * cx + cy * cy), self.params.bend_floor)
+            if limit < self.params.max_error:
+                reach_limit = limit - ROUNDING_SLACK
+                max_error_sq = limit * limit
         last = points[-1]
         dx, dy = point[0] - last[0], point[1] - last[1]
         reach = self._reach + math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK
-        if reach <= self._reach_limit:
+        if reach <= reach_limit:
             self._reach = reach
             return True
         farthest_sq = _farthest_sq(points, len(points), point, max_error_sq)
@@ -424,6 +482,154 @@ class WindowSimplifier:
             min_length=self.params.min_length,
             min_duration_ms=self.params.min_duration_ms,
         )
+
+
+@dataclass
+class Merger:
+    """Merges the pieces the window cuts too short to send into a neighbour, never dropping one.
+
+    A piece is too short when it is shorter than ``min_length`` or briefer than the larger of
+    ``min_duration_ms`` and ``floor_ms`` (the sleeve would slow it). A short piece is held back
+    until the next piece arrives; the two become one stroke, from the first's start to the
+    second's end, when every drawn sample of both lies within ``max_error`` of it (and that
+    stroke, if still short, waits for the next in turn); else the short piece is sent as it is
+    (the window keeps the bound for each piece). A piece long enough is sent at once: holding
+    every stroke back until the next is known would delay the whole drawing (on people's
+    gestures, about 40 ms more from release to felt end at p95; docs/research.md), so a short
+    piece merges forward, not back, and the path's last piece, if short, is sent short. Only a
+    path's one and only piece, too short, is dropped with its reason (a tap: nothing to merge
+    with). Every other drawn sample lies within ``max_error`` of a sent stroke.
+    """
+
+    max_error: float
+    min_length: float
+    min_duration_ms: float
+    floor_ms: float
+    # The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first.
+    _points: list[Point] = field(default_factory=list)
+    _times: list[float] = field(default_factory=list)
+    _held: Segment | None = None
+    _sent_in_path: bool = False
+
+    def sample(self, t_ms: float, point: Point) -> None:
+        """A drawn sample, in order (its time as the window took it)."""
+        self._points.append(point)
+        self._times.append(t_ms)
+
+    def _short(self, segment: Segment) -> bool:
+        return segment.length < self.min_length or segment.duration_ms < max(
+            self.min_duration_ms, self.floor_ms
+        )
+
+    def _fits(self, start: Point, end: Point, start_ms: float, end_ms: float) -> bool:
+        """Whether every sample drawn from start_ms to end_ms lies within max_error of it."""
+        limit_sq = self.max_error * self.max_error
+        for point, t_ms in zip(self._points, self._times, strict=True):
+            if t_ms > end_ms:
+                break
+            if t_ms >= start_ms and segment_distance_sq(point, start, end) > limit_sq:
+                return False
+        return True
+
+    def _send(self, segment: Segment, now_ms: float, out: list[Segment]) -> None:
+        self._sent_in_path = True
+        out.append(replace(segment, emitted_at_ms=now_ms, dropped=None))
+        # The samples before its end are covered now (those at its end may start the next).
+        keep = bisect.bisect_left(self._times, segment.end_ms)
+        del self._points[:keep]
+        del self._times[:keep]
+
+    def take(self, piece: Segment, now_ms: float) -> list[Segment]:
+        """A piece the window cut: the strokes sent now (none while a short one waits)."""
+        out: list[Segment] = []
+        held = self._held
+        if held is not None:
+            self._held = None
+            if self._fits(held.start, piece.end, held.start_ms, piece.end_ms):
+                piece = Segment(
+                    held.start,
+                    piece.end,
+                    held.start_ms,
+                    piece.end_ms,
+                    now_ms,
+                    merged=held.merged + piece.merged + 1,
+                )
+            else:
+                self._send(held, now_ms, out)
+        if self._short(piece):
+            self._held = piece
+        else:
+            self._send(piece, now_ms, out)
+        return out
+
+    def end(self, now_ms: float) -> list[Segment]:
+        """Release, after the window's last piece: the held piece is sent (or, if it is the
+        path's only piece and too short to send, dropped with its reason)."""
+        out: list[Segment] = []
+        held = self._held
+        if held is not None:
+            reason = None
+            if not self._sent_in_path:
+                if held.length < self.min_length:
+                    reason = NOT_ENOUGH_DISTANCE
+                elif held.duration_ms < self.min_duration_ms:
+                    reason = NOT_ENOUGH_DURATION
+            if reason is not None:
+                out.append(replace(held, emitted_at_ms=now_ms, dropped=reason))
+            else:
+                self._send(held, now_ms, out)
+        self._held = None
+        self._sent_in_path = False
+        self._points, self._times = [], []
+        return out
+
+
+@dataclass
+class WindowSimplifier:
+    """The window simplifier: the window's pieces, the too-short ones merged (``Merger``)."""
+
+    params: WindowParams = field(default_factory=WindowParams)
+    _core: WindowCore = field(init=False)
+    _merger: Merger = field(init=False)
+
+    def __post_init__(self) -> None:
+        params = self.params
+        self._core = WindowCore(params)
+        self._merger = Merger(
+            params.max_error, params.min_length, params.min_duration_ms, params.floor_ms
+        )
+
+    @property
+    def drawing(self) -> bool:
+        """True between the first sample of a path and ``end``."""
+        return self._core.drawing
+
+    @property
+    def line_start(self) -> Sample | None:
+        """Where the stroke being drawn starts (canvas pixels); None between paths."""
+        return self._core.line_start
+
+    def push(self, sample: Sample) -> list[Segment]:
+        """One pointer sample while the pointer is down; the first of a path is the press."""
+        core = self._core
+        pieces = core.push(sample)
+        merger = self._merger
+        taken, point = core.last_sample()
+        merger.sample(taken, point)
+        out: list[Segment] = []
+        for piece in pieces:
+            out.extend(merger.take(piece, taken))
+        return out
+
+    def end(self) -> list[Segment]:
+        """Release: the rest of the path, the held piece first (a tap gives one, dropped)."""
+        core = self._core
+        now_ms = core.pointer_ms()
+        out: list[Segment] = []
+        for piece in core.end():
+            out.extend(self._merger.take(piece, now_ms))
+        out.extend(self._merger.end(now_ms))
+        return out
 
 
 def unit_direction(start: Point, end: Point) -> tuple[float, float] | None:
