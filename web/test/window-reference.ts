@@ -128,7 +128,7 @@ export class ReferenceWindowSimplifier {
         }
         window = this.#window = [vertex];
       }
-      if (!this.#fits(window, 1, window.length, item.point)) {
+      if (!this.#fits(window, 1, window.length, item.point, this.#bendSq(window, item.point))) {
         const cut = this.#feature(window, item.point);
         out.push(this.#finish(window[0]!, window[cut]!));
         this.#line = null;
@@ -230,11 +230,26 @@ export class ReferenceWindowSimplifier {
     return window.length - 1; // unreachable: the last sample fits by construction
   }
 
-  /** Whether window[first..stop) all lie within max_error of window[0] -> end. */
-  #fits(window: readonly Drawn[], first: number, stop: number, end: Point): boolean {
+  /**
+   * The squared bound a stroke window[0] -> end grows under: max_error's, or the bend rule's
+   * (max_bend x its length, never under bend_floor) when that is less.
+   */
+  #bendSq(window: readonly Drawn[], end: Point): number {
+    const bend = this.params.max_bend;
+    if (bend <= 0 || window.length === 1) return this.#maxErrorSq;
     const anchor = window[0]!.point;
+    const cx = end[0] - anchor[0];
+    const cy = end[1] - anchor[1];
+    const limit = Math.max(bend * Math.sqrt(cx * cx + cy * cy), this.params.bend_floor);
+    return limit < this.params.max_error ? limit * limit : this.#maxErrorSq;
+  }
+
+  /** Whether window[first..stop) all lie within max_error (or sqrt(limitSq)) of window[0] -> end. */
+  #fits(window: readonly Drawn[], first: number, stop: number, end: Point, limitSq?: number): boolean {
+    const anchor = window[0]!.point;
+    const boundSq = limitSq ?? this.#maxErrorSq;
     for (let i = first; i < stop; i++) {
-      if (distanceSq(window[i]!.point, anchor, end) > this.#maxErrorSq) return false;
+      if (distanceSq(window[i]!.point, anchor, end) > boundSq) return false;
     }
     return true;
   }

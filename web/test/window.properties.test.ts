@@ -4,8 +4,9 @@
  * stroke that covers it, no stroke covers more than max_window samples after
  * its start nor lasts longer than max_stroke_ms (unless it is a single step or
  * was too short to send until its last sample),
- * strokes join end to start from the press to the release, a dropped
- * segment carries the reason that matches its size, and a drawing along the
+ * strokes join end to start from the press to the release, no piece is
+ * dropped but a path that is one piece too short in all (every drawn sample
+ * lies within max_error of a sent stroke, at any setting), and a drawing along the
  * canvas edges gives strokes that start and end on the grid.
  */
 import fc from "fast-check";
@@ -13,7 +14,7 @@ import { describe, expect, it } from "vitest";
 import { CanvasMapping } from "../src/simplify/mapping";
 import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
 import { type Point, type Sample, type Segment } from "../src/simplify/segment";
-import { LINE_SHARE, WindowSimplifier } from "../src/simplify/window";
+import { LINE_SHARE, WindowCore, WindowSimplifier } from "../src/simplify/window";
 import type { WindowParams } from "../src/simplify/window-params";
 
 /** Room for a distance computed another way than the simplifier's (last bits only). */
@@ -32,6 +33,9 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   ),
   max_window: fc.oneof(fc.constantFrom(1, 2, 64), fc.integer({ min: 1, max: 300 })),
   max_stroke_ms: fc.constantFrom(0, 50, 300),
+  max_bend: fc.constantFrom(0, 0.1, 0.3),
+  bend_floor: fc.constantFrom(0, 0.05),
+  floor_ms: fc.constantFrom(0, 73.7, 200),
   ...SHARED_PARAM_ARBS,
 });
 
@@ -51,8 +55,9 @@ function distance(point: Point, start: Point, end: Point): number {
  * each starts where the one before ended, and ends on the sample from there
  * with its end time, at its point or within LINE_SHARE x max_error of it.
  */
-function covered(params: WindowParams, samples: readonly Sample[]) {
-  const simplifier = new WindowSimplifier(params);
+function covered(params: WindowParams, samples: readonly Sample[], pieces = false) {
+  // `pieces`: the window's own pieces, before any is merged (the caps bound those).
+  const simplifier = pieces ? new WindowCore(params) : new WindowSimplifier(params);
   const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
   segments.push(...simplifier.end());
   const map = CanvasMapping.fromParams(params);
@@ -79,11 +84,11 @@ function covered(params: WindowParams, samples: readonly Sample[]) {
 
 describe("window simplifier invariants", () => {
   it(
-    "every drawn sample lies within max_error of its stroke; strokes keep the caps",
+    "every drawn sample lies within max_error of its piece; the pieces keep the caps",
     () => {
       fc.assert(
         fc.property(paramsArb, pathArb, (params, samples) => {
-          const { spans, map } = covered(params, samples);
+          const { spans, map } = covered(params, samples, true);
           for (const { first, last, segment } of spans) {
             expect(last - first).toBeLessThanOrEqual(params.max_window);
             if (params.max_stroke_ms > 0 && segment.duration_ms > params.max_stroke_ms) {
@@ -132,16 +137,30 @@ describe("window simplifier invariants", () => {
   );
 
   it(
-    "sent strokes meet the minimums and dropped ones say why",
+    "no piece is dropped: every drawn sample lies within max_error of a sent stroke",
     () => {
+      // Whatever the caps and minimums: a piece too short to send merges into the next, or is
+      // sent; only a path that is one short piece in all (a tap) is dropped, with its reason.
+      const errorArb = fc.constantFrom(0.001, 0.05, 0.1, 0.15, 0.25, 1);
       fc.assert(
-        fc.property(paramsArb, pathArb, (params, samples) => {
-          for (const segment of covered(params, samples).segments) {
-            expectDropRule(segment, params);
+        fc.property(paramsArb, errorArb, pathArb, (drawn, maxError, samples) => {
+          const params = { ...drawn, max_error: maxError };
+          const { segments, map } = covered(params, samples);
+          if (segments.some((segment) => segment.dropped !== null)) {
+            expect(segments.length).toBe(1);
+            expectDropRule(segments[0]!, params);
+            return;
+          }
+          for (const sample of samples) {
+            const point = map.toGrid(sample.x, sample.y);
+            const nearest = Math.min(...segments.map((s) => distance(point, s.start, s.end)));
+            expect(nearest).toBeLessThanOrEqual(params.max_error + FLOAT_TOLERANCE);
+          }
+          for (const segment of segments) {
             expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
           }
         }),
-        { numRuns: 200 },
+        { numRuns: 300 },
       );
     },
     PROPERTY_TIMEOUT_MS,
@@ -189,6 +208,9 @@ const edgeDrawingArb = fc
       max_error: d.maxError,
       max_window: d.maxWindow,
       max_stroke_ms: d.maxStrokeMs,
+      max_bend: 0.1,
+      bend_floor: 0.1,
+      floor_ms: 73.7,
       clear_on_press: true,
       min_duration_ms: d.minDurationMs,
       min_length: d.minLength,

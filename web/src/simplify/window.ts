@@ -19,7 +19,16 @@
  * or too brief strokes are dropped with their reason. The float operations follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
-import { finishSegment, type Point, type Sample, type Segment } from "./segment";
+import {
+  finishSegment,
+  NOT_ENOUGH_DISTANCE,
+  NOT_ENOUGH_DURATION,
+  segmentLength,
+  type DropReason,
+  type Point,
+  type Sample,
+  type Segment,
+} from "./segment";
 import { checkWindowParams, type WindowParams } from "./window-params";
 
 /**
@@ -99,7 +108,11 @@ class Samples {
   }
 }
 
-export class WindowSimplifier {
+/**
+ * The window itself: strokes cut by the error bound, the bend rule and the caps, before
+ * too-short pieces are merged (`WindowSimplifier` merges them).
+ */
+export class WindowCore {
   readonly params: WindowParams;
   readonly #maxErrorSq: number;
   readonly #minLengthSq: number;
@@ -157,6 +170,18 @@ export class WindowSimplifier {
   /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
   get lineStart(): Sample | null {
     return this.#window.count > 0 ? this.#window.samples[0]! : null;
+  }
+
+  /** The last sample taken, as taken: its time (never before the one before) and grid point. */
+  lastSample(): { readonly t_ms: number; readonly point: Point } {
+    const window = this.#window;
+    const last = window.count - 1;
+    return { t_ms: window.ts[last]!, point: [window.xs[last]!, window.ys[last]!] };
+  }
+
+  /** The time of the last sample pushed, as taken (0 before any). */
+  pointerMs(): number {
+    return this.#pointer ? this.#pointer.t_ms : 0;
   }
 
   /** One pointer sample while the pointer is down; the first of a path is the press. */
@@ -257,14 +282,28 @@ export class WindowSimplifier {
       return true;
     }
     const { xs, ys } = this.#window;
+    let reachLimit = this.#reachLimit;
+    let limitSq = this.#maxErrorSq;
+    const bend = this.params.max_bend;
+    if (bend > 0) {
+      // The bend rule: a round shape is cut before its chord strays farther than a share of the
+      // chord's length, never under the floor, never over max_error.
+      const cx = x - xs[0]!;
+      const cy = y - ys[0]!;
+      const limit = Math.max(bend * Math.sqrt(cx * cx + cy * cy), this.params.bend_floor);
+      if (limit < this.params.max_error) {
+        reachLimit = limit - ROUNDING_SLACK;
+        limitSq = limit * limit;
+      }
+    }
     const dx = x - xs[count - 1]!;
     const dy = y - ys[count - 1]!;
     const reach = this.#reach + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK;
-    if (reach <= this.#reachLimit) {
+    if (reach <= reachLimit) {
       this.#reach = reach;
       return true;
     }
-    const farthestSq = this.#farthestSq(count, x, y, this.#maxErrorSq);
+    const farthestSq = this.#farthestSq(count, x, y, limitSq);
     if (farthestSq < 0) return false;
     this.#reach = Math.sqrt(farthestSq) + ROUNDING_SLACK;
     return true;
@@ -474,6 +513,163 @@ export class WindowSimplifier {
   #finish(start: Point, startMs: number, end: Point, endMs: number): Segment {
     this.#emittedInPath = true;
     return finishSegment(start, end, startMs, endMs, this.#pointer ? this.#pointer.t_ms : endMs, this.params);
+  }
+}
+
+/**
+ * Merges the pieces the window cuts too short to send into a neighbour, never dropping one (the
+ * reference's `Merger`). A piece is too short when it is shorter than `min_length` or briefer
+ * than the larger of `min_duration_ms` and `floor_ms` (the sleeve would slow it). A short piece
+ * waits for the next; the two become one stroke when every drawn sample of both lies within
+ * `max_error` of it (still short, it waits again), else the short one is sent as it is. A piece
+ * long enough is sent at once (holding each back would delay the drawing), so the last piece of
+ * a path, if short, is sent short. Only a path's one and only piece, too short, is dropped.
+ */
+export class Merger {
+  readonly #maxError: number;
+  readonly #minLength: number;
+  readonly #minDurationMs: number;
+  readonly #shortMs: number;
+  /** The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first. */
+  #xs: number[] = [];
+  #ys: number[] = [];
+  #ts: number[] = [];
+  #held: Segment | null = null;
+  #sentInPath = false;
+
+  constructor(maxError: number, minLength: number, minDurationMs: number, floorMs: number) {
+    this.#maxError = maxError;
+    this.#minLength = minLength;
+    this.#minDurationMs = minDurationMs;
+    this.#shortMs = Math.max(minDurationMs, floorMs);
+  }
+
+  /** A drawn sample, in order (its time as the window took it). */
+  sample(tMs: number, point: Point): void {
+    this.#xs.push(point[0]);
+    this.#ys.push(point[1]);
+    this.#ts.push(tMs);
+  }
+
+  #short(segment: Segment): boolean {
+    return segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs;
+  }
+
+  /** Whether every sample drawn from startMs to endMs lies within max_error of start -> end. */
+  #fits(start: Point, end: Point, startMs: number, endMs: number): boolean {
+    const limitSq = this.#maxError * this.#maxError;
+    const xs = this.#xs;
+    const ys = this.#ys;
+    const ts = this.#ts;
+    for (let i = 0; i < ts.length; i++) {
+      const t = ts[i]!;
+      if (t > endMs) break;
+      if (t >= startMs && distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  #send(segment: Segment, nowMs: number, out: Segment[]): void {
+    this.#sentInPath = true;
+    out.push({ ...segment, emitted_at_ms: nowMs, dropped: null });
+    // The samples before its end are covered now (those at its end may start the next).
+    const ts = this.#ts;
+    let keep = 0;
+    while (keep < ts.length && ts[keep]! < segment.end_ms) keep++;
+    this.#xs.splice(0, keep);
+    this.#ys.splice(0, keep);
+    ts.splice(0, keep);
+  }
+
+  /** A piece the window cut: the strokes sent now, into `out` (none while a short one waits). */
+  take(input: Segment, nowMs: number, out: Segment[]): void {
+    let piece = input;
+    const held = this.#held;
+    if (held !== null) {
+      this.#held = null;
+      if (this.#fits(held.start, piece.end, held.start_ms, piece.end_ms)) {
+        piece = {
+          start: held.start,
+          end: piece.end,
+          start_ms: held.start_ms,
+          end_ms: piece.end_ms,
+          duration_ms: piece.end_ms - held.start_ms,
+          emitted_at_ms: nowMs,
+          dropped: null,
+          merged: (held.merged ?? 0) + (piece.merged ?? 0) + 1,
+        };
+      } else {
+        this.#send(held, nowMs, out);
+      }
+    }
+    if (this.#short(piece)) this.#held = piece;
+    else this.#send(piece, nowMs, out);
+  }
+
+  /** Release, after the window's last piece: the held piece is sent (or, a path's only piece too short, dropped). */
+  end(nowMs: number, out: Segment[]): void {
+    const held = this.#held;
+    if (held !== null) {
+      let reason: DropReason | null = null;
+      if (!this.#sentInPath) {
+        if (segmentLength(held) < this.#minLength) reason = NOT_ENOUGH_DISTANCE;
+        else if (held.duration_ms < this.#minDurationMs) reason = NOT_ENOUGH_DURATION;
+      }
+      if (reason !== null) out.push({ ...held, emitted_at_ms: nowMs, dropped: reason });
+      else this.#send(held, nowMs, out);
+    }
+    this.#held = null;
+    this.#sentInPath = false;
+    this.#xs = [];
+    this.#ys = [];
+    this.#ts = [];
+  }
+}
+
+/** The window simplifier: the window's pieces, the too-short ones merged (`Merger`). */
+export class WindowSimplifier {
+  readonly params: WindowParams;
+  readonly #core: WindowCore;
+  readonly #merger: Merger;
+
+  constructor(params: WindowParams) {
+    this.#core = new WindowCore(params);
+    this.params = params;
+    this.#merger = new Merger(params.max_error, params.min_length, params.min_duration_ms, params.floor_ms);
+  }
+
+  /** True between the first sample of a path and `end`. */
+  get drawing(): boolean {
+    return this.#core.drawing;
+  }
+
+  /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
+  get lineStart(): Sample | null {
+    return this.#core.lineStart;
+  }
+
+  /** One pointer sample while the pointer is down; the first of a path is the press. */
+  push(input: Sample): readonly Segment[] {
+    const core = this.#core;
+    const pieces = core.push(input);
+    const merger = this.#merger;
+    const last = core.lastSample();
+    merger.sample(last.t_ms, last.point);
+    const out: Segment[] = [];
+    for (const piece of pieces) merger.take(piece, last.t_ms, out);
+    return out.length > 0 ? out : NO_SEGMENTS;
+  }
+
+  /** Release: the rest of the path, the held piece first (a tap gives one, dropped). */
+  end(): Segment[] {
+    const core = this.#core;
+    const nowMs = core.pointerMs();
+    const out: Segment[] = [];
+    for (const piece of core.end()) this.#merger.take(piece, nowMs, out);
+    this.#merger.end(nowMs, out);
+    return out;
   }
 }
 
