@@ -24,6 +24,62 @@ import java.util.List;
  * value is the same to the last bit.
  */
 public final class WindowSimplifier implements Simplifier {
+  private final WindowCore core;
+  private final Merger merger;
+
+  public WindowSimplifier(Params params) {
+    this.core = new WindowCore(params);
+    this.merger =
+        new Merger(
+            params.number("max_error"),
+            params.number("min_length"),
+            params.number("min_duration_ms"),
+            params.number("floor_ms"));
+  }
+
+  public Params params() {
+    return core.params();
+  }
+
+  @Override
+  public boolean drawing() {
+    return core.drawing();
+  }
+
+  @Override
+  public Sample lineStart() {
+    return core.lineStart();
+  }
+
+  @Override
+  public List<Segment> push(Sample input) {
+    List<Segment> pieces = core.push(input);
+    double takenMs = core.lastMs();
+    merger.sample(takenMs, core.lastX(), core.lastY());
+    List<Segment> out = null;
+    for (Segment piece : pieces) {
+      out = merger.take(piece, takenMs, out);
+    }
+    return out == null ? List.of() : out;
+  }
+
+  @Override
+  public List<Segment> end() {
+    double nowMs = core.pointerMs();
+    List<Segment> out = null;
+    for (Segment piece : core.end()) {
+      out = merger.take(piece, nowMs, out);
+    }
+    out = merger.end(nowMs, out);
+    return out == null ? List.of() : out;
+  }
+}
+
+/**
+ * The window itself: strokes cut by the error bound, the bend rule and the caps, before
+ * too-short pieces are merged ({@link WindowSimplifier} merges them).
+ */
+final class WindowCore implements Simplifier {
   /** The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
    * stroke's start, so that the stroke it ends is not too brief to be felt in its drawn time. */
   static final double CAP_FEATURE_SHARE = 0.5;
@@ -46,6 +102,8 @@ public final class WindowSimplifier implements Simplifier {
   private final double maxErrorSq;
   private final double minLengthSq;
   private final double reachLimit;
+  private final double maxBend;
+  private final double bendFloor;
   private final CanvasMapping mapping;
   /** The grid's extents: every stroke's start and end lies in [0, x] x [0, y]. */
   private final double xExtent;
@@ -72,7 +130,7 @@ public final class WindowSimplifier implements Simplifier {
   /** No sample since the anchor lies farther than this from anchor -> last sample. */
   private double reach;
 
-  public WindowSimplifier(Params params) {
+  WindowCore(Params params) {
     if (params.algorithm() != Algorithm.WINDOW) {
       throw new IllegalArgumentException("the window simplifier needs Params.window()");
     }
@@ -85,6 +143,8 @@ public final class WindowSimplifier implements Simplifier {
     this.maxErrorSq = maxError * maxError;
     this.minLengthSq = minLength * minLength;
     this.reachLimit = maxError - ROUNDING_SLACK;
+    this.maxBend = params.number("max_bend");
+    this.bendFloor = params.number("bend_floor");
     this.mapping = params.mapping();
     this.xExtent = params.columns() - 1;
     this.yExtent = params.rows() - 1;
@@ -102,6 +162,24 @@ public final class WindowSimplifier implements Simplifier {
   @Override
   public Sample lineStart() {
     return count > 0 ? samples[0] : null;
+  }
+
+  /** The time of the last sample taken, as taken (never before the one before). */
+  double lastMs() {
+    return ts[count - 1];
+  }
+
+  double lastX() {
+    return xs[count - 1];
+  }
+
+  double lastY() {
+    return ys[count - 1];
+  }
+
+  /** The time of the last sample pushed, as taken (0 before any). */
+  double pointerMs() {
+    return pointer != null ? pointer.tMs() : 0.0;
   }
 
   private void place(double x, double y, double t, Sample sample) {
@@ -237,14 +315,27 @@ public final class WindowSimplifier implements Simplifier {
       reach = 0;
       return true;
     }
+    double limitReach = reachLimit;
+    double limitSq = maxErrorSq;
+    if (maxBend > 0.0) {
+      // The bend rule: a round shape is cut before its chord strays farther than a share of the
+      // chord's length, never under the floor, never over max_error.
+      double cx = x - xs[0];
+      double cy = y - ys[0];
+      double limit = Math.max(maxBend * Math.sqrt(cx * cx + cy * cy), bendFloor);
+      if (limit < maxError) {
+        limitReach = limit - ROUNDING_SLACK;
+        limitSq = limit * limit;
+      }
+    }
     double dx = x - xs[n - 1];
     double dy = y - ys[n - 1];
     double next = reach + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK;
-    if (next <= reachLimit) {
+    if (next <= limitReach) {
       reach = next;
       return true;
     }
-    double farthestSq = farthestSq(n, x, y, maxErrorSq);
+    double farthestSq = farthestSq(n, x, y, limitSq);
     if (farthestSq < 0) {
       return false;
     }
@@ -484,5 +575,177 @@ public final class WindowSimplifier implements Simplifier {
       qy = qy - t * dy;
     }
     return qx * qx + qy * qy;
+  }
+}
+
+/**
+ * Merges the pieces the window cuts too short to send into a neighbour, never dropping one (the
+ * reference's {@code Merger}). A piece is too short when it is shorter than min_length or
+ * briefer than the larger of min_duration_ms and floor_ms (the sleeve would slow it). A short
+ * piece waits for the next; the two become one stroke when every drawn sample of both lies
+ * within max_error of it (still short, it waits again), else the short one is sent as it is. A
+ * piece long enough is sent at once (holding each back would delay the drawing), so a path's
+ * last piece, if short, is sent short. Only a path's one and only piece, too short, is dropped
+ * with its reason.
+ */
+final class Merger {
+  private final double maxError;
+  private final double minLength;
+  private final double minDurationMs;
+  private final double shortMs;
+  // The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first:
+  // [first, size).
+  private double[] xs = new double[64];
+  private double[] ys = new double[64];
+  private double[] ts = new double[64];
+  private int first;
+  private int size;
+  private Segment held;
+  private boolean sentInPath;
+
+  Merger(double maxError, double minLength, double minDurationMs, double floorMs) {
+    this.maxError = maxError;
+    this.minLength = minLength;
+    this.minDurationMs = minDurationMs;
+    this.shortMs = Math.max(minDurationMs, floorMs);
+  }
+
+  /** A drawn sample, in order (its time as the window took it). */
+  void sample(double tMs, double x, double y) {
+    if (size == xs.length) {
+      int live = size - first;
+      int capacity = live * 2 < xs.length ? xs.length : xs.length * 2;
+      double[] nx = new double[capacity];
+      double[] ny = new double[capacity];
+      double[] nt = new double[capacity];
+      System.arraycopy(xs, first, nx, 0, live);
+      System.arraycopy(ys, first, ny, 0, live);
+      System.arraycopy(ts, first, nt, 0, live);
+      xs = nx;
+      ys = ny;
+      ts = nt;
+      first = 0;
+      size = live;
+    }
+    xs[size] = x;
+    ys[size] = y;
+    ts[size] = tMs;
+    size++;
+  }
+
+  private boolean isShort(Segment segment) {
+    return segment.length() < minLength || segment.durationMs() < shortMs;
+  }
+
+  /** Whether every sample drawn from startMs to endMs lies within max_error of it. */
+  private boolean fits(Segment from, Segment to) {
+    double limitSq = maxError * maxError;
+    double startMs = from.startMs();
+    double endMs = to.endMs();
+    for (int i = first; i < size; i++) {
+      double t = ts[i];
+      if (t > endMs) {
+        break;
+      }
+      if (t >= startMs
+          && WindowCore.distanceSq(xs[i], ys[i], from.startX(), from.startY(), to.endX(), to.endY())
+              > limitSq) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  private static List<Segment> add(List<Segment> out, Segment segment) {
+    List<Segment> list = out == null ? new ArrayList<>(2) : out;
+    list.add(segment);
+    return list;
+  }
+
+  private List<Segment> send(Segment segment, double nowMs, List<Segment> out) {
+    sentInPath = true;
+    // The samples before its end are covered now (those at its end may start the next).
+    while (first < size && ts[first] < segment.endMs()) {
+      first++;
+    }
+    return add(
+        out,
+        new Segment(
+            segment.startX(),
+            segment.startY(),
+            segment.endX(),
+            segment.endY(),
+            segment.startMs(),
+            segment.endMs(),
+            nowMs,
+            null,
+            segment.merged()));
+  }
+
+  /** A piece the window cut: the strokes sent now, added to out (none while a short one
+   * waits). */
+  List<Segment> take(Segment input, double nowMs, List<Segment> out) {
+    Segment piece = input;
+    List<Segment> result = out;
+    Segment before = held;
+    if (before != null) {
+      held = null;
+      if (fits(before, piece)) {
+        piece =
+            new Segment(
+                before.startX(),
+                before.startY(),
+                piece.endX(),
+                piece.endY(),
+                before.startMs(),
+                piece.endMs(),
+                nowMs,
+                null,
+                before.merged() + piece.merged() + 1);
+      } else {
+        result = send(before, nowMs, result);
+      }
+    }
+    if (isShort(piece)) {
+      held = piece;
+      return result;
+    }
+    return send(piece, nowMs, result);
+  }
+
+  /** Release, after the window's last piece: the held piece is sent (or, a path's only piece
+   * too short, dropped with its reason). */
+  List<Segment> end(double nowMs, List<Segment> out) {
+    List<Segment> result = out;
+    if (held != null) {
+      String reason = null;
+      if (!sentInPath) {
+        if (held.length() < minLength) {
+          reason = Segment.NOT_ENOUGH_DISTANCE;
+        } else if (held.durationMs() < minDurationMs) {
+          reason = Segment.NOT_ENOUGH_DURATION;
+        }
+      }
+      result =
+          reason != null
+              ? add(
+                  result,
+                  new Segment(
+                      held.startX(),
+                      held.startY(),
+                      held.endX(),
+                      held.endY(),
+                      held.startMs(),
+                      held.endMs(),
+                      nowMs,
+                      reason,
+                      held.merged()))
+              : send(held, nowMs, result);
+    }
+    held = null;
+    sentInPath = false;
+    first = 0;
+    size = 0;
+    return result;
   }
 }
