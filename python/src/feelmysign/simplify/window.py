@@ -44,8 +44,15 @@ corners land on the drawing's features. Here:
 - On release the rest is one stroke. A path's first sample always starts a
   stroke and its last sample's time always ends one (at the sample, or on the
   line it goes on along).
-- A stroke too short (grid units) or too brief (ms) is dropped with its reason,
-  as the angle simplifier does; it still ends where the next one starts.
+- Bend rule: while ``max_bend`` > 0 a stroke grows only while every sample
+  since its anchor lies within ``max_bend`` x its chord's length (never under
+  ``bend_floor``, never over ``max_error``), so a round shape is cut into more
+  strokes; a cut still keeps ``max_error``.
+- A piece too short (``min_length``) or briefer than the sleeve's floor
+  (``floor_ms``, or ``min_duration_ms`` if longer) is not dropped: ``Merger``
+  merges it into the next piece where every drawn sample of both keeps
+  ``max_error``, else sends it as it is. Only a path that is one such piece in
+  all (a tap) is dropped, with its reason, as the angle simplifier drops.
 
 Pure and streaming: ``push`` one sample at a time, ``end`` on release. A
 sample earlier than the one before it (clocks of two event sources) is taken
