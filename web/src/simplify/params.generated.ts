@@ -145,7 +145,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     algorithms: ["window"],
     paper: null,
     type: "number",
-    default: 0.1,
+    default: 0,
     minimum: 0,
     maximum: 1,
     unit: "of the stroke's length",

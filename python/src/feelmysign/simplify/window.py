@@ -103,9 +103,11 @@ class _WindowOwn:
     spacing), well below the forearm's two-point threshold (about 35 mm);
     strokes of at most 200 ms, with the sleeve catching up queued strokes, end
     the felt drawing about a quarter second after the pen on people's fast and
-    medium gestures. The bend rule (``max_bend`` 0.1, ``bend_floor`` 0.1) cuts a
-    round shape where its chord strays more than a tenth of its length;
-    ``floor_ms`` is the sleeve's own (73.7 ms on ERM motors).
+    medium gestures. The bend rule is off (``max_bend`` 0): on people's gestures
+    it gained at most a gesture or two a speed, within the noise, and with its
+    absolute floor it overrides a coarse ``max_error`` (the study's resolution
+    levels and the page's detail control). ``floor_ms`` is the sleeve's own
+    (73.7 ms on ERM motors).
     """
 
     max_error: float = param(
@@ -135,7 +137,7 @@ class _WindowOwn:
         unit="ms",
     )
     max_bend: float = param(
-        0.1,
+        0.0,
         0,
         1,
         help="farthest a drawn point may lie from its stroke as a share of the stroke's length "

@@ -126,7 +126,7 @@ public final class ParamTable {
               null,
               0,
               ParamSpec.Kind.NUMBER,
-              0.1,
+              0.0,
               0.0,
               1.0,
               "of the stroke's length",
