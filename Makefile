@@ -25,7 +25,7 @@ SYSTEM_PACKAGES := mosquitto mosquitto-clients
 # cores; pytest and the browser tests each leave much of theirs idle.
 TEST_JOBS ?= 3
 
-.PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study system clean
+.PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study bench-study-calibration system clean
 .PHONY: bench-prepare bench-timed bench-prepare-python bench-timed-python
 
 help:
@@ -38,10 +38,15 @@ help:
 	@echo "             need built side by side, then one timed part at a time)"
 	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
 	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
+	@echo "make bench-study-calibration  the shape test's false-positive rate and the interval"
+	@echo "             coverage at 4, 8, 12, 24 participants (TEST_RUNS=400, COVERAGE_RUNS=100)"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 	@echo "make java-build  build the Java port (java/bin/feelmysign-java); make java-test tests it"
 	@echo "make processing-library  the Processing library: java/processing/target/dist/feelmysign.zip"
+	@echo "make sleeve  on a Raspberry Pi: only what the sleeve needs (python3-venv, i2c-tools, the"
+	@echo "             Python package in SLEEVE_PREFIX=/opt/feelmysign); no browser, Node or Java"
+	@echo "make sleeve-unit  the systemd unit for that install, in SLEEVE_UNIT_DIR=/etc/systemd/system"
 
 $(RUN_STAMP): python/pyproject.toml
 	@echo "==> Python packages to run feelmysign (python/pyproject.toml: dependencies) into $(VENV):"
@@ -133,6 +138,11 @@ bench-timed-python: $(STAMP) system
 RUNS ?= 400
 bench-study: $(STAMP)
 	$(PY) -m feelmysign.bench.study_recovery $(RUNS)
+
+TEST_RUNS ?= 400
+COVERAGE_RUNS ?= 100
+bench-study-calibration: $(STAMP)
+	$(PY) -m feelmysign.bench.study_calibration $(TEST_RUNS) $(COVERAGE_RUNS)
 
 up: $(RUN_STAMP) system
 	@echo "==> Starting feelmysign up $(ARGS)"
@@ -323,3 +333,44 @@ clean: java-clean
 # bench-prepare's parts are listed with each part above; the timed ones run in this order.
 bench-prepare: bench-prepare-python
 bench-timed: bench-timed-web bench-timed-java bench-timed-python
+
+# ==== sleeve: a Raspberry Pi that runs only the sleeve (docs/sleeve-hardware.md) ============
+# `make sleeve` installs what the sleeve daemon needs and nothing for the page, the research
+# tools or the tests: python3-venv and i2c-tools from Debian's archive (i2c-tools' udev rule
+# makes the i2c group the unit runs in), then the feelmysign package with its own
+# dependencies only (paho-mqtt, smbus2, ...) into a venv at SLEEVE_PREFIX, where the
+# systemd unit expects it. Run it again after 'git pull' to upgrade. `make sleeve-unit`
+# writes the unit with SLEEVE_PREFIX in its paths.
+SLEEVE_PREFIX ?= /opt/feelmysign
+SLEEVE_UNIT_DIR ?= /etc/systemd/system
+SLEEVE_SYSTEM_PACKAGES := python3-venv i2c-tools
+# sudo where needed: root, or a prefix the user may write, needs none.
+SLEEVE_SUDO ?= $(shell [ "$$(id -u)" = 0 ] && echo "" || echo sudo)
+# The tests check the unit with systemd-analyze, and make and use an install as `make sleeve` does.
+SYSTEM_PACKAGES += systemd $(SLEEVE_SYSTEM_PACKAGES)
+
+.PHONY: sleeve sleeve-system sleeve-unit
+
+sleeve-system:
+	@missing=""; for p in $(SLEEVE_SYSTEM_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "==> System packages for the sleeve from Debian's archive (apt-get):$$missing"; \
+	  $(SLEEVE_SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SLEEVE_SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+sleeve: sleeve-system
+	@echo "==> The sleeve's Python package (python/pyproject.toml: dependencies only) into $(SLEEVE_PREFIX):"
+	$(SLEEVE_SUDO) $(PYTHON) -m venv $(SLEEVE_PREFIX)
+	$(SLEEVE_SUDO) $(SLEEVE_PREFIX)/bin/python -m pip install --disable-pip-version-check --progress-bar off --quiet --upgrade ./python
+	@# pip builds the package in the checkout: leave no (root-owned) build folder behind.
+	$(SLEEVE_SUDO) rm -rf python/build
+	@echo "==> Installed: $(SLEEVE_PREFIX)/bin/feelmysign ($$($(SLEEVE_PREFIX)/bin/feelmysign --version 2>/dev/null || echo '?'))."
+	@echo "    Next: the layout in /etc/feelmysign/layout.toml, 'make sleeve-unit', the join token (docs/sleeve-hardware.md)."
+
+sleeve-unit:
+	@echo "==> The systemd unit for $(SLEEVE_PREFIX) into $(SLEEVE_UNIT_DIR)/feelmysign-sleeve.service"
+	sed 's|/opt/feelmysign/|$(SLEEVE_PREFIX)/|g' deploy/feelmysign-sleeve.service \
+	  | $(SLEEVE_SUDO) tee $(SLEEVE_UNIT_DIR)/feelmysign-sleeve.service >/dev/null
+# ==== end of sleeve =========================================================================

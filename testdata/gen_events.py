@@ -12,7 +12,12 @@
   ``sent_at_ms``) and whether it was ``delayed`` (``events.DELAYED_MS``, kept as
   ``delayed_ms``): the page marks the same strokes as the terminal of ``feelmysign up``.
 
-Every expected value is computed here by feelmysign.events; a case that the
+- ``fates/<name>.json``: the events (``wire``, in the order the sleeve published them) of
+  one drawing's strokes, and what became of each stroke by the rule of
+  feelmysign.fates: ``fates`` by seq, ``counts`` by fate and the refused strokes'
+  reasons (``refusals``). The page, ``up`` and the study report from this rule.
+
+Every expected value is computed here by feelmysign.events (and feelmysign.fates); a case that the
 reference reads differently from what it is meant to show stops generation.
 """
 
@@ -30,6 +35,7 @@ from feelmysign.events import (
     event_from_json,
     is_delayed,
 )
+from feelmysign.fates import DrawingFates
 
 TIMING = {
     "received_at_ms": 1795326267664.25,
@@ -347,6 +353,77 @@ DELAYS: dict[str, tuple[str, dict[str, Any]]] = {
 }
 
 
+def _stroke(seq: int) -> dict[str, Any]:
+    return {**STROKE, "seq": seq}
+
+
+def _played(seq: int) -> dict[str, Any]:
+    return {"type": "played", **_stroke(seq), **TIMING}
+
+
+def _rejected(seq: int, reason: str, **extra: Any) -> dict[str, Any]:
+    message = f"refused as {reason}"
+    wire = {"type": "rejected", "reason": reason, "message": message, **_stroke(seq)}
+    return {**wire, "received_at_ms": 1795326267664.25, **extra}
+
+
+def _cancelled(seq: int, started: bool) -> dict[str, Any]:
+    return {**EVENTS["cancelled-queued"][1], "seq": seq, "started": started}
+
+
+def _capped(seq: int) -> dict[str, Any]:
+    return {**EVENTS["safety-duty-cycle"][1], "seq": seq}
+
+
+# What became of a drawing's strokes (feelmysign.fates), after a broker restart and a Stop.
+FATES: dict[str, tuple[str, list[dict[str, Any]]]] = {
+    "played": ("each stroke played once", [_played(0), _played(1)]),
+    "duplicate-of-played": (
+        "a broker restart delivers a played stroke again: the copy is refused as a duplicate "
+        "of a played stroke, and the stroke stays played, once",
+        [_played(0), _played(1), _rejected(1, "duplicate", original_played=True)],
+    ),
+    "duplicate-played-event-lost": (
+        "the played event was lost: the duplicate's original_played says it was felt",
+        [_played(0), _rejected(1, "duplicate", original_played=True)],
+    ),
+    "duplicate-of-refused": (
+        "a copy of a refused stroke: refused, once, for the reason the stroke had",
+        [_rejected(0, "late"), _rejected(0, "duplicate", original_played=False), _played(1)],
+    ),
+    "duplicate-from-an-older-sleeve": (
+        "a duplicate without original_played, nothing else known: refused (nothing says felt)",
+        [_played(0), _rejected(1, "duplicate")],
+    ),
+    "stop": (
+        "Stop: two played whole, one cut short while playing, one dropped before it started, "
+        "one refused as cancelled on arrival (sent just after the cancel), one capped",
+        [
+            _played(0),
+            _played(1),
+            _played(2),
+            _cancelled(2, started=True),
+            _cancelled(3, started=False),
+            _rejected(4, "cancelled"),
+            _capped(5),
+        ],
+    ),
+    "copy-after-stop": (
+        "a copy of a played stroke delivered after its drawing was stopped is refused as "
+        "cancelled: the stroke stays played",
+        [_played(0), _played(1), _cancelled(1, started=True), _rejected(0, "cancelled")],
+    ),
+    "chip-lost": (
+        "a chip lost while a stroke played cuts it; one cut before its first command is refused",
+        [
+            _played(0),
+            {**EVENTS["safety-duty-cycle"][1], "reason": "chip_lost", "seq": 0},
+            {**EVENTS["safety-duty-cycle"][1], "reason": "chip_lost", "seq": 1},
+        ],
+    ),
+}
+
+
 def _typed(value: Any) -> dict[str, Any]:
     return dataclasses.asdict(value)
 
@@ -357,6 +434,8 @@ def typed_status(status: Status) -> dict[str, Any]:
     typed = _typed(status)
     if typed["floor"] is None:
         del typed["floor"]
+    if typed["hardware"] is None:  # a later field still: only where a status has it
+        del typed["hardware"]
     return typed
 
 
@@ -389,6 +468,17 @@ def cases() -> dict[str, dict[str, Any]]:
             "delayed_ms": DELAYED_MS,
             "delay_ms": delivery_delay_ms(played),
             "delayed": is_delayed(played),
+        }
+    for name, (description, wires) in FATES.items():
+        fates = DrawingFates()
+        for wire in wires:
+            fates.add(event_from_json(wire))
+        out[f"fates/{name}.json"] = {
+            "description": description,
+            "wire": wires,
+            "fates": {str(seq): fate for seq, fate in fates.fates().items()},
+            "counts": fates.counts(),
+            "refusals": dict(fates.refusals()),
         }
     for name, (kind, description, wire) in INVALID.items():
         try:

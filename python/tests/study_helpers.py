@@ -34,3 +34,41 @@ simplifier = "window"
 settings = [{max_error = 1.5, max_stroke_ms = 400}, {max_error = 0.05}]
 synonyms = ["zig zag", "lightning"]
 """
+
+
+# A pilot a new user might design: four shapes at two resolutions, two repetitions.
+PILOT_DESIGN = """
+[study]
+name = "Pilot"
+seed = 1
+repetitions = 2
+resolutions = ["coarse", "fine"]
+
+[[shapes]]
+name = "circle"
+segments = [4, 8]
+
+[[shapes]]
+name = "square"
+segments = [4, 8]
+
+[[shapes]]
+name = "triangle"
+segments = [3, 6]
+
+[[shapes]]
+name = "star"
+segments = [5, 10]
+
+[comfort]
+questions = ["Does the sleeve sit comfortably?", "Can you feel every motor?"]
+
+[questionnaire]
+items = ["The sleeve was comfortable."]
+"""
+
+
+def pilot_study(tmp_path: Path, name: str = "pilot.sqlite") -> StudyStore:
+    design = tmp_path / "pilot.toml"
+    design.write_text(PILOT_DESIGN)
+    return StudyStore.create(tmp_path / name, design, load_design(design))

@@ -116,7 +116,8 @@ def test_a_missing_chip_is_named_and_every_other_chip_is_switched_off_first() ->
     assert str(error.value) == (
         "No DRV2605L answered on multiplexer 0x70 channel 3 (actuator row 0, column 3); "
         + NOT_FOUND_HINT
-        + " (every chip that answered was switched off first)"
+        + " (every chip that answered was switched off first; a motor on a chip that did not"
+        " answer may still run: if one keeps vibrating, cut the sleeve's power)"
     )
     assert len(bus.chips) == 11
     assert all(chip.output == 0.0 and chip.standby for chip in bus.chips.values())
@@ -211,6 +212,7 @@ def test_a_bus_that_does_not_exist_says_to_enable_i2c_or_use_the_simulator() -> 
         backend.open()
     message = str(error.value)
     assert "/dev/i2c-250" in message and "raspi-config" in message and "--backend sim" in message
+    assert "'bus' in the [i2c] table of the sleeve layout" in message  # the key as the file has it
     assert not backend.is_open
 
 

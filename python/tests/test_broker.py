@@ -22,10 +22,11 @@ import subprocess
 import sys
 import textwrap
 import threading
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import IO, Literal, Protocol
+from typing import IO, Any, Literal, Protocol
 
 import paho.mqtt.client as mqtt
 import pytest
@@ -355,6 +356,82 @@ def test_retained_messages_survive_a_restart(start_broker: StartBroker, tmp_path
         assert (message.payload, message.retain) == (b'{"online":true}', True)
     finally:
         sender.close()
+
+
+def test_the_log_has_no_line_per_save(broker: Broker, connect: Connect) -> None:
+    """The broker saves its database after every change (a stroke, a status): its log keeps
+    the connections and errors, not a line per save, so a sleeve that runs for weeks does not
+    fill its SD card with them."""
+    sender = connect("sender")
+    sleeve = connect("sleeve")
+    database = broker.state_dir / "data" / "mosquitto.db"
+    for index in range(5):
+        saved_before = database.stat().st_mtime_ns if database.exists() else None
+        code = sleeve.publish(status_topic(broker.credentials), b"%d" % index, retain=True)
+        assert not code.is_failure, code
+        # Each retained message is a change: wait until the database on disk has it.
+        deadline_s = time.monotonic() + WAIT_S
+        while (database.stat().st_mtime_ns if database.exists() else None) == saved_before:
+            assert time.monotonic() < deadline_s, "the broker did not save its database"
+            time.sleep(0.02)
+    sender.close()
+    log = broker.log_path.read_text()
+    assert "New client connected" in log, log  # the log is written, with its notices
+    assert "Saving in-memory database" not in log, log
+
+
+def _page_session(credentials: Credentials, client_id: str) -> tuple[mqtt.Client, queue.Queue[Any]]:
+    """The page's connection: WebSockets, MQTT 3.1.1, a persistent session under ``client_id``."""
+    inbox: queue.Queue[Any] = queue.Queue()
+    page = mqtt.Client(
+        CallbackAPIVersion.VERSION2,
+        client_id=client_id,
+        clean_session=False,
+        protocol=mqtt.MQTTv311,
+        transport="websockets",
+    )
+    page.username_pw_set(credentials.sender.username, credentials.sender.password)
+    page.on_connect = lambda _c, _u, flags, code, _p: inbox.put(("connack", flags.session_present))
+    page.on_subscribe = lambda _c, _u, _mid, codes, _p: inbox.put(("suback", codes))
+    page.on_message = lambda _c, _u, message: inbox.put(("message", message.payload))
+    page.connect("127.0.0.1", credentials.ws_port)
+    page.loop_start()
+    return page, inbox
+
+
+def test_a_pages_session_keeps_the_sleeves_events_across_a_restart_and_expires(
+    start_broker: StartBroker, tmp_path: Path
+) -> None:
+    first = start_broker(state_dir=tmp_path / "state")
+    events = f"feelmysign/{first.credentials.sleeve_id}/events"
+    page, inbox = _page_session(first.credentials, "feelmysign-web-test")
+    assert inbox.get(timeout=WAIT_S) == ("connack", False)
+    page.subscribe(events, qos=1)
+    kind, codes = inbox.get(timeout=WAIT_S)
+    assert kind == "suback" and [code.value for code in codes] == [1], codes
+    page.disconnect()
+    page.loop_stop()
+    first.stop()
+
+    # The broker comes back from its saved state; the sleeve's event comes before the page.
+    second = start_broker(state_dir=tmp_path / "state")
+    sleeve = Client(second.credentials.sleeve, second.credentials.mqtt_port)
+    sleeve.connack()
+    try:
+        assert not sleeve.publish(events, b'{"type":"played","seq":3}').is_failure
+    finally:
+        sleeve.close()
+    page, inbox = _page_session(second.credentials, "feelmysign-web-test")
+    try:
+        assert inbox.get(timeout=WAIT_S) == ("connack", True)
+        assert inbox.get(timeout=WAIT_S) == ("message", b'{"type":"played","seq":3}')
+    finally:
+        page.disconnect()
+        page.loop_stop()
+    # Each page load leaves a session like this one: the broker drops any not resumed in time.
+    config = (tmp_path / "state" / "mosquitto.conf").read_text()
+    expirations = re.findall(r"^persistent_client_expiration (\d+)([hdwmy])$", config, re.M)
+    assert expirations == [("1", "h")], config
 
 
 def test_credentials_are_private_and_kept_across_restarts(

@@ -18,7 +18,16 @@ from pathlib import Path
 import pytest
 
 # Numerics, plots and statistics (the study and research tools), and MQTT (paho).
-HEAVY_PACKAGES = ("numpy", "scipy", "matplotlib", "statsmodels", "pandas", "questplus", "paho")
+HEAVY_PACKAGES = (
+    "numpy",
+    "scipy",
+    "matplotlib",
+    "statsmodels",
+    "pandas",
+    "questplus",
+    "paho",
+    "gpiod",  # only a layout with an enable line, and only once its backend opens
+)
 # The study's command-line choices are the one module of the study package parsing needs.
 LIGHT_STUDY_MODULES = ("feelmysign.study", "feelmysign.study.choices")
 
@@ -103,6 +112,7 @@ NOT_BEFORE_ALL_OFF = (
     "feelmysign.daemon",
     "feelmysign.broker",
     "feelmysign.research",
+    "gpiod",  # the pull-down holds an enable line low after a crash: the early pass needs none
 )
 # A real bus needs no JSON either; the emulated bus is a JSON file.
 NOT_BEFORE_REAL_BUS = ("json", "re")

@@ -17,7 +17,7 @@ import pytest
 from feelmysign.backends import EmulatedI2CBus, SimBackend
 from feelmysign.backends import factory as factory_module
 from feelmysign.backends.drv2605 import Drv2605Backend
-from feelmysign.backends.emulated_i2c import DRV2604_DEVICE_ID, RTP_INPUT
+from feelmysign.backends.emulated_i2c import DRV2604_DEVICE_ID, MODE, RTP_INPUT
 from feelmysign.backends.factory import open_backend
 from feelmysign.cli import main
 from feelmysign.cli import scan as scan_cli
@@ -358,3 +358,22 @@ def test_the_documented_wiring_table_is_the_paper_layout_s(paper: Layout) -> Non
     assert len(documented) == len(rows)
     layout_wiring = [(w.row, w.column, w.multiplexer, w.channel) for w in paper.wiring]
     assert documented == layout_wiring
+
+
+def test_scan_names_a_motor_left_driving_and_fails(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], paper: Layout
+) -> None:
+    # As a sleeve killed without an enable line leaves a chip: in real-time playback at a level.
+    bus = EmulatedI2CBus.for_layout(paper)
+    chip = bus.chip(mux=0x70, channel=4)
+    chip.registers[RTP_INPUT] = 0x66
+    chip.registers[MODE] = 0x05  # out of standby, real-time playback
+    assert chip.output > 0.0
+    code, out = _scan_with(monkeypatch, bus)(capsys)
+    assert code == 1
+    statuses = _statuses(out)
+    assert statuses[("0x70", "4")] == "DRIVING"
+    assert list(statuses.values()).count("ok") == 11
+    assert "is left driving its motor (MODE 0x05, RTP_INPUT 0x66)" in out
+    assert "'feelmysign off'" in out
+    assert chip.output > 0.0  # scan only reads: it changes nothing on the bus

@@ -106,7 +106,9 @@ def closed_port() -> Iterator[int]:
 def test_a_shape_arrives_in_order_as_json_v1(
     broker: Broker, sleeve: Sleeve, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert send(broker, "--shape", "circle", "--segments", "8", "--duration-ms", "800") == 0
+    # --no-wait: this test's sleeve is a bare client that answers nothing.
+    argv = ("--shape", "circle", "--segments", "8", "--duration-ms", "800", "--no-wait")
+    assert send(broker, *argv) == 0
     payloads = _json_payloads(sleeve.receive(8))
     expected = shape_strokes("circle", layout=PAPER_SLEEVE, segments=8, duration_ms=800)
     assert [p["seq"] for p in payloads] == list(range(8))
@@ -171,7 +173,7 @@ def test_strokes_from_standard_input(
 def test_json_output_lists_every_message(
     broker: Broker, sleeve: Sleeve, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert send(broker, "--shape", "square", "--duration-ms", "200", "--json") == 0
+    assert send(broker, "--shape", "square", "--duration-ms", "200", "--json", "--no-wait") == 0
     received = sleeve.receive(4)
     lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [(line["topic"], line["payload"]) for line in lines] == received
@@ -183,7 +185,9 @@ def test_a_bad_stroke_sends_nothing(
 ) -> None:
     assert send(broker, "0,0,1,1,100", "0,0,5,2,1500") == 1
     error = capsys.readouterr().err
-    assert error.startswith("Error: Stroke 2 '0,0,5,2,1500' would be rejected by the sleeve")
+    # No sleeve status at this broker: checked against the paper's grid, and said so first.
+    assert "No status from sleeve 'sleeve1'" in error and "paper's sleeve" in error
+    assert "\nError: Stroke 2 '0,0,5,2,1500' would be rejected by the sleeve" in error
     assert "outside_grid" in error and "Nothing was sent." in error
     assert send(broker, "2,2,3,2,100", "--legacy") == 0  # the marker
     assert sleeve.receive(1) == [(LEGACY_TOPIC, "2,2,3,2,100")]
@@ -314,6 +318,12 @@ def test_good_broker_urls() -> None:
         (["0,0,1,0,100", "--segments", "4"], "--segments only apply to --shape"),
         (["--shape", "line", "--legacy", "--intensity", "0.5"], "legacy format has no intensity"),
         (["--shape", "line", "--timeout-s", "0"], "--timeout-s: 0 is out of range"),
+        # Nothing would be felt, and the sleeve would report it played: refused, with the range.
+        (
+            ["--shape", "line", "--intensity", "0"],
+            "--intensity: 0 is out of range; give a number "
+            "from 0.01 to 1 (at 0 the sleeve would play strokes no one feels)",
+        ),
         (["--shape", "line", "--id", "a/b"], "--id: the sleeve id 'a/b' cannot be used"),
     ],
 )

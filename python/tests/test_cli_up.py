@@ -191,11 +191,11 @@ def test_events_that_name_no_stroke_are_never_taken_for_copies() -> None:
     assert [copies.is_copy(strokes[0]), copies.is_copy(strokes[2])] == [False, True]
 
 
-def test_a_stroke_cut_short_is_counted_once_as_played() -> None:
+def test_a_stroke_cut_short_is_counted_once_as_cut_short() -> None:
     summaries = DrawingSummaries(quiet_s=1.5)
     drawing = "cccccccc-3333"
-    summaries.add(_played(drawing, 2.0), now_s=0.0)
-    summaries.add(_played(drawing, 4.0), now_s=0.1)
+    summaries.add(_played(drawing, 2.0, seq=0), now_s=0.0)
+    summaries.add(_played(drawing, 4.0, seq=1), now_s=0.1)
     cut = Cancelled(
         message="m",
         stroke=StrokeRef(drawing=drawing, seq=1, received_at_ms=1),
@@ -211,8 +211,35 @@ def test_a_stroke_cut_short_is_counted_once_as_played() -> None:
     summaries.add(cut, now_s=0.2)
     summaries.add(dropped, now_s=0.2)
     assert summaries.finished(100.0) == [
-        "Drawing cccccccc: 2 strokes played (1 cut short), 1 cancelled; "
+        "Drawing cccccccc: 1 stroke played, 1 cut short, 1 cancelled; "
         "start delay median 3 ms, max 4 ms"
+    ]
+
+
+def test_a_copy_refused_as_duplicate_leaves_its_stroke_as_it_was() -> None:
+    # After a broker restart the sleeve gets a stroke again whose acknowledgement was lost:
+    # a copy of a played stroke stays played once, a copy of a refused one stays refused, and
+    # a copy of a stroke whose own event was lost says what became of it.
+    summaries = DrawingSummaries(quiet_s=1.5)
+    drawing = "eeeeeeee-5555"
+
+    def duplicate(seq: int, played: bool | None) -> Rejected:
+        ref = StrokeRef(drawing=drawing, seq=seq, received_at_ms=1)
+        return Rejected(reason="duplicate", message="m", stroke=ref, original_played=played)
+
+    refused = Rejected(
+        reason="late", message="m", stroke=StrokeRef(drawing=drawing, seq=1, received_at_ms=1)
+    )
+    for event in (
+        _played(drawing, 2.0, seq=0),
+        duplicate(0, True),
+        refused,
+        duplicate(1, False),
+        duplicate(2, True),  # its played event was lost
+    ):
+        summaries.add(event, now_s=0.0)
+    assert summaries.finished(10.0) == [
+        "Drawing eeeeeeee: 2 strokes played, 1 rejected (late); start delay median 2 ms, max 2 ms"
     ]
 
 

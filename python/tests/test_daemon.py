@@ -220,6 +220,10 @@ def test_a_stroke_after_later_ones_plays_and_every_copy_is_a_duplicate(
         send(seq)  # copies, and fresh by their send time: still played or refused once
     copies = running.wait_events(8)[5:]
     assert [(e["reason"], e["seq"]) for e in copies] == [("duplicate", s) for s in (2, 4, 1)]
+    # Each copy says whether its stroke was felt: 2 and 1 played, 4 refused as stale.
+    assert [e["original_played"] for e in copies] == [True, False, True]
+    assert "played once already" in copies[0]["message"]
+    assert "was not played before" in copies[1]["message"]
     sender.loop_stop()
 
 
@@ -412,6 +416,6 @@ def test_a_drawing_with_a_refused_stroke_and_one_cut_short_is_one_terminal_line(
         summaries.add(event, now_s=0.0)
     [line] = summaries.finished(100.0)
     assert line.startswith(
-        f"Drawing {drawing[:8]}: 2 strokes played (1 cut short), 1 rejected (outside_grid); "
+        f"Drawing {drawing[:8]}: 1 stroke played, 1 cut short, 1 rejected (outside_grid); "
     ), line
     sender.loop_stop()

@@ -135,9 +135,15 @@ def test_scan_and_buzz_read_the_faults_in_the_file(
     assert [c["status"] for c in report["channels"] if c["status"] not in ("ok", "free")] == [
         "MISSING"
     ]
-    assert main(["buzz", "0", "0", "--layout", PAPER, "--emulate-state", str(path)]) == 1
+    # The missing chip's own motor cannot buzz; another one can, and the missing one is named.
+    assert main(["buzz", "0", "3", "--layout", PAPER, "--emulate-state", str(path)]) == 1
     error = capsys.readouterr().err
-    assert error.startswith("Error: No DRV2605L answered on multiplexer 0x70 channel 3")
+    assert (
+        "Error: Cannot buzz row 0, column 3: its DRV2605L, on multiplexer 0x70 channel 3" in error
+    )
+    buzz = ["buzz", "0", "0", "--duration-ms", "50", "--layout", PAPER]
+    assert main([*buzz, "--emulate-state", str(path)]) == 0
+    assert "no DRV2605L answered on multiplexer 0x70 channel 3" in capsys.readouterr().err
     assert main(["scan", "--emulate-state", str(tmp_path), "--layout", PAPER]) == 1
     assert "not a usable emulated I2C bus state file" in capsys.readouterr().err
 

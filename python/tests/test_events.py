@@ -21,6 +21,7 @@ from feelmysign.events import (
     event_from_json,
     is_delayed,
 )
+from feelmysign.fates import DrawingFates
 
 CASES = load("events")
 EVENTS = [(name, case) for name, case in CASES if name.startswith("event/")]
@@ -49,6 +50,8 @@ def test_status_vectors(name: str, case: dict[str, Any]) -> None:
     typed = dataclasses.asdict(status)
     if "floor" not in case["typed"]:  # vectors older than the floor leave it out
         assert typed.pop("floor") is None
+    if "hardware" not in case["typed"]:  # nor the motors' hardware, later still
+        assert typed.pop("hardware") is None
     assert typed == case["typed"]
     assert status.to_json() == case["json"]
 
@@ -99,3 +102,31 @@ def test_cancelled_defaults_to_its_reason() -> None:
         message="m", stroke=StrokeRef(received_at_ms=1), cancelled_at_ms=2, started=False
     )
     assert event.to_json()["reason"] == "cancelled"
+
+
+FATES = [(name, case) for name, case in CASES if name.startswith("fates/")]
+
+
+@pytest.mark.parametrize(("name", "case"), FATES, ids=[n for n, _ in FATES])
+def test_fate_vectors(name: str, case: dict[str, Any]) -> None:
+    """What became of each stroke: the rule the page, ``up`` and the study report from."""
+    fates = DrawingFates()
+    for wire in case["wire"]:
+        fates.add(event_from_json(wire))
+    assert {str(seq): fate for seq, fate in fates.fates().items()} == case["fates"]
+    assert fates.counts() == case["counts"]
+    assert dict(fates.refusals()) == case["refusals"]
+    # Each stroke once: the counts add up to the strokes the events name.
+    assert sum(case["counts"].values()) == len(case["fates"])
+
+
+def test_the_fate_vectors_cover_every_fate_and_the_copies() -> None:
+    fates = {fate for _, case in FATES for fate in case["fates"].values()}
+    assert fates == {"played", "cut", "cancelled", "refused"}
+    originals = {
+        wire.get("original_played")
+        for _, case in FATES
+        for wire in case["wire"]
+        if wire.get("reason") == "duplicate"
+    }
+    assert originals == {True, False, None}

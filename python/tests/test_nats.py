@@ -161,6 +161,8 @@ def _send(cluster: NatsCluster, *shape: str) -> subprocess.Popen[str]:
         # Node b may drop its clients while JetStream elects new leaders for the
         # streams node a led; the sender reconnects and sends the stroke again.
         *("--timeout-s", "40"),
+        # The test reads the sleeve's events itself: the sender returns once the broker has it all.
+        "--no-wait",
     )
 
 

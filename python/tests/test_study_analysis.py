@@ -99,4 +99,4 @@ def test_a_dry_run_of_the_papers_design_gives_tables_plots_and_report(tmp_path: 
     assert [r["strokes"] for r in circle] == [4, 6, 8, 16]
     assert sum(r["total"] for r in circle) + analysis.unclear >= 4 * 12 - analysis.unclear
     assert "Do shapes differ?" in (tmp_path / "out" / "report.md").read_text()
-    assert analysis.model is not None and analysis.model.wald_df == 5
+    assert analysis.model is not None and analysis.model.test.shapes == 6

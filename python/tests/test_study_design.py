@@ -115,3 +115,11 @@ def test_a_design_that_is_not_utf8_is_named_not_a_crash(tmp_path: Path) -> None:
     assert "not UTF-8 text (byte 9)" in str(caught.value) and "save the design as UTF-8" in str(
         caught.value
     )
+
+
+def test_practice_written_as_one_table_gets_the_double_brackets_hint() -> None:
+    with pytest.raises(DesignError) as caught:
+        parse_design(MINIMAL + '[practice]\nshape = "circle"\n', source="bad.toml")
+    assert "practice: must be a list of tables: write each entry as [[practice]]" in str(
+        caught.value
+    )

@@ -164,7 +164,15 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     // Printed, not asserted: tests never assert timings (a loaded machine would fail them);
     // that every motor goes off after the cancel and none comes on again is checked above.
     console.log(`cancel -> every motor off: ${offAfterMs.toFixed(2)} ms (sleeve's record)`);
-    await waitForData(page, '[data-testid="played-summary"]', "cancelled", String(cancelled.length));
+    // One fate a stroke (fates.ts): cut short while playing, or cancelled before it started.
+    const started = cancelled.filter((e) => e["started"] === true).length;
+    await waitForData(page, '[data-testid="played-summary"]', "cut", String(started));
+    await waitForData(
+      page,
+      '[data-testid="played-summary"]',
+      "cancelled",
+      String(cancelled.length - started),
+    );
     // The stroke stopped mid-way was played in part: the card says it was cut short.
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
       "1 cut short by Stop",
@@ -197,6 +205,11 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     const loaded = await drawingId(page);
     expect(loaded).not.toBe(original);
     expect(watcher.of(loaded)).toHaveLength(0); // loading sends nothing
+    // The time it predicts is the one Play again keeps: all at once, and the page says so.
+    await expect(page.locator('[data-testid="event-log"] li').first().innerText()).resolves.toContain(
+      "Play again sends them all at once",
+    );
+    const predictedMs = Number(await dataOf(page, "timeline", "totalMs"));
     await screenshot(page, "felt-loaded");
 
     // The sleeve idle first: a stroke that would start more than 1 s after it was sent is refused.
@@ -214,11 +227,26 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     const sent = watcher.of(again, "played").map((e) => e["seq"]);
     expect(sent).toEqual([...Array(strokes).keys()]);
     await waitForData(page, '[data-testid="played-summary"]', "played", String(strokes), 30_000);
+    // Printed, not asserted (no timing assertions): the load's prediction against the replay.
+    console.log(
+      `loaded: predicted ${predictedMs} ms; played again: ${await dataOf(page, "timeline", "totalMs")} ms ` +
+        `(drawn: ${Math.round(drawnMs)} ms)`,
+    );
   });
 
   it("compares the drawing under a coarser detail, overlaid", async () => {
     await page.locator('[data-testid="compare-toggle"]').check();
     await expect(dataOf(page, "timeline", "compare")).resolves.toMatch(/^\d+$/);
+    // Detail 1 to 5 changes what B sends, or the note says what limits it (the longest-stroke cap).
+    const note = page.locator("#compare-note");
+    await page.locator('[data-testid="compare-detail"]').fill("1");
+    const coarse = [await dataOf(page, "timeline", "compare"), await note.innerText()];
+    await page.locator('[data-testid="compare-detail"]').fill("5");
+    const fine = [await dataOf(page, "timeline", "compare"), await note.innerText()];
+    expect(coarse[1]).toContain("at detail 1 of 5");
+    expect(fine[1]).toContain("at detail 5 of 5");
+    const capNamed = /The longest-stroke cap \(\d+ ms, Settings → Advanced\) cuts \d+ of them/;
+    expect(coarse[0] !== fine[0] || capNamed.test(coarse[1]!), JSON.stringify({ coarse, fine })).toBe(true);
     await screenshot(page, "felt-compare");
     await page.locator('[data-testid="compare-toggle"]').uncheck();
     await expect(dataOf(page, "timeline", "compare")).resolves.toBe("off");

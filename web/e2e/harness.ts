@@ -388,6 +388,9 @@ export class EventWatcher {
       username: credentials.sender.username,
       password: credentials.sender.password,
       clientId: `test-events-${process.pid}-${Date.now()}`,
+      // A persistent session, as the page's and up's: events the sleeve publishes while this
+      // reader reconnects after a broker restart are kept for it, not lost before it subscribes.
+      clean: false,
     });
     const watcher = new EventWatcher(client);
     await client.subscribeAsync(`feelmysign/${credentials.sleeve.id}/events`, { qos: 1 });

@@ -35,15 +35,22 @@ describe.skipIf(!hasUp)("served by feelmysign up, with the simulated sleeve", ()
   });
 
   it("plays a square drawn with the mouse: strokes along it, cut at its corners, the preview lights up", async () => {
+    // Watched from before the first stroke: the sleeve catches up with a drawing, so its last
+    // strokes may be over before all of them have reached this test's listener.
+    await page.evaluate(() => {
+      const preview = document.querySelector('[data-testid="sleeve-preview"]') as HTMLElement;
+      const seen = window as unknown as { litSeen: number };
+      seen.litSeen = 0;
+      new MutationObserver(() => {
+        seen.litSeen = Math.max(seen.litSeen, Number(preview.dataset["lit"]));
+      }).observe(preview, { attributeFilter: ["data-lit"] });
+    });
     const { area, path, sent } = await drawSquare(page);
     const strokes = await sleeve.waitForStrokes(sent);
     expectStrokesFollow(strokes, path, area, await strokeBounds(page, area));
-    await page.waitForFunction(
-      () =>
-        Number((document.querySelector('[data-testid="sleeve-preview"]') as HTMLElement).dataset["lit"]) > 0,
-      undefined,
-      { timeout: 15_000 },
-    );
+    await page.waitForFunction(() => (window as unknown as { litSeen: number }).litSeen > 0, undefined, {
+      timeout: 15_000,
+    });
     await screenshot(page, "up-playing");
     await waitForData(page, '[data-testid="played-summary"]', "played", String(sent), 30_000);
   });

@@ -16,6 +16,7 @@ import { LATE_LIMIT_MS, loadSettings, saveSettings, withServerBroker, type Setti
 import { lateLimitMs, senderTarget, settingsChange } from "./settings-diff";
 import { withFloor } from "./sleeve-floor";
 import { offlineAdvice, SleeveWatch } from "./sleeve-state";
+import { simplifyPaths } from "./simplify/registry";
 import { parseActuators } from "./telemetry";
 import { DrawingView } from "./ui/canvas";
 import { detailParams } from "./ui/detail";
@@ -138,6 +139,11 @@ export class App {
       acked: (stroke) => this.#session.acked(stroke),
       refused: (_stroke, error) => this.#says.add("error", `A stroke was not sent: ${error.message}`),
       late: (strokes) => {
+        const drawing = this.#session.drawing;
+        for (const stroke of strokes) {
+          if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
+            this.#session.refused(stroke.seq, "unsent");
+        }
         this.#says.addDropped(strokes.length);
         this.#says.add(
           "info",
@@ -224,13 +230,23 @@ export class App {
     // A pen still down draws nothing more: its path ends here, before the cancels go out.
     this.#session.endPath();
     const drawing = this.#session.drawing;
-    let dropped = 0;
-    if (drawing !== null) dropped += this.#sender.cancel(drawing.id);
-    dropped += this.#sender.cancel(CANCEL_ALL);
+    const dropped = [
+      ...(drawing === null ? [] : this.#sender.cancel(drawing.id)),
+      ...this.#sender.cancel(CANCEL_ALL),
+    ];
     this.#felt.stopCursor();
     this.#session.close();
-    if (dropped > 0) this.#says.addDropped(dropped);
-    this.#says.add("info", `Stop sent${dropped > 0 ? `; ${dropped} unsent stroke(s) dropped` : ""}.`);
+    // Never sent: marked as such, and counted apart from what the sleeve cancelled.
+    for (const stroke of dropped) {
+      if (drawing !== null && stroke.drawing === drawing.id && stroke.seq != null)
+        this.#session.refused(stroke.seq, "unsent");
+    }
+    if (dropped.length > 0) this.#says.addDropped(dropped.length);
+    this.#says.add(
+      "info",
+      `Stop sent${dropped.length > 0 ? `; ${dropped.length} unsent stroke(s) dropped` : ""}. ` +
+        "Strokes the sleeve had not played yet are cancelled.",
+    );
   }
 
   /** Sends the current drawing's strokes again, as a new drawing (the sleeve plays them back to back). */
@@ -261,10 +277,15 @@ export class App {
       return false;
     }
     const drawing = drawingFromRecording(recording, newDrawingId(), this.#settings.intensity);
+    // Not sent: Play again will send it, all at once. The timeline shows that, not the drawing's
+    // own pace, so the time it predicts is the time Play again keeps.
+    this.#arrival = "at-once";
     this.#session.adopt(drawing);
     this.#says.add(
       "info",
-      `Loaded ${name}: ${drawing.strokes.length} strokes, not sent. Play again sends them.`,
+      `Loaded ${name}: ${drawing.strokes.length} strokes, not sent. Play again sends them all at once; ` +
+        `the timeline shows them as the sleeve will then play them, back to back and caught up ` +
+        `(${(this.#felt.totalMs / 1000).toFixed(1)} s, where the drawing took ${(drawnMs(drawing) / 1000).toFixed(1)} s).`,
     );
     return true;
   }
@@ -298,8 +319,19 @@ export class App {
     }
     const params = detailParams(drawing.params, level);
     const count = this.#felt.compare(params);
-    byId(this.#doc, "compare-note").textContent =
-      `A (solid): ${drawing.strokes.length} strokes as drawn. B (dashed): ${count} strokes at detail ${level} of 5.`;
+    let note = `A (solid): ${drawing.strokes.length} strokes as drawn. B (dashed): ${count} strokes at detail ${level} of 5.`;
+    // The longest-stroke cap cuts at every detail: say how much of B's count is its doing.
+    if (params.algorithm === "window" && params.max_stroke_ms > 0) {
+      const uncapped = simplifyPaths({ ...params, max_stroke_ms: 0 }, drawing.paths).filter(
+        (piece) => piece.segment.dropped === null,
+      ).length;
+      if (uncapped < count) {
+        note +=
+          ` The longest-stroke cap (${params.max_stroke_ms} ms, Settings → Advanced) cuts ${count - uncapped} of them:` +
+          ` without it, detail ${level} would send ${uncapped}.`;
+      }
+    }
+    byId(this.#doc, "compare-note").textContent = note;
   }
 
   // ---- layout ------------------------------------------------------------------------------
@@ -342,8 +374,10 @@ export class App {
       this.#session.clear();
       this.#fit();
     } else if (change.drawing) {
+      this.#arrival = "at-once"; // not sent: Play again sends it, all at once
       const again = this.#session.recut();
-      if (again !== null) {
+      if (again === null) this.#arrival = "as-drawn";
+      else {
         this.#says.add(
           "info",
           `Re-simplified with the new settings: ${again.strokes.length} strokes, not sent. Play again sends them.`,
@@ -393,12 +427,26 @@ export class App {
   #onEvent(payload: string): void {
     const event = parseEvent(payload);
     if (event === null || this.#copies.isCopy(payload, event)) return;
-    const reading = interpretEvent(event, this.#session.drawing?.id ?? null);
-    for (const what of reading.counts) this.#says.count(what, reading.delayMs);
+    const drawingId = this.#session.drawing?.id ?? null;
+    const reading = interpretEvent(event, drawingId);
+    if (reading.counts.includes("delayed")) this.#says.delayed(reading.delayMs);
+    // What became of the stroke: fates.ts, the rule `up` and the study report from too.
+    const seq = "seq" in event ? event.seq : null;
+    const ours = seq !== null && drawingId !== null && "drawing" in event && event.drawing === drawingId;
+    const fate = ours ? this.#says.fate(event) : null;
+    // A copy's refusal (after a broker restart, or after Stop) of a stroke that was felt.
+    const feltCopy = event.type === "rejected" && (fate === "played" || fate === "cut");
     if (reading.played !== null) this.#felt.played(reading.played);
     if (reading.cancelled !== null) this.#felt.cancelled(reading.cancelled);
-    if (reading.refusedSeq !== null) this.#session.refused(reading.refusedSeq);
-    if (reading.unplayed !== null) this.#felt.unplayed(reading.unplayed);
+    if (ours && (fate === "refused" || fate === "cancelled")) this.#session.refused(seq, fate);
+    if (reading.unplayed !== null && !feltCopy) this.#felt.unplayed(reading.unplayed);
+    if (feltCopy) {
+      this.#says.add(
+        "info",
+        `Stroke ${seq} came again (a reconnect) and was not played twice: it was felt once.`,
+      );
+      return;
+    }
     for (const note of reading.notes) this.#says.add(note.kind, note.text);
   }
 
@@ -422,4 +470,12 @@ export class App {
   get drawingId(): string | null {
     return this.#session.drawing?.id ?? null;
   }
+}
+
+/** How long the drawing took to draw: its first sample to its last, pen lifts included. */
+function drawnMs(drawing: Drawing): number {
+  const times = drawing.paths.flatMap((path) =>
+    path.length > 0 ? [path[0]!.t_ms, path[path.length - 1]!.t_ms] : [],
+  );
+  return times.length === 0 ? 0 : Math.max(...times) - Math.min(...times);
 }

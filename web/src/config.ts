@@ -51,6 +51,14 @@ export async function fetchConfig(fetcher: typeof fetch = fetch): Promise<Config
       note: "No server config (could not fetch /config.json): using Settings → Connection.",
     };
   }
+  if (response.status === 403) {
+    // The server runs with a key (feelmysign up --lan or --host) and this page was opened
+    // without it, e.g. from a typed address: the key is in the printed URL and its QR code.
+    return {
+      config: null,
+      note: "This page was opened without its key (/config.json: HTTP 403): open the URL that 'feelmysign up' printed, or scan its QR code, which hold the key.",
+    };
+  }
   if (!response.ok) {
     return {
       config: null,

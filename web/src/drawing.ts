@@ -9,6 +9,8 @@ import type { SimplifierParams } from "./simplify/registry";
 import type { Sample, Segment } from "./simplify/segment";
 
 export type PointerKind = "mouse" | "pen" | "touch";
+/** Why a stroke sent for a segment was not felt. */
+export type Unfelt = "refused" | "cancelled" | "unsent";
 
 /** A segment of path `path`, and the stroke sent for it (null when dropped). */
 export interface DrawnSegment {
@@ -31,7 +33,8 @@ export class Drawing {
   readonly segments: DrawnSegment[] = [];
   readonly #bySeq = new Map<number, DrawnSegment>();
   readonly #acked = new Set<number>();
-  readonly #refused = new Set<number>();
+  /** Strokes not felt, and why: refused by the sleeve, cancelled by Stop, or never sent. */
+  readonly #refused = new Map<number, Unfelt>();
   #nextSeq = 0;
   /** Segments kept as strokes (not dropped) in the paths still in the drawing. */
   #kept = 0;
@@ -102,15 +105,23 @@ export class Drawing {
     return drawn.stroke?.seq != null && this.#acked.has(drawn.stroke.seq);
   }
 
-  /** The sleeve refused stroke `seq`: it is not felt, however the broker acknowledged it. */
-  markRefused(seq: number): DrawnSegment | undefined {
+  /**
+   * Stroke `seq` was not felt (`why`: the sleeve refused it, Stop cancelled it, or it was never
+   * sent): so it is drawn, however the broker acknowledged it.
+   */
+  markRefused(seq: number, why: Unfelt = "refused"): DrawnSegment | undefined {
     const drawn = this.#bySeq.get(seq);
-    if (drawn !== undefined) this.#refused.add(seq);
+    if (drawn !== undefined) this.#refused.set(seq, why);
     return drawn;
   }
 
   isRefused(drawn: DrawnSegment): boolean {
     return drawn.stroke?.seq != null && this.#refused.has(drawn.stroke.seq);
+  }
+
+  /** Why stroke `drawn` was not felt; null when it was (or may yet be). */
+  unfelt(drawn: DrawnSegment): Unfelt | null {
+    return drawn.stroke?.seq == null ? null : (this.#refused.get(drawn.stroke.seq) ?? null);
   }
 
   /** Strokes numbered so far (sent, or queued to be), including those of undone paths. */

@@ -54,6 +54,11 @@ export interface RejectedEvent extends StrokeRef {
   readonly reason: string;
   readonly message: string;
   readonly received_at_ms: number;
+  /**
+   * A `duplicate` only: whether the stroke it is a copy of started playing (felt once, and it stays
+   * played) or not. Null for other reasons and from a sleeve older than the field.
+   */
+  readonly original_played: boolean | null;
 }
 
 /** A control message cancelled it: `started` when it was cut short while playing. */
@@ -68,7 +73,9 @@ export interface CancelledEvent extends StrokeRef {
 
 /**
  * A motor was protected: `duty_cycle`, a stroke the duty-cycle cap kept from playing (with
- * the stroke's fields, the motor's would-be duty cycle and the limit); or `off_failed`.
+ * the stroke's fields, the motor's would-be duty cycle and the limit); `chip_lost` or
+ * `chip_back`, a DRV2605L that stopped answering or answers again; `silenced`, a stroke cut
+ * while the sleeve's enable line is held low (docs/protocol.md).
  */
 export interface SafetyEvent extends StrokeRef {
   readonly type: "safety";
@@ -161,7 +168,12 @@ const REASON_MESSAGE: readonly Field[] = [
 const EVENT_FIELDS: Record<SleeveEventType, readonly Field[]> = {
   played: [...STROKE, ...TIMING],
   adjusted: [...STROKE, ...TIMING, ["reason", "text", true], ["requested_duration_ms", "number", true]],
-  rejected: [...REASON_MESSAGE, ...STROKE, ["received_at_ms", "number", true]],
+  rejected: [
+    ...REASON_MESSAGE,
+    ...STROKE,
+    ["received_at_ms", "number", true],
+    ["original_played", "flag", false],
+  ],
   cancelled: [
     ...REASON_MESSAGE,
     ...STROKE,

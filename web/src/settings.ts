@@ -27,6 +27,11 @@ export type WireProtocol = "json" | "legacy";
 export type LateStrokes = "send" | "drop";
 /** With "drop": a stroke not sent within this time is no longer the drawing's touch. */
 export const LATE_LIMIT_MS = 2000;
+/**
+ * The faintest intensity sent (Python's `cli.send.MIN_INTENSITY`): at 0 the sleeve plays and reports
+ * a stroke as played that no one feels, so 0 is refused here rather than reported as played.
+ */
+export const MIN_INTENSITY = 0.01;
 export type GridSource = "status" | "manual";
 
 /** Both simplifiers' parameters that a person sets (`PanelParams`), and the page's own settings. */
@@ -143,12 +148,14 @@ export const FIELDS: readonly FieldSpec[] = [
     key: "intensity",
     section: "drawing",
     label: "Intensity",
-    help: "how strongly the sleeve vibrates (0 = off, 1 = strongest)",
+    help: "how strongly the sleeve vibrates (1 = strongest; 0 is not sent: nothing would be felt)",
     kind: "number",
-    minimum: 0,
+    minimum: MIN_INTENSITY,
     maximum: 1,
     problem: (value) =>
-      typeof value === "number" && value >= 0 && value <= 1 ? null : "must be a number from 0 to 1",
+      typeof value === "number" && value >= MIN_INTENSITY && value <= 1
+        ? null
+        : `must be a number from ${MIN_INTENSITY} to 1 (at 0 the sleeve would play strokes no one feels)`,
   },
   boolField(
     "pressure_sets_intensity",

@@ -37,6 +37,12 @@ describe("fetchConfig", () => {
     expect(result.note).toMatch(/HTTP 404.*Settings/);
   });
 
+  it("tells a page opened without its key to open the printed URL (a typed LAN address)", async () => {
+    const result = await fetchConfig(respond(403, "Forbidden", "text/plain"));
+    expect(result.config).toBeNull();
+    expect(result.note).toMatch(/without its key.*printed.*QR code/);
+  });
+
   it("says so when the config is malformed", async () => {
     expect((await fetchConfig(respond(200, '{"ws_url":1}'))).note).toMatch(/no string "ws_url"/);
     expect((await fetchConfig(respond(200, "<html>"))).note).toMatch(/not valid JSON/);

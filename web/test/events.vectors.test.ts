@@ -11,6 +11,7 @@ import {
   readStatus,
   statusToJson,
 } from "../src/events";
+import { DrawingFates } from "../src/fates";
 import { hasVectors, vectors } from "./testdata";
 
 interface ValidVector {
@@ -84,5 +85,36 @@ describe("text that is not JSON", () => {
   it.each(["", "{", "null", '"played"'])("gives null for %j", (text) => {
     expect(parseEvent(text)).toBeNull();
     expect(parseStatus(text)).toBeNull();
+  });
+});
+
+/** What became of a drawing's strokes, as feelmysign.fates says (the page, `up` and the study). */
+interface FateVector {
+  description: string;
+  wire: unknown[];
+  fates: Record<string, string>;
+  counts: Record<string, number>;
+  refusals: Record<string, number>;
+}
+
+const fates = present ? (vectors("events", "fates") as [string, FateVector][]) : [];
+
+describe.skipIf(!present)("fate vectors", () => {
+  it("finds them", () => {
+    expect(fates.length).toBeGreaterThan(0);
+  });
+
+  it.each(fates)("fates %s", (_name, vector) => {
+    const drawing = new DrawingFates();
+    for (const wire of vector.wire) {
+      const event = readEvent(wire);
+      if (event === null) throw new Error(`not an event: ${JSON.stringify(wire)}`);
+      drawing.add(event);
+    }
+    expect(Object.fromEntries([...drawing.fates()].map(([seq, fate]) => [String(seq), fate]))).toEqual(
+      vector.fates,
+    );
+    expect(drawing.counts()).toEqual(vector.counts);
+    expect(Object.fromEntries(drawing.refusals())).toEqual(vector.refusals);
   });
 });

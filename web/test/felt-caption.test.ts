@@ -21,3 +21,18 @@ describe("timelineCaption", () => {
     );
   });
 });
+
+describe("timelineCaption after Stop", () => {
+  it("never says the rest plays as it would once Stop was pressed", () => {
+    expect(timelineCaption(6, 2, 0, { cancelled: 3, stopped: true })).toBe(
+      "; 2 as the sleeve played them, 3 cancelled by Stop before they played, the rest stopped: not felt.",
+    );
+    expect(timelineCaption(4, 0, 0, { cancelled: 0, stopped: true })).toBe("; the rest stopped: not felt.");
+    expect(timelineCaption(4, 3, 0, { cancelled: 1, stopped: true })).toBe(
+      "; 3 as the sleeve played them, 1 cancelled by Stop before it played.",
+    );
+    expect(timelineCaption(6, 4, 0, { cancelled: 2, cut: 1, stopped: true })).toBe(
+      "; 4 as the sleeve played them (1 cut short by Stop), 2 cancelled by Stop before they played.",
+    );
+  });
+});

@@ -91,8 +91,9 @@ describe("settings validation", () => {
   });
 
   it.each<[SettingKey, unknown, RegExp]>([
-    ["intensity", 1.01, /from 0 to 1/],
-    ["intensity", -0.1, /from 0 to 1/],
+    ["intensity", 1.01, /from 0.01 to 1/],
+    ["intensity", -0.1, /from 0.01 to 1/],
+    ["intensity", 0, /from 0.01 to 1 \(at 0 the sleeve would play strokes no one feels\)/],
     ["sleeve_id", "sleeve/1", /letters, digits/],
     ["sleeve_id", "", /letters, digits/],
     ["legacy_topic", "deviceOne/#", /wildcards/],
@@ -110,7 +111,7 @@ describe("settings validation", () => {
   it("accepts the other good values", () => {
     expect(errorsFor("ws_url", "wss://broker.example:8884/mqtt")).toBeUndefined();
     expect(errorsFor("sleeve_id", "Sleeve_2-b")).toBeUndefined();
-    expect(errorsFor("intensity", 0)).toBeUndefined();
+    expect(errorsFor("intensity", 0.01)).toBeUndefined();
   });
 });
 

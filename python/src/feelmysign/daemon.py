@@ -52,10 +52,12 @@ from feelmysign.events import (
     Cancelled,
     ErrorEvent,
     Event,
+    LostChip,
     Played,
     Rejected,
     Safety,
     Status,
+    StatusHardware,
     StatusLayout,
     StrokeRef,
     delivery_delay_ms,
@@ -65,6 +67,7 @@ from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.player import SPIN_MS, PlannedStroke, Player, cancelled
 from feelmysign.protocol import CANCELLED, DUPLICATE, HELD
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
+from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
@@ -78,6 +81,8 @@ KEEPALIVE_S = 15
 # A stroke delayed on its way by more than this (events.delivery_delay_ms) is logged: a higher
 # bar than the page's and the terminal's (events.DELAYED_MS), to keep the sleeve's journal quiet.
 LOG_DELAYED_MS = 1000.0
+# How often the journal looks for drawings that are over (services.drawing_log.QUIET_S).
+JOURNAL_CHECK_S = 0.25
 # Cancelled drawings remembered, so that their later strokes do not start them again.
 NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disconnect
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
@@ -90,6 +95,8 @@ NOT_ACKNOWLEDGED = frozenset({"stopped", "player_stopped"})
 # that reports these itself in its own words (``feelmysign up``) filters them out.
 CONNECTION_STATE = {"connection_state": True}
 CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
+# Safety events after which the status's ``hardware`` changed: published again with them.
+HARDWARE_EVENTS = frozenset({"chip_lost", "chip_back"})
 
 
 def sleeve_client_id(sleeve_id: str, password: str | None) -> str:
@@ -123,6 +130,8 @@ class _Publish:
     payload: str
     qos: int
     retain: bool
+    # An event, for the journal: summed up on the publishing thread, off the player's.
+    event: Event | None = None
 
 
 _Outgoing = _Publish | _Ack
@@ -160,6 +169,7 @@ class Sleeve:
         telemetry: ActuatorTelemetry | None = None,
     ) -> None:
         self._settings = settings
+        self._backend = backend  # its lost chips and enable line go into the status
         self._telemetry = telemetry  # flushed at stop, so previews see the final all-off
         self._layout = layout
         self._options = options
@@ -188,6 +198,12 @@ class Sleeve:
         self._fatal: FeelMySignError | None = None
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
+        # One log line per drawing once it is over (strokes played, refused, start delay):
+        # what the journal shows of a sleeve at work. Kept by the publishing thread (the
+        # lock: the last lines are written at the stop, by whoever stops).
+        self._journal = DrawingSummaries()
+        self._journal_lock = threading.Lock()
+        self._journal_checked_s = 0.0
         self._client = self._make_client()
         self._network: threading.Thread | None = None
         self._control_topic = control_topic(self._id)  # compared with every message's topic
@@ -249,6 +265,7 @@ class Sleeve:
                 self._telemetry.stop()
             self._outbox.put(None)  # the events still queued go out before the goodbye
             publisher.join(timeout=5.0)
+            self._write_journal(every_drawing=True)
             self._say_goodbye()
 
     def _say_goodbye(self) -> None:
@@ -469,9 +486,17 @@ class Sleeve:
     def _reject(self, reason: str, message: str, ref: StrokeRef, ack: _Ack | None = None) -> None:
         """Report a stroke that will not play; acknowledge it after the event unless the
         sleeve is only going away (then the broker must deliver it again)."""
+        original_played = None
+        if reason == DUPLICATE:
+            # The copy's sender learns whether the stroke was felt: a copy of a played stroke
+            # leaves it played (once), a copy of a refused one leaves it refused.
+            original_played = self._player.started(ref.drawing, ref.seq)
+            message = duplicate_message(ref.drawing, ref.seq, original_played)
         self._count("rejected", f"rejected:{reason}")
         log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
-        rejected = Rejected(reason=reason, message=message, stroke=ref)
+        rejected = Rejected(
+            reason=reason, message=message, stroke=ref, original_played=original_played
+        )
         if reason in NOT_ACKNOWLEDGED:
             ack = None
         elif ack is not None:
@@ -492,12 +517,24 @@ class Sleeve:
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":
             self._count("capped")
+        elif isinstance(event, Safety) and event.reason in HARDWARE_EVENTS:
+            self._count(event.reason)
+            # After the event: a reader that sees the status change has the event about it.
+            self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+            self._outbox.put(
+                _Publish(telemetry_topic(self._id, "status"), self._status(online=True), 1, True)
+            )
+            if ack is not None:
+                self._outbox.put(ack)
+            return
         if isinstance(event, ErrorEvent) and event.reason == "player_crashed":
             self._fatal = FeelMySignError(
                 "the player stopped on an unexpected error (see the log); every motor is off"
             )
             self._stopped.set()
-        self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+        self._outbox.put(
+            _Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False, event)
+        )
         if ack is not None:
             self._outbox.put(ack)
 
@@ -526,8 +563,26 @@ class Sleeve:
             _Publish(telemetry_topic(self._id, "actuators"), json.dumps(frame), 0, False)
         )
 
+    def _write_journal(self, *, every_drawing: bool = False) -> None:
+        """Log the drawings that are over (every one, at the end)."""
+        now_s = time.monotonic()
+        self._journal_checked_s = now_s
+        with self._journal_lock:
+            lines = self._journal.finished(now_s, all_of_them=every_drawing)
+        for line in lines:
+            log.info("sleeve %s: %s", self._id, line)
+
     def _publish_loop(self) -> None:
-        while (item := self._outbox.get()) is not None:
+        while True:
+            try:
+                item = self._outbox.get(timeout=JOURNAL_CHECK_S)
+            except queue.Empty:
+                self._write_journal()  # quiet: a good moment to look
+                continue
+            if time.monotonic() - self._journal_checked_s >= JOURNAL_CHECK_S:
+                self._write_journal()
+            if item is None:
+                break
             if isinstance(item, _Ack):
                 self._acknowledge(item)
                 continue
@@ -535,6 +590,9 @@ class Sleeve:
                 self._client.publish(item.topic, item.payload, qos=item.qos, retain=item.retain)
             except (RuntimeError, ValueError, OSError) as error:
                 log.warning("sleeve %s: could not publish on %s: %s", self._id, item.topic, error)
+            if item.event is not None:
+                with self._journal_lock:
+                    self._journal.add(item.event, time.monotonic())
 
     def _acknowledge(self, ack: _Ack) -> None:
         # Once only: a message id is reused by the broker as soon as it is acknowledged. And
@@ -558,4 +616,29 @@ class Sleeve:
             layout=StatusLayout.of(self._layout),
             at_ms=round(time.time() * 1000),
             floor=sleeve_floor(self._layout, self._options.wearer),
+            hardware=self._hardware() if online else None,
         ).dumps()
+
+    def _hardware(self) -> StatusHardware | None:
+        """The motors' hardware now: chips lost, the enable line (the drv2605 backend only)."""
+        lost: dict[tuple[int, int], str] | None = getattr(self._backend, "lost", None)
+        if lost is None:
+            return None
+        chips = []
+        for row, column in sorted(lost):
+            wire = self._backend.wire((row, column)) if hasattr(self._backend, "wire") else None
+            chips.append(
+                LostChip(
+                    row=row,
+                    column=column,
+                    multiplexer=None if wire is None else f"0x{wire.multiplexer:02X}",
+                    channel=None if wire is None else wire.channel,
+                )
+            )
+        enable = getattr(self._backend, "enable", None)
+        silenced = bool(getattr(self._backend, "silenced", False))
+        return StatusHardware(
+            state="silenced" if silenced else "degraded" if chips else "ok",
+            lost=tuple(chips),
+            enable=None if enable is None else "high" if enable.high else "low",
+        )

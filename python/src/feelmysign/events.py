@@ -269,6 +269,10 @@ class Rejected(_AboutAStroke, _Event):
     reason: str
     message: str
     stroke: StrokeRef  # with received_at_ms
+    # A ``duplicate`` only: whether the stroke it is a copy of started playing (it was felt,
+    # and stays played) or not (refused, capped or cancelled before). Absent from other
+    # reasons, and from a sleeve older than the field.
+    original_played: bool | None = None
 
     @classmethod
     def _read(cls, r: _Reader) -> dict[str, Any]:
@@ -276,6 +280,7 @@ class Rejected(_AboutAStroke, _Event):
             "reason": r.text("reason"),
             "message": r.text("message"),
             **_read_stroke(r),
+            "original_played": r.flag("original_played", required=False),
         }
 
 
@@ -305,8 +310,10 @@ class Cancelled(_AboutAStroke, _Event):
 @dataclass(frozen=True, kw_only=True)
 class Safety(_AboutAStroke, _Event):
     """A motor was protected: a stroke the duty-cycle cap kept from playing (``duty_cycle``:
-    the stroke's fields, the motor's would-be duty cycle and the limit), or an off that
-    failed twice, so every motor was switched off (``off_failed``)."""
+    the stroke's fields, the motor's would-be duty cycle and the limit); a chip that stopped
+    answering (``chip_lost``, one per stroke cut, or one without a stroke) or answers again
+    (``chip_back``); a stroke cut while the sleeve is silent (``silenced``). Sleeves before
+    these sent ``off_failed`` for an off that failed twice."""
 
     kind: ClassVar[EventType] = "safety"
     reason: str
@@ -487,6 +494,59 @@ class StatusLayout:
         return _wire(None, {name: values[name] for name in _LAYOUT_ORDER})
 
 
+@dataclass(frozen=True)
+class LostChip:
+    """A DRV2605L that stopped answering and has not taken an "off" since."""
+
+    row: int
+    column: int
+    multiplexer: str | None = None  # "0x70"
+    channel: int | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return _wire(None, asdict(self))
+
+
+@dataclass(frozen=True)
+class StatusHardware:
+    """The motors' hardware as the status tells it: ``state`` is ``ok``, ``degraded`` (a chip
+    lost, its motor perhaps still on, the others playing) or ``silenced`` (the enable line held
+    low for a lost chip: nothing plays); ``enable`` is the line's level, None without one."""
+
+    state: str
+    lost: tuple[LostChip, ...] = ()
+    enable: str | None = None  # "high" or "low"
+
+    @classmethod
+    def from_json(cls, data: object) -> StatusHardware:
+        r = _Reader(data, "hardware")
+        raw = data.get("lost", []) if isinstance(data, dict) else []
+        if not isinstance(raw, list):
+            raise EventError("lost must be an array", "lost")
+        lost = []
+        for item in raw:
+            chip = _Reader(item, "hardware.lost")
+            lost.append(
+                LostChip(
+                    row=chip.index("row"),
+                    column=chip.index("column"),
+                    multiplexer=chip.text("multiplexer", required=False),
+                    channel=chip.index("channel", required=False),
+                )
+            )
+        return cls(state=r.text("state"), lost=tuple(lost), enable=r.text("enable", required=False))
+
+    def to_json(self) -> dict[str, Any]:
+        return _wire(
+            None,
+            {
+                "state": self.state,
+                "lost": [chip.to_json() for chip in self.lost],
+                "enable": self.enable,
+            },
+        )
+
+
 @dataclass(frozen=True, kw_only=True)
 class StatusFloor:
     """The least a stroke should be for this sleeve to play it as sent and its wearer to feel it.
@@ -533,6 +593,7 @@ class Status:
     layout: StatusLayout | None = None
     at_ms: float | None = None
     floor: StatusFloor | None = None
+    hardware: StatusHardware | None = None  # the drv2605 backend's only
 
     @classmethod
     def from_json(cls, data: object) -> Status:
@@ -544,6 +605,7 @@ class Status:
         r = _Reader(data, "a status")
         layout = r.obj("layout")
         floor = r.obj("floor")
+        hardware = r.obj("hardware")
         return cls(
             online=r.flag("online"),
             sleeve_id=r.text("sleeve_id", required=False),
@@ -553,6 +615,7 @@ class Status:
             layout=None if layout is None else StatusLayout.from_json(layout),
             at_ms=r.number("at_ms", required=False),
             floor=None if floor is None else StatusFloor.from_json(floor),
+            hardware=None if hardware is None else StatusHardware.from_json(hardware),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -568,6 +631,7 @@ class Status:
                 "layout": None if self.layout is None else self.layout.to_json(),
                 "at_ms": self.at_ms,
                 "floor": None if self.floor is None else self.floor.to_json(),
+                "hardware": None if self.hardware is None else self.hardware.to_json(),
             },
         )
         return wire

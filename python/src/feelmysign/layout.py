@@ -8,6 +8,9 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     spacing_cm = 3.0              # centre-to-centre distance between neighbours
     actuator_type = "ERM"         # ERM or LRA
     min_burst_ms = 20             # optional; default by actuator_type (ERM 20, LRA 10)
+    rated_voltage_v = 3.0         # optional; the motor's rated voltage (ERM: average, LRA: RMS)
+    overdrive_voltage_v = 3.6     # optional; the most it may get, peak (its datasheet's maximum)
+    # resonant_frequency_hz = 205 # LRA only, optional; its resonance from its datasheet
     default_intensity = 0.8       # for strokes that do not say, 0..1
 
     [safety]
@@ -20,6 +23,8 @@ A layout file (see deploy/layouts/paper-sleeve.toml and docs/protocol.md)::
     [i2c]
     bus = 1                       # /dev/i2c-1
     multiplexers = [0x70, 0x71]   # TCA9548A addresses
+    # Optional: every DRV2605L's EN pin on one GPIO line, pulled down (docs/sleeve-hardware.md)
+    enable = { chip = "gpiochip0", line = 17 }
     wiring = [
       { row = 0, column = 0, multiplexer = 0x70, channel = 0 },
       ...
@@ -35,6 +40,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import re
 import sys
 from dataclasses import dataclass, fields
 from os import PathLike
@@ -63,6 +69,23 @@ ACTUATOR_TYPES: tuple[ActuatorType, ...] = ("ERM", "LRA")
 MIN_BURST_MS: dict[ActuatorType, float] = {"ERM": 20.0, "LRA": 10.0}
 MAX_MIN_BURST_MS = 1000.0  # a burst floor of a second already forbids any drawing
 
+# A motor's datasheet values, as the DRV2605L datasheet (SLOS854, 8.5.2) defines them: the
+# rated voltage (ERM: average; LRA: RMS at resonance) is the full-scale drive, the overdrive
+# voltage (peak) bounds the chip's automatic overdrive. Defaults: a common 10 mm coin ERM
+# (3.0 V rated, 3.6 V maximum) and a coin LRA of the 170-235 Hz kind (2.0 V rms rated, its
+# sine's 2.8 V peak as the clamp, 205 Hz: the middle, as the chip tracks the resonance
+# itself in closed loop and the frequency is only its first guess).
+DEFAULT_RATED_VOLTAGE_V: dict[ActuatorType, float] = {"ERM": 3.0, "LRA": 2.0}
+DEFAULT_OVERDRIVE_VOLTAGE_V: dict[ActuatorType, float] = {"ERM": 3.6, "LRA": 2.8}
+DEFAULT_RESONANT_FREQUENCY_HZ = 205.0
+# RATED_VOLTAGE and OD_CLAMP are 8-bit: up to 5.4 V (ERM closed loop) and 5.5 V (ERM open
+# loop, closed-loop clamp 5.6 V); the chip's supply is at most 5.2 V anyway.
+VOLTAGE_RANGE_V = (0.5, 5.0)
+MAX_OVERDRIVE_VOLTAGE_V = 5.5
+# DRIVE_TIME (5 bits, 0.5 to 3.6 ms half periods) covers 139 Hz and up; the closed-loop
+# rated-voltage equation needs (4 x 300 us + 300 us) x f below 1, under 667 Hz.
+RESONANT_FREQUENCY_RANGE_HZ = (140.0, 400.0)
+
 MAX_GRID_SIDE = 64  # rows or columns; 8 multiplexers x 8 channels drive 64 actuators at most
 MIN_ACTUATORS = 2  # a stroke moves between actuators; one cannot draw anything
 MAX_SPACING_CM = 20.0  # wider than any forearm or back grid; catches millimetres typed as cm
@@ -70,6 +93,8 @@ MAX_DURATION_MS = 600_000.0  # 10 minutes; catches microseconds typed as millise
 MUX_ADDRESSES = range(0x70, 0x78)  # TCA9548A: pins A0..A2 select 0x70..0x77
 MUX_CHANNELS = 8  # TCA9548A channels 0..7; one DRV2605L (fixed address 0x5A) per channel
 MAX_I2C_BUS = 255  # the N of /dev/i2c-N
+MAX_GPIO_LINE = 1023  # a line offset on its chip; a Raspberry Pi's gpiochip0 has 54 to 58
+GPIO_CHIP = re.compile(r"(?:/dev/)?gpiochip[0-9]{1,3}")  # as gpiodetect lists them
 MAX_NAME_CHARS = 64
 NAME_FORBIDDEN = "/+#"  # the name may appear in MQTT topics, where these are special
 
@@ -82,6 +107,24 @@ class Wire:
     column: int
     multiplexer: int
     channel: int
+
+
+@dataclass(frozen=True)
+class EnableLine:
+    """The GPIO line every DRV2605L's EN pin hangs on: high lets the chips drive their motors,
+    low (the pull-down, whenever no process drives the line) shuts every one of them down."""
+
+    chip: str  # "gpiochip0", as gpiodetect names it
+    line: int  # the line's offset on that chip (on a Raspberry Pi, the BCM GPIO number)
+
+    @property
+    def path(self) -> str:
+        """The chip's character device, e.g. ``/dev/gpiochip0``."""
+        return self.chip if self.chip.startswith("/dev/") else f"/dev/{self.chip}"
+
+    @property
+    def name(self) -> str:
+        return f"{self.chip} line {self.line}"
 
 
 @dataclass(frozen=True)
@@ -112,9 +155,15 @@ class Layout:
     actuator_type: ActuatorType = "ERM"
     # None: the actuator type's MIN_BURST_MS; read it through ``shortest_burst_ms``.
     min_burst_ms: float | None = None
+    # None: the actuator type's default; read them through the properties below.
+    rated_voltage_v: float | None = None
+    overdrive_voltage_v: float | None = None
+    resonant_frequency_hz: float | None = None  # LRA only
     i2c_bus: int = 1
     multiplexers: tuple[int, ...] = ()
     wiring: tuple[Wire, ...] = ()
+    # None: no enable line, every EN pin tied high (only I2C switches a motor off).
+    enable: EnableLine | None = None
 
     @property
     def shortest_burst_ms(self) -> float:
@@ -122,6 +171,27 @@ class Layout:
         if self.min_burst_ms is not None:
             return self.min_burst_ms
         return MIN_BURST_MS[self.actuator_type]
+
+    @property
+    def rated_voltage(self) -> float:
+        """The motor's rated voltage in V (ERM average, LRA RMS): set, or the type's default."""
+        if self.rated_voltage_v is not None:
+            return self.rated_voltage_v
+        return DEFAULT_RATED_VOLTAGE_V[self.actuator_type]
+
+    @property
+    def overdrive_voltage(self) -> float:
+        """The motor's overdrive (peak) voltage in V: set, or the type's default."""
+        if self.overdrive_voltage_v is not None:
+            return self.overdrive_voltage_v
+        return DEFAULT_OVERDRIVE_VOLTAGE_V[self.actuator_type]
+
+    @property
+    def resonance_hz(self) -> float:
+        """An LRA's resonant frequency in Hz: set, or the default."""
+        if self.resonant_frequency_hz is not None:
+            return self.resonant_frequency_hz
+        return DEFAULT_RESONANT_FREQUENCY_HZ
 
 
 _DEFAULTS = Layout(rows=1, columns=MIN_ACTUATORS, spacing_cm=1.0)
@@ -133,6 +203,9 @@ TOP_KEYS = (
     "spacing_cm",
     "actuator_type",
     "min_burst_ms",
+    "rated_voltage_v",
+    "overdrive_voltage_v",
+    "resonant_frequency_hz",
     "default_intensity",
 )
 _SAFETY_KEYS = (
@@ -143,7 +216,8 @@ _SAFETY_KEYS = (
     "max_duty_cycle",
 )
 MIN_DUTY_WINDOW_MS = 1000.0  # shorter is no longer about heat but about single strokes
-_I2C_KEYS = ("bus", "multiplexers", "wiring")
+_I2C_KEYS = ("bus", "multiplexers", "enable", "wiring")
+_ENABLE_KEYS = ("chip", "line")
 _WIRE_KEYS = ("row", "column", "multiplexer", "channel")
 _MEANINGS = {
     "rows": "the number of actuator rows",
@@ -275,6 +349,7 @@ def _read_geometry(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
         ),
         "actuator_type": problems.actuator_type(data.get("actuator_type", _DEFAULTS.actuator_type)),
         "min_burst_ms": _read_min_burst(problems, data.get("min_burst_ms")),
+        **_read_motor(problems, data),
     }
 
 
@@ -283,6 +358,45 @@ def _read_min_burst(problems: _Problems, value: Any) -> float | None:
     if value is None:
         return None
     return problems.number("min_burst_ms", value, MAX_MIN_BURST_MS)
+
+
+def _read_motor(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
+    """The motor's datasheet values (all optional); the overdrive at least the rated voltage."""
+    kind = data.get("actuator_type", _DEFAULTS.actuator_type)
+    low, high = VOLTAGE_RANGE_V
+    read: dict[str, Any] = {}
+    for key, top, unit in (
+        ("rated_voltage_v", high, "V (ERM: average; LRA: RMS)"),
+        ("overdrive_voltage_v", MAX_OVERDRIVE_VOLTAGE_V, "V peak"),
+    ):
+        value = data.get(key)
+        read[key] = None if value is None else problems.within(key, value, low, top, unit)
+    rated, overdrive = read["rated_voltage_v"], read["overdrive_voltage_v"]
+    if kind in ACTUATOR_TYPES:
+        rated = DEFAULT_RATED_VOLTAGE_V[kind] if rated is None else rated
+        overdrive = DEFAULT_OVERDRIVE_VOLTAGE_V[kind] if overdrive is None else overdrive
+    if rated is not None and overdrive is not None and overdrive < rated:
+        problems.add(
+            "overdrive_voltage_v",
+            f"{overdrive:g} V is below the rated voltage {rated:g} V: the overdrive clamp must "
+            "be at least the rated voltage; take both from the motor's datasheet (its maximum "
+            "or overdrive voltage, and its rated voltage)",
+        )
+    frequency = data.get("resonant_frequency_hz")
+    read["resonant_frequency_hz"] = None
+    if frequency is not None:
+        if kind != "LRA":
+            problems.add(
+                "resonant_frequency_hz",
+                'is for an LRA only (actuator_type = "LRA"); an ERM has no resonance to '
+                "set: remove it, or set actuator_type",
+            )
+        else:
+            low_hz, high_hz = RESONANT_FREQUENCY_RANGE_HZ
+            read["resonant_frequency_hz"] = problems.within(
+                "resonant_frequency_hz", frequency, low_hz, high_hz, "Hz (the LRA's resonance)"
+            )
+    return read
 
 
 def _read_caps(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
@@ -345,7 +459,54 @@ def _read_i2c(
     bus = problems.integer("i2c.bus", i2c.get("bus", _DEFAULTS.i2c_bus), 0, MAX_I2C_BUS)
     multiplexers = _read_multiplexers(problems, i2c.get("multiplexers", []))
     wiring = _read_wiring(problems, i2c.get("wiring", []), rows, columns, multiplexers)
-    return {"i2c_bus": bus, "multiplexers": multiplexers, "wiring": wiring}
+    enable = None
+    if "enable" in i2c:
+        enable = _read_enable(problems, i2c["enable"], bool(i2c.get("wiring")))
+    return {"i2c_bus": bus, "multiplexers": multiplexers, "wiring": wiring, "enable": enable}
+
+
+def _read_enable(problems: _Problems, value: Any, wired: bool) -> EnableLine | None:
+    """``enable = { chip = "gpiochip0", line = 17 }``: where the chips' EN pins are wired."""
+    example = 'enable = { chip = "gpiochip0", line = 17 }'
+    if not isinstance(value, dict):
+        problems.add("i2c.enable", f"must be a table such as {example}; got {_show(value)}")
+        return None
+    table = problems.table("i2c.enable", value, _ENABLE_KEYS)
+    chip = table.get("chip", _MISSING)
+    if chip is _MISSING:
+        problems.add(
+            "i2c.enable.chip",
+            'missing; the GPIO chip of the line (a name such as "gpiochip0", as gpiodetect '
+            "lists them) is required",
+        )
+        chip = None
+    elif not isinstance(chip, str) or not GPIO_CHIP.fullmatch(chip):
+        problems.add(
+            "i2c.enable.chip",
+            'must be a GPIO chip name such as "gpiochip0" (or its path "/dev/gpiochip0"), as '
+            f"gpiodetect lists them; got {_show(chip)}",
+        )
+        chip = None
+    raw_line = table.get("line", _MISSING)
+    line = None
+    if isinstance(raw_line, str):  # "GPIO17" is a name gpiod also takes, but not the offset
+        problems.add(
+            "i2c.enable.line",
+            f"must be a whole number from 0 to {MAX_GPIO_LINE}, the line's offset (on a "
+            f"Raspberry Pi the BCM GPIO number: 17 for GPIO17, physical pin 11); got "
+            f"{_show(raw_line)}",
+        )
+    else:
+        line = problems.integer("i2c.enable.line", raw_line, 0, MAX_GPIO_LINE)
+    if not wired:
+        problems.add(
+            "i2c.enable",
+            "an enable line needs i2c.wiring: it switches the chips the wiring lists; add the "
+            "wiring or remove enable",
+        )
+    if chip is None or line is None:
+        return None
+    return EnableLine(chip=chip, line=line)
 
 
 def _read_multiplexers(problems: _Problems, value: Any) -> tuple[int, ...]:
@@ -468,7 +629,16 @@ def _to_data(layout: Layout) -> dict[str, Any]:
     return {
         **{key: value for key, value in top.items() if value is not None},
         "safety": {key: getattr(layout, key) for key in _SAFETY_KEYS},
-        "i2c": {"bus": layout.i2c_bus, "multiplexers": list(layout.multiplexers), "wiring": wires},
+        "i2c": {
+            "bus": layout.i2c_bus,
+            "multiplexers": list(layout.multiplexers),
+            "wiring": wires,
+            **(
+                {}
+                if layout.enable is None
+                else {"enable": {"chip": layout.enable.chip, "line": layout.enable.line}}
+            ),
+        },
     }
 
 
@@ -516,6 +686,17 @@ class _Problems:
             self.add(key, f"must be {allowed}; got {_show(value)}")
             return None
         if not (math.isfinite(value) and 0 < value <= high):
+            self.add(key, f"must be {allowed}; got {value}")
+            return None
+        return float(value)
+
+    def within(self, key: str, value: Any, low: float, high: float, unit: str) -> float | None:
+        """A number from ``low`` to ``high`` in ``unit``: a motor's datasheet value."""
+        allowed = f"a number from {low:g} to {high:g} {unit}, from the motor's datasheet"
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            self.add(key, f"must be {allowed}; got {_show(value)}")
+            return None
+        if not (math.isfinite(value) and low <= value <= high):
             self.add(key, f"must be {allowed}; got {value}")
             return None
         return float(value)

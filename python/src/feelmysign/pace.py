@@ -35,6 +35,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 
+from feelmysign.frozen_init import dict_init
 from feelmysign.protocol import LATE, STALE
 from feelmysign.sleeve.queue import REMEMBERED_DRAWINGS, start_ms
 
@@ -51,9 +52,13 @@ MAX_LAG_MS = 1_000.0
 CATCH_UP_FRACTION = 0.25
 
 
+@dict_init
 @dataclass(frozen=True)
 class Verdict:
-    """``reason`` None: play it. ``age_ms`` and ``lag_ms`` are None without ``sent_at_ms``."""
+    """``reason`` None: play it. ``age_ms`` and ``lag_ms`` are None without ``sent_at_ms``.
+
+    Made with one dict update (``dict_init``): one per stroke, before its first motor command.
+    """
 
     reason: str | None = None
     message: str = ""

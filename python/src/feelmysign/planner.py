@@ -73,8 +73,9 @@ _OFF_LINE = 1 - ON_LINE_EPSILON  # a coordinate this far into a cell is on its n
 
 TOO_FAST = "too_fast"
 
-# One burst before it becomes a Burst: x, y (grid units), peak_ms, start_ms, duration_ms.
-RawBurst = tuple[float, float, float, float, float]
+# One burst: a Burst (x, y in grid units, peak_ms, start_ms, duration_ms, intensity), made
+# as a plain tuple of the same six fields (tuple.__new__, in C) on the planning path.
+RawBurst = Burst
 
 # Planning runs on the sleeve before a stroke's first motor command, so the code
 # below works on plain tuples and builds the public dataclasses only for its
@@ -210,16 +211,17 @@ class Outline:
         # Start, end, and each burst's fraction of the way and timing (apparent_motion.Timing).
         self._way = way
         self.thinned = thinned
-        self._bursts: list[RawBurst] | None = None
+        self._bursts: tuple[RawBurst, ...] | None = None
         self._schedule: Schedule | None = None
 
     @property
-    def bursts(self) -> list[RawBurst]:
+    def bursts(self) -> tuple[RawBurst, ...]:
         """Every burst, in stroke order (made once)."""
         if self._bursts is None:
             start, end, fractions, burst_timings = self._way
-            points = _points(start, end, fractions)
-            self._bursts = _bursts(points, fractions, burst_timings, self.duration_ms)
+            self._bursts = _bursts(
+                start, end, fractions, burst_timings, self.duration_ms, self.intensity
+            )
         return self._bursts
 
     def schedule(self) -> Schedule:
@@ -233,7 +235,7 @@ class Outline:
                 commands_from_spans(spans, self.min_command_ms),
                 self.duration_ms,
                 self.adjusted,
-                _bursts_of(bursts, intensity),
+                bursts,
                 self.thinned,
             )
         return self._schedule
@@ -276,6 +278,8 @@ class Outline:
             return
         start, end, fractions, burst_timings = self._way
         t = self.duration_ms
+        intensity = self.intensity
+        new = tuple.__new__
         latest_end = t + overrun_allowance_ms(t)
         last = len(fractions) - 1
         (x0, y0), (x1, y1) = start, end
@@ -301,7 +305,7 @@ class Outline:
                     length_ms = latest_end - start_ms
             else:
                 length_ms = t - start_ms
-            yield (x, y, f * t, start_ms, length_ms)
+            yield new(Burst, (x, y, f * t, start_ms, length_ms, intensity))
 
     def energy_bound_ms(self) -> float:
         """At least the energy (intensity squared x ms) any one actuator gets from the stroke.
@@ -316,7 +320,7 @@ class Outline:
         """
         energy = self.intensity**2
         if self._bursts is not None:
-            return sum(energy * d for _, _, _, _, d in self._bursts if d > 0)
+            return sum(energy * d for _, _, _, _, d, _ in self._bursts if d > 0)
         burst_timings = self._way[3]
         slopes: float = sum(map(_LENGTH_A, burst_timings))
         intercepts_ms: float = sum(map(_LENGTH_B, burst_timings))
@@ -484,21 +488,29 @@ def _snap(value: float) -> float:
 
 
 def _bursts(
-    points: Sequence[Point],
+    start: Point,
+    end: Point,
     fractions: Sequence[float],
     timings: Sequence[Timing],
     duration_ms: float,
-) -> list[RawBurst]:
-    """The bursts at stroke duration ``duration_ms``, the last ending exactly there.
+    intensity: float,
+) -> tuple[Burst, ...]:
+    """The bursts at stroke duration ``duration_ms``, the last ending exactly there, each
+    at its point of the way (``_points``, made here in the same pass).
 
     A burst that would run on past the end by more than the allowance is cut
     there: the motion has reached the stroke's end, and its actuator still
     buzzing would pull the felt point back, into the next stroke's time.
+    Each ``Burst`` is made in C as ``commands_from_spans`` makes its commands
+    (the named tuple's __new__ is Python).
     """
     t = duration_ms
     latest_end = t + overrun_allowance_ms(t)
-    last = len(points) - 1
-    bursts = []
+    last = len(fractions) - 1
+    points = _points(start, end, fractions)
+    new = tuple.__new__
+    bursts: list[Burst] = []
+    append = bursts.append
     for i in range(last):
         onset_a, onset_b, length_a, length_b = timings[i]
         start_ms = onset_a * t + onset_b
@@ -506,20 +518,13 @@ def _bursts(
         if start_ms + length_ms > latest_end:
             length_ms = latest_end - start_ms
         x, y = points[i]
-        bursts.append((x, y, fractions[i] * t, start_ms, length_ms))
+        append(new(Burst, (x, y, fractions[i] * t, start_ms, length_ms, intensity)))
     # The model's last duration is T - S too, but evaluated as a T + b it would
     # leave a float residue after the stroke's end.
     (x, y), (onset_a, onset_b, _, _) = points[last], timings[last]
     start_ms = onset_a * t + onset_b
-    bursts.append((x, y, fractions[last] * t, start_ms, t - start_ms))
-    return bursts
-
-
-def _bursts_of(bursts: list[RawBurst], intensity: float) -> tuple[Burst, ...]:
-    """Each ``Burst(x, y, peak_ms, start_ms, duration_ms, intensity)``, made in C as
-    ``commands_from_spans`` makes its commands (the named tuple's __new__ is Python)."""
-    new = tuple.__new__
-    return tuple([new(Burst, (*burst, intensity)) for burst in bursts])
+    append(new(Burst, (x, y, fractions[last] * t, start_ms, t - start_ms, intensity)))
+    return tuple(bursts)
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
@@ -576,7 +581,7 @@ def _spans_by_actuator(
     by_actuator: defaultdict[Actuator, list[Span]] = defaultdict(list)
     last_column, last_row = layout.columns - 1, layout.rows - 1
     sqrt, floor = math.sqrt, math.floor
-    for x, y, _, span_start, length_ms in bursts:
+    for x, y, _, span_start, length_ms, _ in bursts:
         if length_ms <= 0:
             continue
         span_end = span_start + length_ms  # as Command.end_ms computes it
@@ -630,7 +635,7 @@ def _spans_by_actuator_checked(
 ) -> dict[Actuator, list[Span]]:
     """``_spans_by_actuator`` for a stroke so faint (or off) that a span may be 0: left out."""
     by_actuator: dict[Actuator, list[Span]] = {}
-    for x, y, _, span_start, length_ms in bursts:
+    for x, y, _, span_start, length_ms, _ in bursts:
         if length_ms <= 0:
             continue
         burst = Burst(x, y, 0.0, span_start, length_ms, intensity)

@@ -63,7 +63,7 @@ from feelmysign.events import (
 )
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline, outline
-from feelmysign.protocol import DUPLICATE, PLAYER_STOPPED, QUEUE_FULL
+from feelmysign.protocol import DUPLICATE, PLAYER_STOPPED, QUEUE_FULL, SILENCED
 from feelmysign.schedule import Schedule
 from feelmysign.sleeve.admission import MAX_BACKLOG_MS, MAX_PENDING, duplicate_message, queue_full
 from feelmysign.sleeve.queue import Queue
@@ -79,6 +79,12 @@ SWITCH_INTERVAL_S = 0.0002
 STOP_WAIT_S = 5.0  # how long stop waits for a write under way before every motor goes off
 IDLE_WAIT_S = 1.0  # nothing planned: wake now and then anyway (stop requests also wake us)
 TIMING_SAMPLES = 100_000
+# How often a chip that stopped answering is tried again: once it answers, its motor (which
+# may have run on, without an enable line) is off within this, well inside a second.
+RETRY_LOST_S = 0.2
+# How often, with an enable line, the chips whose motors run are read while nothing else is
+# written: a wire that comes loose mid-stroke drops the line within this (plus a read).
+CHECK_DRIVEN_S = 0.005
 
 
 @dataclass
@@ -178,6 +184,8 @@ class Player:
         self.played = 0
         self.capped = 0
         self.cut = 0  # strokes cut for a chip that stopped answering
+        self._retry_at_s = 0.0  # when the lost chips are tried again next
+        self._check_at_s = 0.0  # when the driven chips are read again next
 
     # --- any thread ------------------------------------------------------------
 
@@ -186,6 +194,8 @@ class Player:
         drawing, seq = stroke.ref.drawing, stroke.ref.seq
         if not self._running:
             return Refusal(PLAYER_STOPPED, "the sleeve's player has stopped; restart the sleeve")
+        if self._silenced():
+            return Refusal(SILENCED, self._silenced_message())
         # A stroke that will wait may play faster (catch up): planned before the lock, so the
         # player's thread is not held up meanwhile; checked under the lock (a cancel may have
         # moved the tail since). An idle sleeve's stroke pays one comparison here.
@@ -313,6 +323,11 @@ class Player:
         with self._lock:
             return self._queue.seen(drawing, seq)
 
+    def started(self, drawing: object, seq: object) -> bool:
+        """Whether this stroke started playing: a ``duplicate`` refusal of a copy says so."""
+        with self._lock:
+            return self._queue.started(drawing, seq)
+
     def remember(self, drawing: object, seq: object) -> None:
         """A stroke settled without playing (refused and acknowledged): a copy of it the broker
         delivers again is a ``duplicate`` too, not a second verdict."""
@@ -343,6 +358,7 @@ class Player:
         Returns the strokes accepted but not started, which will never play.
         """
         self._running = False
+        self._hold_low()  # an enable line low at once, before the wait and any I2C "off"
         self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=STOP_WAIT_S)
@@ -387,6 +403,10 @@ class Player:
                     self._take_inbox()
                     self._apply_cancels()
                     wait_s = self._step()
+                    if wait_s is not None:
+                        wait_s = self._check_driven(wait_s)
+                    if self._lost():
+                        wait_s = self._retry_lost(wait_s)
                 if wait_s is not None:
                     self._wake.wait(wait_s)
         except Exception:  # the thread must never die with motors on
@@ -394,6 +414,7 @@ class Player:
             self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
+            self._hold_low()
             # After a write a submitting thread may be making (see stop).
             locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
             try:
@@ -433,7 +454,7 @@ class Player:
             cut = self._timeline.cancel(chosen, self._clock())
             self._write(cut.changes)
             if cancel.everything:
-                self._backend.all_off()  # nothing may run on after "cancel everything"
+                self._all_off_quietly("cancel everything")  # nothing may run on after it
             with self._lock:
                 self._pending -= len(cut.unstarted)
                 acknowledgements = {
@@ -472,6 +493,9 @@ class Player:
 
     def _play(self) -> None:
         """Write everything due now, then plan the rest of the strokes that started."""
+        if self._silenced():
+            self._refuse_all_silenced()
+            return
         due = self._timeline.pop_due(self._clock())
         written_at_ms = self._clock()  # the first command of a stroke goes out now
         lost = self._write(due.changes)
@@ -506,9 +530,9 @@ class Player:
                         reason="backend", message=str(error), row=change.row, column=change.column
                     )
                 )
-                if change.intensity == 0.0:
-                    self._force_off(change)
-                elif lost is None and isinstance(change.tag, PlannedStroke):
+                if change.intensity == 0.0 and self._off_again(change):
+                    continue  # a glitch: the second "off" went through
+                if lost is None:
                     lost = (change, str(error), self._cut_playing())
         if note is not None:
             note(None, None)  # what follows (an all-off at exit) belongs to no stroke
@@ -521,17 +545,147 @@ class Player:
         cut = self._timeline.cancel(
             lambda tag: isinstance(tag, PlannedStroke) and tag.start_ms <= now, now
         )
-        try:
-            self._backend.all_off()  # tries every chip; the lost one fails again
-        except Exception as error:
-            log.warning("all motors off after a lost chip: %s", error)
+        # Tries every chip; the lost one fails again (an enable line went low first, at the
+        # failed write: every motor, the lost one's included, stopped then).
+        self._all_off_quietly("after a lost chip")
         return [tag for tag in cut.started if isinstance(tag, PlannedStroke)]
+
+    def _all_off_quietly(self, when: str) -> None:
+        """Every motor off; a chip that does not take it is left to ``_retry_lost``."""
+        try:
+            self._backend.all_off()
+        except Exception as error:
+            log.warning("all motors off %s: %s", when, error)
+
+    # --- chips that stopped answering ---------------------------------------------
+
+    def _hold_low(self) -> None:
+        """Stopping: the backend's enable line (if it has one) low, and kept low."""
+        hold_low: Callable[[], None] | None = getattr(self._backend, "hold_low", None)
+        if hold_low is not None:
+            hold_low()
+
+    def _lost(self) -> dict[tuple[int, int], str]:
+        """(row, column) -> why, for each chip the backend could not switch off (none for a
+        backend that cannot lose one)."""
+        lost: dict[tuple[int, int], str] | None = getattr(self._backend, "lost", None)
+        return lost or {}
+
+    def _silenced(self) -> bool:
+        """An enable line held low for a chip that does not answer: nothing can be felt."""
+        return bool(getattr(self._backend, "silenced", False))
+
+    def _silenced_message(self) -> str:
+        lost = self._lost()
+        describe: Callable[[tuple[int, int]], str] | None = getattr(self._backend, "describe", None)
+        chips = "; ".join(describe(key) if describe else str(key) for key in sorted(lost))
+        return (
+            "the sleeve is silent: its enable line is held low, every motor off, because a "
+            f"DRV2605L does not answer ({chips or 'a chip failed its check'}); it cannot be "
+            "switched off on its own, so no motor runs until it answers again (check its wire)"
+        )
+
+    def _retry_lost(self, wait_s: float | None) -> float | None:
+        """Now and then, "off" again to each chip that stopped answering; a ``chip_back``
+        event for each that took it. How long the loop may sleep now."""
+        now_s = time.monotonic()
+        if now_s < self._retry_at_s:
+            return min(wait_s if wait_s is not None else 0.0, self._retry_at_s - now_s)
+        self._retry_at_s = now_s + RETRY_LOST_S
+        retry: Callable[[], list[tuple[int, int]]] | None = getattr(
+            self._backend, "retry_lost", None
+        )
+        back = [] if retry is None else retry()
+        for row, column in back:
+            log.warning("actuator (%d, %d): its chip answers again and is off", row, column)
+            self._on_event(
+                Safety(
+                    reason="chip_back",
+                    row=row,
+                    column=column,
+                    message=(
+                        "its DRV2605L answers again: switched off at once, and set up again "
+                        "for the next stroke"
+                        + ("" if not self._silenced() else "; the sleeve is still silent")
+                    ),
+                )
+            )
+        return RETRY_LOST_S if wait_s is None else min(wait_s, RETRY_LOST_S)
+
+    def _check_driven(self, wait_s: float) -> float:
+        """With nothing due for a while: read the chips whose motors run (a backend with an
+        enable line only), and report one that no longer answers as lost. How long the loop
+        may sleep now."""
+        check: Callable[[], tuple[tuple[int, int], str] | None] | None = getattr(
+            self._backend, "check_driven", None
+        )
+        if check is None or getattr(self._backend, "enable", None) is None:
+            return wait_s
+        if not self._timeline.busy:
+            return wait_s
+        now_s = time.monotonic()
+        if now_s >= self._check_at_s and wait_s * 1000 > self._spin_ms + 1.0:
+            self._check_at_s = now_s + CHECK_DRIVEN_S
+            failed = check()
+            if failed is not None:
+                (row, column), error = failed
+                log.warning("actuator (%d, %d): %s", row, column, error)
+                self._on_event(ErrorEvent(reason="backend", message=error, row=row, column=column))
+                cut = self._cut_playing()
+                self._chip_lost(
+                    Change(self._clock(), row, column, 0.0), error, cut, not_yet_played=[]
+                )
+                return 0.0  # look at the timeline again at once
+        return min(wait_s, max(0.0, self._check_at_s - now_s))
+
+    def _refuse_all_silenced(self) -> None:
+        """Silenced: every stroke in the timeline is cut and said so, none is called played."""
+        cut = self._timeline.cancel(lambda tag: isinstance(tag, PlannedStroke), self._clock())
+        message = f"not played: {self._silenced_message()}"
+        for tags, fresh in ((cut.started, False), (cut.unstarted, True)):
+            for tag in tags:
+                if not isinstance(tag, PlannedStroke):
+                    continue
+                acknowledge = None
+                if fresh:
+                    with self._lock:
+                        self._pending -= 1
+                        acknowledge = self._done(tag)
+                self.cut += 1
+                self._on_event(
+                    Safety(reason="silenced", row=0, column=0, message=message, stroke=tag.ref)
+                )
+                if acknowledge is not None:
+                    acknowledge()
 
     def _chip_lost(
         self, change: Change, error: str, cut: list[PlannedStroke], *, not_yet_played: list[object]
     ) -> None:
         """Each stroke cut for a lost chip: a ``safety`` event naming the chip; one whose first
-        command was this step's is never reported played (and is acknowledged here)."""
+        command was this step's is never reported played (and is acknowledged here). With no
+        stroke cut (the chip was lost switching a motor off), one event naming the chip."""
+        if self._silenced():
+            after = (
+                "The enable line went low first: every motor is off, this one's included, and "
+                "the sleeve stays silent until the chip answers again."
+            )
+        elif getattr(self._backend, "enable", None) is not None:
+            after = "The enable line went low first: every motor is off."
+        else:
+            after = (
+                "Every other motor was switched off; this one cannot be (no enable line): it is "
+                "tried again until it answers."
+            )
+        error = error if error.endswith(".") else f"{error}."  # a sentence before the next
+        if not cut:
+            self._on_event(
+                Safety(
+                    reason="chip_lost",
+                    row=change.row,
+                    column=change.column,
+                    message=f"{error} {after}",
+                )
+            )
         for stroke in cut:
             fresh = any(stroke is tag for tag in not_yet_played)
             acknowledge = None
@@ -546,27 +700,24 @@ class Player:
                     reason="chip_lost",
                     row=change.row,
                     column=change.column,
-                    message=f"cut {when}: {error} Every motor was switched off.",
+                    message=f"cut {when}: {error} {after}",
                     stroke=stroke.ref,
                 )
             )
             if acknowledge is not None:
                 acknowledge()  # reported, never to play: the broker must not send it again
 
-    def _force_off(self, change: Change) -> None:
-        """An 'off' that failed: try once more, then every motor off (a glitch must not leave
-        one running with nothing left to switch it off)."""
+    def _off_again(self, change: Change) -> bool:
+        """An 'off' that failed, tried once more: True when it went through (a glitch); else
+        the chip is lost, and every motor goes off (see ``_cut_playing``)."""
         try:
             self._backend.set_intensity(change.row, change.column, 0.0)
-            return
         except Exception:
             log.warning(
-                "actuator (%d, %d) still not off: all motors off", change.row, change.column
+                "actuator (%d, %d) still not off: its chip is lost", change.row, change.column
             )
-        try:
-            self._backend.all_off()
-        finally:
-            self._on_event(Safety(reason="off_failed", row=change.row, column=change.column))
+            return False
+        return True
 
     def _capped(self, capped: Capped) -> None:
         """A stroke the duty-cycle cap kept from playing: said, and never called played."""
@@ -601,6 +752,7 @@ class Player:
         with self._lock:
             self._pending -= 1
             acknowledge = self._done(stroke)
+            self._queue.mark_started(stroke.ref.drawing, stroke.ref.seq)
         self.played += 1
         self._on_event(played_event(stroke, now))
         if acknowledge is not None:

@@ -24,6 +24,7 @@ from decimal import ROUND_HALF_UP, Context, Decimal
 from typing import Any, Literal
 
 from feelmysign.errors import StrokeError
+from feelmysign.frozen_init import dict_init
 from feelmysign.layout import Layout
 from feelmysign.stroke import Point, Stroke
 
@@ -68,6 +69,7 @@ STALE = "stale"
 LATE = "late"
 QUEUE_FULL = "queue_full"
 PLAYER_STOPPED = "player_stopped"
+SILENCED = "silenced"  # the enable line is held low for a chip that does not answer
 
 REASONS: dict[str, str] = {
     NOT_TEXT: "the payload is not a string or bytes, or its bytes are not UTF-8",
@@ -105,9 +107,13 @@ _LEGACY_QUANTUM = Decimal(1).scaleb(-LEGACY_DECIMALS)
 _EXACT = Context(prec=400)  # enough digits for any finite double, so quantize never overflows
 
 
+@dict_init
 @dataclass(frozen=True)
 class Accepted:
-    """A payload the sleeve would play: the stroke (clamped into the grid) and its format."""
+    """A payload the sleeve would play: the stroke (clamped into the grid) and its format.
+
+    Made with one dict update (``dict_init``): one per message, before its first motor command.
+    """
 
     stroke: Stroke
     format: WireFormat

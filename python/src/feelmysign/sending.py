@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from feelmysign.connection import BrokerSettings
 from feelmysign.errors import BrokerConnectionError
-from feelmysign.events import StatusFloor
+from feelmysign.events import Status, StatusFloor
 from feelmysign.protocol import format_json, format_legacy
 from feelmysign.stroke import Stroke
 
@@ -207,7 +207,16 @@ def sleeve_floor_from_status(
     """The floor the sleeve advertises in its retained status (docs/protocol.md), read on a
     connected ``client``; None when the broker holds no status, or one without a floor (an
     older sleeve), within ``wait_s``."""
-    from feelmysign.events import EventError, Status
+    status = sleeve_status(client, settings, wait_s=wait_s)
+    return None if status is None else status.floor
+
+
+def sleeve_status(
+    client: mqtt.Client, settings: BrokerSettings, *, wait_s: float = STATUS_WAIT_S
+) -> Status | None:
+    """The sleeve's retained status (its layout, floor, online), read on a connected
+    ``client``; None when the broker holds none, or one not understood, within ``wait_s``."""
+    from feelmysign.events import EventError
     from feelmysign.topics import telemetry_topic
 
     topic = telemetry_topic(settings.sleeve_id, "status")
@@ -218,7 +227,7 @@ def sleeve_floor_from_status(
         try:
             read.append(Status.from_json(message.payload) if message.payload else None)
         except EventError:
-            read.append(None)  # not understood: no floor, as from an older sleeve
+            read.append(None)  # not understood: as from no sleeve
         arrived.set()
 
     client.message_callback_add(topic, on_status)
@@ -228,5 +237,4 @@ def sleeve_floor_from_status(
         client.unsubscribe(topic)
     finally:
         client.message_callback_remove(topic)
-    status = read[0] if read else None
-    return None if status is None else status.floor
+    return read[0] if read else None

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from feelmysign.duty_cycle import Drive, DutyCycle, Refusal
+from feelmysign.frozen_init import dict_init
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline
 from feelmysign.schedule import Command, Schedule
@@ -34,11 +35,13 @@ Actuator = tuple[int, int]
 FIRST_COMMANDS_MS = 1.0
 
 
+@dict_init
 @dataclass(frozen=True)
 class Change:
     """Set an actuator's intensity at a planned time (ms on the player's clock).
 
     ``tag`` is the stroke whose command made this change (for records; not compared).
+    Made with one dict update (``dict_init``): a stroke's first motor command is one.
     """
 
     t_ms: float
@@ -63,6 +66,20 @@ class Due:
     changes: list[Change] = field(default_factory=list)
     started: list[object] = field(default_factory=list)
     capped: list[Capped] = field(default_factory=list)
+
+    def __init__(
+        self,
+        changes: list[Change] | None = None,
+        started: list[object] | None = None,
+        capped: list[Capped] | None = None,
+    ) -> None:
+        # One dict update, not object.__setattr__ and a factory per field: the player asks
+        # for what is due before every stroke's first motor command.
+        self.__dict__.update(
+            changes=[] if changes is None else changes,
+            started=[] if started is None else started,
+            capped=[] if capped is None else capped,
+        )
 
 
 @dataclass(frozen=True)
@@ -175,7 +192,7 @@ class Timeline:
             start_ms = stroke.start_ms
             for command in commands:
                 on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
-                drive = Drive(on_ms, off_ms, command.intensity**2)
+                drive = Drive(on_ms, off_ms, self._driven_energy(command.intensity))
                 drives.setdefault((command.row, command.column), []).append(drive)
             stroke.drives = drives
             if stroke.started_ms is not None:
@@ -189,7 +206,8 @@ class Timeline:
             energy = command.intensity**2
             on_ms, off_ms = start_ms + command.start_ms, start_ms + command.end_ms
             if stroke.outline is None:
-                stroke.drives.setdefault(actuator, []).append(Drive(on_ms, off_ms, energy))
+                drive = Drive(on_ms, off_ms, self._driven_energy(command.intensity))
+                stroke.drives.setdefault(actuator, []).append(drive)
             stroke.commands.add(ident)
             self._push(_Event(on_ms, 0, "on", actuator, ident, energy, tag=tag))
             self._push(_Event(off_ms, 0, "off", actuator, ident, tag=tag))
@@ -296,7 +314,11 @@ class Timeline:
 
     def _start(self, stroke: _Stroke, t_ms: float, due: Due) -> None:
         if stroke.outline is not None:
-            if self.duty_cycle.surely_fits(stroke.outline.energy_bound_ms(), t_ms):
+            outline = stroke.outline
+            # No command drives above the cap, so the bound scales down with it.
+            capped = self._driven_energy(outline.intensity) / max(outline.intensity**2, 1e-300)
+            bound_ms = outline.energy_bound_ms() * min(1.0, capped)
+            if self.duty_cycle.surely_fits(bound_ms, t_ms):
                 stroke.started_ms = t_ms  # committed when completed, before anything else
                 due.started.append(stroke.tag)
                 return
@@ -308,6 +330,15 @@ class Timeline:
         else:
             self._dropped.update(stroke.commands)
             due.capped.append(Capped(stroke.tag, refusal))
+
+    def _driven_energy(self, intensity: float) -> float:
+        """The energy a command asking ``intensity`` drives its motor with, alone: as
+        ``_settle`` drives it, capped at full drive and the layout's ``max_intensity``. What
+        the duty-cycle cap counts: the drive that heats the motor, not the drive asked for.
+        (Commands overlapping on one motor add energies and are capped once; counted each
+        capped, they are counted at least at what is driven.)"""
+        driven = min(1.0, intensity, self._layout.max_intensity)
+        return driven * driven
 
     def _settle(self, actuator: Actuator, t_ms: float, due: Due, tag: object = None) -> None:
         active = self._active.get(actuator)

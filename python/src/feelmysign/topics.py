@@ -7,6 +7,7 @@
     feelmysign/<sleeve-id>/status      retained: online, layout, version (last will: offline)
     feelmysign/<sleeve-id>/actuators   actuator intensities, for previews
     feelmysign/<sleeve-id>/events      one message per stroke played, adjusted or rejected
+    feelmysign/clock                   retained: the broker machine's time (feelmysign.broker_clock)
     deviceOne/line                     legacy text strokes (the paper's sleeve)
 
 A sleeve id is one topic level: letters, digits, ``_`` and ``-`` only (see
@@ -23,6 +24,9 @@ STROKES: Final = "strokes"
 CONTROL: Final = "control"
 TelemetryName = Literal["status", "actuators", "events"]
 TELEMETRY_NAMES: Final[tuple[TelemetryName, ...]] = ("status", "actuators", "events")
+# Retained, from the broker's machine: its time, for a sleeve to check its clock against
+# (feelmysign.broker_clock).
+CLOCK_TOPIC: Final = f"{TOPIC_ROOT}/clock"
 # In an ACL or a subscription: every sleeve's topic of one kind.
 ANY_SLEEVE: Final = "+"
 

@@ -2,7 +2,7 @@
 
 On loopback by default: the page gets the sender's broker password from
 ``/config.json``. Off loopback (``feelmysign up --lan``) everything is HTTPS, the
-broker is reached through ``/mqtt`` on the same origin (``web_proxy``), and
+broker is reached through ``/mqtt`` on the same origin (the relay below), and
 ``/config.json`` and ``/mqtt`` need the access key of the printed URL: opening
 ``/?key=KEY`` once leaves it in a cookie only this origin sees over HTTPS.
 
@@ -11,25 +11,53 @@ server: a loopback name (``127.0.0.1``, ``localhost``, ``[::1]``), the address i
 listens on, or one of ``hosts``, with its port; any other Host gets ``403
 Forbidden`` with the reason. Else a web page from anywhere could point its own
 host name at this machine (DNS rebinding) and read the password as its own.
+
+The server is aiohttp's (HTTP parsing with size limits, TLS, a WebSocket server and
+client), on one asyncio loop in one thread: an idle or hostile connection costs a few
+kilobytes, never a thread. What a network peer sends (a malformed or oversized
+request, TLS garbage, a cut handshake, a device that does not trust the certificate
+yet, a disconnect at any point) is answered with its HTTP status or a closed
+connection, and its details go to the debug log (``debug_log``), never to the
+terminal, which belongs to the sleeve's lines. A device that refuses the certificate
+gets one line there, in words, at most once a minute.
+
+Bounds: a request's line and headers (and body) must arrive within
+``HEADER_TIMEOUT_S`` of the connection opening or of the previous answer, else the
+connection is closed; at most ``MAX_CONNECTIONS`` are held, and a new one is always
+taken: the one idle longest is closed to make room, so idle connections never keep a
+page load out.
+
+With TLS, plain ``http://`` on the same port (a user who typed the address) is told
+to go to ``https://``: the first byte tells a TLS handshake (0x16) from anything else.
 """
 
 from __future__ import annotations
 
+import asyncio
 import hmac
 import json
+import logging
+import logging.handlers
+import socket
 import ssl
+import sys
 import threading
+import time
+from collections import OrderedDict
 from collections.abc import Callable, Iterable
-from functools import partial
-from http.cookies import SimpleCookie
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from http.cookies import CookieError, SimpleCookie
 from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs
 
+import aiohttp
+from aiohttp import web
+from aiohttp.abc import AbstractStreamWriter
+
 from feelmysign.broker.tls import TlsFiles
 from feelmysign.errors import FeelMySignError
-from feelmysign.web_proxy import is_websocket_upgrade, relay_websocket
 
 WEB_DIST = Path(__file__).resolve().parents[3] / "web" / "dist"
 # An API mounted under /api/ (the study's): (method, path, host, body, content type) ->
@@ -37,6 +65,41 @@ WEB_DIST = Path(__file__).resolve().parents[3] / "web" / "dist"
 Api = Callable[[str, str, str, bytes, str], tuple[int, str, bytes]]
 MAX_API_BODY_BYTES = 64 * 1024
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
+KEY_COOKIE = "feelmysign_key"
+
+# A request's line and headers (and its body) within this, from the connection's start
+# or the previous answer: a slow or silent client is closed, not waited for.
+HEADER_TIMEOUT_S = 10.0
+TLS_HANDSHAKE_TIMEOUT_S = 10.0
+# The longest a page, file or API answer may take to be sent (a phone on a slow network
+# loads the page's few hundred kilobytes in far less). The /mqtt relay is not bounded by
+# it: the broker ends a silent MQTT session itself (its keep-alive).
+REQUEST_TIMEOUT_S = 60.0
+# Connections held at once; past it the one idle longest is closed (never a new one).
+MAX_CONNECTIONS = 512
+# aiohttp's parser limits: a request line or a header of at most 8 KiB, 100 headers.
+MAX_LINE_BYTES = 8190
+MAX_FIELD_BYTES = 8190
+MAX_HEADERS = 100
+# One MQTT message through the relay (a drawing's stroke is under a kilobyte).
+RELAY_MAX_MESSAGE_BYTES = 1024 * 1024
+RELAY_CONNECT_TIMEOUT_S = 5.0
+# A device's line in the terminal (e.g. it refused the certificate): at most this often.
+NOTICE_INTERVAL_S = 60.0
+DEBUG_LOG_BYTES = 1024 * 1024  # the debug log rotates at this size, one old file kept
+# TLS alerts by which a client says it does not trust the certificate.
+_CERTIFICATE_REFUSED = {
+    "TLSV1_ALERT_UNKNOWN_CA",
+    "SSLV3_ALERT_CERTIFICATE_UNKNOWN",
+    "SSLV3_ALERT_BAD_CERTIFICATE",
+}
+_TLS_HANDSHAKE_RECORD = 0x16
+
+# aiohttp's own loggers (its parser's and WebSocket errors, with tracebacks) go to the debug
+# log of the server that is running, never to the terminal.
+_AIOHTTP_LOG = logging.getLogger("aiohttp")
+_AIOHTTP_LOG.propagate = False
+_AIOHTTP_LOG.addHandler(logging.NullHandler())
 
 
 def host_header_names(hosts: Iterable[str], port: int) -> frozenset[str]:
@@ -55,111 +118,54 @@ def host_header_names(hosts: Iterable[str], port: int) -> frozenset[str]:
     return frozenset(names)
 
 
-KEY_COOKIE = "feelmysign_key"
+@dataclass(eq=False)
+class _Connection:
+    """One client connection, for the timeout and the connection cap."""
+
+    sock: socket.socket
+    peer: str
+    port: int
+    idle_since_s: float
+    opening: asyncio.Task[None] | None = None
+    transport: asyncio.BaseTransport | None = None
+    active: int = 0  # requests being answered (a relayed WebSocket: its whole session)
+
+    @property
+    def closed(self) -> bool:
+        return self.sock.fileno() < 0
+
+    def close(self) -> None:
+        if self.transport is not None:
+            self.transport.abort()  # type: ignore[attr-defined]
+        elif self.opening is not None:
+            self.opening.cancel()  # closes the socket
+        else:
+            self.sock.close()
 
 
-class _Handler(SimpleHTTPRequestHandler):
-    config: bytes = b"{}"
-    allowed_hosts: frozenset[str] = frozenset()
-    api: Api | None = None
-    access_key: str | None = None
-    mqtt_ws_port: int | None = None
+@dataclass
+class _Notices:
+    """A line in the terminal per device, at most once per ``NOTICE_INTERVAL_S``."""
 
-    def _api(self, method: str) -> bool:
-        path = self.path.split("?")[0]
-        if self.api is None or not path.startswith("/api/"):
-            return False
-        length = min(int(self.headers.get("Content-Length") or 0), MAX_API_BODY_BYTES + 1)
-        body = self.rfile.read(length) if length > 0 else b""
-        status, kind, payload = self.api(
-            method, path, self.headers.get("Host", ""), body, self.headers.get("Content-Type", "")
-        )
-        self.send_response(status)
-        self.send_header("Content-Type", kind)
-        self.send_header("Cache-Control", "no-store")
-        self.send_header("Content-Length", str(len(payload)))
-        self.end_headers()
-        self.wfile.write(payload)
-        return True
+    last_s: dict[str, float] = field(default_factory=dict)
 
-    def do_POST(self) -> None:
-        path, _, query = self.path.partition("?")
-        if self.access_key is not None and not self._key_checked(path, query):
+    def say(self, peer: str, line: str) -> None:
+        now = time.monotonic()
+        if now - self.last_s.get(peer, -NOTICE_INTERVAL_S) < NOTICE_INTERVAL_S:
             return
-        if not self._api("POST"):
-            self.send_error(404)
+        if len(self.last_s) > 1024:  # many devices: forget those not heard of for a while
+            self.last_s = {p: t for p, t in self.last_s.items() if now - t < NOTICE_INTERVAL_S}
+        self.last_s[peer] = now
+        sys.stdout.write(line + "\n")
+        sys.stdout.flush()
 
-    def do_GET(self) -> None:
-        path, _, query = self.path.partition("?")
-        if self.access_key is not None and not self._key_checked(path, query):
-            return
-        if self._api("GET"):
-            return
-        if path in ("/study", "/study/"):
-            self.path = "/study.html"  # the researcher's page of the recognition study
-        if path == "/mqtt" and self.mqtt_ws_port is not None and is_websocket_upgrade(self):
-            relay_websocket(self, self.mqtt_ws_port)
-            return
-        if path == "/config.json":
-            if not self._host_allowed():
-                return
-            self.send_response(200)
-            self.send_header("Content-Type", "application/json")
-            self.send_header("Cache-Control", "no-store")
-            self.send_header("Content-Length", str(len(self.config)))
-            self.end_headers()
-            self.wfile.write(self.config)
-            return
-        super().do_GET()
 
-    def _key_checked(self, path: str, query: str) -> bool:
-        """True to go on; else the answer (a cookie and a redirect, or 403) is sent."""
-        assert self.access_key is not None
-        offered = parse_qs(query).get("key", [None])[0]
-        if offered is not None and hmac.compare_digest(offered, self.access_key):
-            self.send_response(303)
-            self.send_header(
-                "Set-Cookie",
-                f"{KEY_COOKIE}={self.access_key}; Secure; HttpOnly; SameSite=Strict; Path=/",
-            )
-            self.send_header("Location", path or "/")
-            self.send_header("Content-Length", "0")
-            self.end_headers()
-            return False
-        if path not in ("/config.json", "/mqtt") and not path.startswith("/api/"):
-            return True  # the page itself is public; the broker, its password, the API are not
-        cookie = SimpleCookie(self.headers.get("Cookie", ""))
-        held = cookie[KEY_COOKIE].value if KEY_COOKIE in cookie else ""
-        if hmac.compare_digest(held, self.access_key):
-            return True
-        self.send_error(403, "Open the URL that 'feelmysign up' printed (it holds the key)")
-        return False
-
-    def _host_allowed(self) -> bool:
-        """Whether the request names this server; else answer 403 saying why."""
-        host = (self.headers.get("Host") or "").strip().lower()
-        if host in self.allowed_hosts:
-            return True
-        body = (
-            f"Forbidden: /config.json holds the broker login and is served only to pages "
-            f"opened from this server ({', '.join(sorted(self.allowed_hosts))}), not to "
-            f"Host {host[:80]!r}. Open the drawing client at one of those addresses.\n"
-        ).encode()
-        self.send_response(403)
-        self.send_header("Content-Type", "text/plain; charset=utf-8")
-        self.send_header("Cache-Control", "no-store")
-        self.send_header("Content-Length", str(len(body)))
-        self.end_headers()
-        self.wfile.write(body)
-        return False
-
-    def end_headers(self) -> None:
-        if not self.path.startswith("/assets/"):
-            self.send_header("Cache-Control", "no-cache")  # a rebuilt client is seen at once
-        super().end_headers()
-
-    def log_message(self, format: str, *args: Any) -> None:
-        pass  # quiet: the terminal belongs to the sleeve's log
+def _text(status: int, text: str, cache: str = "no-cache") -> web.Response:
+    return web.Response(
+        status=status,
+        text=text if text.endswith("\n") else text + "\n",
+        headers={"Cache-Control": cache},
+    )
 
 
 class WebServer:
@@ -167,6 +173,7 @@ class WebServer:
 
     ``hosts``: names besides the loopback ones under which pages may read
     ``/config.json`` (e.g. the machine's LAN address, when serving there).
+    ``debug_log``: where the details of what peers did wrong go (rotated; none: dropped).
     """
 
     def __init__(
@@ -181,65 +188,490 @@ class WebServer:
         access_key: str | None = None,
         mqtt_ws_port: int | None = None,
         hosts: Iterable[str] = (),
+        debug_log: Path | None = None,
     ) -> None:
-        self._hosts = (*LOOPBACK_HOSTS, host, *hosts)
         index = directory / "index.html"
         if not index.is_file():
             raise FeelMySignError(
                 f"the drawing client is not built ({index} is missing); run 'make web-build' "
                 "(or 'make up', which builds it)"
             )
-        attributes: dict[str, object] = {
-            "config": json.dumps(config).encode(),
-            "api": staticmethod(api) if api else None,
-            "access_key": access_key,
-            "mqtt_ws_port": mqtt_ws_port,
-            "allowed_hosts": frozenset(),
-        }
-        handler: type[_Handler] = type("ConfigHandler", (_Handler,), attributes)
-        self._handler = handler
-        try:
-            self._server = ThreadingHTTPServer(
-                (host, port), partial(handler, directory=str(directory))
-            )
-        except OSError as error:
-            raise FeelMySignError(
-                f"cannot serve the drawing client on {host}:{port}: {error.strerror}; "
-                "choose another port with --http-port"
-            ) from error
-        self._tls = tls is not None
-        if tls is not None:
-            context = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
-            context.minimum_version = ssl.TLSVersion.TLSv1_2
-            context.load_cert_chain(tls.cert, tls.key)
-            # The handshake happens in the request's thread, not in accept(): a slow or
-            # silent client cannot hold up everyone else.
-            self._server.socket = context.wrap_socket(
-                self._server.socket, server_side=True, do_handshake_on_connect=False
-            )
+        self._root = directory.resolve()
+        self._config = json.dumps(config).encode()
+        self._api = api
+        self._access_key = access_key
+        self._mqtt_ws_port = mqtt_ws_port
+        self._sock = _listen(host, port)
+        self._tls = _tls_context(tls) if tls is not None else None
+        self._ca_fingerprint = tls.ca_fingerprint if tls is not None else None
         # Known once bound (port 0 picks one): only now can the Host values be listed.
-        handler.allowed_hosts = host_header_names(self._hosts, self._server.server_address[1])
-        self._thread = threading.Thread(target=self._server.serve_forever, daemon=True)
+        self._allowed_hosts = host_header_names((*LOOPBACK_HOSTS, host, *hosts), self.port)
+        self._log = logging.getLogger(f"feelmysign.webserver.{id(self)}")
+        self._log.propagate = False
+        self._log.setLevel(logging.DEBUG)
+        self._log_handler: logging.Handler = logging.NullHandler()
+        if debug_log is not None:
+            debug_log.parent.mkdir(parents=True, exist_ok=True)
+            self._log_handler = logging.handlers.RotatingFileHandler(
+                debug_log, maxBytes=DEBUG_LOG_BYTES, backupCount=1, encoding="utf-8", delay=True
+            )
+            self._log_handler.setFormatter(
+                logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s")
+            )
+        self._log.addHandler(self._log_handler)
+        self._notices = _Notices()
+        # Least recently active first (moved to the end after each answer): the one to close
+        # at the cap is found at the front, in constant time however many are held.
+        self._connections: OrderedDict[tuple[str, int], _Connection] = OrderedDict()
+        # The study API blocks (SQLite, the broker): one thread answers it, away from the loop.
+        self._api_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="page-api")
+        self._loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(
+            target=self._loop.run_forever, name="page-server", daemon=True
+        )
+        self._stopped: asyncio.Future[None] | None = None
+
+    # -- the public side ----------------------------------------------------------------
 
     def set_config(self, config: dict[str, Any]) -> None:
         """Serve ``config`` as /config.json from now on (e.g. once the port is known)."""
-        self._handler.config = json.dumps(config).encode()
+        self._config = json.dumps(config).encode()
+
+    @property
+    def port(self) -> int:
+        return int(self._sock.getsockname()[1])
 
     @property
     def authority(self) -> str:
         """``host:port`` as a URL holds it."""
-        address, port = self._server.server_address[:2]
-        host = address.decode() if isinstance(address, bytes) else address
-        return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
+        host = self._sock.getsockname()[0]
+        return f"[{host}]:{self.port}" if ":" in host else f"{host}:{self.port}"
 
     @property
     def url(self) -> str:
         return f"{'https' if self._tls else 'http'}://{self.authority}/"
 
     def __enter__(self) -> WebServer:
+        _AIOHTTP_LOG.addHandler(self._log_handler)
+        _AIOHTTP_LOG.setLevel(logging.DEBUG)
         self._thread.start()
+        asyncio.run_coroutine_threadsafe(self._start(), self._loop).result(timeout=30)
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self._server.shutdown()
-        self._server.server_close()
+        try:
+            asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(timeout=30)
+        finally:
+            self._loop.call_soon_threadsafe(self._loop.stop)
+            self._thread.join(timeout=30)
+            if not self._thread.is_alive():
+                self._loop.close()
+            self._sock.close()
+            self._api_pool.shutdown(wait=False, cancel_futures=True)
+            _AIOHTTP_LOG.removeHandler(self._log_handler)
+            self._log.removeHandler(self._log_handler)
+            self._log_handler.close()
+
+    # -- the loop's side ------------------------------------------------------------------
+
+    async def _start(self) -> None:
+        loop = asyncio.get_running_loop()
+        loop.set_exception_handler(self._loop_exception)
+        # aiohttp opens and reads files in the loop's executor: a few threads, whatever the cores.
+        loop.set_default_executor(
+            ThreadPoolExecutor(max_workers=4, thread_name_prefix="page-files")
+        )
+        options: dict[str, Any] = {
+            "logger": self._log,
+            "access_log": None,
+            "keepalive_timeout": HEADER_TIMEOUT_S,
+            "max_line_size": MAX_LINE_BYTES,
+            "max_field_size": MAX_FIELD_BYTES,
+            "max_headers": MAX_HEADERS,
+        }
+        self._pages = web.Server(self._handle, **options)
+        self._redirects = web.Server(self._redirect, **options)
+        self._client = aiohttp.ClientSession(
+            timeout=aiohttp.ClientTimeout(total=None, connect=RELAY_CONNECT_TIMEOUT_S)
+        )
+        self._sock.setblocking(False)
+        self._tasks = [
+            loop.create_task(self._accept()),
+            loop.create_task(self._sweep()),
+        ]
+
+    async def _stop(self) -> None:
+        for task in self._tasks:
+            task.cancel()
+        for connection in list(self._connections.values()):
+            connection.close()
+        await asyncio.gather(*self._tasks, return_exceptions=True)
+        await self._pages.shutdown(timeout=1.0)
+        await self._redirects.shutdown(timeout=1.0)
+        await self._client.close()
+
+    def _loop_exception(self, loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
+        self._log.debug("%s", context.get("message"), exc_info=context.get("exception"))
+
+    async def _accept(self) -> None:
+        loop = asyncio.get_running_loop()
+        while True:
+            try:
+                sock, address = await loop.sock_accept(self._sock)
+            except OSError as error:  # e.g. out of file descriptors: wait, then go on
+                self._log.debug("accept: %s", error)
+                await asyncio.sleep(0.1)
+                continue
+            self._make_room()
+            peer = (str(address[0]), int(address[1]))
+            connection = _Connection(sock, peer[0], peer[1], time.monotonic())
+            self._connections[peer] = connection
+            self._connections.move_to_end(peer)  # the address of one closed a moment ago
+            connection.opening = loop.create_task(self._open(connection, peer))
+
+    def _make_room(self) -> None:
+        """Below the cap, by closing the connection idle longest (never refusing a new one)."""
+        if len(self._connections) < MAX_CONNECTIONS:
+            return
+        for peer, connection in self._connections.items():
+            if connection.closed or connection.active == 0:
+                del self._connections[peer]
+                if not connection.closed:
+                    self._log.debug("connection cap: closed an idle one from %s", peer[0])
+                    connection.close()
+                return
+
+    async def _sweep(self) -> None:
+        """Close connections that sent no whole request within ``HEADER_TIMEOUT_S``."""
+        while True:
+            await asyncio.sleep(1.0)
+            now = time.monotonic()
+            for peer, connection in list(self._connections.items()):
+                if connection.closed:
+                    del self._connections[peer]
+                elif connection.active == 0 and now - connection.idle_since_s > HEADER_TIMEOUT_S:
+                    self._log.debug("%s sent no whole request in time: closed", connection.peer)
+                    connection.close()
+
+    async def _open(self, connection: _Connection, peer: tuple[str, int]) -> None:
+        """Hand the connection to aiohttp: the pages, or (plain HTTP on the TLS port) the
+        redirect to https://."""
+        loop = asyncio.get_running_loop()
+        sock = connection.sock
+        try:
+            server, context = self._pages, None
+            if self._tls is not None:
+                first = await asyncio.wait_for(_first_byte(sock), HEADER_TIMEOUT_S)
+                if first is None:
+                    sock.close()
+                    return
+                if first == _TLS_HANDSHAKE_RECORD:
+                    context = self._tls
+                else:
+                    server = self._redirects
+            transport, _ = await loop.connect_accepted_socket(
+                server,
+                sock,
+                ssl=context,
+                ssl_handshake_timeout=TLS_HANDSHAKE_TIMEOUT_S if context else None,
+            )
+            connection.transport = transport
+        except ssl.SSLError as error:
+            self._tls_failed(connection, error)
+            sock.close()
+        except (OSError, asyncio.TimeoutError, asyncio.CancelledError) as error:
+            self._log.debug("%s: connection ended before a request: %r", connection.peer, error)
+            sock.close()
+        finally:
+            connection.opening = None
+
+    def _tls_failed(self, connection: _Connection, error: ssl.SSLError) -> None:
+        self._log.debug("%s: TLS handshake failed: %r", connection.peer, error)
+        if getattr(error, "reason", None) in _CERTIFICATE_REFUSED:
+            fingerprint = (
+                f" (CA SHA-256 {self._ca_fingerprint[:16]}...)" if self._ca_fingerprint else ""
+            )
+            self._notices.say(
+                connection.peer,
+                f"A device at {connection.peer} did not accept this machine's certificate: "
+                f"on it, open the printed URL and accept the certificate{fingerprint}.",
+            )
+
+    def _connection_of(self, request: web.BaseRequest) -> _Connection | None:
+        transport = request.transport
+        peer = transport.get_extra_info("peername") if transport is not None else None
+        if not peer:
+            return None
+        return self._connections.get((str(peer[0]), int(peer[1])))
+
+    # -- the answers ----------------------------------------------------------------------
+
+    async def _redirect(self, request: web.BaseRequest) -> web.StreamResponse:
+        """Plain HTTP on the TLS port: to the same path over HTTPS, at this server's name."""
+        return web.Response(
+            status=301,
+            headers={
+                "Location": f"https://{self.authority}{request.raw_path}",
+                "Cache-Control": "no-store",
+                "Connection": "close",
+            },
+        )
+
+    async def _handle(self, request: web.BaseRequest) -> web.StreamResponse:
+        connection = self._connection_of(request)
+        if connection is not None:
+            connection.active += 1
+        try:
+            if self._is_relay(request):
+                return await self._relay(request)
+            try:
+                return await asyncio.wait_for(self._answer_sent(request), REQUEST_TIMEOUT_S)
+            except asyncio.TimeoutError:
+                self._log.debug("%s: request not done in time: closed", request.remote)
+                if request.transport is not None:
+                    request.transport.abort()
+                return web.Response(status=408)
+        finally:
+            if connection is not None:
+                connection.active -= 1
+                connection.idle_since_s = time.monotonic()
+                peer = (connection.peer, connection.port)
+                if self._connections.get(peer) is connection:
+                    self._connections.move_to_end(peer)
+
+    async def _answer_sent(self, request: web.BaseRequest) -> web.StreamResponse:
+        """The answer, sent here within the time limit (aiohttp would send it after)."""
+        response = await self._answer(request)
+        if not response.prepared:
+            await response.prepare(request)
+            await response.write_eof()
+        return response
+
+    def _is_relay(self, request: web.BaseRequest) -> bool:
+        return (
+            request.path == "/mqtt"
+            and self._mqtt_ws_port is not None
+            and request.method == "GET"
+            and request.headers.get("Upgrade", "").lower() == "websocket"
+            and self._key_checked(request) is None
+        )
+
+    async def _answer(self, request: web.BaseRequest) -> web.StreamResponse:
+        path = request.path
+        if self._access_key is not None:
+            refused = self._key_checked(request)
+            if refused is not None:
+                return refused
+        if self._api is not None and path.startswith("/api/"):
+            return await self._call_api(request)
+        if request.method == "POST":
+            return _text(404, "Not Found")
+        if request.method not in ("GET", "HEAD"):
+            return _text(501, f"Unsupported method {request.method!r}")
+        if path == "/config.json":
+            return self._config_json(request)
+        return self._static(path)
+
+    def _key_checked(self, request: web.BaseRequest) -> web.StreamResponse | None:
+        """None to go on; else the answer: a cookie and a redirect, or 403."""
+        if self._access_key is None:
+            return None
+        path = request.path
+        offered = parse_qs(request.query_string).get("key", [None])[0]
+        if offered is not None and hmac.compare_digest(offered.encode(), self._access_key.encode()):
+            return web.Response(
+                status=303,
+                headers={
+                    "Set-Cookie": f"{KEY_COOKIE}={self._access_key}; Secure; HttpOnly; "
+                    "SameSite=Strict; Path=/",
+                    "Location": path or "/",
+                    "Cache-Control": "no-store",
+                },
+            )
+        if path not in ("/config.json", "/mqtt") and not path.startswith("/api/"):
+            return None  # the page itself is public; the broker, its password, the API are not
+        try:
+            cookie = SimpleCookie(request.headers.get("Cookie", ""))
+        except CookieError:
+            cookie = SimpleCookie()
+        held = cookie[KEY_COOKIE].value if KEY_COOKIE in cookie else ""
+        if hmac.compare_digest(held.encode(), self._access_key.encode()):
+            return None
+        return _text(403, "Forbidden: open the URL that 'feelmysign up' printed (it holds the key)")
+
+    def _config_json(self, request: web.BaseRequest) -> web.StreamResponse:
+        host = (request.headers.get("Host") or "").strip().lower()
+        if host not in self._allowed_hosts:
+            return _text(
+                403,
+                f"Forbidden: /config.json holds the broker login and is served only to pages "
+                f"opened from this server ({', '.join(sorted(self._allowed_hosts))}), not to "
+                f"Host {host[:80]!r}. Open the drawing client at one of those addresses.",
+                cache="no-store",
+            )
+        return web.Response(
+            body=self._config,
+            content_type="application/json",
+            headers={"Cache-Control": "no-store"},
+        )
+
+    async def _call_api(self, request: web.BaseRequest) -> web.StreamResponse:
+        api = self._api
+        assert api is not None
+        # At most one byte past the limit: enough for the API to refuse it as too large.
+        body = await _read_at_most(request, MAX_API_BODY_BYTES + 1)
+        status, kind, payload = await asyncio.get_running_loop().run_in_executor(
+            self._api_pool,
+            api,
+            request.method,
+            request.path,
+            request.headers.get("Host", ""),
+            body,
+            request.headers.get("Content-Type", ""),
+        )
+        return web.Response(
+            status=status, body=payload, headers={"Content-Type": kind, "Cache-Control": "no-store"}
+        )
+
+    def _static(self, path: str) -> web.StreamResponse:
+        if path in ("/study", "/study/"):
+            path = "/study.html"  # the researcher's page of the recognition study
+        try:
+            target = (self._root / path.lstrip("/")).resolve()
+            if target.is_dir():
+                target = target / "index.html"
+            found = target.is_relative_to(self._root) and target.is_file()
+        except (OSError, ValueError):  # a name the file system cannot hold (e.g. a NUL)
+            found = False
+        if not found:
+            return _text(404, "Not Found")
+        # A rebuilt client is seen at once; assets/ names carry their content's hash.
+        assets = path.startswith("/assets/")
+        return _FileResponse(target, headers={} if assets else {"Cache-Control": "no-cache"})
+
+    async def _relay(self, request: web.BaseRequest) -> web.StreamResponse:
+        """MQTT over WebSockets from the page's own origin: ``/mqtt`` relayed, message by
+        message, to the broker's WebSocket listener on 127.0.0.1.
+
+        Off loopback the page is served over HTTPS with the local CA's certificate. A phone
+        that accepts that certificate once for the page would have to accept it again for a
+        broker on another port; relaying keeps a single origin, so one acceptance covers
+        both, and the broker's WebSocket listener never leaves loopback.
+        """
+        offered = [p.strip() for p in request.headers.get("Sec-WebSocket-Protocol", "").split(",")]
+        try:
+            upstream = await self._client.ws_connect(
+                f"http://127.0.0.1:{self._mqtt_ws_port}/mqtt",
+                protocols=[p for p in offered if p],
+                autoping=True,
+                max_msg_size=RELAY_MAX_MESSAGE_BYTES,
+            )
+        except (aiohttp.ClientError, OSError, asyncio.TimeoutError) as error:
+            self._log.debug("relay: the broker's WebSocket listener: %r", error)
+            return _text(502, "The broker's WebSocket listener does not answer")
+        page = web.WebSocketResponse(
+            protocols=[upstream.protocol] if upstream.protocol else [],
+            max_msg_size=RELAY_MAX_MESSAGE_BYTES,
+            compress=False,
+        )
+        try:
+            await page.prepare(request)
+            await asyncio.gather(_pump(page, upstream), _pump(upstream, page))
+        except (OSError, aiohttp.ClientError, asyncio.TimeoutError) as error:
+            self._log.debug("relay from %s ended: %r", request.remote, error)
+        finally:
+            await upstream.close()
+            await page.close()
+        return page
+
+
+Socket = web.WebSocketResponse | aiohttp.ClientWebSocketResponse
+
+
+async def _pump(source: Socket, target: Socket) -> None:
+    """Each message from ``source`` on to ``target``; when ``source`` ends, ``target`` is closed."""
+    try:
+        async for message in source:
+            if message.type == aiohttp.WSMsgType.BINARY:
+                await target.send_bytes(message.data)
+            elif message.type == aiohttp.WSMsgType.TEXT:
+                await target.send_str(message.data)
+            else:
+                break
+    finally:
+        await target.close()
+
+
+async def _read_at_most(request: web.BaseRequest, limit: int) -> bytes:
+    chunks: list[bytes] = []
+    size = 0
+    while size < limit:
+        chunk = await asyncio.wait_for(request.content.read(limit - size), HEADER_TIMEOUT_S)
+        if not chunk:
+            break
+        chunks.append(chunk)
+        size += len(chunk)
+    return b"".join(chunks)
+
+
+async def _first_byte(sock: socket.socket) -> int | None:
+    """The first byte the peer sent, left in the socket (None: it closed first)."""
+    loop = asyncio.get_running_loop()
+    ready: asyncio.Future[None] = loop.create_future()
+
+    def readable() -> None:
+        if not ready.done():
+            ready.set_result(None)
+
+    loop.add_reader(sock.fileno(), readable)
+    try:
+        await ready
+    finally:
+        loop.remove_reader(sock.fileno())
+    try:
+        first = sock.recv(1, socket.MSG_PEEK)
+    except (BlockingIOError, InterruptedError):
+        return await _first_byte(sock)
+    return first[0] if first else None
+
+
+def _listen(host: str, port: int) -> socket.socket:
+    try:
+        family, kind, proto, _, address = socket.getaddrinfo(
+            host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+        )[0]
+        sock = socket.socket(family, kind, proto)
+    except OSError as error:
+        raise FeelMySignError(
+            f"cannot serve the drawing client on {host}:{port}: {error.strerror or error}; "
+            "give an address of this machine"
+        ) from error
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind(address)
+        sock.listen(1024)
+    except OSError as error:
+        sock.close()
+        raise FeelMySignError(
+            f"cannot serve the drawing client on {host}:{port}: {error.strerror}; "
+            "choose another port with --http-port"
+        ) from error
+    return sock
+
+
+def _tls_context(tls: TlsFiles) -> ssl.SSLContext:
+    context = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
+    context.minimum_version = ssl.TLSVersion.TLSv1_2
+    context.load_cert_chain(tls.cert, tls.key)
+    return context
+
+
+class _FileResponse(web.FileResponse):
+    """A file, sent within the time limit by ``_answer_sent``: aiohttp's own prepare after the
+    handler returns is then a no-op, as for any response already sent (FileResponse's would
+    send the file again, and fail on the finished writer, closing the connection)."""
+
+    async def prepare(self, request: web.BaseRequest) -> AbstractStreamWriter | None:
+        if self.prepared:
+            return await web.StreamResponse.prepare(self, request)
+        return await super().prepare(request)

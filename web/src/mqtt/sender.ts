@@ -59,6 +59,13 @@ const KEEPALIVE_S = 20;
 export const BAD_LOGIN_CODES: ReadonlySet<number> = new Set([4, 5, 134, 135]);
 /** Every sleeve's status, retained: who is online, for the picker. */
 const EVERY_STATUS = telemetryTopic(ANY_SLEEVE, "status");
+/**
+ * The chosen sleeve's events at QoS 1 on a persistent session: the broker keeps them while
+ * the page reconnects (a broker restarted from its saved state too), so the page counts every
+ * stroke the sleeve played. Statuses are retained (heard again on subscribing) and actuator
+ * frames only matter live, so those stay QoS 0 and nothing is queued for them.
+ */
+const EVENTS_QOS = 1;
 
 /** A stroke and the sleeve it was drawn for. */
 interface Addressed {
@@ -69,6 +76,23 @@ interface Addressed {
 /** The chosen sleeve's own telemetry: swapped when another sleeve is chosen. */
 const ownTopics = (sleeveId: string): string[] =>
   (["actuators", "events"] as const).map((name) => telemetryTopic(sleeveId, name));
+
+/** Subscriptions with their QoS: the chosen sleeve's events at EVENTS_QOS, the rest at 0. */
+function subscriptions(topics: readonly string[]): Record<string, { qos: 0 | 1 }> {
+  return Object.fromEntries(
+    topics.map((topic) => [topic, { qos: topic.endsWith("/events") ? EVENTS_QOS : 0 }]),
+  );
+}
+
+/**
+ * A client id of its own for each sender (one per page load): the same on every reconnect,
+ * so the broker resumes the session and hands over the events it kept; never shared with
+ * another tab, whose connection would otherwise take this one's session over.
+ */
+function newClientId(): string {
+  const bytes = crypto.getRandomValues(new Uint8Array(8));
+  return `feelmysign-web-${Array.from(bytes, (b) => b.toString(16).padStart(2, "0")).join("")}`;
+}
 
 /** `feelmysign/<id>/<name>` -> [id, name]; null for any other topic. */
 function sleeveTopicParts(topic: string): [string, string] | null {
@@ -88,6 +112,13 @@ export class StrokeSender {
   readonly #statuses = new Map<string, string>();
   /** Strokes not sent within this many ms are dropped; null: they go out whenever possible. */
   #lateLimitMs: number | null = null;
+  /** This page load's MQTT client id: its session on the broker (see newClientId). */
+  readonly #clientId = newClientId();
+  /**
+   * The sleeve whose own topics the broker's session holds subscriptions for: a session
+   * resumed after another sleeve was chosen offline still has the old one's, dropped then.
+   */
+  #sessionSleeve: string | null = null;
 
   constructor(listener: SenderListener) {
     this.#listener = listener;
@@ -123,8 +154,11 @@ export class StrokeSender {
     const options: IClientOptions = {
       username: target.username,
       password: target.password,
-      clientId: `feelmysign-web-${Math.random().toString(16).slice(2, 10)}`,
-      clean: true,
+      clientId: this.#clientId,
+      // A persistent session (docs/protocol.md): the broker keeps the events subscription,
+      // and the events published while the page is away, until the page is back or its
+      // persistent_client_expiration passes.
+      clean: false,
       keepalive: KEEPALIVE_S,
       reconnectPeriod: RECONNECT_PERIOD_MS,
       connectTimeout: CONNECT_TIMEOUT_MS,
@@ -144,7 +178,7 @@ export class StrokeSender {
       return;
     }
     this.#client = client;
-    client.on("connect", () => {
+    client.on("connect", (connack) => {
       if (client !== this.#client) return;
       this.#listener.broker(
         "connected",
@@ -153,8 +187,15 @@ export class StrokeSender {
       // Retained statuses come again with the subscription; one cleared meanwhile would not.
       this.#statuses.clear();
       // The target now, not at connect(): another sleeve may have been chosen since.
-      const topics = [EVERY_STATUS, ...ownTopics(this.#target?.sleeve_id ?? target.sleeve_id)];
-      client.subscribe(topics, { qos: 0 }, (error) => {
+      const sleeveId = this.#target?.sleeve_id ?? target.sleeve_id;
+      const previous = this.#sessionSleeve;
+      if (connack.sessionPresent && previous !== null && previous !== sleeveId) {
+        client.unsubscribe(ownTopics(previous));
+      }
+      this.#sessionSleeve = sleeveId;
+      // Subscribed again even when the session was kept: the broker then sends the retained
+      // statuses again, and a broker that lost its saved state has no subscription left.
+      client.subscribe(subscriptions([EVERY_STATUS, ...ownTopics(sleeveId)]), (error) => {
         if (error)
           this.#listener.broker(
             "connected",
@@ -213,7 +254,8 @@ export class StrokeSender {
     // Offline, nothing is said: the connect handler subscribes for the sleeve chosen by then.
     if (!client.connected) return;
     client.unsubscribe(ownTopics(previous));
-    client.subscribe(ownTopics(target.sleeve_id), { qos: 0 });
+    client.subscribe(subscriptions(ownTopics(target.sleeve_id)));
+    this.#sessionSleeve = target.sleeve_id;
     const status = this.#statuses.get(target.sleeve_id);
     if (status !== undefined) this.#listener.status(status);
   }
@@ -228,11 +270,11 @@ export class StrokeSender {
   /**
    * Cancels a drawing (or everything: "*") on the sleeve: its strokes still in
    * the outbox are dropped here, and a control message tells the sleeve to stop
-   * playing and drop the rest. Returns how many unsent strokes were dropped.
+   * playing and drop the rest. Returns the unsent strokes dropped (never sent).
    */
-  cancel(drawing: string): number {
+  cancel(drawing: string): Stroke[] {
     const sleeveId = this.#target?.sleeve_id;
-    if (sleeveId === undefined) return 0;
+    if (sleeveId === undefined) return [];
     const dropped = this.#outbox.dropQueued(
       ({ stroke, sleeveId: to }) => to === sleeveId && (drawing === CANCEL_ALL || stroke.drawing === drawing),
     );
@@ -240,7 +282,7 @@ export class StrokeSender {
       c.drawing === drawing && c.sleeveId === sleeveId;
     this.#cancels = [...this.#cancels.filter((c) => !same(c)), { drawing, sleeveId }];
     this.#flush();
-    return dropped.length;
+    return dropped.map(({ stroke }) => stroke);
   }
 
   /** The timing policy for strokes drawn while the broker is out of reach. */

@@ -25,7 +25,12 @@ export interface Overview {
 
 export interface SendSummary {
   strokes: number;
+  /** Played whole (python/src/feelmysign/fates.py: each stroke under one fate). */
   played: number;
+  /** Cut short by a stop while playing; absent from a record made before it was counted. */
+  cut_short?: number;
+  /** Dropped by a stop before it started; absent from a record made before it was counted. */
+  cancelled?: number;
   adjusted: number;
   rejected: string[];
   latency_ms_max: number | null;

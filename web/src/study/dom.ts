@@ -26,3 +26,8 @@ export function byId<T extends HTMLElement>(id: string): T {
   if (!element) throw new Error(`the study page has no #${id}`);
   return element as T;
 }
+
+/** "1 stroke", "2 strokes": a count with its noun. */
+export function plural(count: number, noun: string): string {
+  return `${count} ${noun}${count === 1 ? "" : "s"}`;
+}

@@ -1,6 +1,6 @@
 /** Export and analyse on the server; show the report and its figures. */
 import { api, type AnalysisResult } from "./api";
-import { h } from "./dom";
+import { h, plural } from "./dom";
 
 export class ResultsView {
   readonly #root: HTMLElement;
@@ -37,7 +37,7 @@ export class ResultsView {
   }
 
   #show(result: AnalysisResult, status: HTMLElement): void {
-    status.textContent = `${result.participants} participants analysed; ${result.unclear} answer(s) await review. Files in ${result.folder}.`;
+    status.textContent = `${plural(result.participants, "participant")} analysed; ${result.unclear} answer(s) await review. Files in ${result.folder}.`;
     const stamp = Date.now();
     const figures = result.files
       .filter((name) => name.endsWith(".png"))

@@ -4,7 +4,7 @@
  * comes from the server every time, so a reload or a restarted server resumes exactly.
  */
 import { api, type Overview, type SendSummary, type State, type Trial } from "./api";
-import { h } from "./dom";
+import { h, plural } from "./dom";
 
 export interface SessionHooks {
   overview: () => Overview;
@@ -15,7 +15,9 @@ export interface SessionHooks {
 const CONFIDENCE_POINTS = 5;
 
 export function sentText(sent: SendSummary): string {
-  const parts = [`played ${sent.played} of ${sent.strokes} strokes`];
+  const parts = [`played ${sent.played} of ${plural(sent.strokes, "stroke")}`];
+  if ((sent.cut_short ?? 0) > 0) parts.push(`${sent.cut_short} cut short`);
+  if ((sent.cancelled ?? 0) > 0) parts.push(`${sent.cancelled} cancelled`);
   if (sent.adjusted > 0) parts.push(`${sent.adjusted} slowed to be felt`);
   if (sent.rejected.length > 0) parts.push(`rejected: ${sent.rejected.join(", ")}`);
   if (sent.latency_ms_max !== null) parts.push(`latency at most ${sent.latency_ms_max.toFixed(1)} ms`);
@@ -263,8 +265,8 @@ export class SessionView {
           "span",
           {},
           trial.resolution
-            ? ` · ${trial.resolution}, ${trial.segments} strokes`
-            : ` · ${trial.segments} strokes`,
+            ? ` · ${trial.resolution}, ${plural(trial.segments, "stroke")}`
+            : ` · ${plural(trial.segments, "stroke")}`,
         ),
       ),
       h(
@@ -360,7 +362,13 @@ export class SessionView {
       "div",
       { class: "card" },
       h("h3", {}, "4 · Questionnaire"),
-      h("p", { class: "hint" }, "How comfortable was the sleeve?"),
+      // The design's own items say what is asked; the hint only says how to ask them.
+      h(
+        "p",
+        { class: "hint" },
+        `Read each of the ${items.length} statement(s) to the participant and choose their answer` +
+          ` (1 to ${points}).`,
+      ),
       ...groups,
       submit,
     );

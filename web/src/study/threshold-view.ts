@@ -14,7 +14,7 @@ import {
   type ThresholdRun,
   type ThresholdState,
 } from "./api";
-import { h } from "./dom";
+import { h, plural } from "./dom";
 
 const DIRECTIONS: Direction[] = ["up", "down", "left", "right"];
 const ARROWS: Record<string, Direction> = {
@@ -240,7 +240,7 @@ export class ThresholdView {
           h(
             "li",
             { "data-run": r.run },
-            `${number(r.threshold)} ${dimension.unit}, 95% interval ${number(r.low)} to ${number(r.high)}, after ${r.trials} trials${r.stop_reason === `${r.trials} trials` ? "" : ` (stopped: ${r.stop_reason})`}`,
+            `${number(r.threshold)} ${dimension.unit}, 95% interval ${number(r.low)} to ${number(r.high)}, after ${plural(r.trials, "trial")}${r.stop_reason === `${r.trials} trials` ? "" : ` (stopped: ${r.stop_reason})`}`,
           ),
         ),
       ),

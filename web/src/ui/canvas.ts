@@ -6,7 +6,8 @@
  *   grid  the sleeve's actuators, faint; redrawn only when the size or grid changes
  *   ink   finished content: the raw path (faint), strokes waiting for the broker
  *         (dim) and sent ones (solid, drawn over the dim line on PUBACK), dropped
- *         ones (dashed red), strokes the sleeve refused; only the new bits are
+ *         ones (dashed red), strokes the sleeve refused (dotted red, a cross) or that
+ *         Stop cancelled or kept from leaving (dotted grey); only the new bits are
  *         drawn each frame, and everything only on a resize or a new drawing
  *   compare  the same paths under the A/B comparison's settings (dashed), when shown
  *   marker   where the brush is on the sleeve now, while a drawing is felt
@@ -43,6 +44,8 @@ const COLORS = {
   marker: "#ffd166",
   dropped: "#ff6b6b",
   rejected: "#ff6b6b",
+  /** Cancelled by Stop, or never sent: not felt, but nothing went wrong. */
+  cancelled: "rgba(143, 160, 178, 0.7)",
   topEdge: "rgba(255, 138, 91, 0.75)",
   /** The stage's own colour (--surface): a refused stroke is first wiped out with it. */
   erase: "#151d26",
@@ -473,6 +476,7 @@ export class DrawingView {
     const ends = this.#segmentEnds(drawn);
     if (ends === null) return;
     const [[x0, y0], [x1, y1]] = ends;
+    const refused = this.#drawing?.unfelt(drawn) === "refused";
     ctx.save();
     ctx.strokeStyle = COLORS.erase;
     ctx.lineWidth = SENT_WIDTH_PX + 2;
@@ -480,6 +484,18 @@ export class DrawingView {
     ctx.moveTo(x0, y0);
     ctx.lineTo(x1, y1);
     ctx.stroke();
+    if (!refused) {
+      // Cancelled by Stop or never sent: dotted grey, no cross (the sleeve refused nothing).
+      ctx.strokeStyle = COLORS.cancelled;
+      ctx.lineWidth = SENT_WIDTH_PX - 1;
+      ctx.setLineDash([2, 6]);
+      ctx.beginPath();
+      ctx.moveTo(x0, y0);
+      ctx.lineTo(x1, y1);
+      ctx.stroke();
+      ctx.restore();
+      return;
+    }
     ctx.strokeStyle = COLORS.rejected;
     ctx.lineWidth = SENT_WIDTH_PX;
     ctx.setLineDash([2, 7]);

@@ -4,7 +4,7 @@
  * ink to the canvas. The animation loop runs only while a pointer is down, and
  * each frame costs the same however much has been drawn.
  */
-import { Drawing, type PointerKind } from "../drawing";
+import { Drawing, type PointerKind, type Unfelt } from "../drawing";
 import { newDrawingId } from "../drawing-id";
 import { FrameSampler } from "../frame-sampler";
 import type { Stroke } from "../protocol";
@@ -176,9 +176,9 @@ export class DrawingSession {
     this.#scheduleFlush();
   }
 
-  /** The sleeve refused stroke `seq` of this drawing: marked on the canvas. */
-  refused(seq: number): void {
-    const drawn = this.#drawing?.markRefused(seq);
+  /** Stroke `seq` of this drawing was not felt (`why`, fates.ts): marked on the canvas. */
+  refused(seq: number, why: Unfelt = "refused"): void {
+    const drawn = this.#drawing?.markRefused(seq, why);
     if (drawn === undefined) return;
     this.#view.markRejected(drawn);
     this.#scheduleFlush();

@@ -37,6 +37,12 @@ export class FeltPanel {
   /** The cursor runs from `t_ms` at `at` (performance.now()). */
   #anchor: { t_ms: number; at: number } | null = null;
   #running = false;
+  /** Strokes the sleeve dropped at Stop before they started. */
+  readonly #cancelledSeqs = new Set<number>();
+  /** Strokes Stop cut short while they played (reported played too). */
+  readonly #cutSeqs = new Set<number>();
+  /** Stop was pressed: what the sleeve has not played yet never will be. */
+  #stopped = false;
 
   constructor(timeline: TimelineView, view: DrawingView) {
     this.#timeline = timeline;
@@ -49,6 +55,9 @@ export class FeltPanel {
     this.#grid = grid;
     this.#arrival = arrival;
     this.#startedAt.clear();
+    this.#cancelledSeqs.clear();
+    this.#cutSeqs.clear();
+    this.#stopped = false;
     this.#placement = new FeltPlacement();
     this.#segmentsSeen = 0;
     this.#lastSeen = null;
@@ -69,8 +78,17 @@ export class FeltPanel {
       count === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
         : `${count} stroke${count === 1 ? "" : "s"}, ${seconds} s` +
-            timelineCaption(count, placement.reportedCount, placement.cappedCount),
+            timelineCaption(count, placement.reportedCount, placement.cappedCount, {
+              cancelled: this.#cancelledSeqs.size,
+              cut: this.#cutSeqs.size,
+              stopped: this.#stopped,
+            }),
     );
+  }
+
+  /** When the felt drawing ends, ms from its first stroke (as the timeline shows it). */
+  get totalMs(): number {
+    return this.#placement.totalMs;
   }
 
   /** The sleeve played a stroke of this drawing: its real start, and the cursor from there. */
@@ -91,6 +109,7 @@ export class FeltPanel {
   cancelled(event: CancelledEvent): void {
     if (event.seq === null) return;
     const started = this.#startedAt.get(event.seq);
+    (event.started ? this.#cutSeqs : this.#cancelledSeqs).add(event.seq);
     this.#sync();
     this.#placement.cut(
       event.seq,
@@ -110,6 +129,8 @@ export class FeltPanel {
   /** Stop pressed: the cursor stops where it is. */
   stopCursor(): void {
     this.#anchor = null;
+    this.#stopped = true;
+    this.refresh();
   }
 
   /** Compares with the same paths under `params` (null: no comparison). */
@@ -200,18 +221,38 @@ export class FeltPanel {
   }
 }
 
-/** What the timeline's times are: the sleeve's, the page's estimate, or both; and what was not felt. */
-export function timelineCaption(count: number, reported: number, capped: number): string {
-  if (reported === 0 && capped === 0) return ": what would be felt, played back to back as the sleeve does.";
-  const estimated = count - reported - capped;
+/**
+ * What the timeline's times are: the sleeve's, the page's estimate, or both; and what was not felt.
+ * `cancelled`: strokes Stop dropped on the sleeve before they started; `stopped`: Stop was pressed,
+ * so the strokes the sleeve has not reported will not be felt (never "the rest as it would").
+ */
+export function timelineCaption(
+  count: number,
+  reported: number,
+  capped: number,
+  stop: { readonly cancelled: number; readonly cut?: number; readonly stopped: boolean } = {
+    cancelled: 0,
+    stopped: false,
+  },
+): string {
+  const { cancelled, stopped } = stop;
+  const cut = stop.cut ?? 0;
+  if (reported === 0 && capped === 0 && cancelled === 0 && !stopped)
+    return ": what would be felt, played back to back as the sleeve does.";
+  const estimated = count - reported - capped - cancelled;
   const said: string[] = [];
   if (reported > 0)
-    said.push(reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`);
+    said.push(
+      (reported === count ? "as the sleeve played them" : `${reported} as the sleeve played them`) +
+        (cut > 0 ? ` (${cut} cut short by Stop)` : ""),
+    );
   if (capped > 0) {
     said.push(
       `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,
     );
   }
-  if (estimated > 0) said.push("the rest as it would");
+  if (cancelled > 0)
+    said.push(`${cancelled} cancelled by Stop before ${cancelled === 1 ? "it" : "they"} played`);
+  if (estimated > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");
   return `${reported === count ? ", " : "; "}${said.join(", ")}.`;
 }

@@ -69,6 +69,7 @@ export class SettingsPanel {
   #floorNote: HTMLElement | null = null;
   #detail: HTMLInputElement | null = null;
   #detailText: HTMLElement | null = null;
+  #detailLimit: HTMLElement | null = null;
 
   constructor(root: Document, onSave: (settings: Settings) => void) {
     this.#dialog = byId<HTMLDialogElement>(root, "settings");
@@ -172,6 +173,11 @@ export class SettingsPanel {
         "Sets the max error (window) and max angle (angle) under Advanced.",
       "span",
     );
+    // What else cuts strokes, so that a detail that changes little is not a puzzle.
+    const limit = paragraph("field-help", "", "span");
+    limit.dataset["testid"] = "detail-limit";
+    help.append(" ", limit);
+    this.#detailLimit = limit;
     input.addEventListener("input", () => {
       for (const [key, number] of Object.entries(detailValues(Number(input.value)))) {
         const target = this.#inputs.get(key as SettingKey)?.[0];
@@ -297,6 +303,7 @@ export class SettingsPanel {
       const level = Number(this.#detail.value);
       this.#detailText.textContent = `${level} · ${DETAIL_NAMES[level - 1] ?? ""}`;
     }
+    if (this.#detailLimit !== null) this.#detailLimit.textContent = detailLimit(candidate);
     let count = 0;
     for (const field of FIELDS) {
       const message = this.#isDisabled(field.key, candidate) ? undefined : errors[field.key];
@@ -395,6 +402,17 @@ function helpText(field: FieldSpec): string {
     return `${capitalize(field.help)} · ${field.minimum} to ${field.maximum}${unit}`;
   }
   return capitalize(field.help);
+}
+
+/** What limits the Detail setting besides itself: the window simplifier's longest-stroke cap. */
+export function detailLimit(candidate: { algorithm?: unknown; max_stroke_ms?: unknown }): string {
+  const capMs = candidate.max_stroke_ms;
+  if (candidate.algorithm !== "window" || typeof capMs !== "number" || !(capMs > 0)) return "";
+  return (
+    `The longest stroke (${capMs} ms of drawing, under Advanced) cuts too: at any detail no stroke ` +
+    "lasts longer, so for a drawing slower than that, coarse sends about as many strokes as fine. " +
+    "Set it to 0 for the fewest, longest strokes."
+  );
 }
 
 function capitalize(text: string): string {

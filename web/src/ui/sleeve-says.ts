@@ -1,40 +1,40 @@
 /**
  * The "Sleeve says" card for the current drawing: its name, what became of
- * its strokes (played, refused, cancelled, dropped, delayed), and the latest
- * notes. Reset with every new drawing, so nothing of an old drawing lingers.
+ * its strokes, and the latest notes. What became of each stroke is the rule of
+ * fates.ts (the one `up`'s terminal line and the study report from): played,
+ * cut short, cancelled or refused, each stroke once, and never sent for those
+ * dropped before they left; so the counts add up to the strokes drawn once the
+ * sleeve has answered them all. Reset with every new drawing, so nothing of an
+ * old drawing lingers.
  */
-import { seconds } from "../events";
+import { seconds, type SleeveEvent } from "../events";
+import { DrawingFates, type Fate } from "../fates";
 import { EventLog, type LogKind } from "./event-log";
 
 export interface Counts {
+  /** Played whole. */
   played: number;
   refused: number;
+  /** Dropped by Stop before they started (on the sleeve). */
   cancelled: number;
-  /** Of the cancelled, those cut short while playing (also counted as played). */
+  /** Cut short by Stop while playing: felt in part, counted here and not under played. */
   cut: number;
-  /** Not sent: cancelled before they left, or dropped by the timing policy. */
+  /** Never sent: dropped before they left, by Stop or by the timing policy. */
   dropped: number;
   /** Played, but held on the way (events.ts `isDelayed`): not the sleeve's `late` refusal. */
   delayed: number;
   latestDelayMs: number;
 }
 
-const zero = (): Counts => ({
-  played: 0,
-  refused: 0,
-  cancelled: 0,
-  cut: 0,
-  dropped: 0,
-  delayed: 0,
-  latestDelayMs: 0,
-});
-
 export class SleeveSays {
   readonly #title: HTMLElement;
   readonly #log: EventLog;
   readonly #list: HTMLOListElement;
   readonly #summary: HTMLElement;
-  #counts: Counts = zero();
+  #fates = new DrawingFates();
+  #dropped = 0;
+  #delayed = 0;
+  #latestDelayMs = 0;
   #sent = 0;
   #drawing: string | null = null;
 
@@ -46,14 +46,22 @@ export class SleeveSays {
   }
 
   get counts(): Readonly<Counts> {
-    return this.#counts;
+    return {
+      ...this.#fates.counts(),
+      dropped: this.#dropped,
+      delayed: this.#delayed,
+      latestDelayMs: this.#latestDelayMs,
+    };
   }
 
   /** A new drawing (or none): counts and notes start again. */
   reset(drawing: string | null): void {
     if (drawing === this.#drawing) return;
     this.#drawing = drawing;
-    this.#counts = zero();
+    this.#fates = new DrawingFates();
+    this.#dropped = 0;
+    this.#delayed = 0;
+    this.#latestDelayMs = 0;
     this.#sent = 0;
     this.#list.replaceChildren();
     this.#title.textContent =
@@ -62,14 +70,22 @@ export class SleeveSays {
     this.#render();
   }
 
-  count(what: Exclude<keyof Counts, "latestDelayMs">, delayMs = 0): void {
-    this.#counts[what]++;
-    if (what === "delayed") this.#counts.latestDelayMs = delayMs;
+  /** An event about a stroke of this drawing: the stroke's fate now (fates.ts). */
+  fate(event: SleeveEvent): Fate | null {
+    const fate = this.#fates.add(event);
+    this.#render();
+    return fate;
+  }
+
+  /** A played stroke held on the way for `delayMs`. */
+  delayed(delayMs: number): void {
+    this.#delayed++;
+    this.#latestDelayMs = delayMs;
     this.#render();
   }
 
   addDropped(count: number): void {
-    this.#counts.dropped += count;
+    this.#dropped += count;
     this.#render();
   }
 
@@ -83,11 +99,12 @@ export class SleeveSays {
   }
 
   #render(): void {
-    const { played, refused, cancelled, cut, dropped, delayed, latestDelayMs } = this.#counts;
+    const { played, refused, cancelled, cut, dropped, delayed, latestDelayMs } = this.counts;
     const summary = this.#summary;
     summary.dataset["played"] = String(played);
     summary.dataset["sent"] = String(this.#sent);
     summary.dataset["refused"] = String(refused);
+    summary.dataset["cut"] = String(cut);
     summary.dataset["cancelled"] = String(cancelled);
     summary.dataset["dropped"] = String(dropped);
     summary.dataset["delayed"] = String(delayed);
@@ -95,13 +112,19 @@ export class SleeveSays {
       summary.textContent = "No strokes sent yet.";
       return;
     }
-    const parts = [`${played} of ${this.#sent} stroke${this.#sent === 1 ? "" : "s"} played`];
-    if (refused > 0) parts.push(`${refused} refused`);
-    // A stroke stopped while playing was played in part: "4 of 4 played, 1 cancelled" would puzzle.
+    // Each stroke under one fate: the parts add up to the strokes drawn once all are answered.
+    const parts = [`${played} of ${plural(this.#sent, "stroke")} played`];
     if (cut > 0) parts.push(`${cut} cut short by Stop`);
-    if (cancelled > cut) parts.push(`${cancelled - cut} cancelled before playing`);
-    if (dropped > 0) parts.push(`${dropped} dropped unsent`);
+    if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
+    if (refused > 0) parts.push(`${refused} refused`);
+    if (dropped > 0) parts.push(`${dropped} never sent`);
+    const waiting = this.#sent - played - cut - cancelled - refused - dropped;
+    if (waiting > 0 && (cut > 0 || cancelled > 0)) parts.push(`${waiting} not answered yet`);
     if (delayed > 0) parts.push(`${delayed} delayed on the way (last by ${seconds(latestDelayMs)})`);
     summary.textContent = `${parts.join(", ")}.`;
   }
+}
+
+function plural(count: number, noun: string): string {
+  return `${count} ${noun}${count === 1 ? "" : "s"}`;
 }

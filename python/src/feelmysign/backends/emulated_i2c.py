@@ -15,13 +15,31 @@ What it models:
   while that channel is enabled. Its register file starts at the datasheet's
   reset values (MODE 0x40: standby); STATUS, VBAT and LRA_RESONANCE_PERIOD are
   read-only; MODE bit 7 (DEV_RESET) restores the reset values.
+- auto-calibration: GO (0x0C) written 1 in MODE 7, out of standby, with EN high, runs
+  it; GO reads 1 for a few reads (the chip is busy), then clears, with DIAG_RESULT
+  (STATUS bit 3) 0 and results in A_CAL_COMP, A_CAL_BEMF and FEEDBACK's BEMF_GAIN
+  worked out from the motor settings (plausible, not physics); with
+  ``fail_calibration`` set (a motor missing), DIAG_RESULT 1 and the results unchanged.
+  ``calibrations`` counts the calibrations run.
 - nobody answering an address raises ``OSError(121, 'Remote I/O error')`` as
   Linux's i2c-dev does; two devices answering one address (two enabled
   channels with a chip each) is a bus conflict: counted, logged and raised as
   :class:`BusConflictError`.
 
+- an optional enable line (:class:`EmulatedEnableLine`): the GPIO every chip's
+  EN pin hangs on, with a pull-down. A chip whose EN is low drives nothing
+  (``output`` is 0) whatever its registers say; its registers still take
+  writes (as TI found on its own evaluation module, though the datasheet
+  discourages I2C with EN low). The line is high only while a living process
+  drives it high: the process that drives it is recorded (pid and start
+  time), and once that process is gone the line reads low, as the pull-down
+  takes a real line low when the process holding it dies.
+
 Faults to inject: ``detach_chip`` (a missing chip), ``connected = False`` (a
 broken wire, registers kept), ``device_id`` (a wrong chip, e.g. 4 = DRV2604).
+A chip that stops answering records when (``lost_at``: the wall clock in ms and
+the bus's transaction count), and so does the enable line when it changes, so
+a test can read from the state file how soon after a loss every motor was off.
 
 ``on_write``, when set, is called after every write the bus applied, while the
 bus is locked: :mod:`feelmysign.backends.emulated_state` uses it to keep the
@@ -31,7 +49,9 @@ registers in a file, so that they outlive the process as a real chip's do.
 from __future__ import annotations
 
 import errno
+import os
 import threading
+import time
 from collections import Counter, deque, namedtuple
 
 # A restarting sleeve on an emulated bus imports this before it switches its motors
@@ -88,6 +108,10 @@ _DRV2605L_RESET_VALUES = (
     0x00,  # 0x22 LRA_RESONANCE_PERIOD
 )
 STATUS, MODE, RTP_INPUT, FEEDBACK_CONTROL, CONTROL3 = 0x00, 0x01, 0x02, 0x1A, 0x1D
+GO, RATED_VOLTAGE, OD_CLAMP, A_CAL_COMP, A_CAL_BEMF, CONTROL1 = 0x0C, 0x16, 0x17, 0x18, 0x19, 0x1B
+_MODE_AUTO_CALIBRATION = 0x07
+_STATUS_DIAG_RESULT = 0x08
+_CALIBRATION_BUSY_READS = 3  # GO reads 1 this many times before it clears
 _READ_ONLY = frozenset({STATUS, 0x21, 0x22})
 _MODE_DEV_RESET = 0x80
 _MODE_STANDBY = 0x40
@@ -140,6 +164,12 @@ class EmulatedDRV2605L:
         self.reads: Counter[int] = Counter()
         self._pointer = 0
         self.device_id = device_id
+        self.enabled = True  # the EN pin: low is shutdown, the motor driven by nothing
+        # When a transaction first found it not answering (ms, bus transaction), since it last did.
+        self.lost_at: tuple[float, int] | None = None
+        self.fail_calibration = False  # a fault: the next calibrations set DIAG_RESULT
+        self.calibrations = 0
+        self._busy_reads = 0  # while calibrating: GO reads left before it clears
 
     @property
     def device_id(self) -> int:
@@ -168,7 +198,7 @@ class EmulatedDRV2605L:
     @property
     def output(self) -> float:
         """The drive the motor gets, 0..1 (only RTP mode is modelled; other modes give 0)."""
-        if self.standby or not self.rtp_mode:
+        if not self.enabled or self.standby or not self.rtp_mode:
             return 0.0
         rtp = self.registers[RTP_INPUT]
         if self.rtp_unsigned:
@@ -189,6 +219,10 @@ class EmulatedDRV2605L:
         self._check(register)
         self.reads[register] += 1
         self._pointer = register
+        if register == GO and self._busy_reads > 0:
+            self._busy_reads -= 1
+            if self._busy_reads == 0:
+                self._finish_calibration()
         return self.registers[register]
 
     def write(self, register: int, value: int) -> None:
@@ -196,9 +230,34 @@ class EmulatedDRV2605L:
         self.writes[register] += 1
         self._pointer = register
         if register == MODE and value & _MODE_DEV_RESET:
+            self._busy_reads = 0
             self.reset()  # DEV_RESET clears itself once the reset is done
         elif register not in _READ_ONLY:
             self.registers[register] = value
+        if register == GO and value & 1 and self._calibration_mode:
+            self._busy_reads = _CALIBRATION_BUSY_READS
+        elif (register == GO and not value & 1) or (register == MODE and value & _MODE_STANDBY):
+            self._busy_reads = 0  # GO 0 or standby stops a calibration
+            self.registers[GO] = 0
+
+    @property
+    def _calibration_mode(self) -> bool:
+        mode = self.registers[MODE]
+        return self.enabled and not self.standby and (mode & _MODE_FIELD) == _MODE_AUTO_CALIBRATION
+
+    def _finish_calibration(self) -> None:
+        self.calibrations += 1
+        self.registers[GO] = 0
+        if self.fail_calibration:
+            self.registers[STATUS] |= _STATUS_DIAG_RESULT
+            return
+        self.registers[STATUS] &= ~_STATUS_DIAG_RESULT & 0xFF
+        # Plausible values that depend on the settings, so that a test sees them written.
+        rated = self.registers[RATED_VOLTAGE]
+        self.registers[A_CAL_COMP] = 0x0D + rated % 4
+        self.registers[A_CAL_BEMF] = min(0xFF, 0x40 + rated // 2)
+        gain = 3 if self.lra else 1
+        self.registers[FEEDBACK_CONTROL] = (self.registers[FEEDBACK_CONTROL] & 0xFC) | gain
 
     def set_pointer(self, register: int) -> None:
         self._check(register)
@@ -231,6 +290,113 @@ class EmulatedTCA9548A:
 _Device = EmulatedTCA9548A | EmulatedDRV2605L
 
 
+def process_identity(pid: int) -> int | None:
+    """The start time of process ``pid`` (clock ticks since boot, /proc/PID/stat field 22), so
+    that a pid the kernel reused is not taken for the process that drove the line; None when
+    the process does not exist or is a zombie (dead, not yet reaped)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as stat:
+            text = stat.read()
+    except OSError:
+        if os.path.isdir("/proc/self"):
+            return None
+        try:  # no /proc (not Linux): whether the pid exists is all that can be known
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return None
+        except PermissionError:
+            pass
+        return 0
+    fields = text[text.rfind(")") + 2 :].split()  # after "pid (name) "
+    if not fields or fields[0] in ("Z", "X"):
+        return None
+    return int(fields[19])  # field 22 of the whole line
+
+
+class EmulatedEnableLine:
+    """The GPIO line on every chip's EN pin, pulled down: the same methods as the real one.
+
+    ``level`` is what the last process that drove the line drove it to, ``holder``
+    that process (pid, start time); the line is high (``effective_high``) only while
+    that process lives. ``changed_at`` is when it last changed (ms, bus transaction).
+    """
+
+    def __init__(self, chip: str, line: int) -> None:
+        self.chip = chip
+        self.line = line
+        self.level = False
+        self.holder: tuple[int, int] | None = None
+        self.changed_at: tuple[float, int] | None = None
+        self.rises = 0  # how many times it went high, ever: a test sees that it never did
+        self._bus: EmulatedI2CBus | None = None
+
+    @property
+    def description(self) -> str:
+        return f"emulated enable line ({self.chip} line {self.line})"
+
+    @property
+    def holder_alive(self) -> bool:
+        if self.holder is None:
+            return False
+        pid, started = self.holder
+        return pid == os.getpid() or process_identity(pid) == started
+
+    @property
+    def effective_high(self) -> bool:
+        """High only while it is driven high by a process that still exists (the pull-down)."""
+        return self.level and self.holder_alive
+
+    @property
+    def held_here(self) -> bool:
+        return self.holder is not None and self.holder[0] == os.getpid()
+
+    @property
+    def high(self) -> bool:
+        return self.held_here and self.level
+
+    def request(self) -> None:
+        if self.held_here:
+            return
+        if self.holder_alive:
+            from feelmysign.errors import HardwareError
+
+            assert self.holder is not None
+            raise HardwareError(
+                f"the {self.description} is in use by process {self.holder[0]} (another sleeve "
+                "on this state file?); stop it, then try again"
+            )
+        pid = os.getpid()
+        self.holder = (pid, process_identity(pid) or 0)
+        self._change(False)
+
+    def set_high(self, high: bool) -> None:
+        if not self.held_here:
+            from feelmysign.errors import HardwareError
+
+            raise HardwareError(f"the {self.description} is not requested; this is a bug")
+        self._change(high)
+
+    def release(self) -> None:
+        if not self.held_here:
+            return
+        self._change(False)
+        self.holder = None
+        self._changed()
+
+    def _change(self, high: bool) -> None:
+        bus = self._bus
+        transactions = 0 if bus is None else bus.transactions
+        if high and not self.level:
+            self.rises += 1
+        self.level = high
+        self.changed_at = (round(time.time() * 1000, 3), transactions)
+        self._changed()
+
+    def _changed(self) -> None:
+        if self._bus is not None:
+            self._bus.enable_changed()
+
+
 class EmulatedI2CBus:
     """Multiplexers and DRV2605L chips on one emulated bus; smbus2-compatible byte transactions.
 
@@ -247,6 +413,8 @@ class EmulatedI2CBus:
         self.write_count = 0
         self.read_count = 0
         self.max_enabled_channels = 0  # the most channels ever enabled at once, all multiplexers
+        self.transactions = 0  # every transaction tried, answered or not (kept in a state file)
+        self.enable_line: EmulatedEnableLine | None = None
         self.closed = False
         self.on_write: Callable[[EmulatedI2CBus], None] | None = None
         # Called before every transaction, bus locked: a fault injected from outside lands.
@@ -262,7 +430,30 @@ class EmulatedI2CBus:
             bus.add_multiplexer(address)
         for wire in layout.wiring:
             bus.attach_chip(wire.multiplexer, wire.channel, device_id=device_id)
+        if layout.enable is not None:
+            bus.add_enable_line(layout.enable.chip, layout.enable.line)
         return bus
+
+    def add_enable_line(self, chip: str, line: int) -> EmulatedEnableLine:
+        """Every chip's EN pin on one pulled-down line (low until a process drives it high)."""
+        with self._lock:
+            if self.enable_line is None:
+                self.enable_line = EmulatedEnableLine(chip, line)
+            self.enable_line._bus = self
+            self._apply_enable()
+            return self.enable_line
+
+    def enable_changed(self) -> None:
+        """The line changed: every chip's EN follows, and the state is saved (``on_write``)."""
+        with self._lock:
+            self._apply_enable()
+            if self.on_write is not None:
+                self.on_write(self)
+
+    def _apply_enable(self) -> None:
+        high = self.enable_line is None or self.enable_line.effective_high
+        for chip in (*self._chips.values(), *self._main_bus_chips):
+            chip.enabled = high
 
     # -- building and inspecting ------------------------------------------------------------
 
@@ -283,6 +474,7 @@ class EmulatedI2CBus:
         chip = EmulatedDRV2605L(f"DRV2605L 0x{multiplexer:02X}/{channel}", device_id=device_id)
         with self._lock:
             self._chips[(multiplexer, channel)] = chip
+            chip.enabled = self.enable_line is None or self.enable_line.effective_high
         return chip
 
     def attach_main_bus_chip(self, *, device_id: int = DRV2605L_DEVICE_ID) -> EmulatedDRV2605L:
@@ -360,12 +552,17 @@ class EmulatedI2CBus:
         with self._lock:
             if self.before_transaction is not None:
                 self.before_transaction(self)
+            self.transactions += 1
             devices = self._answering(address)
             if len(devices) != 1:
+                if not devices:
+                    self._note_lost(address)
                 error = self._no_answer(address, devices)
                 self.log.append(Transaction(op, address, register, value, None, str(error)))
                 raise error
             device = devices[0]
+            if isinstance(device, EmulatedDRV2605L):
+                device.lost_at = None
             result = self._apply(device, op, register, value)
             self.log.append(Transaction(op, address, register, value, device.name))
             if self.on_write is not None and op.startswith("write"):
@@ -384,6 +581,14 @@ class EmulatedI2CBus:
                 reachable.append(chip)
         devices.extend(c for c in reachable if c.connected and c.address == address)
         return devices
+
+    def _note_lost(self, address: int) -> None:
+        """A chip on an enabled channel whose wire is broken: when it was first found so."""
+        for (mux_address, channel), chip in self._chips.items():
+            mux = self._multiplexers[mux_address]
+            selected = mux.connected and mux.control >> channel & 1
+            if selected and not chip.connected and chip.address == address and chip.lost_at is None:
+                chip.lost_at = (round(time.time() * 1000, 3), self.transactions)
 
     def _no_answer(self, address: int, devices: list[_Device]) -> OSError:
         if not devices:

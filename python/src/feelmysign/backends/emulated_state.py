@@ -23,23 +23,55 @@ to survive a power cut)::
                    "registers": "e04000010100..."},
         ...
       },
-      "main_bus_chips": []
+      "main_bus_chips": [],
+      "transactions": 1234,
+      "enable": {"chip": "gpiochip0", "line": 17, "level": 1,
+                 "holder": {"pid": 4242, "start": 987654},
+                 "effective": 1, "changed_at": {"ms": 1764166000123.5, "transaction": 1201},
+                 "rises": 3}
     }
+
+``enable`` is present when the layout wires every chip's EN pin to one GPIO line
+(``i2c.enable``), absent or null otherwise (EN tied high). ``level`` is what the
+last process that drove the line drove it to and ``holder`` that process (its
+pid and its start time in clock ticks since boot, /proc/PID/stat field 22, so a
+reused pid does not count). The line models its pull-down: it is high only
+while ``level`` is 1 and the holder still runs, so once the sleeve is gone
+(``kill -9``, a crash) every reader sees it low and every chip's ``drive`` 0,
+though no process was left to write "low". ``effective`` is that level when the
+file was written; ``rises`` counts the times it ever went high. A chip whose EN
+is low drives nothing whatever its registers say; with EN high (or no line) it
+drives what its registers say.
+
+``transactions`` counts the bus transactions tried; a chip that stops answering
+gets ``lost_at`` (the wall clock in ms and that count: when the process driving
+the bus took the edit that disconnected it, or when a transaction first found it
+gone; null while it answers), and the line's ``changed_at`` says when it
+last changed: a test reads from these how soon after a chip was lost every
+motor was off.
 
 Faults are set in the file: leave a chip out of ``chips`` (or set
 ``"connected": false``, a broken wire that keeps the registers) for a missing
-chip; set ``device_id`` (e.g. 4, a DRV2604) for a wrong chip. ``drive`` is
-written for people and tests to read (0..1, what the motor gets) and ignored
-when the file is read back. One process at a time should drive a state file;
-others may read it.
+chip; set ``device_id`` (e.g. 4, a DRV2604) for a wrong chip; set ``"fail_calibration":
+true`` for a motor the chip cannot calibrate (DIAG_RESULT set; ``calibrations`` counts the
+calibrations a chip ran). ``drive`` is
+written for people and tests to read (0..1, what the motor gets when the file
+was written; :func:`drive_levels` works it out again at the time it is read, as
+the enable line may have fallen since) and ignored when the file is read
+back. One process at a time should drive a state file; others may read it.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import time
 
-from feelmysign.backends.emulated_i2c import EmulatedDRV2605L, EmulatedI2CBus
+from feelmysign.backends.emulated_i2c import (
+    EmulatedDRV2605L,
+    EmulatedEnableLine,
+    EmulatedI2CBus,
+)
 from feelmysign.errors import FeelMySignError
 from feelmysign.input_files import MAX_STATE_BYTES, loads_json, read_text
 
@@ -91,6 +123,9 @@ def open_state_bus(path: str | os.PathLike[str], layout: Layout | None) -> Emula
             raise EmulatedStateError(
                 state_path, f"cannot be written: {error.strerror or error}"
             ) from error
+    if layout is not None and layout.enable is not None and bus.enable_line is None:
+        # A file made before the layout had a line: the boards are wired to it now.
+        bus.add_enable_line(layout.enable.chip, layout.enable.line)
     write_through = _WriteThrough(state_path)
     bus.on_write = write_through
     bus.before_transaction = write_through.take_faults
@@ -110,26 +145,33 @@ class _WriteThrough:
         self.take_faults(bus)  # an edit made since the last write is not overwritten unseen
         text = _as_text(bus)
         if text != self._last:
-            _replace(self._path, text)
+            self._written = _replace(self._path, text)
             self._last = text
-            self._written = _identity(self._path)
 
     def take_faults(self, bus: EmulatedI2CBus) -> None:
         """A file someone else changed while this process drives it: its faults land now.
 
         A chip left out of ``chips``, or ``"connected": false``, stops answering at once,
         as a chip whose wire comes loose mid-drawing would (registers kept: its motor runs on).
+        So does a multiplexer set ``"connected": false``, and every chip behind it.
         """
         found = _identity(self._path)
         if found == self._written or found is None:
             return
         self._written = found
         try:
-            saved = dict(read_state(self._path).chips)
+            edited = read_state(self._path)
         except EmulatedStateError:
             return  # half-edited by hand: the next change is looked at again
+        saved = dict(edited.chips)
         for key, chip in bus.chips.items():
-            chip.connected = key in saved and saved[key].connected
+            connected = key in saved and saved[key].connected
+            if chip.connected and not connected:  # the wire comes loose now, for this process
+                chip.lost_at = (round(time.time() * 1000, 3), bus.transactions)
+            chip.connected = connected
+        for address, mux in bus.multiplexers.items():
+            kept = edited.multiplexers.get(address)
+            mux.connected = kept is not None and kept.connected
 
 
 def read_state(path: str | os.PathLike[str]) -> EmulatedI2CBus:
@@ -157,13 +199,17 @@ def _as_text(bus: EmulatedI2CBus) -> str:
     return json.dumps(state_of(bus), indent=1) + "\n"
 
 
-def _replace(path: str, text: str) -> None:
-    # A rename replaces the file in one step: readers see the old or the new one.
+def _replace(path: str, text: str) -> tuple[int, int, int] | None:
+    """Writes ``text`` to ``path`` in one step (readers see the old or the new file); the
+    identity of what was written, taken before the rename (which keeps it): an edit renamed
+    over the file just after is then never mistaken for this write, and is seen."""
     folder, name = os.path.split(path)
     temporary = os.path.join(folder, f".{name}.{os.getpid()}.tmp")
     with open(temporary, "w", encoding="utf-8") as file:
         file.write(text)
+    written = _identity(temporary)
     os.replace(temporary, path)
+    return written
 
 
 def _identity(path: str) -> tuple[int, int, int] | None:
@@ -195,7 +241,32 @@ def state_of(bus: EmulatedI2CBus) -> dict[str, Any]:
             for (multiplexer, channel), chip in sorted(bus.chips.items())
         },
         "main_bus_chips": [_chip_state(chip) for chip in bus.main_bus_chips],
+        "transactions": bus.transactions,
+        "enable": None if bus.enable_line is None else _line_state(bus.enable_line),
     }
+
+
+def _line_state(line: EmulatedEnableLine) -> dict[str, Any]:
+    holder = line.holder
+    return {
+        "chip": line.chip,
+        "line": line.line,
+        "level": int(line.level),
+        "holder": None if holder is None else {"pid": holder[0], "start": holder[1]},
+        "effective": int(line.effective_high),
+        "changed_at": _when(line.changed_at),
+        "rises": line.rises,
+    }
+
+
+def _when(at: tuple[float, int] | None) -> dict[str, Any] | None:
+    return None if at is None else {"ms": at[0], "transaction": at[1]}
+
+
+def _read_when(saved: Any) -> tuple[float, int] | None:
+    if saved is None:
+        return None
+    return (float(saved["ms"]), int(saved["transaction"]))
 
 
 def bus_from_state(data: Any) -> EmulatedI2CBus:
@@ -212,6 +283,17 @@ def bus_from_state(data: Any) -> EmulatedI2CBus:
         _restore(bus.attach_chip(int(multiplexer, 16), int(channel)), saved, name)
     for index, saved in enumerate(list(data.get("main_bus_chips", []))):
         _restore(bus.attach_main_bus_chip(), saved, f"main bus chip {index}")
+    bus.transactions = int(data.get("transactions", 0))
+    line = data.get("enable")
+    if line is not None:
+        enable = EmulatedEnableLine(str(line["chip"]), int(line["line"]))
+        enable.level = bool(line.get("level", 0))
+        holder = line.get("holder")
+        enable.holder = None if holder is None else (int(holder["pid"]), int(holder["start"]))
+        enable.changed_at = _read_when(line.get("changed_at"))
+        enable.rises = int(line.get("rises", 0))
+        bus.enable_line = enable
+        bus.add_enable_line(enable.chip, enable.line)  # links it, and every EN follows it
     return bus
 
 
@@ -221,6 +303,9 @@ def _chip_state(chip: EmulatedDRV2605L) -> dict[str, Any]:
         "connected": chip.connected,
         "drive": round(chip.output, 4),
         "registers": chip.registers.hex(),
+        "lost_at": _when(chip.lost_at),
+        "fail_calibration": chip.fail_calibration,
+        "calibrations": chip.calibrations,
     }
 
 
@@ -230,6 +315,9 @@ def _restore(chip: EmulatedDRV2605L, saved: Any, name: str) -> None:
         raise ValueError(f"chip {name} has {len(registers)} registers, not {len(chip.registers)}")
     chip.registers[:] = registers
     chip.connected = bool(saved.get("connected", True))
+    chip.lost_at = _read_when(saved.get("lost_at"))
+    chip.fail_calibration = bool(saved.get("fail_calibration", False))
+    chip.calibrations = int(saved.get("calibrations", 0))
     if "device_id" in saved:  # wins over STATUS, so a test can fit a wrong chip by editing one key
         device_id = int(saved["device_id"])
         if not 0 <= device_id <= 7:

@@ -10,10 +10,17 @@ from __future__ import annotations
 import os
 from typing import Literal
 
+from feelmysign.backends.actuator_config import (
+    CalibrationStore,
+    calibration_path,
+    store_name_for_bus,
+    store_name_for_state_file,
+)
 from feelmysign.backends.base import Backend
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
 from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.enable import GpiodLine, Line
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.sim import SimBackend
 from feelmysign.backends.telemetry import ActuatorTelemetry
@@ -32,6 +39,7 @@ def open_backend(
     telemetry: ActuatorTelemetry | None = None,
     emulate: bool = False,
     emulate_state: str | os.PathLike[str] | None = None,
+    leave_out_missing: bool = False,
 ) -> Backend:
     """An open backend for ``layout``, every actuator silent; close it (or use ``with``).
 
@@ -40,9 +48,9 @@ def open_backend(
     with ``emulate``, on an emulated bus wired as the layout says (to try the
     hardware path without hardware); ``emulate_state`` keeps that bus's registers
     in a file across processes (see :mod:`feelmysign.backends.emulated_state`)
-    and implies ``emulate``. Raises ParameterError for a bad choice,
-    LayoutError for a layout without wiring, HardwareError when the chips do not
-    answer (see :meth:`Drv2605Backend.open`).
+    and implies ``emulate``; ``leave_out_missing``: see ``Drv2605Backend``. Raises
+    ParameterError for a bad choice, LayoutError for a layout without wiring,
+    HardwareError when the chips do not answer (see :meth:`Drv2605Backend.open`).
     """
     if name not in BACKEND_NAMES:
         raise ParameterError(
@@ -64,9 +72,38 @@ def open_backend(
         bus = open_state_bus(emulate_state, layout)
     elif emulate:
         bus = EmulatedI2CBus.for_layout(layout)
-    backend = Drv2605Backend(layout, bus=bus, telemetry=telemetry)
+    backend = Drv2605Backend(
+        layout,
+        bus=bus,
+        telemetry=telemetry,
+        enable=enable_line_for(layout, bus),
+        calibration=calibration_store_for(layout, emulate_state),
+        # An emulated bus without a file starts from reset values every time: a fresh sleeve.
+        calibrate=emulate and emulate_state is None,
+        leave_out_missing=leave_out_missing,
+    )
     backend.open()
     return backend
+
+
+def calibration_store_for(
+    layout: Layout, emulate_state: str | os.PathLike[str] | None
+) -> CalibrationStore:
+    """Where the chips' auto-calibration results are kept: the sleeve's state directory, one
+    file per I2C bus (an emulated bus kept in a file counts as a bus of its own)."""
+    if emulate_state is not None:
+        return CalibrationStore(calibration_path(store_name_for_state_file(emulate_state)))
+    return CalibrationStore(calibration_path(store_name_for_bus(layout.i2c_bus)))
+
+
+def enable_line_for(layout: Layout, bus: I2CBus | None) -> Line | None:
+    """The layout's enable line: the emulated bus's own, or the real GPIO (gpiod is imported
+    only when the line is requested); None for a layout without one."""
+    if layout.enable is None:
+        return None
+    if isinstance(bus, EmulatedI2CBus):
+        return bus.add_enable_line(layout.enable.chip, layout.enable.line)
+    return GpiodLine(layout.enable)
 
 
 def _open_sim(

@@ -53,8 +53,9 @@ def open_smbus(bus_number: int) -> I2CBus:
     except FileNotFoundError as error:
         raise HardwareError(
             f"I2C bus {bus_number} does not exist ({device} not found): enable I2C with "
-            f"'sudo raspi-config' (Interface Options > I2C) and reboot, check i2c_bus in the "
-            f"sleeve layout, {_SIM_HINT}."
+            f"'sudo raspi-config' (Interface Options > I2C) and reboot, check the bus number "
+            f"('bus' in the [i2c] table of the sleeve layout; 'ls /dev/i2c-*' lists the buses), "
+            f"{_SIM_HINT}."
         ) from error
     except PermissionError as error:
         raise HardwareError(
@@ -64,6 +65,6 @@ def open_smbus(bus_number: int) -> I2CBus:
     except OSError as error:
         raise HardwareError(
             f"Cannot open I2C bus {bus_number} ({device}): {error}; check that I2C is enabled "
-            f"('sudo raspi-config') and i2c_bus in the sleeve layout, {_SIM_HINT}."
+            f"('sudo raspi-config') and 'bus' in the [i2c] table of the sleeve layout, {_SIM_HINT}."
         ) from error
     return bus

@@ -6,6 +6,7 @@ driver is missing, on which multiplexer channel, and what answers instead.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Literal
@@ -18,11 +19,15 @@ from feelmysign.backends.drv2605 import (
 )
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.tca9548a import CHANNELS, Multiplexers
+from feelmysign.errors import HardwareError
 from feelmysign.layout import Layout, Wire
 
 # i2cdetect's default range: 0x00-0x07 and 0x78-0x7F are reserved addresses.
 DEFAULT_ADDRESSES = range(0x08, 0x78)
 _STATUS = 0x00  # DRV2605L STATUS register, holds DEVICE_ID
+_MODE = 0x01  # bit 6: standby
+_RTP_INPUT = 0x02
+_MODE_STANDBY = 0x40
 
 
 @dataclass(frozen=True)
@@ -33,6 +38,9 @@ class ChannelScan:
     channel: int
     addresses: tuple[int, ...]
     device_id: int | None  # of the chip at 0x5A, when one answered
+    # What a DRV2605L there holds that drives its motor (out of standby with a non-zero RTP
+    # level), as "MODE 0x05, RTP_INPUT 0x66"; None when silent or not read.
+    driving: str | None = None
 
 
 @dataclass(frozen=True)
@@ -63,6 +71,17 @@ def _read_device_id(bus: I2CBus) -> int | None:
         return None
 
 
+def _read_driving(bus: I2CBus) -> str | None:
+    try:
+        mode = bus.read_byte_data(DRV2605_ADDRESS, _MODE)
+        rtp = bus.read_byte_data(DRV2605_ADDRESS, _RTP_INPUT)
+    except OSError:
+        return None
+    if mode & _MODE_STANDBY or rtp == 0:
+        return None
+    return f"MODE 0x{mode:02X}, RTP_INPUT 0x{rtp:02X}"
+
+
 def scan(
     bus: I2CBus, multiplexers: Iterable[int], *, addresses: Iterable[int] = DEFAULT_ADDRESSES
 ) -> ScanResult:
@@ -89,13 +108,14 @@ def scan(
                 muxes.select(multiplexer, channel)
                 found = tuple(a for a in probe if a not in main_bus and _answers(bus, a))
                 device_id = _read_device_id(bus) if DRV2605_ADDRESS in found else None
-                channels.append(ChannelScan(multiplexer, channel, found, device_id))
+                driving = _read_driving(bus) if device_id in SUPPORTED_DEVICE_IDS else None
+                channels.append(ChannelScan(multiplexer, channel, found, device_id, driving))
     finally:
         muxes.deselect_all()
     return ScanResult(main_bus, tuple(missing), tuple(channels))
 
 
-WireStatus = Literal["ok", "missing", "wrong-chip", "multiplexer-missing"]
+WireStatus = Literal["ok", "missing", "wrong-chip", "multiplexer-missing", "driving"]
 
 
 @dataclass(frozen=True)
@@ -136,6 +156,15 @@ def _check_wire(result: ScanResult, wire: Wire) -> WireCheck:
     if found.device_id not in SUPPORTED_DEVICE_IDS:
         name = device_name(found.device_id) if found.device_id is not None else "unreadable chip"
         return WireCheck(wire, "wrong-chip", f"A {name} answered on {where}, not a DRV2605L")
+    if found.driving is not None:
+        # Left on by a sleeve that died without switching it off (no enable line, or its EN
+        # is tied high): the motor runs now, or as soon as the enable line goes high.
+        return WireCheck(
+            wire,
+            "driving",
+            f"The {device_name(found.device_id)} on {where} is left driving its motor "
+            f"({found.driving}): if no sleeve runs, switch it off with 'feelmysign off'",
+        )
     return WireCheck(wire, "ok", f"{device_name(found.device_id)} on {where}")
 
 
@@ -155,3 +184,42 @@ def compare_with_layout(result: ScanResult, layout: Layout) -> LayoutReport:
             "main bus, not behind a multiplexer, and collides with every other DRV2605L"
         )
     return LayoutReport(wires, tuple(unexpected))
+
+
+# The motor settings and auto-calibration results, as their registers hold them.
+MOTOR_REGISTERS = {
+    "rated_voltage": 0x16,
+    "od_clamp": 0x17,
+    "a_cal_comp": 0x18,
+    "a_cal_bemf": 0x19,
+    "feedback_control": 0x1A,
+    "control1": 0x1B,
+}
+
+
+def read_motor_registers(
+    bus: I2CBus, layout: Layout, result: ScanResult, report: LayoutReport
+) -> dict[tuple[int, int], dict[str, int]]:
+    """(multiplexer, channel) -> register name -> value, for every wired chip that answered.
+
+    Only reads; every channel is disabled afterwards."""
+    present = [m for m in layout.multiplexers if m not in result.missing_multiplexers]
+    muxes = Multiplexers(bus, present)
+    found: dict[tuple[int, int], dict[str, int]] = {}
+    try:
+        for check in report.wires:
+            if check.status != "ok":
+                continue
+            wire = check.wire
+            try:
+                muxes.select(wire.multiplexer, wire.channel)
+                found[(wire.multiplexer, wire.channel)] = {
+                    name: bus.read_byte_data(DRV2605_ADDRESS, register)
+                    for name, register in MOTOR_REGISTERS.items()
+                }
+            except (OSError, HardwareError):
+                continue  # it answered the scan a moment ago; the table shows it as unread
+    finally:
+        with contextlib.suppress(HardwareError):
+            muxes.deselect_all()
+    return found

@@ -20,6 +20,7 @@ from feelmysign.bench import (
     lasa_points,
     persistence,
     planner_lasa,
+    relay,
     restart_off,
     simplifier_timing,
     sleeve,
@@ -31,6 +32,7 @@ GROUPS: dict[str, Callable[[], list[str]]] = {
     "simplifier_timing": simplifier_timing.report,
     "lasa_points": lasa_points.report,
     "sleeve": sleeve.report,
+    "relay": relay.report,
     "restart_off": restart_off.report,
     "persistence": persistence.report,
 }

@@ -186,15 +186,18 @@ def _sleeve(c: Credentials) -> Iterator[Sleeve]:
         backend.close()
 
 
-def stroke_latencies(c: Credentials, shape: Any, count: int) -> list[tuple[float, Played]]:
+def stroke_latencies(
+    c: Credentials, shape: Any, count: int, sender: mqtt.Client | None = None
+) -> list[tuple[float, Played]]:
     """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event.
 
     Each stroke (a drawing of its own) is cancelled once its played event is out, i.e. after
     its first command; the next is sent a pause later, once the sleeve reports it cancelled.
+    ``sender``: the connected client that publishes (closed here); else one over MQTT.
     """
     inbox = _Inbox()
     watcher = _client(c, "sender", inbox, telemetry_topic(c.sleeve_id, "events"))
-    sender = _client(c, "sender")
+    sender = sender or _client(c, "sender")
     (start, end, duration_ms) = shape
     results = []
     for _ in range(count):

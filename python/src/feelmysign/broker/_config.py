@@ -19,6 +19,7 @@ from feelmysign.broker.credentials import Account, write_private_file
 from feelmysign.errors import BrokerError
 from feelmysign.topics import (
     ANY_SLEEVE,
+    CLOCK_TOPIC,
     TELEMETRY_NAMES,
     control_topic,
     strokes_topic,
@@ -33,6 +34,12 @@ MAX_PACKET_SIZE_BYTES = 4096
 # A SIGKILL or a power cut loses everything since (strokes acknowledged to their sender
 # included), which is why `feelmysign broker` saves every change instead.
 AUTOSAVE_INTERVAL_S = 60
+# How long Mosquitto keeps a persistent session (its subscriptions and queued QoS 1 events)
+# for a client that never comes back: each page load opens a session of its own (the page
+# resumes it across a broker restart, docs/protocol.md), and a closed tab never ends it, so
+# without a limit the sessions and the events queued for them would pile up forever. An
+# hour is far longer than any reconnection; the sleeve and up's log reconnect within seconds.
+PERSISTENT_CLIENT_EXPIRATION = "1h"
 # The format Mosquitto 2.0 writes by default ("$7$"): PBKDF2-HMAC-SHA512 with
 # 101 iterations, a 12-byte salt and a 64-byte hash, both base64 encoded.
 PBKDF2_ITERATIONS = 101
@@ -154,8 +161,16 @@ set_tcp_nodelay true
 persistence true
 persistence_location {files.persistence_dir}/
 {autosave}
+# A session no client resumed in this long is dropped (one per page load; docs/protocol.md).
+persistent_client_expiration {PERSISTENT_CLIENT_EXPIRATION}
 
 log_dest file {files.log}
+# Errors, warnings and the connection lines only: "information" adds a line at every save of
+# the database, which with a save per change is a line per stroke, and a log that fills a
+# Pi's SD card between two starts (it is rotated only at a start).
+log_type error
+log_type warning
+log_type notice
 log_timestamp_format %Y-%m-%dT%H:%M:%S
 connection_messages true
 """
@@ -195,6 +210,7 @@ def render_acl(
         f"topic read {strokes_topic(sleeve_id)}",
         f"topic read {control_topic(sleeve_id)}",
         f"topic read {legacy_topic}",
+        f"topic read {CLOCK_TOPIC}",
         *(f"topic write {telemetry_topic(sleeve_id, sub)}" for sub in TELEMETRY_NAMES),
     ]
     for other_id, other_username in other_sleeves:
@@ -203,6 +219,7 @@ def render_acl(
             f"user {other_username}",
             f"topic read {strokes_topic(other_id)}",
             f"topic read {control_topic(other_id)}",
+            f"topic read {CLOCK_TOPIC}",
             *(f"topic write {telemetry_topic(other_id, sub)}" for sub in TELEMETRY_NAMES),
         ]
     sender_lines = [
@@ -210,6 +227,8 @@ def render_acl(
         f"topic write {strokes_topic(ANY_SLEEVE)}",
         f"topic write {control_topic(ANY_SLEEVE)}",
         f"topic write {legacy_topic}",
+        # The broker's clock, published with the sender's login when the broker starts.
+        f"topic write {CLOCK_TOPIC}",
         *(f"topic read {telemetry_topic(ANY_SLEEVE, sub)}" for sub in TELEMETRY_NAMES),
     ]
     return (

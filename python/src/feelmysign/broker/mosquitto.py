@@ -274,6 +274,7 @@ class Broker(Started):
             self.stop()
             raise
         self._credentials = credentials
+        _publish_clock(credentials)
         return credentials
 
     def _write_files(
@@ -436,3 +437,28 @@ def _user_name() -> str | None:
 
 def _indent(text: str) -> str:
     return "\n".join(f"  {line}" for line in text.splitlines()) or "  (the log is empty)"
+
+
+def _publish_clock(credentials: Credentials) -> None:
+    """This machine's time on feelmysign/clock (retained), for sleeves to check their clock
+    against (feelmysign.broker_clock). Best effort: a sleeve without it only checks nothing."""
+    from feelmysign.broker_clock import publish_clock
+    from feelmysign.connection import connect_client
+    from feelmysign.errors import FeelMySignError
+
+    try:
+        client = connect_client(
+            credentials.settings("sender"),
+            f"feelmysign-clock-{os.getpid()}",
+            timeout_s=READY_PROBE_TIMEOUT_S,
+            note=lambda _: None,
+        )
+    except FeelMySignError:
+        return
+    try:
+        publish_clock(client, timeout_s=READY_PROBE_TIMEOUT_S)
+    except (RuntimeError, ValueError, OSError):
+        pass  # refused (an ACL from before the clock) or cut: no clock this time
+    finally:
+        client.disconnect()
+        client.loop_stop()

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from feelmysign.broker import StateFiles, default_state_dir, load_credentials
+from feelmysign.broker import Credentials, StateFiles, default_state_dir, load_credentials
 from feelmysign.broker.accounts import reload_running_broker
 from feelmysign.broker.credentials import check_sleeve_id
 from feelmysign.broker.nats_accounts import render_nats_accounts
@@ -18,22 +18,52 @@ from feelmysign.errors import BrokerError
 from feelmysign.topics import LEGACY_TOPIC
 
 
-def run_add_sleeve(args: argparse.Namespace) -> int:
-    files = StateFiles(Path(args.state_dir or default_state_dir()).absolute())
-    credentials = load_credentials(files.credentials)
-    sleeve_id = check_sleeve_id(args.new_sleeve_id)
+def _join_url(args: argparse.Namespace, credentials: Credentials, who: str) -> str:
     # No TLS listener: the plain loopback listener, as 'up' itself uses, for a second
-    # sleeve on this machine (a password may go in clear text on loopback only).
-    url = args.url or credentials.mqtts_url or credentials.mqtt_url
+    # sleeve (or a sender) on this machine (a password may go in clear text on loopback only).
+    url: str = args.url or credentials.mqtts_url or credentials.mqtt_url
     settings = parse_broker_url(url)
     if not settings.tls and not settings.on_loopback:
         raise BrokerError(
             "bad-option",
-            f"--url {url} is plain mqtt:// or ws:// to another machine: a sleeve joins over "
-            "TLS (mqtts:// or wss://) unless it runs on this machine (127.0.0.1, ::1 or "
+            f"--url {url} is plain mqtt:// or ws:// to another machine: a {who} joins over "
+            f"TLS (mqtts:// or wss://) unless it runs on this machine (127.0.0.1, ::1 or "
             "localhost). Start the broker with 'feelmysign up --lan' (or 'feelmysign broker "
             "--lan') and leave --url out, or give its TLS URL.",
         )
+    return url
+
+
+def run_add_sender(args: argparse.Namespace) -> int:
+    files = StateFiles(Path(args.state_dir or default_state_dir()).absolute())
+    credentials = load_credentials(files.credentials)
+    sleeve_id = check_sleeve_id(args.to_sleeve_id or credentials.sleeve_id)
+    url = _join_url(args, credentials, "sender")
+    fingerprint = credentials.ca_fingerprint if args.url is None else None
+    account = credentials.sender
+    token = JoinToken(url, sleeve_id, account.username, account.password, fingerprint, "sender")
+    print(token.encode(), flush=True)
+    print(
+        f"Sender {account.username}, to sleeve {sleeve_id}. On the sender's machine run\n"
+        "  feelmysign send --join TOKEN --shape heart\n"
+        "with the line above as TOKEN (it holds a password: keep it like one)."
+        + (
+            ""
+            if parse_broker_url(url).tls
+            else f"\nIts broker URL {url} is on this machine only: the sender must run here too."
+        ),
+        file=sys.stderr,
+        flush=True,
+    )
+    return 0
+
+
+def run_add_sleeve(args: argparse.Namespace) -> int:
+    files = StateFiles(Path(args.state_dir or default_state_dir()).absolute())
+    credentials = load_credentials(files.credentials)
+    sleeve_id = check_sleeve_id(args.new_sleeve_id)
+    url = _join_url(args, credentials, "sleeve")
+    settings = parse_broker_url(url)
     if sleeve_id == credentials.sleeve_id:
         account = credentials.sleeve
     else:

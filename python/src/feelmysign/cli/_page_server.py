@@ -33,8 +33,12 @@ def page_server(
         "username": c.sender.username,
         "password": c.sender.password,
     }
+    # What peers did wrong (bad requests, refused certificates), in detail: never the terminal.
+    debug_log = broker.state_dir / "page-server.log"
     if broker.lan is None:
-        server = WebServer(port=http_port, config=config, directory=directory, api=api)
+        server = WebServer(
+            port=http_port, config=config, directory=directory, api=api, debug_log=debug_log
+        )
         return server, server.url
     key = secrets.token_urlsafe(ACCESS_KEY_BYTES)
     server = WebServer(
@@ -46,6 +50,7 @@ def page_server(
         tls=broker.tls,
         access_key=key,
         mqtt_ws_port=c.ws_port,
+        debug_log=debug_log,
     )
     server.set_config({**config, "ws_url": f"wss://{server.authority}/mqtt"})
     return server, f"{server.url}?key={key}"

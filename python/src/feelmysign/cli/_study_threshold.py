@@ -87,14 +87,18 @@ def run(args: argparse.Namespace) -> int:
             offline_player(layout),
             lambda direction, value: observer.respond(direction, value, rng),
             progress,
+            simulated=True,
         )
     else:
         with SleeveLink(broker_settings_from_args(args, "sender")) as link:
             estimate = run_threshold(
                 store, args.participant, args.dimension, layout, link.play, _ask, progress
             )
+    kind = (
+        "Simulated threshold (a dry run, stored as one)" if args.simulated_observer else "Threshold"
+    )
     print(
-        f"Threshold ({args.dimension}): {estimate.threshold:.3g} {unit}, 95% interval "
+        f"{kind} ({args.dimension}): {estimate.threshold:.3g} {unit}, 95% interval "
         f"{estimate.low:.3g} to {estimate.high:.3g}, after {estimate.trials} trials."
     )
     if args.save is not None:

@@ -3,6 +3,7 @@
     feelmysign broker [--state-dir DIR] [--port P] [--ws-port W] [--sleeve-id ID]
                       [--lan | --host ADDRESS] [--tls-port P] [--tls-cert FILE --tls-key FILE]
     feelmysign broker [--state-dir DIR] add-sleeve ID    # prints the sleeve's join token
+    feelmysign broker [--state-dir DIR] add-sender       # prints a sender's join token
 
 Prints the URLs, the credentials file and the log file, then "Ready." once the broker
 accepts connections. Ctrl-C (SIGINT), SIGTERM or SIGHUP stop Mosquitto and exit 0.
@@ -23,7 +24,7 @@ from feelmysign.broker import (
     Broker,
     default_state_dir,
 )
-from feelmysign.cli._join import run_add_sleeve, run_nats_accounts
+from feelmysign.cli._join import run_add_sender, run_add_sleeve, run_nats_accounts
 from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 from feelmysign.cli.options.parser import Subcommands, add_command
 
@@ -93,6 +94,30 @@ def register(subparsers: Subcommands) -> None:
         "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
     )
     add.set_defaults(handler=run_add_sleeve)
+    sender = commands.add_parser(
+        "add-sender",
+        help="print the one-line join token of a sender on another machine (feelmysign send)",
+        description=(
+            "Print a one-line join token with the broker's TLS URL, its CA's fingerprint, the "
+            "sleeve to send to and the sender's login. On the sender's machine: feelmysign "
+            "send --join TOKEN --shape heart (the CA is fetched and checked against the "
+            "fingerprint the first time)."
+        ),
+    )
+    sender.add_argument(
+        "--id",
+        dest="to_sleeve_id",
+        metavar="ID",
+        help="the sleeve the token sends to (default: the broker's first sleeve; send --id "
+        "may name another)",
+    )
+    sender.add_argument(
+        "--url",
+        metavar="URL",
+        help="the broker's URL as the sender reaches it, mqtts:// or wss:// (default: the "
+        "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
+    )
+    sender.set_defaults(handler=run_add_sender)
     nats = commands.add_parser(
         "nats-accounts",
         help="print the accounts.conf of a NATS cluster with this broker's accounts and ACL",

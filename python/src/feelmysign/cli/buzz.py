@@ -7,22 +7,29 @@
 Row and column are grid indices (row 0 = y 0, column 0 = x 0; see the layout
 file's drawing). The intensity is capped at the layout's safety.max_intensity
 and the duration at its safety.max_on_time_ms. Every motor is switched off
-afterwards, also on Ctrl-C or an error.
+afterwards, also on Ctrl-C or an error. With an enable line in the layout
+(``i2c.enable``) the line goes high for the buzz, once every chip is off and
+checked, and low again before the "off" goes out over I2C.
+
+A DRV2605L that does not answer does not keep the others from being tried: it is
+named on stderr and left out, and buzzing its own motor is the error (with an
+enable line, which switches every chip, a missing chip keeps every motor off).
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 
-from feelmysign.backends.base import check_actuator
+from feelmysign.backends.base import Backend, check_actuator
 from feelmysign.backends.factory import BACKEND_NAMES, open_backend
 from feelmysign.backends.sim import SimBackend
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands, add_command
-from feelmysign.errors import ParameterError
+from feelmysign.errors import HardwareError, ParameterError
 from feelmysign.layout import Layout
 from feelmysign.services.stop_signals import interrupt_on_stop_signals
 
@@ -75,12 +82,24 @@ def run(args: argparse.Namespace) -> int:
     intensity, intensity_note = _intensity(args.intensity, layout)
     duration_ms, duration_note = _duration_ms(args.duration_ms, layout)
     backend = open_backend(
-        args.backend, layout, emulate=args.emulate, emulate_state=args.emulate_state
+        args.backend,
+        layout,
+        emulate=args.emulate,
+        emulate_state=args.emulate_state,
+        leave_out_missing=True,
     )
+    try:
+        _check_not_missing(backend, args.row, args.column)
+    except BaseException:
+        backend.close()
+        raise
     where = _where(args, layout)
+    line = layout.enable
     for note in (intensity_note, duration_note):
         if note:
             print(note, flush=True)
+    if line is not None and args.backend == "drv2605":
+        print(f"Enable line {line.name} high: every chip is off and checked.", flush=True)
     print(
         f"Buzzing row {args.row}, column {args.column}{where} at intensity {intensity:g} "
         f"for {duration_ms:g} ms...",
@@ -97,8 +116,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"Interrupted after {elapsed_ms:.0f} ms.", flush=True)
         raise
     finally:
-        backend.close()  # all off first, then release the bus
-        print("Every motor is off.", flush=True)
+        backend.close()  # all off first (the enable line low before that), then the bus
+        after = (
+            "" if line is None or args.backend != "drv2605" else f" Enable line {line.name} low."
+        )
+        print(f"Every motor is off.{after}", flush=True)
     if isinstance(backend, SimBackend):
         for change in backend.changes:
             print(
@@ -106,6 +128,24 @@ def run(args: argparse.Namespace) -> int:
                 f"intensity {change.intensity:g}"
             )
     return 0
+
+
+def _check_not_missing(backend: Backend, row: int, column: int) -> None:
+    """Name the chips that did not answer (left out); HardwareError when ours is one."""
+    missing = getattr(backend, "missing", {})
+    for where in missing.values():
+        print(
+            f"Note: no DRV2605L answered on {where}: left out (check its wiring, or run "
+            "'feelmysign scan').",
+            file=sys.stderr,
+            flush=True,
+        )
+    if (row, column) in missing:
+        raise HardwareError(
+            f"Cannot buzz row {row}, column {column}: its DRV2605L, on {missing[(row, column)]}, "
+            "did not answer. Check that chip's wiring and power, or run 'feelmysign scan' to "
+            "see what answers where; every other motor was switched off."
+        )
 
 
 def _intensity(requested: float | None, layout: Layout) -> tuple[float, str]:

@@ -3,7 +3,9 @@
     feelmysign off --layout /etc/feelmysign/layout.toml
     feelmysign off --layout deploy/layouts/paper-sleeve.toml --emulate-state bus.json
 
-Writes "off" to every DRV2605L the layout wires (real-time level 0, then
+With an enable line in the layout (``i2c.enable``), drives it low first, so
+every motor stops at once whether its chip answers or not, and leaves it low.
+Then writes "off" to every DRV2605L the layout wires (real-time level 0, then
 standby), trying each one even when another does not answer, and checks
 nothing first. Meant for after a crash: the sleeve's service runs it as soon
 as the sleeve process has ended, however it ended (``ExecStopPost``), so a
@@ -18,6 +20,7 @@ import os
 
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.factory import enable_line_for
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import LAYOUT_ENV
@@ -62,12 +65,22 @@ def run(args: argparse.Namespace) -> int:
             open_state_bus(args.emulate_state, layout),
             f"the emulated bus in {args.emulate_state}",
         )
-    problems = Drv2605Backend(layout, bus=bus).switch_off_unchecked()
+    enable = enable_line_for(layout, bus)
+    problems = Drv2605Backend(layout, bus=bus, enable=enable).switch_off_unchecked()
+    if problems and enable is not None and not any("enable line" in p for p in problems):
+        listed = "\n".join(f"  - {p}" for p in problems)
+        print(
+            f"The {enable.description} is low, so every motor is off; these chips did not take "
+            f"the I2C off too ({where}):\n{listed}",
+            flush=True,
+        )
+        return 0
     if problems:
         listed = "\n".join(f"  - {p}" for p in problems)
         raise HardwareError(
             f"Not every motor could be switched off on {where}; if one keeps vibrating, cut the "
             f"sleeve's power:\n{listed}"
         )
-    print(f"Every motor is off ({len(layout.wiring)} DRV2605L on {where}).", flush=True)
+    line = "" if enable is None else f", and the {enable.description} is low"
+    print(f"Every motor is off ({len(layout.wiring)} DRV2605L on {where}{line}).", flush=True)
     return 0

@@ -5,10 +5,20 @@
     feelmysign scan --layout deploy/layouts/paper-sleeve.toml --emulate-state bus.json
 
 One line per channel of every multiplexer the layout lists: the actuator the
-layout expects there, what answered, and the verdict. Exit 0 when every wired
+layout expects there, what answered, and the verdict. With an enable line in the
+layout (``i2c.enable``), who holds it and, when nobody does, that it reads low
+(the pull-down): one that reads high with nobody driving it is a problem. Exit 0 when every wired
 actuator's DRV2605L answers and nothing answers where none is wired, 1
 otherwise (also when the layout wires nothing, as then nothing was checked).
 Only reads: no motor is switched on, and every channel is disabled afterwards.
+
+Below the table, each chip's motor settings (RATED_VOLTAGE, OD_CLAMP, DRIVE_TIME) against
+what the layout's motor asks for, its auto-calibration results (A_CAL_COMP, A_CAL_BEMF,
+BEMF_GAIN) and whether they are kept for the next start. ``--calibrate`` first runs the
+chips' auto-calibration again (each motor buzzes for about a second, one after another)
+and keeps the results: do it after changing a motor; the sleeve calibrates by itself a
+chip that has no result kept. Stop the sleeve first (``sudo systemctl stop
+feelmysign-sleeve``): two processes must not drive one bus.
 """
 
 from __future__ import annotations
@@ -19,11 +29,31 @@ import os
 from dataclasses import dataclass
 from typing import Any
 
-from feelmysign.backends.drv2605 import DRV2605_ADDRESS, SUPPORTED_DEVICE_IDS, device_name
+from feelmysign.backends.actuator_config import (
+    BEMF_GAIN_MASK,
+    CalibrationStore,
+    ChipSettings,
+    chip_settings,
+    motor_description,
+)
+from feelmysign.backends.drv2605 import (
+    DRV2605_ADDRESS,
+    SUPPORTED_DEVICE_IDS,
+    Drv2605Backend,
+    device_name,
+)
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
 from feelmysign.backends.emulated_state import open_state_bus
+from feelmysign.backends.enable import read_free_line
+from feelmysign.backends.factory import calibration_store_for, check_wired, enable_line_for
 from feelmysign.backends.i2c import I2CBus, open_smbus
-from feelmysign.backends.scan import LayoutReport, ScanResult, compare_with_layout, scan
+from feelmysign.backends.scan import (
+    LayoutReport,
+    ScanResult,
+    compare_with_layout,
+    read_motor_registers,
+    scan,
+)
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES
 from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.layout import LAYOUT_ENV
@@ -92,6 +122,12 @@ def register(subparsers: Subcommands) -> None:
         help="scan an emulated bus wired as the layout says, instead of /dev/i2c-N",
     )
     add_emulate_state_option(parser)
+    parser.add_argument(
+        "--calibrate",
+        action="store_true",
+        help="first run every chip's auto-calibration again and keep the results (each motor "
+        "buzzes for about a second); after changing a motor, with the sleeve stopped",
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object, for programs")
     parser.set_defaults(handler=run)
 
@@ -110,12 +146,29 @@ def run(args: argparse.Namespace) -> int:
         bus = EmulatedI2CBus.for_layout(layout)
     else:
         bus = _open_bus(bus_number)
+    # An emulated bus without a file keeps nothing: its calibration is not kept either.
+    store = None if args.emulate and not args.emulate_state else _store(layout, args)
+    calibration_problem = None
     try:
+        if args.calibrate:
+            calibration_problem = _calibrate(layout, bus, store)
         result = scan(bus, addresses)
+        line = _enable_line(layout, bus)
+        report = compare_with_layout(result, layout)
+        registers = read_motor_registers(bus, layout, result, report) if layout.wiring else {}
     finally:
         bus.close()
-    report = compare_with_layout(result, layout)
-    scanned = _Scanned(layout, bus_number, result, report, channel_rows(result, layout))
+    motors = _motor_rows(layout, registers, store)
+    scanned = _Scanned(
+        layout,
+        bus_number,
+        result,
+        report,
+        channel_rows(result, layout),
+        line,
+        motors,
+        calibration_problem,
+    )
     if args.json:
         print(json.dumps(_as_json(args, scanned)))
     else:
@@ -132,11 +185,193 @@ class _Scanned:
     result: ScanResult
     report: LayoutReport
     rows: list[ChannelRow]
+    enable: EnableReport | None = None
+    motors: list[MotorRow] | None = None
+    calibration_problem: str | None = None  # --calibrate, when it failed
 
     @property
     def ok(self) -> bool:
-        """Every wired actuator answers, and the layout wires some."""
-        return self.report.ok and bool(self.layout.wiring)
+        """Every wired actuator answers, the layout wires some, and its enable line is sound."""
+        line_ok = self.enable is None or self.enable.problem is None
+        calibrated = self.calibration_problem is None
+        return self.report.ok and bool(self.layout.wiring) and line_ok and calibrated
+
+
+@dataclass(frozen=True)
+class EnableReport:
+    """The enable line: who holds it, its level when it could be read, what is wrong."""
+
+    name: str
+    holder: str
+    level: bool | None
+    problem: str | None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "line": self.name,
+            "holder": self.holder,
+            "level": None if self.level is None else "high" if self.level else "low",
+            "problem": self.problem,
+        }
+
+    def describe(self) -> str:
+        level = "" if self.level is None else f", reads {'high' if self.level else 'low'}"
+        verdict = f": {self.problem}" if self.problem else ": ok"
+        return f"Enable line {self.name}: {self.holder}{level}{verdict}."
+
+
+@dataclass(frozen=True)
+class MotorRow:
+    """One chip's motor registers as read, against the layout's motor."""
+
+    wire: Wire
+    registers: dict[str, int]
+    stored: bool  # its calibration results are kept for the next start
+    settings: ChipSettings
+
+    @property
+    def drive_time(self) -> int:
+        return self.registers["control1"] & 0x1F
+
+    @property
+    def bemf_gain(self) -> int:
+        return self.registers["feedback_control"] & BEMF_GAIN_MASK
+
+    @property
+    def as_layout(self) -> bool:
+        """RATED_VOLTAGE, OD_CLAMP and DRIVE_TIME hold what the layout's motor asks for."""
+        return (
+            self.registers["rated_voltage"] == self.settings.rated_voltage
+            and self.registers["od_clamp"] == self.settings.od_clamp
+            and self.drive_time == self.settings.drive_time
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "multiplexer": f"0x{self.wire.multiplexer:02X}",
+            "channel": self.wire.channel,
+            "row": self.wire.row,
+            "column": self.wire.column,
+            "rated_voltage": self.registers["rated_voltage"],
+            "od_clamp": self.registers["od_clamp"],
+            "drive_time": self.drive_time,
+            "a_cal_comp": self.registers["a_cal_comp"],
+            "a_cal_bemf": self.registers["a_cal_bemf"],
+            "bemf_gain": self.bemf_gain,
+            "as_layout": self.as_layout,
+            "calibration_stored": self.stored,
+        }
+
+
+def _store(layout: Layout, args: argparse.Namespace) -> CalibrationStore:
+    return calibration_store_for(layout, args.emulate_state)
+
+
+def _calibrate(layout: Layout, bus: I2CBus, store: CalibrationStore | None) -> str | None:
+    """Every chip switched off, set up and auto-calibrated again, the results kept in ``store``;
+    what went wrong (every motor off then too), or None. The scan runs after it either way."""
+    check_wired(layout)
+    backend = Drv2605Backend(
+        layout, bus=bus, enable=enable_line_for(layout, bus), calibration=store, calibrate=True
+    )
+    try:
+        with backend:
+            pass  # open() calibrates; leaving switches every motor off
+    except HardwareError as error:  # open() switched every motor off before it raised
+        return str(error)
+    return None
+
+
+def _motor_rows(
+    layout: Layout,
+    registers: dict[tuple[int, int], dict[str, int]],
+    store: CalibrationStore | None,
+) -> list[MotorRow]:
+    if not layout.wiring:
+        return []
+    settings = chip_settings(layout)
+    stored = {} if store is None else store.results(motor_description(layout))
+    return [
+        MotorRow(
+            w,
+            registers[(w.multiplexer, w.channel)],
+            f"0x{w.multiplexer:02X}/{w.channel}" in stored,
+            settings,
+        )
+        for w in layout.wiring
+        if (w.multiplexer, w.channel) in registers
+    ]
+
+
+def _motor_lines(layout: Layout, motors: list[MotorRow]) -> list[str]:
+    settings = chip_settings(layout)
+    kind = layout.actuator_type
+    motor = (
+        f"{kind}, rated {layout.rated_voltage:g} V {'rms' if kind == 'LRA' else 'average'}, "
+        f"overdrive {layout.overdrive_voltage:g} V peak"
+        + (f", {layout.resonance_hz:g} Hz" if kind == "LRA" else "")
+    )
+    lines = [
+        f"Motor ({motor}): RATED_VOLTAGE 0x{settings.rated_voltage:02X}, OD_CLAMP "
+        f"0x{settings.od_clamp:02X}, DRIVE_TIME {settings.drive_time} by the DRV2605L datasheet.",
+        "",
+    ]
+    header = (
+        "actuator",
+        "RATED_VOLTAGE",
+        "OD_CLAMP",
+        "DRIVE_TIME",
+        "A_CAL_COMP",
+        "A_CAL_BEMF",
+        "BEMF_GAIN",
+        "settings",
+        "calibration",
+    )
+    cells = [header] + [
+        (
+            f"row {m.wire.row}, column {m.wire.column}",
+            f"0x{m.registers['rated_voltage']:02X}",
+            f"0x{m.registers['od_clamp']:02X}",
+            str(m.drive_time),
+            f"0x{m.registers['a_cal_comp']:02X}",
+            f"0x{m.registers['a_cal_bemf']:02X}",
+            str(m.bemf_gain),
+            "as layout" if m.as_layout else "not yet (set when the sleeve starts)",
+            "kept" if m.stored else "none kept (the sleeve calibrates it at its next start)",
+        )
+        for m in motors
+    ]
+    widths = [max(len(line[i]) for line in cells) for i in range(len(header))]
+    lines += [
+        "  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in cells
+    ]
+    return lines
+
+
+def _enable_line(layout: Layout, bus: I2CBus) -> EnableReport | None:
+    """The layout's enable line as it is now (read without driving it); None without one."""
+    enable = layout.enable
+    if enable is None:
+        return None
+    if isinstance(bus, EmulatedI2CBus):
+        line = bus.enable_line
+        if line is None or line.holder is None or not line.holder_alive:
+            holder, level = "free (nobody drives it; the pull-down holds it)", False
+        else:
+            holder, level = f"held by process {line.holder[0]}", line.effective_high
+        return EnableReport(enable.name, holder, level, None)
+    try:
+        holder, read = read_free_line(enable)
+    except HardwareError as error:
+        return EnableReport(enable.name, "not readable", None, str(error))
+    problem = None
+    if read:
+        problem = (
+            "it reads HIGH with nobody driving it, so a crash would leave the motors enabled: "
+            "fit the pull-down (10 kOhm from the line to GND) and check that no driver board "
+            "ties EN high (docs/sleeve-hardware.md)"
+        )
+    return EnableReport(enable.name, holder, read, problem)
 
 
 def _open_bus(bus_number: int) -> I2CBus:
@@ -193,7 +428,9 @@ def _found_and_status(
         return found, "UNEXPECTED" if has_driver else "free"
     if not has_driver:
         return found, "MISSING"
-    return found, "ok" if right_chip else "WRONG CHIP"
+    if not right_chip:
+        return found, "WRONG CHIP"
+    return found, "DRIVING" if scanned is not None and scanned.driving else "ok"
 
 
 def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
@@ -219,14 +456,20 @@ def _describe(args: argparse.Namespace, scanned: _Scanned) -> str:
             "",
         ]
     lines.append(_main_bus_line(result, layout))
+    if scanned.enable is not None:
+        lines.append(scanned.enable.describe())
     if not layout.wiring:
         lines.append(
             f"The layout {layout.name!r} wires no actuator, so nothing was checked: give "
             "--layout FILE with an [i2c] table (e.g. deploy/layouts/paper-sleeve.toml)."
         )
         return "\n".join(lines)
+    if scanned.motors:
+        lines += ["", *_motor_lines(layout, scanned.motors), ""]
+    if scanned.calibration_problem is not None:
+        lines += [f"Calibration failed: {scanned.calibration_problem}", ""]
     wired = len(report.wires)
-    answering = sum(1 for check in report.wires if check.status == "ok")
+    answering = sum(1 for check in report.wires if check.status in ("ok", "driving"))
     if report.ok:
         lines.append(f"All {wired} actuators answer as the layout says.")
     else:
@@ -285,5 +528,11 @@ def _as_json(args: argparse.Namespace, scanned: _Scanned) -> dict[str, Any]:
         "main_bus": [f"0x{a:02X}" for a in result.main_bus],
         "missing_multiplexers": [f"0x{a:02X}" for a in result.missing_multiplexers],
         "channels": [row.as_dict() for row in scanned.rows],
-        "problems": report.problems() if layout.wiring else ["the layout wires no actuator"],
+        "problems": (report.problems() if layout.wiring else ["the layout wires no actuator"])
+        + (
+            [] if scanned.enable is None or not scanned.enable.problem else [scanned.enable.problem]
+        ),
+        "enable": None if scanned.enable is None else scanned.enable.as_dict(),
+        "motors": [row.as_dict() for row in scanned.motors or []],
+        "calibration_problem": scanned.calibration_problem,
     }

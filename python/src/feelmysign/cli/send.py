@@ -19,35 +19,48 @@ from __future__ import annotations
 
 import argparse
 import functools
+import json
 import math
 import sys
+import threading
+import time
 import uuid
 from collections.abc import Iterator
 from dataclasses import replace
+from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli.options.broker import (
     add_broker_options,
     add_broker_timeout_option,
     broker_settings_from_args,
 )
-from feelmysign.cli.options.layout import add_layout_options, layout_from_args
+from feelmysign.cli.options.layout import add_layout_options, layout_from_args, layout_given
 from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
-from feelmysign.errors import ParameterError, StrokeError
-from feelmysign.events import StatusFloor
-from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, Layout
+from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
+from feelmysign.events import Event, Status, StatusFloor
+from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
+from feelmysign.outcome import DrawingOutcome, StrokeOutcome
 from feelmysign.protocol import Accepted, parse
 from feelmysign.sending import (
+    STATUS_WAIT_S,
     OutgoingStroke,
     Pace,
     StrokeSender,
     printer,
-    sleeve_floor_from_status,
+    sleeve_status,
 )
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
 from feelmysign.stroke import Stroke
-from feelmysign.topics import LEGACY_TOPIC
+from feelmysign.topics import LEGACY_TOPIC, telemetry_topic
+
+if TYPE_CHECKING:
+    import paho.mqtt.client as mqtt
+
+# The faintest intensity sent (the page's MIN_INTENSITY): at 0 the sleeve would play, and report
+# as played, a stroke no one feels; so 0 is refused here, with the range to give.
+MIN_INTENSITY = 0.01
 
 
 def _epilog() -> str:
@@ -114,9 +127,10 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("sending")
     group.add_argument(
         "--intensity",
-        type=number(0, 1),
+        type=number(MIN_INTENSITY, 1, unit="(at 0 the sleeve would play strokes no one feels)"),
         metavar="A",
-        help="intensity of every stroke in [0, 1] (default: the sleeve's default intensity)",
+        help=f"intensity of every stroke, from {MIN_INTENSITY:g} to 1 (default: the sleeve's "
+        "default intensity); 0 is refused: the sleeve would report as played what no one feels",
     )
     group.add_argument(
         "--legacy",
@@ -134,11 +148,25 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--pace",
         choices=("realtime", "burst"),
-        help="realtime: send each stroke when the previous one would have finished playing, "
-        "like a person drawing; burst: all at once (default: realtime for --shape, burst for "
-        "STROKEs)",
+        help="realtime (the default): send each stroke when the previous one would have "
+        "finished playing, like a person drawing; burst: all at once, so the sleeve, catching "
+        "up with a drawing that arrived ahead of it, plays every stroke after the first faster, "
+        "down to its floor (docs/protocol.md, Catching up)",
     )
-    add_broker_timeout_option(group, help_start="longest wait for the broker to answer, in seconds")
+    group.add_argument(
+        "--wait",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="wait for the sleeve's events for the strokes sent, print what it played or "
+        "refused, and exit 1 when any stroke was refused, cut or not answered within "
+        "--timeout-s after the drawing; returns once the last stroke has been felt (default: "
+        "--wait for --shape, --no-wait for STROKEs; not with --legacy)",
+    )
+    add_broker_timeout_option(
+        group,
+        help_start="longest wait for the broker to answer, and with --wait for the sleeve's "
+        "answers after the drawing's own time, in seconds",
+    )
     group.add_argument(
         "--json", action="store_true", help="print one JSON object per message sent, for programs"
     )
@@ -146,30 +174,205 @@ def _add_sending_options(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     _check_usage(args, parser)
-    layout = layout_from_args(args)
-    strokes = _strokes(args, layout)  # all checked before connecting: a bad one sends nothing
+    wait = _wait_asked(args, parser)
+    # A layout asked for is checked, and the strokes with it, before connecting: a bad one
+    # sends nothing. Without one, the sleeve's retained status gives it, once connected.
+    layout = layout_from_args(args) if layout_given(args) else None
+    texts = [] if args.shape else list(_stroke_texts(args.strokes))
+    # Without a layout, their form is checked now against any grid, their place once the
+    # sleeve's grid is known.
+    strokes = _strokes(args, layout or ANY_GRID, texts)
     settings = broker_settings_from_args(args, "sender")
-    topic = args.legacy_topic if args.legacy else settings.strokes_topic
-    messages = [OutgoingStroke(i, topic, stroke, args.legacy) for i, stroke in enumerate(strokes)]
-    pace: Pace = args.pace or ("realtime" if args.shape else "burst")
     client_id = f"feelmysign-send-{uuid.uuid4().hex[:12]}"
     client = connect_client(settings, client_id, timeout_s=args.timeout_s)
     try:
-        _say_floor(sleeve_floor_from_status(client, settings, wait_s=FLOOR_WAIT_S), strokes)
-        report = printer(json_lines=args.json, total=len(messages))
-        StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report).send(
-            messages, pace=pace
-        )
+        status = sleeve_status(client, settings, wait_s=STATUS_WAIT_S)
+        if layout is None:
+            layout = _layout_of_sleeve(status, settings)
+            strokes = _strokes(args, layout, texts)
+        _say_offline(status, settings, wait=wait)
+        _say_floor(None if status is None else status.floor, strokes)
+        topic = args.legacy_topic if args.legacy else settings.strokes_topic
+        messages = [OutgoingStroke(i, topic, s, args.legacy) for i, s in enumerate(strokes)]
+        outcome = _watch_events(client, settings, strokes, args) if wait else None
+        _send(client, settings, messages, args)
+        if not args.json:
+            print(_summary(args, settings, strokes), flush=True)
+        if outcome is None:
+            return 0
+        return _await_sleeve(outcome, settings, args, strokes)
     finally:
         client.disconnect()
         client.loop_stop()
-    if not args.json:
-        print(_summary(args, settings, strokes), flush=True)
-    return 0
 
 
-# The retained status comes right after the subscription; on a LAN far within this.
-FLOOR_WAIT_S = 1.0
+def _send(
+    client: mqtt.Client,
+    settings: BrokerSettings,
+    messages: list[OutgoingStroke],
+    args: argparse.Namespace,
+) -> None:
+    pace: Pace = args.pace or "realtime"
+    report = printer(json_lines=args.json, total=len(messages))
+    StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report).send(
+        messages, pace=pace
+    )
+
+
+def _wait_asked(args: argparse.Namespace, parser: argparse.ArgumentParser) -> bool:
+    if args.wait and args.legacy:
+        parser.error(
+            "--wait cannot be used with --legacy: a legacy stroke has no drawing id, so the "
+            "sleeve's events cannot be matched to it"
+        )
+    if args.wait is None:
+        return bool(args.shape) and not args.legacy
+    return bool(args.wait)
+
+
+def _layout_of_sleeve(status: Status | None, settings: BrokerSettings) -> Layout:
+    """The grid and limits the sleeve's status advertises; the paper's sleeve, said on stderr,
+    when the broker holds no status of it."""
+    if status is None or status.layout is None:
+        print(
+            f"No status from sleeve {settings.sleeve_id!r} at {settings.url} within "
+            f"{STATUS_WAIT_S:g} s (it has never connected to this broker, or is an older "
+            f"sleeve): strokes are checked against the paper's sleeve "
+            f"({PAPER_SLEEVE.rows} rows x {PAPER_SLEEVE.columns} columns). Give --layout FILE "
+            "or --rows/--columns for another grid.",
+            file=sys.stderr,
+            flush=True,
+        )
+        return PAPER_SLEEVE
+    advertised = status.layout
+    # Checked below by the layout rules (an actuator type from the wire is a plain string).
+    known: dict[str, Any] = {
+        name: value
+        for name, value in (
+            ("spacing_cm", advertised.spacing_cm),
+            ("default_intensity", advertised.default_intensity),
+            ("max_intensity", advertised.max_intensity),
+            ("max_stroke_duration_ms", advertised.max_stroke_duration_ms),
+            ("actuator_type", advertised.actuator_type),
+        )
+        if value is not None
+    }
+    name = advertised.name or settings.sleeve_id
+    try:
+        grid = replace(
+            PAPER_SLEEVE, name=name, rows=advertised.rows, columns=advertised.columns, **known
+        )
+        return check_layout(grid, f"the status of sleeve {settings.sleeve_id!r}")
+    except LayoutError as error:
+        raise LayoutError(
+            error.source, [*error.problems, "give --layout FILE with the sleeve's layout"]
+        ) from None
+
+
+def _say_offline(status: Status | None, settings: BrokerSettings, *, wait: bool) -> None:
+    if status is None or status.online:
+        return
+    then = (
+        f"the strokes wait at the broker until it returns; this command waits for its answer "
+        f"at most --timeout-s {'after the drawing' if wait else ''}".rstrip()
+        if wait
+        else "the strokes wait at the broker until it returns (and may be stale by then)"
+    )
+    print(
+        f"Sleeve {settings.sleeve_id!r} is offline (its last status): {then}.",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def _watch_events(
+    client: mqtt.Client, settings: BrokerSettings, strokes: list[Stroke], args: argparse.Namespace
+) -> DrawingOutcome:
+    """Subscribed to the sleeve's events before the first stroke goes out, so no answer is
+    missed; each answer printed as it comes."""
+    total = len(strokes)
+
+    def tell(seq: int, stroke: StrokeOutcome, event: Event) -> None:
+        print(_answer_line(seq, total, stroke, event, json_lines=args.json), flush=True)
+
+    outcome = DrawingOutcome(strokes[0].drawing or "", total, tell)
+    topic = telemetry_topic(settings.sleeve_id, "events")
+    client.message_callback_add(topic, outcome.on_message)
+    subscribed = threading.Event()
+    client.on_subscribe = lambda *_: subscribed.set()
+    # Subscribed again on a reconnection: a clean session forgets subscriptions.
+    client.on_connect = lambda c, *_: c.subscribe(topic, qos=1)
+    client.subscribe(topic, qos=1)
+    if not subscribed.wait(args.timeout_s):
+        raise BrokerConnectionError(
+            "timeout",
+            f"{settings.url} did not confirm the subscription to {topic} within "
+            f"{args.timeout_s:g} s; nothing was sent. Try again, or use --no-wait.",
+            url=settings.url,
+        )
+    return outcome
+
+
+def _answer_line(
+    seq: int, total: int, stroke: StrokeOutcome, event: Event, *, json_lines: bool
+) -> str:
+    if json_lines:
+        return json.dumps({"index": seq, "event": event.to_json()})
+    width = len(str(total))
+    where = f"[{seq + 1:>{width}}/{total}]"
+    if stroke.cut_reason is not None:
+        return f"{where} cut part-way ({stroke.cut_reason}): {getattr(event, 'message', '')}"
+    if stroke.refused_reason is not None:
+        return f"{where} refused ({stroke.refused_reason}): {stroke.refused_message or ''}".rstrip()
+    played = stroke.played
+    assert played is not None
+    how = f"{event.kind}" + (
+        f" ({getattr(event, 'reason', '')})" if event.kind == "adjusted" else ""
+    )
+    return (
+        f"{where} {how}: {played.duration_ms:g} ms, latency {played.latency_ms:.0f} ms, "
+        f"queued {played.queued_ms:.0f} ms"
+    )
+
+
+# Beyond the drawing's own time after the last stroke went out, the longest the sleeve's
+# answer may take is --timeout-s; a stroke played is then awaited until it has been felt,
+# at most this long (the sleeve's own cap on queued strokes).
+MAX_FELT_WAIT_S = 30.0
+
+
+def _await_sleeve(
+    outcome: DrawingOutcome,
+    settings: BrokerSettings,
+    args: argparse.Namespace,
+    strokes: list[Stroke],
+) -> int:
+    burst = (args.pace or "realtime") == "burst"
+    drawing_s = (
+        sum(s.duration_ms for s in strokes) / 1000 if burst else strokes[-1].duration_ms / 1000
+    )
+    answered_by_s = time.monotonic() + drawing_s + args.timeout_s
+    outcome.wait_answered(answered_by_s)
+    # Return once the last stroke has been felt, not when it started: a second send right
+    # after this one then starts on a sleeve with nothing left of this drawing.
+    felt_by_s = outcome.felt_by_s()
+    if felt_by_s is not None:
+        time.sleep(min(MAX_FELT_WAIT_S, max(0.0, felt_by_s - time.monotonic())))
+    summary = outcome.summary()
+    line = summary.text()
+    if summary.unheard:
+        unheard = ", ".join(str(seq + 1) for seq in summary.unheard)
+        line += (
+            f"; no answer for stroke(s) {unheard} within {args.timeout_s:g} s after the "
+            f"drawing: is sleeve {settings.sleeve_id!r} running and connected to "
+            f"{settings.url}? (--timeout-s waits longer; --no-wait does not wait)"
+        )
+    if summary.all_played and not summary.unheard:
+        if not args.json:
+            print(f"{line}.", flush=True)
+        return 0
+    print(f"Error: {line}.", file=sys.stderr, flush=True)
+    return 1
 
 
 def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
@@ -216,9 +419,26 @@ def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> N
         parser.error("--intensity cannot be sent with --legacy: the legacy format has no intensity")
 
 
-def _strokes(args: argparse.Namespace, layout: Layout) -> list[Stroke]:
-    if args.intensity is not None and not 0.0 <= args.intensity <= 1.0:
-        raise ParameterError("--intensity", args.intensity, "a number in [0, 1]")
+# What a stroke or shape is checked against before the sleeve's own grid is known.
+ANY_GRID = replace(
+    PAPER_SLEEVE,
+    name="any sleeve",
+    rows=MAX_GRID_SIDE,
+    columns=MAX_GRID_SIDE,
+    max_stroke_duration_ms=MAX_DURATION_MS,
+)
+
+
+def _strokes(
+    args: argparse.Namespace, layout: Layout, texts: list[tuple[str, str]]
+) -> list[Stroke]:
+    if args.intensity is not None and not MIN_INTENSITY <= args.intensity <= 1.0:
+        raise ParameterError(
+            "--intensity",
+            args.intensity,
+            f"a number from {MIN_INTENSITY:g} to 1 "
+            "(at 0 the sleeve would play strokes no one feels)",
+        )
     if args.shape:
         return shape_strokes(
             args.shape,
@@ -230,7 +450,7 @@ def _strokes(args: argparse.Namespace, layout: Layout) -> list[Stroke]:
         )
     drawing = str(uuid.uuid4())
     strokes = []
-    for seq, (where, text) in enumerate(_stroke_texts(args.strokes)):
+    for seq, (where, text) in enumerate(texts):
         result = parse(text, layout, format="legacy")
         if not isinstance(result, Accepted):
             raise result.as_error(f"{where} {text!r}", then=" Nothing was sent.")

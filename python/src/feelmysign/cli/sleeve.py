@@ -176,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
         record=args.record,
         emulate=args.emulate,
         emulate_state=args.emulate_state,
-        on_start=_stop_on_signals,
+        on_start=lambda sleeve: _on_start(sleeve, settings, options),
     )
     print(
         f"Sleeve {options.sleeve_id} stopped, every motor off "
@@ -220,6 +220,28 @@ def run_sleeve(
         on_start(sleeve)
         sleeve.run()
     return sleeve.counts
+
+
+def _on_start(sleeve: Sleeve, settings: BrokerSettings, options: SleeveOptions) -> None:
+    _stop_on_signals(sleeve)
+    _check_clock_meanwhile(settings, options)
+
+
+def _check_clock_meanwhile(settings: BrokerSettings, options: SleeveOptions) -> None:
+    """Compare this machine's clock with the broker's (feelmysign.broker_clock), on a thread
+    of its own, once the motors are open and off: the motors and the strokes never wait for
+    it; the log says what it found."""
+    import threading
+
+    from feelmysign.broker_clock import check_clock
+
+    threading.Thread(
+        target=check_clock,
+        args=(settings,),
+        kwargs={"max_age_ms": options.max_age_ms, "sleeve_id": options.sleeve_id},
+        name="feelmysign-clock-check",
+        daemon=True,
+    ).start()
 
 
 def _stop_on_signals(sleeve: Sleeve) -> None:

@@ -173,6 +173,16 @@ def _status(args: argparse.Namespace) -> int:
         print(
             f"  {row['code']}{kind}: {answered}/{len(trials)} answered, {unclear} unclear, {state}"
         )
+        for run in store.threshold_runs(row["code"]):
+            done = store.threshold_trials(run["id"])
+            what = "simulated threshold run (dry run)" if run["simulated"] else "threshold run"
+            unit = "grid units" if run["dimension"] == "length" else "ms"
+            result = (
+                f"finished, {run['threshold']:.3g} {unit}"
+                if run["finished_at_ms"] is not None and run["threshold"] is not None
+                else "unfinished (the same command resumes it)"
+            )
+            print(f"    {what} {run['id']} ({run['dimension']}): {len(done)} trials, {result}")
     if not store.participants():
         print("  no participant yet")
     return 0
@@ -233,6 +243,10 @@ def _analyse(args: argparse.Namespace) -> int:
         f"{analysis.participants} participants, {analysis.trials} trials, "
         f"{analysis.unclear} awaiting review."
     )
+    if analysis.model is not None:
+        from feelmysign.study.analysis.report import shape_test_sentence
+
+        print(shape_test_sentence(analysis.model.test))
     for path in analysis.files:
         print(path)
     return 0

@@ -152,8 +152,14 @@ def connect_client(
     *,
     timeout_s: float = DEFAULT_TIMEOUT_S,
     note: Callable[[str], None] = _to_stderr,
+    persistent_session: bool = False,
 ) -> mqtt.Client:
     """A client (clean start), logged in, its network loop running on a thread.
+
+    ``persistent_session``: MQTT 3.1.1 with clean session off instead (see ``new_client``):
+    the broker keeps the client's subscriptions and its QoS 1 messages while it is away, a
+    broker restarted from its saved state included, so a listener misses nothing published
+    while it reconnects.
 
     MQTT 5 where the broker offers it, because only its acknowledgements say when a
     publish is refused; MQTT 3.1.1 otherwise (``note`` says so). With several servers,
@@ -163,6 +169,8 @@ def connect_client(
     failure: BrokerConnectionError | None = None
     for endpoint in settings.endpoints():
         try:
+            if persistent_session:
+                return _connect_with(endpoint, client_id, timeout_s, None, persistent_session=True)
             return _connect_one(endpoint, client_id, timeout_s, note)
         except BrokerConnectionError as error:
             if error.reason == "login-refused":
@@ -193,11 +201,15 @@ def _connect_with(
     settings: BrokerSettings,
     client_id: str,
     timeout_s: float,
-    protocol: MQTTProtocolVersion,
+    protocol: MQTTProtocolVersion | None,
+    *,
+    persistent_session: bool = False,
 ) -> mqtt.Client:
     import paho.mqtt.client as mqtt
 
-    client = new_client(settings, client_id=client_id, protocol=protocol)
+    client = new_client(
+        settings, client_id=client_id, protocol=protocol, persistent_session=persistent_session
+    )
     client.connect_timeout = timeout_s
     try:
         answers = _send_login(client, settings, keepalive_s=KEEPALIVE_S)

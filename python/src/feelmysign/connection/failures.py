@@ -47,6 +47,13 @@ def connect_failure_message(settings: BrokerSettings, failure: BaseException | R
             f"No answer from {url}: check the host and port, the network and any firewall; "
             f"or {_START_HINT}."
         )
+    if isinstance(failure, ssl.SSLCertVerificationError) and settings.ca_file is None:
+        return (
+            f"The TLS handshake with {url} failed ({failure.reason or failure}): this machine "
+            "does not trust the broker's certificate. For a 'feelmysign broker --lan' broker, "
+            "send with the token of 'feelmysign broker add-sender' (--join TOKEN), or copy its "
+            "ca.pem here and give --ca FILE."
+        )
     if isinstance(failure, ssl.SSLError):
         return (
             f"The TLS handshake with {url} failed ({failure.reason or failure}): mqtts:// and "

@@ -6,7 +6,10 @@ reads it. The token is ``fms1.`` followed by URL-safe base64 of compact JSON::
     {"url": "mqtts://192.168.1.5:8883", "ca": "<sha-256 of the CA certificate, hex>",
      "id": "arm2", "user": "sleeve-arm2", "pass": "..."}
 
-``ca`` is absent for a broker whose certificate is publicly trusted. The token holds a
+``ca`` is absent for a broker whose certificate is publicly trusted. A sender's token
+(``feelmysign broker add-sender``, read by ``feelmysign send --join TOKEN``) also has
+``"role": "sender"``, its login is the sender's and ``id`` the sleeve it sends to; a
+token without ``role`` is a sleeve's. The token holds a
 password: treat it as one (the systemd unit reads it from a file only root can read).
 """
 
@@ -19,6 +22,7 @@ import os
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Literal
 
 from feelmysign.connection.pinned_ca import pinned_ca_file
 from feelmysign.connection.settings import BrokerSettings, parse_broker_url
@@ -26,6 +30,7 @@ from feelmysign.errors import BrokerConnectionError
 from feelmysign.input_files import loads_json
 
 TOKEN_PREFIX = "fms1."
+Role = Literal["sleeve", "sender"]
 _FINGERPRINT = re.compile(r"[0-9a-f]{64}")
 
 
@@ -36,12 +41,15 @@ class JoinToken:
     username: str
     password: str
     ca_fingerprint: str | None = None
+    role: Role = "sleeve"
 
     def encode(self) -> str:
         data = {"url": self.url, "id": self.sleeve_id, "user": self.username}
         data["pass"] = self.password
         if self.ca_fingerprint:
             data["ca"] = self.ca_fingerprint
+        if self.role != "sleeve":
+            data["role"] = self.role
         raw = json.dumps(data, separators=(",", ":")).encode()
         return TOKEN_PREFIX + base64.urlsafe_b64encode(raw).decode().rstrip("=")
 
@@ -53,9 +61,18 @@ class JoinToken:
         return replace(base, ca_file=ca_file)
 
 
-def join_settings(text: str, trust_dir: Path) -> BrokerSettings:
-    """Settings from a join token, its CA (if any) fetched, checked and kept in ``trust_dir``."""
+def join_settings(text: str, trust_dir: Path, *, role: Role = "sleeve") -> BrokerSettings:
+    """Settings from a join token for ``role``, its CA (if any) fetched, checked and kept in
+    ``trust_dir``."""
     token = decode_join_token(text)
+    if token.role != role:
+        made_by = {"sleeve": "add-sleeve ID", "sender": "add-sender"}
+        raise BrokerConnectionError(
+            "bad-token",
+            f"This join token is a {token.role}'s (from 'feelmysign broker "
+            f"{made_by[token.role]}'), not a {role}'s: its account may not do what a {role} "
+            f"does. Use the token of 'feelmysign broker {made_by[role]}'.",
+        )
     settings = token.settings()
     if token.ca_fingerprint is None:
         return settings
@@ -88,11 +105,14 @@ def decode_join_token(text: str) -> JoinToken:
         not isinstance(fingerprint, str) or not _FINGERPRINT.fullmatch(fingerprint)
     ):
         raise _bad("its CA fingerprint is not 64 hex digits")
-    joined = JoinToken(data["url"], data["id"], data["user"], data["pass"], fingerprint)
+    role = data.get("role", "sleeve")
+    if role not in ("sleeve", "sender"):
+        raise _bad(f"its role {role!r} is neither 'sleeve' nor 'sender'")
+    joined = JoinToken(data["url"], data["id"], data["user"], data["pass"], fingerprint, role)
     settings = joined.settings()  # checks the URL
     if not settings.tls and not settings.on_loopback:
         raise _bad(
-            f"its URL {joined.url} is not mqtts:// or wss://; a sleeve joins over TLS "
+            f"its URL {joined.url} is not mqtts:// or wss://; a {role} joins over TLS "
             "unless it runs on the broker's machine (a loopback URL)"
         )
     return joined

@@ -14,9 +14,14 @@ sleeve skipped for being too far behind is a ``late`` refusal, under rejected.
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
 of the strokes queued before it) to its first motor: the sleeve's own lateness,
-not the wait behind a drawing sent all at once. A stroke cut short by a stop
-was played: it counts once, as played (and cut short). A stroke the duty-cycle
-cap kept from playing counts as rejected (``duty_cycle``), like any refusal.
+not the wait behind a drawing sent all at once. What became of each stroke
+(played, cut short, cancelled, rejected) is :mod:`feelmysign.fates`, the rule the
+page and the study report from too: each stroke is counted once, under one fate,
+so the counts add up to the strokes the sleeve answered. A stroke cut short by a
+stop counts as cut short, not played; a copy the broker delivered again after a
+restart (a ``duplicate``) leaves its stroke as it was, played once. A stroke the
+duty-cycle cap kept from playing counts as rejected (``duty_cycle``), like any
+refusal.
 A drawing is over when it has been quiet for ``QUIET_S`` and an event of another
 drawing has come since (the next drawing started), or once it has been quiet for ``IDLE_S``,
 or when ``up`` stops. A pen that rests a few seconds therefore does not split a
@@ -34,8 +39,7 @@ from __future__ import annotations
 
 import statistics
 import threading
-import uuid
-from collections import Counter, OrderedDict
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -54,6 +58,7 @@ from feelmysign.events import (
     event_from_json,
     is_delayed,
 )
+from feelmysign.fates import DrawingFates
 from feelmysign.topics import telemetry_topic
 
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
@@ -72,11 +77,8 @@ class _Drawing:
     last_event_s: float
     last_event_index: int = 0  # the summaries' event count at its last event
     printed: bool = False  # its line was printed: the next one says "(updated)"
-    played: int = 0
+    fates: DrawingFates = field(default_factory=DrawingFates)
     slowed: int = 0
-    cut_short: int = 0  # played, then stopped by a control message: counted in played only
-    cancelled: int = 0  # dropped by a control message before it played
-    rejected: Counter[str] = field(default_factory=Counter)
     delays_ms: list[float] = field(default_factory=list)
     delays_on_the_way_ms: list[float] = field(default_factory=list)  # of the delayed ones
 
@@ -84,19 +86,21 @@ class _Drawing:
         shown = name if name == NO_DRAWING else f"Drawing {name[:SHOWN_ID_CHARS]}"
         if self.printed:
             shown += " (updated)"
-        parts = [f"{self.played} stroke{'s' if self.played != 1 else ''} played"]
-        notes = [f"{self.slowed} slowed to be felt"] if self.slowed else []
-        notes += [f"{self.cut_short} cut short"] if self.cut_short else []
-        if notes:
-            parts[0] += f" ({', '.join(notes)})"
+        counts = self.fates.counts()
+        played = counts["played"]
+        parts = [f"{played} stroke{'s' if played != 1 else ''} played"]
+        if self.slowed:
+            parts[0] += f" ({self.slowed} slowed to be felt)"
+        if counts["cut"]:
+            parts.append(f"{counts['cut']} cut short")
         if delayed := self.delays_on_the_way_ms:
             parts.append(f"{len(delayed)} delayed on the way (by {_seconds(max(delayed))}")
             parts[-1] += " at most)" if len(delayed) > 1 else ")"
-        if self.rejected:
-            reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in self.rejected.items())
-            parts.append(f"{sum(self.rejected.values())} rejected ({reasons})")
-        if self.cancelled:
-            parts.append(f"{self.cancelled} cancelled")
+        if rejected := self.fates.refusals():
+            reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in rejected.items())
+            parts.append(f"{sum(rejected.values())} rejected ({reasons})")
+        if counts["cancelled"]:
+            parts.append(f"{counts['cancelled']} cancelled")
         text = f"{shown}: " + ", ".join(parts)
         if self.delays_ms:
             text += (
@@ -126,7 +130,7 @@ class DrawingSummaries:
         if self._copies.is_copy(event):
             return
         if isinstance(event, Safety) and event.received_at_ms is None:
-            return  # a motor protected outside any stroke (off_failed): the sleeve logs it
+            return  # about a chip, outside any stroke (chip_lost, chip_back): the sleeve logs it
         if not isinstance(event, Played | Rejected | Cancelled | Safety):
             return  # error events are logged by the sleeve itself
         name = event.drawing or NO_DRAWING
@@ -136,19 +140,13 @@ class DrawingSummaries:
         self._events += 1
         drawing.last_event_s = now_s
         drawing.last_event_index = self._events
+        drawing.fates.add(event)
         if isinstance(event, Played):
-            drawing.played += 1
             drawing.slowed += isinstance(event, Adjusted)
             drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
             delay_ms = delivery_delay_ms(event)
             if delay_ms is not None and is_delayed(event):
                 drawing.delays_on_the_way_ms.append(delay_ms)
-        elif isinstance(event, Rejected | Safety):  # Safety here: a stroke the cap refused
-            drawing.rejected[event.reason] += 1
-        elif event.started:  # its played event counted it already
-            drawing.cut_short += 1
-        else:
-            drawing.cancelled += 1
 
     def _is_over(self, name: str, drawing: _Drawing, now_s: float) -> bool:
         quiet_s = now_s - drawing.last_event_s
@@ -197,6 +195,7 @@ class DrawingLog:
 
         self._settings = settings
         self._topic = telemetry_topic(sleeve_id, "events")
+        self._sleeve_id = sleeve_id
         self._emit = emit
         self._clock = clock or time.monotonic
         self._summaries = DrawingSummaries()
@@ -212,7 +211,13 @@ class DrawingLog:
         from feelmysign.errors import FeelMySignError
 
         try:
-            client = connect_client(self._settings, f"feelmysign-up-log-{uuid.uuid4().hex[:12]}")
+            # A persistent session: the broker keeps the log's subscription and the events
+            # published while it reconnects (a broker restarted from its saved state too), so
+            # a drawing's line has all of its strokes. One session per sleeve: up runs the
+            # broker and the sleeve with it, so nothing is queued for it between two runs.
+            client = connect_client(
+                self._settings, f"feelmysign-up-log-{self._sleeve_id}", persistent_session=True
+            )
         except FeelMySignError as error:
             self._emit(f"No per-drawing log: cannot listen to the sleeve's events ({error}).")
             return self

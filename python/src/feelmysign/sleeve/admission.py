@@ -116,8 +116,13 @@ CANCELLED_MESSAGE = "dropped by a control message before it played"
 HELD_MESSAGE = "a copy of a stroke waiting to play: it waits with it"
 
 
-def duplicate_message(drawing: object, seq: object) -> str:
-    return f"stroke {seq} of drawing {drawing} was already played or refused"
+def duplicate_message(drawing: object, seq: object, played: bool | None = None) -> str:
+    """The sentence of a ``duplicate`` refusal; ``played``: whether the original started."""
+    if played is None:
+        return f"stroke {seq} of drawing {drawing} was already played or refused"
+    if played:
+        return f"stroke {seq} of drawing {drawing} came again; it was played once already"
+    return f"stroke {seq} of drawing {drawing} came again; it was not played before either"
 
 
 def copy_of(

@@ -38,7 +38,10 @@ as ``cancelled``.
 Each ``seq`` of a drawing plays once: a copy of one accepted before is
 ``held`` while the original waits to play (its acknowledgement waits for it)
 and a ``duplicate`` after. A gap never waits for the missing seq, and a
-missing one that comes after later ones still plays.
+missing one that comes after later ones still plays. The queue also keeps
+which seqs started playing (``mark_started``), so that a duplicate's refusal
+can say whether its original was felt: a copy of a played stroke is no news
+to its sender, a copy of a refused one is.
 
 Pure (numbers in, numbers out; no clock, no thread, no I/O): the player keeps
 one :class:`Queue` under its lock, and :func:`replay` runs a whole sequence of
@@ -122,12 +125,14 @@ class Queue:
     Not thread-safe: the player calls it under its lock.
     """
 
-    __slots__ = ("_seen", "tail_drawing", "tail_ms")
+    __slots__ = ("_seen", "_started", "tail_drawing", "tail_ms")
 
     def __init__(self) -> None:
         self.tail_ms = NEVER_MS
         self.tail_drawing: str | None = None  # the drawing of the stroke that ends at the tail
         self._seen: OrderedDict[str, SeenSeqs] = OrderedDict()
+        # Of the seen seqs, those that started playing (kept for the same drawings).
+        self._started: dict[str, SeenSeqs] = {}
 
     def place(
         self, arrival_ms: float, duration_ms: float, drawing: str | None = None, seq: int = 0
@@ -172,6 +177,19 @@ class Queue:
         seqs = self._seen.get(drawing)
         return seqs is not None and seq in seqs
 
+    def mark_started(self, drawing: object, seq: object) -> None:
+        """A seen seq of a drawing started playing (its ``played`` event went out)."""
+        if not isinstance(drawing, str) or not isinstance(seq, int) or drawing not in self._seen:
+            return
+        self._started.setdefault(drawing, SeenSeqs()).add(seq)
+
+    def started(self, drawing: object, seq: object) -> bool:
+        """Whether this seq of this drawing started playing (cut short later or not)."""
+        if not isinstance(drawing, str) or not isinstance(seq, int):
+            return False
+        seqs = self._started.get(drawing)
+        return seqs is not None and seq in seqs
+
     def remember(self, drawing: str, seq: int) -> None:
         """A seq of a drawing settled without being placed: a copy of it is seen too. Placed
         as a stroke of no duration at the tail, which leaves the tail where it is."""
@@ -180,7 +198,8 @@ class Queue:
     def _new_drawing(self, drawing: str) -> SeenSeqs:
         seqs = self._seen[drawing] = SeenSeqs()
         while len(self._seen) > REMEMBERED_DRAWINGS:
-            self._seen.popitem(last=False)
+            forgotten, _ = self._seen.popitem(last=False)
+            self._started.pop(forgotten, None)
         return seqs
 
 

@@ -219,7 +219,8 @@ class StudyApi:
             self._analysing.release()
         return {
             "folder": str(out),
-            "files": [p.name for p in analysis.files],
+            # The files the page can fetch (GET results/NAME): the folder's own, not bids/.
+            "files": [p.name for p in analysis.files if p.parent == out],
             "report": (out / "report.md").read_text(encoding="utf-8"),
             "participants": analysis.participants,
             "unclear": analysis.unclear,

@@ -1,5 +1,5 @@
 """Export a study: anonymised long-format CSV (one row per trial), the questionnaire, the
-threshold trials, and the design as JSON.
+comfort check, the threshold trials, and the design as JSON.
 
 Anonymised: participant codes are replaced by P01, P02, ... in the order they
 were added (the codes may be on signed consent forms; the export must not link
@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from feelmysign.study.bids import export_bids
 from feelmysign.study.runner import events_summary
 from feelmysign.study.store import StudyStore
 
@@ -78,7 +79,9 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                 else int(coding is not None and coding["shape"] == trial["shape"])
             )
             level = trial["level"]
-            first_sent = sends[0]["sent_at_ms"] if sends else trial["answered_at_ms"]
+            # From the send the answer follows (a repeat send restarts the clock; so does a
+            # restart of the session, which sends again).
+            last_sent = sends[-1]["sent_at_ms"] if sends else trial["answered_at_ms"]
             out.append(
                 {
                     "participant": labels[participant["code"]],
@@ -106,7 +109,7 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                     if summary["latency_ms_max"] is None
                     else summary["latency_ms_max"],
                     "felt_duration_ms": summary["felt_duration_ms"],
-                    "response_time_s": round((trial["answered_at_ms"] - first_sent) / 1000, 3),
+                    "response_time_s": round((trial["answered_at_ms"] - last_sent) / 1000, 3),
                 }
             )
     return out
@@ -127,6 +130,33 @@ def questionnaire_rows(store: StudyStore) -> list[dict[str, Any]]:
     ]
 
 
+COMFORT_COLUMNS = ("participant", "simulated", "item", "question", "answer", "adjusted")
+
+
+def comfort_rows(store: StudyStore) -> list[dict[str, Any]]:
+    """The comfort check (section 6.1 step 2), one row per participant and question: the
+    answer yes/no, and whether the sleeve was adjusted (the same on each of their rows)."""
+    labels = anonymous_labels(store)
+    questions = store.design.comfort
+    out = []
+    for participant in store.participants():
+        if participant["comfort_json"] is None:
+            continue
+        check = json.loads(participant["comfort_json"])
+        for item, answer in enumerate(check["answers"]):
+            out.append(
+                {
+                    "participant": labels[participant["code"]],
+                    "simulated": int(participant["simulated"]),
+                    "item": item + 1,
+                    "question": questions[item] if item < len(questions) else "",
+                    "answer": "yes" if answer else "no",
+                    "adjusted": "yes" if check["adjusted"] else "no",
+                }
+            )
+    return out
+
+
 def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
     labels = anonymous_labels(store)
     out = []
@@ -136,6 +166,7 @@ def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
                 {
                     "participant": labels[run["participant"]],
                     "run": run["id"],
+                    "simulated": int(run["simulated"]),
                     "dimension": run["dimension"],
                     "trial": trial["position"] + 1,
                     "value": trial["value"],
@@ -155,16 +186,19 @@ def _write_csv(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...])
 
 
 def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
-    """Write trials.csv, questionnaire.csv, threshold.csv and design.json into ``out_dir``."""
+    """Write trials.csv, questionnaire.csv, comfort.csv, threshold.csv and design.json into
+    ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {
         "trials.csv": (trial_rows(store), TRIAL_COLUMNS),
         "questionnaire.csv": (questionnaire_rows(store), ("participant", "item", "text", "value")),
+        "comfort.csv": (comfort_rows(store), COMFORT_COLUMNS),
         "threshold.csv": (
             threshold_rows(store),
             (
                 "participant",
                 "run",
+                "simulated",
                 "dimension",
                 "trial",
                 "value",
@@ -175,10 +209,12 @@ def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
         ),
     }
     written = []
+    trials = files["trials.csv"][0]
     for name, (rows, columns) in files.items():
         _write_csv(out_dir / name, rows, columns)
         written.append(out_dir / name)
     design = out_dir / "design.json"
     design.write_text(json.dumps(store.design.to_json(), indent=2) + "\n", encoding="utf-8")
     written.append(design)
+    written += export_bids(store, trials, out_dir / "bids")
     return written

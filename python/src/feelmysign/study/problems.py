@@ -96,6 +96,14 @@ class Problems:
     def array(self, key: str, value: Any, *, required: bool = True) -> list[Any] | None:
         if self._absent(key, value, "a list [...]", required):
             return None
+        if isinstance(value, dict) and "." not in key and "[" not in key:
+            # [practice] written where [[practice]] was meant: one table, not a list of them.
+            self.add(
+                key,
+                f"must be a list of tables: write each entry as [[{key}]] (two brackets), "
+                f"not [{key}]; got one table {show(value)}",
+            )
+            return None
         if not isinstance(value, list):
             self.add(key, f"must be a list [...]; got {show(value)}")
             return None

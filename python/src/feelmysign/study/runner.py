@@ -19,7 +19,8 @@ from collections.abc import Callable
 from typing import Any
 
 from feelmysign.errors import FeelMySignError, StudyError
-from feelmysign.events import Adjusted, Event, EventError, Played, Rejected, event_from_json
+from feelmysign.events import Adjusted, Event, EventError, Played, event_from_json
+from feelmysign.fates import DrawingFates
 from feelmysign.layout import Layout
 from feelmysign.schedule import stroke_to_json
 from feelmysign.stroke import Point, Stroke
@@ -55,13 +56,21 @@ def sleeve_events(events: list[dict[str, Any]]) -> list[Event]:
 
 
 def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]:
+    """What became of a send's strokes, by the rule the page and ``up`` report from
+    (:mod:`feelmysign.fates`): each stroke once, under one fate."""
     typed = sleeve_events(events)
     played = [e for e in typed if isinstance(e, Played)]  # adjusted ones were played too
+    fates = DrawingFates()
+    for event in typed:
+        fates.add(event)
+    counts = fates.counts()
     return {
         "strokes": strokes,
-        "played": len(played),
+        "played": counts["played"],
+        "cut_short": counts["cut"],
+        "cancelled": counts["cancelled"],
         "adjusted": sum(1 for e in typed if isinstance(e, Adjusted)),
-        "rejected": [e.reason for e in typed if isinstance(e, Rejected)],
+        "rejected": list(fates.refusals().elements()),
         "latency_ms_max": round(max(e.latency_ms for e in played), 3) if played else None,
         "felt_duration_ms": round(sum(float(e.duration_ms) for e in played), 1),
     }
@@ -247,10 +256,11 @@ class Session:
         strokes = [stroke_from_json(s) for s in json.loads(sends[-1]["strokes_json"])]
         from feelmysign.study.simulated import SimulatedParticipant
 
+        # The participant's number and the trial's position, not their random code and row
+        # id: the same seed then gives the same answers in every new study file.
         participant = SimulatedParticipant(seed=self._simulation_seed + int(row["number"]))
-        result = participant.answer(
-            strokes, self.layout, self.store.design, self._templates, f"{row['code']}:{trial['id']}"
-        )
+        key = f"{row['number']}:{trial['position']}"
+        result = participant.answer(strokes, self.layout, self.store.design, self._templates, key)
         return {
             "answer": result.answer,
             "felt_nothing": result.felt_nothing,

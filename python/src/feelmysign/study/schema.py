@@ -6,7 +6,12 @@ answer is a new ``codings`` row, so every decision is kept with its time.
 
 from __future__ import annotations
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+# Version 1 had no ``threshold_runs.simulated``; such a file is migrated when opened, after a
+# backup (``store.StudyStore``).
+MIGRATIONS = {
+    1: ("ALTER TABLE threshold_runs ADD COLUMN simulated INTEGER NOT NULL DEFAULT 0",),
+}
 
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (
@@ -92,7 +97,8 @@ CREATE TABLE IF NOT EXISTS threshold_runs (
     threshold REAL,
     low REAL,
     high REAL,
-    stop_reason TEXT
+    stop_reason TEXT,
+    simulated INTEGER NOT NULL DEFAULT 0  -- 1: a dry run (a simulated observer answered)
 );
 CREATE TABLE IF NOT EXISTS threshold_trials (
     id INTEGER PRIMARY KEY,

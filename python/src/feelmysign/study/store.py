@@ -15,7 +15,7 @@ import secrets
 import sqlite3
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -26,7 +26,7 @@ from feelmysign.input_files import UnusableFile, check_kind
 from feelmysign.study.design import Design
 from feelmysign.study.design_file import parse_design
 from feelmysign.study.order import participant_order
-from feelmysign.study.schema import SCHEMA, SCHEMA_VERSION
+from feelmysign.study.schema import MIGRATIONS, SCHEMA, SCHEMA_VERSION
 
 # Participant codes: 5 characters without look-alikes (0/O, 1/I/L): 28^5 = 17 million.
 CODE_ALPHABET = "23456789ABCDEFGHJKMNPQRSTUVWXYZ"
@@ -44,8 +44,15 @@ class StudyStore:
         self.path = Path(path)
         self._check_path()
         self._lock = threading.RLock()
+        # The time every row is stamped with: the wall clock, or a dry run's simulated one
+        # (so that a dry run's response times, and so its export, follow from its seed).
+        self.clock: Callable[[], int] = now_ms
+        self.migrated_from: Path | None = None  # the backup, when this open migrated the file
         self._db = self._connect(self.path)
         version = self.meta("schema_version")
+        if version is not None and version.isdigit() and int(version) in MIGRATIONS:
+            self._migrate(int(version))
+            version = self.meta("schema_version")
         if version != str(SCHEMA_VERSION):
             raise StudyError(
                 f"{self.path} is not a study file of this version (schema {version!r}, "
@@ -58,6 +65,25 @@ class StudyStore:
             base_dir=base_dir,
         )
         self.base_dir = base_dir
+
+    def _migrate(self, version: int) -> None:
+        """Bring a study file of an earlier version up to this one, after a backup of it
+        beside it (``NAME.schema-V.bak``, every answer as it was), one step at a time."""
+        backup = self.path.with_name(f"{self.path.name}.schema-{version}.bak")
+        if not backup.exists():
+            target = sqlite3.connect(backup)
+            with target:
+                self._db.backup(target)
+            target.close()
+        while version in MIGRATIONS:
+            with self._transaction() as db:
+                for statement in MIGRATIONS[version]:
+                    db.execute(statement)
+                version += 1
+                db.execute(
+                    "UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(version),)
+                )
+        self.migrated_from = backup
 
     def _check_path(self) -> None:
         """A study file is there and is a regular file (``os.stat`` does not block on a fifo)."""
@@ -147,7 +173,7 @@ class StudyStore:
             db.execute(
                 "INSERT INTO participants (code, number, created_at_ms, simulated) "
                 "VALUES (?,?,?,?)",
-                (code, number, now_ms(), int(simulated)),
+                (code, number, self.clock(), int(simulated)),
             )
             for position, trial in enumerate(participant_order(self.design, number)):
                 db.execute(
@@ -189,7 +215,7 @@ class StudyStore:
         with self._transaction() as db:
             db.execute(
                 "UPDATE participants SET consent = ?, consent_at_ms = ? WHERE code = ?",
-                (int(consent), now_ms(), code),
+                (int(consent), self.clock(), code),
             )
 
     def record_comfort(self, code: str, answers: list[bool], adjusted: bool) -> None:
@@ -204,7 +230,7 @@ class StudyStore:
         with self._transaction() as db:
             db.execute(
                 "UPDATE participants SET comfort_json = ?, comfort_at_ms = ? WHERE code = ?",
-                (data, now_ms(), row["code"]),
+                (data, self.clock(), row["code"]),
             )
 
     def _require_consent(self, row: sqlite3.Row) -> None:
@@ -226,13 +252,13 @@ class StudyStore:
             if paused:
                 db.execute(
                     "INSERT INTO pauses (participant, paused_at_ms) VALUES (?, ?)",
-                    (row["code"], now_ms()),
+                    (row["code"], self.clock()),
                 )
             else:
                 db.execute(
                     "UPDATE pauses SET resumed_at_ms = ? WHERE participant = ? AND resumed_at_ms "
                     "IS NULL",
-                    (now_ms(), row["code"]),
+                    (self.clock(), row["code"]),
                 )
 
     def withdraw(self, code: str) -> None:
@@ -266,7 +292,7 @@ class StudyStore:
         with self._transaction() as db:
             cursor = db.execute(
                 "INSERT INTO sends (trial, drawing, sent_at_ms, strokes_json) VALUES (?,?,?,?)",
-                (trial_id, drawing, now_ms(), json.dumps(strokes)),
+                (trial_id, drawing, self.clock(), json.dumps(strokes)),
             )
             return int(cursor.lastrowid or 0)
 
@@ -310,7 +336,7 @@ class StudyStore:
         """The answer, once (a second answer to a trial is refused), and its automatic coding."""
         trial = self.trial(trial_id)
         self._require_consent(self.participant(trial["participant"]))
-        at_ms = now_ms()
+        at_ms = self.clock()
         with self._transaction() as db:
             cursor = db.execute(
                 "UPDATE trials SET answer = ?, felt_nothing = ?, confidence = ?, "
@@ -351,7 +377,7 @@ class StudyStore:
             db.execute(
                 "INSERT INTO codings (trial, status, shape, rule, decided_by, decided_at_ms) "
                 "VALUES (?,?,?,?,?,?)",
-                (trial_id, "shape" if shape else "none", shape, rule, "researcher", now_ms()),
+                (trial_id, "shape" if shape else "none", shape, rule, "researcher", self.clock()),
             )
 
     def latest_codings(self) -> dict[int, sqlite3.Row]:
@@ -375,7 +401,7 @@ class StudyStore:
                 f"the questionnaire has {len(items)} item(s), each answered 1..{points}; got "
                 f"{values}"
             )
-        at_ms = now_ms()
+        at_ms = self.clock()
         with self._transaction() as db:
             for item, value in enumerate(values):
                 db.execute(
@@ -399,23 +425,32 @@ class StudyStore:
         count = db.execute("SELECT COUNT(*) FROM questionnaire WHERE participant = ?", (code,))
         return bool(count.fetchone()[0])
 
-    @staticmethod
-    def _finish(db: sqlite3.Connection, code: str) -> None:
+    def _finish(self, db: sqlite3.Connection, code: str) -> None:
         db.execute(
             "UPDATE participants SET finished_at_ms = ? WHERE code = ? AND finished_at_ms IS NULL",
-            (now_ms(), code),
+            (self.clock(), code),
         )
 
     # ---- threshold procedure -----------------------------------------------------------
 
-    def start_threshold_run(self, code: str, dimension: str, settings: dict[str, Any]) -> int:
+    def start_threshold_run(
+        self, code: str, dimension: str, settings: dict[str, Any], *, simulated: bool = False
+    ) -> int:
+        """A new run; ``simulated`` (or a simulated participant's) runs are dry runs, kept
+        apart from measurements in the export and the analysis."""
         row = self.participant(code)
         self._require_consent(row)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO threshold_runs (participant, dimension, settings_json, started_at_ms) "
-                "VALUES (?,?,?,?)",
-                (row["code"], dimension, json.dumps(settings), now_ms()),
+                "INSERT INTO threshold_runs (participant, dimension, settings_json, started_at_ms, "
+                "simulated) VALUES (?,?,?,?,?)",
+                (
+                    row["code"],
+                    dimension,
+                    json.dumps(settings),
+                    self.clock(),
+                    int(simulated or bool(row["simulated"])),
+                ),
             )
             return int(cursor.lastrowid or 0)
 
@@ -458,7 +493,7 @@ class StudyStore:
                     response,
                     int(direction == response),
                     json.dumps(events),
-                    now_ms(),
+                    self.clock(),
                 ),
             )
             return int(position)
@@ -475,7 +510,7 @@ class StudyStore:
             db.execute(
                 "UPDATE threshold_runs SET finished_at_ms = ?, threshold = ?, low = ?, high = ?, "
                 "stop_reason = ? WHERE id = ?",
-                (now_ms(), threshold, low, high, stop_reason, run_id),
+                (self.clock(), threshold, low, high, stop_reason, run_id),
             )
 
 

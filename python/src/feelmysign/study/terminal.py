@@ -17,6 +17,17 @@ def _yes(question: str) -> bool:
 
 
 def run_in_terminal(store: StudyStore, settings: BrokerSettings, participant: str | None) -> int:
+    try:
+        return _session(store, settings, participant)
+    except EOFError:  # Ctrl-D, or the end of piped input: every answer given is stored
+        print(
+            "\nStopped at the end of input; every answer given is stored. Resume with "
+            "--participant and the code printed above."
+        )
+        return 0
+
+
+def _session(store: StudyStore, settings: BrokerSettings, participant: str | None) -> int:
     with SleeveLink(settings) as link:
         session = Session(store, link.play)
         code = participant or store.add_participant()
@@ -35,12 +46,12 @@ def run_in_terminal(store: StudyStore, settings: BrokerSettings, participant: st
             what = trial["resolution"] or "practice"
             print(
                 f"Trial {trial['number']}/{trial['total']}: {trial['shape']}, {what}, "
-                f"{trial['segments']} strokes"
+                f"{_plural(trial['segments'], 'stroke')}"
             )
             input("  Enter sends the shape to the sleeve. ")
             sent = session.send(code)
             print(
-                f"  played {sent['played']}/{sent['strokes']} strokes, "
+                f"  played {sent['played']}/{_plural(sent['strokes'], 'stroke')}, "
                 f"rejected {sent['rejected'] or 'none'}"
             )
             answer = input("  Answer (empty = felt nothing, 'r' = send again): ").strip()
@@ -71,18 +82,48 @@ def run_in_terminal(store: StudyStore, settings: BrokerSettings, participant: st
 
 
 def review_in_terminal(store: StudyStore) -> int:
+    """Decide each unclear answer, blind: the prompt shows the answer and names its item,
+    never the shape that was sent. A reply that is not a choice is asked again; every
+    decision is stored at once, so Ctrl-D (or the end of piped input) stops with every
+    earlier one kept, and the same command goes on with the rest."""
+    from feelmysign.study.export import anonymous_labels
+
     shapes = store.design.shape_names
+    labels = anonymous_labels(store)
     codings = store.latest_codings()
     waiting = [t for t, c in codings.items() if c["status"] == "unclear"]
+    choices = f"one of {', '.join(shapes)}; '-' = no shape named; Enter = leave it for later"
     print(
-        f"{len(waiting)} answer(s) to review. Shapes: {', '.join(shapes)}; "
-        "'-' = no shape; Enter skips."
+        f"{len(waiting)} answer(s) to review, blind (the shape sent is not shown). Type {choices}."
     )
-    for trial_id in waiting:
+    decided = 0
+    for number, trial_id in enumerate(waiting, start=1):
         trial = store.trial(trial_id)
-        reply = input(f"  {trial['answer']!r} (sent: {trial['shape']}) -> ").strip().lower()
+        item = (
+            f"  [{number}/{len(waiting)}] {labels[trial['participant']]}, trial "
+            f"{trial['position'] + 1}: {trial['answer']!r} -> "
+        )
+        while True:
+            try:
+                reply = input(item).strip().lower()
+            except EOFError:
+                print(
+                    f"\nStopped: {decided} decided and stored, {len(waiting) - decided} left; "
+                    "the same command goes on with them."
+                )
+                return 0
+            if reply == "" or reply == "-" or reply in shapes:
+                break
+            print(f"  {reply!r} is not a choice. Type {choices}.")
         if reply == "-":
             store.decide(trial_id, None, "researcher: no shape named")
-        elif reply in shapes:
+        elif reply:
             store.decide(trial_id, reply, f"researcher: {reply}")
+        decided += bool(reply)
+    print(f"Review done: {decided} decided, {len(waiting) - decided} left for later.")
     return 0
+
+
+def _plural(count: int, noun: str) -> str:
+    """ "1 stroke", "2 strokes"."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"

@@ -42,20 +42,30 @@ class NextTrial:
     direction: str
 
 
-def open_run(store: StudyStore, code: str, dimension: Dimension) -> tuple[int, Procedure]:
-    """The participant's unfinished run of ``dimension`` (replayed), or a new one."""
+def open_run(
+    store: StudyStore, code: str, dimension: Dimension, *, simulated: bool = False
+) -> tuple[int, Procedure]:
+    """The participant's unfinished run of ``dimension`` (replayed), or a new one; a dry run
+    (``simulated``) never continues a measured run, nor the other way round."""
     procedure = Procedure(store.design.threshold, dimension)
-    run = unfinished_run(store, code, dimension)
+    run = unfinished_run(store, code, dimension, simulated=simulated)
     if run is not None:
         replay(store, run, procedure)
         return run, procedure
     settings = asdict(dimension_settings(store.design.threshold, dimension))
-    return store.start_threshold_run(code, dimension, settings), procedure
+    return store.start_threshold_run(code, dimension, settings, simulated=simulated), procedure
 
 
-def unfinished_run(store: StudyStore, code: str, dimension: Dimension) -> int | None:
+def unfinished_run(
+    store: StudyStore, code: str, dimension: Dimension, *, simulated: bool = False
+) -> int | None:
+    dry = simulated or bool(store.participant(code)["simulated"])
     for run in store.threshold_runs(code):
-        if run["dimension"] == dimension and run["finished_at_ms"] is None:
+        if (
+            run["dimension"] == dimension
+            and run["finished_at_ms"] is None
+            and bool(run["simulated"]) == dry
+        ):
             return int(run["id"])
     return None
 
@@ -124,10 +134,13 @@ def run_threshold(
     play: Play,
     respond: Respond,
     progress: Callable[[int, float, str, str], None] = lambda n, value, sent, said: None,
+    *,
+    simulated: bool = False,
 ) -> Estimate:
-    """Trials until the stopping rule says so; the estimate is stored with the run."""
+    """Trials until the stopping rule says so; the estimate is stored with the run.
+    ``simulated``: a simulated observer answers (a dry run, stored as one)."""
     check_fits(layout, store.design.threshold)
-    run_id, procedure = open_run(store, code, dimension)
+    run_id, procedure = open_run(store, code, dimension, simulated=simulated)
     while procedure.stop_reason() is None:
         trial = next_trial(run_id, procedure)
         events = play([trial_stroke(store, layout, dimension, trial)])
@@ -136,6 +149,8 @@ def run_threshold(
         progress(procedure.trials, trial.value, trial.direction, answer)
     reason = procedure.stop_reason()
     assert reason is not None
-    if unfinished_run(store, code, dimension) == run_id:  # stopped before it was finished
+    if (
+        unfinished_run(store, code, dimension, simulated=simulated) == run_id
+    ):  # stopped before it was finished
         return finish_run(store, run_id, procedure, reason)
     return procedure.estimate()

@@ -98,6 +98,24 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
         help=f"MQTT password (default: ${PASSWORD_ENV}; prefer it or --credentials: "
         "other users can see command lines)",
     )
+    if role == "sender":
+        group.add_argument(
+            "--join",
+            metavar="TOKEN",
+            type=not_empty("join token"),
+            help="the one-line token of 'feelmysign broker add-sender': broker URL (TLS), its "
+            "CA's fingerprint, the sleeve to send to and the sender's login; --id may name "
+            "another sleeve; not to be given with --broker, --username, --password, "
+            "--credentials or --ca",
+        )
+        group.add_argument(
+            "--ca",
+            metavar="FILE",
+            type=not_empty("CA file"),
+            help="the CA certificate (PEM) to check the broker's TLS certificate with, for "
+            "mqtts:// or wss:// to a broker whose certificate is not publicly trusted (a "
+            "'feelmysign broker --lan' one: its ca.pem; default: the system's trusted CAs)",
+        )
     if role == "sleeve":
         group.add_argument(
             "--join",
@@ -130,13 +148,38 @@ def broker_settings_from_args(args: argparse.Namespace, role: Role) -> BrokerSet
 
     A join token (sleeve only) fetches and checks the broker's CA the first time.
     """
+    settings = _settings(args, role)
+    ca = getattr(args, "ca", None)
+    if ca is None:
+        return settings
+    if not settings.tls:
+        raise BrokerConnectionError(
+            "bad-option",
+            f"--ca {ca} is for a TLS broker URL (mqtts:// or wss://); {settings.url} is not "
+            "one. Give the broker's TLS URL with --broker, or leave --ca out.",
+        )
+    if not Path(ca).is_file():
+        raise BrokerConnectionError(
+            "bad-option",
+            f"--ca {ca}: no such file. Copy the broker's ca.pem (in its state directory) to "
+            "this machine and give its path.",
+        )
+    check_input_file(ca, what="CA file", max_bytes=MAX_CREDENTIALS_BYTES)
+    return replace(settings, ca_file=str(Path(ca).absolute()))
+
+
+def _settings(args: argparse.Namespace, role: Role) -> BrokerSettings:
     env = os.environ
     token = getattr(args, "join", None) or (env.get(JOIN_ENV) if role == "sleeve" else None)
     if token:
         _check_nothing_beside_the_token(
-            "--join" if getattr(args, "join", None) else f"${JOIN_ENV}", args
+            "--join" if getattr(args, "join", None) else f"${JOIN_ENV}", args, role
         )
-        return join_settings(token, default_trust_dir())
+        joined = join_settings(token, default_trust_dir(), role=role)
+        # A sender's account may send to every sleeve of its broker.
+        if role == "sender" and args.sleeve_id:
+            return replace(joined, sleeve_id=check_sleeve_id(args.sleeve_id))
+        return joined
     url = args.broker or env.get(BROKER_ENV) or None
     username = args.username or env.get(USERNAME_ENV) or None
     password = args.password or env.get(PASSWORD_ENV) or None
@@ -176,19 +219,20 @@ _IN_A_TOKEN = (
 )
 
 
-def _check_nothing_beside_the_token(token_from: str, args: argparse.Namespace) -> None:
+def _check_nothing_beside_the_token(token_from: str, args: argparse.Namespace, role: Role) -> None:
     """A join token is the broker URL, sleeve id and login: one of these options beside
     it is a conflict, refused rather than silently overruled.
 
     Their environment variables are not: the systemd unit sets $FEELMYSIGN_CREDENTIALS
     for every sleeve, and a token in sleeve.env wins over it, as the unit says.
     """
-    given = [option for key, option in _IN_A_TOKEN if getattr(args, key, None)]
+    held = [(k, o) for k, o in _IN_A_TOKEN if not (role == "sender" and k == "sleeve_id")]
+    given = [option for key, option in [*held, ("ca", "--ca")] if getattr(args, key, None)]
     if given:
         also = " and ".join(given)
         raise BrokerConnectionError(
             "bad-option",
-            f"{token_from} (a join token) holds the broker URL, the sleeve id and its login, "
+            f"{token_from} (a join token) holds the broker URL, its CA, the sleeve id and a login, "
             f"and would win over {also}: give one or the other. Leave {also} out to join "
             f"with the token, or leave {token_from} out to use {also}.",
         )

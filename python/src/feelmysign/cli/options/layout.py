@@ -95,6 +95,13 @@ def add_layout_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def layout_given(args: argparse.Namespace) -> bool:
+    """Whether a layout was asked for (--layout, a grid option, or $FEELMYSIGN_LAYOUT), rather
+    than left to the default: a sender then asks the sleeve for its own."""
+    given = args.layout is not None or any(getattr(args, d) is not None for d in _GRID_DESTS)
+    return given or bool(os.environ.get(LAYOUT_ENV, ""))
+
+
 def layout_from_args(args: argparse.Namespace) -> Layout:
     """The layout the options ask for; raises LayoutError (exit 1) for a bad file or grid."""
     if args.layout is not None:

@@ -20,9 +20,12 @@ import pandas as pd
 from feelmysign.study.analysis.models import ModelResult, shape_differences
 from feelmysign.study.analysis.plots import accuracy_plot, threshold_plot
 from feelmysign.study.analysis.psychometric import (
+    Interval,
+    Needed,
     Threshold,
     counts_by_level,
     threshold_with_interval,
+    within_tested,
 )
 from feelmysign.study.analysis.report import write_report
 from feelmysign.study.analysis.wilson import wilson_interval
@@ -39,10 +42,12 @@ class Analysis:
     unclear: int
     accuracy: dict[str, list[tuple[int, int, int, float, float]]]  # strokes, k, n, low, high
     thresholds: dict[str, Threshold]
+    needed: dict[str, Needed]  # the thresholds as far as the tested range can say
     model: ModelResult | None
     criterion: float
     files: list[Path]
     threshold_runs: list[dict[str, Any]]
+    per_participant: list[dict[str, Any]]  # one row per participant (anonymised)
 
 
 def main_trials(store: StudyStore) -> pd.DataFrame:
@@ -87,9 +92,16 @@ def analyse_study(
                 samples=samples,
                 seed=seed,
             )
+    needed = {}
+    for name, threshold in thresholds.items():
+        answered = [(strokes, k / n) for strokes, k, n, _, _ in accuracy[name] if n]
+        tested = (float(answered[0][0]), float(answered[-1][0]))
+        needed[name] = within_tested(
+            threshold, tested, [share for _, share in answered], design.criterion
+        )
     model = None
-    if len(coded) and coded["shape"].nunique() > 1 and coded["participant"].nunique() > 1:
-        model = shape_differences(coded[["participant", "shape", "segments", "correct"]])
+    if len(coded) and coded["shape"].nunique() > 1:
+        model = shape_differences(coded[["participant", "shape", "segments", "correct"]], seed=seed)
     participants = store.participants()
     analysis = Analysis(
         participants=int(frame["participant"].nunique()) if len(frame) else 0,
@@ -98,27 +110,59 @@ def analyse_study(
         unclear=unclear,
         accuracy=accuracy,
         thresholds=thresholds,
+        needed=needed,
         model=model,
         criterion=design.criterion,
         files=files,
         threshold_runs=threshold_summaries(store),
+        per_participant=participant_table(frame, [s.name for s in design.shapes]),
     )
     files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
-    if thresholds:
-        every = [float(lv.strokes) for s in design.shapes for lv in s.levels]
+    if needed:
         path = out_dir / "needed-resolution.png"
-        files.append(threshold_plot(path, thresholds, (min(every), max(every)), design.criterion))
+        files.append(threshold_plot(path, needed, design.criterion))
     files.append(_results_json(out_dir / "results.json", analysis))
     files.append(write_report(out_dir / "report.md", store, analysis))
     return analysis
 
 
+def participant_table(frame: pd.DataFrame, shapes: list[str]) -> list[dict[str, Any]]:
+    """Per participant: measured trials answered, how many await review, and the correct
+    ones overall and per shape (of the coded ones)."""
+    if not len(frame):
+        return []
+    rows = []
+    for label, mine in frame.groupby("participant", sort=True):
+        coded = mine[mine["coded_status"] != "unclear"]
+        correct = coded["correct"].astype(int)
+        rows.append(
+            {
+                "participant": str(label),
+                "simulated": bool(int(mine["simulated"].iloc[0])),
+                "trials": len(mine),
+                "unclear": len(mine) - len(coded),
+                "correct": int(correct.sum()),
+                "coded": len(coded),
+                "by_shape": {
+                    shape: [
+                        int(correct[coded["shape"] == shape].sum()),
+                        int((coded["shape"] == shape).sum()),
+                    ]
+                    for shape in shapes
+                },
+            }
+        )
+    return rows
+
+
 def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
-    """Every threshold run (SQ2.2), anonymised, with its result when it has finished."""
+    """Every threshold run (SQ2.2), anonymised, with its result when it has finished, and
+    whether it is a dry run (``simulated``: the report keeps those apart)."""
     labels = anonymous_labels(store)
     return [
         {
             "participant": labels[run["participant"]],
+            "simulated": bool(run["simulated"]),
             "dimension": run["dimension"],
             "threshold": run["threshold"],
             "low": run["low"],
@@ -132,6 +176,16 @@ def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
 
 def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
+
+
+def _interval_json(prefix: str, interval: Interval) -> dict[str, Any]:
+    """An interval's ends within the tested range; ``*_open``: it reaches beyond that end."""
+    return {
+        f"{prefix}low": interval.low,
+        f"{prefix}low_open": interval.low_open,
+        f"{prefix}high": interval.high,
+        f"{prefix}high_open": interval.high_open,
+    }
 
 
 def _results_json(path: Path, analysis: Analysis) -> Path:
@@ -149,25 +203,26 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
         },
         "needed_strokes": {
             shape: {
-                "strokes": _finite(t.strokes),
+                "kind": needed.kind,
+                "strokes": needed.strokes,
+                "lowest_tested": needed.lowest_tested,
+                "highest_tested": needed.highest_tested,
                 "interval": "parametric bootstrap with the participants' spread, "
-                "bias-corrected percentiles",
-                "low": _finite(t.boot_low),
-                "high": _finite(t.boot_high),
-                "profile_low": _finite(t.low),
-                "profile_high": _finite(t.high),
-                "cluster_bootstrap_low": _finite(t.cluster_low),
-                "cluster_bootstrap_high": _finite(t.cluster_high),
-                "dispersion": _finite(t.dispersion),
-                "participant_sd_doublings": t.population.spread,
-                "bootstrap_samples": t.samples,
-                "midpoint_log2": t.fit.midpoint,
-                "slope_per_doubling": t.fit.slope,
+                "bias-corrected percentiles, truncated to the tested range",
+                **_interval_json("", needed.interval),
+                **_interval_json("profile_", needed.profile),
+                **_interval_json("cluster_bootstrap_", needed.cluster),
+                "dispersion": _finite(analysis.thresholds[shape].dispersion),
+                "participant_sd_doublings": analysis.thresholds[shape].population.spread,
+                "bootstrap_samples": analysis.thresholds[shape].samples,
+                "midpoint_log2": analysis.thresholds[shape].fit.midpoint,
+                "slope_per_doubling": analysis.thresholds[shape].fit.slope,
             }
-            for shape, t in analysis.thresholds.items()
+            for shape, needed in analysis.needed.items()
         },
         "shape_model": asdict(analysis.model) if analysis.model else None,
         "thresholds": analysis.threshold_runs,
+        "per_participant": analysis.per_participant,
     }
     path.write_text(json.dumps(data, indent=2, default=str) + "\n", encoding="utf-8")
     return path

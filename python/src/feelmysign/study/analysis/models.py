@@ -1,18 +1,30 @@
-"""Do shapes differ in the resolution they need (SQ2.4)? Two logistic models of correct
-answers on shape and log2(strokes), both fitted with statsmodels:
+"""Do shapes differ in the resolution they need (SQ2.4)? A test valid at every number of
+participants, and a mixed-effects model for the size of each difference.
 
-- the mixed-effects model (participant as a random intercept), ``BinomialBayesMixedGLM``
-  fitted by variational Bayes: shape effects with posterior SDs, and how much
-  participants differ;
-- the test: a GLM with standard errors robust to clustering by participant (a
-  participant's answers are not independent), and a Wald chi-square test that all
-  shape effects are zero. Used for the p-value because the variational fit gives
-  no likelihood to test with, and it stays stable when a shape is always (or never)
-  recognised, where mixed-model fits by Laplace approximation fail.
+- The test: a sign-flip permutation test over participants (Fisher's randomisation test
+  of a mean; Good 2005, ch. 3). A logistic GLM without shape (``correct ~
+  log2(strokes)``, statsmodels) gives each trial's expected accuracy at its number of
+  strokes; each participant's mean residual per shape, centred over the shapes, is
+  their *shape profile* (how much better or worse than the strokes alone predict each
+  shape was for them). With no shape effect, a profile is as likely as its negative,
+  so flipping the signs of whole participants' profiles gives the null distribution
+  of the statistic (the squared length of the mean profile). Participants, not
+  trials, are the unit: a participant's answers are not independent, and a test that
+  treats them as such (or a cluster-robust Wald test with few clusters) claims
+  differences that are not there. Every flip is enumerated up to
+  ``EXACT_UP_TO`` participants; above, ``FLIPS`` random ones (seeded).
+- Refused below ``MIN_PARTICIPANTS``, with the reason: there the test cannot reach
+  p < 0.05 whatever the data.
+- The mixed-effects model (participant as a random intercept), ``BinomialBayesMixedGLM``
+  fitted by variational Bayes: shape effects in log odds with posterior SDs, and how
+  much participants differ. Descriptive only (the variational fit gives no likelihood
+  to test with); it may fail (a shape always recognised), and the report says so.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -23,6 +35,12 @@ import statsmodels.formula.api as smf
 from statsmodels.genmod.bayes_mixed_glm import BinomialBayesMixedGLM
 
 FORMULA = "correct ~ C(shape, Treatment(reference=@reference)) + log2_strokes"
+# The sign-flip test's smallest possible p is 2 / 2^n with n participants (the observed
+# profiles and their exact negative give the same statistic). With 5 that is 0.0625:
+# the test could never report a difference at the 5% level, so it is not run below 6.
+MIN_PARTICIPANTS = 6
+EXACT_UP_TO = 14  # 2^14 = 16384 flips, every one
+FLIPS = 9999  # random flips above that (the observed one is added: p >= 1 / 10000)
 
 
 @dataclass(frozen=True)
@@ -33,18 +51,28 @@ class ShapeEffect:
 
 
 @dataclass(frozen=True)
+class ShapeTest:
+    method: str
+    participants: int
+    shapes: int
+    statistic: float | None  # squared length of the mean shape profile (accuracy units^2)
+    p: float | None
+    flips: int  # sign patterns the p-value is counted over (0: not run)
+    refused: str | None  # why no test is reported, when none is
+    participants_needed: int
+
+
+@dataclass(frozen=True)
 class ModelResult:
     reference: str
     mixed: list[ShapeEffect]
     participant_sd: float  # random intercept SD (log odds)
     slope_per_doubling: float
-    wald_chi2: float
-    wald_df: int
-    wald_p: float
+    test: ShapeTest
     note: str
 
 
-def shape_differences(frame: pd.DataFrame) -> ModelResult:
+def shape_differences(frame: pd.DataFrame, *, seed: int = 0) -> ModelResult:
     """``frame`` has columns participant, shape, segments, correct (0/1), main trials only."""
     data = frame.assign(log2_strokes=np.log2(frame["segments"].astype(float)))
     data["correct"] = data["correct"].astype(float)
@@ -52,33 +80,67 @@ def shape_differences(frame: pd.DataFrame) -> ModelResult:
     reference = str(data.groupby("shape")["correct"].mean().idxmax())
     formula = FORMULA.replace("@reference", repr(reference))
     shapes = sorted(s for s in data["shape"].unique() if s != reference)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        glm = smf.glm(formula, data, family=sm.families.Binomial()).fit(
-            cov_type="cluster", cov_kwds={"groups": pd.factorize(data["participant"])[0]}
+    test = sign_flip_test(data, seed=seed)
+    mixed, participant_sd, slope, note = _mixed(formula, data, shapes)
+    return ModelResult(reference, mixed, participant_sd, slope, test, note)
+
+
+def shape_profiles(data: pd.DataFrame) -> np.ndarray:
+    """Per participant (rows) and shape (columns): the mean of correct minus the accuracy a
+    shape-free logistic model of log2(strokes) expects, centred over the shapes."""
+    if data["correct"].nunique() > 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a near-perfect fit warns; its values are still right
+            glm = smf.glm("correct ~ log2_strokes", data, family=sm.families.Binomial()).fit()
+        expected = np.asarray(glm.fittedvalues, dtype=float)
+    else:  # every answer the same: the model is that constant
+        expected = data["correct"].to_numpy(float)
+    residual = data.assign(residual=data["correct"].to_numpy(float) - expected)
+    table = residual.pivot_table(
+        index="participant", columns="shape", values="residual", aggfunc="mean"
+    )
+    # A shape a participant has no coded answer for adds nothing to their profile.
+    profile = table.to_numpy(float)
+    profile = np.where(np.isnan(profile), np.nanmean(profile, axis=1, keepdims=True), profile)
+    return np.asarray(profile - profile.mean(axis=1, keepdims=True))
+
+
+def sign_flip_test(data: pd.DataFrame, *, seed: int = 0) -> ShapeTest:
+    participants, shapes = int(data["participant"].nunique()), int(data["shape"].nunique())
+    method = "sign-flip permutation test over participants"
+    if participants < MIN_PARTICIPANTS:
+        reason = (
+            f"{participants} participant(s): the test over participants needs at least "
+            f"{MIN_PARTICIPANTS}; with fewer, its smallest possible p is 2/2^n "
+            f"= {2 / 2**participants:.3g}, so it could never show a difference"
         )
-        names = [n for n in glm.params.index if n.startswith("C(shape")]
-        if names:
-            contrast = np.zeros((len(names), len(glm.params)))
-            for row, name in enumerate(names):
-                contrast[row, list(glm.params.index).index(name)] = 1.0
-            wald = glm.wald_test(contrast, scalar=True)
-            chi2, df, p = float(wald.statistic), len(names), float(wald.pvalue)
-        else:
-            chi2, df, p = 0.0, 0, 1.0
-        mixed, participant_sd, slope, note = _mixed(formula, data, shapes)
-    return ModelResult(reference, mixed, participant_sd, slope, chi2, df, p, note)
+        return ShapeTest(method, participants, shapes, None, None, 0, reason, MIN_PARTICIPANTS)
+    profile = shape_profiles(data)
+    if participants <= EXACT_UP_TO:
+        signs = np.array(list(itertools.product((1.0, -1.0), repeat=participants)))
+    else:
+        rng = np.random.default_rng(seed)
+        signs = np.vstack([np.ones(participants), rng.choice((1.0, -1.0), (FLIPS, participants))])
+    means = signs @ profile / participants
+    statistics = np.sum(means * means, axis=1)
+    observed = float(statistics[0])  # the first sign pattern is all +1: the data as measured
+    # A relative tolerance: sums in another order differ in the last bits.
+    p = float(np.mean(statistics >= observed * (1 - 1e-9)))
+    assert math.isfinite(observed) and observed >= 0.0
+    return ShapeTest(method, participants, shapes, observed, p, len(signs), None, MIN_PARTICIPANTS)
 
 
 def _mixed(
     formula: str, data: pd.DataFrame, shapes: list[str]
 ) -> tuple[list[ShapeEffect], float, float, str]:
     try:
-        model = BinomialBayesMixedGLM.from_formula(
-            formula, {"participant": "0 + C(participant)"}, data
-        )
-        result = model.fit_vb()
-    except (ValueError, np.linalg.LinAlgError) as error:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = BinomialBayesMixedGLM.from_formula(
+                formula, {"participant": "0 + C(participant)"}, data
+            )
+            result = model.fit_vb()
+    except Exception as error:  # descriptive only: the report says why it is missing
         return [], float("nan"), float("nan"), f"mixed model not fitted: {error}"
     names = list(model.exog_names)
     effects = []

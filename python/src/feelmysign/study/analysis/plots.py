@@ -12,7 +12,7 @@ matplotlib.use("Agg")  # files only: no display on a lab machine or CI
 import matplotlib.pyplot as plt
 import numpy as np
 
-from feelmysign.study.analysis.psychometric import Threshold
+from feelmysign.study.analysis.psychometric import AT_OR_BELOW, ESTIMATE, Needed, Threshold
 
 DPI = 110
 FIGURE_IN = (6.4, 4.0)
@@ -44,9 +44,12 @@ def accuracy_plot(
             label=shape,
         )
         if shape in thresholds and len(strokes) > 1:
-            grid = np.geomspace(strokes.min() * 0.8, strokes.max() * 1.25, 100)
+            grid = np.geomspace(strokes.min(), strokes.max(), 100)  # the tested range only
             axes.plot(grid, thresholds[shape].fit.accuracy(grid), color=colour, linewidth=1)
     axes.axhline(criterion, color="grey", linestyle=":", linewidth=1)
+    # The tested range sets the axis, so that a study with no answer yet still has a plot.
+    every = [float(r[0]) for rows in accuracy.values() for r in rows] or [1.0, 2.0]
+    axes.set_xlim(min(every) / 1.2, max(every) * 1.2)
     axes.set_xscale("log", base=2)
     axes.set_xlabel("strokes per shape (log scale)")
     axes.set_ylabel("share named correctly")
@@ -59,34 +62,43 @@ def accuracy_plot(
     return path
 
 
-def threshold_plot(
-    path: Path, thresholds: dict[str, Threshold], tested: tuple[float, float], criterion: float
-) -> Path:
+def threshold_plot(path: Path, needed: dict[str, Needed], criterion: float) -> Path:
     """The strokes each shape needs for the criterion accuracy, with 95% intervals, drawn
-    within half the tested range's lowest and twice its highest resolution; what lies
-    beyond is an arrow (the data cannot say how far)."""
-    low_edge, high_edge = tested[0] / 2, tested[1] * 2
-    figure, axes = plt.subplots(figsize=(FIGURE_IN[0], 0.45 * len(thresholds) + 1.2), dpi=DPI)
-    names = list(thresholds)
-    axes.axvspan(tested[0], tested[1], color="#eeeeee", zorder=0)
+    only within each shape's tested range (grey); a bound or an interval that goes on
+    beyond the range ends in an arrow at its edge (the data cannot say how far)."""
+    lowest = min(n.lowest_tested for n in needed.values())
+    highest = max(n.highest_tested for n in needed.values())
+    figure, axes = plt.subplots(figsize=(FIGURE_IN[0], 0.45 * len(needed) + 1.2), dpi=DPI)
+    names = list(needed)
     for row, name in enumerate(names):
-        result = thresholds[name]
-        # The reported interval: the parametric bootstrap with the participants' spread.
-        first, last = result.boot_low, result.boot_high
-        low = min(max(first, low_edge), high_edge)
-        high = min(max(last, low_edge), high_edge) if math.isfinite(last) else high_edge
-        axes.plot([low, high], [row, row], color="black", linewidth=1.5)
-        if last > high_edge or not math.isfinite(last):
-            axes.plot(high_edge, row, ">", color="black")
-        if first < low_edge:
-            axes.plot(low_edge, row, "<", color="black")
-        if math.isfinite(result.strokes) and low_edge <= result.strokes <= high_edge:
+        result = needed[name]
+        axes.plot(
+            [result.lowest_tested, result.highest_tested],
+            [row, row],
+            color="#dddddd",
+            linewidth=8,
+            solid_capstyle="butt",
+            zorder=0,
+        )
+        interval = result.interval
+        axes.plot([interval.low, interval.high], [row, row], color="black", linewidth=1.5)
+        if interval.high_open:
+            axes.plot(interval.high, row, ">", color="black")
+        if interval.low_open:
+            axes.plot(interval.low, row, "<", color="black")
+        if result.kind == ESTIMATE and result.strokes is not None:
             axes.plot(result.strokes, row, "o", color="black")
-    axes.set_xlim(low_edge * 0.9, high_edge * 1.1)
+        elif result.kind == AT_OR_BELOW:
+            axes.plot(result.lowest_tested, row, "<", color="tab:blue", markersize=9)
+        else:
+            axes.plot(result.highest_tested, row, ">", color="tab:red", markersize=9)
+    axes.set_xlim(lowest / 1.2, highest * 1.2)
     axes.set_yticks(range(len(names)), names)
     axes.set_xscale("log", base=2)
     axes.set_xlabel(
-        f"strokes needed for {criterion:.0%} correct (95% bootstrap interval; grey: tested)"
+        f"strokes needed for {criterion:.0%} correct (95% bootstrap interval; grey: tested; "
+        "blue <: at or below the lowest tested; red >: above the highest)",
+        fontsize="small",
     )
     axes.invert_yaxis()
     figure.tight_layout()

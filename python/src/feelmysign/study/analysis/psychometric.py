@@ -489,3 +489,75 @@ def bias_corrected_interval(
     percentiles = 100 * norm.cdf([2 * z0 - z, 2 * z0 + z])
     low, high = np.percentile(values, percentiles)
     return float(low), float(high)
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A 95% interval truncated to the tested range; an open end reaches beyond it."""
+
+    low: float
+    high: float
+    low_open: bool  # the interval goes below the lowest tested resolution
+    high_open: bool  # ... above the highest (or the curve may never reach the criterion)
+
+
+@dataclass(frozen=True)
+class Needed:
+    """A needed resolution as far as the data can say: a number only where the tested
+    resolutions bracket the criterion, else a bound at the tested range's end."""
+
+    kind: str  # "estimate" | "at_or_below_lowest_tested" | "above_highest_tested"
+    strokes: float | None  # the estimate, when ``kind`` is "estimate"
+    lowest_tested: float
+    highest_tested: float
+    interval: Interval  # the reported one (parametric bootstrap with the spread)
+    profile: Interval
+    cluster: Interval
+
+
+ESTIMATE, AT_OR_BELOW, ABOVE = "estimate", "at_or_below_lowest_tested", "above_highest_tested"
+
+
+def truncated(low: float, high: float, tested: tuple[float, float]) -> Interval:
+    """``low``-``high`` cut to the tested range; NaN (no interval) counts as open both ways."""
+    lowest, highest = tested
+    low_open = not math.isfinite(low) or low < lowest
+    high_open = not math.isfinite(high) or high > highest
+    # An end beyond the range on the other side (an interval wholly below or above what
+    # was tested) is put at the nearer end: the interval is then "<= lowest" or ">= highest".
+    return Interval(
+        lowest if low_open else min(low, highest),
+        highest if high_open else max(high, lowest),
+        low_open,
+        high_open,
+    )
+
+
+def within_tested(
+    threshold: Threshold,
+    tested: tuple[float, float],
+    shares: list[float],
+    criterion: float,
+) -> Needed:
+    """The needed resolution of ``threshold`` within the ``tested`` range (lowest, highest
+    resolution with answers), given the share correct at each tested resolution: when every
+    share reaches the criterion, the data say only that the lowest tested one is enough;
+    when none does, only that the highest is not; a fitted value beyond either end is
+    the same bound (the curve's shape there is a guess, not data)."""
+    lowest, highest = tested
+    value = threshold.strokes
+    if (shares and all(s >= criterion for s in shares)) or value <= lowest:
+        kind: str = AT_OR_BELOW
+    elif (shares and all(s < criterion for s in shares)) or not value <= highest:
+        kind = ABOVE
+    else:
+        kind = ESTIMATE
+    return Needed(
+        kind,
+        value if kind == ESTIMATE else None,
+        lowest,
+        highest,
+        truncated(threshold.boot_low, threshold.boot_high, tested),
+        truncated(threshold.low, threshold.high, tested),
+        truncated(threshold.cluster_low, threshold.cluster_high, tested),
+    )

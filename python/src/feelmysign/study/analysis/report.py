@@ -2,35 +2,57 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from feelmysign.study.analysis.models import ShapeTest
+from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
 from feelmysign.study.store import StudyStore
 
 if TYPE_CHECKING:
     from feelmysign.study.analysis.analyse import Analysis
 
 
-def _strokes(value: float, tested: tuple[float, float]) -> str:
-    """A needed resolution, or where it lies when the tested range does not contain it."""
-    if not math.isfinite(value) or value > tested[1]:
-        return f"> {tested[1]:g}"
-    if value < tested[0]:
-        return f"< {tested[0]:g}"
-    return f"{value:.1f}"
+def needed_text(needed: Needed) -> str:
+    """A needed resolution as far as the tested range can say."""
+    if needed.kind == AT_OR_BELOW:
+        return f"≤ {needed.lowest_tested:g} (at or below the lowest tested)"
+    if needed.kind == ABOVE:
+        return f"> {needed.highest_tested:g} (above the highest tested)"
+    assert needed.strokes is not None
+    return f"{needed.strokes:.1f}"
 
 
-def _interval(low: float, high: float, tested: tuple[float, float]) -> str:
-    if high < tested[0]:
-        return f"below the tested range (< {tested[0]:g})"
-    if low > tested[1]:
-        return f"above the tested range (> {tested[1]:g})"
-    return f"{_strokes(low, tested)} - {_strokes(high, tested)}"
+def interval_text(interval: Interval) -> str:
+    """An interval truncated to the tested range; an open end is written ≤ or ≥."""
+    if interval.low_open and interval.high <= interval.low:
+        return f"≤ {interval.low:g}"  # wholly at or below the lowest tested
+    if interval.high_open and interval.low >= interval.high:
+        return f"≥ {interval.high:g}"
+    low = f"≤ {interval.low:g}" if interval.low_open else f"{interval.low:.1f}"
+    high = f"≥ {interval.high:g}" if interval.high_open else f"{interval.high:.1f}"
+    return f"{low} - {high}"
 
 
 def _p(value: float) -> str:
     return "p < 0.001" if value < 0.001 else f"p = {value:.3f}"
+
+
+def shape_test_sentence(test: ShapeTest) -> str:
+    """What the shape test found, or why there is none: for the report and the terminal."""
+    if test.refused is not None or test.p is None or test.statistic is None:
+        return (
+            f"No test of whether shapes differ is reported: {test.refused}. Run at least "
+            f"{test.participants_needed} participants (8 or more for the calibrated false-positive "
+            "rate in docs/research.md)."
+        )
+    return (
+        f"Test that shapes differ at equal strokes: {test.method} ({test.participants} "
+        f"participants, {test.shapes} shapes; each participant's mean residual per shape "
+        "against a shape-free logistic model of log2(strokes), centred over shapes; statistic: "
+        f"squared length of the mean profile = {test.statistic:.4g}, over {test.flips} sign "
+        f"patterns): {_p(test.p)}."
+    )
 
 
 def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
@@ -58,6 +80,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             for strokes, k, n, low, high in rows
         ]
         lines.append(f"| {shape} | " + " | ".join(cells) + " |")
+    lines += _participant_section(analysis, [shape for shape in analysis.accuracy])
     lines += [
         "",
         "![accuracy](accuracy.png)",
@@ -83,18 +106,19 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "|---|---|---|---|---|---|---|---|",
     ]
     for shape, t in analysis.thresholds.items():
-        rows = analysis.accuracy[shape]
-        tested = (float(rows[0][0]), float(rows[-1][0]))
+        needed = analysis.needed[shape]
         lines.append(
-            f"| {shape} | {_strokes(t.strokes, tested)} | "
-            f"{_interval(t.boot_low, t.boot_high, tested)} | {_interval(t.low, t.high, tested)} | "
-            f"{_interval(t.cluster_low, t.cluster_high, tested)} | {t.fit.slope:.2f} | "
-            f"{t.population.spread:.2f} | {t.dispersion:.2f} |"
+            f"| {shape} | {needed_text(needed)} | {interval_text(needed.interval)} | "
+            f"{interval_text(needed.profile)} | {interval_text(needed.cluster)} | "
+            f"{t.fit.slope:.2f} | {t.population.spread:.2f} | {t.dispersion:.2f} |"
         )
     lines += [
         "",
-        "'< n': every tested resolution was already recognised at the criterion; '> n': not "
-        "even the finest one was.",
+        "A number is given only where the tested resolutions bracket the criterion. "
+        "'≤ n (at or below the lowest tested)': the share correct reached the criterion at "
+        "every tested resolution, so the data say only that n strokes are enough; '> n (above "
+        "the highest tested)': it reached it at none. Intervals are cut at the tested range: "
+        "'≤ n' or '≥ n' at an end means the interval goes on beyond what was tested.",
     ]
     lines += [
         "",
@@ -105,21 +129,22 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     model = analysis.model
     if model is None:
-        lines.append("Not enough data (two shapes and two participants at least).")
+        lines.append("Not enough data (two shapes with coded answers at least).")
     else:
-        lines += [
-            "Logistic models of a correct answer on shape and log2(strokes). Test: GLM with "
-            "standard errors clustered by participant, Wald test that every shape effect is 0: "
-            f"chi2({model.wald_df}) = {model.wald_chi2:.2f}, {_p(model.wald_p)}.",
-            "",
-            f"Mixed-effects model (participant random intercept; {model.note}): reference shape "
-            f"{model.reference}; slope {model.slope_per_doubling:.2f} log odds per doubling of "
-            f"strokes; participant SD {model.participant_sd:.2f} log odds.",
-            "",
-            "| shape | log odds vs " + model.reference + " | posterior SD |",
-            "|---|---|---|",
-            *(f"| {e.shape} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.mixed),
-        ]
+        lines += [shape_test_sentence(model.test), ""]
+        if model.mixed:
+            lines += [
+                f"Mixed-effects model (participant random intercept; {model.note}; "
+                f"descriptive): reference shape {model.reference}; slope "
+                f"{model.slope_per_doubling:.2f} log odds per doubling of strokes; participant "
+                f"SD {model.participant_sd:.2f} log odds.",
+                "",
+                "| shape | log odds vs " + model.reference + " | posterior SD |",
+                "|---|---|---|",
+                *(f"| {e.shape} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.mixed),
+            ]
+        else:
+            lines.append(f"Mixed-effects model: {model.note}.")
     lines += _threshold_section(analysis)
     lines += [
         "",
@@ -131,8 +156,37 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     return path
 
 
+def _participant_section(analysis: Analysis, shapes: list[str]) -> list[str]:
+    if not analysis.per_participant:
+        return []
+    lines = [
+        "",
+        "## Per participant",
+        "",
+        "Measured trials answered, awaiting review, and correct of the coded ones, overall and "
+        "per shape.",
+        "",
+        "| participant | simulated | trials | awaiting review | correct | "
+        + " | ".join(shapes)
+        + " |",
+        "|---|---|---|---|---|" + "---|" * len(shapes),
+    ]
+    for row in analysis.per_participant:
+        share = f"{row['correct'] / row['coded']:.0%}" if row["coded"] else "-"
+        cells = [f"{k}/{n}" if n else "-" for k, n in (row["by_shape"][shape] for shape in shapes)]
+        lines.append(
+            f"| {row['participant']} | {'yes' if row['simulated'] else 'no'} | {row['trials']} | "
+            f"{row['unclear']} | {row['correct']}/{row['coded']} = {share} | "
+            + " | ".join(cells)
+            + " |"
+        )
+    return lines
+
+
 def _threshold_section(analysis: Analysis) -> list[str]:
-    if not analysis.threshold_runs:
+    measured = [run for run in analysis.threshold_runs if not run["simulated"]]
+    simulated = [run for run in analysis.threshold_runs if run["simulated"]]
+    if not measured and not simulated:
         return []
     lines = [
         "",
@@ -141,10 +195,26 @@ def _threshold_section(analysis: Analysis) -> list[str]:
         "QUEST+ on a Weibull function, four directions (25% by chance); threshold = posterior "
         "mean (about 71% correct), interval = 95% credible interval.",
         "",
+    ]
+    lines += _runs_table(measured) if measured else ["No measured run."]
+    if simulated:
+        lines += [
+            "",
+            f"**Simulated runs (dry runs, not measurements): {len(simulated)}.** A simulated "
+            "observer answered these (or the participant is simulated); they are flagged "
+            "`simulated` in threshold.csv and results.json and are not part of the results above.",
+            "",
+            *_runs_table(simulated),
+        ]
+    return lines
+
+
+def _runs_table(runs: list[dict[str, Any]]) -> list[str]:
+    lines = [
         "| participant | varied | threshold | 95% interval | trials | stopped after |",
         "|---|---|---|---|---|---|",
     ]
-    for run in analysis.threshold_runs:
+    for run in runs:
         unit = "grid units" if run["dimension"] == "length" else "ms"
         if run["threshold"] is None:
             lines.append(

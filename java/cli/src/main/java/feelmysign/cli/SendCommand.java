@@ -34,10 +34,11 @@ import java.util.Set;
  * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
  * feelmysign send} does (its flags where they apply): every stroke checked first, one drawing,
  * QoS 1, and the command returns once the broker has acknowledged every stroke (exit 0), or
- * says why not (exit 1). A shape or a recording goes out at the pace it plays ({@code --pace
- * realtime}: each stroke once the one before would have finished), so a second send right after
- * it is not queued behind it and refused as late; strokes given one by one go out at once
- * ({@code --pace burst}), as the reference does.
+ * says why not (exit 1). Strokes go out at the pace they play ({@code --pace realtime}, the
+ * default, as the reference's: each stroke once the one before would have finished), so a
+ * second send right after it is not queued behind it and refused as late, and no stroke arrives
+ * ahead of its drawing (the sleeve would play it faster to catch up, as {@code --pace burst}
+ * asks).
  */
 final class SendCommand {
   private SendCommand() {}
@@ -55,12 +56,17 @@ final class SendCommand {
       + "Send strokes (startX,startY,endX,endY,duration in grid units and ms), a shape of the\n"
       + "study's library (--shape, --segments), or a recording cut by the simplifier\n"
       + "(--recording; the window simplifier, --paper for the paper's angle one) to a sleeve,\n"
-      + "and wait until the broker has them. --pace realtime (the default for --shape and\n"
-      + "--recording) sends each stroke when the previous one would have finished playing, like\n"
-      + "a person drawing, so the command lasts as long as the drawing plays; --pace burst (the\n"
-      + "default for STROKEs) sends them all at once. Broker settings: the option, else\n"
+      + "and wait until the broker has them. --pace realtime (the default) sends each stroke\n"
+      + "when the previous one would have finished playing, like a person drawing, so the\n"
+      + "command lasts as long as the drawing plays; --pace burst sends them all at once, and\n"
+      + "the sleeve then plays every stroke after the first faster, down to its floor, to catch\n"
+      + "up with a drawing that arrived ahead of it. Broker settings: the option, else\n"
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
       + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
+
+  // The faintest intensity sent (the reference's and the page's): at 0 the sleeve would play,
+  // and report as played, a stroke no one feels.
+  static final double MIN_INTENSITY = 0.01;
 
   // The options that take a value, by the kind of value; --paper and --legacy take none.
   private static final Set<String> WHOLE = Set.of("--segments", "--rows", "--columns");
@@ -86,7 +92,14 @@ final class SendCommand {
       } else if (WHOLE.contains(a)) {
         given.put(a, integer(value(args, ++i, a), a));
       } else if (DECIMAL.contains(a)) {
-        given.put(a, number(value(args, ++i, a), a));
+        String text = value(args, ++i, a);
+        double number = number(text, a);
+        if (a.equals("--intensity") && !(number >= MIN_INTENSITY && number <= 1)) {
+          throw new Main.UsageException(PROG, "argument --intensity: " + text
+              + " is out of range; give a number from 0.01 to 1"
+              + " (at 0 the sleeve would play strokes no one feels)");
+        }
+        given.put(a, number);
       } else if (TEXT.contains(a)) {
         given.put(a, value(args, ++i, a));
       } else if (a.startsWith("--")) {
@@ -121,10 +134,6 @@ final class SendCommand {
     if (sources != 1) {
       throw new Main.UsageException(PROG,
           "give one of: STROKE ..., --shape NAME or --recording FILE");
-    }
-    if (intensity != null && !(intensity >= 0 && intensity <= 1)) {
-      throw new IllegalArgumentException("intensity = " + intensity
-          + " is not allowed; it must be a number in [0, 1], or None for the default");
     }
     if (!(timeoutS > 0 && Double.isFinite(timeoutS))) {
       throw new IllegalArgumentException(
@@ -219,7 +228,7 @@ final class SendCommand {
     });
     refuseWhenNobodyListens(url);
     Object pace = given.get("--pace");
-    boolean realtime = pace == null ? shape != null || recording != null : pace.equals("realtime");
+    boolean realtime = pace == null || pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
       client.newDrawing();

@@ -77,6 +77,19 @@ class SendCommandTest {
     }
   }
 
+  @Test
+  void anIntensityNoOneFeelsIsRefusedBeforeAnythingIsSent() {
+    for (String intensity : List.of("0", "0.001", "1.5")) {
+      Result result = send("--credentials", credentials.toString(), "--shape", "square",
+          "--intensity", intensity);
+      assertEquals(2, result.code(), result.err());
+      assertEquals("Error: --intensity: " + intensity + " is out of range; give a number from"
+          + " 0.01 to 1 (at 0 the sleeve would play strokes no one feels). See '"
+          + SendCommand.PROG + " --help'.\n", result.err().replace("\r\n", "\n"));
+      assertEquals("", result.out());
+    }
+  }
+
   private static List<Map<String, Object>> rejected(LiveSleeve.Listening sleeve) {
     return sleeve.events.stream()
         .filter(e -> SleeveEvent.REJECTED.equals(e.type()))

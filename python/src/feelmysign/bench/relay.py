@@ -1,0 +1,206 @@
+"""The page's path to the sleeve: publish -> first actuator command over MQTT, over the
+broker's WebSocket listener, and through the page server's ``/mqtt`` relay (as a phone on
+the LAN sends), against a bare MQTT publish -> receive on the same broker in the same run.
+And the page server under idle connections: the time to load the page while 0, 500 and
+1,000 idle connections are held, with the process's threads and memory (the page within
+200 ms with 500 held, at most 64 threads).
+
+The relay is the page server's own (``feelmysign.webserver``), with the access key's
+cookie as the page holds it; plain WebSocket on loopback, so that the figure is the
+relay's, not TLS's. The sleeve is a process of its own, as on the Pi.
+"""
+
+from __future__ import annotations
+
+import http.client
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from pathlib import Path
+
+import paho.mqtt.client as mqtt
+from paho.mqtt.enums import CallbackAPIVersion
+
+from feelmysign.bench._mqtt import close
+from feelmysign.bench.sleeve import (
+    MEDIUM,
+    WARM_UP,
+    _client,
+    _sleeve_process,
+    bare_latency_ms,
+    percentile,
+    stroke_latencies,
+)
+from feelmysign.broker import Broker, Credentials
+from feelmysign.topics import strokes_topic
+from feelmysign.webserver import KEY_COOKIE, WebServer
+
+IDLE_CONNECTIONS = (0, 500, 1000)
+PAGE_LOADS = 20
+STROKES = 100
+RELAYED_MESSAGES = 3000  # each path, after WARM_UP unmeasured ones: enough for a p99
+ACCESS_KEY = "bench-key"
+
+
+def _websocket_sender(c: Credentials, port: int, path: str, cookie: str = "") -> mqtt.Client:
+    """The sender's login over MQTT on WebSockets, as the page's mqtt.js connects."""
+    client = mqtt.Client(
+        CallbackAPIVersion.VERSION2,
+        client_id=f"bench-ws-{uuid.uuid4()}",
+        transport="websockets",
+    )
+    client.ws_set_options(path=path, headers={"Cookie": cookie} if cookie else None)
+    client.username_pw_set(c.sender.username, c.sender.password)
+    connected = threading.Event()
+    client.on_connect = lambda *a: connected.set()
+    client.connect("127.0.0.1", port)
+    client.loop_start()
+    if not connected.wait(10):
+        raise TimeoutError(f"no CONNACK over ws://127.0.0.1:{port}{path}")
+    return client
+
+
+def _line(name: str, values: list[float], bare: list[float]) -> str:
+    p50, p99 = statistics.median(values), percentile(values, 99)
+    return (
+        f"  {name:<52} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms   (n={len(values)})"
+        f"   {p50 / statistics.median(bare):.2f}x / {p99 / percentile(bare, 99):.2f}x"
+        " baseline p50 / p99"
+    )
+
+
+def _get_page_ms(port: int) -> float:
+    started = time.perf_counter()
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    try:
+        connection.request("GET", "/")
+        response = connection.getresponse()
+        response.read()
+        if response.status != 200:
+            raise RuntimeError(f"the page answered {response.status}")
+    finally:
+        connection.close()
+    return (time.perf_counter() - started) * 1000
+
+
+def _process_status(field: str) -> int:
+    status = Path("/proc/self/status").read_text()
+    return int(next(line for line in status.splitlines() if line.startswith(field)).split()[1])
+
+
+def _idle_lines(site: Path) -> list[str]:
+    """The page's load time with idle connections held, and what holding them costs."""
+    lines = ["  the page while idle connections are held (aim: within 200 ms, at most 64 threads):"]
+    with WebServer(port=0, config={}, directory=site) as server:
+        port = int(server.url.rstrip("/").rsplit(":", 1)[1])
+        for _ in range(WARM_UP):
+            _get_page_ms(port)
+        threads, rss_kib = _process_status("Threads:"), _process_status("VmRSS:")
+        for idle_count in IDLE_CONNECTIONS:
+            idle = [socket.create_connection(("127.0.0.1", port)) for _ in range(idle_count)]
+            try:
+                time.sleep(0.5)  # the server has taken them all (accepted, a thread each before)
+                times = [_get_page_ms(port) for _ in range(PAGE_LOADS)]
+                lines.append(
+                    f"  page with {idle_count:>4} idle connections held:"
+                    f"   p50 {statistics.median(times):7.3f} ms   max {max(times):7.3f} ms"
+                    f"   threads +{_process_status('Threads:') - threads}"
+                    f"   memory +{(_process_status('VmRSS:') - rss_kib) / 1024:.1f} MiB"
+                )
+            finally:
+                for sock in idle:
+                    sock.close()
+    return lines
+
+
+# The page server alone in a process, for its CPU time per relayed message.
+_SERVE = """
+import sys
+from pathlib import Path
+from feelmysign.webserver import WebServer
+server = WebServer(port=0, config={}, directory=Path(sys.argv[1]), access_key=sys.argv[3],
+                   mqtt_ws_port=int(sys.argv[2]))
+with server:
+    print(server.url, flush=True)
+    sys.stdin.read()
+"""
+
+
+def _cpu_s(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _relay_cpu_line(c: Credentials, site: Path) -> str:
+    """The page server's CPU time per message relayed (a QoS 1 publish and its PUBACK:
+    one message each way), in a process of its own: immune to the machine's load."""
+    server = subprocess.Popen(
+        [sys.executable, "-c", _SERVE, str(site), str(c.ws_port), ACCESS_KEY],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert server.stdout is not None
+        port = int(server.stdout.readline().strip().rstrip("/").rsplit(":", 1)[1])
+        sender = _websocket_sender(c, port, "/mqtt", f"{KEY_COOKIE}={ACCESS_KEY}")
+        topic = strokes_topic("bench-nobody")  # no sleeve listens: only the relay works
+        for _ in range(WARM_UP * 20):
+            sender.publish(topic, b"warm-up", qos=1).wait_for_publish(10)
+        before_s = _cpu_s(server.pid)
+        for _ in range(RELAYED_MESSAGES):
+            sender.publish(topic, b"x" * 200, qos=1).wait_for_publish(10)
+        per_message_us = (_cpu_s(server.pid) - before_s) / (2 * RELAYED_MESSAGES) * 1e6
+        close(sender)
+    finally:
+        server.communicate("", timeout=30)
+    return (
+        f"  the page server's CPU per relayed MQTT message: {per_message_us:6.1f} us"
+        f"   ({RELAYED_MESSAGES} publishes and their PUBACKs)"
+    )
+
+
+def report() -> list[str]:
+    lines = ["Relay (the page's path: real Mosquitto, page server and sleeve process on loopback)"]
+    with tempfile.TemporaryDirectory() as state:
+        site = Path(state) / "site"
+        site.mkdir()
+        (site / "index.html").write_text("<!doctype html><title>bench</title>\n")
+        with Broker(state_dir=Path(state) / "broker", port=0, ws_port=0) as broker:
+            c = broker.credentials
+            server = WebServer(
+                port=0, config={}, directory=site, access_key=ACCESS_KEY, mqtt_ws_port=c.ws_port
+            )
+            with server, _sleeve_process(c, broker.credentials_path):
+                bare = bare_latency_ms(c)
+                lines.append(_line("baseline: bare MQTT publish -> receive (paced)", bare, bare))
+                port = int(server.url.rstrip("/").rsplit(":", 1)[1])
+                senders: dict[str, Callable[[], mqtt.Client]] = {
+                    "over MQTT (TCP)": lambda: _client(c, "sender"),
+                    "over the broker's WebSocket listener": lambda: _websocket_sender(
+                        c, c.ws_port, "/mqtt"
+                    ),
+                    "through the page server's /mqtt relay": lambda: _websocket_sender(
+                        c, port, "/mqtt", f"{KEY_COOKIE}={ACCESS_KEY}"
+                    ),
+                }
+                for name, sender in senders.items():
+                    stroke_latencies(c, MEDIUM, WARM_UP, sender())
+                    events = stroke_latencies(c, MEDIUM, STROKES, sender())
+                    end_to_end = [e.first_command_at_ms - sent_ms for sent_ms, e in events]
+                    lines.append(_line(f"3 cm {name}: publish -> first command", end_to_end, bare))
+            lines.append(_relay_cpu_line(c, site))
+        lines += _idle_lines(site)
+    return lines
+
+
+if __name__ == "__main__":  # python -m feelmysign.bench.relay: this group alone
+    for line in report():
+        print(line, flush=True)

@@ -1,0 +1,100 @@
+"""Calibration of the study analysis at 4, 8, 12 and 24 participants, on simulated studies of the
+paper's design with a known truth:
+
+- the shape test's false-positive rate: no shape effect (each trial's accuracy depends only
+  on its number of strokes and the participant), the share of studies with p < 0.05
+  (a calibrated test: 0.05); below the test's minimum it is refused, never run;
+- the coverage of the needed resolution's reported 95% interval (the parametric bootstrap
+  with the participants' spread), a true curve inside the paper's range (75% at 6.9
+  strokes, participants' SD 0.3 doublings).
+
+Each share with its own 95% Wilson interval. Not part of ``make test`` or ``make bench``:
+
+    make bench-study-calibration                           # 400 and 100 runs per size
+    python -m feelmysign.bench.study_calibration [TEST_RUNS] [COVERAGE_RUNS]
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Iterator
+
+import numpy as np
+import pandas as pd
+
+from feelmysign.study.analysis.models import sign_flip_test
+from feelmysign.study.analysis.recovery import coverage, describe, paper_truths
+from feelmysign.study.analysis.wilson import wilson_interval
+
+SIZES = (4, 8, 12, 24)
+# The paper design's strokes per shape and resolution (deploy/studies/paper.toml).
+PAPER_SHAPES = {
+    "circle": (4, 6, 8, 16),
+    "square": (4, 8, 12, 16),
+    "triangle": (3, 6, 9, 12),
+    "star": (5, 10, 15, 20),
+    "heart": (4, 6, 8, 16),
+    "line": (1, 2, 4, 8),
+}
+REPETITIONS = 3
+PARTICIPANT_SD_LOG_ODDS = 1.0  # how much participants differ, as a random intercept
+LAPSE = 0.02
+
+
+def null_study(participants: int, rng: np.random.Generator) -> pd.DataFrame:
+    """Answers with no shape effect: log odds 1.5 per doubling of strokes (75% near 4.7
+    strokes, inside the tested ranges) plus each participant's own intercept."""
+    rows = []
+    for person in range(participants):
+        own = rng.normal(0.0, PARTICIPANT_SD_LOG_ODDS)
+        for shape, levels in PAPER_SHAPES.items():
+            for strokes in levels:
+                odds = 1.5 * (math.log2(strokes) - 2.5) + own
+                p = LAPSE / 2 + (1 - LAPSE) / (1 + math.exp(-odds))
+                for correct in rng.random(REPETITIONS) < p:
+                    rows.append((f"P{person}", shape, strokes, float(correct)))
+    frame = pd.DataFrame(rows, columns=["participant", "shape", "segments", "correct"])
+    return frame.assign(log2_strokes=np.log2(frame["segments"].astype(float)))
+
+
+def false_positives(participants: int, runs: int) -> tuple[int, int]:
+    """(studies with p < 0.05, studies the test ran in) of ``runs`` seeded null studies."""
+    rejected = ran = 0
+    for run in range(runs):
+        rng = np.random.default_rng([participants, run])
+        test = sign_flip_test(null_study(participants, rng), seed=run)
+        if test.p is not None:
+            ran += 1
+            rejected += test.p < 0.05
+    return rejected, ran
+
+
+def report(test_runs: int, coverage_runs: int) -> Iterator[str]:
+    yield (
+        f"Shape test (sign-flip over participants), paper design, no shape effect, "
+        f"{test_runs} studies per size: share with p < 0.05 (nominal 0.05)"
+    )
+    for size in SIZES:
+        rejected, ran = false_positives(size, test_runs)
+        if not ran:
+            yield f"  {size:>2} participants: refused in every study (below the minimum)"
+            continue
+        low, high = wilson_interval(rejected, ran)
+        yield f"  {size:>2} participants: {rejected / ran:.3f} ({low:.3f} to {high:.3f})"
+    if coverage_runs < 1:
+        return
+    name, truth = next(iter(paper_truths(0.75, 0.3).items()))
+    yield (
+        f"Needed resolution ({name}, participants' SD 0.3 doublings), {coverage_runs} studies "
+        "per size, 200 bootstrap samples: share whose reported 95% interval covers the truth"
+    )
+    for size in SIZES:
+        result = coverage(coverage_runs, truth=truth, participants=size, samples=200)
+        yield f"  {size:>2} participants: {describe(result, 'bootstrap')}"
+
+
+if __name__ == "__main__":
+    args = [int(a) for a in sys.argv[1:3]]
+    for line in report(*(args + [400, 100][len(args) :])):
+        print(line, flush=True)

@@ -1,0 +1,158 @@
+"""What the sleeve did with the strokes of one drawing, read from its ``events`` topic.
+
+``feelmysign send --wait`` subscribes before the first stroke goes out and then
+waits, with a bound, until each stroke of its drawing has a final answer from
+the sleeve: played (``played`` or ``adjusted``), or refused (``rejected``, a
+``safety`` event that kept it from playing, a ``cancelled`` one before it
+started). A stroke played and later cut (``safety`` ``chip_lost``, ``cancelled``
+while playing) is reported as cut. Copies of an event (QoS 1 delivers at least
+once) are counted once (``EventCopies``).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import Counter
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from feelmysign.events import (
+    Cancelled,
+    Event,
+    EventCopies,
+    EventError,
+    Played,
+    Rejected,
+    Safety,
+    event_from_json,
+)
+
+if TYPE_CHECKING:
+    import paho.mqtt.client as mqtt
+
+
+@dataclass
+class StrokeOutcome:
+    """One stroke's answer: its played event, or why it was refused; and a cut after playing."""
+
+    played: Played | None = None
+    refused_reason: str | None = None
+    refused_message: str | None = None
+    cut_reason: str | None = None
+    # When the played event arrived (monotonic s): the stroke ends on the skin duration later.
+    played_seen_s: float | None = None
+
+    @property
+    def final(self) -> bool:
+        return self.played is not None or self.refused_reason is not None
+
+
+class DrawingOutcome:
+    """The answers for the ``count`` strokes (seq 0..count-1) of ``drawing``, from paho's thread.
+
+    ``on_event`` is told of each stroke's first final answer and of a cut, as
+    ``(seq, outcome, event_json)``, on paho's thread.
+    """
+
+    def __init__(self, drawing: str, count: int, on_event: Any = None) -> None:
+        self.drawing = drawing
+        self.count = count
+        self.strokes = [StrokeOutcome() for _ in range(count)]
+        self._condition = threading.Condition()
+        self._copies = EventCopies()
+        self._on_event = on_event
+
+    def on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        try:
+            event = event_from_json(bytes(message.payload))
+        except EventError:
+            return  # not an event this reader understands: an older or newer sleeve's
+        seq = getattr(event, "seq", None)
+        if getattr(event, "drawing", None) != self.drawing or seq is None:
+            return
+        if not 0 <= seq < self.count:
+            return
+        with self._condition:
+            if self._copies.is_copy(event):
+                return
+            told = self._record(self.strokes[seq], event)
+            self._condition.notify_all()
+        if told and self._on_event is not None:
+            self._on_event(seq, self.strokes[seq], event)
+
+    @staticmethod
+    def _record(stroke: StrokeOutcome, event: Event) -> bool:
+        """Note ``event`` for its stroke; True when it changed what is known of it."""
+        if isinstance(event, Played):
+            if stroke.final:
+                return False
+            stroke.played, stroke.played_seen_s = event, time.monotonic()
+            return True
+        if isinstance(event, Rejected):
+            if stroke.final:  # a 'duplicate' for a copy of a stroke already answered
+                return False
+            stroke.refused_reason, stroke.refused_message = event.reason, event.message
+            return True
+        if isinstance(event, Safety | Cancelled):
+            if stroke.played is not None:
+                if stroke.cut_reason is not None:
+                    return False
+                stroke.cut_reason = event.reason
+                return True
+            if stroke.final:
+                return False
+            stroke.refused_reason = event.reason
+            stroke.refused_message = event.message
+            return True
+        return False
+
+    def wait_answered(self, deadline_s: float) -> None:
+        """Until every stroke has a final answer, or the monotonic ``deadline_s``."""
+        with self._condition:
+            self._condition.wait_for(
+                lambda: all(s.final for s in self.strokes), max(0.0, deadline_s - time.monotonic())
+            )
+
+    def felt_by_s(self) -> float | None:
+        """When (monotonic s) the last played stroke ends on the skin, as far as known."""
+        with self._condition:
+            ends = [
+                s.played_seen_s + s.played.duration_ms / 1000
+                for s in self.strokes
+                if s.played is not None and s.played_seen_s is not None
+            ]
+        return max(ends) if ends else None
+
+    def summary(self) -> DrawingSummary:
+        with self._condition:
+            played = [i for i, s in enumerate(self.strokes) if s.played is not None]
+            refused = Counter(s.refused_reason for s in self.strokes if s.refused_reason)
+            cut = Counter(s.cut_reason for s in self.strokes if s.cut_reason)
+            unheard = [i for i, s in enumerate(self.strokes) if not s.final]
+        return DrawingSummary(self.count, len(played), refused, cut, unheard)
+
+
+@dataclass(frozen=True)
+class DrawingSummary:
+    count: int
+    played: int
+    refused: Counter[str]
+    cut: Counter[str]
+    unheard: list[int]  # seqs with no answer
+
+    @property
+    def all_played(self) -> bool:
+        return self.played == self.count and not self.cut
+
+    def text(self) -> str:
+        parts = [f"played {self.played} of {self.count} strokes"]
+        if self.refused:
+            parts.append(f"refused {sum(self.refused.values())} ({_reasons(self.refused)})")
+        if self.cut:
+            parts.append(f"cut {sum(self.cut.values())} part-way ({_reasons(self.cut)})")
+        return "The sleeve " + ", ".join(parts)
+
+
+def _reasons(counts: Counter[str]) -> str:
+    return ", ".join(f"{reason} x{n}" if n > 1 else reason for reason, n in counts.most_common())

@@ -1,0 +1,28 @@
+/** The study page's sentences: counts with their nouns, and what became of the strokes sent. */
+import { describe, expect, it } from "vitest";
+import { plural } from "../src/study/dom";
+import { sentText } from "../src/study/session-view";
+
+describe("the study page's counts", () => {
+  it("says 1 stroke and 1 participant, 2 strokes and 0 participants", () => {
+    expect(plural(1, "stroke")).toBe("1 stroke");
+    expect(plural(2, "stroke")).toBe("2 strokes");
+    expect(plural(1, "participant")).toBe("1 participant");
+    expect(plural(0, "participant")).toBe("0 participants");
+  });
+
+  it("says what became of a send's strokes, cut short and cancelled included", () => {
+    const sent = {
+      strokes: 1,
+      played: 1,
+      adjusted: 0,
+      rejected: [],
+      latency_ms_max: null,
+      felt_duration_ms: 1,
+    };
+    expect(sentText(sent)).toBe("played 1 of 1 stroke");
+    expect(sentText({ ...sent, strokes: 4, played: 1, cut_short: 1, cancelled: 2 })).toBe(
+      "played 1 of 4 strokes · 1 cut short · 2 cancelled",
+    );
+  });
+});
