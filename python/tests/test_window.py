@@ -33,7 +33,7 @@ from feelmysign.simplify import (
     WindowSimplifier,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE
-from feelmysign.simplify.window import LINE_SHARE, WindowCore
+from feelmysign.simplify.window import LINE_SHARE, REST_SHARE, WindowCore
 from feelmysign.stroke import Point
 
 WINDOW = dict(load("window"))
@@ -338,6 +338,7 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
         max_bend=draw(st.sampled_from([0.0, 0.1, 0.3])),
         bend_floor=draw(st.sampled_from([0.0, 0.05])),
         floor_ms=draw(st.sampled_from([0.0, 73.7, 200.0])),
+        rest_ms=draw(st.sampled_from([0.0, 30.0, 100.0])),
         stretch=draw(st.booleans()),
         canvas_width_px=800,
         canvas_height_px=600,
@@ -347,24 +348,29 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
     return params, samples
 
 
-def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:
-    """Each segment with the indices of the first and last sample it covers.
+def _rest_radius(params: WindowParams) -> float:
+    """How far a sample the pen rested at may lie from the point that stands for the rest."""
+    if params.rest_ms <= 0:
+        return 0.0
+    return min(REST_SHARE * params.min_length, 0.5 * params.max_error)
 
-    Segments join end to start, so each starts at the sample the one before
-    ended on; it ends on the last sample (from there) with its end time, at its
-    point or, going on along a line the latency cap cut, within LINE_SHARE x
-    max_error of it.
-    """
-    segments = [s for _, s in run(params, [samples])]
-    mapping = params.mapping
-    moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE
+
+def _moved(params: WindowParams) -> float:
+    return max(LINE_SHARE * params.max_error, _rest_radius(params)) + FLOAT_TOLERANCE
+
+
+def _ends(
+    params: WindowParams, samples: list[Sample], segments: list[Segment]
+) -> list[tuple[int, int, Segment]]:
+    """Each segment with the first and last sample it covers (see ``_covered``)."""
+    mapping, moved = params.mapping, _moved(params)
     covered: list[tuple[int, int, Segment]] = []
     start = 0
     for number, segment in enumerate(segments, start=1):
         ends = [
             j
             for j in range(min(start + 1, len(samples) - 1), len(samples))
-            if samples[j].t_ms == segment.end_ms
+            if samples[j].t_ms >= segment.end_ms
             and math.dist(mapping.to_grid(samples[j].x, samples[j].y), segment.end) <= moved
         ]
         assert ends, f"{segment} does not end on a sample"
@@ -372,8 +378,26 @@ def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int
         end = ends[-1] if number == len(segments) else ends[0]
         covered.append((start, end, segment))
         start = end
-    assert start == len(samples) - 1, "the last segment ends on the last sample"
+    # The samples after the last segment are a rest at its end.
+    if segments:
+        last = segments[-1]
+        limit = min(2 * _rest_radius(params), params.max_error) + FLOAT_TOLERANCE
+        for sample in samples[start + 1 :]:
+            point = mapping.to_grid(sample.x, sample.y)
+            assert _distance(point, last.start, last.end) <= limit, (last, sample)
     return covered
+
+
+def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:
+    """Each segment with the indices of the first and last sample it covers.
+
+    Segments join end to start, so each starts at the sample the one before
+    ended on; it ends on the first sample (from there) drawn at or after its end
+    time, at its point or, going on along a line the latency cap cut, within
+    LINE_SHARE x max_error of it (where the pen rested, within the rest radius).
+    The samples after the last segment are a rest at its end.
+    """
+    return _ends(params, samples, [s for _, s in run(params, [samples])])
 
 
 @settings(max_examples=250, deadline=None)
@@ -394,7 +418,10 @@ def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
 def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sample]]) -> None:
     params, samples = case
     assert_joined_from_press_to_release(
-        params, samples, release_within=LINE_SHARE * params.max_error + FLOAT_TOLERANCE
+        params,
+        samples,
+        release_within=_moved(params),
+        rests=params.rest_ms > 0 or params.max_stroke_ms > 0,
     )
 
 
@@ -440,20 +467,7 @@ def _core_covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int
     """``_covered`` of the window's own pieces, before any is merged."""
     core = WindowCore(params)
     segments = [out for sample in samples for out in core.push(sample)] + core.end()
-    covered, start = [], 0
-    mapping, moved = params.mapping, LINE_SHARE * params.max_error + FLOAT_TOLERANCE
-    for number, segment in enumerate(segments, start=1):
-        ends = [
-            j
-            for j in range(min(start + 1, len(samples) - 1), len(samples))
-            if samples[j].t_ms == segment.end_ms
-            and math.dist(mapping.to_grid(samples[j].x, samples[j].y), segment.end) <= moved
-        ]
-        assert ends, f"{segment} does not end on a sample"
-        end = ends[-1] if number == len(segments) else ends[0]
-        covered.append((start, end, segment))
-        start = end
-    return covered
+    return _ends(params, samples, segments)
 
 
 @settings(max_examples=150, deadline=None)
@@ -465,7 +479,9 @@ def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
     params, samples = case
     times = {s.t_ms for s in samples}
     for first, last, segment in _core_covered(params, samples):
-        assert last - first <= params.max_window
+        # The work cap counts the samples the stroke holds: not those of a rest before it.
+        held = sum(1 for sample in samples[first + 1 : last + 1] if sample.t_ms > segment.start_ms)
+        assert held <= params.max_window
         assert last > first or len(samples) == 1, "only a one-sample path gives an empty stroke"
         if params.max_stroke_ms and segment.duration_ms > params.max_stroke_ms:
             # Only a single step, or a stroke still too short to send a sample earlier.
@@ -515,6 +531,7 @@ def drawings(draw: st.DrawFn) -> tuple[WindowParams, list[list[Sample]]]:
         min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
         max_bend=draw(st.sampled_from([0.0, 0.05, 0.1, 0.3])),
         bend_floor=draw(st.sampled_from([0.0, 0.01, 0.05, 0.5])),
+        rest_ms=draw(st.sampled_from([0.0, 30.0, 100.0])),
         rows=rows,
         columns=columns,
         stretch=draw(st.booleans()),

@@ -92,6 +92,8 @@ describe("parameter tables", () => {
       max_stroke_ms: "window",
       max_bend: "window",
       bend_floor: "window",
+      rest_ms: "window",
+      strict_minimums: "window",
       floor_ms: "window",
     });
   });

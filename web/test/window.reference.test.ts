@@ -39,6 +39,8 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   max_bend: fc.constantFrom(0, 0.05, 0.1, 0.3),
   bend_floor: fc.constantFrom(0, 0.01, 0.05, 0.5),
   floor_ms: fc.constant(73.7),
+  rest_ms: fc.constantFrom(0, 30, 100),
+  strict_minimums: fc.boolean(),
   rows: fc.integer({ min: 1, max: 8 }),
   columns: fc.integer({ min: 1, max: 8 }),
   canvas_width_px: fc.constant(WIDTH_PX),

@@ -36,6 +36,8 @@ export interface WindowParams extends SharedParams {
   readonly max_stroke_ms: number;
   readonly max_bend: number;
   readonly bend_floor: number;
+  readonly rest_ms: number;
+  readonly strict_minimums: boolean;
   readonly floor_ms: number;
 }
 
@@ -46,6 +48,7 @@ export interface PanelParams {
   readonly max_stroke_ms: number;
   readonly max_bend: number;
   readonly bend_floor: number;
+  readonly rest_ms: number;
   readonly floor_ms: number;
   readonly check_frames: number;
   readonly max_angle_deg: number;
@@ -89,6 +92,8 @@ export const WINDOW_PARAM_NAMES = [
   "max_stroke_ms",
   "max_bend",
   "bend_floor",
+  "rest_ms",
+  "strict_minimums",
   "floor_ms",
   ...SHARED_PARAM_NAMES,
 ] as const;
@@ -167,6 +172,36 @@ export const PARAMETERS: readonly ParamSpec[] = [
     label: "Bend floor",
     help: "least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
     panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "rest_ms",
+    algorithms: ["window"],
+    paper: null,
+    type: "number",
+    default: 100,
+    minimum: 0,
+    maximum: 10000,
+    unit: "ms",
+    label: "Rest",
+    help: "a pen resting this long ends the stroke so far, in ms (the rest is not played); 0 = never",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "strict_minimums",
+    algorithms: ["window"],
+    paper: null,
+    type: "boolean",
+    default: false,
+    minimum: null,
+    maximum: null,
+    unit: null,
+    label: "Strict minimums",
+    help: "never send a stroke below min_length or min_duration_ms, even where max_error must yield (a wearer's measured limits: senders set it from the sleeve's status)",
+    panel: null,
     detail_levels: null,
     short: null,
   },

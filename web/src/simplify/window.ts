@@ -57,6 +57,13 @@ export const LINE_SHARE = 0.25;
 const ROUNDING_SLACK = 1e-9;
 
 /** What `push` gives when no stroke is finished (most samples): one frozen array, none made. */
+/**
+ * A pen rests while its samples stay within this share of min_length of one point (never farther
+ * than half of max_error, so the point that ends or starts a stroke covers the rest): well below a
+ * stroke the sleeve renders, well above a still hand's jitter.
+ */
+export const REST_SHARE = 0.25;
+
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
 /**
@@ -106,6 +113,25 @@ class Samples {
     this.count = 1;
     this.end = end - index;
   }
+
+  /** The anchor at another time (while the pen rests or crawls), its Sample too. */
+  retime(t: number): void {
+    this.ts[0] = t;
+    this.samples[0] = { ...this.samples[0]!, t_ms: t };
+  }
+
+  /** The sample to take next (at `count`) is not taken: the ones after it move down. */
+  skip(): void {
+    const { xs, ys, ts, samples } = this;
+    const end = this.end;
+    for (let to = this.count; to < end - 1; to++) {
+      xs[to] = xs[to + 1]!;
+      ys[to] = ys[to + 1]!;
+      ts[to] = ts[to + 1]!;
+      samples[to] = samples[to + 1]!;
+    }
+    this.end = end - 1;
+  }
 }
 
 /**
@@ -149,6 +175,14 @@ export class WindowCore {
    * line's end) needs no sample tested when that bound says so.
    */
   readonly #reaches: number[] = [0]; // index 0 (the anchor) is never read; kept packed
+  /** While the pen rests at the anchor (`rest_ms`): each sample near it moves the anchor's time. */
+  #resting = false;
+  /** Whether the last push found the pen resting (the stroke before the rest is final). */
+  rested = false;
+  /** The last sample pushed, as taken: its time (never before the one before) and grid point. */
+  #taken: { readonly t_ms: number; readonly point: Point } = { t_ms: 0, point: [0, 0] };
+  /** The squared rest radius (see `REST_SHARE`). */
+  readonly #restSq: number;
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
@@ -156,6 +190,8 @@ export class WindowCore {
     this.#maxErrorSq = params.max_error * params.max_error;
     this.#minLengthSq = params.min_length * params.min_length;
     this.#reachLimit = params.max_error - ROUNDING_SLACK;
+    const rest = Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error);
+    this.#restSq = rest * rest;
     this.#xExtent = params.columns - 1;
     this.#yExtent = params.rows - 1;
     this.#mapping = CanvasMapping.fromParams(params);
@@ -174,9 +210,7 @@ export class WindowCore {
 
   /** The last sample taken, as taken: its time (never before the one before) and grid point. */
   lastSample(): { readonly t_ms: number; readonly point: Point } {
-    const window = this.#window;
-    const last = window.count - 1;
-    return { t_ms: window.ts[last]!, point: [window.xs[last]!, window.ys[last]!] };
+    return this.#taken;
   }
 
   /** The time of the last sample pushed, as taken (0 before any). */
@@ -194,12 +228,15 @@ export class WindowCore {
     this.#pointer = sample;
     const x = this.#mapping.gridX(sample.x);
     const y = this.#mapping.gridY(sample.y);
+    this.#taken = { t_ms: sample.t_ms, point: [x, y] };
+    this.rested = false;
     window.place(x, y, sample.t_ms, sample);
     if (count === 0) {
       window.count = 1;
       this.#reach = 0;
       this.#emittedInPath = false;
       this.#line = null;
+      this.#resting = false;
       return NO_SEGMENTS;
     }
     return this.#add() ?? NO_SEGMENTS;
@@ -212,6 +249,7 @@ export class WindowCore {
     if (count === 0) return [];
     window.count = 0;
     window.end = 0;
+    this.#resting = false;
     // The last sample already ends a stroke (a cut at the work cap).
     if (count === 1 && this.#emittedInPath) return [];
     const end = this.#continued(count - 1);
@@ -234,6 +272,26 @@ export class WindowCore {
       const x = xs[count]!;
       const y = ys[count]!;
       const t = ts[count]!;
+      if (this.#resting) {
+        if (count === 1 && squared(x - xs[0]!, y - ys[0]!) <= this.#restSq) {
+          // The pen still rests: the next stroke starts when it moves on, not before.
+          window.retime(t);
+          window.skip();
+          if (window.count === window.end) return out;
+          continue;
+        }
+        this.#resting = false;
+      }
+      if (
+        capMs > 0 &&
+        count > 1 &&
+        t - ts[0]! > capMs &&
+        !this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)
+      ) {
+        // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
+        // rather than lasting longer, so the cap holds for it too.
+        window.retime(t - capMs);
+      }
       if (
         capMs > 0 &&
         count > 1 &&
@@ -259,7 +317,11 @@ export class WindowCore {
       } else {
         window.count = count + 1;
         this.#reaches[count] = this.#reach;
-        if (count >= maxWindow) {
+        const rest = this.#rests(count + 1);
+        if (rest !== false) {
+          // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
+          if (rest !== null) (out ??= []).push(rest);
+        } else if (count >= maxWindow) {
           (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], t));
           this.#line = null;
           window.restart(x, y, count);
@@ -268,6 +330,47 @@ export class WindowCore {
       }
       if (window.count === window.end) return out;
     }
+  }
+
+  /**
+   * Whether the pen has rested `rest_ms` at the stroke's newest sample, window[count - 1].
+   *
+   * It rests when its samples of the last `rest_ms` or more all lie within the rest radius of
+   * that sample. The stroke drawn up to the rest then ends there at the time the rest began, and
+   * is sent now (returned; null if the stroke is all rest, false if the pen does not rest); the
+   * rest is not played (the next stroke starts where and when the
+   * pen moves on). If the stroke is all rest, its anchor waits instead. Every sample of the rest
+   * lies within the rest radius (at most max_error / 2) of the newest, and that one within it of
+   * the anchor when all is rest.
+   */
+  #rests(count: number): Segment | null | false {
+    const restMs = this.params.rest_ms;
+    const window = this.#window;
+    const { xs, ys, ts } = window;
+    const last = count - 1;
+    const t = ts[last]!;
+    if (restMs <= 0 || t - ts[0]! < restMs) return false;
+    const x = xs[last]!;
+    const y = ys[last]!;
+    const restSq = this.#restSq;
+    let start = last;
+    while (start > 0 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
+    if (t - ts[start]! < restMs) return false;
+    let stroke: Segment | null = null;
+    if (start === 0) {
+      const anchor = window.samples[0]!;
+      window.restart(xs[0]!, ys[0]!, last);
+      window.samples[0] = anchor;
+      window.retime(t);
+    } else {
+      stroke = this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], ts[start]!);
+      window.restart(x, y, last);
+    }
+    this.#line = null;
+    this.#reach = 0;
+    this.#resting = true;
+    this.rested = true;
+    return stroke;
   }
 
   /**
@@ -530,6 +633,7 @@ export class Merger {
   readonly #minLength: number;
   readonly #minDurationMs: number;
   readonly #shortMs: number;
+  readonly #strict: boolean;
   /** The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first. */
   #xs: number[] = [];
   #ys: number[] = [];
@@ -537,11 +641,12 @@ export class Merger {
   #held: Segment | null = null;
   #sentInPath = false;
 
-  constructor(maxError: number, minLength: number, minDurationMs: number, floorMs: number) {
+  constructor(maxError: number, minLength: number, minDurationMs: number, floorMs: number, strict = false) {
     this.#maxError = maxError;
     this.#minLength = minLength;
     this.#minDurationMs = minDurationMs;
     this.#shortMs = Math.max(minDurationMs, floorMs);
+    this.#strict = strict;
   }
 
   /** A drawn sample, in order (its time as the window took it). */
@@ -555,8 +660,16 @@ export class Merger {
     return segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs;
   }
 
-  /** Whether every sample drawn from startMs to endMs lies within max_error of start -> end. */
-  #fits(start: Point, end: Point, startMs: number, endMs: number): boolean {
+  #belowMinimums(segment: Segment): boolean {
+    return segmentLength(segment) < this.#minLength || segment.duration_ms < this.#minDurationMs;
+  }
+
+  /**
+   * Whether every sample not yet covered, drawn up to endMs, lies within max_error of
+   * start -> end. All of them, not only those after the held piece's start: a stroke whose pen
+   * crawled or rested starts after samples it covers.
+   */
+  #fits(start: Point, end: Point, endMs: number): boolean {
     const limitSq = this.#maxError * this.#maxError;
     const xs = this.#xs;
     const ys = this.#ys;
@@ -564,7 +677,7 @@ export class Merger {
     for (let i = 0; i < ts.length; i++) {
       const t = ts[i]!;
       if (t > endMs) break;
-      if (t >= startMs && distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
+      if (distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
         return false;
       }
     }
@@ -589,7 +702,7 @@ export class Merger {
     const held = this.#held;
     if (held !== null) {
       this.#held = null;
-      if (this.#fits(held.start, piece.end, held.start_ms, piece.end_ms)) {
+      if (this.#fits(held.start, piece.end, piece.end_ms) || (this.#strict && this.#belowMinimums(held))) {
         piece = {
           start: held.start,
           end: piece.end,
@@ -608,12 +721,33 @@ export class Merger {
     else this.#send(piece, nowMs, out);
   }
 
+  /**
+   * The pen rests (since the held piece's end, until `nowMs`): the held piece is sent now, into
+   * `out`, rather than merged with what comes after the rest, which would play the rest. If it is
+   * briefer than the sleeve's floor, it takes the time it needs from the rest: the pen was at its
+   * end then. With strict minimums, a piece still below them waits.
+   */
+  rest(nowMs: number, out: Segment[]): void {
+    let held = this.#held;
+    if (held === null) return;
+    if (held.duration_ms < this.#shortMs && nowMs > held.end_ms) {
+      const endMs = Math.min(held.start_ms + this.#shortMs, nowMs);
+      held = { ...held, end_ms: endMs, duration_ms: endMs - held.start_ms };
+    }
+    if (this.#strict && this.#belowMinimums(held)) {
+      this.#held = held;
+      return;
+    }
+    this.#held = null;
+    this.#send(held, nowMs, out);
+  }
+
   /** Release, after the window's last piece: the held piece is sent (or, a path's only piece too short, dropped). */
   end(nowMs: number, out: Segment[]): void {
     const held = this.#held;
     if (held !== null) {
       let reason: DropReason | null = null;
-      if (!this.#sentInPath) {
+      if (!this.#sentInPath || this.#strict) {
         if (segmentLength(held) < this.#minLength) reason = NOT_ENOUGH_DISTANCE;
         else if (held.duration_ms < this.#minDurationMs) reason = NOT_ENOUGH_DURATION;
       }
@@ -637,7 +771,13 @@ export class WindowSimplifier {
   constructor(params: WindowParams) {
     this.#core = new WindowCore(params);
     this.params = params;
-    this.#merger = new Merger(params.max_error, params.min_length, params.min_duration_ms, params.floor_ms);
+    this.#merger = new Merger(
+      params.max_error,
+      params.min_length,
+      params.min_duration_ms,
+      params.floor_ms,
+      params.strict_minimums,
+    );
   }
 
   /** True between the first sample of a path and `end`. */
@@ -659,6 +799,7 @@ export class WindowSimplifier {
     merger.sample(last.t_ms, last.point);
     const out: Segment[] = [];
     for (const piece of pieces) merger.take(piece, last.t_ms, out);
+    if (core.rested) merger.rest(last.t_ms, out);
     return out.length > 0 ? out : NO_SEGMENTS;
   }
 
@@ -671,6 +812,10 @@ export class WindowSimplifier {
     this.#merger.end(nowMs, out);
     return out;
   }
+}
+
+function squared(dx: number, dy: number): number {
+  return dx * dx + dy * dy;
 }
 
 /** The unit vector from `start` to `end` (null if they coincide). */

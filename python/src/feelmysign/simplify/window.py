@@ -92,6 +92,10 @@ LINE_SHARE = 0.25
 # distance, and the room it keeps below max_error, so that no distance it lets through could
 # compute above it.
 ROUNDING_SLACK = 1e-9
+# A pen rests while its samples stay within this share of min_length of one point (never
+# farther than half of max_error, so the point that ends or starts a stroke covers the rest):
+# well below a stroke the sleeve renders, well above a still hand's jitter.
+REST_SHARE = 0.25
 
 
 @dataclass(frozen=True)
@@ -153,6 +157,22 @@ class _WindowOwn:
         label="Bend floor",
         unit="grid units",
     )
+    rest_ms: float = param(
+        100.0,
+        0,
+        10_000,
+        help="a pen resting this long ends the stroke so far, in ms (the rest is not played); "
+        "0 = never",
+        label="Rest",
+        unit="ms",
+    )
+    strict_minimums: bool = param(
+        False,
+        help="never send a stroke below min_length or min_duration_ms, even where max_error must "
+        "yield (a wearer's measured limits: senders set it from the sleeve's status)",
+        label="Strict minimums",
+        panel=None,
+    )
     floor_ms: float = param(
         73.7,
         0,
@@ -211,7 +231,14 @@ class WindowCore:
     # a test of points[1:i] against anchor -> points[i] or a point near it (a cut's feature, a
     # line's end) needs no sample tested when that bound says so. Index 0 is never read.
     _reaches: list[float] = field(default_factory=lambda: [0.0])
+    # While the pen rests at the anchor (``rest_ms``): each sample near it moves the anchor's time.
+    _resting: bool = False
+    # Whether the last push found the pen resting (the stroke before the rest is final).
+    rested: bool = False
+    # The last sample pushed, as taken: its time (never before the one before) and grid point.
+    _taken: tuple[float, Point] = (0.0, (0.0, 0.0))
     _max_error_sq: float = field(init=False)
+    _rest_sq: float = field(init=False)
     _min_length_sq: float = field(init=False)
     _reach_limit: float = field(
         init=False
@@ -225,6 +252,8 @@ class WindowCore:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._min_length_sq = self.params.min_length * self.params.min_length
         self._reach_limit = self.params.max_error - ROUNDING_SLACK
+        rest = min(REST_SHARE * self.params.min_length, 0.5 * self.params.max_error)
+        self._rest_sq = rest * rest
         self._mapping = self.params.mapping
         self._x_extent = float(self.params.columns - 1)
         self._y_extent = float(self.params.rows - 1)
@@ -241,7 +270,7 @@ class WindowCore:
 
     def last_sample(self) -> tuple[float, Point]:
         """The last sample taken, as taken: its time (never before the one before) and point."""
-        return self._times[-1], self._points[-1]
+        return self._taken
 
     def pointer_ms(self) -> float:
         """The time of the last sample pushed, as taken (0 before any)."""
@@ -254,11 +283,14 @@ class WindowCore:
             sample = Sample(times[-1], sample.x, sample.y, sample.pressure)
         self._pointer = sample
         point = self._mapping.to_grid(sample.x, sample.y)
+        self._taken = (sample.t_ms, point)
+        self.rested = False
         if not times:
             self._points, self._times, self._samples = [point], [sample.t_ms], [sample]
             self._emitted_in_path = False
             self._line = None
             self._reach = 0.0
+            self._resting = False
             return []
         out: list[Segment] = []
         self._add(point, sample, out)
@@ -268,6 +300,7 @@ class WindowCore:
         """Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0)."""
         points, times = self._points, self._times
         self._points, self._times, self._samples = [], [], []
+        self._resting = False
         if not points:
             return []
         if len(points) == 1 and self._emitted_in_path:
@@ -288,6 +321,24 @@ class WindowCore:
         while True:
             points, times, samples = self._points, self._times, self._samples
             t_ms = sample.t_ms
+            if self._resting:
+                if len(points) == 1 and _distance_sq(point, points[0]) <= self._rest_sq:
+                    # The pen still rests: the next stroke starts when it moves on, not before.
+                    self._retime(t_ms)
+                    if not pending:
+                        return
+                    point, sample = pending.pop()
+                    continue
+                self._resting = False
+            if (
+                cap_ms > 0
+                and len(points) > 1
+                and t_ms - times[0] > cap_ms
+                and not self._sendable(points[0], points[-1])
+            ):
+                # The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts
+                # later rather than lasting longer, so the cap holds for it too.
+                self._retime(t_ms - cap_ms)
             if (
                 cap_ms > 0
                 and len(points) > 1
@@ -335,7 +386,9 @@ class WindowCore:
                 reaches.append(self._reach)
             else:
                 reaches[len(points) - 1] = self._reach
-            if len(points) - 1 >= max_window:
+            if self._rests(points, times, point, sample, out):
+                pass
+            elif len(points) - 1 >= max_window:
                 out.append(self._finish(points[0], times[0], point, t_ms))
                 self._line = None
                 self._points, self._times, self._samples = [point], [t_ms], [sample]
@@ -343,6 +396,51 @@ class WindowCore:
             if not pending:
                 return
             point, sample = pending.pop()
+
+    def _retime(self, t_ms: float) -> None:
+        """The anchor at another time (while the pen rests or crawls), its sample too."""
+        self._times[0] = t_ms
+        self._samples[0] = replace(self._samples[0], t_ms=t_ms)
+
+    def _rests(
+        self,
+        points: list[Point],
+        times: list[float],
+        point: Point,
+        sample: Sample,
+        out: list[Segment],
+    ) -> bool:
+        """Whether the pen has rested ``rest_ms`` at ``point``, the stroke's newest sample.
+
+        It rests when its samples of the last ``rest_ms`` or more all lie within
+        the rest radius of ``point``. The stroke drawn up to the rest then ends
+        at ``point`` at the time the rest began, and is sent now; the rest is
+        not played (the next stroke starts where and when the pen moves on).
+        If the stroke is all rest, its anchor waits instead. Every sample of
+        the rest lies within the rest radius (at most max_error / 2) of
+        ``point``, and ``point`` within it of the anchor when all is rest.
+        """
+        rest_ms = self.params.rest_ms
+        t_ms = times[-1]
+        if rest_ms <= 0.0 or t_ms - times[0] < rest_ms:
+            return False
+        start = len(points) - 1
+        rest_sq = self._rest_sq
+        while start > 0 and _distance_sq(points[start - 1], point) <= rest_sq:
+            start -= 1
+        if t_ms - times[start] < rest_ms:
+            return False
+        if start == 0:
+            self._points, self._times, self._samples = [points[0]], [t_ms], [self._samples[0]]
+            self._retime(t_ms)
+        else:
+            out.append(self._finish(points[0], times[0], point, times[start]))
+            self._points, self._times, self._samples = [point], [t_ms], [sample]
+        self._line = None
+        self._reach = 0.0
+        self._resting = True
+        self.rested = True
+        return True
 
     def _keeps_bound(self, points: list[Point], point: Point, max_error_sq: float) -> bool:
         """Whether every sample since the anchor lies within max_error of anchor -> ``point``.
@@ -514,6 +612,7 @@ class Merger:
     min_length: float
     min_duration_ms: float
     floor_ms: float
+    strict: bool = False
     # The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first.
     _points: list[Point] = field(default_factory=list)
     _times: list[float] = field(default_factory=list)
@@ -530,13 +629,19 @@ class Merger:
             self.min_duration_ms, self.floor_ms
         )
 
-    def _fits(self, start: Point, end: Point, start_ms: float, end_ms: float) -> bool:
-        """Whether every sample drawn from start_ms to end_ms lies within max_error of it."""
+    def _below_minimums(self, segment: Segment) -> bool:
+        return segment.length < self.min_length or segment.duration_ms < self.min_duration_ms
+
+    def _fits(self, start: Point, end: Point, end_ms: float) -> bool:
+        """Whether every sample not yet covered, drawn up to end_ms, lies within max_error of it.
+
+        All of them, not only those after the held piece's start: a stroke whose pen crawled or
+        rested starts after samples it covers."""
         limit_sq = self.max_error * self.max_error
         for point, t_ms in zip(self._points, self._times, strict=True):
             if t_ms > end_ms:
                 break
-            if t_ms >= start_ms and segment_distance_sq(point, start, end) > limit_sq:
+            if segment_distance_sq(point, start, end) > limit_sq:
                 return False
         return True
 
@@ -554,7 +659,9 @@ class Merger:
         held = self._held
         if held is not None:
             self._held = None
-            if self._fits(held.start, piece.end, held.start_ms, piece.end_ms):
+            if self._fits(held.start, piece.end, piece.end_ms) or (
+                self.strict and self._below_minimums(held)
+            ):
                 piece = Segment(
                     held.start,
                     piece.end,
@@ -571,6 +678,26 @@ class Merger:
             self._send(piece, now_ms, out)
         return out
 
+    def rest(self, now_ms: float) -> list[Segment]:
+        """The pen rests (since the held piece's end, until ``now_ms``): the held piece is sent
+        now rather than merged with what comes after the rest, which would play the rest.
+
+        If it is briefer than the sleeve's floor, it takes the time it needs from the rest: the
+        pen was at its end then. With strict minimums, a piece still below them waits."""
+        held = self._held
+        if held is None:
+            return []
+        short_ms = max(self.min_duration_ms, self.floor_ms)
+        if held.duration_ms < short_ms and now_ms > held.end_ms:
+            held = replace(held, end_ms=min(held.start_ms + short_ms, now_ms))
+        if self.strict and self._below_minimums(held):
+            self._held = held
+            return []
+        self._held = None
+        out: list[Segment] = []
+        self._send(held, now_ms, out)
+        return out
+
     def end(self, now_ms: float) -> list[Segment]:
         """Release, after the window's last piece: the held piece is sent (or, if it is the
         path's only piece and too short to send, dropped with its reason)."""
@@ -578,7 +705,7 @@ class Merger:
         held = self._held
         if held is not None:
             reason = None
-            if not self._sent_in_path:
+            if not self._sent_in_path or self.strict:
                 if held.length < self.min_length:
                     reason = NOT_ENOUGH_DISTANCE
                 elif held.duration_ms < self.min_duration_ms:
@@ -605,7 +732,11 @@ class WindowSimplifier:
         params = self.params
         self._core = WindowCore(params)
         self._merger = Merger(
-            params.max_error, params.min_length, params.min_duration_ms, params.floor_ms
+            params.max_error,
+            params.min_length,
+            params.min_duration_ms,
+            params.floor_ms,
+            params.strict_minimums,
         )
 
     @property
@@ -628,6 +759,8 @@ class WindowSimplifier:
         out: list[Segment] = []
         for piece in pieces:
             out.extend(merger.take(piece, taken))
+        if core.rested:
+            out.extend(merger.rest(taken))
         return out
 
     def end(self) -> list[Segment]:
@@ -639,6 +772,11 @@ class WindowSimplifier:
             out.extend(self._merger.take(piece, now_ms))
         out.extend(self._merger.end(now_ms))
         return out
+
+
+def _distance_sq(a: Point, b: Point) -> float:
+    dx, dy = a[0] - b[0], a[1] - b[1]
+    return dx * dx + dy * dy
 
 
 def unit_direction(start: Point, end: Point) -> tuple[float, float] | None:

@@ -67,9 +67,9 @@ public final class ParamTable {
           Map.entry(
               "window",
               names(
-                  "max_error max_window max_stroke_ms max_bend bend_floor floor_ms clear_on_press "
-                      + "min_duration_ms min_length rows columns canvas_width_px canvas_height_px "
-                      + "stretch")));
+                  "max_error max_window max_stroke_ms max_bend bend_floor rest_ms strict_minimums "
+                      + "floor_ms clear_on_press min_duration_ms min_length rows columns "
+                      + "canvas_width_px canvas_height_px stretch")));
 
   /** Every parameter once. */
   public static final List<Row> PARAMETERS =
@@ -149,6 +149,38 @@ public final class ParamTable {
               "Bend floor",
               "least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
               "simplifier",
+              null,
+              null),
+          new Row(
+              "rest_ms",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.NUMBER,
+              100.0,
+              0.0,
+              10000.0,
+              "ms",
+              "Rest",
+              "a pen resting this long ends the stroke so far, in ms (the rest is not played); 0 = "
+                  + "never",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "strict_minimums",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.BOOLEAN,
+              false,
+              null,
+              null,
+              null,
+              "Strict minimums",
+              "never send a stroke below min_length or min_duration_ms, even where max_error must "
+                  + "yield (a wearer's measured limits: senders set it from the sleeve's status)",
+              null,
               null,
               null),
           new Row(

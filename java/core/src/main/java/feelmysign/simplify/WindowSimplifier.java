@@ -34,7 +34,8 @@ public final class WindowSimplifier implements Simplifier {
             params.number("max_error"),
             params.number("min_length"),
             params.number("min_duration_ms"),
-            params.number("floor_ms"));
+            params.number("floor_ms"),
+            params.flag("strict_minimums"));
   }
 
   public Params params() {
@@ -59,6 +60,9 @@ public final class WindowSimplifier implements Simplifier {
     List<Segment> out = null;
     for (Segment piece : pieces) {
       out = merger.take(piece, takenMs, out);
+    }
+    if (core.rested()) {
+      out = merger.rest(takenMs, out);
     }
     return out == null ? List.of() : out;
   }
@@ -92,8 +96,14 @@ final class WindowCore implements Simplifier {
    * max_error (0.001): what a stroke's reach adds for rounding, and the room kept below
    * max_error. */
   static final double ROUNDING_SLACK = 1e-9;
+  /** A pen rests while its samples stay within this share of min_length of one point (never
+   * farther than half of max_error, so the point that ends or starts a stroke covers the rest):
+   * well below a stroke the sleeve renders, well above a still hand's jitter. */
+  static final double REST_SHARE = 0.25;
 
   private final Params params;
+  private final double restMs;
+  private final double restSq;
   private final double maxError;
   private final int maxWindow;
   private final double maxStrokeMs;
@@ -129,6 +139,14 @@ final class WindowCore implements Simplifier {
   private double[] line;
   /** No sample since the anchor lies farther than this from anchor -> last sample. */
   private double reach;
+  /** While the pen rests at the anchor: each sample near it moves the anchor's time. */
+  private boolean resting;
+  /** Whether the last push found the pen resting (the stroke before the rest is final). */
+  private boolean rested;
+  /** The last sample pushed, as taken: its time and grid point. */
+  private double takenMs;
+  private double takenX;
+  private double takenY;
 
   WindowCore(Params params) {
     if (params.algorithm() != Algorithm.WINDOW) {
@@ -148,6 +166,14 @@ final class WindowCore implements Simplifier {
     this.mapping = params.mapping();
     this.xExtent = params.columns() - 1;
     this.yExtent = params.rows() - 1;
+    this.restMs = params.number("rest_ms");
+    double rest = Math.min(REST_SHARE * minLength, 0.5 * maxError);
+    this.restSq = rest * rest;
+  }
+
+  /** Whether the last push found the pen resting. */
+  boolean rested() {
+    return rested;
   }
 
   public Params params() {
@@ -166,15 +192,15 @@ final class WindowCore implements Simplifier {
 
   /** The time of the last sample taken, as taken (never before the one before). */
   double lastMs() {
-    return ts[count - 1];
+    return takenMs;
   }
 
   double lastX() {
-    return xs[count - 1];
+    return takenX;
   }
 
   double lastY() {
-    return ys[count - 1];
+    return takenY;
   }
 
   /** The time of the last sample pushed, as taken (0 before any). */
@@ -217,6 +243,24 @@ final class WindowCore implements Simplifier {
     end = end - index;
   }
 
+  /** The anchor at another time (while the pen rests or crawls), its sample too. */
+  private void retime(double t) {
+    ts[0] = t;
+    Sample anchor = samples[0];
+    samples[0] = new Sample(t, anchor.x(), anchor.y(), anchor.pressure());
+  }
+
+  /** The sample to take next (at count) is not taken: the ones after it move down. */
+  private void skip() {
+    for (int to = count; to < end - 1; to++) {
+      xs[to] = xs[to + 1];
+      ys[to] = ys[to + 1];
+      ts[to] = ts[to + 1];
+      samples[to] = samples[to + 1];
+    }
+    end--;
+  }
+
   @Override
   public List<Segment> push(Sample input) {
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last.
@@ -228,12 +272,17 @@ final class WindowCore implements Simplifier {
     double x = mapping.gridX(sample.x());
     double y = mapping.gridY(sample.y());
     int before = count;
+    takenMs = sample.tMs();
+    takenX = x;
+    takenY = y;
+    rested = false;
     place(x, y, sample.tMs(), sample);
     if (before == 0) {
       count = 1;
       reach = 0;
       emittedInPath = false;
       line = null;
+      resting = false;
       return List.of();
     }
     List<Segment> out = add();
@@ -248,6 +297,7 @@ final class WindowCore implements Simplifier {
     }
     count = 0;
     end = 0;
+    resting = false;
     // The last sample already ends a stroke (a cut at the work cap).
     if (n == 1 && emittedInPath) {
       return List.of();
@@ -265,6 +315,23 @@ final class WindowCore implements Simplifier {
       double x = xs[n];
       double y = ys[n];
       double t = ts[n];
+      if (resting) {
+        if (n == 1 && squared(x - xs[0], y - ys[0]) <= restSq) {
+          // The pen still rests: the next stroke starts when it moves on, not before.
+          retime(t);
+          skip();
+          if (count == end) {
+            return out;
+          }
+          continue;
+        }
+        resting = false;
+      }
+      if (capMs > 0 && n > 1 && t - ts[0] > capMs && !sendable(xs[0], ys[0], xs[n - 1], ys[n - 1])) {
+        // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
+        // rather than lasting longer, so the cap holds for it too.
+        retime(t - capMs);
+      }
       if (capMs > 0 && n > 1 && t - ts[0] > capMs && sendable(xs[0], ys[0], xs[n - 1], ys[n - 1])) {
         int cut = capCut(n);
         double[] vertex = continued(cut);
@@ -292,7 +359,16 @@ final class WindowCore implements Simplifier {
       } else {
         count = n + 1;
         reaches[n] = reach;
-        if (n >= maxWindow) {
+        if (rests(n + 1)) {
+          // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
+          if (restStroke != null) {
+            if (out == null) {
+              out = new ArrayList<>(2);
+            }
+            out.add(restStroke);
+            restStroke = null;
+          }
+        } else if (n >= maxWindow) {
           if (out == null) {
             out = new ArrayList<>(2);
           }
@@ -306,6 +382,51 @@ final class WindowCore implements Simplifier {
         return out;
       }
     }
+  }
+
+  /** The stroke a rest ended, between rests() and add() (null if all was rest). */
+  private Segment restStroke;
+
+  /**
+   * Whether the pen has rested rest_ms at the stroke's newest sample, index n - 1: its samples of
+   * the last rest_ms or more all lie within the rest radius of it. The stroke drawn up to the
+   * rest then ends there at the time the rest began, and is sent now (restStroke); the rest is
+   * not played (the next stroke starts where and when the pen moves on). If the stroke is all
+   * rest, its anchor waits instead.
+   */
+  private boolean rests(int n) {
+    int last = n - 1;
+    double t = ts[last];
+    if (restMs <= 0 || t - ts[0] < restMs) {
+      return false;
+    }
+    double x = xs[last];
+    double y = ys[last];
+    int start = last;
+    while (start > 0 && squared(xs[start - 1] - x, ys[start - 1] - y) <= restSq) {
+      start--;
+    }
+    if (t - ts[start] < restMs) {
+      return false;
+    }
+    if (start == 0) {
+      Sample anchor = samples[0];
+      restart(xs[0], ys[0], last);
+      samples[0] = anchor;
+      retime(t);
+    } else {
+      restStroke = finish(xs[0], ys[0], ts[0], x, y, ts[start]);
+      restart(x, y, last);
+    }
+    line = null;
+    reach = 0;
+    resting = true;
+    rested = true;
+    return true;
+  }
+
+  private static double squared(double dx, double dy) {
+    return dx * dx + dy * dy;
   }
 
   /** Whether every sample since the anchor lies within max_error of anchor -> (x, y); sets the
@@ -593,6 +714,7 @@ final class Merger {
   private final double minLength;
   private final double minDurationMs;
   private final double shortMs;
+  private final boolean strict;
   // The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first:
   // [first, size).
   private double[] xs = new double[64];
@@ -603,11 +725,16 @@ final class Merger {
   private Segment held;
   private boolean sentInPath;
 
-  Merger(double maxError, double minLength, double minDurationMs, double floorMs) {
+  Merger(double maxError, double minLength, double minDurationMs, double floorMs, boolean strict) {
     this.maxError = maxError;
     this.minLength = minLength;
     this.minDurationMs = minDurationMs;
     this.shortMs = Math.max(minDurationMs, floorMs);
+    this.strict = strict;
+  }
+
+  Merger(double maxError, double minLength, double minDurationMs, double floorMs) {
+    this(maxError, minLength, minDurationMs, floorMs, false);
   }
 
   /** A drawn sample, in order (its time as the window took it). */
@@ -637,18 +764,22 @@ final class Merger {
     return segment.length() < minLength || segment.durationMs() < shortMs;
   }
 
-  /** Whether every sample drawn from startMs to endMs lies within max_error of it. */
+  private boolean belowMinimums(Segment segment) {
+    return segment.length() < minLength || segment.durationMs() < minDurationMs;
+  }
+
+  /** Whether every sample not yet covered, drawn up to the second's end, lies within max_error
+   * of the first's start -> the second's end. All of them, not only those after the first's
+   * start: a stroke whose pen crawled or rested starts after samples it covers. */
   private boolean fits(Segment from, Segment to) {
     double limitSq = maxError * maxError;
-    double startMs = from.startMs();
     double endMs = to.endMs();
     for (int i = first; i < size; i++) {
       double t = ts[i];
       if (t > endMs) {
         break;
       }
-      if (t >= startMs
-          && WindowCore.distanceSq(xs[i], ys[i], from.startX(), from.startY(), to.endX(), to.endY())
+      if (WindowCore.distanceSq(xs[i], ys[i], from.startX(), from.startY(), to.endX(), to.endY())
               > limitSq) {
         return false;
       }
@@ -690,7 +821,7 @@ final class Merger {
     Segment before = held;
     if (before != null) {
       held = null;
-      if (fits(before, piece)) {
+      if (fits(before, piece) || (strict && belowMinimums(before))) {
         piece =
             new Segment(
                 before.startX(),
@@ -713,13 +844,43 @@ final class Merger {
     return send(piece, nowMs, result);
   }
 
+  /** The pen rests (since the held piece's end, until nowMs): the held piece is sent now rather
+   * than merged with what comes after the rest, which would play the rest. If it is briefer than
+   * the sleeve's floor, it takes the time it needs from the rest: the pen was at its end then.
+   * With strict minimums, a piece still below them waits. */
+  List<Segment> rest(double nowMs, List<Segment> out) {
+    Segment piece = held;
+    if (piece == null) {
+      return out;
+    }
+    if (piece.durationMs() < shortMs && nowMs > piece.endMs()) {
+      piece =
+          new Segment(
+              piece.startX(),
+              piece.startY(),
+              piece.endX(),
+              piece.endY(),
+              piece.startMs(),
+              Math.min(piece.startMs() + shortMs, nowMs),
+              piece.emittedAtMs(),
+              piece.dropped(),
+              piece.merged());
+    }
+    if (strict && belowMinimums(piece)) {
+      held = piece;
+      return out;
+    }
+    held = null;
+    return send(piece, nowMs, out);
+  }
+
   /** Release, after the window's last piece: the held piece is sent (or, a path's only piece
    * too short, dropped with its reason). */
   List<Segment> end(double nowMs, List<Segment> out) {
     List<Segment> result = out;
     if (held != null) {
       String reason = null;
-      if (!sentInPath) {
+      if (!sentInPath || strict) {
         if (held.length() < minLength) {
           reason = Segment.NOT_ENOUGH_DISTANCE;
         } else if (held.durationMs() < minDurationMs) {
