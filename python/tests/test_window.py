@@ -374,8 +374,11 @@ def _ends(
             and math.dist(mapping.to_grid(samples[j].x, samples[j].y), segment.end) <= moved
         ]
         assert ends, f"{segment} does not end on a sample"
-        # Repeated samples (same time and place) are one: the first, but the last for the last.
-        end = ends[-1] if number == len(segments) else ends[0]
+        # Repeated samples (same time and place) are one: the first, but the last for the last
+        # (of those at the first's time: later ones at that place are a rest after it).
+        end = ends[0]
+        if number == len(segments):
+            end = max(j for j in ends if samples[j].t_ms == samples[ends[0]].t_ms)
         covered.append((start, end, segment))
         start = end
     # The samples after the last segment are a rest at its end.

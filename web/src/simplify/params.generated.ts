@@ -49,6 +49,7 @@ export interface PanelParams {
   readonly max_bend: number;
   readonly bend_floor: number;
   readonly rest_ms: number;
+  readonly strict_minimums: boolean;
   readonly floor_ms: number;
   readonly check_frames: number;
   readonly max_angle_deg: number;
@@ -201,7 +202,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     unit: null,
     label: "Strict minimums",
     help: "never send a stroke below min_length or min_duration_ms, even where max_error must yield (a wearer's measured limits: senders set it from the sleeve's status)",
-    panel: null,
+    panel: "simplifier",
     detail_levels: null,
     short: null,
   },

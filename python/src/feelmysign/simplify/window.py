@@ -171,7 +171,6 @@ class _WindowOwn:
         help="never send a stroke below min_length or min_duration_ms, even where max_error must "
         "yield (a wearer's measured limits: senders set it from the sleeve's status)",
         label="Strict minimums",
-        panel=None,
     )
     floor_ms: float = param(
         73.7,

@@ -180,7 +180,7 @@ public final class ParamTable {
               "Strict minimums",
               "never send a stroke below min_length or min_duration_ms, even where max_error must "
                   + "yield (a wearer's measured limits: senders set it from the sleeve's status)",
-              null,
+              "simplifier",
               null,
               null),
           new Row(
