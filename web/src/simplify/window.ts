@@ -15,8 +15,12 @@
  * `max_window` samples (the work cap). The stroke after one the latency cap
  * ended, if the cap or the release ends it too, ends on the line of the stroke
  * before (its end sample projected onto it) when the bound allows and that end
- * stays on the grid, so a straight line cut by the cap stays straight. Too short
- * or too brief strokes are dropped with their reason. The float operations follow the reference's order.
+ * stays on the grid, so a straight line cut by the cap stays straight. A stroke still too
+ * short to send after `max_stroke_ms` (a crawling pen) starts later rather than lasting longer.
+ * A pen resting `rest_ms` ends the stroke before the rest, and the rest is not played. Too short
+ * or too brief pieces merge into the next (`Merger`); only a tap is dropped with its reason
+ * (with `strict_minimums`, also a path's last piece below the minimums). The float operations
+ * follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
 import {

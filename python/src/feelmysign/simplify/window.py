@@ -54,6 +54,18 @@ corners land on the drawing's features. Here:
   ``max_error``, else sends it as it is. Only a path that is one such piece in
   all (a tap) is dropped, with its reason, as the angle simplifier drops.
 
+- A resting pen (``rest_ms``): when the samples of the last ``rest_ms`` all
+  lie within the rest radius (``REST_SHARE`` x min_length, at most max_error
+  / 2) of the newest, the stroke so far ends there, at the time the rest
+  began, and is sent now; while the pen stays, the next stroke's start moves
+  on with it, so the rest is not played. A held short piece is sent at the
+  rest (briefer than the floor, it takes the time it needs from the rest).
+- A crawling pen: a stroke still too short to send after ``max_stroke_ms``
+  starts later rather than lasting longer, so the latency cap holds for it.
+- Strict minimums (``strict_minimums``, a wearer's limits): a piece below
+  ``min_length`` or ``min_duration_ms`` merges into the next even where
+  ``max_error`` must yield, and a path's last such piece is dropped.
+
 Pure and streaming: ``push`` one sample at a time, ``end`` on release. A
 sample earlier than the one before it (clocks of two event sources) is taken
 at the earlier one's time, so times never run backwards.
