@@ -32,6 +32,7 @@ IDLE_CONNECTIONS = 500
 MAX_THREADS = 64
 FUZZ_REQUESTS = 300
 FUZZ_SEED = 23
+BIG_FILE_BYTES = 16_000_000
 FEELMYSIGN = [sys.executable, "-m", "feelmysign"]
 STATUS_LINE = re.compile(rb"^HTTP/1\.[01] (\d{3}) ")
 
@@ -72,7 +73,8 @@ def _start_up(tmp_path: Path, *lan_args: str) -> Iterator[Up]:
     site.mkdir()
     (site / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
     (site / "assets").mkdir()
-    (site / "assets" / "big.js").write_text("x" * 2_000_000)  # for a disconnect mid-answer
+    # For a disconnect mid-answer: more than the socket buffers on both sides can hold.
+    (site / "assets" / "big.js").write_text("x" * BIG_FILE_BYTES)
     state = tmp_path / "state"
     ports = ["--http-port", "0", "--port", "0", "--ws-port", "0"]
     process = subprocess.Popen(
@@ -260,6 +262,50 @@ def test_disconnects_at_any_point_are_quiet(up: Up) -> None:
         sock.sendall(b"POST /api/study HTTP/1.1\r\nHost: x\r\nContent-Length: 100\r\n\r\nab")
     assert "Traceback" not in up.output_since(mark)
     assert _status(_request(up, "/")) == 200
+
+
+def test_a_closed_tab_or_an_oversized_request_is_one_debug_line_in_the_log(up: Up) -> None:
+    """Expected peer behaviour goes to the debug log as a line each, never as an error with a
+    traceback (those are for the server's own bugs)."""
+    log = up.state_dir / "page-server.log"
+    before = log.read_text() if log.exists() else ""
+    for name in ("a request line of 70 KiB", "a header of 70 KiB"):
+        assert _status(_exchange(up, BAD_REQUESTS[name])) == 400
+    _close_mid_answer(up, "/assets/big.js")
+    added = _log_once(log, before, "went away before /assets/big.js was sent")
+    lines = added.splitlines()
+    assert "Traceback" not in added and " ERROR " not in added, added
+    assert sum("LineTooLong" in line for line in lines) == 2, added
+    assert all(" DEBUG " in line for line in lines), added
+    assert _status(_request(up, "/")) == 200
+
+
+def _close_mid_answer(up: Up, path: str) -> None:
+    """A tab closed while the answer is under way: a small receive window, a reset."""
+    raw = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    raw.settimeout(WAIT_S)
+    raw.connect((up.host, up.port))
+    sock = raw
+    if up.tls:
+        context = ssl.create_default_context(cafile=str(up.ca_file()))
+        context.check_hostname = False
+        sock = context.wrap_socket(raw)
+    sock.sendall(f"GET {path} HTTP/1.1\r\nHost: {up.host}:{up.port}\r\n\r\n".encode())
+    assert _status(sock.recv(100)) == 200
+    time.sleep(0.2)  # the server is blocked on the full window
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
+    sock.close()
+
+
+def _log_once(log: Path, before: str, line: str) -> str:
+    """What the debug log gained since ``before``, once it holds ``line``."""
+    deadline = time.monotonic() + WAIT_S
+    while True:
+        added = log.read_text()[len(before) :]
+        if line in added or time.monotonic() > deadline:
+            return added
+        time.sleep(0.1)
 
 
 def test_a_silent_or_slow_client_is_closed(up: Up) -> None:

@@ -8,9 +8,10 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
-from study_helpers import new_study
+from study_helpers import new_study, pilot_study
 
 from feelmysign.study.api import StudyApi
+from feelmysign.study.dry_run import dry_run
 from feelmysign.study.runner import Session
 from feelmysign.study.simulated_sleeve import offline_player
 from feelmysign.webserver import WebServer
@@ -97,3 +98,27 @@ def test_the_web_server_mounts_the_api_and_serves_the_study_page(tmp_path: Path)
             assert error.code == 404
         else:
             raise AssertionError("an unknown API path must be a 404")
+
+
+def test_the_analysis_lists_only_the_files_the_page_can_fetch(tmp_path: Path) -> None:
+    """The results folder's own files (report, tables, plots) are listed and each is served;
+    the BIDS export in its subfolder is written but neither listed nor served."""
+    store = pilot_study(tmp_path)
+    dry_run(store, 2, seed=3)
+    layout = Session(store, None).layout
+    api = StudyApi(Session(store, offline_player(layout)), tmp_path / "results", bootstrap=50)
+    status, analysis = _call(api, "POST", "/api/study/analyse")
+    assert status == 200, analysis
+    folder = Path(analysis["folder"])
+    listed = analysis["files"]
+    on_disk = sorted(p.name for p in folder.iterdir() if p.is_file())
+    assert sorted(listed) == on_disk and "report.md" in listed
+    nested = [p for p in folder.rglob("*") if p.is_file() and p.parent != folder]
+    assert any(p.parent.name == "bids" for p in nested), nested  # written, in its subfolder
+    assert not {p.name for p in nested} & set(listed)
+    for name in listed:
+        status, _kind, body = api.handle("GET", f"/api/study/results/{name}", HOST, b"", "")
+        assert status == 200 and body == (folder / name).read_bytes(), name
+    for path in nested:
+        status, _, _ = api.handle("GET", f"/api/study/results/{path.name}", HOST, b"", "")
+        assert status == 404, path

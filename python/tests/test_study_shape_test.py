@@ -11,7 +11,7 @@ import pandas as pd
 from study_helpers import pilot_study
 
 from feelmysign.study.analysis import analyse_study
-from feelmysign.study.analysis.models import MIN_PARTICIPANTS, sign_flip_test
+from feelmysign.study.analysis.models import MIN_PARTICIPANTS, shape_profiles, sign_flip_test
 from feelmysign.study.dry_run import dry_run
 
 LEVELS = {"circle": (4, 8), "square": (4, 8), "triangle": (3, 6), "star": (5, 10)}
@@ -75,3 +75,16 @@ def test_a_two_participant_pilot_is_analysed_without_a_test_and_says_why(tmp_pat
         assert sum(row["by_shape"][shape][0] for row in table) == sum(r["correct"] for r in levels)
         assert sum(row["by_shape"][shape][1] for row in table) == sum(r["total"] for r in levels)
     assert "## Per participant" in report and "| P02 | yes | 16 |" in report
+
+
+def test_a_profile_holds_nothing_the_shape_free_model_fits() -> None:
+    """Each participant's profile sums to zero over the shapes (their own level is their
+    intercept's) and has no part along the shapes' mean log2(strokes) (the shared slope's):
+    what sign flips would count as spread while the data's mean cannot vary there."""
+    data = _answers(8, np.random.default_rng(4), star_odds=1.0)
+    profile = shape_profiles(data)
+    levels = data.groupby("shape")["log2_strokes"].mean().sort_index().to_numpy(float)
+    assert profile.shape == (8, len(LEVELS))
+    assert np.abs(profile.sum(axis=1)).max() < 1e-9
+    assert np.abs(profile @ (levels - levels.mean())).max() < 1e-9
+    assert np.abs(profile).max() > 0.01  # and something is left to test

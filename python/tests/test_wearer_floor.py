@@ -24,6 +24,7 @@ from feelmysign.broker import Broker
 from feelmysign.cli import main
 from feelmysign.events import StatusFloor
 from feelmysign.layout import Layout
+from feelmysign.study.store import StudyStore
 from feelmysign.wearer import (
     SLEEVE_MIN_LENGTH,
     Wearer,
@@ -151,6 +152,27 @@ def test_the_motors_floor_alone_leaves_a_senders_minimums_alone() -> None:
     # slow and catch up after; only a wearer's measured limits are kept to.
     floor = StatusFloor(min_duration_ms=73.701, min_length=0.05, wearer=None)
     assert respect_floor(6.1, 0.01, floor) == (6.1, 0.01, None)
+
+
+def test_a_dry_run_is_not_saved_as_a_real_participants_limit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    store = new_study(tmp_path)
+    study, participant = str(store.path), store.add_participant()  # a real participant
+    store.set_consent(participant, True)
+    store.close()
+    wearer = tmp_path / "wearer.json"
+    argv = ["study", "threshold", study, "--participant", participant, "--dimension", "length"]
+    code = main([*argv, "--simulated-observer", str(WEARER_LENGTH), "--save", str(wearer)])
+    err = capsys.readouterr().err
+    assert code == 1 and "Error: --save with --simulated-observer" in err, err
+    assert f"as {participant}'s measured limit" in err and "Traceback" not in err
+    assert not wearer.exists()
+    # Refused before the run: no dry run was stored either.
+    assert StudyStore(tmp_path / "study.sqlite").query("SELECT * FROM threshold_runs") == []
+    # Without --save the dry run goes ahead, stored as one.
+    assert main([*argv, "--simulated-observer", str(WEARER_LENGTH)]) == 0
+    assert not wearer.exists()
 
 
 # ---- the loop ----------------------------------------------------------------------------

@@ -54,6 +54,27 @@ def test_hosts_it_was_told_to_serve_on_are_allowed(site: Path) -> None:
         assert _get(server, "/config.json", f"192.168.1.21:{port}")[0] == 403
 
 
+def test_a_bug_in_the_server_keeps_its_traceback_in_the_debug_log(
+    site: Path, tmp_path: Path
+) -> None:
+    """Peer faults are one debug line each (test_page_server_peers); a bug of the server's own
+    is still logged as an error with its traceback."""
+
+    def broken_api(
+        method: str, path: str, host: str, body: bytes, kind: str
+    ) -> tuple[int, str, bytes]:
+        raise ZeroDivisionError("a bug in the API")
+
+    log = tmp_path / "page-server.log"
+    with WebServer(port=0, config=CONFIG, directory=site, api=broken_api, debug_log=log) as server:
+        status, _ = _get(server, "/api/study", f"127.0.0.1:{_port(server)}")
+    text = log.read_text()
+    assert status == 500
+    assert (
+        " ERROR " in text and "Traceback" in text and "ZeroDivisionError: a bug in the API" in text
+    )
+
+
 def test_host_header_names() -> None:
     assert host_header_names(["::1", "Example.org"], 80) == {
         "[::1]:80",

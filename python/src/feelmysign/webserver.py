@@ -17,8 +17,9 @@ client), on one asyncio loop in one thread: an idle or hostile connection costs 
 kilobytes, never a thread. What a network peer sends (a malformed or oversized
 request, TLS garbage, a cut handshake, a device that does not trust the certificate
 yet, a disconnect at any point) is answered with its HTTP status or a closed
-connection, and its details go to the debug log (``debug_log``), never to the
-terminal, which belongs to the sleeve's lines. A device that refuses the certificate
+connection, and its details go to the debug log (``debug_log``) as one line each, never to
+the terminal, which belongs to the sleeve's lines. A traceback in that log is a bug of the
+server's own. A device that refuses the certificate
 gets one line there, in words, at most once a minute.
 
 Bounds: a request's line and headers (and body) must arrive within
@@ -55,6 +56,7 @@ from urllib.parse import parse_qs
 import aiohttp
 from aiohttp import web
 from aiohttp.abc import AbstractStreamWriter
+from aiohttp.http_exceptions import HttpProcessingError
 
 from feelmysign.broker.tls import TlsFiles
 from feelmysign.errors import FeelMySignError
@@ -98,12 +100,44 @@ _CERTIFICATE_REFUSED = {
     "SSLV3_ALERT_BAD_CERTIFICATE",
 }
 _TLS_HANDSHAKE_RECORD = 0x16
+# What a network peer does that is no fault of the server's: a malformed or oversized request
+# (aiohttp's parser), a connection gone mid-answer (a closed tab, a phone changing networks).
+_PEER_FAULTS = (HttpProcessingError, ConnectionError)
+_PEER_FAULT_TEXT_CHARS = 200  # of the exception's text in its debug line (it may quote the request)
 
 # aiohttp's own loggers (its parser's and WebSocket errors, with tracebacks) go to the debug
 # log of the server that is running, never to the terminal.
 _AIOHTTP_LOG = logging.getLogger("aiohttp")
 _AIOHTTP_LOG.propagate = False
 _AIOHTTP_LOG.addHandler(logging.NullHandler())
+
+
+def _new_loop() -> asyncio.AbstractEventLoop:
+    """libuv's event loop (uvloop) where it is built: a relayed MQTT message costs about half
+    the CPU time of asyncio's own loop, whose plain sockets read into a fresh 256 KiB buffer
+    each time (above glibc's mmap threshold: a map and an unmap per message). Elsewhere
+    (Windows) asyncio's."""
+    try:
+        import uvloop
+    except ImportError:
+        return asyncio.new_event_loop()
+    return uvloop.new_event_loop()
+
+
+class _PeerFaults(logging.Filter):
+    """A peer's fault as one debug line, without a traceback: aiohttp logs an oversized
+    request or a client gone mid-answer as an error with its traceback, which is for bugs."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        fault = record.exc_info[1] if record.exc_info else None
+        if isinstance(fault, _PEER_FAULTS):
+            text = " ".join(str(fault).split())[:_PEER_FAULT_TEXT_CHARS]
+            record.msg = f"{record.getMessage()}: {type(fault).__name__}: {text}"
+            record.args = None
+            record.exc_info = None
+            record.exc_text = None
+            record.levelno, record.levelname = logging.DEBUG, logging.getLevelName(logging.DEBUG)
+        return True
 
 
 def host_header_names(hosts: Iterable[str], port: int) -> frozenset[str]:
@@ -231,6 +265,7 @@ class WebServer:
             self._log_handler.setFormatter(
                 logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s")
             )
+            self._log_handler.addFilter(_PeerFaults())
         self._log.addHandler(self._log_handler)
         self._notices = _Notices()
         # Least recently active first (moved to the end after each answer): the one to close
@@ -238,7 +273,7 @@ class WebServer:
         self._connections: OrderedDict[tuple[str, int], _Connection] = OrderedDict()
         # The study API blocks (SQLite, the broker): one thread answers it, away from the loop.
         self._api_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="page-api")
-        self._loop = asyncio.new_event_loop()
+        self._loop = _new_loop()
         self._thread = threading.Thread(
             target=self._loop.run_forever, name="page-server", daemon=True
         )
@@ -455,9 +490,16 @@ class WebServer:
     async def _answer_sent(self, request: web.BaseRequest) -> web.StreamResponse:
         """The answer, sent here within the time limit (aiohttp would send it after)."""
         response = await self._answer(request)
-        if not response.prepared:
-            await response.prepare(request)
-            await response.write_eof()
+        try:
+            if not response.prepared:
+                await response.prepare(request)
+                await response.write_eof()
+        except ConnectionError as error:  # a closed tab, a phone that changed networks
+            self._log.debug(
+                "%s went away before %s was sent: %r", request.remote, request.path, error
+            )
+            if request.transport is not None:
+                request.transport.abort()
         return response
 
     def _is_relay(self, request: web.BaseRequest) -> bool:
@@ -631,6 +673,7 @@ class WebServer:
                 protocols=[p for p in offered if p],
                 autoping=True,
                 max_msg_size=RELAY_MAX_MESSAGE_BYTES,
+                compress=0,  # MQTT packets are small: no permessage-deflate on either side
             )
         except (aiohttp.ClientError, OSError, asyncio.TimeoutError) as error:
             self._log.debug("relay: the broker's WebSocket listener: %r", error)

@@ -1,13 +1,16 @@
 """``feelmysign study threshold``: SQ2.2's QUEST+ run for one participant, in the terminal.
 
 With ``--simulated-observer T`` a simulated wearer with threshold T answers and
-the sleeve is the offline planner: a dry run of the procedure.
+the sleeve is the offline planner: a dry run of the procedure. Its threshold is T's,
+not the participant's, so ``--save`` refuses it for a real (not simulated)
+participant: the sleeve would take it as that wearer's measured floor.
 """
 
 from __future__ import annotations
 
 import argparse
 import random
+import sqlite3
 from pathlib import Path
 from typing import Any
 
@@ -54,6 +57,18 @@ def _ask(direction: str, value: float) -> str:
         print("  Type u, d, l or r.")
 
 
+def _refuse_a_dry_run_for_a_real_wearer(participant: sqlite3.Row, path: Path) -> None:
+    """A simulated observer's threshold is no measurement of a real participant: written into
+    their wearer file, the sleeve would keep to it as their floor."""
+    if not participant["simulated"]:
+        raise StudyError(
+            f"--save with --simulated-observer would write a simulated threshold into {path} "
+            f"as {participant['code']}'s measured limit, and the sleeve would keep to it; "
+            "leave out --save for a dry run (it is stored in the study file as one), or use a "
+            "simulated participant ('feelmysign study simulate' adds them)"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
     from feelmysign.study.simulated_sleeve import offline_player
     from feelmysign.study.sleeve_link import SleeveLink
@@ -67,6 +82,8 @@ def run(args: argparse.Namespace) -> int:
 
         wearer_to_update(args.save, args.participant)  # a bad file is said before the run
     store = StudyStore(args.study)
+    if args.save is not None and args.simulated_observer is not None:
+        _refuse_a_dry_run_for_a_real_wearer(store.participant(args.participant), args.save)
     layout = stimulus_layout(store.design.stimulus, store.base_dir)
     unit = "grid units" if args.dimension == "length" else "ms"
 

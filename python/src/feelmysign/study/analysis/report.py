@@ -49,7 +49,9 @@ def shape_test_sentence(test: ShapeTest) -> str:
     return (
         f"Test that shapes differ at equal strokes: {test.method} ({test.participants} "
         f"participants, {test.shapes} shapes; each participant's mean residual per shape "
-        "against a shape-free logistic model of log2(strokes), centred over shapes; statistic: "
+        "against a shape-free logistic model of log2(strokes) with each participant's own "
+        "intercept, centred over shapes and without the shapes' mean log2(strokes), which "
+        "the model's slope fits; statistic: "
         f"squared length of the mean profile = {test.statistic:.4g}, over {test.flips} sign "
         f"patterns): {_p(test.p)}."
     )
