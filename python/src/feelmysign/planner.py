@@ -419,6 +419,8 @@ def _fractions(start: Point, end: Point, merge_distance: float) -> list[float]:
     (x0, y0), (x1, y1) = start, end
     crossings = _line_crossings(x0, x1)
     crossings += _line_crossings(y0, y1)
+    if not crossings:  # within one cell (most strokes of a drawing): what merging leaves
+        return [0.0, 1.0]
     if len(crossings) > 1:
         crossings = sorted(set(crossings))  # a stroke through an actuator crosses both lines there
     return _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
