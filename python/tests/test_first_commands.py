@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from timelines import Played, tight_layout
 
+from feelmysign.apparent_motion import fitting_timings, lengths_bound_ms, surely_fits, timings
 from feelmysign.layout import Layout
 from feelmysign.planner import outline, plan
 from feelmysign.stroke import Stroke
@@ -120,3 +121,41 @@ def test_the_cap_is_decided_the_same_for_an_outline_near_it(duration_ms: float) 
         (c.t_ms, c.row, c.column, c.intensity, c.tag) for c in whole[0]
     ]
     assert lazy[1:] == whole[1:]
+
+
+@st.composite
+def _fractions_of_a_way(draw: st.DrawFn) -> list[float]:
+    inside = draw(st.lists(st.floats(1e-6, 1 - 1e-6), min_size=2, max_size=40, unique=True))
+    return [0.0, *sorted(inside), 1.0]
+
+
+@settings(max_examples=500, deadline=None)
+@given(
+    _fractions_of_a_way(),
+    st.floats(50, 30_000),
+    st.sampled_from([0.0, 10.0, 20.0, 60.0]),
+)
+def test_a_stroke_timed_later_surely_fits_and_its_bound_holds(
+    fractions: list[float], duration_ms: float, min_command_ms: float
+) -> None:
+    """``surely_fits`` (which lets a long stroke's timings wait) never says so of timings
+    that do not fit; and the bound on their lengths it then uses is at least their sum."""
+    if not surely_fits(fractions, duration_ms, min_command_ms):
+        return
+    fitting = fitting_timings(fractions, duration_ms, min_command_ms)
+    assert fitting is not None
+    assert fitting == timings(fractions)
+    lengths_ms = sum(a * duration_ms + b for _, _, a, b in fitting)
+    assert lengths_bound_ms(fractions, duration_ms) >= lengths_ms
+
+
+@settings(max_examples=300, deadline=None)
+@given(_layout_and_strokes(1))
+def test_the_energy_bound_before_the_bursts_is_at_least_the_one_after(
+    case: tuple[Layout, list[Stroke]],
+) -> None:
+    layout, (stroke,) = case
+    planned = outline(stroke, layout)
+    before = planned.energy_bound_ms()
+    planned.schedule()
+    assert before >= planned.energy_bound_ms()

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+import operator
+from collections.abc import Iterable, Iterator, Sequence
 
 SOA_SLOPE = 0.32  # Israr & Poupyrev 2011, eq. 1: SOA = 0.32 d + 47.3 (ms)
 SOA_INTERCEPT_MS = 47.3  # ibid.; also the least time between two peaks of a moving touch
@@ -41,20 +42,56 @@ def timings(fractions: Sequence[float]) -> list[Timing]:
     which never reaches an onset or a duration, so it is left out; subtracting
     from it (``0.0 - next_b``) is kept. Every float is the formula's, bit for bit.
     """
+    return list(each_timing(fractions))
+
+
+def each_timing(fractions: Sequence[float]) -> Iterator[Timing]:
+    """The timings of ``timings``, one by one: the first bursts of a long stroke are timed
+    (and started) before the rest."""
     if len(fractions) == 1:
-        return [(0.0, 0.0, 1.0, 0.0)]
+        yield (0.0, 0.0, 1.0, 0.0)
+        return
     onset_a = onset_b = 0.0
     before_a = before_b = 0.0  # d_i minus
-    result: list[Timing] = []
     for tau in itertools.islice(fractions, 1, None):
         soa_a = (before_a + tau - onset_a) * SOA_SLOPE * _SOA_SCALE
         soa_b = ((before_b - onset_b) * SOA_SLOPE + SOA_INTERCEPT_MS) * _SOA_SCALE
         next_a, next_b = onset_a + soa_a, onset_b + soa_b
         after_a, after_b = tau - next_a, 0.0 - next_b  # d_i plus, which is d_{i+1} minus
-        result.append((onset_a, onset_b, before_a + after_a, before_b + after_b))
+        yield (onset_a, onset_b, before_a + after_a, before_b + after_b)
         onset_a, onset_b, before_a, before_b = next_a, next_b, after_a, after_b
-    result.append((onset_a, onset_b, 1.0 - onset_a, 0.0 - onset_b))
-    return result
+    yield (onset_a, onset_b, 1.0 - onset_a, 0.0 - onset_b)
+
+
+def surely_fits(fractions: Sequence[float], duration_ms: float, min_command_ms: float) -> bool:
+    """Whether ``timings(fractions)`` surely ``fits`` at ``duration_ms``, judged from the two
+    closest peaks alone, in C: no timing is computed (a sufficient condition, not a necessary one).
+
+    Between peaks ``g`` ms apart, the recursion of ``timings`` gives each burst's onset a
+    lag behind its own peak of ``e' = (g + 0.68 e - 47.3) / 1.32``, from the lag ``e``
+    before it (0 at the first burst); each burst lasts ``e + e'``, the last one its own
+    lag. The lag grows with ``g`` and ``e``: with every ``g`` at least ``G``, every lag from
+    the second burst on is at least ``(G - 47.3) / 1.32``, and so is every burst. The margin
+    is far above the floats' rounding, far below a burst a skin could tell apart.
+    """
+    closest: float = min(map(operator.sub, itertools.islice(fractions, 1, None), fractions))
+    least_lag_ms = (closest * duration_ms - SOA_INTERCEPT_MS) * _SOA_SCALE
+    return least_lag_ms >= min_command_ms + _SURE_MARGIN_MS
+
+
+_SURE_MARGIN_MS = 1e-3
+
+
+def lengths_bound_ms(fractions: Sequence[float], duration_ms: float) -> float:
+    """At least the sum of the bursts' lengths of ``timings(fractions)`` at ``duration_ms``
+    when the last one lasts 0 ms or more (as when they fit), without computing them.
+
+    Summing the lags of ``surely_fits`` over the ``n`` steps between peaks, which add up to
+    the duration T: the lengths add up to ``(T - 0.68 e_n - 47.3 n) / 0.32``, ``e_n`` the
+    last burst's length; so to at most ``(T - 47.3 n) / 0.32``.
+    """
+    steps = len(fractions) - 1
+    return (duration_ms - SOA_INTERCEPT_MS * steps) / SOA_SLOPE
 
 
 def fitting_timings(

@@ -48,8 +48,10 @@ def commands_from_spans(
     # Command(row, column, start, end - start, intensity), without the named tuple's
     # __new__ (a Python function): the same tuple, made in C.
     new = tuple.__new__
-    for (row, column), spans in by_actuator.items():
-        if len(spans) == 1:  # most actuators of a stroke render one burst: _energy_pieces inline
+    # Actuator by actuator in row, then column order (see the sort below).
+    for (row, column), spans in sorted(by_actuator.items()):
+        count = len(spans)
+        if count == 1:  # most actuators of a stroke render one burst: _energy_pieces inline
             start, end, intensity = spans[0]
             energy = intensity**2
             if not energy <= 0 and start < end:
@@ -61,7 +63,7 @@ def commands_from_spans(
                     )
                 )
             continue
-        if len(spans) == 2:
+        if count == 2:
             actuator_pieces = _two_pieces(spans)
         else:
             actuator_pieces = _paired_pieces(spans) or _chained_pieces(spans)
@@ -74,13 +76,14 @@ def commands_from_spans(
                 break
         for start, end, intensity in actuator_pieces:
             append(new(Command, (row, column, start, end - start, intensity)))
-    # One actuator's pieces never share a start, so start, row and column order
-    # the commands totally (no two compare equal).
-    commands.sort(key=_START_ROW_COLUMN)
+    # Sorted by start, then row, then column: made in row and column order, each actuator's
+    # in time order, so a stable sort by start alone orders them so (one actuator's pieces
+    # never share a start). Its keys are floats, which the sort compares fastest.
+    commands.sort(key=_START)
     return tuple(commands)
 
 
-_START_ROW_COLUMN = operator.itemgetter(2, 0, 1)  # of a Command: a sort key made in C
+_START = operator.itemgetter(2)  # of a Command: a sort key made in C
 
 
 def _two_pieces(spans: list[Span]) -> list[Piece] | None:
@@ -255,35 +258,38 @@ def _add_piece(pieces: list[Piece], start: float, end: float, energy: float) -> 
 
 
 def _join_short(pieces: list[Piece], min_command_ms: float) -> list[Piece]:
-    """Join pieces shorter than the minimum to an adjacent piece of the same on-period."""
-    if len(pieces) < 2:
-        return pieces  # nothing to join with
-    if all(e - s >= min_command_ms for s, e, _ in pieces):
-        return pieces  # none short: the common case, answered without looking for neighbours
-    pieces = list(pieces)
+    """Join pieces shorter than the minimum to an adjacent piece of the same on-period.
+
+    ``pieces`` is the caller's own list, joined in place (every caller made it for this).
+    """
     while True:
-        # The shortest short piece with a neighbour (the first of equals), and
-        # that neighbour: one pass, no list of candidates.
+        # The shortest short piece with a neighbour (the first of equals), and that
+        # neighbour, the piece touching it (the previous one preferred): one pass, no list
+        # of candidates, no call per piece.
         shortest, neighbour, shortest_ms = -1, -1, math.inf
+        joinable = 0  # short pieces with a neighbour
+        last = len(pieces) - 1
+        before_end = math.nan  # of the piece before (none before the first: never equal)
         for i, (start, end, _) in enumerate(pieces):
             length_ms = end - start
-            if length_ms < min_command_ms and (shortest < 0 or length_ms < shortest_ms):
-                j = _neighbour(pieces, i)
-                if j is not None:
-                    shortest, neighbour, shortest_ms = i, j, length_ms
+            if length_ms < min_command_ms:
+                if before_end == start:
+                    joinable += 1
+                    if length_ms < shortest_ms:
+                        shortest, neighbour, shortest_ms = i, i - 1, length_ms
+                elif i < last and pieces[i + 1][0] == end:
+                    joinable += 1
+                    if length_ms < shortest_ms:
+                        shortest, neighbour, shortest_ms = i, i + 1, length_ms
+            before_end = end
         if shortest < 0:
             return pieces
         a, b = (shortest, neighbour) if shortest < neighbour else (neighbour, shortest)
         pieces[a : b + 1] = [_joined(pieces[a], pieces[b])]
-
-
-def _neighbour(pieces: list[Piece], i: int) -> int | None:
-    """The adjacent piece touching piece i (previous preferred), or None if it stands alone."""
-    if i > 0 and pieces[i - 1][1] == pieces[i][0]:
-        return i - 1
-    if i + 1 < len(pieces) and pieces[i + 1][0] == pieces[i][1]:
-        return i + 1
-    return None
+        if joinable == 1:
+            # Its neighbour was not short, and the two joined last at least as long: no short
+            # piece is left with a neighbour (joining changes no other piece's neighbours).
+            return pieces
 
 
 def _joined(first: Piece, second: Piece) -> Piece:

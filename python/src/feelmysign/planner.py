@@ -41,8 +41,11 @@ from collections.abc import Iterable, Iterator, Sequence
 
 from feelmysign.apparent_motion import (
     Timing,
+    each_timing,
     fitting_timings,
+    lengths_bound_ms,
     shortest_planned_ms,
+    surely_fits,
     thinned,
     timings,
 )
@@ -72,6 +75,10 @@ ON_LINE_EPSILON = 1e-9
 _OFF_LINE = 1 - ON_LINE_EPSILON  # a coordinate this far into a cell is on its next line
 
 TOO_FAST = "too_fast"
+
+# Strokes of at least this many virtual actuators are timed when asked for when they surely
+# fit (``apparent_motion.surely_fits``); for fewer, timing them all costs less than the test.
+_TIMED_LATER = 4
 
 # One burst: a Burst (x, y in grid units, peak_ms, start_ms, duration_ms, intensity), made
 # as a plain tuple of the same six fields (tuple.__new__, in C) on the planning path.
@@ -145,15 +152,19 @@ def outline(
         )
     # The fractions and timings of every burst: whether they all fit decides which are
     # kept. Their points and bursts are made when asked for (``Outline.bursts``), or only
-    # the first few of them (``Outline.head``).
+    # the first few of them (``Outline.head``). A stroke of many crossings whose closest
+    # peaks are far enough apart surely fits: its timings too are computed when asked for,
+    # so that its first motors start in the same time whatever its length.
     fractions = _fractions(start, end, merge_distance)
     left_out = 0
-    burst_timings = fitting_timings(fractions, duration_ms, min_ms)
-    if burst_timings is None:
-        kept = thinned(fractions, duration_ms, min_ms)
-        left_out = len(fractions) - len(kept)
-        fractions = [fractions[i] for i in kept]
-        burst_timings = timings(fractions)
+    burst_timings: list[Timing] | None = None  # None: they surely fit, timed when asked for
+    if len(fractions) < _TIMED_LATER or not surely_fits(fractions, duration_ms, min_ms):
+        burst_timings = fitting_timings(fractions, duration_ms, min_ms)
+        if burst_timings is None:
+            kept = thinned(fractions, duration_ms, min_ms)
+            left_out = len(fractions) - len(kept)
+            fractions = [fractions[i] for i in kept]
+            burst_timings = timings(fractions)
     return Outline(
         stroke,
         layout,
@@ -199,7 +210,7 @@ class Outline:
         adjusted: Adjustment | None,
         intensity: float,
         min_command_ms: float,
-        way: tuple[Point, Point, list[float], list[Timing]],
+        way: tuple[Point, Point, list[float], list[Timing] | None],
         thinned: int,
     ) -> None:
         self.stroke = stroke
@@ -208,7 +219,8 @@ class Outline:
         self.adjusted = adjusted
         self.intensity = intensity
         self.min_command_ms = min_command_ms
-        # Start, end, and each burst's fraction of the way and timing (apparent_motion.Timing).
+        # Start, end, and each burst's fraction of the way and timing (apparent_motion.Timing;
+        # None until asked for, for a stroke that surely fits: see ``outline``).
         self._way = way
         self.thinned = thinned
         self._bursts: tuple[RawBurst, ...] | None = None
@@ -218,7 +230,7 @@ class Outline:
     def bursts(self) -> tuple[RawBurst, ...]:
         """Every burst, in stroke order (made once)."""
         if self._bursts is None:
-            start, end, fractions, burst_timings = self._way
+            start, end, fractions, burst_timings = self._timed_way()
             self._bursts = _bursts(
                 start, end, fractions, burst_timings, self.duration_ms, self.intensity
             )
@@ -277,6 +289,7 @@ class Outline:
             yield from self._bursts
             return
         start, end, fractions, burst_timings = self._way
+        timed = each_timing(fractions) if burst_timings is None else iter(burst_timings)
         t = self.duration_ms
         intensity = self.intensity
         new = tuple.__new__
@@ -284,7 +297,7 @@ class Outline:
         last = len(fractions) - 1
         (x0, y0), (x1, y1) = start, end
         dx, dy = x1 - x0, y1 - y0
-        for i, f in enumerate(fractions):
+        for (i, f), timing in zip(enumerate(fractions), timed, strict=True):
             if f == 0.0:  # _points, for one fraction
                 x, y = start
             elif f == 1.0:
@@ -297,7 +310,7 @@ class Outline:
                 nearest = round(y)
                 if abs(y - nearest) <= ON_LINE_EPSILON:
                     y = float(nearest)
-            onset_a, onset_b, length_a, length_b = burst_timings[i]
+            onset_a, onset_b, length_a, length_b = timing
             start_ms = onset_a * t + onset_b
             if i < last:  # as _bursts makes them
                 length_ms = length_a * t + length_b
@@ -316,17 +329,29 @@ class Outline:
         (a stroke's first motors start before that), from their timings: the
         sum of their lengths before any is cut at the overrun allowance (a cut
         only shortens a burst), as ``T * sum(a) + sum(b)`` (summed in C, not per
-        burst), with a margin far above its rounding.
+        burst), with a margin far above its rounding; before they are timed, from
+        the motion model's bound on that sum (``apparent_motion.lengths_bound_ms``).
         """
         energy = self.intensity**2
         if self._bursts is not None:
             return sum(energy * d for _, _, _, _, d, _ in self._bursts if d > 0)
-        burst_timings = self._way[3]
-        slopes: float = sum(map(_LENGTH_A, burst_timings))
-        intercepts_ms: float = sum(map(_LENGTH_B, burst_timings))
-        total_ms = self.duration_ms * slopes + intercepts_ms
-        margin_ms = _BOUND_MARGIN_MS * len(burst_timings)
+        _, _, fractions, burst_timings = self._way
+        if burst_timings is None:
+            total_ms = lengths_bound_ms(fractions, self.duration_ms)
+        else:
+            slopes: float = sum(map(_LENGTH_A, burst_timings))
+            intercepts_ms: float = sum(map(_LENGTH_B, burst_timings))
+            total_ms = self.duration_ms * slopes + intercepts_ms
+        margin_ms = _BOUND_MARGIN_MS * len(fractions)
         return energy * (total_ms * (1 + _BOUND_MARGIN) + margin_ms)
+
+    def _timed_way(self) -> tuple[Point, Point, list[float], list[Timing]]:
+        """``_way`` with every burst timed (now, if it was not)."""
+        start, end, fractions, burst_timings = self._way
+        if burst_timings is None:
+            burst_timings = timings(fractions)
+            self._way = (start, end, fractions, burst_timings)
+        return start, end, fractions, burst_timings
 
 
 # Of a burst's timing (apparent_motion.Timing): its length's coefficients, length = a T + b.
@@ -419,6 +444,8 @@ def _fractions(start: Point, end: Point, merge_distance: float) -> list[float]:
     (x0, y0), (x1, y1) = start, end
     crossings = _line_crossings(x0, x1)
     crossings += _line_crossings(y0, y1)
+    if not crossings:  # within one cell (most strokes of a drawing): what merging leaves
+        return [0.0, 1.0]
     if len(crossings) > 1:
         crossings = sorted(set(crossings))  # a stroke through an actuator crosses both lines there
     return _merged_fractions([0.0, *crossings, 1.0], merge_distance / length)
