@@ -135,3 +135,33 @@ def test_the_fate_vectors_cover_every_fate_and_the_copies() -> None:
         if wire.get("reason") == "duplicate"
     }
     assert originals == {True, False, None}
+
+
+@pytest.mark.parametrize(
+    "controls",
+    [
+        {"paused": "yes"},
+        {},
+        {"paused": True, "paused_by": 1},
+        {"paused": False, "ceiling": 1.5},
+        {"paused": False, "ceiling": -0.2},
+        {"paused": False, "ceiling": True},
+        {"paused": False, "ceiling": "0.6"},
+        {"paused": False, "do_not_disturb_until_ms": 1.5},
+        {"paused": False, "do_not_disturb_until_ms": "14:30"},
+        {"paused": False, "do_not_disturb_until_ms": -1},
+        [True],
+    ],
+)
+def test_controls_of_the_wrong_type_are_refused(controls: object) -> None:
+    with pytest.raises(EventError):
+        Status.from_json({"online": True, "controls": controls})
+
+
+def test_controls_read_from_bytes_or_text_alike_and_a_whole_float_is_a_time() -> None:
+    text = json.dumps(
+        {"online": True, "controls": {"paused": False, "do_not_disturb_until_ms": 1795330000000.0}}
+    )
+    read = Status.from_json(text).controls
+    assert read == Status.from_json(text.encode()).controls
+    assert read is not None and read.do_not_disturb_until_ms == 1795330000000

@@ -8,7 +8,7 @@ import { CANCEL_ALL } from "./control";
 import type { ServerConfig } from "./config";
 import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
-import { EventCopies, interpretEvent, parseEvent } from "./events";
+import { EventCopies, interpretEvent, parseEvent, parseStatus } from "./events";
 import { StrokeSender, type BrokerState } from "./mqtt/sender";
 import type { Stroke } from "./protocol";
 import { buildRecording, recordingFileName } from "./recording";
@@ -34,13 +34,7 @@ import { byId, StatusBar } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
 import { WearerNotice } from "./ui/wearer-notice";
 import { WearerHoldKeeper } from "./wearer-hold";
-import {
-  ceilingNote,
-  holdReason,
-  isWearerRefusal,
-  parseWearerControls,
-  wearerRefusalNote,
-} from "./wearer-status";
+import { ceilingNote, holdReason, isWearerRefusal, NO_CONTROLS, wearerRefusalNote } from "./wearer-status";
 
 export interface AppOptions {
   readonly config: ServerConfig | null;
@@ -567,7 +561,8 @@ export class App {
 
   #onControls(payload: string): void {
     const online = this.#sleeve.status?.online === true && payload.trim() !== "";
-    const controls = online ? parseWearerControls(payload) : null;
+    const status = online ? parseStatus(payload) : null;
+    const controls = status === null ? null : (status.controls ?? NO_CONTROLS);
     if (online && controls === null) {
       this.#says.add(
         "error",

@@ -10,7 +10,8 @@
  * "Pace"). They play back to back, at once, not at the pace they were drawn.
  */
 import type { Stroke } from "./protocol";
-import { NO_CONTROLS, wearerHold, type WearerControls, type WearerHold } from "./wearer-status";
+import type { SleeveControls } from "./events";
+import { NO_CONTROLS, wearerHold, type WearerHold } from "./wearer-status";
 
 /** What the page's wearer notice shows. */
 export type WearerView =
@@ -19,7 +20,7 @@ export type WearerView =
   | { readonly state: "resumed"; readonly held: number };
 
 export class WearerHoldKeeper {
-  #controls: WearerControls = NO_CONTROLS;
+  #controls: SleeveControls = NO_CONTROLS;
   /** When the sleeve paused, when this page saw it happen (the status that said so). */
   #pausedSinceMs: number | null = null;
   #held: Stroke[] = [];
@@ -30,7 +31,7 @@ export class WearerHoldKeeper {
   /** A status has been read since the page (or the sleeve) started. */
   #seen = false;
 
-  get controls(): WearerControls {
+  get controls(): SleeveControls {
     return this.#controls;
   }
 
@@ -48,7 +49,7 @@ export class WearerHoldKeeper {
    * `at_ms`. An offline status (the last will) carries no controls: the wearer's choice is kept
    * on the sleeve, so the page keeps the last it knew until the sleeve reports again.
    */
-  onStatus(controls: WearerControls, online: boolean, atMs: number | null, nowMs: number): void {
+  onStatus(controls: SleeveControls, online: boolean, atMs: number | null, nowMs: number): void {
     if (!online) return;
     if (controls.paused && !this.#controls.paused) {
       // The first status of this page: paused since before it looked, time unknown.

@@ -1,66 +1,21 @@
 /**
- * The wearer's choice, as the sleeve's retained status carries it (`controls`, docs/protocol.md):
- * paused, an intensity ceiling, "do not disturb" until a time. The wearer's choice always wins
+ * What a sender does with the wearer's choice, as the sleeve's retained status carries it
+ * (`controls`, docs/protocol.md, read by events.ts): paused, an intensity ceiling, "do not
+ * disturb" until a time. The wearer's choice always wins
  * over the sender's, so a sender holds its drawing instead of sending it into refusals, and says
  * what the sleeve will play. A status without `controls` (an older sleeve, a last will) means
- * none of them. Like events.ts, a value of the wrong type gives null, never an exception.
+ * none of them.
  */
 
-export interface WearerControls {
-  readonly paused: boolean;
-  /** Who paused ("button", "page", "cli"); null when not paused or not said. */
-  readonly paused_by: string | null;
-  /** The wearer's intensity ceiling (0..1); null: none. */
-  readonly ceiling: number | null;
-  /** Wall clock, ms since 1970; null: off. */
-  readonly do_not_disturb_until_ms: number | null;
-}
+import { DO_NOT_DISTURB_REASON, PAUSED_REASON, type SleeveControls } from "./events";
 
-/** What a status without `controls` means. */
-export const NO_CONTROLS: WearerControls = {
+/** What a status without `controls` means: not paused, no ceiling, no "do not disturb". */
+export const NO_CONTROLS: SleeveControls = {
   paused: false,
   paused_by: null,
   ceiling: null,
   do_not_disturb_until_ms: null,
 };
-
-/** Refusal reasons of a stroke the wearer's choice kept from playing (docs/protocol.md). */
-export const PAUSED_REASON = "paused";
-export const DO_NOT_DISTURB_REASON = "do_not_disturb";
-
-/**
- * The `controls` of a status (its JSON value, already parsed); NO_CONTROLS when it has none;
- * null when the status is not an object or `controls` has a field of the wrong type.
- */
-export function readWearerControls(status: unknown): WearerControls | null {
-  if (!isObject(status)) return null;
-  const controls = status["controls"];
-  if (controls === undefined || controls === null) return NO_CONTROLS;
-  if (!isObject(controls)) return null;
-  const paused = controls["paused"];
-  const pausedBy = controls["paused_by"] ?? null;
-  const ceiling = controls["ceiling"] ?? null;
-  const untilMs = controls["do_not_disturb_until_ms"] ?? null;
-  if (typeof paused !== "boolean") return null;
-  if (pausedBy !== null && typeof pausedBy !== "string") return null;
-  if (ceiling !== null && !(isFinite(ceiling) && ceiling >= 0 && ceiling <= 1)) return null;
-  if (untilMs !== null && !(isFinite(untilMs) && Number.isInteger(untilMs) && untilMs >= 0)) return null;
-  return {
-    paused,
-    paused_by: paused ? pausedBy : null,
-    ceiling,
-    do_not_disturb_until_ms: untilMs,
-  };
-}
-
-/** `readWearerControls` of a status message's text; null when it is not JSON. */
-export function parseWearerControls(text: string): WearerControls | null {
-  try {
-    return readWearerControls(JSON.parse(text));
-  } catch {
-    return null;
-  }
-}
 
 /** Why the sleeve plays nothing now by the wearer's choice; `sinceMs`: when it paused, if known. */
 export type WearerHold =
@@ -72,7 +27,7 @@ export type WearerHold =
  * and a "do not disturb" whose time has passed holds nothing, whether or not the sleeve has said so.
  */
 export function wearerHold(
-  controls: WearerControls,
+  controls: SleeveControls,
   nowMs: number,
   sinceMs: number | null = null,
 ): WearerHold | null {
@@ -156,12 +111,4 @@ function percent(fraction: number): string {
 
 function pad(value: number): string {
   return String(value).padStart(2, "0");
-}
-
-function isObject(value: unknown): value is Record<string, unknown> {
-  return typeof value === "object" && value !== null && !Array.isArray(value);
-}
-
-function isFinite(value: unknown): value is number {
-  return typeof value === "number" && Number.isFinite(value);
 }

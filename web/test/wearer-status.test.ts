@@ -1,4 +1,4 @@
-/** The wearer's choice read from the sleeve's status, and what the page says of it. */
+/** What the page does with the wearer's choice in the sleeve's status, and what it says of it. */
 import { describe, expect, it } from "vitest";
 import {
   ceilingNote,
@@ -6,76 +6,10 @@ import {
   holdDetail,
   holdHeadline,
   NO_CONTROLS,
-  parseWearerControls,
   playedIntensity,
-  readWearerControls,
   wearerHold,
   wearerRefusalNote,
 } from "../src/wearer-status";
-
-/** The status as docs/protocol.md and the sleeve's contract write it. */
-const PAUSED_STATUS = {
-  online: true,
-  sleeve_id: "sleeve",
-  controls: { paused: true, paused_by: "button", ceiling: 0.6, do_not_disturb_until_ms: 1795330000000 },
-};
-
-describe("readWearerControls", () => {
-  it("reads the four fields of the contract", () => {
-    expect(readWearerControls(PAUSED_STATUS)).toEqual({
-      paused: true,
-      paused_by: "button",
-      ceiling: 0.6,
-      do_not_disturb_until_ms: 1795330000000,
-    });
-  });
-
-  it("reads nulls as unset", () => {
-    const status = {
-      online: true,
-      controls: { paused: false, paused_by: null, ceiling: null, do_not_disturb_until_ms: null },
-    };
-    expect(readWearerControls(status)).toEqual(NO_CONTROLS);
-  });
-
-  it("takes a status without controls (an older sleeve, a last will) as not paused", () => {
-    expect(readWearerControls({ online: true, sleeve_id: "s" })).toBe(NO_CONTROLS);
-    expect(readWearerControls({ online: false })).toBe(NO_CONTROLS);
-    expect(readWearerControls({ online: true, controls: null })).toBe(NO_CONTROLS);
-  });
-
-  it("forgets who paused when not paused", () => {
-    const status = {
-      controls: { paused: false, paused_by: "page", ceiling: null, do_not_disturb_until_ms: null },
-    };
-    expect(readWearerControls(status)?.paused_by).toBeNull();
-  });
-
-  it.each([
-    ["paused as a string", { paused: "true", paused_by: null, ceiling: null, do_not_disturb_until_ms: null }],
-    ["paused missing", { paused_by: null, ceiling: null, do_not_disturb_until_ms: null }],
-    ["paused_by a number", { paused: true, paused_by: 3, ceiling: null, do_not_disturb_until_ms: null }],
-    ["ceiling above 1", { paused: false, paused_by: null, ceiling: 1.5, do_not_disturb_until_ms: null }],
-    ["ceiling negative", { paused: false, paused_by: null, ceiling: -0.1, do_not_disturb_until_ms: null }],
-    ["ceiling a string", { paused: false, paused_by: null, ceiling: "0.6", do_not_disturb_until_ms: null }],
-    ["until a fraction", { paused: false, paused_by: null, ceiling: null, do_not_disturb_until_ms: 1.5 }],
-    ["until a string", { paused: false, paused_by: null, ceiling: null, do_not_disturb_until_ms: "14:30" }],
-  ])("refuses %s", (_name, controls) => {
-    expect(readWearerControls({ online: true, controls })).toBeNull();
-  });
-
-  it("refuses controls that are not an object, and a status that is not one", () => {
-    expect(readWearerControls({ online: true, controls: [true] })).toBeNull();
-    expect(readWearerControls({ online: true, controls: true })).toBeNull();
-    expect(readWearerControls([])).toBeNull();
-    expect(readWearerControls("paused")).toBeNull();
-  });
-
-  it("parses the text of a status message, and gives null for text that is not JSON", () => {
-    expect(parseWearerControls(JSON.stringify(PAUSED_STATUS))?.paused).toBe(true);
-    expect(parseWearerControls("{not json")).toBeNull();
-  });
-});
 
 describe("wearerHold", () => {
   const nowMs = Date.UTC(2026, 10, 26, 13, 0);

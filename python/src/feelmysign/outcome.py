@@ -27,7 +27,7 @@ from feelmysign.events import (
     Safety,
     event_from_json,
 )
-from feelmysign.wearer_status import cancelled_by_wearer
+from feelmysign.player import WEARER
 
 if TYPE_CHECKING:
     import paho.mqtt.client as mqtt
@@ -81,11 +81,7 @@ class DrawingOutcome:
             if self._copies.is_copy(event):
                 return
             told = self._record(self.strokes[seq], event)
-            if (
-                told
-                and isinstance(event, Cancelled)
-                and cancelled_by_wearer(bytes(message.payload))
-            ):
+            if told and isinstance(event, Cancelled) and event.by == WEARER:
                 self.strokes[seq].by_wearer = True
             self._condition.notify_all()
         if told and self._on_event is not None:

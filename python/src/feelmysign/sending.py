@@ -222,8 +222,9 @@ def sleeve_status(
 def sleeve_status_and_payload(
     client: mqtt.Client, settings: BrokerSettings, *, wait_s: float = STATUS_WAIT_S
 ) -> tuple[Status | None, bytes | None]:
-    """``sleeve_status``, and the status's payload as it came (for fields read apart, such as
-    the wearer's ``controls``, wearer_status.py); (None, None) when none came within ``wait_s``."""
+    """``sleeve_status``, and the status's payload as it came; (None, None) when none came
+    within ``wait_s``. A status whose only fault is its wearer's ``controls`` is read without
+    them (its ``controls`` None): the payload still has them, for the sender to say so."""
     from feelmysign.events import EventError
     from feelmysign.topics import telemetry_topic
 
@@ -236,7 +237,8 @@ def sleeve_status_and_payload(
         try:
             read.append((Status.from_json(payload) if payload else None, payload or None))
         except EventError:
-            read.append((None, payload))  # not understood: as from no sleeve
+            read.append((_without_controls(payload), payload))
+
         arrived.set()
 
     client.message_callback_add(topic, on_status)
@@ -247,3 +249,18 @@ def sleeve_status_and_payload(
     finally:
         client.message_callback_remove(topic)
     return read[0] if read else (None, None)
+
+
+def _without_controls(payload: bytes) -> Status | None:
+    """A status not understood read without its ``controls``; None when that is not its fault
+    (not understood: as from no sleeve)."""
+    from feelmysign.events import EventError
+    from feelmysign.input_files import loads_json
+
+    try:
+        data = loads_json(payload)
+        if not isinstance(data, dict) or data.get("controls") is None:
+            return None
+        return Status.from_json({**data, "controls": None})
+    except (EventError, ValueError):
+        return None

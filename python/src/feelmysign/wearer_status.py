@@ -1,29 +1,27 @@
-"""The wearer's choice as a sender reads it from the sleeve's retained status (``controls``,
-docs/protocol.md): paused, an intensity ceiling, "do not disturb" until a time.
+"""What a sender does with the wearer's choice in the sleeve's retained status (``controls``,
+docs/protocol.md, read by ``feelmysign.events.Status.controls``): paused, an intensity
+ceiling, "do not disturb" until a time.
 
 The wearer's choice always wins over the sender's: a paused sleeve refuses every stroke
 (``paused``), one in "do not disturb" every stroke until its end (``do_not_disturb``), and a
 ceiling caps every stroke's intensity. So a sender does not send into refusals: it says so and
-waits. A status without ``controls`` (an older sleeve, the last will) means none of them; a
-``controls`` of the wrong shape raises ``EventError``, as the typed readers of events.py do.
+waits. A status without ``controls`` (an older sleeve, the last will) means none of them.
 The mirror of web/src/wearer-status.ts.
 """
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal
 
-from feelmysign.events import EventError
+from feelmysign.protocol import DO_NOT_DISTURB, PAUSED
 
-PAUSED_REASON = "paused"
-DO_NOT_DISTURB_REASON = "do_not_disturb"
+if TYPE_CHECKING:
+    from feelmysign.events import StatusControls
+
 # Refusals that are the wearer's choice, not the sender's fault: waiting is what to do.
-WEARER_REASONS = frozenset({PAUSED_REASON, DO_NOT_DISTURB_REASON})
-# The ``by`` of a ``cancelled`` event when the wearer's pause or stop cut the stroke.
-BY_WEARER = "wearer"
+WEARER_REASONS = frozenset({PAUSED, DO_NOT_DISTURB})
 
 
 @dataclass(frozen=True)
@@ -34,84 +32,19 @@ class WearerHold:
     until_ms: int | None = None
 
 
-@dataclass(frozen=True)
-class WearerControls:
-    paused: bool = False
-    paused_by: str | None = None  # "button" | "page" | "cli"; None when not paused
-    ceiling: float | None = None  # the wearer's intensity ceiling, 0..1; None: none
-    do_not_disturb_until_ms: int | None = None  # wall clock, ms since 1970; None: off
-
-    def hold(self, now_ms: int | None = None) -> WearerHold | None:
-        """What holds a drawing now, or None. A "do not disturb" whose time has passed holds
-        nothing, whether or not the sleeve has republished its status yet."""
-        if self.paused:
-            return WearerHold("paused")
-        until_ms = self.do_not_disturb_until_ms
-        now = int(time.time() * 1000) if now_ms is None else now_ms
-        if until_ms is not None and until_ms > now:
-            return WearerHold("do_not_disturb", until_ms)
-        return None
-
-
-NO_CONTROLS = WearerControls()
-
-
-def controls_from_status(status: object) -> WearerControls:
-    """The ``controls`` of a status: its JSON object, or its payload (bytes or text).
-
-    NO_CONTROLS when it has none; EventError naming the field when one has the wrong type."""
-    if isinstance(status, bytes | str):
-        try:
-            status = json.loads(status)
-        except ValueError as error:
-            raise EventError(f"The status is not JSON: {error}.") from None
-    if not isinstance(status, dict):
-        raise EventError("The status is not a JSON object.")
-    controls = status.get("controls")
+def wearer_hold(controls: StatusControls | None, now_ms: int | None = None) -> WearerHold | None:
+    """What holds a drawing now, or None (no ``controls``: an older sleeve, the last will). A
+    "do not disturb" whose time has passed holds nothing, whether or not the sleeve has
+    republished its status yet."""
     if controls is None:
-        return NO_CONTROLS
-    if not isinstance(controls, dict):
-        raise EventError("The status's controls is not a JSON object.", "controls")
-    paused = controls.get("paused")
-    if not isinstance(paused, bool):
-        raise EventError("controls.paused must be true or false.", "controls.paused")
-    return WearerControls(
-        paused=paused,
-        paused_by=_text(controls, "paused_by") if paused else None,
-        ceiling=_fraction(controls, "ceiling"),
-        do_not_disturb_until_ms=_time_ms(controls, "do_not_disturb_until_ms"),
-    )
-
-
-def _text(controls: dict[str, Any], name: str) -> str | None:
-    value = controls.get(name)
-    if value is not None and not isinstance(value, str):
-        raise EventError(f"controls.{name} must be a string or null.", f"controls.{name}")
-    return value
-
-
-def _fraction(controls: dict[str, Any], name: str) -> float | None:
-    value = controls.get(name)
-    if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value <= 1:
-        raise EventError(
-            f"controls.{name} must be a number from 0 to 1 or null.", f"controls.{name}"
-        )
-    return float(value)
-
-
-def _time_ms(controls: dict[str, Any], name: str) -> int | None:
-    value = controls.get(name)
-    if value is None:
-        return None
-    # 3.0 is the whole number 3 (events.py's rule for every reader).
-    whole = isinstance(value, int | float) and not isinstance(value, bool) and value == int(value)
-    if not whole or value < 0:
-        raise EventError(
-            f"controls.{name} must be a whole number of ms since 1970 or null.", f"controls.{name}"
-        )
-    return int(value)
+    if controls.paused:
+        return WearerHold("paused")
+    until_ms = controls.do_not_disturb_until_ms
+    now = int(time.time() * 1000) if now_ms is None else now_ms
+    if until_ms is not None and until_ms > now:
+        return WearerHold("do_not_disturb", until_ms)
+    return None
 
 
 def clock_time(ms: int) -> str:
@@ -146,15 +79,4 @@ def ceiling_sentence(ceiling: float, asked: list[float]) -> str:
     return (
         f"The wearer set a ceiling of {ceiling * 100:.0f} % (intensity {ceiling:g}): it caps "
         f"every stroke's intensity; {capped}."
-    )
-
-
-def cancelled_by_wearer(payload: bytes | str) -> bool:
-    """Whether an event's payload is a ``cancelled`` one the wearer caused (``"by": "wearer"``)."""
-    try:
-        data = json.loads(payload)
-    except ValueError:
-        return False
-    return (
-        isinstance(data, dict) and data.get("type") == "cancelled" and data.get("by") == BY_WEARER
     )

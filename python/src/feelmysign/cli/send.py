@@ -52,7 +52,8 @@ from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
-from feelmysign.events import Event, EventError, Status, StatusFloor
+from feelmysign.events import Event, Status, StatusControls, StatusFloor
+from feelmysign.input_files import loads_json
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
 from feelmysign.outcome import DrawingOutcome, StrokeOutcome
 from feelmysign.protocol import Accepted, parse
@@ -68,12 +69,10 @@ from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_str
 from feelmysign.stroke import Stroke
 from feelmysign.topics import LEGACY_TOPIC, telemetry_topic
 from feelmysign.wearer_status import (
-    NO_CONTROLS,
     WEARER_REASONS,
-    WearerControls,
     ceiling_sentence,
-    controls_from_status,
     hold_sentence,
+    wearer_hold,
 )
 
 if TYPE_CHECKING:
@@ -217,7 +216,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
             strokes = _strokes(args, layout, texts)
         _say_offline(status, settings, wait=wait)
         controls = _wearer_controls(status, payload)
-        hold = controls.hold()
+        hold = wearer_hold(controls)
         if hold is not None:
             print(f"Error: {hold_sentence(hold, settings.sleeve_id)}", file=sys.stderr, flush=True)
             return WEARER_HOLD_EXIT
@@ -316,27 +315,33 @@ def _say_offline(status: Status | None, settings: BrokerSettings, *, wait: bool)
     )
 
 
-def _wearer_controls(status: Status | None, payload: bytes | None) -> WearerControls:
+def _wearer_controls(status: Status | None, payload: bytes | None) -> StatusControls | None:
     """The wearer's choice in the sleeve's status; none for no status or an offline one (the
     last will carries none). Controls not understood are said, and the sleeve still enforces
     them: its refusals then say what holds it."""
     if status is None or payload is None or not status.online:
-        return NO_CONTROLS
+        return None
+    if status.controls is not None:
+        return status.controls
     try:
-        return controls_from_status(payload)
-    except EventError as error:
+        controls = loads_json(payload).get("controls")
+        if controls is not None:
+            StatusControls.from_json(controls)
+    except (ValueError, AttributeError) as error:
+        field = getattr(error, "field", None)
         print(
-            f"The sleeve's status has wearer controls this command does not understand ({error}); "
+            "The sleeve's status has wearer controls this command does not understand "
+            f"({f'controls.{field}: ' if field else ''}{error}); "
             "sending anyway: the sleeve refuses strokes if its wearer paused it.",
             file=sys.stderr,
             flush=True,
         )
-        return NO_CONTROLS
+    return None
 
 
-def _say_ceiling(controls: WearerControls, strokes: list[Stroke], layout: Layout) -> None:
+def _say_ceiling(controls: StatusControls | None, strokes: list[Stroke], layout: Layout) -> None:
     """One line on stderr: the wearer's ceiling caps every stroke's intensity."""
-    if controls.ceiling is None:
+    if controls is None or controls.ceiling is None:
         return
     asked = [layout.default_intensity if s.intensity is None else s.intensity for s in strokes]
     print(ceiling_sentence(controls.ceiling, asked), file=sys.stderr, flush=True)
