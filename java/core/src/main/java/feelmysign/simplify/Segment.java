@@ -15,21 +15,7 @@ public record Segment(
     double startMs,
     double endMs,
     double emittedAtMs,
-    String dropped,
-    int merged) {
-
-  /** A segment into which no piece was merged. */
-  public Segment(
-      double startX,
-      double startY,
-      double endX,
-      double endY,
-      double startMs,
-      double endMs,
-      double emittedAtMs,
-      String dropped) {
-    this(startX, startY, endX, endY, startMs, endMs, emittedAtMs, dropped, 0);
-  }
+    String dropped) {
 
   /** The paper's NotEnoughDistanceException. */
   public static final String NOT_ENOUGH_DISTANCE = "not_enough_distance";
@@ -64,6 +50,6 @@ public record Segment(
     }
     return reason == null
         ? this
-        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, reason, merged);
+        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, reason);
   }
 }
