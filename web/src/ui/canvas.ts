@@ -500,37 +500,24 @@ export class DrawingView {
     const refused = this.#drawing?.unfelt(drawn) === "refused";
     this.#wipe(ctx, drawn);
     ctx.save();
-    if (this.#drawing?.isHeld(drawn) === true && !refused) {
-      // Held while the wearer paused: violet dashes, as the legend's "held, not sent".
-      ctx.strokeStyle = COLORS.held;
-      ctx.lineWidth = SENT_WIDTH_PX - 1;
-      ctx.setLineDash([9, 6]);
-      ctx.beginPath();
-      ctx.moveTo(x0, y0);
-      ctx.lineTo(x1, y1);
-      ctx.stroke();
-      ctx.restore();
-      return;
-    }
-    if (!refused) {
-      // Cancelled by Stop or never sent: dotted grey, no cross (the sleeve refused nothing).
-      ctx.strokeStyle = COLORS.cancelled;
-      ctx.lineWidth = SENT_WIDTH_PX - 1;
-      ctx.setLineDash([2, 6]);
-      ctx.beginPath();
-      ctx.moveTo(x0, y0);
-      ctx.lineTo(x1, y1);
-      ctx.stroke();
-      ctx.restore();
-      return;
-    }
-    ctx.strokeStyle = COLORS.rejected;
-    ctx.lineWidth = SENT_WIDTH_PX;
-    ctx.setLineDash([2, 7]);
+    // Held while the wearer paused: violet dashes, as the legend's "held, not sent". Cancelled
+    // by Stop or never sent: dotted grey, no cross (the sleeve refused nothing).
+    const [color, width, dash] = refused
+      ? [COLORS.rejected, SENT_WIDTH_PX, [2, 7]]
+      : this.#drawing?.isHeld(drawn) === true
+        ? [COLORS.held, SENT_WIDTH_PX - 1, [9, 6]]
+        : [COLORS.cancelled, SENT_WIDTH_PX - 1, [2, 6]];
+    ctx.strokeStyle = color;
+    ctx.lineWidth = width;
+    ctx.setLineDash(dash);
     ctx.beginPath();
     ctx.moveTo(x0, y0);
     ctx.lineTo(x1, y1);
     ctx.stroke();
+    if (!refused) {
+      ctx.restore();
+      return;
+    }
     // A cross at the middle: refused, not merely thin.
     const mx = (x0 + x1) / 2;
     const my = (y0 + y1) / 2;
