@@ -181,6 +181,37 @@ describe("honest after faults: the page, up and the study agree with what the sl
   let output = "";
   const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
 
+  /**
+   * A zigzag of `legs` legs between heights `low` and `high` (fractions of the area), 250 ms a
+   * leg with the pen down (every corner cuts a stroke); `beforeLeg(i)` runs before leg i.
+   * Returns the drawing's id.
+   */
+  async function drawZigzag(
+    legs: number,
+    [left, right, low, high]: [number, number, number, number],
+    beforeLeg: (leg: number) => Promise<void> | void = () => {},
+  ): Promise<string> {
+    const corners: Point[] = [];
+    for (let i = 0; i <= legs; i++)
+      corners.push(at(left + ((right - left) * i) / legs, i % 2 === 0 ? low : high));
+    await page.mouse.move(...corners[0]!);
+    await page.mouse.down();
+    await nextFrame(page);
+    for (let i = 1; i < corners.length; i++) {
+      await beforeLeg(i);
+      const [ax, ay] = corners[i - 1]!;
+      const [bx, by] = corners[i]!;
+      const startMs = performance.now();
+      for (let done = 0; done < 1;) {
+        done = Math.min(1, (performance.now() - startMs) / 250);
+        await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
+        await nextFrame(page);
+      }
+    }
+    await page.mouse.up();
+    return page.evaluate(() => window.feelmysign?.drawingId ?? "");
+  }
+
   beforeAll(async () => {
     recordPath = join(processes.dir("honest-record"), "felt.jsonl");
     up = await processes.up("honest", { args: ["--record", recordPath] });
@@ -267,24 +298,9 @@ describe("honest after faults: the page, up and the study agree with what the sl
     { timeout: 240_000 },
     async () => {
       // A zigzag: every corner cuts a stroke; the broker dies after the fifth leg, pen down.
-      const corners: Point[] = [];
-      for (let i = 0; i <= 12; i++) corners.push(at(0.06 + (0.88 * i) / 12, i % 2 === 0 ? 0.2 : 0.8));
-      await page.mouse.move(...corners[0]!);
-      await page.mouse.down();
-      await nextFrame(page);
-      for (let i = 1; i < corners.length; i++) {
-        if (i === 6) process.kill(mosquittoOf(up), "SIGKILL");
-        const [ax, ay] = corners[i - 1]!;
-        const [bx, by] = corners[i]!;
-        const startMs = performance.now();
-        for (let done = 0; done < 1;) {
-          done = Math.min(1, (performance.now() - startMs) / 250);
-          await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
-          await nextFrame(page);
-        }
-      }
-      await page.mouse.up();
-      const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
+      const drawing = await drawZigzag(12, [0.06, 0.94, 0.2, 0.8], (leg) => {
+        if (leg === 6) process.kill(mosquittoOf(up), "SIGKILL");
+      });
       expect(drawing).not.toBe("");
       await collectUntil(up.child, /Back: the broker is running again/, "up after the kill", 60_000).catch(
         (error: unknown) => {
@@ -349,32 +365,16 @@ describe("honest after faults: the page, up and the study agree with what the sl
       await page.locator('[data-testid="new-button"]').click();
       // A zigzag of 28 legs (7 s); the broker is killed three times, pen down: at the first leg
       // from 3, 12 and 21 on at which up runs one (not while it is starting the next).
-      const legs = 28;
       const killFrom = [3, 12, 21];
-      const corners: Point[] = [];
-      for (let i = 0; i <= legs; i++) corners.push(at(0.04 + (0.92 * i) / legs, i % 2 === 0 ? 0.2 : 0.8));
       let kills = 0;
-      await page.mouse.move(...corners[0]!);
-      await page.mouse.down();
-      await nextFrame(page);
-      for (let i = 1; i < corners.length; i++) {
+      const drawing = await drawZigzag(28, [0.04, 0.96, 0.2, 0.8], (leg) => {
         const pids = mosquittosOf(up);
-        if (kills < killFrom.length && i >= killFrom[kills]! && pids.length === 1) {
+        if (kills < killFrom.length && leg >= killFrom[kills]! && pids.length === 1) {
           process.kill(pids[0]!, "SIGKILL");
           kills++;
         }
-        const [ax, ay] = corners[i - 1]!;
-        const [bx, by] = corners[i]!;
-        const startMs = performance.now();
-        for (let done = 0; done < 1;) {
-          done = Math.min(1, (performance.now() - startMs) / 250);
-          await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
-          await nextFrame(page);
-        }
-      }
-      await page.mouse.up();
+      });
       expect(kills).toBeGreaterThanOrEqual(2); // repeated, whatever the machine's pace
-      const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
       // The broker back for good, the sleeve connected to it, and the page too.
       const deadline = Date.now() + 60_000;
       const back = () =>
@@ -430,28 +430,13 @@ describe("honest after faults: the page, up and the study agree with what the sl
     { timeout: 180_000 },
     async () => {
       await page.locator('[data-testid="new-button"]').click();
-      const corners: Point[] = [];
-      for (let i = 0; i <= 10; i++) corners.push(at(0.06 + (0.88 * i) / 10, i % 2 === 0 ? 0.25 : 0.75));
-      await page.mouse.move(...corners[0]!);
-      await page.mouse.down();
-      await nextFrame(page);
       let sentAtStop = 0;
-      for (let i = 1; i < corners.length; i++) {
-        if (i === 5) {
+      const drawing = await drawZigzag(10, [0.06, 0.94, 0.25, 0.75], async (leg) => {
+        if (leg === 5) {
           await page.keyboard.press("Escape"); // Stop, the pen still down
           sentAtStop = (await pageCounts(page)).sent;
         }
-        const [ax, ay] = corners[i - 1]!;
-        const [bx, by] = corners[i]!;
-        const startMs = performance.now();
-        for (let done = 0; done < 1;) {
-          done = Math.min(1, (performance.now() - startMs) / 250);
-          await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
-          await nextFrame(page);
-        }
-      }
-      await page.mouse.up();
-      const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
+      });
       const counts = await waitForEveryStroke(page);
       // The pen moving on after Stop drew nothing more: no stroke was made, none sent.
       expect(counts.sent).toBe(sentAtStop);

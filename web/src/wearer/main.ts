@@ -4,7 +4,6 @@
  * Made for a phone and a screen reader: large real buttons, a live region saying what
  * changed. It reads the sleeve's state every second; each button's answer is the new state.
  */
-import "../palette.css";
 import "./wearer.css";
 import { act, readState, WearerApiError, type Action, type Sender, type WearerState } from "./api";
 

@@ -21,6 +21,7 @@ import os
 import re
 import secrets
 import string
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -273,6 +274,44 @@ def write_private_file(path: Path, text: str) -> None:
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+
+
+def load_named_accounts(
+    path: Path, kind: str, check_name: Callable[[str], str]
+) -> dict[str, tuple[Account, dict[str, Any]]]:
+    """A file of named accounts (``{name: {"username", "password", ...}}``, as
+    ``sleeves.json`` and ``senders.json``): each name's account and its whole entry, or
+    none when the file does not exist yet. ``kind`` names one entry in errors ("sleeve")."""
+    try:
+        data = loads_json(read_text(path, max_bytes=MAX_CREDENTIALS_BYTES))
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError) as error:
+        raise named_accounts_error(path, kind, f"it cannot be read as JSON ({error})") from None
+    if not isinstance(data, dict):
+        raise named_accounts_error(path, kind, "it is not a JSON object")
+    accounts: dict[str, tuple[Account, dict[str, Any]]] = {}
+    for name, entry in data.items():
+        check_name(name)
+        if not isinstance(entry, dict) or not all(
+            isinstance(entry.get(key), str) for key in ("username", "password")
+        ):
+            raise named_accounts_error(path, kind, f"{kind} {name!r} lacks a username or password")
+        accounts[name] = (Account(entry["username"], entry["password"]), entry)
+    return accounts
+
+
+def write_named_accounts(path: Path, entries: dict[str, dict[str, Any]]) -> None:
+    """Write a file of named accounts (mode 0600, atomically); the reverse of the above."""
+    write_private_file(path, json.dumps(entries, indent=2) + "\n")
+
+
+def named_accounts_error(path: Path, kind: str, problem: str) -> BrokerError:
+    return BrokerError(
+        "credentials-file",
+        f"The {kind}s file {path} is not usable: {problem}. Fix it, or delete it and add "
+        f"the {kind}s again (each then needs its new join token).",
+    )
 
 
 def write_credentials(path: Path, credentials: Credentials) -> None:

@@ -16,15 +16,19 @@ instead): ``up`` itself needs it to log each drawing.
 
 from __future__ import annotations
 
-import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from feelmysign.broker.credentials import Account, new_password, write_private_file
+from feelmysign.broker.credentials import (
+    Account,
+    load_named_accounts,
+    named_accounts_error,
+    new_password,
+    write_named_accounts,
+)
 from feelmysign.connection.settings import SENDER_USERNAME_PREFIX
 from feelmysign.errors import BrokerError
-from feelmysign.input_files import MAX_CREDENTIALS_BYTES, loads_json, read_text
 
 PAGE_SENDER = "page"  # the name of up's page, on the shared sender account
 _NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,64}")
@@ -50,25 +54,14 @@ def check_sender_name(name: str) -> str:
 
 def load_senders(path: Path) -> dict[str, Sender]:
     """The named senders by name; none when the file does not exist yet."""
-    try:
-        data = loads_json(read_text(path, max_bytes=MAX_CREDENTIALS_BYTES))
-    except FileNotFoundError:
-        return {}
-    except (OSError, ValueError) as error:
-        raise _bad_file(path, f"it cannot be read as JSON ({error})") from None
-    if not isinstance(data, dict):
-        raise _bad_file(path, "it is not a JSON object")
     senders: dict[str, Sender] = {}
-    for name, entry in data.items():
-        check_sender_name(name)
-        if (
-            not isinstance(entry, dict)
-            or not all(isinstance(entry.get(key), str) for key in ("username", "password"))
-            or not isinstance(entry.get("blocked", False), bool)
-        ):
-            raise _bad_file(path, f"sender {name!r} lacks a username or password")
-        account = Account(entry["username"], entry["password"])
-        senders[name] = Sender(name, account, entry.get("blocked", False))
+    for name, (account, entry) in load_named_accounts(path, "sender", check_sender_name).items():
+        blocked = entry.get("blocked", False)
+        if not isinstance(blocked, bool):
+            raise named_accounts_error(
+                path, "sender", f"sender {name!r} has a 'blocked' that is not true or false"
+            )
+        senders[name] = Sender(name, account, blocked)
     return senders
 
 
@@ -98,16 +91,14 @@ def set_blocked(path: Path, name: str, blocked: bool) -> Sender:
 
 
 def _write(path: Path, senders: dict[str, Sender]) -> None:
-    data = {
-        name: {"username": s.account.username, "password": s.account.password, "blocked": s.blocked}
-        for name, s in senders.items()
-    }
-    write_private_file(path, json.dumps(data, indent=2) + "\n")
-
-
-def _bad_file(path: Path, problem: str) -> BrokerError:
-    return BrokerError(
-        "credentials-file",
-        f"The senders file {path} is not usable: {problem}. Fix it, or delete it and add "
-        "the senders again (each then needs its new join token).",
+    write_named_accounts(
+        path,
+        {
+            name: {
+                "username": s.account.username,
+                "password": s.account.password,
+                "blocked": s.blocked,
+            }
+            for name, s in senders.items()
+        },
     )

@@ -87,12 +87,7 @@ def register(subparsers: Subcommands) -> None:
         ),
     )
     add.add_argument("new_sleeve_id", metavar="ID", help="1-64 letters, digits, '_' or '-'")
-    add.add_argument(
-        "--url",
-        metavar="URL",
-        help="the broker's URL as the sleeve reaches it, mqtts:// or wss:// (default: the "
-        "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
-    )
+    _add_url_option(add, "sleeve")
     add.set_defaults(handler=run_add_sleeve)
     sender = commands.add_parser(
         "add-sender",
@@ -118,12 +113,7 @@ def register(subparsers: Subcommands) -> None:
         "wearer's page (1-64 letters, digits, '_' or '-'; the same name again prints the same "
         "token); without it, the token holds the sender account every such token shares",
     )
-    sender.add_argument(
-        "--url",
-        metavar="URL",
-        help="the broker's URL as the sender reaches it, mqtts:// or wss:// (default: the "
-        "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
-    )
+    _add_url_option(sender, "sender")
     sender.set_defaults(handler=run_add_sender)
     nats = commands.add_parser(
         "nats-accounts",
@@ -197,3 +187,12 @@ def _announce(broker: Broker) -> None:
         "Ready. Press Ctrl-C to stop.",
     ]
     print("\n".join(lines), flush=True)
+
+
+def _add_url_option(parser: argparse.ArgumentParser, who: str) -> None:
+    parser.add_argument(
+        "--url",
+        metavar="URL",
+        help=f"the broker's URL as the {who} reaches it, mqtts:// or wss:// (default: the "
+        "TLS listener of the last 'feelmysign broker --lan' or 'feelmysign up --lan')",
+    )
