@@ -25,6 +25,7 @@ export const FATES: readonly Fate[] = ["played", "cut", "cancelled", "refused"];
 const DUPLICATE = "duplicate";
 const CANCELLED = "cancelled";
 const DUTY_CYCLE = "duty_cycle";
+const WEARER = "wearer";
 // How much an event says about its stroke: higher replaces lower, equal never does.
 const COPY = 1;
 const REFUSAL = 2;
@@ -35,7 +36,14 @@ const CUT = 5;
 interface Verdict {
   readonly rank: number;
   readonly fate: Fate;
+  /** Why it was refused; for a cut, who or what cut it: "wearer", a safety reason, null for Stop. */
   readonly reason: string | null;
+}
+
+/** Of the strokes cut short: how many the wearer cut, and how many a fault on the sleeve did. */
+export interface CutCauses {
+  readonly byWearer: number;
+  readonly byFault: number;
 }
 
 /** What `event` says of its stroke; null when nothing (an error, a safety off outside a stroke). */
@@ -46,11 +54,12 @@ export function verdict(event: SleeveEvent, playedBefore: boolean): Verdict | nu
       return { rank: PLAYED, fate: "played", reason: null };
     case "cancelled":
       return event.started
-        ? { rank: CUT, fate: "cut", reason: null }
+        ? { rank: CUT, fate: "cut", reason: event.by === WEARER ? WEARER : null }
         : { rank: OWN, fate: "cancelled", reason: null };
     case "safety":
       if (event.received_at_ms === null) return null;
-      if (event.reason !== DUTY_CYCLE && playedBefore) return { rank: CUT, fate: "cut", reason: null };
+      if (event.reason !== DUTY_CYCLE && playedBefore)
+        return { rank: CUT, fate: "cut", reason: event.reason };
       return { rank: OWN, fate: "refused", reason: event.reason };
     case "rejected":
       if (event.reason === DUPLICATE) {
@@ -102,6 +111,18 @@ export class DrawingFates {
     return counts;
   }
 
+  /** Who or what cut the strokes cut short (the rest: the sender's Stop). */
+  cutCauses(): CutCauses {
+    let byWearer = 0;
+    let byFault = 0;
+    for (const { fate, reason } of [...this.#bySeq.values(), ...this.#unnamed]) {
+      if (fate !== "cut" || reason === null) continue;
+      if (reason === WEARER) byWearer++;
+      else byFault++;
+    }
+    return { byWearer, byFault };
+  }
+
   /** The refused strokes by reason, in the order first met. */
   refusals(): Map<string, number> {
     const out = new Map<string, number>();
@@ -110,4 +131,19 @@ export class DrawingFates {
     }
     return out;
   }
+}
+
+/**
+ * The card's and the caption's words for `cut` strokes cut short while playing: by Stop, by the
+ * wearer (their pause or stop), or by a fault on the sleeve (a chip lost mid-stroke).
+ */
+export function cutShortWords(cut: number, causes: Partial<CutCauses> = {}): string[] {
+  const byWearer = Math.min(cut, causes.byWearer ?? 0);
+  const byFault = Math.min(cut - byWearer, causes.byFault ?? 0);
+  const byStop = cut - byWearer - byFault;
+  const words: string[] = [];
+  if (byStop > 0) words.push(`${byStop} cut short by Stop`);
+  if (byWearer > 0) words.push(`${byWearer} cut short by the wearer`);
+  if (byFault > 0) words.push(`${byFault} cut short by a fault on the sleeve`);
+  return words;
 }

@@ -12,7 +12,7 @@
  */
 import type { Drawing, DrawnSegment } from "../drawing";
 import type { CancelledEvent, AdjustedEvent, PlayedEvent, Unplayed } from "../events";
-import type { Fate } from "../fates";
+import { cutShortWords, type Fate } from "../fates";
 import { brushAt, placeStrokes, type FeltStroke, type Grid, type PlacedStroke } from "../felt";
 import { FeltPlacement } from "../felt-placement";
 import { simplifyPaths, type SimplifierParams } from "../simplify/registry";
@@ -29,6 +29,9 @@ export interface Tally {
   readonly sent: number;
   readonly played: number;
   readonly cut: number;
+  /** Of the cut: by the wearer, and by a fault on the sleeve (the rest by Stop). */
+  readonly cutByWearer?: number;
+  readonly cutByFault?: number;
   readonly cancelled: number;
   /** Refused on arrival, or kept from playing by the duty-cycle cap. */
   readonly refused: number;
@@ -296,7 +299,7 @@ export function timelineCaption(
         : `${played} played (the times of ${placedByPage} are the page's: the sleeve's report of ${placedByPage === 1 ? "it" : "them"} never came)`,
     );
   }
-  if (cut > 0) said.push(`${cut} cut short by Stop`);
+  said.push(...cutShortWords(cut, { byWearer: tally.cutByWearer ?? 0, byFault: tally.cutByFault ?? 0 }));
   if (capped > 0) {
     said.push(
       `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,

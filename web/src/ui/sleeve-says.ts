@@ -8,7 +8,7 @@
  * old drawing lingers.
  */
 import { seconds, type SleeveEvent } from "../events";
-import { DrawingFates, type Fate } from "../fates";
+import { cutShortWords, DrawingFates, type Fate } from "../fates";
 import { EventLog, type LogKind } from "./event-log";
 
 export interface Counts {
@@ -19,8 +19,11 @@ export interface Counts {
   refused: number;
   /** Dropped by Stop before they started (on the sleeve). */
   cancelled: number;
-  /** Cut short by Stop while playing: felt in part, counted here and not under played. */
+  /** Cut short while playing (by Stop, the wearer or a fault): felt in part, not under played. */
   cut: number;
+  /** Of the cut: by the wearer, and by a fault on the sleeve (fates.ts `cutCauses`). */
+  cutByWearer: number;
+  cutByFault: number;
   /** Never sent: dropped before they left, by Stop or by the timing policy. */
   dropped: number;
   /** Played, but held on the way (events.ts `isDelayed`): not the sleeve's `late` refusal. */
@@ -53,9 +56,12 @@ export class SleeveSays {
   }
 
   get counts(): Readonly<Counts> {
+    const causes = this.#fates.cutCauses();
     return {
       sent: this.#sent,
       ...this.#fates.counts(),
+      cutByWearer: causes.byWearer,
+      cutByFault: causes.byFault,
       dropped: this.#dropped,
       delayed: this.#delayed,
       latestDelayMs: this.#latestDelayMs,
@@ -132,7 +138,8 @@ export class SleeveSays {
   }
 
   #render(): void {
-    const { played, refused, cancelled, cut, dropped, delayed, latestDelayMs } = this.counts;
+    const { played, refused, cancelled, cut, cutByWearer, cutByFault, dropped, delayed, latestDelayMs } =
+      this.counts;
     const summary = this.#summary;
     summary.dataset["played"] = String(played);
     summary.dataset["sent"] = String(this.#sent);
@@ -149,7 +156,7 @@ export class SleeveSays {
     }
     // Each stroke under one fate: the parts add up to the strokes drawn once all are answered.
     const parts = [`${played} of ${plural(this.#sent, "stroke")} played`];
-    if (cut > 0) parts.push(`${cut} cut short by Stop`);
+    parts.push(...cutShortWords(cut, { byWearer: cutByWearer, byFault: cutByFault }));
     if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
     if (refused > 0) {
       const wearer = Math.min(this.#wearerRefused, refused);

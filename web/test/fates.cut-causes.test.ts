@@ -1,0 +1,73 @@
+/**
+ * A stroke cut short while playing is said with what cut it: the sender's Stop, the wearer's
+ * pause or stop, or a fault on the sleeve (a chip lost mid-stroke), never a fault as "Stop".
+ */
+import { describe, expect, it } from "vitest";
+import { parseEvent, type SleeveEvent } from "../src/events";
+import { cutShortWords, DrawingFates } from "../src/fates";
+
+const event = (fields: Record<string, unknown>): SleeveEvent => {
+  const parsed = parseEvent(JSON.stringify(fields));
+  if (parsed === null) throw new Error(`not an event: ${JSON.stringify(fields)}`);
+  return parsed;
+};
+const stroke = { topic: "feelmysign/sleeve1/strokes", drawing: "d-1", received_at_ms: 1795326267664.25 };
+const played = (seq: number): SleeveEvent =>
+  event({
+    type: "played",
+    ...stroke,
+    seq,
+    start_at_ms: 1795326267664.25,
+    first_command_at_ms: 1795326267664.5,
+    latency_ms: 0.25,
+    start_error_ms: 0.031,
+    queued_ms: 0,
+    duration_ms: 417.5,
+    commands: 5,
+  });
+const cut = (seq: number, by?: string): SleeveEvent =>
+  event({
+    type: "cancelled",
+    reason: "cancelled",
+    message: "cut short",
+    ...stroke,
+    seq,
+    cancelled_at_ms: 1795326268000.5,
+    started: true,
+    ...(by === undefined ? {} : { by }),
+  });
+const chipLost = (seq: number): SleeveEvent =>
+  event({
+    type: "safety",
+    reason: "chip_lost",
+    row: 0,
+    column: 3,
+    message: "a chip stopped answering",
+    ...stroke,
+    seq,
+  });
+
+describe("what cut a stroke short", () => {
+  it("tells Stop, the wearer and a fault apart, each stroke once", () => {
+    const fates = new DrawingFates();
+    fates.add(cut(1));
+    fates.add(cut(2, "wearer"));
+    fates.add(cut(2, "wearer")); // delivered again
+    fates.add(played(3));
+    fates.add(chipLost(3)); // a lost chip after the stroke started: cut, not played
+    expect(fates.counts()).toEqual({ played: 0, cut: 3, cancelled: 0, refused: 0 });
+    expect(fates.cutCauses()).toEqual({ byWearer: 1, byFault: 1 });
+    const causes = fates.cutCauses();
+    expect(cutShortWords(3, causes)).toEqual([
+      "1 cut short by Stop",
+      "1 cut short by the wearer",
+      "1 cut short by a fault on the sleeve",
+    ]);
+  });
+
+  it("says Stop only for what no one else cut, and never more causes than cuts", () => {
+    expect(cutShortWords(2)).toEqual(["2 cut short by Stop"]);
+    expect(cutShortWords(0, { byWearer: 0, byFault: 0 })).toEqual([]);
+    expect(cutShortWords(1, { byWearer: 3, byFault: 2 })).toEqual(["1 cut short by the wearer"]);
+  });
+});
