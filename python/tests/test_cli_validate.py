@@ -176,3 +176,18 @@ def test_console_script_never_shows_a_traceback(payload: str) -> None:
     result = command("--", payload, stdin=payload.encode())
     assert result.returncode == 1 and b"Traceback" not in result.stderr
     assert result.stdout.startswith(b"Rejected (")
+
+
+def test_an_intensity_above_the_layouts_cap_says_what_is_driven(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    layout = tmp_path / "capped.toml"
+    layout.write_text(
+        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\ndefault_intensity = 0.4\n[safety]\nmax_intensity = 0.5\n"
+    )
+    stroke = '{"v": 1, "start": [0, 0], "end": [3, 0], "duration_ms": 600, "intensity": %s}'
+    code, out, _ = run(capsys, "--layout", str(layout), stroke % "0.9")
+    assert code == 0
+    assert "at intensity 0.9 (driven at most 0.5: the layout's safety.max_intensity" in out
+    code, out, _ = run(capsys, "--layout", str(layout), stroke % "0.5")
+    assert code == 0 and "driven at most" not in out

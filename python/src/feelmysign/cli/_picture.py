@@ -60,3 +60,14 @@ def _first_command_numbers(schedule: Schedule) -> dict[tuple[int, int], int]:
     for number, command in enumerate(schedule.commands, start=1):  # sorted by start time
         first.setdefault((command.row, command.column), number)
     return first
+
+
+def capped_note(intensity: float, layout: Layout) -> str:
+    """What the sleeve drives a stroke asked at ``intensity`` with, when its cap lowers it
+    (the player drives no motor above the layout's ``safety.max_intensity``); else ""."""
+    if intensity <= layout.max_intensity:
+        return ""
+    return (
+        f" (driven at most {layout.max_intensity:g}: the layout's safety.max_intensity caps "
+        "every motor)"
+    )

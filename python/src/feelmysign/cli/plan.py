@@ -6,7 +6,7 @@ import argparse
 import json
 from dataclasses import replace
 
-from feelmysign.cli._picture import LEGEND, grid_picture
+from feelmysign.cli._picture import LEGEND, capped_note, grid_picture
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands
 from feelmysign.cli.options.strokes import strokes_from
@@ -95,8 +95,9 @@ def describe(schedule: Schedule, layout: Layout) -> str:
     intensity = layout.default_intensity if stroke.intensity is None else stroke.intensity
     lines = [
         f"Stroke ({_p(stroke.start)}) -> ({_p(stroke.end)}): {length_cm:.2f} cm in "
-        f"{schedule.duration_ms:.3f} ms ({speed:.1f} cm/s), intensity {intensity:g}, "
-        f"on a {layout.rows} x {layout.columns} grid, {layout.spacing_cm:g} cm apart",
+        f"{schedule.duration_ms:.3f} ms ({speed:.1f} cm/s), intensity {intensity:g}"
+        f"{capped_note(intensity, layout)}, on a {layout.rows} x {layout.columns} grid, "
+        f"{layout.spacing_cm:g} cm apart",
     ]
     if schedule.adjusted is not None:
         lines.append(
@@ -117,9 +118,11 @@ def describe(schedule: Schedule, layout: Layout) -> str:
         f"{'end ms':>10} {'intensity':>9}"
     )
     for i, c in enumerate(schedule.commands, start=1):
+        # As the motor is driven: the player caps every output at the layout's max_intensity.
+        driven = min(c.intensity, layout.max_intensity)
         lines.append(
             f"{i:>3} {c.row:>5} {c.column:>8} {c.start_ms:>10.3f} {c.duration_ms:>12.3f} "
-            f"{c.end_ms:>10.3f} {c.intensity:>9.3f}"
+            f"{c.end_ms:>10.3f} {driven:>9.3f}"
         )
     lines.append("")
     lines.append(grid_picture(schedule, layout))

@@ -16,6 +16,7 @@ import json
 import os
 from typing import Any
 
+from feelmysign.cli._picture import capped_note
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import read_stdin
@@ -91,7 +92,7 @@ def _sentence(result: Accepted | Rejected, layout: Layout) -> str:
         return f"Rejected ({result.reason}): {result.message}"
     stroke = result.stroke
     intensity = (
-        f"intensity {stroke.intensity:g}"
+        f"intensity {stroke.intensity:g}{capped_note(stroke.intensity, layout)}"
         if stroke.intensity is not None
         else f"the sleeve's default intensity {layout.default_intensity:g}"
     )
