@@ -221,7 +221,9 @@ def test_a_pause_during_a_send_names_the_strokes_it_kept_from_the_skin(
     assert result.returncode == WEARER_HOLD_EXIT, result.stdout + result.stderr
     assert "refused (paused)" in result.stdout
     error = result.stderr.strip().splitlines()[-1]
-    assert error.startswith("Error: The sleeve played 2 of 4 strokes, refused 2 (paused x2)")
+    assert error.startswith(
+        "Error: The sleeve played 1 of 4 strokes, refused 2 (paused x2), cut 1 part-way (cancelled)"
+    )
     assert "The wearer paused the sleeve: stroke(s) 3, 4 refused" in error
     assert "the wearer's pause or stop cut or dropped stroke(s) 2" in error
     assert error.endswith("Send again once the wearer has resumed.")

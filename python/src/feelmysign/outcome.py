@@ -14,7 +14,7 @@ from __future__ import annotations
 import threading
 import time
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.events import (
@@ -28,6 +28,7 @@ from feelmysign.events import (
     event_from_json,
 )
 from feelmysign.player import WEARER
+from feelmysign.wearer_status import WEARER_REASONS
 
 if TYPE_CHECKING:
     import paho.mqtt.client as mqtt
@@ -47,9 +48,12 @@ class StrokeOutcome:
     # not by a sender's control message.
     by_wearer: bool = False
 
+    # Never sent: the sender stopped once the sleeve refused a stroke as its wearer paused it.
+    held: bool = False
+
     @property
     def final(self) -> bool:
-        return self.played is not None or self.refused_reason is not None
+        return self.played is not None or self.refused_reason is not None or self.held
 
 
 class DrawingOutcome:
@@ -113,6 +117,19 @@ class DrawingOutcome:
             return True
         return False
 
+    def held_by_wearer(self) -> bool:
+        """Whether the sleeve refused a stroke as its wearer paused it (or asked not to be
+        disturbed): what is not sent yet would be refused as well."""
+        with self._condition:
+            return any(s.refused_reason in WEARER_REASONS for s in self.strokes)
+
+    def hold(self, seqs: range) -> None:
+        """These strokes were not sent (the wearer's hold): final, with no answer to wait for."""
+        with self._condition:
+            for seq in seqs:
+                self.strokes[seq].held = True
+            self._condition.notify_all()
+
     def wait_answered(self, deadline_s: float) -> None:
         """Until every stroke has a final answer, or the monotonic ``deadline_s``."""
         with self._condition:
@@ -132,11 +149,15 @@ class DrawingOutcome:
 
     def summary(self) -> DrawingSummary:
         with self._condition:
-            played = [i for i, s in enumerate(self.strokes) if s.played is not None]
+            # One fate a stroke, as feelmysign.fates counts them: one cut part-way is not played.
+            played = [
+                i for i, s in enumerate(self.strokes) if s.played is not None and not s.cut_reason
+            ]
             refused = Counter(s.refused_reason for s in self.strokes if s.refused_reason)
             cut = Counter(s.cut_reason for s in self.strokes if s.cut_reason)
             unheard = [i for i, s in enumerate(self.strokes) if not s.final]
-        return DrawingSummary(self.count, len(played), refused, cut, unheard)
+            held = [i for i, s in enumerate(self.strokes) if s.held]
+        return DrawingSummary(self.count, len(played), refused, cut, unheard, held)
 
 
 @dataclass(frozen=True)
@@ -146,6 +167,7 @@ class DrawingSummary:
     refused: Counter[str]
     cut: Counter[str]
     unheard: list[int]  # seqs with no answer
+    held: list[int] = field(default_factory=list)  # seqs not sent: the wearer's hold
 
     @property
     def all_played(self) -> bool:
@@ -157,7 +179,10 @@ class DrawingSummary:
             parts.append(f"refused {sum(self.refused.values())} ({_reasons(self.refused)})")
         if self.cut:
             parts.append(f"cut {sum(self.cut.values())} part-way ({_reasons(self.cut)})")
-        return "The sleeve " + ", ".join(parts)
+        text = "The sleeve " + ", ".join(parts)
+        if self.held:
+            text += f"; {len(self.held)} not sent (from stroke {self.held[0] + 1} on)"
+        return text
 
 
 def _reasons(counts: Counter[str]) -> str:

@@ -82,6 +82,10 @@ class _Acks:
             return self._lost if self._lost is not None else "timeout"
 
 
+def _never() -> bool:
+    return False
+
+
 class StrokeSender:
     """Publishes strokes at their pace and reports each once the broker acknowledged it."""
 
@@ -101,18 +105,33 @@ class StrokeSender:
         client.on_publish = self._acks.on_publish
         client.on_disconnect = self._acks.on_disconnect
 
-    def send(self, messages: list[OutgoingStroke], *, pace: Pace) -> None:
+    def send(
+        self, messages: list[OutgoingStroke], *, pace: Pace, until: Callable[[], bool] = _never
+    ) -> int:
+        """Publishes ``messages`` at ``pace``; how many went out. None goes out once ``until()``
+        is true (checked before each): the sleeve refused one as its wearer paused it."""
         if pace == "burst":
-            sent = [(message, self._publish(message, message.payload())) for message in messages]
+            sent: list[tuple[OutgoingStroke, tuple[str, int]]] = []
+            for message in messages:
+                if until():
+                    break
+                sent.append((message, self._publish(message, message.payload())))
             deadline_s = time.monotonic() + self._timeout_s
             for message, (payload, mid) in sent:
                 self._confirm(message, payload, mid, deadline_s, len(messages))
-            return
+            return len(sent)
         offsets_ms = list(itertools.accumulate((m.stroke.duration_ms for m in messages), initial=0))
-        self.send_at(messages, offsets_ms[:-1])
+        return self.send_at(messages, offsets_ms[:-1], until=until)
 
-    def send_at(self, messages: list[OutgoingStroke], offsets_ms: list[float]) -> None:
-        """Each message published ``offsets_ms`` after this call, once the previous is acked.
+    def send_at(
+        self,
+        messages: list[OutgoingStroke],
+        offsets_ms: list[float],
+        *,
+        until: Callable[[], bool] = _never,
+    ) -> int:
+        """Each message published ``offsets_ms`` after this call, once the previous is acked;
+        how many went out before ``until()`` was true (checked before each).
 
         From the second message on, the pace counts from the moment the first one was
         stamped with its ``sent_at_ms`` rather than from this call: whatever held the first
@@ -121,7 +140,7 @@ class StrokeSender:
         """
         start_s = time.monotonic()
         first: tuple[float, float] | None = None  # (monotonic s after its stamp, its offset)
-        for message, offset_ms in zip(messages, offsets_ms, strict=True):
+        for count, (message, offset_ms) in enumerate(zip(messages, offsets_ms, strict=True)):
             if first is None:
                 due_s = start_s + offset_ms / 1000
             else:
@@ -129,12 +148,15 @@ class StrokeSender:
                 due_s = first_s + (offset_ms - first_offset_ms) / 1000
             # Drawing time, not a wait for an event: the pace is the point.
             time.sleep(max(0.0, due_s - time.monotonic()))
+            if until():
+                return count
             payload = message.payload()
             if first is None:
                 # Read after the stamp: the moment it counts from is never before it.
                 first = (time.monotonic(), offset_ms)
             payload, mid = self._publish(message, payload)
             self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
+        return len(messages)
 
     def _publish(self, message: OutgoingStroke, payload: str) -> tuple[str, int]:
         import paho.mqtt.client as mqtt

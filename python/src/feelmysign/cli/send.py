@@ -225,9 +225,11 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         topic = args.legacy_topic if args.legacy else settings.strokes_topic
         messages = [OutgoingStroke(i, topic, s, args.legacy) for i, s in enumerate(strokes)]
         outcome = _watch_events(client, settings, strokes, args) if wait else None
-        _send(client, settings, messages, args)
+        sent = _send(client, settings, messages, args, outcome)
+        if outcome is not None and sent < len(messages):
+            outcome.hold(range(sent, len(messages)))
         if not args.json:
-            print(_summary(args, settings, strokes), flush=True)
+            print(_summary(args, settings, strokes, sent), flush=True)
         if outcome is None:
             return 0
         return _await_sleeve(outcome, settings, args, strokes)
@@ -241,12 +243,16 @@ def _send(
     settings: BrokerSettings,
     messages: list[OutgoingStroke],
     args: argparse.Namespace,
-) -> None:
+    outcome: DrawingOutcome | None,
+) -> int:
+    """Publishes the strokes; how many went out. Waiting for the sleeve's answers, it stops
+    once the sleeve refuses one as its wearer paused it: the rest would be refused too."""
     pace: Pace = args.pace or "realtime"
     report = printer(json_lines=args.json, total=len(messages))
-    StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report).send(
-        messages, pace=pace
-    )
+    sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
+    if outcome is None:
+        return sender.send(messages, pace=pace)
+    return sender.send(messages, pace=pace, until=outcome.held_by_wearer)
 
 
 def _wait_asked(args: argparse.Namespace, parser: argparse.ArgumentParser) -> bool:
@@ -460,12 +466,24 @@ def _wearer_line(outcome: DrawingOutcome) -> str | None:
         )
     if cut:
         parts.append(f"the wearer's pause or stop cut or dropped stroke(s) {_numbers(cut)}")
+    held = [i + 1 for i, s in enumerate(outcome.strokes) if s.held]
+    if held:
+        parts.append(f"stroke(s) {_numbers(held)} not sent, since the sleeve would refuse them")
     text = "; ".join(parts)
     return f" {text[0].upper()}{text[1:]}. Send again once the wearer has resumed."
 
 
 def _numbers(numbers: list[int]) -> str:
-    return ", ".join(str(n) for n in numbers)
+    """Stroke numbers, a run of three or more as one range: "1, 3, 5 to 24"."""
+    runs: list[list[int]] = []
+    for n in numbers:
+        if runs and n == runs[-1][-1] + 1:
+            runs[-1].append(n)
+        else:
+            runs.append([n])
+    return ", ".join(
+        f"{run[0]} to {run[-1]}" if len(run) >= 3 else ", ".join(map(str, run)) for run in runs
+    )
 
 
 def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
@@ -564,11 +582,15 @@ def _stroke_texts(arguments: list[str]) -> Iterator[tuple[str, str]]:
                 yield f"Line {line_number} of standard input", line
 
 
-def _summary(args: argparse.Namespace, settings: BrokerSettings, strokes: list[Stroke]) -> str:
+def _summary(
+    args: argparse.Namespace, settings: BrokerSettings, strokes: list[Stroke], sent: int
+) -> str:
     what = (
         f"a {args.shape} of {len(strokes)} strokes" if args.shape else f"{len(strokes)} stroke(s)"
     )
-    total_ms = sum(s.duration_ms for s in strokes)
+    if sent < len(strokes):
+        what = f"{sent} of {what} (the rest not sent: the sleeve refused strokes for its wearer)"
+    total_ms = sum(s.duration_ms for s in strokes[:sent])
     where = (
         f"the legacy topic {args.legacy_topic}"
         if args.legacy

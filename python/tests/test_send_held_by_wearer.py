@@ -1,0 +1,78 @@
+"""``feelmysign send`` stops sending once the wearer pauses: a real sleeve (its chips and its
+pause button emulated), a real Mosquitto, ``send`` as its own process drawing a shape at its
+own pace; the wearer presses pause part-way. The sleeve refuses what arrives paused, and
+``send``, told so by the first refusal, sends none of the rest: it names them as not sent, its
+counts add up (one fate a stroke: a stroke cut part-way is not also played), and it exits 3.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+from pathlib import Path
+
+from sleeve_watch import SleeveWatch, online, reaped
+from test_wearer_button import PAUSE_LINE, paper_with_buttons, press, start
+
+from feelmysign.bench.restart_off import feelmysign_command
+from feelmysign.broker import Broker
+from feelmysign.cli.send import WEARER_HOLD_EXIT
+from feelmysign.events import event_from_json
+from feelmysign.fates import DrawingFates
+
+SEGMENTS = 24
+WAIT_S = 120.0
+
+
+def test_send_stops_at_the_wearers_pause_and_says_what_it_kept(
+    broker: Broker, tmp_path: Path
+) -> None:
+    state, layout, home = tmp_path / "bus.json", paper_with_buttons(tmp_path), tmp_path / "s"
+    with (
+        SleeveWatch(broker.credentials, "status", "events") as watcher,
+        reaped(start(broker, state, layout, home)),
+    ):
+        watcher.next(online, "the sleeve online")
+        sender = subprocess.Popen(
+            [
+                *feelmysign_command(),
+                *("send", "--credentials", str(broker.credentials_path)),
+                *("--shape", "circle", "--segments", str(SEGMENTS), "--duration-ms", "12000"),
+                "--wait",
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        with reaped(sender):
+            # A few strokes felt, then the wearer presses pause (half a second a stroke: the
+            # press comes long before the last one, however busy the machine).
+            played = lambda _n, b: b.get("type") == "played" and b.get("seq") == 2  # noqa: E731
+            watcher.next(played, "the third stroke playing")
+            press(state, PAUSE_LINE)
+            out, err = sender.communicate(timeout=WAIT_S)
+        assert sender.returncode == WEARER_HOLD_EXIT, out + err
+        fates = DrawingFates()
+        for body in watcher.received("events"):
+            if body.get("seq") is not None:
+                fates.add(event_from_json(json.dumps(body).encode()))
+        answered = fates.fates()
+        error = err.strip().splitlines()[-1]
+        print(out, err, sep="\n")
+        # What send says it kept back is exactly what the sleeve never heard of.
+        held = re.search(r"(\d+) not sent \(from stroke (\d+) on\)", error)
+        assert held is not None, error
+        count, first = int(held[1]), int(held[2])
+        assert count >= 1 and first - 1 + count == SEGMENTS
+        assert sorted(answered) == list(range(first - 1)), (answered, error)
+        # At least one stroke was refused as paused: the answer send stopped on.
+        assert fates.refusals().get("paused", 0) >= 1, fates.refusals()
+        # Its counts are the fates': played + cut + refused + not sent = every stroke.
+        counts = fates.counts()
+        assert f"The sleeve played {counts['played']} of {SEGMENTS} strokes" in error, error
+        assert (
+            counts["played"] + counts["cut"] + counts["cancelled"] + counts["refused"] + count
+            == SEGMENTS
+        )
+        assert f"Sent {first - 1} of a circle of {SEGMENTS} strokes" in out, out
