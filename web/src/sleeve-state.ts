@@ -7,6 +7,7 @@
  * shows what this says through `SleeveStateHost`.
  */
 import { parseStatus, type SleeveStatus } from "./events";
+import { holdHeadline, NO_CONTROLS, wearerHold } from "./wearer-status";
 import type { BrokerState } from "./mqtt/sender";
 import type { SleeveState } from "./ui/status";
 
@@ -142,8 +143,14 @@ export class SleeveWatch {
     const id = this.#host.sleeveId();
     const connected = this.#broker === "connected";
     const layout = this.#status?.layout;
+    // The wearer's pause or "do not disturb": the sleeve is online but takes no strokes.
+    const hold = wearerHold(this.#status?.controls ?? NO_CONTROLS, Date.now());
+    const grid = layout ? `: ${layout.rows} × ${layout.columns} actuators` : "";
     const caption = {
-      online: `Sleeve ${id} online${layout ? `: ${layout.rows} × ${layout.columns} actuators` : ""}, waiting for strokes.`,
+      online:
+        hold === null
+          ? `Sleeve ${id} online${grid}, waiting for strokes.`
+          : `Sleeve ${id} online${grid}, playing nothing. ${holdHeadline(hold)}`,
       offline: `Sleeve ${id} is offline: nothing is felt now.`,
       absent: `No sleeve answers on id ${id}: nothing is felt.`,
       unknown: connected

@@ -79,6 +79,27 @@ describe("the sleeve's state", () => {
     expect(watch.onStatus(ONLINE)).toEqual({ back: false });
   });
 
+  it("says the sleeve plays nothing while the wearer paused it or asked not to be disturbed", () => {
+    const { seen, target } = host();
+    const watch = new SleeveWatch(target, null);
+    watch.onBroker("connected", null);
+    const withControls = (controls: Record<string, unknown>): string =>
+      JSON.stringify({ ...JSON.parse(ONLINE), controls });
+    const none = { paused: false, paused_by: null, ceiling: null, do_not_disturb_until_ms: null };
+    watch.onStatus(withControls({ ...none, paused: true, paused_by: "button" }));
+    expect(seen.sleeve!.caption).toBe(
+      "Sleeve sleeve1 online: 3 × 4 actuators, playing nothing. The wearer paused the sleeve.",
+    );
+    const untilMs = Date.now() + 30 * 60_000;
+    watch.onStatus(withControls({ ...none, do_not_disturb_until_ms: untilMs }));
+    expect(seen.sleeve!.caption).toMatch(
+      /^Sleeve sleeve1 online: 3 × 4 actuators, playing nothing\. The wearer asked not to be disturbed until \d\d:\d\d\.$/,
+    );
+    // A "do not disturb" already over holds nothing; resumed, the sleeve waits for strokes.
+    watch.onStatus(withControls({ ...none, do_not_disturb_until_ms: Date.now() - 1000 }));
+    expect(seen.sleeve!.caption).toBe("Sleeve sleeve1 online: 3 × 4 actuators, waiting for strokes.");
+  });
+
   it("warns of an offline sleeve, and says when it is back", () => {
     const { seen, target } = host();
     const watch = new SleeveWatch(target, null);
