@@ -1,6 +1,7 @@
 package feelmysign.cli;
 
 import feelmysign.client.SleeveClient;
+import feelmysign.client.WearerState;
 import feelmysign.json.PyJson;
 import feelmysign.protocol.Layout;
 import feelmysign.protocol.ParseResult;
@@ -34,7 +35,8 @@ import java.util.Set;
  * {@code feelmysign-java send}: strokes, a shape or a recording to a sleeve, as {@code
  * feelmysign send} does (its flags where they apply): every stroke checked first, one drawing,
  * QoS 1, and the command returns once the broker has acknowledged every stroke (exit 0), or
- * says why not (exit 1). Strokes go out at the pace they play ({@code --pace realtime}, the
+ * says why not (exit 1). A sleeve its wearer paused, or asked not to be disturbed, gets nothing:
+ * one line says so and what to do (exit 3), as the Python CLI's. Strokes go out at the pace they play ({@code --pace realtime}, the
  * default, as the reference's: each stroke once the one before would have finished), so a
  * second send right after it is not queued behind it and refused as late, and no stroke arrives
  * ahead of its drawing (the sleeve would play it faster to catch up, as {@code --pace burst}
@@ -218,6 +220,9 @@ final class SendCommand {
       builder.caFingerprint(fingerprint);
     }
     String[] lastSaid = {"no answer"};
+    // The sleeve's retained status, the first that comes: the wearer's choice in it.
+    java.util.concurrent.CompletableFuture<WearerState> wearer =
+        new java.util.concurrent.CompletableFuture<>();
     builder.listener(new SleeveClient.Listener() {
       @Override
       public void broker(SleeveClient.State state, String detail) {
@@ -225,12 +230,32 @@ final class SendCommand {
           lastSaid[0] = detail;
         }
       }
+
+      @Override
+      public void status(String payload) {
+        if (SleeveClient.onlineWearer(payload) == null) {
+          wearer.complete(WearerState.NONE); // offline, cleared or not understood: no hold known
+        }
+      }
+
+      @Override
+      public void wearer(WearerState state) {
+        wearer.complete(state);
+      }
     });
     refuseWhenNobodyListens(url);
     Object pace = given.get("--pace");
     boolean realtime = pace == null || pace.equals("realtime");
     try (SleeveClient client = builder.build()) {
       client.connect();
+      // A paused sleeve, or one in "do not disturb", refuses every stroke: nothing is sent into
+      // refusals. The retained status comes at once if the sleeve ever reported; else none.
+      WearerState said = awaitWearer(wearer);
+      long nowMs = System.currentTimeMillis();
+      if (!legacy && said.holds(nowMs)) {
+        err.println("Error: " + said.holdSentence(sleeveId, nowMs, java.time.ZoneId.systemDefault()));
+        return WEARER_HOLD_EXIT;
+      }
       client.newDrawing();
       if (realtime) {
         // Each stroke when the one before would have finished playing, once the broker has the
@@ -269,6 +294,23 @@ final class SendCommand {
       out.println("Sent " + strokes.size() + " stroke" + (strokes.size() == 1 ? "" : "s")
           + (legacy ? " as legacy text" : " to sleeve '" + sleeveId + "' (drawing " + client.drawing() + ")") + "; the broker has them.");
       return 0;
+    }
+  }
+
+  /** How long the retained status may take to come after connecting (the Python CLI's too). */
+  static final double STATUS_WAIT_S = 2.5;
+
+  /** The exit status when the wearer's choice holds the drawing (the Python CLI's too). */
+  static final int WEARER_HOLD_EXIT = 3;
+
+  private static WearerState awaitWearer(java.util.concurrent.CompletableFuture<WearerState> said) {
+    try {
+      return said.get((long) (STATUS_WAIT_S * 1000), java.util.concurrent.TimeUnit.MILLISECONDS);
+    } catch (java.util.concurrent.TimeoutException | java.util.concurrent.ExecutionException e) {
+      return WearerState.NONE;
+    } catch (InterruptedException e) {
+      Thread.currentThread().interrupt();
+      return WearerState.NONE;
     }
   }
 

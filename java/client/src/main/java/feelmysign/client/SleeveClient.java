@@ -431,7 +431,7 @@ public final class SleeveClient implements AutoCloseable {
   }
 
   /** The wearer's state in an online status; null for an offline one or one not understood. */
-  static WearerState onlineWearer(String statusPayload) {
+  public static WearerState onlineWearer(String statusPayload) {
     try {
       if (!(PyJson.loads(statusPayload) instanceof Map<?, ?> status)
           || !Boolean.TRUE.equals(status.get("online"))) {

@@ -130,6 +130,25 @@ public record WearerState(
     return null;
   }
 
+  /**
+   * What holds the sleeve at {@code nowMs} and what to do, for a command that sent nothing: the
+   * Python CLI's sentence ({@code feelmysign.wearer_status.hold_sentence}); null when nothing holds.
+   */
+  public String holdSentence(String sleeveId, long nowMs, ZoneId zone) {
+    if (paused) {
+      return "The wearer paused sleeve '" + sleeveId + "': it plays nothing and refuses every"
+          + " stroke until the wearer resumes it (their button or the wearer's page). Nothing was"
+          + " sent; send again once the wearer has resumed.";
+    }
+    if (doNotDisturb(nowMs)) {
+      String until = CLOCK.format(Instant.ofEpochMilli(doNotDisturbUntilMs).atZone(zone));
+      return "The wearer of sleeve '" + sleeveId + "' asked not to be disturbed until " + until
+          + ": it refuses every stroke until then. Nothing was sent; send again after " + until
+          + ", or once the wearer has ended it.";
+    }
+    return null;
+  }
+
   private String ceilingClause() {
     return ceiling == null ? "" : " (and a ceiling of " + Math.round(ceiling * 100) + " %)";
   }
