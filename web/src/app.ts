@@ -586,7 +586,7 @@ export class App {
     if (online && controls === null) {
       this.#says.add(
         "error",
-        "The sleeve's wearer controls (its status, controls) are not understood: the page cannot tell whether the wearer paused.",
+        "The sleeve's wearer controls (its status, controls) are not understood: the page cannot tell whether the wearer paused the sleeve or asked not to be disturbed.",
       );
     }
     const nowMs = Date.now();
