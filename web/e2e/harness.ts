@@ -189,6 +189,8 @@ export interface BrowserOptions {
   deviceScaleFactor?: number;
   hasTouch?: boolean;
   isMobile?: boolean;
+  /** The browser's locale (e.g. "en-US", whose own clock says "10:11 PM"). */
+  locale?: string;
   /** Another Chromium, e.g. a wrapper that starts it in a network namespace. */
   executablePath?: string;
   /** Flags beyond the usual ones, e.g. the one certificate to trust. */
@@ -263,7 +265,7 @@ export async function startUp(
   stateDir: string,
   extraArgs: readonly string[] = [],
   options: { url?: RegExp; detached?: boolean; timeoutMs?: number } = {},
-): Promise<{ child: ChildProcess; url: string }> {
+): Promise<{ child: ChildProcess; url: string; match: RegExpExecArray }> {
   const child = spawn(
     FEELMYSIGN,
     ["up", "--state-dir", stateDir, "--http-port", "0", "--port", "0", "--ws-port", "0", ...extraArgs],
@@ -273,7 +275,7 @@ export async function startUp(
   // The URL, then the last line it prints once everything runs.
   const ready = new RegExp(`${url.source}[\\s\\S]*Ctrl-C`);
   const match = await collectUntil(child, ready, "feelmysign up", options.timeoutMs ?? UP_READY_TIMEOUT_MS);
-  return { child, url: match[1]! };
+  return { child, url: match[1]!, match };
 }
 
 /**

@@ -21,17 +21,22 @@ const NOT_PAUSED = { paused: false, paused_by: null, ceiling: null, do_not_distu
 const PAUSED = { paused: true, paused_by: "button", ceiling: null, do_not_disturb_until_ms: null };
 
 /** The sleeve's online status with `controls`, published retained as the sleeve does. */
-async function publishControls(sleeve: FakeSleeve, controls: object): Promise<void> {
-  const status = { online: true, sleeve_id: sleeve.sleeveId, layout: LAYOUT, at_ms: Date.now(), controls };
+async function publishControls(sleeve: FakeSleeve, controls: object, layout: object = LAYOUT): Promise<void> {
+  const status = { online: true, sleeve_id: sleeve.sleeveId, layout, at_ms: Date.now(), controls };
   await sleeve.publish("status", status, true);
 }
 
-/** "14:30" for `ms` in the page's own time zone. */
+/** "14:30" (or "tomorrow at 00:10") for `ms` in the page's own time zone, 24-hour. */
 async function clockInPage(page: Page, ms: number): Promise<string> {
   return page.evaluate((at) => {
     const date = new Date(at);
-    return `${String(date.getHours()).padStart(2, "0")}:${String(date.getMinutes()).padStart(2, "0")}`;
+    const hhmm = `${String(date.getHours()).padStart(2, "0")}:${String(date.getMinutes()).padStart(2, "0")}`;
+    return date.getDate() === new Date().getDate() ? hhmm : `tomorrow at ${hhmm}`;
   }, ms);
+}
+
+async function logText(page: Page): Promise<string> {
+  return page.locator('[data-testid="event-log"]').innerText();
 }
 
 async function noticeText(page: Page): Promise<string> {
@@ -126,8 +131,17 @@ describe("the sender sees the wearer's choice", () => {
     const untilMs = Date.now() + 45 * 60_000;
     await publishControls(sleeve, { ...NOT_PAUSED, do_not_disturb_until_ms: untilMs });
     await waitForData(page, NOTICE, "state", "held");
+    const until = await clockInPage(page, untilMs);
     await expect(page.locator('[data-testid="wearer-headline"]').innerText()).resolves.toBe(
-      `The wearer asked not to be disturbed until ${await clockInPage(page, untilMs)}.`,
+      `The wearer asked not to be disturbed until ${until}.`,
+    );
+    // When the page offers the held strokes: at that time ("at 22:11", not "when 22:11").
+    expect(await page.locator('[data-testid="wearer-detail"]').innerText()).toContain(
+      `The page offers to send them ${until.startsWith("tomorrow") ? until : `at ${until}`}, when do not disturb ends, or sooner if the wearer ends it.`,
+    );
+    // The log says do not disturb, not a pause.
+    expect(await logText(page)).toContain(
+      `The wearer asked not to be disturbed until ${until}: what you draw is held here until then.`,
     );
     await page.locator('[data-testid="new-button"]').click();
     const before = sleeve.strokes().length;
@@ -157,6 +171,11 @@ describe("the sender sees the wearer's choice", () => {
   it("shows the wearer's ceiling beside the intensity, and what the sleeve plays", async () => {
     await publishControls(sleeve, { ...NOT_PAUSED, ceiling: 0.6 });
     await waitForData(page, NOTICE, "state", "resumed");
+    // The wearer ended do not disturb long before its time: said so, not as a resume.
+    expect(await page.locator('[data-testid="wearer-headline"]').innerText()).toBe(
+      "The wearer ended do not disturb.",
+    );
+    expect(await logText(page)).toContain("The wearer ended do not disturb: what you draw is sent again.");
     // The held stroke of do-not-disturb is dropped: the notice then says only the ceiling.
     await page.locator('[data-testid="drop-held"]').click();
     await waitForData(page, NOTICE, "state", "ceiling");
@@ -179,6 +198,33 @@ describe("the sender sees the wearer's choice", () => {
     await waitForData(page, SUMMARY, "held", "0");
     await waitForData(page, SUMMARY, "dropped", drawn);
     expect(await page.locator(SUMMARY).innerText()).toContain(`${drawn} never sent`);
+  });
+
+  it("says do not disturb ended at its time, not that the wearer resumed", async () => {
+    // Paused (the test before); the wearer resumes under a do not disturb that ends in a few seconds.
+    const untilMs = Date.now() + 4000;
+    await publishControls(sleeve, { ...NOT_PAUSED, ceiling: 0.6, do_not_disturb_until_ms: untilMs });
+    const until = await clockInPage(page, untilMs);
+    await page.waitForFunction(
+      (text) => document.querySelector('[data-testid="event-log"]')!.textContent!.includes(text),
+      `The wearer resumed the sleeve, but asked not to be disturbed until ${until}: what you draw is still held here.`,
+    );
+    await waitForData(page, NOTICE, "state", "held");
+    const resumedBefore = (await logText(page)).split("The wearer resumed the sleeve:").length;
+    // The page's own clock ends it; the sleeve's status saying so a moment later adds nothing.
+    await waitForData(page, NOTICE, "state", "resumed");
+    const ended = `Do not disturb ended ${until.startsWith("tomorrow") ? until : `at ${until}`}`;
+    expect(await page.locator('[data-testid="wearer-headline"]').innerText()).toBe(`${ended}.`);
+    await publishControls(sleeve, { ...NOT_PAUSED, ceiling: 0.6 });
+    await page.waitForFunction(
+      (text) => document.querySelector('[data-testid="event-log"]')!.textContent!.includes(text),
+      `${ended}: what you draw is sent again.`,
+    );
+    expect(await page.locator('[data-testid="wearer-headline"]').innerText()).toBe(`${ended}.`);
+    await screenshot(page, "wearer-do-not-disturb-ended-desktop");
+    const log = await logText(page);
+    expect(log.split(`${ended}:`).length).toBe(2); // said once
+    expect(log.split("The wearer resumed the sleeve:").length).toBe(resumedBefore);
   });
 
   it("on a phone: the notice and the held drawing fit the small screen", async () => {
@@ -213,5 +259,16 @@ describe("the sender sees the wearer's choice", () => {
     await publishControls(sleeve, NOT_PAUSED);
     await waitForData(phone, NOTICE, "state", "resumed");
     await screenshot(phone, "wearer-resumed-phone");
+  });
+
+  it("shows the sleeve's own grid in the felt timeline before the first drawing", async () => {
+    const twoByFive = { rows: 2, columns: 5, spacing_cm: 3, max_intensity: 1 };
+    await publishControls(sleeve, NOT_PAUSED, twoByFive);
+    // A page opened afresh: its settings' grid is the paper's 3 x 4 until the status says otherwise.
+    const fresh = await processes.page(url);
+    await waitForData(fresh, '[data-testid="sleeve-status"]', "state", "online");
+    await waitForData(fresh, '[data-testid="timeline"]', "grid", "2x5");
+    expect(await fresh.locator('[data-testid="timeline"]').getAttribute("data-strokes")).toBe("0");
+    await screenshot(fresh, "felt-timeline-sleeve-grid-2x5");
   });
 });

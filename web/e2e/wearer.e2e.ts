@@ -3,20 +3,39 @@
  * URL opens it with the wearer's key; pause, resume, stop, the ceiling, "do not disturb"
  * and blocking a named sender each change the sleeve's state (read back from the API and
  * from the state directory), and axe-core finds no serious or critical accessibility
- * violation, paused or not.
+ * violation, paused or not. The sleeve's layout allows 0.9 at most and the phone's locale is
+ * en-US (whose own clock says "10:11 PM"): the wearer's page and the sender's page, side by
+ * side, say the same ceiling and the same time.
  */
 import { spawnSync } from "node:child_process";
-import { readFileSync } from "node:fs";
+import { readFileSync, writeFileSync } from "node:fs";
 import { createRequire } from "node:module";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { checkPrerequisites, FEELMYSIGN, RESULTS_DIR, startUp, stopChild } from "./harness";
+import { checkPrerequisites, FEELMYSIGN, REPO_DIR, RESULTS_DIR, startUp, stopChild } from "./harness";
 import { screenshot, waitForData } from "./page";
 import { Processes } from "./processes";
 
 const AXE_SCRIPT = createRequire(import.meta.url).resolve("axe-core/axe.min.js");
-const PHONE = { viewport: { width: 390, height: 844 }, deviceScaleFactor: 2, hasTouch: true, isMobile: true };
+const PHONE = {
+  viewport: { width: 390, height: 844 },
+  deviceScaleFactor: 2,
+  hasTouch: true,
+  isMobile: true,
+  locale: "en-US",
+};
+const DESKTOP = { viewport: { width: 1280, height: 800 }, locale: "en-US" };
+const MAX_INTENSITY = 0.9;
+
+/** "22:11", or "tomorrow at 07:00", for `ms` in the page's own time zone (24-hour, as both pages say it). */
+async function untilInPage(page: Page, ms: number): Promise<string> {
+  return page.evaluate((at) => {
+    const date = new Date(at);
+    const hhmm = `${String(date.getHours()).padStart(2, "0")}:${String(date.getMinutes()).padStart(2, "0")}`;
+    return date.getDate() === new Date().getDate() ? hhmm : `tomorrow at ${hhmm}`;
+  }, ms);
+}
 
 interface Controls {
   paused: boolean;
@@ -48,14 +67,21 @@ describe("the wearer's page served by feelmysign up", () => {
   const processes = new Processes();
   let page: Page;
   let stateDir: string;
+  let senderUrl: string;
 
   beforeAll(async () => {
     checkPrerequisites();
     stateDir = processes.dir("wearer");
-    const { child, url } = await startUp(stateDir, [], {
-      url: /(http:\/\/127\.0\.0\.1:\d+\/wearer\?key=[\w-]+)/,
+    // The paper's sleeve, allowing 0.9 at most: the wearer's choices are laid out from there down.
+    const layout = join(stateDir, "sleeve-0.9.toml");
+    const paper = readFileSync(join(REPO_DIR, "deploy", "layouts", "paper-sleeve.toml"), "utf8");
+    writeFileSync(layout, paper.replace(/^max_intensity = 1\.0/m, `max_intensity = ${MAX_INTENSITY}`));
+    const { child, match } = await startUp(stateDir, ["--layout", layout], {
+      url: /Draw here:\s+(http:\/\/127\.0\.0\.1:\d+\/\S*)[\s\S]*?(http:\/\/127\.0\.0\.1:\d+\/wearer\?key=[\w-]+)/,
     });
     processes.add(() => stopChild(child));
+    senderUrl = match[1]!;
+    const url = match[2]!;
     const added = spawnSync(
       FEELMYSIGN,
       ["broker", "--state-dir", stateDir, "add-sender", "--name", "alice"],
@@ -116,17 +142,70 @@ describe("the wearer's page served by feelmysign up", () => {
     );
   });
 
-  it("sets a ceiling below the sleeve's maximum, and removes it", async () => {
+  it("offers ceilings as drive levels from the sleeve's strongest down, and removes it", async () => {
+    const labels = await page.locator("#ceiling-choices button").allTextContents();
+    expect(labels.map((label) => label.trim())).toEqual([
+      "The strongest this sleeve allows (90 %)",
+      "80 % at most",
+      "60 % at most",
+      "40 % at most",
+      "20 % at most",
+    ]);
     await page.locator('[data-testid="ceiling-0.6"]').click();
     await page.waitForFunction(
       () => document.querySelector('[data-testid="ceiling-0.6"]')!.getAttribute("aria-pressed") === "true",
     );
     expect((await apiState(page)).controls.ceiling).toBe(0.6);
+    expect(await page.locator('[data-testid="ceiling-line"]').textContent()).toBe(
+      "At most 60 %, whatever the sender asks (this sleeve allows up to 90 %).",
+    );
+    expect(await page.locator('[data-testid="live"]').textContent()).toContain("Strongest vibration 60 %.");
+    await screenshot(page, "wearer-phone-ceiling");
     await page.locator('[data-testid="ceiling-none"]').click();
     await page.waitForFunction(
       () => document.querySelector('[data-testid="ceiling-none"]')!.getAttribute("aria-pressed") === "true",
     );
     expect((await apiState(page)).controls.ceiling).toBeNull();
+    expect(await page.locator('[data-testid="ceiling-line"]').textContent()).toBe(
+      "No ceiling: up to the strongest this sleeve allows, 90 %.",
+    );
+  });
+
+  it("shows the sender the same ceiling and the same time as the wearer's page", async () => {
+    await page.locator('[data-testid="ceiling-0.6"]').click();
+    await page.locator('[data-testid="dnd-60"]').click();
+    await page.waitForFunction(() =>
+      document.querySelector('[data-testid="dnd-line"]')!.getAttribute("data-until"),
+    );
+    const until = (await apiState(page)).controls.do_not_disturb_until_ms!;
+    const when = await untilInPage(page, until);
+    expect(await page.locator('[data-testid="dnd-line"]').textContent()).toBe(
+      `On until ${when}: nothing reaches you.`,
+    );
+    const sender = await processes.page(senderUrl, DESKTOP);
+    await waitForData(sender, '[data-testid="wearer-notice"]', "state", "held");
+    expect(await sender.locator('[data-testid="wearer-headline"]').textContent()).toBe(
+      `The wearer asked not to be disturbed until ${when}.`,
+    );
+    // The page's intensity is 80 %: the sleeve plays it at the wearer's 60 %, as the wearer's page says.
+    expect(await sender.locator('[data-testid="wearer-ceiling"]').textContent()).toBe(
+      "The wearer set a ceiling of 60 %: your 80 % plays at 60 %.",
+    );
+    await screenshot(sender, "wearer-sender-sees-ceiling-and-dnd");
+    await page.locator('[data-testid="dnd-end"]').click();
+    await waitForData(page, '[data-testid="dnd-line"]', "until", "");
+    // Ended by the wearer before its time: said so, not as a resume.
+    await waitForData(sender, '[data-testid="wearer-notice"]', "state", "resumed");
+    expect(await sender.locator('[data-testid="wearer-headline"]').textContent()).toBe(
+      "The wearer ended do not disturb.",
+    );
+    expect(await sender.locator('[data-testid="event-log"]').innerText()).toContain(
+      `The wearer asked not to be disturbed until ${when}: what you draw is held here until then.`,
+    );
+    await page.locator('[data-testid="ceiling-none"]').click();
+    await page.waitForFunction(
+      () => document.querySelector('[data-testid="ceiling-none"]')!.getAttribute("aria-pressed") === "true",
+    );
   });
 
   it("turns on do not disturb for 15 minutes, and ends it", async () => {
@@ -160,8 +239,52 @@ describe("the wearer's page served by feelmysign up", () => {
     const until = (await apiState(page)).controls.do_not_disturb_until_ms!;
     expect(until).toBeGreaterThan(Date.now() + 118 * 60_000);
     expect(until).toBeLessThanOrEqual(Date.now() + 120 * 60_000);
+    expect(await page.locator('[data-testid="dnd-line"]').textContent()).toBe(
+      `On until ${await untilInPage(page, until)}: nothing reaches you.`,
+    );
     await page.locator('[data-testid="dnd-end"]').click();
     await waitForData(page, '[data-testid="dnd-line"]', "until", "");
+  });
+
+  it("says tomorrow for a time that has passed today, before and after setting it", async () => {
+    // Midnight has always passed today: the next one is tomorrow's.
+    const hhmm = "00:00";
+    const hint = page.locator('[data-testid="dnd-time-hint"]');
+    await page.locator('[data-testid="dnd-time"]').fill(hhmm);
+    await expect(hint.textContent()).resolves.toBe(
+      `Set makes it until tomorrow at ${hhmm}: that time has passed today.`,
+    );
+    await screenshot(page, "wearer-phone-dnd-tomorrow-hint");
+    await page.locator('[data-testid="dnd-set"]').click();
+    await page.waitForFunction(() =>
+      document.querySelector('[data-testid="dnd-line"]')!.getAttribute("data-until"),
+    );
+    const until = (await apiState(page)).controls.do_not_disturb_until_ms!;
+    expect(until).toBe(
+      await page.evaluate(() => new Date(new Date().setHours(24, 0, 0, 0)).getTime()), // the next midnight
+    );
+    expect(await page.locator('[data-testid="dnd-line"]').textContent()).toBe(
+      `On until tomorrow at ${hhmm}: nothing reaches you.`,
+    );
+    await page.locator('[data-testid="dnd-end"]').click();
+    await waitForData(page, '[data-testid="dnd-line"]', "until", "");
+  });
+
+  it("says what to enter when Set is pressed without a time", async () => {
+    const field = page.locator('[data-testid="dnd-time"]');
+    await field.fill("");
+    await page.locator('[data-testid="dnd-set"]').click();
+    const hint = page.locator('[data-testid="dnd-time-hint"]');
+    await waitForData(page, '[data-testid="dnd-time-hint"]', "state", "problem");
+    expect(await hint.textContent()).toBe(
+      "Enter the time do not disturb ends, such as 22:30, then press Set.",
+    );
+    expect(await hint.isVisible()).toBe(true);
+    expect(await field.getAttribute("aria-invalid")).toBe("true");
+    expect(await page.evaluate(() => document.activeElement?.id)).toBe("dnd-time");
+    expect((await apiState(page)).controls.do_not_disturb_until_ms).toBeNull();
+    expect(await seriousViolations(page)).toEqual([]);
+    await screenshot(page, "wearer-phone-dnd-empty-time");
   });
 
   it("blocks a named sender on the broker, and unblocks it", async () => {

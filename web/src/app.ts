@@ -33,8 +33,15 @@ import { StageSpace } from "./ui/stage-space";
 import { byId, StatusBar } from "./ui/status";
 import { TimelineView } from "./ui/timeline";
 import { WearerNotice } from "./ui/wearer-notice";
-import { WearerHoldKeeper } from "./wearer-hold";
-import { ceilingNote, holdReason, isWearerRefusal, NO_CONTROLS, wearerRefusalNote } from "./wearer-status";
+import { WearerHoldKeeper, type HoldChange } from "./wearer-hold";
+import {
+  ceilingNote,
+  holdChangeNote,
+  holdReason,
+  isWearerRefusal,
+  NO_CONTROLS,
+  wearerRefusalNote,
+} from "./wearer-status";
 
 export interface AppOptions {
   readonly config: ServerConfig | null;
@@ -73,6 +80,8 @@ export class App {
   #arrival: Arrival = "as-drawn";
   /** The drawing the felt panel shows. */
   #feltDrawing: string | null = null;
+  /** The grid the felt panel's lanes show. */
+  #feltGrid: GridSize = { rows: 0, columns: 0 };
 
   constructor(doc: Document, options: AppOptions) {
     this.#doc = doc;
@@ -239,7 +248,7 @@ export class App {
     this.#buttons.replay.disabled = drawing === null || drawing.keptStrokeCount === 0;
     if (drawing === null || drawing.id !== this.#feltDrawing) {
       this.#feltDrawing = drawing?.id ?? null;
-      this.#felt.setDrawing(drawing, this.#grid(), this.#arrival);
+      this.#setFelt(drawing, this.#grid());
       this.#arrival = "as-drawn";
       this.#compare();
     } else {
@@ -372,6 +381,12 @@ export class App {
 
   // ---- layout ------------------------------------------------------------------------------
 
+  /** The felt panel's drawing (or none) on `grid`: its lanes are the grid's actuators. */
+  #setFelt(drawing: Drawing | null, grid: GridSize): void {
+    this.#feltGrid = grid;
+    this.#felt.setDrawing(drawing, grid, this.#arrival);
+  }
+
   #grid(): GridSize {
     const layout = this.#sleeve.status?.layout;
     if (this.#settings.grid_source === "status" && layout)
@@ -396,6 +411,11 @@ export class App {
     this.#view.fit(grid, this.#settings.stretch, widthPx, heightPx);
     this.#space.setTurned(this.#view.turned);
     this.#preview.setGrid(grid, this.#view.turned);
+    // Before the first drawing the timeline's lanes are the sleeve's too, as soon as its status
+    // says its grid (a drawing's grid is given with the drawing, in #drawingChanged).
+    const shown = this.#feltGrid;
+    if (this.#feltDrawing === null && (shown.rows !== grid.rows || shown.columns !== grid.columns))
+      this.#setFelt(null, grid);
   }
 
   // ---- settings ----------------------------------------------------------------------------
@@ -566,32 +586,44 @@ export class App {
     if (online && controls === null) {
       this.#says.add(
         "error",
-        "The sleeve's wearer controls (its status, controls) are not understood: the page cannot tell whether the wearer paused.",
+        "The sleeve's wearer controls (its status, controls) are not understood: the page cannot tell whether the wearer paused the sleeve or asked not to be disturbed.",
       );
     }
     const nowMs = Date.now();
-    const before = this.#wearer.hold(nowMs);
-    if (controls !== null) this.#wearer.onStatus(controls, online, this.#sleeve.status?.at_ms ?? null, nowMs);
-    const after = this.#wearer.hold(nowMs);
-    if (before !== null && after === null) this.#says.add("info", "The wearer resumed the sleeve.");
-    if (before === null && after !== null)
-      this.#says.add("info", "The wearer paused the sleeve: what you draw is held here.");
+    if (controls !== null)
+      this.#holdChanged(
+        this.#wearer.onStatus(controls, online, this.#sleeve.status?.at_ms ?? null, nowMs),
+        nowMs,
+      );
     this.#showWearer();
+  }
+
+  /** What holds the drawing changed: said in the log, and the card's held strokes say why now. */
+  #holdChanged(change: HoldChange | null, nowMs: number): void {
+    if (change === null) return;
+    const note = holdChangeNote(change.before, change.after, change.ranOut, nowMs);
+    if (note !== null) this.#says.add("info", note);
+    if (change.after !== null) this.#says.setHeld(this.#wearer.heldCount, holdReason(change.after));
   }
 
   #showWearer(): void {
     const nowMs = Date.now();
-    this.#wearer.tick(nowMs);
+    this.#holdChanged(this.#wearer.tick(nowMs), nowMs);
     this.#wearerNotice.show(
       this.#wearer.view(nowMs),
       ceilingNote(this.#wearer.ceiling, this.#settings.intensity),
+      nowMs,
     );
     if (this.#wearerTimer !== null) clearTimeout(this.#wearerTimer);
     this.#wearerTimer = null;
     const hold = this.#wearer.hold(nowMs);
-    if (hold?.reason === "do_not_disturb") {
-      // setTimeout holds at most 2^31 - 1 ms; a "do not disturb" is at most 24 h.
-      const waitMs = Math.min(hold.untilMs - nowMs + 50, 2 ** 31 - 1);
+    if (hold !== null) {
+      // Again when "do not disturb" runs out, and at midnight, when "tomorrow at 07:00" becomes
+      // "07:00". setTimeout holds at most 2^31 - 1 ms; a "do not disturb" is at most 24 h.
+      const midnight = new Date(nowMs);
+      midnight.setHours(24, 0, 0, 0);
+      const ends = hold.untilMs === null ? [] : [hold.untilMs];
+      const waitMs = Math.min(Math.min(midnight.getTime(), ...ends) - nowMs + 50, 2 ** 31 - 1);
       this.#wearerTimer = setTimeout(() => {
         this.#wearerTimer = null;
         this.#showWearer();

@@ -7,6 +7,8 @@
  * none of them.
  */
 
+import { atClock, untilClock } from "./clock";
+import { drivePercent } from "./drive-level";
 import { DO_NOT_DISTURB_REASON, PAUSED_REASON, type SleeveControls } from "./events";
 
 /** What a status without `controls` means: not paused, no ceiling, no "do not disturb". */
@@ -17,9 +19,12 @@ export const NO_CONTROLS: SleeveControls = {
   do_not_disturb_until_ms: null,
 };
 
-/** Why the sleeve plays nothing now by the wearer's choice; `sinceMs`: when it paused, if known. */
+/**
+ * Why the sleeve plays nothing now by the wearer's choice. `sinceMs`: when it paused, if known;
+ * a pause's `untilMs`: a "do not disturb" that runs under the pause and still holds after a resume.
+ */
 export type WearerHold =
-  | { readonly reason: "paused"; readonly sinceMs: number | null }
+  | { readonly reason: "paused"; readonly sinceMs: number | null; readonly untilMs: number | null }
   | { readonly reason: "do_not_disturb"; readonly untilMs: number };
 
 /**
@@ -31,9 +36,10 @@ export function wearerHold(
   nowMs: number,
   sinceMs: number | null = null,
 ): WearerHold | null {
-  if (controls.paused) return { reason: "paused", sinceMs };
-  const untilMs = controls.do_not_disturb_until_ms;
-  if (untilMs !== null && untilMs > nowMs) return { reason: "do_not_disturb", untilMs };
+  const dndUntilMs = controls.do_not_disturb_until_ms;
+  const untilMs = dndUntilMs !== null && dndUntilMs > nowMs ? dndUntilMs : null;
+  if (controls.paused) return { reason: "paused", sinceMs, untilMs };
+  if (untilMs !== null) return { reason: "do_not_disturb", untilMs };
   return null;
 }
 
@@ -42,38 +48,90 @@ export function isWearerRefusal(reason: string): reason is "paused" | "do_not_di
   return reason === PAUSED_REASON || reason === DO_NOT_DISTURB_REASON;
 }
 
-/** A wall-clock time as the page shows it: "14:30", the browser's time zone. */
-export function clockTime(ms: number): string {
-  const at = new Date(ms);
-  return `${pad(at.getHours())}:${pad(at.getMinutes())}`;
-}
-
 /** The headline of the notice: what the wearer chose ("The wearer paused the sleeve at 14:02."). */
-export function holdHeadline(hold: WearerHold): string {
+export function holdHeadline(hold: WearerHold, nowMs: number): string {
   if (hold.reason === "paused") {
     return hold.sinceMs === null
       ? "The wearer paused the sleeve."
-      : `The wearer paused the sleeve at ${clockTime(hold.sinceMs)}.`;
+      : `The wearer paused the sleeve ${atClock(hold.sinceMs, nowMs)}.`;
   }
-  return `The wearer asked not to be disturbed until ${clockTime(hold.untilMs)}.`;
+  return `The wearer asked not to be disturbed until ${untilClock(hold.untilMs, nowMs)}.`;
 }
 
-/** What the page does about it: the strokes drawn now are kept here, not sent. */
-export function holdDetail(hold: WearerHold, heldStrokes: number): string {
+/** What the page does about it: the strokes drawn now are kept here, not sent, and until when. */
+export function holdDetail(hold: WearerHold, heldStrokes: number, nowMs: number): string {
   const held =
     heldStrokes === 0
       ? "What you draw is held here, not sent"
       : `${heldStrokes} stroke${heldStrokes === 1 ? "" : "s"} held here, not sent`;
-  const back =
-    hold.reason === "paused"
-      ? "the wearer resumes"
-      : `${clockTime(hold.untilMs)}, or when the wearer ends it`;
-  return `${held}: the sleeve would refuse them. The page offers to send them when ${back}.`;
+  let back: string;
+  if (hold.reason === "do_not_disturb") {
+    back = `${atClock(hold.untilMs, nowMs)}, when do not disturb ends, or sooner if the wearer ends it`;
+  } else if (hold.untilMs === null) {
+    back = "when the wearer resumes";
+  } else {
+    // Resuming alone does not let the strokes through: "do not disturb" runs under the pause.
+    back =
+      `when the wearer resumes and do not disturb has ended ` +
+      `(it runs until ${untilClock(hold.untilMs, nowMs)})`;
+  }
+  return `${held}: the sleeve would refuse them. The page offers to send them ${back}.`;
 }
 
 /** Why strokes are held, in a few words (the legend, the counts). */
 export function holdReason(hold: WearerHold): string {
   return hold.reason === "paused" ? "the wearer paused" : "the wearer asked not to be disturbed";
+}
+
+/** A hold that ended: `ranOut` when a "do not disturb" reached its time (not ended by the wearer). */
+export interface EndedHold {
+  readonly hold: WearerHold;
+  readonly ranOut: boolean;
+}
+
+/** The headline once nothing holds the drawing any more: who or what ended the hold. */
+export function endedHeadline(ended: EndedHold | null, nowMs: number): string {
+  if (ended === null) return "Nothing holds the drawing now.";
+  if (ended.hold.reason === "paused") return "The wearer resumed the sleeve.";
+  return ended.ranOut
+    ? `Do not disturb ended ${atClock(ended.hold.untilMs, nowMs)}.`
+    : "The wearer ended do not disturb.";
+}
+
+/**
+ * The log's line for a change of what holds the drawing, `before` to `after` (null: nothing), or
+ * null when there is nothing new to say. `ranOut`: a "do not disturb" ended as it reached its time.
+ */
+export function holdChangeNote(
+  before: WearerHold | null,
+  after: WearerHold | null,
+  ranOut: boolean,
+  nowMs: number,
+): string | null {
+  const sentAgain = "what you draw is sent again.";
+  if (after === null) {
+    if (before === null) return null;
+    if (before.reason === "paused") return `The wearer resumed the sleeve: ${sentAgain}`;
+    return ranOut
+      ? `Do not disturb ended ${atClock(before.untilMs, nowMs)}: ${sentAgain}`
+      : `The wearer ended do not disturb: ${sentAgain}`;
+  }
+  if (after.reason === "paused") {
+    if (before?.reason === "paused") return null;
+    return after.untilMs === null
+      ? "The wearer paused the sleeve: what you draw is held here until the wearer resumes."
+      : "The wearer paused the sleeve: what you draw is held here until the wearer resumes and " +
+          `do not disturb has ended (it runs until ${untilClock(after.untilMs, nowMs)}).`;
+  }
+  const until = untilClock(after.untilMs, nowMs);
+  if (before === null) {
+    return `The wearer asked not to be disturbed until ${until}: what you draw is held here until then.`;
+  }
+  if (before.reason === "paused") {
+    return `The wearer resumed the sleeve, but asked not to be disturbed until ${until}: what you draw is still held here.`;
+  }
+  if (before.untilMs === after.untilMs) return null;
+  return `The wearer now asks not to be disturbed until ${until}: what you draw is held here until then.`;
 }
 
 /** The line for a stroke the sleeve refused `paused` or `do_not_disturb` (its status came late). */
@@ -95,20 +153,12 @@ export function ceilingNote(ceiling: number | null, intensity: number): string |
   if (ceiling === null) return null;
   const capped = intensity > ceiling;
   const plays = capped
-    ? `your ${percent(intensity)} plays at ${percent(ceiling)}`
-    : `your ${percent(intensity)} plays as set`;
-  return `The wearer set a ceiling of ${percent(ceiling)}: ${plays}.`;
+    ? `your ${drivePercent(intensity)} plays at ${drivePercent(ceiling)}`
+    : `your ${drivePercent(intensity)} plays as set`;
+  return `The wearer set a ceiling of ${drivePercent(ceiling)}: ${plays}.`;
 }
 
 /** What the sleeve plays for a stroke sent at `intensity` under `ceiling`. */
 export function playedIntensity(intensity: number, ceiling: number | null): number {
   return ceiling === null ? intensity : Math.min(intensity, ceiling);
-}
-
-function percent(fraction: number): string {
-  return `${Math.round(fraction * 100)} %`;
-}
-
-function pad(value: number): string {
-  return String(value).padStart(2, "0");
 }

@@ -28,11 +28,15 @@ describe("WearerHoldKeeper", () => {
     // The page saw the pause happen: it knows when.
     expect(keeper.view(T0 + 2200)).toEqual({
       state: "held",
-      hold: { reason: "paused", sinceMs: T0 + 1000 },
+      hold: { reason: "paused", sinceMs: T0 + 1000, untilMs: null },
       held: 2,
     });
     keeper.onStatus(NO_CONTROLS, true, T0 + 5000, T0 + 5010);
-    expect(keeper.view(T0 + 5010)).toEqual({ state: "resumed", held: 2 });
+    expect(keeper.view(T0 + 5010)).toEqual({
+      state: "resumed",
+      held: 2,
+      ended: { hold: { reason: "paused", sinceMs: T0 + 1000, untilMs: null }, ranOut: false },
+    });
     expect(keeper.take().map((s) => s.seq)).toEqual([0, 1]);
     expect(keeper.view(T0 + 5020)).toEqual({ state: "none" });
     expect(keeper.keep(stroke(2), T0 + 5030)).toBe(false);
@@ -41,7 +45,7 @@ describe("WearerHoldKeeper", () => {
   it("does not claim a pause time it did not see (the first status is already paused)", () => {
     const keeper = new WearerHoldKeeper();
     keeper.onStatus(PAUSED, true, T0, T0 + 10);
-    expect(keeper.hold(T0 + 20)).toEqual({ reason: "paused", sinceMs: null });
+    expect(keeper.hold(T0 + 20)).toEqual({ reason: "paused", sinceMs: null, untilMs: null });
   });
 
   it("keeps the last known choice through the sleeve's offline status (its last will has none)", () => {
@@ -51,20 +55,72 @@ describe("WearerHoldKeeper", () => {
     expect(keeper.keep(stroke(0), T0 + 200)).toBe(true);
   });
 
-  it("lets go when do not disturb runs out, and says the wearer is back", () => {
+  it("lets go when do not disturb runs out, and says it ran out (not that the wearer resumed)", () => {
     const keeper = new WearerHoldKeeper();
-    keeper.onStatus({ ...NO_CONTROLS, do_not_disturb_until_ms: T0 + 60_000 }, true, T0, T0);
+    const dnd = { reason: "do_not_disturb", untilMs: T0 + 60_000 } as const;
+    expect(keeper.onStatus({ ...NO_CONTROLS, do_not_disturb_until_ms: T0 + 60_000 }, true, T0, T0)).toEqual({
+      before: null,
+      after: dnd,
+      ranOut: false,
+    });
     expect(keeper.keep(stroke(0), T0 + 1000)).toBe(true);
-    keeper.tick(T0 + 60_001);
-    expect(keeper.view(T0 + 60_001)).toEqual({ state: "resumed", held: 1 });
-    expect(keeper.keep(stroke(1), T0 + 60_002)).toBe(false);
+    expect(keeper.tick(T0 + 30_000)).toBeNull(); // nothing changed
+    expect(keeper.tick(T0 + 60_001)).toEqual({ before: dnd, after: null, ranOut: true });
+    expect(keeper.view(T0 + 60_001)).toEqual({
+      state: "resumed",
+      held: 1,
+      ended: { hold: dnd, ranOut: true },
+    });
+    // The sleeve's own status saying so a moment later changes nothing more.
+    expect(keeper.onStatus(NO_CONTROLS, true, T0 + 60_020, T0 + 60_030)).toBeNull();
+    expect(keeper.keep(stroke(1), T0 + 60_040)).toBe(false);
+  });
+
+  it("takes do not disturb as run out when the sleeve's clock reached its end before the page's", () => {
+    const keeper = new WearerHoldKeeper();
+    const until = T0 + 60_000;
+    keeper.onStatus({ ...NO_CONTROLS, do_not_disturb_until_ms: until }, true, T0, T0);
+    // The page's clock is 3 s behind: the sleeve ended it at its time, the page has not yet.
+    expect(keeper.onStatus(NO_CONTROLS, true, until + 5, until - 3000)?.ranOut).toBe(true);
+  });
+
+  it("says the wearer ended do not disturb early (its status came well before the end)", () => {
+    const keeper = new WearerHoldKeeper();
+    const dnd = { reason: "do_not_disturb", untilMs: T0 + 60_000 } as const;
+    keeper.onStatus({ ...NO_CONTROLS, do_not_disturb_until_ms: T0 + 60_000 }, true, T0, T0);
+    expect(keeper.onStatus(NO_CONTROLS, true, T0 + 20_000, T0 + 20_010)).toEqual({
+      before: dnd,
+      after: null,
+      ranOut: false,
+    });
+    expect(keeper.view(T0 + 20_010)).toEqual({
+      state: "resumed",
+      held: 0,
+      ended: { hold: dnd, ranOut: false },
+    });
+  });
+
+  it("still holds when the wearer resumes under do not disturb, and says so as a change", () => {
+    const keeper = new WearerHoldKeeper();
+    const both = { ...PAUSED, do_not_disturb_until_ms: T0 + 60_000 };
+    keeper.onStatus(NO_CONTROLS, true, T0, T0);
+    expect(keeper.onStatus(both, true, T0 + 10, T0 + 10)?.after).toEqual({
+      reason: "paused",
+      sinceMs: T0 + 10,
+      untilMs: T0 + 60_000,
+    });
+    const change = keeper.onStatus({ ...both, paused: false, paused_by: null }, true, T0 + 20, T0 + 20);
+    expect(change?.before?.reason).toBe("paused");
+    expect(change?.after).toEqual({ reason: "do_not_disturb", untilMs: T0 + 60_000 });
+    expect(keeper.keep(stroke(0), T0 + 30)).toBe(true);
+    expect(keeper.view(T0 + 30).state).toBe("held");
   });
 
   it("resumed with nothing held: the notice goes with the next stroke sent", () => {
     const keeper = new WearerHoldKeeper();
     keeper.onStatus(PAUSED, true, T0, T0);
     keeper.onStatus(NO_CONTROLS, true, T0 + 1, T0 + 1);
-    expect(keeper.view(T0 + 2)).toEqual({ state: "resumed", held: 0 });
+    expect(keeper.view(T0 + 2)).toMatchObject({ state: "resumed", held: 0 });
     keeper.dismissResumed();
     expect(keeper.view(T0 + 3)).toEqual({ state: "none" });
   });

@@ -1,8 +1,10 @@
 /** What the page does with the wearer's choice in the sleeve's status, and what it says of it. */
 import { describe, expect, it } from "vitest";
+import { clockTime } from "../src/clock";
 import {
   ceilingNote,
-  clockTime,
+  endedHeadline,
+  holdChangeNote,
   holdDetail,
   holdHeadline,
   NO_CONTROLS,
@@ -17,6 +19,7 @@ describe("wearerHold", () => {
     expect(wearerHold({ ...NO_CONTROLS, paused: true }, nowMs, 123)).toEqual({
       reason: "paused",
       sinceMs: 123,
+      untilMs: null,
     });
   });
 
@@ -26,9 +29,10 @@ describe("wearerHold", () => {
     expect(wearerHold(controls, nowMs + 60_000)).toBeNull();
   });
 
-  it("says paused when paused and do not disturb both hold (pausing has no end)", () => {
+  it("says paused when paused and do not disturb both hold (pausing has no end), with the end of the other", () => {
     const controls = { ...NO_CONTROLS, paused: true, do_not_disturb_until_ms: nowMs + 60_000 };
-    expect(wearerHold(controls, nowMs)?.reason).toBe("paused");
+    expect(wearerHold(controls, nowMs)).toEqual({ reason: "paused", sinceMs: null, untilMs: nowMs + 60_000 });
+    expect(wearerHold(controls, nowMs + 60_000)).toEqual({ reason: "paused", sinceMs: null, untilMs: null });
   });
 
   it("holds nothing under a ceiling alone", () => {
@@ -38,30 +42,80 @@ describe("wearerHold", () => {
 
 describe("the page's words", () => {
   const at = new Date(2026, 10, 26, 14, 30).getTime();
+  const before = new Date(2026, 10, 26, 13, 0).getTime();
+  const paused = { reason: "paused", sinceMs: null, untilMs: null } as const;
+  const dnd = { reason: "do_not_disturb", untilMs: at } as const;
 
   it("names the wearer's pause, and when when known", () => {
-    expect(holdHeadline({ reason: "paused", sinceMs: null })).toBe("The wearer paused the sleeve.");
-    expect(holdHeadline({ reason: "paused", sinceMs: at })).toBe("The wearer paused the sleeve at 14:30.");
+    expect(holdHeadline(paused, before)).toBe("The wearer paused the sleeve.");
+    expect(holdHeadline({ ...paused, sinceMs: before }, at)).toBe("The wearer paused the sleeve at 13:00.");
+    // Seen yesterday: said so, not as if today.
+    const lateLastNight = new Date(2026, 10, 25, 23, 50).getTime();
+    expect(holdHeadline({ ...paused, sinceMs: lateLastNight }, at)).toBe(
+      "The wearer paused the sleeve yesterday at 23:50.",
+    );
   });
 
-  it("names the end of do not disturb", () => {
-    expect(holdHeadline({ reason: "do_not_disturb", untilMs: at })).toBe(
-      "The wearer asked not to be disturbed until 14:30.",
+  it("names the end of do not disturb, and its day when not today", () => {
+    expect(holdHeadline(dnd, before)).toBe("The wearer asked not to be disturbed until 14:30.");
+    const lateEvening = new Date(2026, 10, 25, 23, 0).getTime();
+    expect(holdHeadline(dnd, lateEvening)).toBe(
+      "The wearer asked not to be disturbed until tomorrow at 14:30.",
     );
     expect(clockTime(new Date(2026, 0, 1, 9, 5).getTime())).toBe("09:05");
   });
 
-  it("says how many strokes are held and that they are not sent", () => {
-    expect(holdDetail({ reason: "paused", sinceMs: null }, 3)).toBe(
+  it("says how many strokes are held, that they are not sent, and when they may be", () => {
+    expect(holdDetail(paused, 3, before)).toBe(
       "3 strokes held here, not sent: the sleeve would refuse them. The page offers to send them when the wearer resumes.",
     );
-    expect(holdDetail({ reason: "paused", sinceMs: null }, 1)).toMatch(/^1 stroke held/);
-    expect(holdDetail({ reason: "paused", sinceMs: null }, 0)).toMatch(
-      /^What you draw is held here, not sent/,
+    expect(holdDetail(paused, 1, before)).toMatch(/^1 stroke held/);
+    expect(holdDetail(paused, 0, before)).toMatch(/^What you draw is held here, not sent/);
+    expect(holdDetail(dnd, 2, before)).toBe(
+      "2 strokes held here, not sent: the sleeve would refuse them. The page offers to send them at 14:30, when do not disturb ends, or sooner if the wearer ends it.",
     );
-    expect(holdDetail({ reason: "do_not_disturb", untilMs: at }, 2)).toContain(
-      "when 14:30, or when the wearer ends it",
+    // Paused under do not disturb: resuming alone does not let them through.
+    expect(holdDetail({ ...paused, untilMs: at }, 2, before)).toContain(
+      "when the wearer resumes and do not disturb has ended (it runs until 14:30)",
     );
+  });
+
+  it("says who ended the hold: the wearer's resume, do not disturb's time, or the wearer ending it", () => {
+    expect(endedHeadline({ hold: paused, ranOut: false }, at)).toBe("The wearer resumed the sleeve.");
+    expect(endedHeadline({ hold: dnd, ranOut: true }, at)).toBe("Do not disturb ended at 14:30.");
+    expect(endedHeadline({ hold: dnd, ranOut: false }, before)).toBe("The wearer ended do not disturb.");
+    expect(endedHeadline(null, at)).not.toMatch(/wearer/);
+  });
+
+  it("logs each change of what holds the drawing as what happened", () => {
+    expect(holdChangeNote(null, paused, false, before)).toBe(
+      "The wearer paused the sleeve: what you draw is held here until the wearer resumes.",
+    );
+    expect(holdChangeNote(null, dnd, false, before)).toBe(
+      "The wearer asked not to be disturbed until 14:30: what you draw is held here until then.",
+    );
+    expect(holdChangeNote(paused, null, false, before)).toBe(
+      "The wearer resumed the sleeve: what you draw is sent again.",
+    );
+    expect(holdChangeNote(dnd, null, true, at)).toBe(
+      "Do not disturb ended at 14:30: what you draw is sent again.",
+    );
+    expect(holdChangeNote(dnd, null, false, before)).toBe(
+      "The wearer ended do not disturb: what you draw is sent again.",
+    );
+    expect(holdChangeNote(paused, dnd, false, before)).toBe(
+      "The wearer resumed the sleeve, but asked not to be disturbed until 14:30: what you draw is still held here.",
+    );
+    expect(holdChangeNote(dnd, { ...paused, untilMs: at }, false, before)).toContain(
+      "until the wearer resumes and do not disturb has ended (it runs until 14:30)",
+    );
+    expect(holdChangeNote(dnd, { ...dnd, untilMs: at + 3_600_000 }, false, before)).toBe(
+      "The wearer now asks not to be disturbed until 15:30: what you draw is held here until then.",
+    );
+    // Nothing new: no line.
+    expect(holdChangeNote(dnd, dnd, false, before)).toBeNull();
+    expect(holdChangeNote(paused, { ...paused, untilMs: at }, false, before)).toBeNull();
+    expect(holdChangeNote(null, null, false, before)).toBeNull();
   });
 
   it("says a late refusal is the wearer's pause, with the sleeve's message", () => {

@@ -64,6 +64,7 @@ export class TimelineView {
       if (b !== null) this.#b.paintAll(b, grid);
       this.#bTotalMs = b === null ? 0 : totalMs(b);
     }
+    this.#canvas.dataset["grid"] = `${grid.rows}x${grid.columns}`;
     this.#canvas.dataset["strokes"] = String(a.placed.length);
     this.#canvas.dataset["compare"] = b === null ? "off" : String(b.length);
     this.#canvas.dataset["totalMs"] = String(Math.round(this.totalMs));

@@ -4,7 +4,7 @@
  * ceiling. The words come from wearer-status.ts; this only puts them on the page.
  */
 import type { WearerView } from "../wearer-hold";
-import { holdDetail, holdHeadline, holdReason } from "../wearer-status";
+import { endedHeadline, holdDetail, holdHeadline, holdReason } from "../wearer-status";
 import { byId } from "./status";
 
 export interface WearerNoticeActions {
@@ -33,8 +33,8 @@ export class WearerNotice {
     byId(doc, "drop-held-button").addEventListener("click", () => actions.dropHeld());
   }
 
-  /** `ceiling`: the line about the wearer's ceiling (ceilingNote), or null. */
-  show(view: WearerView, ceiling: string | null): void {
+  /** `ceiling`: the line about the wearer's ceiling (ceilingNote), or null; `nowMs`: for the day of a time. */
+  show(view: WearerView, ceiling: string | null, nowMs: number): void {
     const state = view.state === "none" ? (ceiling === null ? "none" : "ceiling") : view.state;
     this.#box.dataset["state"] = state;
     this.#box.dataset["held"] = String(view.state === "none" ? 0 : view.held);
@@ -43,14 +43,14 @@ export class WearerNotice {
     this.#actions.hidden = view.state !== "resumed" || view.held === 0;
     if (view.state === "held") {
       this.#legendWhy.textContent = holdReason(view.hold);
-      this.#set(holdHeadline(view.hold), holdDetail(view.hold, view.held), ceiling);
+      this.#set(holdHeadline(view.hold, nowMs), holdDetail(view.hold, view.held, nowMs), ceiling);
     } else if (view.state === "resumed") {
       const detail =
         view.held === 0
           ? "What you draw now is sent again."
           : `${plural(view.held, "stroke")} drawn meanwhile ${view.held === 1 ? "is" : "are"} held here. ` +
             "Send them to play them now, back to back, or drop them; what you draw now is sent.";
-      this.#set("The wearer resumed the sleeve.", detail, ceiling);
+      this.#set(endedHeadline(view.ended, nowMs), detail, ceiling);
     } else if (ceiling !== null) {
       this.#set(ceiling, null, null);
     }

@@ -6,13 +6,18 @@
  */
 import "./wearer.css";
 import { act, readState, WearerApiError, type Action, type Sender, type WearerState } from "./api";
+import {
+  ceilingChoiceLabel,
+  ceilingChoices,
+  ceilingLine,
+  doNotDisturbLine,
+  summary,
+  untilHint,
+  untilTime,
+} from "./words";
 
 const POLL_INTERVAL_MS = 1000;
-// The ceilings offered, as fractions of the sleeve's own maximum (below it: the wearer's cap).
-const CEILING_FRACTIONS = [0.2, 0.4, 0.6, 0.8] as const;
-const MIN_CEILING = 0.05; // the sleeve's lowest ceiling (feelmysign.sleeve.controls)
 const MINUTE_MS = 60_000;
-const DAY_MS = 24 * 60 * MINUTE_MS;
 
 function byId<T extends HTMLElement>(id: string): T {
   const element = document.getElementById(id);
@@ -26,11 +31,12 @@ const problem = byId<HTMLParagraphElement>("problem");
 const pauseLine = byId<HTMLParagraphElement>("pause-line");
 const pauseButton = byId<HTMLButtonElement>("pause");
 const stopButton = byId<HTMLButtonElement>("stop");
-const ceilingLine = byId<HTMLParagraphElement>("ceiling-line");
-const ceilingChoices = byId<HTMLDivElement>("ceiling-choices");
+const ceilingLineElement = byId<HTMLParagraphElement>("ceiling-line");
+const ceilingChoicesElement = byId<HTMLDivElement>("ceiling-choices");
 const dndLine = byId<HTMLParagraphElement>("dnd-line");
 const dndUntil = byId<HTMLFormElement>("dnd-until");
 const dndTime = byId<HTMLInputElement>("dnd-time");
+const dndTimeHint = byId<HTMLParagraphElement>("dnd-time-hint");
 const dndEnd = byId<HTMLButtonElement>("dnd-end");
 const sendersLine = byId<HTMLParagraphElement>("senders-line");
 const sendersList = byId<HTMLUListElement>("senders");
@@ -41,44 +47,26 @@ let lastSaid = "";
 // A refused change stays on screen until the next change succeeds (a poll does not hide it).
 let changeRefused = false;
 
-function percent(fraction: number): string {
-  return `${Math.round(fraction * 100)} %`;
-}
-
-function clock(ms: number): string {
-  return new Date(ms).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit" });
-}
-
-/** The next wall-clock time at `hhmm` ("14:30"): today, or tomorrow when it has passed. */
-function nextTimeMs(hhmm: string, nowMs: number): number | null {
-  const match = /^(\d{2}):(\d{2})$/.exec(hhmm);
-  if (match === null) return null;
-  const at = new Date(nowMs);
-  at.setHours(Number(match[1]), Number(match[2]), 0, 0);
-  let ms = at.getTime();
-  if (ms <= nowMs) ms += DAY_MS;
-  return ms;
-}
-
-function ceilingSteps(max: number): number[] {
-  return CEILING_FRACTIONS.map((f) => Math.round(f * max * 100) / 100).filter((c) => c >= MIN_CEILING);
-}
-
+/** Strongest first: no ceiling (the strongest this sleeve allows), then the ceilings below it. */
 function renderCeilingChoices(max: number): void {
-  const wanted = ["none", ...ceilingSteps(max).map(String)];
-  const have = [...ceilingChoices.children].map((b) => (b as HTMLElement).dataset["ceiling"]);
-  if (wanted.join() === have.join()) return;
-  ceilingChoices.replaceChildren(
-    ...wanted.map((value) => {
+  const wanted: (number | null)[] = [null, ...ceilingChoices(max)];
+  const key = (ceiling: number | null) => (ceiling === null ? "none" : String(ceiling));
+  const have = [...ceilingChoicesElement.children].map((b) => (b as HTMLElement).dataset["ceiling"]);
+  const labels = [...ceilingChoicesElement.children].map((b) => b.textContent);
+  if (
+    wanted.map(key).join() === have.join() &&
+    wanted.map((c) => ceilingChoiceLabel(c, max)).join() === labels.join()
+  )
+    return;
+  ceilingChoicesElement.replaceChildren(
+    ...wanted.map((ceiling) => {
       const button = document.createElement("button");
       button.type = "button";
       button.className = "choice";
-      button.dataset["ceiling"] = value;
-      button.dataset["testid"] = `ceiling-${value}`;
-      button.textContent = value === "none" ? "No limit" : `${percent(Number(value) / max)} at most`;
-      button.addEventListener("click", () =>
-        change("ceiling", { ceiling: value === "none" ? null : Number(value) }),
-      );
+      button.dataset["ceiling"] = key(ceiling);
+      button.dataset["testid"] = `ceiling-${key(ceiling)}`;
+      button.textContent = ceilingChoiceLabel(ceiling, max);
+      button.addEventListener("click", () => void change("ceiling", { ceiling }));
       return button;
     }),
   );
@@ -123,19 +111,6 @@ function renderSenders(senders: readonly Sender[]): void {
   }
 }
 
-/** The words a screen reader says when they change (pause, ceiling, do not disturb, online). */
-function summary(s: WearerState): string {
-  const c = s.controls;
-  if (c === null) return "The sleeve is starting.";
-  const parts = [
-    s.online ? "" : "The sleeve is offline.",
-    c.paused ? "Paused: nothing plays." : "Playing what senders draw.",
-    c.ceiling === null ? "" : `Strongest vibration ${percent(c.ceiling / s.max_intensity)}.`,
-    c.do_not_disturb_until_ms === null ? "" : `Do not disturb until ${clock(c.do_not_disturb_until_ms)}.`,
-  ];
-  return parts.filter(Boolean).join(" ");
-}
-
 function render(s: WearerState): void {
   state = s;
   const c = s.controls;
@@ -162,7 +137,7 @@ function render(s: WearerState): void {
   stopButton.disabled = !ready;
 
   renderCeilingChoices(s.max_intensity);
-  for (const button of ceilingChoices.querySelectorAll<HTMLButtonElement>("button")) {
+  for (const button of ceilingChoicesElement.querySelectorAll<HTMLButtonElement>("button")) {
     const value = button.dataset["ceiling"];
     const chosen =
       value === "none"
@@ -171,17 +146,14 @@ function render(s: WearerState): void {
     button.setAttribute("aria-pressed", String(chosen));
     button.disabled = !ready;
   }
-  ceilingLine.textContent =
-    c === null
-      ? ""
-      : c.ceiling === null
-        ? "No limit: as strong as the sender draws."
-        : `At most ${percent(c.ceiling / s.max_intensity)} of the sleeve's strongest.`;
+  ceilingLineElement.textContent = c === null ? "" : ceilingLine(c.ceiling, s.max_intensity);
 
+  const nowMs = Date.now();
   const until = c?.do_not_disturb_until_ms ?? null;
   dndLine.dataset["until"] = until === null ? "" : String(until);
-  dndLine.textContent =
-    until === null ? "Off: senders may draw on you." : `On until ${clock(until)}: nothing reaches you.`;
+  dndLine.textContent = doNotDisturbLine(until, nowMs);
+  // The hint names the day ("tomorrow at 07:00"), which moves at midnight.
+  if (dndTimeHint.dataset["state"] === "hint") showTimeHint(untilHint(dndTime.value, nowMs), false);
   dndEnd.hidden = until === null;
   dndEnd.disabled = !ready;
   for (const button of document.querySelectorAll<HTMLButtonElement>(
@@ -195,7 +167,7 @@ function render(s: WearerState): void {
     : "Blocking a sender needs the broker feelmysign runs; this sleeve uses another one.";
   renderSenders(s.senders);
 
-  const said = summary(s);
+  const said = summary(s, nowMs);
   if (said !== lastSaid) {
     lastSaid = said;
     live.textContent = said;
@@ -211,8 +183,9 @@ function showProblem(error: unknown): void {
   if (error instanceof WearerApiError && error.status === 403) sleeveLine.dataset["state"] = "no-key";
 }
 
-async function change(action: Action, body: object = {}): Promise<void> {
-  if (busy) return;
+/** True when the sleeve took the change, false when refused (said), null when another was under way. */
+async function change(action: Action, body: object = {}): Promise<boolean | null> {
+  if (busy) return null;
   busy = true;
   try {
     const next = await act(action, body);
@@ -221,11 +194,13 @@ async function change(action: Action, body: object = {}): Promise<void> {
     busy = false;
     render(next);
     if (action === "stop") live.textContent = "Stopped what was playing.";
+    return true;
   } catch (error) {
     busy = false;
     if (state !== null) render(state);
     changeRefused = true;
     showProblem(error);
+    return false;
   }
 }
 
@@ -249,14 +224,29 @@ for (const button of document.querySelectorAll<HTMLButtonElement>("[data-minutes
     change("do-not-disturb", { until_ms: Date.now() + Number(button.dataset["minutes"]) * MINUTE_MS }),
   );
 }
+/** Under the time field: what Set will do, or why it cannot (`problem`: marked so, and the field invalid). */
+function showTimeHint(text: string, isProblem: boolean, state: "hint" | "done" = "hint"): void {
+  dndTimeHint.textContent = text;
+  dndTimeHint.dataset["state"] = isProblem ? "problem" : state;
+  if (isProblem) dndTime.setAttribute("aria-invalid", "true");
+  else dndTime.removeAttribute("aria-invalid");
+}
+
+dndTime.addEventListener("input", () => showTimeHint(untilHint(dndTime.value, Date.now()), false));
 dndUntil.addEventListener("submit", (event) => {
   event.preventDefault();
-  const until = nextTimeMs(dndTime.value, Date.now());
-  if (until === null) {
-    showProblem(new WearerApiError("Choose a time, such as 22:30.", 400));
+  const until = untilTime(dndTime.value, Date.now());
+  if (!until.ok) {
+    showTimeHint(until.problem, true);
+    dndTime.focus();
     return;
   }
-  void change("do-not-disturb", { until_ms: until });
+  // Set: the line above says until when; the hint waits for the next time typed.
+  showTimeHint("", false, "done");
+  void change("do-not-disturb", { until_ms: until.untilMs }).then((done) => {
+    // The sleeve refused it (its clock, its limit): said here too, where the wearer looks.
+    if (done === false) showTimeHint(problem.textContent ?? "", true);
+  });
 });
 dndEnd.addEventListener("click", () => void change("do-not-disturb", { until_ms: null }));
 

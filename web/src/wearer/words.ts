@@ -1,0 +1,120 @@
+/**
+ * What the wearer's page says and offers, apart from the page (no DOM, the time passed in), so
+ * the unit tests read it as the wearer does. Intensities are drive levels (drive-level.ts), the
+ * scale the sender's page, `feelmysign send` and the sleeve's status use: a ceiling of 0.6 is
+ * "60 %" here and there. Times are clock.ts's, as on the sender's page.
+ */
+import { untilClock } from "../clock";
+import { drivePercent } from "../drive-level";
+import type { WearerState } from "./api";
+
+/** The sleeve's lowest ceiling (feelmysign.sleeve.controls MIN_CEILING). */
+export const MIN_CEILING = 0.05;
+/** "do not disturb" lasts at most this (feelmysign.sleeve.controls MAX_DO_NOT_DISTURB_MS). */
+export const MAX_DO_NOT_DISTURB_MS = 24 * 3_600_000;
+/** The choices below the sleeve's strongest, a step apart (two presses of the turn-down button). */
+const CEILING_STEP = 0.2;
+const CEILING_CHOICES = 4;
+
+/**
+ * The ceilings offered, strongest first: the round drive levels (80 %, 60 %, ...) below the
+ * layout's `max_intensity`, a step apart, none below MIN_CEILING. Above them the page offers no
+ * ceiling: the strongest this sleeve allows. A sleeve allowing 0.5 or less gets steps of 0.1.
+ */
+export function ceilingChoices(maxIntensity: number): number[] {
+  const step = maxIntensity > 0.5 ? CEILING_STEP : CEILING_STEP / 2;
+  // In hundredths: 0.6 is 60, never 0.6000000000000001.
+  const top = Math.round(maxIntensity * 100);
+  const stepHundredths = Math.round(step * 100);
+  const choices: number[] = [];
+  for (let level = Math.ceil(top / stepHundredths) - 1; level >= 1; level--) {
+    const hundredths = level * stepHundredths;
+    if (hundredths >= top || hundredths < MIN_CEILING * 100) continue;
+    choices.push(hundredths / 100);
+    if (choices.length === CEILING_CHOICES) break;
+  }
+  return choices;
+}
+
+/** A choice's words: "60 % at most", or the strongest this sleeve allows for none. */
+export function ceilingChoiceLabel(ceiling: number | null, maxIntensity: number): string {
+  return ceiling === null
+    ? `The strongest this sleeve allows (${drivePercent(maxIntensity)})`
+    : `${drivePercent(ceiling)} at most`;
+}
+
+/** The line under "Strongest vibration". */
+export function ceilingLine(ceiling: number | null, maxIntensity: number): string {
+  return ceiling === null
+    ? `No ceiling: up to the strongest this sleeve allows, ${drivePercent(maxIntensity)}.`
+    : `At most ${drivePercent(ceiling)}, whatever the sender asks (this sleeve allows up to ${drivePercent(maxIntensity)}).`;
+}
+
+/** The line under "Do not disturb". */
+export function doNotDisturbLine(untilMs: number | null, nowMs: number): string {
+  return untilMs === null
+    ? "Off: senders may draw on you."
+    : `On until ${untilClock(untilMs, nowMs)}: nothing reaches you.`;
+}
+
+/** The words a screen reader says when they change (pause, ceiling, do not disturb, online). */
+export function summary(state: WearerState, nowMs: number): string {
+  const c = state.controls;
+  if (c === null) return "The sleeve is starting.";
+  const parts = [
+    state.online ? "" : "The sleeve is offline.",
+    c.paused ? "Paused: nothing plays." : "Playing what senders draw.",
+    c.ceiling === null ? "" : `Strongest vibration ${drivePercent(c.ceiling)}.`,
+    c.do_not_disturb_until_ms === null
+      ? ""
+      : `Do not disturb until ${untilClock(c.do_not_disturb_until_ms, nowMs)}.`,
+  ];
+  return parts.filter(Boolean).join(" ");
+}
+
+/** A time of day the wearer typed, as "do not disturb" would take it. */
+export type UntilTime =
+  | { readonly ok: true; readonly untilMs: number; readonly words: string }
+  | { readonly ok: false; readonly problem: string };
+
+/**
+ * The next time `hhmm` ("22:30", as an `<input type="time">` gives it) comes: today, or tomorrow
+ * when it has passed (said so: "until tomorrow at 07:00"). Refused in words when empty, or when
+ * it is more than 24 h away (the sleeve's limit; only on the day the clocks go back).
+ */
+export function untilTime(hhmm: string, nowMs: number): UntilTime {
+  const match = /^(\d{2}):(\d{2})(?::\d{2}(?:\.\d+)?)?$/.exec(hhmm.trim());
+  if (match === null) {
+    return {
+      ok: false,
+      problem:
+        hhmm.trim() === ""
+          ? "Enter the time do not disturb ends, such as 22:30, then press Set."
+          : `${hhmm} is not a time of day: enter one such as 22:30, then press Set.`,
+    };
+  }
+  const at = new Date(nowMs);
+  at.setHours(Number(match[1]), Number(match[2]), 0, 0);
+  // Tomorrow on the calendar (not 24 h on): the clock time asked for, even when the clocks change.
+  if (at.getTime() <= nowMs) at.setDate(at.getDate() + 1);
+  const untilMs = at.getTime();
+  const words = `until ${untilClock(untilMs, nowMs)}`;
+  if (untilMs - nowMs > MAX_DO_NOT_DISTURB_MS) {
+    return {
+      ok: false,
+      problem:
+        `Do not disturb ${words} is more than 24 hours away (the clocks change tonight), and ` +
+        "it lasts at most 24 hours: choose an earlier time.",
+    };
+  }
+  return { ok: true, untilMs, words };
+}
+
+/** What the time field's hint says while the wearer types, before Set. */
+export function untilHint(hhmm: string, nowMs: number): string {
+  if (hhmm.trim() === "") return "";
+  const until = untilTime(hhmm, nowMs);
+  if (!until.ok) return until.problem;
+  const tomorrow = until.words.startsWith("until tomorrow");
+  return `Set makes it ${until.words}${tomorrow ? ": that time has passed today" : ""}.`;
+}
