@@ -512,7 +512,6 @@ export class App {
     if (event.type === "rejected" && isWearerRefusal(event.reason)) {
       // The status came after the stroke left: said as the wearer's pause, not a generic refusal.
       // Shown as the generic refusal would be: for this drawing, or for no drawing in particular.
-      if (ours) this.#says.wearerRefused();
       if (ours || event.drawing == null) {
         const label = seq === null ? "A stroke" : `Stroke ${seq}`;
         this.#says.add("rejected", wearerRefusalNote(label, event.reason, event.message));

@@ -144,13 +144,14 @@ export class SleeveWatch {
     const connected = this.#broker === "connected";
     const layout = this.#status?.layout;
     // The wearer's pause or "do not disturb": the sleeve is online but takes no strokes.
-    const hold = wearerHold(this.#status?.controls ?? NO_CONTROLS, Date.now());
+    const nowMs = Date.now();
+    const hold = wearerHold(this.#status?.controls ?? NO_CONTROLS, nowMs);
     const grid = layout ? `: ${layout.rows} × ${layout.columns} actuators` : "";
     const caption = {
       online:
         hold === null
           ? `Sleeve ${id} online${grid}, waiting for strokes.`
-          : `Sleeve ${id} online${grid}, playing nothing. ${holdHeadline(hold)}`,
+          : `Sleeve ${id} online${grid}, playing nothing. ${holdHeadline(hold, nowMs)}`,
       offline: `Sleeve ${id} is offline: nothing is felt now.`,
       absent: `No sleeve answers on id ${id}: nothing is felt.`,
       unknown: connected

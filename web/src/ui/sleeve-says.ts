@@ -44,8 +44,6 @@ export class SleeveSays {
   /** Kept on the page, not sent, while the wearer paused the sleeve (wearer-hold.ts). */
   #held = 0;
   #heldWhy = "the wearer paused";
-  /** Of the refused: refused `paused` or `do_not_disturb` (the page heard of the pause late). */
-  #wearerRefused = 0;
   #drawing: string | null = null;
 
   constructor(title: HTMLElement, list: HTMLOListElement, summary: HTMLElement) {
@@ -83,7 +81,6 @@ export class SleeveSays {
     this.#latestDelayMs = 0;
     this.#sent = 0;
     this.#held = 0;
-    this.#wearerRefused = 0;
     this.#list.replaceChildren();
     this.#title.textContent =
       drawing === null ? "Sleeve says" : `Sleeve says · drawing ${drawing.slice(0, 8)}`;
@@ -122,12 +119,6 @@ export class SleeveSays {
     this.#render();
   }
 
-  /** A stroke of this drawing was refused because the wearer paused (also counted by `fate`). */
-  wearerRefused(): void {
-    this.#wearerRefused++;
-    this.#render();
-  }
-
   setSent(sent: number): void {
     this.#sent = sent;
     this.#render();
@@ -149,7 +140,11 @@ export class SleeveSays {
     summary.dataset["dropped"] = String(dropped);
     summary.dataset["delayed"] = String(delayed);
     summary.dataset["held"] = String(this.#held);
-    summary.dataset["wearerRefused"] = String(this.#wearerRefused);
+    // Of the refused: by the wearer's pause or "do not disturb" (the page heard of it late).
+    const refusals = this.#fates.refusals();
+    const paused = refusals.get("paused") ?? 0;
+    const quiet = refusals.get("do_not_disturb") ?? 0;
+    summary.dataset["wearerRefused"] = String(paused + quiet);
     if (this.#sent === 0 && dropped === 0) {
       summary.textContent = "No strokes sent yet.";
       return;
@@ -159,10 +154,17 @@ export class SleeveSays {
     parts.push(...cutShortWords(cut, { byWearer: cutByWearer, byFault: cutByFault }));
     if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
     if (refused > 0) {
-      const wearer = Math.min(this.#wearerRefused, refused);
-      const why =
-        wearer === 0 ? "" : wearer === refused ? " (the wearer paused)" : ` (${wearer} as the wearer paused)`;
-      parts.push(`${refused} refused${why}`);
+      const wearer: string[] = [];
+      if (paused > 0)
+        wearer.push(paused === refused ? "the wearer paused" : `${paused} as the wearer paused`);
+      if (quiet > 0) {
+        wearer.push(
+          quiet === refused
+            ? "the wearer asked not to be disturbed"
+            : `${quiet} as the wearer asked not to be disturbed`,
+        );
+      }
+      parts.push(`${refused} refused${wearer.length === 0 ? "" : ` (${wearer.join(", ")})`}`);
     }
     if (this.#held > 0) parts.push(`${this.#held} held on this page, not sent (${this.#heldWhy})`);
     if (dropped > 0) parts.push(`${dropped} never sent`);
