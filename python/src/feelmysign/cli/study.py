@@ -3,6 +3,7 @@
     feelmysign study check deploy/studies/paper.toml            # validate a design
     feelmysign study new deploy/studies/paper.toml --out s.sqlite
     feelmysign study simulate s.sqlite --participants 12        # a dry run, no sleeve needed
+    feelmysign study simulate s.sqlite --wearer in-range        # ... thresholds inside the range
     feelmysign study run s.sqlite                               # a session in the terminal
     feelmysign up --study s.sqlite                              # ... or on the page /study
     feelmysign study review s.sqlite                            # decide unclear answers
@@ -77,6 +78,15 @@ def register(subparsers: Subcommands) -> None:
         "--participants", type=int, default=12, metavar="N", help="how many (default 12)"
     )
     simulate.add_argument("--seed", type=int, default=0, help="the simulation's seed (default 0)")
+    simulate.add_argument(
+        "--wearer",
+        choices=("template", "in-range"),
+        default="template",
+        help="how the simulated participants answer: 'template' (default) matches the felt "
+        "path with each shape's outline, near ceiling for most shapes of the paper's design; "
+        "'in-range' answers by a known curve per shape whose needed resolution lies inside "
+        "the tested range (printed here and shown in the report beside the estimates)",
+    )
     simulate.set_defaults(handler=_simulate)
 
     run = commands.add_parser("run", help="run a session in the terminal (the sleeve over MQTT)")
@@ -198,6 +208,7 @@ def _simulate(args: argparse.Namespace) -> int:
         store,
         args.participants,
         seed=args.seed,
+        wearer=args.wearer,
         progress=lambda n, code: print(
             f"  simulated participant {n}/{args.participants}: {code}", flush=True
         ),
@@ -206,6 +217,22 @@ def _simulate(args: argparse.Namespace) -> int:
         f"Ran {len(codes)} simulated sessions into {args.study}. "
         f"Next: 'feelmysign study analyse {args.study}'."
     )
+    if args.wearer == "in-range":
+        from feelmysign.study.simulated import in_range_truths
+
+        print(
+            "Known truth of the in-range wearers, to compare with the analysis's needed "
+            f"resolutions: the strokes at which the average participant reaches "
+            f"{store.design.criterion:.0%} correct (each participant's curve is shifted by an "
+            "amount of their own):"
+        )
+        for truth in in_range_truths(store.design).values():
+            print(
+                f"  {truth.shape}: {truth.needed_strokes:.2f} strokes (tested "
+                f"{truth.lowest_tested}-{truth.highest_tested}; slope "
+                f"{truth.slope_per_doubling:g} per doubling, participants' SD "
+                f"{truth.spread_doublings:g} doublings)"
+            )
     return 0
 
 

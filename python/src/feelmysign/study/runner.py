@@ -79,11 +79,19 @@ def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]
 class Session:
     """``Session(store, play)``: the operations on one study's participants."""
 
-    def __init__(self, store: StudyStore, play: Play | None, *, simulation_seed: int = 0) -> None:
+    def __init__(
+        self,
+        store: StudyStore,
+        play: Play | None,
+        *,
+        simulation_seed: int = 0,
+        wearer: str = "template",
+    ) -> None:
         self.store = store
         self._play = play
         self.layout: Layout = stimulus_layout(store.design.stimulus, store.base_dir)
         self._simulation_seed = simulation_seed
+        self._wearer = wearer  # how simulated participants answer (simulated.WEARERS)
 
     @functools.cached_property
     def _templates(self) -> dict[str, list[Point]]:
@@ -254,13 +262,31 @@ class Session:
         if not sends:
             raise StudyError("send the shape first: the simulated participant answers what it felt")
         strokes = [stroke_from_json(s) for s in json.loads(sends[-1]["strokes_json"])]
-        from feelmysign.study.simulated import SimulatedParticipant
+        from feelmysign.study.simulated import (
+            IN_RANGE,
+            InRangeWearer,
+            SimulatedParticipant,
+            in_range_truths,
+        )
 
         # The participant's number and the trial's position, not their random code and row
         # id: the same seed then gives the same answers in every new study file.
-        participant = SimulatedParticipant(seed=self._simulation_seed + int(row["number"]))
+        seed = self._simulation_seed + int(row["number"])
         key = f"{row['number']}:{trial['position']}"
-        result = participant.answer(strokes, self.layout, self.store.design, self._templates, key)
+        design = self.store.design
+        if self._wearer == IN_RANGE:
+            result = InRangeWearer(seed, in_range_truths(design)).answer(
+                strokes,
+                self.layout,
+                design,
+                self._templates,
+                key,
+                sent=str(trial["shape"]),
+                segments=int(trial["segments"]),
+            )
+        else:
+            participant = SimulatedParticipant(seed=seed)
+            result = participant.answer(strokes, self.layout, design, self._templates, key)
         return {
             "answer": result.answer,
             "felt_nothing": result.felt_nothing,

@@ -163,6 +163,10 @@ class StudyStore:
         rows = self.query("SELECT value FROM meta WHERE key = ?", (key,))
         return str(rows[0]["value"]) if rows else None
 
+    def set_meta(self, key: str, value: str) -> None:
+        with self._transaction() as db:
+            db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", (key, value))
+
     # ---- participants ------------------------------------------------------------------
 
     def add_participant(self, *, simulated: bool = False) -> str:

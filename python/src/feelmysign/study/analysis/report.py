@@ -122,6 +122,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "the highest tested)': it reached it at none. Intervals are cut at the tested range: "
         "'≤ n' or '≥ n' at an end means the interval goes on beyond what was tested.",
     ]
+    lines += _truth_section(analysis)
     lines += [
         "",
         "![needed resolution](needed-resolution.png)",
@@ -156,6 +157,38 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     path.write_text("\n".join(lines), encoding="utf-8")
     return path
+
+
+def _truth_section(analysis: Analysis) -> list[str]:
+    """A dry run's known truth beside the estimates (in-range simulated wearers)."""
+    truth = analysis.simulated_truth
+    if not truth:
+        return []
+    lines = [
+        "",
+        f"**Dry run: known truth.** {len(truth['participants'])} of the participants are "
+        "simulated in-range wearers, who answer by a known curve per shape (each "
+        "participant's curve shifted along log2(strokes) by their own amount). The strokes at "
+        f"which their average participant reaches {truth['criterion']:.0%} correct:",
+        "",
+        "| shape | true strokes needed | estimate | 95% interval | interval covers the truth |",
+        "|---|---|---|---|---|",
+    ]
+    for shape, known in truth["shapes"].items():
+        needed = analysis.needed.get(shape)
+        value = float(known["needed_strokes"])
+        if needed is None:
+            lines.append(f"| {shape} | {value:.2f} | - | - | - |")
+            continue
+        interval = needed.interval
+        covers = (interval.low_open or interval.low <= value) and (
+            interval.high_open or value <= interval.high
+        )
+        lines.append(
+            f"| {shape} | {value:.2f} | {needed_text(needed)} | {interval_text(interval)} | "
+            f"{'yes' if covers else 'no'} |"
+        )
+    return lines
 
 
 def _participant_section(analysis: Analysis, shapes: list[str]) -> list[str]:
