@@ -252,9 +252,16 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
     await page.click('[data-testid="results-tab"]');
     await page.click('[data-testid="analyse"]');
     await page.locator('[data-testid="report"]').waitFor({ timeout: 60_000 });
-    expect(await page.locator('[data-testid="report"]').textContent()).toContain(
-      "Accuracy by shape and resolution",
-    );
+    const report = page.locator('[data-testid="report"]');
+    // Rendered, not raw Markdown: headings, tables with their header cells, no '|---|'.
+    expect(await report.locator("h2").first().textContent()).toBe("Accuracy by shape and resolution");
+    expect(await report.locator("table").count()).toBeGreaterThanOrEqual(2);
+    expect(await report.locator("table th").first().textContent()).toBe("shape");
+    expect(await report.locator("table td").first().textContent()).toMatch(/^\w+$/);
+    const text = (await report.textContent()) ?? "";
+    expect(text).not.toContain("|---|");
+    expect(text).not.toContain("![");
+    expect(await report.locator('img[alt="accuracy"]').count()).toBe(1);
     const figure = page.locator('[data-testid="figure-accuracy.png"]');
     await page.waitForFunction(
       () =>
