@@ -238,6 +238,22 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       const stored = rows(study);
       expect(stored.threshold_trials).toBe(THRESHOLD_TRIALS);
       expect(stored.threshold_finished).toBe(1);
+      // Another run is a decision (a second click), and a run begun by mistake is discarded.
+      await page.click('[data-testid="threshold-another"]');
+      expect(await page.locator('[data-testid="threshold-another-question"]').textContent()).toContain(
+        "has 1 finished run of the length",
+      );
+      await page.click('[data-testid="threshold-another-cancel"]');
+      await page.locator('[data-testid="threshold-another"]').waitFor();
+      expect(rows(study).threshold_trials).toBe(THRESHOLD_TRIALS); // nothing started
+      await page.click('[data-testid="threshold-another"]');
+      await page.click('[data-testid="threshold-send"]');
+      await page.locator('[data-testid="threshold-simulated"]').waitFor({ timeout: 30_000 });
+      await page.click('[data-testid="threshold-discard"]');
+      await page.click('[data-testid="threshold-discard-confirm"]');
+      await page.locator('[data-testid="threshold-discarded"]').waitFor();
+      expect(await page.locator('[data-testid="threshold-run"]').count()).toBe(0);
+      expect(await finished.count()).toBe(1);
     },
     RESTART_TEST_TIMEOUT_MS,
   );

@@ -169,6 +169,8 @@ def _store(args: argparse.Namespace) -> StudyStore:
 
 
 def _status(args: argparse.Namespace) -> int:
+    from feelmysign.study.store import DISCARDED
+
     store = _store(args)
     codings = store.latest_codings()
     print(f"{args.study}: {store.design.name}")
@@ -187,11 +189,12 @@ def _status(args: argparse.Namespace) -> int:
             done = store.threshold_trials(run["id"])
             what = "simulated threshold run (dry run)" if run["simulated"] else "threshold run"
             unit = "grid units" if run["dimension"] == "length" else "ms"
-            result = (
-                f"finished, {run['threshold']:.3g} {unit}"
-                if run["finished_at_ms"] is not None and run["threshold"] is not None
-                else "unfinished (the same command resumes it)"
-            )
+            if run["stop_reason"] == DISCARDED:
+                result = "discarded (kept in the file, left out of the results)"
+            elif run["finished_at_ms"] is not None and run["threshold"] is not None:
+                result = f"finished, {run['threshold']:.3g} {unit}"
+            else:
+                result = "unfinished (the same command resumes it)"
             print(f"    {what} {run['id']} ({run['dimension']}): {len(done)} trials, {result}")
     if not store.participants():
         print("  no participant yet")
