@@ -22,9 +22,17 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Iterator
 
-import numpy as np
+# One BLAS thread, set before numpy loads it (the user's own setting wins). The shape test's
+# model has a column per participant, wide enough for OpenBLAS to start its threads on every
+# small product, which then spin: 5 to 7 times the CPU of one thread for the same studies on
+# a shared 2-core machine, and the same p-values (they differ only in the statistic's last
+# bits, far inside the test's 1e-9 tie tolerance).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # after the thread setting
 import pandas as pd
 
 from feelmysign.study.analysis.models import sign_flip_test
