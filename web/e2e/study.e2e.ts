@@ -250,6 +250,7 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       await page.click('[data-testid="threshold-send"]');
       await page.locator('[data-testid="threshold-simulated"]').waitFor({ timeout: 30_000 });
       await page.click('[data-testid="threshold-discard"]');
+      await screenshot(page, "study-threshold-discard");
       await page.click('[data-testid="threshold-discard-confirm"]');
       await page.locator('[data-testid="threshold-discarded"]').waitFor();
       expect(await page.locator('[data-testid="threshold-run"]').count()).toBe(0);
