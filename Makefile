@@ -39,7 +39,7 @@ help:
 	@echo "make bench-study  the study analysis's interval coverage over 400 simulated studies"
 	@echo "             per case (about 50 minutes; RUNS=40 for a quick look)"
 	@echo "make bench-study-calibration  the shape test's false-positive rate and the interval"
-	@echo "             coverage at 4, 8, 12, 24 participants (TEST_RUNS=400, COVERAGE_RUNS=100)"
+	@echo "             coverage at 4, 8, 12, 24 participants (TEST_RUNS=400, COVERAGE_RUNS=100; 0 leaves a column out; SIZES='12 24')"
 	@echo "make load    N sleeves and N senders at once on Mosquitto and NATS (N = 20, 100, 200; N='20 100')"
 	@echo "make vectors regenerate testdata/ from the Python reference"
 	@echo "make java-build  build the Java port (java/bin/feelmysign-java); make java-test tests it"
@@ -141,8 +141,9 @@ bench-study: $(STAMP)
 
 TEST_RUNS ?= 400
 COVERAGE_RUNS ?= 100
+SIZES ?= 4 8 12 24
 bench-study-calibration: $(STAMP)
-	$(PY) -m feelmysign.bench.study_calibration $(TEST_RUNS) $(COVERAGE_RUNS)
+	$(PY) -m feelmysign.bench.study_calibration $(TEST_RUNS) $(COVERAGE_RUNS) --sizes $(SIZES)
 
 up: $(RUN_STAMP) system
 	@echo "==> Starting feelmysign up $(ARGS)"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import threading
 import urllib.error
 import urllib.request
 from pathlib import Path
@@ -122,3 +123,44 @@ def test_the_analysis_lists_only_the_files_the_page_can_fetch(tmp_path: Path) ->
     for path in nested:
         status, _, _ = api.handle("GET", f"/api/study/results/{path.name}", HOST, b"", "")
         assert status == 404, path
+
+
+def test_no_answer_is_recorded_while_a_repeat_send_still_plays(tmp_path: Path) -> None:
+    store = new_study(tmp_path)
+    layout = Session(store, None).layout
+    offline = offline_player(layout)
+    started, release = threading.Event(), threading.Event()
+    held = {"on": False}
+
+    def play(strokes: Any) -> Any:
+        if held["on"]:  # the repeat send: the sleeve is still playing until released
+            started.set()
+            assert release.wait(30)
+        return offline(strokes)
+
+    api = StudyApi(Session(store, play), tmp_path / "results", bootstrap=50)
+    _, created = _call(api, "POST", "/api/study/participants", {"simulated": False})
+    base = f"/api/study/participants/{created['code']}"
+    _call(api, "POST", f"{base}/consent", {"consent": True})
+    _call(api, "POST", f"{base}/comfort", {"answers": [True, True], "adjusted": False})
+    trial = _call(api, "GET", base)[1]["trial"]
+    assert _call(api, "POST", f"{base}/send", {"trial": trial["id"]})[0] == 200
+    held["on"] = True
+    repeat = threading.Thread(
+        target=_call, args=(api, "POST", f"{base}/send", {"trial": trial["id"]})
+    )
+    repeat.start()
+    try:
+        assert started.wait(30)
+        answer = {"trial": trial["id"], "answer": "a line"}
+        status, refused = _call(api, "POST", f"{base}/answer", answer)
+        assert status == 400 and "still playing" in refused["error"], refused
+        status, again = _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
+        assert status == 400 and "still playing" in again["error"], again
+        assert _call(api, "GET", base)[1]["answered"] == 0
+    finally:
+        release.set()
+        repeat.join(30)
+    status, answered = _call(api, "POST", f"{base}/answer", answer)
+    assert status == 200 and answered["state"]["answered"] == 1
+    assert len(store.sends(trial["id"])) == 2  # the refused third send was not stored

@@ -123,3 +123,11 @@ def test_practice_written_as_one_table_gets_the_double_brackets_hint() -> None:
     assert "practice: must be a list of tables: write each entry as [[practice]]" in str(
         caught.value
     )
+
+
+def test_several_speeds_are_refused_with_how_to_compare_speeds() -> None:
+    with pytest.raises(DesignError) as caught:
+        parse_design(MINIMAL + "[stimulus]\nspeed_cm_s = [3.0, 8.0]\n", source="bad.toml")
+    message = str(caught.value)
+    assert "stimulus.speed_cm_s: must be one number from 0.5 to 50; got a list of 2" in message
+    assert "make one design file per speed" in message

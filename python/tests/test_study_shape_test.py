@@ -8,10 +8,19 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import statsmodels.api as sm
+import statsmodels.formula.api as smf
 from study_helpers import pilot_study
 
 from feelmysign.study.analysis import analyse_study
-from feelmysign.study.analysis.models import MIN_PARTICIPANTS, shape_profiles, sign_flip_test
+from feelmysign.study.analysis.analyse import main_trials
+from feelmysign.study.analysis.models import (
+    MIN_PARTICIPANTS,
+    NULL_FORMULA,
+    null_design,
+    shape_profiles,
+    sign_flip_test,
+)
 from feelmysign.study.dry_run import dry_run
 
 LEVELS = {"circle": (4, 8), "square": (4, 8), "triangle": (3, 6), "star": (5, 10)}
@@ -88,3 +97,21 @@ def test_a_profile_holds_nothing_the_shape_free_model_fits() -> None:
     assert np.abs(profile.sum(axis=1)).max() < 1e-9
     assert np.abs(profile @ (levels - levels.mean())).max() < 1e-9
     assert np.abs(profile).max() > 0.01  # and something is left to test
+
+
+def test_the_direct_design_is_the_formulas_to_the_last_bit(tmp_path: Path) -> None:
+    # A real study's answers (a dry run of 7 in-range wearers), as the analysis passes them.
+    store = pilot_study(tmp_path)
+    dry_run(store, 7, seed=4, wearer="in-range")
+    frame = main_trials(store)
+    data = frame[frame["coded_status"] != "unclear"][["participant", "shape", "segments"]]
+    data = data.assign(
+        correct=frame["correct"].astype(float),
+        log2_strokes=np.log2(frame["segments"].astype(float)),
+    )
+    family = sm.families.Binomial()
+    formula = smf.glm(NULL_FORMULA, data, family=family)
+    assert np.array_equal(formula.exog, null_design(data))
+    by_formula = formula.fit().fittedvalues.to_numpy()
+    direct = sm.GLM(data["correct"].to_numpy(float), null_design(data), family=family).fit()
+    assert np.array_equal(by_formula, np.asarray(direct.fittedvalues))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import random
 from pathlib import Path
@@ -10,6 +12,7 @@ from typing import Any
 import pytest
 from study_helpers import PAPER_DESIGN, new_study
 
+from feelmysign.cli import main as cli_main
 from feelmysign.errors import StudyError
 from feelmysign.layout import grid_layout
 from feelmysign.study import StudyStore, load_design
@@ -133,3 +136,28 @@ def test_the_page_runs_the_procedure_step_by_step_and_resumes_after_a_restart(
     (stored,) = StudyStore(store.path).threshold_runs(code)
     assert stored["stop_reason"] == f"{store.design.threshold.trials} trials"
     assert len(StudyStore(store.path).threshold_trials(stored["id"])) == finished["trials"]
+    # Another run started by mistake, one stroke in: discarded, kept in the file, not a result.
+    _, again = _desk_call(page, "POST", f"{base}/threshold-send", {"dimension": "length"})
+    _, again = _answer_as_simulated(page, base, again["dimensions"]["length"]["run"])
+    status, discarded = _desk_call(
+        page, "POST", f"{base}/threshold-discard", {"dimension": "length"}
+    )
+    length = discarded["dimensions"]["length"]
+    assert status == 200 and length["run"] is None
+    assert length["finished_runs"] == after["dimensions"]["length"]["finished_runs"]
+    (thrown,) = length["discarded_runs"]
+    assert thrown["trials"] == 1
+    row = next(r for r in StudyStore(store.path).threshold_runs(code) if r["id"] == thrown["run"])
+    assert row["stop_reason"] == "discarded" and row["threshold"] is None
+    status, refused = _desk_call(page, "POST", f"{base}/threshold-discard", {"dimension": "length"})
+    assert status == 400 and "nothing to discard" in refused["error"]
+    shown = _status_lines(store.path)
+    assert f" {thrown['run']} (length): 1 trials, discarded (kept in the file" in shown
+    assert f" {stored['id']} (length): {finished['trials']} trials, finished" in shown
+
+
+def _status_lines(path: Path) -> str:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli_main(["study", "status", str(path)]) == 0
+    return out.getvalue()

@@ -238,6 +238,23 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
       const stored = rows(study);
       expect(stored.threshold_trials).toBe(THRESHOLD_TRIALS);
       expect(stored.threshold_finished).toBe(1);
+      // Another run is a decision (a second click), and a run begun by mistake is discarded.
+      await page.click('[data-testid="threshold-another"]');
+      expect(await page.locator('[data-testid="threshold-another-question"]').textContent()).toContain(
+        "has 1 finished run of the length",
+      );
+      await page.click('[data-testid="threshold-another-cancel"]');
+      await page.locator('[data-testid="threshold-another"]').waitFor();
+      expect(rows(study).threshold_trials).toBe(THRESHOLD_TRIALS); // nothing started
+      await page.click('[data-testid="threshold-another"]');
+      await page.click('[data-testid="threshold-send"]');
+      await page.locator('[data-testid="threshold-simulated"]').waitFor({ timeout: 30_000 });
+      await page.click('[data-testid="threshold-discard"]');
+      await screenshot(page, "study-threshold-discard");
+      await page.click('[data-testid="threshold-discard-confirm"]');
+      await page.locator('[data-testid="threshold-discarded"]').waitFor();
+      expect(await page.locator('[data-testid="threshold-run"]').count()).toBe(0);
+      expect(await finished.count()).toBe(1);
     },
     RESTART_TEST_TIMEOUT_MS,
   );
@@ -252,9 +269,16 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
     await page.click('[data-testid="results-tab"]');
     await page.click('[data-testid="analyse"]');
     await page.locator('[data-testid="report"]').waitFor({ timeout: 60_000 });
-    expect(await page.locator('[data-testid="report"]').textContent()).toContain(
-      "Accuracy by shape and resolution",
-    );
+    const report = page.locator('[data-testid="report"]');
+    // Rendered, not raw Markdown: headings, tables with their header cells, no '|---|'.
+    expect(await report.locator("h2").first().textContent()).toBe("Accuracy by shape and resolution");
+    expect(await report.locator("table").count()).toBeGreaterThanOrEqual(2);
+    expect(await report.locator("table th").first().textContent()).toBe("shape");
+    expect(await report.locator("table td").first().textContent()).toMatch(/^\w+$/);
+    const text = (await report.textContent()) ?? "";
+    expect(text).not.toContain("|---|");
+    expect(text).not.toContain("![");
+    expect(await report.locator('img[alt="accuracy"]').count()).toBe(1);
     const figure = page.locator('[data-testid="figure-accuracy.png"]');
     await page.waitForFunction(
       () =>

@@ -175,6 +175,8 @@ export interface ThresholdDimension {
   range: [number, number];
   fixed: number;
   finished_runs: FinishedThresholdRun[];
+  /** Runs the researcher discarded: kept in the study file, left out of the results. */
+  discarded_runs: { run: number; trials: number }[];
   run: ThresholdRun | null;
 }
 
@@ -191,4 +193,6 @@ export const thresholdApi = {
     call<ThresholdState>("POST", participant(code, "/threshold-send"), { dimension }),
   answer: (code: string, dimension: Dimension, position: number, response: Direction) =>
     call<ThresholdState>("POST", participant(code, "/threshold-answer"), { dimension, position, response }),
+  discard: (code: string, dimension: Dimension) =>
+    call<ThresholdState>("POST", participant(code, "/threshold-discard"), { dimension }),
 };

@@ -1,6 +1,7 @@
 /** Export and analyse on the server; show the report and its figures. */
 import { api, type AnalysisResult } from "./api";
 import { h, plural } from "./dom";
+import { reportHtml } from "./report";
 
 export class ResultsView {
   readonly #root: HTMLElement;
@@ -39,23 +40,22 @@ export class ResultsView {
   #show(result: AnalysisResult, status: HTMLElement): void {
     status.textContent = `${plural(result.participants, "participant")} analysed; ${result.unclear} answer(s) await review. Files in ${result.folder}.`;
     const stamp = Date.now();
+    const figureUrl = (name: string): string => `/api/study/results/${name}?t=${stamp}`;
+    // The report shows its figures in place; any other figure the analysis wrote, above it.
     const figures = result.files
-      .filter((name) => name.endsWith(".png"))
-      .map((name) =>
-        h("img", {
-          src: `/api/study/results/${name}?t=${stamp}`,
-          alt: name,
-          "data-testid": `figure-${name}`,
-        }),
-      );
+      .filter((name) => name.endsWith(".png") && !result.report.includes(`](${name})`))
+      .map((name) => h("img", { src: figureUrl(name), alt: name, "data-testid": `figure-${name}` }));
     const links = result.files.map((name) =>
       h("li", {}, h("a", { href: `/api/study/results/${name}`, download: name }, name)),
     );
+    const report = h("div", { class: "report", "data-testid": "report" });
+    // Safe as markup: reportHtml renders no HTML of the report's own (html: false).
+    report.innerHTML = reportHtml(result.report, figureUrl);
     const body = this.#root.querySelector("#results-body")!;
     body.replaceChildren(
       h("div", { class: "figures" }, ...figures),
       h("ul", { class: "files" }, ...links),
-      h("pre", { class: "report", "data-testid": "report" }, result.report),
+      report,
     );
   }
 }

@@ -238,13 +238,15 @@ export class SessionView {
       this.#run(() => api.answer(code, trial.id, feltNothing ? "" : answer.value, feltNothing, value));
     };
     send.addEventListener("click", () => {
-      send.disabled = true;
+      // No answer while the shape plays (a repeat send too): it answers what was felt.
+      send.disabled = record.disabled = nothing.disabled = true;
       status.textContent = "Sending… the sleeve is playing the shape.";
       api
         .send(code, trial.id)
         .then((result) => this.render(result.state))
         .catch((error: unknown) => {
           send.disabled = false;
+          record.disabled = nothing.disabled = trial.sends === 0;
           this.#hooks.fail(error);
         });
     });

@@ -107,28 +107,111 @@ export class ThresholdView {
       choose,
       h("p", { class: "hint" }, `${fixed} The run ${state.stopping_rule}.`),
       dimension.run ? this.#run(state, dimension, dimension.run) : this.#start(state, dimension),
-      ...(dimension.finished_runs.length > 0 ? [this.#finished(dimension)] : []),
+      ...(dimension.finished_runs.length + dimension.discarded_runs.length > 0
+        ? [this.#finished(dimension)]
+        : []),
     );
     this.#root.dataset["dimension"] = this.#dimension;
   }
 
   #start(state: ThresholdState, dimension: ThresholdDimension): HTMLElement {
     this.#answerKey = null;
-    const started = dimension.finished_runs.length > 0;
-    return h(
-      "div",
-      { class: "card", "data-testid": "threshold-start" },
-      h(
-        "button",
-        {
-          type: "button",
-          class: "button button-primary",
-          "data-testid": "threshold-send",
-          onclick: () => this.#act(() => thresholdApi.send(state.participant, this.#dimension)),
-        },
-        started ? "Start another run: send the first stroke" : "Start: send the first stroke",
-      ),
+    const finished = dimension.finished_runs.length;
+    const start = () => this.#act(() => thresholdApi.send(state.participant, this.#dimension));
+    const card = h("div", { class: "card", "data-testid": "threshold-start" });
+    if (finished === 0) {
+      card.append(
+        h(
+          "button",
+          { type: "button", class: "button button-primary", "data-testid": "threshold-send", onclick: start },
+          "Start: send the first stroke",
+        ),
+      );
+      return card;
+    }
+    // A participant's run is done: another one is a decision, not a stray click.
+    const ask = h(
+      "button",
+      { type: "button", class: "button", "data-testid": "threshold-another" },
+      "Start another run…",
     );
+    ask.addEventListener("click", () => {
+      card.replaceChildren(
+        h(
+          "p",
+          { "data-testid": "threshold-another-question" },
+          `${state.participant} has ${plural(finished, "finished run")} of the ${this.#dimension}. ` +
+            "Another run is stored beside it; a run started by mistake can be discarded.",
+        ),
+        h(
+          "div",
+          { class: "row" },
+          h(
+            "button",
+            {
+              type: "button",
+              class: "button button-primary",
+              "data-testid": "threshold-send",
+              onclick: start,
+            },
+            "Start another run: send the first stroke",
+          ),
+          h(
+            "button",
+            {
+              type: "button",
+              class: "button",
+              "data-testid": "threshold-another-cancel",
+              onclick: () => this.render(state),
+            },
+            "Cancel",
+          ),
+        ),
+      );
+    });
+    card.append(ask);
+    return card;
+  }
+
+  /** Discard the run under way, after a second, explicit click. */
+  #discard(state: ThresholdState, run: ThresholdRun): HTMLElement {
+    const row = h("div", { class: "row" });
+    const ask = h(
+      "button",
+      { type: "button", class: "button button-quiet", "data-testid": "threshold-discard" },
+      "Discard this run…",
+    );
+    ask.addEventListener("click", () => {
+      row.replaceChildren(
+        h(
+          "span",
+          { class: "hint" },
+          `Discard this run of ${plural(run.trials.length, "trial")}? It stays in the study file, marked discarded, and is left out of the results.`,
+        ),
+        h(
+          "button",
+          {
+            type: "button",
+            class: "button",
+            "data-testid": "threshold-discard-confirm",
+            onclick: () => this.#act(() => thresholdApi.discard(state.participant, this.#dimension)),
+          },
+          "Discard",
+        ),
+        h(
+          "button",
+          {
+            type: "button",
+            class: "button",
+            "data-testid": "threshold-discard-cancel",
+            onclick: () => row.replaceChildren(ask),
+          },
+          "Keep it",
+        ),
+      );
+    });
+    row.append(ask);
+    return row;
   }
 
   #run(state: ThresholdState, dimension: ThresholdDimension, run: ThresholdRun): HTMLElement {
@@ -207,6 +290,7 @@ export class ThresholdView {
         ),
       );
     }
+    card.append(this.#discard(state, run));
     if (run.trials.length > 0) {
       card.append(
         h(
@@ -244,6 +328,17 @@ export class ThresholdView {
           ),
         ),
       ),
+      ...(dimension.discarded_runs.length > 0
+        ? [
+            h(
+              "p",
+              { class: "hint", "data-testid": "threshold-discarded" },
+              `Discarded (kept in the study file, left out of the results): ${dimension.discarded_runs
+                .map((r) => `run ${r.run} after ${plural(r.trials, "trial")}`)
+                .join("; ")}.`,
+            ),
+          ]
+        : []),
     );
   }
 }

@@ -11,16 +11,28 @@ paper's design with a known truth:
 Each share with its own 95% Wilson interval. Not part of ``make test`` or ``make bench``:
 
     make bench-study-calibration                           # 400 and 100 runs per size
-    python -m feelmysign.bench.study_calibration [TEST_RUNS] [COVERAGE_RUNS]
+    python -m feelmysign.bench.study_calibration [TEST_RUNS] [COVERAGE_RUNS] [--sizes 12 24]
+
+A column with 0 runs is left out (``0 100``: the coverage alone). Each size's studies are
+seeded by the size and the run's number, so a size measured alone gives the same figures
+as in the full table.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
-import sys
+import os
 from collections.abc import Iterator
 
-import numpy as np
+# One BLAS thread, set before numpy loads it (the user's own setting wins). The shape test's
+# model has a column per participant, wide enough for OpenBLAS to start its threads on every
+# small product, which then spin: 5 to 7 times the CPU of one thread for the same studies on
+# a shared 2-core machine, and the same p-values (they differ only in the statistic's last
+# bits, far inside the test's 1e-9 tie tolerance).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # after the thread setting
 import pandas as pd
 
 from feelmysign.study.analysis.models import sign_flip_test
@@ -70,31 +82,64 @@ def false_positives(participants: int, runs: int) -> tuple[int, int]:
     return rejected, ran
 
 
-def report(test_runs: int, coverage_runs: int) -> Iterator[str]:
+def report(test_runs: int, coverage_runs: int, sizes: tuple[int, ...] = SIZES) -> Iterator[str]:
+    if test_runs > 0:
+        yield from _test_report(test_runs, sizes)
+    if coverage_runs > 0:
+        yield from _coverage_report(coverage_runs, sizes)
+
+
+def _test_report(test_runs: int, sizes: tuple[int, ...]) -> Iterator[str]:
     yield (
         f"Shape test (sign-flip over participants), paper design, no shape effect, "
         f"{test_runs} studies per size: share with p < 0.05 (nominal 0.05)"
     )
-    for size in SIZES:
+    for size in sizes:
         rejected, ran = false_positives(size, test_runs)
         if not ran:
             yield f"  {size:>2} participants: refused in every study (below the minimum)"
             continue
         low, high = wilson_interval(rejected, ran)
         yield f"  {size:>2} participants: {rejected / ran:.3f} ({low:.3f} to {high:.3f})"
-    if coverage_runs < 1:
-        return
+
+
+def _coverage_report(coverage_runs: int, sizes: tuple[int, ...]) -> Iterator[str]:
     name, truth = next(iter(paper_truths(0.75, 0.3).items()))
     yield (
         f"Needed resolution ({name}, participants' SD 0.3 doublings), {coverage_runs} studies "
         "per size, 200 bootstrap samples: share whose reported 95% interval covers the truth"
     )
-    for size in SIZES:
+    for size in sizes:
         result = coverage(coverage_runs, truth=truth, participants=size, samples=200)
         yield f"  {size:>2} participants: {describe(result, 'bootstrap')}"
 
 
-if __name__ == "__main__":
-    args = [int(a) for a in sys.argv[1:3]]
-    for line in report(*(args + [400, 100][len(args) :])):
+def main() -> None:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument(
+        "test_runs", type=int, nargs="?", default=400, help="studies per size for the shape test"
+    )
+    parser.add_argument(
+        "coverage_runs",
+        type=int,
+        nargs="?",
+        default=100,
+        help="studies per size for the interval's coverage",
+    )
+    parser.add_argument(
+        "--sizes",
+        type=int,
+        nargs="+",
+        default=list(SIZES),
+        metavar="PARTICIPANTS",
+        help=f"numbers of participants (default: {' '.join(map(str, SIZES))})",
+    )
+    args = parser.parse_args()
+    if min(args.test_runs, args.coverage_runs) < 0 or min(args.sizes) < 1:
+        parser.error("runs must be 0 or more and every size at least 1 participant")
+    for line in report(args.test_runs, args.coverage_runs, tuple(args.sizes)):
         print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()

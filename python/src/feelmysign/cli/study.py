@@ -3,6 +3,7 @@
     feelmysign study check deploy/studies/paper.toml            # validate a design
     feelmysign study new deploy/studies/paper.toml --out s.sqlite
     feelmysign study simulate s.sqlite --participants 12        # a dry run, no sleeve needed
+    feelmysign study simulate s.sqlite --wearer in-range        # ... thresholds inside the range
     feelmysign study run s.sqlite                               # a session in the terminal
     feelmysign up --study s.sqlite                              # ... or on the page /study
     feelmysign study review s.sqlite                            # decide unclear answers
@@ -77,6 +78,15 @@ def register(subparsers: Subcommands) -> None:
         "--participants", type=int, default=12, metavar="N", help="how many (default 12)"
     )
     simulate.add_argument("--seed", type=int, default=0, help="the simulation's seed (default 0)")
+    simulate.add_argument(
+        "--wearer",
+        choices=("template", "in-range"),
+        default="template",
+        help="how the simulated participants answer: 'template' (default) matches the felt "
+        "path with each shape's outline, near ceiling for most shapes of the paper's design; "
+        "'in-range' answers by a known curve per shape whose needed resolution lies inside "
+        "the tested range (printed here and shown in the report beside the estimates)",
+    )
     simulate.set_defaults(handler=_simulate)
 
     run = commands.add_parser("run", help="run a session in the terminal (the sleeve over MQTT)")
@@ -159,6 +169,8 @@ def _store(args: argparse.Namespace) -> StudyStore:
 
 
 def _status(args: argparse.Namespace) -> int:
+    from feelmysign.study.store import DISCARDED
+
     store = _store(args)
     codings = store.latest_codings()
     print(f"{args.study}: {store.design.name}")
@@ -177,11 +189,12 @@ def _status(args: argparse.Namespace) -> int:
             done = store.threshold_trials(run["id"])
             what = "simulated threshold run (dry run)" if run["simulated"] else "threshold run"
             unit = "grid units" if run["dimension"] == "length" else "ms"
-            result = (
-                f"finished, {run['threshold']:.3g} {unit}"
-                if run["finished_at_ms"] is not None and run["threshold"] is not None
-                else "unfinished (the same command resumes it)"
-            )
+            if run["stop_reason"] == DISCARDED:
+                result = "discarded (kept in the file, left out of the results)"
+            elif run["finished_at_ms"] is not None and run["threshold"] is not None:
+                result = f"finished, {run['threshold']:.3g} {unit}"
+            else:
+                result = "unfinished (the same command resumes it)"
             print(f"    {what} {run['id']} ({run['dimension']}): {len(done)} trials, {result}")
     if not store.participants():
         print("  no participant yet")
@@ -198,6 +211,7 @@ def _simulate(args: argparse.Namespace) -> int:
         store,
         args.participants,
         seed=args.seed,
+        wearer=args.wearer,
         progress=lambda n, code: print(
             f"  simulated participant {n}/{args.participants}: {code}", flush=True
         ),
@@ -206,6 +220,22 @@ def _simulate(args: argparse.Namespace) -> int:
         f"Ran {len(codes)} simulated sessions into {args.study}. "
         f"Next: 'feelmysign study analyse {args.study}'."
     )
+    if args.wearer == "in-range":
+        from feelmysign.study.simulated import in_range_truths
+
+        print(
+            "Known truth of the in-range wearers, to compare with the analysis's needed "
+            f"resolutions: the strokes at which the average participant reaches "
+            f"{store.design.criterion:.0%} correct (each participant's curve is shifted by an "
+            "amount of their own):"
+        )
+        for truth in in_range_truths(store.design).values():
+            print(
+                f"  {truth.shape}: {truth.needed_strokes:.2f} strokes (tested "
+                f"{truth.lowest_tested}-{truth.highest_tested}; slope "
+                f"{truth.slope_per_doubling:g} per doubling, participants' SD "
+                f"{truth.spread_doublings:g} doublings)"
+            )
     return 0
 
 

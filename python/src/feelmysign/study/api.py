@@ -19,6 +19,7 @@ JSON without the browser asking first, which this server never allows).
     GET  /api/study/participants/CODE/threshold       SQ2.2: runs, estimate, next trial
     POST /api/study/participants/CODE/threshold-send  {"dimension": "length" | "duration"}
     POST /api/study/participants/CODE/threshold-answer {"dimension", "position", "response"}
+    POST /api/study/participants/CODE/threshold-discard {"dimension"}: the run under way
     GET  /api/study/review                            answers waiting for a decision (blind)
     POST /api/study/review/TRIAL                      {"shape": name or null}
     POST /api/study/analyse                           export + analysis -> files, report
@@ -200,6 +201,8 @@ class StudyApi:
             dimension = dimension_of(data.get("dimension"))
             position, response = int(data["position"]), str(data.get("response", ""))
             return _json(200, self.threshold.answer(code, dimension, position, response))
+        elif action == "threshold-discard":
+            return _json(200, self.threshold.discard(code, dimension_of(data.get("dimension"))))
         else:
             return _json(404, {"error": f"no such participant action: {action}"})
         return _json(200, {"state": s.state(code)})

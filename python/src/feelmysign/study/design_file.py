@@ -119,7 +119,19 @@ def _randomisation(problems: Problems, value: Any) -> Randomisation:
 def _stimulus(problems: Problems, value: Any, base_dir: Path) -> Stimulus:
     table = problems.table("stimulus", value)
     problems.unknown("stimulus", table, ("speed_cm_s", "margin", "intensity", "layout"))
-    speed = problems.number("stimulus.speed_cm_s", table.get("speed_cm_s", 5.0), 0.5, 50.0)
+    speed_value = table.get("speed_cm_s", 5.0)
+    if isinstance(speed_value, list):
+        # Speed is not a factor of the design (trials, orders and the analysis vary shape and
+        # resolution only): say how to compare speeds instead.
+        problems.add(
+            "stimulus.speed_cm_s",
+            f"must be one number from 0.5 to 50; got a list of {len(speed_value)}. A study "
+            "plays every shape at one speed: to compare speeds, make one design file per "
+            "speed (copies that differ only in speed_cm_s) and a study file from each",
+        )
+        speed = None
+    else:
+        speed = problems.number("stimulus.speed_cm_s", speed_value, 0.5, 50.0)
     margin = problems.number("stimulus.margin", table.get("margin", 0.0), 0.0, 1.0)
     intensity = problems.number(
         "stimulus.intensity", table.get("intensity", MISSING), 0.05, 1.0, required=False

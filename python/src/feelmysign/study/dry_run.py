@@ -14,15 +14,31 @@ the same export byte for byte.
 
 from __future__ import annotations
 
+import json
 import math
 import random
 from collections.abc import Callable
 
+from feelmysign.errors import StudyError
 from feelmysign.study.runner import Play, Session
+from feelmysign.study.simulated import (
+    IN_RANGE,
+    TEMPLATE,
+    TRUTH_KEY,
+    WEARERS,
+    simulated_truth,
+    truth_json,
+)
 from feelmysign.study.simulated_sleeve import offline_player
 from feelmysign.study.store import StudyStore, now_ms
 
 ANSWER_MEDIAN_S = 3.0  # a simulated participant's time to answer after a shape has played
+
+
+def _record_in_range(store: StudyStore, number: int) -> None:
+    truth = simulated_truth(store) or {**truth_json(store.design), "participants": []}
+    truth["participants"] = sorted({*truth["participants"], number})
+    store.set_meta(TRUTH_KEY, json.dumps(truth, sort_keys=True))
 
 
 class SimulatedClock:
@@ -78,12 +94,18 @@ def dry_run(
     participants: int,
     *,
     seed: int = 0,
+    wearer: str = TEMPLATE,
     play: Play | None = None,
     progress: Callable[[int, str], None] = lambda number, code: None,
 ) -> list[str]:
-    """Add ``participants`` simulated participants to ``store`` and run each whole session."""
+    """Add ``participants`` simulated participants to ``store`` and run each whole session;
+    ``wearer`` says how they answer (``simulated.WEARERS``)."""
+    if wearer not in WEARERS:
+        raise StudyError(f"unknown simulated wearer {wearer!r}; one of {', '.join(WEARERS)}")
     session = Session(store, None, simulation_seed=seed)
-    session = Session(store, play or offline_player(session.layout), simulation_seed=seed)
+    session = Session(
+        store, play or offline_player(session.layout), simulation_seed=seed, wearer=wearer
+    )
     clock = SimulatedClock(now_ms()) if play is None else None
     codes = []
     if clock is not None:
@@ -92,6 +114,8 @@ def dry_run(
         for number in range(participants):
             code = store.add_participant(simulated=True)
             row = store.participant(code)
+            if wearer == IN_RANGE:
+                _record_in_range(store, int(row["number"]))
             run_simulated_participant(
                 session, code, random.Random(f"{seed}:{row['number']}"), clock
             )

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import json
 import sqlite3
+import threading
 import uuid
 from collections.abc import Callable
 from typing import Any
@@ -79,11 +80,24 @@ def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]
 class Session:
     """``Session(store, play)``: the operations on one study's participants."""
 
-    def __init__(self, store: StudyStore, play: Play | None, *, simulation_seed: int = 0) -> None:
+    def __init__(
+        self,
+        store: StudyStore,
+        play: Play | None,
+        *,
+        simulation_seed: int = 0,
+        wearer: str = "template",
+    ) -> None:
         self.store = store
         self._play = play
         self.layout: Layout = stimulus_layout(store.design.stimulus, store.base_dir)
         self._simulation_seed = simulation_seed
+        self._wearer = wearer  # how simulated participants answer (simulated.WEARERS)
+        # Trials whose shape the sleeve is playing now (a send, or a repeat send, under way):
+        # their answer waits until it has played. Kept in memory: after a restart nothing
+        # plays, and the trial is sent again.
+        self._playing: set[int] = set()
+        self._playing_lock = threading.Lock()
 
     @functools.cached_property
     def _templates(self) -> dict[str, list[Point]]:
@@ -193,13 +207,26 @@ class Session:
         trial = self._current(code, trial_id)
         drawing = str(uuid.uuid4())
         strokes = self.strokes_of(trial, drawing)
-        send_id = self.store.record_send(trial["id"], drawing, [stroke_to_json(s) for s in strokes])
+        with self._playing_lock:
+            if trial["id"] in self._playing:
+                raise StudyError(
+                    "the sleeve is still playing this trial's shape; wait until it has played, "
+                    "then send again"
+                )
+            self._playing.add(trial["id"])
         try:
-            events = self._play(strokes)
-        except FeelMySignError as error:
-            self.store.record_send_error(send_id, str(error))
-            raise
-        self.store.record_events(send_id, events)
+            send_id = self.store.record_send(
+                trial["id"], drawing, [stroke_to_json(s) for s in strokes]
+            )
+            try:
+                events = self._play(strokes)
+            except FeelMySignError as error:
+                self.store.record_send_error(send_id, str(error))
+                raise
+            self.store.record_events(send_id, events)
+        finally:
+            with self._playing_lock:
+                self._playing.discard(trial["id"])
         return events_summary(events, len(strokes))
 
     def answer(
@@ -214,6 +241,12 @@ class Session:
         trial = self._current(code, trial_id)
         if not self.store.sends(trial["id"]):
             raise StudyError("send the shape to the sleeve before recording an answer")
+        with self._playing_lock:
+            if trial["id"] in self._playing:
+                raise StudyError(
+                    "the sleeve is still playing the shape (sent again); record the answer "
+                    "when it has played, so that it answers what was felt"
+                )
         text = answer.strip()
         if len(text) > MAX_ANSWER_CHARS:
             raise StudyError(f"an answer is at most {MAX_ANSWER_CHARS} characters")
@@ -254,13 +287,31 @@ class Session:
         if not sends:
             raise StudyError("send the shape first: the simulated participant answers what it felt")
         strokes = [stroke_from_json(s) for s in json.loads(sends[-1]["strokes_json"])]
-        from feelmysign.study.simulated import SimulatedParticipant
+        from feelmysign.study.simulated import (
+            IN_RANGE,
+            InRangeWearer,
+            SimulatedParticipant,
+            in_range_truths,
+        )
 
         # The participant's number and the trial's position, not their random code and row
         # id: the same seed then gives the same answers in every new study file.
-        participant = SimulatedParticipant(seed=self._simulation_seed + int(row["number"]))
+        seed = self._simulation_seed + int(row["number"])
         key = f"{row['number']}:{trial['position']}"
-        result = participant.answer(strokes, self.layout, self.store.design, self._templates, key)
+        design = self.store.design
+        if self._wearer == IN_RANGE:
+            result = InRangeWearer(seed, in_range_truths(design)).answer(
+                strokes,
+                self.layout,
+                design,
+                self._templates,
+                key,
+                sent=str(trial["shape"]),
+                segments=int(trial["segments"]),
+            )
+        else:
+            participant = SimulatedParticipant(seed=seed)
+            result = participant.answer(strokes, self.layout, design, self._templates, key)
         return {
             "answer": result.answer,
             "felt_nothing": result.felt_nothing,

@@ -33,6 +33,9 @@ CODE_ALPHABET = "23456789ABCDEFGHJKMNPQRSTUVWXYZ"
 CODE_LENGTH = 5
 
 
+DISCARDED = "discarded"  # a threshold run's stop_reason when the researcher discarded it
+
+
 def now_ms() -> int:
     return round(time.time() * 1000)
 
@@ -162,6 +165,10 @@ class StudyStore:
     def meta(self, key: str) -> str | None:
         rows = self.query("SELECT value FROM meta WHERE key = ?", (key,))
         return str(rows[0]["value"]) if rows else None
+
+    def set_meta(self, key: str, value: str) -> None:
+        with self._transaction() as db:
+            db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", (key, value))
 
     # ---- participants ------------------------------------------------------------------
 
@@ -502,6 +509,16 @@ class StudyStore:
         return self.query(
             "SELECT * FROM threshold_trials WHERE run = ? ORDER BY position", (run_id,)
         )
+
+    def discard_threshold_run(self, run_id: int) -> None:
+        """An unfinished run the researcher discards: kept in the file with its trials, marked
+        ``DISCARDED`` (no threshold), left out of the results."""
+        with self._transaction() as db:
+            db.execute(
+                "UPDATE threshold_runs SET finished_at_ms = ?, stop_reason = ? "
+                "WHERE id = ? AND finished_at_ms IS NULL",
+                (self.clock(), DISCARDED, run_id),
+            )
 
     def finish_threshold_run(
         self, run_id: int, *, threshold: float, low: float, high: float, stop_reason: str

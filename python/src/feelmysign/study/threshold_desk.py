@@ -24,7 +24,7 @@ from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
 from feelmysign.study.choices import DIMENSIONS, Dimension
 from feelmysign.study.runner import Play, events_summary
-from feelmysign.study.store import StudyStore
+from feelmysign.study.store import DISCARDED, StudyStore
 from feelmysign.study.threshold import (
     MIN_TRIALS,
     Procedure,
@@ -117,6 +117,18 @@ class ThresholdDesk:
             del self._sent[run_id]
             return self._state(code)
 
+    def discard(self, code: str, dimension: Dimension) -> dict[str, Any]:
+        """Discard the participant's run under way (a run started by mistake, or one to
+        begin again): it stays in the study file, marked discarded, out of the results."""
+        with self._lock:
+            run_id = unfinished_run(self.store, code, dimension)
+            if run_id is None:
+                raise StudyError(f"no {dimension} run is under way for {code}; nothing to discard")
+            self.store.discard_threshold_run(run_id)
+            self._sent.pop(run_id, None)
+            self._procedures.pop(run_id, None)
+            return self._state(code)
+
     # ---- what the page shows -------------------------------------------------------------
 
     def _state(self, code: str) -> dict[str, Any]:
@@ -156,7 +168,12 @@ class ThresholdDesk:
                     "trials": len(self.store.threshold_trials(r["id"])),
                 }
                 for r in runs
-                if r["finished_at_ms"] is not None
+                if r["finished_at_ms"] is not None and r["stop_reason"] != DISCARDED
+            ],
+            "discarded_runs": [
+                {"run": r["id"], "trials": len(self.store.threshold_trials(r["id"]))}
+                for r in runs
+                if r["stop_reason"] == DISCARDED
             ],
             "run": None,
         }

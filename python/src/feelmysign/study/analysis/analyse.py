@@ -31,6 +31,7 @@ from feelmysign.study.analysis.report import write_report
 from feelmysign.study.analysis.wilson import wilson_interval
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 from feelmysign.study.export import anonymous_labels, export_study, trial_rows
+from feelmysign.study.simulated import simulated_truth
 from feelmysign.study.store import StudyStore
 
 
@@ -48,6 +49,8 @@ class Analysis:
     files: list[Path]
     threshold_runs: list[dict[str, Any]]
     per_participant: list[dict[str, Any]]  # one row per participant (anonymised)
+    # A dry run's known truth (in-range simulated wearers), None for a study without one.
+    simulated_truth: dict[str, Any] | None = None
 
 
 def main_trials(store: StudyStore) -> pd.DataFrame:
@@ -116,6 +119,7 @@ def analyse_study(
         files=files,
         threshold_runs=threshold_summaries(store),
         per_participant=participant_table(frame, [s.name for s in design.shapes]),
+        simulated_truth=_truth_with_labels(store),
     )
     files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
     if needed:
@@ -124,6 +128,16 @@ def analyse_study(
     files.append(_results_json(out_dir / "results.json", analysis))
     files.append(write_report(out_dir / "report.md", store, analysis))
     return analysis
+
+
+def _truth_with_labels(store: StudyStore) -> dict[str, Any] | None:
+    """A dry run's known truth, its participants named as in the export (P01, ...)."""
+    truth = simulated_truth(store)
+    if truth is None:
+        return None
+    numbers, labels = set(truth["participants"]), anonymous_labels(store)
+    named = [labels[p["code"]] for p in store.participants() if p["number"] in numbers]
+    return truth | {"participants": named}
 
 
 def participant_table(frame: pd.DataFrame, shapes: list[str]) -> list[dict[str, Any]]:
@@ -223,6 +237,9 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
         "shape_model": asdict(analysis.model) if analysis.model else None,
         "thresholds": analysis.threshold_runs,
         "per_participant": analysis.per_participant,
+        # A dry run with in-range simulated wearers: their curves, to compare with the
+        # estimates above ("participants": those who answered by it, as labelled above).
+        "simulated_truth": analysis.simulated_truth,
     }
     path.write_text(json.dumps(data, indent=2, default=str) + "\n", encoding="utf-8")
     return path

@@ -37,7 +37,6 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 import statsmodels.api as sm
-import statsmodels.formula.api as smf
 from statsmodels.genmod.bayes_mixed_glm import BinomialBayesMixedGLM
 
 FORMULA = "correct ~ C(shape, Treatment(reference=@reference)) + log2_strokes"
@@ -93,6 +92,19 @@ def shape_differences(frame: pd.DataFrame, *, seed: int = 0) -> ModelResult:
     return ModelResult(reference, mixed, participant_sd, slope, test, note)
 
 
+def null_design(data: pd.DataFrame) -> np.ndarray:
+    """The design matrix of ``NULL_FORMULA``, column for column and bit for bit as the
+    formula interface (patsy) builds it: intercept, one treatment column per participant
+    after the first in sorted order, log2(strokes); column-major, as patsy hands it to the
+    fit, so that the fit is the same to the last bit. Built directly: the formula's parsing
+    and checks cost more than the fit itself in the calibration's thousands of studies."""
+    participants = np.asarray(sorted(data["participant"].unique()))
+    codes = pd.Categorical(data["participant"], categories=participants).codes
+    dummies = codes[:, None] == np.arange(1, len(participants))[None, :]
+    columns = [np.ones(len(data)), *dummies.T.astype(float), data["log2_strokes"].to_numpy(float)]
+    return np.asfortranarray(np.column_stack(columns))
+
+
 def shape_profiles(data: pd.DataFrame) -> np.ndarray:
     """Per participant (rows) and shape (columns): the mean of correct minus the accuracy a
     shape-free logistic model of log2(strokes) with the participant's own intercept expects,
@@ -100,7 +112,9 @@ def shape_profiles(data: pd.DataFrame) -> np.ndarray:
     if data["correct"].nunique() > 1:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # a near-perfect fit warns; its values are still right
-            glm = smf.glm(NULL_FORMULA, data, family=sm.families.Binomial()).fit()
+            glm = sm.GLM(
+                data["correct"].to_numpy(float), null_design(data), family=sm.families.Binomial()
+            ).fit()
         expected = np.asarray(glm.fittedvalues, dtype=float)
     else:  # every answer the same: the model is that constant
         expected = data["correct"].to_numpy(float)

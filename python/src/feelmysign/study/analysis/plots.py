@@ -96,7 +96,8 @@ def threshold_plot(path: Path, needed: dict[str, Needed], criterion: float) -> P
     axes.set_yticks(range(len(names)), names)
     axes.set_xscale("log", base=2)
     axes.set_xlabel(
-        f"strokes needed for {criterion:.0%} correct (95% bootstrap interval; grey: tested; "
+        # Two lines: on one, the label is wider than the figure and is cut at both ends.
+        f"strokes needed for {criterion:.0%} correct (95% bootstrap interval; grey: tested;\n"
         "blue <: at or below the lowest tested; red >: above the highest)",
         fontsize="small",
     )

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from feelmysign.study.analysis.models import ShapeTest
 from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
-from feelmysign.study.store import StudyStore
+from feelmysign.study.store import DISCARDED, StudyStore
 
 if TYPE_CHECKING:
     from feelmysign.study.analysis.analyse import Analysis
@@ -23,14 +23,14 @@ def needed_text(needed: Needed) -> str:
     return f"{needed.strokes:.1f}"
 
 
-def interval_text(interval: Interval) -> str:
+def interval_text(interval: Interval, digits: int = 1) -> str:
     """An interval truncated to the tested range; an open end is written ≤ or ≥."""
     if interval.low_open and interval.high <= interval.low:
         return f"≤ {interval.low:g}"  # wholly at or below the lowest tested
     if interval.high_open and interval.low >= interval.high:
         return f"≥ {interval.high:g}"
-    low = f"≤ {interval.low:g}" if interval.low_open else f"{interval.low:.1f}"
-    high = f"≥ {interval.high:g}" if interval.high_open else f"{interval.high:.1f}"
+    low = f"≤ {interval.low:g}" if interval.low_open else f"{interval.low:.{digits}f}"
+    high = f"≥ {interval.high:g}" if interval.high_open else f"{interval.high:.{digits}f}"
     return f"{low} - {high}"
 
 
@@ -122,6 +122,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "the highest tested)': it reached it at none. Intervals are cut at the tested range: "
         "'≤ n' or '≥ n' at an end means the interval goes on beyond what was tested.",
     ]
+    lines += _truth_section(analysis)
     lines += [
         "",
         "![needed resolution](needed-resolution.png)",
@@ -156,6 +157,41 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     path.write_text("\n".join(lines), encoding="utf-8")
     return path
+
+
+def _truth_section(analysis: Analysis) -> list[str]:
+    """A dry run's known truth beside the estimates (in-range simulated wearers)."""
+    truth = analysis.simulated_truth
+    if not truth:
+        return []
+    lines = [
+        "",
+        f"**Dry run: known truth.** {len(truth['participants'])} of the participants are "
+        "simulated in-range wearers, who answer by a known curve per shape (each "
+        "participant's curve shifted along log2(strokes) by their own amount). The strokes at "
+        f"which their average participant reaches {truth['criterion']:.0%} correct:",
+        "",
+        "| shape | true strokes needed | estimate | 95% interval | interval covers the truth |",
+        "|---|---|---|---|---|",
+    ]
+    # In the design's order; the interval to two decimals, as the truth (6.0 may be 5.96).
+    for shape in [*analysis.accuracy, *(s for s in truth["shapes"] if s not in analysis.accuracy)]:
+        if shape not in truth["shapes"]:
+            continue
+        needed = analysis.needed.get(shape)
+        value = float(truth["shapes"][shape]["needed_strokes"])
+        if needed is None:
+            lines.append(f"| {shape} | {value:.2f} | - | - | - |")
+            continue
+        interval = needed.interval
+        covers = (interval.low_open or interval.low <= value) and (
+            interval.high_open or value <= interval.high
+        )
+        lines.append(
+            f"| {shape} | {value:.2f} | {needed_text(needed)} | {interval_text(interval, 2)} | "
+            f"{'yes' if covers else 'no'} |"
+        )
+    return lines
 
 
 def _participant_section(analysis: Analysis, shapes: list[str]) -> list[str]:
@@ -219,9 +255,9 @@ def _runs_table(runs: list[dict[str, Any]]) -> list[str]:
     for run in runs:
         unit = "grid units" if run["dimension"] == "length" else "ms"
         if run["threshold"] is None:
+            what = "discarded" if run["stop_reason"] == DISCARDED else "not finished"
             lines.append(
-                f"| {run['participant']} | {run['dimension']} | not finished | | "
-                f"{run['trials']} | |"
+                f"| {run['participant']} | {run['dimension']} | {what} | | {run['trials']} | |"
             )
             continue
         lines.append(
