@@ -234,7 +234,8 @@ def test_the_table_shows_each_motor_as_driven_under_the_layouts_cap(
 ) -> None:
     layout = tmp_path / "capped.toml"
     layout.write_text(
-        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\ndefault_intensity = 0.4\n[safety]\nmax_intensity = 0.5\n"
+        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\ndefault_intensity = 0.4\n"
+        "[safety]\nmax_intensity = 0.5\n"
     )
     for asked, driven in ((0.9, 0.5), (0.3, 0.3)):
         assert (
