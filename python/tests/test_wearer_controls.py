@@ -244,6 +244,7 @@ def test_the_sleeve_says_its_controls_in_its_status_and_refuses_while_paused(
         cut = running.wait_events(7)[6]
         assert (cut["type"], cut["seq"], cut["by"]) == ("cancelled", 4, "wearer")
         assert running.sleeve.controls.state().paused is False
+        drawing = str(uuid.uuid4())  # the stop stopped the drawing: a new one plays
         # "Do not disturb": refused with the time it ends, until it is ended.
         until_ms = round(wall_ms()) + 60_000
         running.sleeve.controls.set_do_not_disturb(until_ms, "page")
