@@ -189,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     if args.wearer_page is not None:
         from feelmysign.cli._wearer_page import wearer_page_server
 
-        page = wearer_page_server(args, options.sleeve_id, layout, running)
+        page = wearer_page_server(args, options.sleeve_id, layout, running, settings)
 
     def started(sleeve: Sleeve) -> None:
         running.append(sleeve)
