@@ -70,7 +70,14 @@ from feelmysign.protocol import CANCELLED, DO_NOT_DISTURB, DUPLICATE, HELD, PAUS
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
-from feelmysign.sleeve.controls import ControlsState, WearerControls, controls_path, refusal_for
+from feelmysign.sleeve.controls import (
+    NOT_PAUSED,
+    ControlsState,
+    WearerControls,
+    controls_path,
+    describe,
+    refusal_for,
+)
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -228,6 +235,12 @@ class Sleeve:
             stop=self._wearer_stop,
         )
         self.controls.subscribe(self._controls_changed)
+        if self.controls.state() != NOT_PAUSED:  # kept from before a restart: said once
+            log.info(
+                "sleeve %s: the wearer's controls at start: %s",
+                self._id,
+                describe(self.controls.state()),
+            )
         self._connection = 0  # counts connections: an acknowledgement is valid on its own only
         self._stopped = threading.Event()
         self._connected = threading.Event()
@@ -589,14 +602,7 @@ class Sleeve:
         )
 
     def _controls_changed(self, state: ControlsState) -> None:
-        log.info(
-            "sleeve %s: the wearer's controls: paused %s%s, ceiling %s, do not disturb until %s",
-            self._id,
-            state.paused,
-            f" (by {state.paused_by})" if state.paused_by else "",
-            "none" if state.ceiling is None else f"{state.ceiling:g}",
-            state.do_not_disturb_until_ms,
-        )
+        log.info("sleeve %s: the wearer's controls: %s", self._id, describe(state))
         self._outbox.put(
             _Publish(telemetry_topic(self._id, "status"), self._status(online=True), 1, True)
         )
