@@ -9,7 +9,9 @@ the sleeve opens when it takes its buttons::
     press gpiochip0 27
     release gpiochip0 27
 
-(:func:`press_in` and :func:`release_in` write them.) The pipe wakes the sleeve the way
+(:func:`press_in` and :func:`release_in` write them, and say when no sleeve reads the
+pipe; a shell's plain ``echo`` into it then waits forever, a FIFO having no reader, so the
+commands the sleeve prints run it under ``timeout 2``, see :func:`press_command`.) The pipe wakes the sleeve the way
 a real line's edge does, with no polling, and the button records when it saw each
 change as the bus records everything else, in the state file: ``pressed_at`` and
 ``released_at`` (the wall clock in ms, and the bus's transaction count then), the number
