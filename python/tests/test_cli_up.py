@@ -372,6 +372,57 @@ def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
     assert all(c["drawing"] is None and c["intensity"] == 0.0 for c in changes[len(played) :])
 
 
+@pytest.mark.broker
+def test_up_with_a_sleeve_builder_s_layout_emulates_its_buttons_and_says_how_to_press_them(
+    tmp_path: Path,
+) -> None:
+    """A layout with [controls] and an enable line, on a machine with no GPIO: the simulated
+    sleeve emulates the buttons, prints how to press them, and a press pauses it."""
+    layout = tmp_path / "builder.toml"
+    paper = (Path(__file__).resolve().parents[2] / "deploy/layouts/paper-sleeve.toml").read_text()
+    layout.write_text(
+        paper.replace("[i2c]\n", '[i2c]\nenable = { chip = "gpiochip0", line = 17 }\n', 1)
+        + '\n[controls]\npause_button = { chip = "gpiochip0", line = 27 }\n'
+    )
+    web = tmp_path / "web"
+    web.mkdir()
+    (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    env["XDG_STATE_HOME"] = str(tmp_path / "xdg")
+    argv = [*RUN_ONLY, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
+    ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
+    up = subprocess.Popen(
+        [*argv, *ports, "--layout", str(layout)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env=env,
+    )
+    seen: list[str] = []
+    try:
+        out = _lines(up.stdout)
+        press = _wait_for(out, "  press it:", seen).split(":", 1)[1].strip()
+        _wait_for(out, "Press Ctrl-C to stop.", seen)
+        assert any("enable line (gpiochip0 line 17) is left alone" in line for line in seen), seen
+        assert press.startswith("timeout 2 sh -c 'echo press gpiochip0 27 > "), press
+        subprocess.run(press, shell=True, check=True, timeout=WAIT_S)
+        controls = tmp_path / "xdg" / "feelmysign" / "controls" / "sleeve1.json"
+        deadline_s = time.monotonic() + WAIT_S
+        while not (controls.exists() and json.loads(controls.read_text())["paused"]):
+            assert time.monotonic() < deadline_s, f"the press never paused the sleeve: {seen}"
+            time.sleep(0.05)
+        assert json.loads(controls.read_text())["paused_by"] == "button"
+    finally:
+        up.send_signal(signal.SIGINT)
+        try:
+            up.wait(timeout=WAIT_S)
+        finally:
+            if up.poll() is None:
+                up.kill()
+    assert up.returncode == 0, seen
+    assert not any("Error" in line for line in seen), seen
+
+
 @pytest.mark.skipif(shutil.which("make") is None, reason="needs make")
 def test_make_up_passes_args_on() -> None:
     done = subprocess.run(

@@ -197,10 +197,20 @@ def test_kill_9_while_paused_restarts_paused_and_a_ceiling_holds(
             "ceiling": 0.7,
             "do_not_disturb_until_ms": None,
         }
-        watcher.send(Stroke((0.0, 1.0), (3.0, 1.0), 300.0, 1.0, "while-paused", 0))
-        refused = watcher.next(lambda n, b: b.get("drawing") == "while-paused", "its refusal")
-        assert (refused["type"], refused["reason"]) == ("rejected", "paused"), refused
+        for seq in range(3):
+            watcher.send(Stroke((0.0, 1.0), (3.0, 1.0), 300.0, 1.0, "while-paused", seq))
+            refused = watcher.next(lambda n, b: b.get("drawing") == "while-paused", "a refusal")
+            assert (refused["type"], refused["reason"]) == ("rejected", "paused"), refused
         assert set(drive_levels(state).values()) == {0.0}
+        # The log: the state kept said once at start, the presses in words, and one line for
+        # the drawing refused while paused, not one a stroke.
+        log = (tmp_path / "sleeve.log").read_text()
+        restarted = log[log.rindex("connecting to") :]
+        print(restarted)
+        assert "the wearer's controls at start: paused (by button), ceiling 0.7" in log
+        assert "press press" not in log and f"line {PAUSE_LINE}): pressed" in log
+        assert restarted.count("drawing while-paused") == 1, restarted
+        assert "until None" not in log
 
         press(state, PAUSE_LINE)  # resume: the ceiling still holds, on every motor
         watcher.next(controls_said(paused=False, ceiling=0.7), "a status saying resumed")

@@ -127,18 +127,40 @@ def test_a_pause_and_a_ceiling_survive_a_restart(tmp_path: Path) -> None:
     assert controls(path).state() == ControlsState(paused=False, ceiling=0.6)
 
 
-def test_an_unreadable_controls_file_starts_the_sleeve_paused(
+def test_a_controls_file_unreadable_falls_back_to_its_last_good_copy(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     path = tmp_path / "controls.json"
-    path.write_text('{"format": "feelmysign-controls/1", "paused": "maybe"')
+    controls(path).set_ceiling(0.6, "page")
+    path.write_text('{"format": "feelmysign-controls/1", "paused": "maybe"')  # a disk's damage
     state = controls(path).state()
-    assert (state.paused, state.paused_by) == (True, "sleeve")
-    (line,) = [r.getMessage() for r in caplog.records if "controls file" in r.getMessage()]
-    assert str(path) in line and "starting paused" in line
-    # Resuming writes the file anew.
+    assert state == ControlsState(paused=False, ceiling=0.6)  # the wearer's choice, whole
+    (line,) = [r.getMessage() for r in caplog.records if "last good copy" in r.getMessage()]
+    assert str(path) in line and "ceiling 0.6" in line
+
+
+@pytest.mark.parametrize("last_good", ["missing", "damaged"])
+def test_no_readable_controls_start_the_sleeve_paused_with_the_least_ceiling(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, last_good: str
+) -> None:
+    """Never stronger than the wearer chose: the chosen ceiling is unknown, so the least."""
+    path = tmp_path / "controls.json"
+    controls(path).set_ceiling(0.6, "page")
+    path.write_text('{"format": "feelmysign-controls/1", "paused": "maybe"')
+    backup = Path(f"{path}.last-good")
+    if last_good == "missing":
+        backup.unlink()
+    else:
+        backup.write_bytes(b"\xff\xfe")
+    state = controls(path).state()
+    assert state == ControlsState(paused=True, paused_by="sleeve", ceiling=MIN_CEILING)
+    (line,) = [r.getMessage() for r in caplog.records if "cannot be read" in r.getMessage()]
+    assert str(path) in line and "starting paused" in line and "least ceiling" in line
+    assert "sets the ceiling again" in line
+    # Resuming writes both files anew, with the ceiling still the least until set again.
     controls(path).resume("page")
-    assert controls(path).state() == ControlsState(paused=False)
+    assert controls(path).state() == ControlsState(paused=False, ceiling=MIN_CEILING)
+    assert json.loads(backup.read_text())["paused"] is False
 
 
 @pytest.mark.parametrize("ceiling", [0.0, 0.04, 0.95, float("nan"), True, "0.5"])
@@ -244,6 +266,7 @@ def test_the_sleeve_says_its_controls_in_its_status_and_refuses_while_paused(
         cut = running.wait_events(7)[6]
         assert (cut["type"], cut["seq"], cut["by"]) == ("cancelled", 4, "wearer")
         assert running.sleeve.controls.state().paused is False
+        drawing = str(uuid.uuid4())  # the stop stopped the drawing: a new one plays
         # "Do not disturb": refused with the time it ends, until it is ended.
         until_ms = round(wall_ms()) + 60_000
         running.sleeve.controls.set_do_not_disturb(until_ms, "page")

@@ -114,3 +114,75 @@ def test_wearer_host_without_wearer_page_is_refused(broker: Broker) -> None:
     )
     assert result.returncode == 1, result.stdout + result.stderr
     assert "needs --wearer-page" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_a_second_sleeve_beside_up_s_broker_blocks_senders_on_its_own_page(
+    start_broker: Any, tmp_path: Path
+) -> None:
+    """``broker add-sleeve arm2`` and ``sleeve --join TOKEN --wearer-page`` on the machine
+    whose usual state directory holds the broker: the page finds that broker and blocks."""
+    xdg = tmp_path / "xdg"
+    env = {**os.environ, "XDG_STATE_HOME": str(xdg)}
+    state_dir = xdg / "feelmysign" / "broker"  # where up and 'feelmysign broker' keep it
+    start_broker(state_dir=state_dir)
+
+    def broker_command(*words: str) -> str:
+        done = subprocess.run(
+            [FEELMYSIGN, "broker", *words],
+            capture_output=True,
+            text=True,
+            timeout=WAIT_S,
+            env=env,
+            check=True,
+        )
+        return done.stdout.strip().splitlines()[-1]
+
+    token = broker_command("add-sleeve", "arm2")
+    broker_command("add-sender", "--name", "alice")
+    sleeve = subprocess.Popen(
+        [FEELMYSIGN, "sleeve", "--join", token, "--wearer-page", "0", "--wearer-host", "127.0.0.1"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env=env,
+    )
+    lines: queue.Queue[str] = queue.Queue()
+    stdout = sleeve.stdout
+    assert stdout is not None
+
+    def read() -> None:
+        for line in stdout:
+            lines.put(line)
+
+    threading.Thread(target=read, daemon=True).start()
+    try:
+        seen = ""
+        url = re.compile(r"http://127\.0\.0\.1:(\d+)/wearer\?key=([\w-]+)")
+        while (found := url.search(seen)) is None:
+            seen += lines.get(timeout=WAIT_S)
+        port, key = int(found[1]), found[2]
+
+        def call(method: str, path: str, body: dict[str, Any] | None = None) -> tuple[int, Any]:
+            connection = http.client.HTTPConnection("127.0.0.1", port, timeout=WAIT_S)
+            headers = {"Cookie": f"feelmysign_wearer_key={key}", "Content-Type": "application/json"}
+            data = None if body is None else json.dumps(body).encode()
+            connection.request(method, path, body=data, headers=headers)
+            answer = connection.getresponse()
+            result = answer.status, json.loads(answer.read())
+            connection.close()
+            return result
+
+        deadline_s = time.monotonic() + WAIT_S
+        while not (state := call("GET", "/api/wearer/state")[1])["online"]:
+            assert time.monotonic() < deadline_s, f"the sleeve never came online: {seen}"
+            time.sleep(0.1)
+        assert state["sleeve_id"] == "arm2", state
+        assert state["blocking"] is True, state
+        assert {"name": "alice", "blocked": False, "blockable": True} in state["senders"]
+        status, state = call("POST", "/api/wearer/block", {"sender": "alice"})
+        assert status == 200, state
+        assert {"name": "alice", "blocked": True, "blockable": True} in state["senders"]
+    finally:
+        sleeve.send_signal(signal.SIGINT)
+        sleeve.wait(WAIT_S)
+    assert sleeve.returncode == 0, seen

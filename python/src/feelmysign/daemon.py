@@ -37,7 +37,7 @@ import logging
 import queue
 import threading
 import time
-from collections import Counter
+from collections import Counter, OrderedDict, deque
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -46,7 +46,7 @@ from feelmysign.backends.base import Backend
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
-from feelmysign.control import CANCEL_ALL, Cancel, parse_control
+from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError
 from feelmysign.events import (
     Cancelled,
@@ -66,11 +66,18 @@ from feelmysign.fates import Fate
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.player import SPIN_MS, WEARER, PlannedStroke, Player, cancelled
-from feelmysign.protocol import CANCELLED, DUPLICATE, HELD
+from feelmysign.protocol import CANCELLED, DO_NOT_DISTURB, DUPLICATE, HELD, PAUSED
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
-from feelmysign.sleeve.controls import ControlsState, WearerControls, controls_path, refusal_for
+from feelmysign.sleeve.controls import (
+    NOT_PAUSED,
+    ControlsState,
+    WearerControls,
+    controls_path,
+    describe,
+    refusal_for,
+)
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -99,6 +106,18 @@ CONNECTION_STATE = {"connection_state": True}
 CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
 # Safety events after which the status's ``hardware`` changed: published again with them.
 HARDWARE_EVENTS = frozenset({"chip_lost", "chip_back"})
+# The wearer's stop stops every drawing "under way": one with a stroke arriving in this last
+# while (or one playing or waiting). Longer than a pen rests mid-drawing; a drawing that is
+# over sends no more strokes, so stopping it too changes nothing. A new drawing (a new id)
+# plays.
+DRAWING_UNDER_WAY_MS = 10_000.0
+# Drawings remembered with their last stroke's arrival, for the wearer's stop.
+REMEMBERED_ARRIVALS = 64
+# Strokes refused "paused" during one pause, remembered: a long press (a stop) that follows
+# tells their senders the drawing was stopped.
+REMEMBERED_PAUSED = 1024
+# The wearer's refusals (a pause, "do not disturb"): logged once per drawing, not per stroke.
+WEARER_REFUSALS = frozenset({PAUSED, DO_NOT_DISTURB})
 
 
 def sleeve_client_id(sleeve_id: str, password: str | None) -> str:
@@ -197,6 +216,16 @@ class Sleeve:
             max_age_ms=options.max_age_ms,
             max_lag_ms=options.max_lag_ms,
         )
+        # For the wearer's stop: the drawings lately seen (drawing -> the monotonic ms of its
+        # last stroke's arrival), the strokes refused during the present pause, and the
+        # drawings stopped (drawing -> when, wall clock: the admission's cancel of it).
+        self._arrivals: OrderedDict[str, float] = OrderedDict()
+        self._arrivals_lock = threading.Lock()
+        self._refused_paused: deque[StrokeRef] = deque(maxlen=REMEMBERED_PAUSED)
+        self._wearer_stops: dict[str, float] = {}
+        self._was_paused = False
+        # The drawings whose refusal for the wearer's pause or DND was logged (one line each).
+        self._quiet_refusals: set[tuple[str, object]] = set()
         # The wearer's pause, stop, ceiling and "do not disturb": in force before the player
         # starts (a sleeve restarted while paused never plays a stroke).
         self.controls = WearerControls(
@@ -206,6 +235,12 @@ class Sleeve:
             stop=self._wearer_stop,
         )
         self.controls.subscribe(self._controls_changed)
+        if self.controls.state() != NOT_PAUSED:  # kept from before a restart: said once
+            log.info(
+                "sleeve %s: the wearer's controls at start: %s",
+                self._id,
+                describe(self.controls.state()),
+            )
         self._connection = 0  # counts connections: an acknowledgement is valid on its own only
         self._stopped = threading.Event()
         self._connected = threading.Event()
@@ -454,17 +489,38 @@ class Sleeve:
             if ack is not None:
                 planned.acknowledge = lambda: self._outbox.put(ack)
             refusal = self._player.submit(planned)
-            if refusal is not None:
+            self._arrived(ref.drawing, received_at_ms)
+            if refusal is None:
+                return
+            if refusal.reason == CANCELLED and refusal.cancelled_at_ms is not None:
+                at_ms = refusal.cancelled_at_ms
+                self._event(cancelled(ref, at_ms, started=False, by=refusal.by), ack)
+            else:
                 self._reject(refusal.reason, refusal.message, ref, ack)
             return
         ref = verdict.ref
+        self._arrived(ref.drawing, received_at_ms)
         if verdict.reason == CANCELLED and verdict.cancelled_at_ms is not None:
-            self._event(cancelled(ref, verdict.cancelled_at_ms, started=False), ack)
+            at_ms = verdict.cancelled_at_ms
+            by = WEARER if self._wearer_stops.get(ref.drawing) == at_ms else None  # type: ignore[arg-type]
+            self._event(cancelled(ref, at_ms, started=False, by=by), ack)
         elif verdict.reason != HELD:
             self._reject(verdict.reason, verdict.message, ref, ack)
         elif not self._hold(ref, ack):
             # The original started (or was dropped) since: this copy is a duplicate.
             self._reject(DUPLICATE, duplicate_message(ref.drawing, ref.seq), ref, ack)
+
+    def _arrived(self, drawing: object, received_at_ms: float) -> None:
+        """A stroke of ``drawing`` arrived (whatever became of it): under way, for the wearer's
+        stop."""
+        if not isinstance(drawing, str):
+            return
+        arrivals = self._arrivals
+        with self._arrivals_lock:
+            arrivals[drawing] = received_at_ms
+            arrivals.move_to_end(drawing)
+            if len(arrivals) > REMEMBERED_ARRIVALS:
+                arrivals.popitem(last=False)
 
     def _hold(self, ref: StrokeRef, ack: _Ack | None) -> bool:
         """The copy waits with its original, acknowledged when that one plays: False when the
@@ -505,20 +561,48 @@ class Sleeve:
         self._admission.ceiling = state.ceiling
         self._player.set_ceiling(state.ceiling)
         received_wall_ms = wall_ms()
+        if state.paused != self._was_paused:
+            # A new pause (or its end): the strokes refused for the last one are its own.
+            self._refused_paused.clear()
+            self._was_paused = state.paused
+        self._quiet_refusals.clear()  # a change is logged: the next refusal is said again
         self._player.refuse(refusal_for(state, received_wall_ms), received_wall_ms)
 
     def _wearer_stop(self) -> None:
-        self._player.cancel(Cancel(CANCEL_ALL), wall_ms(), by=WEARER)
+        """Stop every drawing under way, as a sender's Stop stops its own: what plays is cut,
+        what waits dropped (``cancelled`` by the wearer), and every later stroke of those
+        drawings refused as ``cancelled`` by the wearer; a new drawing plays. Strokes of them
+        refused ``paused`` during this pause (the first edge of a long press pauses) are told
+        ``cancelled`` by the wearer too, so that the stop is what their sender hears last."""
+        now_wall_ms, now_ms = wall_ms(), monotonic_ms()
+        with self._arrivals_lock:
+            recent = [
+                drawing
+                for drawing, at_ms in self._arrivals.items()
+                if now_ms - at_ms <= DRAWING_UNDER_WAY_MS
+            ]
+        # The player's set first: from here no stroke of these drawings is placed.
+        stopped = self._player.stop_drawings(recent, now_wall_ms)
+        for drawing in stopped:
+            self._wearer_stops[drawing] = now_wall_ms
+            self._admission.cancelled.cancel(drawing, now_wall_ms)
+        for drawing in list(self._wearer_stops):  # as many as the admission remembers
+            if drawing not in self._admission.cancelled:
+                self._wearer_stops.pop(drawing, None)
+        told = [ref for ref in list(self._refused_paused) if ref.drawing in stopped]
+        self._refused_paused.clear()
+        for ref in told:
+            self._event(cancelled(ref, now_wall_ms, started=False, by=WEARER))
+        log.info(
+            "sleeve %s: the wearer stopped %s",
+            self._id,
+            f"drawing{'s' if len(stopped) > 1 else ''} {', '.join(sorted(stopped))}"
+            if stopped
+            else "what played (no drawing under way)",
+        )
 
     def _controls_changed(self, state: ControlsState) -> None:
-        log.info(
-            "sleeve %s: the wearer's controls: paused %s%s, ceiling %s, do not disturb until %s",
-            self._id,
-            state.paused,
-            f" (by {state.paused_by})" if state.paused_by else "",
-            "none" if state.ceiling is None else f"{state.ceiling:g}",
-            state.do_not_disturb_until_ms,
-        )
+        log.info("sleeve %s: the wearer's controls: %s", self._id, describe(state))
         self._outbox.put(
             _Publish(telemetry_topic(self._id, "status"), self._status(online=True), 1, True)
         )
@@ -534,7 +618,21 @@ class Sleeve:
             # leaves it played (once), a copy of a refused one leaves it refused.
             original_played = self._player.started(ref.drawing, ref.seq)
             message = duplicate_message(ref.drawing, ref.seq, original_played)
-        log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
+        if reason in WEARER_REFUSALS:
+            # Once per drawing while the wearer's choice lasts: a drawing sent to a paused
+            # sleeve would otherwise fill the journal a line a stroke.
+            key = (reason, ref.drawing)
+            if key not in self._quiet_refusals:
+                self._quiet_refusals.add(key)
+                log.info(
+                    "sleeve %s: refusing the strokes of drawing %s (%s): %s",
+                    self._id,
+                    ref.drawing,
+                    reason,
+                    message,
+                )
+        else:
+            log.info("sleeve %s: rejected a stroke (%s): %s", self._id, reason, message)
         rejected = Rejected(
             reason=reason, message=message, stroke=ref, original_played=original_played
         )
@@ -556,6 +654,8 @@ class Sleeve:
             self._say_if_delayed(event)
         elif isinstance(event, Rejected):  # by the sleeve, or by the player for a pause
             self._count("rejected", f"rejected:{event.reason}")
+            if event.reason == PAUSED and isinstance(event.stroke.drawing, str):
+                self._refused_paused.append(event.stroke)
         elif isinstance(event, Cancelled):
             self._count("cancelled")
         elif isinstance(event, Safety) and event.reason == "duty_cycle":

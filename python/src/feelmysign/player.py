@@ -42,8 +42,8 @@ import logging
 import sys
 import threading
 import time
-from collections import deque
-from collections.abc import Callable
+from collections import OrderedDict, deque
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -64,10 +64,10 @@ from feelmysign.events import (
 )
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline, outline
-from feelmysign.protocol import DUPLICATE, PLAYER_STOPPED, QUEUE_FULL, SILENCED
+from feelmysign.protocol import CANCELLED, DUPLICATE, PLAYER_STOPPED, QUEUE_FULL, SILENCED
 from feelmysign.schedule import Schedule
 from feelmysign.sleeve.admission import MAX_BACKLOG_MS, MAX_PENDING, duplicate_message, queue_full
-from feelmysign.sleeve.queue import Queue
+from feelmysign.sleeve.queue import REMEMBERED_CANCELS, Queue
 from feelmysign.timeline import Capped, Change, Timeline
 
 log = logging.getLogger(__name__)
@@ -87,6 +87,7 @@ RETRY_LOST_S = 0.2
 # written: a wire that comes loose mid-stroke drops the line within this (plus a read).
 CHECK_DRIVEN_S = 0.005
 WEARER = "wearer"  # the ``by`` of the events of strokes the wearer stopped or paused
+STOPPED_MESSAGE = "the wearer stopped this drawing; a new drawing plays"
 
 
 @dataclass
@@ -121,6 +122,9 @@ class PlannedStroke:
 class Refusal:
     reason: str
     message: str
+    # ``cancelled``: when the cancel came (wall clock ms), and who sent it ("wearer").
+    cancelled_at_ms: float | None = None
+    by: str | None = None
 
 
 @dataclass(frozen=True)
@@ -186,6 +190,11 @@ class Player:
         self._cancels: list[_CancelRequest] = []
         # The wearer paused the sleeve (or "do not disturb" runs): every stroke is refused so.
         self._refusal: Refusal | None = None
+        # Drawings the wearer stopped, each with when: their later strokes are refused as
+        # cancelled (checked here, under the lock, as well as on arrival: a stroke admitted
+        # just before the stop and placed just after it must not play).
+        self._stopped_drawings: OrderedDict[str, float] = OrderedDict()
+        self._started_drawing: str | None = None  # the drawing of the stroke started last
         self._thread: threading.Thread | None = None
         self._beat_s = time.monotonic()  # when the player's loop last went round (``alive``)
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
@@ -209,6 +218,9 @@ class Player:
         # moved the tail since). An idle sleeve's stroke pays one comparison here.
         faster = self._faster(stroke) if self._queue.tail_ms > stroke.received_at_ms else None
         with self._lock:
+            if self._stopped_drawings and drawing in self._stopped_drawings:
+                at_ms = self._stopped_drawings[drawing]  # type: ignore[index]
+                return Refusal(CANCELLED, STOPPED_MESSAGE, at_ms, WEARER)
             if self._refusal is not None:  # under the lock: a pause covers every stroke
                 return self._refusal
             if self._queue.seen(drawing, seq):
@@ -355,6 +367,28 @@ class Player:
         with self._lock:
             self._cancels.append(_CancelRequest(cancel, self._accepted, received_wall_ms, by))
         self._wake.set()
+
+    def stop_drawings(self, drawings: Iterable[str], received_wall_ms: float) -> set[str]:
+        """The wearer's stop: every stroke accepted so far is cut (playing) or dropped
+        (waiting), reported ``cancelled`` by the wearer, and every later stroke of
+        ``drawings`` and of the drawings with strokes accepted is refused as ``cancelled``.
+        Returns the drawings stopped."""
+        with self._lock:
+            # The timeline is the player thread's: what waits is in _unplayed, the drawing
+            # playing is the last one started.
+            stopped = set(drawings) | {drawing for drawing, _ in self._unplayed}
+            if self._started_drawing is not None:
+                stopped.add(self._started_drawing)
+            for drawing in stopped:
+                self._stopped_drawings[drawing] = received_wall_ms
+                self._stopped_drawings.move_to_end(drawing)
+            while len(self._stopped_drawings) > REMEMBERED_CANCELS:
+                self._stopped_drawings.popitem(last=False)
+            self._cancels.append(
+                _CancelRequest(Cancel(CANCEL_ALL), self._accepted, received_wall_ms, WEARER)
+            )
+        self._wake.set()
+        return stopped
 
     def refuse(self, refusal: Refusal | None, received_wall_ms: float) -> None:
         """The wearer paused the sleeve (or set "do not disturb"): from now on every stroke is
@@ -787,6 +821,8 @@ class Player:
             self._pending -= 1
             acknowledge = self._done(stroke)
             self._queue.mark_started(stroke.ref.drawing, stroke.ref.seq)
+            drawing = stroke.ref.drawing
+            self._started_drawing = drawing if isinstance(drawing, str) else None
         self.played += 1
         self._on_event(played_event(stroke, now))
         if acknowledge is not None:

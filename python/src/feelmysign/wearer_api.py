@@ -81,7 +81,7 @@ class WearerApi:
         max_intensity: float,
         controls: Callable[[], WearerControls | None],
         online: Callable[[], bool],
-        blocking: Blocking | None = None,
+        blocking: Blocking | Callable[[], Blocking | None] | None = None,
     ) -> None:
         self._sleeve_id = sleeve_id
         self._max_intensity = max_intensity
@@ -99,12 +99,19 @@ class WearerApi:
         except FeelMySignError as error:
             return 400, JSON, _json({"error": str(error)})
 
+    def _blocking_now(self) -> Blocking | None:
+        """The broker whose senders may be blocked: given, or looked for at each call (a
+        sleeve's own page finds the local broker once it runs)."""
+        blocking = self._blocking
+        return blocking() if callable(blocking) else blocking
+
     def state(self) -> dict[str, Any]:
         controls = self._controls()
         senders: list[dict[str, Any]] = []
-        if self._blocking is not None:
+        blocking = self._blocking_now()
+        if blocking is not None:
             senders.append({"name": PAGE_SENDER, "blocked": False, "blockable": False})
-            for name, sender in sorted(load_senders(self._blocking.files.senders).items()):
+            for name, sender in sorted(load_senders(blocking.files.senders).items()):
                 senders.append({"name": name, "blocked": sender.blocked, "blockable": True})
         return {
             "sleeve_id": self._sleeve_id,
@@ -112,7 +119,7 @@ class WearerApi:
             "controls": None if controls is None else controls.state().to_json(),
             "max_intensity": self._max_intensity,
             "senders": senders,
-            "blocking": self._blocking is not None,
+            "blocking": blocking is not None,
         }
 
     def _answer(self, method: str, path: str, body: bytes, content_type: str) -> dict[str, Any]:
@@ -146,12 +153,15 @@ class WearerApi:
         return self.state()
 
     def _block(self, name: str, *, blocked: bool) -> None:
-        if self._blocking is None:
+        blocking = self._blocking_now()
+        if blocking is None:
             raise _Refused(
                 400,
-                "Blocking a sender needs the broker feelmysign runs, from its own machine (the "
-                "wearer's page of 'feelmysign up'); this sleeve reaches a broker this page does "
-                "not run: its owner removes the sender's account there.",
+                "Blocking a sender needs the broker feelmysign runs, on the machine of this "
+                "page (in its usual state directory, as 'feelmysign up' and 'feelmysign broker' "
+                "keep it); this sleeve's broker is not found there: block the sender on the "
+                "wearer's page of 'feelmysign up' where the broker runs, or its owner removes "
+                "the sender's account.",
             )
         if name == PAGE_SENDER:
             raise _Refused(
@@ -159,8 +169,8 @@ class WearerApi:
                 f"The drawing page of 'feelmysign up' ({PAGE_SENDER!r}) cannot be blocked here: "
                 "pause the sleeve instead, or stop 'feelmysign up'.",
             )
-        set_blocked(self._blocking.files.senders, name, blocked)
-        reload_running_broker(self._blocking.files, self._blocking.credentials)
+        set_blocked(blocking.files.senders, name, blocked)
+        reload_running_broker(blocking.files, blocking.credentials)
 
 
 _ACTIONS = ("pause", "resume", "stop", "ceiling", "do-not-disturb", "block", "unblock")

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from feelmysign.backends.enable import CONSUMER, import_gpiod, line_error
 from feelmysign.errors import HardwareError
 from feelmysign.sleeve.controls import MIN_CEILING, WearerControls
-from feelmysign.sleeve.presses import Press, Presses
+from feelmysign.sleeve.presses import LONG_PRESS_MS, Press, Presses
 
 if TYPE_CHECKING:
     from feelmysign.layout import ButtonLine
@@ -42,6 +42,12 @@ log = logging.getLogger(__name__)
 TURN_DOWN_STEP = 0.1  # ten presses from full drive to the least; each one clearly felt
 IDLE_WAIT_S = 1.0  # nothing pending: wake now and then to see whether to stop
 BY = "button"
+# What the log says of each press (presses.Press).
+PRESS_WORDS: dict[Press, str] = {
+    "press": "pressed",
+    "short": "let go (a short press)",
+    "long": f"held {LONG_PRESS_MS / 1000:g} s (a long press)",
+}
 
 
 class ButtonInput(Protocol):
@@ -167,7 +173,7 @@ class ButtonWatcher:
                 self._act(press)
 
     def _act(self, press: Press) -> None:
-        log.info("the wearer's %s: %s press", self._line.description, press)
+        log.info("the wearer's %s: %s", self._line.description, PRESS_WORDS[press])
         try:
             if self._role == "pause":
                 self._pause_button(press)

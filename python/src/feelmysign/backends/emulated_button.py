@@ -9,7 +9,9 @@ the sleeve opens when it takes its buttons::
     press gpiochip0 27
     release gpiochip0 27
 
-(:func:`press_in` and :func:`release_in` write them.) The pipe wakes the sleeve the way
+(:func:`press_in` and :func:`release_in` write them, and say when no sleeve reads the
+pipe; a shell's plain ``echo`` into it then waits forever, a FIFO having no reader, so the
+commands the sleeve prints run it under ``timeout 2``, see :func:`press_command`.) The pipe wakes the sleeve the way
 a real line's edge does, with no polling, and the button records when it saw each
 change as the bus records everything else, in the state file: ``pressed_at`` and
 ``released_at`` (the wall clock in ms, and the bus's transaction count then), the number
@@ -22,9 +24,11 @@ from __future__ import annotations
 
 import errno
 import os
+import shlex
 import stat
 import threading
 import time
+from collections.abc import Mapping
 
 # The emulated bus imports this; it stays light (see emulated_i2c).
 TYPE_CHECKING = False
@@ -111,12 +115,12 @@ def pipe_path(state_path: str | os.PathLike[str]) -> str:
 
 
 class ButtonPipe:
-    """The named pipe next to a state file, read on a thread of its own: each line moves a
-    button of ``bus``. Opened for reading and writing, so it never reads end-of-file when
+    """The named pipe next to a state file, read on a thread of its own: each line moves one
+    of ``buttons``. Opened for reading and writing, so it never reads end-of-file when
     a writer goes away (Linux lets a FIFO be opened so)."""
 
-    def __init__(self, bus: EmulatedI2CBus, path: str) -> None:
-        self._bus = bus
+    def __init__(self, buttons: Mapping[tuple[str, int], EmulatedButton], path: str) -> None:
+        self._buttons = buttons  # (chip, line) -> its button
         self._path = path
         self._fd: int | None = None
         self._thread: threading.Thread | None = None
@@ -126,6 +130,7 @@ class ButtonPipe:
 
         try:
             if not os.path.exists(self._path):
+                os.makedirs(os.path.dirname(self._path) or ".", mode=0o700, exist_ok=True)
                 os.mkfifo(self._path, 0o600)
             elif not stat.S_ISFIFO(os.stat(self._path).st_mode):
                 raise HardwareError(
@@ -150,13 +155,20 @@ class ButtonPipe:
     def _take(self, words: list[str]) -> None:
         if len(words) != 3 or words[0] not in ("press", "release") or not words[2].isdigit():
             return  # not ours: a pipe anyone may write to must not stop the sleeve
-        button = self._bus.buttons.get((words[1], int(words[2])))
+        button = self._buttons.get((words[1], int(words[2])))
         if button is None:
             return
         if words[0] == "press":
             button.press()
         else:
             button.let_go()
+
+
+def press_command(pipe: str, chip: str, line: int, what: str = "press") -> str:
+    """The shell command that presses (``what="release"``: lets go) a button through ``pipe``.
+    Under ``timeout``: with no sleeve reading the pipe, a plain ``echo`` into it would wait
+    for one forever."""
+    return f"timeout 2 sh -c 'echo {what} {chip} {line} > {shlex.quote(pipe)}'"
 
 
 def press_in(state_path: str | os.PathLike[str], chip: str, line: int) -> None:

@@ -109,13 +109,22 @@ def enable_line_for(layout: Layout, bus: I2CBus | None) -> Line | None:
     return GpiodLine(layout.enable)
 
 
-def button_inputs(layout: Layout, backend: Backend) -> list[tuple[ButtonLine, ButtonInput]]:
+def button_inputs(
+    layout: Layout, backend: Backend, *, sim_pipe: str | None = None
+) -> list[tuple[ButtonLine, ButtonInput]]:
     """The wearer's buttons of ``layout`` ([controls]), each with its line: the emulated bus's
     own when ``backend`` drives one (pressed through the pipe next to its state file, if it
-    has one), else the real GPIO line (gpiod is imported when it is requested)."""
+    has one); emulated too with the simulator when ``sim_pipe`` is given, pressed through it
+    (``feelmysign up``: a sender trying a sleeve builder's layout on a machine with no GPIO);
+    else the real GPIO line (gpiod is imported when it is requested)."""
     from feelmysign.backends.button import GpiodButton
-    from feelmysign.backends.emulated_button import ButtonPipe, pipe_path
+    from feelmysign.backends.emulated_button import ButtonPipe, EmulatedButton, pipe_path
 
+    if isinstance(backend, SimBackend) and sim_pipe is not None:
+        buttons = {(b.chip, b.line): EmulatedButton(b.chip, b.line) for b in layout.buttons}
+        if buttons:
+            ButtonPipe(buttons, sim_pipe).open()
+        return [(b, buttons[(b.chip, b.line)]) for b in layout.buttons]
     bus = getattr(backend, "bus", None)
     if not isinstance(bus, EmulatedI2CBus):
         return [(button, GpiodButton(button)) for button in layout.buttons]
@@ -123,7 +132,7 @@ def button_inputs(layout: Layout, backend: Backend) -> list[tuple[ButtonLine, Bu
         (button, bus.add_button(button.chip, button.line)) for button in layout.buttons
     ]
     if found and bus.state_path is not None:
-        ButtonPipe(bus, pipe_path(bus.state_path)).open()
+        ButtonPipe(bus.buttons, pipe_path(bus.state_path)).open()
     return found
 
 

@@ -5,7 +5,9 @@ On the Pi there is no ``feelmysign up``: the sleeve process serves the same page
 can pause even when the broker is down. Off loopback it is HTTPS with a certificate from
 the same local CA machinery as ``up --lan`` (``feelmysign.broker.tls``), kept with the
 wearer's key in ``$XDG_STATE_HOME/feelmysign/wearer-page``. Blocking senders needs the
-broker feelmysign runs, which is not here: the page says so.
+broker feelmysign runs: when this sleeve reaches the broker kept in this machine's usual
+state directory (a second sleeve beside ``up``, joined with ``broker add-sleeve``), the page
+blocks there; otherwise (the Pi, whose broker runs elsewhere) the page says so.
 """
 
 from __future__ import annotations
@@ -14,13 +16,18 @@ import argparse
 import os
 from pathlib import Path
 
+from feelmysign.broker._config import StateFiles
+from feelmysign.broker.credentials import load_credentials
+from feelmysign.broker.mosquitto import default_state_dir
 from feelmysign.broker.tls import LanOptions
 from feelmysign.cli._page_server import qr_text
 from feelmysign.cli.options.lan import default_route_address
+from feelmysign.connection import BrokerSettings
+from feelmysign.connection.settings import parse_broker_url
 from feelmysign.daemon import Sleeve
 from feelmysign.errors import BrokerError, FeelMySignError
 from feelmysign.layout import Layout
-from feelmysign.wearer_api import WearerApi, wearer_key
+from feelmysign.wearer_api import Blocking, WearerApi, wearer_key
 from feelmysign.webserver import LOOPBACK_HOSTS, WEB_DIST, WebServer
 
 
@@ -29,8 +36,34 @@ def state_dir() -> Path:
     return Path(state_home) / "feelmysign" / "wearer-page"
 
 
+LOOPBACK_NAMES = frozenset({"127.0.0.1", "localhost", "::1"})
+
+
+def local_broker(settings: BrokerSettings) -> Blocking | None:
+    """The broker feelmysign runs from this machine's usual state directory (as ``up`` and
+    ``feelmysign broker`` keep it), when the sleeve's ``settings`` reach that broker; else
+    None. Read at each call: the broker may start after the sleeve, or restart."""
+    files = StateFiles(default_state_dir())
+    try:
+        credentials = load_credentials(files.credentials)
+    except (FeelMySignError, OSError):
+        return None  # no broker kept here (the Pi), or a file being rewritten
+    urls = [credentials.mqtt_url, credentials.mqtts_url, credentials.ws_url]
+    served = {_endpoint(parse_broker_url(url)) for url in urls if url}
+    return Blocking(files, credentials) if _endpoint(settings) in served else None
+
+
+def _endpoint(settings: BrokerSettings) -> tuple[str, int]:
+    host = "127.0.0.1" if settings.host in LOOPBACK_NAMES else settings.host
+    return host, settings.port
+
+
 def wearer_page_server(
-    args: argparse.Namespace, sleeve_id: str, layout: Layout, running: list[Sleeve]
+    args: argparse.Namespace,
+    sleeve_id: str,
+    layout: Layout,
+    running: list[Sleeve],
+    settings: BrokerSettings | None = None,
 ) -> tuple[WebServer, str] | None:
     """The server (not yet started) and what to print (the wearer's URL with the key, and a
     QR code off loopback), or None without --wearer-page.
@@ -57,6 +90,7 @@ def wearer_page_server(
         max_intensity=layout.max_intensity,
         controls=lambda: running[0].controls if running else None,
         online=lambda: bool(running) and running[0].connected.is_set(),
+        blocking=None if settings is None else lambda: local_broker(settings),
     )
     server = WebServer(
         port=args.wearer_page,

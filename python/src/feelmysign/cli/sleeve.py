@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Callable, Mapping
 from contextlib import nullcontext
@@ -11,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from feelmysign.backends.base import Backend
 from feelmysign.backends.factory import BACKEND_NAMES, BackendName, button_inputs, open_backend
+from feelmysign.backends.sim import SimBackend
 from feelmysign.backends.telemetry import ActuatorFrame, ActuatorTelemetry
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.cli.options.emulation import add_emulate_state_option
@@ -187,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     if args.wearer_page is not None:
         from feelmysign.cli._wearer_page import wearer_page_server
 
-        page = wearer_page_server(args, options.sleeve_id, layout, running)
+        page = wearer_page_server(args, options.sleeve_id, layout, running, settings)
 
     def started(sleeve: Sleeve) -> None:
         running.append(sleeve)
@@ -233,9 +235,12 @@ def run_sleeve(
     emulate: bool = False,
     emulate_state: str | None = None,
     on_start: Callable[[Sleeve], None] = lambda sleeve: None,
+    sim_buttons: bool = False,
 ) -> Sleeve:
     """Open the backend with its telemetry, run the sleeve until it stops; every motor off after.
-    Returns the stopped sleeve (its counts, its strokes by fate)."""
+    Returns the stopped sleeve (its counts, its strokes by fate). ``sim_buttons``: with the
+    simulator, the layout's buttons are emulated, pressed through a pipe beside the sleeve's
+    controls file (``feelmysign up``), instead of read from GPIO lines."""
     sleeves: list[Sleeve] = []
 
     def publish(frame: ActuatorFrame) -> None:
@@ -255,7 +260,13 @@ def run_sleeve(
     ):
         sleeve = Sleeve(settings, layout, opened, options, telemetry=telemetry)
         sleeves.append(sleeve)
-        watchers = _watch_buttons(layout, opened, sleeve)
+        watchers = _watch_buttons(layout, opened, sleeve, sim_buttons=sim_buttons)
+        if sim_buttons and isinstance(opened, SimBackend) and layout.enable is not None:
+            print(
+                f"The layout's enable line ({layout.enable.name}) is left alone: the "
+                "simulated sleeve drives no GPIO.",
+                flush=True,
+            )
         try:
             on_start(sleeve)
             sleeve.run()
@@ -265,14 +276,20 @@ def run_sleeve(
     return sleeve
 
 
-def _watch_buttons(layout: Layout, backend: Backend, sleeve: Sleeve) -> list[ButtonWatcher]:
+def _watch_buttons(
+    layout: Layout, backend: Backend, sleeve: Sleeve, *, sim_buttons: bool = False
+) -> list[ButtonWatcher]:
     """The wearer's buttons ([controls]) watched, each on a thread; HardwareError (what to
     check) for one that cannot be had: the wearer's control is never silently absent."""
     from feelmysign.backends.button import ButtonWatcher
+    from feelmysign.backends.emulated_button import PIPE_SUFFIX, pipe_path, press_command
 
     watchers: list[ButtonWatcher] = []
+    sim_pipe = os.path.splitext(sleeve.controls.path)[0] + PIPE_SUFFIX if sim_buttons else None
+    bus_state = getattr(getattr(backend, "bus", None), "state_path", None)
+    pipe = sim_pipe if isinstance(backend, SimBackend) else bus_state and pipe_path(bus_state)
     try:
-        for button, line in button_inputs(layout, backend):
+        for button, line in button_inputs(layout, backend, sim_pipe=sim_pipe):
             watcher = ButtonWatcher(line, button.role, sleeve.controls)
             watcher.start()
             watchers.append(watcher)
@@ -280,6 +297,12 @@ def _watch_buttons(layout: Layout, backend: Backend, sleeve: Sleeve) -> list[But
             if button.role != "pause":
                 kind = "turn-down button (each press: a step down)"
             print(f"The wearer's {kind}: {line.description}", flush=True)
+            if pipe:
+                print(
+                    f"  press it:  {press_command(pipe, button.chip, button.line)}\n"
+                    f"  let go:    {press_command(pipe, button.chip, button.line, 'release')}",
+                    flush=True,
+                )
     except BaseException:
         for watcher in watchers:
             watcher.stop()

@@ -165,6 +165,8 @@ def run(args: argparse.Namespace) -> int:
                     backend=args.sleeve_backend,
                     record=args.record,
                     on_start=started,
+                    # The simulated sleeve has no GPIO: a layout's buttons are emulated.
+                    sim_buttons=True,
                 )
     print("Stopped: sleeve (every motor off), drawing client and broker.", flush=True)
     return 0

@@ -16,9 +16,15 @@ before a method returns, so that it survives a restart, ``kill -9`` included::
     {"format": "feelmysign-controls/1", "paused": true, "paused_by": "button",
      "ceiling": 0.6, "do_not_disturb_until_ms": null}
 
-A file that cannot be read or makes no sense is said in one log line, and the sleeve
-starts paused (``paused_by: "sleeve"``): the wearer's last choice is unknown, and
-paused is the safe side. The wearer resumes as after any pause.
+Each change is first written to a second file, ``<sleeve-id>.json.last-good``, the same
+way, then to the first: a file that cannot be read or makes no sense (a disk that lost
+it, a hand edit) is said in one log line, and the other one is used. When neither can be
+read the wearer's last choice is unknown, and the sleeve starts on the safe side of both
+choices: **paused** (``paused_by: "sleeve"``) and with the **least ceiling**
+(``MIN_CEILING``, 0.05), as the log line says. Not "no ceiling": after the wearer
+resumes, the sleeve must never play stronger than the wearer chose, and the least
+ceiling is below any ceiling the wearer can choose; the wearer raises it again on the
+wearer's page (or removes it), which writes both files anew.
 """
 
 from __future__ import annotations
@@ -47,6 +53,7 @@ ControlsState = StatusControls
 
 CONTROLS_FORMAT = "feelmysign-controls/1"
 MAX_CONTROLS_BYTES = 64 * 1024  # the file is under 200 bytes
+LAST_GOOD_SUFFIX = ".last-good"  # the second copy, written before the first
 # Below this a stroke is barely felt at all: a ceiling lower than it is a pause, which the
 # wearer has its own control for.
 MIN_CEILING = 0.05
@@ -249,17 +256,20 @@ class WearerControls:
         return state
 
     def _save(self, state: ControlsState) -> None:
-        """Written whole or not at all. A disk that refuses leaves the choice in force in this
-        process (the wearer's choice wins now) and says it will not survive a restart."""
+        """Written whole or not at all, the second copy first (so one of the two holds a
+        whole state whatever happens meanwhile). A disk that refuses leaves the choice in
+        force in this process (the wearer's choice wins now) and says it will not survive a
+        restart."""
         text = json.dumps({"format": CONTROLS_FORMAT, **state.to_json()}) + "\n"
-        temporary = f"{self._path}.{os.getpid()}.tmp"
         try:
             os.makedirs(os.path.dirname(self._path), mode=0o700, exist_ok=True)
-            with open(temporary, "w", encoding="utf-8") as file:
-                file.write(text)
-                file.flush()
-                os.fsync(file.fileno())  # a pause must survive a power cut that follows it
-            os.replace(temporary, self._path)
+            for path in (self._path + LAST_GOOD_SUFFIX, self._path):
+                temporary = f"{path}.{os.getpid()}.tmp"
+                with open(temporary, "w", encoding="utf-8") as file:
+                    file.write(text)
+                    file.flush()
+                    os.fsync(file.fileno())  # a pause must survive a power cut that follows it
+                os.replace(temporary, path)
         except OSError as error:
             log.error(
                 "the wearer's controls could not be kept in %s (%s): they hold until the sleeve "
@@ -269,17 +279,42 @@ class WearerControls:
             )
 
     def _load(self) -> ControlsState:
+        """The first file's state; else the second copy's, said in one line; else the safe
+        side (paused, the least ceiling). Neither file: a sleeve the wearer never touched."""
+        last_good = self._path + LAST_GOOD_SUFFIX
+        state, problem = self._read(self._path)
+        if state is not None:
+            return state
+        if problem is None and not os.path.exists(last_good):
+            return NOT_PAUSED
+        fallback, fallback_problem = self._read(last_good)
+        if fallback is not None:
+            if problem is not None:
+                log.error(
+                    "the wearer's controls file %s is unusable (%s): using its last good copy "
+                    "%s (%s)",
+                    self._path,
+                    problem,
+                    last_good,
+                    describe(fallback),
+                )
+            return fallback
+        problems = [f"{self._path}: {problem or 'missing'}"]
+        problems.append(f"{last_good}: {fallback_problem or 'missing'}")
+        return self._unreadable("; ".join(problems))
+
+    def _read(self, path: str) -> tuple[ControlsState | None, str | None]:
+        """The state in ``path``, or None and what is wrong with it (None: no such file)."""
         try:
-            text = read_text(self._path, max_bytes=MAX_CONTROLS_BYTES)
+            text = read_text(path, max_bytes=MAX_CONTROLS_BYTES)
         except FileNotFoundError:
-            return NOT_PAUSED  # a sleeve the wearer never touched
+            return None, None
         except (OSError, UnicodeDecodeError) as error:
-            return self._unreadable(f"cannot be read: {getattr(error, 'strerror', None) or error}")
+            return None, f"cannot be read: {getattr(error, 'strerror', None) or error}"
         try:
-            state = self._parse(loads_json(text))
+            return self._parse(loads_json(text)), None
         except (ValueError, TypeError, KeyError) as error:
-            return self._unreadable(str(error))
-        return state
+            return None, str(error) or type(error).__name__
 
     def _parse(self, data: Any) -> ControlsState:
         if not isinstance(data, dict) or data.get("format") != CONTROLS_FORMAT:
@@ -304,13 +339,14 @@ class WearerControls:
 
     def _unreadable(self, problem: str) -> ControlsState:
         log.error(
-            "the wearer's controls file %s is unusable (%s): starting paused, the safe side; "
-            "the wearer resumes with the pause button or the wearer's page (which writes the "
-            "file anew)",
-            self._path,
+            "the wearer's controls cannot be read (%s): starting paused and with the least "
+            "ceiling, %g, the safe side, as the ceiling the wearer chose is unknown; the wearer "
+            "resumes with the pause button or the wearer's page, and sets the ceiling again "
+            "there (which writes the file anew)",
             problem,
+            MIN_CEILING,
         )
-        return ControlsState(paused=True, paused_by=BY_SLEEVE)
+        return ControlsState(paused=True, paused_by=BY_SLEEVE, ceiling=MIN_CEILING)
 
     def _time_do_not_disturb(self) -> None:
         """A timer that ends "do not disturb" at its time (none when it is off)."""
@@ -337,6 +373,16 @@ class WearerControls:
             log.info('"do not disturb" ended at %s', _clock_time(until_ms))
             self._timer = None
             self._change(do_not_disturb_until_ms=None)
+
+
+def describe(state: ControlsState) -> str:
+    """The controls in words, for the log: "paused (by button), ceiling 0.6, do not disturb
+    until 2026-11-26 23:00:00 UTC"."""
+    paused = f"paused (by {state.paused_by})" if state.paused else "not paused"
+    ceiling = "no ceiling" if state.ceiling is None else f"ceiling {state.ceiling:g}"
+    until_ms = state.do_not_disturb_until_ms
+    dnd = "" if until_ms is None else f', "do not disturb" until {_clock_time(until_ms)}'
+    return f"{paused}, {ceiling}{dnd}"
 
 
 def _finite(value: object) -> float | None:
