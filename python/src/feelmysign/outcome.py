@@ -110,7 +110,7 @@ class DrawingOutcome:
                     return False
                 stroke.cut_reason = event.reason
                 return True
-            if stroke.final:
+            if stroke.final and not _stopped_after_pause(stroke, event):
                 return False
             stroke.refused_reason = event.reason
             stroke.refused_message = event.message
@@ -183,6 +183,18 @@ class DrawingSummary:
         if self.held:
             text += f"; {len(self.held)} not sent (from stroke {self.held[0] + 1} on)"
         return text
+
+
+def _stopped_after_pause(stroke: StrokeOutcome, event: Safety | Cancelled) -> bool:
+    """The wearer's long press pauses at once and then stops the drawing: a stroke refused
+    ``paused`` during the press is then ``cancelled`` by the wearer, the word that stands (as
+    in feelmysign.fates, where a stroke's own cancel ranks above a refusal)."""
+    return (
+        isinstance(event, Cancelled)
+        and event.by == WEARER
+        and stroke.played is None
+        and stroke.refused_reason in WEARER_REASONS
+    )
 
 
 def _reasons(counts: Counter[str]) -> str:
