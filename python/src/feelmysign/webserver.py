@@ -12,8 +12,8 @@ listens on, or one of ``hosts``, with its port; any other Host gets ``403
 Forbidden`` with the reason. Else a web page from anywhere could point its own
 host name at this machine (DNS rebinding) and read the password as its own.
 
-The server is aiohttp's (HTTP parsing with size limits, TLS, a WebSocket server and
-client), on one asyncio loop in one thread: an idle or hostile connection costs a few
+The server is aiohttp's (HTTP parsing with size limits, TLS, the WebSocket handshake
+for the relay), on one asyncio loop in one thread: an idle or hostile connection costs a few
 kilobytes, never a thread. What a network peer sends (a malformed or oversized
 request, TLS garbage, a cut handshake, a device that does not trust the certificate
 yet, a disconnect at any point) is answered with its HTTP status or a closed
