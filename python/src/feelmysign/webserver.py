@@ -715,6 +715,8 @@ class WebServer:
             # the broker as they arrive: aiohttp's own WebSocketResponse takes them likewise.
             request.protocol.set_parser(_PageBytes(upstream_transport, upstream))  # type: ignore[arg-type]
             upstream.start()
+            if page.is_closing():  # gone before its bytes came here: no end of them will
+                upstream_transport.close()
             await upstream.ended
         except (OSError, asyncio.CancelledError) as error:
             self._log.debug("relay from %s ended: %r", request.remote, error)
