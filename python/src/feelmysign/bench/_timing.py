@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import Any, TypeVar
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -31,6 +34,16 @@ def best_rate(name: str, work: Callable[[], int], *, repeats: int = 5) -> Rate:
         items = work()
         best = min(best, time.perf_counter() - start)
     return Rate(name, items, best)
+
+
+def each(work: Callable[[T], Any], items: Iterable[T]) -> int:
+    """``work`` on every item, each result let go at once (as the sleeve does with a stroke's
+    plan); how many. Keeping them all would make the garbage collector walk them on each pass."""
+    count = 0
+    for item in items:
+        work(item)
+        count += 1
+    return count
 
 
 def row(rate: Rate, baseline: Rate) -> str:

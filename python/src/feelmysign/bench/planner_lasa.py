@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from feelmysign.bench._timing import Rate, best_rate, row
+from feelmysign.bench._timing import Rate, best_rate, each, row
 from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.planner import plan
 from feelmysign.protocol import format_legacy, parse
@@ -111,16 +111,17 @@ def faster(stroke: Stroke, speed: float) -> Stroke:
 
 
 def planner_rates(name: str, strokes: list[Stroke]) -> tuple[Rate, Rate]:
-    """Planning these strokes, beside parsing their legacy payloads (the sleeve's step before)."""
+    """Planning these strokes, beside parsing their legacy payloads (the sleeve's step before),
+    each result let go at once as the sleeve does (``each``)."""
     payloads = [format_legacy(s) for s in strokes]
     baseline = best_rate(
         f"baseline: parse legacy payload ({name})",
-        lambda: len([parse(p, PAPER_SLEEVE) for p in payloads]),
+        lambda: each(lambda p: parse(p, PAPER_SLEEVE), payloads),
         repeats=TIMED_REPEATS,
     )
     planned = best_rate(
         f"planner: plan one LASA stroke ({name})",
-        lambda: len([plan(s, PAPER_SLEEVE) for s in strokes]),
+        lambda: each(lambda s: plan(s, PAPER_SLEEVE), strokes),
         repeats=TIMED_REPEATS,
     )
     return baseline, planned
