@@ -91,8 +91,11 @@ PYTEST_ARGS ?= --durations=10
 # takes the next test (worksteal), every test with its own ports and temporary state.
 PYTEST_WORKERS ?= 2
 
+# OpenBLAS on one thread in each worker: the study statistics' small matrix products are
+# slower spread over threads that spin on two shared cores (the coverage tests took 1.7x the
+# time with its default threads), and the workers already keep both cores busy.
 pytest: $(STAMP) system
-	cd python && ../$(BIN)/pytest -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS)
+	cd python && OPENBLAS_NUM_THREADS=1 ../$(BIN)/pytest -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS)
 
 # Everything `make test` installs; independent of each other, so `make -j` runs them at once.
 install: system $(STAMP)
