@@ -548,6 +548,14 @@ export class App {
       this.#sender.send(stroke);
     }
     this.#says.setHeld(0);
+    // On the timeline now, arriving as they go; their fate (played, refused) moves them from there.
+    const drawing = this.#session.drawing;
+    this.#felt.heldSent(
+      strokes.flatMap((stroke) =>
+        drawing !== null && stroke.drawing === drawing.id && stroke.seq != null ? [stroke.seq] : [],
+      ),
+      performance.now(),
+    );
     if (strokes.length > 0) this.#says.add("info", `${strokes.length} held stroke(s) sent.`);
     this.#showWearer();
   }
@@ -556,6 +564,7 @@ export class App {
     const strokes = this.#wearer.take();
     this.#markNeverSent(strokes);
     this.#says.setHeld(0);
+    this.#felt.refresh();
     this.#showWearer();
   }
 

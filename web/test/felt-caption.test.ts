@@ -8,6 +8,7 @@ import { readEvent, type SleeveEvent } from "../src/events";
 import { DrawingFates } from "../src/fates";
 import { DEFAULT_ANGLE_PARAMS } from "../src/simplify/params";
 import type { DrawingView } from "../src/ui/canvas";
+import type { PlacedStroke } from "../src/felt";
 import { FeltPanel, timelineCaption, type Tally, type TallySource } from "../src/ui/felt-panel";
 import type { TimelineView } from "../src/ui/timeline";
 
@@ -49,6 +50,26 @@ describe("timelineCaption", () => {
     expect(timelineCaption(on(2, 2), { ...NONE, played: 2, refused: 1, dropped: 1 }, false)).toBe(
       "2 strokes, 1.0 s; 2 as the sleeve played them, 1 refused by the sleeve (not on the timeline), " +
         "1 never sent (not on the timeline).",
+    );
+  });
+});
+
+describe("timelineCaption with strokes held on the page (the wearer paused)", () => {
+  it("never says a held stroke is what would be felt: it is held, not sent yet", () => {
+    expect(timelineCaption(on(0, 0), { ...NONE, held: 4 }, false)).toBe(
+      "4 held on this page, not sent yet (the wearer paused; not on the timeline).",
+    );
+    expect(
+      timelineCaption(on(2, 0), { ...NONE, held: 2, heldWhy: "the wearer asked not to be disturbed" }, false),
+    ).toBe(
+      "2 strokes, 1.0 s: what would be felt, played back to back as the sleeve does; " +
+        "2 held on this page, not sent yet (the wearer asked not to be disturbed; not on the timeline).",
+    );
+  });
+
+  it("says the held strokes apart from those played", () => {
+    expect(timelineCaption(on(2, 2), { ...NONE, played: 2, held: 2 }, false)).toBe(
+      "2 strokes, 1.0 s; 2 as the sleeve played them, 2 held on this page, not sent yet (the wearer paused; not on the timeline).",
     );
   });
 });
@@ -116,25 +137,39 @@ function drawingOf(strokes: number): Drawing {
   return drawing;
 }
 
-/** The panel with the card's tally (the same fates the card counts), and what it shows. */
-function panelOf(strokes: number) {
+/**
+ * The panel with the card's tally (the same fates the card counts), and what it shows. `heldSeqs`:
+ * strokes held on the page as they were drawn (the wearer paused), as the page marks them before
+ * the panel sees them.
+ */
+function panelOf(strokes: number, heldSeqs: readonly number[] = []) {
   const fates = new DrawingFates();
   let dropped = 0;
+  const drawing = drawingOf(strokes);
+  for (const seq of heldSeqs) drawing.markHeld(seq);
+  let held = heldSeqs.length;
   const told: TallySource = {
     get counts() {
-      return { sent: strokes, ...fates.counts(), dropped };
+      return { sent: strokes, ...fates.counts(), dropped, held };
     },
     fateOf: (seq) => fates.fate(seq),
   };
-  const shown = { caption: "", onTimeline: 0 };
+  const shown: { caption: string; onTimeline: number; placed: readonly PlacedStroke[] } = {
+    caption: "",
+    onTimeline: 0,
+    placed: [],
+  };
   const timeline = {
-    show: (_grid: unknown, a: { placed: readonly unknown[] }) => (shown.onTimeline = a.placed.length),
+    show: (_grid: unknown, a: { placed: readonly PlacedStroke[] }) => {
+      shown.placed = a.placed;
+      shown.onTimeline = a.placed.length;
+    },
     setCaption: (text: string) => (shown.caption = text),
     setCursor: () => undefined,
   } as unknown as TimelineView;
   const view = { setCompare: () => undefined, drawMarker: () => undefined } as unknown as DrawingView;
   const panel = new FeltPanel(timeline, view, told);
-  panel.setDrawing(drawingOf(strokes), { rows: 3, columns: 4 });
+  panel.setDrawing(drawing, { rows: 3, columns: 4 });
   /** An event, as the page takes it: the card's fate first, then the timeline. */
   const hear = (event: SleeveEvent) => {
     fates.add(event);
@@ -145,7 +180,13 @@ function panelOf(strokes: number) {
     dropped += seqs.length;
     panel.unsent(seqs);
   };
-  return { fates, shown, hear, neverSent };
+  /** The wearer resumed and the held strokes went out at `atMs`, as the page's sendHeld does. */
+  const sendHeld = (atMs: number) => {
+    for (const seq of heldSeqs) drawing.unhold(seq);
+    held = 0;
+    panel.heldSent(heldSeqs, atMs);
+  };
+  return { fates, shown, hear, neverSent, sendHeld };
 }
 
 describe("the felt panel's caption and the card count from the same fates", () => {
@@ -181,6 +222,45 @@ describe("the felt panel's caption and the card count from the same fates", () =
     expect(shown.onTimeline).toBe(1);
     expect(shown.caption).toContain(
       "1 as the sleeve played them, 1 refused by the sleeve (not on the timeline)",
+    );
+  });
+});
+
+describe("the felt panel with strokes held while the wearer paused", () => {
+  beforeAll(() => vi.stubGlobal("requestAnimationFrame", () => 0));
+
+  function refused(seq: number): SleeveEvent {
+    return wire("rejected", seq, { reason: "paused", message: "the wearer paused", received_at_ms: 0 });
+  }
+
+  it("keeps held strokes off the timeline and says them held, not what would be felt", () => {
+    const { shown, hear } = panelOf(4, [2, 3]);
+    expect(shown.onTimeline).toBe(2);
+    expect(shown.placed.map((stroke) => stroke.seq)).toEqual([0, 1]);
+    expect(shown.caption).toMatch(
+      /^2 strokes, [\d.]+ s: what would be felt, played back to back as the sleeve does; 2 held on this page, not sent yet \(the wearer paused; not on the timeline\)\.$/,
+    );
+    hear(played(0, 1000));
+    hear(played(1, 1200));
+    expect(shown.caption).toContain("2 as the sleeve played them, 2 held on this page, not sent yet");
+  });
+
+  it("puts held strokes on the timeline when they are sent, arriving then, and moves them by their fate", () => {
+    const { shown, hear, sendHeld } = panelOf(4, [2, 3]);
+    hear(played(0, 1000));
+    hear(played(1, 1200));
+    sendHeld(5000); // drawn at 400..800 ms: they reach the sleeve at 5 s, when they were sent
+    expect(shown.placed.map((stroke) => stroke.seq)).toEqual([0, 1, 2, 3]);
+    const sentLate = shown.placed.filter((stroke) => stroke.seq >= 2);
+    // The timeline's zero is the first stroke's arrival (200 ms): drawn-time arrival would place them by 1 s.
+    expect(Math.min(...sentLate.map((stroke) => stroke.start_ms))).toBeGreaterThanOrEqual(5000 - 200);
+    expect(shown.caption).not.toContain("held");
+    expect(shown.caption).toContain("the rest as it would");
+    hear(played(2, 6000));
+    hear(refused(3)); // the wearer paused again before it played
+    expect(shown.placed.map((stroke) => stroke.seq)).toEqual([0, 1, 2]);
+    expect(shown.caption).toMatch(
+      /^3 strokes, [\d.]+ s; 3 as the sleeve played them, 1 refused by the sleeve \(not on the timeline\)\.$/,
     );
   });
 });

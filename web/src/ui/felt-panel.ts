@@ -37,6 +37,13 @@ export interface Tally {
   readonly refused: number;
   /** Never sent. */
   readonly dropped: number;
+  /**
+   * Held on this page, not sent yet (the wearer paused the sleeve, or asked not to be disturbed):
+   * counted in `sent`, not on the timeline until they go. Absent: none.
+   */
+  readonly held?: number;
+  /** Why they are held, in the card's words (`holdReason`); absent: "the wearer paused". */
+  readonly heldWhy?: string;
 }
 
 /** Where the caption reads the tally, and each stroke's fate: the card (SleeveSays). */
@@ -65,6 +72,11 @@ export class FeltPanel {
   #running = false;
   /** Stop was pressed: what the sleeve has not played yet never will be. */
   #stopped = false;
+  /**
+   * seq -> when a stroke held on the page (the wearer paused) was sent after all, ms on the
+   * drawing's clock: it reaches the sleeve then, not when it was drawn.
+   */
+  readonly #sentLateMs = new Map<number, number>();
 
   constructor(timeline: TimelineView, view: DrawingView, told: TallySource) {
     this.#timeline = timeline;
@@ -78,6 +90,7 @@ export class FeltPanel {
     this.#grid = grid;
     this.#arrival = arrival;
     this.#startedAt.clear();
+    this.#sentLateMs.clear();
     this.#stopped = false;
     this.#placement = new FeltPlacement();
     this.#segmentsSeen = 0;
@@ -96,7 +109,7 @@ export class FeltPanel {
     const count = placement.placed.length;
     const seconds = (placement.totalMs / 1000).toFixed(1);
     this.#timeline.setCaption(
-      count === 0 && this.#told.counts.dropped === 0
+      count === 0 && this.#told.counts.dropped === 0 && (this.#told.counts.held ?? 0) === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
         : timelineCaption(
             { count, seconds, reported: placement.reportedCount, capped: placement.cappedCount },
@@ -152,6 +165,20 @@ export class FeltPanel {
   unsent(seqs: readonly number[]): void {
     this.#sync();
     for (const seq of seqs) this.#placement.refuse(seq);
+    this.refresh();
+  }
+
+  /**
+   * Strokes held on the page while the wearer paused were sent after all, at `atMs`
+   * (performance.now(), the clock the drawing's samples are on): they join the timeline, arriving
+   * then. Placed again from scratch: it happens once per resume, not once per stroke.
+   */
+  heldSent(seqs: readonly number[], atMs: number): void {
+    if (seqs.length === 0) return;
+    const origin = this.#drawing?.paths[0]?.[0]?.t_ms ?? 0;
+    for (const seq of seqs) this.#sentLateMs.set(seq, atMs - origin);
+    this.#segmentsSeen = 0;
+    this.#lastSeen = HELD_CHANGED;
     this.refresh();
   }
 
@@ -226,17 +253,24 @@ export class FeltPanel {
     this.#lastSeen = segments[segments.length - 1] ?? null;
   }
 
-  /** A drawn segment as felt (null for a dropped one): arriving when it was drawn, or at once. */
-  #feltStroke({ segment, stroke }: DrawnSegment): FeltStroke | null {
+  /**
+   * A drawn segment as felt: arriving when it was drawn, at once, or when it was sent after being
+   * held. Null for a dropped one, and for one held on the page now (the wearer paused): it is not
+   * sent, so nothing of it can be felt yet (`heldSent` brings it in when it goes).
+   */
+  #feltStroke(drawn: DrawnSegment): FeltStroke | null {
+    const { segment, stroke } = drawn;
     if (stroke === null || stroke.seq == null) return null;
+    if (this.#drawing?.isHeld(drawn) === true) return null;
     const origin = this.#drawing?.paths[0]?.[0]?.t_ms ?? 0;
+    const sentLateMs = this.#sentLateMs.get(stroke.seq);
     return {
       seq: stroke.seq,
       start: stroke.start,
       end: stroke.end,
       duration_ms: stroke.duration_ms,
       intensity: stroke.intensity ?? 0.8,
-      arrives_ms: this.#arrival === "at-once" ? 0 : segment.end_ms - origin,
+      arrives_ms: sentLateMs ?? (this.#arrival === "at-once" ? 0 : segment.end_ms - origin),
     };
   }
 
@@ -283,13 +317,19 @@ export function timelineCaption(
 ): string {
   const { count, seconds, reported, capped } = timeline;
   const { played, cut, cancelled, refused, dropped } = tally;
+  const held = tally.held ?? 0;
   const head = `${plural(count, "stroke")}, ${seconds} s`;
-  const waiting = Math.max(0, tally.sent - played - cut - cancelled - refused - dropped);
-  if (waiting === tally.sent && !stopped)
-    return `${head}: what would be felt, played back to back as the sleeve does.`;
+  // Held strokes are not sent yet: neither felt nor "what would be felt", said apart (as the card does).
+  const heldPart = `${held} held on this page, not sent yet (${tally.heldWhy ?? "the wearer paused"}; not on the timeline)`;
+  const waiting = Math.max(0, tally.sent - played - cut - cancelled - refused - dropped - held);
+  if (held > 0 && held === tally.sent) return `${heldPart[0]!.toUpperCase()}${heldPart.slice(1)}.`;
+  if (waiting === tally.sent - held && !stopped)
+    return held === 0
+      ? `${head}: what would be felt, played back to back as the sleeve does.`
+      : `${head}: what would be felt, played back to back as the sleeve does; ${heldPart}.`;
   // Played strokes whose report never came (a copy's refusal told they were felt): the page places them.
   const placedByPage = Math.max(0, played - Math.max(0, reported - cut));
-  if (played === tally.sent && played === count && placedByPage === 0)
+  if (played === tally.sent && played === count && placedByPage === 0 && held === 0)
     return `${head}, as the sleeve played them.`;
   const said: string[] = [];
   if (played > 0) {
@@ -310,9 +350,13 @@ export function timelineCaption(
   const refusedOff = refused - capped;
   if (refusedOff > 0) said.push(`${refusedOff} refused by the sleeve (not on the timeline)`);
   if (dropped > 0) said.push(`${dropped} never sent (not on the timeline)`);
+  if (held > 0) said.push(heldPart);
   if (waiting > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");
   return `${head}; ${said.join(", ")}.`;
 }
+
+/** Forces the next sync to place every stroke again (a held stroke went out). */
+const HELD_CHANGED = {};
 
 function plural(count: number, noun: string): string {
   return `${count} ${noun}${count === 1 ? "" : "s"}`;

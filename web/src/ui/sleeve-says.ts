@@ -29,6 +29,9 @@ export interface Counts {
   /** Played, but held on the way (events.ts `isDelayed`): not the sleeve's `late` refusal. */
   delayed: number;
   latestDelayMs: number;
+  /** Held on this page, not sent yet (the wearer paused), and why (`holdReason`). */
+  held: number;
+  heldWhy: string;
 }
 
 export class SleeveSays {
@@ -61,6 +64,8 @@ export class SleeveSays {
       cutByWearer: causes.byWearer,
       cutByFault: causes.byFault,
       dropped: this.#dropped,
+      held: this.#held,
+      heldWhy: this.#heldWhy,
       delayed: this.#delayed,
       latestDelayMs: this.#latestDelayMs,
     };
