@@ -25,12 +25,14 @@ SYSTEM_PACKAGES := mosquitto mosquitto-clients
 # cores; pytest and the browser tests each leave much of theirs idle.
 TEST_JOBS ?= 3
 
-.PHONY: help up test check install lint typecheck pytest vectors vectors-check bench bench-study bench-study-calibration system clean
+.PHONY: help up research test check install lint typecheck pytest vectors vectors-check bench bench-study bench-study-calibration system clean
 .PHONY: bench-prepare bench-timed bench-prepare-python bench-timed-python
 
 help:
 	@echo "make up      set up and start everything (broker, sleeve simulator, drawing client);"
 	@echo "             options for 'feelmysign up' go in ARGS, e.g. make up ARGS=\"--http-port 8080\""
+	@echo "make research  install what the recognition study needs (its statistics and plots in"
+	@echo "             .venv, the page built), without building the Java port or the Go tools"
 	@echo "make test    install what is needed, then lint, type-check and run every test,"
 	@echo "             side by side (TEST_JOBS=3 lanes; each part's output printed whole when it ends)"
 	@echo "make check   the same parts one at a time"
@@ -96,6 +98,11 @@ PYTEST_WORKERS ?= 2
 # time with its default threads), and the workers already keep both cores busy.
 pytest: $(STAMP) system
 	cd python && OPENBLAS_NUM_THREADS=1 ../$(BIN)/pytest -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS)
+
+# What a researcher needs for `feelmysign study` (docs/study.md): the statistics and plots
+# (python[research]), the system packages and the page the study is served on; the Java port
+# and the Go tools (NATS) are not built.
+research: $(STAMP) system web-build
 
 # Everything `make test` installs; independent of each other, so `make -j` runs them at once.
 install: system $(STAMP)
