@@ -137,7 +137,8 @@ def test_douglas_peucker_runs_above_a_tie_with_the_rows_deviation() -> None:
         samples = (*line[: at + 1], Sample(line[at].t_ms + 1, bump_x, bump_y), *line[at + 1 :])
         recording = Recording(1200.0, 800.0, (samples,), 3, 4)
         run = Run(
-            ALGORITHMS["window"], {"max_error": 0.6, "min_duration_ms": 0.0, "max_stroke_ms": 0.0}
+            ALGORITHMS["window"],
+            {"max_error": 0.6, "min_duration_ms": 0.0, "max_stroke_ms": 0.0, "max_bend": 0.0},
         )
         row = evaluate_one(Source("bump", "bump", recording), run)
         assert row.strokes == 1 and row.dp_strokes == 1
