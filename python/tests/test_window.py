@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from simplifier_checks import (
     assert_four_strokes_on_the_corners,
@@ -33,7 +33,7 @@ from feelmysign.simplify import (
     WindowSimplifier,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE
-from feelmysign.simplify.window import LINE_SHARE, REST_SHARE, WindowCore
+from feelmysign.simplify.window import LINE_SHARE, WindowCore, rest_radius
 from feelmysign.stroke import Point
 
 WINDOW = dict(load("window"))
@@ -350,9 +350,7 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
 
 def _rest_radius(params: WindowParams) -> float:
     """How far a sample the pen rested at may lie from the point that stands for the rest."""
-    if params.rest_ms <= 0:
-        return 0.0
-    return min(REST_SHARE * params.min_length, 0.5 * params.max_error)
+    return rest_radius(params) if params.rest_ms > 0 else 0.0
 
 
 def _moved(params: WindowParams) -> float:
@@ -655,3 +653,130 @@ def test_a_drawing_along_the_edges_gives_strokes_on_the_grid(
     for _, segment in run(params, [samples]):
         for x, y in (segment.start, segment.end):
             assert 0.0 <= x <= x_max and 0.0 <= y <= y_max, segment
+
+
+# --- a resting pen and a slow, steady one -------------------------------------------------------
+
+# The slowest steady pen that is never taken for a resting one: half a pixel a frame at 60 fps.
+SLOW_PEN_PX_PER_MS = 0.5 * 60 / 1000
+
+
+@st.composite
+def slow_legs(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
+    """A straight leg drawn at a steady speed of at least ``SLOW_PEN_PX_PER_MS``, in any
+    direction, on any canvas and grid, sampled every frame or every pointer event (times
+    jittered), its samples at exact or whole pixels."""
+    width_px = draw(st.floats(200, 4000))
+    height_px = draw(st.floats(200, 4000))
+    params = WindowParams(
+        max_stroke_ms=0.0,  # one stroke a leg: only a rest could cut it
+        max_window=10_000,
+        rest_ms=draw(st.sampled_from([100.0, 200.0, 500.0])),
+        min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
+        max_error=draw(st.sampled_from([0.05, 0.25, 1.0])),
+        columns=draw(st.integers(2, 12)),
+        rows=draw(st.integers(2, 12)),
+        stretch=draw(st.booleans()),
+        canvas_width_px=width_px,
+        canvas_height_px=height_px,
+    )
+    speed = draw(st.floats(SLOW_PEN_PX_PER_MS, 0.5))
+    angle = draw(st.floats(0, 2 * math.pi))
+    duration_ms = draw(st.floats(300, 4000))
+    step_ms = draw(st.sampled_from([1000 / 60, 8.0]))
+    whole_px = draw(st.booleans())
+    length_px = speed * duration_ms
+    ux, uy = math.cos(angle), math.sin(angle)
+    # A start from which the whole leg stays on the canvas (no clamping onto the grid's edge).
+    room_x, room_y = width_px - abs(ux) * length_px - 2, height_px - abs(uy) * length_px - 2
+    assume(room_x > 0 and room_y > 0)
+    x0 = draw(st.floats(0, 1)) * room_x + 1 + max(0.0, -ux) * length_px
+    y0 = draw(st.floats(0, 1)) * room_y + 1 + max(0.0, -uy) * length_px
+    samples, t_ms = [], 0.0
+    while t_ms <= duration_ms:
+        x, y = x0 + ux * speed * t_ms, y0 + uy * speed * t_ms
+        if whole_px:
+            x, y = round(x), round(y)
+        samples.append(Sample(t_ms, x, y))
+        t_ms += step_ms * draw(st.floats(0.5, 1.5))
+    return params, samples
+
+
+@settings(max_examples=300, deadline=None)
+@given(slow_legs())
+def test_a_slow_steady_leg_is_never_cut_for_rest(case: tuple[WindowParams, list[Sample]]) -> None:
+    params, samples = case
+    core = WindowCore(params)
+    for sample in samples:
+        assert core.push(sample) == [], sample
+        assert not core.rested, sample
+    (stroke,) = core.end()
+    mapping = params.mapping
+    assert stroke.start_ms == samples[0].t_ms and stroke.end_ms == samples[-1].t_ms
+    assert stroke.start == mapping.to_grid(samples[0].x, samples[0].y)
+    assert stroke.end == mapping.to_grid(samples[-1].x, samples[-1].y)
+
+
+@st.composite
+def rests(draw: st.DrawFn) -> tuple[WindowParams, list[Sample], int, int]:
+    """A leg, a rest of at least rest_ms at its end (the pen still, or trembling well within the
+    rest radius), then a leg in another direction; with the index of the rest's first and last
+    samples."""
+    cap_ms = draw(st.sampled_from([0.0, 200.0]))
+    params = WindowParams(
+        max_stroke_ms=cap_ms,
+        # A rest longer than the latency cap is the crawl rule's: the stroke after it starts at
+        # most the cap before the pen moves on.
+        rest_ms=draw(st.sampled_from([50.0, 100.0] if cap_ms else [50.0, 100.0, 300.0])),
+        canvas_width_px=1200.0,
+        canvas_height_px=800.0,
+    )
+    radius_px = rest_radius(params) / params.mapping.scale
+    step_ms = draw(st.sampled_from([1000 / 60, 8.0]))
+    step_px = draw(st.floats(1.5, 9.0))  # long enough to send, short enough to stay on the canvas
+    speed = step_px / step_ms
+    samples = [Sample(k * step_ms, 200.0 + step_px * k, 400.0) for k in range(40)]
+    arrival = len(samples) - 1
+    x, y, t_ms = samples[-1].x, samples[-1].y, samples[-1].t_ms
+    tremble = draw(st.sampled_from([0.0, 0.4])) * radius_px
+    rest_steps = math.ceil(draw(st.floats(1.2, 4.0)) * params.rest_ms / step_ms)
+    for _ in range(rest_steps):
+        t_ms += step_ms
+        dx, dy = draw(st.floats(-1, 1)) * tremble, draw(st.floats(-1, 1)) * tremble
+        samples.append(Sample(t_ms, x + dx / math.sqrt(2), y + dy / math.sqrt(2)))
+    leave = len(samples) - 1
+    for k in range(1, 40):
+        samples.append(Sample(t_ms + k * step_ms, x, y - speed * step_ms * k))
+    return params, samples, arrival, leave
+
+
+@settings(max_examples=200, deadline=None)
+@given(rests())
+def test_a_rest_ends_the_stroke_before_it_and_is_not_played(
+    case: tuple[WindowParams, list[Sample], int, int],
+) -> None:
+    params, samples, arrival, leave = case
+    simplifier = WindowSimplifier(params)
+    during_rest: list[Segment] = []
+    after: list[Segment] = []
+    for index, sample in enumerate(samples):
+        out = simplifier.push(sample)
+        if arrival < index <= leave:
+            during_rest.extend(out)
+        elif index > leave:
+            after.extend(out)
+    after.extend(simplifier.end())
+    # The stroke that arrives at the rest is sent while the pen still rests, ending where it
+    # rests, when the rest began (no later than the pen's arrival).
+    assert during_rest, "no stroke was let go while the pen rested"
+    last = during_rest[-1]
+    rest_point = params.mapping.to_grid(samples[arrival].x, samples[arrival].y)
+    assert math.dist(last.end, rest_point) <= rest_radius(params) + FLOAT_TOLERANCE
+    # A rest is told after rest_ms of it, and the latency cap may end a stroke first; a piece
+    # held to merge, briefer than the sleeve's floor, takes the time it needs from the rest.
+    assert last.end_ms <= samples[arrival].t_ms + max(params.rest_ms, params.floor_ms)
+    # Nothing plays the rest: the next stroke starts when the pen moves on (if the latency cap
+    # ended a stroke in the rest, what is left of it may be too brief to tell: under rest_ms).
+    assert after, "the leg after the rest was not sent"
+    told_ms = params.rest_ms if params.max_stroke_ms else 0.0
+    assert after[0].start_ms >= samples[leave].t_ms - told_ms

@@ -20,6 +20,7 @@ from feelmysign.simplify.window import (
     CAP_FEATURE_SHARE,
     LINE_SHARE,
     REST_SHARE,
+    REST_SPEED_PX_PER_MS,
     STRAIGHT,
     WindowParams,
     segment_distance_sq,
@@ -76,7 +77,20 @@ class ReferenceWindowSimplifier:
     def __post_init__(self) -> None:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._mapping = self.params.mapping
-        rest = min(REST_SHARE * self.params.min_length, 0.5 * self.params.max_error)
+        params = self.params
+        # The canvas's tighter scale (grid units per pixel), from the axes that have an extent.
+        scales = [
+            extent / size
+            for extent, size in (
+                (params.columns - 1, params.canvas_width_px),
+                (params.rows - 1, params.canvas_height_px),
+            )
+            if extent > 0
+        ]
+        px = REST_SPEED_PX_PER_MS * params.rest_ms
+        rest = min(
+            REST_SHARE * params.min_length, 0.5 * params.max_error, px * min(scales, default=0.0)
+        )
         self._rest_sq = rest * rest
 
     @property

@@ -30,6 +30,8 @@ const LINE_SHARE = 0.25;
  * than half of max_error).
  */
 const REST_SHARE = 0.25;
+/** ... and never farther than a pen this slow covers in rest_ms (canvas pixels per ms). */
+const REST_SPEED_PX_PER_MS = 0.015;
 
 interface Drawn {
   readonly sample: Sample;
@@ -60,7 +62,19 @@ export class ReferenceWindowSimplifier {
     checkWindowParams(params);
     this.params = params;
     this.#maxErrorSq = params.max_error * params.max_error;
-    const rest = Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error);
+    // The canvas's tighter scale (grid units per pixel), from the axes that have an extent.
+    const scales = [
+      [params.columns - 1, params.canvas_width_px],
+      [params.rows - 1, params.canvas_height_px],
+    ]
+      .filter(([extent]) => extent! > 0)
+      .map(([extent, size]) => extent! / size!);
+    const scale = scales.length > 0 ? Math.min(...scales) : 0;
+    const rest = Math.min(
+      REST_SHARE * params.min_length,
+      0.5 * params.max_error,
+      REST_SPEED_PX_PER_MS * params.rest_ms * scale,
+    );
     this.#restSq = rest * rest;
     this.#mapping = {
       width_px: params.canvas_width_px,

@@ -15,8 +15,13 @@ import { describe, expect, it } from "vitest";
 import { CanvasMapping } from "../src/simplify/mapping";
 import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
 import { type Point, type Sample, type Segment } from "../src/simplify/segment";
-import { LINE_SHARE, REST_SHARE, WindowCore, WindowSimplifier } from "../src/simplify/window";
-import type { WindowParams } from "../src/simplify/window-params";
+import {
+  LINE_SHARE,
+  WindowCore,
+  WindowSimplifier,
+  restRadius as windowRestRadius,
+} from "../src/simplify/window";
+import { DEFAULT_WINDOW_PARAMS, type WindowParams } from "../src/simplify/window-params";
 
 /** Room for a distance computed another way than the simplifier's (last bits only). */
 const FLOAT_TOLERANCE = 1e-12;
@@ -56,7 +61,7 @@ function distance(point: Point, start: Point, end: Point): number {
 
 /** How far a sample the pen rested at may lie from the point that stands for the rest. */
 function restRadius(params: WindowParams): number {
-  return params.rest_ms > 0 ? Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error) : 0;
+  return params.rest_ms > 0 ? windowRestRadius(params, CanvasMapping.fromParams(params)) : 0;
 }
 
 /**
@@ -301,6 +306,188 @@ describe("window simplifier along the canvas edges", () => {
           }
         }),
         { numRuns: 400 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+});
+
+/** The slowest steady pen that is never taken for a resting one: half a pixel a frame at 60 fps. */
+const SLOW_PEN_PX_PER_MS = (0.5 * 60) / 1000;
+
+/**
+ * A straight leg drawn at a steady speed of at least `SLOW_PEN_PX_PER_MS`, in any direction, on any
+ * canvas and grid, sampled every frame or every pointer event (times jittered), its samples at exact
+ * or whole pixels; one stroke a leg (no latency cap), so only a rest could cut it.
+ */
+const slowLegArb = fc
+  .record({
+    widthPx: fc.double({ min: 200, max: 4000, noNaN: true }),
+    heightPx: fc.double({ min: 200, max: 4000, noNaN: true }),
+    restMs: fc.constantFrom(100, 200, 500),
+    minLength: fc.constantFrom(0, 0.1, 0.4),
+    maxError: fc.constantFrom(0.05, 0.25, 1),
+    columns: fc.integer({ min: 2, max: 12 }),
+    rows: fc.integer({ min: 2, max: 12 }),
+    stretch: fc.boolean(),
+    speed: fc.double({ min: SLOW_PEN_PX_PER_MS, max: 0.5, noNaN: true }),
+    angle: fc.double({ min: 0, max: 2 * Math.PI, noNaN: true }),
+    durationMs: fc.double({ min: 300, max: 4000, noNaN: true }),
+    stepMs: fc.constantFrom(1000 / 60, 8),
+    jitters: fc.array(fc.double({ min: 0.5, max: 1.5, noNaN: true }), { minLength: 1, maxLength: 50 }),
+    wholePx: fc.boolean(),
+    fx: fc.double({ min: 0, max: 1, noNaN: true }),
+    fy: fc.double({ min: 0, max: 1, noNaN: true }),
+  })
+  .filter(({ widthPx, heightPx, speed, angle, durationMs }) => {
+    const length = speed * durationMs;
+    return (
+      Math.abs(Math.cos(angle)) * length + 2 < widthPx && Math.abs(Math.sin(angle)) * length + 2 < heightPx
+    );
+  })
+  .map((leg) => {
+    const params: WindowParams = {
+      ...DEFAULT_WINDOW_PARAMS,
+      max_stroke_ms: 0,
+      max_window: 10_000,
+      rest_ms: leg.restMs,
+      min_length: leg.minLength,
+      max_error: leg.maxError,
+      columns: leg.columns,
+      rows: leg.rows,
+      stretch: leg.stretch,
+      canvas_width_px: leg.widthPx,
+      canvas_height_px: leg.heightPx,
+    };
+    const ux = Math.cos(leg.angle);
+    const uy = Math.sin(leg.angle);
+    const length = leg.speed * leg.durationMs;
+    // A start from which the whole leg stays on the canvas (no clamping onto the grid's edge).
+    const x0 = leg.fx * (leg.widthPx - Math.abs(ux) * length - 2) + 1 + Math.max(0, -ux) * length;
+    const y0 = leg.fy * (leg.heightPx - Math.abs(uy) * length - 2) + 1 + Math.max(0, -uy) * length;
+    const samples: Sample[] = [];
+    for (let t = 0, k = 0; t <= leg.durationMs; k++) {
+      let x = x0 + ux * leg.speed * t;
+      let y = y0 + uy * leg.speed * t;
+      if (leg.wholePx) [x, y] = [Math.round(x), Math.round(y)];
+      samples.push({ t_ms: t, x, y, pressure: 0.5 });
+      t += leg.stepMs * leg.jitters[k % leg.jitters.length]!;
+    }
+    return { params, samples };
+  });
+
+/**
+ * A leg, a rest of at least rest_ms at its end (the pen still, or trembling well within the rest
+ * radius), then a leg in another direction; with the index of the rest's first and last samples.
+ */
+const restArb = fc
+  .record({
+    capMs: fc.constantFrom(0, 200),
+    restPick: fc.integer({ min: 0, max: 2 }),
+    stepMs: fc.constantFrom(1000 / 60, 8),
+    stepPx: fc.double({ min: 1.5, max: 9, noNaN: true }),
+    tremble: fc.constantFrom(0, 0.4),
+    restShare: fc.double({ min: 1.2, max: 4, noNaN: true }),
+    shakes: fc.array(
+      fc.tuple(fc.double({ min: -1, max: 1, noNaN: true }), fc.double({ min: -1, max: 1, noNaN: true })),
+      {
+        minLength: 1,
+        maxLength: 40,
+      },
+    ),
+  })
+  .map((r) => {
+    // A rest longer than the latency cap is the crawl rule's: the stroke after it starts at most
+    // the cap before the pen moves on.
+    const rests = r.capMs > 0 ? [50, 100] : [50, 100, 300];
+    const params: WindowParams = {
+      ...DEFAULT_WINDOW_PARAMS,
+      max_stroke_ms: r.capMs,
+      rest_ms: rests[r.restPick % rests.length]!,
+      canvas_width_px: 1200,
+      canvas_height_px: 800,
+    };
+    const mapping = CanvasMapping.fromParams(params);
+    const radiusPx = windowRestRadius(params, mapping) / mapping.scale;
+    const samples: Sample[] = [];
+    for (let k = 0; k < 40; k++)
+      samples.push({ t_ms: k * r.stepMs, x: 200 + r.stepPx * k, y: 400, pressure: 0.5 });
+    const arrival = samples.length - 1;
+    const { x, y } = samples[arrival]!;
+    let t = samples[arrival]!.t_ms;
+    const steps = Math.ceil((r.restShare * params.rest_ms) / r.stepMs);
+    for (let k = 0; k < steps; k++) {
+      t += r.stepMs;
+      const [dx, dy] = r.shakes[k % r.shakes.length]!;
+      const shake = (r.tremble * radiusPx) / Math.SQRT2;
+      samples.push({ t_ms: t, x: x + dx * shake, y: y + dy * shake, pressure: 0.5 });
+    }
+    const leave = samples.length - 1;
+    for (let k = 1; k < 40; k++)
+      samples.push({ t_ms: t + k * r.stepMs, x, y: y - r.stepPx * k, pressure: 0.5 });
+    return { params, samples, arrival, leave, mapping };
+  });
+
+describe("a resting pen and a slow, steady one", () => {
+  it(
+    "never cuts a slow steady leg for rest",
+    () => {
+      fc.assert(
+        fc.property(slowLegArb, ({ params, samples }) => {
+          const core = new WindowCore(params);
+          for (const sample of samples) {
+            expect(core.push(sample)).toEqual([]);
+            expect(core.rested).toBe(false);
+          }
+          const strokes = core.end();
+          expect(strokes).toHaveLength(1);
+          const map = CanvasMapping.fromParams(params);
+          const [stroke] = strokes;
+          expect(stroke!.start_ms).toBe(samples[0]!.t_ms);
+          expect(stroke!.end_ms).toBe(samples[samples.length - 1]!.t_ms);
+          expect(stroke!.start).toEqual(map.toGrid(samples[0]!.x, samples[0]!.y));
+          expect(stroke!.end).toEqual(
+            map.toGrid(samples[samples.length - 1]!.x, samples[samples.length - 1]!.y),
+          );
+        }),
+        { numRuns: 300 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+
+  it(
+    "ends the stroke before a rest while the pen rests, and does not play the rest",
+    () => {
+      fc.assert(
+        fc.property(restArb, ({ params, samples, arrival, leave, mapping }) => {
+          const simplifier = new WindowSimplifier(params);
+          const duringRest: Segment[] = [];
+          const after: Segment[] = [];
+          samples.forEach((sample, index) => {
+            const out = simplifier.push(sample);
+            if (arrival < index && index <= leave) duringRest.push(...out);
+            else if (index > leave) after.push(...out);
+          });
+          after.push(...simplifier.end());
+          expect(duringRest.length, "a stroke let go while the pen rests").toBeGreaterThan(0);
+          const last = duringRest[duringRest.length - 1]!;
+          const [rx, ry] = mapping.toGrid(samples[arrival]!.x, samples[arrival]!.y);
+          expect(Math.hypot(last.end[0] - rx, last.end[1] - ry)).toBeLessThanOrEqual(
+            windowRestRadius(params, mapping) + FLOAT_TOLERANCE,
+          );
+          // A rest is told after rest_ms of it, and the latency cap may end a stroke first; a
+          // piece held to merge, briefer than the sleeve's floor, takes the time it needs from it.
+          expect(last.end_ms).toBeLessThanOrEqual(
+            samples[arrival]!.t_ms + Math.max(params.rest_ms, params.floor_ms),
+          );
+          // Nothing plays the rest: the next stroke starts when the pen moves on (if the cap ended
+          // a stroke in the rest, what is left of it may be too brief to tell: under rest_ms).
+          expect(after.length, "the leg after the rest is sent").toBeGreaterThan(0);
+          const toldMs = params.max_stroke_ms > 0 ? params.rest_ms : 0;
+          expect(after[0]!.start_ms).toBeGreaterThanOrEqual(samples[leave]!.t_ms - toldMs);
+        }),
+        { numRuns: 200 },
       );
     },
     PROPERTY_TIMEOUT_MS,

@@ -67,6 +67,26 @@ const ROUNDING_SLACK = 1e-9;
  * stroke the sleeve renders, well above a still hand's jitter.
  */
 export const REST_SHARE = 0.25;
+/**
+ * ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a quarter of
+ * a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests; a slow, steady
+ * pen does not, as the distance it covers over the whole window tells: at twice this speed (half a
+ * pixel a frame) or more, in any direction, it leaves the radius well within rest_ms, even with its
+ * samples rounded to whole pixels. In pixels, not grid units: a hand's speed on the screen does not
+ * depend on how the canvas maps onto the sleeve (at the default canvas a quarter of min_length is 16
+ * pixels, which a pen at 2 pixels a frame took 100 ms to leave).
+ */
+export const REST_SPEED_PX_PER_MS = 0.015;
+
+/**
+ * How near one point a resting pen stays, in grid units: the least of `REST_SHARE` x min_length,
+ * half of max_error and the distance a pen at `REST_SPEED_PX_PER_MS` covers in rest_ms, mapped at
+ * the canvas's tighter scale (so no more pixels on either axis).
+ */
+export function restRadius(params: WindowParams, mapping: CanvasMapping): number {
+  const px = REST_SPEED_PX_PER_MS * params.rest_ms;
+  return Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error, px * mapping.scale);
+}
 
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
@@ -194,11 +214,11 @@ export class WindowCore {
     this.#maxErrorSq = params.max_error * params.max_error;
     this.#minLengthSq = params.min_length * params.min_length;
     this.#reachLimit = params.max_error - ROUNDING_SLACK;
-    const rest = Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error);
-    this.#restSq = rest * rest;
     this.#xExtent = params.columns - 1;
     this.#yExtent = params.rows - 1;
     this.#mapping = CanvasMapping.fromParams(params);
+    const rest = restRadius(params, this.#mapping);
+    this.#restSq = rest * rest;
     this.#window = new Samples();
   }
 

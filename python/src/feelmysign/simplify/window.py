@@ -56,7 +56,9 @@ corners land on the drawing's features. Here:
 
 - A resting pen (``rest_ms``): when the samples of the last ``rest_ms`` all
   lie within the rest radius (``REST_SHARE`` x min_length, at most max_error
-  / 2) of the newest, the stroke so far ends there, at the time the rest
+  / 2, and at most what a pen at ``REST_SPEED_PX_PER_MS`` covers in
+  ``rest_ms``, so a slow steady pen is never taken for a resting one) of the
+  newest, the stroke so far ends there, at the time the rest
   began, and is sent now; while the pen stays, the next stroke's start moves
   on with it, so the rest is not played. A held short piece is sent at the
   rest (briefer than the floor, it takes the time it needs from the rest).
@@ -108,6 +110,14 @@ ROUNDING_SLACK = 1e-9
 # farther than half of max_error, so the point that ends or starts a stroke covers the rest):
 # well below a stroke the sleeve renders, well above a still hand's jitter.
 REST_SHARE = 0.25
+# ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a quarter
+# of a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests; a slow,
+# steady pen does not, as the distance it covers over the whole window tells: at twice this speed
+# (half a pixel a frame) or more, in any direction, it leaves the radius well within rest_ms, even
+# with its samples rounded to whole pixels. In pixels, not grid units: a hand's speed on the
+# screen does not depend on how the canvas maps onto the sleeve (at the default canvas a quarter
+# of min_length is 16 pixels, which a pen at 2 pixels a frame took 100 ms to leave).
+REST_SPEED_PX_PER_MS = 0.015
 
 
 @dataclass(frozen=True)
@@ -263,7 +273,7 @@ class WindowCore:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._min_length_sq = self.params.min_length * self.params.min_length
         self._reach_limit = self.params.max_error - ROUNDING_SLACK
-        rest = min(REST_SHARE * self.params.min_length, 0.5 * self.params.max_error)
+        rest = rest_radius(self.params)
         self._rest_sq = rest * rest
         self._mapping = self.params.mapping
         self._x_extent = float(self.params.columns - 1)
@@ -783,6 +793,14 @@ class WindowSimplifier:
             out.extend(self._merger.take(piece, now_ms))
         out.extend(self._merger.end(now_ms))
         return out
+
+
+def rest_radius(params: WindowParams) -> float:
+    """How near one point a resting pen stays, in grid units: the least of ``REST_SHARE`` x
+    min_length, half of max_error and the distance a pen at ``REST_SPEED_PX_PER_MS`` covers in
+    rest_ms, mapped at the canvas's tighter scale (so no more pixels on either axis)."""
+    px = REST_SPEED_PX_PER_MS * params.rest_ms
+    return min(REST_SHARE * params.min_length, 0.5 * params.max_error, px * params.mapping.scale)
 
 
 def _distance_sq(a: Point, b: Point) -> float:

@@ -100,6 +100,13 @@ final class WindowCore implements Simplifier {
    * farther than half of max_error, so the point that ends or starts a stroke covers the rest):
    * well below a stroke the sleeve renders, well above a still hand's jitter. */
   static final double REST_SHARE = 0.25;
+  /** ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a
+   * quarter of a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests;
+   * a slow, steady pen does not, as the distance it covers over the whole window tells: at twice
+   * this speed (half a pixel a frame) or more, in any direction, it leaves the radius well within
+   * rest_ms, even with its samples rounded to whole pixels. In pixels, not grid units: a hand's
+   * speed on the screen does not depend on how the canvas maps onto the sleeve. */
+  static final double REST_SPEED_PX_PER_MS = 0.015;
 
   private final Params params;
   private final double restMs;
@@ -167,7 +174,12 @@ final class WindowCore implements Simplifier {
     this.xExtent = params.columns() - 1;
     this.yExtent = params.rows() - 1;
     this.restMs = params.number("rest_ms");
-    double rest = Math.min(REST_SHARE * minLength, 0.5 * maxError);
+    // The least of a share of min_length, half of max_error and what a pen at the rest speed
+    // covers in rest_ms, at the canvas's tighter scale (as Python's and the page's rest radius).
+    double rest =
+        Math.min(
+            Math.min(REST_SHARE * minLength, 0.5 * maxError),
+            REST_SPEED_PX_PER_MS * restMs * mapping.scale());
     this.restSq = rest * rest;
   }
 
