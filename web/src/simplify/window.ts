@@ -141,7 +141,9 @@ class Samples {
   /** The anchor at another time (while the pen rests or crawls), its Sample too. */
   retime(t: number): void {
     this.ts[0] = t;
-    this.samples[0] = { ...this.samples[0]!, t_ms: t };
+    // Built field by field, not spread: a crawling pen retimes at every sample.
+    const anchor = this.samples[0]!;
+    this.samples[0] = { t_ms: t, x: anchor.x, y: anchor.y, pressure: anchor.pressure };
   }
 
   /** The sample to take next (at `count`) is not taken: the ones after it move down. */
@@ -203,8 +205,13 @@ export class WindowCore {
   #resting = false;
   /** Whether the last push found the pen resting (the stroke before the rest is final). */
   rested = false;
-  /** The last sample pushed, as taken: its time (never before the one before) and grid point. */
-  #taken: { readonly t_ms: number; readonly point: Point } = { t_ms: 0, point: [0, 0] };
+  /**
+   * The last sample pushed, as taken: its time (never before the one before) and grid point. Three
+   * numbers, not an object: it is read once per sample (`lastSample` makes the object if asked).
+   */
+  takenMs = 0;
+  takenX = 0;
+  takenY = 0;
   /** The squared rest radius (see `REST_SHARE`). */
   readonly #restSq: number;
 
@@ -234,7 +241,7 @@ export class WindowCore {
 
   /** The last sample taken, as taken: its time (never before the one before) and grid point. */
   lastSample(): { readonly t_ms: number; readonly point: Point } {
-    return this.#taken;
+    return { t_ms: this.takenMs, point: [this.takenX, this.takenY] };
   }
 
   /** The time of the last sample pushed, as taken (0 before any). */
@@ -252,7 +259,9 @@ export class WindowCore {
     this.#pointer = sample;
     const x = this.#mapping.gridX(sample.x);
     const y = this.#mapping.gridY(sample.y);
-    this.#taken = { t_ms: sample.t_ms, point: [x, y] };
+    this.takenMs = sample.t_ms;
+    this.takenX = x;
+    this.takenY = y;
     this.rested = false;
     window.place(x, y, sample.t_ms, sample);
     if (count === 0) {
@@ -291,6 +300,7 @@ export class WindowCore {
     const { xs, ys, ts } = window;
     const capMs = this.params.max_stroke_ms;
     const maxWindow = this.params.max_window;
+    const restMs = this.params.rest_ms;
     for (;;) {
       const count = window.count;
       const x = xs[count]!;
@@ -306,30 +316,21 @@ export class WindowCore {
         }
         this.#resting = false;
       }
-      if (
-        capMs > 0 &&
-        count > 1 &&
-        t - ts[0]! > capMs &&
-        !this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)
-      ) {
-        // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
-        // rather than lasting longer, so the cap holds for it too.
-        window.retime(t - capMs);
-      }
-      if (
-        capMs > 0 &&
-        count > 1 &&
-        t - ts[0]! > capMs &&
-        this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)
-      ) {
-        const cut = this.#capCut(count);
-        const vertex = this.#continued(cut);
-        (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, vertex, ts[cut]!));
-        this.#line = this.#lineOf(cut, vertex);
-        // The samples after the cut, this one included, are taken again into the next stroke.
-        window.restart(vertex[0], vertex[1], cut);
-        this.#reach = 0;
-        continue;
+      if (capMs > 0 && count > 1 && t - ts[0]! > capMs) {
+        if (!this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)) {
+          // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
+          // rather than lasting longer, so the cap holds for it too.
+          window.retime(t - capMs);
+        } else {
+          const cut = this.#capCut(count);
+          const vertex = this.#continued(cut);
+          (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, vertex, ts[cut]!));
+          this.#line = this.#lineOf(cut, vertex);
+          // The samples after the cut, this one included, are taken again into the next stroke.
+          window.restart(vertex[0], vertex[1], cut);
+          this.#reach = 0;
+          continue;
+        }
       }
       if (!this.#keepsBound(count, x, y)) {
         const cut = this.#feature(count, x, y, 1);
@@ -341,7 +342,14 @@ export class WindowCore {
       } else {
         window.count = count + 1;
         this.#reaches[count] = this.#reach;
-        const rest = this.#rests(count + 1);
+        // A stroke younger than rest_ms cannot hold a rest, nor a pen that left the rest radius
+        // since the sample before: most samples stop at these two tests.
+        const rest =
+          restMs > 0 &&
+          t - ts[0]! >= restMs &&
+          squared(xs[count - 1]! - x, ys[count - 1]! - y) <= this.#restSq
+            ? this.#rests(count + 1)
+            : false;
         if (rest !== false) {
           // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
           if (rest !== null) (out ??= []).push(rest);
@@ -652,6 +660,9 @@ export class WindowCore {
  * long enough is sent at once (holding each back would delay the drawing), so the last piece of
  * a path, if short, is sent short. Only a path's one and only piece, too short, is dropped.
  */
+/** The merger drops covered samples from its arrays once this many have gathered at their start. */
+const COMPACT_AFTER = 256;
+
 export class Merger {
   readonly #maxError: number;
   readonly #minLength: number;
@@ -662,6 +673,11 @@ export class Merger {
   #xs: number[] = [];
   #ys: number[] = [];
   #ts: number[] = [];
+  /**
+   * The first sample not yet covered: those before it are, and are dropped from the arrays only
+   * now and then (`#send`), not at every stroke sent (three splices, each an array made).
+   */
+  #first = 0;
   #held: Segment | null = null;
   #sentInPath = false;
 
@@ -674,9 +690,9 @@ export class Merger {
   }
 
   /** A drawn sample, in order (its time as the window took it). */
-  sample(tMs: number, point: Point): void {
-    this.#xs.push(point[0]);
-    this.#ys.push(point[1]);
+  sample(tMs: number, x: number, y: number): void {
+    this.#xs.push(x);
+    this.#ys.push(y);
     this.#ts.push(tMs);
   }
 
@@ -698,7 +714,7 @@ export class Merger {
     const xs = this.#xs;
     const ys = this.#ys;
     const ts = this.#ts;
-    for (let i = 0; i < ts.length; i++) {
+    for (let i = this.#first; i < ts.length; i++) {
       const t = ts[i]!;
       if (t > endMs) break;
       if (distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
@@ -713,11 +729,22 @@ export class Merger {
     out.push({ ...segment, emitted_at_ms: nowMs, dropped: null });
     // The samples before its end are covered now (those at its end may start the next).
     const ts = this.#ts;
-    let keep = 0;
+    let keep = this.#first;
     while (keep < ts.length && ts[keep]! < segment.end_ms) keep++;
-    this.#xs.splice(0, keep);
-    this.#ys.splice(0, keep);
-    ts.splice(0, keep);
+    this.#first = keep;
+    if (keep >= COMPACT_AFTER && 2 * keep >= ts.length) {
+      // Most of the arrays are covered: move what is not to their start, in place.
+      const xs = this.#xs;
+      const ys = this.#ys;
+      const left = ts.length - keep;
+      xs.copyWithin(0, keep);
+      ys.copyWithin(0, keep);
+      ts.copyWithin(0, keep);
+      xs.length = left;
+      ys.length = left;
+      ts.length = left;
+      this.#first = 0;
+    }
   }
 
   /** A piece the window cut: the strokes sent now, into `out` (none while a short one waits). */
@@ -783,6 +810,7 @@ export class Merger {
     this.#xs = [];
     this.#ys = [];
     this.#ts = [];
+    this.#first = 0;
   }
 }
 
@@ -819,11 +847,13 @@ export class WindowSimplifier {
     const core = this.#core;
     const pieces = core.push(input);
     const merger = this.#merger;
-    const last = core.lastSample();
-    merger.sample(last.t_ms, last.point);
+    const takenMs = core.takenMs;
+    merger.sample(takenMs, core.takenX, core.takenY);
+    // Most samples finish no piece: nothing to merge, no array made.
+    if (pieces.length === 0 && !core.rested) return NO_SEGMENTS;
     const out: Segment[] = [];
-    for (const piece of pieces) merger.take(piece, last.t_ms, out);
-    if (core.rested) merger.rest(last.t_ms, out);
+    for (const piece of pieces) merger.take(piece, takenMs, out);
+    if (core.rested) merger.rest(takenMs, out);
     return out.length > 0 ? out : NO_SEGMENTS;
   }
 

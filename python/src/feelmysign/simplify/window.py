@@ -337,6 +337,7 @@ class WindowCore:
         """
         cap_ms = self.params.max_stroke_ms
         max_window = self.params.max_window
+        rest_ms = self.params.rest_ms
         max_error_sq = self._max_error_sq
         pending: list[tuple[Point, Sample]] = []  # a stack: the next sample to take is last
         while True:
@@ -351,22 +352,17 @@ class WindowCore:
                     point, sample = pending.pop()
                     continue
                 self._resting = False
-            if (
-                cap_ms > 0
-                and len(points) > 1
-                and t_ms - times[0] > cap_ms
-                and not self._sendable(points[0], points[-1])
-            ):
-                # The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts
-                # later rather than lasting longer, so the cap holds for it too.
-                self._retime(t_ms - cap_ms)
-            if (
-                cap_ms > 0
-                and len(points) > 1
-                and t_ms - times[0] > cap_ms
-                and self._sendable(points[0], points[-1])
-            ):
-                cut = self._cap_cut(points, times)
+            if cap_ms > 0 and len(points) > 1 and t_ms - times[0] > cap_ms:
+                if not self._sendable(points[0], points[-1]):
+                    # The pen crawls: too little drawn in max_stroke_ms to send. The stroke
+                    # starts later rather than lasting longer, so the cap holds for it too.
+                    self._retime(t_ms - cap_ms)
+                    cut = -1
+                else:
+                    cut = self._cap_cut(points, times)
+            else:
+                cut = -1
+            if cut >= 0:
                 vertex = self._continued(points, cut)
                 out.append(self._finish(points[0], times[0], vertex, times[cut]))
                 self._line = self._line_of(points, cut, vertex)
@@ -407,7 +403,14 @@ class WindowCore:
                 reaches.append(self._reach)
             else:
                 reaches[len(points) - 1] = self._reach
-            if self._rests(points, times, point, sample, out):
+            # A stroke younger than rest_ms cannot hold a rest, nor a pen that left the rest
+            # radius since the sample before: most samples stop at these two tests.
+            if (
+                rest_ms > 0.0
+                and t_ms - times[0] >= rest_ms
+                and _distance_sq(points[-2], point) <= self._rest_sq
+                and self._rests(points, times, point, sample, out)
+            ):
                 pass
             elif len(points) - 1 >= max_window:
                 out.append(self._finish(points[0], times[0], point, t_ms))
@@ -421,7 +424,9 @@ class WindowCore:
     def _retime(self, t_ms: float) -> None:
         """The anchor at another time (while the pen rests or crawls), its sample too."""
         self._times[0] = t_ms
-        self._samples[0] = replace(self._samples[0], t_ms=t_ms)
+        anchor = self._samples[0]
+        # Built directly, not by dataclasses.replace: a crawling pen retimes at every sample.
+        self._samples[0] = Sample(t_ms, anchor.x, anchor.y, anchor.pressure)
 
     def _rests(
         self,
@@ -447,7 +452,12 @@ class WindowCore:
             return False
         start = len(points) - 1
         rest_sq = self._rest_sq
-        while start > 0 and _distance_sq(points[start - 1], point) <= rest_sq:
+        x, y = point
+        while start > 0:  # _distance_sq(points[start - 1], point) <= rest_sq, inlined
+            px, py = points[start - 1]
+            dx, dy = px - x, py - y
+            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN ends the rest too)
+                break
             start -= 1
         if t_ms - times[start] < rest_ms:
             return False
@@ -668,7 +678,18 @@ class Merger:
 
     def _send(self, segment: Segment, now_ms: float, out: list[Segment]) -> None:
         self._sent_in_path = True
-        out.append(replace(segment, emitted_at_ms=now_ms, dropped=None))
+        # Built directly, not by dataclasses.replace (several times slower): one per stroke.
+        out.append(
+            Segment(
+                segment.start,
+                segment.end,
+                segment.start_ms,
+                segment.end_ms,
+                now_ms,
+                None,
+                segment.merged,
+            )
+        )
         # The samples before its end are covered now (those at its end may start the next).
         keep = bisect.bisect_left(self._times, segment.end_ms)
         del self._points[:keep]
@@ -775,8 +796,11 @@ class WindowSimplifier:
         core = self._core
         pieces = core.push(sample)
         merger = self._merger
-        taken, point = core.last_sample()
-        merger.sample(taken, point)
+        taken, point = core._taken  # core.last_sample() and merger.sample, inlined: per sample
+        merger._points.append(point)
+        merger._times.append(taken)
+        if not pieces and not core.rested:
+            return []
         out: list[Segment] = []
         for piece in pieces:
             out.extend(merger.take(piece, taken))
