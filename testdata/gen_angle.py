@@ -18,7 +18,7 @@ from collections.abc import Callable
 from dataclasses import asdict, fields
 from typing import Any
 
-from feelmysign.simplify import AngleParams, Sample, simplify_paths
+from feelmysign.simplify import AngleParams, Sample, WindowParams, simplify_paths
 from feelmysign.simplify.angle import ANGLE_PARAMS
 from feelmysign.simplify.params import ParamSpec
 from feelmysign.simplify.registry import Params, algorithm_of
@@ -143,6 +143,8 @@ def _segments(params: Params, paths: list[Path]) -> dict[str, Any]:
             "end_ms": s.end_ms,
             "emitted_at_ms": s.emitted_at_ms,
             "dropped": s.dropped,
+            # The window simplifier merges pieces too short to send: how many are in this one.
+            **({"merged": s.merged} if isinstance(params, WindowParams) else {}),
         }
         for p in simplify_paths(params, paths)
         for s in [p.segment]

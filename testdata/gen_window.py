@@ -34,6 +34,9 @@ VARIATIONS: dict[str, dict[str, Any]] = {
     "min-length-0.5": {"min_length": 0.5},
     "stretch": {"stretch": True, "canvas_width_px": 1600.0},
     "sleeve-4x6": {"rows": 4, "columns": 6},
+    "rest-off": {"rest_ms": 0.0},
+    "rest-300": {"rest_ms": 300.0},
+    "strict-minimums": {"strict_minimums": True, "min_length": 0.5, "min_duration_ms": 120.0},
 }
 
 
@@ -58,10 +61,44 @@ def _edge_u(seed: int = 3) -> Path:
     return samples
 
 
+def _crawl(seed: int = 5) -> Path:
+    """A line, a crawl (the pen creeping on, too little in 200 ms to send), a rest with a still
+    hand's jitter, a short hook, a rest, a line, and a crawl before the release."""
+    rng = random.Random(seed)
+    samples = list(_line([(100, 400), (500, 400)], 0.5))
+
+    def go_on(dx: float, dy: float, count: int, step_ms: float = 8.0) -> None:
+        last = samples[-1]
+        for k in range(1, count + 1):
+            jitter_x, jitter_y = rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6)
+            samples.append(
+                Sample(
+                    round(last.t_ms + step_ms * k, 3),
+                    last.x + dx * k / count + jitter_x,
+                    last.y + dy * k / count + jitter_y,
+                )
+            )
+
+    go_on(30, 10, 60)  # 480 ms creeping 32 px (0.1 grid units)
+    go_on(0, 0, 40)  # 320 ms at rest
+    go_on(-20, 30, 5)  # a brief hook
+    go_on(0, 0, 30)  # 240 ms at rest
+    go_on(0, -300, 40)  # a line
+    go_on(12, 0, 50)  # a crawl, then the release
+    return samples
+
+
 # Window-only shapes, each with the defaults and the latency cap's variations (W x H fills the
 # default 3 x 4 grid, so the canvas edges are the grid's).
-EDGE_SHAPES = {"edge-u": lambda: [_edge_u()]}
-EDGE_VARIATIONS = ("defaults", "max-stroke-ms-100", "max-error-0.05")
+EDGE_SHAPES = {"edge-u": lambda: [_edge_u()], "crawl": lambda: [_crawl()]}
+EDGE_VARIATIONS = (
+    "defaults",
+    "max-stroke-ms-100",
+    "max-error-0.05",
+    "rest-off",
+    "rest-300",
+    "strict-minimums",
+)
 
 
 def _edge_case(shape: str, variation: str) -> dict[str, Any]:

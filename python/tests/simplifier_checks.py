@@ -37,6 +37,7 @@ def check_vector(
     assert len(actual) == len(expected), name
     for (path, segment), want in zip(actual, expected, strict=True):
         assert path == want["path"] and segment.dropped == want["dropped"]
+        assert segment.merged == want.get("merged", 0), name
         got = [
             *segment.start,
             *segment.end,
@@ -75,18 +76,34 @@ def random_walk(draw: st.DrawFn, *, margin_px: float, min_step_ms: float = 0.0) 
 
 
 def assert_joined_from_press_to_release(
-    params: SimplifierParams, samples: list[Sample], *, release_within: float = 0.0
+    params: SimplifierParams,
+    samples: list[Sample],
+    *,
+    release_within: float = 0.0,
+    rests: bool = False,
 ) -> None:
-    """Segments start at the press, end at the release (within release_within), and join."""
+    """Segments start at the press, end at the release (within release_within), and join.
+
+    With ``rests`` (the window simplifier's rest_ms and max_stroke_ms) a rest or a crawl is not
+    played: a segment may start
+    after the one before ends, the first after the press, the last end before the release."""
     segments = [s for _, s in run(params, [samples])]
     assert segments, "a path always gives at least one segment (sent or dropped)"
     mapping = params.mapping
     assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
     release = mapping.to_grid(samples[-1].x, samples[-1].y)
     assert math.dist(segments[-1].end, release) <= release_within
-    assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
+    if rests:
+        assert segments[0].start_ms >= samples[0].t_ms
+        assert segments[-1].end_ms <= samples[-1].t_ms
+    else:
+        assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
     for before, after in itertools.pairwise(segments):
-        assert after.start == before.end and after.start_ms == before.end_ms
+        assert after.start == before.end
+        if rests:
+            assert after.start_ms >= before.end_ms
+        else:
+            assert after.start_ms == before.end_ms
 
 
 def assert_dropped_say_why(params: SimplifierParams, samples: list[Sample]) -> None:

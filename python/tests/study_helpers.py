@@ -31,7 +31,7 @@ ZIGZAG_SHAPE = """
 name = "zigzag"
 recording = "zigzag.json"
 simplifier = "window"
-settings = [{max_error = 1.5}, {max_error = 0.05}]
+settings = [{max_error = 1.5, max_stroke_ms = 400}, {max_error = 0.05}]
 synonyms = ["zig zag", "lightning"]
 """
 

@@ -39,6 +39,7 @@ def test_strokes_play_back_to_back_and_the_felt_end_follows_the_last() -> None:
     played = simulate(segments, [path], PAPER_SLEEVE)
     assert played.drawing_ms == 1200.0
     assert played.skin_ms == pytest.approx(1200.0)  # kept in time: no stroke slowed
+    assert played.slowed == 0
     # Each starts when let go (its end), so pen to skin is one stroke's duration.
     assert played.pen_to_skin_ms == pytest.approx((400.0, 400.0, 400.0))
     (release,) = played.release_to_felt_end_ms
@@ -56,6 +57,7 @@ def test_a_slowed_stroke_delays_the_ones_after_it() -> None:
     played = simulate(segments, [[Sample(0.0, 0, 0), Sample(10.0, 0, 0)]], PAPER_SLEEVE)
     assert played.skin_ratio > 2
     assert played.pen_to_skin_ms[1] > played.pen_to_skin_ms[0]
+    assert played.slowed == 2  # both, counted for evaluate's slowed_total
 
 
 def test_a_stroke_behind_its_drawing_plays_faster_and_the_felt_end_catches_up() -> None:
@@ -137,7 +139,8 @@ def test_douglas_peucker_runs_above_a_tie_with_the_rows_deviation() -> None:
         samples = (*line[: at + 1], Sample(line[at].t_ms + 1, bump_x, bump_y), *line[at + 1 :])
         recording = Recording(1200.0, 800.0, (samples,), 3, 4)
         run = Run(
-            ALGORITHMS["window"], {"max_error": 0.6, "min_duration_ms": 0.0, "max_stroke_ms": 0.0}
+            ALGORITHMS["window"],
+            {"max_error": 0.6, "min_duration_ms": 0.0, "max_stroke_ms": 0.0, "max_bend": 0.0},
         )
         row = evaluate_one(Source("bump", "bump", recording), run)
         assert row.strokes == 1 and row.dp_strokes == 1

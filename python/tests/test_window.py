@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from simplifier_checks import (
     assert_four_strokes_on_the_corners,
@@ -33,7 +33,7 @@ from feelmysign.simplify import (
     WindowSimplifier,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE
-from feelmysign.simplify.window import LINE_SHARE
+from feelmysign.simplify.window import LINE_SHARE, WindowCore, rest_radius
 from feelmysign.stroke import Point
 
 WINDOW = dict(load("window"))
@@ -42,6 +42,9 @@ PARAMS_TABLE = WINDOW["params"]
 # The bound is tested on the reference's own float arithmetic; a different
 # formula for the same distance may differ in the last bits.
 FLOAT_TOLERANCE = 1e-12
+# Nothing too short to send and no bend rule: each piece the window cuts is sent as it is, when
+# it is cut, so the tests of the window's own cuts see them as cut.
+UNMERGED: dict[str, Any] = {"min_length": 0.0, "min_duration_ms": 0.0, "floor_ms": 0.0}
 
 
 def _distance(point: Point, start: Point, end: Point) -> float:
@@ -91,7 +94,12 @@ def test_out_of_range_parameters_are_refused_with_the_range(field: str, value: o
 def test_square_is_four_strokes_with_its_corners() -> None:
     # 10 px a sample is 0.033 grid units: above the error, so a corner shows at once.
     params = WindowParams(
-        canvas_width_px=900, canvas_height_px=600, max_error=0.01, max_window=1000, max_stroke_ms=0
+        canvas_width_px=900,
+        canvas_height_px=600,
+        max_error=0.01,
+        max_window=1000,
+        max_stroke_ms=0,
+        **UNMERGED,
     )
     segments = [s for _, s in run(params, [square_path(8.0)])]
     assert_four_strokes_on_the_corners(params, segments)
@@ -103,7 +111,7 @@ def test_a_straight_line_the_latency_cap_cuts_stays_one_straight_line() -> None:
     # A level line drawn in 1 s at 125 Hz, each sample 0.6 px (0.0025 grid units) above or below
     # it: the cap cuts it into strokes of at most 300 ms, and their ends are not the noisy
     # samples but points on the line of the first, so the felt line does not bend.
-    params = WindowParams()
+    params = WindowParams(max_stroke_ms=300.0)
     path = [Sample(i * 8.0, 100 + 12.0 * i, 540 + (0.6 if i % 2 else -0.6)) for i in range(126)]
     segments = [s for _, s in run(params, [path]) if s.dropped is None]
     assert len(segments) >= 4
@@ -141,12 +149,41 @@ def test_the_cut_goes_on_the_feature_not_where_the_bound_first_breaks() -> None:
 def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
     params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=100)
     line = [Sample(8.0 * k, 1.0 * k, 100) for k in range(76)]  # 600 ms, straight
-    segments = [s for _, s in run(params, [line])]
-    assert all(s.duration_ms <= 100 for s in segments)
+    cut = [s for _, s in run(replace(params, **UNMERGED), [line])]
+    assert all(s.duration_ms <= 100 for s in cut)
     # Samples 8 ms apart: each stroke covers 12 of them (96 ms), the seventh the rest.
-    assert [s.duration_ms for s in segments] == [96.0] * 6 + [24.0]
-    assert segments[0].emitted_at_ms == 104.0  # let go by the sample that would pass 100 ms
-    assert segments[-1].end_ms == 600.0
+    assert [s.duration_ms for s in cut] == [96.0] * 6 + [24.0]
+    assert cut[0].emitted_at_ms == 104.0  # let go by the sample that would pass 100 ms
+    assert cut[-1].end_ms == 600.0
+    # With the sleeve's floor (73.7 ms) the strokes are the same: a stroke the cap ends is
+    # merged into nothing before it, and the rest, 24 ms, the last, has nothing after it.
+    assert [s.duration_ms for _, s in run(params, [line])] == [96.0] * 6 + [24.0]
+
+
+def test_pieces_briefer_than_the_floor_merge_into_the_next() -> None:
+    # A circle of radius 0.5 grid units drawn in 400 ms: the bend rule (0.1 x the chord) cuts
+    # it every 47 degrees, 52 ms, briefer than the sleeve's floor (73.7 ms); two such pieces
+    # still lie within max_error (0.25) of one stroke, so they merge, and every stroke sent but
+    # the last lasts at least the floor.
+    params = WindowParams(
+        canvas_width_px=300, canvas_height_px=200, max_stroke_ms=0, max_bend=0.1, bend_floor=0.01
+    )
+    px = 100.0  # pixels per grid unit on this canvas (a 4 x 3 grid)
+    circle = [
+        Sample(
+            8.0 * k,
+            150 + 0.5 * px * math.cos(2 * math.pi * k / 50),
+            100 + 0.5 * px * math.sin(2 * math.pi * k / 50),
+        )
+        for k in range(51)
+    ]
+    unmerged = [s for _, s in run(replace(params, floor_ms=0.0), [circle])]
+    merged = [s for _, s in run(params, [circle])]
+    assert all(s.duration_ms < params.floor_ms for s in unmerged)
+    assert len(merged) < len(unmerged)
+    assert all(s.dropped is None for s in merged)
+    assert sum(s.merged for s in merged) == len(unmerged) - len(merged)
+    assert all(s.duration_ms >= params.floor_ms for s in merged[:-1])
 
 
 def _bumped_line(params: WindowParams, bump_ms: float, height: float) -> list[Sample]:
@@ -160,7 +197,9 @@ def _bumped_line(params: WindowParams, bump_ms: float, height: float) -> list[Sa
 
 
 def test_the_latency_cap_cuts_at_a_feature_of_the_strokes_second_half_only() -> None:
-    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=300)
+    params = WindowParams(
+        canvas_width_px=300, canvas_height_px=200, max_stroke_ms=300, max_bend=0.0, **UNMERGED
+    )
     # A bump 0.2 high (within the bound) 40 ms in: cutting there would leave a 40 ms
     # stroke, too brief to be felt in its drawn time; the line after it is straight, so
     # the cap cuts at the last sample it allows.
@@ -193,7 +232,7 @@ def test_a_sample_earlier_than_the_one_before_is_taken_at_its_time() -> None:
 
 
 def test_window_cap_cuts_at_the_current_frame() -> None:
-    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_window=3)
+    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_window=3, **UNMERGED)
     simplifier = WindowSimplifier(params)
     frames = [Sample(20.0 * k, 10.0 * k, 100) for k in range(7)]
     pushed = [[s.end_ms for s in simplifier.push(frame)] for frame in frames]
@@ -296,6 +335,10 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
         max_stroke_ms=draw(st.sampled_from([0.0, 50.0, 300.0])),
         min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
         min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
+        max_bend=draw(st.sampled_from([0.0, 0.1, 0.3])),
+        bend_floor=draw(st.sampled_from([0.0, 0.05])),
+        floor_ms=draw(st.sampled_from([0.0, 73.7, 200.0])),
+        rest_ms=draw(st.sampled_from([0.0, 30.0, 100.0])),
         stretch=draw(st.booleans()),
         canvas_width_px=800,
         canvas_height_px=600,
@@ -305,33 +348,57 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
     return params, samples
 
 
-def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:
-    """Each segment with the indices of the first and last sample it covers.
+def _rest_radius(params: WindowParams) -> float:
+    """How far a sample the pen rested at may lie from the point that stands for the rest."""
+    return rest_radius(params) if params.rest_ms > 0 else 0.0
 
-    Segments join end to start, so each starts at the sample the one before
-    ended on; it ends on the last sample (from there) with its end time, at its
-    point or, going on along a line the latency cap cut, within LINE_SHARE x
-    max_error of it.
-    """
-    segments = [s for _, s in run(params, [samples])]
-    mapping = params.mapping
-    moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE
+
+def _moved(params: WindowParams) -> float:
+    return max(LINE_SHARE * params.max_error, _rest_radius(params)) + FLOAT_TOLERANCE
+
+
+def _ends(
+    params: WindowParams, samples: list[Sample], segments: list[Segment]
+) -> list[tuple[int, int, Segment]]:
+    """Each segment with the first and last sample it covers (see ``_covered``)."""
+    mapping, moved = params.mapping, _moved(params)
     covered: list[tuple[int, int, Segment]] = []
     start = 0
     for number, segment in enumerate(segments, start=1):
         ends = [
             j
             for j in range(min(start + 1, len(samples) - 1), len(samples))
-            if samples[j].t_ms == segment.end_ms
+            if samples[j].t_ms >= segment.end_ms
             and math.dist(mapping.to_grid(samples[j].x, samples[j].y), segment.end) <= moved
         ]
         assert ends, f"{segment} does not end on a sample"
-        # Repeated samples (same time and place) are one: the first, but the last for the last.
-        end = ends[-1] if number == len(segments) else ends[0]
+        # Repeated samples (same time and place) are one: the first, but the last for the last
+        # (of those at the first's time: later ones at that place are a rest after it).
+        end = ends[0]
+        if number == len(segments):
+            end = max(j for j in ends if samples[j].t_ms == samples[ends[0]].t_ms)
         covered.append((start, end, segment))
         start = end
-    assert start == len(samples) - 1, "the last segment ends on the last sample"
+    # The samples after the last segment are a rest at its end.
+    if segments:
+        last = segments[-1]
+        limit = min(2 * _rest_radius(params), params.max_error) + FLOAT_TOLERANCE
+        for sample in samples[start + 1 :]:
+            point = mapping.to_grid(sample.x, sample.y)
+            assert _distance(point, last.start, last.end) <= limit, (last, sample)
     return covered
+
+
+def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:
+    """Each segment with the indices of the first and last sample it covers.
+
+    Segments join end to start, so each starts at the sample the one before
+    ended on; it ends on the first sample (from there) drawn at or after its end
+    time, at its point or, going on along a line the latency cap cut, within
+    LINE_SHARE x max_error of it (where the pen rested, within the rest radius).
+    The samples after the last segment are a rest at its end.
+    """
+    return _ends(params, samples, [s for _, s in run(params, [samples])])
 
 
 @settings(max_examples=250, deadline=None)
@@ -352,8 +419,56 @@ def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
 def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sample]]) -> None:
     params, samples = case
     assert_joined_from_press_to_release(
-        params, samples, release_within=LINE_SHARE * params.max_error + FLOAT_TOLERANCE
+        params,
+        samples,
+        release_within=_moved(params),
+        rests=params.rest_ms > 0 or params.max_stroke_ms > 0,
     )
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths(), st.sampled_from([0.001, 0.05, 0.1, 0.15, 0.25, 1.0]))
+def test_no_piece_is_dropped_and_every_sample_lies_within_max_error_of_a_sent_stroke(
+    case: tuple[WindowParams, list[Sample]], max_error: float
+) -> None:
+    # Whatever the caps and minimums: a piece too short to send merges into a neighbour, or is
+    # sent; only a path that is one piece too short in all (a tap) is dropped, and all of it.
+    params, samples = case
+    params = replace(params, max_error=max_error)
+    segments = [s for _, s in run(params, [samples])]
+    if any(s.dropped is not None for s in segments):
+        assert len(segments) == 1, segments
+        assert segments[0].length < params.min_length or segments[0].duration_ms < (
+            params.min_duration_ms
+        )
+        return
+    mapping = params.mapping
+    for sample in samples:
+        point = mapping.to_grid(sample.x, sample.y)
+        nearest = min(_distance(point, s.start, s.end) for s in segments)
+        assert nearest <= params.max_error + FLOAT_TOLERANCE, (sample, nearest)
+
+
+@settings(max_examples=150, deadline=None)
+@given(paths(min_step_ms=0.01))
+def test_a_short_piece_is_merged_or_else_could_not_be(
+    case: tuple[WindowParams, list[Sample]],
+) -> None:
+    # A stroke sent too short to send, or briefer than the sleeve's floor, next to a stroke it
+    # was held with, could not have merged: the stroke from the first's start to the second's
+    # end would leave a sample farther than max_error. A merged stroke covers the pieces it
+    # counts, so it is at least as long in time as they are many (each drawn at least one step).
+    params, samples = case
+    covered = _covered(params, samples)
+    for first, last, segment in covered:
+        assert last - first >= segment.merged + 1 or len(samples) == 1, segment
+
+
+def _core_covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:
+    """``_covered`` of the window's own pieces, before any is merged."""
+    core = WindowCore(params)
+    segments = [out for sample in samples for out in core.push(sample)] + core.end()
+    return _ends(params, samples, segments)
 
 
 @settings(max_examples=150, deadline=None)
@@ -361,10 +476,13 @@ def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sam
 def test_strokes_keep_the_caps_and_are_let_go_by_a_later_sample(
     case: tuple[WindowParams, list[Sample]],
 ) -> None:
+    # The caps bound the window's pieces; a merged stroke may be longer than one piece.
     params, samples = case
     times = {s.t_ms for s in samples}
-    for first, last, segment in _covered(params, samples):
-        assert last - first <= params.max_window
+    for first, last, segment in _core_covered(params, samples):
+        # The work cap counts the samples the stroke holds: not those of a rest before it.
+        held = sum(1 for sample in samples[first + 1 : last + 1] if sample.t_ms > segment.start_ms)
+        assert held <= params.max_window
         assert last > first or len(samples) == 1, "only a one-sample path gives an empty stroke"
         if params.max_stroke_ms and segment.duration_ms > params.max_stroke_ms:
             # Only a single step, or a stroke still too short to send a sample earlier.
@@ -412,6 +530,9 @@ def drawings(draw: st.DrawFn) -> tuple[WindowParams, list[list[Sample]]]:
         max_stroke_ms=draw(st.sampled_from([0.0, 50.0, 300.0])),
         min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
         min_duration_ms=draw(st.sampled_from([0.0, 6.1, 80.0])),
+        max_bend=draw(st.sampled_from([0.0, 0.05, 0.1, 0.3])),
+        bend_floor=draw(st.sampled_from([0.0, 0.01, 0.05, 0.5])),
+        rest_ms=draw(st.sampled_from([0.0, 30.0, 100.0])),
         rows=rows,
         columns=columns,
         stretch=draw(st.booleans()),
@@ -452,7 +573,7 @@ def test_the_same_strokes_to_the_last_bit_as_the_reference(
     case: tuple[WindowParams, list[list[Sample]]],
 ) -> None:
     params, drawn = case
-    fast, reference = WindowSimplifier(params), ReferenceWindowSimplifier(params)
+    fast, reference = WindowCore(params), ReferenceWindowSimplifier(params)
     for path in drawn:
         for sample in path:
             assert _bits(fast.push(sample)) == _bits(reference.push(sample)), sample
@@ -532,3 +653,130 @@ def test_a_drawing_along_the_edges_gives_strokes_on_the_grid(
     for _, segment in run(params, [samples]):
         for x, y in (segment.start, segment.end):
             assert 0.0 <= x <= x_max and 0.0 <= y <= y_max, segment
+
+
+# --- a resting pen and a slow, steady one -------------------------------------------------------
+
+# The slowest steady pen that is never taken for a resting one: half a pixel a frame at 60 fps.
+SLOW_PEN_PX_PER_MS = 0.5 * 60 / 1000
+
+
+@st.composite
+def slow_legs(draw: st.DrawFn) -> tuple[WindowParams, list[Sample]]:
+    """A straight leg drawn at a steady speed of at least ``SLOW_PEN_PX_PER_MS``, in any
+    direction, on any canvas and grid, sampled every frame or every pointer event (times
+    jittered), its samples at exact or whole pixels."""
+    width_px = draw(st.floats(200, 4000))
+    height_px = draw(st.floats(200, 4000))
+    params = WindowParams(
+        max_stroke_ms=0.0,  # one stroke a leg: only a rest could cut it
+        max_window=10_000,
+        rest_ms=draw(st.sampled_from([100.0, 200.0, 500.0])),
+        min_length=draw(st.sampled_from([0.0, 0.1, 0.4])),
+        max_error=draw(st.sampled_from([0.05, 0.25, 1.0])),
+        columns=draw(st.integers(2, 12)),
+        rows=draw(st.integers(2, 12)),
+        stretch=draw(st.booleans()),
+        canvas_width_px=width_px,
+        canvas_height_px=height_px,
+    )
+    speed = draw(st.floats(SLOW_PEN_PX_PER_MS, 0.5))
+    angle = draw(st.floats(0, 2 * math.pi))
+    duration_ms = draw(st.floats(300, 4000))
+    step_ms = draw(st.sampled_from([1000 / 60, 8.0]))
+    whole_px = draw(st.booleans())
+    length_px = speed * duration_ms
+    ux, uy = math.cos(angle), math.sin(angle)
+    # A start from which the whole leg stays on the canvas (no clamping onto the grid's edge).
+    room_x, room_y = width_px - abs(ux) * length_px - 2, height_px - abs(uy) * length_px - 2
+    assume(room_x > 0 and room_y > 0)
+    x0 = draw(st.floats(0, 1)) * room_x + 1 + max(0.0, -ux) * length_px
+    y0 = draw(st.floats(0, 1)) * room_y + 1 + max(0.0, -uy) * length_px
+    samples, t_ms = [], 0.0
+    while t_ms <= duration_ms:
+        x, y = x0 + ux * speed * t_ms, y0 + uy * speed * t_ms
+        if whole_px:
+            x, y = round(x), round(y)
+        samples.append(Sample(t_ms, x, y))
+        t_ms += step_ms * draw(st.floats(0.5, 1.5))
+    return params, samples
+
+
+@settings(max_examples=300, deadline=None)
+@given(slow_legs())
+def test_a_slow_steady_leg_is_never_cut_for_rest(case: tuple[WindowParams, list[Sample]]) -> None:
+    params, samples = case
+    core = WindowCore(params)
+    for sample in samples:
+        assert core.push(sample) == [], sample
+        assert not core.rested, sample
+    (stroke,) = core.end()
+    mapping = params.mapping
+    assert stroke.start_ms == samples[0].t_ms and stroke.end_ms == samples[-1].t_ms
+    assert stroke.start == mapping.to_grid(samples[0].x, samples[0].y)
+    assert stroke.end == mapping.to_grid(samples[-1].x, samples[-1].y)
+
+
+@st.composite
+def rests(draw: st.DrawFn) -> tuple[WindowParams, list[Sample], int, int]:
+    """A leg, a rest of at least rest_ms at its end (the pen still, or trembling well within the
+    rest radius), then a leg in another direction; with the index of the rest's first and last
+    samples."""
+    cap_ms = draw(st.sampled_from([0.0, 200.0]))
+    params = WindowParams(
+        max_stroke_ms=cap_ms,
+        # A rest longer than the latency cap is the crawl rule's: the stroke after it starts at
+        # most the cap before the pen moves on.
+        rest_ms=draw(st.sampled_from([50.0, 100.0] if cap_ms else [50.0, 100.0, 300.0])),
+        canvas_width_px=1200.0,
+        canvas_height_px=800.0,
+    )
+    radius_px = rest_radius(params) / params.mapping.scale
+    step_ms = draw(st.sampled_from([1000 / 60, 8.0]))
+    step_px = draw(st.floats(1.5, 9.0))  # long enough to send, short enough to stay on the canvas
+    speed = step_px / step_ms
+    samples = [Sample(k * step_ms, 200.0 + step_px * k, 400.0) for k in range(40)]
+    arrival = len(samples) - 1
+    x, y, t_ms = samples[-1].x, samples[-1].y, samples[-1].t_ms
+    tremble = draw(st.sampled_from([0.0, 0.4])) * radius_px
+    rest_steps = math.ceil(draw(st.floats(1.2, 4.0)) * params.rest_ms / step_ms)
+    for _ in range(rest_steps):
+        t_ms += step_ms
+        dx, dy = draw(st.floats(-1, 1)) * tremble, draw(st.floats(-1, 1)) * tremble
+        samples.append(Sample(t_ms, x + dx / math.sqrt(2), y + dy / math.sqrt(2)))
+    leave = len(samples) - 1
+    for k in range(1, 40):
+        samples.append(Sample(t_ms + k * step_ms, x, y - speed * step_ms * k))
+    return params, samples, arrival, leave
+
+
+@settings(max_examples=200, deadline=None)
+@given(rests())
+def test_a_rest_ends_the_stroke_before_it_and_is_not_played(
+    case: tuple[WindowParams, list[Sample], int, int],
+) -> None:
+    params, samples, arrival, leave = case
+    simplifier = WindowSimplifier(params)
+    during_rest: list[Segment] = []
+    after: list[Segment] = []
+    for index, sample in enumerate(samples):
+        out = simplifier.push(sample)
+        if arrival < index <= leave:
+            during_rest.extend(out)
+        elif index > leave:
+            after.extend(out)
+    after.extend(simplifier.end())
+    # The stroke that arrives at the rest is sent while the pen still rests, ending where it
+    # rests, when the rest began (no later than the pen's arrival).
+    assert during_rest, "no stroke was let go while the pen rested"
+    last = during_rest[-1]
+    rest_point = params.mapping.to_grid(samples[arrival].x, samples[arrival].y)
+    assert math.dist(last.end, rest_point) <= rest_radius(params) + FLOAT_TOLERANCE
+    # A rest is told after rest_ms of it, and the latency cap may end a stroke first; a piece
+    # held to merge, briefer than the sleeve's floor, takes the time it needs from the rest.
+    assert last.end_ms <= samples[arrival].t_ms + max(params.rest_ms, params.floor_ms)
+    # Nothing plays the rest: the next stroke starts when the pen moves on (if the latency cap
+    # ended a stroke in the rest, what is left of it may be too brief to tell: under rest_ms).
+    assert after, "the leg after the rest was not sent"
+    told_ms = params.rest_ms if params.max_stroke_ms else 0.0
+    assert after[0].start_ms >= samples[leave].t_ms - told_ms

@@ -11,13 +11,16 @@ simplifier's inlined loops must equal that distance to the last bit.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, replace
 
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.simplify.window import (
     CAP_FEATURE_SHARE,
     LINE_SHARE,
+    REST_SHARE,
+    REST_SPEED_PX_PER_MS,
     STRAIGHT,
     WindowParams,
     segment_distance_sq,
@@ -45,6 +48,16 @@ class _Point:
     point: Point  # the sample in grid units
 
 
+def _retimed(drawn: _Point, t_ms: float) -> _Point:
+    """``drawn`` at another time (the anchor's, while the pen rests or crawls)."""
+    return _Point(replace(drawn.sample, t_ms=t_ms), drawn.point)
+
+
+def _squared(a: Point, b: Point) -> float:
+    dx, dy = a[0] - b[0], a[1] - b[1]
+    return dx * dx + dy * dy
+
+
 @dataclass
 class ReferenceWindowSimplifier:
     params: WindowParams = field(default_factory=WindowParams)
@@ -55,12 +68,30 @@ class ReferenceWindowSimplifier:
     # The direction of the stroke the latency cap ended last, while the next one may go on along
     # it (None at a path's start and after any other cut).
     _line: tuple[float, float] | None = None
+    # While the pen rests at the anchor: each sample near it moves the anchor's time.
+    _resting: bool = False
     _max_error_sq: float = field(init=False)
+    _rest_sq: float = field(init=False)
     _mapping: CanvasMapping = field(init=False)
 
     def __post_init__(self) -> None:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._mapping = self.params.mapping
+        params = self.params
+        # The canvas's tighter scale (grid units per pixel), from the axes that have an extent.
+        scales = [
+            extent / size
+            for extent, size in (
+                (params.columns - 1, params.canvas_width_px),
+                (params.rows - 1, params.canvas_height_px),
+            )
+            if extent > 0
+        ]
+        px = REST_SPEED_PX_PER_MS * params.rest_ms
+        rest = min(
+            REST_SHARE * params.min_length, 0.5 * params.max_error, px * min(scales, default=0.0)
+        )
+        self._rest_sq = rest * rest
 
     @property
     def drawing(self) -> bool:
@@ -82,6 +113,7 @@ class ReferenceWindowSimplifier:
             self._window = [current]
             self._emitted_in_path = False
             self._line = None
+            self._resting = False
             return []
         out: list[Segment] = []
         self._add(current, out)
@@ -91,6 +123,7 @@ class ReferenceWindowSimplifier:
         """Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0)."""
         window = self._window
         self._window = []
+        self._resting = False
         if not window:
             return []
         if len(window) == 1 and self._emitted_in_path:
@@ -109,6 +142,18 @@ class ReferenceWindowSimplifier:
             window = self._window
             anchor = window[0]
             cap_ms = self.params.max_stroke_ms
+            if self._resting:
+                if len(window) == 1 and _squared(item.point, anchor.point) <= self._rest_sq:
+                    self._window = [_retimed(anchor, item.sample.t_ms)]
+                    continue
+                self._resting = False
+            if (
+                cap_ms > 0
+                and len(window) > 1
+                and item.sample.t_ms - anchor.sample.t_ms > cap_ms
+                and not self._sendable(anchor, window[-1])
+            ):
+                anchor = window[0] = _retimed(anchor, item.sample.t_ms - cap_ms)
             if (
                 cap_ms > 0
                 and len(window) > 1
@@ -125,7 +170,8 @@ class ReferenceWindowSimplifier:
                     self._window = [vertex]
                     continue
                 window = self._window = [vertex]
-            if not self._fits(window, 1, len(window), item.point):
+            bound_sq = self._bend_sq(window, item.point)
+            if not self._fits(window, 1, len(window), item.point, bound_sq):
                 cut = self._feature(window, item.point)
                 out.append(self._finish(window[0], window[cut]))
                 self._line = None
@@ -134,10 +180,33 @@ class ReferenceWindowSimplifier:
                 self._window = [window[cut]]
                 continue
             window.append(item)
+            if self._rests(window, out):
+                continue
             if len(window) - 1 >= self.params.max_window:
                 out.append(self._finish(window[0], item))
                 self._line = None
                 self._window = [item]
+
+    def _rests(self, window: list[_Point], out: list[Segment]) -> bool:
+        """Whether the pen has rested rest_ms at the last sample (then as the package's)."""
+        rest_ms = self.params.rest_ms
+        last = window[-1]
+        t_ms = last.sample.t_ms
+        if rest_ms <= 0 or t_ms - window[0].sample.t_ms < rest_ms:
+            return False
+        start = len(window) - 1
+        while start > 0 and _squared(window[start - 1].point, last.point) <= self._rest_sq:
+            start -= 1
+        if t_ms - window[start].sample.t_ms < rest_ms:
+            return False
+        if start == 0:
+            self._window = [_retimed(window[0], t_ms)]
+        else:
+            out.append(self._finish(window[0], _Point(window[start].sample, last.point)))
+            self._window = [last]
+        self._line = None
+        self._resting = True
+        return True
 
     def _cap_cut(self, window: list[_Point]) -> int:
         """Where the latency cap cuts: at a feature in the stroke's later part, else at its end.
@@ -224,11 +293,26 @@ class ReferenceWindowSimplifier:
                 return index
         return len(window) - 1  # unreachable: the last sample fits by construction
 
-    def _fits(self, window: list[_Point], first: int, stop: int, end: Point) -> bool:
-        """Whether window[first:stop] all lie within max_error of window[0] -> end."""
+    def _bend_sq(self, window: list[_Point], end: Point) -> float:
+        """The squared bound a stroke window[0] -> end grows under: max_error's, or the bend
+        rule's (max_bend x its length, never under bend_floor) when that is less."""
+        bend = self.params.max_bend
+        if bend <= 0.0 or len(window) == 1:
+            return self._max_error_sq
         anchor = window[0].point
+        cx, cy = end[0] - anchor[0], end[1] - anchor[1]
+        limit = max(bend * math.sqrt(cx * cx + cy * cy), self.params.bend_floor)
+        return limit * limit if limit < self.params.max_error else self._max_error_sq
+
+    def _fits(
+        self, window: list[_Point], first: int, stop: int, end: Point, limit_sq: float | None = None
+    ) -> bool:
+        """Whether window[first:stop] all lie within max_error (or sqrt(limit_sq)) of
+        window[0] -> end."""
+        anchor = window[0].point
+        bound_sq = self._max_error_sq if limit_sq is None else limit_sq
         for index in range(first, stop):
-            if segment_distance_sq(window[index].point, anchor, end) > self._max_error_sq:
+            if segment_distance_sq(window[index].point, anchor, end) > bound_sq:
                 return False
         return True
 

@@ -11,16 +11,30 @@ export interface Minimums {
   readonly min_length: number;
 }
 
-/** `settings` with its minimums raised to `floor` (the same object when nothing is raised). */
+/**
+ * `settings` with its minimums raised to `floor` (the same object when nothing changes). The window
+ * simplifier's also take the sleeve's floor as the shortest stroke to merge up to (`floor_ms`), and
+ * with a wearer's limits never go below them (`strict_minimums`), as Python's replay does.
+ */
 export function withFloor<T extends Minimums>(settings: T, floor: SleeveFloor | null | undefined): T {
-  // Only a wearer's measured limits are kept to (as Python's respect_floor): the motors' floor
-  // alone would make the simplifier drop brief strokes, which costs more of the shape than the
-  // sleeve's slowing them and catching up afterwards.
-  if (floor == null || !floor.wearer) return settings;
+  if (floor == null) return settings;
+  let out = settings;
+  if ("floor_ms" in settings && "strict_minimums" in settings) {
+    // The window simplifier merges a piece briefer than the floor into its neighbour, without
+    // dropping anything, so the motors' floor alone is kept to as well.
+    const strict = Boolean(floor.wearer);
+    if (settings.floor_ms !== floor.min_duration_ms || settings.strict_minimums !== strict) {
+      out = { ...out, floor_ms: floor.min_duration_ms, strict_minimums: strict };
+    }
+  }
+  // Only a wearer's measured limits raise the minimums (as Python's respect_floor): the motors'
+  // floor alone would make a simplifier drop brief strokes, which costs more of the shape than
+  // the sleeve's slowing them and catching up afterwards.
+  if (!floor.wearer) return out;
   const minDurationMs = Math.max(settings.min_duration_ms, floor.min_duration_ms);
   const minLength = Math.max(settings.min_length, floor.min_length);
-  if (minDurationMs === settings.min_duration_ms && minLength === settings.min_length) return settings;
-  return { ...settings, min_duration_ms: minDurationMs, min_length: minLength };
+  if (minDurationMs === settings.min_duration_ms && minLength === settings.min_length) return out;
+  return { ...out, min_duration_ms: minDurationMs, min_length: minLength };
 }
 
 /** One sentence for the settings panel: what the floor makes the simplifier use; null without one. */

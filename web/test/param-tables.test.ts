@@ -90,6 +90,11 @@ describe("parameter tables", () => {
       max_error: "window",
       max_window: "window",
       max_stroke_ms: "window",
+      max_bend: "window",
+      bend_floor: "window",
+      rest_ms: "window",
+      strict_minimums: "window",
+      floor_ms: "window",
     });
   });
 

@@ -18,6 +18,8 @@ interface ExpectedSegment {
   end_ms: number;
   emitted_at_ms: number;
   dropped: string | null;
+  /** The window simplifier's: how many pieces too short to send were merged into it. */
+  merged?: number;
 }
 
 interface SimplifierVector<P> {
@@ -54,6 +56,7 @@ function checkVector(
     const where = `segment ${i}`;
     expect(got.path, `${where} path`).toBe(want.path);
     expect(got.segment.dropped, `${where} dropped`).toBe(want.dropped);
+    expect(got.segment.merged ?? 0, `${where} merged`).toBe(want.merged ?? 0);
     close(got.segment.start[0], want.start[0], tol, `${where} start x`);
     close(got.segment.start[1], want.start[1], tol, `${where} start y`);
     close(got.segment.end[0], want.end[0], tol, `${where} end x`);

@@ -23,6 +23,20 @@ describe("withFloor", () => {
     expect(withFloor(high, { ...floor, min_length: 0.62, wearer: "P01" })).toBe(high);
   });
 
+  it("gives the window simplifier the sleeve's floor to merge up to, strict only with a wearer", () => {
+    const window = { ...user, floor_ms: 73.7, strict_minimums: false };
+    expect(withFloor(window, { ...floor, min_duration_ms: 90 })).toEqual({ ...window, floor_ms: 90 });
+    expect(withFloor(window, { ...floor, min_duration_ms: 118.4, min_length: 0.62, wearer: "P01" })).toEqual({
+      ...window,
+      floor_ms: 118.4,
+      strict_minimums: true,
+      min_duration_ms: 118.4,
+      min_length: 0.62,
+    });
+    const same = { ...user, floor_ms: 73.701, strict_minimums: false };
+    expect(withFloor(same, floor)).toBe(same);
+  });
+
   it("leaves the settings alone without a floor (an older sleeve)", () => {
     expect(withFloor(user, undefined)).toBe(user);
     expect(withFloor(user, null)).toBe(user);

@@ -25,6 +25,13 @@ const STRAIGHT = 1e-6;
  * moving its end at most this share of max_error off its drawn sample (no drift along a bend).
  */
 const LINE_SHARE = 0.25;
+/**
+ * A pen rests while its samples stay within this share of min_length of one point (never farther
+ * than half of max_error).
+ */
+const REST_SHARE = 0.25;
+/** ... and never farther than a pen this slow covers in rest_ms (canvas pixels per ms). */
+const REST_SPEED_PX_PER_MS = 0.015;
 
 interface Drawn {
   readonly sample: Sample;
@@ -45,11 +52,30 @@ export class ReferenceWindowSimplifier {
    * it (null at a path's start and after any other cut).
    */
   #line: Point | null = null;
+  /** While the pen rests at the anchor: each sample near it moves the anchor's time. */
+  #resting = false;
+  /** Whether the last push found the pen resting. */
+  rested = false;
+  readonly #restSq: number;
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
     this.params = params;
     this.#maxErrorSq = params.max_error * params.max_error;
+    // The canvas's tighter scale (grid units per pixel), from the axes that have an extent.
+    const scales = [
+      [params.columns - 1, params.canvas_width_px],
+      [params.rows - 1, params.canvas_height_px],
+    ]
+      .filter(([extent]) => extent! > 0)
+      .map(([extent, size]) => extent! / size!);
+    const scale = scales.length > 0 ? Math.min(...scales) : 0;
+    const rest = Math.min(
+      REST_SHARE * params.min_length,
+      0.5 * params.max_error,
+      REST_SPEED_PX_PER_MS * params.rest_ms * scale,
+    );
+    this.#restSq = rest * rest;
     this.#mapping = {
       width_px: params.canvas_width_px,
       height_px: params.canvas_height_px,
@@ -79,10 +105,12 @@ export class ReferenceWindowSimplifier {
         : input;
     this.#pointer = sample;
     const current: Drawn = { sample, point: toGrid(this.#mapping, sample.x, sample.y) };
+    this.rested = false;
     if (this.#window.length === 0) {
       this.#window = [current];
       this.#emittedInPath = false;
       this.#line = null;
+      this.#resting = false;
       return [];
     }
     const out: Segment[] = [];
@@ -94,6 +122,7 @@ export class ReferenceWindowSimplifier {
   end(): Segment[] {
     const window = this.#window;
     this.#window = [];
+    this.#resting = false;
     const first = window[0];
     const last = window[window.length - 1];
     if (first === undefined || last === undefined) return [];
@@ -108,8 +137,23 @@ export class ReferenceWindowSimplifier {
     const pending: Drawn[] = [current];
     for (let item = pending.pop(); item !== undefined; item = pending.pop()) {
       let window = this.#window;
-      const anchor = window[0]!;
+      let anchor = window[0]!;
       const capMs = this.params.max_stroke_ms;
+      if (this.#resting) {
+        if (window.length === 1 && squaredDistance(item.point, anchor.point) <= this.#restSq) {
+          this.#window = [retimed(anchor, item.sample.t_ms)];
+          continue;
+        }
+        this.#resting = false;
+      }
+      if (
+        capMs > 0 &&
+        window.length > 1 &&
+        item.sample.t_ms - anchor.sample.t_ms > capMs &&
+        !this.#sendable(anchor, window[window.length - 1]!)
+      ) {
+        anchor = window[0] = retimed(anchor, item.sample.t_ms - capMs);
+      }
       if (
         capMs > 0 &&
         window.length > 1 &&
@@ -128,7 +172,7 @@ export class ReferenceWindowSimplifier {
         }
         window = this.#window = [vertex];
       }
-      if (!this.#fits(window, 1, window.length, item.point)) {
+      if (!this.#fits(window, 1, window.length, item.point, this.#bendSq(window, item.point))) {
         const cut = this.#feature(window, item.point);
         out.push(this.#finish(window[0]!, window[cut]!));
         this.#line = null;
@@ -138,6 +182,7 @@ export class ReferenceWindowSimplifier {
         continue;
       }
       window.push(item);
+      if (this.#rests(window, out)) continue;
       if (window.length - 1 >= this.params.max_window) {
         out.push(this.#finish(window[0]!, item));
         this.#line = null;
@@ -230,12 +275,48 @@ export class ReferenceWindowSimplifier {
     return window.length - 1; // unreachable: the last sample fits by construction
   }
 
-  /** Whether window[first..stop) all lie within max_error of window[0] -> end. */
-  #fits(window: readonly Drawn[], first: number, stop: number, end: Point): boolean {
+  /**
+   * The squared bound a stroke window[0] -> end grows under: max_error's, or the bend rule's
+   * (max_bend x its length, never under bend_floor) when that is less.
+   */
+  #bendSq(window: readonly Drawn[], end: Point): number {
+    const bend = this.params.max_bend;
+    if (bend <= 0 || window.length === 1) return this.#maxErrorSq;
     const anchor = window[0]!.point;
+    const cx = end[0] - anchor[0];
+    const cy = end[1] - anchor[1];
+    const limit = Math.max(bend * Math.sqrt(cx * cx + cy * cy), this.params.bend_floor);
+    return limit < this.params.max_error ? limit * limit : this.#maxErrorSq;
+  }
+
+  /** Whether window[first..stop) all lie within max_error (or sqrt(limitSq)) of window[0] -> end. */
+  #fits(window: readonly Drawn[], first: number, stop: number, end: Point, limitSq?: number): boolean {
+    const anchor = window[0]!.point;
+    const boundSq = limitSq ?? this.#maxErrorSq;
     for (let i = first; i < stop; i++) {
-      if (distanceSq(window[i]!.point, anchor, end) > this.#maxErrorSq) return false;
+      if (distanceSq(window[i]!.point, anchor, end) > boundSq) return false;
     }
+    return true;
+  }
+
+  /** Whether the pen has rested rest_ms at the window's last sample (then as the page's). */
+  #rests(window: readonly Drawn[], out: Segment[]): boolean {
+    const restMs = this.params.rest_ms;
+    const last = window[window.length - 1]!;
+    const t = last.sample.t_ms;
+    if (restMs <= 0 || t - window[0]!.sample.t_ms < restMs) return false;
+    let start = window.length - 1;
+    while (start > 0 && squaredDistance(window[start - 1]!.point, last.point) <= this.#restSq) start--;
+    if (t - window[start]!.sample.t_ms < restMs) return false;
+    if (start === 0) {
+      this.#window = [retimed(window[0]!, t)];
+    } else {
+      out.push(this.#finish(window[0]!, { sample: window[start]!.sample, point: last.point }));
+      this.#window = [last];
+    }
+    this.#line = null;
+    this.#resting = true;
+    this.rested = true;
     return true;
   }
 
@@ -250,6 +331,17 @@ export class ReferenceWindowSimplifier {
       this.params,
     );
   }
+}
+
+/** `drawn` at another time (the anchor's, while the pen rests or crawls). */
+function retimed(drawn: Drawn, tMs: number): Drawn {
+  return { sample: { ...drawn.sample, t_ms: tMs }, point: drawn.point };
+}
+
+function squaredDistance(a: Point, b: Point): number {
+  const dx = a[0] - b[0];
+  const dy = a[1] - b[1];
+  return dx * dx + dy * dy;
 }
 
 /** The unit vector from `start` to `end` (null if they coincide). */

@@ -4,8 +4,10 @@
  * stroke that covers it, no stroke covers more than max_window samples after
  * its start nor lasts longer than max_stroke_ms (unless it is a single step or
  * was too short to send until its last sample),
- * strokes join end to start from the press to the release, a dropped
- * segment carries the reason that matches its size, and a drawing along the
+ * strokes join end to start from the press to the release (a rest or a crawl
+ * between them is not played: the next starts later, never earlier), no piece is
+ * dropped but a path that is one piece too short in all (every drawn sample
+ * lies within max_error of a sent stroke, at any setting), and a drawing along the
  * canvas edges gives strokes that start and end on the grid.
  */
 import fc from "fast-check";
@@ -13,8 +15,13 @@ import { describe, expect, it } from "vitest";
 import { CanvasMapping } from "../src/simplify/mapping";
 import { SHARED_PARAM_ARBS, expectDropRule, pointerPathArb } from "./simplifier-arbitraries";
 import { type Point, type Sample, type Segment } from "../src/simplify/segment";
-import { LINE_SHARE, WindowSimplifier } from "../src/simplify/window";
-import type { WindowParams } from "../src/simplify/window-params";
+import {
+  LINE_SHARE,
+  WindowCore,
+  WindowSimplifier,
+  restRadius as windowRestRadius,
+} from "../src/simplify/window";
+import { DEFAULT_WINDOW_PARAMS, type WindowParams } from "../src/simplify/window-params";
 
 /** Room for a distance computed another way than the simplifier's (last bits only). */
 const FLOAT_TOLERANCE = 1e-12;
@@ -32,6 +39,12 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   ),
   max_window: fc.oneof(fc.constantFrom(1, 2, 64), fc.integer({ min: 1, max: 300 })),
   max_stroke_ms: fc.constantFrom(0, 50, 300),
+  max_bend: fc.constantFrom(0, 0.1, 0.3),
+  bend_floor: fc.constantFrom(0, 0.05),
+  floor_ms: fc.constantFrom(0, 73.7, 200),
+  rest_ms: fc.constantFrom(0, 30, 100, 300),
+  // Strict minimums let the bound yield to a wearer's limits: not this property's.
+  strict_minimums: fc.constant(false),
   ...SHARED_PARAM_ARBS,
 });
 
@@ -46,19 +59,27 @@ function distance(point: Point, start: Point, end: Point): number {
   return Math.hypot(qx - t * dx, qy - t * dy);
 }
 
+/** How far a sample the pen rested at may lie from the point that stands for the rest. */
+function restRadius(params: WindowParams): number {
+  return params.rest_ms > 0 ? windowRestRadius(params, CanvasMapping.fromParams(params)) : 0;
+}
+
 /**
  * Each segment with the first and last sample it covers: segments join, so
- * each starts where the one before ended, and ends on the sample from there
- * with its end time, at its point or within LINE_SHARE x max_error of it.
+ * each starts where the one before ended, and ends on the first sample from there
+ * drawn at or after its end time, at its point or within LINE_SHARE x max_error of it
+ * (or, where the pen rested, the rest radius). Samples after the last segment
+ * are a rest at its end.
  */
-function covered(params: WindowParams, samples: readonly Sample[]) {
-  const simplifier = new WindowSimplifier(params);
+function covered(params: WindowParams, samples: readonly Sample[], pieces = false) {
+  // `pieces`: the window's own pieces, before any is merged (the caps bound those).
+  const simplifier = pieces ? new WindowCore(params) : new WindowSimplifier(params);
   const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
   segments.push(...simplifier.end());
   const map = CanvasMapping.fromParams(params);
   // An end is its sample, or within LINE_SHARE x max_error of it going on along a line the
   // latency cap cut.
-  const moved = LINE_SHARE * params.max_error + FLOAT_TOLERANCE;
+  const moved = Math.max(LINE_SHARE * params.max_error, restRadius(params)) + FLOAT_TOLERANCE;
   const spans: { first: number; last: number; segment: Segment }[] = [];
   let start = 0;
   for (const segment of segments) {
@@ -66,26 +87,35 @@ function covered(params: WindowParams, samples: readonly Sample[]) {
     for (let j = start; j < samples.length && last < 0; j++) {
       const [x, y] = map.toGrid(samples[j]!.x, samples[j]!.y);
       const isEnd =
-        samples[j]!.t_ms === segment.end_ms && Math.hypot(x - segment.end[0], y - segment.end[1]) <= moved;
+        samples[j]!.t_ms >= segment.end_ms && Math.hypot(x - segment.end[0], y - segment.end[1]) <= moved;
       if (isEnd && (j > start || samples.length === 1)) last = j;
     }
     expect(last, "a segment ends on a sample").toBeGreaterThanOrEqual(start);
     spans.push({ first: start, last, segment });
     start = last;
   }
-  expect(start, "the last segment ends on the last sample").toBe(samples.length - 1);
+  const lastSegment = segments[segments.length - 1]!;
+  for (let j = start + 1; j < samples.length; j++) {
+    const point = map.toGrid(samples[j]!.x, samples[j]!.y);
+    expect(distance(point, lastSegment.start, lastSegment.end), "a rest at the end").toBeLessThanOrEqual(
+      Math.min(2 * restRadius(params), params.max_error) + FLOAT_TOLERANCE,
+    );
+  }
   return { spans, segments, map };
 }
 
 describe("window simplifier invariants", () => {
   it(
-    "every drawn sample lies within max_error of its stroke; strokes keep the caps",
+    "every drawn sample lies within max_error of its piece; the pieces keep the caps",
     () => {
       fc.assert(
         fc.property(paramsArb, pathArb, (params, samples) => {
-          const { spans, map } = covered(params, samples);
+          const { spans, map } = covered(params, samples, true);
           for (const { first, last, segment } of spans) {
-            expect(last - first).toBeLessThanOrEqual(params.max_window);
+            // The work cap counts the samples the stroke holds: not those of a rest before it.
+            let held = 0;
+            for (let j = first + 1; j <= last; j++) if (samples[j]!.t_ms > segment.start_ms) held++;
+            expect(held).toBeLessThanOrEqual(params.max_window);
             if (params.max_stroke_ms > 0 && segment.duration_ms > params.max_stroke_ms) {
               // Only a single step, or a stroke still too short to send a sample earlier.
               const [bx, by] = map.toGrid(samples[last - 1]!.x, samples[last - 1]!.y);
@@ -118,11 +148,11 @@ describe("window simplifier invariants", () => {
           const [rx, ry] = map.toGrid(last.x, last.y);
           const end = segments[segments.length - 1]!.end;
           expect(Math.hypot(end[0] - rx, end[1] - ry)).toBeLessThanOrEqual(
-            LINE_SHARE * params.max_error + FLOAT_TOLERANCE,
+            Math.max(LINE_SHARE * params.max_error, restRadius(params)) + FLOAT_TOLERANCE,
           );
           for (let i = 1; i < segments.length; i++) {
             expect(segments[i]!.start).toEqual(segments[i - 1]!.end);
-            expect(segments[i]!.start_ms).toBe(segments[i - 1]!.end_ms);
+            expect(segments[i]!.start_ms).toBeGreaterThanOrEqual(segments[i - 1]!.end_ms);
           }
         }),
         { numRuns: 200 },
@@ -132,16 +162,30 @@ describe("window simplifier invariants", () => {
   );
 
   it(
-    "sent strokes meet the minimums and dropped ones say why",
+    "no piece is dropped: every drawn sample lies within max_error of a sent stroke",
     () => {
+      // Whatever the caps and minimums: a piece too short to send merges into the next, or is
+      // sent; only a path that is one short piece in all (a tap) is dropped, with its reason.
+      const errorArb = fc.constantFrom(0.001, 0.05, 0.1, 0.15, 0.25, 1);
       fc.assert(
-        fc.property(paramsArb, pathArb, (params, samples) => {
-          for (const segment of covered(params, samples).segments) {
-            expectDropRule(segment, params);
+        fc.property(paramsArb, errorArb, pathArb, (drawn, maxError, samples) => {
+          const params = { ...drawn, max_error: maxError };
+          const { segments, map } = covered(params, samples);
+          if (segments.some((segment) => segment.dropped !== null)) {
+            expect(segments.length).toBe(1);
+            expectDropRule(segments[0]!, params);
+            return;
+          }
+          for (const sample of samples) {
+            const point = map.toGrid(sample.x, sample.y);
+            const nearest = Math.min(...segments.map((s) => distance(point, s.start, s.end)));
+            expect(nearest).toBeLessThanOrEqual(params.max_error + FLOAT_TOLERANCE);
+          }
+          for (const segment of segments) {
             expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
           }
         }),
-        { numRuns: 200 },
+        { numRuns: 300 },
       );
     },
     PROPERTY_TIMEOUT_MS,
@@ -189,6 +233,11 @@ const edgeDrawingArb = fc
       max_error: d.maxError,
       max_window: d.maxWindow,
       max_stroke_ms: d.maxStrokeMs,
+      max_bend: 0.1,
+      bend_floor: 0.1,
+      floor_ms: 73.7,
+      rest_ms: 100,
+      strict_minimums: false,
       clear_on_press: true,
       min_duration_ms: d.minDurationMs,
       min_length: d.minLength,
@@ -257,6 +306,188 @@ describe("window simplifier along the canvas edges", () => {
           }
         }),
         { numRuns: 400 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+});
+
+/** The slowest steady pen that is never taken for a resting one: half a pixel a frame at 60 fps. */
+const SLOW_PEN_PX_PER_MS = (0.5 * 60) / 1000;
+
+/**
+ * A straight leg drawn at a steady speed of at least `SLOW_PEN_PX_PER_MS`, in any direction, on any
+ * canvas and grid, sampled every frame or every pointer event (times jittered), its samples at exact
+ * or whole pixels; one stroke a leg (no latency cap), so only a rest could cut it.
+ */
+const slowLegArb = fc
+  .record({
+    widthPx: fc.double({ min: 200, max: 4000, noNaN: true }),
+    heightPx: fc.double({ min: 200, max: 4000, noNaN: true }),
+    restMs: fc.constantFrom(100, 200, 500),
+    minLength: fc.constantFrom(0, 0.1, 0.4),
+    maxError: fc.constantFrom(0.05, 0.25, 1),
+    columns: fc.integer({ min: 2, max: 12 }),
+    rows: fc.integer({ min: 2, max: 12 }),
+    stretch: fc.boolean(),
+    speed: fc.double({ min: SLOW_PEN_PX_PER_MS, max: 0.5, noNaN: true }),
+    angle: fc.double({ min: 0, max: 2 * Math.PI, noNaN: true }),
+    durationMs: fc.double({ min: 300, max: 4000, noNaN: true }),
+    stepMs: fc.constantFrom(1000 / 60, 8),
+    jitters: fc.array(fc.double({ min: 0.5, max: 1.5, noNaN: true }), { minLength: 1, maxLength: 50 }),
+    wholePx: fc.boolean(),
+    fx: fc.double({ min: 0, max: 1, noNaN: true }),
+    fy: fc.double({ min: 0, max: 1, noNaN: true }),
+  })
+  .filter(({ widthPx, heightPx, speed, angle, durationMs }) => {
+    const length = speed * durationMs;
+    return (
+      Math.abs(Math.cos(angle)) * length + 2 < widthPx && Math.abs(Math.sin(angle)) * length + 2 < heightPx
+    );
+  })
+  .map((leg) => {
+    const params: WindowParams = {
+      ...DEFAULT_WINDOW_PARAMS,
+      max_stroke_ms: 0,
+      max_window: 10_000,
+      rest_ms: leg.restMs,
+      min_length: leg.minLength,
+      max_error: leg.maxError,
+      columns: leg.columns,
+      rows: leg.rows,
+      stretch: leg.stretch,
+      canvas_width_px: leg.widthPx,
+      canvas_height_px: leg.heightPx,
+    };
+    const ux = Math.cos(leg.angle);
+    const uy = Math.sin(leg.angle);
+    const length = leg.speed * leg.durationMs;
+    // A start from which the whole leg stays on the canvas (no clamping onto the grid's edge).
+    const x0 = leg.fx * (leg.widthPx - Math.abs(ux) * length - 2) + 1 + Math.max(0, -ux) * length;
+    const y0 = leg.fy * (leg.heightPx - Math.abs(uy) * length - 2) + 1 + Math.max(0, -uy) * length;
+    const samples: Sample[] = [];
+    for (let t = 0, k = 0; t <= leg.durationMs; k++) {
+      let x = x0 + ux * leg.speed * t;
+      let y = y0 + uy * leg.speed * t;
+      if (leg.wholePx) [x, y] = [Math.round(x), Math.round(y)];
+      samples.push({ t_ms: t, x, y, pressure: 0.5 });
+      t += leg.stepMs * leg.jitters[k % leg.jitters.length]!;
+    }
+    return { params, samples };
+  });
+
+/**
+ * A leg, a rest of at least rest_ms at its end (the pen still, or trembling well within the rest
+ * radius), then a leg in another direction; with the index of the rest's first and last samples.
+ */
+const restArb = fc
+  .record({
+    capMs: fc.constantFrom(0, 200),
+    restPick: fc.integer({ min: 0, max: 2 }),
+    stepMs: fc.constantFrom(1000 / 60, 8),
+    stepPx: fc.double({ min: 1.5, max: 9, noNaN: true }),
+    tremble: fc.constantFrom(0, 0.4),
+    restShare: fc.double({ min: 1.2, max: 4, noNaN: true }),
+    shakes: fc.array(
+      fc.tuple(fc.double({ min: -1, max: 1, noNaN: true }), fc.double({ min: -1, max: 1, noNaN: true })),
+      {
+        minLength: 1,
+        maxLength: 40,
+      },
+    ),
+  })
+  .map((r) => {
+    // A rest longer than the latency cap is the crawl rule's: the stroke after it starts at most
+    // the cap before the pen moves on.
+    const rests = r.capMs > 0 ? [50, 100] : [50, 100, 300];
+    const params: WindowParams = {
+      ...DEFAULT_WINDOW_PARAMS,
+      max_stroke_ms: r.capMs,
+      rest_ms: rests[r.restPick % rests.length]!,
+      canvas_width_px: 1200,
+      canvas_height_px: 800,
+    };
+    const mapping = CanvasMapping.fromParams(params);
+    const radiusPx = windowRestRadius(params, mapping) / mapping.scale;
+    const samples: Sample[] = [];
+    for (let k = 0; k < 40; k++)
+      samples.push({ t_ms: k * r.stepMs, x: 200 + r.stepPx * k, y: 400, pressure: 0.5 });
+    const arrival = samples.length - 1;
+    const { x, y } = samples[arrival]!;
+    let t = samples[arrival]!.t_ms;
+    const steps = Math.ceil((r.restShare * params.rest_ms) / r.stepMs);
+    for (let k = 0; k < steps; k++) {
+      t += r.stepMs;
+      const [dx, dy] = r.shakes[k % r.shakes.length]!;
+      const shake = (r.tremble * radiusPx) / Math.SQRT2;
+      samples.push({ t_ms: t, x: x + dx * shake, y: y + dy * shake, pressure: 0.5 });
+    }
+    const leave = samples.length - 1;
+    for (let k = 1; k < 40; k++)
+      samples.push({ t_ms: t + k * r.stepMs, x, y: y - r.stepPx * k, pressure: 0.5 });
+    return { params, samples, arrival, leave, mapping };
+  });
+
+describe("a resting pen and a slow, steady one", () => {
+  it(
+    "never cuts a slow steady leg for rest",
+    () => {
+      fc.assert(
+        fc.property(slowLegArb, ({ params, samples }) => {
+          const core = new WindowCore(params);
+          for (const sample of samples) {
+            expect(core.push(sample)).toEqual([]);
+            expect(core.rested).toBe(false);
+          }
+          const strokes = core.end();
+          expect(strokes).toHaveLength(1);
+          const map = CanvasMapping.fromParams(params);
+          const [stroke] = strokes;
+          expect(stroke!.start_ms).toBe(samples[0]!.t_ms);
+          expect(stroke!.end_ms).toBe(samples[samples.length - 1]!.t_ms);
+          expect(stroke!.start).toEqual(map.toGrid(samples[0]!.x, samples[0]!.y));
+          expect(stroke!.end).toEqual(
+            map.toGrid(samples[samples.length - 1]!.x, samples[samples.length - 1]!.y),
+          );
+        }),
+        { numRuns: 300 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+
+  it(
+    "ends the stroke before a rest while the pen rests, and does not play the rest",
+    () => {
+      fc.assert(
+        fc.property(restArb, ({ params, samples, arrival, leave, mapping }) => {
+          const simplifier = new WindowSimplifier(params);
+          const duringRest: Segment[] = [];
+          const after: Segment[] = [];
+          samples.forEach((sample, index) => {
+            const out = simplifier.push(sample);
+            if (arrival < index && index <= leave) duringRest.push(...out);
+            else if (index > leave) after.push(...out);
+          });
+          after.push(...simplifier.end());
+          expect(duringRest.length, "a stroke let go while the pen rests").toBeGreaterThan(0);
+          const last = duringRest[duringRest.length - 1]!;
+          const [rx, ry] = mapping.toGrid(samples[arrival]!.x, samples[arrival]!.y);
+          expect(Math.hypot(last.end[0] - rx, last.end[1] - ry)).toBeLessThanOrEqual(
+            windowRestRadius(params, mapping) + FLOAT_TOLERANCE,
+          );
+          // A rest is told after rest_ms of it, and the latency cap may end a stroke first; a
+          // piece held to merge, briefer than the sleeve's floor, takes the time it needs from it.
+          expect(last.end_ms).toBeLessThanOrEqual(
+            samples[arrival]!.t_ms + Math.max(params.rest_ms, params.floor_ms),
+          );
+          // Nothing plays the rest: the next stroke starts when the pen moves on (if the cap ended
+          // a stroke in the rest, what is left of it may be too brief to tell: under rest_ms).
+          expect(after.length, "the leg after the rest is sent").toBeGreaterThan(0);
+          const toldMs = params.max_stroke_ms > 0 ? params.rest_ms : 0;
+          expect(after[0]!.start_ms).toBeGreaterThanOrEqual(samples[leave]!.t_ms - toldMs);
+        }),
+        { numRuns: 200 },
       );
     },
     PROPERTY_TIMEOUT_MS,

@@ -10,7 +10,7 @@ import fc from "fast-check";
 import { describe, expect, it } from "vitest";
 import { CanvasMapping } from "../src/simplify/mapping";
 import type { Sample, Segment } from "../src/simplify/segment";
-import { WindowSimplifier } from "../src/simplify/window";
+import { WindowCore } from "../src/simplify/window";
 import type { WindowParams } from "../src/simplify/window-params";
 import { ReferenceWindowSimplifier } from "./window-reference";
 
@@ -36,6 +36,11 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   clear_on_press: fc.constant(true),
   min_duration_ms: fc.constantFrom(0, 6.1, 80),
   min_length: fc.constantFrom(0, 0.1, 0.4),
+  max_bend: fc.constantFrom(0, 0.05, 0.1, 0.3),
+  bend_floor: fc.constantFrom(0, 0.01, 0.05, 0.5),
+  floor_ms: fc.constant(73.7),
+  rest_ms: fc.constantFrom(0, 30, 100),
+  strict_minimums: fc.boolean(),
   rows: fc.integer({ min: 1, max: 8 }),
   columns: fc.integer({ min: 1, max: 8 }),
   canvas_width_px: fc.constant(WIDTH_PX),
@@ -113,7 +118,7 @@ describe("window simplifier against the reference", () => {
     () => {
       fc.assert(
         fc.property(drawingArb, (drawing) => {
-          const fast = new WindowSimplifier(drawing.params);
+          const fast = new WindowCore(drawing.params);
           const reference = new ReferenceWindowSimplifier(drawing.params);
           for (const path of pathsOf(drawing)) {
             for (const sample of path) {

@@ -34,6 +34,11 @@ export interface WindowParams extends SharedParams {
   readonly max_error: number;
   readonly max_window: number;
   readonly max_stroke_ms: number;
+  readonly max_bend: number;
+  readonly bend_floor: number;
+  readonly rest_ms: number;
+  readonly strict_minimums: boolean;
+  readonly floor_ms: number;
 }
 
 /** Every parameter a person sets in the settings panel, of every simplifier. */
@@ -41,6 +46,11 @@ export interface PanelParams {
   readonly max_error: number;
   readonly max_window: number;
   readonly max_stroke_ms: number;
+  readonly max_bend: number;
+  readonly bend_floor: number;
+  readonly rest_ms: number;
+  readonly strict_minimums: boolean;
+  readonly floor_ms: number;
   readonly check_frames: number;
   readonly max_angle_deg: number;
   readonly frame_max: number;
@@ -81,6 +91,11 @@ export const WINDOW_PARAM_NAMES = [
   "max_error",
   "max_window",
   "max_stroke_ms",
+  "max_bend",
+  "bend_floor",
+  "rest_ms",
+  "strict_minimums",
+  "floor_ms",
   ...SHARED_PARAM_NAMES,
 ] as const;
 
@@ -121,12 +136,87 @@ export const PARAMETERS: readonly ParamSpec[] = [
     algorithms: ["window"],
     paper: null,
     type: "number",
-    default: 300,
+    default: 200,
     minimum: 0,
     maximum: 60000,
     unit: "ms",
     label: "Longest stroke",
     help: "longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "max_bend",
+    algorithms: ["window"],
+    paper: null,
+    type: "number",
+    default: 0,
+    minimum: 0,
+    maximum: 1,
+    unit: "of the stroke's length",
+    label: "Max bend",
+    help: "farthest a drawn point may lie from its stroke as a share of the stroke's length (never under bend_floor), so round shapes stay round; 0 = no limit",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "bend_floor",
+    algorithms: ["window"],
+    paper: null,
+    type: "number",
+    default: 0.1,
+    minimum: 0,
+    maximum: 100,
+    unit: "grid units",
+    label: "Bend floor",
+    help: "least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "rest_ms",
+    algorithms: ["window"],
+    paper: null,
+    type: "number",
+    default: 100,
+    minimum: 0,
+    maximum: 10000,
+    unit: "ms",
+    label: "Rest",
+    help: "a pen resting this long ends the stroke so far, in ms (the rest is not played); 0 = never",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "strict_minimums",
+    algorithms: ["window"],
+    paper: null,
+    type: "boolean",
+    default: false,
+    minimum: null,
+    maximum: null,
+    unit: null,
+    label: "Strict minimums",
+    help: "never send a stroke below min_length or min_duration_ms, even where max_error must yield (a wearer's measured limits: senders set it from the sleeve's status)",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "floor_ms",
+    algorithms: ["window"],
+    paper: null,
+    type: "number",
+    default: 73.7,
+    minimum: 0,
+    maximum: 10000,
+    unit: "ms",
+    label: "Sleeve floor",
+    help: "shortest stroke the sleeve plays without slowing it, in ms (its status says); a briefer piece merges into a neighbour where the error bound allows",
     panel: "simplifier",
     detail_levels: null,
     short: null,

@@ -39,6 +39,8 @@ export interface Segment {
   readonly duration_ms: number;
   readonly emitted_at_ms: number;
   readonly dropped: DropReason | null;
+  /** How many pieces too short to send were merged into this one (the window simplifier's; absent: none). */
+  readonly merged?: number;
 }
 
 /** The segment's length in grid units, computed as the reference does (not Math.hypot). */

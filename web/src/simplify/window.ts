@@ -15,11 +15,24 @@
  * `max_window` samples (the work cap). The stroke after one the latency cap
  * ended, if the cap or the release ends it too, ends on the line of the stroke
  * before (its end sample projected onto it) when the bound allows and that end
- * stays on the grid, so a straight line cut by the cap stays straight. Too short
- * or too brief strokes are dropped with their reason. The float operations follow the reference's order.
+ * stays on the grid, so a straight line cut by the cap stays straight. A stroke still too
+ * short to send after `max_stroke_ms` (a crawling pen) starts later rather than lasting longer.
+ * A pen resting `rest_ms` ends the stroke before the rest, and the rest is not played. Too short
+ * or too brief pieces merge into the next (`Merger`); only a tap is dropped with its reason
+ * (with `strict_minimums`, also a path's last piece below the minimums). The float operations
+ * follow the reference's order.
  */
 import { CanvasMapping } from "./mapping";
-import { finishSegment, type Point, type Sample, type Segment } from "./segment";
+import {
+  finishSegment,
+  NOT_ENOUGH_DISTANCE,
+  NOT_ENOUGH_DURATION,
+  segmentLength,
+  type DropReason,
+  type Point,
+  type Sample,
+  type Segment,
+} from "./segment";
 import { checkWindowParams, type WindowParams } from "./window-params";
 
 /**
@@ -48,6 +61,33 @@ export const LINE_SHARE = 0.25;
 const ROUNDING_SLACK = 1e-9;
 
 /** What `push` gives when no stroke is finished (most samples): one frozen array, none made. */
+/**
+ * A pen rests while its samples stay within this share of min_length of one point (never farther
+ * than half of max_error, so the point that ends or starts a stroke covers the rest): well below a
+ * stroke the sleeve renders, well above a still hand's jitter.
+ */
+export const REST_SHARE = 0.25;
+/**
+ * ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a quarter of
+ * a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests; a slow, steady
+ * pen does not, as the distance it covers over the whole window tells: at twice this speed (half a
+ * pixel a frame) or more, in any direction, it leaves the radius well within rest_ms, even with its
+ * samples rounded to whole pixels. In pixels, not grid units: a hand's speed on the screen does not
+ * depend on how the canvas maps onto the sleeve (at the default canvas a quarter of min_length is 16
+ * pixels, which a pen at 2 pixels a frame took 100 ms to leave).
+ */
+export const REST_SPEED_PX_PER_MS = 0.015;
+
+/**
+ * How near one point a resting pen stays, in grid units: the least of `REST_SHARE` x min_length,
+ * half of max_error and the distance a pen at `REST_SPEED_PX_PER_MS` covers in rest_ms, mapped at
+ * the canvas's tighter scale (so no more pixels on either axis).
+ */
+export function restRadius(params: WindowParams, mapping: CanvasMapping): number {
+  const px = REST_SPEED_PX_PER_MS * params.rest_ms;
+  return Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error, px * mapping.scale);
+}
+
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
 /**
@@ -97,9 +137,34 @@ class Samples {
     this.count = 1;
     this.end = end - index;
   }
+
+  /** The anchor at another time (while the pen rests or crawls), its Sample too. */
+  retime(t: number): void {
+    this.ts[0] = t;
+    // Built field by field, not spread: a crawling pen retimes at every sample.
+    const anchor = this.samples[0]!;
+    this.samples[0] = { t_ms: t, x: anchor.x, y: anchor.y, pressure: anchor.pressure };
+  }
+
+  /** The sample to take next (at `count`) is not taken: the ones after it move down. */
+  skip(): void {
+    const { xs, ys, ts, samples } = this;
+    const end = this.end;
+    for (let to = this.count; to < end - 1; to++) {
+      xs[to] = xs[to + 1]!;
+      ys[to] = ys[to + 1]!;
+      ts[to] = ts[to + 1]!;
+      samples[to] = samples[to + 1]!;
+    }
+    this.end = end - 1;
+  }
 }
 
-export class WindowSimplifier {
+/**
+ * The window itself: strokes cut by the error bound, the bend rule and the caps, before
+ * too-short pieces are merged (`WindowSimplifier` merges them).
+ */
+export class WindowCore {
   readonly params: WindowParams;
   readonly #maxErrorSq: number;
   readonly #minLengthSq: number;
@@ -136,6 +201,19 @@ export class WindowSimplifier {
    * line's end) needs no sample tested when that bound says so.
    */
   readonly #reaches: number[] = [0]; // index 0 (the anchor) is never read; kept packed
+  /** While the pen rests at the anchor (`rest_ms`): each sample near it moves the anchor's time. */
+  #resting = false;
+  /** Whether the last push found the pen resting (the stroke before the rest is final). */
+  rested = false;
+  /**
+   * The last sample pushed, as taken: its time (never before the one before) and grid point. Three
+   * numbers, not an object: it is read once per sample (`lastSample` makes the object if asked).
+   */
+  takenMs = 0;
+  takenX = 0;
+  takenY = 0;
+  /** The squared rest radius (see `REST_SHARE`). */
+  readonly #restSq: number;
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
@@ -146,6 +224,8 @@ export class WindowSimplifier {
     this.#xExtent = params.columns - 1;
     this.#yExtent = params.rows - 1;
     this.#mapping = CanvasMapping.fromParams(params);
+    const rest = restRadius(params, this.#mapping);
+    this.#restSq = rest * rest;
     this.#window = new Samples();
   }
 
@@ -159,6 +239,16 @@ export class WindowSimplifier {
     return this.#window.count > 0 ? this.#window.samples[0]! : null;
   }
 
+  /** The last sample taken, as taken: its time (never before the one before) and grid point. */
+  lastSample(): { readonly t_ms: number; readonly point: Point } {
+    return { t_ms: this.takenMs, point: [this.takenX, this.takenY] };
+  }
+
+  /** The time of the last sample pushed, as taken (0 before any). */
+  pointerMs(): number {
+    return this.#pointer ? this.#pointer.t_ms : 0;
+  }
+
   /** One pointer sample while the pointer is down; the first of a path is the press. */
   push(input: Sample): readonly Segment[] {
     const window = this.#window;
@@ -169,12 +259,17 @@ export class WindowSimplifier {
     this.#pointer = sample;
     const x = this.#mapping.gridX(sample.x);
     const y = this.#mapping.gridY(sample.y);
+    this.takenMs = sample.t_ms;
+    this.takenX = x;
+    this.takenY = y;
+    this.rested = false;
     window.place(x, y, sample.t_ms, sample);
     if (count === 0) {
       window.count = 1;
       this.#reach = 0;
       this.#emittedInPath = false;
       this.#line = null;
+      this.#resting = false;
       return NO_SEGMENTS;
     }
     return this.#add() ?? NO_SEGMENTS;
@@ -187,6 +282,7 @@ export class WindowSimplifier {
     if (count === 0) return [];
     window.count = 0;
     window.end = 0;
+    this.#resting = false;
     // The last sample already ends a stroke (a cut at the work cap).
     if (count === 1 && this.#emittedInPath) return [];
     const end = this.#continued(count - 1);
@@ -204,25 +300,37 @@ export class WindowSimplifier {
     const { xs, ys, ts } = window;
     const capMs = this.params.max_stroke_ms;
     const maxWindow = this.params.max_window;
+    const restMs = this.params.rest_ms;
     for (;;) {
       const count = window.count;
       const x = xs[count]!;
       const y = ys[count]!;
       const t = ts[count]!;
-      if (
-        capMs > 0 &&
-        count > 1 &&
-        t - ts[0]! > capMs &&
-        this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)
-      ) {
-        const cut = this.#capCut(count);
-        const vertex = this.#continued(cut);
-        (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, vertex, ts[cut]!));
-        this.#line = this.#lineOf(cut, vertex);
-        // The samples after the cut, this one included, are taken again into the next stroke.
-        window.restart(vertex[0], vertex[1], cut);
-        this.#reach = 0;
-        continue;
+      if (this.#resting) {
+        if (count === 1 && squared(x - xs[0]!, y - ys[0]!) <= this.#restSq) {
+          // The pen still rests: the next stroke starts when it moves on, not before.
+          window.retime(t);
+          window.skip();
+          if (window.count === window.end) return out;
+          continue;
+        }
+        this.#resting = false;
+      }
+      if (capMs > 0 && count > 1 && t - ts[0]! > capMs) {
+        if (!this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)) {
+          // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
+          // rather than lasting longer, so the cap holds for it too.
+          window.retime(t - capMs);
+        } else {
+          const cut = this.#capCut(count);
+          const vertex = this.#continued(cut);
+          (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, vertex, ts[cut]!));
+          this.#line = this.#lineOf(cut, vertex);
+          // The samples after the cut, this one included, are taken again into the next stroke.
+          window.restart(vertex[0], vertex[1], cut);
+          this.#reach = 0;
+          continue;
+        }
       }
       if (!this.#keepsBound(count, x, y)) {
         const cut = this.#feature(count, x, y, 1);
@@ -234,7 +342,18 @@ export class WindowSimplifier {
       } else {
         window.count = count + 1;
         this.#reaches[count] = this.#reach;
-        if (count >= maxWindow) {
+        // A stroke younger than rest_ms cannot hold a rest, nor a pen that left the rest radius
+        // since the sample before: most samples stop at these two tests.
+        const rest =
+          restMs > 0 &&
+          t - ts[0]! >= restMs &&
+          squared(xs[count - 1]! - x, ys[count - 1]! - y) <= this.#restSq
+            ? this.#rests(count + 1)
+            : false;
+        if (rest !== false) {
+          // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
+          if (rest !== null) (out ??= []).push(rest);
+        } else if (count >= maxWindow) {
           (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], t));
           this.#line = null;
           window.restart(x, y, count);
@@ -243,6 +362,47 @@ export class WindowSimplifier {
       }
       if (window.count === window.end) return out;
     }
+  }
+
+  /**
+   * Whether the pen has rested `rest_ms` at the stroke's newest sample, window[count - 1].
+   *
+   * It rests when its samples of the last `rest_ms` or more all lie within the rest radius of
+   * that sample. The stroke drawn up to the rest then ends there at the time the rest began, and
+   * is sent now (returned; null if the stroke is all rest, false if the pen does not rest); the
+   * rest is not played (the next stroke starts where and when the
+   * pen moves on). If the stroke is all rest, its anchor waits instead. Every sample of the rest
+   * lies within the rest radius (at most max_error / 2) of the newest, and that one within it of
+   * the anchor when all is rest.
+   */
+  #rests(count: number): Segment | null | false {
+    const restMs = this.params.rest_ms;
+    const window = this.#window;
+    const { xs, ys, ts } = window;
+    const last = count - 1;
+    const t = ts[last]!;
+    if (restMs <= 0 || t - ts[0]! < restMs) return false;
+    const x = xs[last]!;
+    const y = ys[last]!;
+    const restSq = this.#restSq;
+    let start = last;
+    while (start > 0 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
+    if (t - ts[start]! < restMs) return false;
+    let stroke: Segment | null = null;
+    if (start === 0) {
+      const anchor = window.samples[0]!;
+      window.restart(xs[0]!, ys[0]!, last);
+      window.samples[0] = anchor;
+      window.retime(t);
+    } else {
+      stroke = this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], ts[start]!);
+      window.restart(x, y, last);
+    }
+    this.#line = null;
+    this.#reach = 0;
+    this.#resting = true;
+    this.rested = true;
+    return stroke;
   }
 
   /**
@@ -257,14 +417,28 @@ export class WindowSimplifier {
       return true;
     }
     const { xs, ys } = this.#window;
+    let reachLimit = this.#reachLimit;
+    let limitSq = this.#maxErrorSq;
+    const bend = this.params.max_bend;
+    if (bend > 0) {
+      // The bend rule: a round shape is cut before its chord strays farther than a share of the
+      // chord's length, never under the floor, never over max_error.
+      const cx = x - xs[0]!;
+      const cy = y - ys[0]!;
+      const limit = Math.max(bend * Math.sqrt(cx * cx + cy * cy), this.params.bend_floor);
+      if (limit < this.params.max_error) {
+        reachLimit = limit - ROUNDING_SLACK;
+        limitSq = limit * limit;
+      }
+    }
     const dx = x - xs[count - 1]!;
     const dy = y - ys[count - 1]!;
     const reach = this.#reach + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK;
-    if (reach <= this.#reachLimit) {
+    if (reach <= reachLimit) {
       this.#reach = reach;
       return true;
     }
-    const farthestSq = this.#farthestSq(count, x, y, this.#maxErrorSq);
+    const farthestSq = this.#farthestSq(count, x, y, limitSq);
     if (farthestSq < 0) return false;
     this.#reach = Math.sqrt(farthestSq) + ROUNDING_SLACK;
     return true;
@@ -475,6 +649,227 @@ export class WindowSimplifier {
     this.#emittedInPath = true;
     return finishSegment(start, end, startMs, endMs, this.#pointer ? this.#pointer.t_ms : endMs, this.params);
   }
+}
+
+/**
+ * Merges the pieces the window cuts too short to send into a neighbour, never dropping one (the
+ * reference's `Merger`). A piece is too short when it is shorter than `min_length` or briefer
+ * than the larger of `min_duration_ms` and `floor_ms` (the sleeve would slow it). A short piece
+ * waits for the next; the two become one stroke when every drawn sample of both lies within
+ * `max_error` of it (still short, it waits again), else the short one is sent as it is. A piece
+ * long enough is sent at once (holding each back would delay the drawing), so the last piece of
+ * a path, if short, is sent short. Only a path's one and only piece, too short, is dropped.
+ */
+/** The merger drops covered samples from its arrays once this many have gathered at their start. */
+const COMPACT_AFTER = 256;
+
+export class Merger {
+  readonly #maxError: number;
+  readonly #minLength: number;
+  readonly #minDurationMs: number;
+  readonly #shortMs: number;
+  readonly #strict: boolean;
+  /** The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first. */
+  #xs: number[] = [];
+  #ys: number[] = [];
+  #ts: number[] = [];
+  /**
+   * The first sample not yet covered: those before it are, and are dropped from the arrays only
+   * now and then (`#send`), not at every stroke sent (three splices, each an array made).
+   */
+  #first = 0;
+  #held: Segment | null = null;
+  #sentInPath = false;
+
+  constructor(maxError: number, minLength: number, minDurationMs: number, floorMs: number, strict = false) {
+    this.#maxError = maxError;
+    this.#minLength = minLength;
+    this.#minDurationMs = minDurationMs;
+    this.#shortMs = Math.max(minDurationMs, floorMs);
+    this.#strict = strict;
+  }
+
+  /** A drawn sample, in order (its time as the window took it). */
+  sample(tMs: number, x: number, y: number): void {
+    this.#xs.push(x);
+    this.#ys.push(y);
+    this.#ts.push(tMs);
+  }
+
+  #short(segment: Segment): boolean {
+    return segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs;
+  }
+
+  #belowMinimums(segment: Segment): boolean {
+    return segmentLength(segment) < this.#minLength || segment.duration_ms < this.#minDurationMs;
+  }
+
+  /**
+   * Whether every sample not yet covered, drawn up to endMs, lies within max_error of
+   * start -> end. All of them, not only those after the held piece's start: a stroke whose pen
+   * crawled or rested starts after samples it covers.
+   */
+  #fits(start: Point, end: Point, endMs: number): boolean {
+    const limitSq = this.#maxError * this.#maxError;
+    const xs = this.#xs;
+    const ys = this.#ys;
+    const ts = this.#ts;
+    for (let i = this.#first; i < ts.length; i++) {
+      const t = ts[i]!;
+      if (t > endMs) break;
+      if (distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  #send(segment: Segment, nowMs: number, out: Segment[]): void {
+    this.#sentInPath = true;
+    out.push({ ...segment, emitted_at_ms: nowMs, dropped: null });
+    // The samples before its end are covered now (those at its end may start the next).
+    const ts = this.#ts;
+    let keep = this.#first;
+    while (keep < ts.length && ts[keep]! < segment.end_ms) keep++;
+    this.#first = keep;
+    if (keep >= COMPACT_AFTER && 2 * keep >= ts.length) {
+      // Most of the arrays are covered: move what is not to their start, in place.
+      const xs = this.#xs;
+      const ys = this.#ys;
+      const left = ts.length - keep;
+      xs.copyWithin(0, keep);
+      ys.copyWithin(0, keep);
+      ts.copyWithin(0, keep);
+      xs.length = left;
+      ys.length = left;
+      ts.length = left;
+      this.#first = 0;
+    }
+  }
+
+  /** A piece the window cut: the strokes sent now, into `out` (none while a short one waits). */
+  take(input: Segment, nowMs: number, out: Segment[]): void {
+    let piece = input;
+    const held = this.#held;
+    if (held !== null) {
+      this.#held = null;
+      if (this.#fits(held.start, piece.end, piece.end_ms) || (this.#strict && this.#belowMinimums(held))) {
+        piece = {
+          start: held.start,
+          end: piece.end,
+          start_ms: held.start_ms,
+          end_ms: piece.end_ms,
+          duration_ms: piece.end_ms - held.start_ms,
+          emitted_at_ms: nowMs,
+          dropped: null,
+          merged: (held.merged ?? 0) + (piece.merged ?? 0) + 1,
+        };
+      } else {
+        this.#send(held, nowMs, out);
+      }
+    }
+    if (this.#short(piece)) this.#held = piece;
+    else this.#send(piece, nowMs, out);
+  }
+
+  /**
+   * The pen rests (since the held piece's end, until `nowMs`): the held piece is sent now, into
+   * `out`, rather than merged with what comes after the rest, which would play the rest. If it is
+   * briefer than the sleeve's floor, it takes the time it needs from the rest: the pen was at its
+   * end then. With strict minimums, a piece still below them waits.
+   */
+  rest(nowMs: number, out: Segment[]): void {
+    let held = this.#held;
+    if (held === null) return;
+    if (held.duration_ms < this.#shortMs && nowMs > held.end_ms) {
+      const endMs = Math.min(held.start_ms + this.#shortMs, nowMs);
+      held = { ...held, end_ms: endMs, duration_ms: endMs - held.start_ms };
+    }
+    if (this.#strict && this.#belowMinimums(held)) {
+      this.#held = held;
+      return;
+    }
+    this.#held = null;
+    this.#send(held, nowMs, out);
+  }
+
+  /** Release, after the window's last piece: the held piece is sent (or, a path's only piece too short, dropped). */
+  end(nowMs: number, out: Segment[]): void {
+    const held = this.#held;
+    if (held !== null) {
+      let reason: DropReason | null = null;
+      if (!this.#sentInPath || this.#strict) {
+        if (segmentLength(held) < this.#minLength) reason = NOT_ENOUGH_DISTANCE;
+        else if (held.duration_ms < this.#minDurationMs) reason = NOT_ENOUGH_DURATION;
+      }
+      if (reason !== null) out.push({ ...held, emitted_at_ms: nowMs, dropped: reason });
+      else this.#send(held, nowMs, out);
+    }
+    this.#held = null;
+    this.#sentInPath = false;
+    this.#xs = [];
+    this.#ys = [];
+    this.#ts = [];
+    this.#first = 0;
+  }
+}
+
+/** The window simplifier: the window's pieces, the too-short ones merged (`Merger`). */
+export class WindowSimplifier {
+  readonly params: WindowParams;
+  readonly #core: WindowCore;
+  readonly #merger: Merger;
+
+  constructor(params: WindowParams) {
+    this.#core = new WindowCore(params);
+    this.params = params;
+    this.#merger = new Merger(
+      params.max_error,
+      params.min_length,
+      params.min_duration_ms,
+      params.floor_ms,
+      params.strict_minimums,
+    );
+  }
+
+  /** True between the first sample of a path and `end`. */
+  get drawing(): boolean {
+    return this.#core.drawing;
+  }
+
+  /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
+  get lineStart(): Sample | null {
+    return this.#core.lineStart;
+  }
+
+  /** One pointer sample while the pointer is down; the first of a path is the press. */
+  push(input: Sample): readonly Segment[] {
+    const core = this.#core;
+    const pieces = core.push(input);
+    const merger = this.#merger;
+    const takenMs = core.takenMs;
+    merger.sample(takenMs, core.takenX, core.takenY);
+    // Most samples finish no piece: nothing to merge, no array made.
+    if (pieces.length === 0 && !core.rested) return NO_SEGMENTS;
+    const out: Segment[] = [];
+    for (const piece of pieces) merger.take(piece, takenMs, out);
+    if (core.rested) merger.rest(takenMs, out);
+    return out.length > 0 ? out : NO_SEGMENTS;
+  }
+
+  /** Release: the rest of the path, the held piece first (a tap gives one, dropped). */
+  end(): Segment[] {
+    const core = this.#core;
+    const nowMs = core.pointerMs();
+    const out: Segment[] = [];
+    for (const piece of core.end()) this.#merger.take(piece, nowMs, out);
+    this.#merger.end(nowMs, out);
+    return out;
+  }
+}
+
+function squared(dx: number, dy: number): number {
+  return dx * dx + dy * dy;
 }
 
 /** The unit vector from `start` to `end` (null if they coincide). */

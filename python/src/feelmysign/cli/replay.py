@@ -202,6 +202,7 @@ def _connect(args: argparse.Namespace) -> mqtt.Client:
 def _respect_floor(client: mqtt.Client, settings: BrokerSettings, params: Params) -> Params:
     """The simplifier's minimums raised to the floor the sleeve advertises (never lowered), said
     on stderr (stdout may be JSON for a program)."""
+    from feelmysign.simplify.window import WindowParams
     from feelmysign.wearer import respect_floor  # the planner's constants: not by --help
 
     floor = sleeve_floor_from_status(client, settings)
@@ -210,7 +211,14 @@ def _respect_floor(client: mqtt.Client, settings: BrokerSettings, params: Params
     )
     if note is not None:
         print(note, file=sys.stderr, flush=True)
-    return replace(params, min_duration_ms=min_duration_ms, min_length=min_length)
+    params = replace(params, min_duration_ms=min_duration_ms, min_length=min_length)
+    if floor is not None and isinstance(params, WindowParams):
+        # The window simplifier merges what is briefer than the sleeve's floor into a neighbour,
+        # so the motors' floor is kept to as well; a wearer's limits are never gone below.
+        params = replace(
+            params, floor_ms=floor.min_duration_ms, strict_minimums=floor.wearer is not None
+        )
+    return params
 
 
 def _send(args: argparse.Namespace, client: mqtt.Client, result: Rerun, params: Params) -> None:

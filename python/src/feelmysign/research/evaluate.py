@@ -12,7 +12,8 @@ Each row measures the shape (deviation of every drawn sample, Fréchet
 distance, strokes against Douglas-Peucker at the same error), the timing as
 the sleeve would play it (``playback``: time on the skin against drawing time,
 release to felt end, pen to skin, and how much the sleeve caught up by playing
-strokes faster and how much it skipped as ``late``) and, when the recording is a LASA shape,
+strokes faster, how much it skipped as ``late`` and how many strokes it had to slow,
+briefer than it can play) and, when the recording is a LASA shape,
 whether the $1 recogniser (``dollar``) names the shape from the drawing, from
 the polyline of the strokes sent, and from the felt path (``felt``: the
 phantom point the planned schedules render over time). A shape can survive
@@ -107,6 +108,7 @@ class Row:
     compressed_ms: float = 0.0  # by how much, added up
     skipped: int = 0  # strokes skipped as late
     skipped_ms: float = 0.0  # their planned durations, added up
+    slowed: int = 0  # strokes the planner made longer than sent (the sleeve's floor)
 
     @property
     def skin_ratio(self) -> float:
@@ -144,6 +146,7 @@ class Row:
             "compressed_ms": _round(self.compressed_ms),
             "skipped": self.skipped,
             "skipped_ms": _round(self.skipped_ms),
+            "slowed": self.slowed,
             "recognised_drawn": _flag(self.recognised_drawn),
             "recognised_sent": _flag(self.recognised_sent),
             "recognised_felt": _flag(self.recognised_felt),
@@ -324,6 +327,7 @@ def evaluate_one(
         compressed_ms=playback.compressed_ms,
         skipped=playback.skipped,
         skipped_ms=playback.skipped_ms,
+        slowed=playback.slowed,
     )
 
 
@@ -390,6 +394,7 @@ def summarize(rows: Sequence[Row]) -> list[dict[str, Any]]:
                 if planned_ms
                 else None,
                 "skipped_total": sum(r.skipped for r in members),
+                "slowed_total": sum(r.slowed for r in members),
                 "skipped_time_pct": round(
                     100.0 * sum(r.skipped_ms for r in members) / planned_ms, 2
                 )

@@ -53,11 +53,15 @@ class Playback:
     compressed_ms: float = 0.0  # by how much in all
     skipped: int = 0  # strokes skipped as late (the pace rule)
     skipped_ms: float = 0.0  # their planned durations, added up
+    slowed: int = 0  # strokes the planner made longer than sent (briefer than the sleeve can play)
 
     @property
     def skin_ratio(self) -> float:
         return self.skin_ms / self.drawing_ms if self.drawing_ms > 0 else float("nan")
 
+
+# A planned duration longer than the sent one by more than this was slowed (not rounding).
+SLOWED_TOLERANCE_MS = 1e-6
 
 DRAWING = "recording"  # one drawing per recording: its strokes catch up with each other
 
@@ -71,7 +75,7 @@ def simulate(
     pace = PacePolicy()
     floor_ms = shortest_planned_ms(layout.shortest_burst_ms)
     skin_ms = compressed_ms = skipped_ms = 0.0
-    compressed = skipped = refused = 0
+    compressed = skipped = refused = slowed = 0
     felt_end: dict[int, float] = {}
     pen_to_skin: list[float] = []
     schedules: list[Schedule] = []
@@ -84,6 +88,8 @@ def simulate(
         except StrokeError:
             refused += 1
             continue
+        if given.duration_ms > segment.duration_ms + SLOWED_TOLERANCE_MS:
+            slowed += 1
         arrival_ms = segment.emitted_at_ms
         verdict = pace.check(  # as the sleeve's admission does, the network taken as instant
             drawing=DRAWING,
@@ -124,4 +130,5 @@ def simulate(
         compressed_ms,
         skipped,
         skipped_ms,
+        slowed,
     )

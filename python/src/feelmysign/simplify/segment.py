@@ -36,6 +36,8 @@ class Segment:
     end_ms: float
     emitted_at_ms: float
     dropped: str | None = None
+    # How many pieces too short to send were merged into this one (the window simplifier's).
+    merged: int = 0
 
     @property
     def duration_ms(self) -> float:

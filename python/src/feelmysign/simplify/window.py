@@ -44,8 +44,29 @@ corners land on the drawing's features. Here:
 - On release the rest is one stroke. A path's first sample always starts a
   stroke and its last sample's time always ends one (at the sample, or on the
   line it goes on along).
-- A stroke too short (grid units) or too brief (ms) is dropped with its reason,
-  as the angle simplifier does; it still ends where the next one starts.
+- Bend rule: while ``max_bend`` > 0 a stroke grows only while every sample
+  since its anchor lies within ``max_bend`` x its chord's length (never under
+  ``bend_floor``, never over ``max_error``), so a round shape is cut into more
+  strokes; a cut still keeps ``max_error``.
+- A piece too short (``min_length``) or briefer than the sleeve's floor
+  (``floor_ms``, or ``min_duration_ms`` if longer) is not dropped: ``Merger``
+  merges it into the next piece where every drawn sample of both keeps
+  ``max_error``, else sends it as it is. Only a path that is one such piece in
+  all (a tap) is dropped, with its reason, as the angle simplifier drops.
+
+- A resting pen (``rest_ms``): when the samples of the last ``rest_ms`` all
+  lie within the rest radius (``REST_SHARE`` x min_length, at most max_error
+  / 2, and at most what a pen at ``REST_SPEED_PX_PER_MS`` covers in
+  ``rest_ms``, so a slow steady pen is never taken for a resting one) of the
+  newest, the stroke so far ends there, at the time the rest
+  began, and is sent now; while the pen stays, the next stroke's start moves
+  on with it, so the rest is not played. A held short piece is sent at the
+  rest (briefer than the floor, it takes the time it needs from the rest).
+- A crawling pen: a stroke still too short to send after ``max_stroke_ms``
+  starts later rather than lasting longer, so the latency cap holds for it.
+- Strict minimums (``strict_minimums``, a wearer's limits): a piece below
+  ``min_length`` or ``min_duration_ms`` merges into the next even where
+  ``max_error`` must yield, and a path's last such piece is dropped.
 
 Pure and streaming: ``push`` one sample at a time, ``end`` on release. A
 sample earlier than the one before it (clocks of two event sources) is taken
@@ -54,12 +75,19 @@ at the earlier one's time, so times never run backwards.
 
 from __future__ import annotations
 
+import bisect
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import ParamSpec, SharedParams, param, specs_of
-from feelmysign.simplify.segment import Sample, Segment, finish_segment
+from feelmysign.simplify.segment import (
+    NOT_ENOUGH_DISTANCE,
+    NOT_ENOUGH_DURATION,
+    Sample,
+    Segment,
+    finish_segment,
+)
 from feelmysign.stroke import Point
 
 # The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
@@ -78,6 +106,18 @@ LINE_SHARE = 0.25
 # distance, and the room it keeps below max_error, so that no distance it lets through could
 # compute above it.
 ROUNDING_SLACK = 1e-9
+# A pen rests while its samples stay within this share of min_length of one point (never
+# farther than half of max_error, so the point that ends or starts a stroke covers the rest):
+# well below a stroke the sleeve renders, well above a still hand's jitter.
+REST_SHARE = 0.25
+# ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a quarter
+# of a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests; a slow,
+# steady pen does not, as the distance it covers over the whole window tells: at twice this speed
+# (half a pixel a frame) or more, in any direction, it leaves the radius well within rest_ms, even
+# with its samples rounded to whole pixels. In pixels, not grid units: a hand's speed on the
+# screen does not depend on how the canvas maps onto the sleeve (at the default canvas a quarter
+# of min_length is 16 pixels, which a pen at 2 pixels a frame took 100 ms to leave).
+REST_SPEED_PX_PER_MS = 0.015
 
 
 @dataclass(frozen=True)
@@ -87,8 +127,13 @@ class _WindowOwn:
     The defaults are the project's (docs/research.md, "Default settings"):
     ``max_error`` 0.25 grid units is 7.5 mm on the paper's sleeve (3 cm
     spacing), well below the forearm's two-point threshold (about 35 mm);
-    strokes of at most 300 ms keep the felt drawing within about a third of a
-    second of the pen.
+    strokes of at most 200 ms, with the sleeve catching up queued strokes, end
+    the felt drawing about a quarter second after the pen on people's fast and
+    medium gestures. The bend rule is off (``max_bend`` 0): on people's gestures
+    it gained at most a gesture or two a speed, within the noise, and with its
+    absolute floor it overrides a coarse ``max_error`` (the study's resolution
+    levels and the page's detail control). ``floor_ms`` is the sleeve's own
+    (73.7 ms on ERM motors).
     """
 
     max_error: float = param(
@@ -110,11 +155,52 @@ class _WindowOwn:
         unit="samples",
     )
     max_stroke_ms: float = param(
-        300.0,
+        200.0,
         0,
         60_000,
         help="longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no limit",
         label="Longest stroke",
+        unit="ms",
+    )
+    max_bend: float = param(
+        0.0,
+        0,
+        1,
+        help="farthest a drawn point may lie from its stroke as a share of the stroke's length "
+        "(never under bend_floor), so round shapes stay round; 0 = no limit",
+        label="Max bend",
+        unit="of the stroke's length",
+    )
+    bend_floor: float = param(
+        0.1,
+        0,
+        100,
+        help="least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
+        label="Bend floor",
+        unit="grid units",
+    )
+    rest_ms: float = param(
+        100.0,
+        0,
+        10_000,
+        help="a pen resting this long ends the stroke so far, in ms (the rest is not played); "
+        "0 = never",
+        label="Rest",
+        unit="ms",
+    )
+    strict_minimums: bool = param(
+        False,
+        help="never send a stroke below min_length or min_duration_ms, even where max_error must "
+        "yield (a wearer's measured limits: senders set it from the sleeve's status)",
+        label="Strict minimums",
+    )
+    floor_ms: float = param(
+        73.7,
+        0,
+        10_000,
+        help="shortest stroke the sleeve plays without slowing it, in ms (its status says); "
+        "a briefer piece merges into a neighbour where the error bound allows",
+        label="Sleeve floor",
         unit="ms",
     )
 
@@ -138,7 +224,10 @@ def describe(params: WindowParams) -> str:
 
 
 @dataclass
-class WindowSimplifier:
+class WindowCore:
+    """The window itself: strokes cut by the error bound, the bend rule and the caps, before
+    too-short pieces are merged (``WindowSimplifier`` merges them)."""
+
     params: WindowParams = field(default_factory=WindowParams)
     # The stroke being drawn, its anchor first, then every sample since, as three parallel lists:
     # the points in grid units, their times and their samples. Plain lists of floats and tuples,
@@ -163,7 +252,14 @@ class WindowSimplifier:
     # a test of points[1:i] against anchor -> points[i] or a point near it (a cut's feature, a
     # line's end) needs no sample tested when that bound says so. Index 0 is never read.
     _reaches: list[float] = field(default_factory=lambda: [0.0])
+    # While the pen rests at the anchor (``rest_ms``): each sample near it moves the anchor's time.
+    _resting: bool = False
+    # Whether the last push found the pen resting (the stroke before the rest is final).
+    rested: bool = False
+    # The last sample pushed, as taken: its time (never before the one before) and grid point.
+    _taken: tuple[float, Point] = (0.0, (0.0, 0.0))
     _max_error_sq: float = field(init=False)
+    _rest_sq: float = field(init=False)
     _min_length_sq: float = field(init=False)
     _reach_limit: float = field(
         init=False
@@ -177,6 +273,8 @@ class WindowSimplifier:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._min_length_sq = self.params.min_length * self.params.min_length
         self._reach_limit = self.params.max_error - ROUNDING_SLACK
+        rest = rest_radius(self.params)
+        self._rest_sq = rest * rest
         self._mapping = self.params.mapping
         self._x_extent = float(self.params.columns - 1)
         self._y_extent = float(self.params.rows - 1)
@@ -191,6 +289,14 @@ class WindowSimplifier:
         """Where the stroke being drawn starts (canvas pixels); None between paths."""
         return self._samples[0] if self._samples else None
 
+    def last_sample(self) -> tuple[float, Point]:
+        """The last sample taken, as taken: its time (never before the one before) and point."""
+        return self._taken
+
+    def pointer_ms(self) -> float:
+        """The time of the last sample pushed, as taken (0 before any)."""
+        return self._pointer.t_ms if self._pointer else 0.0
+
     def push(self, sample: Sample) -> list[Segment]:
         """One pointer sample while the pointer is down; the first of a path is the press."""
         times = self._times
@@ -198,11 +304,14 @@ class WindowSimplifier:
             sample = Sample(times[-1], sample.x, sample.y, sample.pressure)
         self._pointer = sample
         point = self._mapping.to_grid(sample.x, sample.y)
+        self._taken = (sample.t_ms, point)
+        self.rested = False
         if not times:
             self._points, self._times, self._samples = [point], [sample.t_ms], [sample]
             self._emitted_in_path = False
             self._line = None
             self._reach = 0.0
+            self._resting = False
             return []
         out: list[Segment] = []
         self._add(point, sample, out)
@@ -212,6 +321,7 @@ class WindowSimplifier:
         """Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0)."""
         points, times = self._points, self._times
         self._points, self._times, self._samples = [], [], []
+        self._resting = False
         if not points:
             return []
         if len(points) == 1 and self._emitted_in_path:
@@ -227,18 +337,32 @@ class WindowSimplifier:
         """
         cap_ms = self.params.max_stroke_ms
         max_window = self.params.max_window
+        rest_ms = self.params.rest_ms
         max_error_sq = self._max_error_sq
         pending: list[tuple[Point, Sample]] = []  # a stack: the next sample to take is last
         while True:
             points, times, samples = self._points, self._times, self._samples
             t_ms = sample.t_ms
-            if (
-                cap_ms > 0
-                and len(points) > 1
-                and t_ms - times[0] > cap_ms
-                and self._sendable(points[0], points[-1])
-            ):
-                cut = self._cap_cut(points, times)
+            if self._resting:
+                if len(points) == 1 and _distance_sq(point, points[0]) <= self._rest_sq:
+                    # The pen still rests: the next stroke starts when it moves on, not before.
+                    self._retime(t_ms)
+                    if not pending:
+                        return
+                    point, sample = pending.pop()
+                    continue
+                self._resting = False
+            if cap_ms > 0 and len(points) > 1 and t_ms - times[0] > cap_ms:
+                if not self._sendable(points[0], points[-1]):
+                    # The pen crawls: too little drawn in max_stroke_ms to send. The stroke
+                    # starts later rather than lasting longer, so the cap holds for it too.
+                    self._retime(t_ms - cap_ms)
+                    cut = -1
+                else:
+                    cut = self._cap_cut(points, times)
+            else:
+                cut = -1
+            if cut >= 0:
                 vertex = self._continued(points, cut)
                 out.append(self._finish(points[0], times[0], vertex, times[cut]))
                 self._line = self._line_of(points, cut, vertex)
@@ -279,7 +403,16 @@ class WindowSimplifier:
                 reaches.append(self._reach)
             else:
                 reaches[len(points) - 1] = self._reach
-            if len(points) - 1 >= max_window:
+            # A stroke younger than rest_ms cannot hold a rest, nor a pen that left the rest
+            # radius since the sample before: most samples stop at these two tests.
+            if (
+                rest_ms > 0.0
+                and t_ms - times[0] >= rest_ms
+                and _distance_sq(points[-2], point) <= self._rest_sq
+                and self._rests(points, times, point, sample, out)
+            ):
+                pass
+            elif len(points) - 1 >= max_window:
                 out.append(self._finish(points[0], times[0], point, t_ms))
                 self._line = None
                 self._points, self._times, self._samples = [point], [t_ms], [sample]
@@ -287,6 +420,58 @@ class WindowSimplifier:
             if not pending:
                 return
             point, sample = pending.pop()
+
+    def _retime(self, t_ms: float) -> None:
+        """The anchor at another time (while the pen rests or crawls), its sample too."""
+        self._times[0] = t_ms
+        anchor = self._samples[0]
+        # Built directly, not by dataclasses.replace: a crawling pen retimes at every sample.
+        self._samples[0] = Sample(t_ms, anchor.x, anchor.y, anchor.pressure)
+
+    def _rests(
+        self,
+        points: list[Point],
+        times: list[float],
+        point: Point,
+        sample: Sample,
+        out: list[Segment],
+    ) -> bool:
+        """Whether the pen has rested ``rest_ms`` at ``point``, the stroke's newest sample.
+
+        It rests when its samples of the last ``rest_ms`` or more all lie within
+        the rest radius of ``point``. The stroke drawn up to the rest then ends
+        at ``point`` at the time the rest began, and is sent now; the rest is
+        not played (the next stroke starts where and when the pen moves on).
+        If the stroke is all rest, its anchor waits instead. Every sample of
+        the rest lies within the rest radius (at most max_error / 2) of
+        ``point``, and ``point`` within it of the anchor when all is rest.
+        """
+        rest_ms = self.params.rest_ms
+        t_ms = times[-1]
+        if rest_ms <= 0.0 or t_ms - times[0] < rest_ms:
+            return False
+        start = len(points) - 1
+        rest_sq = self._rest_sq
+        x, y = point
+        while start > 0:  # _distance_sq(points[start - 1], point) <= rest_sq, inlined
+            px, py = points[start - 1]
+            dx, dy = px - x, py - y
+            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN ends the rest too)
+                break
+            start -= 1
+        if t_ms - times[start] < rest_ms:
+            return False
+        if start == 0:
+            self._points, self._times, self._samples = [points[0]], [t_ms], [self._samples[0]]
+            self._retime(t_ms)
+        else:
+            out.append(self._finish(points[0], times[0], point, times[start]))
+            self._points, self._times, self._samples = [point], [t_ms], [sample]
+        self._line = None
+        self._reach = 0.0
+        self._resting = True
+        self.rested = True
+        return True
 
     def _keeps_bound(self, points: list[Point], point: Point, max_error_sq: float) -> bool:
         """Whether every sample since the anchor lies within max_error of anchor -> ``point``.
@@ -298,10 +483,21 @@ class WindowSimplifier:
         if len(points) == 1:
             self._reach = 0.0
             return True
+        reach_limit = self._reach_limit
+        bend = self.params.max_bend
+        if bend > 0.0:
+            # The bend rule: a round shape is cut before its chord strays farther than a share of
+            # the chord's length, never under the floor, never over max_error.
+            ax, ay = points[0]
+            cx, cy = point[0] - ax, point[1] - ay
+            limit = max(bend * math.sqrt(cx * cx + cy * cy), self.params.bend_floor)
+            if limit < self.params.max_error:
+                reach_limit = limit - ROUNDING_SLACK
+                max_error_sq = limit * limit
         last = points[-1]
         dx, dy = point[0] - last[0], point[1] - last[1]
         reach = self._reach + math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK
-        if reach <= self._reach_limit:
+        if reach <= reach_limit:
             self._reach = reach
             return True
         farthest_sq = _farthest_sq(points, len(points), point, max_error_sq)
@@ -424,6 +620,216 @@ class WindowSimplifier:
             min_length=self.params.min_length,
             min_duration_ms=self.params.min_duration_ms,
         )
+
+
+@dataclass
+class Merger:
+    """Merges the pieces the window cuts too short to send into a neighbour, never dropping one.
+
+    A piece is too short when it is shorter than ``min_length`` or briefer than the larger of
+    ``min_duration_ms`` and ``floor_ms`` (the sleeve would slow it). A short piece is held back
+    until the next piece arrives; the two become one stroke, from the first's start to the
+    second's end, when every drawn sample of both lies within ``max_error`` of it (and that
+    stroke, if still short, waits for the next in turn); else the short piece is sent as it is
+    (the window keeps the bound for each piece). A piece long enough is sent at once: holding
+    every stroke back until the next is known would delay the whole drawing (on people's
+    gestures, about 40 ms more from release to felt end at p95; docs/research.md), so a short
+    piece merges forward, not back, and the path's last piece, if short, is sent short. Only a
+    path's one and only piece, too short, is dropped with its reason (a tap: nothing to merge
+    with). Every other drawn sample lies within ``max_error`` of a sent stroke.
+    """
+
+    max_error: float
+    min_length: float
+    min_duration_ms: float
+    floor_ms: float
+    strict: bool = False
+    # The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first.
+    _points: list[Point] = field(default_factory=list)
+    _times: list[float] = field(default_factory=list)
+    _held: Segment | None = None
+    _sent_in_path: bool = False
+
+    def sample(self, t_ms: float, point: Point) -> None:
+        """A drawn sample, in order (its time as the window took it)."""
+        self._points.append(point)
+        self._times.append(t_ms)
+
+    def _short(self, segment: Segment) -> bool:
+        return segment.length < self.min_length or segment.duration_ms < max(
+            self.min_duration_ms, self.floor_ms
+        )
+
+    def _below_minimums(self, segment: Segment) -> bool:
+        return segment.length < self.min_length or segment.duration_ms < self.min_duration_ms
+
+    def _fits(self, start: Point, end: Point, end_ms: float) -> bool:
+        """Whether every sample not yet covered, drawn up to end_ms, lies within max_error of it.
+
+        All of them, not only those after the held piece's start: a stroke whose pen crawled or
+        rested starts after samples it covers."""
+        limit_sq = self.max_error * self.max_error
+        for point, t_ms in zip(self._points, self._times, strict=True):
+            if t_ms > end_ms:
+                break
+            if segment_distance_sq(point, start, end) > limit_sq:
+                return False
+        return True
+
+    def _send(self, segment: Segment, now_ms: float, out: list[Segment]) -> None:
+        self._sent_in_path = True
+        # Built directly, not by dataclasses.replace (several times slower): one per stroke.
+        out.append(
+            Segment(
+                segment.start,
+                segment.end,
+                segment.start_ms,
+                segment.end_ms,
+                now_ms,
+                None,
+                segment.merged,
+            )
+        )
+        # The samples before its end are covered now (those at its end may start the next).
+        keep = bisect.bisect_left(self._times, segment.end_ms)
+        del self._points[:keep]
+        del self._times[:keep]
+
+    def take(self, piece: Segment, now_ms: float) -> list[Segment]:
+        """A piece the window cut: the strokes sent now (none while a short one waits)."""
+        out: list[Segment] = []
+        held = self._held
+        if held is not None:
+            self._held = None
+            if self._fits(held.start, piece.end, piece.end_ms) or (
+                self.strict and self._below_minimums(held)
+            ):
+                piece = Segment(
+                    held.start,
+                    piece.end,
+                    held.start_ms,
+                    piece.end_ms,
+                    now_ms,
+                    merged=held.merged + piece.merged + 1,
+                )
+            else:
+                self._send(held, now_ms, out)
+        if self._short(piece):
+            self._held = piece
+        else:
+            self._send(piece, now_ms, out)
+        return out
+
+    def rest(self, now_ms: float) -> list[Segment]:
+        """The pen rests (since the held piece's end, until ``now_ms``): the held piece is sent
+        now rather than merged with what comes after the rest, which would play the rest.
+
+        If it is briefer than the sleeve's floor, it takes the time it needs from the rest: the
+        pen was at its end then. With strict minimums, a piece still below them waits."""
+        held = self._held
+        if held is None:
+            return []
+        short_ms = max(self.min_duration_ms, self.floor_ms)
+        if held.duration_ms < short_ms and now_ms > held.end_ms:
+            held = replace(held, end_ms=min(held.start_ms + short_ms, now_ms))
+        if self.strict and self._below_minimums(held):
+            self._held = held
+            return []
+        self._held = None
+        out: list[Segment] = []
+        self._send(held, now_ms, out)
+        return out
+
+    def end(self, now_ms: float) -> list[Segment]:
+        """Release, after the window's last piece: the held piece is sent (or, if it is the
+        path's only piece and too short to send, dropped with its reason)."""
+        out: list[Segment] = []
+        held = self._held
+        if held is not None:
+            reason = None
+            if not self._sent_in_path or self.strict:
+                if held.length < self.min_length:
+                    reason = NOT_ENOUGH_DISTANCE
+                elif held.duration_ms < self.min_duration_ms:
+                    reason = NOT_ENOUGH_DURATION
+            if reason is not None:
+                out.append(replace(held, emitted_at_ms=now_ms, dropped=reason))
+            else:
+                self._send(held, now_ms, out)
+        self._held = None
+        self._sent_in_path = False
+        self._points, self._times = [], []
+        return out
+
+
+@dataclass
+class WindowSimplifier:
+    """The window simplifier: the window's pieces, the too-short ones merged (``Merger``)."""
+
+    params: WindowParams = field(default_factory=WindowParams)
+    _core: WindowCore = field(init=False)
+    _merger: Merger = field(init=False)
+
+    def __post_init__(self) -> None:
+        params = self.params
+        self._core = WindowCore(params)
+        self._merger = Merger(
+            params.max_error,
+            params.min_length,
+            params.min_duration_ms,
+            params.floor_ms,
+            params.strict_minimums,
+        )
+
+    @property
+    def drawing(self) -> bool:
+        """True between the first sample of a path and ``end``."""
+        return self._core.drawing
+
+    @property
+    def line_start(self) -> Sample | None:
+        """Where the stroke being drawn starts (canvas pixels); None between paths."""
+        return self._core.line_start
+
+    def push(self, sample: Sample) -> list[Segment]:
+        """One pointer sample while the pointer is down; the first of a path is the press."""
+        core = self._core
+        pieces = core.push(sample)
+        merger = self._merger
+        taken, point = core._taken  # core.last_sample() and merger.sample, inlined: per sample
+        merger._points.append(point)
+        merger._times.append(taken)
+        if not pieces and not core.rested:
+            return []
+        out: list[Segment] = []
+        for piece in pieces:
+            out.extend(merger.take(piece, taken))
+        if core.rested:
+            out.extend(merger.rest(taken))
+        return out
+
+    def end(self) -> list[Segment]:
+        """Release: the rest of the path, the held piece first (a tap gives one, dropped)."""
+        core = self._core
+        now_ms = core.pointer_ms()
+        out: list[Segment] = []
+        for piece in core.end():
+            out.extend(self._merger.take(piece, now_ms))
+        out.extend(self._merger.end(now_ms))
+        return out
+
+
+def rest_radius(params: WindowParams) -> float:
+    """How near one point a resting pen stays, in grid units: the least of ``REST_SHARE`` x
+    min_length, half of max_error and the distance a pen at ``REST_SPEED_PX_PER_MS`` covers in
+    rest_ms, mapped at the canvas's tighter scale (so no more pixels on either axis)."""
+    px = REST_SPEED_PX_PER_MS * params.rest_ms
+    return min(REST_SHARE * params.min_length, 0.5 * params.max_error, px * params.mapping.scale)
+
+
+def _distance_sq(a: Point, b: Point) -> float:
+    dx, dy = a[0] - b[0], a[1] - b[1]
+    return dx * dx + dy * dy
 
 
 def unit_direction(start: Point, end: Point) -> tuple[float, float] | None:

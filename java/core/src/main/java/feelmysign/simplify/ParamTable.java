@@ -67,8 +67,9 @@ public final class ParamTable {
           Map.entry(
               "window",
               names(
-                  "max_error max_window max_stroke_ms clear_on_press min_duration_ms min_length "
-                      + "rows columns canvas_width_px canvas_height_px stretch")));
+                  "max_error max_window max_stroke_ms max_bend bend_floor rest_ms strict_minimums "
+                      + "floor_ms clear_on_press min_duration_ms min_length rows columns "
+                      + "canvas_width_px canvas_height_px stretch")));
 
   /** Every parameter once. */
   public static final List<Row> PARAMETERS =
@@ -109,13 +110,92 @@ public final class ParamTable {
               null,
               0,
               ParamSpec.Kind.NUMBER,
-              300.0,
+              200.0,
               0.0,
               60000.0,
               "ms",
               "Longest stroke",
               "longest stroke in ms of drawing, so a long line is felt before it ends; 0 = no "
                   + "limit",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "max_bend",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.NUMBER,
+              0.0,
+              0.0,
+              1.0,
+              "of the stroke's length",
+              "Max bend",
+              "farthest a drawn point may lie from its stroke as a share of the stroke's length "
+                  + "(never under bend_floor), so round shapes stay round; 0 = no limit",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "bend_floor",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.NUMBER,
+              0.1,
+              0.0,
+              100.0,
+              "grid units",
+              "Bend floor",
+              "least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "rest_ms",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.NUMBER,
+              100.0,
+              0.0,
+              10000.0,
+              "ms",
+              "Rest",
+              "a pen resting this long ends the stroke so far, in ms (the rest is not played); 0 = "
+                  + "never",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "strict_minimums",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.BOOLEAN,
+              false,
+              null,
+              null,
+              null,
+              "Strict minimums",
+              "never send a stroke below min_length or min_duration_ms, even where max_error must "
+                  + "yield (a wearer's measured limits: senders set it from the sleeve's status)",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "floor_ms",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.NUMBER,
+              73.7,
+              0.0,
+              10000.0,
+              "ms",
+              "Sleeve floor",
+              "shortest stroke the sleeve plays without slowing it, in ms (its status says); a "
+                  + "briefer piece merges into a neighbour where the error bound allows",
               "simplifier",
               null,
               null),

@@ -15,7 +15,21 @@ public record Segment(
     double startMs,
     double endMs,
     double emittedAtMs,
-    String dropped) {
+    String dropped,
+    int merged) {
+
+  /** A segment into which no piece was merged. */
+  public Segment(
+      double startX,
+      double startY,
+      double endX,
+      double endY,
+      double startMs,
+      double endMs,
+      double emittedAtMs,
+      String dropped) {
+    this(startX, startY, endX, endY, startMs, endMs, emittedAtMs, dropped, 0);
+  }
 
   /** The paper's NotEnoughDistanceException. */
   public static final String NOT_ENOUGH_DISTANCE = "not_enough_distance";
@@ -50,6 +64,6 @@ public record Segment(
     }
     return reason == null
         ? this
-        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, reason);
+        : new Segment(startX, startY, endX, endY, startMs, endMs, emittedAtMs, reason, merged);
   }
 }

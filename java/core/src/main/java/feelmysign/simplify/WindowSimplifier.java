@@ -24,6 +24,66 @@ import java.util.List;
  * value is the same to the last bit.
  */
 public final class WindowSimplifier implements Simplifier {
+  private final WindowCore core;
+  private final Merger merger;
+
+  public WindowSimplifier(Params params) {
+    this.core = new WindowCore(params);
+    this.merger =
+        new Merger(
+            params.number("max_error"),
+            params.number("min_length"),
+            params.number("min_duration_ms"),
+            params.number("floor_ms"),
+            params.flag("strict_minimums"));
+  }
+
+  public Params params() {
+    return core.params();
+  }
+
+  @Override
+  public boolean drawing() {
+    return core.drawing();
+  }
+
+  @Override
+  public Sample lineStart() {
+    return core.lineStart();
+  }
+
+  @Override
+  public List<Segment> push(Sample input) {
+    List<Segment> pieces = core.push(input);
+    double takenMs = core.lastMs();
+    merger.sample(takenMs, core.lastX(), core.lastY());
+    List<Segment> out = null;
+    for (Segment piece : pieces) {
+      out = merger.take(piece, takenMs, out);
+    }
+    if (core.rested()) {
+      out = merger.rest(takenMs, out);
+    }
+    return out == null ? List.of() : out;
+  }
+
+  @Override
+  public List<Segment> end() {
+    double nowMs = core.pointerMs();
+    List<Segment> out = null;
+    for (Segment piece : core.end()) {
+      out = merger.take(piece, nowMs, out);
+    }
+    out = merger.end(nowMs, out);
+    return out == null ? List.of() : out;
+  }
+}
+
+/**
+ * The window itself: strokes cut by the error bound, the bend rule and the caps, before
+ * too-short pieces are merged ({@link WindowSimplifier} merges them).
+ */
+final class WindowCore implements Simplifier {
   /** The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
    * stroke's start, so that the stroke it ends is not too brief to be felt in its drawn time. */
   static final double CAP_FEATURE_SHARE = 0.5;
@@ -36,8 +96,21 @@ public final class WindowSimplifier implements Simplifier {
    * max_error (0.001): what a stroke's reach adds for rounding, and the room kept below
    * max_error. */
   static final double ROUNDING_SLACK = 1e-9;
+  /** A pen rests while its samples stay within this share of min_length of one point (never
+   * farther than half of max_error, so the point that ends or starts a stroke covers the rest):
+   * well below a stroke the sleeve renders, well above a still hand's jitter. */
+  static final double REST_SHARE = 0.25;
+  /** ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a
+   * quarter of a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests;
+   * a slow, steady pen does not, as the distance it covers over the whole window tells: at twice
+   * this speed (half a pixel a frame) or more, in any direction, it leaves the radius well within
+   * rest_ms, even with its samples rounded to whole pixels. In pixels, not grid units: a hand's
+   * speed on the screen does not depend on how the canvas maps onto the sleeve. */
+  static final double REST_SPEED_PX_PER_MS = 0.015;
 
   private final Params params;
+  private final double restMs;
+  private final double restSq;
   private final double maxError;
   private final int maxWindow;
   private final double maxStrokeMs;
@@ -46,6 +119,8 @@ public final class WindowSimplifier implements Simplifier {
   private final double maxErrorSq;
   private final double minLengthSq;
   private final double reachLimit;
+  private final double maxBend;
+  private final double bendFloor;
   private final CanvasMapping mapping;
   /** The grid's extents: every stroke's start and end lies in [0, x] x [0, y]. */
   private final double xExtent;
@@ -71,8 +146,16 @@ public final class WindowSimplifier implements Simplifier {
   private double[] line;
   /** No sample since the anchor lies farther than this from anchor -> last sample. */
   private double reach;
+  /** While the pen rests at the anchor: each sample near it moves the anchor's time. */
+  private boolean resting;
+  /** Whether the last push found the pen resting (the stroke before the rest is final). */
+  private boolean rested;
+  /** The last sample pushed, as taken: its time and grid point. */
+  private double takenMs;
+  private double takenX;
+  private double takenY;
 
-  public WindowSimplifier(Params params) {
+  WindowCore(Params params) {
     if (params.algorithm() != Algorithm.WINDOW) {
       throw new IllegalArgumentException("the window simplifier needs Params.window()");
     }
@@ -85,9 +168,24 @@ public final class WindowSimplifier implements Simplifier {
     this.maxErrorSq = maxError * maxError;
     this.minLengthSq = minLength * minLength;
     this.reachLimit = maxError - ROUNDING_SLACK;
+    this.maxBend = params.number("max_bend");
+    this.bendFloor = params.number("bend_floor");
     this.mapping = params.mapping();
     this.xExtent = params.columns() - 1;
     this.yExtent = params.rows() - 1;
+    this.restMs = params.number("rest_ms");
+    // The least of a share of min_length, half of max_error and what a pen at the rest speed
+    // covers in rest_ms, at the canvas's tighter scale (as Python's and the page's rest radius).
+    double rest =
+        Math.min(
+            Math.min(REST_SHARE * minLength, 0.5 * maxError),
+            REST_SPEED_PX_PER_MS * restMs * mapping.scale());
+    this.restSq = rest * rest;
+  }
+
+  /** Whether the last push found the pen resting. */
+  boolean rested() {
+    return rested;
   }
 
   public Params params() {
@@ -102,6 +200,24 @@ public final class WindowSimplifier implements Simplifier {
   @Override
   public Sample lineStart() {
     return count > 0 ? samples[0] : null;
+  }
+
+  /** The time of the last sample taken, as taken (never before the one before). */
+  double lastMs() {
+    return takenMs;
+  }
+
+  double lastX() {
+    return takenX;
+  }
+
+  double lastY() {
+    return takenY;
+  }
+
+  /** The time of the last sample pushed, as taken (0 before any). */
+  double pointerMs() {
+    return pointer != null ? pointer.tMs() : 0.0;
   }
 
   private void place(double x, double y, double t, Sample sample) {
@@ -139,6 +255,24 @@ public final class WindowSimplifier implements Simplifier {
     end = end - index;
   }
 
+  /** The anchor at another time (while the pen rests or crawls), its sample too. */
+  private void retime(double t) {
+    ts[0] = t;
+    Sample anchor = samples[0];
+    samples[0] = new Sample(t, anchor.x(), anchor.y(), anchor.pressure());
+  }
+
+  /** The sample to take next (at count) is not taken: the ones after it move down. */
+  private void skip() {
+    for (int to = count; to < end - 1; to++) {
+      xs[to] = xs[to + 1];
+      ys[to] = ys[to + 1];
+      ts[to] = ts[to + 1];
+      samples[to] = samples[to + 1];
+    }
+    end--;
+  }
+
   @Override
   public List<Segment> push(Sample input) {
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last.
@@ -150,12 +284,17 @@ public final class WindowSimplifier implements Simplifier {
     double x = mapping.gridX(sample.x());
     double y = mapping.gridY(sample.y());
     int before = count;
+    takenMs = sample.tMs();
+    takenX = x;
+    takenY = y;
+    rested = false;
     place(x, y, sample.tMs(), sample);
     if (before == 0) {
       count = 1;
       reach = 0;
       emittedInPath = false;
       line = null;
+      resting = false;
       return List.of();
     }
     List<Segment> out = add();
@@ -170,6 +309,7 @@ public final class WindowSimplifier implements Simplifier {
     }
     count = 0;
     end = 0;
+    resting = false;
     // The last sample already ends a stroke (a cut at the work cap).
     if (n == 1 && emittedInPath) {
       return List.of();
@@ -187,6 +327,23 @@ public final class WindowSimplifier implements Simplifier {
       double x = xs[n];
       double y = ys[n];
       double t = ts[n];
+      if (resting) {
+        if (n == 1 && squared(x - xs[0], y - ys[0]) <= restSq) {
+          // The pen still rests: the next stroke starts when it moves on, not before.
+          retime(t);
+          skip();
+          if (count == end) {
+            return out;
+          }
+          continue;
+        }
+        resting = false;
+      }
+      if (capMs > 0 && n > 1 && t - ts[0] > capMs && !sendable(xs[0], ys[0], xs[n - 1], ys[n - 1])) {
+        // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
+        // rather than lasting longer, so the cap holds for it too.
+        retime(t - capMs);
+      }
       if (capMs > 0 && n > 1 && t - ts[0] > capMs && sendable(xs[0], ys[0], xs[n - 1], ys[n - 1])) {
         int cut = capCut(n);
         double[] vertex = continued(cut);
@@ -214,7 +371,16 @@ public final class WindowSimplifier implements Simplifier {
       } else {
         count = n + 1;
         reaches[n] = reach;
-        if (n >= maxWindow) {
+        if (rests(n + 1)) {
+          // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
+          if (restStroke != null) {
+            if (out == null) {
+              out = new ArrayList<>(2);
+            }
+            out.add(restStroke);
+            restStroke = null;
+          }
+        } else if (n >= maxWindow) {
           if (out == null) {
             out = new ArrayList<>(2);
           }
@@ -230,6 +396,51 @@ public final class WindowSimplifier implements Simplifier {
     }
   }
 
+  /** The stroke a rest ended, between rests() and add() (null if all was rest). */
+  private Segment restStroke;
+
+  /**
+   * Whether the pen has rested rest_ms at the stroke's newest sample, index n - 1: its samples of
+   * the last rest_ms or more all lie within the rest radius of it. The stroke drawn up to the
+   * rest then ends there at the time the rest began, and is sent now (restStroke); the rest is
+   * not played (the next stroke starts where and when the pen moves on). If the stroke is all
+   * rest, its anchor waits instead.
+   */
+  private boolean rests(int n) {
+    int last = n - 1;
+    double t = ts[last];
+    if (restMs <= 0 || t - ts[0] < restMs) {
+      return false;
+    }
+    double x = xs[last];
+    double y = ys[last];
+    int start = last;
+    while (start > 0 && squared(xs[start - 1] - x, ys[start - 1] - y) <= restSq) {
+      start--;
+    }
+    if (t - ts[start] < restMs) {
+      return false;
+    }
+    if (start == 0) {
+      Sample anchor = samples[0];
+      restart(xs[0], ys[0], last);
+      samples[0] = anchor;
+      retime(t);
+    } else {
+      restStroke = finish(xs[0], ys[0], ts[0], x, y, ts[start]);
+      restart(x, y, last);
+    }
+    line = null;
+    reach = 0;
+    resting = true;
+    rested = true;
+    return true;
+  }
+
+  private static double squared(double dx, double dy) {
+    return dx * dx + dy * dy;
+  }
+
   /** Whether every sample since the anchor lies within max_error of anchor -> (x, y); sets the
    * reach for (x, y) as the stroke's new last sample. A NaN is never farther than max_error. */
   private boolean keepsBound(int n, double x, double y) {
@@ -237,14 +448,27 @@ public final class WindowSimplifier implements Simplifier {
       reach = 0;
       return true;
     }
+    double limitReach = reachLimit;
+    double limitSq = maxErrorSq;
+    if (maxBend > 0.0) {
+      // The bend rule: a round shape is cut before its chord strays farther than a share of the
+      // chord's length, never under the floor, never over max_error.
+      double cx = x - xs[0];
+      double cy = y - ys[0];
+      double limit = Math.max(maxBend * Math.sqrt(cx * cx + cy * cy), bendFloor);
+      if (limit < maxError) {
+        limitReach = limit - ROUNDING_SLACK;
+        limitSq = limit * limit;
+      }
+    }
     double dx = x - xs[n - 1];
     double dy = y - ys[n - 1];
     double next = reach + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK;
-    if (next <= reachLimit) {
+    if (next <= limitReach) {
       reach = next;
       return true;
     }
-    double farthestSq = farthestSq(n, x, y, maxErrorSq);
+    double farthestSq = farthestSq(n, x, y, limitSq);
     if (farthestSq < 0) {
       return false;
     }
@@ -484,5 +708,217 @@ public final class WindowSimplifier implements Simplifier {
       qy = qy - t * dy;
     }
     return qx * qx + qy * qy;
+  }
+}
+
+/**
+ * Merges the pieces the window cuts too short to send into a neighbour, never dropping one (the
+ * reference's {@code Merger}). A piece is too short when it is shorter than min_length or
+ * briefer than the larger of min_duration_ms and floor_ms (the sleeve would slow it). A short
+ * piece waits for the next; the two become one stroke when every drawn sample of both lies
+ * within max_error of it (still short, it waits again), else the short one is sent as it is. A
+ * piece long enough is sent at once (holding each back would delay the drawing), so a path's
+ * last piece, if short, is sent short. Only a path's one and only piece, too short, is dropped
+ * with its reason.
+ */
+final class Merger {
+  private final double maxError;
+  private final double minLength;
+  private final double minDurationMs;
+  private final double shortMs;
+  private final boolean strict;
+  // The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first:
+  // [first, size).
+  private double[] xs = new double[64];
+  private double[] ys = new double[64];
+  private double[] ts = new double[64];
+  private int first;
+  private int size;
+  private Segment held;
+  private boolean sentInPath;
+
+  Merger(double maxError, double minLength, double minDurationMs, double floorMs, boolean strict) {
+    this.maxError = maxError;
+    this.minLength = minLength;
+    this.minDurationMs = minDurationMs;
+    this.shortMs = Math.max(minDurationMs, floorMs);
+    this.strict = strict;
+  }
+
+  Merger(double maxError, double minLength, double minDurationMs, double floorMs) {
+    this(maxError, minLength, minDurationMs, floorMs, false);
+  }
+
+  /** A drawn sample, in order (its time as the window took it). */
+  void sample(double tMs, double x, double y) {
+    if (size == xs.length) {
+      int live = size - first;
+      int capacity = live * 2 < xs.length ? xs.length : xs.length * 2;
+      double[] nx = new double[capacity];
+      double[] ny = new double[capacity];
+      double[] nt = new double[capacity];
+      System.arraycopy(xs, first, nx, 0, live);
+      System.arraycopy(ys, first, ny, 0, live);
+      System.arraycopy(ts, first, nt, 0, live);
+      xs = nx;
+      ys = ny;
+      ts = nt;
+      first = 0;
+      size = live;
+    }
+    xs[size] = x;
+    ys[size] = y;
+    ts[size] = tMs;
+    size++;
+  }
+
+  private boolean isShort(Segment segment) {
+    return segment.length() < minLength || segment.durationMs() < shortMs;
+  }
+
+  private boolean belowMinimums(Segment segment) {
+    return segment.length() < minLength || segment.durationMs() < minDurationMs;
+  }
+
+  /** Whether every sample not yet covered, drawn up to the second's end, lies within max_error
+   * of the first's start -> the second's end. All of them, not only those after the first's
+   * start: a stroke whose pen crawled or rested starts after samples it covers. */
+  private boolean fits(Segment from, Segment to) {
+    double limitSq = maxError * maxError;
+    double endMs = to.endMs();
+    for (int i = first; i < size; i++) {
+      double t = ts[i];
+      if (t > endMs) {
+        break;
+      }
+      if (WindowCore.distanceSq(xs[i], ys[i], from.startX(), from.startY(), to.endX(), to.endY())
+              > limitSq) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  private static List<Segment> add(List<Segment> out, Segment segment) {
+    List<Segment> list = out == null ? new ArrayList<>(2) : out;
+    list.add(segment);
+    return list;
+  }
+
+  private List<Segment> send(Segment segment, double nowMs, List<Segment> out) {
+    sentInPath = true;
+    // The samples before its end are covered now (those at its end may start the next).
+    while (first < size && ts[first] < segment.endMs()) {
+      first++;
+    }
+    return add(
+        out,
+        new Segment(
+            segment.startX(),
+            segment.startY(),
+            segment.endX(),
+            segment.endY(),
+            segment.startMs(),
+            segment.endMs(),
+            nowMs,
+            null,
+            segment.merged()));
+  }
+
+  /** A piece the window cut: the strokes sent now, added to out (none while a short one
+   * waits). */
+  List<Segment> take(Segment input, double nowMs, List<Segment> out) {
+    Segment piece = input;
+    List<Segment> result = out;
+    Segment before = held;
+    if (before != null) {
+      held = null;
+      if (fits(before, piece) || (strict && belowMinimums(before))) {
+        piece =
+            new Segment(
+                before.startX(),
+                before.startY(),
+                piece.endX(),
+                piece.endY(),
+                before.startMs(),
+                piece.endMs(),
+                nowMs,
+                null,
+                before.merged() + piece.merged() + 1);
+      } else {
+        result = send(before, nowMs, result);
+      }
+    }
+    if (isShort(piece)) {
+      held = piece;
+      return result;
+    }
+    return send(piece, nowMs, result);
+  }
+
+  /** The pen rests (since the held piece's end, until nowMs): the held piece is sent now rather
+   * than merged with what comes after the rest, which would play the rest. If it is briefer than
+   * the sleeve's floor, it takes the time it needs from the rest: the pen was at its end then.
+   * With strict minimums, a piece still below them waits. */
+  List<Segment> rest(double nowMs, List<Segment> out) {
+    Segment piece = held;
+    if (piece == null) {
+      return out;
+    }
+    if (piece.durationMs() < shortMs && nowMs > piece.endMs()) {
+      piece =
+          new Segment(
+              piece.startX(),
+              piece.startY(),
+              piece.endX(),
+              piece.endY(),
+              piece.startMs(),
+              Math.min(piece.startMs() + shortMs, nowMs),
+              piece.emittedAtMs(),
+              piece.dropped(),
+              piece.merged());
+    }
+    if (strict && belowMinimums(piece)) {
+      held = piece;
+      return out;
+    }
+    held = null;
+    return send(piece, nowMs, out);
+  }
+
+  /** Release, after the window's last piece: the held piece is sent (or, a path's only piece
+   * too short, dropped with its reason). */
+  List<Segment> end(double nowMs, List<Segment> out) {
+    List<Segment> result = out;
+    if (held != null) {
+      String reason = null;
+      if (!sentInPath || strict) {
+        if (held.length() < minLength) {
+          reason = Segment.NOT_ENOUGH_DISTANCE;
+        } else if (held.durationMs() < minDurationMs) {
+          reason = Segment.NOT_ENOUGH_DURATION;
+        }
+      }
+      result =
+          reason != null
+              ? add(
+                  result,
+                  new Segment(
+                      held.startX(),
+                      held.startY(),
+                      held.endX(),
+                      held.endY(),
+                      held.startMs(),
+                      held.endMs(),
+                      nowMs,
+                      reason,
+                      held.merged()))
+              : send(held, nowMs, result);
+    }
+    held = null;
+    sentInPath = false;
+    first = 0;
+    size = 0;
+    return result;
   }
 }

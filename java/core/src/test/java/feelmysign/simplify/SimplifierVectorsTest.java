@@ -77,6 +77,9 @@ class SimplifierVectorsTest {
           want.get("dropped").isNull() ? null : want.get("dropped").asText(),
           s.dropped(),
           where + " dropped");
+      // The window simplifier's: how many pieces too short to send were merged into it.
+      assertEquals(
+          want.has("merged") ? want.get("merged").asInt() : 0, s.merged(), where + " merged");
       assertEquals(want.get("start").get(0).asDouble(), s.startX(), tolerance, where + " start x");
       assertEquals(want.get("start").get(1).asDouble(), s.startY(), tolerance, where + " start y");
       assertEquals(want.get("end").get(0).asDouble(), s.endX(), tolerance, where + " end x");
