@@ -11,9 +11,9 @@ the sleeve opens when it takes its buttons::
 
 (:func:`press_in` and :func:`release_in` write them, and say when no sleeve reads the
 pipe; a shell's plain ``echo`` into it then waits forever, a FIFO having no reader, so the
-commands the sleeve prints run it under ``timeout 2``, see :func:`press_command`.) The pipe wakes the sleeve the way
-a real line's edge does, with no polling, and the button records when it saw each
-change as the bus records everything else, in the state file: ``pressed_at`` and
+commands the sleeve prints run it under ``timeout 2``, see :func:`press_command`.) The pipe
+wakes the sleeve the way a real line's edge does, with no polling, and the button records
+when it saw each change as the bus records everything else, in the state file: ``pressed_at`` and
 ``released_at`` (the wall clock in ms, and the bus's transaction count then), the number
 of ``presses``, and ``driven_at_press`` (how many motors were driven at the last press).
 With the bus's ``silent_since`` (when every motor was last found off) a test reads how
