@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from feelmysign.plural import plural
 from feelmysign.study.analysis.models import ShapeTest
 from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
 from feelmysign.study.store import DISCARDED, StudyStore
@@ -43,8 +44,8 @@ def shape_test_sentence(test: ShapeTest) -> str:
     if test.refused is not None or test.p is None or test.statistic is None:
         return (
             f"No test of whether shapes differ is reported: {test.refused}. Run at least "
-            f"{test.participants_needed} participants (8 or more for the calibrated false-positive "
-            "rate in docs/research.md)."
+            f"{plural(test.participants_needed, 'participant')} (8 or more for the calibrated "
+            "false-positive rate in docs/research.md)."
         )
     return (
         f"Test that shapes differ at equal strokes: {test.method} ({test.participants} "
@@ -62,12 +63,14 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     lines = [
         f"# {design.name}",
         "",
-        f"{analysis.participants} participants ({analysis.simulated} simulated), "
+        f"{plural(analysis.participants, 'participant')} ({analysis.simulated} simulated), "
         f"{analysis.trials} measured trials: {len(design.shapes)} shapes x "
         f"{len(design.resolutions)} resolutions x {design.repetitions} repetitions, order by "
         f"{design.randomisation} (seed {design.seed}). Answers were free; they were coded to "
         f"shapes by synonyms, unclear ones by the researcher. "
-        f"{analysis.unclear} answer(s) still await review and are left out.",
+        f"{plural(analysis.unclear, 'answer')} still "
+        + ("awaits review and is" if analysis.unclear == 1 else "await review and are")
+        + " left out.",
         "",
         "## Accuracy by shape and resolution",
         "",
@@ -78,7 +81,9 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     for shape, rows in analysis.accuracy.items():
         cells = [
-            f"{k}/{n} = {k / n:.0%} [{low:.0%}, {high:.0%}] ({strokes} strokes)" if n else "-"
+            f"{k}/{n} = {k / n:.0%} [{low:.0%}, {high:.0%}] ({plural(strokes, 'stroke')})"
+            if n
+            else "-"
             for strokes, k, n, low, high in rows
         ]
         lines.append(f"| {shape} | " + " | ".join(cells) + " |")
