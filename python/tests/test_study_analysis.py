@@ -112,6 +112,11 @@ def test_counts_of_one_are_singular_in_the_report_and_the_design_check(tmp_path:
     assert "1 participant (1 simulated)" in report
     assert "(s)" not in report
     assert "1 participants" not in report
+    # One person: no spread, no dispersion; nothing printed as nan or a fit's limit.
+    assert "not estimable with 1 participant" in report
+    assert "nan" not in report.replace("Nan", "")
+    assert "| 40.00 |" not in report
+    assert "resampling participants needs 3 or more" in report
     bad = PILOT_DESIGN.replace("segments = [3, 6]", "segments = [3, 7]")
     with pytest.raises(DesignError) as caught:
         parse_design(bad, source="pilot.toml")

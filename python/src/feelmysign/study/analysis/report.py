@@ -2,12 +2,19 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.plural import plural
 from feelmysign.study.analysis.models import ShapeTest
-from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
+from feelmysign.study.analysis.psychometric import (
+    ABOVE,
+    AT_OR_BELOW,
+    SLOPE_BOUNDS,
+    Interval,
+    Needed,
+)
 from feelmysign.study.store import DISCARDED, StudyStore
 
 if TYPE_CHECKING:
@@ -37,6 +44,43 @@ def interval_text(interval: Interval, digits: int = 1) -> str:
 
 def _p(value: float) -> str:
     return "p < 0.001" if value < 0.001 else f"p = {value:.3f}"
+
+
+def _not_estimable(participants: int, why: str) -> str:
+    return f"not estimable with {plural(participants, 'participant')} ({why})"
+
+
+def _cluster_text(interval: Interval | None, participants: int) -> str:
+    """Resampling participants says nothing when there are too few to differ: with one every
+    sample is the same person, with two most are one person twice (a zero-width interval)."""
+    if interval is not None and participants >= 3:
+        return interval_text(interval)
+    return _not_estimable(participants, "resampling participants needs 3 or more")
+
+
+def _slope_text(slope: float) -> str:
+    """The fit's slope, or why there is none: at its upper bound the answers jump from wrong
+    to right between two tested resolutions (or never change), so no slope was measured."""
+    if not math.isfinite(slope) or slope >= SLOPE_BOUNDS[1] * 0.999:
+        return (
+            f"not estimable: at the fit's limit ({SLOPE_BOUNDS[1]:g}), the answers change "
+            "from wrong to right between two tested resolutions or not at all"
+        )
+    return f"{slope:.2f}"
+
+
+def _spread_text(spread: float, participants: int) -> str:
+    if participants < 2 or not math.isfinite(spread):
+        return _not_estimable(participants, "a spread between participants needs 2 or more")
+    return f"{spread:.2f}"
+
+
+def _dispersion_text(dispersion: float, participants: int) -> str:
+    if participants < 2 or not math.isfinite(dispersion):
+        return _not_estimable(
+            participants, "it compares participants' counts: 2 or more, and answers that vary"
+        )
+    return f"{dispersion:.2f}"
 
 
 def shape_test_sentence(test: ShapeTest) -> str:
@@ -112,12 +156,14 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "| slope per doubling | participants' SD | dispersion |",
         "|---|---|---|---|---|---|---|---|",
     ]
+    people = analysis.participants
     for shape, t in analysis.thresholds.items():
         needed = analysis.needed[shape]
         lines.append(
             f"| {shape} | {needed_text(needed)} | {interval_text(needed.interval)} | "
-            f"{interval_text(needed.profile)} | {interval_text(needed.cluster)} | "
-            f"{t.fit.slope:.2f} | {t.population.spread:.2f} | {t.dispersion:.2f} |"
+            f"{interval_text(needed.profile)} | {_cluster_text(needed.cluster, people)} | "
+            f"{_slope_text(t.fit.slope)} | {_spread_text(t.population.spread, people)} | "
+            f"{_dispersion_text(t.dispersion, people)} |"
         )
     lines += [
         "",
@@ -145,7 +191,13 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
                 f"Mixed-effects model (participant random intercept; {model.note}; "
                 f"descriptive): reference shape {model.reference}; slope "
                 f"{model.slope_per_doubling:.2f} log odds per doubling of strokes; participant "
-                f"SD {model.participant_sd:.2f} log odds.",
+                + (
+                    f"SD {model.participant_sd:.2f} log odds."
+                    if analysis.participants >= 2
+                    else "SD "
+                    + _not_estimable(analysis.participants, "a spread needs 2 or more")
+                    + "."
+                ),
                 "",
                 "| shape | log odds vs " + model.reference + " | posterior SD |",
                 "|---|---|---|",
