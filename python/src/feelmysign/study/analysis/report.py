@@ -50,6 +50,40 @@ def _not_estimable(participants: int, why: str) -> str:
     return f"not estimable with {plural(participants, 'participant')} ({why})"
 
 
+def interval_notes(shape: str, needed: Needed) -> list[str]:
+    """Where an interval says more or other than the bound: why it is wide, or that the two
+    disagree (never a bound and an interval left side by side without a word)."""
+    notes = []
+    named = (
+        ("95% interval", needed.interval),
+        ("profile likelihood", needed.profile),
+        ("cluster bootstrap", needed.cluster),
+    )
+    for name, interval in named:
+        if needed.kind == AT_OR_BELOW and interval.high_open:
+            notes.append(
+                f"{shape}, {name}: reaches above the highest tested resolution although every "
+                "tested resolution reached the criterion: some resampled studies (or the "
+                "likelihood) allow curves that stay below it at the tested resolutions, because "
+                "the share correct there is close to the criterion with few answers. The bound "
+                f"≤ {needed.lowest_tested:g} is what these data show; the interval says how "
+                "uncertain that is."
+            )
+        elif needed.kind == AT_OR_BELOW and not interval.low_open:
+            notes.append(
+                f"{shape}, {name}: {interval_text(interval)} disagrees with the bound "
+                f"≤ {needed.lowest_tested:g}; the fitted curve and the counts differ, read the "
+                "accuracy table."
+            )
+        elif needed.kind == ABOVE and not interval.high_open:
+            notes.append(
+                f"{shape}, {name}: {interval_text(interval)} disagrees with the bound "
+                f"> {needed.highest_tested:g}; the fitted curve and the counts differ, read the "
+                "accuracy table."
+            )
+    return notes
+
+
 def _cluster_text(interval: Interval | None, participants: int) -> str:
     """Resampling participants says nothing when there are too few to differ: with one every
     sample is the same person, with two most are one person twice (a zero-width interval)."""
@@ -165,6 +199,11 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             f"{_slope_text(t.fit.slope)} | {_spread_text(t.population.spread, people)} | "
             f"{_dispersion_text(t.dispersion, people)} |"
         )
+    notes = [
+        n for shape in analysis.thresholds for n in interval_notes(shape, analysis.needed[shape])
+    ]
+    if notes:
+        lines += ["", *(f"- {n}" for n in notes)]
     lines += [
         "",
         "A number is given only where the tested resolutions bracket the criterion. "
