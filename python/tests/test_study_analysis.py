@@ -9,8 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from study_helpers import new_study
+from study_helpers import PILOT_DESIGN, new_study, pilot_study
 
+from feelmysign.errors import DesignError
+from feelmysign.study import parse_design
 from feelmysign.study.analysis import analyse_study
 from feelmysign.study.analysis.psychometric import LAPSE, Fit, Population, fit, fit_population
 from feelmysign.study.analysis.recovery import Truth, coverage, paper_truths, synthetic_counts
@@ -100,3 +102,24 @@ def test_a_dry_run_of_the_papers_design_gives_tables_plots_and_report(tmp_path: 
     assert sum(r["total"] for r in circle) + analysis.unclear >= 4 * 12 - analysis.unclear
     assert "Do shapes differ?" in (tmp_path / "out" / "report.md").read_text()
     assert analysis.model is not None and analysis.model.test.shapes == 6
+
+
+def test_counts_of_one_are_singular_in_the_report_and_the_design_check(tmp_path: Path) -> None:
+    store = pilot_study(tmp_path)
+    dry_run(store, 1, seed=3)
+    analyse_study(store, tmp_path / "out", samples=20)
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "1 participant (1 simulated)" in report
+    assert "(s)" not in report
+    assert "1 participants" not in report
+    # One person: no spread, no dispersion; nothing printed as nan or a fit's limit.
+    assert "not estimable with 1 participant" in report
+    assert "nan" not in report.replace("Nan", "")
+    assert "| 40.00 |" not in report
+    assert "resampling participants needs 3 or more" in report
+    # A bound with a wider interval says why; the pilot's square is at ceiling (≤ 4).
+    assert "- square, 95% interval: reaches above the highest tested resolution" in report
+    bad = PILOT_DESIGN.replace("segments = [3, 6]", "segments = [3, 7]")
+    with pytest.raises(DesignError) as caught:
+        parse_design(bad, source="pilot.toml")
+    assert str(caught.value).startswith("pilot.toml: 1 problem in the study design:")

@@ -131,3 +131,30 @@ def test_several_speeds_are_refused_with_how_to_compare_speeds() -> None:
     message = str(caught.value)
     assert "stimulus.speed_cm_s: must be one number from 0.5 to 50; got a list of 2" in message
     assert "make one design file per speed" in message
+
+
+def test_resolutions_that_repeat_or_go_back_are_refused_saying_what_to_do() -> None:
+    bad = MINIMAL.replace('resolutions = ["low", "high"]', 'resolutions = ["a", "b", "c"]')
+    bad = bad.replace("segments = [4, 16]", "segments = [12, 6, 6]")
+    bad = bad.replace("segments = [4, 8]", "segments = [8, 4, 12]")
+    with pytest.raises(DesignError) as caught:
+        parse_design(bad, source="bad.toml")
+    problems = caught.value.problems
+    assert any(
+        p.startswith("shapes[0].segments: must increase strictly from coarse to fine")
+        and "got 12, 6, 6" in p
+        and "fewest segments first" in p
+        for p in problems
+    ), problems
+    assert any("shapes[1].segments" in p and "got 8, 4, 12" in p for p in problems), problems
+    assert len(problems) == 2
+
+
+def test_a_shape_listed_twice_is_one_problem() -> None:
+    bad = MINIMAL + '[[shapes]]\nname = "circle"\nsegments = [4, 8]\n'
+    with pytest.raises(DesignError) as caught:
+        parse_design(bad)
+    assert caught.value.problems == [
+        "shapes: 'circle' is listed 2 times: give each shape once, with one entry per "
+        "resolution in its segments (or settings)"
+    ]

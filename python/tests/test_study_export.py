@@ -85,3 +85,30 @@ def test_the_response_time_counts_from_the_send_the_answer_follows(tmp_path: Pat
     session.answer(code, None, answer="circle", felt_nothing=False, confidence=3)
     (row,) = trial_rows(store)
     assert row["sends"] == 2 and row["response_time_s"] == 4.5
+
+
+def test_latency_ms_max_is_what_its_description_says(tmp_path: Path) -> None:
+    import json
+
+    from feelmysign.study.dry_run import dry_run
+
+    store = pilot_study(tmp_path)
+    dry_run(store, 1, seed=1)
+    export_study(store, tmp_path / "out")
+    (path,) = (tmp_path / "out" / "bids").glob("sub-*/beh/*_beh.json")
+    sidecar = json.loads(path.read_text())
+    described = sidecar["latency_ms_max"]["Description"]
+    assert "arrival at the sleeve to its first motor command" in described
+    assert "including its wait behind the strokes queued before it" in described
+    with (tmp_path / "out" / "trials.csv").open() as file:
+        rows = list(csv.DictReader(file))
+    checked = 0
+    for row, trial in zip(rows, store.query("SELECT * FROM trials ORDER BY id"), strict=True):
+        last = store.sends(trial["id"])[-1]
+        latencies = [
+            e["latency_ms"] for e in store.events(last["id"]) if e["type"] in ("played", "adjusted")
+        ]
+        if latencies:
+            assert float(row["latency_ms_max"]) == round(max(latencies), 3)
+            checked += 1
+    assert checked > 0

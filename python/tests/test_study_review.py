@@ -62,5 +62,5 @@ def test_review_is_blind_asks_again_and_keeps_codes_at_the_end_of_input(tmp_path
     assert codings[ids[2]]["status"] == "unclear"
     # The same command goes on with what is left.
     again = _review(study, "circle\n")
-    assert "1 answer(s) to review" in again.stdout and "Review done: 1 decided" in again.stdout
+    assert "1 answer to review" in again.stdout and "Review done: 1 decided" in again.stdout
     assert StudyStore(study).latest_codings()[ids[2]]["shape"] == "circle"

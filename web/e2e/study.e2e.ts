@@ -98,7 +98,8 @@ async function runTrial(page: Page): Promise<void> {
   if ((await hint.getAttribute("data-felt-nothing")) === "true") {
     await page.click('[data-testid="felt-nothing"]');
   } else {
-    await page.fill('[data-testid="answer"]', (await hint.getAttribute("data-answer")) ?? "");
+    // By its label, as a screen reader finds it: the box must have one, not only a placeholder.
+    await page.getByLabel("Answer, in their words").fill((await hint.getAttribute("data-answer")) ?? "");
     const confidence = (await hint.getAttribute("data-confidence")) ?? "";
     await page.selectOption('[data-testid="confidence"]', confidence);
     await page.click('[data-testid="record"]');

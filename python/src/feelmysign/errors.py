@@ -6,6 +6,8 @@ values, not exceptions; these are for what a caller cannot go on from.
 
 from __future__ import annotations
 
+from feelmysign.plural import plural
+
 TYPE_CHECKING = False  # typing and pathlib cost start-up imports; mypy reads this name as True
 if TYPE_CHECKING:
     from pathlib import Path
@@ -36,7 +38,7 @@ class LayoutError(FeelMySignError):
         self.problems = list(problems)
         lines = "\n".join(f"  - {p}" for p in self.problems)
         super().__init__(
-            f"{source}: {len(self.problems)} problem(s) in the sleeve layout:\n{lines}"
+            f"{source}: {plural(len(self.problems), 'problem')} in the sleeve layout:\n{lines}"
         )
 
 
@@ -114,4 +116,5 @@ class DesignError(StudyError):
         self.source = source
         self.problems = list(problems)
         lines = "\n".join(f"  - {p}" for p in self.problems)
-        super().__init__(f"{source}: {len(self.problems)} problem(s) in the study design:\n{lines}")
+        counted = plural(len(self.problems), "problem")
+        super().__init__(f"{source}: {counted} in the study design:\n{lines}")

@@ -29,6 +29,7 @@ from feelmysign.events import StatusFloor
 from feelmysign.input_files import loads_json, read_text
 from feelmysign.layout import MAX_GRID_SIDE, Layout
 from feelmysign.planner import MERGE_DISTANCE
+from feelmysign.plural import plural
 
 MAX_WEARER_BYTES = 64 * 1024  # the file is under 100 bytes
 MAX_NAME_CHARS = 64
@@ -81,7 +82,7 @@ def wearer_from_json(data: Any, source: str) -> Wearer:
     if problems:
         lines = "\n".join(f"  - {p}" for p in problems)
         raise WearerError(
-            f"{source}: {len(problems)} problem(s) in the wearer file:\n{lines}\n{fix}"
+            f"{source}: {plural(len(problems), 'problem')} in the wearer file:\n{lines}\n{fix}"
         )
     assert isinstance(name, str)
     return Wearer(name.strip(), length, duration)

@@ -212,7 +212,7 @@ export class SessionView {
     });
     const confidence = h(
       "select",
-      { "data-testid": "confidence" },
+      { "data-testid": "confidence", "aria-label": "Confidence" },
       h("option", { value: "" }, "no confidence given"),
       ...Array.from({ length: CONFIDENCE_POINTS }, (_, i) =>
         h("option", { value: String(i + 1) }, `confidence ${i + 1} of ${CONFIDENCE_POINTS}`),
@@ -278,7 +278,12 @@ export class SessionView {
       ),
       h("div", { class: "row" }, send),
       status,
-      h("div", { class: "row" }, answer, confidence),
+      h(
+        "div",
+        { class: "row" },
+        h("label", { class: "answer-label" }, "Answer, in their words ", answer),
+        confidence,
+      ),
       h("div", { class: "row" }, record, nothing),
     );
     if (
@@ -368,7 +373,7 @@ export class SessionView {
       h(
         "p",
         { class: "hint" },
-        `Read each of the ${items.length} statement(s) to the participant and choose their answer` +
+        `Read ${items.length === 1 ? "the statement" : `each of the ${items.length} statements`} to the participant and choose their answer` +
           ` (1 to ${points}).`,
       ),
       ...groups,

@@ -25,6 +25,7 @@ from feelmysign.cli._study_threshold import add_threshold_parser
 from feelmysign.cli.options.broker import add_broker_options, broker_settings_from_args
 from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.errors import StudyError
+from feelmysign.plural import plural
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 
 if TYPE_CHECKING:
@@ -140,7 +141,7 @@ def _check(args: argparse.Namespace) -> int:
     print(
         f"  {len(design.shapes)} shapes x {len(design.resolutions)} resolutions x "
         f"{design.repetitions} repetitions = {design.main_trials} measured trials per participant, "
-        f"after {len(design.practice)} practice trial(s); order: {design.randomisation}"
+        f"after {plural(len(design.practice), 'practice trial')}; order: {design.randomisation}"
     )
     for shape in design.shapes:
         strokes = ", ".join(str(level.strokes) for level in shape.levels)

@@ -67,7 +67,11 @@ COLUMNS: dict[str, dict[str, Any]] = {
     },
     "rejected": {"Description": "Strokes the sleeve refused, last send.", "Units": "strokes"},
     "latency_ms_max": {
-        "Description": "Longest wait of a stroke between its arrival and its start, last send.",
+        "Description": (
+            "Longest time of a stroke from its arrival at the sleeve to its first motor "
+            "command, last send, including its wait behind the strokes queued before it "
+            "(feelmysign up's 'start delay' leaves that wait out, so it is shorter)."
+        ),
         "Units": "ms",
     },
     "felt_duration_ms": {

@@ -10,6 +10,7 @@ shapes.
 from __future__ import annotations
 
 import uuid
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -180,7 +181,34 @@ def _shape(
         found = _library_levels(problems, key, name, table.get("segments", MISSING), levels)
     else:
         found = _recorded_levels(problems, key, table, recording, levels, stimulus, base_dir)
+    if found is not None and not _coarse_to_fine(problems, key, recording, found):
+        return None
     return None if found is None else Shape(name, found, words, recording)
+
+
+def _coarse_to_fine(
+    problems: Problems, key: str, recording: str | None, levels: tuple[Level, ...]
+) -> bool:
+    """The levels must gain strokes from each resolution to the next: the analysis reads
+    accuracy against strokes, and a level that repeats or goes back is a mistyped design."""
+    strokes = [level.strokes for level in levels]
+    if all(a < b for a, b in pairwise(strokes)):
+        return True
+    shown = ", ".join(map(str, strokes))
+    if recording is None:
+        problems.add(
+            f"{key}.segments",
+            f"must increase strictly from coarse to fine (each more than the one before); "
+            f"got {shown}: list each resolution once, fewest segments first",
+        )
+    else:
+        problems.add(
+            f"{key}.settings",
+            f"the settings must give strictly more strokes from coarse to fine (each more "
+            f"than the one before); they gave {shown} strokes: order the settings from "
+            "coarsest to finest and change any that give the same count",
+        )
+    return False
 
 
 def _library_levels(
@@ -258,9 +286,18 @@ def _recorded_levels(
 
 def _check_names_and_synonyms(problems: Problems, shapes: list[Shape]) -> None:
     owners: dict[str, str] = {}
+    seen: set[str] = set()
     for shape in shapes:
-        if any(other.name == shape.name for other in shapes if other is not shape):
-            problems.add("shapes", f"{shape.name!r} is listed twice")
+        if shape.name in seen:
+            continue  # reported once, with every listing, below
+        seen.add(shape.name)
+        listed = sum(other.name == shape.name for other in shapes)
+        if listed > 1:
+            problems.add(
+                "shapes",
+                f"{shape.name!r} is listed {listed} times: give each shape once, with one "
+                "entry per resolution in its segments (or settings)",
+            )
         for word in shape.synonyms:
             owner = owners.setdefault(word, shape.name)
             if owner != shape.name:

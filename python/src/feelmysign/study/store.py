@@ -23,6 +23,7 @@ from typing import Any
 from feelmysign.errors import StudyError
 from feelmysign.events import EventError, event_from_json
 from feelmysign.input_files import UnusableFile, check_kind
+from feelmysign.plural import plural
 from feelmysign.study.design import Design
 from feelmysign.study.design_file import parse_design
 from feelmysign.study.order import participant_order
@@ -230,8 +231,8 @@ class StudyStore:
         self._require_consent(row)
         if len(answers) != len(self.design.comfort):
             raise StudyError(
-                f"the comfort check has {len(self.design.comfort)} question(s); got "
-                f"{len(answers)} answer(s)"
+                f"the comfort check has {plural(len(self.design.comfort), 'question')}; got "
+                f"{plural(len(answers), 'answer')}"
             )
         data = json.dumps({"answers": answers, "adjusted": adjusted})
         with self._transaction() as db:
@@ -405,8 +406,8 @@ class StudyStore:
         items, points = self.design.questionnaire.items, self.design.questionnaire.points
         if len(values) != len(items) or not all(1 <= v <= points for v in values):
             raise StudyError(
-                f"the questionnaire has {len(items)} item(s), each answered 1..{points}; got "
-                f"{values}"
+                f"the questionnaire has {plural(len(items), 'item')}, each answered "
+                f"1..{points}; got {values}"
             )
         at_ms = self.clock()
         with self._transaction() as db:

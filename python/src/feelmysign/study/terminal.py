@@ -7,6 +7,7 @@ stops with every answer given so far stored, and the same command resumes.
 from __future__ import annotations
 
 from feelmysign.connection import BrokerSettings
+from feelmysign.plural import plural
 from feelmysign.study.runner import Session
 from feelmysign.study.sleeve_link import SleeveLink
 from feelmysign.study.store import StudyStore
@@ -94,7 +95,8 @@ def review_in_terminal(store: StudyStore) -> int:
     waiting = [t for t, c in codings.items() if c["status"] == "unclear"]
     choices = f"one of {', '.join(shapes)}; '-' = no shape named; Enter = leave it for later"
     print(
-        f"{len(waiting)} answer(s) to review, blind (the shape sent is not shown). Type {choices}."
+        f"{plural(len(waiting), 'answer')} to review, blind (the shape sent is not shown). "
+        f"Type {choices}."
     )
     decided = 0
     for number, trial_id in enumerate(waiting, start=1):

@@ -39,6 +39,8 @@ import pandas as pd
 import statsmodels.api as sm
 from statsmodels.genmod.bayes_mixed_glm import BinomialBayesMixedGLM
 
+from feelmysign.plural import plural
+
 FORMULA = "correct ~ C(shape, Treatment(reference=@reference)) + log2_strokes"
 # Each participant's own intercept (how well they do overall), one slope for everyone.
 NULL_FORMULA = "correct ~ log2_strokes + C(participant)"
@@ -142,7 +144,7 @@ def sign_flip_test(data: pd.DataFrame, *, seed: int = 0) -> ShapeTest:
     method = "sign-flip permutation test over participants"
     if participants < MIN_PARTICIPANTS:
         reason = (
-            f"{participants} participant(s): the test over participants needs at least "
+            f"{plural(participants, 'participant')}: the test over participants needs at least "
             f"{MIN_PARTICIPANTS}; with fewer, its smallest possible p is 2/2^n "
             f"= {2 / 2**participants:.3g}, so it could never show a difference"
         )

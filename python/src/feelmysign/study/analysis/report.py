@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from feelmysign.plural import plural
 from feelmysign.study.analysis.models import ShapeTest
-from feelmysign.study.analysis.psychometric import ABOVE, AT_OR_BELOW, Interval, Needed
+from feelmysign.study.analysis.psychometric import (
+    ABOVE,
+    AT_OR_BELOW,
+    SLOPE_BOUNDS,
+    Interval,
+    Needed,
+)
 from feelmysign.study.store import DISCARDED, StudyStore
 
 if TYPE_CHECKING:
@@ -38,13 +46,84 @@ def _p(value: float) -> str:
     return "p < 0.001" if value < 0.001 else f"p = {value:.3f}"
 
 
+def _not_estimable(participants: int, why: str) -> str:
+    return f"not estimable with {plural(participants, 'participant')} ({why})"
+
+
+def interval_notes(shape: str, needed: Needed) -> list[str]:
+    """Where an interval says more or other than the bound: why it is wide, or that the two
+    disagree (never a bound and an interval left side by side without a word)."""
+    notes = []
+    named = (
+        ("95% interval", needed.interval),
+        ("profile likelihood", needed.profile),
+        ("cluster bootstrap", needed.cluster),
+    )
+    for name, interval in named:
+        if needed.kind == AT_OR_BELOW and interval.high_open:
+            notes.append(
+                f"{shape}, {name}: reaches above the highest tested resolution although every "
+                "tested resolution reached the criterion: some resampled studies (or the "
+                "likelihood) allow curves that stay below it at the tested resolutions, because "
+                "the share correct there is close to the criterion with few answers. The bound "
+                f"≤ {needed.lowest_tested:g} is what these data show; the interval says how "
+                "uncertain that is."
+            )
+        elif needed.kind == AT_OR_BELOW and not interval.low_open:
+            notes.append(
+                f"{shape}, {name}: {interval_text(interval)} disagrees with the bound "
+                f"≤ {needed.lowest_tested:g}; the fitted curve and the counts differ, read the "
+                "accuracy table."
+            )
+        elif needed.kind == ABOVE and not interval.high_open:
+            notes.append(
+                f"{shape}, {name}: {interval_text(interval)} disagrees with the bound "
+                f"> {needed.highest_tested:g}; the fitted curve and the counts differ, read the "
+                "accuracy table."
+            )
+    return notes
+
+
+def _cluster_text(interval: Interval | None, participants: int) -> str:
+    """Resampling participants says nothing when there are too few to differ: with one every
+    sample is the same person, with two most are one person twice (a zero-width interval)."""
+    if interval is not None and participants >= 3:
+        return interval_text(interval)
+    return _not_estimable(participants, "resampling participants needs 3 or more")
+
+
+def _slope_text(slope: float) -> str:
+    """The fit's slope, or why there is none: at its upper bound the answers jump from wrong
+    to right between two tested resolutions (or never change), so no slope was measured."""
+    if not math.isfinite(slope) or slope >= SLOPE_BOUNDS[1] * 0.999:
+        return (
+            f"not estimable: at the fit's limit ({SLOPE_BOUNDS[1]:g}), the answers change "
+            "from wrong to right between two tested resolutions or not at all"
+        )
+    return f"{slope:.2f}"
+
+
+def _spread_text(spread: float, participants: int) -> str:
+    if participants < 2 or not math.isfinite(spread):
+        return _not_estimable(participants, "a spread between participants needs 2 or more")
+    return f"{spread:.2f}"
+
+
+def _dispersion_text(dispersion: float, participants: int) -> str:
+    if participants < 2 or not math.isfinite(dispersion):
+        return _not_estimable(
+            participants, "it compares participants' counts: 2 or more, and answers that vary"
+        )
+    return f"{dispersion:.2f}"
+
+
 def shape_test_sentence(test: ShapeTest) -> str:
     """What the shape test found, or why there is none: for the report and the terminal."""
     if test.refused is not None or test.p is None or test.statistic is None:
         return (
             f"No test of whether shapes differ is reported: {test.refused}. Run at least "
-            f"{test.participants_needed} participants (8 or more for the calibrated false-positive "
-            "rate in docs/research.md)."
+            f"{plural(test.participants_needed, 'participant')} (8 or more for the calibrated "
+            "false-positive rate in docs/research.md)."
         )
     return (
         f"Test that shapes differ at equal strokes: {test.method} ({test.participants} "
@@ -62,12 +141,14 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     lines = [
         f"# {design.name}",
         "",
-        f"{analysis.participants} participants ({analysis.simulated} simulated), "
+        f"{plural(analysis.participants, 'participant')} ({analysis.simulated} simulated), "
         f"{analysis.trials} measured trials: {len(design.shapes)} shapes x "
         f"{len(design.resolutions)} resolutions x {design.repetitions} repetitions, order by "
         f"{design.randomisation} (seed {design.seed}). Answers were free; they were coded to "
         f"shapes by synonyms, unclear ones by the researcher. "
-        f"{analysis.unclear} answer(s) still await review and are left out.",
+        f"{plural(analysis.unclear, 'answer')} still "
+        + ("awaits review and is" if analysis.unclear == 1 else "await review and are")
+        + " left out.",
         "",
         "## Accuracy by shape and resolution",
         "",
@@ -78,7 +159,9 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     for shape, rows in analysis.accuracy.items():
         cells = [
-            f"{k}/{n} = {k / n:.0%} [{low:.0%}, {high:.0%}] ({strokes} strokes)" if n else "-"
+            f"{k}/{n} = {k / n:.0%} [{low:.0%}, {high:.0%}] ({plural(strokes, 'stroke')})"
+            if n
+            else "-"
             for strokes, k, n, low, high in rows
         ]
         lines.append(f"| {shape} | " + " | ".join(cells) + " |")
@@ -107,13 +190,20 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "| slope per doubling | participants' SD | dispersion |",
         "|---|---|---|---|---|---|---|---|",
     ]
+    people = analysis.participants
     for shape, t in analysis.thresholds.items():
         needed = analysis.needed[shape]
         lines.append(
             f"| {shape} | {needed_text(needed)} | {interval_text(needed.interval)} | "
-            f"{interval_text(needed.profile)} | {interval_text(needed.cluster)} | "
-            f"{t.fit.slope:.2f} | {t.population.spread:.2f} | {t.dispersion:.2f} |"
+            f"{interval_text(needed.profile)} | {_cluster_text(needed.cluster, people)} | "
+            f"{_slope_text(t.fit.slope)} | {_spread_text(t.population.spread, people)} | "
+            f"{_dispersion_text(t.dispersion, people)} |"
         )
+    notes = [
+        n for shape in analysis.thresholds for n in interval_notes(shape, analysis.needed[shape])
+    ]
+    if notes:
+        lines += ["", *(f"- {n}" for n in notes)]
     lines += [
         "",
         "A number is given only where the tested resolutions bracket the criterion. "
@@ -140,7 +230,13 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
                 f"Mixed-effects model (participant random intercept; {model.note}; "
                 f"descriptive): reference shape {model.reference}; slope "
                 f"{model.slope_per_doubling:.2f} log odds per doubling of strokes; participant "
-                f"SD {model.participant_sd:.2f} log odds.",
+                + (
+                    f"SD {model.participant_sd:.2f} log odds."
+                    if analysis.participants >= 2
+                    else "SD "
+                    + _not_estimable(analysis.participants, "a spread needs 2 or more")
+                    + "."
+                ),
                 "",
                 "| shape | log odds vs " + model.reference + " | posterior SD |",
                 "|---|---|---|",
