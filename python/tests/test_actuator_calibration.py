@@ -99,6 +99,12 @@ def power_cycle(state: Path) -> None:
     os.replace(temporary, state)
 
 
+def log_file(folder: Path) -> Any:
+    """The sleeve's log, to read when a test fails: a pipe never read would fill with its
+    lines and block the sleeve before it could exit."""
+    return (folder / "sleeve.log").open("a")
+
+
 @pytest.fixture
 def watcher(broker: Broker) -> Any:
     with SleeveWatch(broker.credentials, "status", "events") as watching:
@@ -111,7 +117,7 @@ def test_a_sleeve_programs_its_motors_calibrates_once_and_restores_it_after_a_po
 ) -> None:
     state, layout = tmp_path / "bus.json", layout_file(tmp_path, kind)
     with reaped(
-        subprocess.Popen(command(broker, state, layout), stderr=subprocess.PIPE, text=True)
+        subprocess.Popen(command(broker, state, layout), stderr=log_file(tmp_path), text=True)
     ) as first:
         watcher.next(online, "the sleeve online")
         assert exit_code_after(first, signal.SIGTERM) == 0
@@ -130,7 +136,7 @@ def test_a_sleeve_programs_its_motors_calibrates_once_and_restores_it_after_a_po
     power_cycle(state)
     assert motor_registers(chips(state)["0x70/0"])["rated_voltage"] == 0x3E
     with reaped(
-        subprocess.Popen(command(broker, state, layout), stderr=subprocess.PIPE, text=True)
+        subprocess.Popen(command(broker, state, layout), stderr=log_file(tmp_path), text=True)
     ) as again:
         watcher.next(online, "the restarted sleeve online")
         assert exit_code_after(again, signal.SIGTERM) == 0
