@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING, Any
 from feelmysign import __version__
 from feelmysign.backends.base import Backend
 from feelmysign.backends.telemetry import ActuatorTelemetry
-from feelmysign.clock import monotonic_ms, wall_ms
+from feelmysign.clock import both_ms, wall_ms
 from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
 from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError
@@ -442,7 +442,7 @@ class Sleeve:
             )
 
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
-        received_at_ms, received_wall_ms = monotonic_ms(), wall_ms()
+        received_at_ms, received_wall_ms = both_ms()
         # The garbage collector can wait until the stroke's first motor command is out: a
         # collection that a message's allocations would set off in the middle of its
         # receipt runs when the handler returns instead (collecting is never skipped).
@@ -574,7 +574,7 @@ class Sleeve:
         drawings refused as ``cancelled`` by the wearer; a new drawing plays. Strokes of them
         refused ``paused`` during this pause (the first edge of a long press pauses) are told
         ``cancelled`` by the wearer too, so that the stop is what their sender hears last."""
-        now_wall_ms, now_ms = wall_ms(), monotonic_ms()
+        now_ms, now_wall_ms = both_ms()
         with self._arrivals_lock:
             recent = [
                 drawing
