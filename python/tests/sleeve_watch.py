@@ -93,9 +93,12 @@ def reaped(process: subprocess.Popen[str]) -> Iterator[subprocess.Popen[str]]:
 
 def exit_code_after(process: subprocess.Popen[str], sent: signal.Signals) -> int:
     """Send ``sent`` and wait for the process to end: its exit code, or minus the number of
-    the signal that ended it."""
+    the signal that ended it. Its piped output is read and dropped."""
     process.send_signal(sent)
-    return process.wait(WAIT_S)
+    # Reads what is left of a piped stderr while waiting: a process blocked writing to a
+    # full pipe would never end.
+    process.communicate(timeout=WAIT_S)
+    return process.returncode
 
 
 def online(name: str, body: dict[str, Any]) -> bool:

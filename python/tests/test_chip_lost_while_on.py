@@ -16,7 +16,7 @@ import subprocess
 from pathlib import Path
 
 from lost_chip import a_motor_on, excerpt, register_drive, set_connected, wait_until
-from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
+from sleeve_watch import WAIT_S, SleeveWatch, online, reaped
 
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
@@ -90,8 +90,9 @@ def test_a_chip_lost_while_its_motor_is_on_leaves_the_sleeve_up_and_is_switched_
                 lambda n, b: b.get("drawing") == "after" and b.get("type") == "played",
                 "the stroke on the chip that came back played",
             )
-            assert exit_code_after(sleeve, signal.SIGTERM) == 0
-            errors = sleeve.stderr.read() if sleeve.stderr else ""
+            sleeve.send_signal(signal.SIGTERM)
+            _, errors = sleeve.communicate(timeout=WAIT_S)
+            assert sleeve.returncode == 0, errors
     events = watcher.received("events")
     print("events:", [(e.get("type"), e.get("reason"), e.get("drawing")) for e in events])
     # The failed write is told (error "backend"); the player never stopped.

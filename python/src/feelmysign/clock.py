@@ -29,6 +29,7 @@ def both_ms() -> tuple[float, float]:
     more than 20 µs apart (at most a few times), so that the wall times of events placed
     on the monotonic clock line up with each other.
     """
+
     def read() -> tuple[int, float, float]:
         before = time.monotonic_ns()
         wall = time.time_ns()
