@@ -95,3 +95,14 @@ def broker(start_broker: StartBroker) -> Broker:
 @pytest.fixture
 def broker_credentials(broker: Broker) -> Credentials:
     return broker.credentials
+
+
+@pytest.fixture
+def capped_layout(tmp_path: Path) -> Path:
+    """A 3 x 4 layout whose safety cap (0.5) is below what a sender may ask for."""
+    layout = tmp_path / "capped.toml"
+    layout.write_text(
+        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\ndefault_intensity = 0.4\n"
+        "[safety]\nmax_intensity = 0.5\n"
+    )
+    return layout

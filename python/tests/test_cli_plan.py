@@ -230,13 +230,9 @@ def test_piped_strokes_off_the_grid_name_the_grid_they_were_made_for(tmp_path: P
 
 
 def test_the_table_shows_each_motor_as_driven_under_the_layouts_cap(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    capped_layout: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    layout = tmp_path / "capped.toml"
-    layout.write_text(
-        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\ndefault_intensity = 0.4\n"
-        "[safety]\nmax_intensity = 0.5\n"
-    )
+    layout = capped_layout
     for asked, driven in ((0.9, 0.5), (0.3, 0.3)):
         assert (
             main(["plan", "--layout", str(layout), "--intensity", str(asked), "0,0,3,0,600"]) == 0

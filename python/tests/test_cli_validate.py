@@ -179,13 +179,9 @@ def test_console_script_never_shows_a_traceback(payload: str) -> None:
 
 
 def test_an_intensity_above_the_layouts_cap_says_what_is_driven(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    capped_layout: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    layout = tmp_path / "capped.toml"
-    layout.write_text(
-        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\ndefault_intensity = 0.4\n"
-        "[safety]\nmax_intensity = 0.5\n"
-    )
+    layout = capped_layout
     stroke = '{"v": 1, "start": [0, 0], "end": [3, 0], "duration_ms": 600, "intensity": %s}'
     code, out, _ = run(capsys, "--layout", str(layout), stroke % "0.9")
     assert code == 0

@@ -2,10 +2,10 @@
 ``feelmysign send`` as its own process (its exit code as a shell sees it), and a client logged
 in as the sleeve that publishes its retained status and answers its strokes.
 
-The status carries ``controls`` exactly as docs/protocol.md writes it. The sleeve daemon of this
-branch does not publish it yet: the client here stands in for the sleeve's status until the
-sleeve's side of the wearer's controls publishes it itself. Nothing sent is shown with a marker:
-a stroke sent afterwards must be the first the sleeve receives.
+The status carries ``controls`` exactly as docs/protocol.md writes it. A client stands in for
+the sleeve so that each test can set any status, including ones a real sleeve would publish only
+after a button press or a restart (test_send_held_by_wearer.py runs the real sleeve). Nothing
+sent is shown with a marker: a stroke sent afterwards must be the first the sleeve receives.
 """
 
 from __future__ import annotations
