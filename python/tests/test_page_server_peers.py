@@ -449,3 +449,32 @@ def _client_hello(up: Up) -> bytes:
     with pytest.raises(ssl.SSLWantReadError):
         client.do_handshake()
     return outgoing.read()
+
+
+def test_plain_http_in_absolute_form_is_sent_to_this_server(tls_up: Up) -> None:
+    """A request line as sent to a proxy names a host: the redirect keeps only its path."""
+    answer = _exchange(
+        tls_up, b"GET http://elsewhere.example/a/b?c=1 HTTP/1.1\r\nHost: typed\r\n\r\n", tls=False
+    )
+    assert _status(answer) == 301, answer[:300]
+    location = f"location: https://{tls_up.host}:{tls_up.port}/a/b?c=1\r\n"
+    assert location.encode() in answer.lower(), answer[:300]
+
+
+@pytest.mark.parametrize(
+    ("path", "location"),
+    [
+        ("/%0d%0aSet-Cookie:%20x=1", "/%0D%0ASet-Cookie%3A%20x%3D1"),  # no header injected
+        ("//elsewhere.example/", "/elsewhere.example/"),  # not a page on another host
+        ("/%5celsewhere.example/", "/elsewhere.example/"),
+    ],
+)
+def test_the_key_url_leads_to_a_page_of_this_server(tls_up: Up, path: str, location: str) -> None:
+    log = tls_up.state_dir / "page-server.log"
+    before = log.read_text() if log.exists() else ""
+    answer = _request(tls_up, f"{path}?key={tls_up.key}")
+    assert _status(answer) == 303, answer[:300]
+    assert f"\r\nLocation: {location}\r\n".encode() in answer, answer[:300]
+    assert b"\r\nSet-Cookie: x" not in answer
+    after = log.read_text() if log.exists() else ""
+    assert "Traceback" not in after[len(before) :], after

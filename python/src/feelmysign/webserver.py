@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 from http.cookies import CookieError, SimpleCookie
 from pathlib import Path
 from typing import Any
-from urllib.parse import parse_qs
+from urllib.parse import parse_qs, quote
 
 import aiohttp
 from aiohttp import web
@@ -454,10 +454,12 @@ class WebServer:
 
     async def _redirect(self, request: web.BaseRequest) -> web.StreamResponse:
         """Plain HTTP on the TLS port: to the same path over HTTPS, at this server's name."""
+        # The target as a path: a request in absolute form (``GET http://name/x``, as sent to
+        # a proxy) would otherwise leave its scheme and name after this server's.
         return web.Response(
             status=301,
             headers={
-                "Location": f"https://{self.authority}{request.raw_path}",
+                "Location": f"https://{self.authority}{request.rel_url.raw_path_qs}",
                 "Cache-Control": "no-store",
                 "Connection": "close",
             },
@@ -541,7 +543,7 @@ class WebServer:
                 headers={
                     "Set-Cookie": f"{KEY_COOKIE}={self._access_key}; Secure; HttpOnly; "
                     "SameSite=Strict; Path=/",
-                    "Location": path or "/",
+                    "Location": _local_location(path),
                     "Cache-Control": "no-store",
                 },
             )
@@ -858,6 +860,13 @@ class _PageBytes:
         self._upstream.close()
         if not self._ending.ended.done():
             self._ending.ended.set_result(None)
+
+
+def _local_location(path: str) -> str:
+    """A ``Location`` on this server for the decoded ``path``: percent-encoded, so that no CR
+    or LF of the request reaches the header (aiohttp refuses to send one, a 500), and with
+    one leading slash, so that ``//name/`` (a page on another host) stays on this one."""
+    return "/" + quote(path.lstrip("/\\"), safe="/")
 
 
 def _parse_head(head: bytes) -> tuple[int, dict[str, str]]:
