@@ -478,3 +478,28 @@ def test_the_key_url_leads_to_a_page_of_this_server(tls_up: Up, path: str, locat
     assert b"\r\nSet-Cookie: x" not in answer
     after = log.read_text() if log.exists() else ""
     assert "Traceback" not in after[len(before) :], after
+
+
+def test_a_page_of_another_origin_cannot_use_the_keys_cookies(tls_up: Up) -> None:
+    """A browser sends this host's cookies with a request from any page, on any of its
+    ports; the relay and the wearer's API answer only this server's own pages."""
+    up = tls_up
+    wearer_key = next(up.state_dir.rglob("wearer-key")).read_text().strip()
+    own, foreign = f"Origin: https://{up.host}:{up.port}", "Origin: https://elsewhere.example"
+    websocket = (
+        "Upgrade: websocket",
+        "Connection: Upgrade",
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+        "Sec-WebSocket-Version: 13",
+        "Sec-WebSocket-Protocol: mqtt",
+        f"Cookie: feelmysign_key={up.key}",
+    )
+    for origin, status in ((foreign, 403), ("Origin: null", 403), (own, 101)):
+        with _connect(up) as sock:
+            head = f"GET /mqtt HTTP/1.1\r\nHost: {up.host}:{up.port}\r\n"
+            sock.sendall((head + "\r\n".join((*websocket, origin)) + "\r\n\r\n").encode())
+            assert _status(sock.recv(4096)) == status, origin
+    wearer = (f"Cookie: feelmysign_wearer_key={wearer_key}", "Content-Length: 0")
+    for origin, status in ((foreign, 403), (own, 200)):
+        answer = _request(up, "/api/wearer/resume", *wearer, origin, method="POST")
+        assert _status(answer) == status, answer[:300]

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 from http.cookies import CookieError, SimpleCookie
 from pathlib import Path
 from typing import Any
-from urllib.parse import parse_qs, quote
+from urllib.parse import parse_qs, quote, urlsplit
 
 import aiohttp
 from aiohttp import web
@@ -522,6 +522,10 @@ class WebServer:
             if refused is not None:
                 return refused
         if self._api is not None and path.startswith("/api/"):
+            if request.method not in ("GET", "HEAD"):
+                refused = self._foreign_origin(request)
+                if refused is not None:
+                    return refused
             return await self._call_api(request)
         if request.method == "POST":
             return _text(404, "Not Found")
@@ -558,6 +562,26 @@ class WebServer:
             return None
         return _text(403, "Forbidden: open the URL that 'feelmysign up' printed (it holds the key)")
 
+    def _foreign_origin(self, request: web.BaseRequest) -> web.StreamResponse | None:
+        """None to go on; else 403 for a browser's request made by a page of another origin.
+
+        A cookie goes with every request a browser makes to this host, whichever page makes
+        it, on any of the host's ports: a page served elsewhere on this machine (or by another
+        service on the same address) could otherwise pause the sleeve or unblock a sender
+        with the wearer's cookie, or speak MQTT through ``/mqtt`` with the sender's. Browsers
+        name the page's origin in ``Origin`` on such requests; a client that is not a browser
+        sends none, or (paho) this server's."""
+        origin = request.headers.get("Origin")
+        if origin is None or _origin_authority(origin) in self._allowed_hosts:
+            return None
+        self._log.debug("%s: refused a request from the origin %r", request.remote, origin[:80])
+        return _text(
+            403,
+            f"Forbidden: a page from {origin[:80]!r} may not use this server; open the URL "
+            "that 'feelmysign up' printed.",
+            cache="no-store",
+        )
+
     async def _wearer(self, request: web.BaseRequest) -> web.StreamResponse:
         """The wearer's page and API: only for a Host naming this server (else a page from
         anywhere could rebind its name to this machine and pause or unblock), and the API
@@ -593,6 +617,10 @@ class WebServer:
             cookie = SimpleCookie(request.headers.get("Cookie", ""))
         except CookieError:
             cookie = SimpleCookie()
+        if request.method not in ("GET", "HEAD"):
+            refused = self._foreign_origin(request)
+            if refused is not None:
+                return refused
         held = cookie[WEARER_COOKIE].value if WEARER_COOKIE in cookie else ""
         if not hmac.compare_digest(held.encode(), key.encode()):
             return web.json_response(
@@ -673,6 +701,9 @@ class WebServer:
         encoded again, and no task wakes per message (which cost about four times the CPU
         time of the byte relay before aiohttp, and a visible latency).
         """
+        refused = self._foreign_origin(request)
+        if refused is not None:
+            return refused
         offered = [p.strip() for p in request.headers.get("Sec-WebSocket-Protocol", "").split(",")]
         offered = [p for p in offered if p]
         if not web.WebSocketResponse(protocols=offered).can_prepare(request).ok:
@@ -860,6 +891,20 @@ class _PageBytes:
         self._upstream.close()
         if not self._ending.ended.done():
             self._ending.ended.set_result(None)
+
+
+def _origin_authority(origin: str) -> str:
+    """``host:port`` of an ``Origin`` header (lower case; the scheme's port when it names
+    none), as a ``Host`` header names it; "" for ``null`` or anything else."""
+    try:
+        parts = urlsplit(origin.strip())
+        port = parts.port or {"http": 80, "https": 443}.get(parts.scheme)
+    except ValueError:
+        return ""
+    host = parts.hostname
+    if not host or port is None:
+        return ""
+    return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
 
 
 def _local_location(path: str) -> str:
