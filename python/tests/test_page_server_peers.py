@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from lan import Lan, lan
 
-from feelmysign.webserver import MAX_CONNECTIONS
+from feelmysign.webserver import MAX_CONNECTIONS, NOTICE_LINES
 
 WAIT_S = 60.0
 IDLE_CONNECTIONS = 500
@@ -503,3 +503,21 @@ def test_a_page_of_another_origin_cannot_use_the_keys_cookies(tls_up: Up) -> Non
     for origin, status in ((foreign, 403), (own, 200)):
         answer = _request(up, "/api/wearer/resume", *wearer, origin, method="POST")
         assert _status(answer) == status, answer[:300]
+
+
+def test_devices_at_many_addresses_fill_no_terminal(tls_up: Up) -> None:
+    """One peer may have many addresses: the lines about certificates are few in all."""
+    mark = len(tls_up.lines)
+    for last in range(100, 100 + 3 * NOTICE_LINES):  # loopback's addresses reach this one too
+        raw = socket.create_connection(
+            (tls_up.host, tls_up.port), timeout=WAIT_S, source_address=(f"127.0.0.{last}", 0)
+        )
+        context = ssl.create_default_context()
+        context.check_hostname = False
+        with pytest.raises(ssl.SSLCertVerificationError):
+            context.wrap_socket(raw)
+        raw.close()
+    said = tls_up.output_since(mark).splitlines()
+    named = [line for line in said if line.startswith("A device at 127.0.0.")]
+    assert 1 <= len(named) <= NOTICE_LINES, said  # other tests' devices may have had a line
+    assert sum(line.startswith("More devices did not accept") for line in said) == 1, said

@@ -44,7 +44,7 @@ import ssl
 import sys
 import threading
 import time
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -90,6 +90,7 @@ MAX_HEADERS = 100
 RELAY_CONNECT_TIMEOUT_S = 5.0
 # A device's line in the terminal (e.g. it refused the certificate): at most this often.
 NOTICE_INTERVAL_S = 60.0
+NOTICE_LINES = 5  # of such lines in all per interval, whatever the number of devices
 DEBUG_LOG_BYTES = 1024 * 1024  # the debug log rotates at this size, one old file kept
 # TLS alerts by which a client says it does not trust the certificate.
 _CERTIFICATE_REFUSED = {
@@ -181,17 +182,32 @@ class _Connection:
 
 @dataclass
 class _Notices:
-    """A line in the terminal per device, at most once per ``NOTICE_INTERVAL_S``."""
+    """A line in the terminal per device, at most once per ``NOTICE_INTERVAL_S``, and at most
+    ``NOTICE_LINES`` lines in all per interval: a peer with many addresses (IPv6 gives a
+    device as many as it likes) would otherwise fill the terminal, a line per address. Past
+    that, one line says that more are held back (each is in the debug log)."""
 
     last_s: dict[str, float] = field(default_factory=dict)
+    said_s: deque[float] = field(default_factory=deque)
+    held_back: bool = False
 
-    def say(self, peer: str, line: str) -> None:
+    def say(self, peer: str, line: str, held_back: str) -> None:
         now = time.monotonic()
         if now - self.last_s.get(peer, -NOTICE_INTERVAL_S) < NOTICE_INTERVAL_S:
             return
         if len(self.last_s) > 1024:  # many devices: forget those not heard of for a while
             self.last_s = {p: t for p, t in self.last_s.items() if now - t < NOTICE_INTERVAL_S}
         self.last_s[peer] = now
+        while self.said_s and now - self.said_s[0] >= NOTICE_INTERVAL_S:
+            self.said_s.popleft()
+        if len(self.said_s) < NOTICE_LINES:
+            self.said_s.append(now)
+            self.held_back = False
+        elif self.held_back:
+            return
+        else:
+            self.held_back = True
+            line = held_back
         sys.stdout.write(line + "\n")
         sys.stdout.flush()
 
@@ -441,6 +457,8 @@ class WebServer:
                 connection.peer,
                 f"A device at {connection.peer} did not accept this machine's certificate: "
                 f"on it, open the printed URL and accept the certificate{fingerprint}.",
+                "More devices did not accept this machine's certificate; for a minute they are "
+                "not named here (each is in page-server.log).",
             )
 
     def _connection_of(self, request: web.BaseRequest) -> _Connection | None:
