@@ -521,3 +521,4 @@ def test_devices_at_many_addresses_fill_no_terminal(tls_up: Up) -> None:
     named = [line for line in said if line.startswith("A device at 127.0.0.")]
     assert 1 <= len(named) <= NOTICE_LINES, said  # other tests' devices may have had a line
     assert sum(line.startswith("More devices did not accept") for line in said) == 1, said
+
