@@ -522,3 +522,19 @@ def test_devices_at_many_addresses_fill_no_terminal(tls_up: Up) -> None:
     assert 1 <= len(named) <= NOTICE_LINES, said  # other tests' devices may have had a line
     assert sum(line.startswith("More devices did not accept") for line in said) == 1, said
 
+
+def test_a_websocket_of_another_subprotocol_is_a_bad_request(tls_up: Up) -> None:
+    """Not the broker's fault (502): the page asked for a protocol other than MQTT."""
+    up = tls_up
+    answer = _request(
+        up,
+        "/mqtt",
+        "Upgrade: websocket",
+        "Connection: Upgrade",
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+        "Sec-WebSocket-Version: 13",
+        "Sec-WebSocket-Protocol: chat, superchat",
+        f"Cookie: feelmysign_key={up.key}",
+    )
+    assert _status(answer) == 400, answer[:300]
+    assert b"subprotocol mqtt" in answer, answer[:300]

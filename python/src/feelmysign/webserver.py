@@ -89,6 +89,8 @@ MAX_LINE_BYTES = 8190
 MAX_FIELD_BYTES = 8190
 MAX_HEADERS = 100
 RELAY_CONNECT_TIMEOUT_S = 5.0
+# The WebSocket subprotocols of MQTT (3.1.1 and 5; 3.1): a page that offers others gets 400.
+MQTT_SUBPROTOCOLS = frozenset({"mqtt", "mqttv3.1"})
 # A device's line in the terminal (e.g. it refused the certificate): at most this often.
 NOTICE_INTERVAL_S = 60.0
 NOTICE_LINES = 5  # of such lines in all per interval, whatever the number of devices
@@ -742,6 +744,13 @@ class WebServer:
         offered = [p for p in offered if p]
         if not web.WebSocketResponse(protocols=offered).can_prepare(request).ok:
             return _text(400, "Bad Request: not a WebSocket handshake")
+        if offered and not set(offered) & MQTT_SUBPROTOCOLS:
+            # The broker would close the connection unanswered, which reads as its fault (502).
+            return _text(
+                400,
+                "Bad Request: /mqtt speaks the WebSocket subprotocol "
+                f"{' or '.join(sorted(MQTT_SUBPROTOCOLS))}, not {', '.join(offered)[:80]!r}",
+            )
         loop = asyncio.get_running_loop()
         page, port = request.transport, self._mqtt_ws_port
         assert port is not None  # _is_relay: only with the broker's WebSocket port
