@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from lan import Lan, lan
 
-from feelmysign.webserver import MAX_CONNECTIONS
+from feelmysign.webserver import MAX_CONNECTIONS, NOTICE_LINES
 
 WAIT_S = 60.0
 IDLE_CONNECTIONS = 500
@@ -449,3 +449,92 @@ def _client_hello(up: Up) -> bytes:
     with pytest.raises(ssl.SSLWantReadError):
         client.do_handshake()
     return outgoing.read()
+
+
+def test_plain_http_in_absolute_form_is_sent_to_this_server(tls_up: Up) -> None:
+    """A request line as sent to a proxy names a host: the redirect keeps only its path."""
+    answer = _exchange(
+        tls_up, b"GET http://elsewhere.example/a/b?c=1 HTTP/1.1\r\nHost: typed\r\n\r\n", tls=False
+    )
+    assert _status(answer) == 301, answer[:300]
+    location = f"location: https://{tls_up.host}:{tls_up.port}/a/b?c=1\r\n"
+    assert location.encode() in answer.lower(), answer[:300]
+
+
+@pytest.mark.parametrize(
+    ("path", "location"),
+    [
+        ("/%0d%0aSet-Cookie:%20x=1", "/%0D%0ASet-Cookie%3A%20x%3D1"),  # no header injected
+        ("//elsewhere.example/", "/elsewhere.example/"),  # not a page on another host
+        ("/%5celsewhere.example/", "/elsewhere.example/"),
+    ],
+)
+def test_the_key_url_leads_to_a_page_of_this_server(tls_up: Up, path: str, location: str) -> None:
+    log = tls_up.state_dir / "page-server.log"
+    before = log.read_text() if log.exists() else ""
+    answer = _request(tls_up, f"{path}?key={tls_up.key}")
+    assert _status(answer) == 303, answer[:300]
+    assert f"\r\nLocation: {location}\r\n".encode() in answer, answer[:300]
+    assert b"\r\nSet-Cookie: x" not in answer
+    after = log.read_text() if log.exists() else ""
+    assert "Traceback" not in after[len(before) :], after
+
+
+def test_a_page_of_another_origin_cannot_use_the_keys_cookies(tls_up: Up) -> None:
+    """A browser sends this host's cookies with a request from any page, on any of its
+    ports; the relay and the wearer's API answer only this server's own pages."""
+    up = tls_up
+    wearer_key = next(up.state_dir.rglob("wearer-key")).read_text().strip()
+    own, foreign = f"Origin: https://{up.host}:{up.port}", "Origin: https://elsewhere.example"
+    websocket = (
+        "Upgrade: websocket",
+        "Connection: Upgrade",
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+        "Sec-WebSocket-Version: 13",
+        "Sec-WebSocket-Protocol: mqtt",
+        f"Cookie: feelmysign_key={up.key}",
+    )
+    for origin, status in ((foreign, 403), ("Origin: null", 403), (own, 101)):
+        with _connect(up) as sock:
+            head = f"GET /mqtt HTTP/1.1\r\nHost: {up.host}:{up.port}\r\n"
+            sock.sendall((head + "\r\n".join((*websocket, origin)) + "\r\n\r\n").encode())
+            assert _status(sock.recv(4096)) == status, origin
+    wearer = (f"Cookie: feelmysign_wearer_key={wearer_key}", "Content-Length: 0")
+    for origin, status in ((foreign, 403), (own, 200)):
+        answer = _request(up, "/api/wearer/resume", *wearer, origin, method="POST")
+        assert _status(answer) == status, answer[:300]
+
+
+def test_devices_at_many_addresses_fill_no_terminal(tls_up: Up) -> None:
+    """One peer may have many addresses: the lines about certificates are few in all."""
+    mark = len(tls_up.lines)
+    for last in range(100, 100 + 3 * NOTICE_LINES):  # loopback's addresses reach this one too
+        raw = socket.create_connection(
+            (tls_up.host, tls_up.port), timeout=WAIT_S, source_address=(f"127.0.0.{last}", 0)
+        )
+        context = ssl.create_default_context()
+        context.check_hostname = False
+        with pytest.raises(ssl.SSLCertVerificationError):
+            context.wrap_socket(raw)
+        raw.close()
+    said = tls_up.output_since(mark).splitlines()
+    named = [line for line in said if line.startswith("A device at 127.0.0.")]
+    assert 1 <= len(named) <= NOTICE_LINES, said  # other tests' devices may have had a line
+    assert sum(line.startswith("More devices did not accept") for line in said) == 1, said
+
+
+def test_a_websocket_of_another_subprotocol_is_a_bad_request(tls_up: Up) -> None:
+    """Not the broker's fault (502): the page asked for a protocol other than MQTT."""
+    up = tls_up
+    answer = _request(
+        up,
+        "/mqtt",
+        "Upgrade: websocket",
+        "Connection: Upgrade",
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+        "Sec-WebSocket-Version: 13",
+        "Sec-WebSocket-Protocol: chat, superchat",
+        f"Cookie: feelmysign_key={up.key}",
+    )
+    assert _status(answer) == 400, answer[:300]
+    assert b"subprotocol mqtt" in answer, answer[:300]

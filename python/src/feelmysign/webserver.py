@@ -44,14 +44,14 @@ import ssl
 import sys
 import threading
 import time
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from http.cookies import CookieError, SimpleCookie
 from pathlib import Path
 from typing import Any
-from urllib.parse import parse_qs
+from urllib.parse import parse_qs, quote, urlsplit
 
 import aiohttp
 from aiohttp import web
@@ -83,13 +83,17 @@ TLS_HANDSHAKE_TIMEOUT_S = 10.0
 REQUEST_TIMEOUT_S = 60.0
 # Connections held at once; past it the one idle longest is closed (never a new one).
 MAX_CONNECTIONS = 512
+ACCEPT_BATCH = 256  # connections taken from the listening socket's queue per turn of the loop
 # aiohttp's parser limits: a request line or a header of at most 8 KiB, 100 headers.
 MAX_LINE_BYTES = 8190
 MAX_FIELD_BYTES = 8190
 MAX_HEADERS = 100
 RELAY_CONNECT_TIMEOUT_S = 5.0
+# The WebSocket subprotocols of MQTT (3.1.1 and 5; 3.1): a page that offers others gets 400.
+MQTT_SUBPROTOCOLS = frozenset({"mqtt", "mqttv3.1"})
 # A device's line in the terminal (e.g. it refused the certificate): at most this often.
 NOTICE_INTERVAL_S = 60.0
+NOTICE_LINES = 5  # of such lines in all per interval, whatever the number of devices
 DEBUG_LOG_BYTES = 1024 * 1024  # the debug log rotates at this size, one old file kept
 # TLS alerts by which a client says it does not trust the certificate.
 _CERTIFICATE_REFUSED = {
@@ -181,17 +185,32 @@ class _Connection:
 
 @dataclass
 class _Notices:
-    """A line in the terminal per device, at most once per ``NOTICE_INTERVAL_S``."""
+    """A line in the terminal per device, at most once per ``NOTICE_INTERVAL_S``, and at most
+    ``NOTICE_LINES`` lines in all per interval: a peer with many addresses (IPv6 gives a
+    device as many as it likes) would otherwise fill the terminal, a line per address. Past
+    that, one line says that more are held back (each is in the debug log)."""
 
     last_s: dict[str, float] = field(default_factory=dict)
+    said_s: deque[float] = field(default_factory=deque)
+    held_back: bool = False
 
-    def say(self, peer: str, line: str) -> None:
+    def say(self, peer: str, line: str, held_back: str) -> None:
         now = time.monotonic()
         if now - self.last_s.get(peer, -NOTICE_INTERVAL_S) < NOTICE_INTERVAL_S:
             return
         if len(self.last_s) > 1024:  # many devices: forget those not heard of for a while
             self.last_s = {p: t for p, t in self.last_s.items() if now - t < NOTICE_INTERVAL_S}
         self.last_s[peer] = now
+        while self.said_s and now - self.said_s[0] >= NOTICE_INTERVAL_S:
+            self.said_s.popleft()
+        if len(self.said_s) < NOTICE_LINES:
+            self.said_s.append(now)
+            self.held_back = False
+        elif self.held_back:
+            return
+        else:
+            self.held_back = True
+            line = held_back
         sys.stdout.write(line + "\n")
         sys.stdout.flush()
 
@@ -368,12 +387,27 @@ class WebServer:
                 self._log.debug("accept: %s", error)
                 await asyncio.sleep(0.1)
                 continue
-            self._make_room()
-            peer = (str(address[0]), int(address[1]))
-            connection = _Connection(sock, peer[0], peer[1], time.monotonic())
-            self._connections[peer] = connection
-            self._connections.move_to_end(peer)  # the address of one closed a moment ago
-            connection.opening = loop.create_task(self._open(connection, peer))
+            self._take(loop, sock, address)
+            # The rest of a burst at once: a turn of the loop for each connection waiting made
+            # a page load behind a thousand of them wait about a second.
+            for _ in range(ACCEPT_BATCH):
+                try:
+                    sock, address = self._sock.accept()
+                except (BlockingIOError, InterruptedError):
+                    break
+                except OSError as error:
+                    self._log.debug("accept: %s", error)
+                    break
+                sock.setblocking(False)
+                self._take(loop, sock, address)
+
+    def _take(self, loop: asyncio.AbstractEventLoop, sock: socket.socket, address: Any) -> None:
+        self._make_room()
+        peer = (str(address[0]), int(address[1]))
+        connection = _Connection(sock, peer[0], peer[1], time.monotonic())
+        self._connections[peer] = connection
+        self._connections.move_to_end(peer)  # the address of one closed a moment ago
+        connection.opening = loop.create_task(self._open(connection, peer))
 
     def _make_room(self) -> None:
         """Below the cap, by closing the connection idle longest (never refusing a new one)."""
@@ -441,6 +475,8 @@ class WebServer:
                 connection.peer,
                 f"A device at {connection.peer} did not accept this machine's certificate: "
                 f"on it, open the printed URL and accept the certificate{fingerprint}.",
+                "More devices did not accept this machine's certificate; for a minute they are "
+                "not named here (each is in page-server.log).",
             )
 
     def _connection_of(self, request: web.BaseRequest) -> _Connection | None:
@@ -454,10 +490,12 @@ class WebServer:
 
     async def _redirect(self, request: web.BaseRequest) -> web.StreamResponse:
         """Plain HTTP on the TLS port: to the same path over HTTPS, at this server's name."""
+        # The target as a path: a request in absolute form (``GET http://name/x``, as sent to
+        # a proxy) would otherwise leave its scheme and name after this server's.
         return web.Response(
             status=301,
             headers={
-                "Location": f"https://{self.authority}{request.raw_path}",
+                "Location": f"https://{self.authority}{request.rel_url.raw_path_qs}",
                 "Cache-Control": "no-store",
                 "Connection": "close",
             },
@@ -520,6 +558,10 @@ class WebServer:
             if refused is not None:
                 return refused
         if self._api is not None and path.startswith("/api/"):
+            if request.method not in ("GET", "HEAD"):
+                refused = self._foreign_origin(request)
+                if refused is not None:
+                    return refused
             return await self._call_api(request)
         if request.method == "POST":
             return _text(404, "Not Found")
@@ -541,7 +583,7 @@ class WebServer:
                 headers={
                     "Set-Cookie": f"{KEY_COOKIE}={self._access_key}; Secure; HttpOnly; "
                     "SameSite=Strict; Path=/",
-                    "Location": path or "/",
+                    "Location": _local_location(path),
                     "Cache-Control": "no-store",
                 },
             )
@@ -555,6 +597,26 @@ class WebServer:
         if hmac.compare_digest(held.encode(), self._access_key.encode()):
             return None
         return _text(403, "Forbidden: open the URL that 'feelmysign up' printed (it holds the key)")
+
+    def _foreign_origin(self, request: web.BaseRequest) -> web.StreamResponse | None:
+        """None to go on; else 403 for a browser's request made by a page of another origin.
+
+        A cookie goes with every request a browser makes to this host, whichever page makes
+        it, on any of the host's ports: a page served elsewhere on this machine (or by another
+        service on the same address) could otherwise pause the sleeve or unblock a sender
+        with the wearer's cookie, or speak MQTT through ``/mqtt`` with the sender's. Browsers
+        name the page's origin in ``Origin`` on such requests; a client that is not a browser
+        sends none, or (paho) this server's."""
+        origin = request.headers.get("Origin")
+        if origin is None or _origin_authority(origin) in self._allowed_hosts:
+            return None
+        self._log.debug("%s: refused a request from the origin %r", request.remote, origin[:80])
+        return _text(
+            403,
+            f"Forbidden: a page from {origin[:80]!r} may not use this server; open the URL "
+            "that 'feelmysign up' printed.",
+            cache="no-store",
+        )
 
     async def _wearer(self, request: web.BaseRequest) -> web.StreamResponse:
         """The wearer's page and API: only for a Host naming this server (else a page from
@@ -591,6 +653,10 @@ class WebServer:
             cookie = SimpleCookie(request.headers.get("Cookie", ""))
         except CookieError:
             cookie = SimpleCookie()
+        if request.method not in ("GET", "HEAD"):
+            refused = self._foreign_origin(request)
+            if refused is not None:
+                return refused
         held = cookie[WEARER_COOKIE].value if WEARER_COOKIE in cookie else ""
         if not hmac.compare_digest(held.encode(), key.encode()):
             return web.json_response(
@@ -671,10 +737,20 @@ class WebServer:
         encoded again, and no task wakes per message (which cost about four times the CPU
         time of the byte relay before aiohttp, and a visible latency).
         """
+        refused = self._foreign_origin(request)
+        if refused is not None:
+            return refused
         offered = [p.strip() for p in request.headers.get("Sec-WebSocket-Protocol", "").split(",")]
         offered = [p for p in offered if p]
         if not web.WebSocketResponse(protocols=offered).can_prepare(request).ok:
             return _text(400, "Bad Request: not a WebSocket handshake")
+        if offered and not set(offered) & MQTT_SUBPROTOCOLS:
+            # The broker would close the connection unanswered, which reads as its fault (502).
+            return _text(
+                400,
+                "Bad Request: /mqtt speaks the WebSocket subprotocol "
+                f"{' or '.join(sorted(MQTT_SUBPROTOCOLS))}, not {', '.join(offered)[:80]!r}",
+            )
         loop = asyncio.get_running_loop()
         page, port = request.transport, self._mqtt_ws_port
         assert port is not None  # _is_relay: only with the broker's WebSocket port
@@ -858,6 +934,27 @@ class _PageBytes:
         self._upstream.close()
         if not self._ending.ended.done():
             self._ending.ended.set_result(None)
+
+
+def _origin_authority(origin: str) -> str:
+    """``host:port`` of an ``Origin`` header (lower case; the scheme's port when it names
+    none), as a ``Host`` header names it; "" for ``null`` or anything else."""
+    try:
+        parts = urlsplit(origin.strip())
+        port = parts.port or {"http": 80, "https": 443}.get(parts.scheme)
+    except ValueError:
+        return ""
+    host = parts.hostname
+    if not host or port is None:
+        return ""
+    return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
+
+
+def _local_location(path: str) -> str:
+    """A ``Location`` on this server for the decoded ``path``: percent-encoded, so that no CR
+    or LF of the request reaches the header (aiohttp refuses to send one, a 500), and with
+    one leading slash, so that ``//name/`` (a page on another host) stays on this one."""
+    return "/" + quote(path.lstrip("/\\"), safe="/")
 
 
 def _parse_head(head: bytes) -> tuple[int, dict[str, str]]:

@@ -39,8 +39,9 @@ def register(subparsers: Subcommands) -> None:
         help="start the broker, a sleeve and the drawing client, all on this machine",
         description=(
             "Start Mosquitto with generated credentials, a sleeve (simulated, or the real one "
-            "on a Raspberry Pi), and serve the drawing client on http://127.0.0.1:PORT with the "
-            "broker's address and the sender's login built in. Ctrl-C stops everything."
+            "on a Raspberry Pi), and serve the drawing client on http://127.0.0.1:PORT (with "
+            "--lan or --host: https://ADDRESS:PORT) with the broker's address and the sender's "
+            "login built in. Ctrl-C stops everything."
         ),
     )
     parser.add_argument(
