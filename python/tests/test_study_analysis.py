@@ -117,8 +117,9 @@ def test_counts_of_one_are_singular_in_the_report_and_the_design_check(tmp_path:
     assert "nan" not in report.replace("Nan", "")
     assert "| 40.00 |" not in report
     assert "resampling participants needs 3 or more" in report
-    # A bound with a wider interval says why; the pilot's square is at ceiling (≤ 4).
-    assert "- square, 95% interval: reaches above the highest tested resolution" in report
+    # A bound with a wider interval says why; the pilot's square is at ceiling (≤ 4), and
+    # two answers per resolution leave the likelihood room for a curve below the criterion.
+    assert "- square, profile likelihood: reaches above the highest tested resolution" in report
     bad = PILOT_DESIGN.replace("segments = [3, 6]", "segments = [3, 7]")
     with pytest.raises(DesignError) as caught:
         parse_design(bad, source="pilot.toml")

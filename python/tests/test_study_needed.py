@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 from study_helpers import pilot_study
 
 from feelmysign.study.analysis import analyse_study
@@ -16,6 +17,9 @@ from feelmysign.study.analysis.psychometric import (
     ESTIMATE,
     LAPSE,
     Fit,
+    Interval,
+    Needed,
+    bias_corrected_interval,
     threshold_with_interval,
     truncated,
     within_tested,
@@ -83,3 +87,63 @@ def test_a_pilot_reports_every_needed_resolution_within_what_it_tested(tmp_path:
             assert lowest <= needed[f"{prefix}low"] <= needed[f"{prefix}high"] <= highest, shape
     report = (tmp_path / "out" / "report.md").read_text()
     assert "e+" not in report  # no astronomically large number anywhere
+
+
+def _reaches_its_estimate(needed: Needed, interval: Interval) -> bool:
+    """A bound's interval reaches the bound's side; an estimate's holds the estimate."""
+    if needed.kind == AT_OR_BELOW:
+        return interval.low_open
+    if needed.kind == ABOVE:
+        return interval.high_open
+    assert needed.strokes is not None
+    return (interval.low_open or interval.low <= needed.strokes) and (
+        interval.high_open or needed.strokes <= interval.high
+    )
+
+
+def test_a_shape_named_every_time_gets_a_bound_and_an_interval_that_stays_there(
+    tmp_path: Path,
+) -> None:
+    # Two simulated participants (seed 1) name every triangle of the pilot, at 3 and at 6
+    # strokes: the data say 3 strokes are enough. The reported interval was built from
+    # bootstrap values relative to the needed resolutions of curves extrapolated far below
+    # the range, around the fit's own extrapolated value (0.78 strokes), and read
+    # "<= 3 - >= 6": a bound below the range with an interval reaching above it. Censored
+    # at the range as the estimate is, it stays at the bound.
+    store = pilot_study(tmp_path)
+    dry_run(store, 2, seed=1)
+    analysis = analyse_study(store, tmp_path / "out")
+    assert all(k == n > 0 for _, k, n, _, _ in analysis.accuracy["triangle"])
+    needed = analysis.needed["triangle"]
+    assert needed.kind == AT_OR_BELOW
+    for interval in (needed.interval, needed.profile, needed.cluster):
+        assert interval.low_open and not interval.high_open, interval
+        assert interval.high < 6.0
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "disagrees" not in report
+
+
+@pytest.mark.parametrize(("wearer", "seed"), [("template", 1), ("template", 7), ("in-range", 2)])
+def test_every_interval_reaches_its_own_estimate_or_bound(
+    tmp_path: Path, wearer: str, seed: int
+) -> None:
+    # Two participants: estimates land beyond the range's ends, bootstrap values pile up at
+    # the fit's bounds, and the bias correction is at its most extreme. Template seed 7: the
+    # circle's shares all reach the criterion while its curve crosses inside the range.
+    store = pilot_study(tmp_path)
+    dry_run(store, 2, seed=seed, wearer=wearer)
+    analysis = analyse_study(store, tmp_path / "out", samples=200)
+    for shape, needed in analysis.needed.items():
+        for interval in (needed.interval, needed.profile, needed.cluster):
+            assert _reaches_its_estimate(needed, interval), (shape, needed)
+
+
+def test_the_bias_corrected_interval_holds_its_estimate_when_the_values_lie_to_one_side() -> None:
+    # Every bootstrap value above the estimate (a fit at its bound, values a grid step away):
+    # uncorrected for that, both percentiles moved to the far tail, away from the estimate.
+    values = np.concatenate([np.full(990, 3.1), np.geomspace(20.0, 1e6, 10)])
+    low, high = bias_corrected_interval(values, 3.0)
+    assert low <= 3.0 <= high
+    assert high < 20.0  # not the outliers' tail
+    low, high = bias_corrected_interval(-values, -3.0)  # and mirrored
+    assert low <= -3.0 <= high and low > -20.0

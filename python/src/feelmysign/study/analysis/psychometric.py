@@ -443,13 +443,27 @@ def threshold_with_interval(
     parametric = fit_many(
         x, drawn.astype(float), np.tile(n_used, (samples, 1)), guess=guess, lapse=lapse
     )
+    # Every needed resolution, the estimate's and the bootstrap's, is censored at the tested
+    # range's ends before the interval is read off: beyond them the curve's shape is a guess
+    # (a fit pinned at the midpoint's bound, a flat curve whose 75% lies at millions of
+    # strokes), and the report gives such an estimate only as a bound. Uncensored, an
+    # estimate far below the range sat beyond nearly all of its bootstrap values, and the
+    # bias correction then moved both percentiles into the far tail of the other side: an
+    # estimate "<= 3" with an interval wholly ">= 12".
+    tested = (float(x[0]), float(x[-1]))
+    censored = float(censor(estimate, tested))
     values = np.array([f.strokes_at(criterion) for f in parametric])
     world = np.array([p.strokes_at(criterion) for p in populations])[picks]
-    if np.all(np.isfinite(world)) and math.isfinite(estimate):
+    if np.all(np.isfinite(world)) and tested[0] < estimate < tested[1]:
+        # The pivot (each bootstrap value relative to the needed resolution of the population
+        # it was drawn from) holds only where the estimate is a measured value; at a bound
+        # the drawn values themselves, censored as the estimate is, say what the data allow.
         boot_low, boot_high = bias_corrected_interval(values / world, 1.0)
-        boot_low, boot_high = boot_low * estimate, boot_high * estimate
-    else:  # a curve that never reaches the criterion: its interval as drawn
-        boot_low, boot_high = bias_corrected_interval(values, estimate)
+        boot_low, boot_high = censor_interval(
+            boot_low * estimate, boot_high * estimate, estimate, tested
+        )
+    else:
+        boot_low, boot_high = bias_corrected_interval(censor(values, tested), censored)
     # Cluster: participants resampled with replacement. Levels without a trial in a resample
     # count as no data (0 of 0): the likelihood ignores them.
     picks = rng.integers(0, len(per_participant), (samples, len(per_participant)))
@@ -457,9 +471,13 @@ def threshold_with_interval(
         x, ks[picks].sum(axis=1)[:, used], ns[picks].sum(axis=1)[:, used], guess=guess, lapse=lapse
     )
     cluster_low, cluster_high = bias_corrected_interval(
-        np.array([f.strokes_at(criterion) for f in clustered]), estimate
+        censor(np.array([f.strokes_at(criterion) for f in clustered]), tested), censored
     )
-    low, high = profile_interval(x, k_used, n_used, criterion=criterion, guess=guess, lapse=lapse)
+    low, high = censor_interval(
+        *profile_interval(x, k_used, n_used, criterion=criterion, guess=guess, lapse=lapse),
+        estimate,
+        tested,
+    )
     return Threshold(
         best,
         estimate,
@@ -475,20 +493,40 @@ def threshold_with_interval(
     )
 
 
+def censor(values: NDArray[np.float64] | float, tested: tuple[float, float]) -> NDArray[np.float64]:
+    """Needed resolutions censored at the tested range: below it becomes the lowest tested
+    resolution ("at or below"), above it or never reached (inf) the highest ("at or above")."""
+    return np.asarray(np.clip(np.asarray(values, dtype=float), *tested), dtype=float)
+
+
+def censor_interval(
+    low: float, high: float, estimate: float, tested: tuple[float, float]
+) -> tuple[float, float]:
+    """An interval censored as its estimate is, and reaching it (``bias_corrected_interval``)."""
+    at = float(censor(estimate, tested))
+    low, high = (float(v) for v in censor(np.array([low, high]), tested))
+    return min(low, at), max(high, at)
+
+
 def bias_corrected_interval(
     values: NDArray[np.float64], estimate: float, level: float = 0.95
 ) -> tuple[float, float]:
     """The bias-corrected percentile interval (Efron 1981): the percentiles shifted by how far
     the bootstrap distribution's median sits from the estimate. A skewed, biased statistic
-    such as a threshold on a log scale needs it; the plain percentile interval undercovers."""
+    such as a threshold on a log scale needs it; the plain percentile interval undercovers.
+
+    Where fewer than (1 - level) / 2 of the values lie on one side of the estimate, the
+    shift would carry both percentiles past the estimate into the other side's tail (the
+    interval would not hold its own estimate): the shift is then capped there, and the
+    interval always reaches the estimate."""
     if len(values) == 0:
         return math.nan, math.nan
     below = (np.sum(values < estimate) + 0.5 * np.sum(values == estimate)) / len(values)
-    z0 = float(norm.ppf(min(max(below, 1e-6), 1 - 1e-6)))
     z = float(norm.ppf(0.5 + level / 2))
+    z0 = min(max(float(norm.ppf(min(max(below, 1e-6), 1 - 1e-6))), -z), z)
     percentiles = 100 * norm.cdf([2 * z0 - z, 2 * z0 + z])
     low, high = np.percentile(values, percentiles)
-    return float(low), float(high)
+    return min(float(low), estimate), max(float(high), estimate)
 
 
 @dataclass(frozen=True)
@@ -519,10 +557,12 @@ ESTIMATE, AT_OR_BELOW, ABOVE = "estimate", "at_or_below_lowest_tested", "above_h
 
 
 def truncated(low: float, high: float, tested: tuple[float, float]) -> Interval:
-    """``low``-``high`` cut to the tested range; NaN (no interval) counts as open both ways."""
+    """``low``-``high`` cut to the tested range; NaN (no interval) counts as open both ways.
+    An end at the range's end is open: the intervals are censored there (``censor``), so
+    an end at the lowest tested resolution stands for "at or below" it."""
     lowest, highest = tested
-    low_open = not math.isfinite(low) or low < lowest
-    high_open = not math.isfinite(high) or high > highest
+    low_open = not math.isfinite(low) or low <= lowest
+    high_open = not math.isfinite(high) or high >= highest
     # An end beyond the range on the other side (an interval wholly below or above what
     # was tested) is put at the nearer end: the interval is then "<= lowest" or ">= highest".
     return Interval(
@@ -552,12 +592,21 @@ def within_tested(
         kind = ABOVE
     else:
         kind = ESTIMATE
+    # A bound's intervals reach the bound, as the estimate's reach the estimate: when the
+    # shares alone decide the bound (the curve crosses inside the range, every share on one
+    # side of the criterion), the interval is widened to the range's end the bound names.
+    low_end = lowest if kind == AT_OR_BELOW else math.inf
+    high_end = highest if kind == ABOVE else -math.inf
+
+    def reaching(low: float, high: float) -> Interval:
+        return truncated(min(low, low_end), max(high, high_end), tested)
+
     return Needed(
         kind,
         value if kind == ESTIMATE else None,
         lowest,
         highest,
-        truncated(threshold.boot_low, threshold.boot_high, tested),
-        truncated(threshold.low, threshold.high, tested),
-        truncated(threshold.cluster_low, threshold.cluster_high, tested),
+        reaching(threshold.boot_low, threshold.boot_high),
+        reaching(threshold.low, threshold.high),
+        reaching(threshold.cluster_low, threshold.cluster_high),
     )
