@@ -93,19 +93,34 @@ export async function drawWithMouse(
       await nextFrame(page);
     }
   } else {
-    for (let i = 1; i < points.length; i++) {
-      const [ax, ay] = points[i - 1]!;
-      const [bx, by] = points[i]!;
-      const startMs = performance.now();
-      for (let done = 0; done < 1;) {
-        done = Math.min(1, (performance.now() - startMs) / options.legMs);
-        await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
-        await nextFrame(page);
-      }
-    }
+    const legMs = options.legMs;
+    await moveByClock(page, points, () => legMs);
   }
   await options.beforeRelease?.();
   await page.mouse.up();
+}
+
+/**
+ * Moves the mouse along the polyline from its first point, each leg taking `legMs(from, to)`
+ * by the clock: each frame's step goes where the leg is at that time, so a loaded machine that
+ * gives frames slowly gets fewer, longer steps, and a path takes as long as on a quiet one.
+ */
+export async function moveByClock(
+  page: Page,
+  points: readonly (readonly [number, number])[],
+  legMs: (from: readonly [number, number], to: readonly [number, number]) => number,
+): Promise<void> {
+  for (let i = 1; i < points.length; i++) {
+    const [ax, ay] = points[i - 1]!;
+    const [bx, by] = points[i]!;
+    const durationMs = legMs([ax, ay], [bx, by]);
+    const startMs = performance.now();
+    for (let done = 0; done < 1;) {
+      done = Math.min(1, (performance.now() - startMs) / durationMs);
+      await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
+      await nextFrame(page);
+    }
+  }
 }
 
 /** Touch through the DevTools protocol: a real touchstart/touchmove/touchend sequence. */
