@@ -10,7 +10,7 @@ import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { FakeSleeve, REPO_DIR } from "./harness";
-import { drawingArea, nextFrame, screenshot, waitForData, walk } from "./page";
+import { drawingArea, moveByClock, nextFrame, screenshot, waitForData } from "./page";
 import { DESKTOP, Processes } from "./processes";
 
 const STATUS_ONLINE = { online: true, layout: { rows: 3, columns: 4, spacing_cm: 3.0 }, version: "test" };
@@ -20,6 +20,9 @@ const SENT_RGB = [0xff, 0x8a, 0x5b] as const;
 const REFUSED_RGB = [0xff, 0x6b, 0x6b] as const;
 /** The comparison's dashed line (canvas.ts COLORS.compare). */
 const COMPARE_RGB = [0x5e, 0xc8, 0xff] as const;
+
+/** How fast the hand moves: 8 px a frame at 60 frames a second. */
+const HAND_PX_PER_MS = (8 * 60) / 1000;
 
 type Point = readonly [number, number];
 type Rgb = readonly [number, number, number];
@@ -61,12 +64,14 @@ describe("the drawing area's marks", () => {
     await nextFrame(page);
   }
 
-  /** Moves along the polyline from its first point, a step a frame. */
+  /**
+   * Moves along the polyline from its first point as a quiet machine did a step of 8 px a frame
+   * (60 a second), but by the clock: a loaded machine, giving frames slowly, gets fewer and
+   * longer steps, and a path lasts as long (a stroke as many of the latency cap's 200 ms), where
+   * 8 px a frame took minutes.
+   */
   async function moveAlong(points: readonly Point[]): Promise<void> {
-    for (const [x, y] of walk(points, 8)) {
-      await page.mouse.move(x, y);
-      await nextFrame(page);
-    }
+    await moveByClock(page, points, ([ax, ay], [bx, by]) => Math.hypot(bx - ax, by - ay) / HAND_PX_PER_MS);
   }
 
   async function draw(points: readonly Point[]): Promise<void> {

@@ -26,11 +26,23 @@ interface RecordLine {
   seq: number | null;
 }
 
+/** The sleeve's record's lines written so far (a last line still being written is left out). */
 function readRecord(path: string): RecordLine[] {
-  return readFileSync(path, "utf8")
-    .split("\n")
+  const lines = readFileSync(path, "utf8").split("\n");
+  return lines
+    .slice(0, -1)
     .filter((line) => line.trim() !== "")
     .map((line) => JSON.parse(line) as RecordLine);
+}
+
+/** How many motors are on after `record`'s last line. */
+function motorsOn(record: readonly RecordLine[]): number {
+  const on = new Set<string>();
+  for (const line of record) {
+    if (line.intensity > 0) on.add(`${line.row},${line.column}`);
+    else on.delete(`${line.row},${line.column}`);
+  }
+  return on.size;
 }
 
 async function drawingId(page: Page): Promise<string> {
@@ -114,14 +126,29 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
       watcher.of(drawing, "played").some((e) => e["seq"] === last),
     );
     await page.keyboard.press("Escape");
+    // Every stroke sent with its fate, and every motor off again in the sleeve's record: the
+    // sleeve tells one cancelled stroke after another and writes its record as the motors
+    // change, so a fixed 300 ms after the first cancel could read either before its end on a
+    // loaded machine.
+    const sent = Number(await dataOf(page, "played-summary", "sent"));
+    const fates = new Set(["played", "adjusted", "cancelled", "rejected"]);
     const events = await watcher.waitFor(
       "every stroke of the drawing played or cancelled",
-      () => watcher.of(drawing, "cancelled").length >= 1,
+      () =>
+        watcher.of(drawing, "cancelled").length >= 1 &&
+        new Set(
+          watcher
+            .of(drawing)
+            .filter((e) => fates.has(e["type"] as string))
+            .map((e) => e["seq"]),
+        ).size >= sent,
     );
-    await new Promise((wake) => setTimeout(wake, 300));
     const cancelled = watcher.of(drawing, "cancelled");
     const cut = cancelled.find((e) => e["started"] === true);
     expect(cut, JSON.stringify(events.slice(-6))).toBeDefined();
+    await expect
+      .poll(() => motorsOn(readRecord(recordPath)), { timeout: 30_000, message: "motors on in the record" })
+      .toBe(0);
     const record = readRecord(recordPath).slice(before);
     // The record's clock starts at the sleeve's start. The drawing's first stroke played ties it
     // to the sleeve's wall clock: it starts from every motor off (the sleeve was idle), so its

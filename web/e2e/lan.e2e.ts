@@ -165,8 +165,10 @@ describe("a phone and a sleeve on the LAN, over TLS", () => {
     await page.locator('[data-testid="setting-sleeve_id"]').fill(SLEEVE_ID);
     await page.locator('[data-testid="settings-save"]').click();
     await waitForData(page, '[data-testid="sleeve-status"]', "state", "online", 30_000);
-    const { sent } = await drawSquare(page);
-    await waitForData(page, '[data-testid="played-summary"]', "played", String(sent), 30_000);
+    // Each side 400 ms by the clock: only its strokes being played matters here, and a step a
+    // frame (hundreds of round trips to the browser) took a minute on a loaded machine.
+    const { sent } = await drawSquare(page, { legMs: 400 });
+    await waitForData(page, '[data-testid="played-summary"]', "played", String(sent), 60_000);
     await screenshot(page, "lan-played");
   });
 });

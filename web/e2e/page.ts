@@ -93,34 +93,60 @@ export async function drawWithMouse(
       await nextFrame(page);
     }
   } else {
-    for (let i = 1; i < points.length; i++) {
-      const [ax, ay] = points[i - 1]!;
-      const [bx, by] = points[i]!;
-      const startMs = performance.now();
-      for (let done = 0; done < 1;) {
-        done = Math.min(1, (performance.now() - startMs) / options.legMs);
-        await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
-        await nextFrame(page);
-      }
-    }
+    const legMs = options.legMs;
+    await moveByClock(page, points, () => legMs);
   }
   await options.beforeRelease?.();
   await page.mouse.up();
 }
 
-/** Touch through the DevTools protocol: a real touchstart/touchmove/touchend sequence. */
+/**
+ * Moves the mouse along the polyline from its first point, each leg taking `legMs(from, to)`
+ * by the clock: each frame's step goes where the leg is at that time, so a loaded machine that
+ * gives frames slowly gets fewer, longer steps, and a path takes as long as on a quiet one.
+ */
+export async function moveByClock(
+  page: Page,
+  points: readonly (readonly [number, number])[],
+  legMs: (from: readonly [number, number], to: readonly [number, number]) => number,
+  move: (x: number, y: number) => Promise<unknown> = (x, y) => page.mouse.move(x, y),
+): Promise<void> {
+  for (let i = 1; i < points.length; i++) {
+    const [ax, ay] = points[i - 1]!;
+    const [bx, by] = points[i]!;
+    const durationMs = legMs([ax, ay], [bx, by]);
+    const startMs = performance.now();
+    for (let done = 0; done < 1;) {
+      done = Math.min(1, (performance.now() - startMs) / durationMs);
+      await move(ax + (bx - ax) * done, ay + (by - ay) * done);
+      await nextFrame(page);
+    }
+  }
+}
+
+/**
+ * Touch through the DevTools protocol: a real touchstart/touchmove/touchend sequence, a move a
+ * frame, `step` px apart, or with `{ legMs }` each leg taking that long by the clock (as
+ * drawWithMouse's legMs).
+ */
 export async function drawWithTouch(
   page: Page,
   cdp: CDPSession,
   points: readonly (readonly [number, number])[],
-  stepPx = 5,
+  step: number | { legMs: number } = 5,
 ): Promise<void> {
   const [x0, y0] = points[0]!;
+  const touch = (x: number, y: number) =>
+    cdp.send("Input.dispatchTouchEvent", { type: "touchMove", touchPoints: [{ x, y, id: 1 }] });
   await cdp.send("Input.dispatchTouchEvent", { type: "touchStart", touchPoints: [{ x: x0, y: y0, id: 1 }] });
   await nextFrame(page);
-  for (const [x, y] of walk(points, stepPx)) {
-    await cdp.send("Input.dispatchTouchEvent", { type: "touchMove", touchPoints: [{ x, y, id: 1 }] });
-    await nextFrame(page);
+  if (typeof step === "number") {
+    for (const [x, y] of walk(points, step)) {
+      await touch(x, y);
+      await nextFrame(page);
+    }
+  } else {
+    await moveByClock(page, points, () => step.legMs, touch);
   }
   await cdp.send("Input.dispatchTouchEvent", { type: "touchEnd", touchPoints: [] });
 }

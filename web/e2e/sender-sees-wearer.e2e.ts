@@ -201,6 +201,18 @@ describe("the sender sees the wearer's choice", () => {
   });
 
   it("says do not disturb ended at its time, not that the wearer resumed", async () => {
+    // Every state the notice takes from now, recorded by the page: the few seconds it is held
+    // are seen however late this test looks (on a loaded machine, a look after the publish and
+    // the log's line could come after those seconds had passed, and find it resumed already).
+    await page.evaluate((selector) => {
+      const notice = document.querySelector<HTMLElement>(selector)!;
+      const shared = window as unknown as { noticeStates: string[] };
+      shared.noticeStates = [];
+      new MutationObserver(() => shared.noticeStates.push(notice.dataset["state"] ?? "")).observe(notice, {
+        attributeFilter: ["data-state"],
+      });
+    }, NOTICE);
+    const resumedBefore = (await logText(page)).split("The wearer resumed the sleeve:").length;
     // Paused (the test before); the wearer resumes under a do not disturb that ends in a few seconds.
     const untilMs = Date.now() + 4000;
     await publishControls(sleeve, { ...NOT_PAUSED, ceiling: 0.6, do_not_disturb_until_ms: untilMs });
@@ -209,9 +221,11 @@ describe("the sender sees the wearer's choice", () => {
       (text) => document.querySelector('[data-testid="event-log"]')!.textContent!.includes(text),
       `The wearer resumed the sleeve, but asked not to be disturbed until ${until}: what you draw is still held here.`,
     );
-    await waitForData(page, NOTICE, "state", "held");
-    const resumedBefore = (await logText(page)).split("The wearer resumed the sleeve:").length;
-    // The page's own clock ends it; the sleeve's status saying so a moment later adds nothing.
+    // Held, then the page's own clock ends it; the sleeve's status saying so a moment later adds nothing.
+    await page.waitForFunction(() => {
+      const states = (window as unknown as { noticeStates: string[] }).noticeStates;
+      return states.includes("held") && states.indexOf("resumed", states.indexOf("held")) >= 0;
+    });
     await waitForData(page, NOTICE, "state", "resumed");
     const ended = `Do not disturb ended ${until.startsWith("tomorrow") ? until : `at ${until}`}`;
     expect(await page.locator('[data-testid="wearer-headline"]').innerText()).toBe(`${ended}.`);

@@ -17,6 +17,8 @@ const SECOND = "arm2";
 const PICKER = '[data-testid="sleeve-select"]';
 const CHIP = '[data-testid="sleeve-status"]';
 const LAYOUT = { rows: 3, columns: 4, spacing_cm: 3 };
+/** How long each leg of a drawn Z takes to draw, by the clock. */
+const LEG_MS = 400;
 /** Telemetry of every actuator of a 3 x 4 sleeve at full strength. */
 const ALL_ON = { rows: 3, columns: 4, intensities: [1, 1, 1].map(() => [1, 1, 1, 1]) };
 
@@ -34,11 +36,15 @@ async function waitForOption(page: Page, text: string): Promise<void> {
   );
 }
 
-/** A Z across the area: three strokes or more (a long leg may be cut by the latency cap). */
+/**
+ * A Z across the area: three strokes or more (a long leg may be cut by the latency cap). Each
+ * leg takes LEG_MS by the clock: a step of a few pixels a frame made a Z hundreds of round
+ * trips to the browser, which took minutes on a loaded machine.
+ */
 async function drawZ(page: Page): Promise<number> {
   const area = await drawingArea(page);
   const at = (fx: number, fy: number) => [area.left + area.width * fx, area.top + area.height * fy] as const;
-  await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.2, 0.8), at(0.8, 0.8)]);
+  await drawWithMouse(page, [at(0.2, 0.2), at(0.8, 0.2), at(0.2, 0.8), at(0.8, 0.8)], { legMs: LEG_MS });
   await nextFrame(page);
   return Number(await page.locator('[data-testid="played-summary"]').getAttribute("data-sent"));
 }

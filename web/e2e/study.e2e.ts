@@ -263,9 +263,16 @@ describe.skipIf(!hasStudy)("the study page against feelmysign up --study", () =>
   it("reviews unclear answers, then exports and analyses with plots and a report", async () => {
     await page.click('[data-testid="review-tab"]');
     await page.locator('[data-testid="review-list"], [data-testid="review-empty"]').first().waitFor();
-    while ((await page.locator('[data-testid="review-list"] li').count()) > 0) {
-      await page.locator('[data-testid="review-list"] li').first().getByText("no shape").click();
-      await page.waitForTimeout(100);
+    const answers = page.locator('[data-testid="review-list"] li');
+    while ((await answers.count()) > 0) {
+      const trial = await answers.first().getAttribute("data-trial");
+      await answers.first().getByText("no shape").click();
+      // Decided once: the list is shown again without it before the next is decided. A fixed
+      // 100 ms was not always enough on a loaded machine, and the same answer, still first,
+      // was decided twice.
+      await page
+        .locator(`[data-testid="review-list"] li[data-trial="${trial}"]`)
+        .waitFor({ state: "detached", timeout: 30_000 });
     }
     await page.click('[data-testid="results-tab"]');
     await page.click('[data-testid="analyse"]');

@@ -21,6 +21,13 @@ import { Processes } from "./processes";
 
 const BROKER = '[data-testid="broker-status"]';
 const PREVIEW = '[data-testid="sleeve-preview"]';
+/**
+ * How long the touch along the sleeve's top row takes, by the clock: so it is sent as the same
+ * strokes, lasting as long, however slowly a loaded machine gives frames. Drawn a step a frame,
+ * the same touch took many times as long there, cut by the 200 ms latency cap into many short
+ * strokes for the sleeve to keep up with, while the test's look at the glow waits 30 s at most.
+ */
+const ROW_MS = 3000;
 
 /** The Mosquitto `up` runs, by parent process id: the one this test may kill. */
 function mosquittoOf(up: ChildProcess): number {
@@ -93,7 +100,7 @@ describe("a phone against feelmysign up, its broker killed and started again", (
     const cdp = await page.context().newCDPSession(page);
     const at = (fx: number, fy: number) =>
       [area.left + area.width * fx, area.top + area.height * fy] as const;
-    await drawWithTouch(page, cdp, [at(0.98, 0.05), at(0.98, 0.95)]);
+    await drawWithTouch(page, cdp, [at(0.98, 0.05), at(0.98, 0.95)], { legMs: ROW_MS });
     await waitForPlayed(page);
     // Felt from the screen's top down: the glow reaches the preview's lower half.
     await page
@@ -154,7 +161,7 @@ describe("a phone against feelmysign up, its broker killed and started again", (
     const area = await drawingArea(page);
     const at = (fx: number, fy: number) =>
       [area.left + area.width * fx, area.top + area.height * fy] as const;
-    await drawWithTouch(page, cdp, [at(0.2, 0.2), at(0.8, 0.2), at(0.8, 0.8)]);
+    await drawWithTouch(page, cdp, [at(0.2, 0.2), at(0.8, 0.2), at(0.8, 0.8)], { legMs: 400 });
     await nextFrame(page);
     await waitForPlayed(page);
     expect(await page.locator(CANVAS).boundingBox()).toEqual(before);
