@@ -21,6 +21,18 @@ Span = tuple[float, float, float]  # start_ms, end_ms, intensity of one actuator
 Piece = tuple[float, float, float]  # start_ms, end_ms, intensity after merging
 Actuator = tuple[int, int]  # row, column
 
+# Spans are gathered per actuator under one int, ``row << ROW_SHIFT | column``: cheaper to
+# hash and compare than a (row, column) tuple, and sorted the same (a grid side is at
+# most 64, layout.MAX_GRID_SIDE).
+ROW_SHIFT = 16
+ROW_STEP = 1 << ROW_SHIFT  # the key of the actuator one row further, less this one's
+COLUMN_MASK = ROW_STEP - 1
+
+
+def actuator_key(row: int, column: int) -> int:
+    """The key ``commands_from_spans`` gathers one actuator's spans under."""
+    return row << ROW_SHIFT | column
+
 
 def merge_commands(commands: Iterable[Command], *, min_command_ms: float) -> tuple[Command, ...]:
     """One actuator, one intensity at a time.
@@ -30,26 +42,30 @@ def merge_commands(commands: Iterable[Command], *, min_command_ms: float) -> tup
     joins its neighbour with the energy-weighted intensity, so no command is
     shorter than the minimum unless the whole on-period is.
     """
-    by_actuator: dict[Actuator, list[Span]] = {}
+    by_actuator: dict[int, list[Span]] = {}
     for command in commands:
         if command.intensity > 0 and command.duration_ms > 0:
             span = (command.start_ms, command.end_ms, command.intensity)
-            by_actuator.setdefault((command.row, command.column), []).append(span)
+            key = actuator_key(command.row, command.column)
+            by_actuator.setdefault(key, []).append(span)
     return commands_from_spans(by_actuator, min_command_ms)
 
 
 def commands_from_spans(
-    by_actuator: dict[Actuator, list[Span]], min_command_ms: float
+    by_actuator: dict[int, list[Span]], min_command_ms: float
 ) -> tuple[Command, ...]:
-    """Each actuator's spans merged, as commands sorted by start, then row, then column."""
+    """Each actuator's spans (under its ``actuator_key``) merged, as commands sorted by
+    start, then row, then column."""
     commands: list[Command] = []
     append = commands.append
     sqrt = math.sqrt
     # Command(row, column, start, end - start, intensity), without the named tuple's
     # __new__ (a Python function): the same tuple, made in C.
     new = tuple.__new__
-    # Actuator by actuator in row, then column order (see the sort below).
-    for (row, column), spans in sorted(by_actuator.items()):
+    # Actuator by actuator in row, then column order (see the sort below): the keys' order.
+    for key in sorted(by_actuator):
+        spans = by_actuator[key]
+        row, column = key >> ROW_SHIFT, key & COLUMN_MASK
         count = len(spans)
         if count == 1:  # most actuators of a stroke render one burst: _energy_pieces inline
             start, end, intensity = spans[0]

@@ -51,7 +51,7 @@ from feelmysign.apparent_motion import (
 )
 from feelmysign.errors import StrokeError
 from feelmysign.layout import Layout
-from feelmysign.overlaps import Actuator, Span, commands_from_spans
+from feelmysign.overlaps import COLUMN_MASK, ROW_SHIFT, ROW_STEP, Span, commands_from_spans
 from feelmysign.protocol import playable
 from feelmysign.schedule import Adjustment, Burst, Command, Schedule
 from feelmysign.stroke import Point, Stroke
@@ -267,8 +267,8 @@ class Outline:
         """
         if self._schedule is not None:
             return tuple(c for c in self._schedule.commands if c.start_ms < before_ms)
-        early: set[Actuator] = set()
-        spans: dict[Actuator, list[Span]] = {}
+        early: set[int] = set()  # of the actuators these commands drive, by key
+        spans: dict[int, list[Span]] = {}
         starting = True  # still reading bursts that start before before_ms
         for burst in self._each_burst():
             if starting and not burst[3] < before_ms:
@@ -442,8 +442,21 @@ def _fractions(start: Point, end: Point, merge_distance: float) -> list[float]:
     if length <= ON_LINE_EPSILON:
         return [0.0]
     (x0, y0), (x1, y1) = start, end
-    crossings = _line_crossings(x0, x1)
-    crossings += _line_crossings(y0, y1)
+    # The fractions in (0, 1) where x, then y, goes through an integer: inline, with no call
+    # and no list comprehension's frame per axis.
+    crossings = []
+    step = x1 - x0
+    if abs(step) > ON_LINE_EPSILON:
+        low, high = (x0, x1) if x0 < x1 else (x1, x0)
+        for k in range(math.ceil(low - ON_LINE_EPSILON), math.floor(high + ON_LINE_EPSILON) + 1):
+            if 0.0 < (f := (k - x0) / step) < 1.0:
+                crossings.append(f)
+    step = y1 - y0
+    if abs(step) > ON_LINE_EPSILON:
+        low, high = (y0, y1) if y0 < y1 else (y1, y0)
+        for k in range(math.ceil(low - ON_LINE_EPSILON), math.floor(high + ON_LINE_EPSILON) + 1):
+            if 0.0 < (f := (k - y0) / step) < 1.0:
+                crossings.append(f)
     if not crossings:  # within one cell (most strokes of a drawing): what merging leaves
         return [0.0, 1.0]
     if len(crossings) > 1:
@@ -474,16 +487,6 @@ def _points(start: Point, end: Point, fractions: Iterable[float]) -> list[Point]
                 y = float(nearest)
             append((x, y))
     return points
-
-
-def _line_crossings(a: float, b: float) -> list[float]:
-    """Fractions in (0, 1) where the coordinate goes from a to b through an integer."""
-    step = b - a
-    if abs(step) <= ON_LINE_EPSILON:
-        return []
-    low, high = (a, b) if a < b else (b, a)
-    first, last = math.ceil(low - ON_LINE_EPSILON), math.floor(high + ON_LINE_EPSILON)
-    return [f for k in range(first, last + 1) if 0.0 < (f := (k - a) / step) < 1.0]
 
 
 def _merged_fractions(fractions: list[float], merge_fraction: float) -> list[float]:
@@ -532,32 +535,49 @@ def _bursts(
     (the named tuple's __new__ is Python).
     """
     t = duration_ms
-    latest_end = t + overrun_allowance_ms(t)
+    allowance_ms = OVERRUN_FRACTION * t  # overrun_allowance_ms, inline
+    latest_end = t + (allowance_ms if allowance_ms > OVERRUN_MIN_MS else OVERRUN_MIN_MS)
     last = len(fractions) - 1
-    points = _points(start, end, fractions)
     new = tuple.__new__
     bursts: list[Burst] = []
     append = bursts.append
-    for i in range(last):
+    (x0, y0), (x1, y1) = start, end
+    dx, dy = x1 - x0, y1 - y0
+    for i, f in enumerate(fractions):
+        # The point of the way at f, as _points makes it (made here: no list of points).
+        if f == 0.0:
+            x, y = start
+        elif f == 1.0:
+            x, y = end
+        else:
+            x, y = x0 + dx * f, y0 + dy * f
+            nearest = round(x)
+            if abs(x - nearest) <= ON_LINE_EPSILON:
+                x = float(nearest)
+            nearest = round(y)
+            if abs(y - nearest) <= ON_LINE_EPSILON:
+                y = float(nearest)
         onset_a, onset_b, length_a, length_b = timings[i]
         start_ms = onset_a * t + onset_b
-        length_ms = length_a * t + length_b
-        if start_ms + length_ms > latest_end:
-            length_ms = latest_end - start_ms
-        x, y = points[i]
-        append(new(Burst, (x, y, fractions[i] * t, start_ms, length_ms, intensity)))
-    # The model's last duration is T - S too, but evaluated as a T + b it would
-    # leave a float residue after the stroke's end.
-    (x, y), (onset_a, onset_b, _, _) = points[last], timings[last]
-    start_ms = onset_a * t + onset_b
-    append(new(Burst, (x, y, fractions[last] * t, start_ms, t - start_ms, intensity)))
+        if i < last:
+            length_ms = length_a * t + length_b
+            if start_ms + length_ms > latest_end:
+                length_ms = latest_end - start_ms
+        else:
+            # The model's last duration is T - S too, but evaluated as a T + b it would
+            # leave a float residue after the stroke's end.
+            length_ms = t - start_ms
+        append(new(Burst, (x, y, f * t, start_ms, length_ms, intensity)))
     return tuple(bursts)
 
 
-def _far_from(burst: RawBurst, actuators: Iterable[Actuator]) -> bool:
-    """Whether the burst lies two grid units or more from each actuator along some axis."""
+def _far_from(burst: RawBurst, actuators: Iterable[int]) -> bool:
+    """Whether the burst lies two grid units or more from each actuator (by its
+    ``overlaps.actuator_key``) along some axis."""
     x, y = burst[0], burst[1]
-    return all(abs(x - column) >= 2 or abs(y - row) >= 2 for row, column in actuators)
+    return all(
+        abs(x - (key & COLUMN_MASK)) >= 2 or abs(y - (key >> ROW_SHIFT)) >= 2 for key in actuators
+    )
 
 
 def render_point(burst: Burst, layout: Layout) -> list[Command]:
@@ -601,13 +621,15 @@ def _axis_weights(coordinate: float, count: int) -> list[tuple[int, float]]:
 
 def _spans_by_actuator(
     bursts: Iterable[RawBurst], intensity: float, layout: Layout
-) -> dict[Actuator, list[Span]]:
-    """The rendered commands of the bursts, in stroke order, per actuator; none empty."""
+) -> dict[int, list[Span]]:
+    """The rendered commands of the bursts, in stroke order, per actuator (by its
+    ``overlaps.actuator_key``); none empty."""
     if not intensity >= _LEAST_SAFE_INTENSITY:
         return _spans_by_actuator_checked(bursts, intensity, layout)
-    by_actuator: defaultdict[Actuator, list[Span]] = defaultdict(list)
+    by_actuator: defaultdict[int, list[Span]] = defaultdict(list)
     last_column, last_row = layout.columns - 1, layout.rows - 1
     sqrt, floor = math.sqrt, math.floor
+    below = ROW_STEP  # the key of the actuator below another, less that actuator's
     for x, y, _, span_start, length_ms, _ in bursts:
         if length_ms <= 0:
             continue
@@ -629,26 +651,25 @@ def _spans_by_actuator(
             if fy <= ON_LINE_EPSILON or fy >= _OFF_LINE:  # on an actuator
                 if fy > ON_LINE_EPSILON:
                     row += 1
-                by_actuator[(row, column)].append((span_start, span_end, intensity))
+                by_actuator[row << ROW_SHIFT | column].append((span_start, span_end, intensity))
             else:  # between two rows
-                by_actuator[(row, column)].append(
-                    (span_start, span_end, intensity * sqrt(1.0 - fy))
-                )
-                by_actuator[(row + 1, column)].append((span_start, span_end, intensity * sqrt(fy)))
+                key = row << ROW_SHIFT | column
+                by_actuator[key].append((span_start, span_end, intensity * sqrt(1.0 - fy)))
+                by_actuator[key + below].append((span_start, span_end, intensity * sqrt(fy)))
         elif fy <= ON_LINE_EPSILON or fy >= _OFF_LINE:  # on a row line, between two columns
             if fy > ON_LINE_EPSILON:
                 row += 1
-            by_actuator[(row, column)].append((span_start, span_end, intensity * sqrt(1.0 - fx)))
-            by_actuator[(row, column + 1)].append((span_start, span_end, intensity * sqrt(fx)))
+            key = row << ROW_SHIFT | column
+            by_actuator[key].append((span_start, span_end, intensity * sqrt(1.0 - fx)))
+            by_actuator[key + 1].append((span_start, span_end, intensity * sqrt(fx)))
         else:  # inside a cell: its four corners
             wx = 1.0 - fx
             wy = 1.0 - fy
-            by_actuator[(row, column)].append((span_start, span_end, intensity * sqrt(wx * wy)))
-            by_actuator[(row, column + 1)].append((span_start, span_end, intensity * sqrt(fx * wy)))
-            by_actuator[(row + 1, column)].append((span_start, span_end, intensity * sqrt(wx * fy)))
-            by_actuator[(row + 1, column + 1)].append(
-                (span_start, span_end, intensity * sqrt(fx * fy))
-            )
+            key = row << ROW_SHIFT | column
+            by_actuator[key].append((span_start, span_end, intensity * sqrt(wx * wy)))
+            by_actuator[key + 1].append((span_start, span_end, intensity * sqrt(fx * wy)))
+            by_actuator[key + below].append((span_start, span_end, intensity * sqrt(wx * fy)))
+            by_actuator[key + below + 1].append((span_start, span_end, intensity * sqrt(fx * fy)))
     return by_actuator
 
 
@@ -659,16 +680,16 @@ _LEAST_SAFE_INTENSITY = 1e-280
 
 def _spans_by_actuator_checked(
     bursts: Iterable[RawBurst], intensity: float, layout: Layout
-) -> dict[Actuator, list[Span]]:
+) -> dict[int, list[Span]]:
     """``_spans_by_actuator`` for a stroke so faint (or off) that a span may be 0: left out."""
-    by_actuator: dict[Actuator, list[Span]] = {}
+    by_actuator: dict[int, list[Span]] = {}
     for x, y, _, span_start, length_ms, _ in bursts:
         if length_ms <= 0:
             continue
         burst = Burst(x, y, 0.0, span_start, length_ms, intensity)
         for row, column, value in _funneled(burst, layout):
             if value > 0:
-                by_actuator.setdefault((row, column), []).append(
+                by_actuator.setdefault(row << ROW_SHIFT | column, []).append(
                     (span_start, span_start + length_ms, value)
                 )
     return by_actuator
