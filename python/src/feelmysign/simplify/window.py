@@ -339,6 +339,10 @@ class WindowCore:
         max_window = self.params.max_window
         rest_ms = self.params.rest_ms
         max_error_sq = self._max_error_sq
+        rest_sq = self._rest_sq
+        # _keeps_bound's first test, inlined for the common case (no bend rule): most samples
+        # pass it, and a call per sample costs more than the test.
+        reach_limit = self._reach_limit if self.params.max_bend <= 0.0 else -math.inf
         pending: list[tuple[Point, Sample]] = []  # a stack: the next sample to take is last
         while True:
             points, times, samples = self._points, self._times, self._samples
@@ -381,7 +385,19 @@ class WindowCore:
                 self._points = points = [vertex]
                 self._times = times = [times[cut]]
                 self._samples = samples = [samples[cut]]
-            if not self._keeps_bound(points, point, max_error_sq):
+            if len(points) > 1:
+                last = points[-1]
+                dx, dy = point[0] - last[0], point[1] - last[1]
+                reach = self._reach + math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK
+                if reach <= reach_limit:
+                    self._reach = reach
+                    keeps = True
+                else:
+                    keeps = self._keeps_bound(points, point, max_error_sq)
+            else:
+                self._reach = 0.0
+                keeps = True
+            if not keeps:
                 cut = self._feature(points, point)
                 out.append(self._finish(points[0], times[0], points[cut], times[cut]))
                 self._line = None
@@ -408,7 +424,7 @@ class WindowCore:
             if (
                 rest_ms > 0.0
                 and t_ms - times[0] >= rest_ms
-                and _distance_sq(points[-2], point) <= self._rest_sq
+                and _distance_sq(points[-2], point) <= rest_sq
                 and self._rests(points, times, point, sample, out)
             ):
                 pass
