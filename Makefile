@@ -227,6 +227,9 @@ check: web-test
 bench: $(WEB_STAMP)
 bench-prepare: web-build $(LASA_FRAMES)
 up: web-build
+# Tests of the sleeve's wearer page and of up serve the built client (web/dist): built before
+# pytest starts, not left to race the browser tests' lane, which builds it too.
+pytest: web-build
 clean: web-clean
 # ==== end of web ===========================================================================
 

@@ -4,7 +4,7 @@ Each stroke gets an intensity of its own, so the record (``--record``, every
 actuator change) shows which strokes were felt: a stroke is felt when every
 level its plan drives an actuator to (played alone) shows in the record.
 Strokes are sent one after the other at the pace they play (each once the
-previous one's last burst is over), as a person draws: the duty-cycle cap
+previous one's last burst is over on the sleeve), as a person draws: the duty-cycle cap
 must leave such use alone, and a stroke it does refuse must be reported as
 ``safety``/``duty_cycle``, never as ``played``.
 """
@@ -83,6 +83,24 @@ def _felt(record: Path, strokes: list[Stroke], layout: Layout) -> set[int]:
     }
 
 
+def _started_at_s(events: SleeveWatch, stroke: Stroke, sent_at_s: float) -> float:
+    """When the sleeve started ``stroke`` by the wall clock (its planned start), once its event
+    is in; ``sent_at_s`` for a stroke that did not play (nothing of it runs on)."""
+    found: list[dict[str, Any]] = []
+
+    def told() -> bool:
+        found[:] = [
+            e
+            for e in events.received("events")
+            if e.get("drawing") == stroke.drawing and e.get("seq") == stroke.seq
+        ]
+        return bool(found)
+
+    events.wait_until(told, f"an event about stroke {stroke.seq}", WAIT_S)
+    start_at_ms = found[0].get("start_at_ms")
+    return sent_at_s if start_at_ms is None else float(start_at_ms) / 1000
+
+
 def _play_paced(
     broker: Broker, tmp_path: Path, layout_file: Path, strokes: list[Stroke]
 ) -> tuple[list[dict[str, Any]], set[int]]:
@@ -105,9 +123,15 @@ def _play_paced(
     try:
         events.next(online, "the sleeve online")
         for stroke in strokes:
+            sent_at_s = time.time()
             events.send(stroke)
             last_burst_ms = max(c.end_ms for c in plan(stroke, layout).commands)
-            time.sleep(last_burst_ms / 1000 + MARGIN_S)
+            # Paced by when the sleeve started the stroke, not by when it was sent: a message
+            # held up on a busy machine would start late, and the next one, sent on time, would
+            # then arrive while its last bursts still run (their levels add) or even while it
+            # plays (it is played faster to catch up): neither plays as planned alone.
+            started_at_s = _started_at_s(events, stroke, sent_at_s)
+            time.sleep(max(0.0, started_at_s + last_burst_ms / 1000 + MARGIN_S - time.time()))
         events.wait_until(
             lambda: (
                 len([e for e in events.received("events") if e.get("drawing") == "felt"])
