@@ -93,6 +93,7 @@ LOG_DELAYED_MS = 1000.0
 # How often the journal looks for drawings that are over (services.drawing_log.QUIET_S).
 JOURNAL_CHECK_S = 0.25
 # Cancelled drawings remembered, so that their later strokes do not start them again.
+STOP_POLL_S = 0.5  # how soon a stop signal stops the sleeve, however it arrived
 NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disconnect
 # CONNACK reasons that retrying cannot fix: MQTT 5's "Bad user name or password" and
 # "Not authorized" (paho reports MQTT 3.1.1's return codes 4 and 5 as these).
@@ -290,7 +291,11 @@ class Sleeve:
             # What start-up made stays for the sleeve's life: kept out of the collector's
             # scans, so a full collection during a stroke's receipt is short.
             gc.freeze()
-            self._stopped.wait()
+            # Woken now and then, never blocked for good: a stop signal's Python handler runs
+            # only when the main thread runs bytecode, and one that reaches another thread
+            # (or whose wake-up is lost) would otherwise wait here for ever.
+            while not self._stopped.wait(STOP_POLL_S):
+                pass
             if self._fatal is not None:
                 raise self._fatal
         finally:
