@@ -11,9 +11,11 @@ Only a stroke's first command counts for latency, so each measured stroke is
 cancelled (the control message) once its ``played`` event is out, instead of
 being played to its end: the sleeve receives, checks and plans it as any other
 stroke, and its first command takes the same path; only the motors it would have
-driven later are switched off early. The next stroke is sent after the same
-pause as the baseline's (an idle sleeve, as an idle broker). The gaps between
-strokes of a drawing need real back-to-back play, so those strokes play out.
+driven later are switched off early. The next stroke is sent once the sleeve has
+reported it cancelled and a short settle has passed, as the baseline's next message
+once the last one is received and acknowledged and the same settle has passed (an
+idle sleeve, as an idle broker). The gaps between strokes of a drawing need real
+back-to-back play, so those strokes play out.
 """
 
 from __future__ import annotations
@@ -66,9 +68,13 @@ LENGTHS = (
     ("10 cm", LONG, 100, ()),
     ("30 cm", LONGEST, 100, WIDE_GRID),
 )
-# Between one stroke's end and the next publish, as between the baseline's messages: with
-# no pause every thread stays awake and latencies halve (see bare_latency_ms).
-PAUSE_S = 0.12
+# Every measured publish goes to an idle sleeve and broker: after what says the last one is
+# over (the stroke reported cancelled; the baseline's message received and acknowledged),
+# this long more, the same for both, so that the threads that handled it are asleep again.
+# Back to back they are not, and the figures move (a bare message: 8.7 ms p50 at once, 1.5 ms
+# 120 ms later, load average 7). Against 120 ms, in one sitting (200 of each, interleaved,
+# load average 11): bare p50 1.30 / 1.96 ms, 3 cm stroke p50 1.43 / 1.53 ms; no rise at 50.
+SETTLE_S = 0.05
 WARM_UP = 5  # strokes first, unmeasured: first-use costs are not latency
 # Strokes of the drawings played back to back (for the gaps between them and the lateness of
 # writes): these play out, so the longer ones are fewer.
@@ -149,12 +155,11 @@ def _client(
     return client
 
 
-def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = PAUSE_S) -> list[float]:
+def bare_latency_ms(c: Credentials, count: int = 100, settle_s: float = SETTLE_S) -> list[float]:
     """Publish -> receive on the same broker, sender to sleeve account, QoS 1.
 
-    Paced like the strokes measured against it (one, then a pause as long as a
-    short stroke): back to back, every thread stays awake and the figure halves,
-    which would flatter the baseline.
+    Paced like the strokes measured against it: each message once the one before
+    is received and acknowledged, and ``settle_s`` more (see SETTLE_S).
     """
     inbox = _Inbox()
     receiver = _client(c, "sleeve", inbox, strokes_topic(c.sleeve_id))
@@ -162,9 +167,10 @@ def bare_latency_ms(c: Credentials, count: int = 100, pause_s: float = PAUSE_S) 
     sent: list[float] = []
     for k in range(count):
         sent.append(time.time_ns() / 1e6)
-        sender.publish(strokes_topic(c.sleeve_id), b"bench", qos=1)
+        info = sender.publish(strokes_topic(c.sleeve_id), b"bench", qos=1)
         inbox.wait(k + 1)
-        time.sleep(pause_s)
+        info.wait_for_publish(10)  # the broker's PUBACK: it is done with this message
+        time.sleep(settle_s)
     received = inbox.wait(count)
     close(receiver, sender)
     return [r - s for (r, _), s in zip(received, sent, strict=True)]
@@ -192,7 +198,7 @@ def stroke_latencies(
     """One stroke at a time to an idle sleeve: publish time beside the sleeve's played event.
 
     Each stroke (a drawing of its own) is cancelled once its played event is out, i.e. after
-    its first command; the next is sent a pause later, once the sleeve reports it cancelled.
+    its first command; the next is sent once the sleeve reports it cancelled, SETTLE_S later.
     ``sender``: the connected client that publishes (closed here); else one over MQTT.
     """
     inbox = _Inbox()
@@ -212,11 +218,11 @@ def stroke_latencies(
             raise RuntimeError(f"expected a played event of {drawing}, got {event}")
         results.append((published_ms, event))
         sender.publish(control_topic(c.sleeve_id), format_control(Cancel(drawing)), qos=1)
-        time.sleep(PAUSE_S)
-        # Its motors are off once it is reported cancelled (mostly during the pause); a stroke
-        # that ended before the cancel came is not reported: wait no longer than its end.
+        # Its motors are off once it is reported cancelled; a stroke that ended before the
+        # cancel came is not reported: wait no longer than its end. Then the settle.
         end_ms = event.first_command_at_ms + event.duration_ms + 100.0
         inbox.wait_event(Cancelled, drawing, max(0.0, end_ms - time.time_ns() / 1e6) / 1000)
+        time.sleep(SETTLE_S)
     close(watcher, sender)
     return results
 

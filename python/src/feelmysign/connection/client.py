@@ -5,7 +5,9 @@ transport, TLS and protocol choices; ``probe_login`` asks whether a broker is re
 
 from __future__ import annotations
 
+import contextlib
 import random
+import socket
 import ssl
 import sys
 import time
@@ -83,10 +85,26 @@ def new_client(
         client.tls_set(ca_certs=settings.ca_file, cert_reqs=ssl.CERT_REQUIRED)
     if settings.username is not None:
         client.username_pw_set(settings.username, settings.password)
+    client.on_socket_open = send_at_once
     jitter_reconnects(client)
     if settings.fallbacks:
         _fail_over(client, settings)
     return client
+
+
+def send_at_once(client: mqtt.Client, userdata: object, sock: object) -> None:
+    """Every packet leaves when written (TCP_NODELAY, as the broker sends its own).
+
+    With Nagle's algorithm a small packet waits until the broker has acknowledged the one
+    before it, and the broker holds that acknowledgement up to 40 ms when it has nothing to
+    send back: a sleeve's ``cancelled`` event, written just after its PUBACK of the cancel,
+    reached the page 40 ms late. paho calls this as each connection's socket opens; under
+    a WebSocket its wrapper holds the socket.
+    """
+    tcp: Any = getattr(sock, "_socket", sock)
+    # Not a TCP socket (a Unix socket, a test's stand-in): no Nagle there, nothing to set.
+    with contextlib.suppress(AttributeError, OSError):
+        tcp.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
 
 
 def jitter_reconnects(
