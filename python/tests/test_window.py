@@ -186,6 +186,30 @@ def test_pieces_briefer_than_the_floor_merge_into_the_next() -> None:
     assert all(s.duration_ms >= params.floor_ms for s in merged[:-1])
 
 
+def test_a_cut_the_bound_makes_leaves_no_piece_briefer_than_the_floor_where_it_can() -> None:
+    # A corner drawn 40 ms after the press (40 px right, 8 px a sample), then down 4 px a sample:
+    # the bound (0.25 grid units, 25 px here) breaks at 112 ms. At the feature, the corner, the
+    # piece would last 40 ms, briefer than the sleeve's floor, and the stroke after it bends away
+    # too far to merge with it: it would be sent as it is and the sleeve would slow it. The
+    # window holds samples drawn at least the floor after the press whose stroke keeps the
+    # bound, so the cut is the feature among those.
+    params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=0)
+    right = [Sample(8.0 * k, 50.0 + 8.0 * k, 50.0) for k in range(6)]
+    down = [Sample(40.0 + 8.0 * k, 90.0, 50.0 + 4.0 * k) for k in range(1, 40)]
+    path = right + down
+    at_corner = [s for _, s in run(replace(params, floor_ms=0.0), [path])]
+    assert at_corner[0].end_ms == 40.0  # without the floor: the corner, a 40 ms piece
+    strokes = [s for _, s in run(params, [path])]
+    first = strokes[0]
+    assert first.end_ms == 80.0  # the first sample drawn at least the floor after the press
+    assert all(s.duration_ms >= params.floor_ms and s.dropped is None for s in strokes)
+    mapping = params.mapping
+    for sample in path:
+        stroke = next(s for s in strokes if s.start_ms <= sample.t_ms <= s.end_ms)
+        point = mapping.to_grid(sample.x, sample.y)
+        assert _distance(point, stroke.start, stroke.end) <= params.max_error + FLOAT_TOLERANCE
+
+
 def _bumped_line(params: WindowParams, bump_ms: float, height: float) -> list[Sample]:
     """A straight line drawn for 400 ms with a bump ``height`` grid units high at ``bump_ms``."""
     origin, right = params.mapping.to_grid(0, 0), params.mapping.to_grid(100, 0)

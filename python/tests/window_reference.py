@@ -173,6 +173,15 @@ class ReferenceWindowSimplifier:
             bound_sq = self._bend_sq(window, item.point)
             if not self._fits(window, 1, len(window), item.point, bound_sq):
                 cut = self._feature(window, item.point)
+                # A piece briefer than the floor, where the window holds a longer one: the
+                # feature among the samples drawn at least the floor after the anchor.
+                floor_ms = max(self.params.floor_ms, self.params.min_duration_ms)
+                floor_end_ms = window[0].sample.t_ms + floor_ms
+                if window[cut].sample.t_ms < floor_end_ms <= window[-1].sample.t_ms:
+                    later = next(
+                        i for i in range(1, len(window)) if window[i].sample.t_ms >= floor_end_ms
+                    )
+                    cut = self._feature(window, item.point, later)
                 out.append(self._finish(window[0], window[cut]))
                 self._line = None
                 pending.append(item)

@@ -173,7 +173,15 @@ export class ReferenceWindowSimplifier {
         window = this.#window = [vertex];
       }
       if (!this.#fits(window, 1, window.length, item.point, this.#bendSq(window, item.point))) {
-        const cut = this.#feature(window, item.point);
+        let cut = this.#feature(window, item.point);
+        // A piece briefer than the floor, where the window holds a longer one: the feature among
+        // the samples drawn at least the floor after the anchor.
+        const floorMs = Math.max(this.params.floor_ms, this.params.min_duration_ms);
+        const floorEndMs = window[0]!.sample.t_ms + floorMs;
+        if (window[cut]!.sample.t_ms < floorEndMs && floorEndMs <= window[window.length - 1]!.sample.t_ms) {
+          const later = window.findIndex((drawn, i) => i > 0 && drawn.sample.t_ms >= floorEndMs);
+          cut = this.#feature(window, item.point, later);
+        }
         out.push(this.#finish(window[0]!, window[cut]!));
         this.#line = null;
         pending.push(item);

@@ -211,7 +211,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     algorithms: ["window"],
     paper: null,
     type: "number",
-    default: 73.7,
+    default: 73.701,
     minimum: 0,
     maximum: 10000,
     unit: "ms",

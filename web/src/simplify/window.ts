@@ -10,7 +10,10 @@
  * when a sample would put a sample since the anchor farther than `max_error`
  * (grid units) from the stroke, the stroke is cut at the sample farthest from
  * the chord (among those whose own stroke keeps the bound), emitted now, and
- * the samples after the cut are taken again into the next stroke. A stroke
+ * the samples after the cut are taken again into the next stroke; a cut that
+ * would end a piece briefer than the sleeve's floor is made at the farthest of
+ * the samples drawn at least the floor after the anchor, where the window holds
+ * one. A stroke
  * long enough to send lasts at most `max_stroke_ms` of drawing (the latency cap) and holds at most
  * `max_window` samples (the work cap). The stroke after one the latency cap
  * ended, if the cap or the release ends it too, ends on the line of the stroke
@@ -168,6 +171,8 @@ export class WindowCore {
   readonly params: WindowParams;
   readonly #maxErrorSq: number;
   readonly #minLengthSq: number;
+  /** The shortest piece the merger need not hold: the larger of floor_ms and min_duration_ms. */
+  readonly #floorMs: number;
   readonly #mapping: CanvasMapping;
   /** The grid's extents (grid units): every stroke's start and end lies in [0, x] x [0, y]. */
   readonly #xExtent: number;
@@ -220,6 +225,7 @@ export class WindowCore {
     this.params = params;
     this.#maxErrorSq = params.max_error * params.max_error;
     this.#minLengthSq = params.min_length * params.min_length;
+    this.#floorMs = Math.max(params.floor_ms, params.min_duration_ms);
     this.#reachLimit = params.max_error - ROUNDING_SLACK;
     this.#xExtent = params.columns - 1;
     this.#yExtent = params.rows - 1;
@@ -333,7 +339,17 @@ export class WindowCore {
         }
       }
       if (!this.#keepsBound(count, x, y)) {
-        const cut = this.#feature(count, x, y, 1);
+        let cut = this.#feature(count, x, y, 1);
+        const floorEndMs = ts[0]! + this.#floorMs;
+        if (ts[cut]! < floorEndMs && floorEndMs <= ts[count - 1]!) {
+          // The piece would be briefer than the sleeve's floor, and the window holds a longer
+          // one: cut at the feature among the samples drawn at least the floor after the anchor
+          // (the last one always keeps the bound), so the sleeve need not slow the piece and the
+          // merger need not hold it.
+          let later = cut + 1;
+          while (ts[later]! < floorEndMs) later++;
+          cut = this.#feature(count, x, y, later);
+        }
         const end: Point = [xs[cut]!, ys[cut]!];
         (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, end, ts[cut]!));
         this.#line = null;

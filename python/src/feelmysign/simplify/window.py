@@ -20,7 +20,12 @@ corners land on the drawing's features. Here:
   whose own stroke (anchor -> it) keeps the bound (the sample before the new
   one always does). That stroke is emitted now; the cut sample anchors the
   next stroke, and the samples after it are taken again, so strokes join end
-  to start and every sample keeps the bound.
+  to start and every sample keeps the bound. A cut that would end a piece
+  briefer than the sleeve's floor (``floor_ms``, or ``min_duration_ms`` if
+  longer) is made, where the window holds a sample drawn at least that long
+  after the anchor, at the feature among those samples: the sleeve need not
+  slow the piece, and the merger need not hold it (a corner it passes lies
+  within max_error of the piece, as every sample does).
 - Latency cap: a stroke lasts at most ``max_stroke_ms`` of drawing. A sample
   that would make it longer cuts it, so the wearer feels a long line begin
   before it ends (the paper's "frame max", in ms): at a feature (as above,
@@ -133,7 +138,9 @@ class _WindowOwn:
     it gained at most a gesture or two a speed, within the noise, and with its
     absolute floor it overrides a coarse ``max_error`` (the study's resolution
     levels and the page's detail control). ``floor_ms`` is the sleeve's own
-    (73.7 ms on ERM motors).
+    (73.701 ms on ERM motors, as its status reports it: two 20 ms end bursts,
+    ``apparent_motion.shortest_planned_ms``, rounded up to the microsecond; a
+    piece of 73.7 ms would be slowed by a microsecond).
     """
 
     max_error: float = param(
@@ -195,7 +202,7 @@ class _WindowOwn:
         label="Strict minimums",
     )
     floor_ms: float = param(
-        73.7,
+        73.701,
         0,
         10_000,
         help="shortest stroke the sleeve plays without slowing it, in ms (its status says); "
@@ -261,6 +268,8 @@ class WindowCore:
     _max_error_sq: float = field(init=False)
     _rest_sq: float = field(init=False)
     _min_length_sq: float = field(init=False)
+    # The shortest piece the merger need not hold: the larger of floor_ms and min_duration_ms.
+    _floor_ms: float = field(init=False)
     _reach_limit: float = field(
         init=False
     )  # reach + step at most this: every sample keeps the bound
@@ -272,6 +281,7 @@ class WindowCore:
     def __post_init__(self) -> None:
         self._max_error_sq = self.params.max_error * self.params.max_error
         self._min_length_sq = self.params.min_length * self.params.min_length
+        self._floor_ms = max(self.params.floor_ms, self.params.min_duration_ms)
         self._reach_limit = self.params.max_error - ROUNDING_SLACK
         rest = rest_radius(self.params)
         self._rest_sq = rest * rest
@@ -399,6 +409,15 @@ class WindowCore:
                 keeps = True
             if not keeps:
                 cut = self._feature(points, point)
+                floor_end_ms = times[0] + self._floor_ms
+                if times[cut] < floor_end_ms <= times[-1]:
+                    # The piece would be briefer than the sleeve's floor, and the window holds
+                    # a longer one: cut at the feature among the samples drawn at least the
+                    # floor after the anchor (the last one always keeps the bound), so the
+                    # sleeve need not slow the piece and the merger need not hold it.
+                    cut = self._feature(
+                        points, point, bisect.bisect_left(times, floor_end_ms, cut + 1)
+                    )
                 out.append(self._finish(points[0], times[0], points[cut], times[cut]))
                 self._line = None
                 pending.append((point, sample))

@@ -189,7 +189,7 @@ public final class ParamTable {
               null,
               0,
               ParamSpec.Kind.NUMBER,
-              73.7,
+              73.701,
               0.0,
               10000.0,
               "ms",

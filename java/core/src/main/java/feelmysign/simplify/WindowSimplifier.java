@@ -15,7 +15,9 @@ import java.util.List;
  * from its anchor; when a sample would put a sample since the anchor farther than
  * {@code max_error} (grid units) from the stroke, the stroke is cut at the sample farthest from
  * the chord (among those whose own stroke keeps the bound), emitted now, and the samples after
- * the cut are taken again into the next stroke. A stroke long enough to send lasts at most
+ * the cut are taken again into the next stroke; a cut that would end a piece briefer than the
+ * sleeve's floor is made at the farthest of the samples drawn at least the floor after the
+ * anchor, where the window holds one. A stroke long enough to send lasts at most
  * {@code max_stroke_ms} of drawing (the latency cap) and holds at most {@code max_window}
  * samples (the work cap). The stroke after one the latency cap ended, if the cap or the release
  * ends it too, ends on the line of the stroke before when the bound allows and that end stays
@@ -118,6 +120,8 @@ final class WindowCore implements Simplifier {
   private final double minDurationMs;
   private final double maxErrorSq;
   private final double minLengthSq;
+  /** The shortest piece the merger need not hold: the larger of floor_ms and min_duration_ms. */
+  private final double floorMs;
   private final double reachLimit;
   private final double maxBend;
   private final double bendFloor;
@@ -167,6 +171,7 @@ final class WindowCore implements Simplifier {
     this.minDurationMs = params.number("min_duration_ms");
     this.maxErrorSq = maxError * maxError;
     this.minLengthSq = minLength * minLength;
+    this.floorMs = Math.max(params.number("floor_ms"), minDurationMs);
     this.reachLimit = maxError - ROUNDING_SLACK;
     this.maxBend = params.number("max_bend");
     this.bendFloor = params.number("bend_floor");
@@ -359,6 +364,18 @@ final class WindowCore implements Simplifier {
       }
       if (!keepsBound(n, x, y)) {
         int cut = feature(n, x, y, 1);
+        double floorEndMs = ts[0] + floorMs;
+        if (ts[cut] < floorEndMs && floorEndMs <= ts[n - 1]) {
+          // The piece would be briefer than the sleeve's floor, and the window holds a longer
+          // one: cut at the feature among the samples drawn at least the floor after the anchor
+          // (the last one always keeps the bound), so the sleeve need not slow the piece and the
+          // merger need not hold it.
+          int later = cut + 1;
+          while (ts[later] < floorEndMs) {
+            later++;
+          }
+          cut = feature(n, x, y, later);
+        }
         double endX = xs[cut];
         double endY = ys[cut];
         if (out == null) {
