@@ -726,12 +726,18 @@ export class Merger {
     const ys = this.#ys;
     const ts = this.#ts;
     const count = this.#count;
+    // `distanceSq` with the chord's terms computed once (the same operations, as in `#farthestSq`).
+    const ax = start[0];
+    const ay = start[1];
+    const dx = end[0] - ax;
+    const dy = end[1] - ay;
+    const lengthSq = dx * dx + dy * dy;
     for (let i = this.#first; i < count; i++) {
-      const t = ts[i]!;
-      if (t > endMs) break;
-      if (distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
-        return false;
-      }
+      if (ts[i]! > endMs) break;
+      const qx = xs[i]! - ax;
+      const qy = ys[i]! - ay;
+      const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
+      if (d > limitSq) return false;
     }
     return true;
   }
@@ -768,8 +774,9 @@ export class Merger {
     // The samples before its end are covered now (those at its end may start the next).
     const ts = this.#ts;
     const count = this.#count;
+    const endMs = segment.end_ms;
     let keep = this.#first;
-    while (keep < count && ts[keep]! < segment.end_ms) keep++;
+    while (keep < count && ts[keep]! < endMs) keep++;
     this.#first = keep;
     if (keep >= COMPACT_AFTER && 2 * keep >= count) {
       // Most of the arrays are covered: move what is not to their start, in place.
