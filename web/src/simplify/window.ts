@@ -181,7 +181,6 @@ export class WindowCore {
   readonly #window: Samples;
   /** Each sample's squared distance to a chord, while a cut looks for its feature. */
   readonly #distances: number[] = [];
-  #pointer: Sample | null = null;
   #emittedInPath = false;
   /**
    * The direction of the stroke the latency cap ended last, while the next one may go on along
@@ -252,7 +251,7 @@ export class WindowCore {
 
   /** The time of the last sample pushed, as taken (0 before any). */
   pointerMs(): number {
-    return this.#pointer ? this.#pointer.t_ms : 0;
+    return this.takenMs;
   }
 
   /** One pointer sample while the pointer is down; the first of a path is the press. */
@@ -262,7 +261,6 @@ export class WindowCore {
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
     const sample =
       count > 0 && input.t_ms < window.ts[count - 1]! ? { ...input, t_ms: window.ts[count - 1]! } : input;
-    this.#pointer = sample;
     const x = this.#mapping.gridX(sample.x);
     const y = this.#mapping.gridY(sample.y);
     this.takenMs = sample.t_ms;
@@ -663,7 +661,7 @@ export class WindowCore {
 
   #finish(start: Point, startMs: number, end: Point, endMs: number): Segment {
     this.#emittedInPath = true;
-    return finishSegment(start, end, startMs, endMs, this.#pointer ? this.#pointer.t_ms : endMs, this.params);
+    return finishSegment(start, end, startMs, endMs, this.takenMs, this.params);
   }
 }
 
@@ -676,10 +674,12 @@ export class WindowCore {
  * long enough is sent at once (holding each back would delay the drawing), so the last piece of
  * a path, if short, is sent short. Only a path's one and only piece, too short, is dropped.
  */
-/** The merger drops covered samples from its arrays once this many have gathered at their start. */
-const COMPACT_AFTER = 256;
-/** The merger's first capacity in samples (about 4 s at 60 Hz); it doubles as a path needs. */
-const MERGER_CAPACITY = 256;
+/**
+ * The merger drops covered samples from its arrays once this many have gathered at their start
+ * (and they are at least half): few enough that the arrays stay small (few regrowths for a
+ * simplifier made per path), enough that each sample is moved at most once on average.
+ */
+const COMPACT_AFTER = 32;
 
 export class Merger {
   readonly #maxError: number;
@@ -689,12 +689,14 @@ export class Merger {
   readonly #strict: boolean;
   /**
    * The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first: [#first,
-   * #count) of typed arrays that grow by doubling and are kept from one path to the next, so a
-   * sample is three stores, not three pushes.
+   * #count) of arrays kept from one path to the next, so a sample is three stores, not three
+   * pushes. Plain arrays of numbers (stored unboxed, as in `Samples`), not typed arrays: a typed
+   * array's buffer lives outside the heap and is zeroed when made, which cost more than its samples
+   * for a simplifier made per path (as the bench makes one per demonstration).
    */
-  #xs = new Float64Array(MERGER_CAPACITY);
-  #ys = new Float64Array(MERGER_CAPACITY);
-  #ts = new Float64Array(MERGER_CAPACITY);
+  readonly #xs: number[] = [];
+  readonly #ys: number[] = [];
+  readonly #ts: number[] = [];
   #count = 0;
   /**
    * The first sample not yet covered: those before it are, and are dropped from the arrays only
@@ -715,24 +717,10 @@ export class Merger {
   /** A drawn sample, in order (its time as the window took it). */
   sample(tMs: number, x: number, y: number): void {
     const at = this.#count;
-    if (at === this.#ts.length) this.#grow();
     this.#xs[at] = x;
     this.#ys[at] = y;
     this.#ts[at] = tMs;
     this.#count = at + 1;
-  }
-
-  #grow(): void {
-    const capacity = 2 * this.#ts.length;
-    const xs = new Float64Array(capacity);
-    const ys = new Float64Array(capacity);
-    const ts = new Float64Array(capacity);
-    xs.set(this.#xs);
-    ys.set(this.#ys);
-    ts.set(this.#ts);
-    this.#xs = xs;
-    this.#ys = ys;
-    this.#ts = ts;
   }
 
   #short(segment: Segment): boolean {
@@ -754,52 +742,67 @@ export class Merger {
     const ys = this.#ys;
     const ts = this.#ts;
     const count = this.#count;
+    // `distanceSq` with the chord's terms computed once (the same operations, as in `#farthestSq`).
+    const ax = start[0];
+    const ay = start[1];
+    const dx = end[0] - ax;
+    const dy = end[1] - ay;
+    const lengthSq = dx * dx + dy * dy;
     for (let i = this.#first; i < count; i++) {
-      const t = ts[i]!;
-      if (t > endMs) break;
-      if (distanceSq(xs[i]!, ys[i]!, start[0], start[1], end[0], end[1]) > limitSq) {
-        return false;
-      }
+      if (ts[i]! > endMs) break;
+      const qx = xs[i]! - ax;
+      const qy = ys[i]! - ay;
+      const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
+      if (d > limitSq) return false;
     }
     return true;
   }
 
   #send(segment: Segment, nowMs: number, out: Segment[]): void {
     this.#sentInPath = true;
-    // Built field by field, not spread (several times slower): the same keys in the same order.
+    // A piece made at this sample and not dropped (most: the window's and the merged ones) is sent
+    // as it is; else a copy, built field by field, not spread (several times slower): the same
+    // keys in the same order. Object.is: -0 and 0 are different times to the vectors.
     const sent: Segment =
-      segment.merged === undefined
-        ? {
-            start: segment.start,
-            end: segment.end,
-            start_ms: segment.start_ms,
-            end_ms: segment.end_ms,
-            duration_ms: segment.duration_ms,
-            emitted_at_ms: nowMs,
-            dropped: null,
-          }
-        : {
-            start: segment.start,
-            end: segment.end,
-            start_ms: segment.start_ms,
-            end_ms: segment.end_ms,
-            duration_ms: segment.duration_ms,
-            emitted_at_ms: nowMs,
-            dropped: null,
-            merged: segment.merged,
-          };
+      segment.dropped === null && Object.is(segment.emitted_at_ms, nowMs)
+        ? segment
+        : segment.merged === undefined
+          ? {
+              start: segment.start,
+              end: segment.end,
+              start_ms: segment.start_ms,
+              end_ms: segment.end_ms,
+              duration_ms: segment.duration_ms,
+              emitted_at_ms: nowMs,
+              dropped: null,
+            }
+          : {
+              start: segment.start,
+              end: segment.end,
+              start_ms: segment.start_ms,
+              end_ms: segment.end_ms,
+              duration_ms: segment.duration_ms,
+              emitted_at_ms: nowMs,
+              dropped: null,
+              merged: segment.merged,
+            };
     out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
     const ts = this.#ts;
     const count = this.#count;
+    const endMs = segment.end_ms;
     let keep = this.#first;
-    while (keep < count && ts[keep]! < segment.end_ms) keep++;
+    while (keep < count && ts[keep]! < endMs) keep++;
     this.#first = keep;
     if (keep >= COMPACT_AFTER && 2 * keep >= count) {
       // Most of the arrays are covered: move what is not to their start, in place.
-      this.#xs.copyWithin(0, keep, count);
-      this.#ys.copyWithin(0, keep, count);
-      ts.copyWithin(0, keep, count);
+      const xs = this.#xs;
+      const ys = this.#ys;
+      for (let from = keep, to = 0; from < count; from++, to++) {
+        xs[to] = xs[from]!;
+        ys[to] = ys[from]!;
+        ts[to] = ts[from]!;
+      }
       this.#count = count - keep;
       this.#first = 0;
     }
@@ -908,7 +911,8 @@ export class WindowSimplifier {
     // Most samples finish no piece: nothing to merge, no array made.
     if (pieces.length === 0 && !core.rested) return NO_SEGMENTS;
     const out: Segment[] = [];
-    for (const piece of pieces) merger.take(piece, takenMs, out);
+    // Indexed, no iterator made: this runs at every stroke.
+    for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
     if (core.rested) merger.rest(takenMs, out);
     return out.length > 0 ? out : NO_SEGMENTS;
   }
