@@ -16,8 +16,10 @@ from study_helpers import PILOT_DESIGN
 
 from feelmysign.study import StudyStore, load_design
 from feelmysign.study.analysis.models import MIN_PARTICIPANTS, speed_flip_test, speed_profiles
+from feelmysign.study.api import StudyApi
 from feelmysign.study.dry_run import dry_run
 from feelmysign.study.export import export_study
+from feelmysign.study.runner import Session
 
 SPEEDS = (4.0, 10.0)
 
@@ -80,6 +82,23 @@ def test_every_trial_is_played_at_its_speed_and_exported_with_it(tmp_path: Path)
     assert sidecar["speed_cm_s"]["Units"] == "cm/s" and sidecar["speed_cm_s"]["Description"]
     assert "2 drawing speeds (4, 10 cm/s)" in sidecar["TaskDescription"]
     assert json.loads(files["design.json"].read_text())["stimulus"]["speed_cm_s"] == [4.0, 10.0]
+
+
+def test_the_page_is_told_the_speeds_and_each_trials_speed(tmp_path: Path) -> None:
+    store = speeds_study(tmp_path)
+    session = Session(store, None)
+    api = StudyApi(session, tmp_path / "results")
+    assert api.overview()["speeds_cm_s"] == list(SPEEDS)
+    code = store.add_participant()
+    session.consent(code, True)
+    session.comfort(code, [True, True], adjusted=False)
+    trials = store.trials(code)
+    trial = session.state(code)["trial"]
+    assert trial["block"] == "practice" and trial["speed_cm_s"] == 4.0
+    store.record_send(trials[0]["id"], "d", [])
+    session.answer(code, None, answer="line", felt_nothing=False, confidence=None)
+    trial = session.state(code)["trial"]
+    assert trial["speed_cm_s"] == trials[1]["speed_cm_s"] and trial["speed_cm_s"] in SPEEDS
 
 
 def test_analyse_with_speeds_exits_0_and_reports_each_shape_at_each_speed(tmp_path: Path) -> None:
