@@ -276,3 +276,9 @@ def test_a_shape_listed_twice_is_one_problem() -> None:
         "shapes: 'circle' is listed 2 times: give each shape once, with one entry per "
         "resolution in its segments (or settings)"
     ]
+
+
+def test_the_example_design_with_speeds_loads() -> None:
+    design = load_design(PAPER_DESIGN.parent / "speeds.toml")
+    assert design.speeds == (3.0, 6.0, 12.0) and design.main_trials == 4 * 3 * 3 * 2
+    assert [design.practice_speed_cm_s(p) for p in design.practice] == [3.0, 12.0]
