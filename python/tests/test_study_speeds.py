@@ -15,7 +15,12 @@ import pytest
 from study_helpers import PILOT_DESIGN
 
 from feelmysign.study import StudyStore, load_design
-from feelmysign.study.analysis.models import MIN_PARTICIPANTS, speed_flip_test, speed_profiles
+from feelmysign.study.analysis.models import (
+    MIN_PARTICIPANTS,
+    MIN_SPEED_PARTICIPANTS,
+    speed_flip_test,
+    speed_profiles,
+)
 from feelmysign.study.api import StudyApi
 from feelmysign.study.dry_run import dry_run
 from feelmysign.study.export import export_study
@@ -114,7 +119,9 @@ def test_analyse_with_speeds_exits_0_and_reports_each_shape_at_each_speed(tmp_pa
         timeout=600,
     )
     assert result.returncode == 0, result.stderr
-    assert "Test that speeds differ at equal shape and strokes" in result.stdout
+    # 6 participants: the shape test runs, the speed test says why it does not.
+    assert "Test that shapes differ at equal strokes" in result.stdout
+    assert "No test of whether speeds differ is reported" in result.stdout
     results = json.loads((out / "results.json").read_text())
     assert results["speeds_cm_s"] == list(SPEEDS)
     keys = [
@@ -130,7 +137,8 @@ def test_analyse_with_speeds_exits_0_and_reports_each_shape_at_each_speed(tmp_pa
         needed = results["needed_strokes"][key]
         assert needed["speed_cm_s"] in SPEEDS and key.startswith(needed["shape"])
     model = results["shape_model"]
-    assert model["speed_test"]["speeds"] == 2 and 0 < model["speed_test"]["p"] <= 1
+    assert model["speed_test"]["speeds"] == 2 and model["speed_test"]["p"] is None
+    assert model["speed_test"]["participants_needed"] == MIN_SPEED_PARTICIPANTS
     assert [e["speed_cm_s"] for e in model["speed_effects"]] == [10.0]
     assert model["reference_speed_cm_s"] == 4.0
     report = (out / "report.md").read_text()
@@ -158,17 +166,16 @@ def _speed_answers(participants: int, rng: np.random.Generator, slow_odds: float
 
 
 def test_the_speed_test_finds_an_effect_all_show_and_rarely_one_that_is_not_there() -> None:
-    found = speed_flip_test(_speed_answers(8, np.random.default_rng(1), slow_odds=3.0))
-    assert found.flips == 2**8 and found.p == 2 / 2**8
+    found = speed_flip_test(_speed_answers(12, np.random.default_rng(1), slow_odds=3.0))
+    assert found.flips == 2**12 and found.p == 2 / 2**12
     # 20 studies with no speed effect: a 5% test rejects in about 1; 4 or more: p = 0.016.
     rejected = sum(
-        (speed_flip_test(_speed_answers(8, np.random.default_rng(s), 0.0)).p or 1) < 0.05
+        (speed_flip_test(_speed_answers(12, np.random.default_rng(s), 0.0)).p or 1) < 0.05
         for s in range(20)
     )
     assert rejected <= 3
-    few = speed_flip_test(_speed_answers(MIN_PARTICIPANTS - 1, np.random.default_rng(2), 3.0))
-    assert (
-        few.p is None and few.refused is not None and f"at least {MIN_PARTICIPANTS}" in few.refused
-    )
+    few = speed_flip_test(_speed_answers(MIN_SPEED_PARTICIPANTS - 1, np.random.default_rng(2), 3))
+    assert few.p is None and few.refused is not None
+    assert f"the speed test needs at least {MIN_SPEED_PARTICIPANTS}" in few.refused
     profile = speed_profiles(_speed_answers(8, np.random.default_rng(3), 1.0))
     assert profile.shape == (8, 2) and np.abs(profile.sum(axis=1)).max() < 1e-9
