@@ -8,8 +8,10 @@ import pytest
 from study_helpers import PAPER_DESIGN, ZIGZAG_SHAPE, zigzag_recording
 
 from feelmysign.errors import DesignError
+from feelmysign.layout import PAPER_SLEEVE
 from feelmysign.study import load_design, parse_design
 from feelmysign.study.order import participant_order, williams_rows
+from feelmysign.study.stimulus import trial_strokes
 
 MINIMAL = """
 [study]
@@ -125,12 +127,128 @@ def test_practice_written_as_one_table_gets_the_double_brackets_hint() -> None:
     )
 
 
-def test_several_speeds_are_refused_with_how_to_compare_speeds() -> None:
+SPEEDS = "[stimulus]\nspeed_cm_s = [3, 6, 12]\n"
+
+
+def test_a_list_of_speeds_crosses_with_shape_resolution_and_repetition() -> None:
+    design = parse_design(MINIMAL + SPEEDS + '[[practice]]\nshape = "line"\n')
+    assert design.speeds == (3.0, 6.0, 12.0) and design.speed_is_factor
+    assert design.main_trials == 2 * 2 * 3 * 2
+    order = participant_order(design, 1)
+    (practice,) = [t for t in order if t.block == "practice"]
+    assert practice.speed_cm_s == 3.0  # the first listed speed
+    main = [t for t in order if t.block == "main"]
+    for repetition in (1, 2):
+        block = [(t.shape, t.level, t.speed_cm_s) for t in main if t.repetition == repetition]
+        assert sorted(block) == sorted(
+            (shape, level, speed)
+            for shape in ("circle", "square")
+            for level in (0, 1)
+            for speed in (3.0, 6.0, 12.0)
+        )
+    # The speeds are mixed within a block, not played one after another.
+    assert len({t.speed_cm_s for t in main[:3]}) > 1
+    assert design.to_json()["stimulus"]["speed_cm_s"] == [3.0, 6.0, 12.0]
+
+
+def test_with_one_speed_orders_and_design_json_are_what_they_were() -> None:
+    one = parse_design(MINIMAL)
+    listed = parse_design(MINIMAL + "[stimulus]\nspeed_cm_s = [5]\n")
+    assert not one.speed_is_factor and one.speeds == (5.0,) and one.main_trials == 8
+    assert listed == one
+    assert one.to_json()["stimulus"] == {
+        "speed_cm_s": 5.0,
+        "margin": 0.0,
+        "intensity": None,
+        "layout": None,
+    }
+    order = [(t.shape, t.level, t.segments) for t in participant_order(one, 2)]
+    conditions = [("circle", 0, 4), ("circle", 1, 16), ("square", 0, 4), ("square", 1, 8)]
+    rows = williams_rows(4)
+    expected = [conditions[i] for r in (4, 5) for i in rows[r % len(rows)]]
+    assert order == expected  # the Latin square of the conditions, as before speeds
+
+
+def test_a_practice_trial_may_have_its_own_speed() -> None:
+    practice = '[[practice]]\nshape = "circle"\nspeed_cm_s = 2.5\n'
+    design = parse_design(MINIMAL + SPEEDS + practice)
+    assert design.practice[0].speed_cm_s == 2.5
+    assert participant_order(design, 0)[0].speed_cm_s == 2.5
+    assert design.to_json()["practice"][0]["speed_cm_s"] == 2.5
     with pytest.raises(DesignError) as caught:
-        parse_design(MINIMAL + "[stimulus]\nspeed_cm_s = [3.0, 8.0]\n", source="bad.toml")
-    message = str(caught.value)
-    assert "stimulus.speed_cm_s: must be one number from 0.5 to 50; got a list of 2" in message
-    assert "make one design file per speed" in message
+        parse_design(MINIMAL + practice.replace("2.5", "'slow'"), source="bad.toml")
+    assert caught.value.problems == [
+        "practice[0].speed_cm_s: must be a number from 0.5 to 50; got 'slow'"
+    ]
+
+
+@pytest.mark.parametrize(
+    ("speeds", "problem"),
+    [
+        (
+            "[3, 6, 3.0]",
+            "stimulus.speed_cm_s: each speed once; 3 cm/s is listed more than once in "
+            "[3, 6, 3.0]: remove the copies (study.repetitions says how often each condition "
+            "is played)",
+        ),
+        (
+            "[]",
+            "stimulus.speed_cm_s: the list is empty; give one number from 0.5 to 50 cm/s, or a "
+            "list of different ones (e.g. [3, 6, 12])",
+        ),
+        ("[3, 0.2]", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got 0.2"),
+        ("[3, 'fast']", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got 'fast'"),
+        ("[3, true]", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got True"),
+        (
+            "[1, 2, 3, 4, 5, 6, 7, 8, 9]",
+            "stimulus.speed_cm_s: at most 8 speeds; got 9: each speed plays every shape x "
+            "resolution x repetition again; keep the speeds the question needs",
+        ),
+    ],
+)
+def test_a_bad_list_of_speeds_is_refused_saying_what_and_what_to_do(
+    speeds: str, problem: str
+) -> None:
+    with pytest.raises(DesignError) as caught:
+        parse_design(MINIMAL + f"[stimulus]\nspeed_cm_s = {speeds}\n", source="bad.toml")
+    assert caught.value.problems == [problem]
+
+
+def test_a_speed_too_slow_for_a_shape_is_refused_before_anything_is_sent() -> None:
+    slow = MINIMAL + '[stimulus]\nspeed_cm_s = [0.5, 5]\n[[shapes]]\nname = "line"\n'
+    with pytest.raises(DesignError) as caught:
+        parse_design(slow + "segments = [1, 2]\n", source="bad.toml")
+    square, line = caught.value.problems  # one problem per level too slow to play
+    assert square.startswith("shapes[1].segments[0]: at 0.5 cm/s: duration_ms of this square")
+    assert line.startswith("shapes[2].segments[0]: at 0.5 cm/s: duration_ms of this line")
+    assert "max_stroke_duration_ms 10000" in line and "or give a faster speed" in line
+    fixed = slow.replace("segments = [4, 8]", "segments = [8, 12]") + "segments = [2, 4]\n"
+    assert parse_design(fixed).speeds == (0.5, 5.0)
+
+
+def test_a_recorded_drawing_is_redrawn_at_each_speed_only_when_speed_is_a_factor(
+    tmp_path: Path,
+) -> None:
+    zigzag_recording(tmp_path / "zigzag.json")
+    one = parse_design(MINIMAL + ZIGZAG_SHAPE, base_dir=tmp_path)
+    several = parse_design(MINIMAL + ZIGZAG_SHAPE + SPEEDS, base_dir=tmp_path)
+    kept = {t.speed_cm_s for t in participant_order(one, 0) if t.shape == "zigzag"}
+    assert kept == {None}  # one speed: the drawing keeps the hand's timing
+    drawn = {t.speed_cm_s for t in participant_order(several, 0) if t.shape == "zigzag"}
+    assert drawn == {3.0, 6.0, 12.0}
+    own = trial_strokes(one, tmp_path, "zigzag", level=1, segments=None, drawing="d")
+    at = {
+        speed: trial_strokes(
+            several, tmp_path, "zigzag", level=1, segments=None, drawing="d", speed_cm_s=speed
+        )
+        for speed in (3.0, 6.0)
+    }
+    assert [(s.start, s.end) for s in at[3.0]] == [(s.start, s.end) for s in own]
+    for slow, fast in zip(at[3.0], at[6.0], strict=True):
+        assert slow.duration_ms == pytest.approx(2 * fast.duration_ms, rel=1e-3)
+        assert slow.duration_ms == pytest.approx(
+            slow.length * PAPER_SLEEVE.spacing_cm / 3.0 * 1000, rel=1e-3
+        )
 
 
 def test_resolutions_that_repeat_or_go_back_are_refused_saying_what_to_do() -> None:
@@ -158,3 +276,9 @@ def test_a_shape_listed_twice_is_one_problem() -> None:
         "shapes: 'circle' is listed 2 times: give each shape once, with one entry per "
         "resolution in its segments (or settings)"
     ]
+
+
+def test_the_example_design_with_speeds_loads() -> None:
+    design = load_design(PAPER_DESIGN.parent / "speeds.toml")
+    assert design.speeds == (3.0, 6.0, 12.0) and design.main_trials == 4 * 3 * 3 * 2
+    assert [design.practice_speed_cm_s(p) for p in design.practice] == [3.0, 12.0]

@@ -75,13 +75,14 @@ def test_a_study_file_of_the_first_version_is_migrated_after_a_backup(tmp_path: 
     store.close()
     db = sqlite3.connect(tmp_path / "old.sqlite")  # as the first version made it
     db.execute("ALTER TABLE threshold_runs DROP COLUMN simulated")
+    db.execute("ALTER TABLE trials DROP COLUMN speed_cm_s")
     db.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
     db.commit()
     db.close()
     reopened = StudyStore(tmp_path / "old.sqlite")
     backup = tmp_path / "old.sqlite.schema-1.bak"
     assert reopened.migrated_from == backup and backup.is_file()
-    assert reopened.meta("schema_version") == "2"
+    assert reopened.meta("schema_version") == "3"
     (run,) = reopened.threshold_runs(code)
     assert run["simulated"] == 0  # a run of the old file is what it was: a measured one
     old = sqlite3.connect(backup)

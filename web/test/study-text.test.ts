@@ -1,7 +1,7 @@
 /** The study page's sentences: counts with their nouns, and what became of the strokes sent. */
 import { describe, expect, it } from "vitest";
 import { plural } from "../src/study/dom";
-import { sentText } from "../src/study/session-view";
+import { sentText, trialDetail } from "../src/study/session-view";
 
 describe("the study page's counts", () => {
   it("says 1 stroke and 1 participant, 2 strokes and 0 participants", () => {
@@ -24,5 +24,33 @@ describe("the study page's counts", () => {
     expect(sentText({ ...sent, strokes: 4, played: 1, cut_short: 1, cancelled: 2 })).toBe(
       "played 1 of 4 strokes · 1 cut short · 2 cancelled",
     );
+  });
+});
+
+describe("the trial's line on the study page", () => {
+  const trial = {
+    id: 1,
+    number: 3,
+    total: 10,
+    block: "main" as const,
+    repetition: 1,
+    shape: "circle",
+    resolution: "coarse",
+    segments: 4,
+    speed_cm_s: 6,
+    sends: 0,
+    last_send: null,
+  };
+
+  it("shows the speed only when the design compares speeds", () => {
+    expect(trialDetail(trial, true)).toBe(" · coarse, 4 strokes · 6 cm/s");
+    expect(trialDetail(trial, false)).toBe(" · coarse, 4 strokes");
+  });
+
+  it("says a practice shape's strokes, and no speed for a drawing at its own timing", () => {
+    expect(trialDetail({ ...trial, resolution: null, segments: 1, speed_cm_s: 3 }, true)).toBe(
+      " · 1 stroke · 3 cm/s",
+    );
+    expect(trialDetail({ ...trial, speed_cm_s: null }, true)).toBe(" · coarse, 4 strokes");
   });
 });

@@ -16,6 +16,8 @@ export interface Overview {
   file: string;
   shapes: string[];
   resolutions: string[];
+  /** The design's drawing speeds; two or more: speed is a factor and each trial has its own. */
+  speeds_cm_s: number[];
   comfort: string[];
   questionnaire: { items: string[]; points: number; labels: string[] };
   participants: ParticipantSummary[];
@@ -47,6 +49,8 @@ export interface Trial {
   shape: string;
   resolution: string | null;
   segments: number;
+  /** cm/s the shape is drawn at; null: a recorded drawing at its own (the hand's) timing. */
+  speed_cm_s: number | null;
   sends: number;
   last_send: SendSummary | null;
 }

@@ -25,6 +25,20 @@ export function sentText(sent: SendSummary): string {
   return parts.join(" · ");
 }
 
+/**
+ * What the trial sends, after its shape: its resolution and strokes, and its drawing speed
+ * when the design compares speeds (a design of one speed shows what it always showed).
+ */
+export function trialDetail(trial: Trial, speedIsFactor: boolean): string {
+  const parts = [
+    trial.resolution
+      ? `${trial.resolution}, ${plural(trial.segments, "stroke")}`
+      : plural(trial.segments, "stroke"),
+  ];
+  if (speedIsFactor && trial.speed_cm_s !== null) parts.push(`${trial.speed_cm_s} cm/s`);
+  return ` · ${parts.join(" · ")}`;
+}
+
 export class SessionView {
   readonly #root: HTMLElement;
   readonly #hooks: SessionHooks;
@@ -263,13 +277,7 @@ export class SessionView {
         "p",
         { class: "trial-shape", "data-testid": "trial-shape" },
         `${trial.shape}`,
-        h(
-          "span",
-          {},
-          trial.resolution
-            ? ` · ${trial.resolution}, ${plural(trial.segments, "stroke")}`
-            : ` · ${plural(trial.segments, "stroke")}`,
-        ),
+        h("span", {}, trialDetail(trial, this.#hooks.overview().speeds_cm_s.length > 1)),
       ),
       h(
         "p",

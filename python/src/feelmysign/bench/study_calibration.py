@@ -12,6 +12,10 @@ Each share with its own 95% Wilson interval. Not part of ``make test`` or ``make
 
     make bench-study-calibration                           # 400 and 100 runs per size
     python -m feelmysign.bench.study_calibration [TEST_RUNS] [COVERAGE_RUNS] [--sizes 12 24]
+    python -m feelmysign.bench.study_calibration 0 0 --speed-runs 200 --sizes 8 12
+
+``--speed-runs``: with speed as a factor of the design, the speed test's false-positive rate
+(no speed effect) and the shape test's with a speed effect (no shape effect).
 
 A column with 0 runs is left out (``0 100``: the coverage alone). Each size's studies are
 seeded by the size and the run's number, so a size measured alone gives the same figures
@@ -35,7 +39,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # after the thread setting
 import pandas as pd
 
-from feelmysign.study.analysis.models import sign_flip_test
+from feelmysign.study.analysis.models import sign_flip_test, speed_flip_test
 from feelmysign.study.analysis.recovery import coverage, describe, paper_truths
 from feelmysign.study.analysis.wilson import wilson_interval
 
@@ -82,11 +86,81 @@ def false_positives(participants: int, runs: int) -> tuple[int, int]:
     return rejected, ran
 
 
-def report(test_runs: int, coverage_runs: int, sizes: tuple[int, ...] = SIZES) -> Iterator[str]:
+SPEEDS_CM_S = (3.0, 6.0, 12.0)
+SPEED_REPETITIONS = 2  # deploy/studies/speeds.toml's; the paper's shapes and resolutions
+
+
+def speed_study(
+    participants: int, rng: np.random.Generator, *, shape_odds: float, speed_odds: float
+) -> pd.DataFrame:
+    """The paper's shapes and resolutions at three speeds: log odds 1.5 per doubling of
+    strokes plus each participant's own intercept, shapes spread over +-``shape_odds`` and
+    each faster speed ``speed_odds`` log odds harder."""
+    rows = []
+    for person in range(participants):
+        own = rng.normal(0.0, PARTICIPANT_SD_LOG_ODDS)
+        for index, (shape, levels) in enumerate(PAPER_SHAPES.items()):
+            easier = shape_odds * (2 * index / (len(PAPER_SHAPES) - 1) - 1)
+            for strokes in levels:
+                for step, speed in enumerate(SPEEDS_CM_S):
+                    odds = 1.5 * (math.log2(strokes) - 2.5) + own + easier - speed_odds * step
+                    p = LAPSE / 2 + (1 - LAPSE) / (1 + math.exp(-odds))
+                    for correct in rng.random(SPEED_REPETITIONS) < p:
+                        rows.append((f"P{person}", shape, strokes, speed, float(correct)))
+    columns = ["participant", "shape", "segments", "speed", "correct"]
+    frame = pd.DataFrame(rows, columns=columns)
+    return frame.assign(log2_strokes=np.log2(frame["segments"].astype(float)))
+
+
+def speed_false_positives(participants: int, runs: int) -> tuple[tuple[int, int], tuple[int, int]]:
+    """Of ``runs`` seeded studies: (p < 0.05, ran) for the speed test with no speed effect
+    (shapes differing), and for the shape test with no shape effect (speeds differing)."""
+    speed = shape = ran = 0
+    for run in range(runs):
+        rng = np.random.default_rng([participants, run, 1])
+        data = speed_study(participants, rng, shape_odds=1.0, speed_odds=0.0)
+        speed_test = speed_flip_test(data, seed=run)
+        data = speed_study(participants, rng, shape_odds=0.0, speed_odds=0.8)
+        shape_test = sign_flip_test(data, seed=run)
+        if speed_test.p is not None and shape_test.p is not None:
+            ran += 1
+            speed += speed_test.p < 0.05
+            shape += shape_test.p < 0.05
+    return (speed, ran), (shape, ran)
+
+
+def report(
+    test_runs: int,
+    coverage_runs: int,
+    sizes: tuple[int, ...] = SIZES,
+    speed_runs: int = 0,
+) -> Iterator[str]:
     if test_runs > 0:
         yield from _test_report(test_runs, sizes)
     if coverage_runs > 0:
         yield from _coverage_report(coverage_runs, sizes)
+    if speed_runs > 0:
+        yield from _speed_report(speed_runs, sizes)
+
+
+def _speed_report(runs: int, sizes: tuple[int, ...]) -> Iterator[str]:
+    yield (
+        f"Speed as a factor (paper's shapes x 3 speeds x {SPEED_REPETITIONS} repetitions), "
+        f"{runs} studies per size: share with p < 0.05 (nominal 0.05) of the speed test with no "
+        "speed effect (shapes differing), and of the shape test with no shape effect (each "
+        "faster speed 0.8 log odds harder)"
+    )
+    for size in sizes:
+        (speed, ran), (shape, _) = speed_false_positives(size, runs)
+        if not ran:
+            yield f"  {size:>2} participants: refused in every study (below the minimum)"
+            continue
+        speed_low, speed_high = wilson_interval(speed, ran)
+        shape_low, shape_high = wilson_interval(shape, ran)
+        yield (
+            f"  {size:>2} participants: speed test {speed / ran:.3f} ({speed_low:.3f} to "
+            f"{speed_high:.3f}); shape test {shape / ran:.3f} ({shape_low:.3f} to {shape_high:.3f})"
+        )
 
 
 def _test_report(test_runs: int, sizes: tuple[int, ...]) -> Iterator[str]:
@@ -134,10 +208,19 @@ def main() -> None:
         metavar="PARTICIPANTS",
         help=f"numbers of participants (default: {' '.join(map(str, SIZES))})",
     )
+    parser.add_argument(
+        "--speed-runs",
+        type=int,
+        default=0,
+        metavar="N",
+        help="studies per size for the tests with speed as a factor (default 0: not run)",
+    )
     args = parser.parse_args()
     if min(args.test_runs, args.coverage_runs) < 0 or min(args.sizes) < 1:
         parser.error("runs must be 0 or more and every size at least 1 participant")
-    for line in report(args.test_runs, args.coverage_runs, tuple(args.sizes)):
+    if args.speed_runs < 0:
+        parser.error("--speed-runs must be 0 or more")
+    for line in report(args.test_runs, args.coverage_runs, tuple(args.sizes), args.speed_runs):
         print(line, flush=True)
 
 

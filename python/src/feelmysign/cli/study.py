@@ -29,6 +29,7 @@ from feelmysign.plural import plural
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 
 if TYPE_CHECKING:
+    from feelmysign.study.design import Design
     from feelmysign.study.store import StudyStore
 
 # Checked (not imported) when the parser is built: without them 'study' is listed as not installed.
@@ -138,15 +139,53 @@ def _check(args: argparse.Namespace) -> int:
 
     design = load_design(args.design)
     print(f"{args.design}: valid. {design.name}")
+    speeds = ", ".join(f"{speed:g}" for speed in design.speeds)
+    by_speed = f"{len(design.speeds)} speeds ({speeds} cm/s) x " if design.speed_is_factor else ""
     print(
-        f"  {len(design.shapes)} shapes x {len(design.resolutions)} resolutions x "
+        f"  {len(design.shapes)} shapes x {len(design.resolutions)} resolutions x {by_speed}"
         f"{design.repetitions} repetitions = {design.main_trials} measured trials per participant, "
         f"after {plural(len(design.practice), 'practice trial')}; order: {design.randomisation}"
     )
     for shape in design.shapes:
         strokes = ", ".join(str(level.strokes) for level in shape.levels)
         print(f"  {shape.name:<10} strokes {strokes}; synonyms: {', '.join(shape.synonyms)}")
+    if design.speed_is_factor:
+        practice = [f"{p.shape} at {design.practice_speed_cm_s(p):g} cm/s" for p in design.practice]
+        if practice:
+            print(f"  practice: {', '.join(practice)}")
+    print(_session_length(design, args.design))
     return 0
+
+
+SECONDS_PER_ANSWER = 12.0  # asking, the answer typed and recorded: an assumption, not measured
+
+
+def _session_length(design: Design, path: Path) -> str:
+    """How long one participant's trials take: the shapes' drawing time (exact) and an
+    assumed time per answer."""
+    from feelmysign.study.order import participant_order
+    from feelmysign.study.stimulus import trial_strokes
+
+    base_dir = path.resolve().parent
+    drawn_ms = 0.0
+    trials = participant_order(design, 0)
+    for trial in trials:
+        strokes = trial_strokes(
+            design,
+            base_dir,
+            trial.shape,
+            level=trial.level,
+            segments=trial.segments,
+            drawing="-",
+            speed_cm_s=trial.speed_cm_s,
+        )
+        drawn_ms += sum(stroke.duration_ms for stroke in strokes)
+    total_s = drawn_ms / 1000 + SECONDS_PER_ANSWER * len(trials)
+    return (
+        f"  session: {plural(len(trials), 'trial')}, {drawn_ms / 60000:.1f} min of drawing; "
+        f"about {total_s / 60:.0f} min with {SECONDS_PER_ANSWER:g} s per answer (an assumption), "
+        "before the comfort check, the questionnaire and any pause"
+    )
 
 
 def _new(args: argparse.Namespace) -> int:
@@ -278,6 +317,10 @@ def _analyse(args: argparse.Namespace) -> int:
         from feelmysign.study.analysis.report import shape_test_sentence
 
         print(shape_test_sentence(analysis.model.test))
+        if analysis.model.speed_test is not None:
+            from feelmysign.study.analysis.report import speed_test_sentence
+
+            print(speed_test_sentence(analysis.model.speed_test))
     for path in analysis.files:
         print(path)
     return 0

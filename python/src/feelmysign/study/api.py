@@ -133,6 +133,7 @@ class StudyApi:
             "file": str(self.store.path),
             "shapes": list(design.shape_names),
             "resolutions": list(design.resolutions),
+            "speeds_cm_s": list(design.speeds),
             "comfort": list(design.comfort),
             "questionnaire": {
                 "items": list(design.questionnaire.items),

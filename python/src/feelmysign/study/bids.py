@@ -18,6 +18,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from feelmysign.study.design import Design
 from feelmysign.study.store import StudyStore
 
 BIDS_VERSION = "1.9.0"
@@ -35,6 +36,14 @@ COLUMNS: dict[str, dict[str, Any]] = {
     "resolution": {"Description": "The resolution's label in the design, coarse to fine."},
     "level": {"Description": "The resolution's index in the design, from 1 (coarsest)."},
     "segments": {"Description": "Straight strokes the shape was sent as.", "Units": "strokes"},
+    # Only in a design with speed as a factor (beh_columns).
+    "speed_cm_s": {
+        "Description": (
+            "Drawing speed of the trial: every stroke lasts its length on the sleeve at this "
+            "speed (a factor of the design, crossed with shape, resolution and repetition)."
+        ),
+        "Units": "cm/s",
+    },
     "answer": {"Description": "The participant's free answer, as typed by the researcher."},
     "felt_nothing": {
         "Description": "The participant felt nothing.",
@@ -87,6 +96,15 @@ COLUMNS: dict[str, dict[str, Any]] = {
         "Levels": {"0": "a person", "1": "simulated"},
     },
 }
+
+
+def beh_columns(design: Design) -> dict[str, dict[str, Any]]:
+    """The _beh.tsv's columns, as ``COLUMNS``: speed_cm_s only when speed is a factor of the
+    design (a design of one speed gives it in the task description)."""
+    if design.speed_is_factor:
+        return COLUMNS
+    return {name: column for name, column in COLUMNS.items() if name != "speed_cm_s"}
+
 
 PARTICIPANT_COLUMNS: dict[str, dict[str, Any]] = {
     "participant_id": {"Description": "sub-<number>: P<number> in the study's other files."},
@@ -144,10 +162,11 @@ def export_bids(store: StudyStore, rows: list[dict[str, Any]], out_dir: Path) ->
         folder.mkdir(parents=True, exist_ok=True)
         stem = f"{subject(label)}_task-{TASK}_beh"
         table = [{**r, "response_time": r["response_time_s"]} for r in group]
-        _write_tsv(folder / f"{stem}.tsv", table, list(COLUMNS))
+        columns = beh_columns(store.design)
+        _write_tsv(folder / f"{stem}.tsv", table, list(columns))
         _write_json(
             folder / f"{stem}.json",
-            {"TaskName": TASK, "TaskDescription": _task(store), **COLUMNS},
+            {"TaskName": TASK, "TaskDescription": _task(store), **columns},
         )
         written += [folder / f"{stem}.tsv", folder / f"{stem}.json"]
     return written
@@ -155,9 +174,12 @@ def export_bids(store: StudyStore, rows: list[dict[str, Any]], out_dir: Path) ->
 
 def _task(store: StudyStore) -> str:
     design = store.design
+    speeds = ", ".join(f"{speed:g}" for speed in design.speeds)
+    at_speeds = f" x {len(design.speeds)} drawing speeds ({speeds} cm/s)"
     return (
         f"{design.name}: shapes drawn on the forearm by a grid of vibration motors, each at "
-        f"{len(design.resolutions)} resolutions ({', '.join(design.resolutions)}) x "
+        f"{len(design.resolutions)} resolutions ({', '.join(design.resolutions)})"
+        f"{at_speeds if design.speed_is_factor else ''} x "
         f"{design.repetitions} repetitions; the participant names each shape freely, and the "
         "answers are coded to shapes by synonyms or the researcher's blind review."
     )

@@ -49,6 +49,7 @@ class PracticeTrial:
     shape: str
     segments: int
     level: int | None = None
+    speed_cm_s: float | None = None  # its own speed; None: the design's first speed
 
 
 @dataclass(frozen=True)
@@ -62,12 +63,23 @@ class Questionnaire:
 
 @dataclass(frozen=True)
 class Stimulus:
-    """How every shape is drawn on the sleeve."""
+    """How every shape is drawn on the sleeve.
+
+    ``speed_cm_s`` is the design's one speed, or the first of ``speeds_cm_s`` when speed is a
+    factor of the design (two or more speeds, each crossed with shape x resolution x
+    repetition; empty when there is one speed).
+    """
 
     speed_cm_s: float
     margin: float
     intensity: float | None  # None: the sleeve's default
     layout: str | None  # a sleeve layout file; None: the paper's sleeve
+    speeds_cm_s: tuple[float, ...] = ()
+
+    @property
+    def speeds(self) -> tuple[float, ...]:
+        """Every speed of the design, in the order listed (one for a design of one speed)."""
+        return self.speeds_cm_s or (self.speed_cm_s,)
 
 
 @dataclass(frozen=True)
@@ -120,10 +132,33 @@ class Design:
         return tuple(s.name for s in self.shapes)
 
     @property
+    def speeds(self) -> tuple[float, ...]:
+        return self.stimulus.speeds
+
+    @property
+    def speed_is_factor(self) -> bool:
+        """Two or more speeds, crossed with the other factors: trials, exports and the
+        analysis then carry each trial's speed."""
+        return len(self.stimulus.speeds) > 1
+
+    @property
     def main_trials(self) -> int:
-        return len(self.shapes) * len(self.resolutions) * self.repetitions
+        return len(self.shapes) * len(self.resolutions) * len(self.speeds) * self.repetitions
+
+    def practice_speed_cm_s(self, practice: PracticeTrial) -> float:
+        return self.speeds[0] if practice.speed_cm_s is None else practice.speed_cm_s
 
     def to_json(self) -> dict[str, Any]:
+        """The design as exported (design.json): ``stimulus.speed_cm_s`` one number, or the
+        list of speeds as the design file gives it; a practice trial's speed when it has one
+        of its own."""
         data = asdict(self)
         data.pop("source")
+        stimulus = data["stimulus"]
+        speeds = stimulus.pop("speeds_cm_s")
+        if speeds:
+            stimulus["speed_cm_s"] = list(speeds)
+        for practice in data["practice"]:
+            if practice["speed_cm_s"] is None:
+                del practice["speed_cm_s"]
         return data

@@ -10,13 +10,15 @@ shapes.
 from __future__ import annotations
 
 import uuid
+from collections.abc import Callable
+from functools import partial
 from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
 from feelmysign.errors import DesignError, FeelMySignError
 from feelmysign.input_files import MAX_DESIGN_BYTES, read_text
-from feelmysign.layout import loads_toml
+from feelmysign.layout import Layout, loads_toml
 from feelmysign.shapes import SHAPES
 from feelmysign.simplify.registry import ALGORITHMS
 from feelmysign.study.coding import normalise
@@ -33,13 +35,15 @@ from feelmysign.study.design import (
     ThresholdDimension,
 )
 from feelmysign.study.problems import MISSING, Problems
-from feelmysign.study.stimulus import recorded_strokes, stimulus_layout
+from feelmysign.study.stimulus import at_speed, library_strokes, recorded_strokes, stimulus_layout
 from feelmysign.study.threshold import check_fits
 
 MAX_SHAPES = 24
 MAX_LEVELS = 12
 MAX_REPETITIONS = 20
 MAX_LIKERT_POINTS = 11
+MAX_SPEEDS = 8
+SPEED_RANGE_CM_S = (0.5, 50.0)
 _TOP = ("study", "stimulus", "shapes", "practice", "comfort", "questionnaire", "threshold")
 _STUDY = ("name", "seed", "randomisation", "repetitions", "resolutions", "criterion", "guess_rate")
 
@@ -84,7 +88,9 @@ def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path("
         or 1,
         resolutions=resolutions,
         shapes=shapes,
-        practice=_practice(problems, data.get("practice", []), shapes, resolutions),
+        practice=_practice(
+            problems, data.get("practice", []), shapes, resolutions, stimulus, base_dir
+        ),
         questionnaire=_questionnaire(problems, data.get("questionnaire", MISSING)),
         comfort=_comfort(problems, data.get("comfort", {})),
         stimulus=stimulus,
@@ -120,31 +126,71 @@ def _randomisation(problems: Problems, value: Any) -> Randomisation:
 def _stimulus(problems: Problems, value: Any, base_dir: Path) -> Stimulus:
     table = problems.table("stimulus", value)
     problems.unknown("stimulus", table, ("speed_cm_s", "margin", "intensity", "layout"))
-    speed_value = table.get("speed_cm_s", 5.0)
-    if isinstance(speed_value, list):
-        # Speed is not a factor of the design (trials, orders and the analysis vary shape and
-        # resolution only): say how to compare speeds instead.
-        problems.add(
-            "stimulus.speed_cm_s",
-            f"must be one number from 0.5 to 50; got a list of {len(speed_value)}. A study "
-            "plays every shape at one speed: to compare speeds, make one design file per "
-            "speed (copies that differ only in speed_cm_s) and a study file from each",
-        )
-        speed = None
-    else:
-        speed = problems.number("stimulus.speed_cm_s", speed_value, 0.5, 50.0)
+    speeds = _speeds(problems, table.get("speed_cm_s", 5.0)) or (5.0,)
     margin = problems.number("stimulus.margin", table.get("margin", 0.0), 0.0, 1.0)
     intensity = problems.number(
         "stimulus.intensity", table.get("intensity", MISSING), 0.05, 1.0, required=False
     )
     layout = problems.text("stimulus.layout", table.get("layout", MISSING), required=False)
-    stimulus = Stimulus(speed or 5.0, margin or 0.0, intensity, layout)
+    # One speed is the design's speed; a list of two or more makes speed a factor.
+    factor = speeds if len(speeds) > 1 else ()
+    stimulus = Stimulus(speeds[0], margin or 0.0, intensity, layout, factor)
     try:
         stimulus_layout(stimulus, base_dir)
     except FeelMySignError as error:
         problems.add("stimulus.layout", str(error))
-        return Stimulus(stimulus.speed_cm_s, stimulus.margin, intensity, None)
+        return Stimulus(stimulus.speed_cm_s, stimulus.margin, intensity, None, factor)
     return stimulus
+
+
+def _speeds(problems: Problems, value: Any) -> tuple[float, ...] | None:
+    """``speed_cm_s``: one number, or a list of different speeds (speed as a factor)."""
+    key = "stimulus.speed_cm_s"
+    low, high = SPEED_RANGE_CM_S
+    if not isinstance(value, list):
+        speed = problems.number(key, value, low, high)
+        return None if speed is None else (speed,)
+    example = (
+        f"one number from {low:g} to {high:g} cm/s, or a list of different ones (e.g. [3, 6, 12])"
+    )
+    if not value:
+        problems.add(key, f"the list is empty; give {example}")
+        return None
+    if len(value) > MAX_SPEEDS:
+        problems.add(
+            key,
+            f"at most {MAX_SPEEDS} speeds; got {len(value)}: each speed plays every shape x "
+            "resolution x repetition again; keep the speeds the question needs",
+        )
+        return None
+    speeds = [problems.number(f"{key}[{i}]", v, low, high) for i, v in enumerate(value)]
+    if any(speed is None for speed in speeds):
+        return None
+    found = [float(speed) for speed in speeds if speed is not None]
+    twice = sorted({speed for speed in found if found.count(speed) > 1})
+    if twice:
+        shown = ", ".join(f"{speed:g}" for speed in twice)
+        problems.add(
+            key,
+            f"each speed once; {shown} cm/s is listed more than once in {value!r}: remove the "
+            "copies (study.repetitions says how often each condition is played)",
+        )
+        return None
+    return tuple(found)
+
+
+def _drawable(
+    problems: Problems, where: str, speeds: tuple[float, ...], make: Callable[[float], object]
+) -> bool:
+    """``make(speed)`` gives strokes the sleeve plays at every speed of ``speeds``: a slow speed
+    can make a stroke last longer than the sleeve allows. One problem per level."""
+    for speed in speeds:
+        try:
+            make(speed)
+        except FeelMySignError as error:
+            problems.add(where, f"at {speed:g} cm/s: {error}; or give a faster speed")
+            return False
+    return True
 
 
 def _shapes(
@@ -179,6 +225,10 @@ def _shape(
     recording = problems.text(f"{key}.recording", table.get("recording", MISSING), required=False)
     if recording is None:
         found = _library_levels(problems, key, name, table.get("segments", MISSING), levels)
+        if found is not None and not _library_drawable(
+            problems, key, name, found, stimulus, base_dir
+        ):
+            return None
     else:
         found = _recorded_levels(problems, key, table, recording, levels, stimulus, base_dir)
     if found is not None and not _coarse_to_fine(problems, key, recording, found):
@@ -209,6 +259,35 @@ def _coarse_to_fine(
             "coarsest to finest and change any that give the same count",
         )
     return False
+
+
+def _library_drawable(
+    problems: Problems,
+    key: str,
+    name: str,
+    levels: tuple[Level, ...],
+    stimulus: Stimulus,
+    base_dir: Path,
+) -> bool:
+    layout = _layout_or_none(stimulus, base_dir)
+    if layout is None:
+        return True  # the layout's own problem is reported
+    return all(
+        _drawable(
+            problems,
+            f"{key}.segments[{i}]",
+            stimulus.speeds,
+            partial(library_strokes, name, level.strokes, stimulus, layout, "-"),
+        )
+        for i, level in enumerate(levels)
+    )
+
+
+def _layout_or_none(stimulus: Stimulus, base_dir: Path) -> Layout | None:
+    try:
+        return stimulus_layout(stimulus, base_dir)
+    except FeelMySignError:
+        return None
 
 
 def _library_levels(
@@ -280,6 +359,10 @@ def _recorded_levels(
         except FeelMySignError as error:
             problems.add(where, str(error))
             return None
+        # Speed a factor: the drawing is redrawn at each speed (stimulus.trial_strokes).
+        speeds = stimulus.speeds_cm_s
+        if not _drawable(problems, where, speeds, partial(at_speed, strokes, layout=layout)):
+            return None
         out.append(Level(len(strokes), simplifier=simplifier, settings=dict(overrides)))
     return tuple(out)
 
@@ -308,22 +391,32 @@ def _check_names_and_synonyms(problems: Problems, shapes: list[Shape]) -> None:
 
 
 def _practice(
-    problems: Problems, value: Any, shapes: tuple[Shape, ...], resolutions: tuple[str, ...]
+    problems: Problems,
+    value: Any,
+    shapes: tuple[Shape, ...],
+    resolutions: tuple[str, ...],
+    stimulus: Stimulus,
+    base_dir: Path,
 ) -> tuple[PracticeTrial, ...]:
-    """Library shapes at ``segments``, or the design's recorded drawings at ``resolution``."""
+    """Library shapes at ``segments``, or the design's recorded drawings at ``resolution``; at
+    their own ``speed_cm_s``, or the design's first speed."""
     recorded = {shape.name: shape for shape in shapes if shape.recording is not None}
     items = problems.array("practice", value, required=False) or []
+    layout = _layout_or_none(stimulus, base_dir)
     out = []
     for index, item in enumerate(items):
         key = f"practice[{index}]"
         table = problems.table(key, item, required=True)
-        problems.unknown(key, table, ("shape", "segments", "resolution"))
+        problems.unknown(key, table, ("shape", "segments", "resolution", "speed_cm_s"))
         names = (*SHAPES, *recorded)
         name = problems.choice(f"{key}.shape", table.get("shape", MISSING), names, "")
-        if not name:
+        own = table.get("speed_cm_s", MISSING)
+        speed = problems.number(f"{key}.speed_cm_s", own, *SPEED_RANGE_CM_S, required=False)
+        if not name or (own is not MISSING and speed is None):
             if name == "":
                 problems.add(f"{key}.shape", f"missing; give one of {', '.join(names)}")
             continue
+        played_at = stimulus.speed_cm_s if speed is None else speed
         if name in recorded:
             if "segments" in table:
                 problems.add(
@@ -337,7 +430,17 @@ def _practice(
                 problems.add(f"{key}.resolution", f"one of {', '.join(resolutions)}; got {label!r}")
                 continue
             level = resolutions.index(label)
-            out.append(PracticeTrial(name, recorded[name].levels[level].strokes, level))
+            chosen = recorded[name].levels[level]
+            if speed is not None and layout is not None and chosen.simplifier is not None:
+                # Its own speed: the drawing is redrawn at it (stimulus.trial_strokes).
+                path = base_dir / str(recorded[name].recording)
+                strokes = recorded_strokes(
+                    path, chosen.simplifier, chosen.settings, stimulus, layout, "-"
+                )
+                redrawn = partial(at_speed, strokes, layout=layout)
+                if not _drawable(problems, f"{key}.speed_cm_s", (speed,), redrawn):
+                    continue
+            out.append(PracticeTrial(name, chosen.strokes, level, speed))
             continue
         if "resolution" in table:
             problems.add(
@@ -354,7 +457,14 @@ def _practice(
         ):
             problems.add(f"{key}.segments", f"a {name} takes {spec.allowed()}; got {segments!r}")
             continue
-        out.append(PracticeTrial(name, segments))
+        if layout is not None and not _drawable(
+            problems,
+            f"{key}.segments" if speed is None else f"{key}.speed_cm_s",
+            (played_at,),
+            partial(library_strokes, name, segments, stimulus, layout, "-"),
+        ):
+            continue
+        out.append(PracticeTrial(name, segments, None, speed))
     return tuple(out)
 
 

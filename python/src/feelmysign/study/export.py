@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from feelmysign.study.bids import export_bids
+from feelmysign.study.design import Design
 from feelmysign.study.runner import events_summary
 from feelmysign.study.store import StudyStore
 
@@ -45,6 +46,19 @@ TRIAL_COLUMNS = (
     "felt_duration_ms",
     "response_time_s",
 )
+
+
+SPEED_COLUMN = "speed_cm_s"
+
+
+def trial_columns(design: Design) -> tuple[str, ...]:
+    """trials.csv's columns: with speed as a factor of the design, each trial's speed after its
+    segments (a design of one speed keeps the columns it always had; its speed is in
+    design.json)."""
+    if not design.speed_is_factor:
+        return TRIAL_COLUMNS
+    at = TRIAL_COLUMNS.index("segments") + 1
+    return (*TRIAL_COLUMNS[:at], SPEED_COLUMN, *TRIAL_COLUMNS[at:])
 
 
 def anonymous_labels(store: StudyStore) -> dict[str, str]:
@@ -82,6 +96,7 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
             # From the send the answer follows (a repeat send restarts the clock; so does a
             # restart of the session, which sends again).
             last_sent = sends[-1]["sent_at_ms"] if sends else trial["answered_at_ms"]
+            speed = {} if not design.speed_is_factor else {SPEED_COLUMN: trial["speed_cm_s"]}
             out.append(
                 {
                     "participant": labels[participant["code"]],
@@ -93,6 +108,7 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                     "resolution": "" if level is None else design.resolutions[level],
                     "level": "" if level is None else level + 1,
                     "segments": trial["segments"],
+                    **speed,
                     "answer": trial["answer"],
                     "felt_nothing": trial["felt_nothing"],
                     "confidence": "" if trial["confidence"] is None else trial["confidence"],
@@ -190,7 +206,7 @@ def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
     ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {
-        "trials.csv": (trial_rows(store), TRIAL_COLUMNS),
+        "trials.csv": (trial_rows(store), trial_columns(store.design)),
         "questionnaire.csv": (questionnaire_rows(store), ("participant", "item", "text", "value")),
         "comfort.csv": (comfort_rows(store), COMFORT_COLUMNS),
         "threshold.csv": (

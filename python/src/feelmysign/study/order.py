@@ -1,10 +1,11 @@
-"""The order of one participant's trials: practice first, then every shape x resolution once per
-repetition block, balanced across participants and reproducible from the study's seed.
+"""The order of one participant's trials: practice first, then every shape x resolution (x speed,
+when the design lists several) once per repetition block, balanced across participants and
+reproducible from the study's seed.
 
 Two schemes (``[study] randomisation``):
 
 - ``latin-square``: a balanced Latin square (Williams 1949) over the N = shapes x
-  resolutions conditions. Participant p's block r follows row (p x R + r) mod N,
+  resolutions (x speeds) conditions. Participant p's block r follows row (p x R + r) mod N,
   so over N/R participants every condition appears equally often at every
   position, and follows every other condition equally often (first-order
   carry-over balanced; for odd N the square and its mirror are alternated).
@@ -30,6 +31,9 @@ class PlannedTrial:
     shape: str
     level: int | None  # index into the shape's levels; None for a library practice shape
     segments: int  # strokes the trial sends (a recording's: what its simplifier gives)
+    # cm/s the shape is drawn at; None: a recorded drawing at its own (the hand's) timing, in a
+    # design of one speed
+    speed_cm_s: float | None = None
 
 
 def williams_rows(n: int) -> list[list[int]]:
@@ -53,12 +57,25 @@ def williams_rows(n: int) -> list[list[int]]:
 
 def participant_order(design: Design, number: int) -> list[PlannedTrial]:
     """Every trial of participant ``number`` (0 for the first one added), in order."""
+    # Speed innermost: with one speed the conditions, and so every order, are those of a
+    # design without speed as a factor.
     conditions = [
-        (shape.name, level, shape.levels[level].strokes)
+        (shape.name, level, shape.levels[level].strokes, _speed(design, shape.name, speed))
         for shape in design.shapes
         for level in range(len(design.resolutions))
+        for speed in design.speeds
     ]
-    trials = [PlannedTrial("practice", 0, p.shape, p.level, p.segments) for p in design.practice]
+    trials = [
+        PlannedTrial(
+            "practice",
+            0,
+            p.shape,
+            p.level,
+            p.segments,
+            p.speed_cm_s if p.speed_cm_s is not None else _speed(design, p.shape, design.speeds[0]),
+        )
+        for p in design.practice
+    ]
     rng = random.Random(f"{design.seed}:{number}")
     rows = williams_rows(len(conditions))
     for repetition in range(1, design.repetitions + 1):
@@ -68,5 +85,12 @@ def participant_order(design: Design, number: int) -> list[PlannedTrial]:
         else:
             block = list(conditions)
             rng.shuffle(block)
-        trials += [PlannedTrial("main", repetition, s, lv, n) for s, lv, n in block]
+        trials += [PlannedTrial("main", repetition, s, lv, n, v) for s, lv, n, v in block]
     return trials
+
+
+def _speed(design: Design, shape: str, speed: float) -> float | None:
+    """A trial's speed; None for a recorded drawing in a design of one speed, which keeps the
+    timing it was recorded with (``stimulus.trial_strokes``)."""
+    recorded = any(s.name == shape and s.recording is not None for s in design.shapes)
+    return None if recorded and not design.speed_is_factor else speed

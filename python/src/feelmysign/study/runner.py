@@ -162,6 +162,8 @@ class Session:
             "shape": trial["shape"],
             "resolution": None if level is None else design.resolutions[level],
             "segments": trial["segments"],
+            # cm/s the shape is drawn at; None: a recorded drawing at its own timing
+            "speed_cm_s": trial["speed_cm_s"],
             "sends": len(sends),
             "last_send": last,
         }
@@ -198,6 +200,7 @@ class Session:
             segments=trial["segments"],
             drawing=drawing,
             layout=self.layout,
+            speed_cm_s=trial["speed_cm_s"],
         )
 
     def send(self, code: str, trial_id: int | None = None) -> dict[str, Any]:

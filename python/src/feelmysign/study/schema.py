@@ -6,11 +6,21 @@ answer is a new ``codings`` row, so every decision is kept with its time.
 
 from __future__ import annotations
 
-SCHEMA_VERSION = 2
-# Version 1 had no ``threshold_runs.simulated``; such a file is migrated when opened, after a
-# backup (``store.StudyStore``).
+SCHEMA_VERSION = 3
+# A file of an earlier version is migrated when opened, after a backup (``store.StudyStore``),
+# one version at a time. Version 1 had no ``threshold_runs.simulated``; version 2 no
+# ``trials.speed_cm_s`` (its designs had one speed: every trial is given that speed, but a
+# recorded drawing, which played at its own timing, keeps NULL).
+_DESIGN_JSON = "(SELECT value FROM meta WHERE key = 'design_json')"
 MIGRATIONS = {
     1: ("ALTER TABLE threshold_runs ADD COLUMN simulated INTEGER NOT NULL DEFAULT 0",),
+    2: (
+        "ALTER TABLE trials ADD COLUMN speed_cm_s REAL",
+        f"UPDATE trials SET speed_cm_s = json_extract({_DESIGN_JSON}, '$.stimulus.speed_cm_s') "
+        "WHERE shape NOT IN (SELECT json_extract(shape.value, '$.name') "
+        f"FROM json_each({_DESIGN_JSON}, '$.shapes') AS shape "
+        "WHERE json_extract(shape.value, '$.recording') IS NOT NULL)",
+    ),
 }
 
 SCHEMA = """
@@ -40,6 +50,7 @@ CREATE TABLE IF NOT EXISTS trials (
     shape TEXT NOT NULL,
     level INTEGER,                        -- index of the resolution; NULL: library practice
     segments INTEGER NOT NULL,
+    speed_cm_s REAL,                      -- drawn at; NULL: a recording at its own timing
     answer TEXT,
     felt_nothing INTEGER,
     confidence INTEGER,

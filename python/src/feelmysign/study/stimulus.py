@@ -30,12 +30,19 @@ def stimulus_layout(stimulus: Stimulus, base_dir: Path) -> Layout:
 
 
 def library_strokes(
-    name: str, segments: int, stimulus: Stimulus, layout: Layout, drawing: str
+    name: str,
+    segments: int,
+    stimulus: Stimulus,
+    layout: Layout,
+    drawing: str,
+    speed_cm_s: float | None = None,
 ) -> list[Stroke]:
-    """A library shape of ``segments`` strokes, drawn at the design's speed."""
+    """A library shape of ``segments`` strokes, drawn at ``speed_cm_s`` (default: the
+    design's first speed)."""
+    speed = stimulus.speed_cm_s if speed_cm_s is None else speed_cm_s
     unit = shape_strokes(name, layout=layout, segments=segments, margin=stimulus.margin)
     length_cm = sum(s.length for s in unit) * layout.spacing_cm
-    duration_ms = length_cm / stimulus.speed_cm_s * 1000.0
+    duration_ms = length_cm / speed * 1000.0
     return shape_strokes(
         name,
         layout=layout,
@@ -92,6 +99,24 @@ def recorded_strokes(
     return strokes
 
 
+def at_speed(
+    strokes: list[Stroke], speed_cm_s: float, layout: Layout, where: str = "stroke"
+) -> list[Stroke]:
+    """A recorded drawing's strokes redrawn at ``speed_cm_s``: the same path, each stroke
+    lasting its length at that speed (a stroke of no length, a point, keeps its duration:
+    it has no speed). ParameterError when the sleeve could not play one at that speed."""
+    out: list[Stroke] = []
+    for stroke in strokes:
+        length_cm = stroke.length * layout.spacing_cm
+        if length_cm > 0:
+            stroke = replace(stroke, duration_ms=round(length_cm / speed_cm_s * 1000.0, 3))
+        checked = validate_stroke(stroke, layout)
+        if isinstance(checked, Rejected):
+            raise checked.as_error(f"{where} {len(out) + 1} at {speed_cm_s:g} cm/s")
+        out.append(checked)
+    return out
+
+
 def trial_strokes(
     design: Design,
     base_dir: Path,
@@ -101,18 +126,24 @@ def trial_strokes(
     segments: int | None,
     drawing: str,
     layout: Layout | None = None,
+    speed_cm_s: float | None = None,
 ) -> list[Stroke]:
     """The strokes of a trial: a design shape at ``level``, or a library shape at ``segments``
-    (practice trials)."""
+    (practice trials), at the trial's speed.
+
+    ``speed_cm_s`` None: a library shape at the design's first speed, a recorded drawing at
+    its own (the hand's) timing, as a design of one speed plays it. A recorded drawing with a
+    speed (speed a factor of the design, or a practice trial's own) is redrawn at it.
+    """
     sleeve = layout or stimulus_layout(design.stimulus, base_dir)
     if level is None:
         assert segments is not None
-        return library_strokes(shape_name, segments, design.stimulus, sleeve, drawing)
+        return library_strokes(shape_name, segments, design.stimulus, sleeve, drawing, speed_cm_s)
     shape = design.shape(shape_name)
     chosen = shape.levels[level]
     if shape.recording is not None:
         assert chosen.simplifier is not None
-        return recorded_strokes(
+        strokes = recorded_strokes(
             base_dir / shape.recording,
             chosen.simplifier,
             chosen.settings,
@@ -120,5 +151,10 @@ def trial_strokes(
             sleeve,
             drawing,
         )
+        if speed_cm_s is None:
+            return strokes
+        return at_speed(strokes, speed_cm_s, sleeve, f"{shape.recording}: stroke")
     assert chosen.segments is not None
-    return library_strokes(shape_name, chosen.segments, design.stimulus, sleeve, drawing)
+    return library_strokes(
+        shape_name, chosen.segments, design.stimulus, sleeve, drawing, speed_cm_s
+    )

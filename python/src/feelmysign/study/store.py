@@ -186,7 +186,7 @@ class StudyStore:
             for position, trial in enumerate(participant_order(self.design, number)):
                 db.execute(
                     "INSERT INTO trials (participant, position, block, repetition, shape, level, "
-                    "segments) VALUES (?,?,?,?,?,?,?)",
+                    "segments, speed_cm_s) VALUES (?,?,?,?,?,?,?,?)",
                     (
                         code,
                         position,
@@ -195,6 +195,7 @@ class StudyStore:
                         trial.shape,
                         trial.level,
                         trial.segments,
+                        trial.speed_cm_s,
                     ),
                 )
         return code

@@ -45,9 +45,11 @@ def _session(store: StudyStore, settings: BrokerSettings, participant: str | Non
         while session.step(code) == "trial":
             trial = session.state(code)["trial"]
             what = trial["resolution"] or "practice"
+            speed = trial["speed_cm_s"]
+            at = f", {speed:g} cm/s" if design.speed_is_factor and speed is not None else ""
             print(
                 f"Trial {trial['number']}/{trial['total']}: {trial['shape']}, {what}, "
-                f"{_plural(trial['segments'], 'stroke')}"
+                f"{_plural(trial['segments'], 'stroke')}{at}"
             )
             input("  Enter sends the shape to the sleeve. ")
             sent = session.send(code)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +30,7 @@ from feelmysign.study.analysis.psychometric import (
 from feelmysign.study.analysis.report import write_report
 from feelmysign.study.analysis.wilson import wilson_interval
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
-from feelmysign.study.export import anonymous_labels, export_study, trial_rows
+from feelmysign.study.export import SPEED_COLUMN, anonymous_labels, export_study, trial_rows
 from feelmysign.study.simulated import simulated_truth
 from feelmysign.study.store import StudyStore
 
@@ -51,6 +51,19 @@ class Analysis:
     per_participant: list[dict[str, Any]]  # one row per participant (anonymised)
     # A dry run's known truth (in-range simulated wearers), None for a study without one.
     simulated_truth: dict[str, Any] | None = None
+    # Speed a factor of the design: its speeds, and for each key of accuracy, thresholds and
+    # needed (then "circle at 3 cm/s") the shape and speed it is of. A design of one speed:
+    # () and the keys are the shapes' names.
+    speeds: tuple[float, ...] = ()
+    cells: dict[str, tuple[str, float | None]] = field(default_factory=dict)
+
+    def shape_of(self, key: str) -> str:
+        return self.cells[key][0] if key in self.cells else key
+
+
+def cell_label(shape: str, speed: float) -> str:
+    """A shape at one speed, as the report, the figures and results.json name it."""
+    return f"{shape} at {speed:g} cm/s"
 
 
 def main_trials(store: StudyStore) -> pd.DataFrame:
@@ -71,15 +84,25 @@ def analyse_study(
         coded["correct"] = coded["correct"].astype(int)
     accuracy: dict[str, list[tuple[int, int, int, float, float]]] = {}
     thresholds: dict[str, Threshold] = {}
+    # Speed a factor: each shape at each speed is read on its own, by the same rules.
+    speeds = design.speeds if design.speed_is_factor else ()
+    cells: dict[str, tuple[str, float | None]] = {}
     for shape in design.shapes:
+        for speed in speeds or (None,):
+            key = shape.name if speed is None else cell_label(shape.name, speed)
+            cells[key] = (shape.name, speed)
+    for key, (name, speed) in cells.items():
+        shape = design.shape(name)
         levels = np.array(sorted({lv.strokes for lv in shape.levels}), dtype=float)
         mine = coded[coded["shape"] == shape.name] if len(coded) else coded
+        if speed is not None and len(mine):
+            mine = mine[mine[SPEED_COLUMN] == speed]
         rows = []
         for strokes in levels:
             at = mine[mine["segments"] == strokes] if len(mine) else mine
             k, n = int(at["correct"].sum()) if len(at) else 0, len(at)
             rows.append((int(strokes), k, n, *wilson_interval(k, n)))
-        accuracy[shape.name] = rows
+        accuracy[key] = rows
         if len(mine) and len(levels) > 1:
             per_participant = [
                 counts_by_level(
@@ -87,7 +110,7 @@ def analyse_study(
                 )
                 for _, group in mine.groupby("participant")
             ]
-            thresholds[shape.name] = threshold_with_interval(
+            thresholds[key] = threshold_with_interval(
                 per_participant,
                 levels,
                 criterion=design.criterion,
@@ -104,7 +127,10 @@ def analyse_study(
         )
     model = None
     if len(coded) and coded["shape"].nunique() > 1:
-        model = shape_differences(coded[["participant", "shape", "segments", "correct"]], seed=seed)
+        columns = ["participant", "shape", "segments", "correct"]
+        if speeds:
+            columns.append(SPEED_COLUMN)
+        model = shape_differences(coded[columns].rename(columns={SPEED_COLUMN: "speed"}), seed=seed)
     participants = store.participants()
     analysis = Analysis(
         participants=int(frame["participant"].nunique()) if len(frame) else 0,
@@ -118,10 +144,17 @@ def analyse_study(
         criterion=design.criterion,
         files=files,
         threshold_runs=threshold_summaries(store),
-        per_participant=participant_table(frame, [s.name for s in design.shapes]),
+        per_participant=participant_table(frame, [s.name for s in design.shapes], speeds),
         simulated_truth=_truth_with_labels(store),
+        speeds=speeds,
+        cells=cells if speeds else {},
     )
-    files.append(accuracy_plot(out_dir / "accuracy.png", accuracy, thresholds, design.criterion))
+    panels = {f"{speed:g} cm/s": [k for k, c in cells.items() if c[1] == speed] for speed in speeds}
+    files.append(
+        accuracy_plot(
+            out_dir / "accuracy.png", accuracy, thresholds, design.criterion, panels or None
+        )
+    )
     if needed:
         path = out_dir / "needed-resolution.png"
         files.append(threshold_plot(path, needed, design.criterion))
@@ -140,9 +173,11 @@ def _truth_with_labels(store: StudyStore) -> dict[str, Any] | None:
     return truth | {"participants": named}
 
 
-def participant_table(frame: pd.DataFrame, shapes: list[str]) -> list[dict[str, Any]]:
+def participant_table(
+    frame: pd.DataFrame, shapes: list[str], speeds: tuple[float, ...] = ()
+) -> list[dict[str, Any]]:
     """Per participant: measured trials answered, how many await review, and the correct
-    ones overall and per shape (of the coded ones)."""
+    ones overall and per shape (of the coded ones); per speed too when speed is a factor."""
     if not len(frame):
         return []
     rows = []
@@ -166,6 +201,14 @@ def participant_table(frame: pd.DataFrame, shapes: list[str]) -> list[dict[str, 
                 },
             }
         )
+        if speeds:
+            rows[-1]["by_speed"] = {
+                f"{speed:g}": [
+                    int(correct[coded[SPEED_COLUMN] == speed].sum()),
+                    int((coded[SPEED_COLUMN] == speed).sum()),
+                ]
+                for speed in speeds
+            }
     return rows
 
 
@@ -234,12 +277,34 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
             }
             for shape, needed in analysis.needed.items()
         },
-        "shape_model": asdict(analysis.model) if analysis.model else None,
+        "shape_model": _model_json(analysis),
         "thresholds": analysis.threshold_runs,
         "per_participant": analysis.per_participant,
         # A dry run with in-range simulated wearers: their curves, to compare with the
         # estimates above ("participants": those who answered by it, as labelled above).
         "simulated_truth": analysis.simulated_truth,
     }
+    if analysis.speeds:
+        # Speed a factor: accuracy and needed_strokes are per shape and speed, keyed as the
+        # report names them ("circle at 3 cm/s"); cells says which shape and speed each is.
+        data["speeds_cm_s"] = list(analysis.speeds)
+        data["cells"] = {
+            key: {"shape": shape, "speed_cm_s": speed}
+            for key, (shape, speed) in analysis.cells.items()
+        }
+        for key, entry in data["needed_strokes"].items():
+            entry["shape"], entry["speed_cm_s"] = analysis.cells[key]
     path.write_text(json.dumps(data, indent=2, default=str) + "\n", encoding="utf-8")
     return path
+
+
+def _model_json(analysis: Analysis) -> dict[str, Any] | None:
+    """The shape model; its speed test and effects only when speed is a factor (a design of
+    one speed gives what it always gave)."""
+    if analysis.model is None:
+        return None
+    data = asdict(analysis.model)
+    if not analysis.speeds:
+        for key in ("speed_test", "speed_effects", "reference_speed_cm_s"):
+            del data[key]
+    return data

@@ -32,7 +32,7 @@ from __future__ import annotations
 import itertools
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -48,6 +48,10 @@ NULL_FORMULA = "correct ~ log2_strokes + C(participant)"
 # profiles and their exact negative give the same statistic). With 5 that is 0.0625:
 # the test could never report a difference at the 5% level, so it is not run below 6.
 MIN_PARTICIPANTS = 6
+# The speed test's own minimum: on simulated studies with no speed effect (paper's shapes x 3
+# speeds, 200 each; bench.study_calibration --speed-runs) it found one in 8.5% (5.4 to 13.2)
+# of studies of 8 participants, and in 3.5% of 12.
+MIN_SPEED_PARTICIPANTS = 12
 EXACT_UP_TO = 14  # 2^14 = 16384 flips, every one
 FLIPS = 9999  # random flips above that (the observed one is added: p >= 1 / 10000)
 
@@ -72,6 +76,27 @@ class ShapeTest:
 
 
 @dataclass(frozen=True)
+class SpeedEffect:
+    speed_cm_s: float
+    log_odds: float  # against the first speed of the design, at equal shape and strokes
+    sd: float
+
+
+@dataclass(frozen=True)
+class SpeedTest:
+    """The shape test's method over the speeds (``speed_flip_test``)."""
+
+    method: str
+    participants: int
+    speeds: int
+    statistic: float | None  # squared length of the mean speed profile (accuracy units^2)
+    p: float | None
+    flips: int
+    refused: str | None
+    participants_needed: int
+
+
+@dataclass(frozen=True)
 class ModelResult:
     reference: str
     mixed: list[ShapeEffect]
@@ -79,19 +104,43 @@ class ModelResult:
     slope_per_doubling: float
     test: ShapeTest
     note: str
+    # Speed a factor of the design (a ``speed`` column): its test, and its effects in the
+    # mixed model (which then has speed as a fixed effect too); else None and empty.
+    speed_test: SpeedTest | None = None
+    speed_effects: list[SpeedEffect] = field(default_factory=list)
+    reference_speed_cm_s: float | None = None
 
 
 def shape_differences(frame: pd.DataFrame, *, seed: int = 0) -> ModelResult:
-    """``frame`` has columns participant, shape, segments, correct (0/1), main trials only."""
+    """``frame`` has columns participant, shape, segments, correct (0/1), main trials only;
+    and ``speed`` (cm/s) when speed is a factor of the design."""
     data = frame.assign(log2_strokes=np.log2(frame["segments"].astype(float)))
     data["correct"] = data["correct"].astype(float)
     # The best-recognised shape as reference: the other effects are then how much harder each is.
     reference = str(data.groupby("shape")["correct"].mean().idxmax())
     formula = FORMULA.replace("@reference", repr(reference))
     shapes = sorted(s for s in data["shape"].unique() if s != reference)
+    # Speeds are crossed with shape x strokes within every participant: the shape test's
+    # profiles hold the same mix of speeds for every shape, so it needs no speed term.
     test = sign_flip_test(data, seed=seed)
-    mixed, participant_sd, slope, note = _mixed(formula, data, shapes)
-    return ModelResult(reference, mixed, participant_sd, slope, test, note)
+    if "speed" not in data or data["speed"].nunique() < 2:
+        mixed, participant_sd, slope, note, _ = _mixed(formula, data, shapes)
+        return ModelResult(reference, mixed, participant_sd, slope, test, note)
+    speeds = sorted(float(v) for v in data["speed"].unique())
+    first = speeds[0]
+    formula += f" + C(speed, Treatment(reference={first!r}))"
+    mixed, participant_sd, slope, note, effects = _mixed(formula, data, shapes, speeds[1:])
+    return ModelResult(
+        reference,
+        mixed,
+        participant_sd,
+        slope,
+        test,
+        note,
+        speed_flip_test(data, seed=seed),
+        effects,
+        first,
+    )
 
 
 def null_design(data: pd.DataFrame) -> np.ndarray:
@@ -149,7 +198,14 @@ def sign_flip_test(data: pd.DataFrame, *, seed: int = 0) -> ShapeTest:
             f"= {2 / 2**participants:.3g}, so it could never show a difference"
         )
         return ShapeTest(method, participants, shapes, None, None, 0, reason, MIN_PARTICIPANTS)
-    profile = shape_profiles(data)
+    observed, p, flips = _flip(shape_profiles(data), seed)
+    return ShapeTest(method, participants, shapes, observed, p, flips, None, MIN_PARTICIPANTS)
+
+
+def _flip(profile: np.ndarray, seed: int) -> tuple[float, float, int]:
+    """The statistic (squared length of the mean profile), its p over sign flips of whole
+    participants (rows), and the number of sign patterns counted."""
+    participants = profile.shape[0]
     if participants <= EXACT_UP_TO:
         signs = np.array(list(itertools.product((1.0, -1.0), repeat=participants)))
     else:
@@ -161,12 +217,59 @@ def sign_flip_test(data: pd.DataFrame, *, seed: int = 0) -> ShapeTest:
     # A relative tolerance: sums in another order differ in the last bits.
     p = float(np.mean(statistics >= observed * (1 - 1e-9)))
     assert math.isfinite(observed) and observed >= 0.0
-    return ShapeTest(method, participants, shapes, observed, p, len(signs), None, MIN_PARTICIPANTS)
+    return observed, p, len(signs)
+
+
+def speed_profiles(data: pd.DataFrame) -> np.ndarray:
+    """Per participant (rows) and speed (columns, ascending): the mean of correct minus the
+    accuracy the shape test's speed-free model expects, centred over the speeds.
+
+    Nothing of the model's fit is taken out along the speeds, unlike the shapes' mean
+    log2(strokes): every speed plays the same shapes at the same strokes, so the expected
+    accuracies average alike at every speed and the profile is, to within unclear answers
+    left out, the participant's share correct per speed less their mean over speeds."""
+    if data["correct"].nunique() > 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            glm = sm.GLM(
+                data["correct"].to_numpy(float), null_design(data), family=sm.families.Binomial()
+            ).fit()
+        expected = np.asarray(glm.fittedvalues, dtype=float)
+    else:
+        expected = data["correct"].to_numpy(float)
+    residual = data.assign(residual=data["correct"].to_numpy(float) - expected)
+    table = residual.pivot_table(
+        index="participant", columns="speed", values="residual", aggfunc="mean"
+    )
+    profile = table.to_numpy(float)
+    profile = np.where(np.isnan(profile), np.nanmean(profile, axis=1, keepdims=True), profile)
+    return np.asarray(profile - profile.mean(axis=1, keepdims=True))
+
+
+def speed_flip_test(data: pd.DataFrame, *, seed: int = 0) -> SpeedTest:
+    """Does accuracy differ between speeds at equal shape and strokes? The shape test's
+    sign-flip over participants, with per-speed profiles (``speed_profiles``). With no speed
+    effect a participant's speed profile is as likely as its negative: exactly so with two
+    speeds (their two shares are exchangeable), as for the shapes with more."""
+    participants, speeds = int(data["participant"].nunique()), int(data["speed"].nunique())
+    method = "sign-flip permutation test over participants"
+    needed = MIN_SPEED_PARTICIPANTS
+    if participants < needed:
+        reason = (
+            f"{plural(participants, 'participant')}: the speed test needs at least {needed}; "
+            "with 8, on simulated studies with no speed effect, it found one in 8.5% of them "
+            "(docs/study.md), more than the 5% it should"
+        )
+        return SpeedTest(method, participants, speeds, None, None, 0, reason, needed)
+    observed, p, flips = _flip(speed_profiles(data), seed)
+    return SpeedTest(method, participants, speeds, observed, p, flips, None, needed)
 
 
 def _mixed(
-    formula: str, data: pd.DataFrame, shapes: list[str]
-) -> tuple[list[ShapeEffect], float, float, str]:
+    formula: str, data: pd.DataFrame, shapes: list[str], speeds: list[float] | None = None
+) -> tuple[list[ShapeEffect], float, float, str, list[SpeedEffect]]:
+    """The mixed model's shape effects, participant SD, slope and how it was fitted; and,
+    with ``speeds`` (the design's after its first, a term of ``formula``), their effects."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -175,12 +278,19 @@ def _mixed(
             )
             result = model.fit_vb()
     except Exception as error:  # descriptive only: the report says why it is missing
-        return [], float("nan"), float("nan"), f"mixed model not fitted: {error}"
+        return [], float("nan"), float("nan"), f"mixed model not fitted: {error}", []
     names = list(model.exog_names)
     effects = []
     for shape in shapes:
         index = next(i for i, n in enumerate(names) if n.endswith(f"[T.{shape}]"))
         effects.append(ShapeEffect(shape, float(result.fe_mean[index]), float(result.fe_sd[index])))
+    speed_effects = []
+    for speed in speeds or []:
+        index = next(i for i, n in enumerate(names) if n.endswith(f"[T.{speed!r}]"))
+        speed_effects.append(
+            SpeedEffect(speed, float(result.fe_mean[index]), float(result.fe_sd[index]))
+        )
     slope = float(result.fe_mean[names.index("log2_strokes")])
     participant_sd = float(np.exp(result.vcp_mean[0]))
-    return effects, participant_sd, slope, "mixed model fitted by variational Bayes (fit_vb)"
+    note = "mixed model fitted by variational Bayes (fit_vb)"
+    return effects, participant_sd, slope, note, speed_effects

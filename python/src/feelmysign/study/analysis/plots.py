@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -23,11 +24,41 @@ def accuracy_plot(
     accuracy: dict[str, list[tuple[int, int, int, float, float]]],
     thresholds: dict[str, Threshold],
     criterion: float,
+    panels: dict[str, list[str]] | None = None,
 ) -> Path:
-    """Per shape: points (strokes, share correct) with Wilson bars, and the fitted curve."""
-    figure, axes = plt.subplots(figsize=FIGURE_IN, dpi=DPI)
+    """Per shape: points (strokes, share correct) with Wilson bars, and the fitted curve.
+    ``panels`` (speed a factor): one panel per title ("3 cm/s") holding those keys of
+    ``accuracy`` ("circle at 3 cm/s"), side by side on the same axes."""
+    groups = panels or {"": list(accuracy)}
+    width = FIGURE_IN[0] if len(groups) == 1 else 3.6 * len(groups)
+    figure, all_axes = plt.subplots(
+        1, len(groups), figsize=(width, FIGURE_IN[1]), dpi=DPI, sharey=True, squeeze=False
+    )
+    # The tested range sets the axis, so that a study with no answer yet still has a plot.
+    every = [float(r[0]) for rows in accuracy.values() for r in rows] or [1.0, 2.0]
+    for axes, (title, keys) in zip(all_axes[0], groups.items(), strict=True):
+        _accuracy_panel(axes, {key: accuracy[key] for key in keys}, thresholds, criterion, title)
+        axes.set_xlim(min(every) / 1.2, max(every) * 1.2)
+    all_axes[0][0].set_ylabel("share named correctly")
+    if panels:
+        figure.suptitle("Recognition by resolution and speed (95% Wilson intervals, fitted curves)")
+    else:
+        all_axes[0][0].set_title("Recognition by resolution (95% Wilson intervals, fitted curves)")
+    figure.tight_layout()
+    figure.savefig(path)
+    plt.close(figure)
+    return path
+
+
+def _accuracy_panel(
+    axes: Any,
+    accuracy: dict[str, list[tuple[int, int, int, float, float]]],
+    thresholds: dict[str, Threshold],
+    criterion: float,
+    title: str,
+) -> None:
     colours = plt.get_cmap("tab10")
-    for index, (shape, rows) in enumerate(accuracy.items()):
+    for index, (key, rows) in enumerate(accuracy.items()):
         colour = colours(index % 10)
         strokes = np.array([r[0] for r in rows], dtype=float)
         share = np.array([r[1] / r[2] if r[2] else math.nan for r in rows])
@@ -41,25 +72,18 @@ def accuracy_plot(
             color=colour,
             capsize=2,
             markersize=4,
-            label=shape,
+            label=key.removesuffix(f" at {title}") if title else key,
         )
-        if shape in thresholds and len(strokes) > 1:
+        if key in thresholds and len(strokes) > 1:
             grid = np.geomspace(strokes.min(), strokes.max(), 100)  # the tested range only
-            axes.plot(grid, thresholds[shape].fit.accuracy(grid), color=colour, linewidth=1)
+            axes.plot(grid, thresholds[key].fit.accuracy(grid), color=colour, linewidth=1)
     axes.axhline(criterion, color="grey", linestyle=":", linewidth=1)
-    # The tested range sets the axis, so that a study with no answer yet still has a plot.
-    every = [float(r[0]) for rows in accuracy.values() for r in rows] or [1.0, 2.0]
-    axes.set_xlim(min(every) / 1.2, max(every) * 1.2)
     axes.set_xscale("log", base=2)
     axes.set_xlabel("strokes per shape (log scale)")
-    axes.set_ylabel("share named correctly")
     axes.set_ylim(-0.02, 1.02)
-    axes.set_title("Recognition by resolution (95% Wilson intervals, fitted curves)")
+    if title:
+        axes.set_title(title, fontsize="medium")
     axes.legend(fontsize="small", ncol=2, loc="lower right")
-    figure.tight_layout()
-    figure.savefig(path)
-    plt.close(figure)
-    return path
 
 
 def threshold_plot(path: Path, needed: dict[str, Needed], criterion: float) -> Path:

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.plural import plural
-from feelmysign.study.analysis.models import ShapeTest
+from feelmysign.study.analysis.models import ShapeTest, SpeedTest
 from feelmysign.study.analysis.psychometric import (
     ABOVE,
     AT_OR_BELOW,
@@ -136,14 +136,46 @@ def shape_test_sentence(test: ShapeTest) -> str:
     )
 
 
+def speed_test_sentence(test: SpeedTest) -> str:
+    """What the speed test found, or why there is none."""
+    if test.refused is not None or test.p is None or test.statistic is None:
+        return (
+            f"No test of whether speeds differ is reported: {test.refused}. Run at least "
+            f"{plural(test.participants_needed, 'participant')}."
+        )
+    return (
+        f"Test that speeds differ at equal shape and strokes: {test.method}, as for the shapes "
+        f"({test.participants} participants, {test.speeds} speeds; each participant's mean "
+        "residual per speed against the same speed-free model, centred over speeds; every "
+        "speed plays the same shapes at the same strokes, so nothing else is taken out; "
+        f"statistic: squared length of the mean profile = {test.statistic:.4g}, over "
+        f"{test.flips} sign patterns): {_p(test.p)}."
+    )
+
+
+def _speeds_text(speeds: tuple[float, ...]) -> str:
+    return f"{len(speeds)} speeds ({', '.join(f'{v:g}' for v in speeds)} cm/s)"
+
+
+def _head(analysis: Analysis, key: str) -> str:
+    """The first cells of a row: the shape, and its speed when speed is a factor."""
+    if not analysis.speeds:
+        return key
+    shape, speed = analysis.cells[key]
+    return f"{shape} | {speed:g}"
+
+
 def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     design = store.design
+    by_speed = f"{_speeds_text(analysis.speeds)} x " if analysis.speeds else ""
+    speed_column = " speed (cm/s) |" if analysis.speeds else ""
     lines = [
         f"# {design.name}",
         "",
         f"{plural(analysis.participants, 'participant')} ({analysis.simulated} simulated), "
         f"{analysis.trials} measured trials: {len(design.shapes)} shapes x "
-        f"{len(design.resolutions)} resolutions x {design.repetitions} repetitions, order by "
+        f"{len(design.resolutions)} resolutions x {by_speed}{design.repetitions} repetitions, "
+        "order by "
         f"{design.randomisation} (seed {design.seed}). Answers were free; they were coded to "
         f"shapes by synonyms, unclear ones by the researcher. "
         f"{plural(analysis.unclear, 'answer')} still "
@@ -154,8 +186,8 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "",
         "Share named correctly, with 95% Wilson intervals.",
         "",
-        "| shape | " + " | ".join(design.resolutions) + " |",
-        "|---|" + "---|" * len(design.resolutions),
+        "| shape |" + speed_column + " " + " | ".join(design.resolutions) + " |",
+        "|---|" + "---|" * (len(design.resolutions) + bool(analysis.speeds)),
     ]
     for shape, rows in analysis.accuracy.items():
         cells = [
@@ -164,8 +196,8 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             else "-"
             for strokes, k, n, low, high in rows
         ]
-        lines.append(f"| {shape} | " + " | ".join(cells) + " |")
-    lines += _participant_section(analysis, [shape for shape in analysis.accuracy])
+        lines.append(f"| {_head(analysis, shape)} | " + " | ".join(cells) + " |")
+    lines += _participant_section(analysis, [shape.name for shape in design.shapes])
     lines += [
         "",
         "![accuracy](accuracy.png)",
@@ -186,15 +218,16 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         "correct answers against the fitted curve (about 1 when participants differ only by "
         "chance).",
         "",
-        "| shape | strokes needed | 95% interval | profile likelihood | cluster bootstrap "
-        "| slope per doubling | participants' SD | dispersion |",
-        "|---|---|---|---|---|---|---|---|",
+        "| shape |" + speed_column + " strokes needed | 95% interval | profile likelihood | "
+        "cluster bootstrap | slope per doubling | participants' SD | dispersion |",
+        "|---|---|---|---|---|---|---|---|" + "---|" * bool(analysis.speeds),
     ]
     people = analysis.participants
     for shape, t in analysis.thresholds.items():
         needed = analysis.needed[shape]
         lines.append(
-            f"| {shape} | {needed_text(needed)} | {interval_text(needed.interval)} | "
+            f"| {_head(analysis, shape)} | {needed_text(needed)} | "
+            f"{interval_text(needed.interval)} | "
             f"{interval_text(needed.profile)} | {_cluster_text(needed.cluster, people)} | "
             f"{_slope_text(t.fit.slope)} | {_spread_text(t.population.spread, people)} | "
             f"{_dispersion_text(t.dispersion, people)} |"
@@ -244,6 +277,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
             ]
         else:
             lines.append(f"Mixed-effects model: {model.note}.")
+    lines += _speed_section(analysis)
     lines += _threshold_section(analysis)
     lines += [
         "",
@@ -253,6 +287,40 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     ]
     path.write_text("\n".join(lines), encoding="utf-8")
     return path
+
+
+def _speed_section(analysis: Analysis) -> list[str]:
+    """Speed a factor: its test and its effects in the mixed model (the needed resolution per
+    shape and speed is in the table above)."""
+    if not analysis.speeds:
+        return []
+    lines = [
+        "",
+        "## Does speed matter?",
+        "",
+        f"Every shape was drawn at {_speeds_text(analysis.speeds)}, crossed with shape, "
+        "resolution and repetition and mixed within each block; the tables above read each "
+        "shape at each speed on its own, by the same rules. The shape test above holds the "
+        "same mix of speeds for every shape, so a speed effect does not show in it as a shape "
+        "difference.",
+        "",
+    ]
+    model = analysis.model
+    if model is None or model.speed_test is None:
+        return [*lines, "Not enough data (two shapes with coded answers at least)."]
+    lines.append(speed_test_sentence(model.speed_test))
+    if model.speed_effects:
+        lines += [
+            "",
+            f"Mixed-effects model above, with speed as a fixed effect (descriptive): each "
+            f"speed's log odds of a correct answer against {model.reference_speed_cm_s:g} cm/s "
+            "(the slowest), at equal shape and strokes.",
+            "",
+            f"| speed (cm/s) | log odds vs {model.reference_speed_cm_s:g} cm/s | posterior SD |",
+            "|---|---|---|",
+            *(f"| {e.speed_cm_s:g} | {e.log_odds:.2f} | {e.sd:.2f} |" for e in model.speed_effects),
+        ]
+    return lines
 
 
 def _truth_section(analysis: Analysis) -> list[str]:
@@ -271,43 +339,54 @@ def _truth_section(analysis: Analysis) -> list[str]:
         "|---|---|---|---|---|",
     ]
     # In the design's order; the interval to two decimals, as the truth (6.0 may be 5.96).
-    for shape in [*analysis.accuracy, *(s for s in truth["shapes"] if s not in analysis.accuracy)]:
+    shown = {analysis.shape_of(key) for key in analysis.accuracy}
+    for key in [*analysis.accuracy, *(s for s in truth["shapes"] if s not in shown)]:
+        shape = analysis.shape_of(key)
         if shape not in truth["shapes"]:
             continue
-        needed = analysis.needed.get(shape)
+        needed = analysis.needed.get(key)
         value = float(truth["shapes"][shape]["needed_strokes"])
         if needed is None:
-            lines.append(f"| {shape} | {value:.2f} | - | - | - |")
+            lines.append(f"| {key} | {value:.2f} | - | - | - |")
             continue
         interval = needed.interval
         covers = (interval.low_open or interval.low <= value) and (
             interval.high_open or value <= interval.high
         )
         lines.append(
-            f"| {shape} | {value:.2f} | {needed_text(needed)} | {interval_text(interval, 2)} | "
+            f"| {key} | {value:.2f} | {needed_text(needed)} | {interval_text(interval, 2)} | "
             f"{'yes' if covers else 'no'} |"
         )
+    if analysis.speeds:
+        lines += [
+            "",
+            "The simulated wearers feel no difference between speeds: the same truth holds at "
+            "every speed (docs/study.md).",
+        ]
     return lines
 
 
 def _participant_section(analysis: Analysis, shapes: list[str]) -> list[str]:
     if not analysis.per_participant:
         return []
+    speeds = [f"{speed:g}" for speed in analysis.speeds]
     lines = [
         "",
         "## Per participant",
         "",
         "Measured trials answered, awaiting review, and correct of the coded ones, overall and "
-        "per shape.",
+        "per shape" + (" and per speed (cm/s)." if speeds else "."),
         "",
         "| participant | simulated | trials | awaiting review | correct | "
-        + " | ".join(shapes)
+        + " | ".join([*shapes, *(f"{speed} cm/s" for speed in speeds)])
         + " |",
-        "|---|---|---|---|---|" + "---|" * len(shapes),
+        "|---|---|---|---|---|" + "---|" * (len(shapes) + len(speeds)),
     ]
     for row in analysis.per_participant:
         share = f"{row['correct'] / row['coded']:.0%}" if row["coded"] else "-"
-        cells = [f"{k}/{n}" if n else "-" for k, n in (row["by_shape"][shape] for shape in shapes)]
+        counts = [row["by_shape"][shape] for shape in shapes]
+        counts += [row["by_speed"][speed] for speed in speeds]
+        cells = [f"{k}/{n}" if n else "-" for k, n in counts]
         lines.append(
             f"| {row['participant']} | {'yes' if row['simulated'] else 'no'} | {row['trials']} | "
             f"{row['unclear']} | {row['correct']}/{row['coded']} = {share} | "
