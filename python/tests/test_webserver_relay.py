@@ -18,6 +18,7 @@ import pytest
 from paho.mqtt.enums import CallbackAPIVersion
 
 from feelmysign.broker import Broker
+from feelmysign.broker.tls import TlsFiles, ensure_local_ca
 from feelmysign.webserver import KEY_COOKIE, WebServer
 
 KEY = "relay-test-key"
@@ -33,7 +34,9 @@ def _port(server: WebServer) -> int:
     return int(server.url.rstrip("/").rsplit(":", 1)[1])
 
 
-def _websocket_client(broker: Broker, port: int, role: str) -> tuple[mqtt.Client, list[bytes]]:
+def _websocket_client(
+    broker: Broker, port: int, role: str, tls: TlsFiles | None = None
+) -> tuple[mqtt.Client, list[bytes]]:
     c = broker.credentials
     login = c.sender if role == "sender" else c.sleeve
     client = mqtt.Client(
@@ -41,6 +44,8 @@ def _websocket_client(broker: Broker, port: int, role: str) -> tuple[mqtt.Client
     )
     client.ws_set_options(path="/mqtt", headers={"Cookie": f"{KEY_COOKIE}={KEY}"})
     client.username_pw_set(login.username, login.password)
+    if tls is not None:
+        client.tls_set(ca_certs=str(tls.ca))
     received: list[bytes] = []
     got = threading.Condition()
     connected, subscribed = threading.Event(), threading.Event()
@@ -63,13 +68,18 @@ def _websocket_client(broker: Broker, port: int, role: str) -> tuple[mqtt.Client
     return client, received
 
 
-def test_mqtt_goes_both_ways_through_the_relay(broker: Broker, site: Path) -> None:
+@pytest.mark.parametrize("scheme", ["ws", "wss"])
+def test_mqtt_goes_both_ways_through_the_relay(
+    broker: Broker, site: Path, tmp_path: Path, scheme: str
+) -> None:
+    """Plain, and over TLS as a phone on the LAN reaches it (``feelmysign up --lan``)."""
     c = broker.credentials
+    tls = ensure_local_ca(tmp_path / "tls", ["127.0.0.1"]) if scheme == "wss" else None
     with WebServer(
-        port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=c.ws_port
+        port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=c.ws_port, tls=tls
     ) as server:
-        receiver, received = _websocket_client(broker, _port(server), "sleeve")
-        sender, _ = _websocket_client(broker, _port(server), "sender")
+        receiver, received = _websocket_client(broker, _port(server), "sleeve", tls)
+        sender, _ = _websocket_client(broker, _port(server), "sender", tls)
         try:
             payloads = [os.urandom(n) for n in (1, 125, 126, 3000)]  # each frame length form
             for payload in payloads:
