@@ -879,7 +879,7 @@ class _Upstream(asyncio.Protocol):
         if self._buffer:
             self._page.write(bytes(self._buffer))
             self._buffer.clear()
-        self.transport.set_protocol(_ToPage(self._page, self.transport, self.ended))
+        self.transport.set_protocol(_ToPage(self._page, self.ended))
 
     def connection_lost(self, exc: Exception | None) -> None:
         if not self.head.done():
@@ -899,12 +899,9 @@ class _Upstream(asyncio.Protocol):
 class _ToPage(asyncio.Protocol):
     """The broker's connection: its bytes on to the page as they come."""
 
-    def __init__(
-        self, page: asyncio.Transport, upstream: asyncio.Transport, ended: asyncio.Future[None]
-    ) -> None:
+    def __init__(self, page: asyncio.Transport, ended: asyncio.Future[None]) -> None:
         self.data_received = page.write  # type: ignore[method-assign]
         self._page = page
-        self._upstream = upstream
         self._ended = ended
 
     def pause_writing(self) -> None:  # the broker reads slower than the page sends
