@@ -5,6 +5,7 @@ when the broker's listener is gone."""
 
 from __future__ import annotations
 
+import asyncio
 import base64
 import os
 import socket
@@ -17,6 +18,7 @@ import pytest
 from paho.mqtt.enums import CallbackAPIVersion
 
 from feelmysign.broker import Broker
+from feelmysign.broker.tls import TlsFiles, ensure_local_ca
 from feelmysign.webserver import KEY_COOKIE, WebServer
 
 KEY = "relay-test-key"
@@ -32,7 +34,9 @@ def _port(server: WebServer) -> int:
     return int(server.url.rstrip("/").rsplit(":", 1)[1])
 
 
-def _websocket_client(broker: Broker, port: int, role: str) -> tuple[mqtt.Client, list[bytes]]:
+def _websocket_client(
+    broker: Broker, port: int, role: str, tls: TlsFiles | None = None
+) -> tuple[mqtt.Client, list[bytes]]:
     c = broker.credentials
     login = c.sender if role == "sender" else c.sleeve
     client = mqtt.Client(
@@ -40,6 +44,8 @@ def _websocket_client(broker: Broker, port: int, role: str) -> tuple[mqtt.Client
     )
     client.ws_set_options(path="/mqtt", headers={"Cookie": f"{KEY_COOKIE}={KEY}"})
     client.username_pw_set(login.username, login.password)
+    if tls is not None:
+        client.tls_set(ca_certs=str(tls.ca))
     received: list[bytes] = []
     got = threading.Condition()
     connected, subscribed = threading.Event(), threading.Event()
@@ -62,13 +68,18 @@ def _websocket_client(broker: Broker, port: int, role: str) -> tuple[mqtt.Client
     return client, received
 
 
-def test_mqtt_goes_both_ways_through_the_relay(broker: Broker, site: Path) -> None:
+@pytest.mark.parametrize("scheme", ["ws", "wss"])
+def test_mqtt_goes_both_ways_through_the_relay(
+    broker: Broker, site: Path, tmp_path: Path, scheme: str
+) -> None:
+    """Plain, and over TLS as a phone on the LAN reaches it (``feelmysign up --lan``)."""
     c = broker.credentials
+    tls = ensure_local_ca(tmp_path / "tls", ["127.0.0.1"]) if scheme == "wss" else None
     with WebServer(
-        port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=c.ws_port
+        port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=c.ws_port, tls=tls
     ) as server:
-        receiver, received = _websocket_client(broker, _port(server), "sleeve")
-        sender, _ = _websocket_client(broker, _port(server), "sender")
+        receiver, received = _websocket_client(broker, _port(server), "sleeve", tls)
+        sender, _ = _websocket_client(broker, _port(server), "sender", tls)
         try:
             payloads = [os.urandom(n) for n in (1, 125, 126, 3000)]  # each frame length form
             for payload in payloads:
@@ -141,3 +152,115 @@ def test_a_broker_listener_that_is_gone_gets_502(site: Path) -> None:
         port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=gone_port
     ) as server:
         assert _upgrade(_port(server), f"{KEY_COOKIE}={KEY}").startswith(b"HTTP/1.1 502")
+
+
+def _relay_sockets(server: WebServer, broker_port: int) -> tuple[socket.socket, socket.socket]:
+    """This process's two sockets of the one relayed connection (duplicates, to be closed):
+    the page's (on the server's port) and the relay's to the broker's WebSocket listener."""
+    page = upstream = None
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            sock = socket.socket(fileno=os.dup(int(fd)))
+        except OSError:
+            continue
+        try:
+            local, peer = sock.getsockname(), sock.getpeername()
+        except (OSError, TypeError):
+            sock.close()
+            continue
+        if sock.family == socket.AF_INET and local[1] == _port(server):
+            page = sock
+        elif sock.family == socket.AF_INET and peer[1] == broker_port:
+            upstream = sock
+        else:
+            sock.close()
+    assert page is not None and upstream is not None, "the relay's sockets are not found"
+    return page, upstream
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="lists sockets in /proc")
+def test_the_relay_sends_each_packet_at_once_both_ways(broker: Broker, site: Path) -> None:
+    """TCP_NODELAY on both sockets the relay writes to: a PUBACK or a stroke is not held
+    back by Nagle's algorithm until the previous one's ACK comes."""
+    c = broker.credentials
+    with WebServer(
+        port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=c.ws_port
+    ) as server:
+        client, _ = _websocket_client(broker, _port(server), "sender")
+        try:
+            page, upstream = _relay_sockets(server, c.ws_port)
+            with page, upstream:
+                for sock in (page, upstream):
+                    assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY), sock
+        finally:
+            client.disconnect()
+            client.loop_stop()
+
+
+def test_a_page_that_does_not_read_holds_the_broker_s_bytes_back(
+    broker: Broker, site: Path
+) -> None:
+    """A page that stops reading while the broker sends it megabytes: the relay stops
+    reading from the broker rather than keep them in the page server's memory (the broker
+    holds them, or drops what its own limits drop), and reads again once the page does."""
+    c = broker.credentials
+    count, size = 4000, 4000  # 16 MB, past what the kernel's socket buffers hold on loopback
+    topic = f"feelmysign/{c.sleeve_id}/strokes"
+    with WebServer(
+        port=0, config={}, directory=site, access_key=KEY, mqtt_ws_port=c.ws_port
+    ) as server:
+
+        def relay_state() -> tuple[int, bool]:
+            """(bytes held for the page, whether the relay reads from the broker)"""
+
+            async def state() -> tuple[int, bool]:
+                connection = next(k for k in server._connections.values() if k.active)
+                assert connection.transport is not None
+                transport = connection.transport
+                upstream = transport.get_protocol()._upstream  # type: ignore[attr-defined]
+                return transport.get_write_buffer_size(), upstream.is_reading()  # type: ignore[attr-defined]
+
+            return asyncio.run_coroutine_threadsafe(state(), server._loop).result(10)
+
+        page = mqtt.Client(
+            CallbackAPIVersion.VERSION2, client_id=f"relay-{uuid.uuid4()}", transport="websockets"
+        )
+        page.ws_set_options(path="/mqtt", headers={"Cookie": f"{KEY_COOKIE}={KEY}"})
+        page.username_pw_set(c.sleeve.username, c.sleeve.password)
+        received: list[int] = []
+        page.on_message = lambda *args: received.append(len(args[2].payload))
+        subscribed = threading.Event()
+        page.on_subscribe = lambda *a: subscribed.set()
+        page.connect("127.0.0.1", _port(server))
+        page.subscribe(topic, qos=1)
+        for _ in range(100):  # the page's loop by hand: it reads only when told to
+            page.loop(0.1)
+            if subscribed.is_set():
+                break
+        assert subscribed.is_set(), "no SUBACK through the relay"
+        sender = mqtt.Client(CallbackAPIVersion.VERSION2, client_id=f"relay-{uuid.uuid4()}")
+        sender.username_pw_set(c.sender.username, c.sender.password)
+        sender.connect("127.0.0.1", c.mqtt_port)
+        sender.loop_start()
+        try:
+            for _ in range(count):
+                sender.publish(topic, b"x" * size, qos=1)
+            sender.publish(topic, b"x" * size, qos=1).wait_for_publish(30)
+            held, reading = 0, True
+            for _ in range(300):  # until the relay stops reading from the broker
+                held, reading = relay_state()
+                if not reading:
+                    break
+                threading.Event().wait(0.1)
+            assert not reading, f"the relay still reads from the broker, holding {held} bytes"
+            assert held < 1024 * 1024, f"the relay holds {held} bytes for a page that does not read"
+            for _ in range(100 * count):  # the page reads: the relay reads again
+                page.loop(0.1)
+                if received and relay_state() == (0, True):
+                    break
+            assert relay_state() == (0, True)
+            assert received and set(received) == {size}
+        finally:
+            sender.disconnect()
+            sender.loop_stop()
+            page.disconnect()

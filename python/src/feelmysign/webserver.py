@@ -732,10 +732,12 @@ class WebServer:
 
         The page's handshake is checked here, then made again with the broker (its key and
         subprotocols, nothing else: no cookie, no compression), and the broker's answer is
-        the page's. From then on the relay passes bytes both ways as they come, in the
-        transports' callbacks: the frames are the page's and the broker's, not decoded and
-        encoded again, and no task wakes per message (which cost about four times the CPU
-        time of the byte relay before aiohttp, and a visible latency).
+        the page's. From then on the relay passes bytes both ways as they come, each
+        transport's reads written to the other by the event loop itself (``_ToPage``,
+        ``_ToBroker``): the frames are the page's and the broker's, not decoded and encoded
+        again, no task wakes per message (which cost about four times the CPU time of the
+        byte relay before aiohttp, and a visible latency), and no Python of the relay's or
+        aiohttp's runs per message.
         """
         refused = self._foreign_origin(request)
         if refused is not None:
@@ -759,7 +761,7 @@ class WebServer:
         try:
             upstream_transport, upstream = await asyncio.wait_for(
                 loop.create_connection(
-                    lambda: _Upstream(page, request.protocol, request.writer),
+                    lambda: _Upstream(page),
                     "127.0.0.1",
                     port,
                 ),
@@ -787,9 +789,10 @@ class WebServer:
         try:
             await switched.prepare(request)
             request.protocol.keep_alive(False)
-            # The page's bytes from now on (and any that came with the handshake) go to
-            # the broker as they arrive: aiohttp's own WebSocketResponse takes them likewise.
+            # Any bytes that came with the handshake go to the broker (as aiohttp's own
+            # WebSocketResponse takes them), then the page's connection is the relay's.
             request.protocol.set_parser(_PageBytes(upstream_transport, upstream))  # type: ignore[arg-type]
+            page.set_protocol(_ToBroker(upstream_transport, request.protocol))
             upstream.start()
             if page.is_closing():  # gone before its bytes came here: no end of them will
                 upstream_transport.close()
@@ -833,21 +836,14 @@ class _Switched(web.StreamResponse):
 
 
 class _Upstream(asyncio.Protocol):
-    """The relay's connection to the broker: first the broker's answer to the handshake
-    (``head``), then every byte on to the page, as it comes. Reading from the broker waits
-    while the page's connection has more unsent than its transport's limit (a page that
-    does not read), so what the relay holds stays bounded."""
+    """The relay's connection to the broker until the page has its 101: the broker's answer
+    to the handshake (``head``), and what follows it held for the page. Then (``start``)
+    the connection is a ``_ToPage``'s."""
 
-    def __init__(
-        self, page: asyncio.Transport, page_protocol: Any, page_writer: AbstractStreamWriter
-    ) -> None:
+    def __init__(self, page: asyncio.Transport) -> None:
         self._page = page
-        self._page_protocol = page_protocol
-        self._page_writer = page_writer
         self._buffer = bytearray()
         self._head_read = False
-        self._relaying = False
-        self._draining = False
         self.transport: asyncio.Transport | None = None
         loop = asyncio.get_running_loop()
         self.head: asyncio.Future[tuple[int, dict[str, str]]] = loop.create_future()
@@ -860,9 +856,6 @@ class _Upstream(asyncio.Protocol):
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
 
     def data_received(self, data: bytes) -> None:
-        if self._relaying:
-            self._to_page(data)
-            return
         self._buffer += data
         if self._head_read:
             return
@@ -882,34 +875,11 @@ class _Upstream(asyncio.Protocol):
 
     def start(self) -> None:
         """Relay to the page from now on (its 101 is sent), with what came after the head."""
-        self._relaying = True
+        assert self.transport is not None
         if self._buffer:
-            self._to_page(bytes(self._buffer))
+            self._page.write(bytes(self._buffer))
             self._buffer.clear()
-
-    def _to_page(self, data: bytes) -> None:
-        self._page.write(data)
-        if self._page_protocol.writing_paused and not self._draining:
-            self._draining = True
-            assert self.transport is not None
-            self.transport.pause_reading()
-            asyncio.get_running_loop().create_task(self._resume_when_sent())
-
-    async def _resume_when_sent(self) -> None:
-        try:
-            await self._page_writer.drain()
-        except ConnectionError:
-            return
-        finally:
-            self._draining = False
-        if self.transport is not None and not self.transport.is_closing():
-            self.transport.resume_reading()
-
-    def pause_writing(self) -> None:  # the broker reads slower than the page sends
-        self._page_protocol.pause_reading()
-
-    def resume_writing(self) -> None:
-        self._page_protocol.resume_reading()
+        self.transport.set_protocol(_ToPage(self._page, self.ended))
 
     def connection_lost(self, exc: Exception | None) -> None:
         if not self.head.done():
@@ -918,9 +888,59 @@ class _Upstream(asyncio.Protocol):
             self.ended.set_result(None)
 
 
+# Once relaying, each connection's protocol is one of the two below. Its ``data_received``
+# is the other transport's own ``write``: the event loop hands each read straight to the
+# other socket, with no Python of the relay's per message (the relay's CPU time is then
+# the sockets'). The flow control is asyncio's: when one side's unsent bytes pass its
+# transport's high-water mark, reading from the other stops until they are sent, so a
+# page or a broker that does not read makes the relay hold no more than that.
+
+
+class _ToPage(asyncio.Protocol):
+    """The broker's connection: its bytes on to the page as they come."""
+
+    def __init__(self, page: asyncio.Transport, ended: asyncio.Future[None]) -> None:
+        self.data_received = page.write  # type: ignore[method-assign]
+        self._page = page
+        self._ended = ended
+
+    def pause_writing(self) -> None:  # the broker reads slower than the page sends
+        self._page.pause_reading()
+
+    def resume_writing(self) -> None:
+        self._page.resume_reading()
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        if not self._ended.done():
+            self._ended.set_result(None)
+
+
+class _ToBroker(asyncio.Protocol):
+    """The page's connection, in the place of aiohttp's protocol: its bytes on to the broker
+    as they come. Its end is still aiohttp's to handle (its ``connection_lost`` ends the
+    request, and through ``_PageBytes`` the relay)."""
+
+    def __init__(self, upstream: asyncio.Transport, aiohttp_protocol: asyncio.Protocol) -> None:
+        self.data_received = upstream.write  # type: ignore[method-assign]
+        self._upstream = upstream
+        self._aiohttp = aiohttp_protocol
+
+    def pause_writing(self) -> None:  # the page reads slower than the broker sends
+        self._upstream.pause_reading()
+
+    def resume_writing(self) -> None:
+        self._upstream.resume_reading()
+
+    def eof_received(self) -> bool | None:
+        return self._aiohttp.eof_received()
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._aiohttp.connection_lost(exc)
+
+
 class _PageBytes:
-    """The page's bytes after the handshake, on to the broker as they come (in aiohttp's
-    place for a parser: ``feed_data`` and ``feed_eof``)."""
+    """What the page sent with its handshake, on to the broker, and the page's end (aiohttp's
+    protocol calls ``feed_eof`` when the connection is lost)."""
 
     def __init__(self, upstream: asyncio.Transport, ending: _Upstream) -> None:
         self._upstream = upstream
