@@ -453,7 +453,8 @@ def _plain_json(document: dict[str, Any], layout: Layout) -> Stroke | None:
     seq = get("seq")
     if seq is not None and (type(seq) is not int or not 0 <= seq <= MAX_SEQ):
         return None
-    start, end, duration_ms = get("start"), get("end"), get("duration_ms")
+    start, end = get("start"), get("end")
+    duration_ms: Any = get("duration_ms")  # checked below to be a number
     if type(start) is not list or type(end) is not list or len(start) != 2 or len(end) != 2:
         return None
     (x0, y0), (x1, y1) = start, end
