@@ -257,13 +257,15 @@ class Outline:
 
         Only an actuator a burst starting before ``before_ms`` drives can have
         such a command; its commands depend on every burst that drives it (an
-        overlap merges them) and on nothing else. Those bursts lie within one
-        grid unit of it, and the stroke moves away monotonically along each
-        axis, so the bursts are read in order until one lies two grid units or
-        more from each of these actuators along some axis: no burst after it
-        comes back. Bursts start in order (each at least an SOA, 35.8 ms, after
-        the one before), so those starting before ``before_ms`` come first; only
-        the bursts read are made.
+        overlap merges them) and on nothing else. A burst drives an actuator
+        only from less than one grid unit away along each axis, and the stroke
+        moves monotonically along each axis: once a burst lies one grid unit or
+        more from an actuator along an axis, having started nearer, it has passed
+        it there for good. So the bursts are read in order until one lies so
+        from each of these actuators: no burst after it drives any of them.
+        Bursts start in order (each at least an SOA, 35.8 ms, after the one
+        before), so those starting before ``before_ms`` come first; only the
+        bursts read are made.
         """
         if self._schedule is not None:
             return tuple(c for c in self._schedule.commands if c.start_ms < before_ms)
@@ -576,11 +578,11 @@ def _bursts(
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[int]) -> bool:
-    """Whether the burst lies two grid units or more from each actuator (by its
-    ``overlaps.actuator_key``) along some axis."""
+    """Whether the burst lies one grid unit or more from each actuator (by its
+    ``overlaps.actuator_key``) along some axis: it does not drive any of them."""
     x, y = burst[0], burst[1]
     for key in actuators:  # a loop, not all() over a generator: read before a first command
-        if abs(x - (key & COLUMN_MASK)) < 2 and abs(y - (key >> ROW_SHIFT)) < 2:
+        if abs(x - (key & COLUMN_MASK)) < 1 and abs(y - (key >> ROW_SHIFT)) < 1:
             return False
     return True
 
