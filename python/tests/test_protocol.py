@@ -10,6 +10,7 @@ import re
 import sys
 from pathlib import Path
 from typing import Any
+from unittest.mock import patch
 
 import pytest
 from hypothesis import given
@@ -297,6 +298,48 @@ def check_result(result: Accepted | Rejected, layout: Layout) -> None:
 @given(PAYLOADS, FORMATS)
 def test_parse_never_raises_and_accepts_only_playable_strokes(payload: object, fmt: str) -> None:
     check_result(parse(payload, PAPER, format=fmt), PAPER)  # type: ignore[arg-type]
+
+
+PLAIN_NUMBERS = (
+    st.integers(min_value=-2, max_value=12)
+    | st.floats(min_value=-1, max_value=13)
+    | st.sampled_from([-0.0, 3, 3.0, 1e-320, math.inf, math.nan, 10**400, 2**53])
+)
+PLAIN_STROKE_OBJECTS = st.fixed_dictionaries(
+    {
+        "v": st.sampled_from([1, 1.0, True, 2]),
+        "start": st.lists(PLAIN_NUMBERS, min_size=2, max_size=2),
+        "end": st.lists(PLAIN_NUMBERS, min_size=2, max_size=2),
+        "duration_ms": PLAIN_NUMBERS | st.floats(min_value=0, max_value=20_000),
+    },
+    optional={
+        "drawing": st.none() | st.text(max_size=70) | st.integers(),
+        "seq": st.none() | st.integers(min_value=-1, max_value=2**54) | st.just(3.0),
+        "intensity": st.none() | PLAIN_NUMBERS | st.booleans(),
+        "sent_at_ms": st.none() | PLAIN_NUMBERS | st.sampled_from([1.7e12, 10**16, 1e300]),
+    },
+)
+
+
+@given(PLAIN_STROKE_OBJECTS, st.sampled_from([PAPER, Layout(rows=3, columns=12, spacing_cm=3.0)]))
+def test_json_read_with_the_grid_is_the_field_by_field_read(
+    document: dict[str, Any], layout: Layout
+) -> None:
+    # parse takes a quick way for a stroke plainly valid on the grid: the same verdict, the
+    # same stroke (-0.0 made 0.0, ints made floats) as reading, checking and clamping it.
+    text = json.dumps(document)
+    result = parse(text, layout, format="json")
+    with patch("feelmysign.protocol._plain_json", return_value=None) as plain:
+        slow = parse(text, layout, format="json")
+    assert result == slow
+    if isinstance(result, Accepted) and isinstance(slow, Accepted):
+        assert plain.called
+        for got, want in zip(
+            (*result.stroke.start, *result.stroke.end),
+            (*slow.stroke.start, *slow.stroke.end),
+            strict=True,
+        ):
+            assert type(got) is float and math.copysign(1, got) == math.copysign(1, want)
 
 
 @given(st.text(max_size=100))

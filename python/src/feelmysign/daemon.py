@@ -464,6 +464,9 @@ class Sleeve:
         finally:
             if collecting:
                 gc.enable()
+            # Counted once the stroke's first motor command is out (read by `up` and the load
+            # bench, never needed on the way to it).
+            self._count("received")
 
     def _handle(
         self,
@@ -472,7 +475,6 @@ class Sleeve:
         received_at_ms: float,
         received_wall_ms: float,
     ) -> None:
-        self._count("received")
         name = message.topic
         if name == self._control_topic and not message.retain:
             ref = StrokeRef(name, received_at_ms=received_wall_ms)

@@ -257,29 +257,35 @@ class Outline:
 
         Only an actuator a burst starting before ``before_ms`` drives can have
         such a command; its commands depend on every burst that drives it (an
-        overlap merges them) and on nothing else. Those bursts lie within one
-        grid unit of it, and the stroke moves away monotonically along each
-        axis, so the bursts are read in order until one lies two grid units or
-        more from each of these actuators along some axis: no burst after it
-        comes back. Bursts start in order (each at least an SOA, 35.8 ms, after
-        the one before), so those starting before ``before_ms`` come first; only
-        the bursts read are made.
+        overlap merges them) and on nothing else. A burst drives an actuator
+        only from less than one grid unit away along each axis, and the stroke
+        moves monotonically along each axis: once a burst lies one grid unit or
+        more from an actuator along an axis, having started nearer, it has passed
+        it there for good. So the bursts are read in order until one lies so
+        from each of these actuators: no burst after it drives any of them.
+        Bursts start in order (each at least an SOA, 35.8 ms, after the one
+        before), so those starting before ``before_ms`` come first; only the
+        bursts read are made.
         """
         if self._schedule is not None:
             return tuple(c for c in self._schedule.commands if c.start_ms < before_ms)
-        early: set[int] = set()  # of the actuators these commands drive, by key
-        spans: dict[int, list[Span]] = {}
-        starting = True  # still reading bursts that start before before_ms
+        intensity, layout = self.intensity, self.layout
+        read: list[RawBurst] = []  # the bursts read, in order
+        early: Iterable[int] | None = None  # the actuators they drive, once known (by key)
         for burst in self._each_burst():
-            if starting and not burst[3] < before_ms:
-                starting = False
-            if not starting and _far_from(burst, early):
+            if early is None:
+                if burst[3] < before_ms:
+                    read.append(burst)
+                    continue
+                early = _spans_by_actuator(read, intensity, layout).keys()
+            if _far_from(burst, early):
                 break
-            drives = _spans_by_actuator([burst], self.intensity, self.layout)
-            for actuator, actuator_spans in drives.items():
-                spans.setdefault(actuator, []).extend(actuator_spans)
-                if starting:
-                    early.add(actuator)
+            read.append(burst)
+        # The spans of every burst read, gathered at once (per actuator in stroke order, as
+        # one burst at a time would gather them).
+        spans = _spans_by_actuator(read, intensity, layout)
+        if early is None:  # every burst starts before before_ms
+            early = spans.keys()
         commands = commands_from_spans({a: spans[a] for a in early}, self.min_command_ms)
         return tuple(c for c in commands if c.start_ms < before_ms)
 
@@ -572,12 +578,13 @@ def _bursts(
 
 
 def _far_from(burst: RawBurst, actuators: Iterable[int]) -> bool:
-    """Whether the burst lies two grid units or more from each actuator (by its
-    ``overlaps.actuator_key``) along some axis."""
+    """Whether the burst lies one grid unit or more from each actuator (by its
+    ``overlaps.actuator_key``) along some axis: it does not drive any of them."""
     x, y = burst[0], burst[1]
-    return all(
-        abs(x - (key & COLUMN_MASK)) >= 2 or abs(y - (key >> ROW_SHIFT)) >= 2 for key in actuators
-    )
+    for key in actuators:  # a loop, not all() over a generator: read before a first command
+        if abs(x - (key & COLUMN_MASK)) < 1 and abs(y - (key >> ROW_SHIFT)) < 1:
+            return False
+    return True
 
 
 def render_point(burst: Burst, layout: Layout) -> list[Command]:

@@ -163,7 +163,12 @@ def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accept
             f"(startX,startY,endX,endY,duration in grid units and ms) or {_JSON_EXAMPLE}.",
         )
     chosen = _detect(body) if format == "auto" else format
-    stroke = _parse_json(body) if chosen == "json" else _parse_legacy(body)
+    if chosen == "json":
+        stroke = _parse_json(body, layout)
+        if isinstance(stroke, Accepted):  # plainly valid: checked as it was read
+            return stroke
+    else:
+        stroke = _parse_legacy(body)
     if isinstance(stroke, Rejected):
         return stroke
     checked = validate_stroke(stroke, layout)
@@ -395,7 +400,9 @@ def _loads(body: str) -> Any:
     return _DECODER.decode(body)
 
 
-def _parse_json(body: str) -> Stroke | Rejected:
+def _parse_json(body: str, layout: Layout | None = None) -> Stroke | Accepted | Rejected:
+    """The stroke of a JSON payload, or why not; with ``layout``, a stroke plainly valid on its
+    grid comes back already ``Accepted`` (see ``_plain_json``)."""
     try:
         document = _loads(body)
     except _NonFiniteLiteral as error:
@@ -416,7 +423,87 @@ def _parse_json(body: str) -> Stroke | Rejected:
             f"The JSON payload is {_described(document)}, not an object; send an object "
             f"such as {_JSON_EXAMPLE}.",
         )
+    if layout is not None:
+        plain = _plain_json(document, layout)
+        if plain is not None:
+            return Accepted(plain, "json")
     return _stroke_from_object(document)
+
+
+_NUMBER_TYPES = (int, float)  # exactly these: bool, an int subclass, is not a JSON number
+
+
+def _plain_json(document: dict[str, Any], layout: Layout) -> Stroke | None:
+    """The stroke of ``document`` when it is plainly valid on ``layout``'s grid, else None.
+
+    Plainly valid: version 1, every field of the type the protocol asks (numbers read as
+    int or float, never bool), each value inside its range with no clamping to do (points
+    on the grid itself, not within its tolerance outside). Such a stroke is what reading it
+    field by field, checking it and clamping it would give, in a few comparisons: it is
+    read on the path from a stroke's message to its first motor command. Anything else
+    (None) goes the long way, which says what is wrong.
+    """
+    get = document.get
+    version = get("v")
+    if type(version) is not int or version != JSON_VERSION:
+        return None
+    drawing = get("drawing")
+    if drawing is not None and (type(drawing) is not str or not _DRAWING_ID.fullmatch(drawing)):
+        return None
+    seq = get("seq")
+    if seq is not None and (type(seq) is not int or not 0 <= seq <= MAX_SEQ):
+        return None
+    start, end = get("start"), get("end")
+    duration_ms: Any = get("duration_ms")  # checked below to be a number
+    if type(start) is not list or type(end) is not list or len(start) != 2 or len(end) != 2:
+        return None
+    (x0, y0), (x1, y1) = start, end
+    numbers = _NUMBER_TYPES
+    if not (
+        type(x0) in numbers
+        and type(y0) in numbers
+        and type(x1) in numbers
+        and type(y1) in numbers
+        and type(duration_ms) in numbers
+    ):
+        return None
+    x_max, y_max = layout.columns - 1, layout.rows - 1
+    # Comparisons fail for NaN, so these also say every number is finite (and an int this
+    # small converts exactly as _to_float converts it).
+    if not (
+        0 <= x0 <= x_max
+        and 0 <= x1 <= x_max
+        and 0 <= y0 <= y_max
+        and 0 <= y1 <= y_max
+        and 0 < duration_ms < math.inf
+        and duration_ms <= layout.max_stroke_duration_ms
+    ):
+        return None
+    intensity = get("intensity")
+    if intensity is not None:
+        if type(intensity) not in numbers or not 0 <= intensity <= 1:
+            return None
+        intensity = float(intensity)
+    sent_at_ms = get("sent_at_ms")
+    if sent_at_ms is not None:
+        if type(sent_at_ms) not in numbers or not 0 <= sent_at_ms <= _PLAIN_SENT_AT_MAX_MS:
+            return None
+        sent_at_ms = float(sent_at_ms)
+    # As _clamp leaves a point inside the grid: a float, -0.0 made 0.0.
+    return Stroke(
+        (float(x0) + 0.0, float(y0) + 0.0),
+        (float(x1) + 0.0, float(y1) + 0.0),
+        float(duration_ms),
+        intensity,
+        drawing,
+        seq,
+        sent_at_ms,
+    )
+
+
+# sent_at_ms beyond this (the year 33,000 and on) is read the long way, where an integer too
+# large for a float becomes infinite and is refused.
+_PLAIN_SENT_AT_MAX_MS = 1e15
 
 
 def _json_error_text(error: Exception) -> str:

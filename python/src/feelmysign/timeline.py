@@ -151,11 +151,27 @@ class Timeline:
         self._output: dict[Actuator, float] = {}
         self._dropped: set[int] = set()  # commands of strokes the cap refused
         self._incomplete: list[_Stroke] = []  # added by their outline, in the order added
-        self.duty_cycle = DutyCycle(layout.duty_cycle_window_ms, layout.max_duty_cycle)
+        self._duty_cycle = DutyCycle(layout.duty_cycle_window_ms, layout.max_duty_cycle)
+        # Outputs changed and not yet told to the duty cycle, in order: told after the
+        # changes are written (``complete``), or as soon as the duty cycle is read.
+        self._outputs: list[tuple[Actuator, float, float]] = []
         # No motor is driven above this: the layout's max_intensity, lowered by the wearer's
         # ceiling (set_ceiling). Read at every change, so a ceiling lowered mid-stroke holds
         # from the stroke's next change on.
         self.max_intensity = layout.max_intensity
+
+    @property
+    def duty_cycle(self) -> DutyCycle:
+        """Each motor's drive (``feelmysign.duty_cycle``), every output change so far in it."""
+        if self._outputs:
+            self._record_outputs()
+        return self._duty_cycle
+
+    def _record_outputs(self) -> None:
+        outputs, self._outputs = self._outputs, []
+        output = self._duty_cycle.output
+        for actuator, t_ms, intensity in outputs:
+            output(actuator, t_ms, intensity)
 
     def set_ceiling(self, ceiling: float | None) -> None:
         """The wearer's intensity ceiling (None: none): it only ever lowers the layout's cap."""
@@ -188,7 +204,11 @@ class Timeline:
 
     def complete(self) -> None:
         """Add the rest of every stroke added by its outline (a stroke already admitted is
-        committed to the duty cycle now, as at its start)."""
+        committed to the duty cycle now, as at its start), and tell the duty cycle the output
+        changes made since it was last told (the player calls this once the changes due are
+        written: a stroke's first motor command waits for none of this)."""
+        if self._outputs:
+            self._record_outputs()
         while self._incomplete:
             stroke = self._incomplete.pop(0)
             outline = stroke.outline
@@ -358,5 +378,5 @@ class Timeline:
         if wanted == self._output.get(actuator, 0.0):
             return
         self._output[actuator] = wanted
-        self.duty_cycle.output(actuator, t_ms, wanted)
+        self._outputs.append((actuator, t_ms, wanted))  # for the duty cycle (see complete)
         due.changes.append(Change(t_ms, actuator[0], actuator[1], wanted, tag))
