@@ -11,6 +11,7 @@ from typing import Any
 
 from study_helpers import new_study, pilot_study
 
+from feelmysign.errors import StudyError
 from feelmysign.study.api import StudyApi
 from feelmysign.study.dry_run import dry_run
 from feelmysign.study.runner import Session
@@ -108,8 +109,12 @@ def test_the_analysis_lists_only_the_files_the_page_can_fetch(tmp_path: Path) ->
     dry_run(store, 2, seed=3)
     layout = Session(store, None).layout
     api = StudyApi(Session(store, offline_player(layout)), tmp_path / "results", bootstrap=50)
-    status, analysis = _call(api, "POST", "/api/study/analyse")
-    assert status == 200, analysis
+    status, started = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and started["state"] in ("running", "done"), started
+    api.wait_for_analysis()
+    status, job = _call(api, "GET", "/api/study/analysis")
+    assert status == 200 and job["state"] == "done", job
+    analysis = job["result"]
     folder = Path(analysis["folder"])
     listed = analysis["files"]
     on_disk = sorted(p.name for p in folder.iterdir() if p.is_file())
@@ -164,3 +169,51 @@ def test_no_answer_is_recorded_while_a_repeat_send_still_plays(tmp_path: Path) -
     status, answered = _call(api, "POST", f"{base}/answer", answer)
     assert status == 200 and answered["state"]["answered"] == 1
     assert len(store.sends(trial["id"])) == 2  # the refused third send was not stored
+
+
+def test_an_analysis_request_sent_again_while_one_runs_joins_it(tmp_path: Path) -> None:
+    """The browser re-sends a POST whose connection was cut: it must not start a second
+    analysis of the same study, and the page learns the one result by polling."""
+    store = pilot_study(tmp_path)
+    dry_run(store, 2, seed=3)
+    layout = Session(store, None).layout
+    api = StudyApi(Session(store, offline_player(layout)), tmp_path / "results", bootstrap=20)
+    release = threading.Event()
+    runs: list[int] = []
+    real_analyse = api.analyse
+
+    def gated_analyse() -> dict[str, Any]:
+        runs.append(1)
+        release.wait()  # held running until both requests are in, whatever the machine's speed
+        return real_analyse()
+
+    api.analyse = gated_analyse  # type: ignore[method-assign]
+    status, first = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and first["state"] == "running"
+    status, again = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and again["state"] == "running" and again["job"] == first["job"]
+    status, polled = _call(api, "GET", "/api/study/analysis")
+    assert polled["state"] == "running" and polled["result"] is None
+    release.set()
+    done = api.wait_for_analysis()
+    assert done["state"] == "done" and done["job"] == first["job"], done
+    assert len(runs) == 1
+    assert [p.name for p in (tmp_path / "results").iterdir()] == [
+        Path(done["result"]["folder"]).name
+    ]
+    # Asked again once done: a new analysis, with its own job number.
+    status, next_job = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and next_job["job"] == first["job"] + 1
+    assert api.wait_for_analysis()["state"] == "done" and len(runs) == 2
+
+
+def test_a_failed_analysis_is_reported_to_the_polling_page(tmp_path: Path) -> None:
+    api = _api(tmp_path)
+
+    def failing() -> dict[str, Any]:
+        raise StudyError("no answers to analyse yet")
+
+    api.analyse = failing  # type: ignore[method-assign]
+    _call(api, "POST", "/api/study/analyse")
+    done = api.wait_for_analysis()
+    assert done["state"] == "failed" and "no answers" in done["error"] and done["result"] is None
