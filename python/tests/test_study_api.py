@@ -57,17 +57,33 @@ def test_a_session_through_the_api_and_a_blind_review(tmp_path: Path) -> None:
     status, state = _call(api, "GET", base)
     trial = state["trial"]
     assert state["step"] == "trial" and trial["block"] == "practice"
-    status, sent = _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
-    assert status == 200 and sent["sent"]["played"] == sent["sent"]["strokes"]
+    # Practice answers, however unclear, are not analysed and never wait for review.
+    answered_count = 0
+    while trial["block"] == "practice":
+        status, sent = _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
+        assert status == 200 and sent["sent"]["played"] == sent["sent"]["strokes"]
+        status, answered = _call(
+            api, "POST", f"{base}/answer", {"trial": trial["id"], "answer": "a wobbly thing"}
+        )
+        answered_count += 1
+        assert answered["coding"]["status"] == "unclear"
+        assert answered["state"]["answered"] == answered_count
+        assert _call(api, "GET", "/api/study/review")[1] == []
+        assert _call(api, "GET", "/api/study")[1]["review"] == 0
+        status, refused = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": None})
+        assert status == 400 and "practice" in refused["error"]
+        trial = answered["state"]["trial"]
+    assert trial["block"] == "main"
+    _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
     status, answered = _call(
         api, "POST", f"{base}/answer", {"trial": trial["id"], "answer": "a wobbly thing"}
     )
     assert answered["coding"]["status"] == "unclear"
-    assert answered["state"]["answered"] == 1
     status, review = _call(api, "GET", "/api/study/review")
     assert review == [{"trial": trial["id"], "answer": "a wobbly thing", "rule": review[0]["rule"]}]
     assert "shape" not in review[0]  # the shape that was sent is not shown: blind decision
-    status, decided = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": "line"})
+    shape = api.store.design.shape_names[0]
+    status, decided = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": shape})
     assert decided == {"review": 0}
     decisions = api.store.codings(trial["id"])
     assert [d["decided_by"] for d in decisions] == ["auto", "researcher"]

@@ -159,10 +159,9 @@ class StudyApi:
     def review(self) -> list[dict[str, Any]]:
         """Unclear answers, without the shape that was sent: the decision is made blind."""
         codings = self.store.latest_codings()
-        waiting = [trial for trial, c in sorted(codings.items()) if c["status"] == "unclear"]
         return [
             {"trial": t, "answer": self.store.trial(t)["answer"], "rule": codings[t]["rule"]}
-            for t in waiting
+            for t in self.store.awaiting_review()
         ]
 
     # ---- POST ------------------------------------------------------------------------------
