@@ -111,3 +111,17 @@ def test_three_participants_keep_their_cluster_interval(tmp_path: Path) -> None:
     for shape, entry in needed.items():
         assert entry["cluster_bootstrap_not_estimable"] is None, shape
         assert entry["cluster_bootstrap_low"] is not None, shape
+
+
+def test_one_participant_has_no_spread_in_the_shape_model(tmp_path: Path) -> None:
+    store = pilot_study(tmp_path)
+    dry_run(store, 1, seed=3)
+    analyse_study(store, tmp_path / "out", samples=50)
+    report = (tmp_path / "out" / "report.md").read_text()
+    model = json.loads((tmp_path / "out" / "results.json").read_text())["shape_model"]
+    assert model is not None
+    if model["mixed"]:  # the report names the SD only for the mixed model
+        assert model["participant_sd"] is None
+        assert model["participant_sd_not_estimable"] in report
+    else:
+        assert model["participant_sd_not_estimable"] is not None

@@ -30,6 +30,7 @@ from feelmysign.study.analysis.psychometric import (
 from feelmysign.study.analysis.report import (
     cluster_not_estimable,
     dispersion_not_estimable,
+    model_sd_not_estimable,
     slope_not_estimable,
     spread_not_estimable,
     write_report,
@@ -337,6 +338,13 @@ def _model_json(analysis: Analysis) -> dict[str, Any] | None:
     if analysis.model is None:
         return None
     data = asdict(analysis.model)
+    data.update(
+        _estimate_json(
+            "participant_sd",
+            data["participant_sd"],
+            model_sd_not_estimable(analysis.participants),
+        )
+    )
     if not analysis.speeds:
         for key in ("speed_test", "speed_effects", "reference_speed_cm_s"):
             del data[key]

@@ -118,6 +118,13 @@ def dispersion_not_estimable(dispersion: float, participants: int) -> str | None
     return None
 
 
+def model_sd_not_estimable(participants: int) -> str | None:
+    """Why the shape model's participant SD says nothing, or None when it stands."""
+    if participants >= 2:
+        return None
+    return _not_estimable(participants, "a spread needs 2 or more")
+
+
 def _cluster_text(interval: Interval | None, participants: int) -> str:
     why = cluster_not_estimable(interval, participants)
     if why is not None or interval is None:
@@ -284,11 +291,9 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
                 f"descriptive): reference shape {model.reference}; slope "
                 f"{model.slope_per_doubling:.2f} log odds per doubling of strokes; participant "
                 + (
-                    f"SD {model.participant_sd:.2f} log odds."
-                    if analysis.participants >= 2
-                    else "SD "
-                    + _not_estimable(analysis.participants, "a spread needs 2 or more")
-                    + "."
+                    "SD " + (model_sd_not_estimable(analysis.participants) or "") + "."
+                    if model_sd_not_estimable(analysis.participants)
+                    else f"SD {model.participant_sd:.2f} log odds."
                 ),
                 "",
                 "| shape | log odds vs " + model.reference + " | posterior SD |",
