@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -27,6 +28,69 @@ def test_a_bad_design_is_refused_with_every_problem_and_no_traceback(tmp_path: P
     assert result.stderr.startswith("Error: ")
     assert "study.repetitions: must be a whole number from 1 to 20; got 'three'" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def _review_counts(study: Path, tmp_path: Path) -> tuple[int, int, int]:
+    """Answers awaiting review as ``status`` (summed), ``review`` and ``analyse`` count them."""
+    status = _cli("status", str(study), cwd=tmp_path).stdout
+    in_status = sum(int(n) for n in re.findall(r"(\d+) unclear", status))
+    review = subprocess.run(
+        [sys.executable, "-m", "feelmysign", "study", "review", str(study)],
+        input="",  # the end of input at once: nothing decided, the count printed
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    in_review = int(re.search(r"(\d+) answers? to review", review.stdout).group(1))  # type: ignore[union-attr]
+    out = tmp_path / "counted"
+    analysed = _cli("analyse", str(study), "--out", str(out), "--bootstrap", "50", cwd=tmp_path)
+    assert analysed.returncode == 0, analysed.stderr
+    in_analysis = int(re.search(r"(\d+) awaiting review", analysed.stdout).group(1))  # type: ignore[union-attr]
+    return in_status, in_review, in_analysis
+
+
+def test_practice_answers_never_wait_for_review_and_every_count_agrees(tmp_path: Path) -> None:
+    """A practice shape ('line') that is no shape of the study: its answers are coded
+    unclear, yet they are not analysed, so neither status, review nor analyse counts them."""
+    from feelmysign.study.store import StudyStore
+
+    line_shape = '[[shapes]]\nname = "line"\nsegments = [1, 2, 4, 8]\n'
+    paper = PAPER_DESIGN.read_text()
+    start = paper.index(line_shape)
+    design = tmp_path / "no-line.toml"
+    design.write_text(paper[:start] + paper[paper.index("[[practice]]", start) :])
+    study = tmp_path / "s.sqlite"
+    assert _cli("new", str(design), "--out", str(study), cwd=tmp_path).returncode == 0
+    simulate = [
+        "simulate",
+        str(study),
+        "--participants",
+        "2",
+        "--seed",
+        "1",
+        "--wearer",
+        "in-range",
+    ]
+    simulated = _cli(*simulate, cwd=tmp_path)
+    assert simulated.returncode == 0, simulated.stderr
+    store = StudyStore(study)
+    codings = store.latest_codings()
+    practice_unclear = [
+        t["id"]
+        for row in store.participants()
+        for t in store.trials(row["code"])
+        if t["block"] == "practice" and codings[t["id"]]["status"] == "unclear"
+    ]
+    main_unclear = [
+        t["id"]
+        for row in store.participants()
+        for t in store.trials(row["code"])
+        if t["block"] == "main" and codings[t["id"]]["status"] == "unclear"
+    ]
+    store.close()
+    assert practice_unclear  # the case in question: unclear practice answers exist
+    assert _review_counts(study, tmp_path) == (len(main_unclear),) * 3
 
 
 def test_new_simulate_status_analyse(tmp_path: Path) -> None:

@@ -11,6 +11,7 @@ from typing import Any
 
 from study_helpers import new_study, pilot_study
 
+from feelmysign.errors import StudyError
 from feelmysign.study.api import StudyApi
 from feelmysign.study.dry_run import dry_run
 from feelmysign.study.runner import Session
@@ -56,17 +57,33 @@ def test_a_session_through_the_api_and_a_blind_review(tmp_path: Path) -> None:
     status, state = _call(api, "GET", base)
     trial = state["trial"]
     assert state["step"] == "trial" and trial["block"] == "practice"
-    status, sent = _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
-    assert status == 200 and sent["sent"]["played"] == sent["sent"]["strokes"]
+    # Practice answers, however unclear, are not analysed and never wait for review.
+    answered_count = 0
+    while trial["block"] == "practice":
+        status, sent = _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
+        assert status == 200 and sent["sent"]["played"] == sent["sent"]["strokes"]
+        status, answered = _call(
+            api, "POST", f"{base}/answer", {"trial": trial["id"], "answer": "a wobbly thing"}
+        )
+        answered_count += 1
+        assert answered["coding"]["status"] == "unclear"
+        assert answered["state"]["answered"] == answered_count
+        assert _call(api, "GET", "/api/study/review")[1] == []
+        assert _call(api, "GET", "/api/study")[1]["review"] == 0
+        status, refused = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": None})
+        assert status == 400 and "practice" in refused["error"]
+        trial = answered["state"]["trial"]
+    assert trial["block"] == "main"
+    _call(api, "POST", f"{base}/send", {"trial": trial["id"]})
     status, answered = _call(
         api, "POST", f"{base}/answer", {"trial": trial["id"], "answer": "a wobbly thing"}
     )
     assert answered["coding"]["status"] == "unclear"
-    assert answered["state"]["answered"] == 1
     status, review = _call(api, "GET", "/api/study/review")
     assert review == [{"trial": trial["id"], "answer": "a wobbly thing", "rule": review[0]["rule"]}]
     assert "shape" not in review[0]  # the shape that was sent is not shown: blind decision
-    status, decided = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": "line"})
+    shape = api.store.design.shape_names[0]
+    status, decided = _call(api, "POST", f"/api/study/review/{trial['id']}", {"shape": shape})
     assert decided == {"review": 0}
     decisions = api.store.codings(trial["id"])
     assert [d["decided_by"] for d in decisions] == ["auto", "researcher"]
@@ -108,8 +125,12 @@ def test_the_analysis_lists_only_the_files_the_page_can_fetch(tmp_path: Path) ->
     dry_run(store, 2, seed=3)
     layout = Session(store, None).layout
     api = StudyApi(Session(store, offline_player(layout)), tmp_path / "results", bootstrap=50)
-    status, analysis = _call(api, "POST", "/api/study/analyse")
-    assert status == 200, analysis
+    status, started = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and started["state"] in ("running", "done"), started
+    api.wait_for_analysis()
+    status, job = _call(api, "GET", "/api/study/analysis")
+    assert status == 200 and job["state"] == "done", job
+    analysis = job["result"]
     folder = Path(analysis["folder"])
     listed = analysis["files"]
     on_disk = sorted(p.name for p in folder.iterdir() if p.is_file())
@@ -164,3 +185,51 @@ def test_no_answer_is_recorded_while_a_repeat_send_still_plays(tmp_path: Path) -
     status, answered = _call(api, "POST", f"{base}/answer", answer)
     assert status == 200 and answered["state"]["answered"] == 1
     assert len(store.sends(trial["id"])) == 2  # the refused third send was not stored
+
+
+def test_an_analysis_request_sent_again_while_one_runs_joins_it(tmp_path: Path) -> None:
+    """The browser re-sends a POST whose connection was cut: it must not start a second
+    analysis of the same study, and the page learns the one result by polling."""
+    store = pilot_study(tmp_path)
+    dry_run(store, 2, seed=3)
+    layout = Session(store, None).layout
+    api = StudyApi(Session(store, offline_player(layout)), tmp_path / "results", bootstrap=20)
+    release = threading.Event()
+    runs: list[int] = []
+    real_analyse = api.analyse
+
+    def gated_analyse() -> dict[str, Any]:
+        runs.append(1)
+        release.wait()  # held running until both requests are in, whatever the machine's speed
+        return real_analyse()
+
+    api.analyse = gated_analyse  # type: ignore[method-assign]
+    status, first = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and first["state"] == "running"
+    status, again = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and again["state"] == "running" and again["job"] == first["job"]
+    status, polled = _call(api, "GET", "/api/study/analysis")
+    assert polled["state"] == "running" and polled["result"] is None
+    release.set()
+    done = api.wait_for_analysis()
+    assert done["state"] == "done" and done["job"] == first["job"], done
+    assert len(runs) == 1
+    assert [p.name for p in (tmp_path / "results").iterdir()] == [
+        Path(done["result"]["folder"]).name
+    ]
+    # Asked again once done: a new analysis, with its own job number.
+    status, next_job = _call(api, "POST", "/api/study/analyse")
+    assert status == 202 and next_job["job"] == first["job"] + 1
+    assert api.wait_for_analysis()["state"] == "done" and len(runs) == 2
+
+
+def test_a_failed_analysis_is_reported_to_the_polling_page(tmp_path: Path) -> None:
+    api = _api(tmp_path)
+
+    def failing() -> dict[str, Any]:
+        raise StudyError("no answers to analyse yet")
+
+    api.analyse = failing  # type: ignore[method-assign]
+    _call(api, "POST", "/api/study/analyse")
+    done = api.wait_for_analysis()
+    assert done["state"] == "failed" and "no answers" in done["error"] and done["result"] is None

@@ -83,7 +83,10 @@ def test_a_pilot_reports_every_needed_resolution_within_what_it_tested(tmp_path:
             assert lowest <= needed["strokes"] <= highest, shape
         else:
             assert needed["strokes"] is None, shape
-        for prefix in ("", "profile_", "cluster_bootstrap_"):
+        # Two participants: the cluster bootstrap is not estimable, its ends null.
+        assert needed["cluster_bootstrap_not_estimable"] is not None, shape
+        assert needed["cluster_bootstrap_low"] is None, shape
+        for prefix in ("", "profile_"):
             assert lowest <= needed[f"{prefix}low"] <= needed[f"{prefix}high"] <= highest, shape
     report = (tmp_path / "out" / "report.md").read_text()
     assert "e+" not in report  # no astronomically large number anywhere

@@ -79,6 +79,14 @@ export interface AnalysisResult {
   unclear: number;
 }
 
+/** The export and analysis the server runs in the background; the page polls it. */
+export interface AnalysisJob {
+  job: number;
+  state: "idle" | "running" | "done" | "failed";
+  result: AnalysisResult | null;
+  error: string | null;
+}
+
 export interface SimulatedAnswer {
   answer: string;
   felt_nothing: boolean;
@@ -138,7 +146,8 @@ export const api = {
   review: () => call<ReviewItem[]>("GET", "/review"),
   decide: (trial: number, shape: string | null) =>
     call<{ review: number }>("POST", `/review/${trial}`, { shape }),
-  analyse: () => call<AnalysisResult>("POST", "/analyse", {}),
+  startAnalysis: () => call<AnalysisJob>("POST", "/analyse", {}),
+  analysis: () => call<AnalysisJob>("GET", "/analysis"),
 };
 
 export type Dimension = "length" | "duration";

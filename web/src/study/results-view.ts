@@ -1,7 +1,25 @@
 /** Export and analyse on the server; show the report and its figures. */
-import { api, type AnalysisResult } from "./api";
+import { api, StudyApiError, type AnalysisJob, type AnalysisResult } from "./api";
 import { h, plural } from "./dom";
 import { reportHtml } from "./report";
+
+// How often the page asks whether the analysis is done: it takes a minute or two.
+const POLL_INTERVAL_MS = 1000;
+
+/** The analysis started on the server (or the one already running there), once it ends. */
+async function analysed(): Promise<AnalysisResult> {
+  let job: AnalysisJob = await api.startAnalysis();
+  const mine = job.job;
+  while (job.state === "running") {
+    await new Promise((resolve) => setTimeout(resolve, POLL_INTERVAL_MS));
+    job = await api.analysis();
+  }
+  if (job.job !== mine) throw new StudyApiError(409, "Another analysis was started meanwhile; ask again.");
+  if (job.state === "failed" || job.result === null) {
+    throw new StudyApiError(500, job.error ?? "The analysis failed; see the server's terminal.");
+  }
+  return job.result;
+}
 
 export class ResultsView {
   readonly #root: HTMLElement;
@@ -22,9 +40,8 @@ export class ResultsView {
     );
     run.addEventListener("click", () => {
       run.disabled = true;
-      status.textContent = "Analysing (the bootstrap takes a few seconds)…";
-      api
-        .analyse()
+      status.textContent = "Analysing (the bootstrap can take a minute or two)…";
+      analysed()
         .then((result) => this.#show(result, status))
         .catch(this.#fail)
         .finally(() => (run.disabled = false));

@@ -212,14 +212,12 @@ def _status(args: argparse.Namespace) -> int:
     from feelmysign.study.store import DISCARDED
 
     store = _store(args)
-    codings = store.latest_codings()
     print(f"{args.study}: {store.design.name}")
     for row in store.participants():
         trials = store.trials(row["code"])
         answered = sum(1 for t in trials if t["answered_at_ms"] is not None)
-        unclear = sum(
-            1 for t in trials if t["id"] in codings and codings[t["id"]]["status"] == "unclear"
-        )
+        # The measured answers awaiting review, as the review, the page and the analysis count.
+        unclear = len(store.awaiting_review(row["code"]))
         state = "done" if row["finished_at_ms"] else ("paused" if row["paused"] else "open")
         kind = " (simulated)" if row["simulated"] else ""
         print(

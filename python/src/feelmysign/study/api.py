@@ -22,7 +22,9 @@ JSON without the browser asking first, which this server never allows).
     POST /api/study/participants/CODE/threshold-discard {"dimension"}: the run under way
     GET  /api/study/review                            answers waiting for a decision (blind)
     POST /api/study/review/TRIAL                      {"shape": name or null}
-    POST /api/study/analyse                           export + analysis -> files, report
+    POST /api/study/analyse                           starts export + analysis (or joins the
+                                                      one running) -> 202 {"job", "state"}
+    GET  /api/study/analysis                          that job: state, then files and report
     GET  /api/study/results/NAME                      a file of the latest analysis
 """
 
@@ -68,7 +70,14 @@ class StudyApi:
         self.results_dir = results_dir
         self._bootstrap = bootstrap
         self._latest: Path | None = None
+        # The analysis runs in its own thread, one at a time, and the page polls for it: it
+        # takes a minute or two, longer than the page server lets a request run, and a
+        # request the browser re-sends after a cut-off joins the running job.
         self._analysing = threading.Lock()
+        self._job = 0
+        self._job_state = "idle"  # idle, running, done or failed
+        self._job_result: dict[str, Any] | None = None
+        self._job_error: str | None = None
         self.threshold = ThresholdDesk(session.store, session.player, session.layout)
 
     def handle(self, method: str, path: str, host: str, body: bytes, content_type: str) -> Response:
@@ -103,6 +112,8 @@ class StudyApi:
             return _json(200, self.overview())
         if path == "/api/study/review":
             return _json(200, self.review())
+        if path == "/api/study/analysis":
+            return _json(200, self.analysis_status())
         if match := _PARTICIPANT.match(path):
             code, action = match.group(1), match.group(2)
             if action is None:
@@ -148,10 +159,9 @@ class StudyApi:
     def review(self) -> list[dict[str, Any]]:
         """Unclear answers, without the shape that was sent: the decision is made blind."""
         codings = self.store.latest_codings()
-        waiting = [trial for trial, c in sorted(codings.items()) if c["status"] == "unclear"]
         return [
             {"trial": t, "answer": self.store.trial(t)["answer"], "rule": codings[t]["rule"]}
-            for t in waiting
+            for t in self.store.awaiting_review()
         ]
 
     # ---- POST ------------------------------------------------------------------------------
@@ -161,7 +171,7 @@ class StudyApi:
             code = self.store.add_participant(simulated=bool(data.get("simulated", False)))
             return _json(201, {"code": code})
         if path == "/api/study/analyse":
-            return _json(200, self.analyse())
+            return _json(202, self.start_analysis())
         if match := _REVIEW.match(path):
             shape = data.get("shape")
             rule = f"researcher: {shape}" if shape else "researcher: no shape named"
@@ -208,19 +218,61 @@ class StudyApi:
             return _json(404, {"error": f"no such participant action: {action}"})
         return _json(200, {"state": s.state(code)})
 
-    def analyse(self) -> dict[str, Any]:
-        if not self._analysing.acquire(blocking=False):
-            raise StudyError("an analysis is already running; wait for it")
-        try:
-            # Imported here: the analysis needs pandas, statsmodels and matplotlib (seconds
-            # to import), and serving the study page needs none of them until this button.
-            from feelmysign.study.analysis import analyse_study
+    def start_analysis(self) -> dict[str, Any]:
+        """Start an export and analysis in the background, or join the one running."""
+        with self._analysing:
+            if self._job_state != "running":
+                self._job += 1
+                self._job_state, self._job_result, self._job_error = "running", None, None
+                threading.Thread(
+                    target=self._run_job, args=(self._job,), name="study-analysis", daemon=True
+                ).start()
+        return self.analysis_status()
 
-            out = self.results_dir / time.strftime("%Y%m%d-%H%M%S")
-            analysis = analyse_study(self.store, out, samples=self._bootstrap)
-            self._latest = out
-        finally:
-            self._analysing.release()
+    def analysis_status(self) -> dict[str, Any]:
+        with self._analysing:
+            return {
+                "job": self._job,
+                "state": self._job_state,
+                "result": self._job_result,
+                "error": self._job_error,
+            }
+
+    def wait_for_analysis(self, timeout_s: float | None = None) -> dict[str, Any]:
+        """The job's status once it is no longer running (for tests and callers in-process)."""
+        deadline = None if timeout_s is None else time.monotonic() + timeout_s
+        while True:
+            status = self.analysis_status()
+            if status["state"] != "running":
+                return status
+            if deadline is not None and time.monotonic() > deadline:
+                return status
+            time.sleep(0.05)
+
+    def _run_job(self, job: int) -> None:
+        result: dict[str, Any] | None = None
+        error: str | None = None
+        try:
+            result = self.analyse()
+        except FeelMySignError as failure:
+            error = str(failure)
+        except Exception as failure:  # a bug must be seen, and the page told, not left polling
+            log.exception("study API: the analysis failed")
+            error = f"internal error: {failure}"
+        with self._analysing:
+            if job == self._job:
+                self._job_result, self._job_error = result, error
+                self._job_state = "failed" if error is not None else "done"
+
+    def analyse(self) -> dict[str, Any]:
+        """Export and analyse now, in the calling thread; the page uses start_analysis."""
+        # Imported here: the analysis needs pandas, statsmodels and matplotlib (seconds
+        # to import), and serving the study page needs none of them until this button.
+        from feelmysign.study.analysis import analyse_study
+
+        out = self.results_dir / time.strftime("%Y%m%d-%H%M%S")
+        analysis = analyse_study(self.store, out, samples=self._bootstrap)
+        self._latest = out
         return {
             "folder": str(out),
             # The files the page can fetch (GET results/NAME): the folder's own, not bids/.

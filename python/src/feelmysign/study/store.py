@@ -378,6 +378,11 @@ class StudyStore:
         trial = self.trial(trial_id)
         if trial["answered_at_ms"] is None:
             raise StudyError(f"trial {trial_id} has no answer yet to decide on")
+        if trial["block"] != "main":
+            raise StudyError(
+                f"trial {trial_id} is a practice trial: its answer is not analysed, so there "
+                "is nothing to decide; decide the measured answers (study review)"
+            )
         if shape is not None and shape not in self.design.shape_names:
             raise StudyError(
                 f"{shape!r} is not a shape of this study ({', '.join(self.design.shape_names)})"
@@ -395,6 +400,19 @@ class StudyStore:
             "SELECT * FROM codings WHERE id IN (SELECT MAX(id) FROM codings GROUP BY trial)"
         )
         return {int(row["trial"]): row for row in rows}
+
+    def awaiting_review(self, code: str | None = None) -> list[int]:
+        """Measured answers whose coding is unclear, in trial order (of one participant, or of
+        all): the review queue. Practice answers are never in it: they are not analysed, and
+        a practice shape need not be a shape of the study the researcher could choose."""
+        rows = self.query(
+            "SELECT t.id FROM trials t JOIN codings c ON c.trial = t.id "
+            "WHERE t.block = 'main' AND t.answered_at_ms IS NOT NULL "
+            "AND (? IS NULL OR t.participant = ?) AND c.status = 'unclear' "
+            "AND c.id = (SELECT MAX(id) FROM codings WHERE trial = t.id) ORDER BY t.id",
+            (code, code),
+        )
+        return [int(row["id"]) for row in rows]
 
     def codings(self, trial_id: int) -> list[sqlite3.Row]:
         return self.query("SELECT * FROM codings WHERE trial = ? ORDER BY id", (trial_id,))

@@ -93,8 +93,7 @@ def review_in_terminal(store: StudyStore) -> int:
 
     shapes = store.design.shape_names
     labels = anonymous_labels(store)
-    codings = store.latest_codings()
-    waiting = [t for t, c in codings.items() if c["status"] == "unclear"]
+    waiting = store.awaiting_review()
     choices = f"one of {', '.join(shapes)}; '-' = no shape named; Enter = leave it for later"
     print(
         f"{plural(len(waiting), 'answer')} to review, blind (the shape sent is not shown). "

@@ -27,7 +27,14 @@ from feelmysign.study.analysis.psychometric import (
     threshold_with_interval,
     within_tested,
 )
-from feelmysign.study.analysis.report import write_report
+from feelmysign.study.analysis.report import (
+    cluster_not_estimable,
+    dispersion_not_estimable,
+    model_sd_not_estimable,
+    slope_not_estimable,
+    spread_not_estimable,
+    write_report,
+)
 from feelmysign.study.analysis.wilson import wilson_interval
 from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 from feelmysign.study.export import SPEED_COLUMN, anonymous_labels, export_study, trial_rows
@@ -245,6 +252,48 @@ def _interval_json(prefix: str, interval: Interval) -> dict[str, Any]:
     }
 
 
+def _estimate_json(name: str, value: Any, why_not: str | None) -> dict[str, Any]:
+    """A number the report gives, or null with the report's reason where it says the data
+    cannot estimate it (``NAME_not_estimable``), so no reader of results.json takes it."""
+    return {name: None if why_not is not None else value, f"{name}_not_estimable": why_not}
+
+
+def _needed_json(analysis: Analysis, shape: str, needed: Needed) -> dict[str, Any]:
+    threshold = analysis.thresholds[shape]
+    participants = analysis.participants
+    cluster_why = cluster_not_estimable(needed.cluster, participants)
+    cluster = _interval_json("cluster_bootstrap_", needed.cluster)
+    if cluster_why is not None:
+        cluster = dict.fromkeys(cluster)
+    return {
+        "kind": needed.kind,
+        "strokes": needed.strokes,
+        "lowest_tested": needed.lowest_tested,
+        "highest_tested": needed.highest_tested,
+        "interval": "parametric bootstrap with the participants' spread, "
+        "bias-corrected percentiles, truncated to the tested range",
+        **_interval_json("", needed.interval),
+        **_interval_json("profile_", needed.profile),
+        **cluster,
+        "cluster_bootstrap_not_estimable": cluster_why,
+        **_estimate_json(
+            "dispersion",
+            _finite(threshold.dispersion),
+            dispersion_not_estimable(threshold.dispersion, participants),
+        ),
+        **_estimate_json(
+            "participant_sd_doublings",
+            threshold.population.spread,
+            spread_not_estimable(threshold.population.spread, participants),
+        ),
+        "bootstrap_samples": threshold.samples,
+        "midpoint_log2": threshold.fit.midpoint,
+        **_estimate_json(
+            "slope_per_doubling", threshold.fit.slope, slope_not_estimable(threshold.fit.slope)
+        ),
+    }
+
+
 def _results_json(path: Path, analysis: Analysis) -> Path:
     data: dict[str, Any] = {
         "participants": analysis.participants,
@@ -259,22 +308,7 @@ def _results_json(path: Path, analysis: Analysis) -> Path:
             for shape, rows in analysis.accuracy.items()
         },
         "needed_strokes": {
-            shape: {
-                "kind": needed.kind,
-                "strokes": needed.strokes,
-                "lowest_tested": needed.lowest_tested,
-                "highest_tested": needed.highest_tested,
-                "interval": "parametric bootstrap with the participants' spread, "
-                "bias-corrected percentiles, truncated to the tested range",
-                **_interval_json("", needed.interval),
-                **_interval_json("profile_", needed.profile),
-                **_interval_json("cluster_bootstrap_", needed.cluster),
-                "dispersion": _finite(analysis.thresholds[shape].dispersion),
-                "participant_sd_doublings": analysis.thresholds[shape].population.spread,
-                "bootstrap_samples": analysis.thresholds[shape].samples,
-                "midpoint_log2": analysis.thresholds[shape].fit.midpoint,
-                "slope_per_doubling": analysis.thresholds[shape].fit.slope,
-            }
+            shape: _needed_json(analysis, shape, needed)
             for shape, needed in analysis.needed.items()
         },
         "shape_model": _model_json(analysis),
@@ -304,6 +338,13 @@ def _model_json(analysis: Analysis) -> dict[str, Any] | None:
     if analysis.model is None:
         return None
     data = asdict(analysis.model)
+    data.update(
+        _estimate_json(
+            "participant_sd",
+            data["participant_sd"],
+            model_sd_not_estimable(analysis.participants),
+        )
+    )
     if not analysis.speeds:
         for key in ("speed_test", "speed_effects", "reference_speed_cm_s"):
             del data[key]

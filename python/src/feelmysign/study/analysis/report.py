@@ -84,37 +84,64 @@ def interval_notes(shape: str, needed: Needed) -> list[str]:
     return notes
 
 
-def _cluster_text(interval: Interval | None, participants: int) -> str:
-    """Resampling participants says nothing when there are too few to differ: with one every
-    sample is the same person, with two most are one person twice (a zero-width interval)."""
+def cluster_not_estimable(interval: Interval | None, participants: int) -> str | None:
+    """Why the cluster bootstrap's interval says nothing, or None when it stands: resampling
+    participants needs some to differ; with one every sample is the same person, with two
+    most are one person twice (a zero-width interval)."""
     if interval is not None and participants >= 3:
-        return interval_text(interval)
+        return None
     return _not_estimable(participants, "resampling participants needs 3 or more")
 
 
-def _slope_text(slope: float) -> str:
-    """The fit's slope, or why there is none: at its upper bound the answers jump from wrong
-    to right between two tested resolutions (or never change), so no slope was measured."""
+def slope_not_estimable(slope: float) -> str | None:
+    """Why there is no slope, or None: at its upper bound the answers jump from wrong to
+    right between two tested resolutions (or never change), so no slope was measured."""
     if not math.isfinite(slope) or slope >= SLOPE_BOUNDS[1] * 0.999:
         return (
             f"not estimable: at the fit's limit ({SLOPE_BOUNDS[1]:g}), the answers change "
             "from wrong to right between two tested resolutions or not at all"
         )
-    return f"{slope:.2f}"
+    return None
 
 
-def _spread_text(spread: float, participants: int) -> str:
+def spread_not_estimable(spread: float, participants: int) -> str | None:
     if participants < 2 or not math.isfinite(spread):
         return _not_estimable(participants, "a spread between participants needs 2 or more")
-    return f"{spread:.2f}"
+    return None
 
 
-def _dispersion_text(dispersion: float, participants: int) -> str:
+def dispersion_not_estimable(dispersion: float, participants: int) -> str | None:
     if participants < 2 or not math.isfinite(dispersion):
         return _not_estimable(
             participants, "it compares participants' counts: 2 or more, and answers that vary"
         )
-    return f"{dispersion:.2f}"
+    return None
+
+
+def model_sd_not_estimable(participants: int) -> str | None:
+    """Why the shape model's participant SD says nothing, or None when it stands."""
+    if participants >= 2:
+        return None
+    return _not_estimable(participants, "a spread needs 2 or more")
+
+
+def _cluster_text(interval: Interval | None, participants: int) -> str:
+    why = cluster_not_estimable(interval, participants)
+    if why is not None or interval is None:
+        return why or ""
+    return interval_text(interval)
+
+
+def _slope_text(slope: float) -> str:
+    return slope_not_estimable(slope) or f"{slope:.2f}"
+
+
+def _spread_text(spread: float, participants: int) -> str:
+    return spread_not_estimable(spread, participants) or f"{spread:.2f}"
+
+
+def _dispersion_text(dispersion: float, participants: int) -> str:
+    return dispersion_not_estimable(dispersion, participants) or f"{dispersion:.2f}"
 
 
 def shape_test_sentence(test: ShapeTest) -> str:
@@ -264,11 +291,9 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
                 f"descriptive): reference shape {model.reference}; slope "
                 f"{model.slope_per_doubling:.2f} log odds per doubling of strokes; participant "
                 + (
-                    f"SD {model.participant_sd:.2f} log odds."
-                    if analysis.participants >= 2
-                    else "SD "
-                    + _not_estimable(analysis.participants, "a spread needs 2 or more")
-                    + "."
+                    "SD " + (model_sd_not_estimable(analysis.participants) or "") + "."
+                    if model_sd_not_estimable(analysis.participants)
+                    else f"SD {model.participant_sd:.2f} log odds."
                 ),
                 "",
                 "| shape | log odds vs " + model.reference + " | posterior SD |",
