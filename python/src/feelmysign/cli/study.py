@@ -154,6 +154,10 @@ def _check(args: argparse.Namespace) -> int:
         if practice:
             print(f"  practice: {', '.join(practice)}")
     print(_session_length(design, args.design))
+    from feelmysign.study.slowed import slowed_trials
+
+    for slowed in slowed_trials(design, args.design.resolve().parent):
+        print(f"  warning: {slowed.message()}")
     return 0
 
 
@@ -198,6 +202,17 @@ def _new(args: argparse.Namespace) -> int:
         f"Created {args.out} for {design.name!r}. Next: 'feelmysign up --study {args.out}' "
         f"(page /study), or 'feelmysign study run {args.out}'."
     )
+    from feelmysign.study.slowed import slowed_trials
+
+    slowed = slowed_trials(design, Path(args.design).resolve().parent)
+    if slowed:
+        named = ", ".join(f"{s.shape} {s.level} at {s.speed_cm_s:g} cm/s" for s in slowed[:3])
+        more = ", ..." if len(slowed) > 3 else ""
+        print(
+            f"Warning: the sleeve would slow strokes in {plural(len(slowed), 'case')} at the "
+            f"design's speeds ({named}{more}): 'feelmysign study check {args.design}' says "
+            "which speeds play them unslowed."
+        )
     return 0
 
 
