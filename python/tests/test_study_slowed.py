@@ -68,7 +68,13 @@ def test_the_fine_heart_at_15_cm_s_is_found_with_its_count_and_fastest_speed(
     assert brief(fastest) == 0  # unslowed at the speed it names
     assert brief(fastest + 2 * SPEED_STEP_CM_S) > 0  # and it is the fastest (to a step)
     message = found[0].message()
-    for said in ("heart", "'fine'", "15 cm/s", f"{found[0].slowed} of 20 strokes", f"{fastest:g}"):
+    for said in (
+        "heart",
+        "'fine'",
+        "15 cm/s",
+        f"{found[0].slowed} of its 20 strokes",
+        f"{fastest:g}",
+    ):
         assert said in message
 
 

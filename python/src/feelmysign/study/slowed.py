@@ -40,9 +40,10 @@ class Slowed:
             else "no speed plays it unslowed"
         )
         return (
-            f"{self.shape} {self.level} ({self.strokes} strokes) at "
-            f"{self.speed_cm_s:g} cm/s: {self.slowed} of {plural(self.strokes, 'stroke')} would "
-            f"be slowed by the sleeve (briefer than its floor, {self.floor_ms:g} ms), so the "
+            f"{self.shape} {self.level} ({plural(self.strokes, 'stroke')}) at "
+            f"{self.speed_cm_s:g} cm/s: {self.slowed} of its "
+            f"{plural(self.strokes, 'stroke')} would be slowed by the sleeve (briefer than "
+            f"its floor, {self.floor_ms:g} ms), so the "
             f"trial is not played at {self.speed_cm_s:g} cm/s; {fastest} (or give it fewer "
             "segments)"
         )
