@@ -100,7 +100,8 @@ pytest: $(STAMP) system
 	cd python && OPENBLAS_NUM_THREADS=1 ../$(BIN)/pytest -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS)
 
 # What a researcher needs for `feelmysign study` (docs/study.md): the statistics and plots
-# (python[research]), the system packages and the page the study is served on; the Java port
+# (python[research], installed with python[dev] in one step), the system packages and the
+# page the study is served on; the Java port
 # and the Go tools (NATS) are not built.
 research: $(STAMP) system web-build
 

@@ -107,3 +107,26 @@ def test_new_simulate_status_analyse(tmp_path: Path) -> None:
     assert (out / "report.md").is_file() and (out / "accuracy.png").is_file()
     missing = _cli("status", str(tmp_path / "none.sqlite"), cwd=tmp_path)
     assert missing.returncode == 1 and "no study file" in missing.stderr
+
+
+def test_a_design_given_for_a_study_file_says_how_to_make_one(tmp_path: Path) -> None:
+    result = _cli("analyse", str(PAPER_DESIGN), cwd=tmp_path)
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert f"{PAPER_DESIGN} is not a study file" in result.stderr
+    assert f"'feelmysign study new {PAPER_DESIGN} --out STUDY.sqlite'" in result.stderr
+
+
+def test_counts_of_one_are_singular(tmp_path: Path) -> None:
+    one = tmp_path / "one.toml"
+    text = PAPER_DESIGN.read_text().replace("repetitions = 3", "repetitions = 1")
+    one.write_text(text)
+    checked = _cli("check", str(one), cwd=tmp_path)
+    assert checked.returncode == 0, checked.stderr
+    assert " x 1 repetition = " in checked.stdout
+    study = tmp_path / "s.sqlite"
+    assert _cli("new", str(one), "--out", str(study), cwd=tmp_path).returncode == 0
+    assert _cli("simulate", str(study), "--participants", "1", cwd=tmp_path).returncode == 0
+    out = tmp_path / "results"
+    analysed = _cli("analyse", str(study), "--out", str(out), "--bootstrap", "50", cwd=tmp_path)
+    assert analysed.returncode == 0, analysed.stderr
+    assert analysed.stdout.startswith("1 participant, ")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -122,9 +123,20 @@ def test_a_design_that_is_not_utf8_is_named_not_a_crash(tmp_path: Path) -> None:
 def test_practice_written_as_one_table_gets_the_double_brackets_hint() -> None:
     with pytest.raises(DesignError) as caught:
         parse_design(MINIMAL + '[practice]\nshape = "circle"\n', source="bad.toml")
-    assert "practice: must be a list of tables: write each entry as [[practice]]" in str(
-        caught.value
-    )
+    assert caught.value.problems == [
+        "practice: must be a list of tables; got a single [practice] table: write [[practice]] "
+        "(two brackets) before each entry instead, one per entry"
+    ]
+
+
+def test_practice_declared_twice_as_a_table_is_named_in_toml_words() -> None:
+    twice = '[practice]\nshape = "circle"\n[practice]\nshape = "line"\n'
+    with pytest.raises(DesignError) as caught:
+        parse_design(MINIMAL + twice, source="bad.toml")
+    (problem,) = caught.value.problems
+    assert problem.startswith("not valid TOML: [practice] is declared twice (at line ")
+    assert "write [[practice]] (two brackets) before each one" in problem
+    assert "('practice',)" not in problem
 
 
 SPEEDS = "[stimulus]\nspeed_cm_s = [3, 6, 12]\n"
@@ -198,7 +210,7 @@ def test_a_practice_trial_may_have_its_own_speed() -> None:
         ),
         ("[3, 0.2]", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got 0.2"),
         ("[3, 'fast']", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got 'fast'"),
-        ("[3, true]", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got True"),
+        ("[3, true]", "stimulus.speed_cm_s[1]: must be a number from 0.5 to 50; got true"),
         (
             "[1, 2, 3, 4, 5, 6, 7, 8, 9]",
             "stimulus.speed_cm_s: at most 8 speeds; got 9: each speed plays every shape x "
@@ -219,9 +231,27 @@ def test_a_speed_too_slow_for_a_shape_is_refused_before_anything_is_sent() -> No
     with pytest.raises(DesignError) as caught:
         parse_design(slow + "segments = [1, 2]\n", source="bad.toml")
     square, line = caught.value.problems  # one problem per level too slow to play
-    assert square.startswith("shapes[1].segments[0]: at 0.5 cm/s: duration_ms of this square")
-    assert line.startswith("shapes[2].segments[0]: at 0.5 cm/s: duration_ms of this line")
-    assert "max_stroke_duration_ms 10000" in line and "or give a faster speed" in line
+    assert square.startswith(
+        "shapes[1].segments[0]: square at resolution 'low' (4 segments) is too slow at "
+        "0.5 cm/s: a stroke would last longer than the sleeve plays one (10000 ms, the "
+        "layout's max_stroke_duration_ms); the slowest speed it plays at is "
+    )
+    assert line.startswith("shapes[2].segments[0]: line at resolution 'low' (1 segment)")
+    # The slowest speed named plays, and a step slower does not.
+    found = re.search(r"the slowest speed it plays at is ([0-9.]+) cm/s", line)
+    assert found is not None
+    slowest = float(found[1])
+    square_fixed = MINIMAL.replace("segments = [4, 8]", "segments = [8, 12]")
+    for speed, plays in ((slowest, True), (round(slowest - 0.1, 6), False)):
+        design = (
+            square_fixed + f'[stimulus]\nspeed_cm_s = [{speed}, 5]\n[[shapes]]\nname = "line"\n'
+        )
+        try:
+            parse_design(design + "segments = [1, 2]\n")
+        except DesignError as error:
+            assert not plays and [p[:21] for p in error.problems] == ["shapes[2].segments[0]"]
+        else:
+            assert plays
     fixed = slow.replace("segments = [4, 8]", "segments = [8, 12]") + "segments = [2, 4]\n"
     assert parse_design(fixed).speeds == (0.5, 5.0)
 

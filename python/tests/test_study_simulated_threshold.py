@@ -31,7 +31,8 @@ def test_a_simulated_observer_run_is_flagged_everywhere(tmp_path: Path) -> None:
         timeout=300,
     )
     assert result.returncode == 0, result.stderr
-    assert "Simulated threshold (a dry run, stored as one)" in result.stdout
+    assert "Simulated length threshold (a dry run, stored as one): " in result.stdout
+    assert ") (" not in result.stdout
     (run,) = store.threshold_runs(code)
     assert run["simulated"] == 1 and run["threshold"] is not None
     status = subprocess.run(
@@ -53,6 +54,23 @@ def test_a_simulated_observer_run_is_flagged_everywhere(tmp_path: Path) -> None:
     measured, _, simulated = report.partition("Simulated runs (dry runs, not measurements): 1")
     assert "No measured run." in measured and "| P01 | length |" in simulated
     assert "| P01 | length |" not in measured
+
+
+def test_an_unknown_participant_is_said_before_any_broker_is_needed(tmp_path: Path) -> None:
+    store = StudyStore.create(tmp_path / "s.sqlite", QUICK, load_design(QUICK))
+    result = subprocess.run(
+        [
+            *(sys.executable, "-m", "feelmysign", "study", "threshold", str(store.path)),
+            *("--participant", "P-NOPE", "--dimension", "length"),
+            *("--broker", "mqtt://127.0.0.1:9"),  # nothing listens: never reached
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 1
+    assert result.stderr.startswith("Error: no participant 'P-NOPE' in ")
+    assert "study status" in result.stderr and "broker" not in result.stderr
 
 
 def test_a_dry_run_never_continues_a_measured_run(tmp_path: Path) -> None:

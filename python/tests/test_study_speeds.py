@@ -179,3 +179,19 @@ def test_the_speed_test_finds_an_effect_all_show_and_rarely_one_that_is_not_ther
     assert f"the speed test needs at least {MIN_SPEED_PARTICIPANTS}" in few.refused
     profile = speed_profiles(_speed_answers(8, np.random.default_rng(3), 1.0))
     assert profile.shape == (8, 2) and np.abs(profile.sum(axis=1)).max() < 1e-9
+
+
+def test_the_calibration_bench_describes_itself_in_whole_sentences() -> None:
+    import subprocess
+    import sys
+
+    shown = subprocess.run(
+        [sys.executable, "-m", "feelmysign.bench.study_calibration", "--help"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert shown.returncode == 0, shown.stderr
+    description = " ".join(shown.stdout.split("\n\n")[1].split())
+    assert description.startswith("Calibration of the study analysis")
+    assert "--speed-runs" in description and description.endswith(".")

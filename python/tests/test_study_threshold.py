@@ -152,7 +152,7 @@ def test_the_page_runs_the_procedure_step_by_step_and_resumes_after_a_restart(
     status, refused = _desk_call(page, "POST", f"{base}/threshold-discard", {"dimension": "length"})
     assert status == 400 and "nothing to discard" in refused["error"]
     shown = _status_lines(store.path)
-    assert f" {thrown['run']} (length): 1 trials, discarded (kept in the file" in shown
+    assert f" {thrown['run']} (length): 1 trial, discarded (kept in the file" in shown
     assert f" {stored['id']} (length): {finished['trials']} trials, finished" in shown
 
 

@@ -43,6 +43,7 @@ bad value and the allowed range.
 
 from __future__ import annotations
 
+import ast
 import difflib
 import json
 import math
@@ -281,6 +282,31 @@ def load_layout(path: str | PathLike[str]) -> Layout:
     return parse_layout(text, source)
 
 
+_DECLARED_TWICE = re.compile(
+    r"Cannot declare \((?P<key>.*)\) twice (?P<where>\(at line \d+, column \d+\))"
+)
+
+
+def _toml_problem(text: str) -> str:
+    """tomllib's message, said in TOML's words: a table declared twice names the table as the
+    file spells it (not a Python tuple) and says how to write a list of tables."""
+    found = _DECLARED_TWICE.fullmatch(text)
+    if found is None:
+        return text
+    try:
+        parts = ast.literal_eval(f"({found['key']})")
+    except (ValueError, SyntaxError):
+        return text
+    if not isinstance(parts, tuple) or not all(isinstance(part, str) for part in parts):
+        return text
+    name = ".".join(parts)
+    return (
+        f"[{name}] is declared twice {found['where']}; a table may appear once. For a list "
+        f"of entries (e.g. several practice trials), write [[{name}]] (two brackets) before "
+        "each one, one per entry"
+    )
+
+
 def loads_toml(
     text: str,
     source: str,
@@ -293,7 +319,7 @@ def loads_toml(
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as problem:
-        raise error(source, [f"not valid TOML: {problem}"]) from None
+        raise error(source, [f"not valid TOML: {_toml_problem(str(problem))}"]) from None
     except RecursionError:
         raise error(source, [f"nested too deeply to read; {nesting}"]) from None
 

@@ -188,8 +188,17 @@ def _coverage_report(coverage_runs: int, sizes: tuple[int, ...]) -> Iterator[str
         yield f"  {size:>2} participants: {describe(result, 'bootstrap')}"
 
 
+DESCRIPTION = (
+    "Calibration of the study analysis on simulated studies of the paper's design with a "
+    "known truth: the shape test's false-positive rate, the coverage of the needed "
+    "resolution's reported 95% interval and, with --speed-runs, the speed test's "
+    "false-positive rate and the shape test's with a speed effect; each share with its 95% "
+    "Wilson interval (docs/research.md, docs/study.md)."
+)
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser = argparse.ArgumentParser(description=DESCRIPTION)
     parser.add_argument(
         "test_runs", type=int, nargs="?", default=400, help="studies per size for the shape test"
     )

@@ -82,8 +82,10 @@ def run(args: argparse.Namespace) -> int:
 
         wearer_to_update(args.save, args.participant)  # a bad file is said before the run
     store = StudyStore(args.study)
+    # Said first: an unknown code is the mistake to fix, not the broker the run would need.
+    participant = store.participant(args.participant)
     if args.save is not None and args.simulated_observer is not None:
-        _refuse_a_dry_run_for_a_real_wearer(store.participant(args.participant), args.save)
+        _refuse_a_dry_run_for_a_real_wearer(participant, args.save)
     layout = stimulus_layout(store.design.stimulus, store.base_dir)
     unit = "grid units" if args.dimension == "length" else "ms"
 
@@ -112,10 +114,12 @@ def run(args: argparse.Namespace) -> int:
                 store, args.participant, args.dimension, layout, link.play, _ask, progress
             )
     kind = (
-        "Simulated threshold (a dry run, stored as one)" if args.simulated_observer else "Threshold"
+        f"Simulated {args.dimension} threshold (a dry run, stored as one)"
+        if args.simulated_observer
+        else f"Threshold ({args.dimension})"
     )
     print(
-        f"{kind} ({args.dimension}): {estimate.threshold:.3g} {unit}, 95% interval "
+        f"{kind}: {estimate.threshold:.3g} {unit}, 95% interval "
         f"{estimate.low:.3g} to {estimate.high:.3g}, after {estimate.trials} trials."
     )
     if args.save is not None:

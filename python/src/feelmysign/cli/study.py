@@ -142,8 +142,9 @@ def _check(args: argparse.Namespace) -> int:
     speeds = ", ".join(f"{speed:g}" for speed in design.speeds)
     by_speed = f"{len(design.speeds)} speeds ({speeds} cm/s) x " if design.speed_is_factor else ""
     print(
-        f"  {len(design.shapes)} shapes x {len(design.resolutions)} resolutions x {by_speed}"
-        f"{design.repetitions} repetitions = {design.main_trials} measured trials per participant, "
+        f"  {plural(len(design.shapes), 'shape')} x {plural(len(design.resolutions), 'resolution')}"
+        f" x {by_speed}{plural(design.repetitions, 'repetition')} = "
+        f"{plural(design.main_trials, 'measured trial')} per participant, "
         f"after {plural(len(design.practice), 'practice trial')}; order: {design.randomisation}"
     )
     for shape in design.shapes:
@@ -154,6 +155,10 @@ def _check(args: argparse.Namespace) -> int:
         if practice:
             print(f"  practice: {', '.join(practice)}")
     print(_session_length(design, args.design))
+    from feelmysign.study.slowed import slowed_trials
+
+    for slowed in slowed_trials(design, args.design.resolve().parent):
+        print(f"  warning: {slowed.message()}")
     return 0
 
 
@@ -198,6 +203,17 @@ def _new(args: argparse.Namespace) -> int:
         f"Created {args.out} for {design.name!r}. Next: 'feelmysign up --study {args.out}' "
         f"(page /study), or 'feelmysign study run {args.out}'."
     )
+    from feelmysign.study.slowed import slowed_trials
+
+    slowed = slowed_trials(design, Path(args.design).resolve().parent)
+    if slowed:
+        named = ", ".join(f"{s.shape} {s.level} at {s.speed_cm_s:g} cm/s" for s in slowed[:3])
+        more = ", ..." if len(slowed) > 3 else ""
+        print(
+            f"Warning: the sleeve would slow strokes in {plural(len(slowed), 'case')} at the "
+            f"design's speeds ({named}{more}): 'feelmysign study check {args.design}' says "
+            "which speeds play them unslowed."
+        )
     return 0
 
 
@@ -233,7 +249,8 @@ def _status(args: argparse.Namespace) -> int:
                 result = f"finished, {run['threshold']:.3g} {unit}"
             else:
                 result = "unfinished (the same command resumes it)"
-            print(f"    {what} {run['id']} ({run['dimension']}): {len(done)} trials, {result}")
+            count = plural(len(done), "trial")
+            print(f"    {what} {run['id']} ({run['dimension']}): {count}, {result}")
     if not store.participants():
         print("  no participant yet")
     return 0
@@ -308,7 +325,7 @@ def _analyse(args: argparse.Namespace) -> int:
     out = _out_dir(args)
     analysis = analyse_study(_store(args), out, samples=args.bootstrap)
     print(
-        f"{analysis.participants} participants, {analysis.trials} trials, "
+        f"{plural(analysis.participants, 'participant')}, {plural(analysis.trials, 'trial')}, "
         f"{analysis.unclear} awaiting review."
     )
     if analysis.model is not None:

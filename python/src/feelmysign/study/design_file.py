@@ -9,6 +9,7 @@ shapes.
 
 from __future__ import annotations
 
+import math
 import uuid
 from collections.abc import Callable
 from functools import partial
@@ -19,6 +20,7 @@ from typing import Any
 from feelmysign.errors import DesignError, FeelMySignError
 from feelmysign.input_files import MAX_DESIGN_BYTES, read_text
 from feelmysign.layout import Layout, loads_toml
+from feelmysign.plural import plural
 from feelmysign.shapes import SHAPES
 from feelmysign.simplify.registry import ALGORITHMS
 from feelmysign.study.coding import normalise
@@ -77,7 +79,7 @@ def parse_design(text: str, *, source: str = "<design>", base_dir: Path = Path("
     if len(set(resolutions)) != len(resolutions):
         problems.add("study.resolutions", "each resolution needs its own label")
     stimulus = _stimulus(problems, data.get("stimulus", MISSING), base_dir)
-    shapes = _shapes(problems, data.get("shapes", MISSING), len(resolutions), stimulus, base_dir)
+    shapes = _shapes(problems, data.get("shapes", MISSING), resolutions, stimulus, base_dir)
     design = Design(
         name=problems.text("study.name", study.get("name", MISSING)) or "",
         seed=problems.integer("study.seed", study.get("seed", MISSING), 0, 2**63 - 1) or 0,
@@ -180,21 +182,71 @@ def _speeds(problems: Problems, value: Any) -> tuple[float, ...] | None:
 
 
 def _drawable(
-    problems: Problems, where: str, speeds: tuple[float, ...], make: Callable[[float], object]
+    problems: Problems,
+    where: str,
+    what: str,
+    speeds: tuple[float, ...],
+    make: Callable[[float], object],
+    layout: Layout,
 ) -> bool:
     """``make(speed)`` gives strokes the sleeve plays at every speed of ``speeds``: a slow speed
-    can make a stroke last longer than the sleeve allows. One problem per level."""
+    can make a stroke last longer than the sleeve allows. One problem per level, naming it
+    (``what``) and the slowest speed it plays at."""
     for speed in speeds:
         try:
             make(speed)
-        except FeelMySignError as error:
-            problems.add(where, f"at {speed:g} cm/s: {error}; or give a faster speed")
+        except FeelMySignError:
+            slowest = _slowest_speed(make, speed)
+            allowed = (
+                f"the slowest speed it plays at is {slowest:g} cm/s: give that speed or a "
+                "faster one"
+                if slowest is not None
+                else f"no speed up to {SPEED_RANGE_CM_S[1]:g} cm/s plays it"
+            )
+            problems.add(
+                where,
+                f"{what} is too slow at {speed:g} cm/s: a stroke would last longer than the "
+                f"sleeve plays one ({layout.max_stroke_duration_ms:g} ms, the layout's "
+                f"max_stroke_duration_ms); {allowed} (or more segments)",
+            )
             return False
     return True
 
 
+_SPEED_STEP_CM_S = 0.1  # the slowest allowed speed is rounded up to this step
+
+
+def _slowest_speed(make: Callable[[float], object], too_slow_cm_s: float) -> float | None:
+    """The slowest speed, in steps of 0.1 cm/s above ``too_slow_cm_s``, at which ``make``
+    succeeds (a faster speed only shortens the strokes); None when even the fastest allowed
+    fails."""
+
+    def plays(step: int) -> bool:
+        try:
+            make(step * _SPEED_STEP_CM_S)
+        except FeelMySignError:
+            return False
+        return True
+
+    low = math.floor(too_slow_cm_s / _SPEED_STEP_CM_S)  # fails (at or below the slow speed)
+    high = round(SPEED_RANGE_CM_S[1] / _SPEED_STEP_CM_S)
+    if not plays(high):
+        return None
+    while high - low > 1:
+        middle = (low + high) // 2
+        if plays(middle):
+            high = middle
+        else:
+            low = middle
+    return round(high * _SPEED_STEP_CM_S, 6)
+
+
 def _shapes(
-    problems: Problems, value: Any, levels: int, stimulus: Stimulus, base_dir: Path
+    problems: Problems,
+    value: Any,
+    resolutions: tuple[str, ...],
+    stimulus: Stimulus,
+    base_dir: Path,
 ) -> tuple[Shape, ...]:
     items = problems.array("shapes", value)
     if items is None:
@@ -203,7 +255,7 @@ def _shapes(
         problems.add("shapes", f"give 1 to {MAX_SHAPES} [[shapes]]; got {len(items)}")
     shapes: list[Shape] = []
     for index, item in enumerate(items):
-        shape = _shape(problems, f"shapes[{index}]", item, levels, stimulus, base_dir)
+        shape = _shape(problems, f"shapes[{index}]", item, resolutions, stimulus, base_dir)
         if shape is not None:
             shapes.append(shape)
     _check_names_and_synonyms(problems, shapes)
@@ -211,8 +263,14 @@ def _shapes(
 
 
 def _shape(
-    problems: Problems, key: str, item: Any, levels: int, stimulus: Stimulus, base_dir: Path
+    problems: Problems,
+    key: str,
+    item: Any,
+    resolutions: tuple[str, ...],
+    stimulus: Stimulus,
+    base_dir: Path,
 ) -> Shape | None:
+    levels = len(resolutions)
     table = problems.table(key, item, required=True)
     problems.unknown(
         key, table, ("name", "segments", "recording", "simplifier", "settings", "synonyms")
@@ -226,11 +284,11 @@ def _shape(
     if recording is None:
         found = _library_levels(problems, key, name, table.get("segments", MISSING), levels)
         if found is not None and not _library_drawable(
-            problems, key, name, found, stimulus, base_dir
+            problems, key, name, found, resolutions, stimulus, base_dir
         ):
             return None
     else:
-        found = _recorded_levels(problems, key, table, recording, levels, stimulus, base_dir)
+        found = _recorded_levels(problems, key, table, recording, resolutions, stimulus, base_dir)
     if found is not None and not _coarse_to_fine(problems, key, recording, found):
         return None
     return None if found is None else Shape(name, found, words, recording)
@@ -266,6 +324,7 @@ def _library_drawable(
     key: str,
     name: str,
     levels: tuple[Level, ...],
+    resolutions: tuple[str, ...],
     stimulus: Stimulus,
     base_dir: Path,
 ) -> bool:
@@ -276,10 +335,12 @@ def _library_drawable(
         _drawable(
             problems,
             f"{key}.segments[{i}]",
+            f"{name} at resolution {resolution!r} ({plural(level.strokes, 'segment')})",
             stimulus.speeds,
             partial(library_strokes, name, level.strokes, stimulus, layout, "-"),
+            layout,
         )
-        for i, level in enumerate(levels)
+        for i, (level, resolution) in enumerate(zip(levels, resolutions, strict=True))
     )
 
 
@@ -321,10 +382,11 @@ def _recorded_levels(
     key: str,
     table: dict[str, Any],
     recording: str,
-    levels: int,
+    resolutions: tuple[str, ...],
     stimulus: Stimulus,
     base_dir: Path,
 ) -> tuple[Level, ...] | None:
+    levels = len(resolutions)
     simplifier = problems.choice(
         f"{key}.simplifier", table.get("simplifier", MISSING), tuple(ALGORITHMS), "window"
     )
@@ -361,7 +423,9 @@ def _recorded_levels(
             return None
         # Speed a factor: the drawing is redrawn at each speed (stimulus.trial_strokes).
         speeds = stimulus.speeds_cm_s
-        if not _drawable(problems, where, speeds, partial(at_speed, strokes, layout=layout)):
+        what = f"{recording} at resolution {resolutions[i]!r} ({plural(len(strokes), 'stroke')})"
+        redraw = partial(at_speed, strokes, layout=layout)
+        if not _drawable(problems, where, what, speeds, redraw, layout):
             return None
         out.append(Level(len(strokes), simplifier=simplifier, settings=dict(overrides)))
     return tuple(out)
@@ -438,7 +502,8 @@ def _practice(
                     path, chosen.simplifier, chosen.settings, stimulus, layout, "-"
                 )
                 redrawn = partial(at_speed, strokes, layout=layout)
-                if not _drawable(problems, f"{key}.speed_cm_s", (speed,), redrawn):
+                what = f"practice trial {index + 1} ({name} at resolution {label!r})"
+                if not _drawable(problems, f"{key}.speed_cm_s", what, (speed,), redrawn, layout):
                     continue
             out.append(PracticeTrial(name, chosen.strokes, level, speed))
             continue
@@ -460,8 +525,10 @@ def _practice(
         if layout is not None and not _drawable(
             problems,
             f"{key}.segments" if speed is None else f"{key}.speed_cm_s",
+            f"practice trial {index + 1} ({name}, {plural(segments, 'segment')})",
             (played_at,),
             partial(library_strokes, name, segments, stimulus, layout, "-"),
+            layout,
         ):
             continue
         out.append(PracticeTrial(name, segments, None, speed))

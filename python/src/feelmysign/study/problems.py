@@ -15,6 +15,9 @@ MISSING: Any = object()
 
 
 def show(value: Any) -> str:
+    """``value`` as the design file spells it: ``true``, not Python's ``True``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
     if isinstance(value, str):
         return repr(value)
     if isinstance(value, dict):
@@ -100,8 +103,8 @@ class Problems:
             # [practice] written where [[practice]] was meant: one table, not a list of them.
             self.add(
                 key,
-                f"must be a list of tables: write each entry as [[{key}]] (two brackets), "
-                f"not [{key}]; got one table {show(value)}",
+                f"must be a list of tables; got a single [{key}] table: write [[{key}]] (two "
+                "brackets) before each entry instead, one per entry",
             )
             return None
         if not isinstance(value, list):

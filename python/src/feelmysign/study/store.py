@@ -117,7 +117,17 @@ class StudyStore:
             db.execute("PRAGMA synchronous=FULL")
             db.execute("PRAGMA foreign_keys=ON")
         except sqlite3.DatabaseError as error:
-            raise StudyError(f"{path} is not a study file ({error})") from error
+            if Path(path).suffix.lower() == ".toml":
+                what = (
+                    f"it looks like a design: make a study file from it with 'feelmysign study "
+                    f"new {path} --out STUDY.sqlite', then give STUDY.sqlite here"
+                )
+            else:
+                what = (
+                    "give the path of the file that 'feelmysign study new DESIGN.toml --out "
+                    "FILE.sqlite' made ('feelmysign study check DESIGN.toml' checks a design)"
+                )
+            raise StudyError(f"{path} is not a study file ({error}); {what}") from error
         db.row_factory = sqlite3.Row
         return db
 
