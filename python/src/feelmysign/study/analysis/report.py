@@ -200,8 +200,9 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
         f"# {design.name}",
         "",
         f"{plural(analysis.participants, 'participant')} ({analysis.simulated} simulated), "
-        f"{analysis.trials} measured trials: {len(design.shapes)} shapes x "
-        f"{len(design.resolutions)} resolutions x {by_speed}{design.repetitions} repetitions, "
+        f"{plural(analysis.trials, 'measured trial')}: {plural(len(design.shapes), 'shape')} x "
+        f"{plural(len(design.resolutions), 'resolution')} x {by_speed}"
+        f"{plural(design.repetitions, 'repetition')}, "
         "order by "
         f"{design.randomisation} (seed {design.seed}). Answers were free; they were coded to "
         f"shapes by synonyms, unclear ones by the researcher. "
