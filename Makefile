@@ -229,7 +229,8 @@ web-clean:
 	rm -rf $(WEB)/node_modules $(WEB)/dist $(WEB)/test-results
 
 # The web client joins the project-wide targets (extra prerequisites; their recipes stay above).
-install: $(WEB_STAMP)
+# make install builds the page too, so that `feelmysign up` serves it right after.
+install: web-build
 check: web-test
 bench: $(WEB_STAMP)
 bench-prepare: web-build $(LASA_FRAMES)
