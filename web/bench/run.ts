@@ -11,11 +11,12 @@
  *     for a minute on the page `feelmysign up` serves, its simulated sleeve
  *     playing: the last seconds against the first (budget <= 1.2).
  * Needs `vite build` (dist/), the Python venv (feelmysign) and Debian's chromium.
- * FEELMYSIGN_BENCH_WEB_DIR measures the scribble on another build of the page.
+ * FEELMYSIGN_BENCH_WEB_DIR measures the scribble on another build of the page;
+ * FEELMYSIGN_SCRIBBLE_S scribbles that many seconds instead of a minute (a long call).
  */
 import { benchFrameCost, type FramePhase } from "./frame-cost";
 import { benchLasa, type LasaRate } from "./lasa";
-import { benchScribble, PATH_SECONDS } from "./scribble";
+import { benchScribble, PATH_SECONDS, SCRIBBLE_SECONDS } from "./scribble";
 import { benchSimplifier } from "./simplifier";
 
 /** Each part's wall time, printed after its figures: make bench is meant to take minutes. */
@@ -94,7 +95,7 @@ partTime();
 
 const scribble = await benchScribble();
 console.log(
-  `web: a minute of scribbling on 'feelmysign up' with its simulated sleeve (${scribble.browser}, headless):` +
+  `web: ${SCRIBBLE_SECONDS === 60 ? "a minute" : `${SCRIBBLE_SECONDS} s`} of scribbling on 'feelmysign up' with its simulated sleeve (${scribble.browser}, headless):` +
     ` ${scribble.paths} paths of ${PATH_SECONDS} s in one drawing, ${scribble.samples.toLocaleString("en")} pointer samples,` +
     ` ${scribble.strokes} strokes sent, ${scribble.played} reported played`,
 );

@@ -14,8 +14,9 @@ import { DIST_DIR } from "../e2e/harness";
 import { drawingArea, type Area } from "../e2e/page";
 import { DESKTOP, Processes } from "../e2e/processes";
 
-/** How long the scribbling goes on. */
-const SCRIBBLE_MS = 60_000;
+/** How long the scribbling goes on: a minute, or FEELMYSIGN_SCRIBBLE_S seconds (a long call). */
+export const SCRIBBLE_SECONDS = scribbleSeconds(process.env["FEELMYSIGN_SCRIBBLE_S"]);
+const SCRIBBLE_MS = SCRIBBLE_SECONDS * 1000;
 /** One path: about 1.5 s of pointer samples, one every 12 ms. */
 const PATH_MS = 1500;
 export const PATH_SECONDS = PATH_MS / 1000;
@@ -47,6 +48,16 @@ export interface WindowFigures {
 }
 
 type Shape = (u: number) => [number, number];
+
+/** FEELMYSIGN_SCRIBBLE_S read: whole seconds from 15 (three windows of 5 s) to a day. */
+function scribbleSeconds(given: string | undefined): number {
+  if (given === undefined || given === "") return 60;
+  const seconds = Number(given);
+  if (!Number.isInteger(seconds) || seconds < 15 || seconds > 86_400) {
+    throw new Error(`FEELMYSIGN_SCRIBBLE_S=${given}: give whole seconds from 15 to 86400 (default 60)`);
+  }
+  return seconds;
+}
 
 /** A small deterministic generator: the same scribble every run. */
 function random(seed: number): () => number {
