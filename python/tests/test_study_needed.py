@@ -150,3 +150,39 @@ def test_the_bias_corrected_interval_holds_its_estimate_when_the_values_lie_to_o
     assert high < 20.0  # not the outliers' tail
     low, high = bias_corrected_interval(-values, -3.0)  # and mirrored
     assert low <= -3.0 <= high and low > -20.0
+
+
+@pytest.mark.parametrize(
+    "correct",
+    [
+        # Every participant wrong at 4 strokes and below, right from 6: complete separation.
+        [[1, 0, 1, 4, 4, 4], [0, 1, 1, 4, 4, 4], [1, 1, 0, 4, 4, 4], [0, 0, 1, 4, 4, 4]],
+        # The same answers for everyone: every resampled study is the real one.
+        [[0, 0, 0, 4, 4, 4]] * 5,
+    ],
+)
+def test_answers_that_jump_between_two_resolutions_place_it_only_between_them(
+    correct: list[list[int]],
+) -> None:
+    # Resampled studies all jump where the real one does and fit the same value: the cluster
+    # interval had no width (4.92 - 4.92) although nothing was measured between 4 and 6.
+    levels = np.array([2.0, 3.0, 4.0, 6.0, 8.0, 12.0])
+    data = [(np.array(k, dtype=float), np.full(6, 4.0)) for k in correct]
+    threshold = threshold_with_interval(data, levels, criterion=0.625, guess=0.25, samples=200)
+    assert 4.0 < threshold.strokes < 6.0
+    for low, high in (
+        (threshold.boot_low, threshold.boot_high),
+        (threshold.low, threshold.high),
+        (threshold.cluster_low, threshold.cluster_high),
+    ):
+        assert low <= 4.0 and high >= 6.0, (low, high)
+
+
+def test_a_measured_slope_keeps_its_intervals_narrower_than_the_tested_step() -> None:
+    # Answers that climb level by level: a slope was measured, so nothing is widened to the
+    # neighbouring resolutions.
+    levels = np.array([2.0, 3.0, 4.0, 6.0, 8.0, 12.0])
+    correct = [[1, 1, 2, 3, 4, 4], [0, 1, 2, 4, 3, 4], [1, 2, 2, 3, 4, 4], [1, 1, 3, 3, 4, 4]]
+    data = [(np.array(k, dtype=float), np.full(6, 4.0)) for k in correct]
+    threshold = threshold_with_interval(data, levels, criterion=0.625, guess=0.25, samples=200)
+    assert threshold.cluster_high - threshold.cluster_low < 6.0 - 4.0

@@ -58,6 +58,24 @@ from feelmysign.study.choices import BOOTSTRAP_SAMPLES
 
 LAPSE = 0.02  # Wichmann & Hill 2001: a small fixed lapse keeps the slope unbiased
 SLOPE_BOUNDS = (0.05, 40.0)  # per doubling of strokes; 40 is a step, 0.05 is flat
+
+
+def is_step(slope: float) -> bool:
+    """The fit's slope at its upper bound (or not finite): the answers change from wrong to
+    right between two tested resolutions (or never change), so no slope was measured."""
+    return not math.isfinite(slope) or slope >= SLOPE_BOUNDS[1] * 0.999
+
+
+def step_bracket(estimate: float, levels: NDArray[np.float64]) -> tuple[float, float]:
+    """The tested resolutions on either side of ``estimate``: where the answers of a step
+    (``is_step``) change, all that the data say of where the criterion is reached."""
+    below, above = levels[levels < estimate], levels[levels > estimate]
+    return (
+        float(below.max()) if below.size else estimate,
+        float(above.min()) if above.size else estimate,
+    )
+
+
 SPREAD_BOUNDS = (0.0, 3.0)  # SD of the participants' shifts, doublings of strokes
 
 
@@ -478,6 +496,16 @@ def threshold_with_interval(
         estimate,
         tested,
     )
+    if is_step(best.slope) and tested[0] < estimate < tested[1]:
+        # Every participant's answers jump from wrong to right between the same two tested
+        # resolutions: the likelihood hardly prefers any point between them, yet every
+        # resampled study jumps there too and its fit lands on the same value (a cluster
+        # interval of zero width). The data place the needed resolution only between the
+        # two, so each interval spans at least them.
+        bracket_low, bracket_high = step_bracket(estimate, x)
+        boot_low, boot_high = min(boot_low, bracket_low), max(boot_high, bracket_high)
+        low, high = min(low, bracket_low), max(high, bracket_high)
+        cluster_low, cluster_high = min(cluster_low, bracket_low), max(cluster_high, bracket_high)
     return Threshold(
         best,
         estimate,

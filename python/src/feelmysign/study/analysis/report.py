@@ -14,6 +14,7 @@ from feelmysign.study.analysis.psychometric import (
     SLOPE_BOUNDS,
     Interval,
     Needed,
+    is_step,
 )
 from feelmysign.study.store import DISCARDED, StudyStore
 
@@ -96,10 +97,11 @@ def cluster_not_estimable(interval: Interval | None, participants: int) -> str |
 def slope_not_estimable(slope: float) -> str | None:
     """Why there is no slope, or None: at its upper bound the answers jump from wrong to
     right between two tested resolutions (or never change), so no slope was measured."""
-    if not math.isfinite(slope) or slope >= SLOPE_BOUNDS[1] * 0.999:
+    if is_step(slope):
         return (
             f"not estimable: at the fit's limit ({SLOPE_BOUNDS[1]:g}), the answers change "
-            "from wrong to right between two tested resolutions or not at all"
+            "from wrong to right between two tested resolutions or not at all (each interval "
+            "of the needed resolution then spans at least those two)"
         )
     return None
 
