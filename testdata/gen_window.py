@@ -6,9 +6,13 @@ pointer samples of each path (``[t_ms, x_px, y_px, pressure]``) and the
 expected segments. An implementation pushes every sample of a path (the window
 simplifier takes samples, not frames), calls ``end``, and must reproduce
 ``expected.segments`` (path index, start, end, times, dropped reason) and
-``expected.inputs`` (samples per path) within ``tolerance``. ``params.json`` is the
+``expected.inputs`` (samples per path) within ``tolerance``, and ``expected.merged_back``:
+per path, the pieces merged at release into the stroke already sent before them (nothing is
+sent for them; ``WindowSimplifier.merged_back``). ``params.json`` is the
 parameter table (defaults and allowed ranges). Besides gen_angle's shapes, a window-only
-one (``EDGE_SHAPES``): a drawing along the canvas edges, whose strokes must stay on the grid.
+ones (``EDGE_SHAPES``): a drawing along the canvas edges, whose strokes must stay on the grid,
+a crawl, and lines released just after a cut of the latency cap (a last piece merged at release,
+and one sent).
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ import random
 from typing import Any
 
 from feelmysign.simplify import Sample, WindowParams
-from feelmysign.simplify.window import WINDOW_PARAMS
+from feelmysign.simplify.window import WINDOW_PARAMS, WindowSimplifier
 from gen_angle import H, Path, W, _line, simplifier_case, simplifier_cases
 
 VARIATIONS: dict[str, dict[str, Any]] = {
@@ -88,9 +92,21 @@ def _crawl(seed: int = 5) -> Path:
     return samples
 
 
+def _tail() -> list[Path]:
+    """Two lines released about 30 ms after the latency cap's last cut: the first goes on
+    straight to the release (its last piece lies within max_error of the stroke before, and
+    merges into it at release: nothing more is sent), the second ends in a quick hook 0.36 grid
+    units across (too far from the stroke before: the piece is sent, briefer than the floor)."""
+    line = _line([(100, 400), (540, 400)], 1.0, seed=7)
+    hooked = _line([(100, 400), (540, 400)], 1.0, seed=7)
+    last = hooked[-1]
+    hooked += [Sample(round(last.t_ms + 8.0 * k, 3), last.x, last.y + 48.0 * k) for k in (1, 2, 3)]
+    return [line, hooked]
+
+
 # Window-only shapes, each with the defaults and the latency cap's variations (W x H fills the
 # default 3 x 4 grid, so the canvas edges are the grid's).
-EDGE_SHAPES = {"edge-u": lambda: [_edge_u()], "crawl": lambda: [_crawl()]}
+EDGE_SHAPES = {"edge-u": lambda: [_edge_u()], "crawl": lambda: [_crawl()], "tail": _tail}
 EDGE_VARIATIONS = (
     "defaults",
     "max-stroke-ms-100",
@@ -107,6 +123,19 @@ def _edge_case(shape: str, variation: str) -> dict[str, Any]:
     )
 
 
+def _merged_back(case: dict[str, Any]) -> list[int]:
+    """Per path of ``case``, the pieces the reference merges at release into a sent stroke."""
+    simplifier = WindowSimplifier(WindowParams(**case["params"]))
+    counts = []
+    for path in case["paths"]:
+        before = simplifier.merged_back
+        for t_ms, x, y, pressure in path:
+            simplifier.push(Sample(t_ms, x, y, pressure))
+        simplifier.end()
+        counts.append(simplifier.merged_back - before)
+    return counts
+
+
 def cases() -> dict[str, dict[str, Any]]:
     result = simplifier_cases(
         WindowParams,
@@ -117,4 +146,7 @@ def cases() -> dict[str, dict[str, Any]]:
     for shape in EDGE_SHAPES:
         for variation in EDGE_VARIATIONS:
             result[f"{shape}/{variation}.json"] = _edge_case(shape, variation)
+    for name, case in result.items():
+        if name != "params.json":
+            case["expected"]["merged_back"] = _merged_back(case)
     return result

@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from feelmysign.simplify import Sample, Segment, simplify_paths
 from feelmysign.simplify.registry import Params as SimplifierParams
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE, NOT_ENOUGH_DURATION
+from feelmysign.stroke import Point
 
 CANVAS_WIDTH_PX = 800
 CANVAS_HEIGHT_PX = 600
@@ -81,8 +82,12 @@ def assert_joined_from_press_to_release(
     *,
     release_within: float = 0.0,
     rests: bool = False,
+    release_on_last: bool = False,
 ) -> None:
     """Segments start at the press, end at the release (within release_within), and join.
+
+    With ``release_on_last`` (the window simplifier's last piece merged at release into the
+    stroke before it) the release lies within release_within of the last segment, not its end.
 
     With ``rests`` (the window simplifier's rest_ms and max_stroke_ms) a rest or a crawl is not
     played: a segment may start
@@ -92,18 +97,35 @@ def assert_joined_from_press_to_release(
     mapping = params.mapping
     assert segments[0].start == mapping.to_grid(samples[0].x, samples[0].y)
     release = mapping.to_grid(samples[-1].x, samples[-1].y)
-    assert math.dist(segments[-1].end, release) <= release_within
+    last = segments[-1]
+    if release_on_last:
+        assert _distance_to(release, last.start, last.end) <= release_within
+    else:
+        assert math.dist(last.end, release) <= release_within
     if rests:
         assert segments[0].start_ms >= samples[0].t_ms
         assert segments[-1].end_ms <= samples[-1].t_ms
     else:
-        assert segments[0].start_ms == samples[0].t_ms and segments[-1].end_ms == samples[-1].t_ms
+        assert segments[0].start_ms == samples[0].t_ms
+        if release_on_last:  # the last piece, drawn after the last segment, merged into it
+            assert segments[-1].end_ms <= samples[-1].t_ms
+        else:
+            assert segments[-1].end_ms == samples[-1].t_ms
     for before, after in itertools.pairwise(segments):
         assert after.start == before.end
         if rests:
             assert after.start_ms >= before.end_ms
         else:
             assert after.start_ms == before.end_ms
+
+
+def _distance_to(point: tuple[float, float], start: Point, end: Point) -> float:
+    """Distance from a point to the segment start -> end (its nearest point)."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    qx, qy = point[0] - start[0], point[1] - start[1]
+    length_sq = dx * dx + dy * dy
+    t = 0.0 if length_sq == 0 else min(max((qx * dx + qy * dy) / length_sq, 0.0), 1.0)
+    return math.hypot(qx - t * dx, qy - t * dy)
 
 
 def assert_dropped_say_why(params: SimplifierParams, samples: list[Sample]) -> None:

@@ -62,6 +62,20 @@ def test_vector(name: str, case: dict[str, Any]) -> None:
     paths = [[Sample(*s) for s in path] for path in case["paths"]]
     assert [len(p) for p in paths] == case["expected"]["inputs"]
     check_vector(name, case, params, paths)
+    assert _merged_back(params, paths) == case["expected"]["merged_back"], name
+
+
+def _merged_back(params: WindowParams, paths: list[list[Sample]]) -> list[int]:
+    """Per path, the pieces merged at release into the stroke sent before them."""
+    simplifier = WindowSimplifier(params)
+    counts = []
+    for path in paths:
+        before = simplifier.merged_back
+        for sample in path:
+            simplifier.push(sample)
+        simplifier.end()
+        counts.append(simplifier.merged_back - before)
+    return counts
 
 
 def test_parameter_table_matches_the_defaults() -> None:
@@ -155,9 +169,15 @@ def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
     assert [s.duration_ms for s in cut] == [96.0] * 6 + [24.0]
     assert cut[0].emitted_at_ms == 104.0  # let go by the sample that would pass 100 ms
     assert cut[-1].end_ms == 600.0
-    # With the sleeve's floor (73.7 ms) the strokes are the same: a stroke the cap ends is
-    # merged into nothing before it, and the rest, 24 ms, the last, has nothing after it.
-    assert [s.duration_ms for _, s in run(params, [line])] == [96.0] * 6 + [24.0]
+    # With the sleeve's floor (73.7 ms) a stroke the cap ends is merged into nothing before it,
+    # and the rest, 24 ms, the last, lies on the sixth stroke's line, 0.03 grid units past its
+    # end (max_error 0.25): it merges into it at release, and nothing more is sent.
+    assert [s.duration_ms for _, s in run(params, [line])] == [96.0] * 6
+    assert _merged_back(params, [line]) == [1]
+    # A bound tighter than those 0.03 keeps the rest apart: sent as it is, briefer than the floor.
+    tight = replace(params, max_error=0.02)
+    assert [s.duration_ms for _, s in run(tight, [line])] == [96.0] * 6 + [24.0]
+    assert _merged_back(tight, [line]) == [0]
 
 
 def test_pieces_briefer_than_the_floor_merge_into_the_next() -> None:
@@ -382,9 +402,10 @@ def _moved(params: WindowParams) -> float:
 
 
 def _ends(
-    params: WindowParams, samples: list[Sample], segments: list[Segment]
+    params: WindowParams, samples: list[Sample], segments: list[Segment], merged_back: int = 0
 ) -> list[tuple[int, int, Segment]]:
-    """Each segment with the first and last sample it covers (see ``_covered``)."""
+    """Each segment with the first and last sample it covers (see ``_covered``); with
+    ``merged_back``, the path's last piece merged at release into the last segment."""
     mapping, moved = params.mapping, _moved(params)
     covered: list[tuple[int, int, Segment]] = []
     start = 0
@@ -403,10 +424,13 @@ def _ends(
             end = max(j for j in ends if samples[j].t_ms == samples[ends[0]].t_ms)
         covered.append((start, end, segment))
         start = end
-    # The samples after the last segment are a rest at its end.
+    # The samples after the last segment are a rest at its end, or the last piece, merged into it
+    # at release: within max_error of it.
     if segments:
         last = segments[-1]
         limit = min(2 * _rest_radius(params), params.max_error) + FLOAT_TOLERANCE
+        if merged_back:
+            limit = params.max_error + FLOAT_TOLERANCE
         for sample in samples[start + 1 :]:
             point = mapping.to_grid(sample.x, sample.y)
             assert _distance(point, last.start, last.end) <= limit, (last, sample)
@@ -420,9 +444,12 @@ def _covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int
     ended on; it ends on the first sample (from there) drawn at or after its end
     time, at its point or, going on along a line the latency cap cut, within
     LINE_SHARE x max_error of it (where the pen rested, within the rest radius).
-    The samples after the last segment are a rest at its end.
+    The samples after the last segment are a rest at its end, or a last piece merged into it at
+    release (``merged_back``).
     """
-    return _ends(params, samples, [s for _, s in run(params, [samples])])
+    simplifier = WindowSimplifier(params)
+    segments = [out for sample in samples for out in simplifier.push(sample)] + simplifier.end()
+    return _ends(params, samples, segments, simplifier.merged_back)
 
 
 @settings(max_examples=250, deadline=None)
@@ -442,11 +469,14 @@ def test_every_drawn_sample_lies_within_max_error_of_its_stroke(
 @given(paths())
 def test_segments_join_and_keep_the_path_ends(case: tuple[WindowParams, list[Sample]]) -> None:
     params, samples = case
+    # A last piece merged at release leaves the release within max_error of the last stroke.
+    merged_back = _merged_back(params, [samples]) != [0]
     assert_joined_from_press_to_release(
         params,
         samples,
-        release_within=_moved(params),
+        release_within=params.max_error + FLOAT_TOLERANCE if merged_back else _moved(params),
         rests=params.rest_ms > 0 or params.max_stroke_ms > 0,
+        release_on_last=merged_back,
     )
 
 
@@ -486,6 +516,36 @@ def test_a_short_piece_is_merged_or_else_could_not_be(
     covered = _covered(params, samples)
     for first, last, segment in covered:
         assert last - first >= segment.merged + 1 or len(samples) == 1, segment
+
+
+@settings(max_examples=300, deadline=None)
+@given(paths(), st.sampled_from([0.05, 0.1, 0.15, 0.25]), st.booleans())
+def test_a_last_piece_merges_at_release_where_the_stroke_before_covers_it_or_else_could_not(
+    case: tuple[WindowParams, list[Sample]], max_error: float, strict: bool
+) -> None:
+    # Merged at release: nothing dropped, the path's last sent stroke ends before the release and
+    # every sample drawn from its end on lies within max_error of it. Not merged, the last sent
+    # stroke briefer than the floor has a stroke before it that leaves a sample drawn from its
+    # end on farther than max_error (without rests, which send a held piece before the release).
+    params, samples = case
+    params = replace(params, max_error=max_error, strict_minimums=strict)
+    simplifier = WindowSimplifier(params)
+    segments = [out for sample in samples for out in simplifier.push(sample)] + simplifier.end()
+    sent = [s for s in segments if s.dropped is None]
+    mapping = params.mapping
+    points = [(sample.t_ms, mapping.to_grid(sample.x, sample.y)) for sample in samples]
+
+    def farthest_from(stroke: Segment) -> float:
+        return max(_distance(p, stroke.start, stroke.end) for t, p in points if t >= stroke.end_ms)
+
+    if simplifier.merged_back:
+        assert simplifier.merged_back >= 1 and sent and len(sent) == len(segments)
+        assert sent[-1].end_ms <= samples[-1].t_ms
+        assert farthest_from(sent[-1]) <= params.max_error + FLOAT_TOLERANCE
+        return
+    brief = max(params.min_duration_ms, params.floor_ms)
+    if params.rest_ms == 0 and len(sent) >= 2 and sent[-1].duration_ms < brief:
+        assert farthest_from(sent[-2]) > params.max_error - FLOAT_TOLERANCE
 
 
 def _core_covered(params: WindowParams, samples: list[Sample]) -> list[tuple[int, int, Segment]]:

@@ -7,6 +7,7 @@ import { describe, expect, it } from "vitest";
 import type { AngleParams } from "../src/simplify/params";
 import { inputsFor, simplifyPaths } from "../src/simplify/registry";
 import type { Sample } from "../src/simplify/segment";
+import { WindowSimplifier } from "../src/simplify/window";
 import type { WindowParams } from "../src/simplify/window-params";
 import { vectors } from "./testdata";
 
@@ -27,7 +28,8 @@ interface SimplifierVector<P> {
   tolerance: number;
   params: Omit<P, "algorithm">;
   paths: [number, number, number, number][][];
-  expected: { inputs: number[]; segments: ExpectedSegment[] };
+  /** merged_back (the window simplifier's): per path, the pieces merged at release into a stroke already sent. */
+  expected: { inputs: number[]; segments: ExpectedSegment[]; merged_back?: number[] };
 }
 
 function casesOf<P>(folder: string): [string, SimplifierVector<P>][] {
@@ -65,6 +67,17 @@ function checkVector(
     close(got.segment.end_ms, want.end_ms, tol, `${where} end_ms`);
     close(got.segment.emitted_at_ms, want.emitted_at_ms, tol, `${where} emitted_at_ms`);
   });
+  if (params.algorithm === "window") {
+    // The pieces merged at release into the stroke before them, path by path (nothing was sent).
+    const simplifier = new WindowSimplifier(params);
+    const mergedBack = paths.map((path) => {
+      const before = simplifier.mergedBack;
+      for (const sample of path) simplifier.push(sample);
+      simplifier.end();
+      return simplifier.mergedBack - before;
+    });
+    expect(mergedBack, "merged back").toEqual(vector.expected.merged_back);
+  }
 }
 
 describe.each(["angle", "window"] as const)("%s vectors", (algorithm) => {

@@ -69,13 +69,15 @@ function restRadius(params: WindowParams): number {
  * each starts where the one before ended, and ends on the first sample from there
  * drawn at or after its end time, at its point or within LINE_SHARE x max_error of it
  * (or, where the pen rested, the rest radius). Samples after the last segment
- * are a rest at its end.
+ * are a rest at its end, or the last piece, merged into it at release (within max_error).
  */
 function covered(params: WindowParams, samples: readonly Sample[], pieces = false) {
   // `pieces`: the window's own pieces, before any is merged (the caps bound those).
   const simplifier = pieces ? new WindowCore(params) : new WindowSimplifier(params);
   const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
   segments.push(...simplifier.end());
+  // The path's last piece merged at release into the last segment (nothing more was sent).
+  const mergedBack = simplifier instanceof WindowSimplifier ? simplifier.mergedBack : 0;
   const map = CanvasMapping.fromParams(params);
   // An end is its sample, or within LINE_SHARE x max_error of it going on along a line the
   // latency cap cut.
@@ -98,10 +100,11 @@ function covered(params: WindowParams, samples: readonly Sample[], pieces = fals
   for (let j = start + 1; j < samples.length; j++) {
     const point = map.toGrid(samples[j]!.x, samples[j]!.y);
     expect(distance(point, lastSegment.start, lastSegment.end), "a rest at the end").toBeLessThanOrEqual(
-      Math.min(2 * restRadius(params), params.max_error) + FLOAT_TOLERANCE,
+      (mergedBack > 0 ? params.max_error : Math.min(2 * restRadius(params), params.max_error)) +
+        FLOAT_TOLERANCE,
     );
   }
-  return { spans, segments, map };
+  return { spans, segments, map, mergedBack };
 }
 
 describe("window simplifier invariants", () => {
@@ -141,15 +144,23 @@ describe("window simplifier invariants", () => {
     () => {
       fc.assert(
         fc.property(paramsArb, pathArb, (params, samples) => {
-          const { segments, map } = covered(params, samples);
+          const { segments, map, mergedBack } = covered(params, samples);
           const first = samples[0]!;
           const last = samples[samples.length - 1]!;
           expect(segments[0]!.start).toEqual(map.toGrid(first.x, first.y));
-          const [rx, ry] = map.toGrid(last.x, last.y);
-          const end = segments[segments.length - 1]!.end;
-          expect(Math.hypot(end[0] - rx, end[1] - ry)).toBeLessThanOrEqual(
-            Math.max(LINE_SHARE * params.max_error, restRadius(params)) + FLOAT_TOLERANCE,
-          );
+          const release = map.toGrid(last.x, last.y);
+          const lastSegment = segments[segments.length - 1]!;
+          if (mergedBack > 0) {
+            // The last piece merged at release: the release lies within max_error of the stroke.
+            expect(distance(release, lastSegment.start, lastSegment.end)).toBeLessThanOrEqual(
+              params.max_error + FLOAT_TOLERANCE,
+            );
+          } else {
+            const end = lastSegment.end;
+            expect(Math.hypot(end[0] - release[0], end[1] - release[1])).toBeLessThanOrEqual(
+              Math.max(LINE_SHARE * params.max_error, restRadius(params)) + FLOAT_TOLERANCE,
+            );
+          }
           for (let i = 1; i < segments.length; i++) {
             expect(segments[i]!.start).toEqual(segments[i - 1]!.end);
             expect(segments[i]!.start_ms).toBeGreaterThanOrEqual(segments[i - 1]!.end_ms);
@@ -183,6 +194,51 @@ describe("window simplifier invariants", () => {
           }
           for (const segment of segments) {
             expect(segment.emitted_at_ms).toBeGreaterThanOrEqual(segment.end_ms);
+          }
+        }),
+        { numRuns: 300 },
+      );
+    },
+    PROPERTY_TIMEOUT_MS,
+  );
+
+  it(
+    "a last piece merges at release where the stroke before covers it, or else could not",
+    () => {
+      // Merged at release: nothing dropped, the last sent stroke ends by the release and every
+      // sample drawn from its end on lies within max_error of it. Not merged, a last sent stroke
+      // briefer than the floor has a stroke before it that leaves a sample drawn from its end on
+      // farther than max_error (without rests, which send a held piece before the release).
+      const errorArb = fc.constantFrom(0.05, 0.1, 0.15, 0.25);
+      fc.assert(
+        fc.property(paramsArb, errorArb, fc.boolean(), pathArb, (drawn, maxError, strict, samples) => {
+          const params = { ...drawn, max_error: maxError, strict_minimums: strict };
+          const simplifier = new WindowSimplifier(params);
+          const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
+          segments.push(...simplifier.end());
+          const sent = segments.filter((segment) => segment.dropped === null);
+          const map = CanvasMapping.fromParams(params);
+          const farthestFrom = (stroke: Segment): number => {
+            let farthest = 0;
+            for (const sample of samples) {
+              if (sample.t_ms < stroke.end_ms) continue;
+              const point = map.toGrid(sample.x, sample.y);
+              farthest = Math.max(farthest, distance(point, stroke.start, stroke.end));
+            }
+            return farthest;
+          };
+          if (simplifier.mergedBack > 0) {
+            expect(sent.length).toBeGreaterThan(0);
+            expect(sent.length).toBe(segments.length);
+            expect(sent[sent.length - 1]!.end_ms).toBeLessThanOrEqual(samples[samples.length - 1]!.t_ms);
+            expect(farthestFrom(sent[sent.length - 1]!)).toBeLessThanOrEqual(
+              params.max_error + FLOAT_TOLERANCE,
+            );
+            return;
+          }
+          const brief = Math.max(params.min_duration_ms, params.floor_ms);
+          if (params.rest_ms === 0 && sent.length >= 2 && sent[sent.length - 1]!.duration_ms < brief) {
+            expect(farthestFrom(sent[sent.length - 2]!)).toBeGreaterThan(params.max_error - FLOAT_TOLERANCE);
           }
         }),
         { numRuns: 300 },

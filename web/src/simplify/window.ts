@@ -21,9 +21,12 @@
  * stays on the grid, so a straight line cut by the cap stays straight. A stroke still too
  * short to send after `max_stroke_ms` (a crawling pen) starts later rather than lasting longer.
  * A pen resting `rest_ms` ends the stroke before the rest, and the rest is not played. Too short
- * or too brief pieces merge into the next (`Merger`); only a tap is dropped with its reason
- * (with `strict_minimums`, also a path's last piece below the minimums). The float operations
- * follow the reference's order.
+ * or too brief pieces merge into the next (`Merger`); a path's last piece briefer than the floor
+ * merges at release into the stroke already sent before it where every drawn sample it has not
+ * covered lies within max_error of that stroke (nothing more is sent: `mergedBack` counts them);
+ * only a tap is dropped with its reason (with `strict_minimums`, also a path's last piece below
+ * the minimums that the stroke before cannot cover). The float operations follow the reference's
+ * order.
  */
 import { CanvasMapping } from "./mapping";
 import {
@@ -672,7 +675,10 @@ export class WindowCore {
  * waits for the next; the two become one stroke when every drawn sample of both lies within
  * `max_error` of it (still short, it waits again), else the short one is sent as it is. A piece
  * long enough is sent at once (holding each back would delay the drawing), so the last piece of
- * a path, if short, is sent short. Only a path's one and only piece, too short, is dropped.
+ * a path, if short, is sent short, unless at release it is briefer than the floor and lies, with
+ * every drawn sample not yet covered, within `max_error` of the stroke already sent before it:
+ * then it merges into that stroke and nothing more is sent (`mergedBack`). Only a path's one and
+ * only piece, too short, is dropped.
  */
 /**
  * The merger drops covered samples from its arrays once this many have gathered at their start
@@ -705,6 +711,14 @@ export class Merger {
   #first = 0;
   #held: Segment | null = null;
   #sentInPath = false;
+  /**
+   * The path's last sent stroke (null before its first): a piece briefer than the sleeve's floor
+   * left at release merges into it when every drawn sample it has not covered lies within
+   * max_error of it (`end`).
+   */
+  #last: Segment | null = null;
+  /** Pieces merged at release into a stroke already sent (nothing more is sent for them), in all. */
+  mergedBack = 0;
 
   constructor(maxError: number, minLength: number, minDurationMs: number, floorMs: number, strict = false) {
     this.#maxError = maxError;
@@ -760,6 +774,7 @@ export class Merger {
 
   #send(segment: Segment, nowMs: number, out: Segment[]): void {
     this.#sentInPath = true;
+    this.#last = segment;
     // A piece made at this sample and not dropped (most: the window's and the merged ones) is sent
     // as it is; else a copy, built field by field, not spread (several times slower): the same
     // keys in the same order. Object.is: -0 and 0 are different times to the vectors.
@@ -854,9 +869,31 @@ export class Merger {
     this.#send(held, nowMs, out);
   }
 
-  /** Release, after the window's last piece: the held piece is sent (or, a path's only piece too short, dropped). */
+  /**
+   * Whether the piece held at release merges into the path's last sent stroke: it is briefer
+   * than the sleeve's floor (or, with strict minimums, shorter than min_length: it would be
+   * dropped), and every drawn sample not yet covered lies within max_error of that stroke.
+   */
+  #mergesBack(held: Segment): boolean {
+    const last = this.#last;
+    if (last === null) return false;
+    if (!(held.duration_ms < this.#shortMs || (this.#strict && segmentLength(held) < this.#minLength))) {
+      return false;
+    }
+    return this.#fits(last.start, last.end, Infinity);
+  }
+
+  /**
+   * Release, after the window's last piece: the held piece merges into the path's last sent
+   * stroke where that keeps the bound (`#mergesBack`: nothing more is sent), else it is sent (or,
+   * a path's only piece too short, dropped).
+   */
   end(nowMs: number, out: Segment[]): void {
-    const held = this.#held;
+    let held = this.#held;
+    if (held !== null && this.#mergesBack(held)) {
+      this.mergedBack += (held.merged ?? 0) + 1;
+      held = null;
+    }
     if (held !== null) {
       let reason: DropReason | null = null;
       if (!this.#sentInPath || this.#strict) {
@@ -868,6 +905,7 @@ export class Merger {
     }
     this.#held = null;
     this.#sentInPath = false;
+    this.#last = null;
     this.#count = 0;
     this.#first = 0;
   }
@@ -915,6 +953,11 @@ export class WindowSimplifier {
     for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
     if (core.rested) merger.rest(takenMs, out);
     return out.length > 0 ? out : NO_SEGMENTS;
+  }
+
+  /** Pieces merged at release into a stroke already sent (`Merger.end`), over every path so far. */
+  get mergedBack(): number {
+    return this.#merger.mergedBack;
   }
 
   /** Release: the rest of the path, the held piece first (a tap gives one, dropped). */

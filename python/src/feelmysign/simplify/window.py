@@ -47,8 +47,8 @@ corners land on the drawing's features. Here:
 - Work cap: when a stroke holds ``max_window`` samples after its anchor it is
   cut at the current sample (each sample costs at most that many tests).
 - On release the rest is one stroke. A path's first sample always starts a
-  stroke and its last sample's time always ends one (at the sample, or on the
-  line it goes on along).
+  stroke and its last sample's time ends one (at the sample, or on the line it
+  goes on along), unless that last piece merges back (below).
 - Bend rule: while ``max_bend`` > 0 a stroke grows only while every sample
   since its anchor lies within ``max_bend`` x its chord's length (never under
   ``bend_floor``, never over ``max_error``), so a round shape is cut into more
@@ -58,6 +58,15 @@ corners land on the drawing's features. Here:
   merges it into the next piece where every drawn sample of both keeps
   ``max_error``, else sends it as it is. Only a path that is one such piece in
   all (a tap) is dropped, with its reason, as the angle simplifier drops.
+- Merged back at release: the piece left when the pen lifts, if briefer than
+  the floor (the pen lifted within the floor after the last cut, mostly one of
+  the latency cap), merges into the stroke already sent before it when every
+  drawn sample that stroke has not covered lies within ``max_error`` of it:
+  nothing more is sent, the sent stroke is not held back or changed, and the
+  path's felt end is earlier (the sleeve would play the piece at the floor,
+  after the stroke before). ``merged_back`` counts such pieces (a held piece
+  that had merged others counts them too). With strict minimums a last piece
+  below ``min_length`` merges back the same way instead of being dropped.
 
 - A resting pen (``rest_ms``): when the samples of the last ``rest_ms`` all
   lie within the rest radius (``REST_SHARE`` x min_length, at most max_error
@@ -669,9 +678,12 @@ class Merger:
     (the window keeps the bound for each piece). A piece long enough is sent at once: holding
     every stroke back until the next is known would delay the whole drawing (on people's
     gestures, about 40 ms more from release to felt end at p95; docs/research.md), so a short
-    piece merges forward, not back, and the path's last piece, if short, is sent short. Only a
-    path's one and only piece, too short, is dropped with its reason (a tap: nothing to merge
-    with). Every other drawn sample lies within ``max_error`` of a sent stroke.
+    piece merges forward, not back, and the path's last piece, if short, is sent short, except
+    that at release (``end``), when nothing comes after it, a last piece briefer than the floor
+    merges into the stroke already sent before it where every drawn sample it has not covered
+    lies within ``max_error`` of that stroke (nothing more is sent; ``merged_back`` counts
+    them). Only a path's one and only piece, too short, is dropped with its reason (a tap:
+    nothing to merge with). Every other drawn sample lies within ``max_error`` of a sent stroke.
     """
 
     max_error: float
@@ -684,6 +696,13 @@ class Merger:
     _times: list[float] = field(default_factory=list)
     _held: Segment | None = None
     _sent_in_path: bool = False
+    # The path's last sent stroke, its start and end (None before its first): a piece briefer
+    # than the sleeve's floor left at release merges into it when every drawn sample it has not
+    # covered lies within max_error of it (``end``).
+    _last_start: Point | None = None
+    _last_end: Point = (0.0, 0.0)
+    # Pieces merged at release into a stroke already sent (nothing more is sent for them), in all.
+    merged_back: int = 0
 
     def sample(self, t_ms: float, point: Point) -> None:
         """A drawn sample, in order (its time as the window took it)."""
@@ -713,6 +732,7 @@ class Merger:
 
     def _send(self, segment: Segment, now_ms: float, out: list[Segment]) -> None:
         self._sent_in_path = True
+        self._last_start, self._last_end = segment.start, segment.end
         # Built directly, not by dataclasses.replace (several times slower): one per stroke.
         out.append(
             Segment(
@@ -775,11 +795,32 @@ class Merger:
         self._send(held, now_ms, out)
         return out
 
+    def _merges_back(self, held: Segment) -> bool:
+        """Whether the piece held at release merges into the path's last sent stroke.
+
+        It does when it is briefer than the sleeve's floor (the sleeve would slow it; or, with
+        strict minimums, shorter than min_length: it would be dropped) and every drawn sample
+        not yet covered, its own and any after it, lies within max_error of that stroke. The
+        stroke was sent and is not held back: nothing more is sent, the bound holds for every
+        sample and the path's felt end is earlier.
+        """
+        if self._last_start is None:
+            return False
+        brief = held.duration_ms < max(self.min_duration_ms, self.floor_ms)
+        if not brief and not (self.strict and held.length < self.min_length):
+            return False
+        return self._fits(self._last_start, self._last_end, math.inf)
+
     def end(self, now_ms: float) -> list[Segment]:
-        """Release, after the window's last piece: the held piece is sent (or, if it is the
-        path's only piece and too short to send, dropped with its reason)."""
+        """Release, after the window's last piece: the held piece merges into the path's last
+        sent stroke where that keeps the bound (``_merges_back``: nothing more is sent), else it
+        is sent (or, if it is the path's only piece and too short to send, dropped with its
+        reason)."""
         out: list[Segment] = []
         held = self._held
+        if held is not None and self._merges_back(held):
+            self.merged_back += held.merged + 1
+            held = None
         if held is not None:
             reason = None
             if not self._sent_in_path or self.strict:
@@ -793,6 +834,7 @@ class Merger:
                 self._send(held, now_ms, out)
         self._held = None
         self._sent_in_path = False
+        self._last_start = None
         self._points, self._times = [], []
         return out
 
@@ -842,6 +884,12 @@ class WindowSimplifier:
         if core.rested:
             out.extend(merger.rest(taken))
         return out
+
+    @property
+    def merged_back(self) -> int:
+        """Pieces merged at release into a stroke already sent (``Merger.end``: nothing more was
+        sent for them), over every path so far."""
+        return self._merger.merged_back
 
     def end(self) -> list[Segment]:
         """Release: the rest of the path, the held piece first (a tap gives one, dropped)."""

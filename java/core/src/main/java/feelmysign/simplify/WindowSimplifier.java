@@ -21,9 +21,12 @@ import java.util.List;
  * {@code max_stroke_ms} of drawing (the latency cap) and holds at most {@code max_window}
  * samples (the work cap). The stroke after one the latency cap ended, if the cap or the release
  * ends it too, ends on the line of the stroke before when the bound allows and that end stays
- * on the grid, so a straight line cut by the cap stays straight. Too short or too brief strokes
- * are dropped with their reason. The float operations follow the reference's order, so every
- * value is the same to the last bit.
+ * on the grid, so a straight line cut by the cap stays straight. Too short or too brief pieces
+ * merge into the next ({@code Merger}); a path's last piece briefer than the sleeve's floor
+ * merges at release into the stroke already sent before it where every drawn sample it has not
+ * covered lies within {@code max_error} of that stroke (nothing more is sent; {@link
+ * #mergedBack} counts them); only a tap is dropped with its reason. The float operations follow
+ * the reference's order, so every value is the same to the last bit.
  */
 public final class WindowSimplifier implements Simplifier {
   private final WindowCore core;
@@ -67,6 +70,12 @@ public final class WindowSimplifier implements Simplifier {
       out = merger.rest(takenMs, out);
     }
     return out == null ? List.of() : out;
+  }
+
+  /** Pieces merged at release into a stroke already sent, over every path so far: nothing more
+   * was sent for them (each lies within max_error of the stroke before it). */
+  public int mergedBack() {
+    return merger.mergedBack();
   }
 
   @Override
@@ -735,8 +744,10 @@ final class WindowCore implements Simplifier {
  * piece waits for the next; the two become one stroke when every drawn sample of both lies
  * within max_error of it (still short, it waits again), else the short one is sent as it is. A
  * piece long enough is sent at once (holding each back would delay the drawing), so a path's
- * last piece, if short, is sent short. Only a path's one and only piece, too short, is dropped
- * with its reason.
+ * last piece, if short, is sent short, unless at release it is briefer than the floor and lies,
+ * with every drawn sample not yet covered, within max_error of the stroke already sent before
+ * it: then it merges into that stroke and nothing more is sent. Only a path's one and only
+ * piece, too short, is dropped with its reason.
  */
 final class Merger {
   private final double maxError;
@@ -753,6 +764,12 @@ final class Merger {
   private int size;
   private Segment held;
   private boolean sentInPath;
+  // The path's last sent stroke (null before its first): a piece briefer than the sleeve's floor
+  // left at release merges into it when every drawn sample it has not covered lies within
+  // max_error of it (end).
+  private Segment last;
+  // Pieces merged at release into a stroke already sent (nothing more is sent for them), in all.
+  private int mergedBack;
 
   Merger(double maxError, double minLength, double minDurationMs, double floorMs, boolean strict) {
     this.maxError = maxError;
@@ -801,19 +818,28 @@ final class Merger {
    * of the first's start -> the second's end. All of them, not only those after the first's
    * start: a stroke whose pen crawled or rested starts after samples it covers. */
   private boolean fits(Segment from, Segment to) {
+    return fits(from.startX(), from.startY(), to.endX(), to.endY(), to.endMs());
+  }
+
+  /** Whether every sample not yet covered, drawn up to endMs, lies within max_error of the
+   * segment (startX, startY) -> (endX, endY). */
+  private boolean fits(double startX, double startY, double endX, double endY, double endMs) {
     double limitSq = maxError * maxError;
-    double endMs = to.endMs();
     for (int i = first; i < size; i++) {
       double t = ts[i];
       if (t > endMs) {
         break;
       }
-      if (WindowCore.distanceSq(xs[i], ys[i], from.startX(), from.startY(), to.endX(), to.endY())
-              > limitSq) {
+      if (WindowCore.distanceSq(xs[i], ys[i], startX, startY, endX, endY) > limitSq) {
         return false;
       }
     }
     return true;
+  }
+
+  /** Pieces merged at release into a stroke already sent ({@link #end}), over every path so far. */
+  int mergedBack() {
+    return mergedBack;
   }
 
   private static List<Segment> add(List<Segment> out, Segment segment) {
@@ -824,6 +850,7 @@ final class Merger {
 
   private List<Segment> send(Segment segment, double nowMs, List<Segment> out) {
     sentInPath = true;
+    last = segment;
     // The samples before its end are covered now (those at its end may start the next).
     while (first < size && ts[first] < segment.endMs()) {
       first++;
@@ -903,10 +930,28 @@ final class Merger {
     return send(piece, nowMs, out);
   }
 
-  /** Release, after the window's last piece: the held piece is sent (or, a path's only piece
-   * too short, dropped with its reason). */
+  /** Whether the piece held at release merges into the path's last sent stroke: it is briefer
+   * than the sleeve's floor (or, with strict minimums, shorter than min_length: it would be
+   * dropped), and every drawn sample not yet covered lies within max_error of that stroke. */
+  private boolean mergesBack(Segment piece) {
+    if (last == null) {
+      return false;
+    }
+    if (!(piece.durationMs() < shortMs || (strict && piece.length() < minLength))) {
+      return false;
+    }
+    return fits(last.startX(), last.startY(), last.endX(), last.endY(), Double.POSITIVE_INFINITY);
+  }
+
+  /** Release, after the window's last piece: the held piece merges into the path's last sent
+   * stroke where that keeps the bound ({@link #mergesBack}: nothing more is sent), else it is
+   * sent (or, a path's only piece too short, dropped with its reason). */
   List<Segment> end(double nowMs, List<Segment> out) {
     List<Segment> result = out;
+    if (held != null && mergesBack(held)) {
+      mergedBack += held.merged() + 1;
+      held = null;
+    }
     if (held != null) {
       String reason = null;
       if (!sentInPath || strict) {
@@ -934,6 +979,7 @@ final class Merger {
     }
     held = null;
     sentInPath = false;
+    last = null;
     first = 0;
     size = 0;
     return result;

@@ -89,5 +89,21 @@ class SimplifierVectorsTest {
       assertEquals(
           want.get("emitted_at_ms").asDouble(), s.emittedAtMs(), tolerance, where + " emitted");
     }
+    if (algorithm == Algorithm.WINDOW) {
+      // The pieces merged at release into the stroke before them, path by path (nothing sent).
+      WindowSimplifier simplifier = new WindowSimplifier(params);
+      List<Integer> mergedBack = new ArrayList<>();
+      for (List<Sample> path : paths) {
+        int before = simplifier.mergedBack();
+        for (Sample sample : path) {
+          simplifier.push(sample);
+        }
+        simplifier.end();
+        mergedBack.add(simplifier.mergedBack() - before);
+      }
+      List<Integer> expectedMergedBack = new ArrayList<>();
+      vector.get("expected").get("merged_back").forEach(n -> expectedMergedBack.add(n.asInt()));
+      assertEquals(expectedMergedBack, mergedBack, "merged back per path");
+    }
   }
 }
