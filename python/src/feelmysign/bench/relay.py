@@ -10,6 +10,13 @@ as ``feelmysign up`` runs it, with the access key's cookie as the page holds it;
 figure is also given against the broker's own WebSocket listener in the same run, with
 its budget; plain WebSocket on loopback, so that the figure is the
 relay's, not TLS's. The sleeve is a process of its own, as on the Pi.
+
+The samples are interleaved: each round sends one bare message (to a receiver process of
+its own, as in the sleeve group: ``feelmysign.bench.sleeve``) and one stroke by each of the
+three senders, in an order that turns by one each round, each once the one before it is
+over and a settle has passed. So every path, and the baseline, is measured over the same
+minutes, and the relay/listener ratio is the relay's, not the machine's changing load
+between one path's hundred strokes and the next's.
 """
 
 from __future__ import annotations
@@ -35,11 +42,14 @@ from feelmysign.bench._mqtt import close
 from feelmysign.bench.sleeve import (
     MEDIUM,
     WARM_UP,
+    BareReceiver,
+    Strokes,
     _client,
     _sleeve_process,
-    bare_latency_ms,
+    add_bare_account,
+    bare_receiver,
+    end_to_end_ms,
     percentile,
-    stroke_latencies,
 )
 from feelmysign.broker import Broker, Credentials
 from feelmysign.topics import strokes_topic
@@ -78,7 +88,7 @@ def _websocket_sender(c: Credentials, port: int, path: str, cookie: str = "") ->
 def _line(name: str, values: list[float], bare: list[float]) -> str:
     p50, p99 = statistics.median(values), percentile(values, 99)
     return (
-        f"  {name:<52} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms   (n={len(values)})"
+        f"  {name:<68} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms   (n={len(values)})"
         f"   {p50 / statistics.median(bare):.2f}x / {p99 / percentile(bare, 99):.2f}x"
         " baseline p50 / p99"
     )
@@ -194,36 +204,69 @@ def _relay_cpu_line(c: Credentials, pid: int, port: int) -> str:
     )
 
 
+BARE = "bare MQTT publish -> receive (a process of its own)"
+
+
+def interleaved_latencies(
+    senders: dict[str, mqtt.Client], bare: BareReceiver, strokes: Strokes, rounds: int
+) -> dict[str, list[float]]:
+    """Each round one bare message (with the TCP sender, "over MQTT (TCP)") and one 3 cm
+    stroke by each sender, in an order that turns by one each round; after WARM_UP rounds
+    unmeasured. The latencies (ms) by sender, and the bare ones under BARE."""
+
+    def bare_one() -> float:
+        return bare.latency_ms(senders["over MQTT (TCP)"])
+
+    def stroke_by(sender: mqtt.Client) -> Callable[[], float]:
+        return lambda: end_to_end_ms([strokes.latency(MEDIUM, sender)])[0]
+
+    samplers = {BARE: bare_one} | {name: stroke_by(s) for name, s in senders.items()}
+    names = list(samplers)
+    measured: dict[str, list[float]] = {name: [] for name in names}
+    for k in range(WARM_UP + rounds):
+        for name in names[k % len(names) :] + names[: k % len(names)]:
+            value = samplers[name]()
+            if k >= WARM_UP:
+                measured[name].append(value)
+    return measured
+
+
 def report() -> list[str]:
     lines = ["Relay (the page's path: real Mosquitto, page server and sleeve process on loopback)"]
     with tempfile.TemporaryDirectory() as state:
         site = Path(state) / "site"
         site.mkdir()
         (site / "index.html").write_text("<!doctype html><title>bench</title>\n")
+        account = add_bare_account(Path(state) / "broker")
         with Broker(state_dir=Path(state) / "broker", port=0, ws_port=0) as broker:
             c = broker.credentials
             with (
                 _page_server_process(c, site) as (pid, port),
                 _sleeve_process(c, broker.credentials_path),
+                bare_receiver(c, account) as bare,
             ):
-                bare = bare_latency_ms(c)
-                lines.append(_line("baseline: bare MQTT publish -> receive (paced)", bare, bare))
-                senders: dict[str, Callable[[], mqtt.Client]] = {
-                    "over MQTT (TCP)": lambda: _client(c, "sender"),
-                    "over the broker's WebSocket listener": lambda: _websocket_sender(
+                senders: dict[str, mqtt.Client] = {
+                    "over MQTT (TCP)": _client(c, "sender"),
+                    "over the broker's WebSocket listener": _websocket_sender(
                         c, c.ws_port, "/mqtt"
                     ),
-                    "through the page server's /mqtt relay": lambda: _websocket_sender(
+                    "through the page server's /mqtt relay": _websocket_sender(
                         c, port, "/mqtt", f"{KEY_COOKIE}={ACCESS_KEY}"
                     ),
                 }
-                measured: dict[str, list[float]] = {}
-                for name, sender in senders.items():
-                    stroke_latencies(c, MEDIUM, WARM_UP, sender())
-                    events = stroke_latencies(c, MEDIUM, STROKES, sender())
-                    end_to_end = [e.first_command_at_ms - sent_ms for sent_ms, e in events]
-                    measured[name] = end_to_end
-                    lines.append(_line(f"3 cm {name}: publish -> first command", end_to_end, bare))
+                strokes = Strokes(c)
+                measured = interleaved_latencies(senders, bare, strokes, STROKES)
+                close(*senders.values())
+                strokes.close()
+                paired = measured[BARE]
+                lines.append(
+                    "  one bare message and one stroke by each sender a round, interleaved:"
+                )
+                lines.append(_line(f"baseline: {BARE}", paired, paired))
+                for name in senders:
+                    lines.append(
+                        _line(f"3 cm {name}: publish -> first command", measured[name], paired)
+                    )
                 lines.append(
                     _against_listener(
                         measured["through the page server's /mqtt relay"],
