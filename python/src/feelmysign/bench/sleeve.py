@@ -451,10 +451,11 @@ def _latency_lines(
     strokes.close()
     end_to_end = end_to_end_ms(events)
     p99 = percentile(end_to_end, 99)
+    p50_ratio = statistics.median(end_to_end) / statistics.median(paired)
     return [
         _figures(f"{label}: publish -> first actuator command", end_to_end)
-        + f"   {p99 / percentile(paired, 99):.2f}x paired baseline p99"
-        + f" ({p99 / percentile(in_process, 99):.2f}x former)",
+        + f"   {p99 / percentile(paired, 99):.2f}x / {p50_ratio:.2f}x paired baseline p99 / p50"
+        + f" (p99: {p99 / percentile(in_process, 99):.2f}x the former)",
         _figures(f"{label}: paired baseline: bare publish -> receive", paired),
         _figures(
             f"{label}: sleeve's share (receive -> first command)",
