@@ -49,6 +49,7 @@ from feelmysign.bench.sleeve import (
     add_bare_account,
     bare_receiver,
     end_to_end_ms,
+    paired_interval,
     percentile,
 )
 from feelmysign.broker import Broker, Credentials
@@ -95,12 +96,15 @@ def _line(name: str, values: list[float], bare: list[float]) -> str:
 
 
 def _against_listener(relayed: list[float], listener: list[float]) -> str:
-    """What the relay adds: through it against the broker's own listener, same run."""
+    """What the relay adds: through it against the broker's own listener, same rounds (the
+    i-th sample of each from the same round: pairs for the interval of chance)."""
     p50 = statistics.median(relayed) / statistics.median(listener)
     p99 = percentile(relayed, 99) / percentile(listener, 99)
+    low, high = paired_interval(relayed, listener, statistics.median)
     verdict = "within" if p50 <= RELAY_BUDGET_P50 else "OVER"
     return (
-        f"  the relay against the broker's WebSocket listener: {p50:.2f}x p50 / {p99:.2f}x p99"
+        f"  the relay against the broker's WebSocket listener: {p50:.2f}x p50"
+        f" (chance: {low:.2f} to {high:.2f}x) / {p99:.2f}x p99"
         f"   ({verdict} the budget of {RELAY_BUDGET_P50:.2f}x p50)"
     )
 

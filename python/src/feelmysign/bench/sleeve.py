@@ -34,6 +34,7 @@ import itertools
 import json
 import math
 import queue
+import random
 import signal
 import statistics
 import subprocess
@@ -42,7 +43,7 @@ import tempfile
 import threading
 import time
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
@@ -98,6 +99,37 @@ BARE_SLEEVE_ID = "bench-bare"
 def percentile(values: list[float], q: float) -> float:
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, round(q / 100 * (len(ordered) - 1)))]
+
+
+def p99(values: Sequence[float]) -> float:
+    return percentile(list(values), 99)
+
+
+def paired_interval(
+    measured: Sequence[float],
+    baseline: Sequence[float],
+    statistic: Callable[[Sequence[float]], float],
+    *,
+    resamples: int = 1000,
+    seed: int = 0,
+) -> tuple[float, float]:
+    """How far chance alone moves ``statistic(measured) / statistic(baseline)``: the 5th and
+    95th percentiles of the ratio over bootstrap resamples of the pairs (the i-th measured
+    sample goes with the i-th of the baseline, taken in the same minutes). A p99 of 100
+    samples is their second highest, so one or two disturbed samples decide it; the interval
+    says when they do."""
+    if len(measured) != len(baseline) or not measured:
+        raise ValueError("paired samples: as many of each, at least one")
+    rng = random.Random(seed)
+    n = len(measured)
+    ratios = []
+    for _ in range(resamples):
+        picks = [rng.randrange(n) for _ in range(n)]
+        ratios.append(
+            statistic([measured[i] for i in picks]) / statistic([baseline[i] for i in picks])
+        )
+    ratios.sort()
+    return ratios[round(0.05 * (resamples - 1))], ratios[round(0.95 * (resamples - 1))]
 
 
 def _settings(c: Credentials, role: str) -> BrokerSettings:
@@ -450,12 +482,13 @@ def _latency_lines(
     close(sender)
     strokes.close()
     end_to_end = end_to_end_ms(events)
-    p99 = percentile(end_to_end, 99)
     p50_ratio = statistics.median(end_to_end) / statistics.median(paired)
+    low, high = paired_interval(end_to_end, paired, p99)
     return [
         _figures(f"{label}: publish -> first actuator command", end_to_end)
-        + f"   {p99 / percentile(paired, 99):.2f}x / {p50_ratio:.2f}x paired baseline p99 / p50"
-        + f" (p99: {p99 / percentile(in_process, 99):.2f}x the former)",
+        + f"   {p99(end_to_end) / p99(paired):.2f}x (chance: {low:.2f} to {high:.2f}x)"
+        + f" / {p50_ratio:.2f}x paired baseline p99 / p50"
+        + f"   (p99: {p99(end_to_end) / p99(in_process):.2f}x the former)",
         _figures(f"{label}: paired baseline: bare publish -> receive", paired),
         _figures(
             f"{label}: sleeve's share (receive -> first command)",
