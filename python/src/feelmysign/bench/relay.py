@@ -16,7 +16,8 @@ its own, as in the sleeve group: ``feelmysign.bench.sleeve``) and one stroke by 
 three senders, in an order that turns by one each round, each once the one before it is
 over and a settle has passed. So every path, and the baseline, is measured over the same
 minutes, and the relay/listener ratio is the relay's, not the machine's changing load
-between one path's hundred strokes and the next's.
+between one path's hundred strokes and the next's; it comes with the interval that chance
+alone gives it (bootstrap over the rounds).
 """
 
 from __future__ import annotations

@@ -10,12 +10,16 @@ Baseline, paired with the strokes: a bare MQTT publish -> receive on the same br
 the same sender client), whose receiver is a process of its own as the sleeve is (an idle
 paho client woken by the message, TCP_NODELAY as every client of ours), logged in as a
 second sleeve's account added to the broker for it, so that it runs beside the real sleeve
-process. It stamps each receipt's wall time and reports it on its standard output, read
-after the fact. At each length the bare messages and the strokes alternate, one of each in
-turn, so that each ratio (p99 of the strokes over p99 of their own bare messages) compares
-the same minutes of a shared machine: its CPU, caches and neighbours then weigh on both.
-The former baseline, 100 bare messages to a receiver in this (warm) process once before the
-strokes, is still printed, and each ratio against it too, to show what the pairing changes.
+process. It stamps each receipt's wall time as the message arrives and prints it on its
+standard output; the bench waits for that line (its own wake-up is not counted) and takes
+the time from it. At each length the bare messages and the strokes alternate, one of each
+in turn, so that each ratio (p99 of the strokes over p99 of their own bare messages)
+compares the same minutes of a shared machine: its load, caches and neighbours then weigh
+on both. Pairing takes out what drifts between minutes, not what strikes one sample: a
+p99 of 100 samples is the second highest, so each ratio comes with the interval that
+chance alone gives it (bootstrap over the pairs), and with the p50 ratio. The former
+baseline, 100 bare messages to a receiver in this (warm) process once before the strokes,
+is still printed, and each p99 ratio against it too, to show what the pairing changes.
 
 Only a stroke's first command counts for latency, so each measured stroke is
 cancelled (the control message) once its ``played`` event is out, instead of
