@@ -70,11 +70,11 @@ def test_the_relay_groups_senders_and_baseline_are_measured_round_by_round(
     account = add_bare_account(tmp_path / "broker")
     broker = start_broker(state_dir=tmp_path / "broker")
     c = broker.credentials
-    senders = {"over MQTT (TCP)": _client(c, "sender"), "a second TCP sender": _client(c, "sender")}
+    senders = {"one TCP sender": _client(c, "sender"), "another": _client(c, "sender")}
     strokes = Strokes(c)
     try:
         with _sleeve_process(c, broker.credentials_path), bare_receiver(c, account) as bare:
-            measured = interleaved_latencies(senders, bare, strokes, 2)
+            measured = interleaved_latencies(senders, bare, senders["another"], strokes, 2)
     finally:
         strokes.close()
         close(*senders.values())

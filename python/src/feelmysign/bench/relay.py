@@ -213,14 +213,18 @@ BARE = "bare MQTT publish -> receive (a process of its own)"
 
 
 def interleaved_latencies(
-    senders: dict[str, mqtt.Client], bare: BareReceiver, strokes: Strokes, rounds: int
+    senders: dict[str, mqtt.Client],
+    bare: BareReceiver,
+    bare_sender: mqtt.Client,
+    strokes: Strokes,
+    rounds: int,
 ) -> dict[str, list[float]]:
-    """Each round one bare message (with the TCP sender, "over MQTT (TCP)") and one 3 cm
-    stroke by each sender, in an order that turns by one each round; after WARM_UP rounds
-    unmeasured. The latencies (ms) by sender, and the bare ones under BARE."""
+    """Each round one bare message (by ``bare_sender``) and one 3 cm stroke by each sender,
+    in an order that turns by one each round; after WARM_UP rounds unmeasured. The
+    latencies (ms) by sender, and the bare ones under BARE."""
 
     def bare_one() -> float:
-        return bare.latency_ms(senders["over MQTT (TCP)"])
+        return bare.latency_ms(bare_sender)
 
     def stroke_by(sender: mqtt.Client) -> Callable[[], float]:
         return lambda: end_to_end_ms([strokes.latency(MEDIUM, sender)])[0]
@@ -260,7 +264,9 @@ def report() -> list[str]:
                     ),
                 }
                 strokes = Strokes(c)
-                measured = interleaved_latencies(senders, bare, strokes, STROKES)
+                measured = interleaved_latencies(
+                    senders, bare, senders["over MQTT (TCP)"], strokes, STROKES
+                )
                 close(*senders.values())
                 strokes.close()
                 paired = measured[BARE]
