@@ -10,6 +10,14 @@ as ``feelmysign up`` runs it, with the access key's cookie as the page holds it;
 figure is also given against the broker's own WebSocket listener in the same run, with
 its budget; plain WebSocket on loopback, so that the figure is the
 relay's, not TLS's. The sleeve is a process of its own, as on the Pi.
+
+The samples are interleaved: each round sends one bare message (to a receiver process of
+its own, as in the sleeve group: ``feelmysign.bench.sleeve``) and one stroke by each of the
+three senders, in an order that turns by one each round, each once the one before it is
+over and a settle has passed. So every path, and the baseline, is measured over the same
+minutes, and the relay/listener ratio is the relay's, not the machine's changing load
+between one path's hundred strokes and the next's; it comes with the interval that chance
+alone gives it (bootstrap over the rounds).
 """
 
 from __future__ import annotations
@@ -35,11 +43,15 @@ from feelmysign.bench._mqtt import close
 from feelmysign.bench.sleeve import (
     MEDIUM,
     WARM_UP,
+    BareReceiver,
+    Strokes,
     _client,
     _sleeve_process,
-    bare_latency_ms,
+    add_bare_account,
+    bare_receiver,
+    end_to_end_ms,
+    paired_interval,
     percentile,
-    stroke_latencies,
 )
 from feelmysign.broker import Broker, Credentials
 from feelmysign.topics import strokes_topic
@@ -78,19 +90,22 @@ def _websocket_sender(c: Credentials, port: int, path: str, cookie: str = "") ->
 def _line(name: str, values: list[float], bare: list[float]) -> str:
     p50, p99 = statistics.median(values), percentile(values, 99)
     return (
-        f"  {name:<52} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms   (n={len(values)})"
+        f"  {name:<68} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms   (n={len(values)})"
         f"   {p50 / statistics.median(bare):.2f}x / {p99 / percentile(bare, 99):.2f}x"
         " baseline p50 / p99"
     )
 
 
 def _against_listener(relayed: list[float], listener: list[float]) -> str:
-    """What the relay adds: through it against the broker's own listener, same run."""
+    """What the relay adds: through it against the broker's own listener, same rounds (the
+    i-th sample of each from the same round: pairs for the interval of chance)."""
     p50 = statistics.median(relayed) / statistics.median(listener)
     p99 = percentile(relayed, 99) / percentile(listener, 99)
+    low, high = paired_interval(relayed, listener, statistics.median)
     verdict = "within" if p50 <= RELAY_BUDGET_P50 else "OVER"
     return (
-        f"  the relay against the broker's WebSocket listener: {p50:.2f}x p50 / {p99:.2f}x p99"
+        f"  the relay against the broker's WebSocket listener: {p50:.2f}x p50"
+        f" (chance: {low:.2f} to {high:.2f}x) / {p99:.2f}x p99"
         f"   ({verdict} the budget of {RELAY_BUDGET_P50:.2f}x p50)"
     )
 
@@ -194,36 +209,75 @@ def _relay_cpu_line(c: Credentials, pid: int, port: int) -> str:
     )
 
 
+BARE = "bare MQTT publish -> receive (a process of its own)"
+
+
+def interleaved_latencies(
+    senders: dict[str, mqtt.Client],
+    bare: BareReceiver,
+    bare_sender: mqtt.Client,
+    strokes: Strokes,
+    rounds: int,
+) -> dict[str, list[float]]:
+    """Each round one bare message (by ``bare_sender``) and one 3 cm stroke by each sender,
+    in an order that turns by one each round; after WARM_UP rounds unmeasured. The
+    latencies (ms) by sender, and the bare ones under BARE."""
+
+    def bare_one() -> float:
+        return bare.latency_ms(bare_sender)
+
+    def stroke_by(sender: mqtt.Client) -> Callable[[], float]:
+        return lambda: end_to_end_ms([strokes.latency(MEDIUM, sender)])[0]
+
+    samplers = {BARE: bare_one} | {name: stroke_by(s) for name, s in senders.items()}
+    names = list(samplers)
+    measured: dict[str, list[float]] = {name: [] for name in names}
+    for k in range(WARM_UP + rounds):
+        for name in names[k % len(names) :] + names[: k % len(names)]:
+            value = samplers[name]()
+            if k >= WARM_UP:
+                measured[name].append(value)
+    return measured
+
+
 def report() -> list[str]:
     lines = ["Relay (the page's path: real Mosquitto, page server and sleeve process on loopback)"]
     with tempfile.TemporaryDirectory() as state:
         site = Path(state) / "site"
         site.mkdir()
         (site / "index.html").write_text("<!doctype html><title>bench</title>\n")
+        account = add_bare_account(Path(state) / "broker")
         with Broker(state_dir=Path(state) / "broker", port=0, ws_port=0) as broker:
             c = broker.credentials
             with (
                 _page_server_process(c, site) as (pid, port),
                 _sleeve_process(c, broker.credentials_path),
+                bare_receiver(c, account) as bare,
             ):
-                bare = bare_latency_ms(c)
-                lines.append(_line("baseline: bare MQTT publish -> receive (paced)", bare, bare))
-                senders: dict[str, Callable[[], mqtt.Client]] = {
-                    "over MQTT (TCP)": lambda: _client(c, "sender"),
-                    "over the broker's WebSocket listener": lambda: _websocket_sender(
+                senders: dict[str, mqtt.Client] = {
+                    "over MQTT (TCP)": _client(c, "sender"),
+                    "over the broker's WebSocket listener": _websocket_sender(
                         c, c.ws_port, "/mqtt"
                     ),
-                    "through the page server's /mqtt relay": lambda: _websocket_sender(
+                    "through the page server's /mqtt relay": _websocket_sender(
                         c, port, "/mqtt", f"{KEY_COOKIE}={ACCESS_KEY}"
                     ),
                 }
-                measured: dict[str, list[float]] = {}
-                for name, sender in senders.items():
-                    stroke_latencies(c, MEDIUM, WARM_UP, sender())
-                    events = stroke_latencies(c, MEDIUM, STROKES, sender())
-                    end_to_end = [e.first_command_at_ms - sent_ms for sent_ms, e in events]
-                    measured[name] = end_to_end
-                    lines.append(_line(f"3 cm {name}: publish -> first command", end_to_end, bare))
+                strokes = Strokes(c)
+                measured = interleaved_latencies(
+                    senders, bare, senders["over MQTT (TCP)"], strokes, STROKES
+                )
+                close(*senders.values())
+                strokes.close()
+                paired = measured[BARE]
+                lines.append(
+                    "  one bare message and one stroke by each sender a round, interleaved:"
+                )
+                lines.append(_line(f"baseline: {BARE}", paired, paired))
+                for name in senders:
+                    lines.append(
+                        _line(f"3 cm {name}: publish -> first command", measured[name], paired)
+                    )
                 lines.append(
                     _against_listener(
                         measured["through the page server's /mqtt relay"],
