@@ -381,6 +381,7 @@ def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
         caught_up = re.search(r"\((3 faster to catch up, [\d.]+ m?s shorter in all)\)", line)
         assert caught_up is not None, line
         assert f"The sleeve played 4 of 4 strokes ({caught_up[1]})" in sent.stdout, sent.stdout
+        assert sent.stdout.count(" ms shorter to catch up\n") == 3, sent.stdout  # per stroke
     finally:
         up.send_signal(signal.SIGINT)
         try:

@@ -88,7 +88,8 @@ function upCounts(line: string): Record<"played" | "cut" | "cancelled" | "refuse
     played: count(/: (\d+) strokes? played/),
     cut: count(/(\d+) cut short/),
     cancelled: count(/(\d+) cancelled/),
-    refused: count(/(\d+) rejected/),
+    // Skipped as late is said apart from the other refusals; both are refused.
+    refused: count(/(\d+) rejected/) + count(/(\d+) skipped as late/),
   };
 }
 
