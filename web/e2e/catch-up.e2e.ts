@@ -72,25 +72,31 @@ async function waitForEveryStroke(page: Page, timeoutMs = 60_000): Promise<Card>
 function fromEvents(events: readonly Record<string, unknown>[]): {
   compressed: number;
   compressedMs: number;
+  slowed: number;
   late: number;
 } {
   const seen = new Set<string>();
   let compressed = 0;
   let compressedMs = 0;
+  let slowed = 0;
   const late = new Set<number>();
   for (const event of events) {
     const text = JSON.stringify(event);
     if (seen.has(text)) continue;
     seen.add(text);
     if (event["type"] === "rejected" && event["reason"] === "late") late.add(event["seq"] as number);
+    if (event["type"] === "adjusted") {
+      const asked = event["requested_duration_ms"] as number;
+      if (Math.abs((event["duration_ms"] as number) - asked) >= NOTABLE * asked) slowed++;
+    }
     const shorter = event["compressed_ms"];
-    if (event["type"] !== "played" || typeof shorter !== "number") continue;
+    if ((event["type"] !== "played" && event["type"] !== "adjusted") || typeof shorter !== "number") continue;
     if (shorter > 0 && shorter >= NOTABLE * ((event["duration_ms"] as number) + shorter)) {
       compressed++;
       compressedMs += shorter;
     }
   }
-  return { compressed, compressedMs, late: late.size };
+  return { compressed, compressedMs, slowed, late: late.size };
 }
 
 describe("the sender is told how the sleeve caught up with a drawing", () => {
@@ -187,12 +193,20 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       expect(said.late).toBe(0);
       // The card says what the sleeve's events say, the caught-up among the played.
       expect(card.played).toBe(card.sent);
-      expect({ compressed: card.compressed, compressedMs: card.compressedMs, late: card.late }).toEqual({
+      expect({
+        compressed: card.compressed,
+        compressedMs: card.compressedMs,
+        slowed: card.slowed,
+        late: card.late,
+      }).toEqual({
         compressed: said.compressed,
         compressedMs: Math.round(said.compressedMs),
+        slowed: said.slowed,
         late: 0,
       });
-      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all`;
+      // (A stroke briefer than the floor, the tail of a leg, would be slowed: said after a ";".)
+      const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
+      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
       const summary = await page.locator(SUMMARY).innerText();
       expect(summary).toBe(`${card.sent} of ${card.sent} strokes played (${words}).`);
       // up's line says the same of the drawing.
@@ -232,6 +246,7 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       expect(card.late).toBe(said.late);
       expect(card.compressed).toBe(said.compressed);
       expect(card.compressedMs).toBe(Math.round(said.compressedMs));
+      expect(card.slowed).toBe(said.slowed); // a stroke briefer than the floor, cut by the stall
       // Each stroke once: the late among the refused, the caught-up among the played.
       expect(card.played + card.cut + card.cancelled + card.refused + card.dropped).toBe(card.sent);
       const summary = await page.locator(SUMMARY).innerText();
