@@ -255,10 +255,13 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       if (otherwise === 0) expect(summary).not.toContain("refused");
       else expect(summary).toContain(`${otherwise} refused`);
       if (card.compressed > 0) expect(summary).toContain(`(${card.compressed} faster to catch up, `);
+      // The felt timeline's caption says them as the card does: off the timeline.
+      const caption = await page.locator('[data-testid="timeline-caption"]').innerText();
+      expect(caption).toContain(`${card.late} skipped as late (not on the timeline)`);
       const line = await upLine(drawing, card.sent);
       expect(line).toContain(`${card.late} skipped as late`);
       expect(line).not.toMatch(/rejected \([^)]*late/);
-      console.log(`card: ${summary}\nup: ${line.trim()}`);
+      console.log(`card: ${summary}\ncaption: ${caption}\nup: ${line.trim()}`);
       const full = await screenshot(page, "catch-up-after-a-stall");
       await page.locator(CARD).screenshot({ path: full.replace(/\.png$/, "-card.png") });
       await waitForData(page, '[data-testid="broker-status"]', "state", "connected");

@@ -64,7 +64,7 @@ function captionCounts(caption: string, sent: number): Omit<PageCounts, "sent" |
     played: all ? sent : count(/(\d+) (?:as the sleeve played them|played \()/g),
     cut: count(/(\d+) cut short/g),
     cancelled: count(/(\d+) cancelled by Stop/g),
-    refused: count(/(\d+) (?:refused by the sleeve|not felt \(the sleeve's duty-cycle cap)/g),
+    refused: count(/(\d+) (?:refused by the sleeve|skipped as late|not felt \(the sleeve's duty-cycle cap)/g),
     dropped: count(/(\d+) never sent/g),
   };
 }
