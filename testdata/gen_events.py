@@ -15,7 +15,10 @@
 - ``fates/<name>.json``: the events (``wire``, in the order the sleeve published them) of
   one drawing's strokes, and what became of each stroke by the rule of
   feelmysign.fates: ``fates`` by seq, ``counts`` by fate and the refused strokes'
-  reasons (``refusals``). The page, ``up`` and the study report from this rule.
+  reasons (``refusals``). The page, ``up`` and the study report from this rule. And how the
+  sleeve kept the drawing in time (``catch_up``: strokes played faster to catch up and by
+  how much in all, slowed to its floor, skipped as late) with the words the page's card,
+  ``up`` and ``send --wait`` say of the played (``catch_up_words``).
 
 Every expected value is computed here by feelmysign.events (and feelmysign.fates); a case that the
 reference reads differently from what it is meant to show stops generation.
@@ -36,7 +39,7 @@ from feelmysign.events import (
     event_from_json,
     is_delayed,
 )
-from feelmysign.fates import DrawingFates
+from feelmysign.fates import NOTABLE_CHANGE, DrawingFates
 
 TIMING = {
     "received_at_ms": 1795326267664.25,
@@ -454,6 +457,15 @@ def _played(seq: int) -> dict[str, Any]:
     return {"type": "played", **_stroke(seq), **TIMING}
 
 
+def _compressed(seq: int, compressed_ms: float) -> dict[str, Any]:
+    return {**_played(seq), "queued_ms": 180.5, "compressed_ms": compressed_ms}
+
+
+def _slowed(seq: int) -> dict[str, Any]:
+    wire = {"type": "adjusted", **_stroke(seq), **TIMING, "duration_ms": 73.7}
+    return {**wire, "reason": "too_fast", "requested_duration_ms": 41.5}
+
+
 def _rejected(seq: int, reason: str, **extra: Any) -> dict[str, Any]:
     message = f"refused as {reason}"
     wire = {"type": "rejected", "reason": reason, "message": message, **_stroke(seq)}
@@ -524,6 +536,40 @@ FATES: dict[str, tuple[str, list[dict[str, Any]]]] = {
             _played(0),
             {**EVENTS["cancelled-by-wearer"][1], "seq": 0},
             {**EVENTS["cancelled-by-wearer"][1], "seq": 1, "started": False},
+        ],
+    ),
+    "catching-up": (
+        "strokes queued: two played faster to catch up, one slowed to the floor, two skipped as "
+        "late; one caught up then cut by Stop counts under cut, not caught up",
+        [
+            _played(0),
+            _compressed(1, 143.25),
+            _slowed(2),
+            _compressed(3, 66.75),
+            _rejected(4, "late", lag_ms=1320.5),
+            _rejected(5, "late", lag_ms=1102.25),
+            _compressed(6, 88.5),
+            _cancelled(6, started=True),
+            _rejected(7, "queue_full"),
+        ],
+    ),
+    "caught-up-over-a-second": (
+        "caught up by more than a second in all, said in seconds; a copy of a caught-up stroke "
+        "counts it once, a compressed_ms of 0 is no catching up",
+        [
+            _compressed(0, 612.25),
+            _compressed(1, 622.5),
+            _rejected(1, "duplicate", original_played=True),
+            _compressed(2, 0.0),
+        ],
+    ),
+    "caught-up-unfelt": (
+        "changes below 5 % of the duration a stroke came with are not said: 20 ms shorter of "
+        "437.5 ms (jitter), slowed from 72.5 to 73.7 ms; 22 ms shorter of 439.5 ms is said",
+        [
+            _compressed(0, 20.0),
+            {**_slowed(1), "requested_duration_ms": 72.5},
+            _compressed(2, 22.0),
         ],
     ),
     "chip-lost": (
@@ -602,6 +648,9 @@ def cases() -> dict[str, dict[str, Any]]:
             "fates": {str(seq): fate for seq, fate in fates.fates().items()},
             "counts": fates.counts(),
             "refusals": dict(fates.refusals()),
+            "notable_change": NOTABLE_CHANGE,
+            "catch_up": dataclasses.asdict(fates.catch_up()),
+            "catch_up_words": fates.catch_up().played_words(),
         }
     for name, (kind, description, wire) in INVALID.items():
         try:

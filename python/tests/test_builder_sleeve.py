@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import time
@@ -133,10 +134,9 @@ def test_the_sleeve_logs_one_line_per_drawing(broker: Broker, tmp_path: Path) ->
             _, log = sleeve.communicate(timeout=WAIT_S)
     lines = [line for line in log.splitlines() if f"Drawing {drawing}" in line]
     assert len(lines) == 1, log
-    assert lines[0].endswith(
-        f"sleeve sleeve1: Drawing {drawing}: 4 strokes played; start delay median "
-        + lines[0].rsplit("start delay median ", 1)[1]
-    ), lines
+    # (strokes that queued on a loaded machine are said in brackets: played faster)
+    said = rf"sleeve sleeve1: Drawing {drawing}: 4 strokes played( \([^)]*\))?; start delay median "
+    assert re.search(said, lines[0]) is not None, lines
     assert lines[0].rsplit("start delay median ", 1)[1].endswith(" ms"), lines
     lines = [line for line in log.splitlines() if f"Drawing {second}" in line]
     assert len(lines) == 1, log

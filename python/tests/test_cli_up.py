@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import queue
+import re
 import shutil
 import signal
 import subprocess
@@ -105,8 +106,8 @@ def test_one_line_per_drawing_once_it_is_quiet() -> None:
     assert summaries.finished(1.8) == []  # the last event was 1.4 s ago: still drawing
     lines = summaries.finished(1.9)
     assert lines == [
-        "Drawing aaaaaaaa: 2 strokes played (1 slowed to be felt), 1 rejected (outside_grid); "
-        "start delay median 6 ms, max 9 ms"
+        "Drawing aaaaaaaa: 2 strokes played (1 slowed to the sleeve's floor), "
+        "1 rejected (outside_grid); start delay median 6 ms, max 9 ms"
     ]
     cancelled = Cancelled(
         message="m", stroke=StrokeRef(received_at_ms=1.0), cancelled_at_ms=2.0, started=False
@@ -240,7 +241,29 @@ def test_a_copy_refused_as_duplicate_leaves_its_stroke_as_it_was() -> None:
     ):
         summaries.add(event, now_s=0.0)
     assert summaries.finished(10.0) == [
-        "Drawing eeeeeeee: 2 strokes played, 1 rejected (late); start delay median 2 ms, max 2 ms"
+        "Drawing eeeeeeee: 2 strokes played, 1 skipped as late; start delay median 2 ms, max 2 ms"
+    ]
+
+
+def test_the_line_says_what_was_played_faster_slowed_and_skipped_as_late() -> None:
+    # A drawing that queued: the sleeve played three strokes faster to catch up (by 70, 80 and
+    # 60.4 ms), slowed one to its floor, skipped two as late and refused one for itself.
+    summaries = DrawingSummaries(quiet_s=1.5)
+    drawing = "ffffffff-6666"
+    events: list[Played | Rejected] = [_played(drawing, 2.0, seq=0)]
+    for seq, ms in ((1, 70.0), (2, 80.0), (3, 60.4)):
+        events.append(replace(_played(drawing, 302.0, 300.0, seq=seq), compressed_ms=ms))
+    slowed = _played(drawing, 3.0, seq=4, reason="too_fast", requested_duration_ms=40.0)
+    events.append(slowed)
+    for seq, reason in ((5, "late"), (6, "late"), (7, "outside_grid")):
+        ref = StrokeRef(drawing=drawing, seq=seq, received_at_ms=1)
+        events.append(Rejected(reason=reason, message="m", stroke=ref))
+    for event in events:
+        summaries.add(event, now_s=0.0)
+    assert summaries.finished(100.0) == [
+        "Drawing ffffffff: 5 strokes played (3 faster to catch up, 210 ms shorter in all; "
+        "1 slowed to the sleeve's floor), 2 skipped as late, 1 rejected (outside_grid); "
+        "start delay median 2 ms, max 3 ms"
     ]
 
 
@@ -353,6 +376,12 @@ def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
         line = _wait_for(out, "Drawing ", seen)
         assert line.startswith(f"Drawing {drawing[:8]}: 4 strokes played"), seen
         assert "start delay median" in line and "rejected" not in line
+        # Sent at once, the square's last three strokes queued behind the first: the sleeve
+        # played them faster to catch up, and send --wait and up's line say so alike.
+        caught_up = re.search(r"\((3 faster to catch up, [\d.]+ m?s shorter in all)\)", line)
+        assert caught_up is not None, line
+        assert f"The sleeve played 4 of 4 strokes ({caught_up[1]})" in sent.stdout, sent.stdout
+        assert sent.stdout.count(" ms shorter to catch up\n") == 3, sent.stdout  # per stroke
     finally:
         up.send_signal(signal.SIGINT)
         try:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import os
 import queue
+import re
 import select
 import signal
 import subprocess
@@ -256,4 +257,5 @@ def test_up_prints_one_line_for_a_drawing_whose_pen_rested(tmp_path: Path) -> No
             break
     assert code == 0, "".join(seen)
     (line,) = [line for line in seen if line.startswith(f"Drawing {resting[:8]}")]
-    assert line.startswith(f"Drawing {resting[:8]}: 2 strokes played;"), line
+    # (strokes that queued on a loaded machine are said in brackets: played faster)
+    assert re.match(rf"Drawing {resting[:8]}: 2 strokes played( \([^)]*\))?;", line), line

@@ -5,6 +5,7 @@ by ``feelmysign send`` asking for 1.0."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 from pathlib import Path
 
@@ -72,6 +73,8 @@ def test_strokes_above_the_intensity_cap_count_at_the_drive_applied(
     # What the window would have held: five seconds at 0.5, a quarter of full drive each.
     driven = 5 * STROKE_MS * MAX_INTENSITY**2 / WINDOW_MS
     assert refused[0]["duty_cycle"] == pytest.approx(driven, abs=1e-3), refused
-    assert "played 4 of 5 strokes, refused 1 (duty_cycle)" in sent.stderr, sent.stderr
+    # (strokes that queued on a loaded machine are said in brackets: played faster)
+    said = re.search(r"played 4 of 5 strokes( \([^)]*\))?, refused 1 \(duty_cycle\)", sent.stderr)
+    assert said is not None, sent.stderr
     frames = watcher.received("actuators")
     assert max(max(map(max, f["intensities"])) for f in frames) == pytest.approx(MAX_INTENSITY)

@@ -21,7 +21,7 @@ from feelmysign.events import (
     event_from_json,
     is_delayed,
 )
-from feelmysign.fates import DrawingFates
+from feelmysign.fates import NOTABLE_CHANGE, DrawingFates
 
 CASES = load("events")
 EVENTS = [(name, case) for name, case in CASES if name.startswith("event/")]
@@ -121,6 +121,9 @@ def test_fate_vectors(name: str, case: dict[str, Any]) -> None:
     assert {str(seq): fate for seq, fate in fates.fates().items()} == case["fates"]
     assert fates.counts() == case["counts"]
     assert dict(fates.refusals()) == case["refusals"]
+    assert case["notable_change"] == NOTABLE_CHANGE
+    assert dataclasses.asdict(fates.catch_up()) == case["catch_up"]
+    assert fates.catch_up().played_words() == case["catch_up_words"]
     # Each stroke once: the counts add up to the strokes the events name.
     assert sum(case["counts"].values()) == len(case["fates"])
 
@@ -135,6 +138,11 @@ def test_the_fate_vectors_cover_every_fate_and_the_copies() -> None:
         if wire.get("reason") == "duplicate"
     }
     assert originals == {True, False, None}
+    caught_up = [case["catch_up"] for _, case in FATES]
+    assert any(c["compressed"] and c["compressed_ms"] >= 1000 for c in caught_up)
+    assert any(c["compressed"] and c["compressed_ms"] < 1000 for c in caught_up)
+    assert any(c["slowed"] for c in caught_up)
+    assert any(c["late"] for c in caught_up)
 
 
 @pytest.mark.parametrize(

@@ -313,7 +313,8 @@ def test_a_sender_joined_by_token_sends_over_tls_and_hears_the_sleeve(
         timeout=WAIT_S * 2,
     )
     assert sent.returncode == 0, sent.stdout + sent.stderr
-    assert "The sleeve played 12 of 12 strokes." in sent.stdout, sent.stdout
+    # (strokes that queued on a loaded machine are said in brackets: played faster)
+    assert "The sleeve played 12 of 12 strokes" in sent.stdout, sent.stdout
     trusted = list((tmp_path / "laptop-state" / "feelmysign" / "trusted").iterdir())
     assert [p.read_text() for p in trusted] == [lan_broker.tls.ca.read_text()]  # type: ignore[union-attr]
 

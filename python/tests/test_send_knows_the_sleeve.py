@@ -56,7 +56,8 @@ def test_a_shape_without_a_layout_fits_the_sleeve_s_grid_and_every_stroke_plays(
 ) -> None:
     result = send(broker, "--shape", "heart", "--segments", "8")
     assert result.returncode == 0, result.stdout + result.stderr
-    assert "The sleeve played 8 of 8 strokes." in result.stdout, result.stdout
+    # (strokes that queued on a loaded machine are said in brackets: played faster)
+    assert "The sleeve played 8 of 8 strokes" in result.stdout, result.stdout
     drawing = drawing_of(result)
     events = [e for e in watched_sleeve.received("events") if e.get("drawing") == drawing]
     assert sorted(e["seq"] for e in events if e["type"] in ("played", "adjusted")) == list(
@@ -90,7 +91,7 @@ def test_a_second_send_right_after_a_long_one_is_not_refused_as_late(
     assert line.returncode == 0, line.stdout + line.stderr
     square = send(broker, "--shape", "square", "--duration-ms", "1200")
     assert square.returncode == 0, square.stdout + square.stderr
-    assert "The sleeve played 4 of 4 strokes." in square.stdout, square.stdout
+    assert "The sleeve played 4 of 4 strokes" in square.stdout, square.stdout
     late = [e for e in watched_sleeve.received("events") if e.get("reason") == "late"]
     assert not late, late
 

@@ -64,7 +64,7 @@ function captionCounts(caption: string, sent: number): Omit<PageCounts, "sent" |
     played: all ? sent : count(/(\d+) (?:as the sleeve played them|played \()/g),
     cut: count(/(\d+) cut short/g),
     cancelled: count(/(\d+) cancelled by Stop/g),
-    refused: count(/(\d+) (?:refused by the sleeve|not felt \(the sleeve's duty-cycle cap)/g),
+    refused: count(/(\d+) (?:refused by the sleeve|skipped as late|not felt \(the sleeve's duty-cycle cap)/g),
     dropped: count(/(\d+) never sent/g),
   };
 }
@@ -88,7 +88,8 @@ function upCounts(line: string): Record<"played" | "cut" | "cancelled" | "refuse
     played: count(/: (\d+) strokes? played/),
     cut: count(/(\d+) cut short/),
     cancelled: count(/(\d+) cancelled/),
-    refused: count(/(\d+) rejected/),
+    // Skipped as late is said apart from the other refusals; both are refused.
+    refused: count(/(\d+) rejected/) + count(/(\d+) skipped as late/),
   };
 }
 

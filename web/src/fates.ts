@@ -16,8 +16,17 @@
  * refusal (cut, played, then cancelled or capped), and of two refusals the first stands. A
  * `duplicate` of a stroke with no fate yet takes the fate its `original_played` says.
  * The page adds one fate no sleeve sees: never sent (dropped before it left).
+ *
+ * How the sleeve kept a drawing in time (`CatchUp`, docs/protocol.md, "Catching up"): of the
+ * strokes played, how many it played faster to catch up with the pen (their `played` event's
+ * `compressed_ms`) and by how much in all, and how many it slowed to its floor (`adjusted`); of
+ * the refused, how many it skipped as `late`. Python's `CatchUp`; the vectors keep them equal.
+ * A stroke counts as played faster or slowed only when its duration changed by
+ * `NOTABLE_ADJUSTMENT` (5 %) or more of the duration it came with: a stroke of a drawing played
+ * as drawn waits a few ms behind the one before it (the network's jitter), and is played that
+ * much faster, which no one feels.
  */
-import type { SleeveEvent } from "./events";
+import { NOTABLE_ADJUSTMENT, type AdjustedEvent, type PlayedEvent, type SleeveEvent } from "./events";
 
 export type Fate = "played" | "cut" | "cancelled" | "refused";
 export const FATES: readonly Fate[] = ["played", "cut", "cancelled", "refused"];
@@ -26,6 +35,7 @@ const DUPLICATE = "duplicate";
 const CANCELLED = "cancelled";
 const DUTY_CYCLE = "duty_cycle";
 const WEARER = "wearer";
+const LATE = "late";
 // How much an event says about its stroke: higher replaces lower, equal never does.
 const COPY = 1;
 const REFUSAL = 2;
@@ -44,6 +54,63 @@ interface Verdict {
 export interface CutCauses {
   readonly byWearer: number;
   readonly byFault: number;
+}
+
+/**
+ * How the sleeve kept one drawing in time: `compressed` strokes played faster to catch up,
+ * `compressed_ms` shorter in all; `slowed` strokes slowed to its floor (each counted under played);
+ * and `late` strokes skipped (counted under refused).
+ */
+export interface CatchUp {
+  readonly compressed: number;
+  readonly compressed_ms: number;
+  readonly slowed: number;
+  readonly late: number;
+}
+
+/**
+ * From the played events of the strokes played, each once, and the strokes refused as `late`;
+ * changes below `NOTABLE_ADJUSTMENT` left out.
+ */
+export function catchUpOf(played: Iterable<PlayedEvent | AdjustedEvent>, late: number): CatchUp {
+  let compressed = 0;
+  let compressedMs = 0;
+  let slowed = 0;
+  for (const event of played) {
+    const shorterMs = event.compressed_ms;
+    if (
+      shorterMs !== null &&
+      shorterMs > 0 &&
+      shorterMs >= NOTABLE_ADJUSTMENT * (event.duration_ms + shorterMs)
+    ) {
+      compressed++;
+      compressedMs += shorterMs;
+    }
+    if (event.type === "adjusted") {
+      const askedMs = event.requested_duration_ms;
+      if (Math.abs(event.duration_ms - askedMs) >= NOTABLE_ADJUSTMENT * askedMs) slowed++;
+    }
+  }
+  return { compressed, compressed_ms: compressedMs, slowed, late };
+}
+
+/**
+ * What to say of the strokes played, in brackets after their count: "3 faster to catch up, 210 ms
+ * shorter in all; 1 slowed to the sleeve's floor" ("": none). Python's `CatchUp.played_words`.
+ */
+export function catchUpWords(catchUp: CatchUp): string {
+  const words: string[] = [];
+  if (catchUp.compressed > 0)
+    words.push(
+      `${catchUp.compressed} faster to catch up, ${durationWords(catchUp.compressed_ms)} shorter in all`,
+    );
+  if (catchUp.slowed > 0) words.push(`${catchUp.slowed} slowed to the sleeve's floor`);
+  return words.join("; ");
+}
+
+/** Whole ms below a second, else seconds to a tenth (events.ts `seconds`; Python `duration_words`). */
+export function durationWords(ms: number): string {
+  return ms >= 1000 ? `${(Math.round(ms / 100) / 10).toFixed(1)} s` : `${Math.round(ms)} ms`;
 }
 
 /** What `event` says of its stroke; null when nothing (an error, a safety off outside a stroke). */
@@ -78,6 +145,9 @@ export function verdict(event: SleeveEvent, playedBefore: boolean): Verdict | nu
 export class DrawingFates {
   readonly #bySeq = new Map<number, Verdict>();
   readonly #unnamed: Verdict[] = [];
+  /** The played event that gave a stroke its fate played, by seq (and of unnamed strokes). */
+  readonly #played = new Map<number, PlayedEvent | AdjustedEvent>();
+  readonly #playedUnnamed: (PlayedEvent | AdjustedEvent)[] = [];
 
   /** Takes `event` into account; the stroke's fate now (null: it says nothing of one). */
   add(event: SleeveEvent): Fate | null {
@@ -85,12 +155,16 @@ export class DrawingFates {
     const known = seq === null ? undefined : this.#bySeq.get(seq);
     const said = verdict(event, known?.fate === "played");
     if (said === null) return known?.fate ?? null;
+    const played = event.type === "played" || event.type === "adjusted" ? event : null;
     if (seq === null) {
       this.#unnamed.push(said);
+      if (played !== null) this.#playedUnnamed.push(played);
       return said.fate;
     }
     if (known === undefined || said.rank > known.rank) {
       this.#bySeq.set(seq, said);
+      if (played !== null) this.#played.set(seq, played);
+      else this.#played.delete(seq);
       return said.fate;
     }
     return known.fate;
@@ -121,6 +195,18 @@ export class DrawingFates {
       else byFault++;
     }
     return { byWearer, byFault };
+  }
+
+  /**
+   * Of the strokes played (by their own played event), those played faster to catch up and those
+   * slowed; of the refused, those skipped as `late`.
+   */
+  catchUp(): CatchUp {
+    const played = [...this.#played].filter(([seq]) => this.#bySeq.get(seq)?.fate === "played");
+    return catchUpOf(
+      [...played.map(([, event]) => event), ...this.#playedUnnamed],
+      this.refusals().get(LATE) ?? 0,
+    );
   }
 
   /** The refused strokes by reason, in the order first met. */

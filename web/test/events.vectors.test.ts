@@ -5,13 +5,14 @@ import {
   deliveryDelayMs,
   eventToJson,
   isDelayed,
+  NOTABLE_ADJUSTMENT,
   parseEvent,
   parseStatus,
   readEvent,
   readStatus,
   statusToJson,
 } from "../src/events";
-import { DrawingFates } from "../src/fates";
+import { catchUpWords, DrawingFates, type CatchUp } from "../src/fates";
 import { hasVectors, vectors } from "./testdata";
 
 interface ValidVector {
@@ -95,6 +96,12 @@ interface FateVector {
   fates: Record<string, string>;
   counts: Record<string, number>;
   refusals: Record<string, number>;
+  /** Played faster to catch up (and by how much in all), slowed to the floor, skipped as late. */
+  catch_up: CatchUp;
+  /** Changes of duration below this share are not said (events.ts `NOTABLE_ADJUSTMENT`). */
+  notable_change: number;
+  /** What the card, `up` and `send --wait` say of the played strokes' pace. */
+  catch_up_words: string;
 }
 
 const fates = present ? (vectors("events", "fates") as [string, FateVector][]) : [];
@@ -116,5 +123,16 @@ describe.skipIf(!present)("fate vectors", () => {
     );
     expect(drawing.counts()).toEqual(vector.counts);
     expect(Object.fromEntries(drawing.refusals())).toEqual(vector.refusals);
+    expect(NOTABLE_ADJUSTMENT).toBe(vector.notable_change);
+    expect(drawing.catchUp()).toEqual(vector.catch_up);
+    expect(catchUpWords(drawing.catchUp())).toBe(vector.catch_up_words);
+  });
+
+  it("cover catching up, slowing and skipping as late", () => {
+    const caughtUp = fates.map(([, vector]) => vector.catch_up);
+    expect(caughtUp.some((c) => c.compressed > 0 && c.compressed_ms >= 1000)).toBe(true);
+    expect(caughtUp.some((c) => c.compressed > 0 && c.compressed_ms < 1000)).toBe(true);
+    expect(caughtUp.some((c) => c.slowed > 0)).toBe(true);
+    expect(caughtUp.some((c) => c.late > 0)).toBe(true);
   });
 });

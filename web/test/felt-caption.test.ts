@@ -52,6 +52,16 @@ describe("timelineCaption", () => {
         "1 never sent (not on the timeline).",
     );
   });
+
+  it("says the strokes skipped as late apart from the other refusals, as the card does", () => {
+    expect(timelineCaption(on(2, 2), { ...NONE, played: 2, refused: 2, late: 1 }, false)).toBe(
+      "2 strokes, 1.0 s; 2 as the sleeve played them, 1 skipped as late (not on the timeline), " +
+        "1 refused by the sleeve (not on the timeline).",
+    );
+    expect(timelineCaption(on(1, 1), { ...NONE, played: 1, refused: 3, late: 3 }, false)).toBe(
+      "1 stroke, 1.0 s; 1 as the sleeve played them, 3 skipped as late (not on the timeline).",
+    );
+  });
 });
 
 describe("timelineCaption with strokes held on the page (the wearer paused)", () => {

@@ -27,23 +27,87 @@ field leaves it out: nothing says it was felt).
 The page adds one fate no sleeve sees: ``never sent`` (dropped before it left, by Stop
 or the sender's late limit). ``web/src/fates.ts`` is the page's copy of this rule;
 ``testdata/events/fates`` keeps the two equal.
+
+How the sleeve kept a drawing in time (``CatchUp``, docs/protocol.md, "Catching up"): of
+the strokes played, how many it played faster to catch up with the pen (their
+``played`` event's ``compressed_ms``) and by how much in all, and how many it slowed to
+its floor (``adjusted``); of the refused, how many it skipped as ``late``. A stroke counts
+as played faster or slowed only when its duration changed by ``NOTABLE_CHANGE`` (5 %) or
+more of the duration it came with: a stroke of a drawing played as drawn waits a few ms
+behind the one before it (the network's jitter) and is played that much faster, which no
+one feels (the page's notes leave out an adjustment below the same 5 %). The page's card,
+``up``'s line and ``send --wait`` say it in the words of ``CatchUp.played_words``.
 """
 
 from __future__ import annotations
 
+import math
 from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import Literal
 
 from feelmysign.events import Adjusted, Cancelled, Event, Played, Rejected, Safety
-from feelmysign.protocol import CANCELLED, DUPLICATE
+from feelmysign.protocol import CANCELLED, DUPLICATE, LATE
 
 Fate = Literal["played", "cut", "cancelled", "refused"]
 FATES: tuple[Fate, ...] = ("played", "cut", "cancelled", "refused")
 DUTY_CYCLE = "duty_cycle"
+# A change of a stroke's duration below this share of the duration it came with is not said:
+# no one feels it (web/src/events.ts NOTABLE_ADJUSTMENT, for the page's notes, is the same).
+NOTABLE_CHANGE = 0.05
 
 # How much an event says about its stroke: a higher rank replaces a lower one, an equal one
 # never does (the first refusal stands).
 _COPY, _REFUSAL, _OWN, _PLAYED, _CUT = 1, 2, 3, 4, 5
+
+
+@dataclass(frozen=True)
+class CatchUp:
+    """How the sleeve kept one drawing in time: ``compressed`` strokes played faster to catch
+    up, ``compressed_ms`` shorter in all; ``slowed`` strokes slowed to its floor (each counted
+    under played), and ``late`` strokes skipped (counted under refused)."""
+
+    compressed: int = 0
+    compressed_ms: float = 0.0
+    slowed: int = 0
+    late: int = 0
+
+    @classmethod
+    def of(cls, played: Iterable[Played], late: int) -> CatchUp:
+        """From the ``played`` (or ``adjusted``) events of the strokes played, each once, and
+        the number of strokes refused as ``late``; changes below ``NOTABLE_CHANGE`` left out."""
+        compressed, compressed_ms, slowed = 0, 0.0, 0
+        for event in played:
+            shorter_ms = event.compressed_ms or 0.0  # as it came: duration_ms + shorter_ms
+            if shorter_ms > 0 and shorter_ms >= NOTABLE_CHANGE * (event.duration_ms + shorter_ms):
+                compressed += 1
+                compressed_ms += shorter_ms
+            if isinstance(event, Adjusted):
+                asked_ms = event.requested_duration_ms
+                slowed += abs(event.duration_ms - asked_ms) >= NOTABLE_CHANGE * asked_ms
+        return cls(compressed, compressed_ms, slowed, late)
+
+    def played_words(self) -> str:
+        """What to say of the strokes played, in brackets after their count: "3 faster to
+        catch up, 210 ms shorter in all; 1 slowed to the sleeve's floor" ("": none)."""
+        words = []
+        if self.compressed:
+            words.append(
+                f"{self.compressed} faster to catch up, "
+                f"{duration_words(self.compressed_ms)} shorter in all"
+            )
+        if self.slowed:
+            words.append(f"{self.slowed} slowed to the sleeve's floor")
+        return "; ".join(words)
+
+
+def duration_words(ms: float) -> str:
+    """A duration as the page writes one (events.ts ``seconds``): whole ms below a second, else
+    seconds to a tenth; halves rounded up, as JavaScript's ``Math.round`` does."""
+    if ms >= 1000:
+        return f"{math.floor(ms / 100 + 0.5) / 10:.1f} s"
+    return f"{math.floor(ms + 0.5)} ms"
 
 
 def verdict(event: Event, played_before: bool) -> tuple[int, Fate, str | None] | None:
@@ -79,6 +143,9 @@ class DrawingFates:
     def __init__(self) -> None:
         self._by_seq: dict[int, tuple[int, Fate, str | None]] = {}
         self._unnamed: list[tuple[int, Fate, str | None]] = []
+        # The played event that gave a stroke its fate played, by seq (and of unnamed strokes).
+        self._played: dict[int, Played] = {}
+        self._played_unnamed: list[Played] = []
 
     def add(self, event: Event) -> Fate | None:
         """Takes ``event`` into account; the stroke's fate now (None: it says nothing)."""
@@ -87,11 +154,18 @@ class DrawingFates:
         said = verdict(event, known is not None and known[1] == "played")
         if said is None:
             return known[1] if known is not None else None
+        played = event if isinstance(event, Played) else None
         if seq is None:
             self._unnamed.append(said)
+            if played is not None:
+                self._played_unnamed.append(played)
             return said[1]
         if known is None or said[0] > known[0]:
             self._by_seq[seq] = said
+            if played is not None:
+                self._played[seq] = played
+            else:
+                self._played.pop(seq, None)
             return said[1]
         return known[1]
 
@@ -116,6 +190,12 @@ class DrawingFates:
             for _, fate, reason in [*self._by_seq.values(), *self._unnamed]
             if fate == "refused" and reason is not None
         )
+
+    def catch_up(self) -> CatchUp:
+        """Of the strokes played (by their own played event), those played faster to catch up
+        and those slowed; of the refused, those skipped as ``late``."""
+        played = [event for seq, event in self._played.items() if self._by_seq[seq][1] == "played"]
+        return CatchUp.of([*played, *self._played_unnamed], self.refusals()[LATE])
 
     @property
     def answered(self) -> int:

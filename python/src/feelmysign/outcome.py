@@ -6,7 +6,10 @@ the sleeve: played (``played`` or ``adjusted``), or refused (``rejected``, a
 ``safety`` event that kept it from playing, a ``cancelled`` one before it
 started). A stroke played and later cut (``safety`` ``chip_lost``, ``cancelled``
 while playing) is reported as cut. Copies of an event (QoS 1 delivers at least
-once) are counted once (``EventCopies``).
+once) are counted once (``EventCopies``). Its summary says too, in the words of
+``feelmysign.fates.CatchUp`` (as the page's card and ``up``'s line), how many strokes
+the sleeve played faster to catch up with the drawing and by how much in all, how many
+it slowed to its floor, and how many it skipped as ``late``.
 """
 
 from __future__ import annotations
@@ -27,7 +30,9 @@ from feelmysign.events import (
     Safety,
     event_from_json,
 )
+from feelmysign.fates import CatchUp
 from feelmysign.player import WEARER
+from feelmysign.protocol import LATE
 from feelmysign.wearer_status import WEARER_REASONS
 
 if TYPE_CHECKING:
@@ -150,14 +155,13 @@ class DrawingOutcome:
     def summary(self) -> DrawingSummary:
         with self._condition:
             # One fate a stroke, as feelmysign.fates counts them: one cut part-way is not played.
-            played = [
-                i for i, s in enumerate(self.strokes) if s.played is not None and not s.cut_reason
-            ]
+            played = [s.played for s in self.strokes if s.played is not None and not s.cut_reason]
             refused = Counter(s.refused_reason for s in self.strokes if s.refused_reason)
             cut = Counter(s.cut_reason for s in self.strokes if s.cut_reason)
             unheard = [i for i, s in enumerate(self.strokes) if not s.final]
             held = [i for i, s in enumerate(self.strokes) if s.held]
-        return DrawingSummary(self.count, len(played), refused, cut, unheard, held)
+        catch_up = CatchUp.of(played, refused[LATE])
+        return DrawingSummary(self.count, len(played), refused, cut, unheard, held, catch_up)
 
 
 @dataclass(frozen=True)
@@ -168,6 +172,8 @@ class DrawingSummary:
     cut: Counter[str]
     unheard: list[int]  # seqs with no answer
     held: list[int] = field(default_factory=list)  # seqs not sent: the wearer's hold
+    # Played faster to catch up, slowed to the floor, skipped as late (refused[LATE] too).
+    catch_up: CatchUp = field(default_factory=CatchUp)
 
     @property
     def all_played(self) -> bool:
@@ -175,8 +181,13 @@ class DrawingSummary:
 
     def text(self) -> str:
         parts = [f"played {self.played} of {self.count} strokes"]
-        if self.refused:
-            parts.append(f"refused {sum(self.refused.values())} ({_reasons(self.refused)})")
+        if pace := self.catch_up.played_words():
+            parts[0] += f" ({pace})"
+        refused = Counter(self.refused)
+        if late := refused.pop(LATE, 0):
+            parts.append(f"skipped {late} as late")
+        if refused:
+            parts.append(f"refused {sum(refused.values())} ({_reasons(refused)})")
         if self.cut:
             parts.append(f"cut {sum(self.cut.values())} part-way ({_reasons(self.cut)})")
         text = "The sleeve " + ", ".join(parts)

@@ -35,6 +35,8 @@ export interface Tally {
   readonly cancelled: number;
   /** Refused on arrival, or kept from playing by the duty-cycle cap. */
   readonly refused: number;
+  /** Of the refused: skipped as late (the sleeve too far behind its sender), said apart. Absent: none. */
+  readonly late?: number;
   /** Never sent. */
   readonly dropped: number;
   /**
@@ -348,7 +350,10 @@ export function timelineCaption(
   if (cancelled > 0)
     said.push(`${cancelled} cancelled by Stop before ${cancelled === 1 ? "it" : "they"} played`);
   const refusedOff = refused - capped;
-  if (refusedOff > 0) said.push(`${refusedOff} refused by the sleeve (not on the timeline)`);
+  // Skipped as late, as the card says them: refused on arrival too, apart from the others.
+  const late = Math.min(tally.late ?? 0, refusedOff);
+  if (late > 0) said.push(`${late} skipped as late (not on the timeline)`);
+  if (refusedOff - late > 0) said.push(`${refusedOff - late} refused by the sleeve (not on the timeline)`);
   if (dropped > 0) said.push(`${dropped} never sent (not on the timeline)`);
   if (held > 0) said.push(heldPart);
   if (waiting > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");

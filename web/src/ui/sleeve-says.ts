@@ -4,11 +4,14 @@
  * fates.ts (the one `up`'s terminal line and the study report from): played,
  * cut short, cancelled or refused, each stroke once, and never sent for those
  * dropped before they left; so the counts add up to the strokes drawn once the
- * sleeve has answered them all. Reset with every new drawing, so nothing of an
- * old drawing lingers.
+ * sleeve has answered them all. Of the played, it says how many the sleeve played
+ * faster to catch up with the pen (and how much shorter in all) and how many it
+ * slowed to its floor; of the refused, how many it skipped as late, apart from the
+ * other refusals (fates.ts `CatchUp`, the words `up` and `send --wait` use too).
+ * Reset with every new drawing, so nothing of an old drawing lingers.
  */
 import { seconds, type SleeveEvent } from "../events";
-import { cutShortWords, DrawingFates, type Fate } from "../fates";
+import { catchUpWords, cutShortWords, DrawingFates, type Fate } from "../fates";
 import { EventLog, type LogKind } from "./event-log";
 
 export interface Counts {
@@ -16,7 +19,14 @@ export interface Counts {
   sent: number;
   /** Played whole. */
   played: number;
+  /** Of the played: faster to catch up (and how much shorter in all, ms), and slowed to the floor. */
+  compressed: number;
+  compressedMs: number;
+  slowed: number;
+  /** Refused, `late` among them. */
   refused: number;
+  /** Of the refused: skipped as `late` (the sleeve too far behind its sender). */
+  late: number;
   /** Dropped by Stop before they started (on the sleeve). */
   cancelled: number;
   /** Cut short while playing (by Stop, the wearer or a fault): felt in part, not under played. */
@@ -58,9 +68,14 @@ export class SleeveSays {
 
   get counts(): Readonly<Counts> {
     const causes = this.#fates.cutCauses();
+    const catchUp = this.#fates.catchUp();
     return {
       sent: this.#sent,
       ...this.#fates.counts(),
+      compressed: catchUp.compressed,
+      compressedMs: catchUp.compressed_ms,
+      slowed: catchUp.slowed,
+      late: catchUp.late,
       cutByWearer: causes.byWearer,
       cutByFault: causes.byFault,
       dropped: this.#dropped,
@@ -134,50 +149,71 @@ export class SleeveSays {
   }
 
   #render(): void {
-    const { played, refused, cancelled, cut, cutByWearer, cutByFault, dropped, delayed, latestDelayMs } =
-      this.counts;
+    const counts = this.counts;
     const summary = this.#summary;
-    summary.dataset["played"] = String(played);
-    summary.dataset["sent"] = String(this.#sent);
-    summary.dataset["refused"] = String(refused);
-    summary.dataset["cut"] = String(cut);
-    summary.dataset["cancelled"] = String(cancelled);
-    summary.dataset["dropped"] = String(dropped);
-    summary.dataset["delayed"] = String(delayed);
-    summary.dataset["held"] = String(this.#held);
+    for (const key of [
+      "played",
+      "compressed",
+      "slowed",
+      "late",
+      "sent",
+      "refused",
+      "cut",
+      "cancelled",
+      "dropped",
+      "delayed",
+      "held",
+    ] as const)
+      summary.dataset[key] = String(counts[key]);
+    summary.dataset["compressedMs"] = String(Math.round(counts.compressedMs));
     // Of the refused: by the wearer's pause or "do not disturb" (the page heard of it late).
     const refusals = this.#fates.refusals();
     const paused = refusals.get("paused") ?? 0;
     const quiet = refusals.get("do_not_disturb") ?? 0;
     summary.dataset["wearerRefused"] = String(paused + quiet);
-    if (this.#sent === 0 && dropped === 0) {
-      summary.textContent = "No strokes sent yet.";
-      return;
-    }
-    // Each stroke under one fate: the parts add up to the strokes drawn once all are answered.
-    const parts = [`${played} of ${plural(this.#sent, "stroke")} played`];
-    parts.push(...cutShortWords(cut, { byWearer: cutByWearer, byFault: cutByFault }));
-    if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
-    if (refused > 0) {
-      const wearer: string[] = [];
-      if (paused > 0)
-        wearer.push(paused === refused ? "the wearer paused" : `${paused} as the wearer paused`);
-      if (quiet > 0) {
-        wearer.push(
-          quiet === refused
-            ? "the wearer asked not to be disturbed"
-            : `${quiet} as the wearer asked not to be disturbed`,
-        );
-      }
-      parts.push(`${refused} refused${wearer.length === 0 ? "" : ` (${wearer.join(", ")})`}`);
-    }
-    if (this.#held > 0) parts.push(`${this.#held} held on this page, not sent (${this.#heldWhy})`);
-    if (dropped > 0) parts.push(`${dropped} never sent`);
-    const waiting = this.#sent - played - cut - cancelled - refused - dropped - this.#held;
-    if (waiting > 0 && (cut > 0 || cancelled > 0)) parts.push(`${waiting} not answered yet`);
-    if (delayed > 0) parts.push(`${delayed} delayed on the way (last by ${seconds(latestDelayMs)})`);
-    summary.textContent = `${parts.join(", ")}.`;
+    summary.textContent = summaryText(counts, { paused, quiet });
   }
+}
+
+/**
+ * The card's sentence: each stroke under one fate, so the parts add up to the strokes drawn once
+ * all are answered. Of the played, those the sleeve played faster to catch up or slowed to its
+ * floor (in brackets: they are played too); of the refused, those it skipped as late, apart.
+ * `wearer`: of the refused, those refused as the wearer paused or asked not to be disturbed.
+ */
+export function summaryText(counts: Readonly<Counts>, wearer: { paused: number; quiet: number }): string {
+  const { sent, played, refused, late, cancelled, cut, dropped, held, delayed } = counts;
+  if (sent === 0 && dropped === 0) return "No strokes sent yet.";
+  const pace = catchUpWords({
+    compressed: counts.compressed,
+    compressed_ms: counts.compressedMs,
+    slowed: counts.slowed,
+    late,
+  });
+  const parts = [`${played} of ${plural(sent, "stroke")} played${pace === "" ? "" : ` (${pace})`}`];
+  parts.push(...cutShortWords(cut, { byWearer: counts.cutByWearer, byFault: counts.cutByFault }));
+  if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
+  if (late > 0) parts.push(`${late} skipped as late`);
+  const otherwise = refused - late;
+  if (otherwise > 0) {
+    const { paused, quiet } = wearer;
+    const why: string[] = [];
+    if (paused > 0) why.push(paused === otherwise ? "the wearer paused" : `${paused} as the wearer paused`);
+    if (quiet > 0) {
+      why.push(
+        quiet === otherwise
+          ? "the wearer asked not to be disturbed"
+          : `${quiet} as the wearer asked not to be disturbed`,
+      );
+    }
+    parts.push(`${otherwise} refused${why.length === 0 ? "" : ` (${why.join(", ")})`}`);
+  }
+  if (held > 0) parts.push(`${held} held on this page, not sent (${counts.heldWhy})`);
+  if (dropped > 0) parts.push(`${dropped} never sent`);
+  const waiting = sent - played - cut - cancelled - refused - dropped - held;
+  if (waiting > 0 && (cut > 0 || cancelled > 0)) parts.push(`${waiting} not answered yet`);
+  if (delayed > 0) parts.push(`${delayed} delayed on the way (last by ${seconds(counts.latestDelayMs)})`);
+  return `${parts.join(", ")}.`;
 }
 
 function plural(count: number, noun: string): string {

@@ -397,10 +397,13 @@ def _answer_line(
     how = f"{event.kind}" + (
         f" ({getattr(event, 'reason', '')})" if event.kind == "adjusted" else ""
     )
-    return (
+    line = (
         f"{where} {how}: {played.duration_ms:g} ms, latency {played.latency_ms:.0f} ms, "
         f"queued {played.queued_ms:.0f} ms"
     )
+    if played.compressed_ms:  # played faster to catch up with the strokes before it
+        line += f", {played.compressed_ms:.0f} ms shorter to catch up"
+    return line
 
 
 # Beyond the drawing's own time after the last stroke went out, the longest the sleeve's

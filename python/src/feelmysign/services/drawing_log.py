@@ -3,15 +3,21 @@
 ``up`` listens on ``feelmysign/<id>/events`` like any page does (with the
 sender's account) and prints one line per drawing id once that drawing is over::
 
-    Drawing 3f2a9c1e: 12 strokes played (2 slowed to be felt), 1 delayed on the way
-    (by 1.6 s), 1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
+    Drawing 3f2a9c1e: 12 strokes played (3 faster to catch up, 210 ms shorter in all;
+    1 slowed to the sleeve's floor), 1 delayed on the way (by 1.6 s), 2 skipped as late,
+    1 rejected (outside_grid); start delay median 3 ms, max 9 ms   (on one line)
+
+In brackets after the strokes played: those the sleeve played faster to catch up with the
+pen, and by how much in all, and those it slowed to its floor (``fates.CatchUp``, in the
+words the page's card and ``send --wait`` use).
 
 A stroke delayed on the way was felt more than ``events.DELAYED_MS`` after its
 sender drew it (its ``sent_at_ms``), not counting its wait behind the strokes before
 it (``events.is_delayed``; the page marks the same ones): it was held on the way, by
 its sender while the broker was out of reach, at the broker while the sleeve was
 offline, or by a slow network. It was played; a stroke the
-sleeve skipped for being too far behind is a ``late`` refusal, under rejected.
+sleeve skipped for being too far behind is a ``late`` refusal, said as "skipped as late",
+apart from the other refusals (it is counted once, as rejected is).
 
 The start delay of a stroke is the time from its turn (its arrival, or the end
 of the strokes queued before it) to its first motor: the sleeve's own lateness,
@@ -47,7 +53,6 @@ from typing import TYPE_CHECKING, Any
 
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.events import (
-    Adjusted,
     Cancelled,
     Event,
     EventCopies,
@@ -60,6 +65,7 @@ from feelmysign.events import (
     is_delayed,
 )
 from feelmysign.fates import FATES, DrawingFates, Fate
+from feelmysign.protocol import LATE
 from feelmysign.topics import telemetry_topic
 
 if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign --help'
@@ -79,7 +85,6 @@ class _Drawing:
     last_event_index: int = 0  # the summaries' event count at its last event
     printed: bool = False  # its line was printed: the next one says "(updated)"
     fates: DrawingFates = field(default_factory=DrawingFates)
-    slowed: int = 0
     delays_ms: list[float] = field(default_factory=list)
     delays_on_the_way_ms: list[float] = field(default_factory=list)  # of the delayed ones
 
@@ -90,14 +95,17 @@ class _Drawing:
         counts = self.fates.counts()
         played = counts["played"]
         parts = [f"{played} stroke{'s' if played != 1 else ''} played"]
-        if self.slowed:
-            parts[0] += f" ({self.slowed} slowed to be felt)"
+        if pace := self.fates.catch_up().played_words():
+            parts[0] += f" ({pace})"
         if counts["cut"]:
             parts.append(f"{counts['cut']} cut short")
         if delayed := self.delays_on_the_way_ms:
             parts.append(f"{len(delayed)} delayed on the way (by {_seconds(max(delayed))}")
             parts[-1] += " at most)" if len(delayed) > 1 else ")"
-        if rejected := self.fates.refusals():
+        rejected = self.fates.refusals()
+        if late := rejected.pop(LATE, 0):
+            parts.append(f"{late} skipped as late")
+        if rejected:
             reasons = ", ".join(f"{n} {r}" if n > 1 else r for r, n in rejected.items())
             parts.append(f"{sum(rejected.values())} rejected ({reasons})")
         if counts["cancelled"]:
@@ -151,7 +159,6 @@ class DrawingSummaries:
                 self._totals[before] -= 1
             self._totals[after] += 1
         if isinstance(event, Played):
-            drawing.slowed += isinstance(event, Adjusted)
             drawing.delays_ms.append(max(0.0, event.latency_ms - event.queued_ms))
             delay_ms = delivery_delay_ms(event)
             if delay_ms is not None and is_delayed(event):

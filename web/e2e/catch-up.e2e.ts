@@ -1,0 +1,270 @@
+/**
+ * When a drawing's strokes queue, the sender is told how the sleeve caught up, on real processes:
+ * `feelmysign up` with the simulated sleeve, the page in Chromium. Play again sends a drawing at
+ * once: the sleeve plays the strokes that queue faster, down to its floor, and the "Sleeve says"
+ * card and `up`'s line say how many and how much shorter in all, as the sleeve's `played` events
+ * say (their `compressed_ms`). A stall on the way (the broker frozen while the pen draws on) sends
+ * a backlog at once: the sleeve skips what it is too late for, and the card and `up` say those
+ * skipped as late apart from other refusals, each stroke still counted once.
+ */
+import { spawnSync } from "node:child_process";
+import type { Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import { durationWords } from "../src/fates";
+import { EventWatcher } from "./harness";
+import { drawingArea, nextFrame, screenshot, waitForData, type Area } from "./page";
+import { Processes, type Up } from "./processes";
+
+const SUMMARY = '[data-testid="played-summary"]';
+const CARD = 'section.card:has([data-testid="played-summary"])';
+/** events.ts NOTABLE_ADJUSTMENT: a stroke shortened by less than this share is not said. */
+const NOTABLE = 0.05;
+const LINE_TIMEOUT_MS = 40_000;
+
+type Point = readonly [number, number];
+
+interface Card {
+  sent: number;
+  played: number;
+  cut: number;
+  cancelled: number;
+  refused: number;
+  dropped: number;
+  compressed: number;
+  compressedMs: number;
+  slowed: number;
+  late: number;
+}
+
+async function cardData(page: Page): Promise<Card> {
+  const data = await page.locator(SUMMARY).evaluate((element) => ({ ...(element as HTMLElement).dataset }));
+  const read = (key: string) => Number(data[key]);
+  return {
+    sent: read("sent"),
+    played: read("played"),
+    cut: read("cut"),
+    cancelled: read("cancelled"),
+    refused: read("refused"),
+    dropped: read("dropped"),
+    compressed: read("compressed"),
+    compressedMs: read("compressedMs"),
+    slowed: read("slowed"),
+    late: read("late"),
+  };
+}
+
+/** Waits until every stroke drawn has a fate on the card. */
+async function waitForEveryStroke(page: Page, timeoutMs = 60_000): Promise<Card> {
+  const deadline = Date.now() + timeoutMs;
+  for (;;) {
+    const card = await cardData(page);
+    const answered = card.played + card.cut + card.cancelled + card.refused + card.dropped;
+    if (card.sent > 0 && answered === card.sent) return card;
+    if (Date.now() > deadline) throw new Error(`not every stroke answered: ${JSON.stringify(card)}`);
+    await new Promise((wake) => setTimeout(wake, 100));
+  }
+}
+
+/**
+ * What the sleeve's own events say, counted here from the wire (each event once): strokes played
+ * faster by a share a person could feel and how much shorter in all, and strokes skipped as late.
+ */
+function fromEvents(events: readonly Record<string, unknown>[]): {
+  compressed: number;
+  compressedMs: number;
+  slowed: number;
+  late: number;
+} {
+  const seen = new Set<string>();
+  let compressed = 0;
+  let compressedMs = 0;
+  let slowed = 0;
+  const late = new Set<number>();
+  for (const event of events) {
+    const text = JSON.stringify(event);
+    if (seen.has(text)) continue;
+    seen.add(text);
+    if (event["type"] === "rejected" && event["reason"] === "late") late.add(event["seq"] as number);
+    if (event["type"] === "adjusted") {
+      const asked = event["requested_duration_ms"] as number;
+      if (Math.abs((event["duration_ms"] as number) - asked) >= NOTABLE * asked) slowed++;
+    }
+    const shorter = event["compressed_ms"];
+    if ((event["type"] !== "played" && event["type"] !== "adjusted") || typeof shorter !== "number") continue;
+    if (shorter > 0 && shorter >= NOTABLE * ((event["duration_ms"] as number) + shorter)) {
+      compressed++;
+      compressedMs += shorter;
+    }
+  }
+  return { compressed, compressedMs, slowed, late: late.size };
+}
+
+describe("the sender is told how the sleeve caught up with a drawing", () => {
+  const processes = new Processes();
+  let up: Up;
+  let page: Page;
+  let area: Area;
+  let watcher: EventWatcher;
+  let output = "";
+  const at = (fx: number, fy: number): Point => [area.left + area.width * fx, area.top + area.height * fy];
+
+  /** A zigzag of `legs` legs, 250 ms a leg with the pen down; `beforeLeg(i)` runs before leg i. */
+  async function drawZigzag(legs: number, beforeLeg: (leg: number) => void = () => {}): Promise<string> {
+    const corners: Point[] = [];
+    for (let i = 0; i <= legs; i++) corners.push(at(0.06 + (0.88 * i) / legs, i % 2 === 0 ? 0.2 : 0.8));
+    await page.mouse.move(...corners[0]!);
+    await page.mouse.down();
+    await nextFrame(page);
+    for (let i = 1; i < corners.length; i++) {
+      beforeLeg(i);
+      const [ax, ay] = corners[i - 1]!;
+      const [bx, by] = corners[i]!;
+      const startMs = performance.now();
+      for (let done = 0; done < 1;) {
+        done = Math.min(1, (performance.now() - startMs) / 250);
+        await page.mouse.move(ax + (bx - ax) * done, ay + (by - ay) * done);
+        await nextFrame(page);
+      }
+    }
+    await page.mouse.up();
+    return page.evaluate(() => window.feelmysign?.drawingId ?? "");
+  }
+
+  /** `up`'s last line about `drawing` once it counts `answered` strokes (played and refused). */
+  async function upLine(drawing: string, answered: number): Promise<string> {
+    const pattern = new RegExp(`Drawing ${drawing.slice(0, 8)}( \\(updated\\))?: [^\\n]*\\n`, "g");
+    const count = (line: string, what: RegExp) => Number(what.exec(line)?.[1] ?? 0);
+    const deadline = Date.now() + LINE_TIMEOUT_MS;
+    for (;;) {
+      const line = output.match(pattern)?.at(-1);
+      if (line !== undefined) {
+        const told =
+          count(line, /: (\d+) strokes? played/) +
+          count(line, /(\d+) skipped as late/) +
+          count(line, /(\d+) rejected/) +
+          count(line, /(\d+) cut short/) +
+          count(line, /(\d+) cancelled/);
+        if (told === answered) return line;
+      }
+      if (Date.now() > deadline) throw new Error(`up printed no whole line for ${drawing}:\n${output}`);
+      await new Promise((wake) => setTimeout(wake, 200));
+    }
+  }
+
+  /** The Mosquitto `up` runs (its child). */
+  function mosquittoOf(): number {
+    const found = spawnSync("pgrep", ["-P", String(up.child.pid), "mosquitto"], { encoding: "utf8" });
+    const pids = found.stdout.split(/\s+/).filter(Boolean).map(Number);
+    if (pids.length !== 1) throw new Error(`expected one mosquitto under up, found ${JSON.stringify(pids)}`);
+    return pids[0]!;
+  }
+
+  beforeAll(async () => {
+    up = await processes.up("catch-up");
+    up.child.stdout?.on("data", (chunk: Buffer) => (output += chunk.toString()));
+    watcher = await EventWatcher.connect(up.credentials);
+    processes.add(() => watcher.client.endAsync(true));
+    page = await processes.onlinePage(up.url);
+    area = await drawingArea(page);
+  });
+
+  afterAll(() => processes.stop());
+
+  it(
+    "Play again sends the drawing at once: the card and up's line say how many strokes the sleeve played faster, and how much shorter in all",
+    { timeout: 180_000 },
+    async () => {
+      const drawn = await drawZigzag(10);
+      expect(drawn).not.toBe("");
+      await waitForEveryStroke(page);
+      // Play again: every stroke at once, each queued behind the one before it.
+      await page.locator('[data-testid="replay-button"]').click();
+      const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
+      expect(drawing).not.toBe(drawn);
+      const card = await waitForEveryStroke(page);
+      await watcher.waitFor(
+        "an event for every stroke",
+        () => watcher.of(drawing).length >= card.sent,
+        60_000,
+      );
+      const said = fromEvents(watcher.of(drawing));
+      // The sleeve caught up: most strokes of a drawing sent at once play faster, none skipped.
+      expect(said.compressed).toBeGreaterThanOrEqual(card.sent / 2);
+      expect(said.late).toBe(0);
+      // The card says what the sleeve's events say, the caught-up among the played.
+      expect(card.played).toBe(card.sent);
+      expect({
+        compressed: card.compressed,
+        compressedMs: card.compressedMs,
+        slowed: card.slowed,
+        late: card.late,
+      }).toEqual({
+        compressed: said.compressed,
+        compressedMs: Math.round(said.compressedMs),
+        slowed: said.slowed,
+        late: 0,
+      });
+      // (A stroke briefer than the floor, the tail of a leg, would be slowed: said after a ";".)
+      const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
+      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
+      const summary = await page.locator(SUMMARY).innerText();
+      expect(summary).toBe(`${card.sent} of ${card.sent} strokes played (${words}).`);
+      // up's line says the same of the drawing.
+      const line = await upLine(drawing, card.sent);
+      expect(line).toContain(`: ${card.sent} strokes played (${words})`);
+      console.log(`card: ${summary}\nup: ${line.trim()}`);
+      const full = await screenshot(page, "catch-up-play-again");
+      await page.locator(CARD).screenshot({ path: full.replace(/\.png$/, "-card.png") });
+    },
+  );
+
+  it(
+    "a stall on the way sends a backlog at once: the strokes skipped as late are said apart, each stroke once",
+    { timeout: 180_000 },
+    async () => {
+      await page.locator('[data-testid="new-button"]').click();
+      // The broker frozen for 3 s while the pen draws on: what the page sends meanwhile waits on
+      // the way, then reaches the sleeve at once, long after it was drawn.
+      let broker = 0;
+      const drawing = await drawZigzag(20, (leg) => {
+        if (leg === 4) {
+          broker = mosquittoOf();
+          process.kill(broker, "SIGSTOP");
+          processes.add(() => void spawnSync("kill", ["-CONT", String(broker)])); // whatever fails
+        }
+        if (leg === 16) process.kill(broker, "SIGCONT");
+      });
+      expect(broker).toBeGreaterThan(0);
+      const card = await waitForEveryStroke(page);
+      await watcher.waitFor(
+        "an event for every stroke",
+        () => watcher.of(drawing).length >= card.sent,
+        60_000,
+      );
+      const said = fromEvents(watcher.of(drawing));
+      expect(said.late).toBeGreaterThan(0);
+      expect(card.late).toBe(said.late);
+      expect(card.compressed).toBe(said.compressed);
+      expect(card.compressedMs).toBe(Math.round(said.compressedMs));
+      expect(card.slowed).toBe(said.slowed); // a stroke briefer than the floor, cut by the stall
+      // Each stroke once: the late among the refused, the caught-up among the played.
+      expect(card.played + card.cut + card.cancelled + card.refused + card.dropped).toBe(card.sent);
+      const summary = await page.locator(SUMMARY).innerText();
+      expect(summary).toContain(`, ${card.late} skipped as late`);
+      const otherwise = card.refused - card.late;
+      if (otherwise === 0) expect(summary).not.toContain("refused");
+      else expect(summary).toContain(`${otherwise} refused`);
+      if (card.compressed > 0) expect(summary).toContain(`(${card.compressed} faster to catch up, `);
+      // The felt timeline's caption says them as the card does: off the timeline.
+      const caption = await page.locator('[data-testid="timeline-caption"]').innerText();
+      expect(caption).toContain(`${card.late} skipped as late (not on the timeline)`);
+      const line = await upLine(drawing, card.sent);
+      expect(line).toContain(`${card.late} skipped as late`);
+      expect(line).not.toMatch(/rejected \([^)]*late/);
+      console.log(`card: ${summary}\ncaption: ${caption}\nup: ${line.trim()}`);
+      const full = await screenshot(page, "catch-up-after-a-stall");
+      await page.locator(CARD).screenshot({ path: full.replace(/\.png$/, "-card.png") });
+      await waitForData(page, '[data-testid="broker-status"]', "state", "connected");
+    },
+  );
+});
