@@ -218,6 +218,12 @@ export class WindowCore {
   takenY = 0;
   /** The squared rest radius (see `REST_SHARE`). */
   readonly #restSq: number;
+  // The parameters `#follows` reads, read out of `params` once.
+  readonly #capMs: number;
+  readonly #restMs: number;
+  readonly #maxWindow: number;
+  /** Whether the bend rule is on (`max_bend` > 0): `#keepsBound` then tests with a limit of its own. */
+  readonly #bends: boolean;
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
@@ -231,6 +237,10 @@ export class WindowCore {
     this.#mapping = CanvasMapping.fromParams(params);
     const rest = restRadius(params, this.#mapping);
     this.#restSq = rest * rest;
+    this.#capMs = params.max_stroke_ms;
+    this.#restMs = params.rest_ms;
+    this.#maxWindow = params.max_window;
+    this.#bends = params.max_bend > 0;
     this.#window = new Samples();
   }
 
@@ -276,7 +286,43 @@ export class WindowCore {
       this.#resting = false;
       return NO_SEGMENTS;
     }
+    if (this.#follows(count, x, y, sample.t_ms)) return NO_SEGMENTS;
     return this.#add() ?? NO_SEGMENTS;
+  }
+
+  /**
+   * The common sample, taken at once if it is one: it joins the stroke (window[count], with no
+   * sample waiting after it) and cuts nothing, as `#add` would find: the pen neither rests nor
+   * crawls, the stroke stays under the caps, and its reach says every sample keeps the bound
+   * without testing one (the bend rule off). Else (false) nothing has changed, and `#add` takes
+   * it. The same tests as `#add`'s, in a short function for the optimiser to inline, since most
+   * samples end here.
+   */
+  #follows(count: number, x: number, y: number, t: number): boolean {
+    if (this.#resting || count < 2 || count >= this.#maxWindow || this.#bends) return false;
+    const { xs, ys, ts } = this.#window;
+    const sinceAnchorMs = t - ts[0]!;
+    const capMs = this.#capMs;
+    if (capMs > 0 && sinceAnchorMs > capMs) return false;
+    const dx = x - xs[count - 1]!;
+    const dy = y - ys[count - 1]!;
+    const stepSq = dx * dx + dy * dy;
+    const reach = this.#reach + Math.sqrt(stepSq) + ROUNDING_SLACK;
+    // `#keepsBound`'s shortcut.
+    if (!(reach <= this.#reachLimit)) return false;
+    // `#add`'s test for a pen that may rest, then whether it does (`#rests`): many samples of a
+    // slow pen stay near the one before, few near every one of the last rest_ms.
+    const restMs = this.#restMs;
+    const restSq = this.#restSq;
+    if (restMs > 0 && sinceAnchorMs >= restMs && stepSq <= restSq) {
+      let start = count - 1;
+      while (start > 0 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
+      if (!(t - ts[start]! < restMs)) return false;
+    }
+    this.#window.count = count + 1;
+    this.#reach = reach;
+    this.#reaches[count] = reach;
+    return true;
   }
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
