@@ -291,8 +291,8 @@ export class WindowCore {
   }
 
   /**
-   * The common sample, taken at once if it is one: it joins the stroke (window[count], with no
-   * sample waiting after it) and cuts nothing, as `#add` would find: the pen neither rests nor
+   * The common sample, taken at once if it is one: window[count] joins the stroke and cuts
+   * nothing, as `#add` would find: the pen neither rests nor
    * crawls, the stroke stays under the caps, and its reach says every sample keeps the bound
    * without testing one (the bend rule off). Else (false) nothing has changed, and `#add` takes
    * it. The same tests as `#add`'s, in a short function for the optimiser to inline, since most
@@ -351,11 +351,16 @@ export class WindowCore {
     const capMs = this.params.max_stroke_ms;
     const maxWindow = this.params.max_window;
     const restMs = this.params.rest_ms;
-    for (;;) {
+    for (let first = true; ; first = false) {
       const count = window.count;
       const x = xs[count]!;
       const y = ys[count]!;
       const t = ts[count]!;
+      // Most samples a cut gives back are common ones too (`push` tried the new one).
+      if (!first && this.#follows(count, x, y, t)) {
+        if (window.count === window.end) return out;
+        continue;
+      }
       if (this.#resting) {
         if (count === 1 && squared(x - xs[0]!, y - ys[0]!) <= this.#restSq) {
           // The pen still rests: the next stroke starts when it moves on, not before.
@@ -586,7 +591,7 @@ export class WindowCore {
     const limit = LINE_SHARE * this.params.max_error;
     const certain = this.#reachesNear(cut, end[0], end[1], limit - ROUNDING_SLACK);
     if (!certain && !this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
-    return direction([this.#window.xs[0]!, this.#window.ys[0]!], end);
+    return direction(this.#window.xs[0]!, this.#window.ys[0]!, end[0], end[1]);
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
@@ -978,10 +983,10 @@ function squared(dx: number, dy: number): number {
   return dx * dx + dy * dy;
 }
 
-/** The unit vector from `start` to `end` (null if they coincide). */
-function direction(start: Point, end: Point): Point | null {
-  const dx = end[0] - start[0];
-  const dy = end[1] - start[1];
+/** The unit vector from (startX, startY) to (endX, endY) (null if they coincide). */
+function direction(startX: number, startY: number, endX: number, endY: number): Point | null {
+  const dx = endX - startX;
+  const dy = endY - startY;
   const length = Math.sqrt(dx * dx + dy * dy);
   return length > 0 ? [dx / length, dy / length] : null;
 }
