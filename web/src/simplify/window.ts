@@ -292,11 +292,10 @@ export class WindowCore {
 
   /**
    * The common sample, taken at once if it is one: window[count] joins the stroke and cuts
-   * nothing, as `#add` would find: the pen neither rests nor
-   * crawls, the stroke stays under the caps, and its reach says every sample keeps the bound
-   * without testing one (the bend rule off). Else (false) nothing has changed, and `#add` takes
-   * it. The same tests as `#add`'s, in a short function for the optimiser to inline, since most
-   * samples end here.
+   * nothing, as `#add` would find: the pen neither rests nor crawls, the stroke stays under the
+   * caps, and its reach says every sample keeps the bound without testing one (the bend rule
+   * off). Else (false) nothing has changed, and `#add` takes it. The same tests as `#add`'s, in a
+   * short function for the optimiser to inline, since most samples end here.
    */
   #follows(count: number, x: number, y: number, t: number): boolean {
     if (this.#resting || count < 2 || count >= this.#maxWindow || this.#bends) return false;
