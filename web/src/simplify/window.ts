@@ -221,6 +221,12 @@ export class WindowCore {
   takenY = 0;
   /** The squared rest radius (see `REST_SHARE`). */
   readonly #restSq: number;
+  // The parameters `#follows` reads, read out of `params` once.
+  readonly #capMs: number;
+  readonly #restMs: number;
+  readonly #maxWindow: number;
+  /** Whether the bend rule is on (`max_bend` > 0): `#keepsBound` then tests with a limit of its own. */
+  readonly #bends: boolean;
 
   constructor(params: WindowParams) {
     checkWindowParams(params);
@@ -234,6 +240,10 @@ export class WindowCore {
     this.#mapping = CanvasMapping.fromParams(params);
     const rest = restRadius(params, this.#mapping);
     this.#restSq = rest * rest;
+    this.#capMs = params.max_stroke_ms;
+    this.#restMs = params.rest_ms;
+    this.#maxWindow = params.max_window;
+    this.#bends = params.max_bend > 0;
     this.#window = new Samples();
   }
 
@@ -279,7 +289,42 @@ export class WindowCore {
       this.#resting = false;
       return NO_SEGMENTS;
     }
+    if (this.#follows(count, x, y, sample.t_ms)) return NO_SEGMENTS;
     return this.#add() ?? NO_SEGMENTS;
+  }
+
+  /**
+   * The common sample, taken at once if it is one: window[count] joins the stroke and cuts
+   * nothing, as `#add` would find: the pen neither rests nor crawls, the stroke stays under the
+   * caps, and its reach says every sample keeps the bound without testing one (the bend rule
+   * off). Else (false) nothing has changed, and `#add` takes it. The same tests as `#add`'s, in a
+   * short function for the optimiser to inline, since most samples end here.
+   */
+  #follows(count: number, x: number, y: number, t: number): boolean {
+    if (this.#resting || count < 2 || count >= this.#maxWindow || this.#bends) return false;
+    const { xs, ys, ts } = this.#window;
+    const sinceAnchorMs = t - ts[0]!;
+    const capMs = this.#capMs;
+    if (capMs > 0 && sinceAnchorMs > capMs) return false;
+    const dx = x - xs[count - 1]!;
+    const dy = y - ys[count - 1]!;
+    const stepSq = dx * dx + dy * dy;
+    const reach = this.#reach + Math.sqrt(stepSq) + ROUNDING_SLACK;
+    // `#keepsBound`'s shortcut.
+    if (!(reach <= this.#reachLimit)) return false;
+    // `#add`'s test for a pen that may rest, then whether it does (`#rests`): many samples of a
+    // slow pen stay near the one before, few near every one of the last rest_ms.
+    const restMs = this.#restMs;
+    const restSq = this.#restSq;
+    if (restMs > 0 && sinceAnchorMs >= restMs && stepSq <= restSq) {
+      let start = count - 1;
+      while (start > 0 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
+      if (!(t - ts[start]! < restMs)) return false;
+    }
+    this.#window.count = count + 1;
+    this.#reach = reach;
+    this.#reaches[count] = reach;
+    return true;
   }
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
@@ -308,11 +353,16 @@ export class WindowCore {
     const capMs = this.params.max_stroke_ms;
     const maxWindow = this.params.max_window;
     const restMs = this.params.rest_ms;
-    for (;;) {
+    for (let first = true; ; first = false) {
       const count = window.count;
       const x = xs[count]!;
       const y = ys[count]!;
       const t = ts[count]!;
+      // Most samples a cut gives back are common ones too (`push` tried the new one).
+      if (!first && this.#follows(count, x, y, t)) {
+        if (window.count === window.end) return out;
+        continue;
+      }
       if (this.#resting) {
         if (count === 1 && squared(x - xs[0]!, y - ys[0]!) <= this.#restSq) {
           // The pen still rests: the next stroke starts when it moves on, not before.
@@ -543,7 +593,7 @@ export class WindowCore {
     const limit = LINE_SHARE * this.params.max_error;
     const certain = this.#reachesNear(cut, end[0], end[1], limit - ROUNDING_SLACK);
     if (!certain && !this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
-    return direction([this.#window.xs[0]!, this.#window.ys[0]!], end);
+    return direction(this.#window.xs[0]!, this.#window.ys[0]!, end[0], end[1]);
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
@@ -975,10 +1025,10 @@ function squared(dx: number, dy: number): number {
   return dx * dx + dy * dy;
 }
 
-/** The unit vector from `start` to `end` (null if they coincide). */
-function direction(start: Point, end: Point): Point | null {
-  const dx = end[0] - start[0];
-  const dy = end[1] - start[1];
+/** The unit vector from (startX, startY) to (endX, endY) (null if they coincide). */
+function direction(startX: number, startY: number, endX: number, endY: number): Point | null {
+  const dx = endX - startX;
+  const dy = endY - startY;
   const length = Math.sqrt(dx * dx + dy * dy);
   return length > 0 ? [dx / length, dy / length] : null;
 }
