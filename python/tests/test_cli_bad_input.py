@@ -73,12 +73,14 @@ def files(tmp_path: Path) -> dict[str, str]:
     rows_a.write_text(json.dumps({**RECORDING, "sleeve": {"rows": "a"}}), encoding="utf-8")
     a_file = tmp_path / "a-file"
     a_file.write_text("not a folder\n", encoding="utf-8")
+    no_canvas = tmp_path / "no-canvas.json"
+    no_canvas.write_text(json.dumps({**RECORDING, "canvas": None}), encoding="utf-8")
     deep_json = tmp_path / "deep.json"
     deep_json.write_text("[" * 5000 + "]" * 5000, encoding="utf-8")
     deep_design = tmp_path / "deep-design.toml"
     deep_design.write_text("[study]\nname = " + "{a=" * 5000 + "}" * 5000 + "\n", "utf-8")
     names = {"deep": deep, "fifo": fifo, "huge": huge, "good": good, "rows_a": rows_a}
-    names |= {"deep_json": deep_json, "deep_design": deep_design}
+    names |= {"deep_json": deep_json, "deep_design": deep_design, "no_canvas": no_canvas}
     names |= {"fifo_design": _design_naming(tmp_path / "fifo-study", fifo)}
     paper = Path(__file__).resolve().parents[2] / "deploy" / "layouts" / "paper-sleeve.toml"
     body = base64.urlsafe_b64encode(b"[" * 5000 + b"]" * 5000).decode().rstrip("=")
@@ -245,8 +247,16 @@ def test_a_negative_stroke_is_judged_not_taken_for_an_option(tmp_path: Path) -> 
 
 def test_an_unknown_option_is_one_error_line_with_exit_2(tmp_path: Path) -> None:
     done = run(["plan", "0,0,1,0,500", "--no-such-option"], tmp_path)
-    assert_one_error(done, "unrecognized arguments: --no-such-option", "--help")
+    # The help that lists the options of the command given, not the program's list of commands.
+    assert_one_error(done, "unrecognized arguments: --no-such-option", "'feelmysign plan --help'")
     assert done.returncode == 2
+
+
+def test_a_recording_without_its_canvas_says_what_it_has_in_json_words(
+    files: dict[str, str], tmp_path: Path
+) -> None:
+    done = run(["replay", files["no_canvas"]], tmp_path)
+    assert_one_error(done, "'canvas' must be an object but is null", "Save recording")
 
 
 def test_an_unexpected_exception_is_one_error_line_asking_for_a_report(

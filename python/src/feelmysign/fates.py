@@ -62,6 +62,15 @@ NOTABLE_CHANGE = 0.05
 _COPY, _REFUSAL, _OWN, _PLAYED, _CUT = 1, 2, 3, 4, 5
 
 
+def caught_up_ms(event: Played) -> float:
+    """How much shorter the stroke of ``event`` played to catch up with its drawing; 0 when
+    it played as it came or the change is below ``NOTABLE_CHANGE`` (no one feels it)."""
+    shorter_ms = event.compressed_ms or 0.0  # as it came: duration_ms + shorter_ms
+    if shorter_ms > 0 and shorter_ms >= NOTABLE_CHANGE * (event.duration_ms + shorter_ms):
+        return shorter_ms
+    return 0.0
+
+
 @dataclass(frozen=True)
 class CatchUp:
     """How the sleeve kept one drawing in time: ``compressed`` strokes played faster to catch
@@ -79,8 +88,8 @@ class CatchUp:
         the number of strokes refused as ``late``; changes below ``NOTABLE_CHANGE`` left out."""
         compressed, compressed_ms, slowed = 0, 0.0, 0
         for event in played:
-            shorter_ms = event.compressed_ms or 0.0  # as it came: duration_ms + shorter_ms
-            if shorter_ms > 0 and shorter_ms >= NOTABLE_CHANGE * (event.duration_ms + shorter_ms):
+            shorter_ms = caught_up_ms(event)
+            if shorter_ms:
                 compressed += 1
                 compressed_ms += shorter_ms
             if isinstance(event, Adjusted):

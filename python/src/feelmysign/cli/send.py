@@ -53,9 +53,11 @@ from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
 from feelmysign.events import Event, Status, StatusControls, StatusFloor
+from feelmysign.fates import caught_up_ms
 from feelmysign.input_files import loads_json
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
 from feelmysign.outcome import DrawingOutcome, StrokeOutcome
+from feelmysign.plural import plural
 from feelmysign.protocol import Accepted, parse
 from feelmysign.sending import (
     STATUS_WAIT_S,
@@ -397,12 +399,12 @@ def _answer_line(
     how = f"{event.kind}" + (
         f" ({getattr(event, 'reason', '')})" if event.kind == "adjusted" else ""
     )
-    line = (
-        f"{where} {how}: {played.duration_ms:g} ms, latency {played.latency_ms:.0f} ms, "
-        f"queued {played.queued_ms:.0f} ms"
-    )
-    if played.compressed_ms:  # played faster to catch up with the strokes before it
-        line += f", {played.compressed_ms:.0f} ms shorter to catch up"
+    line = f"{where} {how}: {played.duration_ms:g} ms, latency {played.latency_ms:.0f} ms"
+    if played.queued_ms >= 1:  # most of that latency was the wait, not the network
+        line += f" (of which {played.queued_ms:.0f} ms waiting for the strokes before it)"
+    shorter_ms = caught_up_ms(played)
+    if shorter_ms:  # played faster to catch up with the strokes before it
+        line += f", {shorter_ms:.0f} ms shorter to catch up"
     return line
 
 
@@ -589,7 +591,9 @@ def _summary(
     args: argparse.Namespace, settings: BrokerSettings, strokes: list[Stroke], sent: int
 ) -> str:
     what = (
-        f"a {args.shape} of {len(strokes)} strokes" if args.shape else f"{len(strokes)} stroke(s)"
+        f"a {args.shape} of {plural(len(strokes), 'stroke')}"
+        if args.shape
+        else plural(len(strokes), "stroke")
     )
     if sent < len(strokes):
         what = f"{sent} of {what} (the rest not sent: the sleeve refused strokes for its wearer)"

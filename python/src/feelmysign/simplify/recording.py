@@ -111,11 +111,28 @@ def _reject_constant(name: str) -> float:
     raise ValueError(f"{name} is not a number")
 
 
+def _json_kind(value: object) -> str:
+    """What a JSON value is, in JSON's words (null, a number...), for an error message."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true or false"
+    if isinstance(value, int | float):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    return "a list" if isinstance(value, list) else "an object"
+
+
 def _field(data: dict[str, Any], key: str, kind: type, source: str) -> Any:
     value = data.get(key)
     if not isinstance(value, kind):
         wanted = "an object" if kind is dict else "a list"
-        raise RecordingError(f"{source}: '{key}' must be {wanted}, got {type(value).__name__}")
+        found = "is missing" if key not in data else f"is {_json_kind(value)}"
+        raise RecordingError(
+            f"{source}: '{key}' must be {wanted} but {found}; a recording is the JSON file the "
+            'drawing page\'s "Save recording" downloads (its format: docs/research.md, Recordings)'
+        )
     return value
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+from collections.abc import Sequence
 from typing import Any, NoReturn, TypeAlias
 
 from feelmysign.cli.options.values import decimal_float_option, decimal_int_option
@@ -34,11 +35,26 @@ class CliParser(argparse.ArgumentParser):
         self.register("type", float, decimal_float_option)
         self.register("type", int, decimal_int_option)
 
+    def parse_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> argparse.Namespace:
+        """As argparse's, but an argument no command takes is told with the help of the
+        command it was given to ('feelmysign stop --help'), not the program's."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            command = getattr(parsed, "command", None)
+            prog = f"{self.prog} {command}" if isinstance(command, str) else self.prog
+            self._fail(f"unrecognized arguments: {' '.join(extras)}", prog)
+        return parsed
+
     def error(self, message: str) -> NoReturn:
+        self._fail(message, self.prog)
+
+    def _fail(self, message: str, prog: str) -> NoReturn:
         text = " ".join(message.split()).rstrip(".")
         # "argument --port: 99999 is out of range" -> "--port: 99999 is out of range"
         text = _ARGUMENT_PREFIX.sub("", text)
-        sys.stderr.write(f"Error: {text}. See '{self.prog} --help'.\n")
+        sys.stderr.write(f"Error: {text}. See '{prog} --help'.\n")
         sys.exit(USAGE_ERROR_EXIT)
 
 
