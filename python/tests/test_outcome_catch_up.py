@@ -96,3 +96,21 @@ def test_a_drawing_played_as_it_came_reads_as_before() -> None:
     summary = outcome_of(2, played(0), played(1)).summary()
     assert summary.text() == "The sleeve played 2 of 2 strokes"
     assert summary.all_played
+
+
+def test_each_stroke_skipped_as_late_is_said_so_as_the_summary_says_it() -> None:
+    from feelmysign.cli.send import _answer_line
+    from feelmysign.events import event_from_json
+
+    late = {**rejected(1, "late"), "message": "the stroke would start 2.10 s after it was due"}
+    other = rejected(2, "outside_grid")
+    outcome = outcome_of(3, played(0), late, other)
+    lines = [
+        _answer_line(seq, 3, outcome.strokes[seq], event_from_json(body), json_lines=False)
+        for seq, body in ((1, late), (2, other))
+    ]
+    assert lines == [
+        "[2/3] skipped as late: the stroke would start 2.10 s after it was due",
+        "[3/3] refused (outside_grid): outside_grid",
+    ]
+    assert "skipped 1 as late" in outcome.summary().text()

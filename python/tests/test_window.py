@@ -864,3 +864,30 @@ def test_a_rest_ends_the_stroke_before_it_and_is_not_played(
     assert after, "the leg after the rest was not sent"
     told_ms = params.rest_ms if params.max_stroke_ms else 0.0
     assert after[0].start_ms >= samples[leave].t_ms - told_ms
+
+
+@pytest.mark.parametrize("start_ms", [100.3, 2000.7, 15000.1, 612345.6])
+def test_a_piece_lent_the_floor_by_a_rest_lasts_the_floor_to_the_last_bit(start_ms: float) -> None:
+    """A rest lends a held piece briefer than the sleeve's floor the time it needs: it lasts the
+    floor, never a rounding below it (``start + floor - start`` can be 73.70099999999911 ms, which
+    the sleeve slows to 73.701 and reports ``adjusted``)."""
+    from feelmysign.apparent_motion import shortest_planned_ms
+    from feelmysign.layout import PAPER_SLEEVE
+    from feelmysign.planner import plan
+    from feelmysign.simplify.segment import Segment
+    from feelmysign.simplify.window import Merger, floor_end_ms
+    from feelmysign.stroke import Stroke
+
+    floor_ms = shortest_planned_ms(PAPER_SLEEVE.shortest_burst_ms)
+    merger = Merger(max_error=0.25, min_length=0.05, min_duration_ms=0.0, floor_ms=floor_ms)
+    merger.sample(start_ms, (0.0, 0.0))
+    merger.sample(start_ms + 30.0, (1.0, 0.0))
+    piece = Segment((0.0, 0.0), (1.0, 0.0), start_ms, start_ms + 30.0, start_ms + 30.0)
+    assert merger.take(piece, start_ms + 30.0) == []  # briefer than the floor: held
+    (sent,) = merger.rest(start_ms + 300.0)
+    assert sent.duration_ms >= floor_ms
+    assert sent.end_ms == floor_end_ms(start_ms, floor_ms)
+    assert sent.end_ms <= math.nextafter(start_ms + floor_ms, math.inf)  # the least such end
+    # The sleeve plays it as sent: not slowed, not reported adjusted.
+    stroke = Stroke(start=sent.start, end=sent.end, duration_ms=sent.duration_ms)
+    assert plan(stroke, PAPER_SLEEVE).adjusted is None

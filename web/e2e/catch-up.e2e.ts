@@ -5,7 +5,15 @@
  * card and `up`'s line say how many and how much shorter in all, as the sleeve's `played` events
  * say (their `compressed_ms`). A stall on the way (the broker frozen while the pen draws on) sends
  * a backlog at once: the sleeve skips what it is too late for, and the card and `up` say those
- * skipped as late apart from other refusals, each stroke still counted once.
+ * skipped as late apart from other refusals, each stroke still counted once, and each note in
+ * the card's log says "Stroke N skipped as late: ...".
+ *
+ * The sleeve slows (reports `adjusted`) only a stroke briefer than its floor (73.701 ms, in its
+ * status). The page sends none in the middle of a path: each drawing here is one path, and only
+ * its last stroke may be briefer than the floor, the piece left at release that could not merge
+ * back into the stroke before it (window.ts `Merger.end`). A pen resting mid-path (as the drawing
+ * pauses while the test freezes the broker) lends a held piece the floor: before it lasted
+ * `start + floor - start`, which rounds to 73.70099999999911 ms from 15000.1 ms and was slowed.
  */
 import { spawnSync } from "node:child_process";
 import type { Page } from "playwright-core";
@@ -51,6 +59,18 @@ async function cardData(page: Page): Promise<Card> {
     slowed: read("slowed"),
     late: read("late"),
   };
+}
+
+/**
+ * The strokes the sleeve slowed that are not their path's last (`lastSeq`: each drawing here is
+ * one path, seq 0 on): none, as the page sends no mid-path stroke briefer than the floor.
+ */
+function slowedMidPath(events: readonly Record<string, unknown>[], lastSeq: number): string[] {
+  return events
+    .filter((event) => event["type"] === "adjusted" && event["seq"] !== lastSeq)
+    .map(
+      (event) => `seq ${String(event["seq"])} of 0..${lastSeq}: ${String(event["requested_duration_ms"])} ms`,
+    );
 }
 
 /** Waits until every stroke drawn has a fate on the card. */
@@ -188,6 +208,7 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
         60_000,
       );
       const said = fromEvents(watcher.of(drawing));
+      expect(slowedMidPath(watcher.of(drawing), card.sent - 1)).toEqual([]);
       // The sleeve caught up: most strokes of a drawing sent at once play faster, none skipped.
       expect(said.compressed).toBeGreaterThanOrEqual(card.sent / 2);
       expect(said.late).toBe(0);
@@ -204,7 +225,8 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
         slowed: said.slowed,
         late: 0,
       });
-      // (A stroke briefer than the floor, the tail of a leg, would be slowed: said after a ";".)
+      // (The path's last stroke, briefer than the floor where it could not merge back, is slowed:
+      // said after a ";".)
       const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
       const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
       const summary = await page.locator(SUMMARY).innerText();
@@ -223,6 +245,15 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
     { timeout: 180_000 },
     async () => {
       await page.locator('[data-testid="new-button"]').click();
+      // Every note the card's log adds, also those it no longer shows (it keeps the latest few).
+      await page.evaluate(() => {
+        const notes: string[] = [];
+        (window as unknown as { notes: string[] }).notes = notes;
+        new MutationObserver((changes) => {
+          for (const change of changes)
+            for (const node of change.addedNodes) notes.push(node.textContent ?? "");
+        }).observe(document.querySelector('[data-testid="event-log"]')!, { childList: true });
+      });
       // The broker frozen for 3 s while the pen draws on: what the page sends meanwhile waits on
       // the way, then reaches the sleeve at once, long after it was drawn.
       let broker = 0;
@@ -242,11 +273,14 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
         60_000,
       );
       const said = fromEvents(watcher.of(drawing));
+      // Nothing slowed but the path's last stroke: the rest while the broker froze lends the
+      // stroke before it the floor, to the last bit.
+      expect(slowedMidPath(watcher.of(drawing), card.sent - 1)).toEqual([]);
       expect(said.late).toBeGreaterThan(0);
       expect(card.late).toBe(said.late);
       expect(card.compressed).toBe(said.compressed);
       expect(card.compressedMs).toBe(Math.round(said.compressedMs));
-      expect(card.slowed).toBe(said.slowed); // a stroke briefer than the floor, cut by the stall
+      expect(card.slowed).toBe(said.slowed); // the path's last stroke at most (see above)
       // Each stroke once: the late among the refused, the caught-up among the played.
       expect(card.played + card.cut + card.cancelled + card.refused + card.dropped).toBe(card.sent);
       const summary = await page.locator(SUMMARY).innerText();
@@ -256,6 +290,21 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       else expect(summary).toContain(`${otherwise} refused`);
       if (card.compressed > 0) expect(summary).toContain(`(${card.compressed} faster to catch up, `);
       // The felt timeline's caption says them as the card does: off the timeline.
+      // Each stroke skipped is said so in the card's log (every note, not only those it still
+      // shows), as the summary says it, and none as refused.
+      const notes = await page.evaluate(() => (window as unknown as { notes: string[] }).notes);
+      const skipped = new Set(
+        watcher
+          .of(drawing, "rejected")
+          .filter((e) => e["reason"] === "late")
+          .map((e) => e["seq"] as number),
+      );
+      for (const seq of skipped) {
+        const about = notes.filter((note) => note.startsWith(`Stroke ${seq} `));
+        expect(about.length, `notes of stroke ${seq}`).toBeGreaterThan(0);
+        for (const note of about)
+          expect(note).toMatch(/^Stroke \d+ skipped as late: the stroke would start /);
+      }
       const caption = await page.locator('[data-testid="timeline-caption"]').innerText();
       expect(caption).toContain(`${card.late} skipped as late (not on the timeline)`);
       const line = await upLine(drawing, card.sent);

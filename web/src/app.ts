@@ -121,8 +121,9 @@ export class App {
     this.#compareToggle = byId<HTMLInputElement>(doc, "compare-toggle");
     this.#compareDetail = byId<HTMLInputElement>(doc, "compare-detail");
     this.#session = new DrawingSession(this.#view, {
-      // The simplifier keeps every stroke at or above the sleeve's floor (its status).
-      settings: () => withFloor(this.#settings, this.#sleeve.status?.floor),
+      // The simplifier keeps every stroke at or above the sleeve's floor (its status), the last
+      // one known while the sleeve or the broker is away.
+      settings: () => withFloor(this.#settings, this.#sleeve.floor),
       grid: () => this.#grid(),
       send: (stroke) => this.#send(stroke),
       changed: (drawing) => this.#drawingChanged(drawing),
@@ -221,7 +222,7 @@ export class App {
         config: this.#config,
         sleeveGrid: this.#sleeve.status?.layout ?? null,
         spacingCm: this.#sleeve.status?.layout?.spacing_cm ?? null,
-        floor: this.#sleeve.status?.floor ?? null,
+        floor: this.#sleeve.floor,
         ceiling: this.#wearer.ceiling,
       }),
     );

@@ -472,6 +472,11 @@ export interface Unplayed {
 export const DUPLICATE_REASON = "duplicate";
 /** The safety event of a stroke the duty-cycle cap kept from playing. */
 export const DUTY_CYCLE_REASON = "duty_cycle";
+/**
+ * A stroke the sleeve skipped, too far behind its sender (after a stall): said "skipped as late",
+ * as the card's summary, `up`'s line and `feelmysign send` say it, not as a refusal of the stroke.
+ */
+export const LATE_REASON = "late";
 
 const NOTHING: EventReading = {
   counts: [],
@@ -536,10 +541,11 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
       const shown = ours || ref?.drawing == null;
       // A copy's refusal leaves the stroke where the sleeve put it (played, or refused before).
       const unplayed = ours && event.reason !== DUPLICATE_REASON;
+      const verdict = event.reason === LATE_REASON ? "skipped as late" : "refused";
       return {
         ...NOTHING,
         counts: ours ? ["refused"] : [],
-        notes: shown ? [{ kind: "rejected", text: `${label} refused: ${describe(event)}` }] : [],
+        notes: shown ? [{ kind: "rejected", text: `${label} ${verdict}: ${describe(event)}` }] : [],
         refusedSeq: ours ? event.seq : null,
         unplayed: unplayed ? { seq: event.seq!, why: "refused" } : null,
       };

@@ -6,7 +6,7 @@
  * after connecting before it says that nothing listens. No DOM: the page
  * shows what this says through `SleeveStateHost`.
  */
-import { parseStatus, type SleeveStatus } from "./events";
+import { parseStatus, type SleeveFloor, type SleeveStatus } from "./events";
 import { holdHeadline, NO_CONTROLS, wearerHold } from "./wearer-status";
 import type { BrokerState } from "./mqtt/sender";
 import type { SleeveState } from "./ui/status";
@@ -37,6 +37,8 @@ export interface SleeveStateHost {
 export class SleeveWatch {
   readonly #host: SleeveStateHost;
   #status: SleeveStatus | null = null;
+  /** The sleeve's last known floor: kept while it is offline or out of reach (`floor`). */
+  #floor: SleeveFloor | null = null;
   #state: SleeveState = "unknown";
   #broker: BrokerState = "connecting";
   #timer: ReturnType<typeof setTimeout> | null = null;
@@ -53,6 +55,17 @@ export class SleeveWatch {
   /** The sleeve's last status, or null when none is known. */
   get status(): SleeveStatus | null {
     return this.#status;
+  }
+
+  /**
+   * The sleeve's floor, as its last status that could say it said it: kept while the broker is
+   * out of reach, while the broker holds no status (one restarted without its saved state), and
+   * through an offline status without one (an older sleeve's last will): a sleeve's floor does
+   * not change because it or the network went away. Only its online status (with a floor, or
+   * without: an older sleeve has none) or another sleeve replaces it.
+   */
+  get floor(): SleeveFloor | null {
+    return this.#floor;
   }
 
   get state(): SleeveState {
@@ -104,6 +117,7 @@ export class SleeveWatch {
     }
     const wasOnline = this.#state === "online";
     this.#status = status;
+    if (status.floor !== undefined || status.online) this.#floor = status.floor ?? null;
     this.#setSleeve(
       status.online ? "online" : "offline",
       status.online
@@ -116,6 +130,7 @@ export class SleeveWatch {
   /** Another sleeve is drawn on: nothing is known of it until its status comes. */
   sleeveChanged(): void {
     this.#status = null;
+    this.#floor = null;
     this.#setSleeve("unknown");
   }
 

@@ -101,6 +101,16 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     ]);
   });
 
+  it("says a stroke skipped as late as the card's summary says it, counted among the refused", () => {
+    const message =
+      "the stroke would start 2.10 s after it was due: it arrived 2.05 s later than its drawing's quickest stroke";
+    const late = { ...vector("rejected"), reason: "late", message } as SleeveEvent;
+    const reading = interpretEvent(late, DRAWING);
+    expect(reading.counts).toEqual(["refused"]);
+    expect(reading.unplayed).toEqual({ seq: 3, why: "refused" });
+    expect(reading.notes).toEqual([{ kind: "rejected", text: `Stroke 3 skipped as late: ${message}` }]);
+  });
+
   it("shows a refusal of no drawing in particular, but counts and marks nothing", () => {
     const reading = interpretEvent(vector("rejected-unparsed"), DRAWING);
     expect(reading.counts).toEqual([]);

@@ -170,6 +170,53 @@ describe("the sleeve's state", () => {
   });
 });
 
+describe("the sleeve's floor", () => {
+  const floor = { min_duration_ms: 73.701, min_length: 0.05, wearer: null };
+  const online = (withFloor: boolean) =>
+    JSON.stringify({ online: true, layout: { rows: 3, columns: 4 }, ...(withFloor ? { floor } : {}) });
+
+  it("is kept while the broker is away, while it holds no status, and through an offline status without one", () => {
+    const { target } = host();
+    const watch = new SleeveWatch(target, null);
+    watch.onBroker("connected", null);
+    watch.onStatus(online(true));
+    expect(watch.floor).toEqual(floor);
+    watch.onBroker("offline", "closed");
+    watch.onBroker("connecting", null);
+    expect(watch.floor).toEqual(floor);
+    watch.onBroker("connected", null);
+    watch.onStatus(""); // a broker restarted without its saved state: no status held
+    expect(watch.status).toBeNull();
+    expect(watch.floor).toEqual(floor);
+    watch.onStatus(OFFLINE); // an older sleeve's last will: online false, nothing more
+    expect(watch.state).toBe("offline");
+    expect(watch.floor).toEqual(floor);
+    watch.onStatus("not json");
+    expect(watch.floor).toEqual(floor);
+  });
+
+  it("follows the sleeve's own word: an offline status with one, an online status without", () => {
+    const { target } = host();
+    const watch = new SleeveWatch(target, null);
+    watch.onBroker("connected", null);
+    watch.onStatus(online(true));
+    const raised = { min_duration_ms: 150, min_length: 0.3, wearer: "W1" };
+    watch.onStatus(JSON.stringify({ online: false, floor: raised }));
+    expect(watch.floor).toEqual(raised);
+    watch.onStatus(online(false)); // back as an older sleeve: it has none
+    expect(watch.floor).toBeNull();
+  });
+
+  it("is forgotten when another sleeve is chosen", () => {
+    const { target } = host();
+    const watch = new SleeveWatch(target, null);
+    watch.onBroker("connected", null);
+    watch.onStatus(online(true));
+    watch.sleeveChanged();
+    expect(watch.floor).toBeNull();
+  });
+});
+
 describe("advice for a lost broker", () => {
   it("passes a refused login on as it is", () => {
     const refused = "The broker at ws://x refused the login of 'sender' (bad password).";

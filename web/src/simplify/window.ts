@@ -908,7 +908,7 @@ export class Merger {
     let held = this.#held;
     if (held === null) return;
     if (held.duration_ms < this.#shortMs && nowMs > held.end_ms) {
-      const endMs = Math.min(held.start_ms + this.#shortMs, nowMs);
+      const endMs = Math.min(floorEndMs(held.start_ms, this.#shortMs), nowMs);
       held = { ...held, end_ms: endMs, duration_ms: endMs - held.start_ms };
     }
     if (this.#strict && this.#belowMinimums(held)) {
@@ -1019,6 +1019,28 @@ export class WindowSimplifier {
     this.#merger.end(nowMs, out);
     return out;
   }
+}
+
+/**
+ * The earliest end a piece starting at `startMs` lasts `floorMs` to: `startMs + floorMs`, or the
+ * double above it where that sum rounds down (15000.1 + 73.701 - 15000.1 is 73.70099999999911,
+ * which the sleeve would slow to 73.701 and report `adjusted`). Python `floor_end_ms`.
+ */
+export function floorEndMs(startMs: number, floorMs: number): number {
+  let endMs = startMs + floorMs;
+  while (endMs - startMs < floorMs) endMs = nextUp(endMs);
+  return endMs;
+}
+
+const NEXT_UP = new Float64Array(1);
+const NEXT_UP_BITS = new BigInt64Array(NEXT_UP.buffer);
+
+/** The least double above `value` (finite), as Python's math.nextafter(value, inf). */
+function nextUp(value: number): number {
+  if (value === 0) return Number.MIN_VALUE;
+  NEXT_UP[0] = value;
+  NEXT_UP_BITS[0] = NEXT_UP_BITS[0]! + (value > 0 ? 1n : -1n);
+  return NEXT_UP[0]!;
 }
 
 function squared(dx: number, dy: number): number {

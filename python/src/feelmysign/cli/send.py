@@ -58,7 +58,7 @@ from feelmysign.input_files import loads_json
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
 from feelmysign.outcome import DrawingOutcome, StrokeOutcome
 from feelmysign.plural import plural
-from feelmysign.protocol import Accepted, parse
+from feelmysign.protocol import LATE, Accepted, parse
 from feelmysign.sending import (
     STATUS_WAIT_S,
     OutgoingStroke,
@@ -392,6 +392,8 @@ def _answer_line(
     where = f"[{seq + 1:>{width}}/{total}]"
     if stroke.cut_reason is not None:
         return f"{where} cut part-way ({stroke.cut_reason}): {getattr(event, 'message', '')}"
+    if stroke.refused_reason == LATE:  # said as the summary, up's line and the page say it
+        return f"{where} skipped as late: {stroke.refused_message or ''}".rstrip()
     if stroke.refused_reason is not None:
         return f"{where} refused ({stroke.refused_reason}): {stroke.refused_message or ''}".rstrip()
     played = stroke.played

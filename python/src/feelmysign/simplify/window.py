@@ -780,13 +780,14 @@ class Merger:
         now rather than merged with what comes after the rest, which would play the rest.
 
         If it is briefer than the sleeve's floor, it takes the time it needs from the rest: the
-        pen was at its end then. With strict minimums, a piece still below them waits."""
+        pen was at its end then (``floor_end_ms``). With strict minimums, a piece still below
+        them waits."""
         held = self._held
         if held is None:
             return []
         short_ms = max(self.min_duration_ms, self.floor_ms)
         if held.duration_ms < short_ms and now_ms > held.end_ms:
-            held = replace(held, end_ms=min(held.start_ms + short_ms, now_ms))
+            held = replace(held, end_ms=min(floor_end_ms(held.start_ms, short_ms), now_ms))
         if self.strict and self._below_minimums(held):
             self._held = held
             return []
@@ -900,6 +901,16 @@ class WindowSimplifier:
             out.extend(self._merger.take(piece, now_ms))
         out.extend(self._merger.end(now_ms))
         return out
+
+
+def floor_end_ms(start_ms: float, floor_ms: float) -> float:
+    """The earliest end a piece starting at ``start_ms`` lasts ``floor_ms`` to: ``start_ms +
+    floor_ms``, or the double above it where that sum rounds down (15000.1 + 73.701 - 15000.1 is
+    73.70099999999911, which the sleeve would slow to 73.701 and report ``adjusted``)."""
+    end_ms = start_ms + floor_ms
+    while end_ms - start_ms < floor_ms:
+        end_ms = math.nextafter(end_ms, math.inf)
+    return end_ms
 
 
 def rest_radius(params: WindowParams) -> float:

@@ -900,6 +900,17 @@ final class Merger {
     return send(piece, nowMs, result);
   }
 
+  /** The earliest end a piece starting at startMs lasts floorMs to: startMs + floorMs, or the
+   * double above it where that sum rounds down (15000.1 + 73.701 - 15000.1 is 73.70099999999911,
+   * which the sleeve would slow to 73.701 and report adjusted). Python floor_end_ms. */
+  static double floorEndMs(double startMs, double floorMs) {
+    double endMs = startMs + floorMs;
+    while (endMs - startMs < floorMs) {
+      endMs = Math.nextUp(endMs);
+    }
+    return endMs;
+  }
+
   /** The pen rests (since the held piece's end, until nowMs): the held piece is sent now rather
    * than merged with what comes after the rest, which would play the rest. If it is briefer than
    * the sleeve's floor, it takes the time it needs from the rest: the pen was at its end then.
@@ -917,7 +928,7 @@ final class Merger {
               piece.endX(),
               piece.endY(),
               piece.startMs(),
-              Math.min(piece.startMs() + shortMs, nowMs),
+              Math.min(floorEndMs(piece.startMs(), shortMs), nowMs),
               piece.emittedAtMs(),
               piece.dropped(),
               piece.merged());
