@@ -8,7 +8,7 @@ import { CANCEL_ALL } from "./control";
 import type { ServerConfig } from "./config";
 import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
-import { EventCopies, interpretEvent, parseEvent, parseStatus } from "./events";
+import { EventCopies, interpretEvent, parseEvent, parseStatus, strokeLabel } from "./events";
 import { StrokeSender, type BrokerState } from "./mqtt/sender";
 import type { Stroke } from "./protocol";
 import { buildRecording, recordingFileName } from "./recording";
@@ -505,7 +505,7 @@ export class App {
     if (feltCopy) {
       this.#says.add(
         "info",
-        `Stroke ${seq} came again (a reconnect) and was not played twice: it was felt once.`,
+        `${strokeLabel(seq)} came again (a reconnect) and was not played twice: it was felt once.`,
       );
       return;
     }
@@ -513,8 +513,7 @@ export class App {
       // The status came after the stroke left: said as the wearer's pause, not a generic refusal.
       // Shown as the generic refusal would be: for this drawing, or for no drawing in particular.
       if (ours || event.drawing == null) {
-        const label = seq === null ? "A stroke" : `Stroke ${seq}`;
-        this.#says.add("rejected", wearerRefusalNote(label, event.reason, event.message));
+        this.#says.add("rejected", wearerRefusalNote(strokeLabel(seq), event.reason, event.message));
       }
       return;
     }
