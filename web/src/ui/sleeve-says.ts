@@ -120,6 +120,11 @@ export class SleeveSays {
     return this.#fates.fate(seq);
   }
 
+  /** Why stroke `seq` was refused (or who cut it): fates.ts; null when neither. */
+  reasonOf(seq: number): string | null {
+    return this.#fates.reason(seq);
+  }
+
   /** A played stroke held on the way for `delayMs`. */
   delayed(delayMs: number): void {
     this.#delayed++;
