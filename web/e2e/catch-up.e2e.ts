@@ -99,6 +99,19 @@ function fromEvents(events: readonly Record<string, unknown>[]): {
   return { compressed, compressedMs, slowed, late: late.size };
 }
 
+/** The span the sleeve played a drawing's strokes over, by its own times: first start to last end. */
+function spanOf(events: readonly Record<string, unknown>[]): number {
+  let first = Infinity;
+  let last = -Infinity;
+  for (const event of events) {
+    if (event["type"] !== "played" && event["type"] !== "adjusted") continue;
+    const start = event["start_at_ms"] as number;
+    first = Math.min(first, start);
+    last = Math.max(last, start + (event["duration_ms"] as number));
+  }
+  return last - first;
+}
+
 describe("the sender is told how the sleeve caught up with a drawing", () => {
   const processes = new Processes();
   let up: Up;
@@ -206,10 +219,22 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       });
       // (A stroke briefer than the floor, the tail of a leg, would be slowed: said after a ";".)
       const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
-      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
+      // No pen to catch up with: the card says the strokes were played back to back, over the span
+      // the sleeve's own times give, and how much shorter than the drawing took to draw.
+      const spanMs = spanOf(watcher.of(drawing));
+      const drawnMs = Number(await page.locator(SUMMARY).getAttribute("data-drawn-ms"));
+      expect(drawnMs).toBeGreaterThan(spanMs);
       const summary = await page.locator(SUMMARY).innerText();
-      expect(summary).toBe(`${card.sent} of ${card.sent} strokes played (${words}).`);
-      // up's line says the same of the drawing.
+      expect(summary).toBe(
+        `${card.sent} of ${card.sent} strokes played (back to back in ${durationWords(spanMs)}, ` +
+          `${durationWords(drawnMs - spanMs)} shorter than drawn: the pauses left out and ` +
+          `${said.compressed} strokes played faster${slowed}).`,
+      );
+      await expect(page.locator('[data-testid="event-log"]').innerText()).resolves.toContain(
+        `Played again: ${card.sent} strokes sent all at once.`,
+      );
+      // up's line says the sleeve's catch-up in its own words.
+      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
       const line = await upLine(drawing, card.sent);
       expect(line).toContain(`: ${card.sent} strokes played (${words})`);
       console.log(`card: ${summary}\nup: ${line.trim()}`);

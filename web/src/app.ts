@@ -303,6 +303,11 @@ export class App {
     this.#session.adopt(copy);
     for (const stroke of copy.strokes) this.#send(stroke);
     this.#says.setSent(copy.strokeCount);
+    // No pen to catch up with: the sleeve plays what it has in hand back to back, the pauses
+    // between strokes left out, and the card says so (sleeve-says.ts).
+    const drawn = drawnMs(copy);
+    this.#says.replayed(drawn);
+    this.#says.add("info", playAgainNote(copy.strokes.length, this.#felt.totalMs, drawn));
   }
 
   /** A saved recording back on the canvas: what would be felt, ready for Play again. */
@@ -326,6 +331,7 @@ export class App {
     // own pace, so the time it predicts is the time Play again keeps.
     this.#arrival = "at-once";
     this.#session.adopt(drawing);
+    this.#says.notSent(drawing.strokeCount, "loaded");
     this.#says.add(
       "info",
       `Loaded ${name}: ${drawing.strokes.length} strokes, not sent. Play again sends them all at once; ` +
@@ -435,6 +441,7 @@ export class App {
       const again = this.#session.recut();
       if (again === null) this.#arrival = "as-drawn";
       else {
+        this.#says.notSent(again.strokeCount, "re-simplified");
         this.#says.add(
           "info",
           `Re-simplified with the new settings: ${again.strokes.length} strokes, not sent. Play again sends them.`,
@@ -658,6 +665,19 @@ export class App {
   get drawingId(): string | null {
     return this.#session.drawing?.id ?? null;
   }
+}
+
+/**
+ * The note Play again leaves: `strokes` sent all at once, which the sleeve plays back to back, in
+ * `playsMs` (the timeline's prediction) where the drawing took `drawnMs`.
+ */
+export function playAgainNote(strokes: number, playsMs: number, drawnMs: number): string {
+  const s = (ms: number) => (ms / 1000).toFixed(1);
+  return (
+    `Played again: ${strokes} strokes sent all at once. With no pen to keep pace with, the sleeve ` +
+    `plays them back to back and caught up, the pauses between strokes left out; the timeline shows ` +
+    `them so (${s(playsMs)} s, where the drawing took ${s(drawnMs)} s).`
+  );
 }
 
 /** How long the drawing took to draw: its first sample to its last, pen lifts included. */
