@@ -185,6 +185,7 @@ describe("drawing with a mouse on a desktop", () => {
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
       "1 delayed on the way (last by 1.5 s)",
     );
+    await screenshot(page, "desktop-notes-numbered-from-1");
   });
 
   it("downloads a recording that feelmysign simplify reads, with the same ends", async () => {
