@@ -185,7 +185,10 @@ describe("drawing with a mouse on a desktop", () => {
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
       "1 delayed on the way (last by 1.5 s)",
     );
-    await screenshot(page, "desktop-notes-numbered-from-1");
+    const full = await screenshot(page, "desktop-notes-numbered-from-1");
+    await page
+      .locator('section.card:has([data-testid="played-summary"])')
+      .screenshot({ path: full.replace(/\.png$/, "-card.png") });
   });
 
   it("downloads a recording that feelmysign simplify reads, with the same ends", async () => {
