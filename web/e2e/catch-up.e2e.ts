@@ -119,6 +119,19 @@ function fromEvents(events: readonly Record<string, unknown>[]): {
   return { compressed, compressedMs, slowed, late: late.size };
 }
 
+/** The span the sleeve played a drawing's strokes over, by its own times: first start to last end. */
+function spanOf(events: readonly Record<string, unknown>[]): number {
+  let first = Infinity;
+  let last = -Infinity;
+  for (const event of events) {
+    if (event["type"] !== "played" && event["type"] !== "adjusted") continue;
+    const start = event["start_at_ms"] as number;
+    first = Math.min(first, start);
+    last = Math.max(last, start + (event["duration_ms"] as number));
+  }
+  return last - first;
+}
+
 describe("the sender is told how the sleeve caught up with a drawing", () => {
   const processes = new Processes();
   let up: Up;
@@ -228,10 +241,22 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       // (The path's last stroke, briefer than the floor where it could not merge back, is slowed:
       // said after a ";".)
       const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
-      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
+      // No pen to catch up with: the card says the strokes were played back to back, over the span
+      // the sleeve's own times give, and how much shorter than the drawing took to draw.
+      const spanMs = spanOf(watcher.of(drawing));
+      const drawnMs = Number(await page.locator(SUMMARY).getAttribute("data-drawn-ms"));
+      expect(drawnMs).toBeGreaterThan(spanMs);
       const summary = await page.locator(SUMMARY).innerText();
-      expect(summary).toBe(`${card.sent} of ${card.sent} strokes played (${words}).`);
-      // up's line says the same of the drawing.
+      expect(summary).toBe(
+        `${card.sent} of ${card.sent} strokes played (back to back in ${durationWords(spanMs)}, ` +
+          `${durationWords(drawnMs - spanMs)} shorter than drawn: the pauses left out and ` +
+          `${said.compressed} strokes played faster${slowed}).`,
+      );
+      await expect(page.locator('[data-testid="event-log"]').innerText()).resolves.toContain(
+        `Played again: ${card.sent} strokes sent all at once.`,
+      );
+      // up's line says the sleeve's catch-up in its own words.
+      const words = `${said.compressed} faster to catch up, ${durationWords(said.compressedMs)} shorter in all${slowed}`;
       const line = await upLine(drawing, card.sent);
       expect(line).toContain(`: ${card.sent} strokes played (${words})`);
       console.log(`card: ${summary}\nup: ${line.trim()}`);
@@ -300,7 +325,8 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
           .map((e) => e["seq"] as number),
       );
       for (const seq of skipped) {
-        const about = notes.filter((note) => note.startsWith(`Stroke ${seq} `));
+        // The card names strokes from 1: seq 0 is "Stroke 1".
+        const about = notes.filter((note) => note.startsWith(`Stroke ${seq + 1} `));
         expect(about.length, `notes of stroke ${seq}`).toBeGreaterThan(0);
         for (const note of about)
           expect(note).toMatch(/^Stroke \d+ skipped as late: the stroke would start /);

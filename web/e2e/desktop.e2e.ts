@@ -137,7 +137,7 @@ describe("drawing with a mouse on a desktop", () => {
     });
     await waitForData(page, '[data-testid="played-summary"]', "played", "3");
     const log = page.locator('[data-testid="event-log"] li').first();
-    await expect(log.innerText()).resolves.toContain("Stroke 2 refused: duration_ms is 12000");
+    await expect(log.innerText()).resolves.toContain("Stroke 3 refused: duration_ms is 12000");
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toBe(
       `3 of ${sentCount} strokes played, 1 refused.`,
     );
@@ -178,13 +178,17 @@ describe("drawing with a mouse on a desktop", () => {
     await waitForData(page, '[data-testid="played-summary"]', "refused", "0");
     await waitForData(page, '[data-testid="played-summary"]', "delayed", "1");
     const log = await page.locator('[data-testid="event-log"]').innerText();
-    expect(log).toContain("Stroke 1 played in 600 ms instead of 417 ms (min duration).");
-    expect(log).toContain("Stroke 2 delayed 1.5 s on the way");
-    expect(log).not.toContain("Stroke 0 played in");
-    expect(log).not.toContain("Stroke 3 played");
+    expect(log).toContain("Stroke 2 played in 600 ms instead of 417 ms (min duration).");
+    expect(log).toContain("Stroke 3 delayed 1.5 s on the way");
+    expect(log).not.toContain("Stroke 1 played in");
+    expect(log).not.toContain("Stroke 4 played");
     await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toContain(
       "1 delayed on the way (last by 1.5 s)",
     );
+    const full = await screenshot(page, "desktop-notes-numbered-from-1");
+    await page
+      .locator('section.card:has([data-testid="played-summary"])')
+      .screenshot({ path: full.replace(/\.png$/, "-card.png") });
   });
 
   it("downloads a recording that feelmysign simplify reads, with the same ends", async () => {

@@ -241,7 +241,7 @@ describe("the drawing area's marks", () => {
     expect(await page.locator(timeline).getAttribute("data-strokes")).toBe(String(strokes - 1));
     expect(Math.abs((await totalMs()) - after)).toBeLessThanOrEqual(1);
     await expect(page.locator('[data-testid="event-log"] li').first().innerText()).resolves.toContain(
-      "Stroke 1 refused by the duty-cycle cap",
+      "Stroke 2 refused by the duty-cycle cap",
     );
     await expect(page.locator('[data-testid="timeline-caption"]').innerText()).resolves.toContain(
       "1 not felt (the sleeve's duty-cycle cap kept it from playing)",

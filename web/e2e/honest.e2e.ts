@@ -330,7 +330,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
       const duplicate = copy.find((e) => e["drawing"] === drawing && e["reason"] === "duplicate")!;
       expect(duplicate["original_played"]).toBe(true);
       // The page hears the refusal after the watcher does: its note is waited for, then read.
-      const cameAgain = `Stroke ${playedSeq} came again`;
+      const cameAgain = `Stroke ${playedSeq + 1} came again`;
       await page
         .waitForFunction(
           (text) => document.querySelector('[data-testid="event-log"]')?.textContent?.includes(text) === true,
@@ -346,7 +346,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
       expectHeldStrokesKeepTheirDrawnTime(watcher.of(drawing));
       const log = await page.locator('[data-testid="event-log"]').innerText();
       expect(log).toContain(cameAgain);
-      expect(log).not.toContain(`Stroke ${playedSeq} refused`);
+      expect(log).not.toContain(`Stroke ${playedSeq + 1} refused`);
       // The copy counted nothing: the stroke it copies is played, once (checked against up, the
       // study and the record above); refusals are only those of other strokes (late, after the outage).
       expect(fatesOf(watcher.of(drawing)).fate(playedSeq)).toBe("played");

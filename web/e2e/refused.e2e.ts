@@ -68,7 +68,7 @@ describe("a stroke the sleeve refuses", () => {
     // The refused strokes are not on the timeline: the others are.
     await waitForData(page, TIMELINE, "strokes", String(sent - refused.length));
     const log = await page.locator('[data-testid="event-log"]').innerText();
-    for (const event of refused) expect(log).toContain(`Stroke ${event["seq"]} refused`);
+    for (const event of refused) expect(log).toContain(`Stroke ${(event["seq"] as number) + 1} refused`);
     await screenshot(page, "refused-by-the-sleeve");
   });
 });

@@ -123,7 +123,9 @@ describe("the sender sees the wearer's choice", () => {
     });
     await waitForData(page, SUMMARY, "wearerRefused", "1");
     const log = await page.locator('[data-testid="event-log"]').innerText();
-    expect(log).toContain(`Stroke ${stroke!["seq"]} not played: the wearer paused the sleeve.`);
+    expect(log).toContain(
+      `Stroke ${(stroke!["seq"] as number) + 1} not played: the wearer paused the sleeve.`,
+    );
     expect(await page.locator(SUMMARY).innerText()).toContain("refused (the wearer paused)");
   });
 

@@ -8,7 +8,7 @@ import { CANCEL_ALL } from "./control";
 import type { ServerConfig } from "./config";
 import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
-import { EventCopies, interpretEvent, parseEvent, parseStatus } from "./events";
+import { EventCopies, interpretEvent, parseEvent, parseStatus, strokeLabel } from "./events";
 import { StrokeSender, type BrokerState } from "./mqtt/sender";
 import type { Stroke } from "./protocol";
 import { buildRecording, recordingFileName } from "./recording";
@@ -304,6 +304,11 @@ export class App {
     this.#session.adopt(copy);
     for (const stroke of copy.strokes) this.#send(stroke);
     this.#says.setSent(copy.strokeCount);
+    // No pen to catch up with: the sleeve plays what it has in hand back to back, the pauses
+    // between strokes left out, and the card says so (sleeve-says.ts).
+    const drawn = drawnMs(copy);
+    this.#says.replayed(drawn);
+    this.#says.add("info", playAgainNote(copy.strokes.length, this.#felt.totalMs, drawn));
   }
 
   /** A saved recording back on the canvas: what would be felt, ready for Play again. */
@@ -327,6 +332,7 @@ export class App {
     // own pace, so the time it predicts is the time Play again keeps.
     this.#arrival = "at-once";
     this.#session.adopt(drawing);
+    this.#says.notSent(drawing.strokeCount, "loaded");
     this.#says.add(
       "info",
       `Loaded ${name}: ${drawing.strokes.length} strokes, not sent. Play again sends them all at once; ` +
@@ -436,6 +442,7 @@ export class App {
       const again = this.#session.recut();
       if (again === null) this.#arrival = "as-drawn";
       else {
+        this.#says.notSent(again.strokeCount, "re-simplified");
         this.#says.add(
           "info",
           `Re-simplified with the new settings: ${again.strokes.length} strokes, not sent. Play again sends them.`,
@@ -506,7 +513,7 @@ export class App {
     if (feltCopy) {
       this.#says.add(
         "info",
-        `Stroke ${seq} came again (a reconnect) and was not played twice: it was felt once.`,
+        `${strokeLabel(seq)} came again (a reconnect) and was not played twice: it was felt once.`,
       );
       return;
     }
@@ -514,8 +521,7 @@ export class App {
       // The status came after the stroke left: said as the wearer's pause, not a generic refusal.
       // Shown as the generic refusal would be: for this drawing, or for no drawing in particular.
       if (ours || event.drawing == null) {
-        const label = seq === null ? "A stroke" : `Stroke ${seq}`;
-        this.#says.add("rejected", wearerRefusalNote(label, event.reason, event.message));
+        this.#says.add("rejected", wearerRefusalNote(strokeLabel(seq), event.reason, event.message));
       }
       return;
     }
@@ -660,6 +666,19 @@ export class App {
   get drawingId(): string | null {
     return this.#session.drawing?.id ?? null;
   }
+}
+
+/**
+ * The note Play again leaves: `strokes` sent all at once, which the sleeve plays back to back, in
+ * `playsMs` (the timeline's prediction) where the drawing took `drawnMs`.
+ */
+export function playAgainNote(strokes: number, playsMs: number, drawnMs: number): string {
+  const s = (ms: number) => (ms / 1000).toFixed(1);
+  return (
+    `Played again: ${strokes} strokes sent all at once. With no pen to keep pace with, the sleeve ` +
+    `plays them back to back and caught up, the pauses between strokes left out; the timeline shows ` +
+    `them so (${s(playsMs)} s, where the drawing took ${s(drawnMs)} s).`
+  );
 }
 
 /** How long the drawing took to draw: its first sample to its last, pen lifts included. */

@@ -38,6 +38,8 @@ export class Drawing {
   /** Strokes kept on the page, not sent, while the wearer paused the sleeve (or asked not to be disturbed). */
   readonly #held = new Set<number>();
   #nextSeq = 0;
+  /** Seqs of the strokes of undone paths (they keep their seq: the sleeve may have them). */
+  readonly #undone: number[] = [];
   /** Segments kept as strokes (not dropped) in the paths still in the drawing. */
   #kept = 0;
 
@@ -138,6 +140,21 @@ export class Drawing {
     return drawn.stroke?.seq != null && this.#refused.has(drawn.stroke.seq);
   }
 
+  /**
+   * Whether stroke `seq` never left this page, and how: dropped before it was sent (counted as
+   * never sent), or held (the wearer paused) when its path was taken back; null: it was sent (or
+   * is still to be). Kept for the strokes of undone paths too.
+   */
+  unsent(seq: number): "dropped" | "held" | null {
+    if (this.#refused.get(seq) === "unsent") return "dropped";
+    return this.#held.has(seq) ? "held" : null;
+  }
+
+  /** The seqs of the strokes of paths taken back with Undo, in order: numbered, no longer drawn. */
+  get undoneSeqs(): readonly number[] {
+    return this.#undone;
+  }
+
   /** Why stroke `drawn` was not felt; null when it was (or may yet be). */
   unfelt(drawn: DrawnSegment): Unfelt | null {
     return drawn.stroke?.seq == null ? null : (this.#refused.get(drawn.stroke.seq) ?? null);
@@ -170,7 +187,10 @@ export class Drawing {
     this.pointerKinds.pop();
     while (this.segments.length > 0 && this.segments[this.segments.length - 1]!.path === path) {
       const drawn = this.segments.pop()!;
-      if (drawn.stroke?.seq != null) this.#bySeq.delete(drawn.stroke.seq);
+      if (drawn.stroke?.seq != null) {
+        this.#bySeq.delete(drawn.stroke.seq);
+        this.#undone.push(drawn.stroke.seq);
+      }
       if (drawn.stroke !== null) this.#kept--;
     }
     return true;

@@ -508,7 +508,7 @@ export function isDelayed(event: PlayedEvent | AdjustedEvent, thresholdMs = DELA
 export function interpretEvent(event: SleeveEvent, drawingId: string | null): EventReading {
   const ref = "seq" in event ? event : null;
   const ours = drawingId !== null && ref !== null && ref.drawing === drawingId && ref.seq !== null;
-  const label = ref === null || ref.seq === null ? "A stroke" : `Stroke ${ref.seq}`;
+  const label = strokeLabel(ref?.seq ?? null);
   switch (event.type) {
     case "played":
     case "adjusted": {
@@ -594,6 +594,15 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
 function describe(event: SleeveEvent): string {
   const message = "message" in event ? event.message : null;
   return message ?? ("reason" in event ? event.reason.replaceAll("_", " ") : "no reason given");
+}
+
+/**
+ * A stroke as the page's notes name it: "Stroke 1" for the first stroke of a drawing. The seq on
+ * the wire counts from 0 (docs/protocol.md); the sender counts strokes from 1, so a note names
+ * `seq + 1`, and every note of the page says it the same way.
+ */
+export function strokeLabel(seq: number | null): string {
+  return seq === null ? "A stroke" : `Stroke ${seq + 1}`;
 }
 
 /** A duration as a person reads it: "420 ms", "1.5 s". */

@@ -174,6 +174,11 @@ export class DrawingFates {
     return this.#bySeq.get(seq)?.fate ?? null;
   }
 
+  /** Why stroke `seq` was refused, or who or what cut it ("wearer", a safety reason); null: neither. */
+  reason(seq: number): string | null {
+    return this.#bySeq.get(seq)?.reason ?? null;
+  }
+
   fates(): Map<number, Fate> {
     return new Map([...this.#bySeq.entries()].sort(([a], [b]) => a - b).map(([seq, v]) => [seq, v.fate]));
   }

@@ -6,6 +6,7 @@ import {
   interpretEvent,
   parseEvent,
   seconds,
+  strokeLabel,
   type PlayedEvent,
   type SleeveEvent,
 } from "../src/events";
@@ -64,7 +65,7 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     const reading = interpretEvent(vector("adjusted"), DRAWING);
     expect(reading.counts).toEqual(["played"]);
     expect(reading.notes).toEqual([
-      { kind: "adjusted", text: "Stroke 3 played in 418 ms instead of 120 ms (too fast)." },
+      { kind: "adjusted", text: "Stroke 4 played in 418 ms instead of 120 ms (too fast)." },
     ]);
   });
 
@@ -82,7 +83,7 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     expect(delayed.counts).toEqual(["played", "delayed"]);
     expect(delayed.delayMs).toBeCloseTo(1500, 6);
     expect(delayed.notes.map((note) => note.text)).toEqual([
-      "Stroke 3 delayed 1.5 s on the way (held while the broker was out of reach, at the broker, or by the network).",
+      "Stroke 4 delayed 1.5 s on the way (held while the broker was out of reach, at the broker, or by the network).",
     ]);
     const queued = interpretEvent({ ...played, sent_at_ms: sentAtMs, queued_ms: 1500 }, DRAWING);
     expect(queued.counts).toEqual(["played"]);
@@ -97,7 +98,7 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     expect(reading.refusedSeq).toBe(3);
     expect(reading.unplayed).toEqual({ seq: 3, why: "refused" });
     expect(reading.notes).toEqual([
-      { kind: "rejected", text: "Stroke 3 refused: start (4, 0) is outside the grid" },
+      { kind: "rejected", text: "Stroke 4 refused: start (4, 0) is outside the grid" },
     ]);
   });
 
@@ -108,7 +109,7 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     const reading = interpretEvent(late, DRAWING);
     expect(reading.counts).toEqual(["refused"]);
     expect(reading.unplayed).toEqual({ seq: 3, why: "refused" });
-    expect(reading.notes).toEqual([{ kind: "rejected", text: `Stroke 3 skipped as late: ${message}` }]);
+    expect(reading.notes).toEqual([{ kind: "rejected", text: `Stroke 4 skipped as late: ${message}` }]);
   });
 
   it("shows a refusal of no drawing in particular, but counts and marks nothing", () => {
@@ -133,7 +134,7 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
       notes: [
         {
           kind: "rejected",
-          text: "Stroke 3 refused by the duty-cycle cap: not played: the motor would have been driven 52% of the last 60 s",
+          text: "Stroke 4 refused by the duty-cycle cap: not played: the motor would have been driven 52% of the last 60 s",
         },
       ],
     });
@@ -156,10 +157,10 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     const cut = interpretEvent(vector("cancelled-playing"), DRAWING);
     expect(cut.counts).toEqual(["cancelled", "cut"]);
     expect(cut.cancelled).toBe(vector("cancelled-playing"));
-    expect(cut.notes).toEqual([{ kind: "info", text: "Stroke 3 cancelled while playing." }]);
+    expect(cut.notes).toEqual([{ kind: "info", text: "Stroke 4 cancelled while playing." }]);
     const queued = interpretEvent(vector("cancelled-queued"), DRAWING);
     expect(queued.counts).toEqual(["cancelled"]);
-    expect(queued.notes).toEqual([{ kind: "info", text: "Stroke 3 cancelled before it played." }]);
+    expect(queued.notes).toEqual([{ kind: "info", text: "Stroke 4 cancelled before it played." }]);
   });
 
   it("reports safety and errors whatever the drawing", () => {
@@ -185,5 +186,23 @@ describe("durations as read", () => {
     [1549, "1.5 s"],
   ])("%d ms reads %s", (ms, text) => {
     expect(seconds(ms)).toBe(text);
+  });
+});
+
+describe.skipIf(!present)("strokeLabel", () => {
+  it("names strokes from 1, as the sender counts them: seq 0 on the wire is the first", () => {
+    expect(strokeLabel(0)).toBe("Stroke 1");
+    expect(strokeLabel(75)).toBe("Stroke 76");
+    expect(strokeLabel(null)).toBe("A stroke");
+  });
+
+  it("every note about a stroke names it the same way", () => {
+    for (const name of ["adjusted", "cancelled-playing", "cancelled-queued"] as const) {
+      const event = vector(name);
+      const seq = "seq" in event ? event.seq : null;
+      const reading = interpretEvent(event, DRAWING);
+      expect(seq).not.toBeNull();
+      for (const note of reading.notes) expect(note.text.startsWith(`${strokeLabel(seq)} `)).toBe(true);
+    }
   });
 });

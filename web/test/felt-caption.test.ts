@@ -274,3 +274,76 @@ describe("the felt panel with strokes held while the wearer paused", () => {
     );
   });
 });
+
+describe("the felt panel's caption after Undo", () => {
+  beforeAll(() => vi.stubGlobal("requestAnimationFrame", () => 0));
+
+  /** Two paths, `first` and `second` strokes of 200 ms, the panel told by the card's fates. */
+  function twoPaths(first: number, second: number) {
+    const drawing = new Drawing(DRAWING, {
+      ...DEFAULT_ANGLE_PARAMS,
+      canvas_width_px: 400,
+      canvas_height_px: 300,
+    });
+    let t = 0;
+    for (const strokes of [first, second]) {
+      drawing.beginPath("mouse");
+      for (let i = 0; i < strokes; i++, t += 200) {
+        const segment = { start: [i % 2, 0], end: [(i + 1) % 2, 1], start_ms: t, end_ms: t + 200 } as const;
+        drawing.addSegment({ ...segment, duration_ms: 200, emitted_at_ms: t + 200, dropped: null }, 0.8);
+      }
+    }
+    const fates = new DrawingFates();
+    const shown = { caption: "", onTimeline: 0 };
+    const timeline = {
+      show: (_grid: unknown, a: { placed: readonly PlacedStroke[] }) => (shown.onTimeline = a.placed.length),
+      setCaption: (text: string) => (shown.caption = text),
+      setCursor: () => undefined,
+    } as unknown as TimelineView;
+    const view = { setCompare: () => undefined, drawMarker: () => undefined } as unknown as DrawingView;
+    // As the card counts: every stroke the drawing numbered, undone ones too (Drawing.strokeCount).
+    const told: TallySource = {
+      get counts() {
+        return { sent: drawing.strokeCount, ...fates.counts(), dropped: 0 };
+      },
+      fateOf: (seq) => fates.fate(seq),
+      reasonOf: (seq) => fates.reason(seq),
+    };
+    const panel = new FeltPanel(timeline, view, told);
+    panel.setDrawing(drawing, { rows: 3, columns: 4 });
+    const hear = (event: SleeveEvent) => {
+      fates.add(event);
+      if (event.type === "played" || event.type === "adjusted") panel.played(event);
+      else panel.told("seq" in event ? event.seq : null);
+    };
+    const undo = () => {
+      drawing.removeLastPath();
+      panel.refresh();
+    };
+    return { shown, hear, undo };
+  }
+
+  it("counts only the drawing as it stands, and never says the reports of undone strokes are missing", () => {
+    const { shown, hear, undo } = twoPaths(9, 8);
+    for (let seq = 0; seq < 17; seq++) hear(played(seq, 1000 + seq * 200));
+    expect(shown.caption).toMatch(/^17 strokes, [\d.]+ s, as the sleeve played them\.$/);
+    undo();
+    expect(shown.onTimeline).toBe(9);
+    expect(shown.caption).not.toContain("never came");
+    expect(shown.caption).toMatch(
+      /^9 strokes, [\d.]+ s, as the sleeve played them\. Not counted: 8 strokes taken back with Undo \(8 played\)\.$/,
+    );
+  });
+
+  it("says what became of undone strokes the sleeve has not answered yet, or refused", () => {
+    const { shown, hear, undo } = twoPaths(2, 3);
+    hear(played(0, 1000));
+    hear(played(1, 1200));
+    hear(played(2, 1400));
+    hear(wire("rejected", 3, { reason: "late", message: "too late", received_at_ms: 0 }));
+    undo();
+    expect(shown.caption).toMatch(
+      /^2 strokes, [\d.]+ s, as the sleeve played them\. Not counted: 3 strokes taken back with Undo \(1 played, 1 skipped as late, 1 not answered yet\)\.$/,
+    );
+  });
+});

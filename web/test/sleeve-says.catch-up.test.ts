@@ -132,3 +132,72 @@ describe("the card says how the sleeve caught up", () => {
     expect(summary.dataset).toMatchObject({ compressed: "0", slowed: "0", late: "0" });
   });
 });
+
+describe("the card for a drawing not sent, or sent all at once by Play again", () => {
+  /** Stroke `seq` played by the sleeve at `startMs` after the first, for `durationMs`, `shorterMs` faster. */
+  const playedAt = (seq: number, startMs: number, durationMs: number, shorterMs = 0): SleeveEvent =>
+    played(seq, {
+      start_at_ms: AT_MS + startMs,
+      first_command_at_ms: AT_MS + startMs + 0.25,
+      duration_ms: durationMs,
+      ...(shorterMs > 0 ? { queued_ms: startMs, compressed_ms: shorterMs } : {}),
+    });
+
+  it("says a loaded drawing is not sent yet and Play again sends it, not that none was played", () => {
+    const { says, summary } = card();
+    says.setSent(52);
+    says.notSent(52, "loaded");
+    expect(summary.textContent).toBe("52 strokes loaded, not sent yet: Play again sends them.");
+    expect(summary.textContent).not.toContain("0 of");
+    expect(summary.dataset).toMatchObject({ sent: "52", notSent: "52", played: "0" });
+    says.notSent(1, "re-simplified");
+    says.setSent(1);
+    expect(summary.textContent).toBe("1 stroke re-simplified, not sent yet: Play again sends them.");
+  });
+
+  it("counts strokes drawn on after a load as sent, and the loaded ones apart", () => {
+    const { says, summary } = card();
+    says.setSent(5);
+    says.notSent(3, "loaded");
+    says.fate(playedAt(3, 0, 400));
+    expect(summary.textContent).toBe(
+      "1 of 2 strokes played, 3 strokes loaded, not sent yet: Play again sends them.",
+    );
+  });
+
+  it("says a drawing played again was played back to back, and how much shorter than drawn", () => {
+    const { says, summary } = card();
+    says.setSent(4);
+    says.replayed(13_600);
+    // Back to back from the first start: 1000 + 1000 + 1000 + 1000 ms, three of them played faster.
+    says.fate(playedAt(0, 0, 1000));
+    says.fate(playedAt(1, 1000, 1000, 500));
+    expect(summary.textContent).toBe("2 of 4 strokes played (back to back).");
+    says.fate(playedAt(2, 2000, 1000, 400));
+    says.fate(playedAt(3, 3000, 1000, 600));
+    expect(summary.textContent).toBe(
+      "4 of 4 strokes played (back to back in 4.0 s, 9.6 s shorter than drawn: the pauses left out " +
+        "and 3 strokes played faster).",
+    );
+    expect(summary.textContent).not.toContain("catch up");
+    // The figures as before: the caught-up among the played, and how much shorter they were.
+    expect(summary.dataset).toMatchObject({
+      sent: "4",
+      played: "4",
+      compressed: "3",
+      compressedMs: "1500",
+      replay: "yes",
+      drawnMs: "13600",
+      spanMs: "4000",
+    });
+  });
+
+  it("keeps the catch-up words for a drawing sent as it was drawn", () => {
+    const { says, summary } = card();
+    says.setSent(2);
+    says.fate(playedAt(0, 0, 1000));
+    says.fate(playedAt(1, 1000, 1000, 500));
+    expect(summary.textContent).toBe("2 of 2 strokes played (1 faster to catch up, 500 ms shorter in all).");
+    expect(summary.dataset).toMatchObject({ replay: "no" });
+  });
+});

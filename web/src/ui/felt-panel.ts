@@ -52,6 +52,18 @@ export interface Tally {
 export interface TallySource {
   readonly counts: Tally;
   fateOf(seq: number): Fate | null;
+  /** Why a stroke was refused, or who or what cut it (fates.ts); absent: never said. */
+  reasonOf?(seq: number): string | null;
+}
+
+/**
+ * A stroke of a path taken back with Undo: its fate (null: no answer yet), why it was refused or
+ * who cut it, and whether it never left the page (dropped, or held when its path was taken back).
+ */
+export interface UndoneStroke {
+  readonly fate: Fate | null;
+  readonly reason: string | null;
+  readonly unsent: "dropped" | "held" | null;
 }
 
 export class FeltPanel {
@@ -110,15 +122,31 @@ export class FeltPanel {
     this.#timeline.show(this.#grid, placement, this.#b?.placed ?? null);
     const count = placement.placed.length;
     const seconds = (placement.totalMs / 1000).toFixed(1);
-    this.#timeline.setCaption(
-      count === 0 && this.#told.counts.dropped === 0 && (this.#told.counts.held ?? 0) === 0
+    // The card counts every stroke the drawing sent; the timeline shows the drawing as it stands,
+    // so the caption leaves out the strokes of paths taken back with Undo, and says so.
+    const undone = this.#undone();
+    const tally = standingTally(this.#told.counts, undone);
+    const caption =
+      count === 0 && tally.dropped === 0 && (tally.held ?? 0) === 0
         ? "Each lane is one actuator (row, column); draw to see where and when the touch is felt."
         : timelineCaption(
             { count, seconds, reported: placement.reportedCount, capped: placement.cappedCount },
-            this.#told.counts,
+            tally,
             this.#stopped,
-          ),
-    );
+          );
+    const left = undoneWords(undone);
+    this.#timeline.setCaption(left === null ? caption : `${caption} ${left}`);
+  }
+
+  /** What became of the strokes of the paths taken back with Undo, as the card counted them. */
+  #undone(): UndoneStroke[] {
+    const drawing = this.#drawing;
+    if (drawing === null) return [];
+    return drawing.undoneSeqs.map((seq) => ({
+      fate: this.#told.fateOf(seq),
+      reason: this.#told.reasonOf?.(seq) ?? null,
+      unsent: drawing.unsent(seq),
+    }));
   }
 
   /** When the felt drawing ends, ms from its first stroke (as the timeline shows it). */
@@ -358,6 +386,61 @@ export function timelineCaption(
   if (held > 0) said.push(heldPart);
   if (waiting > 0) said.push(stopped ? "the rest stopped: not felt" : "the rest as it would");
   return `${head}; ${said.join(", ")}.`;
+}
+
+/**
+ * The card's tally of the drawing as it stands: `tally` (every stroke the drawing sent) less the
+ * strokes of paths taken back with Undo (`undone`), each under the fate the card counted it.
+ */
+export function standingTally(tally: Tally, undone: readonly UndoneStroke[]): Tally {
+  if (undone.length === 0) return tally;
+  let { sent, played, cut, cancelled, refused, dropped } = tally;
+  let late = tally.late ?? 0;
+  let cutByWearer = tally.cutByWearer ?? 0;
+  let cutByFault = tally.cutByFault ?? 0;
+  for (const { fate, reason, unsent } of undone) {
+    sent--;
+    if (fate === "played") played--;
+    else if (fate === "cancelled") cancelled--;
+    else if (fate === "cut") {
+      cut--;
+      if (reason === "wearer") cutByWearer--;
+      else if (reason !== null) cutByFault--;
+    } else if (fate === "refused") {
+      refused--;
+      if (reason === "late") late--;
+    } else if (unsent === "dropped") dropped--;
+  }
+  const atLeast0 = (n: number) => Math.max(0, n);
+  return {
+    ...tally,
+    sent: atLeast0(sent),
+    played: atLeast0(played),
+    cut: atLeast0(cut),
+    cancelled: atLeast0(cancelled),
+    refused: atLeast0(refused),
+    dropped: atLeast0(dropped),
+    late: atLeast0(late),
+    cutByWearer: atLeast0(cutByWearer),
+    cutByFault: atLeast0(cutByFault),
+  };
+}
+
+/** What the caption adds of the strokes taken back with Undo (null: none), each under its fate. */
+export function undoneWords(undone: readonly UndoneStroke[]): string | null {
+  if (undone.length === 0) return null;
+  const by = (test: (stroke: UndoneStroke) => boolean) => undone.filter(test).length;
+  const parts: [number, string][] = [
+    [by((s) => s.fate === "played"), "played"],
+    [by((s) => s.fate === "cut"), "cut short"],
+    [by((s) => s.fate === "cancelled"), "cancelled by Stop"],
+    [by((s) => s.fate === "refused" && s.reason === "late"), "skipped as late"],
+    [by((s) => s.fate === "refused" && s.reason !== "late"), "not felt (refused by the sleeve)"],
+    [by((s) => s.fate === null && s.unsent !== null), "never sent"],
+    [by((s) => s.fate === null && s.unsent === null), "not answered yet"],
+  ];
+  const said = parts.filter(([n]) => n > 0).map(([n, words]) => `${n} ${words}`);
+  return `Not counted: ${plural(undone.length, "stroke")} taken back with Undo (${said.join(", ")}).`;
 }
 
 /** Forces the next sync to place every stroke again (a held stroke went out). */

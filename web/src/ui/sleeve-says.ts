@@ -8,10 +8,14 @@
  * faster to catch up with the pen (and how much shorter in all) and how many it
  * slowed to its floor; of the refused, how many it skipped as late, apart from the
  * other refusals (fates.ts `CatchUp`, the words `up` and `send --wait` use too).
+ * A drawing sent all at once (Play again) has no pen to catch up with: the sleeve plays its strokes
+ * back to back, and the card says so, and how much shorter than drawn that was (the pauses between
+ * strokes left out, and the strokes played faster). A drawing shown but not sent (loaded, or
+ * re-simplified) is said to be not sent yet, not as strokes the sleeve failed to play.
  * Reset with every new drawing, so nothing of an old drawing lingers.
  */
 import { seconds, type SleeveEvent } from "../events";
-import { catchUpWords, cutShortWords, DrawingFates, type Fate } from "../fates";
+import { catchUpWords, cutShortWords, durationWords, DrawingFates, type Fate } from "../fates";
 import { EventLog, type LogKind } from "./event-log";
 
 export interface Counts {
@@ -42,6 +46,19 @@ export interface Counts {
   /** Held on this page, not sent yet (the wearer paused), and why (`holdReason`). */
   held: number;
   heldWhy: string;
+  /** Shown on the page but not sent (loaded, or re-simplified): Play again sends them. */
+  notSent: number;
+}
+
+/**
+ * How a drawing reached the sleeve, when not as it was drawn: shown but not sent (`notSent`: how,
+ * "loaded" or "re-simplified"), or sent all at once by Play again (`replay`: how long the drawing
+ * took to draw, ms, and the span the sleeve played its strokes over, first start to last end, null
+ * before any played).
+ */
+export interface Delivery {
+  readonly notSentWhy?: string;
+  readonly replay?: { readonly drawnMs: number; readonly spanMs: number | null };
 }
 
 export class SleeveSays {
@@ -58,6 +75,14 @@ export class SleeveSays {
   #held = 0;
   #heldWhy = "the wearer paused";
   #drawing: string | null = null;
+  /** Strokes shown, not sent (loaded or re-simplified), and how they came. */
+  #notSent = 0;
+  #notSentWhy = "loaded";
+  /** Sent all at once by Play again: how long the drawing took to draw (ms); null: not a replay. */
+  #replayOfMs: number | null = null;
+  /** The sleeve's own times of the strokes it played: the first start and the last end (ms). */
+  #firstStartMs = Infinity;
+  #lastEndMs = -Infinity;
 
   constructor(title: HTMLElement, list: HTMLOListElement, summary: HTMLElement) {
     this.#title = title;
@@ -81,6 +106,7 @@ export class SleeveSays {
       dropped: this.#dropped,
       held: this.#held,
       heldWhy: this.#heldWhy,
+      notSent: this.#notSent,
       delayed: this.#delayed,
       latestDelayMs: this.#latestDelayMs,
     };
@@ -101,6 +127,10 @@ export class SleeveSays {
     this.#latestDelayMs = 0;
     this.#sent = 0;
     this.#held = 0;
+    this.#notSent = 0;
+    this.#replayOfMs = null;
+    this.#firstStartMs = Infinity;
+    this.#lastEndMs = -Infinity;
     this.#list.replaceChildren();
     this.#title.textContent =
       drawing === null ? "Sleeve says" : `Sleeve says · drawing ${drawing.slice(0, 8)}`;
@@ -111,6 +141,10 @@ export class SleeveSays {
   /** An event about a stroke of this drawing: the stroke's fate now (fates.ts). */
   fate(event: SleeveEvent): Fate | null {
     const fate = this.#fates.add(event);
+    if (event.type === "played" || event.type === "adjusted") {
+      this.#firstStartMs = Math.min(this.#firstStartMs, event.start_at_ms);
+      this.#lastEndMs = Math.max(this.#lastEndMs, event.start_at_ms + event.duration_ms);
+    }
     this.#render();
     return fate;
   }
@@ -118,6 +152,11 @@ export class SleeveSays {
   /** Stroke `seq`'s fate so far (fates.ts); null before the sleeve answered it. */
   fateOf(seq: number): Fate | null {
     return this.#fates.fate(seq);
+  }
+
+  /** Why stroke `seq` was refused (or who cut it): fates.ts; null when neither. */
+  reasonOf(seq: number): string | null {
+    return this.#fates.reason(seq);
   }
 
   /** A played stroke held on the way for `delayMs`. */
@@ -136,6 +175,22 @@ export class SleeveSays {
   setHeld(held: number, why: string | null = null): void {
     this.#held = held;
     if (why !== null) this.#heldWhy = why;
+    this.#render();
+  }
+
+  /**
+   * `count` strokes of this drawing are shown on the page, not sent (`why`: "loaded" or
+   * "re-simplified"): Play again sends them.
+   */
+  notSent(count: number, why: string): void {
+    this.#notSent = count;
+    this.#notSentWhy = why;
+    this.#render();
+  }
+
+  /** This drawing was sent all at once (Play again) of one that took `drawnMs` to draw. */
+  replayed(drawnMs: number): void {
+    this.#replayOfMs = drawnMs;
     this.#render();
   }
 
@@ -163,6 +218,7 @@ export class SleeveSays {
       "dropped",
       "delayed",
       "held",
+      "notSent",
     ] as const)
       summary.dataset[key] = String(counts[key]);
     summary.dataset["compressedMs"] = String(Math.round(counts.compressedMs));
@@ -171,7 +227,16 @@ export class SleeveSays {
     const paused = refusals.get("paused") ?? 0;
     const quiet = refusals.get("do_not_disturb") ?? 0;
     summary.dataset["wearerRefused"] = String(paused + quiet);
-    summary.textContent = summaryText(counts, { paused, quiet });
+    const spanMs = this.#lastEndMs > this.#firstStartMs ? this.#lastEndMs - this.#firstStartMs : null;
+    const replay = this.#replayOfMs === null ? undefined : { drawnMs: this.#replayOfMs, spanMs };
+    summary.dataset["replay"] = replay === undefined ? "no" : "yes";
+    summary.dataset["drawnMs"] = replay === undefined ? "" : String(Math.round(replay.drawnMs));
+    summary.dataset["spanMs"] = spanMs === null ? "" : String(Math.round(spanMs));
+    summary.textContent = summaryText(
+      counts,
+      { paused, quiet },
+      { notSentWhy: this.#notSentWhy, ...(replay === undefined ? {} : { replay }) },
+    );
   }
 }
 
@@ -181,16 +246,28 @@ export class SleeveSays {
  * floor (in brackets: they are played too); of the refused, those it skipped as late, apart.
  * `wearer`: of the refused, those refused as the wearer paused or asked not to be disturbed.
  */
-export function summaryText(counts: Readonly<Counts>, wearer: { paused: number; quiet: number }): string {
+export function summaryText(
+  counts: Readonly<Counts>,
+  wearer: { paused: number; quiet: number },
+  delivery: Delivery = {},
+): string {
   const { sent, played, refused, late, cancelled, cut, dropped, held, delayed } = counts;
+  const notSent = Math.min(counts.notSent, sent);
+  const notSentWords = `${plural(notSent, "stroke")} ${delivery.notSentWhy ?? "loaded"}, not sent yet: Play again sends them`;
+  if (notSent > 0 && notSent === sent && dropped === 0) return `${notSentWords}.`;
   if (sent === 0 && dropped === 0) return "No strokes sent yet.";
-  const pace = catchUpWords({
-    compressed: counts.compressed,
-    compressed_ms: counts.compressedMs,
-    slowed: counts.slowed,
-    late,
-  });
-  const parts = [`${played} of ${plural(sent, "stroke")} played${pace === "" ? "" : ` (${pace})`}`];
+  const waiting = sent - notSent - played - cut - cancelled - refused - dropped - held;
+  const pace =
+    delivery.replay === undefined
+      ? catchUpWords({
+          compressed: counts.compressed,
+          compressed_ms: counts.compressedMs,
+          slowed: counts.slowed,
+          late,
+        })
+      : replayWords(counts, delivery.replay, waiting === 0);
+  // Of the strokes sent: those shown but not sent yet are said apart.
+  const parts = [`${played} of ${plural(sent - notSent, "stroke")} played${pace === "" ? "" : ` (${pace})`}`];
   parts.push(...cutShortWords(cut, { byWearer: counts.cutByWearer, byFault: counts.cutByFault }));
   if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
   if (late > 0) parts.push(`${late} skipped as late`);
@@ -210,10 +287,35 @@ export function summaryText(counts: Readonly<Counts>, wearer: { paused: number; 
   }
   if (held > 0) parts.push(`${held} held on this page, not sent (${counts.heldWhy})`);
   if (dropped > 0) parts.push(`${dropped} never sent`);
-  const waiting = sent - played - cut - cancelled - refused - dropped - held;
+  if (notSent > 0) parts.push(notSentWords);
   if (waiting > 0 && (cut > 0 || cancelled > 0)) parts.push(`${waiting} not answered yet`);
   if (delayed > 0) parts.push(`${delayed} delayed on the way (last by ${seconds(counts.latestDelayMs)})`);
   return `${parts.join(", ")}.`;
+}
+
+/**
+ * What to say of the strokes of a drawing sent all at once (Play again), played: back to back, as
+ * the sleeve plays what it has in hand; once all are answered, how long that took and how much
+ * shorter than drawn (the pauses between strokes left out, and the strokes played faster, down to
+ * the sleeve's floor); and the strokes slowed to its floor.
+ */
+function replayWords(
+  counts: Readonly<Counts>,
+  replay: NonNullable<Delivery["replay"]>,
+  answered: boolean,
+): string {
+  const words = ["back to back"];
+  const { drawnMs, spanMs } = replay;
+  if (answered && spanMs !== null) {
+    const shorterMs = drawnMs - spanMs;
+    const faster = counts.compressed === 0 ? "" : ` and ${plural(counts.compressed, "stroke")} played faster`;
+    words[0] +=
+      shorterMs >= 100
+        ? ` in ${durationWords(spanMs)}, ${durationWords(shorterMs)} shorter than drawn: the pauses left out${faster}`
+        : ` in ${durationWords(spanMs)}`;
+  }
+  if (counts.slowed > 0) words.push(`${counts.slowed} slowed to the sleeve's floor`);
+  return words.join("; ");
 }
 
 function plural(count: number, noun: string): string {
