@@ -627,7 +627,8 @@ def _to_float(value: int | float) -> float:
         return math.inf if value > 0 else -math.inf
 
 
-def _json_kind(value: Any) -> str:
+def json_kind(value: Any) -> str:
+    """What a JSON value is, in JSON's words ("null", "an array"...), for error messages."""
     kinds = {dict: "an object", list: "an array", str: "a string", bool: "a boolean"}
     if value is None:
         return "null"
@@ -846,12 +847,12 @@ def _show_text(text: str) -> str:
 
 def _described(value: Any) -> str:
     """A JSON value and its kind, for wrong_type messages: '"0,0" (a string)'."""
-    return "null" if value is None else f"{_show_json(value)} ({_json_kind(value)})"
+    return "null" if value is None else f"{_show_json(value)} ({json_kind(value)})"
 
 
 def _show_json(value: Any) -> str:
     try:
         shown = json.dumps(value, ensure_ascii=False)
     except (ValueError, RecursionError):  # deeper than the decoder allowed from here
-        return _json_kind(value)
+        return json_kind(value)
     return _cut(shown)

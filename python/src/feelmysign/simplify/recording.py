@@ -27,6 +27,7 @@ from typing import Any, TypeGuard
 
 from feelmysign.errors import FeelMySignError
 from feelmysign.input_files import MAX_RECORDING_BYTES, loads_json, read_text
+from feelmysign.protocol import json_kind
 from feelmysign.simplify.segment import Sample
 from feelmysign.stroke import Point
 
@@ -111,24 +112,11 @@ def _reject_constant(name: str) -> float:
     raise ValueError(f"{name} is not a number")
 
 
-def _json_kind(value: object) -> str:
-    """What a JSON value is, in JSON's words (null, a number...), for an error message."""
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true or false"
-    if isinstance(value, int | float):
-        return "a number"
-    if isinstance(value, str):
-        return "a string"
-    return "a list" if isinstance(value, list) else "an object"
-
-
 def _field(data: dict[str, Any], key: str, kind: type, source: str) -> Any:
     value = data.get(key)
     if not isinstance(value, kind):
-        wanted = "an object" if kind is dict else "a list"
-        found = "is missing" if key not in data else f"is {_json_kind(value)}"
+        wanted = "an object" if kind is dict else "an array"
+        found = "is missing" if key not in data else f"is {json_kind(value)}"
         raise RecordingError(
             f"{source}: '{key}' must be {wanted} but {found}; a recording is the JSON file the "
             'drawing page\'s "Save recording" downloads (its format: docs/research.md, Recordings)'

@@ -1,5 +1,6 @@
 package feelmysign.protocol;
 
+import feelmysign.json.JsonKind;
 import feelmysign.json.PyDumps;
 import feelmysign.json.PyRepr;
 import java.math.BigInteger;
@@ -40,14 +41,7 @@ final class Text {
   }
 
   static String jsonKind(Object value) {
-    return switch (PyRepr.typeName(value)) {
-      case "NoneType" -> "null";
-      case "dict" -> "an object";
-      case "list" -> "an array";
-      case "str" -> "a string";
-      case "bool" -> "a boolean";
-      default -> "a number";
-    };
+    return JsonKind.of(value);
   }
 
   /** Python's {@code str()} of a JSON number: "2", "2.5", "1e+16". */

@@ -1,6 +1,7 @@
 package feelmysign.simplify;
 
 import feelmysign.json.JsonDecodeException;
+import feelmysign.json.JsonKind;
 import feelmysign.json.Numbers;
 import feelmysign.json.NonFiniteLiteralException;
 import feelmysign.json.PyJson;
@@ -123,9 +124,18 @@ public record Recording(
   private static Object field(Map<?, ?> data, String key, boolean object, String source) {
     Object value = data.get(key);
     if (object ? !(value instanceof Map) : !(value instanceof List)) {
-      String wanted = object ? "an object" : "a list";
+      String wanted = object ? "an object" : "an array";
+      String found = data.containsKey(key) ? "is " + JsonKind.of(value) : "is missing";
       throw new RecordingException(
-          source + ": '" + key + "' must be " + wanted + ", got " + PyRepr.typeName(value));
+          source
+              + ": '"
+              + key
+              + "' must be "
+              + wanted
+              + " but "
+              + found
+              + "; a recording is the JSON file the drawing page's \"Save recording\" downloads"
+              + " (its format: docs/research.md, Recordings)");
     }
     return value;
   }
