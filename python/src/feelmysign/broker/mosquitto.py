@@ -190,7 +190,9 @@ class Broker(Started):
         return self._credentials
 
     def start(self) -> Credentials:
-        """Write the files, start Mosquitto, wait until it accepts a login; return credentials."""
+        """Take the state directory's lock (BrokerError ``already-running`` if another process
+        holds it), write the files, start Mosquitto, wait until it accepts a login, then write
+        credentials.json; return the credentials. A failure puts back the files it rewrote."""
         if self._process is not None:
             raise BrokerError("start-failed", f"This broker already runs (pid {self.pid}).")
         taken_here = not self._lock.held
