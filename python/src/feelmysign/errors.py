@@ -66,7 +66,9 @@ class BrokerError(FeelMySignError):
     - ``bad-option``: a sleeve id, port or topic that cannot be used;
     - ``credentials-file``: a ``credentials.json`` that cannot be read or is wrong;
     - ``start-failed``: Mosquitto exited or never accepted connections at start-up;
-    - ``exited``: Mosquitto stopped while it should have been running.
+    - ``exited``: Mosquitto stopped while it should have been running;
+    - ``already-running``: another feelmysign holds the state directory (``up`` or
+      ``broker``); the message says which, where it is, and how to stop it.
 
     ``log_path`` is Mosquitto's log file when there is one to look at; ``exit_code``
     is how Mosquitto ended, for ``exited``.

@@ -249,13 +249,9 @@ class WebServer:
         debug_log: Path | None = None,
         wearer_api: Api | None = None,
         wearer_key: str | None = None,
+        sock: socket.socket | None = None,
     ) -> None:
-        index = directory / "index.html"
-        if not index.is_file():
-            raise FeelMySignError(
-                f"the drawing client is not built ({index} is missing); run 'make web-build' "
-                "(or 'make up', which builds it)"
-            )
+        check_built(directory)
         self._root = directory.resolve()
         self._config = json.dumps(config).encode()
         self._api = api
@@ -265,7 +261,9 @@ class WebServer:
         self._wearer_key = wearer_key
         self._access_key = access_key
         self._mqtt_ws_port = mqtt_ws_port
-        self._sock = _listen(host, port)
+        # ``sock``: bound beforehand by listen(host, port), so the port is known to be ours
+        # before anything else starts (feelmysign up binds it before its broker writes a file).
+        self._sock = sock if sock is not None else listen(host, port)
         self._tls = _tls_context(tls) if tls is not None else None
         self._ca_fingerprint = tls.ca_fingerprint if tls is not None else None
         # Known once bound (port 0 picks one): only now can the Host values be listed.
@@ -1023,7 +1021,18 @@ async def _first_byte(sock: socket.socket) -> int | None:
     return first[0] if first else None
 
 
-def _listen(host: str, port: int) -> socket.socket:
+def check_built(directory: Path) -> None:
+    """FeelMySignError saying how to build the drawing client when ``directory`` lacks it."""
+    index = directory / "index.html"
+    if not index.is_file():
+        raise FeelMySignError(
+            f"the drawing client is not built ({index} is missing); run 'make web-build' "
+            "(or 'make up', which builds it)"
+        )
+
+
+def listen(host: str, port: int) -> socket.socket:
+    """A socket listening on ``host:port`` for WebServer(sock=...); FeelMySignError if not."""
     try:
         family, kind, proto, _, address = socket.getaddrinfo(
             host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE

@@ -10,6 +10,11 @@ Everything lives in the state directory (default ``$XDG_STATE_HOME/feelmysign/br
 ``mosquitto.conf``, ``acl``, ``passwd``, ``credentials.json`` (what clients read),
 ``mosquitto.log`` and ``data/`` (retained messages and sessions). Passwords are kept
 across restarts, so a running sleeve keeps working. Listeners are on 127.0.0.1 only.
+
+One broker at a time per state directory: ``start()`` takes its ``InstanceLock``
+(``instance.lock``) before writing anything, and refuses (BrokerError
+``already-running``) while another process holds it. A start that fails puts back the
+files it had rewritten; ``credentials.json`` is written only once Mosquitto accepts logins.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from feelmysign.broker.credentials import (
     write_private_file,
     write_sleeve_credentials,
 )
+from feelmysign.broker.instance import LIBRARY_COMMAND, InstanceLock
 from feelmysign.broker.tls import LanOptions, TlsFiles
 from feelmysign.connection.client import probe_login
 from feelmysign.connection.settings import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
@@ -73,6 +79,8 @@ class Broker(Started):
     started from the main thread on Linux, by the kernel if this process dies.
     ``save_every_change`` (default) has Mosquitto save its state after every change, so
     that a SIGKILL loses no stroke it acknowledged; False saves every 60 s (for benchmarks).
+    ``lock``: the state directory's lock when the caller holds it already (``feelmysign up``
+    holds it for its whole run); else ``start()`` takes it and ``stop()`` lets it go.
     """
 
     def __init__(
@@ -88,6 +96,7 @@ class Broker(Started):
         stop_timeout_s: float = DEFAULT_STOP_TIMEOUT_S,
         lan: LanOptions | None = None,
         save_every_change: bool = True,
+        lock: InstanceLock | None = None,
     ) -> None:
         _check_port(port, "--port")
         if lan is not None:
@@ -104,6 +113,10 @@ class Broker(Started):
             # Mosquitto's config is line based: such a path cannot be written into it.
             raise BrokerError("bad-option", f"State directory {state_dir!r} contains a line break.")
         self._files = StateFiles(state_dir.absolute())
+        if lock is not None and lock.state_dir != self._files.state_dir:
+            raise ValueError(f"the lock of {lock.state_dir} for a broker in {state_dir}")
+        self._lock = lock or InstanceLock(self._files.state_dir, LIBRARY_COMMAND)
+        self._release_lock_at_stop = False
         self._requested_port = port
         self._requested_ws_port = ws_port
         self._sleeve_id = check_sleeve_id(sleeve_id)
@@ -155,6 +168,11 @@ class Broker(Started):
         return self._tls
 
     @property
+    def lock(self) -> InstanceLock:
+        """The state directory's lock (held while this broker runs)."""
+        return self._lock
+
+    @property
     def pid(self) -> int | None:
         return self._process.pid if self._process is not None else None
 
@@ -172,24 +190,46 @@ class Broker(Started):
         return self._credentials
 
     def start(self) -> Credentials:
-        """Write the files, start Mosquitto, wait until it accepts a login; return credentials."""
+        """Take the state directory's lock (BrokerError ``already-running`` if another process
+        holds it), write the files, start Mosquitto, wait until it accepts a login, then write
+        credentials.json; return the credentials. A failure puts back the files it rewrote."""
         if self._process is not None:
             raise BrokerError("start-failed", f"This broker already runs (pid {self.pid}).")
+        taken_here = not self._lock.held
+        self._lock.acquire()  # first: another instance on this state directory refuses us
+        try:
+            credentials = self._start()
+        except BaseException:
+            if taken_here:
+                self._lock.release()
+            raise
+        self._release_lock_at_stop = taken_here
+        self._lock.describe(
+            mqtt_url=credentials.mqtt_url,
+            ws_url=credentials.ws_url,
+            mqtts_url=credentials.mqtts_url,
+        )
+        return credentials
+
+    def _start(self) -> Credentials:
         executable = process_.find_mosquitto(self._mosquitto, process_.search_dirs())
         self.version = process_.mosquitto_version(executable)
         self._make_state_dir()
         if self._lan is not None:
             self._lan = self._bindable(self._lan)
+        # Ports checked before anything is written: a port taken leaves the state as it was.
+        port, ws_port = self._choose_ports()
+        if self._lan is not None:
             self._tls = self._lan.tls_files(self._files.tls_dir)
         attempts_left = AUTO_PORT_ATTEMPTS
         while True:
-            port, ws_port = self._choose_ports()
             try:
                 return self._start_on(executable, port, ws_port)
             except BrokerError as error:
                 attempts_left -= 1
                 if attempts_left == 0 or not self._took_a_port_we_chose(error):
                     raise
+            port, ws_port = self._choose_ports()
 
     def _took_a_port_we_chose(self, error: BrokerError) -> bool:
         """Someone else bound a port we picked before Mosquitto could: worth another pick."""
@@ -197,7 +237,16 @@ class Broker(Started):
         return error.reason == "port-in-use" and error.port not in (None, *requested)
 
     def stop(self) -> None:
-        """Stop Mosquitto (SIGTERM, so it saves retained messages; SIGKILL after the timeout)."""
+        """Stop Mosquitto (SIGTERM, so it saves retained messages; SIGKILL after the timeout),
+        and let the state directory's lock go if ``start()`` took it."""
+        try:
+            self._stop_process()
+        finally:
+            if self._release_lock_at_stop:
+                self._release_lock_at_stop = False
+                self._lock.release()
+
+    def _stop_process(self) -> None:
         process, self._process = self._process, None
         self._credentials = None
         atexit.unregister(self.stop)
@@ -254,25 +303,31 @@ class Broker(Started):
             mqtts_url=self._mqtts_url(),
             ca_fingerprint=self._tls.ca_fingerprint if self._tls else None,
         )
-        self._write_files(credentials, executable, port, ws_port)
-        _rotate(self._files.log)
-        log_offset_bytes = self._files.log.stat().st_size if self._files.log.exists() else 0
-        # The log names clients and accounts: private like the rest of the state directory.
-        log_fd = os.open(self._files.log, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-        with os.fdopen(log_fd, "ab") as log:
-            self._process = process_.spawn(executable, self._files.config, log)
-        atexit.register(self.stop)
-        write_runtime(
-            self._files,
-            pid=self._process.pid,
-            legacy_topic=self._legacy_topic,
-            executable=executable,
-        )
+        files = self._files
+        previous = _contents(files.config, files.acl, files.passwords)
         try:
+            self._write_files(credentials, executable, port, ws_port)
+            _rotate(files.log)
+            log_offset_bytes = files.log.stat().st_size if files.log.exists() else 0
+            # The log names clients and accounts: private like the rest of the state directory.
+            log_fd = os.open(files.log, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+            with os.fdopen(log_fd, "ab") as log:
+                self._process = process_.spawn(executable, files.config, log)
+            atexit.register(self.stop)
+            write_runtime(
+                files,
+                pid=self._process.pid,
+                legacy_topic=self._legacy_topic,
+                executable=executable,
+            )
             self._wait_until_ready(credentials, port, ws_port, log_offset_bytes)
         except BaseException:
-            self.stop()
+            self._stop_process()
+            _restore(previous)  # a failed start leaves the state directory as it found it
             raise
+        # What clients read, written once the broker it names accepts them.
+        write_credentials(files.credentials, credentials)
+        write_sleeve_credentials(files.sleeve_credentials, credentials)
         self._credentials = credentials
         _publish_clock(credentials)
         return credentials
@@ -281,8 +336,6 @@ class Broker(Started):
         self, credentials: Credentials, executable: str, port: int, ws_port: int
     ) -> None:
         files = self._files
-        write_credentials(files.credentials, credentials)
-        write_sleeve_credentials(files.sleeve_credentials, credentials)
         write_auth_files(
             files,
             credentials,
@@ -397,6 +450,28 @@ class Broker(Started):
             port=port,
             log_path=self.log_path,
         )
+
+
+def _contents(*paths: Path) -> dict[Path, bytes | None]:
+    """Each file's bytes (None: it does not exist), to put back with ``_restore``."""
+    contents: dict[Path, bytes | None] = {}
+    for path in paths:
+        try:
+            contents[path] = path.read_bytes()
+        except FileNotFoundError:
+            contents[path] = None
+    return contents
+
+
+def _restore(contents: dict[Path, bytes | None]) -> None:
+    for path, data in contents.items():
+        try:
+            if data is None:
+                path.unlink(missing_ok=True)
+            else:
+                write_private_file(path, data.decode())
+        except (OSError, UnicodeDecodeError):
+            pass  # best effort: the error being raised says more than this one would
 
 
 def _rotate(log: Path) -> None:

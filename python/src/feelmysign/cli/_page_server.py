@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import secrets
+import socket
 from pathlib import Path
 from typing import Any
 
@@ -29,10 +30,12 @@ def page_server(
     directory: Path,
     api: Api | None = None,
     wearer_api: Api | None = None,
+    sock: socket.socket | None = None,
 ) -> tuple[WebServer, str, str | None]:
     """The server (not yet started), the URL to open, with its key when off loopback, and
     with ``wearer_api`` the wearer's URL (always with the wearer's key, kept in the state
-    directory so that the wearer's bookmark outlives a restart)."""
+    directory so that the wearer's bookmark outlives a restart). ``sock``: the page's
+    socket, bound beforehand (``webserver.listen``) on ``http_port``."""
     w_key = wearer_key(broker.state_dir) if wearer_api is not None else None
     c = broker.credentials
     config: dict[str, Any] = {
@@ -53,6 +56,7 @@ def page_server(
             debug_log=debug_log,
             wearer_api=wearer_api,
             wearer_key=w_key,
+            sock=sock,
         )
         return server, server.url, _wearer_url(server, w_key)
     key = secrets.token_urlsafe(ACCESS_KEY_BYTES)
@@ -68,6 +72,7 @@ def page_server(
         debug_log=debug_log,
         wearer_api=wearer_api,
         wearer_key=w_key,
+        sock=sock,
     )
     server.set_config({**config, "ws_url": f"wss://{server.authority}/mqtt"})
     return server, f"{server.url}?key={key}", _wearer_url(server, w_key)

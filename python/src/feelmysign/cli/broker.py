@@ -7,6 +7,8 @@
 
 Prints the URLs, the credentials file and the log file, then "Ready." once the broker
 accepts connections. Ctrl-C (SIGINT), SIGTERM or SIGHUP stop Mosquitto and exit 0.
+While another 'feelmysign broker' or 'feelmysign up' runs on the same state directory it
+refuses (exit 1), saying which and how to stop it, and changes nothing there.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from feelmysign.broker import (
     Broker,
     default_state_dir,
 )
+from feelmysign.broker.instance import InstanceLock
 from feelmysign.cli._join import run_add_sender, run_add_sleeve, run_nats_accounts
 from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 from feelmysign.cli.options.parser import Subcommands, add_command
@@ -137,6 +140,7 @@ def _port(text: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    lock = InstanceLock(args.state_dir or default_state_dir(), "feelmysign broker")
     broker = Broker(
         state_dir=args.state_dir,
         port=args.port,
@@ -144,8 +148,9 @@ def run(args: argparse.Namespace) -> int:
         sleeve_id=args.sleeve_id,
         mosquitto=args.mosquitto,
         lan=lan_from_args(args),
+        lock=lock,
     )
-    with _stop_requests() as stop_requested, broker:
+    with lock, _stop_requests() as stop_requested, broker:
         _announce(broker)
         while not stop_requested:
             broker.check_running(wait_s=WATCH_INTERVAL_S)

@@ -7,6 +7,7 @@ import socket
 import threading
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from feelmysign.backends.factory import BACKEND_NAMES
 from feelmysign.broker import (
@@ -15,7 +16,10 @@ from feelmysign.broker import (
     DEFAULT_WS_PORT,
     Broker,
     Credentials,
+    default_state_dir,
 )
+from feelmysign.broker.instance import InstanceLock
+from feelmysign.broker.tls import LanOptions
 from feelmysign.cli._page_server import page_server, qr_text
 from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
@@ -28,7 +32,11 @@ from feelmysign.services.drawing_log import DrawingLog
 from feelmysign.services.stop_signals import call_on_stop_signals
 from feelmysign.services.watchdog import Watchdog
 from feelmysign.wearer_api import Blocking, WearerApi
-from feelmysign.webserver import WEB_DIST, Api
+from feelmysign.webserver import WEB_DIST, Api, check_built, listen
+
+if TYPE_CHECKING:
+    from feelmysign.layout import Layout
+    from feelmysign.wearer import Wearer
 
 DEFAULT_HTTP_PORT = 8000
 
@@ -41,7 +49,8 @@ def register(subparsers: Subcommands) -> None:
             "Start Mosquitto with generated credentials, a sleeve (simulated, or the real one "
             "on a Raspberry Pi), and serve the drawing client on http://127.0.0.1:PORT (with "
             "--lan or --host: https://ADDRESS:PORT) with the broker's address and the sender's "
-            "login built in. Ctrl-C stops everything."
+            "login built in. Ctrl-C stops everything. One instance per state directory: "
+            "while another up or broker runs on it, up says so and changes nothing."
         ),
     )
     parser.add_argument(
@@ -113,14 +122,37 @@ def run(args: argparse.Namespace) -> int:
         output_file(args.record, option="--record")
     layout = layout_from_args(args)
     wearer = wearer_from_args(args)
+    lan = lan_from_args(args)
+    check_built(args.web_dir)
+    state_dir = args.state_dir if args.state_dir is not None else default_state_dir()
+    # The state directory is this run's alone (another up or broker there: refused before
+    # anything is written), and the page's port is bound before the broker writes a file:
+    # a start that fails leaves the state, and any instance using it, as they were.
+    with InstanceLock(state_dir, "feelmysign up") as lock:
+        page_socket = listen(lan.host if lan is not None else "127.0.0.1", args.http_port)
+        try:
+            return _run(args, layout, wearer, lan, lock, page_socket)
+        finally:
+            page_socket.close()
+
+
+def _run(
+    args: argparse.Namespace,
+    layout: Layout,
+    wearer: Wearer | None,
+    lan: LanOptions | None,
+    lock: InstanceLock,
+    page_socket: socket.socket,
+) -> int:
     port = _port_or_free(args.port, DEFAULT_MQTT_PORT, "MQTT")
     ws_port = _port_or_free(args.ws_port, DEFAULT_WS_PORT, "WebSocket")
     broker = Broker(
-        state_dir=args.state_dir,
+        state_dir=lock.state_dir,
         port=port,
         ws_port=ws_port,
         sleeve_id=args.sleeve_id,
-        lan=lan_from_args(args),
+        lan=lan,
+        lock=lock,
     )
     watchdog = Watchdog(broker)
     with broker, watchdog, _study_api(args.study, broker.credentials) as api:
@@ -139,7 +171,9 @@ def run(args: argparse.Namespace) -> int:
             directory=args.web_dir,
             api=api,
             wearer_api=wearer_api,
+            sock=page_socket,
         )
+        lock.describe(page=page_url)
         with server:
             settings = c.settings("sleeve")
             options = SleeveOptions(

@@ -149,6 +149,7 @@ class Watchdog(Started):
             port=c.mqtt_port,
             ws_port=c.ws_port,
             sleeve_id=c.sleeve_id,
+            lock=self._broker.lock,  # up holds it: the new broker runs under it
         )
         try:
             broker.start()
