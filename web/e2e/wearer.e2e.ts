@@ -225,6 +225,49 @@ describe("the wearer's page served by feelmysign up", () => {
     expect(await end.isVisible()).toBe(false);
   });
 
+  it("carries out a tap made while another change is under way, and never holds Stop behind it", async () => {
+    // A slow network: the ceiling's answer takes a second. Taps meanwhile were once ignored.
+    const posted: string[] = [];
+    let releaseCeiling = () => {};
+    const ceilingHeld = new Promise<void>((done) => (releaseCeiling = done));
+    await page.route("**/api/wearer/ceiling", async (route) => {
+      await ceilingHeld;
+      await route.continue();
+    });
+    const seen = (request: { method(): string; url(): string }) => {
+      if (request.method() === "POST") posted.push(new URL(request.url()).pathname);
+    };
+    page.on("request", seen);
+    try {
+      await page.locator('[data-testid="ceiling-0.4"]').click();
+      await page.locator('[data-testid="dnd-15"]').click();
+      await page.locator('[data-testid="stop"]').click();
+      // Stop went out at once, while the ceiling waits; the do-not-disturb waits its turn.
+      await page.waitForFunction(() =>
+        document.querySelector('[data-testid="live"]')!.textContent!.includes("Stopped"),
+      );
+      expect(posted).toEqual(["/api/wearer/ceiling", "/api/wearer/stop"]);
+      releaseCeiling();
+      await page.waitForFunction(() =>
+        document.querySelector('[data-testid="dnd-line"]')!.getAttribute("data-until"),
+      );
+      expect(posted).toEqual(["/api/wearer/ceiling", "/api/wearer/stop", "/api/wearer/do-not-disturb"]);
+      const controls = (await apiState(page)).controls;
+      expect(controls.ceiling).toBe(0.4);
+      expect(controls.do_not_disturb_until_ms).not.toBeNull();
+    } finally {
+      releaseCeiling();
+      page.off("request", seen);
+      await page.unroute("**/api/wearer/ceiling");
+    }
+    await page.locator('[data-testid="dnd-end"]').click();
+    await waitForData(page, '[data-testid="dnd-line"]', "until", "");
+    await page.locator('[data-testid="ceiling-none"]').click();
+    await page.waitForFunction(
+      () => document.querySelector('[data-testid="ceiling-none"]')!.getAttribute("aria-pressed") === "true",
+    );
+  });
+
   it("turns on do not disturb until a time of day", async () => {
     // Two hours from now, in the browser's own time zone, as the time field takes it.
     const hhmm = await page.evaluate(() => {

@@ -42,7 +42,11 @@ const sendersLine = byId<HTMLParagraphElement>("senders-line");
 const sendersList = byId<HTMLUListElement>("senders");
 
 let state: WearerState | null = null;
-let busy = false; // one change at a time: a second tap is ignored until the first is answered
+// Changes under way: while any is, a poll's older state is not shown over what the wearer did.
+let pending = 0;
+// Changes run one after the other, in the order tapped (a second tap waits for the first's
+// answer, never lost); Pause and Stop never wait behind another change.
+let queue: Promise<unknown> = Promise.resolve();
 let lastSaid = "";
 // A refused change stays on screen until the next change succeeds (a poll does not hide it).
 let changeRefused = false;
@@ -115,7 +119,7 @@ function render(s: WearerState): void {
   state = s;
   const c = s.controls;
   // Not disabled while a change is under way: a disabled button would lose the focus (the
-  // screen reader's place); change() ignores a second press until the first is answered.
+  // screen reader's place); change() queues a second press behind the first.
   const ready = c !== null;
   sleeveLine.dataset["state"] = c === null ? "starting" : s.online ? "online" : "offline";
   sleeveLine.textContent =
@@ -183,20 +187,33 @@ function showProblem(error: unknown): void {
   if (error instanceof WearerApiError && error.status === 403) sleeveLine.dataset["state"] = "no-key";
 }
 
-/** True when the sleeve took the change, false when refused (said), null when another was under way. */
-async function change(action: Action, body: object = {}): Promise<boolean | null> {
-  if (busy) return null;
-  busy = true;
+/** Actions that stop what the wearer feels: sent at once, never queued behind another change. */
+const URGENT: ReadonlySet<Action> = new Set<Action>(["stop", "pause"]);
+
+/**
+ * True when the sleeve took the change, false when refused (said). A change tapped while another
+ * is under way waits for its answer, then runs: the wearer's taps are all carried out, in order.
+ */
+function change(action: Action, body: object = {}): Promise<boolean> {
+  const run = () => apply(action, body);
+  if (URGENT.has(action)) return run();
+  const result = queue.then(run, run);
+  queue = result;
+  return result;
+}
+
+async function apply(action: Action, body: object): Promise<boolean> {
+  pending++;
   try {
     const next = await act(action, body);
     problem.hidden = true;
     changeRefused = false;
-    busy = false;
+    pending--;
     render(next);
     if (action === "stop") live.textContent = "Stopped what was playing.";
     return true;
   } catch (error) {
-    busy = false;
+    pending--;
     if (state !== null) render(state);
     changeRefused = true;
     showProblem(error);
@@ -207,7 +224,7 @@ async function change(action: Action, body: object = {}): Promise<boolean | null
 async function poll(): Promise<void> {
   try {
     const next = await readState();
-    if (!busy) render(next);
+    if (pending === 0) render(next);
     if (!changeRefused) problem.hidden = true;
   } catch (error) {
     showProblem(error);
