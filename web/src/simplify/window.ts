@@ -736,6 +736,8 @@ export class WindowCore {
  * simplifier made per path), enough that each sample is moved at most once on average.
  */
 const COMPACT_AFTER = 32;
+/** The numbers the merger keeps of a drawn sample: its time, x and y. */
+const DRAWN = 3;
 
 export class Merger {
   readonly #maxError: number;
@@ -744,18 +746,18 @@ export class Merger {
   readonly #shortMs: number;
   readonly #strict: boolean;
   /**
-   * The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first: [#first,
-   * #count) of arrays kept from one path to the next, so a sample is three stores, not three
-   * pushes. Plain arrays of numbers (stored unboxed, as in `Samples`), not typed arrays: a typed
-   * array's buffer lives outside the heap and is zeroed when made, which cost more than its samples
-   * for a simplifier made per path (as the bench makes one per demonstration).
+   * The drawn samples not yet covered by a sent stroke (ms, grid units), oldest first: samples
+   * [#first, #count) of one array kept from one path to the next, three numbers a sample (time, x,
+   * y) side by side. One array of numbers (stored unboxed, as in `Samples`), not three: every
+   * sample drawn is stored here, and one array grows and checks its bounds once where three did
+   * three times. Not a typed array: its buffer lives outside the heap and is zeroed when made,
+   * which cost more than its samples for a simplifier made per path (as the bench makes one per
+   * demonstration).
    */
-  readonly #xs: number[] = [];
-  readonly #ys: number[] = [];
-  readonly #ts: number[] = [];
+  readonly #drawn: number[] = [];
   #count = 0;
   /**
-   * The first sample not yet covered: those before it are, and are dropped from the arrays only
+   * The first sample not yet covered: those before it are, and are dropped from the array only
    * now and then (`#send`), not at every stroke sent (three splices, each an array made).
    */
   #first = 0;
@@ -781,9 +783,10 @@ export class Merger {
   /** A drawn sample, in order (its time as the window took it). */
   sample(tMs: number, x: number, y: number): void {
     const at = this.#count;
-    this.#xs[at] = x;
-    this.#ys[at] = y;
-    this.#ts[at] = tMs;
+    const drawn = this.#drawn;
+    drawn[DRAWN * at] = tMs;
+    drawn[DRAWN * at + 1] = x;
+    drawn[DRAWN * at + 2] = y;
     this.#count = at + 1;
   }
 
@@ -802,9 +805,7 @@ export class Merger {
    */
   #fits(start: Point, end: Point, endMs: number): boolean {
     const limitSq = this.#maxError * this.#maxError;
-    const xs = this.#xs;
-    const ys = this.#ys;
-    const ts = this.#ts;
+    const drawn = this.#drawn;
     const count = this.#count;
     // `distanceSq` with the chord's terms computed once (the same operations, as in `#farthestSq`).
     const ax = start[0];
@@ -813,9 +814,10 @@ export class Merger {
     const dy = end[1] - ay;
     const lengthSq = dx * dx + dy * dy;
     for (let i = this.#first; i < count; i++) {
-      if (ts[i]! > endMs) break;
-      const qx = xs[i]! - ax;
-      const qy = ys[i]! - ay;
+      const at = DRAWN * i;
+      if (drawn[at]! > endMs) break;
+      const qx = drawn[at + 1]! - ax;
+      const qy = drawn[at + 2]! - ay;
       const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
       if (d > limitSq) return false;
     }
@@ -853,20 +855,16 @@ export class Merger {
             };
     out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
-    const ts = this.#ts;
+    const drawn = this.#drawn;
     const count = this.#count;
     const endMs = segment.end_ms;
     let keep = this.#first;
-    while (keep < count && ts[keep]! < endMs) keep++;
+    while (keep < count && drawn[DRAWN * keep]! < endMs) keep++;
     this.#first = keep;
     if (keep >= COMPACT_AFTER && 2 * keep >= count) {
-      // Most of the arrays are covered: move what is not to their start, in place.
-      const xs = this.#xs;
-      const ys = this.#ys;
-      for (let from = keep, to = 0; from < count; from++, to++) {
-        xs[to] = xs[from]!;
-        ys[to] = ys[from]!;
-        ts[to] = ts[from]!;
+      // Most of the array is covered: move what is not to its start, in place.
+      for (let from = DRAWN * keep, to = 0, stop = DRAWN * count; from < stop; from++, to++) {
+        drawn[to] = drawn[from]!;
       }
       this.#count = count - keep;
       this.#first = 0;
