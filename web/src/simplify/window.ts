@@ -186,6 +186,12 @@ export class WindowCore {
   readonly #distances: number[] = [];
   #emittedInPath = false;
   /**
+   * The anchor, window[0], as the point that ended the stroke before (null at a path's start):
+   * the next stroke starts at that same point, a readonly pair, rather than at a copy made at
+   * every cut.
+   */
+  #anchor: Point | null = null;
+  /**
    * The direction of the stroke the latency cap ended last, while the next one may go on along
    * it (null at a path's start and after any other cut).
    */
@@ -284,6 +290,7 @@ export class WindowCore {
     if (count === 0) {
       window.count = 1;
       this.#reach = 0;
+      this.#anchor = null;
       this.#emittedInPath = false;
       this.#line = null;
       this.#resting = false;
@@ -338,7 +345,7 @@ export class WindowCore {
     // The last sample already ends a stroke (a cut at the work cap).
     if (count === 1 && this.#emittedInPath) return [];
     const end = this.#continued(count - 1);
-    return [this.#finish([window.xs[0]!, window.ys[0]!], window.ts[0]!, end, window.ts[count - 1]!)];
+    return [this.#finish(this.#start(), window.ts[0]!, end, window.ts[count - 1]!)];
   }
 
   /**
@@ -381,11 +388,10 @@ export class WindowCore {
         } else {
           const cut = this.#capCut(count);
           const vertex = this.#continued(cut);
-          (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, vertex, ts[cut]!));
+          (out ??= []).push(this.#finish(this.#start(), ts[0]!, vertex, ts[cut]!));
           this.#line = this.#lineOf(cut, vertex);
           // The samples after the cut, this one included, are taken again into the next stroke.
-          window.restart(vertex[0], vertex[1], cut);
-          this.#reach = 0;
+          this.#restart(vertex, cut);
           continue;
         }
       }
@@ -402,10 +408,9 @@ export class WindowCore {
           cut = this.#feature(count, x, y, later);
         }
         const end: Point = [xs[cut]!, ys[cut]!];
-        (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, end, ts[cut]!));
+        (out ??= []).push(this.#finish(this.#start(), ts[0]!, end, ts[cut]!));
         this.#line = null;
-        window.restart(end[0], end[1], cut);
-        this.#reach = 0;
+        this.#restart(end, cut);
       } else {
         window.count = count + 1;
         this.#reaches[count] = this.#reach;
@@ -421,14 +426,29 @@ export class WindowCore {
           // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
           if (rest !== null) (out ??= []).push(rest);
         } else if (count >= maxWindow) {
-          (out ??= []).push(this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], t));
+          const end: Point = [x, y];
+          (out ??= []).push(this.#finish(this.#start(), ts[0]!, end, t));
           this.#line = null;
-          window.restart(x, y, count);
-          this.#reach = 0;
+          this.#restart(end, count);
         }
       }
       if (window.count === window.end) return out;
     }
+  }
+
+  /** Where the stroke being drawn starts: its anchor, window[0]. */
+  #start(): Point {
+    return this.#anchor ?? [this.#window.xs[0]!, this.#window.ys[0]!];
+  }
+
+  /**
+   * Only one sample in the stroke, its anchor at `anchor`, the samples after window[index] to take
+   * again (`Samples.restart`): nothing measured of the stroke before holds for the next.
+   */
+  #restart(anchor: Point, index: number): void {
+    this.#window.restart(anchor[0], anchor[1], index);
+    this.#anchor = anchor;
+    this.#reach = 0;
   }
 
   /**
@@ -458,15 +478,15 @@ export class WindowCore {
     let stroke: Segment | null = null;
     if (start === 0) {
       const anchor = window.samples[0]!;
-      window.restart(xs[0]!, ys[0]!, last);
+      this.#restart(this.#start(), last);
       window.samples[0] = anchor;
       window.retime(t);
     } else {
-      stroke = this.#finish([xs[0]!, ys[0]!], ts[0]!, [x, y], ts[start]!);
-      window.restart(x, y, last);
+      const end: Point = [x, y];
+      stroke = this.#finish(this.#start(), ts[0]!, end, ts[start]!);
+      this.#restart(end, last);
     }
     this.#line = null;
-    this.#reach = 0;
     this.#resting = true;
     this.rested = true;
     return stroke;
@@ -556,8 +576,11 @@ export class WindowCore {
     const { xs, ys } = this.#window;
     const atX = xs[cut]!;
     const atY = ys[cut]!;
-    if (this.#line === null) return [atX, atY];
-    const [ux, uy] = this.#line;
+    const line = this.#line;
+    if (line === null) return [atX, atY];
+    // Indexed, not destructured: destructuring goes through the array's iterator.
+    const ux = line[0];
+    const uy = line[1];
     const ax = xs[0]!;
     const ay = ys[0]!;
     const along = (atX - ax) * ux + (atY - ay) * uy;
@@ -736,6 +759,8 @@ export class WindowCore {
  * simplifier made per path), enough that each sample is moved at most once on average.
  */
 const COMPACT_AFTER = 32;
+/** The numbers the merger keeps of a drawn sample: its time, x and y. */
+const DRAWN = 3;
 
 export class Merger {
   readonly #maxError: number;
@@ -744,18 +769,18 @@ export class Merger {
   readonly #shortMs: number;
   readonly #strict: boolean;
   /**
-   * The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first: [#first,
-   * #count) of arrays kept from one path to the next, so a sample is three stores, not three
-   * pushes. Plain arrays of numbers (stored unboxed, as in `Samples`), not typed arrays: a typed
-   * array's buffer lives outside the heap and is zeroed when made, which cost more than its samples
-   * for a simplifier made per path (as the bench makes one per demonstration).
+   * The drawn samples not yet covered by a sent stroke (ms, grid units), oldest first: samples
+   * [#first, #count) of one array kept from one path to the next, three numbers a sample (time, x,
+   * y) side by side. One array of numbers (stored unboxed, as in `Samples`), not three: every
+   * sample drawn is stored here, and one array grows and checks its bounds once where three did
+   * three times. Not a typed array: its buffer lives outside the heap and is zeroed when made,
+   * which cost more than its samples for a simplifier made per path (as the bench makes one per
+   * demonstration).
    */
-  readonly #xs: number[] = [];
-  readonly #ys: number[] = [];
-  readonly #ts: number[] = [];
+  readonly #drawn: number[] = [];
   #count = 0;
   /**
-   * The first sample not yet covered: those before it are, and are dropped from the arrays only
+   * The first sample not yet covered: those before it are, and are dropped from the array only
    * now and then (`#send`), not at every stroke sent (three splices, each an array made).
    */
   #first = 0;
@@ -781,9 +806,10 @@ export class Merger {
   /** A drawn sample, in order (its time as the window took it). */
   sample(tMs: number, x: number, y: number): void {
     const at = this.#count;
-    this.#xs[at] = x;
-    this.#ys[at] = y;
-    this.#ts[at] = tMs;
+    const drawn = this.#drawn;
+    drawn[DRAWN * at] = tMs;
+    drawn[DRAWN * at + 1] = x;
+    drawn[DRAWN * at + 2] = y;
     this.#count = at + 1;
   }
 
@@ -802,9 +828,7 @@ export class Merger {
    */
   #fits(start: Point, end: Point, endMs: number): boolean {
     const limitSq = this.#maxError * this.#maxError;
-    const xs = this.#xs;
-    const ys = this.#ys;
-    const ts = this.#ts;
+    const drawn = this.#drawn;
     const count = this.#count;
     // `distanceSq` with the chord's terms computed once (the same operations, as in `#farthestSq`).
     const ax = start[0];
@@ -813,9 +837,10 @@ export class Merger {
     const dy = end[1] - ay;
     const lengthSq = dx * dx + dy * dy;
     for (let i = this.#first; i < count; i++) {
-      if (ts[i]! > endMs) break;
-      const qx = xs[i]! - ax;
-      const qy = ys[i]! - ay;
+      const at = DRAWN * i;
+      if (drawn[at]! > endMs) break;
+      const qx = drawn[at + 1]! - ax;
+      const qy = drawn[at + 2]! - ay;
       const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
       if (d > limitSq) return false;
     }
@@ -853,20 +878,16 @@ export class Merger {
             };
     out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
-    const ts = this.#ts;
+    const drawn = this.#drawn;
     const count = this.#count;
     const endMs = segment.end_ms;
     let keep = this.#first;
-    while (keep < count && ts[keep]! < endMs) keep++;
+    while (keep < count && drawn[DRAWN * keep]! < endMs) keep++;
     this.#first = keep;
     if (keep >= COMPACT_AFTER && 2 * keep >= count) {
-      // Most of the arrays are covered: move what is not to their start, in place.
-      const xs = this.#xs;
-      const ys = this.#ys;
-      for (let from = keep, to = 0; from < count; from++, to++) {
-        xs[to] = xs[from]!;
-        ys[to] = ys[from]!;
-        ts[to] = ts[from]!;
+      // Most of the array is covered: move what is not to its start, in place.
+      for (let from = DRAWN * keep, to = 0, stop = DRAWN * count; from < stop; from++, to++) {
+        drawn[to] = drawn[from]!;
       }
       this.#count = count - keep;
       this.#first = 0;
