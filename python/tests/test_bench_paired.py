@@ -24,13 +24,21 @@ from feelmysign.bench.sleeve import (
     paired_interval,
     paired_latencies,
 )
+from feelmysign.broker import Broker
+from feelmysign.broker.credentials import Account
+
+
+@pytest.fixture
+def paired_broker(start_broker: StartBroker, tmp_path: Path) -> tuple[Broker, Account]:
+    """A broker whose state holds the bare receiver's account, added before it starts."""
+    account = add_bare_account(tmp_path / "broker")
+    return start_broker(state_dir=tmp_path / "broker"), account
 
 
 def test_the_bare_receiver_reads_its_own_topic_beside_the_sleeve(
-    start_broker: StartBroker, tmp_path: Path
+    paired_broker: tuple[Broker, Account],
 ) -> None:
-    account = add_bare_account(tmp_path / "broker")
-    broker = start_broker(state_dir=tmp_path / "broker")
+    broker, account = paired_broker
     c = broker.credentials
     sender = _client(c, "sender")
     try:
@@ -44,10 +52,9 @@ def test_the_bare_receiver_reads_its_own_topic_beside_the_sleeve(
 
 
 def test_strokes_and_bare_messages_alternate_at_each_length(
-    start_broker: StartBroker, tmp_path: Path
+    paired_broker: tuple[Broker, Account],
 ) -> None:
-    account = add_bare_account(tmp_path / "broker")
-    broker = start_broker(state_dir=tmp_path / "broker")
+    broker, account = paired_broker
     c = broker.credentials
     sender = _client(c, "sender")
     strokes = Strokes(c)
@@ -65,10 +72,9 @@ def test_strokes_and_bare_messages_alternate_at_each_length(
 
 
 def test_the_relay_groups_senders_and_baseline_are_measured_round_by_round(
-    start_broker: StartBroker, tmp_path: Path
+    paired_broker: tuple[Broker, Account],
 ) -> None:
-    account = add_bare_account(tmp_path / "broker")
-    broker = start_broker(state_dir=tmp_path / "broker")
+    broker, account = paired_broker
     c = broker.credentials
     senders = {"one TCP sender": _client(c, "sender"), "another": _client(c, "sender")}
     strokes = Strokes(c)

@@ -20,10 +20,17 @@ import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { durationWords } from "../src/fates";
 import { EventWatcher } from "./harness";
-import { drawingArea, nextFrame, screenshot, waitForData, type Area } from "./page";
+import {
+  drawingArea,
+  nextFrame,
+  screenshot,
+  SUMMARY,
+  waitForData,
+  waitForEveryStroke,
+  type Area,
+} from "./page";
 import { Processes, type Up } from "./processes";
 
-const SUMMARY = '[data-testid="played-summary"]';
 const CARD = 'section.card:has([data-testid="played-summary"])';
 /** events.ts NOTABLE_ADJUSTMENT: a stroke shortened by less than this share is not said. */
 const NOTABLE = 0.05;
@@ -31,35 +38,19 @@ const LINE_TIMEOUT_MS = 40_000;
 
 type Point = readonly [number, number];
 
-interface Card {
-  sent: number;
-  played: number;
-  cut: number;
-  cancelled: number;
-  refused: number;
-  dropped: number;
-  compressed: number;
-  compressedMs: number;
-  slowed: number;
-  late: number;
-}
-
-async function cardData(page: Page): Promise<Card> {
-  const data = await page.locator(SUMMARY).evaluate((element) => ({ ...(element as HTMLElement).dataset }));
-  const read = (key: string) => Number(data[key]);
-  return {
-    sent: read("sent"),
-    played: read("played"),
-    cut: read("cut"),
-    cancelled: read("cancelled"),
-    refused: read("refused"),
-    dropped: read("dropped"),
-    compressed: read("compressed"),
-    compressedMs: read("compressedMs"),
-    slowed: read("slowed"),
-    late: read("late"),
-  };
-}
+/** The card's counts this test reads. */
+const CARD_KEYS = [
+  "sent",
+  "played",
+  "cut",
+  "cancelled",
+  "refused",
+  "dropped",
+  "compressed",
+  "compressedMs",
+  "slowed",
+  "late",
+] as const;
 
 /**
  * The strokes the sleeve slowed that are not their path's last (`lastSeq`: each drawing here is
@@ -71,18 +62,6 @@ function slowedMidPath(events: readonly Record<string, unknown>[], lastSeq: numb
     .map(
       (event) => `seq ${String(event["seq"])} of 0..${lastSeq}: ${String(event["requested_duration_ms"])} ms`,
     );
-}
-
-/** Waits until every stroke drawn has a fate on the card. */
-async function waitForEveryStroke(page: Page, timeoutMs = 60_000): Promise<Card> {
-  const deadline = Date.now() + timeoutMs;
-  for (;;) {
-    const card = await cardData(page);
-    const answered = card.played + card.cut + card.cancelled + card.refused + card.dropped;
-    if (card.sent > 0 && answered === card.sent) return card;
-    if (Date.now() > deadline) throw new Error(`not every stroke answered: ${JSON.stringify(card)}`);
-    await new Promise((wake) => setTimeout(wake, 100));
-  }
 }
 
 /**
@@ -209,12 +188,12 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
     async () => {
       const drawn = await drawZigzag(10);
       expect(drawn).not.toBe("");
-      await waitForEveryStroke(page);
+      await waitForEveryStroke(page, CARD_KEYS);
       // Play again: every stroke at once, each queued behind the one before it.
       await page.locator('[data-testid="replay-button"]').click();
       const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
       expect(drawing).not.toBe(drawn);
-      const card = await waitForEveryStroke(page);
+      const card = await waitForEveryStroke(page, CARD_KEYS);
       await watcher.waitFor(
         "an event for every stroke",
         () => watcher.of(drawing).length >= card.sent,
@@ -291,7 +270,7 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
         if (leg === 16) process.kill(broker, "SIGCONT");
       });
       expect(broker).toBeGreaterThan(0);
-      const card = await waitForEveryStroke(page);
+      const card = await waitForEveryStroke(page, CARD_KEYS);
       await watcher.waitFor(
         "an event for every stroke",
         () => watcher.of(drawing).length >= card.sent,

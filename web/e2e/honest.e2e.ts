@@ -18,10 +18,18 @@ import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { isDelayed, readEvent, type AdjustedEvent, type PlayedEvent } from "../src/events";
 import { DrawingFates, type Fate } from "../src/fates";
 import { collectUntil, EventWatcher, REPO_DIR, type Credentials } from "./harness";
-import { drawingArea, nextFrame, screenshot, waitForData, type Area } from "./page";
+import {
+  cardCounts,
+  drawingArea,
+  nextFrame,
+  screenshot,
+  SUMMARY,
+  waitForData,
+  waitForEveryStroke,
+  type Area,
+} from "./page";
 import { Processes, type Up } from "./processes";
 
-const SUMMARY = '[data-testid="played-summary"]';
 const CAPTION = '[data-testid="timeline-caption"]';
 const PYTHON = join(REPO_DIR, ".venv", "bin", "python");
 /** `up` prints a drawing's line once it has been quiet this long (drawing_log.IDLE_S) and more. */
@@ -29,29 +37,9 @@ const LINE_TIMEOUT_MS = 40_000;
 
 type Point = readonly [number, number];
 
-interface PageCounts {
-  sent: number;
-  played: number;
-  cut: number;
-  cancelled: number;
-  refused: number;
-  dropped: number;
-  delayed: number;
-}
-
-async function pageCounts(page: Page): Promise<PageCounts> {
-  const data = await page.locator(SUMMARY).evaluate((element) => ({ ...(element as HTMLElement).dataset }));
-  const read = (key: string) => Number(data[key]);
-  return {
-    sent: read("sent"),
-    played: read("played"),
-    cut: read("cut"),
-    cancelled: read("cancelled"),
-    refused: read("refused"),
-    dropped: read("dropped"),
-    delayed: read("delayed"),
-  };
-}
+/** The card's counts this test compares. */
+const PAGE_KEYS = ["sent", "played", "cut", "cancelled", "refused", "dropped", "delayed"] as const;
+type PageCounts = Record<(typeof PAGE_KEYS)[number], number>;
 
 /**
  * What the felt timeline's caption says became of the strokes, in the card's terms. Its short
@@ -67,18 +55,6 @@ function captionCounts(caption: string, sent: number): Omit<PageCounts, "sent" |
     refused: count(/(\d+) (?:refused by the sleeve|skipped as late|not felt \(the sleeve's duty-cycle cap)/g),
     dropped: count(/(\d+) never sent/g),
   };
-}
-
-/** Waits until every stroke drawn has a fate on the page (or was never sent). */
-async function waitForEveryStroke(page: Page, timeoutMs = 60_000): Promise<PageCounts> {
-  const deadline = Date.now() + timeoutMs;
-  for (;;) {
-    const counts = await pageCounts(page);
-    const answered = counts.played + counts.cut + counts.cancelled + counts.refused + counts.dropped;
-    if (counts.sent > 0 && answered === counts.sent) return counts;
-    if (Date.now() > deadline) throw new Error(`not every stroke answered: ${JSON.stringify(counts)}`);
-    await new Promise((wake) => setTimeout(wake, 100));
-  }
 }
 
 /** What `up` printed about `drawing`: its last "Drawing" line (the whole drawing). */
@@ -312,7 +288,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
       await waitForData(page, '[data-testid="broker-status"]', "state", "connected", 60_000);
       // Every stroke answered first: the page's log keeps its last few notes, and strokes held
       // in the outbox through the outage, played after the copy, would push its note out.
-      const before = await waitForEveryStroke(page);
+      const before = await waitForEveryStroke(page, PAGE_KEYS);
       // The broker delivers a stroke again that the sleeve has played (its acknowledgement lost
       // with the broker): here sent again by hand, so that it happens on every run.
       await watcher.waitFor("a played stroke", () => watcher.of(drawing, "played").length > 0, 60_000);
@@ -338,7 +314,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
           { timeout: 30_000 },
         )
         .catch(() => undefined); // the assertion below then shows the log as it is
-      const counts = await waitForEveryStroke(page);
+      const counts = await waitForEveryStroke(page, PAGE_KEYS);
       // The copy changed no count: each stroke still counts once.
       expect(counts).toEqual(before);
       const byFate = await expectAllAgree(drawing, counts);
@@ -386,7 +362,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
         await new Promise((wake) => setTimeout(wake, 200));
       }
       await waitForData(page, '[data-testid="broker-status"]', "state", "connected", 60_000);
-      const counts = await waitForEveryStroke(page);
+      const counts = await waitForEveryStroke(page, PAGE_KEYS);
       console.log(`${kills} broker kills`);
       await expectAllAgree(drawing, counts);
       expectHeldStrokesKeepTheirDrawnTime(watcher.of(drawing));
@@ -415,7 +391,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
         { timeout: 30_000 },
       );
       await page.keyboard.press("Escape");
-      const counts = await waitForEveryStroke(page);
+      const counts = await waitForEveryStroke(page, PAGE_KEYS);
       const byFate = await expectAllAgree(drawing, counts);
       expect(byFate.cancelled).toBeGreaterThan(0);
       const summary = await page.locator(SUMMARY).innerText();
@@ -435,10 +411,10 @@ describe("honest after faults: the page, up and the study agree with what the sl
       const drawing = await drawZigzag(10, [0.06, 0.94, 0.25, 0.75], async (leg) => {
         if (leg === 5) {
           await page.keyboard.press("Escape"); // Stop, the pen still down
-          sentAtStop = (await pageCounts(page)).sent;
+          sentAtStop = (await cardCounts(page, PAGE_KEYS)).sent;
         }
       });
-      const counts = await waitForEveryStroke(page);
+      const counts = await waitForEveryStroke(page, PAGE_KEYS);
       // The pen moving on after Stop drew nothing more: no stroke was made, none sent.
       expect(counts.sent).toBe(sentAtStop);
       await expectAllAgree(drawing, counts);

@@ -10,32 +10,24 @@ import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { EventWatcher, RESULTS_DIR } from "./harness";
-import { drawingArea, drawWithMouse, screenshot, waitForData, type Area } from "./page";
+import {
+  drawingArea,
+  drawWithMouse,
+  screenshot,
+  SUMMARY,
+  waitForData,
+  waitForEveryStroke,
+  type Area,
+} from "./page";
 import { Processes } from "./processes";
 
 type Point = readonly [number, number];
-const SUMMARY = '[data-testid="played-summary"]';
 const CAPTION = '[data-testid="timeline-caption"]';
 const CARD = `section.card:has(${SUMMARY})`;
 const FELT = `section:has(${CAPTION})`;
 
 async function data(page: Page, selector: string, key: string): Promise<number> {
   return Number(await page.locator(selector).evaluate((el, k) => (el as HTMLElement).dataset[k] ?? "", key));
-}
-
-/** Waits until every stroke of the card's drawing has a fate; returns how many played. */
-async function waitAnswered(page: Page, timeoutMs = 60_000): Promise<{ sent: number; played: number }> {
-  const deadline = Date.now() + timeoutMs;
-  for (;;) {
-    const [sent, played, cut, cancelled, refused, dropped] = await Promise.all(
-      ["sent", "played", "cut", "cancelled", "refused", "dropped"].map((key) => data(page, SUMMARY, key)),
-    );
-    if (sent! > 0 && played! + cut! + cancelled! + refused! + dropped! === sent)
-      return { sent: sent!, played: played! };
-    if (Date.now() > deadline)
-      throw new Error(`not every stroke answered: ${await page.locator(SUMMARY).innerText()}`);
-    await new Promise((wake) => setTimeout(wake, 100));
-  }
 }
 
 /** Screenshots of the page, and of the card and the felt timeline alone. */
@@ -70,7 +62,7 @@ describe("a new user's first drawings, served by feelmysign up with the simulate
     await drawWithMouse(page, [at(0.1, 0.2), at(0.9, 0.2), at(0.1, 0.5)], { legMs: 500 });
     const first = await data(page, '[data-testid="timeline"]', "strokes");
     await drawWithMouse(page, [at(0.1, 0.8), at(0.9, 0.8), at(0.5, 0.5)], { legMs: 500 });
-    const both = await waitAnswered(page);
+    const both = await waitForEveryStroke(page);
     const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
     await watcher.waitFor("every played event", () => watcher.of(drawing, "played").length >= both.played);
     expect(both.played).toBe(both.sent);
@@ -114,7 +106,7 @@ describe("a new user's first drawings, served by feelmysign up with the simulate
     // The sleeve idle first, so none is refused for starting too late after it was sent.
     await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0", 30_000);
     await page.locator('[data-testid="replay-button"]').click();
-    const again = await waitAnswered(page);
+    const again = await waitForEveryStroke(page);
     expect(again.played).toBe(strokes);
     const summary = await page.locator(SUMMARY).innerText();
     expect(summary).toMatch(

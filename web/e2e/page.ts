@@ -207,6 +207,41 @@ export async function showActuators(
   await waitForData(page, '[data-testid="sleeve-preview"]', "lit", String(lit));
 }
 
+/** The "Sleeve says" card's summary line, whose data-* attributes hold the drawing's counts. */
+export const SUMMARY = '[data-testid="played-summary"]';
+
+/** What became of a stroke, on the card: every one sent has one of these once answered. */
+const ANSWERED = ["played", "cut", "cancelled", "refused", "dropped"] as const;
+type Answered = (typeof ANSWERED)[number];
+
+/** The card's counts named by `keys` (its summary's data-* attributes), as numbers. */
+export async function cardCounts<K extends string>(
+  page: Page,
+  keys: readonly K[],
+): Promise<Record<K, number>> {
+  const data = await page.locator(SUMMARY).evaluate((element) => ({ ...(element as HTMLElement).dataset }));
+  return Object.fromEntries(keys.map((key) => [key, Number(data[key])])) as Record<K, number>;
+}
+
+/**
+ * Waits until every stroke the card counts sent has a fate there (or was never sent); returns
+ * the counts named by `keys` then, with "sent" and the fates.
+ */
+export async function waitForEveryStroke<K extends string = never>(
+  page: Page,
+  keys: readonly K[] = [],
+  timeoutMs = 60_000,
+): Promise<Record<K | Answered | "sent", number>> {
+  const deadline = Date.now() + timeoutMs;
+  for (;;) {
+    const counts = await cardCounts(page, [...new Set([...keys, "sent" as const, ...ANSWERED])]);
+    const answered = ANSWERED.reduce((sum, fate) => sum + counts[fate], 0);
+    if (counts.sent > 0 && answered === counts.sent) return counts;
+    if (Date.now() > deadline) throw new Error(`not every stroke answered: ${JSON.stringify(counts)}`);
+    await new Promise((wake) => setTimeout(wake, 100));
+  }
+}
+
 /** Waits until the sleeve has played at least one stroke of the page's current drawing. */
 export async function waitForPlayed(page: Page, timeoutMs = 30_000): Promise<void> {
   await page.waitForFunction(
