@@ -336,9 +336,21 @@ def test_usage_errors_exit_2(
     assert says in capsys.readouterr().err
 
 
-def test_shape_errors_name_the_range(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["send", "--shape", "circle", "--segments", "2"]) == 1
-    assert "a whole number from 3 to 64" in capsys.readouterr().err
+@pytest.mark.parametrize(
+    ("shape", "segments", "says"),
+    [
+        ("circle", "2", "--segments: 2 does not fit a circle; give a whole number from 3 to 64"),
+        ("square", "6", "--segments: 6 does not fit a square; give a multiple of 4 from 4 to 64"),
+    ],
+)
+def test_shape_errors_name_the_option_and_range(
+    shape: str, segments: str, says: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A bad option value is a usage error like any other: exit 2, before any connection.
+    with pytest.raises(SystemExit) as caught:
+        main(["send", "--shape", shape, "--segments", segments, "--broker", "mqtt://127.0.0.1:1"])
+    assert caught.value.code == 2
+    assert says in capsys.readouterr().err
 
 
 # --- where the settings come from --------------------------------------------------------------

@@ -114,3 +114,25 @@ def test_each_stroke_skipped_as_late_is_said_so_as_the_summary_says_it() -> None
         "[3/3] refused (outside_grid): outside_grid",
     ]
     assert "skipped 1 as late" in outcome.summary().text()
+
+
+def test_a_strokes_line_says_its_wait_only_when_it_is_notable() -> None:
+    # The wait behind the strokes before it is said when it is 5 % or more of the stroke's
+    # duration (as fates.NOTABLE_CHANGE has it for a catch-up); a few ms of jitter is not.
+    from feelmysign.cli.send import _answer_line
+
+    outcome = outcome_of(
+        3,
+        played(0, queued_ms=4, latency_ms=5),
+        played(1, queued_ms=80, latency_ms=81),
+        played(2, queued_ms=21, latency_ms=22, duration_ms=417.25),
+    )
+    lines = [
+        _answer_line(i, 3, s, s.played, json_lines=False)  # type: ignore[arg-type]
+        for i, s in enumerate(outcome.strokes)
+    ]
+    assert lines[0] == "[1/3] played: 417.5 ms, latency 5 ms"
+    assert lines[1] == (
+        "[2/3] played: 417.5 ms, latency 81 ms (of which 80 ms waiting for the strokes before it)"
+    )
+    assert lines[2].startswith("[3/3] played: 417.2 ms, latency 22 ms (of which 21 ms waiting")

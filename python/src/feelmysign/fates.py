@@ -71,6 +71,17 @@ def caught_up_ms(event: Played) -> float:
     return 0.0
 
 
+def waited_ms(event: Played) -> float:
+    """How long the stroke of ``event`` waited behind the strokes before it; 0 when that wait is
+    below ``NOTABLE_CHANGE`` of its duration as it came (a few ms of the network's jitter)."""
+    queued_ms = event.queued_ms
+    if queued_ms > 0 and queued_ms >= NOTABLE_CHANGE * (
+        event.duration_ms + (event.compressed_ms or 0.0)
+    ):
+        return queued_ms
+    return 0.0
+
+
 @dataclass(frozen=True)
 class CatchUp:
     """How the sleeve kept one drawing in time: ``compressed`` strokes played faster to catch

@@ -53,7 +53,7 @@ from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
 from feelmysign.events import Event, Status, StatusControls, StatusFloor
-from feelmysign.fates import caught_up_ms
+from feelmysign.fates import caught_up_ms, waited_ms
 from feelmysign.input_files import loads_json
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
 from feelmysign.outcome import DrawingOutcome, StrokeOutcome
@@ -401,9 +401,11 @@ def _answer_line(
     how = f"{event.kind}" + (
         f" ({getattr(event, 'reason', '')})" if event.kind == "adjusted" else ""
     )
-    line = f"{where} {how}: {played.duration_ms:g} ms, latency {played.latency_ms:.0f} ms"
-    if played.queued_ms >= 1:  # most of that latency was the wait, not the network
-        line += f" (of which {played.queued_ms:.0f} ms waiting for the strokes before it)"
+    duration = f"{round(played.duration_ms, 1):g}"
+    line = f"{where} {how}: {duration} ms, latency {played.latency_ms:.0f} ms"
+    waited = waited_ms(played)
+    if waited:  # the wait behind the strokes before it, not the network
+        line += f" (of which {waited:.0f} ms waiting for the strokes before it)"
     shorter_ms = caught_up_ms(played)
     if shorter_ms:  # played faster to catch up with the strokes before it
         line += f", {shorter_ms:.0f} ms shorter to catch up"
@@ -495,7 +497,8 @@ def _numbers(numbers: list[int]) -> str:
 
 def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
     """One line on stderr (stdout may be JSON for a program): the floor the sleeve advertises and
-    how many of the strokes, sent as given (no simplifier here), are below it."""
+    how many of the strokes, sent as given (no simplifier here), are below it; said when some
+    are, or when the floor is a wearer's measured limits, not before every send."""
     if floor is None:
         return
     below = sum(
@@ -503,6 +506,8 @@ def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
         for s in strokes
         if s.duration_ms < floor.min_duration_ms or math.dist(s.start, s.end) < floor.min_length
     )
+    if not below and not floor.wearer:
+        return
     whose = f" with wearer {floor.wearer}'s limits" if floor.wearer else ""
     verdict = (
         f"{below} of the {len(strokes)} strokes are below it (the sleeve slows a briefer one; "
@@ -535,6 +540,11 @@ def _check_usage(args: argparse.Namespace, parser: argparse.ArgumentParser) -> N
             parser.error(f"{' and '.join(given)} only apply to --shape (a STROKE has its duration)")
     if args.legacy and args.intensity is not None:
         parser.error("--intensity cannot be sent with --legacy: the legacy format has no intensity")
+    if args.shape and args.segments is not None and not SHAPES[args.shape].accepts(args.segments):
+        parser.error(
+            f"--segments: {args.segments} does not fit a {args.shape}; give "
+            f"{SHAPES[args.shape].allowed()}"
+        )
 
 
 # What a stroke or shape is checked against before the sleeve's own grid is known.
