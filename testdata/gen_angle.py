@@ -145,6 +145,9 @@ def _segments(params: Params, paths: list[Path]) -> dict[str, Any]:
             "dropped": s.dropped,
             # The window simplifier merges pieces too short to send: how many are in this one.
             **({"merged": s.merged} if isinstance(params, WindowParams) else {}),
+            # ... and gives a piece briefer than the sleeve's floor the floor's duration: how
+            # long the sleeve is to play each stroke (end_ms - start_ms unless so).
+            **({"duration_ms": s.duration_ms} if isinstance(params, WindowParams) else {}),
         }
         for p in simplify_paths(params, paths)
         for s in [p.segment]

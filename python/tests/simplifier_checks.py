@@ -45,6 +45,8 @@ def check_vector(
             segment.start_ms,
             segment.end_ms,
             segment.emitted_at_ms,
+            # The window simplifier's: how long the sleeve is to play it (the angle's: as drawn).
+            segment.duration_ms,
         ]
         wanted = [
             *want["start"],
@@ -52,6 +54,7 @@ def check_vector(
             want["start_ms"],
             want["end_ms"],
             want["emitted_at_ms"],
+            want.get("duration_ms", want["end_ms"] - want["start_ms"]),
         ]
         assert got == pytest.approx(wanted, abs=case["tolerance"])
 
@@ -130,10 +133,17 @@ def _distance_to(point: tuple[float, float], start: Point, end: Point) -> float:
 
 def assert_dropped_say_why(params: SimplifierParams, samples: list[Sample]) -> None:
     """Sent strokes meet the minimums, a dropped one names the first it misses."""
+    floor_ms = max(getattr(params, "floor_ms", 0.0), params.min_duration_ms)
     for _, segment in run(params, [samples]):
         if segment.dropped is None:
             assert segment.length >= params.min_length
             assert segment.duration_ms >= params.min_duration_ms
+            # The window simplifier sends no stroke the sleeve must slow: one drawn briefer
+            # than the floor lasts the floor, any other as long as it was drawn.
+            assert segment.duration_ms >= floor_ms
+            assert segment.duration_ms in (segment.drawn_ms, floor_ms)
+            if segment.drawn_ms < floor_ms:
+                assert segment.duration_ms == floor_ms
         elif segment.dropped == NOT_ENOUGH_DISTANCE:
             assert segment.length < params.min_length
         else:

@@ -164,9 +164,9 @@ def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
     params = WindowParams(canvas_width_px=300, canvas_height_px=200, max_stroke_ms=100)
     line = [Sample(8.0 * k, 1.0 * k, 100) for k in range(76)]  # 600 ms, straight
     cut = [s for _, s in run(replace(params, **UNMERGED), [line])]
-    assert all(s.duration_ms <= 100 for s in cut)
+    assert all(s.drawn_ms <= 100 for s in cut)
     # Samples 8 ms apart: each stroke covers 12 of them (96 ms), the seventh the rest.
-    assert [s.duration_ms for s in cut] == [96.0] * 6 + [24.0]
+    assert [s.drawn_ms for s in cut] == [96.0] * 6 + [24.0]
     assert cut[0].emitted_at_ms == 104.0  # let go by the sample that would pass 100 ms
     assert cut[-1].end_ms == 600.0
     # With the sleeve's floor (73.7 ms) a stroke the cap ends is merged into nothing before it,
@@ -174,9 +174,12 @@ def test_the_latency_cap_cuts_a_long_line_before_it_ends() -> None:
     # end (max_error 0.25): it merges into it at release, and nothing more is sent.
     assert [s.duration_ms for _, s in run(params, [line])] == [96.0] * 6
     assert _merged_back(params, [line]) == [1]
-    # A bound tighter than those 0.03 keeps the rest apart: sent as it is, briefer than the floor.
+    # A bound tighter than those 0.03 keeps the rest apart: sent where it was drawn, briefer
+    # than the floor, to last the floor (the sleeve would slow it to that).
     tight = replace(params, max_error=0.02)
-    assert [s.duration_ms for _, s in run(tight, [line])] == [96.0] * 6 + [24.0]
+    sent = [s for _, s in run(tight, [line])]
+    assert [s.drawn_ms for s in sent] == [96.0] * 6 + [24.0]
+    assert [s.duration_ms for s in sent] == [96.0] * 6 + [params.floor_ms]
     assert _merged_back(tight, [line]) == [0]
 
 
@@ -272,7 +275,7 @@ def test_a_sample_earlier_than_the_one_before_is_taken_at_its_time() -> None:
     simplifier.push(Sample(20.0, 100, 100))
     simplifier.push(Sample(19.0, 200, 100))
     (last,) = simplifier.end()
-    assert last.end_ms == 20.0 and last.duration_ms == 10.0
+    assert last.end_ms == 20.0 and last.drawn_ms == 10.0
 
 
 def test_window_cap_cuts_at_the_current_frame() -> None:

@@ -9,11 +9,11 @@
  * the card's log says "Stroke N skipped as late: ...".
  *
  * The sleeve slows (reports `adjusted`) only a stroke briefer than its floor (73.701 ms, in its
- * status). The page sends none in the middle of a path: each drawing here is one path, and only
- * its last stroke may be briefer than the floor, the piece left at release that could not merge
- * back into the stroke before it (window.ts `Merger.end`). A pen resting mid-path (as the drawing
- * pauses while the test freezes the broker) lends a held piece the floor: before it lasted
- * `start + floor - start`, which rounds to 73.70099999999911 ms from 15000.1 ms and was slowed.
+ * status). The page sends none: a piece that could not merge (mid-path, or the one left at
+ * release that could not merge back into the stroke before it, window.ts `Merger.end`) is sent
+ * to last the floor. A pen resting mid-path (as the drawing pauses while the test freezes the
+ * broker) lends a held piece the floor: before it lasted `start + floor - start`, which rounds
+ * to 73.70099999999911 ms from 15000.1 ms and was slowed.
  */
 import { spawnSync } from "node:child_process";
 import type { Page } from "playwright-core";
@@ -201,6 +201,8 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       );
       const said = fromEvents(watcher.of(drawing));
       expect(slowedMidPath(watcher.of(drawing), card.sent - 1)).toEqual([]);
+      // Nor at its end: the page sends no stroke the sleeve must slow.
+      expect(said.slowed).toBe(0);
       // The sleeve caught up: most strokes of a drawing sent at once play faster, none skipped.
       expect(said.compressed).toBeGreaterThanOrEqual(card.sent / 2);
       expect(said.late).toBe(0);
@@ -217,8 +219,7 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
         slowed: said.slowed,
         late: 0,
       });
-      // (The path's last stroke, briefer than the floor where it could not merge back, is slowed:
-      // said after a ";".)
+      // (A stroke slowed would be said after a ";".)
       const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
       // No pen to catch up with: the card says the strokes were played back to back, over the span
       // the sleeve's own times give, and how much shorter than the drawing took to draw.
@@ -277,14 +278,16 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
         60_000,
       );
       const said = fromEvents(watcher.of(drawing));
-      // Nothing slowed but the path's last stroke: the rest while the broker froze lends the
-      // stroke before it the floor, to the last bit.
+      // Nothing slowed mid-path: the rest while the broker froze lends the stroke before it the
+      // floor, to the last bit.
       expect(slowedMidPath(watcher.of(drawing), card.sent - 1)).toEqual([]);
+      // Nor at its end: the page sends no stroke the sleeve must slow.
+      expect(said.slowed).toBe(0);
       expect(said.late).toBeGreaterThan(0);
       expect(card.late).toBe(said.late);
       expect(card.compressed).toBe(said.compressed);
       expect(card.compressedMs).toBe(Math.round(said.compressedMs));
-      expect(card.slowed).toBe(said.slowed); // the path's last stroke at most (see above)
+      expect(card.slowed).toBe(said.slowed);
       // Each stroke once: the late among the refused, the caught-up among the played.
       expect(card.played + card.cut + card.cancelled + card.refused + card.dropped).toBe(card.sent);
       const summary = await page.locator(SUMMARY).innerText();

@@ -81,7 +81,7 @@ export class Drawing {
       stroke = {
         start: segment.start,
         end: segment.end,
-        duration_ms: segment.end_ms - segment.start_ms,
+        duration_ms: segment.duration_ms,
         intensity,
         drawing: this.id,
         seq: this.#nextSeq++,

@@ -90,7 +90,11 @@ function segmentOf(recorded: Recording["strokes"][number] | Recording["dropped"]
     end: recorded.end,
     start_ms: recorded.start_ms,
     end_ms: recorded.end_ms,
-    duration_ms: recorded.end_ms - recorded.start_ms,
+    // As sent (a stroke drawn briefer than the sleeve's floor lasts the floor), else as drawn.
+    duration_ms:
+      Number.isFinite(recorded.duration_ms) && recorded.duration_ms > 0
+        ? recorded.duration_ms
+        : recorded.end_ms - recorded.start_ms,
     emitted_at_ms: recorded.end_ms,
     dropped,
   };

@@ -65,7 +65,7 @@ export function buildRecording(drawing: Drawing, recordedAt: Date): Recording {
       end: segment.end,
       start_ms: segment.start_ms - origin,
       end_ms: segment.end_ms - origin,
-      duration_ms: segment.end_ms - segment.start_ms,
+      duration_ms: segment.duration_ms,
     };
     if (stroke !== null && stroke.seq != null) {
       strokes.push({ ...common, seq: stroke.seq, intensity: stroke.intensity ?? null });

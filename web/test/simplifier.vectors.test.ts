@@ -21,6 +21,8 @@ interface ExpectedSegment {
   dropped: string | null;
   /** The window simplifier's: how many pieces too short to send were merged into it. */
   merged?: number;
+  /** The window simplifier's: how long the sleeve is to play it (a stroke drawn briefer than the floor lasts the floor). */
+  duration_ms?: number;
 }
 
 interface SimplifierVector<P> {
@@ -66,6 +68,12 @@ function checkVector(
     close(got.segment.start_ms, want.start_ms, tol, `${where} start_ms`);
     close(got.segment.end_ms, want.end_ms, tol, `${where} end_ms`);
     close(got.segment.emitted_at_ms, want.emitted_at_ms, tol, `${where} emitted_at_ms`);
+    close(
+      got.segment.duration_ms,
+      want.duration_ms ?? want.end_ms - want.start_ms,
+      tol,
+      `${where} duration_ms`,
+    );
   });
   if (params.algorithm === "window") {
     // The pieces merged at release into the stroke before them, path by path (nothing was sent).

@@ -119,7 +119,7 @@ describe("window simplifier invariants", () => {
             let held = 0;
             for (let j = first + 1; j <= last; j++) if (samples[j]!.t_ms > segment.start_ms) held++;
             expect(held).toBeLessThanOrEqual(params.max_window);
-            if (params.max_stroke_ms > 0 && segment.duration_ms > params.max_stroke_ms) {
+            if (params.max_stroke_ms > 0 && segment.end_ms - segment.start_ms > params.max_stroke_ms) {
               // Only a single step, or a stroke still too short to send a sample earlier.
               const [bx, by] = map.toGrid(samples[last - 1]!.x, samples[last - 1]!.y);
               const short = Math.hypot(bx - segment.start[0], by - segment.start[1]) < params.min_length;
@@ -164,6 +164,14 @@ describe("window simplifier invariants", () => {
           for (let i = 1; i < segments.length; i++) {
             expect(segments[i]!.start).toEqual(segments[i - 1]!.end);
             expect(segments[i]!.start_ms).toBeGreaterThanOrEqual(segments[i - 1]!.end_ms);
+          }
+          // No stroke the sleeve must slow: one drawn briefer than the floor lasts the floor,
+          // any other as long as it was drawn.
+          const floorMs = Math.max(params.min_duration_ms, params.floor_ms);
+          for (const segment of segments) {
+            if (segment.dropped !== null) continue;
+            const drawnMs = segment.end_ms - segment.start_ms;
+            expect(segment.duration_ms).toBe(drawnMs < floorMs ? floorMs : drawnMs);
           }
         }),
         { numRuns: 200 },
@@ -237,7 +245,8 @@ describe("window simplifier invariants", () => {
             return;
           }
           const brief = Math.max(params.min_duration_ms, params.floor_ms);
-          if (params.rest_ms === 0 && sent.length >= 2 && sent[sent.length - 1]!.duration_ms < brief) {
+          const lastSent = sent[sent.length - 1];
+          if (params.rest_ms === 0 && sent.length >= 2 && lastSent!.end_ms - lastSent!.start_ms < brief) {
             expect(farthestFrom(sent[sent.length - 2]!)).toBeGreaterThan(params.max_error - FLOAT_TOLERANCE);
           }
         }),

@@ -35,7 +35,10 @@ export interface Segment {
   readonly end: Point;
   readonly start_ms: number;
   readonly end_ms: number;
-  /** end_ms - start_ms: how long the piece took to draw. */
+  /**
+   * How long the sleeve is to play it: end_ms - start_ms (how long the piece took to draw), or,
+   * for a stroke of the window simplifier drawn briefer than the sleeve's floor, the floor.
+   */
   readonly duration_ms: number;
   readonly emitted_at_ms: number;
   readonly dropped: DropReason | null;

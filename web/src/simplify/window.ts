@@ -853,8 +853,14 @@ export class Merger {
     // A piece made at this sample and not dropped (most: the window's and the merged ones) is sent
     // as it is; else a copy, built field by field, not spread (several times slower): the same
     // keys in the same order. Object.is: -0 and 0 are different times to the vectors.
+    // A stroke drawn briefer than the sleeve's floor (one that could not merge) lasts the floor:
+    // the sleeve would slow it to that, and has nothing to adjust (its times stay the drawn ones).
+    const shortMs = this.#shortMs;
+    const durationMs = segment.end_ms - segment.start_ms < shortMs ? shortMs : segment.duration_ms;
     const sent: Segment =
-      segment.dropped === null && Object.is(segment.emitted_at_ms, nowMs)
+      segment.dropped === null &&
+      Object.is(segment.emitted_at_ms, nowMs) &&
+      durationMs === segment.duration_ms
         ? segment
         : segment.merged === undefined
           ? {
@@ -862,7 +868,7 @@ export class Merger {
               end: segment.end,
               start_ms: segment.start_ms,
               end_ms: segment.end_ms,
-              duration_ms: segment.duration_ms,
+              duration_ms: durationMs,
               emitted_at_ms: nowMs,
               dropped: null,
             }
@@ -871,7 +877,7 @@ export class Merger {
               end: segment.end,
               start_ms: segment.start_ms,
               end_ms: segment.end_ms,
-              duration_ms: segment.duration_ms,
+              duration_ms: durationMs,
               emitted_at_ms: nowMs,
               dropped: null,
               merged: segment.merged,

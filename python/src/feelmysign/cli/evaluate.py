@@ -334,13 +334,15 @@ def _table(
         f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units;",
         "skin: time on the skin / drawing time; felt end: release to the end of the last stroke;",
         "pen: pen to skin; faster: the time the sleeve caught up by playing queued strokes faster,",
-        "as a share of their planned time; skipped: strokes skipped as late;",
+        "as a share of their planned time; skipped: strokes skipped as late; slowed: strokes",
+        "the sleeve played longer than sent (briefer than its floor); dropped: pieces dropped;",
         "recognised: $1 on the drawings / strokes sent / felt path"
         + (f", against {against}" if against else ""),
         "",
         f"{'set':<6} {'algorithm':<9} {'parameters':<30} {'strokes':>7} {'DP':>6} "
         f"{'max dev':>8} {'worst':>6} {'Fréchet':>7} {'skin':>5} {'p95':>5} "
-        f"{'felt end p95':>12} {'pen p95':>8} {'faster':>6} {'skipped':>7} {'recognised':>17}",
+        f"{'felt end p95':>12} {'pen p95':>8} {'faster':>6} {'skipped':>7} {'slowed':>6} "
+        f"{'dropped':>7} {'recognised':>17}",
     ]
     for s in summary:
         lines.append(
@@ -351,7 +353,7 @@ def _table(
             f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
             f"{_num(s['pen_to_skin_p95_ms'], '.0f', ' ms'):>8} "
             f"{_num(s['compressed_time_pct'], '.1f', '%'):>6} {s['skipped_total']:>7} "
-            f"{_recognised(s):>17}"
+            f"{s['slowed_total']:>6} {s['dropped_total']:>7} {_recognised(s):>17}"
         )
     lines += ["", f"Wrote results.csv, frontier.csv, summary.json and 3 plots to {out}/"]
     return "\n".join(lines)

@@ -38,9 +38,19 @@ class Segment:
     dropped: str | None = None
     # How many pieces too short to send were merged into this one (the window simplifier's).
     merged: int = 0
+    # How long the sleeve is to play it, when not as long as it took to draw (the window
+    # simplifier's: a stroke briefer than the sleeve's floor lasts the floor, and the strokes
+    # after it give that time back; ``feelmysign.simplify.window.Merger``). None: as drawn.
+    play_ms: float | None = None
 
     @property
     def duration_ms(self) -> float:
+        """How long the stroke lasts on the sleeve: as drawn (end_ms - start_ms) unless paced."""
+        return self.end_ms - self.start_ms if self.play_ms is None else self.play_ms
+
+    @property
+    def drawn_ms(self) -> float:
+        """How long the piece took to draw."""
         return self.end_ms - self.start_ms
 
     @property

@@ -58,6 +58,12 @@ corners land on the drawing's features. Here:
   merges it into the next piece where every drawn sample of both keeps
   ``max_error``, else sends it as it is. Only a path that is one such piece in
   all (a tap) is dropped, with its reason, as the angle simplifier drops.
+- No stroke the sleeve must slow: a stroke drawn briefer than the floor
+  (one that could not merge, where the bound must win: a circle drawn in a
+  third of a second needs more strokes than the floor leaves time for) is sent
+  to last the floor (``Segment.play_ms``), as the sleeve would have slowed it;
+  its times stay the drawn ones. The strokes after it catch up on the sleeve,
+  as before.
 - Merged back at release: the piece left when the pen lifts, if briefer than
   the floor (the pen lifted within the floor after the last cut, mostly one of
   the latency cap), merges into the stroke already sent before it when every
@@ -710,12 +716,12 @@ class Merger:
         self._times.append(t_ms)
 
     def _short(self, segment: Segment) -> bool:
-        return segment.length < self.min_length or segment.duration_ms < max(
+        return segment.length < self.min_length or segment.drawn_ms < max(
             self.min_duration_ms, self.floor_ms
         )
 
     def _below_minimums(self, segment: Segment) -> bool:
-        return segment.length < self.min_length or segment.duration_ms < self.min_duration_ms
+        return segment.length < self.min_length or segment.drawn_ms < self.min_duration_ms
 
     def _fits(self, start: Point, end: Point, end_ms: float) -> bool:
         """Whether every sample not yet covered, drawn up to end_ms, lies within max_error of it.
@@ -730,6 +736,14 @@ class Merger:
                 return False
         return True
 
+    def _paced(self, segment: Segment) -> float | None:
+        """How long the sleeve is to play ``segment``: None (as drawn), or the floor for a piece
+        briefer than it that could not merge. The sleeve would slow such a piece to its floor;
+        sent lasting the floor, it is played the same, and the sleeve has nothing to adjust
+        (the strokes after it catch up with their drawing as before: docs/protocol.md)."""
+        floor_ms = max(self.min_duration_ms, self.floor_ms)
+        return floor_ms if segment.end_ms - segment.start_ms < floor_ms else None
+
     def _send(self, segment: Segment, now_ms: float, out: list[Segment]) -> None:
         self._sent_in_path = True
         self._last_start, self._last_end = segment.start, segment.end
@@ -743,6 +757,7 @@ class Merger:
                 now_ms,
                 None,
                 segment.merged,
+                self._paced(segment),
             )
         )
         # The samples before its end are covered now (those at its end may start the next).
@@ -786,7 +801,7 @@ class Merger:
         if held is None:
             return []
         short_ms = max(self.min_duration_ms, self.floor_ms)
-        if held.duration_ms < short_ms and now_ms > held.end_ms:
+        if held.drawn_ms < short_ms and now_ms > held.end_ms:
             held = replace(held, end_ms=min(floor_end_ms(held.start_ms, short_ms), now_ms))
         if self.strict and self._below_minimums(held):
             self._held = held
@@ -807,7 +822,7 @@ class Merger:
         """
         if self._last_start is None:
             return False
-        brief = held.duration_ms < max(self.min_duration_ms, self.floor_ms)
+        brief = held.drawn_ms < max(self.min_duration_ms, self.floor_ms)
         if not brief and not (self.strict and held.length < self.min_length):
             return False
         return self._fits(self._last_start, self._last_end, math.inf)
@@ -827,7 +842,7 @@ class Merger:
             if not self._sent_in_path or self.strict:
                 if held.length < self.min_length:
                     reason = NOT_ENOUGH_DISTANCE
-                elif held.duration_ms < self.min_duration_ms:
+                elif held.drawn_ms < self.min_duration_ms:
                     reason = NOT_ENOUGH_DURATION
             if reason is not None:
                 out.append(replace(held, emitted_at_ms=now_ms, dropped=reason))

@@ -16,7 +16,25 @@ public record Segment(
     double endMs,
     double emittedAtMs,
     String dropped,
-    int merged) {
+    int merged,
+    double playMs) {
+
+  /**
+   * A segment played as drawn ({@code playMs} NaN): the window simplifier gives a stroke drawn
+   * briefer than the sleeve's floor the floor as {@code playMs} instead.
+   */
+  public Segment(
+      double startX,
+      double startY,
+      double endX,
+      double endY,
+      double startMs,
+      double endMs,
+      double emittedAtMs,
+      String dropped,
+      int merged) {
+    this(startX, startY, endX, endY, startMs, endMs, emittedAtMs, dropped, merged, Double.NaN);
+  }
 
   /** A segment into which no piece was merged. */
   public Segment(
@@ -36,7 +54,16 @@ public record Segment(
   /** The paper's NotEnoughDurationException. */
   public static final String NOT_ENOUGH_DURATION = "not_enough_duration";
 
+  /**
+   * How long the sleeve is to play it: as drawn ({@link #drawnMs()}), or the floor for a stroke
+   * of the window simplifier drawn briefer than the sleeve's floor.
+   */
   public double durationMs() {
+    return Double.isNaN(playMs) ? endMs - startMs : playMs;
+  }
+
+  /** How long the piece took to draw. */
+  public double drawnMs() {
     return endMs - startMs;
   }
 
@@ -59,7 +86,7 @@ public record Segment(
     String reason = null;
     if (length() < minLength) {
       reason = NOT_ENOUGH_DISTANCE;
-    } else if (durationMs() < minDurationMs) {
+    } else if (drawnMs() < minDurationMs) {
       reason = NOT_ENOUGH_DURATION;
     }
     return reason == null

@@ -807,11 +807,11 @@ final class Merger {
   }
 
   private boolean isShort(Segment segment) {
-    return segment.length() < minLength || segment.durationMs() < shortMs;
+    return segment.length() < minLength || segment.drawnMs() < shortMs;
   }
 
   private boolean belowMinimums(Segment segment) {
-    return segment.length() < minLength || segment.durationMs() < minDurationMs;
+    return segment.length() < minLength || segment.drawnMs() < minDurationMs;
   }
 
   /** Whether every sample not yet covered, drawn up to the second's end, lies within max_error
@@ -855,6 +855,9 @@ final class Merger {
     while (first < size && ts[first] < segment.endMs()) {
       first++;
     }
+    // A stroke drawn briefer than the sleeve's floor (one that could not merge) lasts the floor:
+    // the sleeve would slow it to that, and has nothing to adjust (its times stay the drawn ones).
+    double playMs = segment.endMs() - segment.startMs() < shortMs ? shortMs : Double.NaN;
     return add(
         out,
         new Segment(
@@ -866,7 +869,8 @@ final class Merger {
             segment.endMs(),
             nowMs,
             null,
-            segment.merged()));
+            segment.merged(),
+            playMs));
   }
 
   /** A piece the window cut: the strokes sent now, added to out (none while a short one
@@ -920,7 +924,7 @@ final class Merger {
     if (piece == null) {
       return out;
     }
-    if (piece.durationMs() < shortMs && nowMs > piece.endMs()) {
+    if (piece.drawnMs() < shortMs && nowMs > piece.endMs()) {
       piece =
           new Segment(
               piece.startX(),
@@ -948,7 +952,7 @@ final class Merger {
     if (last == null) {
       return false;
     }
-    if (!(piece.durationMs() < shortMs || (strict && piece.length() < minLength))) {
+    if (!(piece.drawnMs() < shortMs || (strict && piece.length() < minLength))) {
       return false;
     }
     return fits(last.startX(), last.startY(), last.endX(), last.endY(), Double.POSITIVE_INFINITY);
@@ -968,7 +972,7 @@ final class Merger {
       if (!sentInPath || strict) {
         if (held.length() < minLength) {
           reason = Segment.NOT_ENOUGH_DISTANCE;
-        } else if (held.durationMs() < minDurationMs) {
+        } else if (held.drawnMs() < minDurationMs) {
           reason = Segment.NOT_ENOUGH_DURATION;
         }
       }

@@ -88,6 +88,13 @@ class SimplifierVectorsTest {
       assertEquals(want.get("end_ms").asDouble(), s.endMs(), tolerance, where + " end_ms");
       assertEquals(
           want.get("emitted_at_ms").asDouble(), s.emittedAtMs(), tolerance, where + " emitted");
+      // The window simplifier's: how long the sleeve is to play it (as drawn unless briefer
+      // than the sleeve's floor: then the floor).
+      double wantDuration =
+          want.has("duration_ms")
+              ? want.get("duration_ms").asDouble()
+              : want.get("end_ms").asDouble() - want.get("start_ms").asDouble();
+      assertEquals(wantDuration, s.durationMs(), tolerance, where + " duration");
     }
     if (algorithm == Algorithm.WINDOW) {
       // The pieces merged at release into the stroke before them, path by path (nothing sent).
