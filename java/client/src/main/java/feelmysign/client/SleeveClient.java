@@ -485,7 +485,7 @@ public final class SleeveClient implements AutoCloseable {
             "the sleeve's floor in its status is not understood and was ignored ("
                 + bad.problem()
                 + (floor == null
-                    ? "): strokes are simplified as if the sleeve said none"
+                    ? "): none is kept to"
                     : "): the floor it said before is kept")
                 + ". Its status said \"floor\": "
                 + (text.length() > 200 ? text.substring(0, 200) + "..." : text));
