@@ -1,7 +1,9 @@
 package feelmysign.cli;
 
 import feelmysign.client.SleeveClient;
+import feelmysign.client.SleeveFloor;
 import feelmysign.client.WearerState;
+import feelmysign.json.Numbers;
 import feelmysign.json.PyJson;
 import feelmysign.protocol.Layout;
 import feelmysign.protocol.ParseResult;
@@ -64,7 +66,10 @@ final class SendCommand {
       + "the sleeve then plays every stroke after the first faster, down to its floor, to catch\n"
       + "up with a drawing that arrived ahead of it. Broker settings: the option, else\n"
       + "--credentials (the credentials.json of 'feelmysign broker'), else the default\n"
-      + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n";
+      + "(mqtt://127.0.0.1:1883, sleeve1). The grid: the paper's sleeve, 3 x 4, 3 cm apart.\n"
+      + "When the sleeve's status advertises a floor, a recording is cut keeping to it (the\n"
+      + "window simplifier merges what is briefer; a wearer's limits raise the minimums), and\n"
+      + "one line on stderr says how many strokes are below it.\n";
 
   // The faintest intensity sent (the reference's and the page's): at 0 the sleeve would play,
   // and report as played, a stroke no one feels.
@@ -127,7 +132,6 @@ final class SendCommand {
     }
     String shape = (String) given.get("--shape");
     String recording = (String) given.get("--recording");
-    Double intensity = (Double) given.get("--intensity");
     double timeoutS = (Double) given.getOrDefault("--timeout-s", 10.0);
     int rows = ((Long) given.getOrDefault("--rows", 3L)).intValue();
     int columns = ((Long) given.getOrDefault("--columns", 4L)).intValue();
@@ -143,39 +147,7 @@ final class SendCommand {
     }
     Layout layout = new Layout(rows, columns, Layout.PAPER.maxStrokeDurationMs());
 
-    List<Stroke> strokes = new ArrayList<>();
-    if (shape != null) {
-      Long segments = (Long) given.get("--segments");
-      strokes.addAll(Shapes.strokes(shape, rows, columns,
-          (Double) given.getOrDefault("--spacing-cm", 3.0), layout.maxStrokeDurationMs(),
-          segments == null ? null : segments.intValue(), (Double) given.get("--duration-ms"),
-          (Double) given.getOrDefault("--margin", 0.0)));
-    } else if (recording != null) {
-      strokes.addAll(
-          fromRecording(Path.of(recording), given.containsKey("--paper"), rows, columns));
-    } else {
-      for (String text : strokeArgs) {
-        strokes.add(parseStroke(text));
-      }
-    }
-    if (strokes.isEmpty()) {
-      throw new IllegalArgumentException("nothing to send: the recording gave no strokes");
-    }
-    if (intensity != null) {
-      List<Stroke> with = new ArrayList<>();
-      for (Stroke s : strokes) {
-        with.add(new Stroke(s.startX(), s.startY(), s.endX(), s.endY(), s.durationMs(),
-            intensity, null, null, null));
-      }
-      strokes = with;
-    }
-    // Every stroke checked as the sleeve will, before anything is sent.
-    for (int i = 0; i < strokes.size(); i++) {
-      if (Protocol.validateStroke(strokes.get(i), layout) instanceof ParseResult.Rejected r) {
-        String why = r.message().endsWith(".") ? r.message() : r.message() + ".";
-        throw new IllegalArgumentException("stroke " + (i + 1) + ": " + why + " Nothing was sent.");
-      }
-    }
+    List<Stroke> strokes = strokes(given, strokeArgs, layout, null, null);
 
     // Broker settings: option, else credentials file, else default.
     if (given.get("--credentials") instanceof String credentials) {
@@ -242,6 +214,11 @@ final class SendCommand {
       public void wearer(WearerState state) {
         wearer.complete(state);
       }
+
+      @Override
+      public void floorIgnored(String sentence) {
+        err.println(Character.toUpperCase(sentence.charAt(0)) + sentence.substring(1));
+      }
     });
     refuseWhenNobodyListens(url);
     Object pace = given.get("--pace");
@@ -256,6 +233,12 @@ final class SendCommand {
         err.println("Error: " + said.holdSentence(sleeveId, nowMs, java.time.ZoneId.systemDefault()));
         return WEARER_HOLD_EXIT;
       }
+      // The status that said the wearer's choice said the sleeve's floor too, if it has one.
+      SleeveFloor floor = client.floor();
+      if (recording != null && floor != null) {
+        strokes = strokes(given, strokeArgs, layout, floor, err);
+      }
+      sayFloor(floor, strokes, err);
       client.newDrawing();
       if (realtime) {
         // Each stroke when the one before would have finished playing, once the broker has the
@@ -295,6 +278,60 @@ final class SendCommand {
           + (legacy ? " as legacy text" : " to sleeve '" + sleeveId + "' (drawing " + client.drawing() + ")") + "; the broker has them.");
       return 0;
     }
+  }
+
+  /**
+   * The strokes to send, each checked as the sleeve will check it: the STROKE arguments, the
+   * shape, or the recording cut by the simplifier keeping to {@code floor} (null: none known).
+   * {@code said} gets the line of a floor that raised the simplifier's minimums (null: silent).
+   */
+  private static List<Stroke> strokes(Map<String, Object> given, List<String> strokeArgs,
+      Layout layout, SleeveFloor floor, PrintStream said) {
+    String shape = (String) given.get("--shape");
+    String recording = (String) given.get("--recording");
+    Double intensity = (Double) given.get("--intensity");
+    int rows = layout.rows();
+    int columns = layout.columns();
+    List<Stroke> strokes = new ArrayList<>();
+    if (shape != null) {
+      Long segments = (Long) given.get("--segments");
+      strokes.addAll(Shapes.strokes(shape, rows, columns,
+          (Double) given.getOrDefault("--spacing-cm", 3.0), layout.maxStrokeDurationMs(),
+          segments == null ? null : segments.intValue(), (Double) given.get("--duration-ms"),
+          (Double) given.getOrDefault("--margin", 0.0)));
+    } else if (recording != null) {
+      strokes.addAll(fromRecording(
+          Path.of(recording), given.containsKey("--paper"), rows, columns, floor, said));
+    } else {
+      for (String text : strokeArgs) {
+        strokes.add(parseStroke(text));
+      }
+    }
+    if (strokes.isEmpty()) {
+      throw new IllegalArgumentException(floor == null
+          ? "nothing to send: the recording gave no strokes"
+          : "nothing to send: the recording gave no strokes at or above the sleeve's floor ("
+              + Numbers.pythonG(floor.minDurationMs()) + " ms and "
+              + Numbers.pythonG(floor.minLength()) + " grid units"
+              + (floor.hasWearer() ? ", wearer " + floor.wearer() + "'s limits" : "")
+              + "); draw it larger or slower");
+    }
+    if (intensity != null) {
+      List<Stroke> with = new ArrayList<>();
+      for (Stroke s : strokes) {
+        with.add(new Stroke(s.startX(), s.startY(), s.endX(), s.endY(), s.durationMs(),
+            intensity, null, null, null));
+      }
+      strokes = with;
+    }
+    // Every stroke checked as the sleeve will, before anything is sent.
+    for (int i = 0; i < strokes.size(); i++) {
+      if (Protocol.validateStroke(strokes.get(i), layout) instanceof ParseResult.Rejected r) {
+        String why = r.message().endsWith(".") ? r.message() : r.message() + ".";
+        throw new IllegalArgumentException("stroke " + (i + 1) + ": " + why + " Nothing was sent.");
+      }
+    }
+    return strokes;
   }
 
   /** How long the retained status may take to come after connecting (the Python CLI's too). */
@@ -340,7 +377,8 @@ final class SendCommand {
     }
   }
 
-  private static List<Stroke> fromRecording(Path file, boolean paper, int rows, int columns) {
+  private static List<Stroke> fromRecording(
+      Path file, boolean paper, int rows, int columns, SleeveFloor floor, PrintStream said) {
     byte[] data;
     try {
       data = Files.readAllBytes(file);
@@ -353,6 +391,14 @@ final class SendCommand {
         .with("canvas_width_px", rec.widthPx()).with("canvas_height_px", rec.heightPx())
         .with("rows", rec.rows() == null ? rows : rec.rows())
         .with("columns", rec.columns() == null ? columns : rec.columns());
+    if (floor != null) {
+      // As feelmysign replay --send keeps to it (docs/protocol.md, floor).
+      String note = floor.raisedNote(params);
+      if (note != null && said != null) {
+        said.println(note);
+      }
+      params = floor.applyTo(params);
+    }
     List<Stroke> strokes = new ArrayList<>();
     for (PathSegment p : Simplify.paths(params, rec.paths())) {
       var s = p.segment();
@@ -361,6 +407,32 @@ final class SendCommand {
       }
     }
     return strokes;
+  }
+
+  /**
+   * One line on stderr, as {@code feelmysign send} says it: the floor the sleeve advertises and
+   * how many of the strokes are below it; said when some are, or when the floor is a wearer's
+   * measured limits, not before every send.
+   */
+  static void sayFloor(SleeveFloor floor, List<Stroke> strokes, PrintStream err) {
+    if (floor == null) {
+      return;
+    }
+    long below = strokes.stream()
+        .filter(s -> s.durationMs() < floor.minDurationMs()
+            || Math.hypot(s.endX() - s.startX(), s.endY() - s.startY()) < floor.minLength())
+        .count();
+    if (below == 0 && !floor.hasWearer()) {
+      return;
+    }
+    String whose = floor.hasWearer() ? " with wearer " + floor.wearer() + "'s limits" : "";
+    String verdict = below > 0
+        ? below + " of the " + strokes.size() + " strokes are below it (the sleeve slows a"
+            + " briefer one; a shorter one may not be felt)"
+        : "every stroke is at or above it";
+    err.println("The sleeve's floor" + whose + ": strokes of at least "
+        + Numbers.pythonG(floor.minDurationMs()) + " ms and " + Numbers.pythonG(floor.minLength())
+        + " grid units; " + verdict + ".");
   }
 
   private static Stroke parseStroke(String text) {

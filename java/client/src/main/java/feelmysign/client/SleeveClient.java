@@ -13,6 +13,7 @@ import com.hivemq.client.mqtt.mqtt3.message.connect.connack.Mqtt3ConnAckReturnCo
 import com.hivemq.client.mqtt.mqtt3.message.publish.Mqtt3Publish;
 import feelmysign.json.JsonDecodeException;
 import feelmysign.json.NonFiniteLiteralException;
+import feelmysign.json.PyDumps;
 import feelmysign.json.PyJson;
 import feelmysign.protocol.Control;
 import feelmysign.protocol.Protocol;
@@ -44,7 +45,9 @@ import javax.net.ssl.TrustManagerFactory;
  * 0 and {@code sent_at_ms} stamped when it is made, kept while it waits for the broker, so the
  * sleeve's pace rules judge a stroke held offline by when it was drawn) or on the legacy topic (the
  * paper's text),
- * Stop as the cancel message, the sleeve's {@code status} and {@code events} as callbacks.
+ * Stop as the cancel message, the sleeve's {@code status} and {@code events} as callbacks, and
+ * the floor its status advertises ({@link #floor()}: the least stroke it plays as sent and its
+ * wearer feels; a sender's simplifier keeps to it, {@link SleeveFloor#applyTo}).
  *
  * <p>Strokes wait in an outbox while the broker is out of reach and go out, in order, when it is
  * back; one leaves the outbox only on the broker's PUBACK, so {@link #unsent()} is honest. With
@@ -90,6 +93,22 @@ public final class SleeveClient implements AutoCloseable {
      */
     default void wearer(WearerState state) {}
 
+    /**
+     * The sleeve's floor changed ({@link SleeveClient#floor()}): right after the {@link #status}
+     * that says it; null when an online status says none (a sleeve older than it). Not called
+     * for a status that keeps it (see {@link SleeveClient#floor()}).
+     */
+    default void floor(SleeveFloor floor) {}
+
+    /**
+     * A status's {@code floor} is not understood and was ignored (the floor known before is
+     * kept), with a sentence saying why; once per such floor, not per republished status. By
+     * default the sentence is printed on the console (System.err).
+     */
+    default void floorIgnored(String sentence) {
+      System.err.println("feelmysign: " + sentence);
+    }
+
     /** One event of the sleeve: played, adjusted, rejected, cancelled, safety, error. */
     default void event(SleeveEvent event) {}
 
@@ -131,6 +150,10 @@ public final class SleeveClient implements AutoCloseable {
   private boolean outageTold;
   private String drawing;
   private long nextSeq;
+  /** The sleeve's last known floor (network thread writes, any thread reads). */
+  private volatile SleeveFloor floor;
+  /** The last floor not understood, told once (network thread only). */
+  private String floorIgnoredTold;
 
   private SleeveClient(Builder b) {
     this.url = b.url;
@@ -417,7 +440,11 @@ public final class SleeveClient implements AutoCloseable {
     String topic = publish.getTopic().toString();
     String text = new String(publish.getPayloadAsBytes(), StandardCharsets.UTF_8);
     if (topic.equals(Topics.telemetryTopic(sleeveId, Topics.STATUS))) {
+      boolean floorChanged = readFloor(text);
       listener.status(text);
+      if (floorChanged) {
+        listener.floor(floor);
+      }
       WearerState wearer = onlineWearer(text);
       if (wearer != null) {
         listener.wearer(wearer);
@@ -428,6 +455,65 @@ public final class SleeveClient implements AutoCloseable {
         listener.event(event);
       }
     }
+  }
+
+  /**
+   * Updates {@link #floor} from a status payload, as the page keeps it (web/src/sleeve-state.ts):
+   * an online status sets it (to none when it has no floor: an older sleeve); an offline one
+   * (the last will) sets it only when it says one; a cleared status, one not understood, or a
+   * floor not understood keeps the floor known before. Whether it changed.
+   */
+  private boolean readFloor(String payload) {
+    Map<?, ?> status;
+    try {
+      if (!(PyJson.loads(payload) instanceof Map<?, ?> map) || !(map.get("online") instanceof Boolean)) {
+        return false;
+      }
+      status = map;
+    } catch (JsonDecodeException | NonFiniteLiteralException error) {
+      return false;
+    }
+    SleeveFloor now;
+    SleeveFloor.Read read = SleeveFloor.read(status.get("floor"));
+    if (read instanceof SleeveFloor.Said said) {
+      now = said.floor();
+    } else if (read instanceof SleeveFloor.NotUnderstood bad) {
+      String text = PyDumps.dumps(status.get("floor"));
+      if (!text.equals(floorIgnoredTold)) {
+        floorIgnoredTold = text;
+        listener.floorIgnored(
+            "the sleeve's floor in its status is not understood and was ignored ("
+                + bad.problem()
+                + (floor == null
+                    ? "): none is kept to"
+                    : "): the floor it said before is kept")
+                + ". Its status said \"floor\": "
+                + (text.length() > 200 ? text.substring(0, 200) + "..." : text));
+      }
+      return false;
+    } else {
+      if (!Boolean.TRUE.equals(status.get("online"))) {
+        return false; // a last will without a floor: the sleeve's floor has not changed
+      }
+      now = null;
+    }
+    floorIgnoredTold = null;
+    if (java.util.Objects.equals(now, floor)) {
+      return false;
+    }
+    floor = now;
+    return true;
+  }
+
+  /**
+   * The sleeve's last known floor (its retained status, {@code floor}): the least a stroke should
+   * be for this sleeve to play it as sent and its wearer to feel it; null when none is known (no
+   * status yet, or a sleeve older than it). Kept while the broker is out of reach and through the
+   * sleeve's last will: a sleeve's floor does not change because it or the network went away.
+   * Any thread may ask.
+   */
+  public SleeveFloor floor() {
+    return floor;
   }
 
   /** The wearer's state in an online status; null for an offline one or one not understood. */

@@ -2,6 +2,7 @@ package feelmysign.processing;
 
 import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
+import feelmysign.client.SleeveFloor;
 import feelmysign.client.WearerState;
 import feelmysign.protocol.Layout;
 import feelmysign.protocol.ParseResult;
@@ -21,9 +22,11 @@ import java.util.ArrayDeque;
 import java.util.ArrayList;
 import java.util.Deque;
 import java.util.List;
+import java.util.Objects;
 import java.util.concurrent.ArrayBlockingQueue;
 import java.util.concurrent.BlockingQueue;
 import java.util.concurrent.atomic.AtomicLong;
+import java.util.concurrent.atomic.AtomicReference;
 import processing.core.PApplet;
 import processing.event.MouseEvent;
 
@@ -55,6 +58,17 @@ import processing.event.MouseEvent;
  * sleeveStatus}, and the sketch keeps drawing; strokes drawn meanwhile wait in the client's
  * outbox (or are dropped after {@link #lateLimitMs}, the page's policies). Queues and histories
  * are bounded, so a sketch can draw for hours.
+ *
+ * <p>The simplifier keeps to the sleeve's floor, as the page does (docs/protocol.md, {@code
+ * floor}): the least stroke the sleeve plays as sent (its retained status says it; 73.701 ms on
+ * the paper's ERM motors) and, when the sleeve has a wearer file, the shortest stroke its wearer
+ * feels. The window simplifier merges a piece briefer than the floor into the next where the
+ * error bound allows ({@code floor_ms}); with a wearer's limits it raises {@code min_duration_ms}
+ * and {@code min_length} to at least the floor's (a higher setting of the sketch is kept) and
+ * never sends a stroke below them ({@code strict_minimums}), and says so once ("At least 118.4 ms
+ * and 0.62 grid units per stroke: the sleeve's floor with wearer P01's limits; ..."). A floor
+ * that comes while a line is drawn applies from the next line. {@link #params()} is what the
+ * simplifier uses, {@link #floor()} the floor it keeps to.
  */
 public class FeelMySign {
   /** The library's version, as library.properties' prettyVersion. */
@@ -81,7 +95,13 @@ public class FeelMySign {
   private Path caCertificate;
   private String caFingerprint;
   private Long lateLimitMs;
+  /** The sketch's own parameters (as configured). */
   private Params params = Params.window();
+  /**
+   * What the simplifier was made with: the sketch's own, raised to the sleeve's floor (sketch
+   * thread writes; volatile, so any thread reading {@link #params()} sees a whole one).
+   */
+  private volatile Params inUse = params;
   private boolean canvasGiven;
 
   private SleeveClient client;
@@ -109,6 +129,13 @@ public class FeelMySign {
   private final Method wearerMethod;
   /** The wearer's choice, from the sleeve's last online status (sketch thread). */
   private WearerState wearer = WearerState.NONE;
+  /**
+   * The sleeve's floor as the network thread last heard it, until the sketch's next draw()
+   * takes it: the latest wins, none is lost to a full {@link #inbox}.
+   */
+  private final AtomicReference<FloorNews> floorArrived = new AtomicReference<>();
+  /** The sleeve's floor the sketch keeps to (sketch thread); null when none is known. */
+  private SleeveFloor floor;
 
   /** The library for {@code parent}; configure it, then {@link #start()} it in setup(). */
   public FeelMySign(PApplet parent) {
@@ -196,7 +223,8 @@ public class FeelMySign {
 
   /**
    * One parameter, by the reference's name ({@code max_error}) or the paper's B.1 name
-   * ({@code frameMax}, {@code screenX}, ...).
+   * ({@code frameMax}, {@code screenX}, ...). Set after {@link #start()}, it applies from the
+   * next line drawn.
    *
    * @throws IllegalArgumentException naming the parameter, the value and the allowed range
    */
@@ -215,9 +243,24 @@ public class FeelMySign {
     return this;
   }
 
-  /** The simplifier's parameters in use. */
+  /**
+   * The simplifier's parameters in use: the sketch's own, kept to the sleeve's floor
+   * ({@link #floor()}) from the first line drawn after the sleeve said it. A window simplifier
+   * takes the floor's duration as {@code floor_ms}; with a wearer's measured limits, {@code
+   * min_duration_ms} and {@code min_length} are raised to at least the floor's (a sketch's higher
+   * setting is kept) and {@code strict_minimums} is set (docs/protocol.md, {@code floor}).
+   */
   public Params params() {
-    return params;
+    return started ? inUse : wanted();
+  }
+
+  /**
+   * The sleeve's floor the sketch keeps to (its retained status): the least a stroke should be
+   * for the sleeve to play it as sent and its wearer to feel it; null before the sleeve said one,
+   * or from a sleeve older than it. Kept while the broker or the sleeve is away. Sketch thread.
+   */
+  public SleeveFloor floor() {
+    return floor;
   }
 
   /**
@@ -231,7 +274,8 @@ public class FeelMySign {
     if (!canvasGiven) {
       params = params.with("canvas_width_px", parent.width).with("canvas_height_px", parent.height);
     }
-    simplifier = params.algorithm().make(params);
+    inUse = params;
+    simplifier = inUse.algorithm().make(inUse);
     SleeveClient.Builder builder =
         SleeveClient.builder(brokerUrl).sleeveId(sleeveId).format(format).listener(relay);
     if (username != null) {
@@ -442,11 +486,12 @@ public class FeelMySign {
         events.clear();
       }
     }
+    keepToFloor(); // between paths: a floor that came during the last one applies from here
     client.newDrawing();
     line.clear();
     line.add(sample);
-    if (params.algorithm().takesFrames()) {
-      frames = new LiveFrames(params.fps());
+    if (inUse.algorithm().takesFrames()) {
+      frames = new LiveFrames(inUse.fps());
       feed(frames.press(sample));
     } else {
       feed(List.of(sample));
@@ -461,7 +506,7 @@ public class FeelMySign {
       line.remove(1); // bounded: the on-screen line of a path drawn for minutes
     }
     line.add(sample);
-    feed(params.algorithm().takesFrames() ? frames.move(sample) : List.of(sample));
+    feed(inUse.algorithm().takesFrames() ? frames.move(sample) : List.of(sample));
   }
 
   private void release(Sample sample) {
@@ -469,7 +514,7 @@ public class FeelMySign {
       return;
     }
     move(sample);
-    if (params.algorithm().takesFrames()) {
+    if (inUse.algorithm().takesFrames()) {
       feed(frames.release());
     }
     for (Segment s : simplifier.end()) {
@@ -477,6 +522,7 @@ public class FeelMySign {
     }
     line.clear();
     tellDropped();
+    keepToFloor(); // a floor that came during this line applies from the next
   }
 
   /**
@@ -486,11 +532,15 @@ public class FeelMySign {
   private void tellDropped() {
     if (tooShort + tooBrief > 0) {
       String sentence = "this line has " + (tooShort + tooBrief) + " gap(s): " + tooShort
-          + " piece(s) shorter than minimumSize (" + params.number("min_length")
+          + " piece(s) shorter than minimumSize (" + inUse.number("min_length")
           + " grid units) and " + tooBrief + " briefer than minimumDuration ("
-          + params.number("min_duration_ms") + " ms) were not sent. Draw larger or slower, "
-          + "or tune " + (params.algorithm() == Algorithm.ANGLE ? "checkFrame and maxAngleDifDeg"
-              : "max_error") + " (or minimumSize and minimumDuration for your sleeve).";
+          + inUse.number("min_duration_ms") + " ms) were not sent. Draw larger or slower, "
+          + "or tune " + (inUse.algorithm() == Algorithm.ANGLE ? "checkFrame and maxAngleDifDeg"
+              : "max_error") + (inUse.values().containsKey("strict_minimums")
+                  && inUse.flag("strict_minimums") && floor != null && floor.hasWearer()
+              ? " (minimumSize and minimumDuration keep to the wearer " + floor.wearer()
+                  + "'s limits: the sleeve's floor)."
+              : " (or minimumSize and minimumDuration for your sleeve).");
       if (!inbox.offer(sentence)) {
         overflowed.incrementAndGet();
       }
@@ -557,6 +607,10 @@ public class FeelMySign {
         call(statusMethod, said);
       }
     }
+    FloorNews arrived = floorArrived.getAndSet(null);
+    if (arrived != null) {
+      floorChanged(arrived.floor());
+    }
     long lost = overflowed.get();
     if (lost != overflowTold) {
       overflowTold = lost;
@@ -584,6 +638,49 @@ public class FeelMySign {
       call(statusMethod, sentence);
     }
     call(wearerMethod, state);
+  }
+
+  /**
+   * The sleeve said another floor (sketch thread): kept to from now when no line is being drawn,
+   * else from the next one, never in the middle of a line; said once on the console and to
+   * {@code sleeveStatus} when it changes what the simplifier uses.
+   */
+  private void floorChanged(SleeveFloor now) {
+    if (Objects.equals(now, floor)) {
+      return;
+    }
+    Params before = wanted();
+    floor = now;
+    Params after = wanted();
+    if (started && !simplifier.drawing()) {
+      keepToFloor();
+    }
+    if (after.equals(before)) {
+      return; // e.g. the motors' floor at the simplifier's own floor_ms: nothing changes
+    }
+    String sentence = now == null
+        ? "The sleeve no longer says a floor: the simplifier keeps to the sketch's own settings"
+            + " again."
+        : now.note(params);
+    if (started && simplifier.drawing()) {
+      sentence += " (From the next line drawn.)";
+    }
+    PApplet.println("feelmysign: " + sentence);
+    call(statusMethod, sentence);
+  }
+
+  /** The sketch's own parameters kept to the sleeve's floor. */
+  private Params wanted() {
+    return floor == null ? params : floor.applyTo(params);
+  }
+
+  /** Between paths: the simplifier made anew when what it should use has changed. */
+  private void keepToFloor() {
+    Params want = wanted();
+    if (!want.equals(inUse)) {
+      inUse = want;
+      simplifier = inUse.algorithm().make(inUse);
+    }
   }
 
   /**
@@ -638,6 +735,9 @@ public class FeelMySign {
 
   private record BrokerNews(SleeveClient.State state, String detail) {}
 
+  /** The sleeve's floor as heard (null: it says none). */
+  private record FloorNews(SleeveFloor floor) {}
+
   /** Runs on the network thread: only queues, never blocks, never throws. */
   private final class Relay implements SleeveClient.Listener {
     private void offer(Object item) {
@@ -659,6 +759,16 @@ public class FeelMySign {
     @Override
     public void wearer(WearerState state) {
       offer(state);
+    }
+
+    @Override
+    public void floor(SleeveFloor floor) {
+      floorArrived.set(new FloorNews(floor));
+    }
+
+    @Override
+    public void floorIgnored(String sentence) {
+      offer(sentence);
     }
 
     @Override
