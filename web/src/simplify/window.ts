@@ -97,6 +97,20 @@ export function restRadius(params: WindowParams, mapping: CanvasMapping): number
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
 /**
+ * An index past every sample a store holds: `Drawn.base` or `Drawn.first` of a reader that is not
+ * there. A small integer (the largest V8 keeps unboxed), not Infinity: an index field that once
+ * held a double is read as one, and converted, wherever it indexes an array.
+ */
+const UNREAD = 0x3fffffff;
+
+/**
+ * The samples a store drops from its start once this many have gathered there (and they are at
+ * least half): few enough that the arrays stay small (few regrowths for a simplifier made per
+ * path), enough that each sample is moved at most once on average.
+ */
+const COMPACT_AFTER = 32;
+
+/**
  * The samples drawn in a path, as flat arrays of numbers (grid x, grid y, time; arrays of doubles,
  * stored unboxed) and their Sample objects, kept from one path to the next and shared by the
  * window and the merger: every sample is stored once, where both read it. The stroke being drawn
@@ -113,10 +127,10 @@ class Drawn {
   readonly ts: number[] = [];
   readonly samples: Sample[] = [];
   count = 0;
-  /** The sample of the window's anchor (Infinity: no window reads these samples). */
-  base = Infinity;
-  /** The merger's first sample not yet covered (Infinity: no merger reads these samples). */
-  first = Infinity;
+  /** The sample of the window's anchor (`UNREAD`: no window reads these samples). */
+  base = UNREAD;
+  /** The merger's first sample not yet covered (`UNREAD`: no merger reads these samples). */
+  first = UNREAD;
 
   /** Drops the samples neither reader needs, once enough have gathered (`COMPACT_AFTER`). */
   compact(): void {
@@ -131,17 +145,10 @@ class Drawn {
       samples[to] = samples[from]!;
     }
     this.count = count - keep;
-    this.base -= keep;
-    this.first -= keep;
+    if (this.base !== UNREAD) this.base -= keep;
+    if (this.first !== UNREAD) this.first -= keep;
   }
 }
-
-/**
- * The samples a store drops from its start once this many have gathered there (and they are at
- * least half): few enough that the arrays stay small (few regrowths for a simplifier made per
- * path), enough that each sample is moved at most once on average.
- */
-const COMPACT_AFTER = 32;
 
 /**
  * The window itself: strokes cut by the error bound, the bend rule and the caps, before
@@ -194,7 +201,7 @@ export class WindowCore {
    * its stroke adds little to the reach (its step, nearly all along the segment, moves it little).
    */
   #reach = 0;
-  /** Reach + step at most this: every sample keeps the bound. */
+  /** Reach + what a step adds at most this: every sample keeps the bound. */
   readonly #reachLimit: number;
   /**
    * The reach each sample of the stroke had when it was the last: a bound on the distances of
