@@ -115,11 +115,11 @@ const COMPACT_AFTER = 32;
  * stored unboxed) and their Sample objects, kept from one path to the next and shared by the
  * window and the merger: every sample is stored once, where both read it. The stroke being drawn
  * is a range of them: its anchor is held apart (`WindowCore`: a cut's end or a moved time need
- * not be a drawn sample), window index i > 0 is sample `base` + i, and the samples from `base` +
- * count to `count` are the ones still to take into it (after a cut, the samples after the cut,
- * taken again into the next stroke: the window moves on over them, nothing is copied). Samples
- * before the smaller of `base` and `first` (the merger's first not yet covered) are needed by
- * neither and are dropped now and then (`compact`).
+ * not be a drawn sample), window index i > 0 is sample `base` + i, and the samples after the
+ * stroke, up to the store's `count`, are the ones still to take into it (after a cut, the samples
+ * after the cut, taken again into the next stroke: the window moves on over them, nothing is
+ * copied). Samples before the smaller of `base` and `first` (the merger's first not yet covered)
+ * are needed by neither and are dropped now and then (`compact`).
  */
 class Drawn {
   readonly xs: number[] = [];
