@@ -56,6 +56,8 @@ export class ReferenceWindowSimplifier {
   #resting = false;
   /** Whether the last push found the pen resting. */
   rested = false;
+  /** The last sample pushed, as taken (its time never before the one before, its grid point). */
+  taken: { readonly t_ms: number; readonly point: Point } = { t_ms: 0, point: [0, 0] };
   readonly #restSq: number;
 
   constructor(params: WindowParams) {
@@ -105,6 +107,7 @@ export class ReferenceWindowSimplifier {
         : input;
     this.#pointer = sample;
     const current: Drawn = { sample, point: toGrid(this.#mapping, sample.x, sample.y) };
+    this.taken = { t_ms: sample.t_ms, point: current.point };
     this.rested = false;
     if (this.#window.length === 0) {
       this.#window = [current];

@@ -97,72 +97,56 @@ export function restRadius(params: WindowParams, mapping: CanvasMapping): number
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
 /**
- * The stroke being drawn as flat arrays of numbers (grid x, grid y, time) and their Sample
- * objects, then the samples still to take into it. Every sample is tested against the chord at
- * every new one, so the tests read numbers (arrays of doubles, stored unboxed) instead of an
- * object and a tuple per sample. Arrays grow as a stroke needs and are kept from one stroke to
- * the next: [0, count) is the stroke (its anchor first), [count, end) the samples to take next,
- * in order: the new sample, after the samples a cut gave back. A cut moves the samples after it
- * down behind the new anchor, where they are taken again without being copied anywhere else.
+ * An index past every sample a store holds: `Drawn.base` or `Drawn.first` of a reader that is not
+ * there. A small integer (the largest V8 keeps unboxed), not Infinity: an index field that once
+ * held a double is read as one, and converted, wherever it indexes an array.
  */
-class Samples {
+const UNREAD = 0x3fffffff;
+
+/**
+ * The samples a store drops from its start once this many have gathered there (and they are at
+ * least half): few enough that the arrays stay small (few regrowths for a simplifier made per
+ * path), enough that each sample is moved at most once on average.
+ */
+const COMPACT_AFTER = 32;
+
+/**
+ * The samples drawn in a path, as flat arrays of numbers (grid x, grid y, time; arrays of doubles,
+ * stored unboxed) and their Sample objects, kept from one path to the next and shared by the
+ * window and the merger: every sample is stored once, where both read it. The stroke being drawn
+ * is a range of them: its anchor is held apart (`WindowCore`: a cut's end or a moved time need
+ * not be a drawn sample), window index i > 0 is sample `base` + i, and the samples after the
+ * stroke, up to the store's `count`, are the ones still to take into it (after a cut, the samples
+ * after the cut, taken again into the next stroke: the window moves on over them, nothing is
+ * copied). Samples before the smaller of `base` and `first` (the merger's first not yet covered)
+ * are needed by neither and are dropped now and then (`compact`).
+ */
+class Drawn {
   readonly xs: number[] = [];
   readonly ys: number[] = [];
   readonly ts: number[] = [];
   readonly samples: Sample[] = [];
   count = 0;
-  end = 0;
+  /** The sample of the window's anchor (`UNREAD`: no window reads these samples). */
+  base = UNREAD;
+  /** The merger's first sample not yet covered (`UNREAD`: no merger reads these samples). */
+  first = UNREAD;
 
-  /** A sample to take, after those already waiting. */
-  place(x: number, y: number, t: number, sample: Sample): void {
-    const at = this.end;
-    this.xs[at] = x;
-    this.ys[at] = y;
-    this.ts[at] = t;
-    this.samples[at] = sample;
-    this.end = at + 1;
-  }
-
-  /**
-   * Only one sample in the stroke, its anchor: at (x, y), with the time and Sample of the one at
-   * `index`; the samples after `index` are to take again, in order, behind it.
-   */
-  restart(x: number, y: number, index: number): void {
+  /** Drops the samples neither reader needs, once enough have gathered (`COMPACT_AFTER`). */
+  compact(): void {
+    const keep = Math.min(this.base, this.first);
+    const count = this.count;
+    if (!(keep >= COMPACT_AFTER && 2 * keep >= count)) return;
     const { xs, ys, ts, samples } = this;
-    xs[0] = x;
-    ys[0] = y;
-    ts[0] = ts[index]!;
-    samples[0] = samples[index]!;
-    const end = this.end;
-    for (let from = index + 1, to = 1; from < end; from++, to++) {
+    for (let from = keep, to = 0; from < count; from++, to++) {
       xs[to] = xs[from]!;
       ys[to] = ys[from]!;
       ts[to] = ts[from]!;
       samples[to] = samples[from]!;
     }
-    this.count = 1;
-    this.end = end - index;
-  }
-
-  /** The anchor at another time (while the pen rests or crawls), its Sample too. */
-  retime(t: number): void {
-    this.ts[0] = t;
-    // Built field by field, not spread: a crawling pen retimes at every sample.
-    const anchor = this.samples[0]!;
-    this.samples[0] = { t_ms: t, x: anchor.x, y: anchor.y, pressure: anchor.pressure };
-  }
-
-  /** The sample to take next (at `count`) is not taken: the ones after it move down. */
-  skip(): void {
-    const { xs, ys, ts, samples } = this;
-    const end = this.end;
-    for (let to = this.count; to < end - 1; to++) {
-      xs[to] = xs[to + 1]!;
-      ys[to] = ys[to + 1]!;
-      ts[to] = ts[to + 1]!;
-      samples[to] = samples[to + 1]!;
-    }
-    this.end = end - 1;
+    this.count = count - keep;
+    if (this.base !== UNREAD) this.base -= keep;
+    if (this.first !== UNREAD) this.first -= keep;
   }
 }
 
@@ -180,15 +164,24 @@ export class WindowCore {
   /** The grid's extents (grid units): every stroke's start and end lies in [0, x] x [0, y]. */
   readonly #xExtent: number;
   readonly #yExtent: number;
-  /** The samples of the stroke being drawn: its anchor first, then every sample since. */
-  readonly #window: Samples;
+  /** The samples drawn: the stroke being drawn is `#count` of them from `base` (`Drawn`). */
+  readonly #drawn: Drawn;
+  /** How many samples the stroke being drawn holds, its anchor included (0 between paths). */
+  #count = 0;
+  /**
+   * The anchor, window[0]: where the stroke being drawn starts, when (a time a pen resting or
+   * crawling moves on) and its Sample (canvas pixels, for `lineStart`).
+   */
+  #anchorX = 0;
+  #anchorY = 0;
+  #anchorMs = 0;
+  #anchorSample: Sample | null = null;
   /** Each sample's squared distance to a chord, while a cut looks for its feature. */
   readonly #distances: number[] = [];
   #emittedInPath = false;
   /**
-   * The anchor, window[0], as the point that ended the stroke before (null at a path's start):
-   * the next stroke starts at that same point, a readonly pair, rather than at a copy made at
-   * every cut.
+   * The anchor as the point that ended the stroke before (null at a path's start): the next
+   * stroke starts at that same point, a readonly pair, rather than at a copy made at every cut.
    */
   #anchor: Point | null = null;
   /**
@@ -199,13 +192,16 @@ export class WindowCore {
   /**
    * The reach of the stroke being drawn: no sample since its anchor lies farther than this from
    * the segment anchor -> last sample (grid units; true distances, rounding allowed for).
-   * A sample that moves the end by a step moves every point of that segment by at most the step,
-   * so when reach + step stays under max_error (by ROUNDING_SLACK) every sample keeps the bound
-   * to the new segment without testing each one, as testing each one would find; else they are
-   * tested, and their farthest distance is the new reach. The same strokes, fewer tests.
+   * Moving the segment's end from E to E' moves no point of anchor -> E farther from
+   * anchor -> E' than E itself lies from it (the distance to a segment is convex along a
+   * segment, and 0 at the anchor), and that is at most the step E -> E', so when reach + that
+   * distance stays under max_error (by ROUNDING_SLACK) every sample keeps the bound to the new
+   * segment without testing each one, as testing each one would find; else they are tested, and
+   * their farthest distance is the new reach. The same strokes, fewer tests: a pen going on along
+   * its stroke adds little to the reach (its step, nearly all along the segment, moves it little).
    */
   #reach = 0;
-  /** Reach + step at most this: every sample keeps the bound. */
+  /** Reach + what a step adds at most this: every sample keeps the bound. */
   readonly #reachLimit: number;
   /**
    * The reach each sample of the stroke had when it was the last: a bound on the distances of
@@ -234,7 +230,8 @@ export class WindowCore {
   /** Whether the bend rule is on (`max_bend` > 0): `#keepsBound` then tests with a limit of its own. */
   readonly #bends: boolean;
 
-  constructor(params: WindowParams) {
+  /** `drawn`: the store to keep the samples in, shared with a merger (else one of its own). */
+  constructor(params: WindowParams, drawn: Drawn = new Drawn()) {
     checkWindowParams(params);
     this.params = params;
     this.#maxErrorSq = params.max_error * params.max_error;
@@ -250,17 +247,17 @@ export class WindowCore {
     this.#restMs = params.rest_ms;
     this.#maxWindow = params.max_window;
     this.#bends = params.max_bend > 0;
-    this.#window = new Samples();
+    this.#drawn = drawn;
   }
 
   /** True between the first sample of a path and `end`. */
   get drawing(): boolean {
-    return this.#window.count > 0;
+    return this.#count > 0;
   }
 
   /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
   get lineStart(): Sample | null {
-    return this.#window.count > 0 ? this.#window.samples[0]! : null;
+    return this.#count > 0 ? this.#anchorSample : null;
   }
 
   /** The last sample taken, as taken: its time (never before the one before) and grid point. */
@@ -273,31 +270,73 @@ export class WindowCore {
     return this.takenMs;
   }
 
+  // window[index] of the stroke being drawn, the anchor at 0 (for the tests made once a stroke).
+  #xAt(index: number): number {
+    return index === 0 ? this.#anchorX : this.#drawn.xs[this.#drawn.base + index]!;
+  }
+
+  #yAt(index: number): number {
+    return index === 0 ? this.#anchorY : this.#drawn.ys[this.#drawn.base + index]!;
+  }
+
+  #msAt(index: number): number {
+    return index === 0 ? this.#anchorMs : this.#drawn.ts[this.#drawn.base + index]!;
+  }
+
   /** One pointer sample while the pointer is down; the first of a path is the press. */
   push(input: Sample): readonly Segment[] {
-    const window = this.#window;
-    const count = window.count;
+    const count = this.#count;
+    if (count === 0) return this.#press(input);
+    const drawn = this.#drawn;
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
-    const sample =
-      count > 0 && input.t_ms < window.ts[count - 1]! ? { ...input, t_ms: window.ts[count - 1]! } : input;
-    const x = this.#mapping.gridX(sample.x);
-    const y = this.#mapping.gridY(sample.y);
-    this.takenMs = sample.t_ms;
+    const lastMs = count > 1 ? drawn.ts[drawn.base + count - 1]! : this.#anchorMs;
+    const sample = input.t_ms < lastMs ? { ...input, t_ms: lastMs } : input;
+    const t = sample.t_ms;
+    const mapping = this.#mapping;
+    const x = mapping.gridX(sample.x);
+    const y = mapping.gridY(sample.y);
+    this.takenMs = t;
     this.takenX = x;
     this.takenY = y;
     this.rested = false;
-    window.place(x, y, sample.t_ms, sample);
-    if (count === 0) {
-      window.count = 1;
-      this.#reach = 0;
-      this.#anchor = null;
-      this.#emittedInPath = false;
-      this.#line = null;
-      this.#resting = false;
-      return NO_SEGMENTS;
-    }
-    if (this.#follows(count, x, y, sample.t_ms)) return NO_SEGMENTS;
+    // Stored after the others (written out here, not called: every sample runs this).
+    const at = drawn.count;
+    drawn.xs[at] = x;
+    drawn.ys[at] = y;
+    drawn.ts[at] = t;
+    drawn.samples[at] = sample;
+    drawn.count = at + 1;
+    if (this.#follows(count, x, y, t)) return NO_SEGMENTS;
     return this.#add() ?? NO_SEGMENTS;
+  }
+
+  /** A path's first sample: the anchor of its first stroke, the first of the store. */
+  #press(sample: Sample): readonly Segment[] {
+    const t = sample.t_ms;
+    const x = this.#mapping.gridX(sample.x);
+    const y = this.#mapping.gridY(sample.y);
+    this.takenMs = t;
+    this.takenX = x;
+    this.takenY = y;
+    this.rested = false;
+    const drawn = this.#drawn;
+    drawn.xs[0] = x;
+    drawn.ys[0] = y;
+    drawn.ts[0] = t;
+    drawn.samples[0] = sample;
+    drawn.count = 1;
+    drawn.base = 0;
+    this.#anchorX = x;
+    this.#anchorY = y;
+    this.#anchorMs = t;
+    this.#anchorSample = sample;
+    this.#count = 1;
+    this.#reach = 0;
+    this.#anchor = null;
+    this.#emittedInPath = false;
+    this.#line = null;
+    this.#resting = false;
+    return NO_SEGMENTS;
   }
 
   /**
@@ -309,26 +348,32 @@ export class WindowCore {
    */
   #follows(count: number, x: number, y: number, t: number): boolean {
     if (this.#resting || count < 2 || count >= this.#maxWindow || this.#bends) return false;
-    const { xs, ys, ts } = this.#window;
-    const sinceAnchorMs = t - ts[0]!;
+    const sinceAnchorMs = t - this.#anchorMs;
     const capMs = this.#capMs;
     if (capMs > 0 && sinceAnchorMs > capMs) return false;
-    const dx = x - xs[count - 1]!;
-    const dy = y - ys[count - 1]!;
-    const stepSq = dx * dx + dy * dy;
-    const reach = this.#reach + Math.sqrt(stepSq) + ROUNDING_SLACK;
+    const drawn = this.#drawn;
+    const last = drawn.base + count - 1;
+    const lastX = drawn.xs[last]!;
+    const lastY = drawn.ys[last]!;
+    const reach = this.#reach + stepReach(this.#anchorX, this.#anchorY, lastX, lastY, x, y) + ROUNDING_SLACK;
     // `#keepsBound`'s shortcut.
     if (!(reach <= this.#reachLimit)) return false;
     // `#add`'s test for a pen that may rest, then whether it does (`#rests`): many samples of a
     // slow pen stay near the one before, few near every one of the last rest_ms.
     const restMs = this.#restMs;
     const restSq = this.#restSq;
-    if (restMs > 0 && sinceAnchorMs >= restMs && stepSq <= restSq) {
-      let start = count - 1;
-      while (start > 0 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
-      if (!(t - ts[start]! < restMs)) return false;
+    if (restMs > 0 && sinceAnchorMs >= restMs && squared(lastX - x, lastY - y) <= restSq) {
+      const { xs, ys, ts } = drawn;
+      const base = drawn.base;
+      let start = last;
+      while (start > base + 1 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
+      const startMs =
+        start === base + 1 && squared(this.#anchorX - x, this.#anchorY - y) <= restSq
+          ? this.#anchorMs
+          : ts[start]!;
+      if (!(t - startMs < restMs)) return false;
     }
-    this.#window.count = count + 1;
+    this.#count = count + 1;
     this.#reach = reach;
     this.#reaches[count] = reach;
     return true;
@@ -336,16 +381,14 @@ export class WindowCore {
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
   end(): Segment[] {
-    const window = this.#window;
-    const count = window.count;
+    const count = this.#count;
     if (count === 0) return [];
-    window.count = 0;
-    window.end = 0;
+    this.#count = 0;
     this.#resting = false;
     // The last sample already ends a stroke (a cut at the work cap).
     if (count === 1 && this.#emittedInPath) return [];
     const end = this.#continued(count - 1);
-    return [this.#finish(this.#start(), window.ts[0]!, end, window.ts[count - 1]!)];
+    return [this.#finish(this.#start(), this.#anchorMs, end, this.#msAt(count - 1))];
   }
 
   /**
@@ -355,40 +398,42 @@ export class WindowCore {
    */
   #add(): Segment[] | null {
     let out: Segment[] | null = null;
-    const window = this.#window;
-    const { xs, ys, ts } = window;
-    const capMs = this.params.max_stroke_ms;
-    const maxWindow = this.params.max_window;
-    const restMs = this.params.rest_ms;
+    const drawn = this.#drawn;
+    const { xs, ys, ts } = drawn;
+    const capMs = this.#capMs;
+    const maxWindow = this.#maxWindow;
+    const restMs = this.#restMs;
     for (let first = true; ; first = false) {
-      const count = window.count;
-      const x = xs[count]!;
-      const y = ys[count]!;
-      const t = ts[count]!;
+      const count = this.#count;
+      const at = drawn.base + count;
+      const x = xs[at]!;
+      const y = ys[at]!;
+      const t = ts[at]!;
       // Most samples a cut gives back are common ones too (`push` tried the new one).
       if (!first && this.#follows(count, x, y, t)) {
-        if (window.count === window.end) return out;
+        if (drawn.base + this.#count === drawn.count) return out;
         continue;
       }
       if (this.#resting) {
-        if (count === 1 && squared(x - xs[0]!, y - ys[0]!) <= this.#restSq) {
-          // The pen still rests: the next stroke starts when it moves on, not before.
-          window.retime(t);
-          window.skip();
-          if (window.count === window.end) return out;
+        if (count === 1 && squared(x - this.#anchorX, y - this.#anchorY) <= this.#restSq) {
+          // The pen still rests: the next stroke starts when it moves on, not before. The sample
+          // is not taken: the window moves on past it (the merger still sees it).
+          this.#retime(t);
+          drawn.base++;
+          if (drawn.base + this.#count === drawn.count) return out;
           continue;
         }
         this.#resting = false;
       }
-      if (capMs > 0 && count > 1 && t - ts[0]! > capMs) {
-        if (!this.#sendable(xs[0]!, ys[0]!, xs[count - 1]!, ys[count - 1]!)) {
+      if (capMs > 0 && count > 1 && t - this.#anchorMs > capMs) {
+        if (!this.#sendable(this.#anchorX, this.#anchorY, xs[at - 1]!, ys[at - 1]!)) {
           // The pen crawls: too little drawn in max_stroke_ms to send. The stroke starts later
           // rather than lasting longer, so the cap holds for it too.
-          window.retime(t - capMs);
+          this.#retime(t - capMs);
         } else {
           const cut = this.#capCut(count);
           const vertex = this.#continued(cut);
-          (out ??= []).push(this.#finish(this.#start(), ts[0]!, vertex, ts[cut]!));
+          out = more(out, this.#finish(this.#start(), this.#anchorMs, vertex, this.#msAt(cut)));
           this.#line = this.#lineOf(cut, vertex);
           // The samples after the cut, this one included, are taken again into the next stroke.
           this.#restart(vertex, cut);
@@ -397,58 +442,89 @@ export class WindowCore {
       }
       if (!this.#keepsBound(count, x, y)) {
         let cut = this.#feature(count, x, y, 1);
-        const floorEndMs = ts[0]! + this.#floorMs;
-        if (ts[cut]! < floorEndMs && floorEndMs <= ts[count - 1]!) {
+        const floorEndMs = this.#anchorMs + this.#floorMs;
+        const base = drawn.base;
+        if (ts[base + cut]! < floorEndMs && floorEndMs <= ts[at - 1]!) {
           // The piece would be briefer than the sleeve's floor, and the window holds a longer
           // one: cut at the feature among the samples drawn at least the floor after the anchor
           // (the last one always keeps the bound), so the sleeve need not slow the piece and the
           // merger need not hold it.
           let later = cut + 1;
-          while (ts[later]! < floorEndMs) later++;
+          while (ts[base + later]! < floorEndMs) later++;
           cut = this.#feature(count, x, y, later);
         }
-        const end: Point = [xs[cut]!, ys[cut]!];
-        (out ??= []).push(this.#finish(this.#start(), ts[0]!, end, ts[cut]!));
+        const end: Point = [xs[base + cut]!, ys[base + cut]!];
+        out = more(out, this.#finish(this.#start(), this.#anchorMs, end, ts[base + cut]!));
         this.#line = null;
         this.#restart(end, cut);
       } else {
-        window.count = count + 1;
+        this.#count = count + 1;
         this.#reaches[count] = this.#reach;
         // A stroke younger than rest_ms cannot hold a rest, nor a pen that left the rest radius
         // since the sample before: most samples stop at these two tests.
         const rest =
           restMs > 0 &&
-          t - ts[0]! >= restMs &&
-          squared(xs[count - 1]! - x, ys[count - 1]! - y) <= this.#restSq
+          t - this.#anchorMs >= restMs &&
+          squared(this.#xAt(count - 1) - x, this.#yAt(count - 1) - y) <= this.#restSq
             ? this.#rests(count + 1)
             : false;
         if (rest !== false) {
           // The pen rests: the stroke before it, if any, is out; the anchor waits for the pen.
-          if (rest !== null) (out ??= []).push(rest);
+          if (rest !== null) out = more(out, rest);
         } else if (count >= maxWindow) {
           const end: Point = [x, y];
-          (out ??= []).push(this.#finish(this.#start(), ts[0]!, end, t));
+          out = more(out, this.#finish(this.#start(), this.#anchorMs, end, t));
           this.#line = null;
           this.#restart(end, count);
         }
       }
-      if (window.count === window.end) return out;
+      if (drawn.base + this.#count === drawn.count) return out;
     }
   }
 
   /** Where the stroke being drawn starts: its anchor, window[0]. */
   #start(): Point {
-    return this.#anchor ?? [this.#window.xs[0]!, this.#window.ys[0]!];
+    return this.#anchor ?? [this.#anchorX, this.#anchorY];
   }
 
   /**
-   * Only one sample in the stroke, its anchor at `anchor`, the samples after window[index] to take
-   * again (`Samples.restart`): nothing measured of the stroke before holds for the next.
+   * Only one sample in the stroke, its anchor at `anchor` with the time and Sample of
+   * window[index] (index > 0), the samples after it to take again: nothing measured of the
+   * stroke before holds for the next.
    */
   #restart(anchor: Point, index: number): void {
-    this.#window.restart(anchor[0], anchor[1], index);
+    const drawn = this.#drawn;
+    const at = drawn.base + index;
+    this.#anchorX = anchor[0];
+    this.#anchorY = anchor[1];
+    this.#anchorMs = drawn.ts[at]!;
+    this.#anchorSample = drawn.samples[at]!;
+    drawn.base = at;
+    this.#count = 1;
     this.#anchor = anchor;
     this.#reach = 0;
+    drawn.compact();
+  }
+
+  /** The anchor at another time (while the pen rests or crawls), its Sample too. */
+  #retime(t: number): void {
+    this.#anchorMs = t;
+    // Built field by field, not spread: a crawling pen retimes at every sample.
+    const anchor = this.#anchorSample!;
+    this.#anchorSample = { t_ms: t, x: anchor.x, y: anchor.y, pressure: anchor.pressure };
+  }
+
+  /**
+   * Where a rest at (x, y) begins: the least window index from which every sample up to
+   * window[last] (itself not tested) lies within the rest radius of (x, y), walking back.
+   */
+  #restStart(last: number, x: number, y: number): number {
+    const { xs, ys, base } = this.#drawn;
+    const restSq = this.#restSq;
+    let start = last;
+    while (start > 1 && squared(xs[base + start - 1]! - x, ys[base + start - 1]! - y) <= restSq) start--;
+    if (start === 1 && squared(this.#anchorX - x, this.#anchorY - y) <= restSq) start = 0;
+    return start;
   }
 
   /**
@@ -463,27 +539,23 @@ export class WindowCore {
    * the anchor when all is rest.
    */
   #rests(count: number): Segment | null | false {
-    const restMs = this.params.rest_ms;
-    const window = this.#window;
-    const { xs, ys, ts } = window;
+    const restMs = this.#restMs;
     const last = count - 1;
-    const t = ts[last]!;
-    if (restMs <= 0 || t - ts[0]! < restMs) return false;
-    const x = xs[last]!;
-    const y = ys[last]!;
-    const restSq = this.#restSq;
-    let start = last;
-    while (start > 0 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
-    if (t - ts[start]! < restMs) return false;
+    const t = this.#msAt(last);
+    if (restMs <= 0 || t - this.#anchorMs < restMs) return false;
+    const x = this.#xAt(last);
+    const y = this.#yAt(last);
+    const start = this.#restStart(last, x, y);
+    if (t - this.#msAt(start) < restMs) return false;
     let stroke: Segment | null = null;
     if (start === 0) {
-      const anchor = window.samples[0]!;
+      const anchor = this.#anchorSample;
       this.#restart(this.#start(), last);
-      window.samples[0] = anchor;
-      window.retime(t);
+      this.#anchorSample = anchor;
+      this.#retime(t);
     } else {
       const end: Point = [x, y];
-      stroke = this.#finish(this.#start(), ts[0]!, end, ts[start]!);
+      stroke = this.#finish(this.#start(), this.#anchorMs, end, this.#msAt(start));
       this.#restart(end, last);
     }
     this.#line = null;
@@ -503,24 +575,25 @@ export class WindowCore {
       this.#reach = 0;
       return true;
     }
-    const { xs, ys } = this.#window;
+    const drawn = this.#drawn;
+    const ax = this.#anchorX;
+    const ay = this.#anchorY;
     let reachLimit = this.#reachLimit;
     let limitSq = this.#maxErrorSq;
     const bend = this.params.max_bend;
     if (bend > 0) {
       // The bend rule: a round shape is cut before its chord strays farther than a share of the
       // chord's length, never under the floor, never over max_error.
-      const cx = x - xs[0]!;
-      const cy = y - ys[0]!;
+      const cx = x - ax;
+      const cy = y - ay;
       const limit = Math.max(bend * Math.sqrt(cx * cx + cy * cy), this.params.bend_floor);
       if (limit < this.params.max_error) {
         reachLimit = limit - ROUNDING_SLACK;
         limitSq = limit * limit;
       }
     }
-    const dx = x - xs[count - 1]!;
-    const dy = y - ys[count - 1]!;
-    const reach = this.#reach + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK;
+    const last = drawn.base + count - 1;
+    const reach = this.#reach + stepReach(ax, ay, drawn.xs[last]!, drawn.ys[last]!, x, y) + ROUNDING_SLACK;
     if (reach <= reachLimit) {
       this.#reach = reach;
       return true;
@@ -537,8 +610,8 @@ export class WindowCore {
    * then a test of each finds them all within. False when unsure (a NaN too): test each.
    */
   #reachesNear(index: number, endX: number, endY: number, limit: number): boolean {
-    const dx = endX - this.#window.xs[index]!;
-    const dy = endY - this.#window.ys[index]!;
+    const dx = endX - this.#xAt(index);
+    const dy = endY - this.#yAt(index);
     return this.#reaches[index]! + Math.sqrt(dx * dx + dy * dy) + ROUNDING_SLACK <= limit;
   }
 
@@ -550,16 +623,22 @@ export class WindowCore {
    * lies on the chord (a straight stroke, to `STRAIGHT`), at the last sample.
    */
   #capCut(count: number): number {
-    const { xs, ys, ts } = this.#window;
+    const { xs, ys, ts, base } = this.#drawn;
     const last = count - 1;
-    const earliest = ts[0]! + CAP_FEATURE_SHARE * this.params.max_stroke_ms;
+    const earliest = this.#anchorMs + CAP_FEATURE_SHARE * this.params.max_stroke_ms;
     let first = 1;
-    while (first < last && ts[first]! < earliest) first++;
-    const cut = this.#feature(count, xs[last]!, ys[last]!, first);
+    while (first < last && ts[base + first]! < earliest) first++;
+    const lastX = xs[base + last]!;
+    const lastY = ys[base + last]!;
+    const cut = this.#feature(count, lastX, lastY, first);
     const straight = STRAIGHT * this.params.max_error;
-    const farSq = distanceSq(xs[cut]!, ys[cut]!, xs[0]!, ys[0]!, xs[last]!, ys[last]!);
+    const ax = this.#anchorX;
+    const ay = this.#anchorY;
+    const cutX = xs[base + cut]!;
+    const cutY = ys[base + cut]!;
+    const farSq = distanceSq(cutX, cutY, ax, ay, lastX, lastY);
     const bends = farSq > straight * straight;
-    return bends && this.#sendable(xs[0]!, ys[0]!, xs[cut]!, ys[cut]!) ? cut : last;
+    return bends && this.#sendable(ax, ay, cutX, cutY) ? cut : last;
   }
 
   /**
@@ -573,16 +652,15 @@ export class WindowCore {
    * straight line.
    */
   #continued(cut: number): Point {
-    const { xs, ys } = this.#window;
-    const atX = xs[cut]!;
-    const atY = ys[cut]!;
+    const atX = this.#xAt(cut);
+    const atY = this.#yAt(cut);
     const line = this.#line;
     if (line === null) return [atX, atY];
     // Indexed, not destructured: destructuring goes through the array's iterator.
     const ux = line[0];
     const uy = line[1];
-    const ax = xs[0]!;
-    const ay = ys[0]!;
+    const ax = this.#anchorX;
+    const ay = this.#anchorY;
     const along = (atX - ax) * ux + (atY - ay) * uy;
     if (along <= 0) return [atX, atY];
     const endX = ax + along * ux;
@@ -616,7 +694,7 @@ export class WindowCore {
     const limit = LINE_SHARE * this.params.max_error;
     const certain = this.#reachesNear(cut, end[0], end[1], limit - ROUNDING_SLACK);
     if (!certain && !this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
-    return direction(this.#window.xs[0]!, this.#window.ys[0]!, end[0], end[1]);
+    return direction(this.#anchorX, this.#anchorY, end[0], end[1]);
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
@@ -631,10 +709,10 @@ export class WindowCore {
    * the bound (the last sample always does). Ties go to the later sample.
    */
   #feature(count: number, endX: number, endY: number, first: number): number {
-    const { xs, ys } = this.#window;
+    const { xs, ys, base } = this.#drawn;
     const distances = this.#distances;
-    const ax = xs[0]!;
-    const ay = ys[0]!;
+    const ax = this.#anchorX;
+    const ay = this.#anchorY;
     let finite = true;
     // The farthest, found as the distances are: nearly always the cut, so no second pass.
     let farthest = -1;
@@ -644,8 +722,8 @@ export class WindowCore {
     const dy = endY - ay;
     const lengthSq = dx * dx + dy * dy;
     for (let i = first; i < count; i++) {
-      const qx = xs[i]! - ax;
-      const qy = ys[i]! - ay;
+      const qx = xs[base + i]! - ax;
+      const qy = ys[base + i]! - ay;
       const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
       distances[i] = d;
       if (Number.isNaN(d)) finite = false;
@@ -692,10 +770,9 @@ export class WindowCore {
 
   /** Whether window[index] can end the stroke: every sample before it within the bound of its own chord. */
   #fits(index: number): boolean {
-    const { xs, ys } = this.#window;
     return (
       this.#reaches[index]! <= this.#reachLimit ||
-      this.#within(index, xs[index]!, ys[index]!, this.#maxErrorSq)
+      this.#within(index, this.#xAt(index), this.#yAt(index), this.#maxErrorSq)
     );
   }
 
@@ -710,21 +787,22 @@ export class WindowCore {
    * sample: its chord terms computed once (`chordDistanceSq`).
    */
   #farthestSq(stop: number, endX: number, endY: number, limitSq: number): number {
-    const { xs, ys } = this.#window;
-    const ax = xs[0]!;
-    const ay = ys[0]!;
+    const { xs, ys, base } = this.#drawn;
+    const ax = this.#anchorX;
+    const ay = this.#anchorY;
     const dx = endX - ax;
     const dy = endY - ay;
     const lengthSq = dx * dx + dy * dy;
     let farthest = 0;
+    const last = base + stop;
     if (lengthSq > 0) {
-      for (let i = 1; i < stop; i++) {
+      for (let i = base + 1; i < last; i++) {
         const d = chordDistanceSq(xs[i]! - ax, ys[i]! - ay, dx, dy, lengthSq);
         if (d > limitSq) return -1;
         if (d > farthest) farthest = d;
       }
     } else {
-      for (let i = 1; i < stop; i++) {
+      for (let i = base + 1; i < last; i++) {
         const qx = xs[i]! - ax;
         const qy = ys[i]! - ay;
         const d = qx * qx + qy * qy;
@@ -753,15 +831,6 @@ export class WindowCore {
  * then it merges into that stroke and nothing more is sent (`mergedBack`). Only a path's one and
  * only piece, too short, is dropped.
  */
-/**
- * The merger drops covered samples from its arrays once this many have gathered at their start
- * (and they are at least half): few enough that the arrays stay small (few regrowths for a
- * simplifier made per path), enough that each sample is moved at most once on average.
- */
-const COMPACT_AFTER = 32;
-/** The numbers the merger keeps of a drawn sample: its time, x and y. */
-const DRAWN = 3;
-
 export class Merger {
   readonly #maxError: number;
   readonly #minLength: number;
@@ -769,21 +838,13 @@ export class Merger {
   readonly #shortMs: number;
   readonly #strict: boolean;
   /**
-   * The drawn samples not yet covered by a sent stroke (ms, grid units), oldest first: samples
-   * [#first, #count) of one array kept from one path to the next, three numbers a sample (time, x,
-   * y) side by side. One array of numbers (stored unboxed, as in `Samples`), not three: every
-   * sample drawn is stored here, and one array grows and checks its bounds once where three did
-   * three times. Not a typed array: its buffer lives outside the heap and is zeroed when made,
-   * which cost more than its samples for a simplifier made per path (as the bench makes one per
-   * demonstration).
+   * The drawn samples (ms, grid units), oldest first: those not yet covered by a sent stroke are
+   * [first, count) (`Drawn`). The window's own store when the merger takes its pieces (each
+   * sample stored once), else one of its own that `sample` fills. Not a typed array: its buffer
+   * lives outside the heap and is zeroed when made, which cost more than its samples for a
+   * simplifier made per path (as the bench makes one per demonstration).
    */
-  readonly #drawn: number[] = [];
-  #count = 0;
-  /**
-   * The first sample not yet covered: those before it are, and are dropped from the array only
-   * now and then (`#send`), not at every stroke sent (three splices, each an array made).
-   */
-  #first = 0;
+  readonly #drawn: Drawn;
   #held: Segment | null = null;
   #sentInPath = false;
   /**
@@ -795,7 +856,16 @@ export class Merger {
   /** Pieces merged at release into a stroke already sent (nothing more is sent for them), in all. */
   mergedBack = 0;
 
-  constructor(maxError: number, minLength: number, minDurationMs: number, floorMs: number, strict = false) {
+  constructor(
+    maxError: number,
+    minLength: number,
+    minDurationMs: number,
+    floorMs: number,
+    strict = false,
+    drawn: Drawn = new Drawn(),
+  ) {
+    this.#drawn = drawn;
+    drawn.first = 0;
     this.#maxError = maxError;
     this.#minLength = minLength;
     this.#minDurationMs = minDurationMs;
@@ -805,12 +875,12 @@ export class Merger {
 
   /** A drawn sample, in order (its time as the window took it). */
   sample(tMs: number, x: number, y: number): void {
-    const at = this.#count;
     const drawn = this.#drawn;
-    drawn[DRAWN * at] = tMs;
-    drawn[DRAWN * at + 1] = x;
-    drawn[DRAWN * at + 2] = y;
-    this.#count = at + 1;
+    const at = drawn.count;
+    drawn.xs[at] = x;
+    drawn.ys[at] = y;
+    drawn.ts[at] = tMs;
+    drawn.count = at + 1;
   }
 
   #short(segment: Segment): boolean {
@@ -828,19 +898,17 @@ export class Merger {
    */
   #fits(start: Point, end: Point, endMs: number): boolean {
     const limitSq = this.#maxError * this.#maxError;
-    const drawn = this.#drawn;
-    const count = this.#count;
+    const { xs, ys, ts, count } = this.#drawn;
     // `distanceSq` with the chord's terms computed once (the same operations, as in `#farthestSq`).
     const ax = start[0];
     const ay = start[1];
     const dx = end[0] - ax;
     const dy = end[1] - ay;
     const lengthSq = dx * dx + dy * dy;
-    for (let i = this.#first; i < count; i++) {
-      const at = DRAWN * i;
-      if (drawn[at]! > endMs) break;
-      const qx = drawn[at + 1]! - ax;
-      const qy = drawn[at + 2]! - ay;
+    for (let i = this.#drawn.first; i < count; i++) {
+      if (ts[i]! > endMs) break;
+      const qx = xs[i]! - ax;
+      const qy = ys[i]! - ay;
       const d = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
       if (d > limitSq) return false;
     }
@@ -885,19 +953,12 @@ export class Merger {
     out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
     const drawn = this.#drawn;
-    const count = this.#count;
+    const { ts, count } = drawn;
     const endMs = segment.end_ms;
-    let keep = this.#first;
-    while (keep < count && drawn[DRAWN * keep]! < endMs) keep++;
-    this.#first = keep;
-    if (keep >= COMPACT_AFTER && 2 * keep >= count) {
-      // Most of the array is covered: move what is not to its start, in place.
-      for (let from = DRAWN * keep, to = 0, stop = DRAWN * count; from < stop; from++, to++) {
-        drawn[to] = drawn[from]!;
-      }
-      this.#count = count - keep;
-      this.#first = 0;
-    }
+    let keep = drawn.first;
+    while (keep < count && ts[keep]! < endMs) keep++;
+    drawn.first = keep;
+    drawn.compact();
   }
 
   /** A piece the window cut: the strokes sent now, into `out` (none while a short one waits). */
@@ -983,8 +1044,8 @@ export class Merger {
     this.#held = null;
     this.#sentInPath = false;
     this.#last = null;
-    this.#count = 0;
-    this.#first = 0;
+    this.#drawn.count = 0;
+    this.#drawn.first = 0;
   }
 }
 
@@ -995,7 +1056,9 @@ export class WindowSimplifier {
   readonly #merger: Merger;
 
   constructor(params: WindowParams) {
-    this.#core = new WindowCore(params);
+    // One store of the drawn samples, which the window fills and the merger reads too.
+    const drawn = new Drawn();
+    this.#core = new WindowCore(params, drawn);
     this.params = params;
     this.#merger = new Merger(
       params.max_error,
@@ -1003,6 +1066,7 @@ export class WindowSimplifier {
       params.min_duration_ms,
       params.floor_ms,
       params.strict_minimums,
+      drawn,
     );
   }
 
@@ -1022,9 +1086,16 @@ export class WindowSimplifier {
     const pieces = core.push(input);
     const merger = this.#merger;
     const takenMs = core.takenMs;
-    merger.sample(takenMs, core.takenX, core.takenY);
     // Most samples finish no piece: nothing to merge, no array made.
     if (pieces.length === 0 && !core.rested) return NO_SEGMENTS;
+    if (pieces.length === 1 && !core.rested) {
+      // Most of the rest finish one: the window's array (made for it, of one slot) holds what
+      // the merger sends instead, most often that piece itself: no other array made.
+      const out = pieces as Segment[];
+      const piece = out.pop()!;
+      merger.take(piece, takenMs, out);
+      return out.length > 0 ? out : NO_SEGMENTS;
+    }
     const out: Segment[] = [];
     // Indexed, no iterator made: this runs at every stroke.
     for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
@@ -1042,7 +1113,8 @@ export class WindowSimplifier {
     const core = this.#core;
     const nowMs = core.pointerMs();
     const out: Segment[] = [];
-    for (const piece of core.end()) this.#merger.take(piece, nowMs, out);
+    const pieces = core.end();
+    for (let i = 0; i < pieces.length; i++) this.#merger.take(pieces[i]!, nowMs, out);
     this.#merger.end(nowMs, out);
     return out;
   }
@@ -1070,8 +1142,27 @@ function nextUp(value: number): number {
   return NEXT_UP[0]!;
 }
 
+/**
+ * `out` with `segment` after its others, `out` made if null: an array of one slot (`[]` then
+ * push would reserve many), since most samples that finish a stroke finish one.
+ */
+function more(out: Segment[] | null, segment: Segment): Segment[] {
+  if (out === null) return [segment];
+  out.push(segment);
+  return out;
+}
+
 function squared(dx: number, dy: number): number {
   return dx * dx + dy * dy;
+}
+
+/**
+ * What moving the end of anchor -> (lastX, lastY) to (x, y) adds at most to the distance of any
+ * point to it (`WindowCore`'s reach): the distance of (lastX, lastY) to anchor -> (x, y), never
+ * more than the step between them, much less when the step goes on along the segment.
+ */
+function stepReach(ax: number, ay: number, lastX: number, lastY: number, x: number, y: number): number {
+  return Math.sqrt(distanceSq(lastX, lastY, ax, ay, x, y));
 }
 
 /** The unit vector from (startX, startY) to (endX, endY) (null if they coincide). */
