@@ -126,8 +126,13 @@ export class ReferenceMerger {
     // A piece made at this sample and not dropped (most: the window's and the merged ones) is sent
     // as it is; else a copy, built field by field, not spread (several times slower): the same
     // keys in the same order. Object.is: -0 and 0 are different times to the vectors.
+    // A stroke drawn briefer than the sleeve's floor (one that could not merge) lasts the floor.
+    const durationMs =
+      segment.end_ms - segment.start_ms < this.#shortMs ? this.#shortMs : segment.duration_ms;
     const sent: Segment =
-      segment.dropped === null && Object.is(segment.emitted_at_ms, nowMs)
+      segment.dropped === null &&
+      Object.is(segment.emitted_at_ms, nowMs) &&
+      durationMs === segment.duration_ms
         ? segment
         : segment.merged === undefined
           ? {
@@ -135,7 +140,7 @@ export class ReferenceMerger {
               end: segment.end,
               start_ms: segment.start_ms,
               end_ms: segment.end_ms,
-              duration_ms: segment.duration_ms,
+              duration_ms: durationMs,
               emitted_at_ms: nowMs,
               dropped: null,
             }
@@ -144,7 +149,7 @@ export class ReferenceMerger {
               end: segment.end,
               start_ms: segment.start_ms,
               end_ms: segment.end_ms,
-              duration_ms: segment.duration_ms,
+              duration_ms: durationMs,
               emitted_at_ms: nowMs,
               dropped: null,
               merged: segment.merged,
