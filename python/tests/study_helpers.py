@@ -16,7 +16,7 @@ def new_study(tmp_path: Path, design_path: Path = PAPER_DESIGN) -> StudyStore:
 
 
 def zigzag_recording(path: Path) -> Path:
-    """A drawn zigzag (three teeth), as the page's "Save recording" writes it."""
+    """A drawn zigzag (three teeth), as the page's Save button writes it."""
     samples = []
     for i in range(48):
         up = (i // 8) % 2 == 0

@@ -222,4 +222,4 @@ def test_a_stroke_felt_long_after_it_was_sent_is_logged_as_delayed(
         running.wait_events(1)
     # Delayed on the way, not "late" (the refusal of a stroke the sleeve is too far behind for).
     said = [r.getMessage() for r in caplog.records if "delayed" in r.getMessage()]
-    assert len(said) == 1 and "stroke 0 of drawing held delayed by 5." in said[0], said
+    assert len(said) == 1 and "stroke 1 of drawing held delayed by 5." in said[0], said

@@ -256,7 +256,7 @@ def test_a_recording_without_its_canvas_says_what_it_has_in_json_words(
     files: dict[str, str], tmp_path: Path
 ) -> None:
     done = run(["replay", files["no_canvas"]], tmp_path)
-    assert_one_error(done, "'canvas' must be an object but is null", "Save recording")
+    assert_one_error(done, "'canvas' must be an object but is null", "Save button")
 
 
 def test_an_unexpected_exception_is_one_error_line_asking_for_a_report(

@@ -92,5 +92,9 @@ def test_missing_file_and_bad_parameter(tmp_path: Path, capsys: pytest.CaptureFi
     assert main(["simplify", str(tmp_path / "absent.json")]) == 1
     assert "cannot read recording" in capsys.readouterr().err
     recording = write_recording(ANGLE["circle/defaults"], tmp_path / "c.json")
-    assert main(["simplify", str(recording), "--paper", "--check-frames", "1"]) == 1
-    assert "check_frames" in capsys.readouterr().err
+    # A value outside a parameter's range is a usage error, named as its option, with the range.
+    with pytest.raises(SystemExit) as caught:
+        main(["simplify", str(recording), "--paper", "--check-frames", "1"])
+    assert caught.value.code == 2
+    err = capsys.readouterr().err
+    assert "--check-frames: 1 is out of range; give a whole number from" in err, err

@@ -122,7 +122,7 @@ export class SleeveWatch {
       status.online ? "online" : "offline",
       status.online
         ? `Online${status.layout ? `, ${status.layout.rows} × ${status.layout.columns} actuators` : ""}${status.version ? `, version ${status.version}` : ""}`
-        : "Offline: strokes sent now reach the sleeve when it is back (if its session is kept).",
+        : "Offline: strokes sent now reach the sleeve when it is back (if its session is kept), and play if they are not older than its age limit by then.",
     );
     return { back: status.online && !wasOnline };
   }
@@ -167,7 +167,7 @@ export class SleeveWatch {
         hold === null
           ? `Sleeve ${id} online${grid}, waiting for strokes.`
           : `Sleeve ${id} online${grid}, playing nothing. ${holdHeadline(hold, nowMs)}`,
-      offline: `Sleeve ${id} is offline: nothing is felt now.`,
+      offline: `Sleeve ${id} is offline: no new stroke is felt.`,
       absent: `No sleeve answers on id ${id}: nothing is felt.`,
       unknown: connected
         ? `Waiting for sleeve ${id} to report…`
@@ -179,7 +179,9 @@ export class SleeveWatch {
         ? `No sleeve listens on id '${id}': nothing has ever reported there, so strokes sent now are not felt. ` +
           "Check the sleeve id in Settings → Sleeve (a sleeve prints its id when it starts)."
         : state === "offline"
-          ? `Sleeve '${id}' is offline: strokes wait at the broker and play when it is back.`
+          ? `Sleeve '${id}' is offline: strokes wait at the broker and play if it is back within its age limit ` +
+            "(10 s unless set; older ones are refused as stale). If it crashed, a motor it was driving may " +
+            "run until it restarts (docs/sleeve-hardware.md: the enable line)."
           : null;
     this.#showNotice();
   }

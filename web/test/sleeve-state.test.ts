@@ -107,7 +107,10 @@ describe("the sleeve's state", () => {
     watch.onStatus(ONLINE);
     expect(watch.onStatus(OFFLINE)).toEqual({ back: false });
     expect(seen.notice).toEqual({
-      text: "Sleeve 'sleeve1' is offline: strokes wait at the broker and play when it is back.",
+      text:
+        "Sleeve 'sleeve1' is offline: strokes wait at the broker and play if it is back within its age limit " +
+        "(10 s unless set; older ones are refused as stale). If it crashed, a motor it was driving may run " +
+        "until it restarts (docs/sleeve-hardware.md: the enable line).",
       level: "warn",
     });
     expect(watch.onStatus(ONLINE)).toEqual({ back: true });

@@ -700,7 +700,8 @@ class Sleeve:
                 "sleeve %s: stroke %s of drawing %s delayed by %.1f s (it waited at the broker "
                 "or on the way)",
                 self._id,
-                event.seq,
+                # Counted from 1, as the page and send's lines count strokes.
+                "?" if event.seq is None else event.seq + 1,
                 event.drawing,
                 delay_ms / 1000,
             )

@@ -78,15 +78,15 @@ def _why_late(held_ms: float, queued_ms: float) -> str:
     """Why a stroke is late, from the larger of its two parts: ``held_ms``, how much later than
     the quickest stroke of its drawing it arrived (the sender, the network or the broker held
     it); ``queued_ms``, how much longer than its own drawing's time line it would wait behind
-    the strokes queued on the sleeve before it (another drawing playing)."""
+    the strokes queued on the sleeve before it (another drawing playing, or a backlog of its own
+    that a sleeve back from away received at once)."""
     if held_ms >= queued_ms:
         return (
             f"it arrived {held_ms / 1000:.2f} s later than its drawing's quickest stroke, held on "
             "the way (the sender, the network or the broker was away)"
         )
     return (
-        f"it would wait {queued_ms / 1000:.2f} s behind the strokes queued on the sleeve before "
-        "it (another drawing playing)"
+        f"it would wait {queued_ms / 1000:.2f} s behind the strokes queued on the sleeve before it"
     )
 
 
@@ -126,8 +126,9 @@ class PacePolicy:
             return Verdict(
                 STALE,
                 f"the stroke was sent {age_ms / 1000:.1f} s ago (by the sender's clock); the "
-                f"sleeve plays strokes at most {self.max_age_ms / 1000:g} s old. If it was just "
-                "sent, the sender's clock is behind the sleeve's: set both by NTP",
+                f"sleeve plays strokes at most {self.max_age_ms / 1000:g} s old. It was held on "
+                "the way (the sleeve or its broker was away), or, if it was just sent, the "
+                "sender's clock is behind the sleeve's: set both by NTP",
                 age_ms=age_ms,
             )
         line.smallest_delay_ms = min(line.smallest_delay_ms, age_ms)

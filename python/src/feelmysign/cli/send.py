@@ -510,7 +510,8 @@ def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
         return
     whose = f" with wearer {floor.wearer}'s limits" if floor.wearer else ""
     verdict = (
-        f"{below} of the {len(strokes)} strokes are below it (the sleeve slows a briefer one; "
+        f"{'the stroke is' if len(strokes) == 1 else f'{below} of the {len(strokes)} strokes are'}"
+        " below it (the sleeve slows a briefer one; "
         "a shorter one may not be felt)"
         if below
         else "every stroke is at or above it"

@@ -9,7 +9,13 @@ from dataclasses import asdict, fields, replace
 from typing import Any
 
 from feelmysign.cli.options.parser import Subcommands
-from feelmysign.cli.options.values import MAX_RECORDING_BYTES, check_input_file
+from feelmysign.cli.options.values import (
+    MAX_RECORDING_BYTES,
+    check_input_file,
+    decimal_float_option,
+    decimal_int_option,
+)
+from feelmysign.errors import ParameterError
 from feelmysign.simplify import (
     ALGORITHMS,
     PathSegment,
@@ -91,11 +97,40 @@ def _option(parser: argparse.ArgumentParser, spec: ParamSpec) -> None:
     allowed = f"{_bound(spec.minimum)} to {_bound(spec.maximum)}"
     parser.add_argument(
         flag,
-        type=spec.kind,
+        type=_value_of(spec),
         metavar="N" if spec.kind is int else _METAVARS.get(spec.unit or "", "X"),
         default=None,
         help=_escape(f"{prefix}{spec.help} ({allowed}; default: {spec.default:g})"),
     )
+
+
+def _value_of(spec: ParamSpec) -> Any:
+    """The option's argparse type: a value outside the parameter's range is a usage error (exit
+    2) that names the range, before any recording is read, as any other option's."""
+    whole = spec.kind is int
+    kind = "a whole number" if whole else "a number"
+    if spec.minimum is not None and spec.maximum is not None:
+        allowed = f"{kind} from {spec.minimum:g} to {spec.maximum:g}"
+    elif spec.minimum is not None:
+        allowed = f"{kind} of {spec.minimum:g} or more"
+    elif spec.maximum is not None:
+        allowed = f"{kind} of at most {spec.maximum:g}"
+    else:
+        allowed = kind
+    if spec.unit:
+        allowed += f" ({spec.unit})"
+
+    def parse(text: str) -> float | int:
+        # Written in decimal digits, as every number option (a usage error that says so).
+        value: float | int = decimal_int_option(text) if whole else decimal_float_option(text)
+        try:
+            spec.check(value)
+        except ParameterError:
+            raise argparse.ArgumentTypeError(f"{text} is out of range; give {allowed}") from None
+        return value
+
+    parse.__name__ = "whole number" if whole else "number"
+    return parse
 
 
 def _bound(value: float | None) -> str:

@@ -119,7 +119,7 @@ def _field(data: dict[str, Any], key: str, kind: type, source: str) -> Any:
         found = "is missing" if key not in data else f"is {json_kind(value)}"
         raise RecordingError(
             f"{source}: '{key}' must be {wanted} but {found}; a recording is the JSON file the "
-            'drawing page\'s "Save recording" downloads (its format: docs/research.md, Recordings)'
+            "drawing page's Save button downloads (its format: docs/research.md, Recordings)"
         )
     return value
 
