@@ -49,6 +49,7 @@ const CARD_KEYS = [
   "compressed",
   "compressedMs",
   "slowed",
+  "lengthened",
   "late",
 ] as const;
 
@@ -221,6 +222,11 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       });
       // (A stroke slowed would be said after a ";".)
       const slowed = said.slowed === 0 ? "" : `; ${said.slowed} slowed to the sleeve's floor`;
+      // The page's own: strokes drawn faster than the sleeve plays, sent at its floor.
+      const lengthened =
+        card.lengthened === 0
+          ? ""
+          : `; ${card.lengthened} drawn faster than the sleeve can play, sent at its floor`;
       // No pen to catch up with: the card says the strokes were played back to back, over the span
       // the sleeve's own times give, and how much shorter than the drawing took to draw.
       const spanMs = spanOf(watcher.of(drawing));
@@ -230,7 +236,7 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       expect(summary).toBe(
         `${card.sent} of ${card.sent} strokes played (back to back in ${durationWords(spanMs)}, ` +
           `${durationWords(drawnMs - spanMs)} shorter than drawn: the pauses left out and ` +
-          `${said.compressed} strokes played faster${slowed}).`,
+          `${said.compressed} strokes played faster${slowed}${lengthened}).`,
       );
       await expect(page.locator('[data-testid="event-log"]').innerText()).resolves.toContain(
         `Played again: ${card.sent} strokes sent all at once.`,

@@ -240,7 +240,7 @@ export class App {
   #drawingChanged(drawing: Drawing | null): void {
     const another = (drawing?.id ?? null) !== this.#says.drawingId;
     this.#says.reset(drawing?.id ?? null);
-    this.#says.setSent(drawing?.strokeCount ?? 0);
+    this.#says.setSent(drawing?.strokeCount ?? 0, drawing?.lengthenedCount ?? 0);
     if (another) this.#newDrawingHeld();
     this.#hint.hidden = drawing !== null;
     const hasPaths = drawing !== null && drawing.paths.length > 0;
@@ -303,7 +303,7 @@ export class App {
     this.#arrival = "at-once";
     this.#session.adopt(copy);
     for (const stroke of copy.strokes) this.#send(stroke);
-    this.#says.setSent(copy.strokeCount);
+    this.#says.setSent(copy.strokeCount, copy.lengthenedCount);
     // No pen to catch up with: the sleeve plays what it has in hand back to back, the pauses
     // between strokes left out, and the card says so (sleeve-says.ts).
     const drawn = drawnMs(copy);

@@ -165,6 +165,18 @@ export class Drawing {
     return this.#nextSeq;
   }
 
+  /**
+   * Of the strokes, those sent lasting longer than they took to draw: drawn briefer than the
+   * sleeve's floor where they could not merge, they last the floor (window.ts `Merger`).
+   */
+  get lengthenedCount(): number {
+    let count = 0;
+    for (const { segment, stroke } of this.segments) {
+      if (stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms) count++;
+    }
+    return count;
+  }
+
   /** How many `strokes` there are, without building the list. */
   get keptStrokeCount(): number {
     return this.#kept;

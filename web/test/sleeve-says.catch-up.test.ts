@@ -87,6 +87,22 @@ describe("the card says how the sleeve caught up", () => {
     expect(counts.played + counts.cut + counts.cancelled + counts.refused + counts.dropped).toBe(counts.sent);
   });
 
+  it("says how many strokes drawn faster than the sleeve plays were sent at its floor", () => {
+    const { says, summary } = card();
+    says.setSent(6, 2);
+    for (const seq of [0, 1, 2, 3]) says.fate(played(seq));
+    says.fate(compressed(4, 50));
+    says.fate(played(5));
+    expect(summary.textContent).toBe(
+      "6 of 6 strokes played (1 faster to catch up, 50 ms shorter in all; " +
+        "2 drawn faster than the sleeve can play, sent at its floor).",
+    );
+    expect(summary.dataset).toMatchObject({ sent: "6", lengthened: "2", slowed: "0" });
+    // None lengthened: nothing said of it.
+    says.setSent(6, 0);
+    expect(summary.textContent).toBe("6 of 6 strokes played (1 faster to catch up, 50 ms shorter in all).");
+  });
+
   it("keeps the late apart from the other refusals, and the wearer's words on those", () => {
     const { says, summary } = card();
     says.setSent(5);

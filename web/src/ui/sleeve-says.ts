@@ -27,6 +27,8 @@ export interface Counts {
   compressed: number;
   compressedMs: number;
   slowed: number;
+  /** Of the sent: drawn briefer than the sleeve's floor and sent to last it (the page's own). */
+  lengthened: number;
   /** Refused, `late` among them. */
   refused: number;
   /** Of the refused: skipped as `late` (the sleeve too far behind its sender). */
@@ -71,6 +73,7 @@ export class SleeveSays {
   #delayed = 0;
   #latestDelayMs = 0;
   #sent = 0;
+  #lengthened = 0;
   /** Kept on the page, not sent, while the wearer paused the sleeve (wearer-hold.ts). */
   #held = 0;
   #heldWhy = "the wearer paused";
@@ -100,6 +103,7 @@ export class SleeveSays {
       compressed: catchUp.compressed,
       compressedMs: catchUp.compressed_ms,
       slowed: catchUp.slowed,
+      lengthened: this.#lengthened,
       late: catchUp.late,
       cutByWearer: causes.byWearer,
       cutByFault: causes.byFault,
@@ -126,6 +130,7 @@ export class SleeveSays {
     this.#delayed = 0;
     this.#latestDelayMs = 0;
     this.#sent = 0;
+    this.#lengthened = 0;
     this.#held = 0;
     this.#notSent = 0;
     this.#replayOfMs = null;
@@ -194,8 +199,10 @@ export class SleeveSays {
     this.#render();
   }
 
-  setSent(sent: number): void {
+  /** The drawing's strokes, and of them those sent lasting the sleeve's floor (`lengthened`). */
+  setSent(sent: number, lengthened = 0): void {
     this.#sent = sent;
+    this.#lengthened = lengthened;
     this.#render();
   }
 
@@ -210,6 +217,7 @@ export class SleeveSays {
       "played",
       "compressed",
       "slowed",
+      "lengthened",
       "late",
       "sent",
       "refused",
@@ -266,8 +274,16 @@ export function summaryText(
           late,
         })
       : replayWords(counts, delivery.replay, waiting === 0);
+  // The strokes drawn faster than the sleeve plays, sent at its floor: felt longer than drawn.
+  const lengthened =
+    counts.lengthened > 0 && notSent < sent
+      ? `${counts.lengthened} drawn faster than the sleeve can play, sent at its floor`
+      : "";
+  const playedWords = [pace, lengthened].filter((words) => words !== "").join("; ");
   // Of the strokes sent: those shown but not sent yet are said apart.
-  const parts = [`${played} of ${plural(sent - notSent, "stroke")} played${pace === "" ? "" : ` (${pace})`}`];
+  const parts = [
+    `${played} of ${plural(sent - notSent, "stroke")} played${playedWords === "" ? "" : ` (${playedWords})`}`,
+  ];
   parts.push(...cutShortWords(cut, { byWearer: counts.cutByWearer, byFault: counts.cutByFault }));
   if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
   if (late > 0) parts.push(`${late} skipped as late`);
