@@ -60,6 +60,36 @@ def test_readable_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert "stroke(s) sent" in out and "path" in out
 
 
+def test_a_stroke_sent_at_the_floor_is_noted(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The window vector of a line ending in a quick flick back: its last piece, drawn briefer
+    # than the sleeve's floor, is sent lasting the floor; the table says so, and JSON gives both.
+    case = dict(load("window"))["flick-back/defaults"]
+    recording = write_recording(case, tmp_path / "flick.json")
+    params = {**case["params"], "algorithm": "window"}
+    recording.write_text(
+        json.dumps(
+            {
+                **json.loads(recording.read_text()),
+                "simplifier": {"algorithm": "window", "params": params},
+            }
+        )
+    )
+    assert main(["simplify", str(recording)]) == 0
+    out = capsys.readouterr().out
+    paced = [
+        e for e in case["expected"]["segments"] if e["duration_ms"] != e["end_ms"] - e["start_ms"]
+    ]
+    assert len(paced) == 1, paced
+    drawn = paced[0]["end_ms"] - paced[0]["start_ms"]
+    assert f"at the sleeve's floor (drawn in {drawn:.1f} ms)" in out, out
+    assert out.count("at the sleeve's floor") == 1, out
+    assert main(["simplify", str(recording), "--json"]) == 0
+    strokes = json.loads(capsys.readouterr().out)["strokes"]
+    assert [s["duration_ms"] for s in strokes if s["end_ms"] - s["start_ms"] < 73.701] == [73.701]
+
+
 @pytest.mark.parametrize(
     ("content", "words"),
     [

@@ -253,6 +253,8 @@ def describe(result: list[PathSegment], params: Params, source: str) -> str:
     for r in result:
         s = r.segment
         note = f"dropped: {s.dropped}" if s.dropped else ""
+        if not s.dropped and s.duration_ms != s.drawn_ms:  # drawn briefer than the floor
+            note = f"at the sleeve's floor (drawn in {s.drawn_ms:.1f} ms)"
         lines.append(
             f"{r.path:>4}  {_p(s.start):>15}  {_p(s.end):>15}  {s.duration_ms:>8.1f}  "
             f"{s.emitted_at_ms:>10.1f}  {note}"

@@ -301,8 +301,43 @@ final class SimplifyCommand {
                   : "a decimal number; write it with the digits 0-9, e.g. 0.25, 12 or 2e-3";
           throw usage("argument " + option.action() + ": " + PyRepr.of(value) + " is not " + wanted);
         }
+        checkRange(option, value, ((Number) number).doubleValue(), whole);
         return number;
       }
+    }
+  }
+
+  /**
+   * A value outside its parameter's range is a usage error naming the range, before any recording
+   * is read, as the reference's ({@code _value_of} in feelmysign/cli/simplify.py).
+   */
+  private static void checkRange(Flag option, String text, double value, boolean whole) {
+    for (ParamTable.Row row : ParamTable.PARAMETERS) {
+      if (!row.name().equals(option.dest())) {
+        continue;
+      }
+      Double low = row.minimum();
+      Double high = row.maximum();
+      boolean inRange =
+          Double.isFinite(value) && (low == null || value >= low) && (high == null || value <= high);
+      if (inRange) {
+        return;
+      }
+      String kind = whole ? "a whole number" : "a number";
+      String allowed;
+      if (low != null && high != null) {
+        allowed = kind + " from " + Numbers.pythonG(low) + " to " + Numbers.pythonG(high);
+      } else if (low != null) {
+        allowed = kind + " of " + Numbers.pythonG(low) + " or more";
+      } else if (high != null) {
+        allowed = kind + " of at most " + Numbers.pythonG(high);
+      } else {
+        allowed = kind;
+      }
+      if (row.unit() != null && !row.unit().isEmpty()) {
+        allowed += " (" + row.unit() + ")";
+      }
+      throw usage("argument " + option.action() + ": " + text + " is out of range; give " + allowed);
     }
   }
 
@@ -511,6 +546,9 @@ final class SimplifyCommand {
     for (PathSegment r : result) {
       Segment s = r.segment();
       String note = s.dropped() != null ? "dropped: " + s.dropped() : "";
+      if (s.dropped() == null && s.durationMs() != s.drawnMs()) { // drawn briefer than the floor
+        note = "at the sleeve's floor (drawn in " + fixed(s.drawnMs(), 1) + " ms)";
+      }
       out.append('\n')
           .append(
               String.format(

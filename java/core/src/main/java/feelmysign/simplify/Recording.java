@@ -134,7 +134,7 @@ public record Recording(
               + wanted
               + " but "
               + found
-              + "; a recording is the JSON file the drawing page's \"Save recording\" downloads"
+              + "; a recording is the JSON file the drawing page's Save button downloads"
               + " (its format: docs/research.md, Recordings)");
     }
     return value;
