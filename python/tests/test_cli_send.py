@@ -460,3 +460,21 @@ def test_a_bad_sleeve_id_from_the_environment_says_what_to_do(
     with pytest.raises(BrokerError) as caught:
         broker_settings_from_args(_settings_args("--broker", "mqtt://127.0.0.1:1"), "sender")
     assert "Sleeve id 'a/b' cannot be used" in str(caught.value)
+
+
+def test_an_answer_heard_before_its_stroke_is_said_sent_is_printed_after_it() -> None:
+    # The broker's acknowledgement and the sleeve's answer arrive on different threads: a quick
+    # sleeve's answer waits for its stroke's sent line; one of a stroke never said sent is
+    # printed at the end.
+    from feelmysign.cli.send import _InOrder
+
+    said: list[str] = []
+    lines = _InOrder()
+    lines.answer(0, lambda: said.append("[1/3] played"))
+    lines.sent(0, lambda: said.append("[1/3] sent"))
+    lines.sent(1, lambda: said.append("[2/3] sent"))
+    lines.answer(1, lambda: said.append("[2/3] played"))
+    lines.answer(2, lambda: said.append("[3/3] refused"))
+    assert said == ["[1/3] sent", "[1/3] played", "[2/3] sent", "[2/3] played"]
+    lines.flush()
+    assert said[-1] == "[3/3] refused"

@@ -38,7 +38,7 @@ import sys
 import threading
 import time
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
@@ -226,8 +226,10 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         _say_floor(None if status is None else status.floor, strokes)
         topic = args.legacy_topic if args.legacy else settings.strokes_topic
         messages = [OutgoingStroke(i, topic, s, args.legacy) for i, s in enumerate(strokes)]
-        outcome = _watch_events(client, settings, strokes, args) if wait else None
-        sent = _send(client, settings, messages, args, outcome)
+        lines = _InOrder()
+        outcome = _watch_events(client, settings, strokes, args, lines) if wait else None
+        sent = _send(client, settings, messages, args, outcome, lines)
+        lines.flush()
         if outcome is not None and sent < len(messages):
             outcome.hold(range(sent, len(messages)))
         if not args.json:
@@ -246,11 +248,16 @@ def _send(
     messages: list[OutgoingStroke],
     args: argparse.Namespace,
     outcome: DrawingOutcome | None,
+    lines: _InOrder,
 ) -> int:
     """Publishes the strokes; how many went out. Waiting for the sleeve's answers, it stops
     once the sleeve refuses one as its wearer paused it: the rest would be refused too."""
     pace: Pace = args.pace or "realtime"
-    report = printer(json_lines=args.json, total=len(messages))
+    say = printer(json_lines=args.json, total=len(messages))
+
+    def report(message: OutgoingStroke, payload: str) -> None:
+        lines.sent(message.index, lambda: say(message, payload))
+
     sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
     if outcome is None:
         return sender.send(messages, pace=pace)
@@ -356,14 +363,19 @@ def _say_ceiling(controls: StatusControls | None, strokes: list[Stroke], layout:
 
 
 def _watch_events(
-    client: mqtt.Client, settings: BrokerSettings, strokes: list[Stroke], args: argparse.Namespace
+    client: mqtt.Client,
+    settings: BrokerSettings,
+    strokes: list[Stroke],
+    args: argparse.Namespace,
+    lines: _InOrder,
 ) -> DrawingOutcome:
     """Subscribed to the sleeve's events before the first stroke goes out, so no answer is
     missed; each answer printed as it comes."""
     total = len(strokes)
 
     def tell(seq: int, stroke: StrokeOutcome, event: Event) -> None:
-        print(_answer_line(seq, total, stroke, event, json_lines=args.json), flush=True)
+        line = _answer_line(seq, total, stroke, event, json_lines=args.json)
+        lines.answer(seq, lambda: print(line, flush=True))
 
     outcome = DrawingOutcome(strokes[0].drawing or "", total, tell)
     topic = telemetry_topic(settings.sleeve_id, "events")
@@ -381,6 +393,39 @@ def _watch_events(
             url=settings.url,
         )
     return outcome
+
+
+class _InOrder:
+    """Each stroke's answer printed after the line that says it was sent: the broker's
+    acknowledgement and the sleeve's answer reach this process on different threads, and a
+    sleeve quick to answer would otherwise be heard before its stroke is said sent."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._sent: set[int] = set()
+        self._waiting: dict[int, list[Callable[[], None]]] = {}
+
+    def sent(self, index: int, say: Callable[[], None]) -> None:
+        with self._lock:
+            say()
+            self._sent.add(index)
+            for answer in self._waiting.pop(index, []):
+                answer()
+
+    def answer(self, index: int, say: Callable[[], None]) -> None:
+        with self._lock:
+            if index in self._sent:
+                say()
+            else:
+                self._waiting.setdefault(index, []).append(say)
+
+    def flush(self) -> None:
+        """The answers of strokes never said sent (the sending stopped), in order."""
+        with self._lock:
+            for index in sorted(self._waiting):
+                for answer in self._waiting[index]:
+                    answer()
+            self._waiting.clear()
 
 
 def _answer_line(
