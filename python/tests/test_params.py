@@ -106,10 +106,15 @@ def test_the_cli_refuses_a_value_out_of_range_naming_it(
     assert spec.minimum is not None and spec.maximum is not None
     flag = "--" + spec.name.replace("_", "-")
     args = ["simplify", str(_recording(tmp_path / "r.json")), "--algorithm", OWNERS[spec.name][0]]
-    assert main([*args, flag, f"{spec.maximum + 1:g}"]) == 1
+    # A usage error (exit 2), named as the option, with the range, before the recording is read.
+    too_big = f"{spec.maximum + 1:g}"
+    with pytest.raises(SystemExit) as caught:
+        main([*args, flag, too_big])
+    assert caught.value.code == 2
     err = capsys.readouterr().err
-    assert f"Error: {spec.name} = " in err, err
-    assert f"it must be in [{spec.minimum:g}, {spec.maximum:g}]" in err, err
+    kind = "a whole number" if spec.kind is int else "a number"
+    assert f"Error: {flag}: {too_big} is out of range; give {kind} from " in err, err
+    assert f"from {spec.minimum:g} to {spec.maximum:g}" in err, err
 
 
 @pytest.mark.parametrize(("flag", "owner"), [("--no-recover", "angle"), ("--recover", "angle")])

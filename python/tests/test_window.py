@@ -330,8 +330,10 @@ def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixt
     recording = write_recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0.05"]) == 0
     assert "window: max error 0.05 grid units" in capsys.readouterr().out
-    assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"]) == 1
-    assert "max_error" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:
+        main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"])
+    assert exit_.value.code == 2
+    assert "--max-error: 0 is out of range; give a number from 0.001" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_:
         main(["simplify", str(recording), "--algorithm", "window", "--check-frames", "5"])
     assert exit_.value.code == 2
