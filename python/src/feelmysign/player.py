@@ -287,7 +287,8 @@ class Player:
             if not self._running:
                 return  # stopping: stop() switches every motor off under this lock
             self._take_inbox()
-            self._apply_cancels()
+            if self._cancels:  # read without the lock: one appended meanwhile wakes the player
+                self._apply_cancels()
             next_ms = self._timeline.next_ms()
             if next_ms is not None and next_ms <= self._clock():
                 self._play()
