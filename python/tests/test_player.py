@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import itertools
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
 
 import pytest
 
 from feelmysign.backends.sim import SimBackend
+from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.clock import monotonic_ms, wall_ms
 from feelmysign.events import Event, StrokeRef
 from feelmysign.layout import Layout
@@ -376,3 +377,37 @@ def test_stop_switches_every_motor_off_while_a_write_on_the_submitting_thread_ha
     assert offs_while_hung >= 1
     assert not submitter.is_alive()
     backend.close()
+
+
+class _Grids(ActuatorTelemetry):
+    """Telemetry that keeps every grid it is told of (its publisher is never called here)."""
+
+    def __init__(self) -> None:
+        super().__init__(lambda frame: None)
+        self.grids: list[list[list[float]]] = []
+
+    def update(self, grid: Sequence[Sequence[float]]) -> None:
+        self.grids.append([list(row) for row in grid])
+        super().update(grid)
+
+
+def test_the_telemetry_hears_of_a_burst_once_all_its_motors_are_on() -> None:
+    """Inside a cell, a stroke's first burst drives the cell's four corners: they are written
+    one after the other, and the telemetry (whose update wakes its thread) is told after the
+    fourth, once, with all four on: never a grid with the burst half written."""
+    telemetry = _Grids()
+    backend = SimBackend(PAPER, telemetry=telemetry)
+    player = Player(backend, PAPER)
+    player.start()
+    try:
+        assert player.submit(_planned(0.5, 0.5, 1.5, 1.5, 300.0, drawing="d", seq=0)) is None
+        first = backend.changes[:4]
+    finally:
+        player.stop()
+        backend.close()
+    assert {(c.row, c.column) for c in first} == {(0, 0), (0, 1), (1, 0), (1, 1)}
+    assert all(c.intensity > 0 for c in first)
+    driven = [sum(1 for row in grid for value in row if value > 0) for grid in telemetry.grids]
+    assert driven[0] == 4, driven
+    # Every change reached the telemetry: its last grid is the final all-off.
+    assert all(value == 0.0 for row in telemetry.grids[-1] for value in row)

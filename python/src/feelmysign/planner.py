@@ -270,24 +270,31 @@ class Outline:
         if self._schedule is not None:
             return tuple(c for c in self._schedule.commands if c.start_ms < before_ms)
         intensity, layout = self.intensity, self.layout
-        read: list[RawBurst] = []  # the bursts read, in order
-        early: Iterable[int] | None = None  # the actuators they drive, once known (by key)
+        read: list[RawBurst] = []  # the bursts that start before before_ms, in order
+        # The spans of those bursts per actuator they drive (by key), once they are all read.
+        spans: dict[int, list[Span]] | None = None
+        later: list[RawBurst] = []  # the bursts read after them, in order
         for burst in self._each_burst():
-            if early is None:
+            if spans is None:
                 if burst[3] < before_ms:
                     read.append(burst)
                     continue
-                early = _spans_by_actuator(read, intensity, layout).keys()
-            if _far_from(burst, early):
+                spans = _spans_by_actuator(read, intensity, layout)
+            if _far_from(burst, spans):
                 break
-            read.append(burst)
-        # The spans of every burst read, gathered at once (per actuator in stroke order, as
-        # one burst at a time would gather them).
-        spans = _spans_by_actuator(read, intensity, layout)
-        if early is None:  # every burst starts before before_ms
-            early = spans.keys()
-        commands = commands_from_spans({a: spans[a] for a in early}, self.min_command_ms)
-        return tuple(c for c in commands if c.start_ms < before_ms)
+            later.append(burst)
+        if spans is None:  # every burst starts before before_ms
+            spans = _spans_by_actuator(read, intensity, layout)
+        elif later:
+            # The later bursts' spans on those actuators follow theirs (per actuator in stroke
+            # order, as one burst at a time would gather them); other actuators are left out.
+            more = _spans_by_actuator(later, intensity, layout)
+            for key, actuator_spans in spans.items():
+                if key in more:
+                    actuator_spans += more[key]
+        return tuple(
+            c for c in commands_from_spans(spans, self.min_command_ms) if c.start_ms < before_ms
+        )
 
     def _each_burst(self) -> Iterator[RawBurst]:
         """The bursts in order, each made as ``bursts`` makes it, as they are asked for."""

@@ -287,7 +287,8 @@ class Player:
             if not self._running:
                 return  # stopping: stop() switches every motor off under this lock
             self._take_inbox()
-            self._apply_cancels()
+            if self._cancels:  # read without the lock: one appended meanwhile wakes the player
+                self._apply_cancels()
             next_ms = self._timeline.next_ms()
             if next_ms is not None and next_ms <= self._clock():
                 self._play()
@@ -580,8 +581,27 @@ class Player:
         """Output ``changes``; a stroke's motor that could not be switched on is a lost chip:
         returns that change, the error and the strokes cut for it (after every motor went off)."""
         lost: tuple[Change, str, list[PlannedStroke]] | None = None
+        if not changes:
+            return None
         # A recording backend (the simulator) is told whose command each change is.
         note: Callable[[object, object], None] | None = getattr(self._backend, "note_source", None)
+        # The telemetry (previews) hears of the changes once they are all written: a burst's
+        # motors start together, none waiting for a frame of the ones before it.
+        hold: Callable[[], None] | None = getattr(self._backend, "hold_telemetry", None)
+        if hold is not None:
+            hold()
+        try:
+            lost = self._write_each(changes, note)
+        finally:
+            release: Callable[[], None] | None = getattr(self._backend, "release_telemetry", None)
+            if release is not None:
+                release()
+        return lost
+
+    def _write_each(
+        self, changes: list[Change], note: Callable[[object, object], None] | None
+    ) -> tuple[Change, str, list[PlannedStroke]] | None:
+        lost: tuple[Change, str, list[PlannedStroke]] | None = None
         for change in changes:
             if lost is not None and any(change.tag is stroke for stroke in lost[2]):
                 continue  # cut, its motors off: nothing of it plays on

@@ -97,6 +97,9 @@ class GridBackend(Closing, ABC):
         self._grid = [[0.0] * layout.columns for _ in range(layout.rows)]
         self._lock = threading.RLock()
         self._state: Literal["new", "open", "closed"] = "new"
+        # Between hold_telemetry and release_telemetry: the grid changed and telemetry not told.
+        self._holding = False
+        self._unsent = False
 
     @property
     def layout(self) -> Layout:
@@ -129,7 +132,26 @@ class GridBackend(Closing, ABC):
             self._write(row, column, value)
             self._grid[row][column] = value
             if self._telemetry is not None:
-                self._telemetry.update(self._grid)
+                if self._holding:
+                    self._unsent = True
+                else:
+                    self._telemetry.update(self._grid)
+
+    def hold_telemetry(self) -> None:
+        """The changes that follow are one step (the player's changes due at one time): the
+        telemetry hears of them once, at ``release_telemetry``, after the last is written.
+        Telling it copies the grid and wakes its thread, which then competes for the
+        interpreter with the writes still to come: a burst's later motors waited for it."""
+        self._holding = True
+
+    def release_telemetry(self) -> None:
+        """The step is written: the telemetry gets the grid as it now stands (if it changed)."""
+        with self._lock:
+            self._holding = False
+            if self._unsent:
+                self._unsent = False
+                if self._telemetry is not None:
+                    self._telemetry.update(self._grid)
 
     def all_off(self) -> None:
         with self._lock:
