@@ -42,6 +42,8 @@ export class Drawing {
   readonly #undone: number[] = [];
   /** Segments kept as strokes (not dropped) in the paths still in the drawing. */
   #kept = 0;
+  /** Of the kept strokes, those lasting longer than drawn (`lengthenedCount`). */
+  #lengthened = 0;
 
   constructor(id: string, params: SimplifierParams) {
     this.id = id;
@@ -91,6 +93,7 @@ export class Drawing {
     this.segments.push(drawn);
     if (stroke?.seq != null) this.#bySeq.set(stroke.seq, drawn);
     if (stroke !== null) this.#kept++;
+    if (stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms) this.#lengthened++;
     return drawn;
   }
 
@@ -170,11 +173,7 @@ export class Drawing {
    * sleeve's floor where they could not merge, they last the floor (window.ts `Merger`).
    */
   get lengthenedCount(): number {
-    let count = 0;
-    for (const { segment, stroke } of this.segments) {
-      if (stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms) count++;
-    }
-    return count;
+    return this.#lengthened;
   }
 
   /** How many `strokes` there are, without building the list. */
@@ -204,6 +203,8 @@ export class Drawing {
         this.#undone.push(drawn.stroke.seq);
       }
       if (drawn.stroke !== null) this.#kept--;
+      const { segment, stroke } = drawn;
+      if (stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms) this.#lengthened--;
     }
     return true;
   }

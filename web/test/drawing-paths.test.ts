@@ -151,3 +151,28 @@ describe("the outbox", () => {
     expect(outbox.size).toBe(1);
   });
 });
+
+describe("strokes drawn faster than the sleeve can play", () => {
+  it("are counted as the drawing grows and as paths are undone, and kept by Play again's copy", () => {
+    const drawing = new Drawing("d-2", params);
+    const piece = (startMs: number, endMs: number, durationMs: number) => ({
+      start: [0, 0] as [number, number],
+      end: [1, 0] as [number, number],
+      start_ms: startMs,
+      end_ms: endMs,
+      duration_ms: durationMs,
+      emitted_at_ms: endMs,
+      dropped: null,
+    });
+    drawing.beginPath("mouse");
+    drawing.addSegment(piece(0, 120, 120), 0.8);
+    drawing.addSegment(piece(120, 150, 73.701), 0.8); // drawn in 30 ms, sent at the floor
+    drawing.beginPath("mouse");
+    drawing.addSegment(piece(400, 420, 73.701), 0.8);
+    expect(drawing.lengthenedCount).toBe(2);
+    expect(drawing.strokes.map((s) => s.duration_ms)).toEqual([120, 73.701, 73.701]);
+    expect(drawing.copyAs("d-3").lengthenedCount).toBe(2);
+    expect(drawing.removeLastPath()).toBe(true);
+    expect(drawing.lengthenedCount).toBe(1);
+  });
+});
