@@ -124,7 +124,8 @@ def add_broker_options(parser: argparse.ArgumentParser, *, role: Role) -> None:
             help=f"the one-line token of 'feelmysign broker add-sleeve ID': broker URL (TLS), "
             f"its CA's fingerprint, this sleeve's id and login; not to be given with "
             f"--broker, --id, --username, --password or --credentials (default: ${JOIN_ENV}, "
-            "which wins over their environment variables)",
+            "which wins over their environment variables; prefer it: the token holds the "
+            "sleeve's password, and other users can see command lines)",
         )
     group.add_argument(
         "--credentials",
