@@ -4,6 +4,7 @@ import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
 import feelmysign.client.SleeveFloor;
 import feelmysign.client.WearerState;
+import feelmysign.json.PyJson;
 import feelmysign.protocol.Layout;
 import feelmysign.protocol.ParseResult;
 import feelmysign.protocol.Protocol;
@@ -22,6 +23,7 @@ import java.util.ArrayDeque;
 import java.util.ArrayList;
 import java.util.Deque;
 import java.util.List;
+import java.util.Map;
 import java.util.Objects;
 import java.util.concurrent.ArrayBlockingQueue;
 import java.util.concurrent.BlockingQueue;
@@ -359,7 +361,10 @@ public class FeelMySign {
     return status;
   }
 
-  /** Strokes the sleeve may not have yet (queued while offline or awaiting the broker). */
+  /**
+   * Strokes the broker has not acknowledged yet (queued while it is out of reach, or awaiting
+   * its PUBACK); not those a sleeve that is away has not played: the broker keeps those.
+   */
   public int unsent() {
     return client == null ? 0 : client.unsent();
   }
@@ -738,11 +743,60 @@ public class FeelMySign {
   /** The sleeve's floor as heard (null: it says none). */
   private record FloorNews(SleeveFloor floor) {}
 
+  /**
+   * Whether a status says the sleeve is online: true or false, "" for a cleared status (no sleeve
+   * has ever listened there), null for one not understood.
+   */
+  static Object statusOnline(String payload) {
+    if (payload.isBlank()) {
+      return "";
+    }
+    try {
+      if (PyJson.loads(payload) instanceof Map<?, ?> status
+          && status.get("online") instanceof Boolean online) {
+        return online;
+      }
+    } catch (RuntimeException notJson) {
+      return null;
+    }
+    return null;
+  }
+
   /** Runs on the network thread: only queues, never blocks, never throws. */
   private final class Relay implements SleeveClient.Listener {
+    // The sleeve's state by its last status understood (null before any): a change is said.
+    private Object sleeveOnline;
+
     private void offer(Object item) {
       if (!inbox.offer(item)) {
         overflowed.incrementAndGet();
+      }
+    }
+
+    @Override
+    public void status(String payload) {
+      Object online = statusOnline(payload);
+      if (online == null || online.equals(sleeveOnline)) {
+        return;
+      }
+      Object before = sleeveOnline;
+      sleeveOnline = online;
+      if (Boolean.FALSE.equals(online)) {
+        offer(
+            "sleeve "
+                + sleeveId
+                + " is offline: no new stroke is felt. Strokes sent now wait at the broker and"
+                + " play if it is back within its age limit (10 s unless set; older ones are"
+                + " refused as stale); if it crashed, a motor it was driving may run until it"
+                + " restarts");
+      } else if ("".equals(online)) {
+        offer(
+            "no sleeve listens on id '"
+                + sleeveId
+                + "': nothing has ever reported there, so strokes sent now are not felt; check"
+                + " the sleeve id (a sleeve prints its id when it starts)");
+      } else if (before != null) {
+        offer("sleeve " + sleeveId + " is online again");
       }
     }
 

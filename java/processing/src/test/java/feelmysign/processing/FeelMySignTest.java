@@ -89,6 +89,41 @@ class FeelMySignTest {
   }
 
   @Test
+  void theSketchIsToldWhenTheSleeveGoesOfflineAndComesBack() throws Exception {
+    Sketch sketch = new Sketch();
+    FeelMySign library = new FeelMySign(sketch);
+    String online = "{\"online\": true, \"sleeve_id\": \"sleeve1\"}";
+    String offline = "{\"online\": false, \"sleeve_id\": \"sleeve1\"}";
+    Thread network =
+        new Thread(
+            () -> {
+              library.relay().status(online); // as it was when the sketch started: not said
+              library.relay().status(online); // republished for another reason: not said
+              library.relay().status(offline); // the broker's last will
+              library.relay().status(offline);
+              library.relay().status("{not json"); // not understood: nothing said, nothing kept
+              library.relay().status(online);
+              library.relay().status(""); // cleared: nothing listens there
+            });
+    network.start();
+    network.join();
+    library.draw();
+    assertEquals(
+        List.of(
+            "sleeve sleeve1 is offline: no new stroke is felt. Strokes sent now wait at the broker"
+                + " and play if it is back within its age limit (10 s unless set; older ones are"
+                + " refused as stale); if it crashed, a motor it was driving may run until it"
+                + " restarts",
+            "sleeve sleeve1 is online again",
+            "no sleeve listens on id 'sleeve1': nothing has ever reported there, so strokes sent"
+                + " now are not felt; check the sleeve id (a sleeve prints its id when it starts)"),
+        sketch.statuses);
+    for (Thread thread : sketch.threads) {
+      assertSame(Thread.currentThread(), thread, "a callback ran off the sketch's thread");
+    }
+  }
+
+  @Test
   void aBrokerOutOfReachIsSaidOnceAndStrokesWaitInTheOutbox() throws Exception {
     Sketch sketch = new Sketch();
     sketch.width = 1920;
