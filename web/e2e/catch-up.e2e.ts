@@ -19,7 +19,7 @@ import { spawnSync } from "node:child_process";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { durationWords } from "../src/fates";
-import { EventWatcher } from "./harness";
+import type { EventWatcher } from "./harness";
 import {
   drawingArea,
   nextFrame,
@@ -53,16 +53,11 @@ const CARD_KEYS = [
   "late",
 ] as const;
 
-/**
- * The strokes the sleeve slowed that are not their path's last (`lastSeq`: each drawing here is
- * one path, seq 0 on): none, as the page sends no mid-path stroke briefer than the floor.
- */
-function slowedMidPath(events: readonly Record<string, unknown>[], lastSeq: number): string[] {
+/** The strokes the sleeve slowed: none, as the page sends no stroke briefer than the floor. */
+function slowedStrokes(events: readonly Record<string, unknown>[]): string[] {
   return events
-    .filter((event) => event["type"] === "adjusted" && event["seq"] !== lastSeq)
-    .map(
-      (event) => `seq ${String(event["seq"])} of 0..${lastSeq}: ${String(event["requested_duration_ms"])} ms`,
-    );
+    .filter((event) => event["type"] === "adjusted")
+    .map((event) => `seq ${String(event["seq"])}: ${String(event["requested_duration_ms"])} ms`);
 }
 
 /**
@@ -175,13 +170,25 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
   beforeAll(async () => {
     up = await processes.up("catch-up");
     up.child.stdout?.on("data", (chunk: Buffer) => (output += chunk.toString()));
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });
 
   afterAll(() => processes.stop());
+
+  /**
+   * Waits for the sleeve's answer to each of the `sent` strokes of `drawing`; what they say. The
+   * page sends no stroke the sleeve must slow, mid-path or at a path's end.
+   */
+  async function answersOf(drawing: string, sent: number): Promise<ReturnType<typeof fromEvents>> {
+    await watcher.waitFor("an event for every stroke", () => watcher.of(drawing).length >= sent, 60_000);
+    const events = watcher.of(drawing);
+    expect(slowedStrokes(events)).toEqual([]);
+    const said = fromEvents(events);
+    expect(said.slowed).toBe(0);
+    return said;
+  }
 
   it(
     "Play again sends the drawing at once: the card and up's line say how many strokes the sleeve played faster, and how much shorter in all",
@@ -195,15 +202,7 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       const drawing = await page.evaluate(() => window.feelmysign?.drawingId ?? "");
       expect(drawing).not.toBe(drawn);
       const card = await waitForEveryStroke(page, CARD_KEYS);
-      await watcher.waitFor(
-        "an event for every stroke",
-        () => watcher.of(drawing).length >= card.sent,
-        60_000,
-      );
-      const said = fromEvents(watcher.of(drawing));
-      expect(slowedMidPath(watcher.of(drawing), card.sent - 1)).toEqual([]);
-      // Nor at its end: the page sends no stroke the sleeve must slow.
-      expect(said.slowed).toBe(0);
+      const said = await answersOf(drawing, card.sent);
       // The sleeve caught up: most strokes of a drawing sent at once play faster, none skipped.
       expect(said.compressed).toBeGreaterThanOrEqual(card.sent / 2);
       expect(said.late).toBe(0);
@@ -278,17 +277,9 @@ describe("the sender is told how the sleeve caught up with a drawing", () => {
       });
       expect(broker).toBeGreaterThan(0);
       const card = await waitForEveryStroke(page, CARD_KEYS);
-      await watcher.waitFor(
-        "an event for every stroke",
-        () => watcher.of(drawing).length >= card.sent,
-        60_000,
-      );
-      const said = fromEvents(watcher.of(drawing));
-      // Nothing slowed mid-path: the rest while the broker froze lends the stroke before it the
-      // floor, to the last bit.
-      expect(slowedMidPath(watcher.of(drawing), card.sent - 1)).toEqual([]);
-      // Nor at its end: the page sends no stroke the sleeve must slow.
-      expect(said.slowed).toBe(0);
+      // Nothing slowed (answersOf): the rest while the broker froze lends the stroke before it
+      // the floor, to the last bit.
+      const said = await answersOf(drawing, card.sent);
       expect(said.late).toBeGreaterThan(0);
       expect(card.late).toBe(said.late);
       expect(card.compressed).toBe(said.compressed);

@@ -9,7 +9,7 @@ import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { EventWatcher, RESULTS_DIR } from "./harness";
+import { RESULTS_DIR, type EventWatcher } from "./harness";
 import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
 import { Processes } from "./processes";
 
@@ -66,8 +66,7 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
   beforeAll(async () => {
     recordPath = join(processes.dir("felt-record"), "record.jsonl");
     const up = await processes.up("felt", { args: ["--record", recordPath] });
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });

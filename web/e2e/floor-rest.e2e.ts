@@ -9,8 +9,8 @@
  */
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { EventWatcher } from "./harness";
-import { drawingArea, nextFrame, type Area } from "./page";
+import type { EventWatcher } from "./harness";
+import { drawingArea, moveByClock, nextFrame, type Area } from "./page";
 import { Processes } from "./processes";
 
 type Point = readonly [number, number];
@@ -30,23 +30,12 @@ describe("a pen resting mid-path", () => {
 
   beforeAll(async () => {
     const up = await processes.up("floor-rest");
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });
 
   afterAll(() => processes.stop());
-
-  /** The mouse from `from` to `to` in `ms` by the clock, a move a frame. */
-  async function move(from: Point, to: Point, ms: number): Promise<void> {
-    const startMs = performance.now();
-    for (let done = 0; done < 1;) {
-      done = Math.min(1, (performance.now() - startMs) / ms);
-      await page.mouse.move(from[0] + (to[0] - from[0]) * done, from[1] + (to[1] - from[1]) * done);
-      await nextFrame(page);
-    }
-  }
 
   /** The pen held still at `point` for `ms`, still reporting (a tenth of a pixel's jitter). */
   async function rest(point: Point, ms: number): Promise<void> {
@@ -66,7 +55,7 @@ describe("a pen resting mid-path", () => {
     await page.mouse.down();
     await nextFrame(page);
     for (let i = 1; i < corners.length; i++) {
-      await move(corners[i - 1]!, corners[i]!, MOVE_MS);
+      await moveByClock(page, [corners[i - 1]!, corners[i]!], () => MOVE_MS);
       await rest(corners[i]!, REST_MS);
     }
     await page.mouse.up();

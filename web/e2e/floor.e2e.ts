@@ -7,7 +7,7 @@ import { writeFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { EventWatcher } from "./harness";
+import type { EventWatcher } from "./harness";
 import { drawingArea, drawWithMouse, openAdvanced, setLongestStroke, type Area } from "./page";
 import { Processes } from "./processes";
 
@@ -36,8 +36,7 @@ describe("the sleeve's floor", () => {
       }),
     );
     const up = await processes.up("floor", { args: ["--wearer", wearer] });
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });

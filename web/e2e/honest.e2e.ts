@@ -17,7 +17,7 @@ import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { isDelayed, readEvent, type AdjustedEvent, type PlayedEvent } from "../src/events";
 import { DrawingFates, type Fate } from "../src/fates";
-import { collectUntil, EventWatcher, REPO_DIR, type Credentials } from "./harness";
+import { collectUntil, REPO_DIR, type Credentials, type EventWatcher } from "./harness";
 import {
   cardCounts,
   drawingArea,
@@ -194,8 +194,7 @@ describe("honest after faults: the page, up and the study agree with what the sl
     up = await processes.up("honest", { args: ["--record", recordPath] });
     up.child.stdout?.on("data", (chunk: Buffer) => (output += chunk.toString()));
     up.child.stderr?.on("data", (chunk: Buffer) => (output += chunk.toString()));
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });

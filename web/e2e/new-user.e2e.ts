@@ -9,7 +9,7 @@
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { EventWatcher, RESULTS_DIR } from "./harness";
+import { RESULTS_DIR, type EventWatcher } from "./harness";
 import {
   drawingArea,
   drawWithMouse,
@@ -50,8 +50,7 @@ describe("a new user's first drawings, served by feelmysign up with the simulate
 
   beforeAll(async () => {
     const up = await processes.up("new-user");
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });

@@ -10,6 +10,7 @@ import type { BrowserContext, Page } from "playwright-core";
 import {
   Broker,
   checkPrerequisites,
+  EventWatcher,
   launchBrowser,
   pageConfig,
   serveDist,
@@ -93,6 +94,13 @@ export class Processes {
   }
 
   /** A page on `url` in a fresh desktop Chromium (one pixel per CSS pixel), once it is connected and sees the sleeve online. */
+  /** The sleeve's events as a sender sees them on `credentials`' broker, closed by `stop()`. */
+  async watch(credentials: Credentials): Promise<EventWatcher> {
+    const watcher = await EventWatcher.connect(credentials);
+    this.add(() => watcher.client.endAsync(true));
+    return watcher;
+  }
+
   async onlinePage(url: string): Promise<Page> {
     const page = await this.page(url, { ...DESKTOP, deviceScaleFactor: 1 });
     await waitForData(page, '[data-testid="broker-status"]', "state", "connected");

@@ -8,7 +8,7 @@ import { readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { EventWatcher, REPO_DIR } from "./harness";
+import { REPO_DIR, type EventWatcher } from "./harness";
 import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
 import { Processes } from "./processes";
 
@@ -37,8 +37,7 @@ describe("a stroke the sleeve refuses", () => {
     expect(short).not.toBe(paper);
     writeFileSync(layout, short);
     const up = await processes.up("refused", { args: ["--layout", layout] });
-    watcher = await EventWatcher.connect(up.credentials);
-    processes.add(() => watcher.client.endAsync(true));
+    watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
     area = await drawingArea(page);
   });

@@ -21,6 +21,11 @@ export interface DrawnSegment {
   readonly stroke: Stroke | null;
 }
 
+/** A stroke sent lasting longer than it took to draw: drawn briefer than the sleeve's floor. */
+function lengthened({ segment, stroke }: DrawnSegment): boolean {
+  return stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms;
+}
+
 export class Drawing {
   readonly id: string;
   /** The parameters every path of this drawing is simplified with (canvas size included). */
@@ -93,7 +98,7 @@ export class Drawing {
     this.segments.push(drawn);
     if (stroke?.seq != null) this.#bySeq.set(stroke.seq, drawn);
     if (stroke !== null) this.#kept++;
-    if (stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms) this.#lengthened++;
+    if (lengthened(drawn)) this.#lengthened++;
     return drawn;
   }
 
@@ -203,8 +208,7 @@ export class Drawing {
         this.#undone.push(drawn.stroke.seq);
       }
       if (drawn.stroke !== null) this.#kept--;
-      const { segment, stroke } = drawn;
-      if (stroke !== null && stroke.duration_ms > segment.end_ms - segment.start_ms) this.#lengthened--;
+      if (lengthened(drawn)) this.#lengthened--;
     }
     return true;
   }

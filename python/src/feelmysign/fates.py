@@ -62,24 +62,23 @@ NOTABLE_CHANGE = 0.05
 _COPY, _REFUSAL, _OWN, _PLAYED, _CUT = 1, 2, 3, 4, 5
 
 
+def _notable(ms: float, event: Played) -> float:
+    """``ms`` when it is ``NOTABLE_CHANGE`` or more of the duration the stroke of ``event`` came
+    with (``duration_ms`` plus what catching up took off it), else 0 (no one feels it)."""
+    came_ms = event.duration_ms + (event.compressed_ms or 0.0)
+    return ms if ms > 0 and ms >= NOTABLE_CHANGE * came_ms else 0.0
+
+
 def caught_up_ms(event: Played) -> float:
     """How much shorter the stroke of ``event`` played to catch up with its drawing; 0 when
     it played as it came or the change is below ``NOTABLE_CHANGE`` (no one feels it)."""
-    shorter_ms = event.compressed_ms or 0.0  # as it came: duration_ms + shorter_ms
-    if shorter_ms > 0 and shorter_ms >= NOTABLE_CHANGE * (event.duration_ms + shorter_ms):
-        return shorter_ms
-    return 0.0
+    return _notable(event.compressed_ms or 0.0, event)
 
 
 def waited_ms(event: Played) -> float:
     """How long the stroke of ``event`` waited behind the strokes before it; 0 when that wait is
     below ``NOTABLE_CHANGE`` of its duration as it came (a few ms of the network's jitter)."""
-    queued_ms = event.queued_ms
-    if queued_ms > 0 and queued_ms >= NOTABLE_CHANGE * (
-        event.duration_ms + (event.compressed_ms or 0.0)
-    ):
-        return queued_ms
-    return 0.0
+    return _notable(event.queued_ms, event)
 
 
 @dataclass(frozen=True)

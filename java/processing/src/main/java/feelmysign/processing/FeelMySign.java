@@ -743,29 +743,33 @@ public class FeelMySign {
   /** The sleeve's floor as heard (null: it says none). */
   private record FloorNews(SleeveFloor floor) {}
 
-  /**
-   * Whether a status says the sleeve is online: true or false, "" for a cleared status (no sleeve
-   * has ever listened there), null for one not understood.
-   */
-  static Object statusOnline(String payload) {
-    if (payload.isBlank()) {
-      return "";
-    }
-    try {
-      if (PyJson.loads(payload) instanceof Map<?, ?> status
-          && status.get("online") instanceof Boolean online) {
-        return online;
+  /** What a status says of the sleeve: online, offline, or no sleeve ever listened (cleared). */
+  enum SleeveSeen {
+    ONLINE,
+    OFFLINE,
+    NONE;
+
+    /** What {@code payload} says; null for a status not understood. */
+    static SleeveSeen of(String payload) {
+      if (payload.isBlank()) {
+        return NONE;
       }
-    } catch (RuntimeException notJson) {
+      try {
+        if (PyJson.loads(payload) instanceof Map<?, ?> status
+            && status.get("online") instanceof Boolean online) {
+          return online ? ONLINE : OFFLINE;
+        }
+      } catch (RuntimeException notJson) {
+        return null;
+      }
       return null;
     }
-    return null;
   }
 
   /** Runs on the network thread: only queues, never blocks, never throws. */
   private final class Relay implements SleeveClient.Listener {
-    // The sleeve's state by its last status understood (null before any): a change is said.
-    private Object sleeveOnline;
+    // The sleeve as its last status understood says (null before any): a change is said.
+    private SleeveSeen sleeve;
 
     private void offer(Object item) {
       if (!inbox.offer(item)) {
@@ -775,28 +779,32 @@ public class FeelMySign {
 
     @Override
     public void status(String payload) {
-      Object online = statusOnline(payload);
-      if (online == null || online.equals(sleeveOnline)) {
+      SleeveSeen seen = SleeveSeen.of(payload);
+      if (seen == null || seen == sleeve) {
         return;
       }
-      Object before = sleeveOnline;
-      sleeveOnline = online;
-      if (Boolean.FALSE.equals(online)) {
-        offer(
-            "sleeve "
-                + sleeveId
-                + " is offline: no new stroke is felt. Strokes sent now wait at the broker and"
-                + " play if it is back within its age limit (10 s unless set; older ones are"
-                + " refused as stale); if it crashed, a motor it was driving may run until it"
-                + " restarts");
-      } else if ("".equals(online)) {
-        offer(
-            "no sleeve listens on id '"
-                + sleeveId
-                + "': nothing has ever reported there, so strokes sent now are not felt; check"
-                + " the sleeve id (a sleeve prints its id when it starts)");
-      } else if (before != null) {
-        offer("sleeve " + sleeveId + " is online again");
+      SleeveSeen before = sleeve;
+      sleeve = seen;
+      switch (seen) {
+        case OFFLINE ->
+            offer(
+                "sleeve "
+                    + sleeveId
+                    + " is offline: no new stroke is felt. Strokes sent now wait at the broker and"
+                    + " play if it is back within its age limit (10 s unless set; older ones are"
+                    + " refused as stale); if it crashed, a motor it was driving may run until it"
+                    + " restarts");
+        case NONE ->
+            offer(
+                "no sleeve listens on id '"
+                    + sleeveId
+                    + "': nothing has ever reported there, so strokes sent now are not felt; check"
+                    + " the sleeve id (a sleeve prints its id when it starts)");
+        case ONLINE -> {
+          if (before != null) {
+            offer("sleeve " + sleeveId + " is online again");
+          }
+        }
       }
     }
 
