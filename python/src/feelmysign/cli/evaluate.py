@@ -52,11 +52,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from feelmysign.cli.options.parser import Subcommands, add_command
-from feelmysign.cli.options.values import not_empty, output_folder, whole_number
+from feelmysign.cli.options.values import not_empty, number, output_folder, whole_number
 from feelmysign.cli.simplify import load
 from feelmysign.errors import FeelMySignError
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import ALGORITHMS, Algorithm
+from feelmysign.simplify.window import WindowParams
 
 if TYPE_CHECKING:
     from feelmysign.research.evaluate import Recogniser, Row, Run, Source
@@ -64,6 +65,8 @@ if TYPE_CHECKING:
 # The research tools and rich are imported when 'evaluate' runs, not by 'feelmysign --help'.
 
 DEFAULT_OUT_ROOT = Path("evaluations")
+# The window simplifier's default floor_ms (the paper's ERM sleeve), for --best-at-floor.
+DEFAULT_FLOOR_MS = WindowParams().floor_ms
 
 
 def register(subparsers: Subcommands) -> None:
@@ -129,6 +132,17 @@ def register(subparsers: Subcommands) -> None:
         help="folder for the CSV files and plots (default: evaluations/<date>-<time>/)",
     )
     parser.add_argument(
+        "--best-at-floor",
+        nargs="?",
+        const=DEFAULT_FLOOR_MS,
+        type=number(0, 10_000, unit="ms"),
+        metavar="MS",
+        help="also recognise, per drawing, the least-squares polyline through its samples whose "
+        "every stroke lasts at least MS (default: the sleeve's floor, "
+        f"{DEFAULT_FLOOR_MS:g} ms): what the floor leaves of the shape, offline "
+        "(docs/research.md)",
+    )
+    parser.add_argument(
         "--json", action="store_true", help="print the summary as JSON on standard output"
     )
     parser.set_defaults(handler=functools.partial(run, parser=parser))
@@ -184,6 +198,12 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         "summary": summary,
         "frontier": dp,
     }
+    at_floor = None
+    if args.best_at_floor is not None:
+        from feelmysign.research.floor_reference import summarize_at_floor
+
+        at_floor = summarize_at_floor(sources, recogniser, args.best_at_floor)
+        document["best_at_floor"] = at_floor
     (out / "summary.json").write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
     plots.error_vs_strokes(summary, dp, out / "error_vs_strokes.png")
     plots.lag_distribution(rows, out / "lag.png")
@@ -192,6 +212,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         print(json.dumps(document))
     else:
         print(_table(summary, len(sources), out, recogniser.against if recogniser else None))
+        if at_floor is not None:
+            print(_at_floor_table(at_floor))
     return 0
 
 
@@ -356,6 +378,23 @@ def _table(
             f"{s['slowed_total']:>6} {s['dropped_total']:>7} {_recognised(s):>17}"
         )
     lines += ["", f"Wrote results.csv, frontier.csv, summary.json and 3 plots to {out}/"]
+    return "\n".join(lines)
+
+
+def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
+    floor_ms = at_floor[0]["floor_ms"] if at_floor else DEFAULT_FLOOR_MS
+    lines = [
+        "",
+        f"Best at a floor of {floor_ms:g} ms, offline (research.floor_reference): per drawing,",
+        "the polyline through drawn samples, every stroke at least the floor, nearest the",
+        "samples (least squares); no error bound, cap or rest rule, and the whole path known.",
+        "",
+        f"{'set':<6} {'strokes':>7} {'recognised drawn / best at the floor':>38}",
+    ]
+    for s in at_floor:
+        drawn, best = s["recognised_drawn_pct"], s["recognised_pct"]
+        both = "-" if drawn is None else f"{drawn:.1f} / {best:.1f}"
+        lines.append(f"{s['set']:<6} {s['strokes_mean']:>7.2f} {both:>38}")
     return "\n".join(lines)
 
 

@@ -1,0 +1,180 @@
+"""What the sleeve's floor leaves of a drawing's shape: a reference for the simplifiers.
+
+A stroke the sleeve plays in its drawn time lasts at least its floor (73.7 ms on the paper's
+ERM sleeve: two 20 ms end bursts). So whatever a simplifier does, online or offline, a path
+drawn in D ms gets at most D / floor strokes that nothing slows. This finds, offline and with
+the whole path known, the polyline through drawn samples whose every piece lasts at least the
+floor and whose samples lie nearest it: the least integral square error (the sum of each
+sample's squared distance to the line of its piece), by dynamic programming over the samples
+(Perez and Vidal, "Optimum polygonal approximation of digitized curves", Pattern Recognition
+Letters 15, 1994, with the floor as the constraint on each piece instead of a count of pieces).
+Each piece's error comes from prefix sums in O(1), so a path of n samples takes O(n^2).
+
+It keeps no error bound, no latency cap and no rest rule, and it sees the future: a
+reference for the shape alone, not a simplifier. ``feelmysign evaluate --best-at-floor``
+recognises it with $1 beside the drawings and the strokes sent (docs/research.md, "What the
+floor leaves of recognition").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from feelmysign.research import metrics
+
+if TYPE_CHECKING:
+    from feelmysign.research.evaluate import Recogniser, Source
+
+
+def _prefix(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Sums of values[:k] for k = 0 .. n."""
+    return np.concatenate([[0.0], np.cumsum(values)])
+
+
+def piece_errors(
+    points: NDArray[np.float64], starts: NDArray[np.int64], end: int
+) -> NDArray[np.float64]:
+    """The integral square error of the pieces points[i] -> points[end], one per i in ``starts``.
+
+    Each sample from i to end (both included) counts its squared distance to the line through
+    the piece's ends; a piece whose ends coincide (a closed loop) counts the distance to that
+    point. Computed from sums over the samples (`_Sums`) rather than sample by sample.
+    """
+    return _Sums(points).errors(starts, end)
+
+
+class _Sums:
+    """Prefix sums of x, y, x^2, y^2 and xy over a path's samples."""
+
+    def __init__(self, points: NDArray[np.float64]) -> None:
+        x, y = points[:, 0], points[:, 1]
+        self.x, self.y = x, y
+        self.sx, self.sy = _prefix(x), _prefix(y)
+        self.sxx, self.syy, self.sxy = _prefix(x * x), _prefix(y * y), _prefix(x * y)
+
+    def errors(self, starts: NDArray[np.int64], end: int) -> NDArray[np.float64]:
+        i = starts
+        count = (end + 1 - i).astype(np.float64)
+        ax, ay = self.x[i], self.y[i]
+        dx, dy = self.x[end] - ax, self.y[end] - ay
+        sx = self.sx[end + 1] - self.sx[i]
+        sy = self.sy[end + 1] - self.sy[i]
+        # Sums of (x - ax)^2, (y - ay)^2 and (x - ax)(y - ay) over the piece's samples.
+        cxx = self.sxx[end + 1] - self.sxx[i] - 2.0 * ax * sx + count * ax * ax
+        cyy = self.syy[end + 1] - self.syy[i] - 2.0 * ay * sy + count * ay * ay
+        cxy = self.sxy[end + 1] - self.sxy[i] - ax * sy - ay * sx + count * ax * ay
+        length_sq = dx * dx + dy * dy
+        cross_sq = dx * dx * cyy + dy * dy * cxx - 2.0 * dx * dy * cxy
+        with np.errstate(divide="ignore", invalid="ignore"):
+            along_line = cross_sq / length_sq
+        result: NDArray[np.float64] = np.maximum(
+            np.where(length_sq > 0.0, along_line, cxx + cyy), 0.0
+        )
+        return result
+
+
+def best_at_floor(
+    points: Sequence[tuple[float, float]] | NDArray[np.float64],
+    times_ms: ArrayLike,
+    floor_ms: float,
+) -> NDArray[np.int64]:
+    """The indices of the samples the best polyline at the floor passes through, first and
+    last included: every piece lasts at least ``floor_ms`` (a path briefer than that is one
+    piece), and the sum of the samples' squared distances to their pieces is the least such
+    a polyline can have. Times earlier than the one before count as the one before; ties go
+    to the earlier vertex (the longer last piece)."""
+    path = metrics.as_points(points)
+    n = len(path)
+    if n < 2:
+        return np.arange(n, dtype=np.int64)
+    times = np.maximum.accumulate(np.asarray(times_ms, dtype=np.float64))
+    if times[-1] - times[0] < floor_ms:
+        return np.array([0, n - 1], dtype=np.int64)
+    sums = _Sums(path)
+    best = np.full(n, np.inf)
+    best[0] = 0.0
+    before = np.full(n, -1, dtype=np.int64)
+    for j in range(1, n):
+        # The vertices i a piece i -> j may start at: drawn at least the floor before j.
+        stop = int(np.searchsorted(times, times[j] - floor_ms, side="right"))
+        if stop == 0:
+            continue
+        starts = np.arange(stop, dtype=np.int64)
+        totals = best[:stop] + sums.errors(starts, j)
+        i = int(np.argmin(totals))
+        best[j], before[j] = totals[i], i
+    chosen = [n - 1]
+    while chosen[-1] != 0:
+        chosen.append(int(before[chosen[-1]]))
+    return np.array(chosen[::-1], dtype=np.int64)
+
+
+@dataclass(frozen=True)
+class Reference:
+    """The best polyline at the floor of a drawing (its paths one after another), and its
+    stroke count."""
+
+    polyline: NDArray[np.float64]
+    strokes: int
+
+
+def reference(
+    paths: Sequence[NDArray[np.float64]], times_ms: Sequence[ArrayLike], floor_ms: float
+) -> Reference:
+    """The best polyline at the floor of each path (grid points and their times), chained as
+    the strokes sent are."""
+    pieces = []
+    strokes = 0
+    for points, times in zip(paths, times_ms, strict=True):
+        if len(points) == 0:
+            continue
+        kept = best_at_floor(points, times, floor_ms)
+        pieces.append(np.asarray(points, dtype=np.float64)[kept])
+        strokes += max(len(kept) - 1, 0)
+    polyline = np.concatenate(pieces) if pieces else metrics.as_points([])
+    return Reference(polyline, strokes)
+
+
+def summarize_at_floor(
+    sources: Sequence[Source], recogniser: Recogniser | None, floor_ms: float
+) -> list[dict[str, Any]]:
+    """Per set, in first-seen order: how many strokes the best polyline at the floor of each
+    drawing has (mean), and how often $1 names it and the drawing (percent; None without
+    a shape to recognise). Drawings are mapped to the grid as the window simplifier maps them."""
+    from feelmysign.research.evaluate import grid_points
+    from feelmysign.simplify.registry import ALGORITHMS, params_for
+
+    window = ALGORITHMS["window"]
+    sets: dict[str, list[tuple[int, bool | None, bool | None]]] = {}
+    for source in sources:
+        params = params_for(window, source.recording, {})
+        paths = [grid_points(params, path) for path in source.recording.paths]
+        times = [[s.t_ms for s in path] for path in source.recording.paths]
+        found = reference(paths, times, floor_ms)
+        drawn = np.concatenate(paths) if paths else metrics.as_points([])
+        named = recogniser.names(source, found.polyline) if recogniser else None
+        drawn_named = recogniser.drawn(source, drawn) if recogniser else None
+        sets.setdefault(source.set, []).append((found.strokes, drawn_named, named))
+    summary = []
+    for name, members in sets.items():
+        summary.append(
+            {
+                "set": name,
+                "floor_ms": floor_ms,
+                "recordings": len(members),
+                "strokes_mean": round(float(np.mean([m[0] for m in members])), 2),
+                "recognised_drawn_pct": _percent([m[1] for m in members]),
+                "recognised_pct": _percent([m[2] for m in members]),
+            }
+        )
+    return summary
+
+
+def _percent(flags: Sequence[bool | None]) -> float | None:
+    known = [f for f in flags if f is not None]
+    return round(100.0 * sum(known) / len(known), 2) if known else None
