@@ -122,13 +122,17 @@ def test_evaluate_reports_the_best_at_the_floor_beside_the_drawings(
         assert entry["floor_ms"] == pytest.approx(73.701)
         assert entry["recognised_drawn_pct"] == 100.0
         assert entry["recognised_pct"] is not None
+        assert entry["recognised_felt_pct"] is not None
     # A floor given: finer strokes for the slow gestures.
     document = evaluate_json(capsys, *argv, "--best-at-floor", "30")
     finer = {s["set"]: s for s in document["best_at_floor"]}
     assert finer["slow"]["strokes_mean"] > at_floor["slow"]["strokes_mean"]
     assert main(["evaluate", *argv, "--best-at-floor"]) == 0
     out = capsys.readouterr().out
-    assert "Best at a floor of 73.701 ms" in out and "recognised drawn / best at the floor" in out
+    assert (
+        "Best at a floor of 73.701 ms" in out
+        and "recognised drawn / best at the floor / felt" in out
+    )
 
 
 def test_a_floor_out_of_range_names_the_range(capsys: pytest.CaptureFixture[str]) -> None:

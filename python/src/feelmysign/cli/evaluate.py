@@ -389,12 +389,14 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
         "the polyline through drawn samples, every stroke at least the floor, nearest the",
         "samples (least squares); no error bound, cap or rest rule, and the whole path known.",
         "",
-        f"{'set':<6} {'strokes':>7} {'recognised drawn / best at the floor':>38}",
+        f"{'set':<6} {'strokes':>7} {'recognised drawn / best at the floor / felt':>44}",
     ]
     for s in at_floor:
-        drawn, best = s["recognised_drawn_pct"], s["recognised_pct"]
-        both = "-" if drawn is None else f"{drawn:.1f} / {best:.1f}"
-        lines.append(f"{s['set']:<6} {s['strokes_mean']:>7.2f} {both:>38}")
+        drawn, best, felt = (
+            s[k] for k in ("recognised_drawn_pct", "recognised_pct", "recognised_felt_pct")
+        )
+        all_three = "-" if drawn is None else f"{drawn:.1f} / {best:.1f} / {felt:.1f}"
+        lines.append(f"{s['set']:<6} {s['strokes_mean']:>7.2f} {all_three:>44}")
     return "\n".join(lines)
 
 

@@ -18,6 +18,7 @@ floor leaves of recognition").
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -26,6 +27,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from feelmysign.research import metrics
+from feelmysign.simplify.registry import PathSegment
+from feelmysign.simplify.segment import Segment
 
 if TYPE_CHECKING:
     from feelmysign.research.evaluate import Recogniser, Source
@@ -116,11 +119,12 @@ def best_at_floor(
 
 @dataclass(frozen=True)
 class Reference:
-    """The best polyline at the floor of a drawing (its paths one after another), and its
-    stroke count."""
+    """The best polyline at the floor of a drawing (its paths one after another), its stroke
+    count, and its strokes as a simplifier would send them (each let go as it ends)."""
 
     polyline: NDArray[np.float64]
     strokes: int
+    segments: tuple[PathSegment, ...]
 
 
 def reference(
@@ -129,37 +133,52 @@ def reference(
     """The best polyline at the floor of each path (grid points and their times), chained as
     the strokes sent are."""
     pieces = []
-    strokes = 0
-    for points, times in zip(paths, times_ms, strict=True):
+    segments: list[PathSegment] = []
+    for index, (points, times) in enumerate(zip(paths, times_ms, strict=True)):
         if len(points) == 0:
             continue
-        kept = best_at_floor(points, times, floor_ms)
-        pieces.append(np.asarray(points, dtype=np.float64)[kept])
-        strokes += max(len(kept) - 1, 0)
+        path = np.asarray(points, dtype=np.float64)
+        at = np.maximum.accumulate(np.asarray(times, dtype=np.float64))
+        kept = best_at_floor(path, at, floor_ms)
+        pieces.append(path[kept])
+        for a, b in itertools.pairwise(kept):
+            start = (float(path[a, 0]), float(path[a, 1]))
+            end = (float(path[b, 0]), float(path[b, 1]))
+            segment = Segment(start, end, float(at[a]), float(at[b]), float(at[b]))
+            segments.append(PathSegment(index, segment))
     polyline = np.concatenate(pieces) if pieces else metrics.as_points([])
-    return Reference(polyline, strokes)
+    return Reference(polyline, len(segments), tuple(segments))
 
 
 def summarize_at_floor(
     sources: Sequence[Source], recogniser: Recogniser | None, floor_ms: float
 ) -> list[dict[str, Any]]:
     """Per set, in first-seen order: how many strokes the best polyline at the floor of each
-    drawing has (mean), and how often $1 names it and the drawing (percent; None without
-    a shape to recognise). Drawings are mapped to the grid as the window simplifier maps them."""
-    from feelmysign.research.evaluate import grid_points
+    drawing has (mean), and how often $1 names the drawing, that polyline and its felt path
+    (planned and played as the sleeve would; percent, None without a shape to recognise).
+    Drawings are mapped to the grid as the window simplifier maps them."""
+    from feelmysign.research.evaluate import grid_points, layout_for
+    from feelmysign.research.felt import felt_path
+    from feelmysign.research.playback import simulate
     from feelmysign.simplify.registry import ALGORITHMS, params_for
 
     window = ALGORITHMS["window"]
-    sets: dict[str, list[tuple[int, bool | None, bool | None]]] = {}
+    sets: dict[str, list[tuple[int, bool | None, bool | None, bool | None]]] = {}
     for source in sources:
         params = params_for(window, source.recording, {})
         paths = [grid_points(params, path) for path in source.recording.paths]
         times = [[s.t_ms for s in path] for path in source.recording.paths]
         found = reference(paths, times, floor_ms)
         drawn = np.concatenate(paths) if paths else metrics.as_points([])
-        named = recogniser.names(source, found.polyline) if recogniser else None
-        drawn_named = recogniser.drawn(source, drawn) if recogniser else None
-        sets.setdefault(source.set, []).append((found.strokes, drawn_named, named))
+        if recogniser is None:
+            sets.setdefault(source.set, []).append((found.strokes, None, None, None))
+            continue
+        # Felt as the sleeve plans and plays the strokes (research.felt): the phantom's path.
+        playback = simulate(found.segments, source.recording.paths, layout_for(params))
+        felt = recogniser.names(source, felt_path(playback.schedules))
+        named = recogniser.names(source, found.polyline)
+        drawn_named = recogniser.drawn(source, drawn)
+        sets.setdefault(source.set, []).append((found.strokes, drawn_named, named, felt))
     summary = []
     for name, members in sets.items():
         summary.append(
@@ -170,6 +189,7 @@ def summarize_at_floor(
                 "strokes_mean": round(float(np.mean([m[0] for m in members])), 2),
                 "recognised_drawn_pct": _percent([m[1] for m in members]),
                 "recognised_pct": _percent([m[2] for m in members]),
+                "recognised_felt_pct": _percent([m[3] for m in members]),
             }
         )
     return summary
