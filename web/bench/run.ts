@@ -14,10 +14,13 @@
  * FEELMYSIGN_BENCH_WEB_DIR measures the scribble on another build of the page;
  * FEELMYSIGN_SCRIBBLE_S scribbles that many seconds instead of a minute (a long call).
  */
-import { benchFrameCost, type FramePhase } from "./frame-cost";
+import type { FramePhase } from "./frame-cost";
 import { benchLasa, type LasaRate } from "./lasa";
-import { benchScribble, PATH_SECONDS, SCRIBBLE_SECONDS } from "./scribble";
 import { benchSimplifier } from "./simplifier";
+// The browser parts (playwright-core) are loaded after the simplifiers are timed, not before:
+// with playwright-core loaded, simplify-js (the LASA baseline) ran at 40 to 50% of its speed
+// in the same process while the simplifiers did not change, which doubled every ratio to it
+// (docs/research.md, "What is left of the window's budget").
 
 /** Each part's wall time, printed after its figures: make bench is meant to take minutes. */
 let partStarted = performance.now();
@@ -76,6 +79,8 @@ if (lasa !== null) {
 /** Budget of the two growth ratios below: the page's cost must not grow with the drawing. */
 const GROWTH_BUDGET = 1.2;
 
+const { benchFrameCost } = await import("./frame-cost");
+const { benchScribble, PATH_SECONDS, SCRIBBLE_SECONDS } = await import("./scribble");
 const frames = await benchFrameCost();
 console.log(`web: scripting time per frame while drawing (${frames.browser}, headless)`);
 console.log(phase("after 10 strokes:", frames.few));
