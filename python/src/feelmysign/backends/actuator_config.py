@@ -50,6 +50,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from feelmysign.layout import Layout
+from feelmysign.state_home import state_path
 
 ERM_CL_RATED_V_PER_STEP = 21.18e-3
 LRA_CL_RATED_V_PER_STEP = 20.58e-3
@@ -161,8 +162,7 @@ class Calibration:
 
 def calibration_path(name: str) -> str:
     """``$XDG_STATE_HOME/feelmysign/calibration/NAME.json`` (``/var/lib/...`` under systemd)."""
-    state_home = os.environ.get("XDG_STATE_HOME") or os.path.expanduser("~/.local/state")
-    return os.path.join(state_home, "feelmysign", "calibration", f"{name}.json")
+    return state_path("calibration", f"{name}.json")
 
 
 def store_name_for_bus(bus_number: int) -> str:

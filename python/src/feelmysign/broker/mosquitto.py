@@ -46,6 +46,7 @@ from feelmysign.connection.client import probe_login
 from feelmysign.connection.settings import DEFAULT_MQTT_PORT, DEFAULT_SLEEVE_ID
 from feelmysign.errors import BrokerError
 from feelmysign.lifecycle import Started
+from feelmysign.state_home import state_path
 from feelmysign.topics import LEGACY_TOPIC
 
 DEFAULT_WS_PORT = 9001  # the WebSocket port of Mosquitto's documentation and examples
@@ -65,8 +66,7 @@ _TOPIC_PATTERN = re.compile(r"[^\s+#\x00]{1,256}")
 
 def default_state_dir() -> Path:
     """``$XDG_STATE_HOME/feelmysign/broker``, ``~/.local/state/feelmysign/broker`` by default."""
-    state_home = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
-    return Path(state_home) / "feelmysign" / "broker"
+    return Path(state_path("broker"))
 
 
 class Broker(Started):

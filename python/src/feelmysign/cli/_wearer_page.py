@@ -13,7 +13,6 @@ blocks there; otherwise (the Pi, whose broker runs elsewhere) the page says so.
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 from feelmysign.broker._config import StateFiles
@@ -27,13 +26,13 @@ from feelmysign.connection.settings import parse_broker_url
 from feelmysign.daemon import Sleeve
 from feelmysign.errors import BrokerError, FeelMySignError
 from feelmysign.layout import Layout
+from feelmysign.state_home import state_path
 from feelmysign.wearer_api import Blocking, WearerApi, wearer_key
 from feelmysign.webserver import LOOPBACK_HOSTS, WEB_DIST, WebServer
 
 
 def state_dir() -> Path:
-    state_home = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
-    return Path(state_home) / "feelmysign" / "wearer-page"
+    return Path(state_path("wearer-page"))
 
 
 LOOPBACK_NAMES = frozenset({"127.0.0.1", "localhost", "::1"})

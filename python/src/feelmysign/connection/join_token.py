@@ -18,7 +18,6 @@ from __future__ import annotations
 import base64
 import binascii
 import json
-import os
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -28,6 +27,7 @@ from feelmysign.connection.pinned_ca import pinned_ca_file
 from feelmysign.connection.settings import BrokerSettings, parse_broker_url
 from feelmysign.errors import BrokerConnectionError
 from feelmysign.input_files import loads_json
+from feelmysign.state_home import state_path
 
 TOKEN_PREFIX = "fms1."
 Role = Literal["sleeve", "sender"]
@@ -82,8 +82,7 @@ def join_settings(text: str, trust_dir: Path, *, role: Role = "sleeve") -> Broke
 
 def default_trust_dir() -> Path:
     """``$XDG_STATE_HOME/feelmysign/trusted``: the CAs of joined brokers."""
-    state_home = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
-    return Path(state_home) / "feelmysign" / "trusted"
+    return Path(state_path("trusted"))
 
 
 def decode_join_token(text: str) -> JoinToken:

@@ -44,6 +44,7 @@ from feelmysign.events import StatusControls
 from feelmysign.input_files import loads_json, read_text
 from feelmysign.player import Refusal
 from feelmysign.protocol import DO_NOT_DISTURB, PAUSED
+from feelmysign.state_home import state_path
 
 log = logging.getLogger(__name__)
 
@@ -74,8 +75,7 @@ class ControlsError(FeelMySignError):
 def controls_path(sleeve_id: str) -> str:
     """``$XDG_STATE_HOME/feelmysign/controls/<sleeve-id>.json``: one file per sleeve, as two
     sleeves on one machine (the load bench) are two wearers."""
-    state_home = os.environ.get("XDG_STATE_HOME") or os.path.expanduser("~/.local/state")
-    return os.path.join(state_home, "feelmysign", "controls", f"{sleeve_id}.json")
+    return state_path("controls", f"{sleeve_id}.json")
 
 
 def refusal_for(state: ControlsState, now_ms: float) -> Refusal | None:
