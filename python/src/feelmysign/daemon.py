@@ -78,6 +78,7 @@ from feelmysign.sleeve.controls import (
     describe,
     refusal_for,
 )
+from feelmysign.sleeve.pace_memory import PaceMemory, pace_path
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -217,6 +218,10 @@ class Sleeve:
             max_age_ms=options.max_age_ms,
             max_lag_ms=options.max_lag_ms,
         )
+        # The pace's time lines kept from before a crash or kill: strokes the broker held
+        # while the sleeve was down are late by how long they were held, not a new time line.
+        self._pace_memory = PaceMemory(pace_path(self._id))
+        self._admission.remember(self._pace_memory.load(options.max_age_ms))
         # For the wearer's stop: the drawings lately seen (drawing -> the monotonic ms of its
         # last stroke's arrival), the strokes refused during the present pause, and the
         # drawings stopped (drawing -> when, wall clock: the admission's cancel of it).
@@ -320,6 +325,10 @@ class Sleeve:
                 self._telemetry.stop()
             self._outbox.put(None)  # the events still queued go out before the goodbye
             publisher.join(timeout=5.0)
+            if self._fatal is None:
+                self._pace_memory.forget()  # a clean stop: this run's drawings are over
+            else:
+                self._pace_memory.save()  # to restart after a bug as after a crash
             self._write_journal(every_drawing=True)
             self._say_goodbye()
 
@@ -739,6 +748,7 @@ class Sleeve:
                 item = self._outbox.get(timeout=JOURNAL_CHECK_S)
             except queue.Empty:
                 self._write_journal()  # quiet: a good moment to look
+                self._pace_memory.save()  # and to keep the time lines
                 continue
             if time.monotonic() - self._journal_checked_s >= JOURNAL_CHECK_S:
                 self._write_journal()
@@ -754,6 +764,8 @@ class Sleeve:
             if item.event is not None:
                 with self._journal_lock:
                     self._journal.add(item.event, time.monotonic())
+                if isinstance(item.event, Played):
+                    self._pace_memory.played(item.event)
 
     def _acknowledge(self, ack: _Ack) -> None:
         # Once only: a message id is reused by the broker as soon as it is acknowledged. And

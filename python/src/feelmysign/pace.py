@@ -32,7 +32,9 @@ the verdicts as ``rejected`` events with reason ``stale`` or ``late``.
 
 from __future__ import annotations
 
+import math
 from collections import OrderedDict
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from feelmysign.frozen_init import dict_init
@@ -146,6 +148,20 @@ class PacePolicy:
                 lag_ms=lag_ms,
             )
         return Verdict(age_ms=age_ms, lag_ms=max(lag_ms, 0.0))
+
+    def remember(self, drawings: Iterable[tuple[str, float]]) -> None:
+        """Time lines kept from before a restart (``feelmysign.sleeve.pace_memory``), oldest
+        first: each drawing's smallest delay. A stroke the broker held while the sleeve was
+        away is then measured against it, as before the restart, and is late by how long it
+        was held (the sleeve catches up by skipping, as after a stall), where the first of
+        such strokes to arrive would otherwise set the drawing's time line and the newer
+        strokes behind them would be skipped. The line's end is not kept: the first stroke
+        after the restart is due at its own ``sent_at_ms``."""
+        for drawing, smallest_delay_ms in drawings:
+            self._drawings[drawing] = _TimeLine(smallest_delay_ms, -math.inf)
+            self._drawings.move_to_end(drawing)
+        while len(self._drawings) > REMEMBERED_DRAWINGS:
+            self._drawings.popitem(last=False)
 
     def _time_line(self, drawing: str | None, sent_at_ms: float) -> _TimeLine:
         if drawing is None:  # no drawing: nothing to chain or compare with

@@ -28,7 +28,7 @@ its lock, a simulation from its own :class:`feelmysign.sleeve.queue.Queue`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import replace
 from typing import NamedTuple, Protocol
 
@@ -190,6 +190,10 @@ class Admission:
         # The wearer's intensity ceiling (feelmysign.sleeve.controls): a stroke asking more is
         # planned at it, so its phantoms keep their proportions below it.
         self.ceiling: float | None = None
+
+    def remember(self, drawings: Iterable[tuple[str, float]]) -> None:
+        """The pace's time lines kept from before a restart (``PacePolicy.remember``)."""
+        self._pace.remember(drawings)
 
     def admit(
         self,
