@@ -85,7 +85,7 @@ def _why_late(held_ms: float, queued_ms: float) -> str:
     if held_ms >= queued_ms:
         return (
             f"it arrived {held_ms / 1000:.2f} s later than its drawing's quickest stroke, held on "
-            "the way (the sender, the network or the broker was away)"
+            "the way (the sleeve, the sender, the network or the broker was away)"
         )
     return (
         f"it would wait {queued_ms / 1000:.2f} s behind the strokes queued on the sleeve before it"
