@@ -15,7 +15,12 @@ from hypothesis import strategies as st
 from test_cli_evaluate import evaluate_json, gesture_folder
 
 from feelmysign.cli import main
-from feelmysign.research.floor_reference import best_at_floor, piece_errors, reference
+from feelmysign.research.floor_reference import (
+    best_at_floor,
+    online_at_floor,
+    piece_errors,
+    reference,
+)
 
 
 def line_error(points: np.ndarray, i: int, j: int) -> float:
@@ -127,12 +132,16 @@ def test_evaluate_reports_the_best_at_the_floor_beside_the_drawings(
     document = evaluate_json(capsys, *argv, "--best-at-floor", "30")
     finer = {s["set"]: s for s in document["best_at_floor"]}
     assert finer["slow"]["strokes_mean"] > at_floor["slow"]["strokes_mean"]
-    assert main(["evaluate", *argv, "--best-at-floor"]) == 0
+    assert main(["evaluate", *argv, "--best-at-floor", "--lookahead-ms", "30"]) == 0
     out = capsys.readouterr().out
-    assert (
-        "Best at a floor of 73.701 ms" in out
-        and "recognised drawn / best at the floor / felt" in out
-    )
+    assert "Best at a floor of 73.701 ms" in out and "offline" in out and "online, 30 ms" in out
+
+
+def test_lookahead_needs_the_best_at_floor(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main(["evaluate", "--lasa", "--lookahead-ms", "30"])
+    assert exit_info.value.code == 2
+    assert "give it with --best-at-floor" in capsys.readouterr().err
 
 
 def test_a_floor_out_of_range_names_the_range(capsys: pytest.CaptureFixture[str]) -> None:
@@ -140,3 +149,45 @@ def test_a_floor_out_of_range_names_the_range(capsys: pytest.CaptureFixture[str]
         main(["evaluate", "--lasa", "--best-at-floor", "-5"])
     assert exit_info.value.code == 2
     assert "-5 is out of range; give a number from 0 to 10000 ms" in capsys.readouterr().err
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.tuples(coordinate, coordinate, st.floats(0, 40)), min_size=2, max_size=40),
+    st.sampled_from([0.0, 30.0, 100.0]),
+    st.sampled_from([150.0, 200.0, math.inf]),
+)
+def test_online_pieces_join_last_the_floor_and_wait_for_the_lookahead(
+    drawn: list[tuple[float, float, float]], lookahead_ms: float, cap_ms: float
+) -> None:
+    floor_ms = 73.701
+    points = np.array([(x, y) for x, y, _ in drawn])
+    times = np.cumsum([step for _, _, step in drawn])
+    pieces = online_at_floor(points, times, floor_ms, lookahead_ms, cap_ms)
+    assert pieces[0][0] == 0 and pieces[-1][1] == len(points) - 1
+    assert all(a < b for a, b, _ in pieces)
+    assert all(p[1] == q[0] for p, q in itertools.pairwise(pieces))
+    release_ms = times[-1]
+    for a, b, let_go_ms in pieces:
+        assert times[b] <= let_go_ms <= release_ms
+        if let_go_ms < release_ms:  # let go while the pen still draws
+            assert times[b] - times[a] >= floor_ms
+            waited = let_go_ms - times[b] >= lookahead_ms
+            capped = let_go_ms - times[a] > cap_ms
+            assert waited or capped
+    # At release the rest is let go: pieces lasting the floor, the last one briefer only when
+    # what was left after the last piece let go was.
+    assert all(times[b] - times[a] >= floor_ms for a, b, _ in pieces[:-1])
+
+
+@settings(max_examples=100, deadline=None)
+@given(paths, st.sampled_from([20.0, 73.701]))
+def test_online_with_a_lookahead_past_the_path_is_the_offline_polyline(
+    drawn: list[tuple[float, float, float]], floor_ms: float
+) -> None:
+    points = np.array([(x, y) for x, y, _ in drawn])
+    times = np.cumsum([step for _, _, step in drawn])
+    online = online_at_floor(points, times, floor_ms, lookahead_ms=1e9, cap_ms=math.inf)
+    kept = best_at_floor(points, times, floor_ms)
+    assert [a for a, _, _ in online] + [online[-1][1]] == list(kept)
+    assert {let_go for _, _, let_go in online} == {times[-1]}

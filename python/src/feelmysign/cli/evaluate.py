@@ -67,6 +67,7 @@ if TYPE_CHECKING:
 DEFAULT_OUT_ROOT = Path("evaluations")
 # The window simplifier's default floor_ms (the paper's ERM sleeve), for --best-at-floor.
 DEFAULT_FLOOR_MS = WindowParams().floor_ms
+DEFAULT_CAP_MS = WindowParams().max_stroke_ms  # and its latency cap, for --lookahead-ms
 
 
 def register(subparsers: Subcommands) -> None:
@@ -143,6 +144,14 @@ def register(subparsers: Subcommands) -> None:
         "(docs/research.md)",
     )
     parser.add_argument(
+        "--lookahead-ms",
+        type=number(0, 10_000, unit="ms"),
+        metavar="MS",
+        help="with --best-at-floor: also find that polyline online, each stroke let go once "
+        "the pen has drawn MS past its end (or the latency cap, "
+        f"{DEFAULT_CAP_MS:g} ms, ends it): a reference for a simplifier that waits so long",
+    )
+    parser.add_argument(
         "--json", action="store_true", help="print the summary as JSON on standard output"
     )
     parser.set_defaults(handler=functools.partial(run, parser=parser))
@@ -172,6 +181,11 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         parser.error("give either RECORDING files or --lasa, not both")
     if args.templates and args.lasa:
         parser.error("--templates names recorded drawings; LASA is recognised among its own")
+    if args.lookahead_ms is not None and args.best_at_floor is None:
+        parser.error(
+            "--lookahead-ms finds the best polyline at the floor online: "
+            "give it with --best-at-floor"
+        )
     if args.speeds and not args.lasa:
         parser.error("--speeds re-times the LASA drawings: give it with --lasa")
     if args.defaults and args.sweep:
@@ -203,6 +217,14 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         from feelmysign.research.floor_reference import summarize_at_floor
 
         at_floor = summarize_at_floor(sources, recogniser, args.best_at_floor)
+        if args.lookahead_ms is not None:
+            at_floor += summarize_at_floor(
+                sources,
+                recogniser,
+                args.best_at_floor,
+                lookahead_ms=args.lookahead_ms,
+                cap_ms=DEFAULT_CAP_MS,
+            )
         document["best_at_floor"] = at_floor
     (out / "summary.json").write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
     plots.error_vs_strokes(summary, dp, out / "error_vs_strokes.png")
@@ -385,18 +407,29 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
     floor_ms = at_floor[0]["floor_ms"] if at_floor else DEFAULT_FLOOR_MS
     lines = [
         "",
-        f"Best at a floor of {floor_ms:g} ms, offline (research.floor_reference): per drawing,",
-        "the polyline through drawn samples, every stroke at least the floor, nearest the",
-        "samples (least squares); no error bound, cap or rest rule, and the whole path known.",
+        f"Best at a floor of {floor_ms:g} ms (research.floor_reference): per drawing, the",
+        "polyline through drawn samples, every stroke at least the floor, nearest the samples",
+        "(least squares); no error bound or rest rule. Offline: the whole path known, each",
+        "stroke let go as it ends. Online: found again at every sample, each stroke let go once",
+        f"the pen is the lookahead past its end (or the {DEFAULT_CAP_MS:g} ms cap ends it).",
+        "recognised: $1 on the drawings / the polyline / its felt path; worst: the farthest",
+        "drawn sample from its stroke",
         "",
-        f"{'set':<6} {'strokes':>7} {'recognised drawn / best at the floor / felt':>44}",
+        f"{'set':<6} {'found':<18} {'strokes':>7} {'skin':>5} {'p95':>5} "
+        f"{'felt end p95':>12} {'worst':>6} {'recognised':>18}",
     ]
     for s in at_floor:
         drawn, best, felt = (
             s[k] for k in ("recognised_drawn_pct", "recognised_pct", "recognised_felt_pct")
         )
-        all_three = "-" if drawn is None else f"{drawn:.1f} / {best:.1f} / {felt:.1f}"
-        lines.append(f"{s['set']:<6} {s['strokes_mean']:>7.2f} {all_three:>44}")
+        found = "offline" if s["lookahead_ms"] is None else f"online, {s['lookahead_ms']:g} ms"
+        lines.append(
+            f"{s['set']:<6} {found:<18} {s['strokes_mean']:>7.2f} "
+            f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
+            f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
+            f"{s['max_deviation_max']:>6.3f} "
+            + ("-" if drawn is None else f"{drawn:.1f}/{best:.1f}/{felt:.1f}").rjust(18)
+        )
     return "\n".join(lines)
 
 

@@ -19,6 +19,7 @@ floor leaves of recognition").
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -96,103 +97,208 @@ def best_at_floor(
     if n < 2:
         return np.arange(n, dtype=np.int64)
     times = np.maximum.accumulate(np.asarray(times_ms, dtype=np.float64))
-    if times[-1] - times[0] < floor_ms:
-        return np.array([0, n - 1], dtype=np.int64)
-    sums = _Sums(path)
+    return np.array(_best(_Sums(path), times, 0, n - 1, floor_ms), dtype=np.int64)
+
+
+def _best(
+    sums: _Sums,
+    times: NDArray[np.float64],
+    first: int,
+    last: int,
+    floor_ms: float,
+    *,
+    open_end: bool = False,
+) -> list[int]:
+    """The least-squares vertices from sample ``first`` to ``last`` whose pieces all last at
+    least ``floor_ms`` (one piece if none can); with ``open_end`` the last piece may be
+    briefer (the path goes on: that piece is not final)."""
+    n = last - first + 1
     best = np.full(n, np.inf)
     best[0] = 0.0
     before = np.full(n, -1, dtype=np.int64)
-    for j in range(1, n):
+    for k in range(1, n):
+        j = first + k
         # The vertices i a piece i -> j may start at: drawn at least the floor before j.
-        stop = int(np.searchsorted(times, times[j] - floor_ms, side="right"))
-        if stop == 0:
+        stop = (
+            k
+            if open_end and j == last
+            else int(np.searchsorted(times, times[j] - floor_ms, side="right")) - first
+        )
+        stop = min(stop, k)
+        if stop <= 0:
             continue
-        starts = np.arange(stop, dtype=np.int64)
-        totals = best[:stop] + sums.errors(starts, j)
+        totals = best[:stop] + sums.errors(np.arange(first, first + stop, dtype=np.int64), j)
         i = int(np.argmin(totals))
-        best[j], before[j] = totals[i], i
+        best[k], before[k] = totals[i], i
+    if not np.isfinite(best[n - 1]):
+        return [first, last]
     chosen = [n - 1]
     while chosen[-1] != 0:
         chosen.append(int(before[chosen[-1]]))
-    return np.array(chosen[::-1], dtype=np.int64)
+    return [first + k for k in reversed(chosen)]
+
+
+def online_at_floor(
+    points: Sequence[tuple[float, float]] | NDArray[np.float64],
+    times_ms: ArrayLike,
+    floor_ms: float,
+    lookahead_ms: float,
+    cap_ms: float,
+) -> list[tuple[int, int, float]]:
+    """The same polyline found online: the pieces (start index, end index, when let go, ms).
+
+    At each sample the least-squares vertices at the floor are found again from the last
+    vertex let go to the sample (the last piece open); the first of them is let go once the
+    pen has drawn ``lookahead_ms`` past it, or once the piece lasts more than ``cap_ms`` (the
+    latency cap). At release the rest is let go at once, every piece then at least the floor.
+    So each stroke but the last few waits ``lookahead_ms`` for what comes after it: a
+    reference for a simplifier that holds its strokes that long, not one (no error bound).
+    """
+    path = metrics.as_points(points)
+    n = len(path)
+    if n < 2:
+        return []
+    times = np.maximum.accumulate(np.asarray(times_ms, dtype=np.float64))
+    sums = _Sums(path)
+    pieces: list[tuple[int, int, float]] = []
+    anchor = 0
+    for j in range(1, n):
+        while times[j] - times[anchor] >= floor_ms:
+            vertices = _best(sums, times, anchor, j, floor_ms, open_end=True)
+            if len(vertices) < 3:
+                if times[j] - times[anchor] > cap_ms and times[j - 1] - times[anchor] >= floor_ms:
+                    pieces.append((anchor, j - 1, float(times[j])))  # one long piece: capped
+                    anchor = j - 1
+                    continue
+                break
+            vertex = vertices[1]
+            if times[j] - times[vertex] < lookahead_ms and times[vertex] - times[anchor] <= cap_ms:
+                break
+            pieces.append((anchor, vertex, float(times[j])))
+            anchor = vertex
+    rest = _best(sums, times, anchor, n - 1, floor_ms)
+    pieces += [(a, b, float(times[-1])) for a, b in itertools.pairwise(rest)]
+    return pieces
 
 
 @dataclass(frozen=True)
 class Reference:
-    """The best polyline at the floor of a drawing (its paths one after another), its stroke
-    count, and its strokes as a simplifier would send them (each let go as it ends)."""
+    """A reference polyline of a drawing (its paths one after another), its stroke count, its
+    strokes as a simplifier would send them, and each stroke's farthest sample (grid units)."""
 
     polyline: NDArray[np.float64]
     strokes: int
     segments: tuple[PathSegment, ...]
+    deviations: tuple[float, ...]
 
 
 def reference(
-    paths: Sequence[NDArray[np.float64]], times_ms: Sequence[ArrayLike], floor_ms: float
+    paths: Sequence[NDArray[np.float64]],
+    times_ms: Sequence[ArrayLike],
+    floor_ms: float,
+    *,
+    lookahead_ms: float | None = None,
+    cap_ms: float = math.inf,
 ) -> Reference:
     """The best polyline at the floor of each path (grid points and their times), chained as
-    the strokes sent are."""
+    the strokes sent are: offline (``best_at_floor``, each stroke let go as it ends), or with
+    ``lookahead_ms`` online (``online_at_floor``, let go as it says)."""
     pieces = []
     segments: list[PathSegment] = []
+    deviations: list[float] = []
     for index, (points, times) in enumerate(zip(paths, times_ms, strict=True)):
         if len(points) == 0:
             continue
         path = np.asarray(points, dtype=np.float64)
         at = np.maximum.accumulate(np.asarray(times, dtype=np.float64))
-        kept = best_at_floor(path, at, floor_ms)
-        pieces.append(path[kept])
-        for a, b in itertools.pairwise(kept):
+        if lookahead_ms is None:
+            kept = best_at_floor(path, at, floor_ms)
+            let_go = [(int(a), int(b), float(at[b])) for a, b in itertools.pairwise(kept)]
+        else:
+            let_go = online_at_floor(path, at, floor_ms, lookahead_ms, cap_ms)
+        pieces.append(path[[let_go[0][0], *(b for _, b, _ in let_go)]] if let_go else path[:1])
+        for a, b, emitted_ms in let_go:
             start = (float(path[a, 0]), float(path[a, 1]))
             end = (float(path[b, 0]), float(path[b, 1]))
-            segment = Segment(start, end, float(at[a]), float(at[b]), float(at[b]))
+            segment = Segment(start, end, float(at[a]), float(at[b]), emitted_ms)
             segments.append(PathSegment(index, segment))
+            distances = metrics.segment_distances(path[a : b + 1], start, end)
+            deviations.append(float(np.max(distances)))
     polyline = np.concatenate(pieces) if pieces else metrics.as_points([])
-    return Reference(polyline, len(segments), tuple(segments))
+    return Reference(polyline, len(segments), tuple(segments), tuple(deviations))
 
 
 def summarize_at_floor(
-    sources: Sequence[Source], recogniser: Recogniser | None, floor_ms: float
+    sources: Sequence[Source],
+    recogniser: Recogniser | None,
+    floor_ms: float,
+    *,
+    lookahead_ms: float | None = None,
+    cap_ms: float = math.inf,
 ) -> list[dict[str, Any]]:
-    """Per set, in first-seen order: how many strokes the best polyline at the floor of each
-    drawing has (mean), and how often $1 names the drawing, that polyline and its felt path
-    (planned and played as the sleeve would; percent, None without a shape to recognise).
-    Drawings are mapped to the grid as the window simplifier maps them."""
+    """Per set, in first-seen order, of the best polyline at the floor of each drawing
+    (offline, or online with ``lookahead_ms``): its strokes (mean), how often $1 names the
+    drawing, the polyline and its felt path (planned and played as the sleeve would; percent,
+    None without a shape to recognise), the felt end (release to the end of the last stroke
+    felt, p95) and time on the skin over drawing time (mean, p95), and the farthest drawn
+    sample from its stroke (grid units). Drawings are mapped to the grid as the window
+    simplifier maps them."""
     from feelmysign.research.evaluate import grid_points, layout_for
     from feelmysign.research.felt import felt_path
     from feelmysign.research.playback import simulate
     from feelmysign.simplify.registry import ALGORITHMS, params_for
 
     window = ALGORITHMS["window"]
-    sets: dict[str, list[tuple[int, bool | None, bool | None, bool | None]]] = {}
+    sets: dict[str, list[dict[str, Any]]] = {}
     for source in sources:
         params = params_for(window, source.recording, {})
         paths = [grid_points(params, path) for path in source.recording.paths]
         times = [[s.t_ms for s in path] for path in source.recording.paths]
-        found = reference(paths, times, floor_ms)
+        found = reference(paths, times, floor_ms, lookahead_ms=lookahead_ms, cap_ms=cap_ms)
         drawn = np.concatenate(paths) if paths else metrics.as_points([])
-        if recogniser is None:
-            sets.setdefault(source.set, []).append((found.strokes, None, None, None))
-            continue
         # Felt as the sleeve plans and plays the strokes (research.felt): the phantom's path.
         playback = simulate(found.segments, source.recording.paths, layout_for(params))
-        felt = recogniser.names(source, felt_path(playback.schedules))
-        named = recogniser.names(source, found.polyline)
-        drawn_named = recogniser.drawn(source, drawn)
-        sets.setdefault(source.set, []).append((found.strokes, drawn_named, named, felt))
+        named = felt = drawn_named = None
+        if recogniser is not None:
+            felt = recogniser.names(source, felt_path(playback.schedules))
+            named = recogniser.names(source, found.polyline)
+            drawn_named = recogniser.drawn(source, drawn)
+        sets.setdefault(source.set, []).append(
+            {
+                "strokes": found.strokes,
+                "drawn": drawn_named,
+                "named": named,
+                "felt": felt,
+                "felt_end_ms": playback.release_to_felt_end_ms,
+                "skin": playback.skin_ratio if playback.drawing_ms > 0 else None,
+                "deviation": max(found.deviations, default=0.0),
+            }
+        )
     summary = []
     for name, members in sets.items():
+        felt_end = [v for m in members for v in m["felt_end_ms"]]
+        skin = [m["skin"] for m in members if m["skin"] is not None]
         summary.append(
             {
                 "set": name,
                 "floor_ms": floor_ms,
+                "lookahead_ms": lookahead_ms,
                 "recordings": len(members),
-                "strokes_mean": round(float(np.mean([m[0] for m in members])), 2),
-                "recognised_drawn_pct": _percent([m[1] for m in members]),
-                "recognised_pct": _percent([m[2] for m in members]),
-                "recognised_felt_pct": _percent([m[3] for m in members]),
+                "strokes_mean": round(float(np.mean([m["strokes"] for m in members])), 2),
+                "recognised_drawn_pct": _percent([m["drawn"] for m in members]),
+                "recognised_pct": _percent([m["named"] for m in members]),
+                "recognised_felt_pct": _percent([m["felt"] for m in members]),
+                "release_to_felt_end_p95_ms": _rounded(felt_end, 95),
+                "skin_ratio_mean": round(float(np.mean(skin)), 3) if skin else None,
+                "skin_ratio_p95": _rounded(skin, 95, 3),
+                "max_deviation_max": round(max(m["deviation"] for m in members), 6),
             }
         )
     return summary
+
+
+def _rounded(values: Sequence[float], q: float, digits: int = 1) -> float | None:
+    return round(float(np.percentile(values, q)), digits) if len(values) else None
 
 
 def _percent(flags: Sequence[bool | None]) -> float | None:
