@@ -999,6 +999,11 @@ export class Merger {
   }
 
   #send(segment: Segment, nowMs: number, out: Segment[]): void {
+    out.push(this.#sent(segment, nowMs));
+  }
+
+  /** `#send` without the array: the stroke to send, as `#send` gives it. */
+  #sent(segment: Segment, nowMs: number): Segment {
     this.#sentInPath = true;
     this.#last = segment;
     // A piece made at this sample and not dropped (most: the window's and the merged ones) is sent
@@ -1033,7 +1038,6 @@ export class Merger {
               dropped: null,
               merged: segment.merged,
             };
-    out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
     const drawn = this.#drawn;
     const { ts, count } = drawn;
@@ -1042,6 +1046,7 @@ export class Merger {
     while (keep < count && ts[keep]! < endMs) keep++;
     drawn.first = keep;
     drawn.compact();
+    return sent;
   }
 
   /** A piece the window cut: the strokes sent now, into `out` (none while a short one waits). */
@@ -1067,6 +1072,26 @@ export class Merger {
     }
     if (this.#short(piece)) this.#held = piece;
     else this.#send(piece, nowMs, out);
+  }
+
+  /**
+   * `take` for a piece the window cut alone, in `pieces` (an array of one, made for it): the
+   * strokes sent now, in that same array when it is one (most pieces: none held, none short),
+   * else in another (`NO_SEGMENTS` if none).
+   */
+  takeAlone(pieces: Segment[], nowMs: number): readonly Segment[] {
+    const piece = pieces[0]!;
+    if (this.#held === null) {
+      if (this.#short(piece)) {
+        this.#held = piece;
+        return NO_SEGMENTS;
+      }
+      pieces[0] = this.#sent(piece, nowMs);
+      return pieces;
+    }
+    pieces.pop();
+    this.take(piece, nowMs, pieces);
+    return pieces.length > 0 ? pieces : NO_SEGMENTS;
   }
 
   /**
@@ -1171,14 +1196,9 @@ export class WindowSimplifier {
     const takenMs = core.takenMs;
     // Most samples finish no piece: nothing to merge, no array made.
     if (pieces.length === 0 && !core.rested) return NO_SEGMENTS;
-    if (pieces.length === 1 && !core.rested) {
-      // Most of the rest finish one: the window's array (made for it, of one slot) holds what
-      // the merger sends instead, most often that piece itself: no other array made.
-      const out = pieces as Segment[];
-      const piece = out.pop()!;
-      merger.take(piece, takenMs, out);
-      return out.length > 0 ? out : NO_SEGMENTS;
-    }
+    // Most of the rest finish one: the window's array (made for it, of one slot) holds what
+    // the merger sends instead, most often that piece itself: no other array made.
+    if (pieces.length === 1 && !core.rested) return merger.takeAlone(pieces as Segment[], takenMs);
     const out: Segment[] = [];
     // Indexed, no iterator made: this runs at every stroke.
     for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
