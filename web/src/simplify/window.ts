@@ -324,8 +324,9 @@ export class WindowCore {
     const count = this.#count;
     if (count === 0) return this.#press(input);
     const drawn = this.#drawn;
+    const last = drawn.base + count - 1;
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
-    const lastMs = count > 1 ? drawn.ts[drawn.base + count - 1]! : this.#anchorMs;
+    const lastMs = count > 1 ? drawn.ts[last]! : this.#anchorMs;
     let sample = input;
     let t = input.t_ms;
     if (t < lastMs) {
@@ -353,7 +354,51 @@ export class WindowCore {
     drawn.ts[at] = t;
     drawn.samples[at] = sample;
     drawn.count = at + 1;
-    if (this.#follows(count, x, y, t)) return NO_SEGMENTS;
+    // `#follows`, written out (the same tests in the same order): most samples end here, and
+    // whether the optimiser inlines a call here depends on what it inlined before, which made
+    // the simplifier's speed differ by a third from one run to the next.
+    if (!this.#resting && count >= 2 && count < this.#maxWindow && !this.#bends) {
+      const sinceAnchorMs = t - this.#anchorMs;
+      const capMs = this.#capMs;
+      if (!(capMs > 0 && sinceAnchorMs > capMs)) {
+        const lastX = drawn.xs[last]!;
+        const lastY = drawn.ys[last]!;
+        const ax = this.#anchorX;
+        const ay = this.#anchorY;
+        const dx = x - ax;
+        const dy = y - ay;
+        let qx = lastX - ax;
+        let qy = lastY - ay;
+        const lengthSq = dx * dx + dy * dy;
+        if (lengthSq > 0) {
+          const along = (qx * dx + qy * dy) / lengthSq;
+          if (along >= 1) {
+            qx = qx - dx;
+            qy = qy - dy;
+          } else if (!(along <= 0)) {
+            qx = qx - along * dx;
+            qy = qy - along * dy;
+          }
+        }
+        const reach = this.#reach + Math.sqrt(qx * qx + qy * qy) + ROUNDING_SLACK;
+        if (reach <= this.#reachLimit) {
+          const restMs = this.#restMs;
+          const sx = lastX - x;
+          const sy = lastY - y;
+          if (!(
+            restMs > 0 &&
+            sinceAnchorMs >= restMs &&
+            sx * sx + sy * sy <= this.#restSq &&
+            this.#restsAt(last, x, y, t)
+          )) {
+            this.#count = count + 1;
+            this.#reach = reach;
+            this.#reaches[count] = reach;
+            return NO_SEGMENTS;
+          }
+        }
+      }
+    }
     return this.#add() ?? NO_SEGMENTS;
   }
 
@@ -392,7 +437,7 @@ export class WindowCore {
    * nothing, as `#add` would find: the pen neither rests nor crawls, the stroke stays under the
    * caps, and its reach says every sample keeps the bound without testing one (the bend rule
    * off). Else (false) nothing has changed, and `#add` takes it. The same tests as `#add`'s, in a
-   * short function for the optimiser to inline, since most samples end here.
+   * short function for the optimiser to inline in `#add` (`push` has them written out).
    */
   #follows(count: number, x: number, y: number, t: number): boolean {
     if (this.#resting || count < 2 || count >= this.#maxWindow || this.#bends) return false;
