@@ -161,6 +161,16 @@ export class WindowCore {
   /** The shortest piece the merger need not hold: the larger of floor_ms and min_duration_ms. */
   readonly #floorMs: number;
   readonly #mapping: CanvasMapping;
+  /**
+   * The mapping's terms (`CanvasMapping.gridX`, `gridY`), for `push` to map each sample itself
+   * with the same operations: a call there is one too many to inline with the rest.
+   */
+  readonly #stretch: boolean;
+  readonly #scale: number;
+  readonly #offsetX: number;
+  readonly #offsetY: number;
+  readonly #widthPx: number;
+  readonly #heightPx: number;
   /** The grid's extents (grid units): every stroke's start and end lies in [0, x] x [0, y]. */
   readonly #xExtent: number;
   readonly #yExtent: number;
@@ -170,12 +180,15 @@ export class WindowCore {
   #count = 0;
   /**
    * The anchor, window[0]: where the stroke being drawn starts, when (a time a pen resting or
-   * crawling moves on) and its Sample (canvas pixels, for `lineStart`).
+   * crawling moves on) and its Sample (canvas pixels, for `lineStart`): the drawn one, which
+   * `lineStart` gives at `#anchorMs` when the anchor was retimed since (`#anchorRetimed`), made
+   * only when asked rather than at every sample of a crawling pen.
    */
   #anchorX = 0;
   #anchorY = 0;
   #anchorMs = 0;
   #anchorSample: Sample | null = null;
+  #anchorRetimed = false;
   /** Each sample's squared distance to a chord, while a cut looks for its feature. */
   readonly #distances: number[] = [];
   #emittedInPath = false;
@@ -185,10 +198,13 @@ export class WindowCore {
    */
   #anchor: Point | null = null;
   /**
-   * The direction of the stroke the latency cap ended last, while the next one may go on along
-   * it (null at a path's start and after any other cut).
+   * The direction of the stroke the latency cap ended last (a unit vector), while the next one
+   * may go on along it (`#hasLine`; not at a path's start nor after any other cut). Two numbers,
+   * not a pair made at every cut.
    */
-  #line: Point | null = null;
+  #hasLine = false;
+  #lineX = 0;
+  #lineY = 0;
   /**
    * The reach of the stroke being drawn: no sample since its anchor lies farther than this from
    * the segment anchor -> last sample (grid units; true distances, rounding allowed for).
@@ -229,6 +245,10 @@ export class WindowCore {
   readonly #maxWindow: number;
   /** Whether the bend rule is on (`max_bend` > 0): `#keepsBound` then tests with a limit of its own. */
   readonly #bends: boolean;
+  /** `LINE_SHARE` x max_error, `STRAIGHT` x max_error, `CAP_FEATURE_SHARE` x max_stroke_ms. */
+  readonly #lineLimit: number;
+  readonly #straight: number;
+  readonly #capFeatureMs: number;
 
   /** `drawn`: the store to keep the samples in, shared with a merger (else one of its own). */
   constructor(params: WindowParams, drawn: Drawn = new Drawn()) {
@@ -241,12 +261,21 @@ export class WindowCore {
     this.#xExtent = params.columns - 1;
     this.#yExtent = params.rows - 1;
     this.#mapping = CanvasMapping.fromParams(params);
+    this.#stretch = params.stretch;
+    this.#scale = this.#mapping.scale;
+    this.#widthPx = params.canvas_width_px;
+    this.#heightPx = params.canvas_height_px;
+    this.#offsetX = (this.#xExtent - params.canvas_width_px * this.#scale) / 2;
+    this.#offsetY = (this.#yExtent - params.canvas_height_px * this.#scale) / 2;
     const rest = restRadius(params, this.#mapping);
     this.#restSq = rest * rest;
     this.#capMs = params.max_stroke_ms;
     this.#restMs = params.rest_ms;
     this.#maxWindow = params.max_window;
     this.#bends = params.max_bend > 0;
+    this.#lineLimit = LINE_SHARE * params.max_error;
+    this.#straight = STRAIGHT * params.max_error;
+    this.#capFeatureMs = CAP_FEATURE_SHARE * params.max_stroke_ms;
     this.#drawn = drawn;
   }
 
@@ -257,7 +286,14 @@ export class WindowCore {
 
   /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
   get lineStart(): Sample | null {
-    return this.#count > 0 ? this.#anchorSample : null;
+    if (this.#count === 0) return null;
+    if (this.#anchorRetimed) {
+      // Built field by field, not spread (the drawn sample may have more fields).
+      const anchor = this.#anchorSample!;
+      this.#anchorSample = { t_ms: this.#anchorMs, x: anchor.x, y: anchor.y, pressure: anchor.pressure };
+      this.#anchorRetimed = false;
+    }
+    return this.#anchorSample;
   }
 
   /** The last sample taken, as taken: its time (never before the one before) and grid point. */
@@ -288,13 +324,25 @@ export class WindowCore {
     const count = this.#count;
     if (count === 0) return this.#press(input);
     const drawn = this.#drawn;
+    const last = drawn.base + count - 1;
     // Times never run backwards (two event sources' clocks): an earlier sample takes the last time.
-    const lastMs = count > 1 ? drawn.ts[drawn.base + count - 1]! : this.#anchorMs;
-    const sample = input.t_ms < lastMs ? { ...input, t_ms: lastMs } : input;
-    const t = sample.t_ms;
-    const mapping = this.#mapping;
-    const x = mapping.gridX(sample.x);
-    const y = mapping.gridY(sample.y);
+    const lastMs = count > 1 ? drawn.ts[last]! : this.#anchorMs;
+    let sample = input;
+    let t = input.t_ms;
+    if (t < lastMs) {
+      sample = { ...input, t_ms: lastMs };
+      t = lastMs;
+    }
+    // `CanvasMapping.gridX` and `gridY`, written out.
+    const xPx = input.x;
+    const yPx = input.y;
+    const xExtent = this.#xExtent;
+    const yExtent = this.#yExtent;
+    const stretch = this.#stretch;
+    const gridX = stretch ? (xPx * xExtent) / this.#widthPx : this.#offsetX + xPx * this.#scale;
+    const gridY = stretch ? (yPx * yExtent) / this.#heightPx : this.#offsetY + yPx * this.#scale;
+    const x = Math.min(Math.max(gridX, 0), xExtent);
+    const y = Math.min(Math.max(gridY, 0), yExtent);
     this.takenMs = t;
     this.takenX = x;
     this.takenY = y;
@@ -306,7 +354,51 @@ export class WindowCore {
     drawn.ts[at] = t;
     drawn.samples[at] = sample;
     drawn.count = at + 1;
-    if (this.#follows(count, x, y, t)) return NO_SEGMENTS;
+    // `#follows`, written out (the same tests in the same order): most samples end here, and
+    // whether the optimiser inlines a call here depends on what it inlined before, which made
+    // the simplifier's speed differ by a third from one run to the next.
+    if (!this.#resting && count >= 2 && count < this.#maxWindow && !this.#bends) {
+      const sinceAnchorMs = t - this.#anchorMs;
+      const capMs = this.#capMs;
+      if (!(capMs > 0 && sinceAnchorMs > capMs)) {
+        const lastX = drawn.xs[last]!;
+        const lastY = drawn.ys[last]!;
+        const ax = this.#anchorX;
+        const ay = this.#anchorY;
+        const dx = x - ax;
+        const dy = y - ay;
+        let qx = lastX - ax;
+        let qy = lastY - ay;
+        const lengthSq = dx * dx + dy * dy;
+        if (lengthSq > 0) {
+          const along = (qx * dx + qy * dy) / lengthSq;
+          if (along >= 1) {
+            qx = qx - dx;
+            qy = qy - dy;
+          } else if (!(along <= 0)) {
+            qx = qx - along * dx;
+            qy = qy - along * dy;
+          }
+        }
+        const reach = this.#reach + Math.sqrt(qx * qx + qy * qy) + ROUNDING_SLACK;
+        if (reach <= this.#reachLimit) {
+          const restMs = this.#restMs;
+          const sx = lastX - x;
+          const sy = lastY - y;
+          if (!(
+            restMs > 0 &&
+            sinceAnchorMs >= restMs &&
+            sx * sx + sy * sy <= this.#restSq &&
+            this.#restsAt(last, x, y, t)
+          )) {
+            this.#count = count + 1;
+            this.#reach = reach;
+            this.#reaches[count] = reach;
+            return NO_SEGMENTS;
+          }
+        }
+      }
+    }
     return this.#add() ?? NO_SEGMENTS;
   }
 
@@ -330,11 +422,12 @@ export class WindowCore {
     this.#anchorY = y;
     this.#anchorMs = t;
     this.#anchorSample = sample;
+    this.#anchorRetimed = false;
     this.#count = 1;
     this.#reach = 0;
     this.#anchor = null;
     this.#emittedInPath = false;
-    this.#line = null;
+    this.#hasLine = false;
     this.#resting = false;
     return NO_SEGMENTS;
   }
@@ -344,7 +437,7 @@ export class WindowCore {
    * nothing, as `#add` would find: the pen neither rests nor crawls, the stroke stays under the
    * caps, and its reach says every sample keeps the bound without testing one (the bend rule
    * off). Else (false) nothing has changed, and `#add` takes it. The same tests as `#add`'s, in a
-   * short function for the optimiser to inline, since most samples end here.
+   * short function for the optimiser to inline in `#add` (`push` has them written out).
    */
   #follows(count: number, x: number, y: number, t: number): boolean {
     if (this.#resting || count < 2 || count >= this.#maxWindow || this.#bends) return false;
@@ -355,28 +448,56 @@ export class WindowCore {
     const last = drawn.base + count - 1;
     const lastX = drawn.xs[last]!;
     const lastY = drawn.ys[last]!;
-    const reach = this.#reach + stepReach(this.#anchorX, this.#anchorY, lastX, lastY, x, y) + ROUNDING_SLACK;
+    // `stepReach`, written out with the same operations (`distanceSq`, `chordDistanceSq`).
+    const ax = this.#anchorX;
+    const ay = this.#anchorY;
+    const dx = x - ax;
+    const dy = y - ay;
+    let qx = lastX - ax;
+    let qy = lastY - ay;
+    const lengthSq = dx * dx + dy * dy;
+    if (lengthSq > 0) {
+      const along = (qx * dx + qy * dy) / lengthSq;
+      if (along >= 1) {
+        qx = qx - dx;
+        qy = qy - dy;
+      } else if (!(along <= 0)) {
+        qx = qx - along * dx;
+        qy = qy - along * dy;
+      }
+    }
+    const reach = this.#reach + Math.sqrt(qx * qx + qy * qy) + ROUNDING_SLACK;
     // `#keepsBound`'s shortcut.
     if (!(reach <= this.#reachLimit)) return false;
-    // `#add`'s test for a pen that may rest, then whether it does (`#rests`): many samples of a
+    // `#add`'s test for a pen that may rest, then whether it does (`#restsAt`): many samples of a
     // slow pen stay near the one before, few near every one of the last rest_ms.
     const restMs = this.#restMs;
-    const restSq = this.#restSq;
-    if (restMs > 0 && sinceAnchorMs >= restMs && squared(lastX - x, lastY - y) <= restSq) {
-      const { xs, ys, ts } = drawn;
-      const base = drawn.base;
-      let start = last;
-      while (start > base + 1 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
-      const startMs =
-        start === base + 1 && squared(this.#anchorX - x, this.#anchorY - y) <= restSq
-          ? this.#anchorMs
-          : ts[start]!;
-      if (!(t - startMs < restMs)) return false;
+    if (restMs > 0 && sinceAnchorMs >= restMs && squared(lastX - x, lastY - y) <= this.#restSq) {
+      if (this.#restsAt(last, x, y, t)) return false;
     }
     this.#count = count + 1;
     this.#reach = reach;
     this.#reaches[count] = reach;
     return true;
+  }
+
+  /**
+   * Whether the pen rests at (x, y), drawn at `t` after the store's sample `last`, which lies
+   * within the rest radius of it (`#follows`, as `#rests` finds): every sample back to one drawn
+   * rest_ms or more before lies within the rest radius of it.
+   */
+  #restsAt(last: number, x: number, y: number, t: number): boolean {
+    const drawn = this.#drawn;
+    const { xs, ys, ts } = drawn;
+    const base = drawn.base;
+    const restSq = this.#restSq;
+    let start = last;
+    while (start > base + 1 && squared(xs[start - 1]! - x, ys[start - 1]! - y) <= restSq) start--;
+    const startMs =
+      start === base + 1 && squared(this.#anchorX - x, this.#anchorY - y) <= restSq
+        ? this.#anchorMs
+        : ts[start]!;
+    return !(t - startMs < this.#restMs);
   }
 
   /** Release: the rest of the path as one stroke (a tap gives one, dropped, of length 0). */
@@ -434,7 +555,7 @@ export class WindowCore {
           const cut = this.#capCut(count);
           const vertex = this.#continued(cut);
           out = more(out, this.#finish(this.#start(), this.#anchorMs, vertex, this.#msAt(cut)));
-          this.#line = this.#lineOf(cut, vertex);
+          this.#lineOf(cut, vertex);
           // The samples after the cut, this one included, are taken again into the next stroke.
           this.#restart(vertex, cut);
           continue;
@@ -455,7 +576,7 @@ export class WindowCore {
         }
         const end: Point = [xs[base + cut]!, ys[base + cut]!];
         out = more(out, this.#finish(this.#start(), this.#anchorMs, end, ts[base + cut]!));
-        this.#line = null;
+        this.#hasLine = false;
         this.#restart(end, cut);
       } else {
         this.#count = count + 1;
@@ -474,7 +595,7 @@ export class WindowCore {
         } else if (count >= maxWindow) {
           const end: Point = [x, y];
           out = more(out, this.#finish(this.#start(), this.#anchorMs, end, t));
-          this.#line = null;
+          this.#hasLine = false;
           this.#restart(end, count);
         }
       }
@@ -499,6 +620,7 @@ export class WindowCore {
     this.#anchorY = anchor[1];
     this.#anchorMs = drawn.ts[at]!;
     this.#anchorSample = drawn.samples[at]!;
+    this.#anchorRetimed = false;
     drawn.base = at;
     this.#count = 1;
     this.#anchor = anchor;
@@ -506,12 +628,10 @@ export class WindowCore {
     drawn.compact();
   }
 
-  /** The anchor at another time (while the pen rests or crawls), its Sample too. */
+  /** The anchor at another time (while the pen rests or crawls), its Sample too (`lineStart`). */
   #retime(t: number): void {
     this.#anchorMs = t;
-    // Built field by field, not spread: a crawling pen retimes at every sample.
-    const anchor = this.#anchorSample!;
-    this.#anchorSample = { t_ms: t, x: anchor.x, y: anchor.y, pressure: anchor.pressure };
+    this.#anchorRetimed = true;
   }
 
   /**
@@ -558,7 +678,7 @@ export class WindowCore {
       stroke = this.#finish(this.#start(), this.#anchorMs, end, this.#msAt(start));
       this.#restart(end, last);
     }
-    this.#line = null;
+    this.#hasLine = false;
     this.#resting = true;
     this.rested = true;
     return stroke;
@@ -625,13 +745,13 @@ export class WindowCore {
   #capCut(count: number): number {
     const { xs, ys, ts, base } = this.#drawn;
     const last = count - 1;
-    const earliest = this.#anchorMs + CAP_FEATURE_SHARE * this.params.max_stroke_ms;
+    const earliest = this.#anchorMs + this.#capFeatureMs;
     let first = 1;
     while (first < last && ts[base + first]! < earliest) first++;
     const lastX = xs[base + last]!;
     const lastY = ys[base + last]!;
     const cut = this.#feature(count, lastX, lastY, first);
-    const straight = STRAIGHT * this.params.max_error;
+    const straight = this.#straight;
     const ax = this.#anchorX;
     const ay = this.#anchorY;
     const cutX = xs[base + cut]!;
@@ -654,11 +774,9 @@ export class WindowCore {
   #continued(cut: number): Point {
     const atX = this.#xAt(cut);
     const atY = this.#yAt(cut);
-    const line = this.#line;
-    if (line === null) return [atX, atY];
-    // Indexed, not destructured: destructuring goes through the array's iterator.
-    const ux = line[0];
-    const uy = line[1];
+    if (!this.#hasLine) return [atX, atY];
+    const ux = this.#lineX;
+    const uy = this.#lineY;
     const ax = this.#anchorX;
     const ay = this.#anchorY;
     const along = (atX - ax) * ux + (atY - ay) * uy;
@@ -671,7 +789,7 @@ export class WindowCore {
     if (!(0 <= endX && endX <= this.#xExtent && 0 <= endY && endY <= this.#yExtent)) {
       return [atX, atY];
     }
-    const limit = LINE_SHARE * this.params.max_error;
+    const limit = this.#lineLimit;
     // A bend, not noise.
     if (distanceSq(atX, atY, endX, endY, endX, endY) > limit * limit) return [atX, atY];
     if (
@@ -687,14 +805,24 @@ export class WindowCore {
   }
 
   /**
-   * The direction of the stroke window[0] -> end if it is a line (every sample up to
-   * window[cut] within `LINE_SHARE` x max_error of it), else null.
+   * The line the next stroke may go on along (`#hasLine`, `#lineX`, `#lineY`): the direction of
+   * the stroke window[0] -> end if it is a line (every sample up to window[cut] within
+   * `LINE_SHARE` x max_error of it) of some length, else none.
    */
-  #lineOf(cut: number, end: Point): Point | null {
-    const limit = LINE_SHARE * this.params.max_error;
-    const certain = this.#reachesNear(cut, end[0], end[1], limit - ROUNDING_SLACK);
-    if (!certain && !this.#within(cut + 1, end[0], end[1], limit * limit)) return null;
-    return direction(this.#anchorX, this.#anchorY, end[0], end[1]);
+  #lineOf(cut: number, end: Point): void {
+    this.#hasLine = false;
+    const endX = end[0];
+    const endY = end[1];
+    const limit = this.#lineLimit;
+    const certain = this.#reachesNear(cut, endX, endY, limit - ROUNDING_SLACK);
+    if (!certain && !this.#within(cut + 1, endX, endY, limit * limit)) return;
+    const dx = endX - this.#anchorX;
+    const dy = endY - this.#anchorY;
+    const length = Math.sqrt(dx * dx + dy * dy);
+    if (!(length > 0)) return;
+    this.#lineX = dx / length;
+    this.#lineY = dy / length;
+    this.#hasLine = true;
   }
 
   /** Whether start -> end is long enough to send (the cap never cuts off a dropped stroke). */
@@ -916,6 +1044,11 @@ export class Merger {
   }
 
   #send(segment: Segment, nowMs: number, out: Segment[]): void {
+    out.push(this.#sent(segment, nowMs));
+  }
+
+  /** `#send` without the array: the stroke to send, as `#send` gives it. */
+  #sent(segment: Segment, nowMs: number): Segment {
     this.#sentInPath = true;
     this.#last = segment;
     // A piece made at this sample and not dropped (most: the window's and the merged ones) is sent
@@ -950,7 +1083,6 @@ export class Merger {
               dropped: null,
               merged: segment.merged,
             };
-    out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
     const drawn = this.#drawn;
     const { ts, count } = drawn;
@@ -959,6 +1091,7 @@ export class Merger {
     while (keep < count && ts[keep]! < endMs) keep++;
     drawn.first = keep;
     drawn.compact();
+    return sent;
   }
 
   /** A piece the window cut: the strokes sent now, into `out` (none while a short one waits). */
@@ -984,6 +1117,26 @@ export class Merger {
     }
     if (this.#short(piece)) this.#held = piece;
     else this.#send(piece, nowMs, out);
+  }
+
+  /**
+   * `take` for a piece the window cut alone, in `pieces` (an array of one, made for it): the
+   * strokes sent now, in that same array when it is one (most pieces: none held, none short),
+   * else in another (`NO_SEGMENTS` if none).
+   */
+  takeAlone(pieces: Segment[], nowMs: number): readonly Segment[] {
+    const piece = pieces[0]!;
+    if (this.#held === null) {
+      if (this.#short(piece)) {
+        this.#held = piece;
+        return NO_SEGMENTS;
+      }
+      pieces[0] = this.#sent(piece, nowMs);
+      return pieces;
+    }
+    pieces.pop();
+    this.take(piece, nowMs, pieces);
+    return pieces.length > 0 ? pieces : NO_SEGMENTS;
   }
 
   /**
@@ -1088,14 +1241,9 @@ export class WindowSimplifier {
     const takenMs = core.takenMs;
     // Most samples finish no piece: nothing to merge, no array made.
     if (pieces.length === 0 && !core.rested) return NO_SEGMENTS;
-    if (pieces.length === 1 && !core.rested) {
-      // Most of the rest finish one: the window's array (made for it, of one slot) holds what
-      // the merger sends instead, most often that piece itself: no other array made.
-      const out = pieces as Segment[];
-      const piece = out.pop()!;
-      merger.take(piece, takenMs, out);
-      return out.length > 0 ? out : NO_SEGMENTS;
-    }
+    // Most of the rest finish one: the window's array (made for it, of one slot) holds what
+    // the merger sends instead, most often that piece itself: no other array made.
+    if (pieces.length === 1 && !core.rested) return merger.takeAlone(pieces as Segment[], takenMs);
     const out: Segment[] = [];
     // Indexed, no iterator made: this runs at every stroke.
     for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
@@ -1163,14 +1311,6 @@ function squared(dx: number, dy: number): number {
  */
 function stepReach(ax: number, ay: number, lastX: number, lastY: number, x: number, y: number): number {
   return Math.sqrt(distanceSq(lastX, lastY, ax, ay, x, y));
-}
-
-/** The unit vector from (startX, startY) to (endX, endY) (null if they coincide). */
-function direction(startX: number, startY: number, endX: number, endY: number): Point | null {
-  const dx = endX - startX;
-  const dy = endY - startY;
-  const length = Math.sqrt(dx * dx + dy * dy);
-  return length > 0 ? [dx / length, dy / length] : null;
 }
 
 /** Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey) (its nearest point). */
