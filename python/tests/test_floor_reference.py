@@ -132,9 +132,25 @@ def test_evaluate_reports_the_best_at_the_floor_beside_the_drawings(
     document = evaluate_json(capsys, *argv, "--best-at-floor", "30")
     finer = {s["set"]: s for s in document["best_at_floor"]}
     assert finer["slow"]["strokes_mean"] > at_floor["slow"]["strokes_mean"]
+    # Bounded, offline and online: every stroke keeps its samples within the bound.
+    document = evaluate_json(
+        capsys, *argv, "--best-at-floor", "--lookahead-ms", "30", "--bound", "0.05"
+    )
+    assert {(s["lookahead_ms"], s["max_error"]) for s in document["best_at_floor"]} == {
+        (None, 0.05),
+        (30.0, 0.05),
+    }
+    assert all(s["max_deviation_max"] <= 0.05 + 1e-9 for s in document["best_at_floor"])
     assert main(["evaluate", *argv, "--best-at-floor", "--lookahead-ms", "30"]) == 0
     out = capsys.readouterr().out
     assert "Best at a floor of 73.701 ms" in out and "offline" in out and "online, 30 ms" in out
+
+
+def test_bound_needs_the_best_at_floor(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main(["evaluate", "--lasa", "--bound", "0.25"])
+    assert exit_info.value.code == 2
+    assert "give it with --best-at-floor" in capsys.readouterr().err
 
 
 def test_lookahead_needs_the_best_at_floor(capsys: pytest.CaptureFixture[str]) -> None:
@@ -191,3 +207,64 @@ def test_online_with_a_lookahead_past_the_path_is_the_offline_polyline(
     kept = best_at_floor(points, times, floor_ms)
     assert [a for a, _, _ in online] + [online[-1][1]] == list(kept)
     assert {let_go for _, _, let_go in online} == {times[-1]}
+
+
+def farthest(points: np.ndarray, a: int, b: int) -> float:
+    start, end = points[a], points[b]
+    d = end - start
+    length_sq = float(d @ d)
+    worst = 0.0
+    for k in range(a, b + 1):
+        q = points[k] - start
+        t = min(max(float(q @ d) / length_sq, 0.0), 1.0) if length_sq > 0 else 0.0
+        worst = max(worst, math.hypot(*(q - t * d)))
+    return worst
+
+
+@settings(max_examples=150, deadline=None)
+@given(paths, st.sampled_from([20.0, 73.701]), st.sampled_from([0.1, 0.5]))
+def test_bounded_pieces_keep_the_bound_with_the_fewest_brief_ones(
+    drawn: list[tuple[float, float, float]], floor_ms: float, max_error: float
+) -> None:
+    points = np.array([(x, y) for x, y, _ in drawn])
+    times = np.cumsum([step for _, _, step in drawn])
+    kept = list(best_at_floor(points, times, floor_ms, max_error))
+    assert kept[0] == 0 and kept[-1] == len(points) - 1
+    assert all(farthest(points, a, b) <= max_error + 2e-9 for a, b in itertools.pairwise(kept))
+
+    def rank(vertices: list[int]) -> tuple[int, float]:
+        pairs = list(itertools.pairwise(vertices))
+        brief = sum(times[b] - times[a] < floor_ms for a, b in pairs)
+        return brief, sum(line_error(points, a, b) for a, b in pairs)
+
+    n = len(points)
+    splits = [
+        [0, *inner, n - 1]
+        for count in range(n - 1)
+        for inner in itertools.combinations(range(1, n - 1), count)
+    ]
+    valid = [
+        v
+        for v in splits
+        if all(farthest(points, a, b) <= max_error + 1e-9 for a, b in itertools.pairwise(v))
+    ]
+    best_brief, best_error = min(rank(v) for v in valid)
+    brief, error = rank(kept)
+    assert brief == best_brief
+    assert error == pytest.approx(best_error, rel=1e-6, abs=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.lists(st.tuples(coordinate, coordinate, st.floats(0, 40)), min_size=2, max_size=30),
+    st.sampled_from([0.0, 30.0]),
+)
+def test_online_bounded_pieces_keep_the_bound(
+    drawn: list[tuple[float, float, float]], lookahead_ms: float
+) -> None:
+    points = np.array([(x, y) for x, y, _ in drawn])
+    times = np.cumsum([step for _, _, step in drawn])
+    pieces = online_at_floor(points, times, 73.701, lookahead_ms, 200.0, max_error=0.25)
+    assert pieces[0][0] == 0 and pieces[-1][1] == len(points) - 1
+    assert all(p[1] == q[0] for p, q in itertools.pairwise(pieces))
+    assert all(farthest(points, a, b) <= 0.25 + 2e-9 for a, b, _ in pieces)

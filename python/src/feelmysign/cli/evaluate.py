@@ -152,6 +152,13 @@ def register(subparsers: Subcommands) -> None:
         f"{DEFAULT_CAP_MS:g} ms, ends it): a reference for a simplifier that waits so long",
     )
     parser.add_argument(
+        "--bound",
+        type=number(0, 100, unit="grid units", above_low=True),
+        metavar="E",
+        help="with --best-at-floor: every stroke of those polylines keeps its samples within E, "
+        "a stroke briefer than the floor taken where none lasting it can (played at the floor)",
+    )
+    parser.add_argument(
         "--json", action="store_true", help="print the summary as JSON on standard output"
     )
     parser.set_defaults(handler=functools.partial(run, parser=parser))
@@ -181,6 +188,10 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         parser.error("give either RECORDING files or --lasa, not both")
     if args.templates and args.lasa:
         parser.error("--templates names recorded drawings; LASA is recognised among its own")
+    if args.bound is not None and args.best_at_floor is None:
+        parser.error(
+            "--bound bounds the polylines of --best-at-floor: give it with --best-at-floor"
+        )
     if args.lookahead_ms is not None and args.best_at_floor is None:
         parser.error(
             "--lookahead-ms finds the best polyline at the floor online: "
@@ -216,7 +227,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     if args.best_at_floor is not None:
         from feelmysign.research.floor_reference import summarize_at_floor
 
-        at_floor = summarize_at_floor(sources, recogniser, args.best_at_floor)
+        at_floor = summarize_at_floor(sources, recogniser, args.best_at_floor, max_error=args.bound)
         if args.lookahead_ms is not None:
             at_floor += summarize_at_floor(
                 sources,
@@ -224,6 +235,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
                 args.best_at_floor,
                 lookahead_ms=args.lookahead_ms,
                 cap_ms=DEFAULT_CAP_MS,
+                max_error=args.bound,
             )
         document["best_at_floor"] = at_floor
     (out / "summary.json").write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
@@ -409,9 +421,10 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
         "",
         f"Best at a floor of {floor_ms:g} ms (research.floor_reference): per drawing, the",
         "polyline through drawn samples, every stroke at least the floor, nearest the samples",
-        "(least squares); no error bound or rest rule. Offline: the whole path known, each",
-        "stroke let go as it ends. Online: found again at every sample, each stroke let go once",
-        f"the pen is the lookahead past its end (or the {DEFAULT_CAP_MS:g} ms cap ends it).",
+        "(least squares); no rest rule, and no error bound unless --bound. Offline: the whole",
+        "path known, each stroke let go as it ends. Online: found again at every sample, each",
+        f"stroke let go once the pen is the lookahead past its end (or the {DEFAULT_CAP_MS:g} ms",
+        "cap ends it). With --bound, a stroke briefer than the floor where needed, sent at it.",
         "recognised: $1 on the drawings / the polyline / its felt path; worst: the farthest",
         "drawn sample from its stroke",
         "",

@@ -86,18 +86,75 @@ def best_at_floor(
     points: Sequence[tuple[float, float]] | NDArray[np.float64],
     times_ms: ArrayLike,
     floor_ms: float,
+    max_error: float | None = None,
 ) -> NDArray[np.int64]:
     """The indices of the samples the best polyline at the floor passes through, first and
     last included: every piece lasts at least ``floor_ms`` (a path briefer than that is one
     piece), and the sum of the samples' squared distances to their pieces is the least such
     a polyline can have. Times earlier than the one before count as the one before; ties go
-    to the earlier vertex (the longer last piece)."""
+    to the earlier vertex (the longer last piece).
+
+    With ``max_error``, every piece keeps each of its samples within it (grid units), and a
+    piece briefer than the floor is taken where no piece lasting it keeps the bound: the
+    fewest such pieces first, then the least squares (as the window simplifier sends such a
+    piece, to be played at the floor)."""
     path = metrics.as_points(points)
     n = len(path)
     if n < 2:
         return np.arange(n, dtype=np.int64)
     times = np.maximum.accumulate(np.asarray(times_ms, dtype=np.float64))
-    return np.array(_best(_Sums(path), times, 0, n - 1, floor_ms), dtype=np.int64)
+    bound = None if max_error is None else _Bound(path, max_error)
+    return np.array(_best(_Sums(path), times, 0, n - 1, floor_ms, bound=bound), dtype=np.int64)
+
+
+# Far more than a distance's rounding error on a grid, far less than any bound (as the window
+# simplifier's ROUNDING_SLACK): a sample at the bound, to within rounding, keeps it.
+ROUNDING_SLACK = 1e-9
+# What a piece briefer than the floor costs in the bounded search: more than any sum of squared
+# distances on a grid (at most 63 units a side) over any path, so the fewest such pieces win.
+BRIEF_PIECE_COST = 1e12
+# The most samples a piece of the bounded search holds: the window simplifier's default work
+# cap (max_window), which keeps the search's cost (samples x this squared) within reach.
+MAX_PIECE_SAMPLES = 256
+
+
+class _Bound:
+    """Which pieces keep every sample within ``max_error`` of them (distances to the segment)."""
+
+    def __init__(self, path: NDArray[np.float64], max_error: float) -> None:
+        self.path = path
+        self.limit_sq = (max_error + ROUNDING_SLACK) ** 2  # a distance at the bound keeps it
+        # end -> (the first start asked, its answers): the online search asks the same pieces
+        # again at every sample, from the same or a later start.
+        self._answers: dict[int, tuple[int, NDArray[np.bool_]]] = {}
+
+    def keeps(self, starts: NDArray[np.int64], end: int) -> NDArray[np.bool_]:
+        """For each piece starts[i] -> end (consecutive starts): whether every sample between
+        lies within the bound."""
+        first = int(starts[0])
+        known = self._answers.get(end)
+        if known is not None and known[0] <= first:
+            return known[1][first - known[0] : first - known[0] + len(starts)]
+        answers = self._compute(starts, end)
+        self._answers[end] = (first, answers)
+        return answers
+
+    def _compute(self, starts: NDArray[np.int64], end: int) -> NDArray[np.bool_]:
+        first = int(starts[0])
+        a = self.path[starts]  # (m, 2)
+        d = self.path[end] - a
+        q = self.path[None, first : end + 1, :] - a[:, None, :]  # (m, samples, 2)
+        length_sq = np.einsum("ij,ij->i", d, d)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.clip(np.einsum("ikj,ij->ik", q, d) / length_sq[:, None], 0.0, 1.0)
+        t = np.where(length_sq[:, None] > 0.0, t, 0.0)
+        r = q - t[:, :, None] * d[:, None, :]
+        distance_sq = np.einsum("ikj,ikj->ik", r, r)
+        # Only the samples of each piece: those after its start (and up to the end).
+        inside = np.arange(first, end + 1)[None, :] > starts[:, None]
+        farthest = np.max(np.where(inside, distance_sq, 0.0), axis=1)
+        result: NDArray[np.bool_] = farthest <= self.limit_sq
+        return result
 
 
 def _best(
@@ -108,28 +165,42 @@ def _best(
     floor_ms: float,
     *,
     open_end: bool = False,
+    bound: _Bound | None = None,
 ) -> list[int]:
     """The least-squares vertices from sample ``first`` to ``last`` whose pieces all last at
     least ``floor_ms`` (one piece if none can); with ``open_end`` the last piece may be
-    briefer (the path goes on: that piece is not final)."""
+    briefer (the path goes on: that piece is not final). With ``bound``, every piece keeps
+    it, and briefer pieces are taken where needed, the fewest first, each piece at most
+    ``MAX_PIECE_SAMPLES`` samples long."""
     n = last - first + 1
     best = np.full(n, np.inf)
     best[0] = 0.0
     before = np.full(n, -1, dtype=np.int64)
     for k in range(1, n):
         j = first + k
-        # The vertices i a piece i -> j may start at: drawn at least the floor before j.
-        stop = (
-            k
-            if open_end and j == last
-            else int(np.searchsorted(times, times[j] - floor_ms, side="right")) - first
-        )
-        stop = min(stop, k)
-        if stop <= 0:
-            continue
-        totals = best[:stop] + sums.errors(np.arange(first, first + stop, dtype=np.int64), j)
+        if bound is None:
+            # The vertices i a piece i -> j may start at: drawn at least the floor before j.
+            stop = (
+                k
+                if open_end and j == last
+                else int(np.searchsorted(times, times[j] - floor_ms, side="right")) - first
+            )
+            stop = min(stop, k)
+            if stop <= 0:
+                continue
+            low = 0
+            starts = np.arange(first, first + stop, dtype=np.int64)
+            totals = best[:stop] + sums.errors(starts, j)
+        else:
+            # At most MAX_PIECE_SAMPLES samples a piece, as the window's work cap (max_window).
+            low = max(0, k - MAX_PIECE_SAMPLES)
+            starts = np.arange(first + low, j, dtype=np.int64)
+            totals = best[low:k] + sums.errors(starts, j)
+            if not (open_end and j == last):
+                totals += BRIEF_PIECE_COST * (times[j] - times[starts] < floor_ms)
+            totals = np.where(bound.keeps(starts, j), totals, np.inf)
         i = int(np.argmin(totals))
-        best[k], before[k] = totals[i], i
+        best[k], before[k] = totals[i], low + i
     if not np.isfinite(best[n - 1]):
         return [first, last]
     chosen = [n - 1]
@@ -138,12 +209,17 @@ def _best(
     return [first + k for k in reversed(chosen)]
 
 
+def _keeps(bound: _Bound | None, start: int, end: int) -> bool:
+    return bound is None or bool(bound.keeps(np.array([start], dtype=np.int64), end)[0])
+
+
 def online_at_floor(
     points: Sequence[tuple[float, float]] | NDArray[np.float64],
     times_ms: ArrayLike,
     floor_ms: float,
     lookahead_ms: float,
     cap_ms: float,
+    max_error: float | None = None,
 ) -> list[tuple[int, int, float]]:
     """The same polyline found online: the pieces (start index, end index, when let go, ms).
 
@@ -152,7 +228,8 @@ def online_at_floor(
     pen has drawn ``lookahead_ms`` past it, or once the piece lasts more than ``cap_ms`` (the
     latency cap). At release the rest is let go at once, every piece then at least the floor.
     So each stroke but the last few waits ``lookahead_ms`` for what comes after it: a
-    reference for a simplifier that holds its strokes that long, not one (no error bound).
+    reference for a simplifier that holds its strokes that long, not one. ``max_error``
+    bounds every piece as ``best_at_floor``'s does.
     """
     path = metrics.as_points(points)
     n = len(path)
@@ -160,13 +237,19 @@ def online_at_floor(
         return []
     times = np.maximum.accumulate(np.asarray(times_ms, dtype=np.float64))
     sums = _Sums(path)
+    bound = None if max_error is None else _Bound(path, max_error)
     pieces: list[tuple[int, int, float]] = []
     anchor = 0
     for j in range(1, n):
         while times[j] - times[anchor] >= floor_ms:
-            vertices = _best(sums, times, anchor, j, floor_ms, open_end=True)
+            vertices = _best(sums, times, anchor, j, floor_ms, open_end=True, bound=bound)
             if len(vertices) < 3:
-                if times[j] - times[anchor] > cap_ms and times[j - 1] - times[anchor] >= floor_ms:
+                capped = times[j] - times[anchor] > cap_ms
+                if (
+                    capped
+                    and times[j - 1] - times[anchor] >= floor_ms
+                    and _keeps(bound, anchor, j - 1)
+                ):
                     pieces.append((anchor, j - 1, float(times[j])))  # one long piece: capped
                     anchor = j - 1
                     continue
@@ -176,7 +259,7 @@ def online_at_floor(
                 break
             pieces.append((anchor, vertex, float(times[j])))
             anchor = vertex
-    rest = _best(sums, times, anchor, n - 1, floor_ms)
+    rest = _best(sums, times, anchor, n - 1, floor_ms, bound=bound)
     pieces += [(a, b, float(times[-1])) for a, b in itertools.pairwise(rest)]
     return pieces
 
@@ -199,6 +282,7 @@ def reference(
     *,
     lookahead_ms: float | None = None,
     cap_ms: float = math.inf,
+    max_error: float | None = None,
 ) -> Reference:
     """The best polyline at the floor of each path (grid points and their times), chained as
     the strokes sent are: offline (``best_at_floor``, each stroke let go as it ends), or with
@@ -212,15 +296,17 @@ def reference(
         path = np.asarray(points, dtype=np.float64)
         at = np.maximum.accumulate(np.asarray(times, dtype=np.float64))
         if lookahead_ms is None:
-            kept = best_at_floor(path, at, floor_ms)
+            kept = best_at_floor(path, at, floor_ms, max_error)
             let_go = [(int(a), int(b), float(at[b])) for a, b in itertools.pairwise(kept)]
         else:
-            let_go = online_at_floor(path, at, floor_ms, lookahead_ms, cap_ms)
+            let_go = online_at_floor(path, at, floor_ms, lookahead_ms, cap_ms, max_error)
         pieces.append(path[[let_go[0][0], *(b for _, b, _ in let_go)]] if let_go else path[:1])
         for a, b, emitted_ms in let_go:
             start = (float(path[a, 0]), float(path[a, 1]))
             end = (float(path[b, 0]), float(path[b, 1]))
-            segment = Segment(start, end, float(at[a]), float(at[b]), emitted_ms)
+            # A piece briefer than the floor is sent to last it, as the window sends one.
+            play_ms = floor_ms if at[b] - at[a] < floor_ms else None
+            segment = Segment(start, end, float(at[a]), float(at[b]), emitted_ms, play_ms=play_ms)
             segments.append(PathSegment(index, segment))
             distances = metrics.segment_distances(path[a : b + 1], start, end)
             deviations.append(float(np.max(distances)))
@@ -235,6 +321,7 @@ def summarize_at_floor(
     *,
     lookahead_ms: float | None = None,
     cap_ms: float = math.inf,
+    max_error: float | None = None,
 ) -> list[dict[str, Any]]:
     """Per set, in first-seen order, of the best polyline at the floor of each drawing
     (offline, or online with ``lookahead_ms``): its strokes (mean), how often $1 names the
@@ -254,7 +341,9 @@ def summarize_at_floor(
         params = params_for(window, source.recording, {})
         paths = [grid_points(params, path) for path in source.recording.paths]
         times = [[s.t_ms for s in path] for path in source.recording.paths]
-        found = reference(paths, times, floor_ms, lookahead_ms=lookahead_ms, cap_ms=cap_ms)
+        found = reference(
+            paths, times, floor_ms, lookahead_ms=lookahead_ms, cap_ms=cap_ms, max_error=max_error
+        )
         drawn = np.concatenate(paths) if paths else metrics.as_points([])
         # Felt as the sleeve plans and plays the strokes (research.felt): the phantom's path.
         playback = simulate(found.segments, source.recording.paths, layout_for(params))
@@ -283,6 +372,7 @@ def summarize_at_floor(
                 "set": name,
                 "floor_ms": floor_ms,
                 "lookahead_ms": lookahead_ms,
+                "max_error": max_error,
                 "recordings": len(members),
                 "strokes_mean": round(float(np.mean([m["strokes"] for m in members])), 2),
                 "recognised_drawn_pct": _percent([m["drawn"] for m in members]),
