@@ -1,8 +1,9 @@
 """``feelmysign send`` stops sending once the wearer pauses: a real sleeve (its chips and its
 pause button emulated), a real Mosquitto, ``send`` as its own process drawing a shape at its
-own pace; the wearer presses pause part-way. The sleeve refuses what arrives paused, and
-``send``, told so by the first refusal, sends none of the rest: it names them as not sent, its
-counts add up (one fate a stroke: a stroke cut part-way is not also played), and it exits 3.
+own pace; the wearer presses pause part-way. The sleeve cuts the stroke playing and refuses
+what arrives paused, and ``send``, told so by the first of these, sends none of the rest: it
+names them as not sent, its counts add up (one fate a stroke: a stroke cut part-way is not
+also played), and it exits 3.
 """
 
 from __future__ import annotations
@@ -66,8 +67,9 @@ def test_send_stops_at_the_wearers_pause_and_says_what_it_kept(
         count, first = int(held[1]), int(held[2])
         assert count >= 1 and first - 1 + count == SEGMENTS
         assert sorted(answered) == list(range(first - 1)), (answered, error)
-        # At least one stroke was refused as paused: the answer send stopped on.
-        assert fates.refusals().get("paused", 0) >= 1, fates.refusals()
+        # The answer send stopped on: a stroke refused as paused, or cut by the wearer's pause.
+        by_wearer = [b for b in watcher.received("events") if b.get("by") == "wearer"]
+        assert fates.refusals().get("paused", 0) >= 1 or by_wearer, fates.refusals()
         # Its counts are the fates': played + cut + refused + not sent = every stroke.
         counts = fates.counts()
         assert f"The sleeve played {counts['played']} of {SEGMENTS} strokes" in error, error
@@ -76,3 +78,44 @@ def test_send_stops_at_the_wearers_pause_and_says_what_it_kept(
             == SEGMENTS
         )
         assert f"Sent {first - 1} of a circle of {SEGMENTS} strokes" in out, out
+
+
+def test_send_stops_when_its_drawing_is_stopped(broker: Broker, tmp_path: Path) -> None:
+    """``feelmysign stop`` while ``send --wait`` draws: the sleeve cuts the stroke playing, and
+    ``send``, told so by the ``cancelled`` event, sends none of the rest (a stop of everything
+    does not refuse later strokes: without this they would play on); it says why, exit 1."""
+    state, layout, home = tmp_path / "bus.json", paper_with_buttons(tmp_path), tmp_path / "s"
+    credentials = ("--credentials", str(broker.credentials_path))
+    with (
+        SleeveWatch(broker.credentials, "status", "events") as watcher,
+        reaped(start(broker, state, layout, home)),
+    ):
+        watcher.next(online, "the sleeve online")
+        sender = subprocess.Popen(
+            [
+                *feelmysign_command(),
+                *("send", *credentials),
+                *("--shape", "circle", "--segments", str(SEGMENTS), "--duration-ms", "12000"),
+                "--wait",
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        with reaped(sender):
+            played = lambda _n, b: b.get("type") == "played" and b.get("seq") == 2  # noqa: E731
+            watcher.next(played, "the third stroke playing")
+            subprocess.run([*feelmysign_command(), "stop", *credentials], check=True, timeout=60)
+            out, err = sender.communicate(timeout=WAIT_S)
+        assert sender.returncode == 1, out + err
+        events = [b for b in watcher.received("events") if b.get("seq") is not None]
+    error = err.strip().splitlines()[-1]
+    held = re.search(r"(\d+) not sent \(from stroke (\d+) on\)", error)
+    assert held is not None, error
+    count, first = int(held[1]), int(held[2])
+    assert count >= 1 and first - 1 + count == SEGMENTS
+    # Nothing of the rest reached the sleeve: every event is about a stroke that was sent.
+    assert max(b["seq"] for b in events) < first - 1, (events, error)
+    assert any(b["type"] == "cancelled" for b in events), events
+    assert "The drawing was stopped" in error, error
+    assert "(the rest not sent: the drawing was stopped)" in out, out

@@ -32,7 +32,7 @@ from feelmysign.events import (
 )
 from feelmysign.fates import CatchUp
 from feelmysign.player import WEARER
-from feelmysign.protocol import LATE
+from feelmysign.protocol import CANCELLED, LATE
 from feelmysign.wearer_status import WEARER_REASONS
 
 if TYPE_CHECKING:
@@ -124,9 +124,20 @@ class DrawingOutcome:
 
     def held_by_wearer(self) -> bool:
         """Whether the sleeve refused a stroke as its wearer paused it (or asked not to be
-        disturbed): what is not sent yet would be refused as well."""
+        disturbed), or the wearer's pause or stop cut or dropped one: what is not sent yet
+        would be refused as well."""
         with self._condition:
-            return any(s.refused_reason in WEARER_REASONS for s in self.strokes)
+            return any(s.refused_reason in WEARER_REASONS or s.by_wearer for s in self.strokes)
+
+    def stopped(self) -> bool:
+        """Whether a sender's stop (``feelmysign stop``, the page's) cancelled a stroke of the
+        drawing: it is over for its sender, so the rest is not sent (a stop of every drawing
+        does not refuse later strokes). The wearer's: ``held_by_wearer``."""
+        with self._condition:
+            return any(
+                CANCELLED in (s.refused_reason, s.cut_reason) and not s.by_wearer
+                for s in self.strokes
+            )
 
     def hold(self, seqs: range) -> None:
         """These strokes were not sent (the wearer's hold): final, with no answer to wait for."""

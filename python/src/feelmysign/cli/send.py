@@ -233,7 +233,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         if outcome is not None and sent < len(messages):
             outcome.hold(range(sent, len(messages)))
         if not args.json:
-            print(_summary(args, settings, strokes, sent), flush=True)
+            stopped = outcome is not None and outcome.stopped() and not outcome.held_by_wearer()
+            print(_summary(args, settings, strokes, sent, stopped=stopped), flush=True)
         if outcome is None:
             return 0
         return _await_sleeve(outcome, settings, args, strokes)
@@ -251,7 +252,8 @@ def _send(
     lines: _InOrder,
 ) -> int:
     """Publishes the strokes; how many went out. Waiting for the sleeve's answers, it stops
-    once the sleeve refuses one as its wearer paused it: the rest would be refused too."""
+    once the sleeve refuses one as its wearer paused it (the rest would be refused too), or
+    once the drawing is cancelled (``feelmysign stop``, or the wearer's stop): it is over."""
     pace: Pace = args.pace or "realtime"
     say = printer(json_lines=args.json, total=len(messages))
 
@@ -261,7 +263,9 @@ def _send(
     sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
     if outcome is None:
         return sender.send(messages, pace=pace)
-    return sender.send(messages, pace=pace, until=outcome.held_by_wearer)
+    return sender.send(
+        messages, pace=pace, until=lambda: outcome.held_by_wearer() or outcome.stopped()
+    )
 
 
 def _wait_asked(args: argparse.Namespace, parser: argparse.ArgumentParser) -> bool:
@@ -494,7 +498,12 @@ def _await_sleeve(
             print(f"{line}.", flush=True)
         return 0
     wearer = _wearer_line(outcome)
-    print(f"Error: {line}.{wearer or ''}", file=sys.stderr, flush=True)
+    stopped = ""
+    if wearer is None and summary.held and outcome.stopped():
+        stopped = (
+            " The drawing was stopped (feelmysign stop, or a sender's stop): the rest was not sent."
+        )
+    print(f"Error: {line}.{wearer or stopped}", file=sys.stderr, flush=True)
     return 1 if wearer is None else WEARER_HOLD_EXIT
 
 
@@ -646,7 +655,12 @@ def _stroke_texts(arguments: list[str]) -> Iterator[tuple[str, str]]:
 
 
 def _summary(
-    args: argparse.Namespace, settings: BrokerSettings, strokes: list[Stroke], sent: int
+    args: argparse.Namespace,
+    settings: BrokerSettings,
+    strokes: list[Stroke],
+    sent: int,
+    *,
+    stopped: bool = False,
 ) -> str:
     what = (
         f"a {args.shape} of {plural(len(strokes), 'stroke')}"
@@ -654,7 +668,8 @@ def _summary(
         else plural(len(strokes), "stroke")
     )
     if sent < len(strokes):
-        what = f"{sent} of {what} (the rest not sent: the sleeve refused strokes for its wearer)"
+        why = "the drawing was stopped" if stopped else "the sleeve refused strokes for its wearer"
+        what = f"{sent} of {what} (the rest not sent: {why})"
     total_ms = sum(s.duration_ms for s in strokes[:sent])
     where = (
         f"the legacy topic {args.legacy_topic}"
