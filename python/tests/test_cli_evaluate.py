@@ -257,6 +257,10 @@ def test_a_gesture_alone_in_its_set_is_not_recognised(
         ("<Gesture Name='x'><Point X='1' Y='2' T='0'/></Gesture>", "at least 2 points"),
         ("<Gestures/>", "expected a $1 gesture log"),
         ("<Gesture", "not valid XML"),
+        (
+            "<Gesture Name='x'><Point X='1' Y='2' T='3'/><Point X='1' Y='2' T='5'/></Gesture>",
+            "bad01.xml: its points span 0 px; a gesture must span at least 10 px",
+        ),
     ],
 )
 def test_a_bad_gesture_log_says_what_is_wrong(

@@ -136,12 +136,12 @@ def register(subparsers: Subcommands) -> None:
         "--best-at-floor",
         nargs="?",
         const=DEFAULT_FLOOR_MS,
-        type=number(0, 10_000, unit="ms"),
+        type=_floor_ms,
         metavar="MS",
         help="also recognise, per drawing, the least-squares polyline through its samples whose "
         "every stroke lasts at least MS (default: the sleeve's floor, "
-        f"{DEFAULT_FLOOR_MS:g} ms): what the floor leaves of the shape, offline "
-        "(docs/research.md)",
+        f"{DEFAULT_FLOOR_MS:g} ms): a measure of what the floor leaves of the shape, not a "
+        "bound (docs/research.md)",
     )
     parser.add_argument(
         "--lookahead-ms",
@@ -249,6 +249,20 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         if at_floor is not None:
             print(_at_floor_table(at_floor))
     return 0
+
+
+def _floor_ms(text: str) -> float:
+    """--best-at-floor's MS; a word that is not a number is most likely a RECORDING given
+    after the option, which took it as its MS."""
+    try:
+        return number(0, 10_000, unit="ms")(text)
+    except argparse.ArgumentTypeError as error:
+        if any(c.isdigit() for c in text) and not any(c in text for c in "/\\."):
+            raise
+        raise argparse.ArgumentTypeError(
+            f"{error}; if {text!r} is a RECORDING, give the recordings before --best-at-floor "
+            "(its MS is optional)"
+        ) from None
 
 
 def _algorithms(text: str, parser: argparse.ArgumentParser) -> list[Algorithm]:
@@ -388,7 +402,10 @@ def _table(
 ) -> str:
     lines = [
         f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units;",
-        "skin: time on the skin / drawing time; felt end: release to the end of the last stroke;",
+        "strokes: sent per recording; DP: offline Douglas-Peucker's at the same deviation; max",
+        "dev: the farthest drawn sample from its stroke (worst: of all); Fréchet: discrete, to",
+        "the strokes; skin: time on the skin / drawing time (mean, then p95); felt end: release",
+        "to the end of the last stroke;",
         "pen: pen to skin; faster: the time the sleeve caught up by playing queued strokes faster,",
         "as a share of their planned time; skipped: strokes skipped as late; slowed: strokes",
         "the sleeve played longer than sent (briefer than its floor); dropped: pieces dropped;",
@@ -425,10 +442,14 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
         "path known, each stroke let go as it ends. Online: found again at every sample, each",
         f"stroke let go once the pen is the lookahead past its end (or the {DEFAULT_CAP_MS:g} ms",
         "cap ends it). With --bound, a stroke briefer than the floor where needed, sent at it.",
-        "recognised: $1 on the drawings / the polyline / its felt path; worst: the farthest",
-        "drawn sample from its stroke",
+        "A measure of what the floor leaves of the shape, not a bound on recognition.",
+        "strokes: mean per drawing; brief: strokes briefer than the floor, of all; skin, felt",
+        "end: as the paper's sleeve plays them (its floor "
+        f"{DEFAULT_FLOOR_MS:g} ms: a briefer stroke is played at it);",
+        "worst: the farthest drawn sample from its stroke (grid units); recognised: $1 on the",
+        "drawings / the polyline / its felt path",
         "",
-        f"{'set':<6} {'found':<18} {'strokes':>7} {'skin':>5} {'p95':>5} "
+        f"{'set':<6} {'found':<18} {'strokes':>7} {'brief':>9} {'skin':>5} {'p95':>5} "
         f"{'felt end p95':>12} {'worst':>6} {'recognised':>18}",
     ]
     for s in at_floor:
@@ -436,8 +457,9 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
             s[k] for k in ("recognised_drawn_pct", "recognised_pct", "recognised_felt_pct")
         )
         found = "offline" if s["lookahead_ms"] is None else f"online, {s['lookahead_ms']:g} ms"
+        brief = f"{s['brief_strokes_total']}/{s['strokes_total']}"
         lines.append(
-            f"{s['set']:<6} {found:<18} {s['strokes_mean']:>7.2f} "
+            f"{s['set']:<6} {found:<18} {s['strokes_mean']:>7.2f} {brief:>9} "
             f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
             f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
             f"{s['max_deviation_max']:>6.3f} "

@@ -324,7 +324,8 @@ def summarize_at_floor(
     max_error: float | None = None,
 ) -> list[dict[str, Any]]:
     """Per set, in first-seen order, of the best polyline at the floor of each drawing
-    (offline, or online with ``lookahead_ms``): its strokes (mean), how often $1 names the
+    (offline, or online with ``lookahead_ms``): its strokes (mean; and in all, and how many
+    of them are briefer than the floor, played at it), how often $1 names the
     drawing, the polyline and its felt path (planned and played as the sleeve would; percent,
     None without a shape to recognise), the felt end (release to the end of the last stroke
     felt, p95) and time on the skin over drawing time (mean, p95), and the farthest drawn
@@ -355,6 +356,10 @@ def summarize_at_floor(
         sets.setdefault(source.set, []).append(
             {
                 "strokes": found.strokes,
+                "brief": sum(
+                    item.segment.end_ms - item.segment.start_ms < floor_ms
+                    for item in found.segments
+                ),
                 "drawn": drawn_named,
                 "named": named,
                 "felt": felt,
@@ -375,6 +380,8 @@ def summarize_at_floor(
                 "max_error": max_error,
                 "recordings": len(members),
                 "strokes_mean": round(float(np.mean([m["strokes"] for m in members])), 2),
+                "brief_strokes_total": sum(m["brief"] for m in members),
+                "strokes_total": sum(m["strokes"] for m in members),
                 "recognised_drawn_pct": _percent([m["drawn"] for m in members]),
                 "recognised_pct": _percent([m["named"] for m in members]),
                 "recognised_felt_pct": _percent([m["felt"] for m in members]),

@@ -46,6 +46,9 @@ FILES_SET = "files"
 TEMPLATES_FILE = "templates.json"
 MAX_TEMPLATES_BYTES = 10_000_000
 MAX_GESTURE_BYTES = 10_000_000
+# The least a gesture log's points may span: its canvas (its box plus a twentieth of the larger
+# side on every side, lasa.recording_in_box) is then at least a pixel on each side.
+MIN_GESTURE_EXTENT_PX = 10.0
 
 
 @dataclass(frozen=True)
@@ -124,6 +127,13 @@ def load_gesture_log(path: Path, folder: str | None = None) -> Gesture:
         ) from error
     if len(xyt) < 2 or not np.all(np.isfinite(xyt)):
         raise RecordingError(f"{path}: a gesture needs at least 2 points with finite X, Y and T")
+    extent = float(np.ptp(xyt[:, :2], axis=0).max())
+    if extent < MIN_GESTURE_EXTENT_PX:
+        raise RecordingError(
+            f"{path}: its points span {extent:g} px; a gesture must span at least "
+            f"{MIN_GESTURE_EXTENT_PX:g} px to be mapped onto the sleeve (its canvas is its box "
+            "plus a margin of a twentieth of its larger side)"
+        )
     times = np.maximum.accumulate(xyt[:, 2]) - xyt[0, 2]
     recording = recording_in_box(xyt[:, 0], xyt[:, 1], times, px_per_unit=1.0)
     name = root.attrib.get("Name") or path.stem
