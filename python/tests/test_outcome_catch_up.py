@@ -136,3 +136,18 @@ def test_a_strokes_line_says_its_wait_only_when_it_is_notable() -> None:
         "[2/3] played: 417.5 ms, latency 81 ms (of which 80 ms waiting for the strokes before it)"
     )
     assert lines[2].startswith("[3/3] played: 417.2 ms, latency 22 ms (of which 21 ms waiting")
+
+
+def test_a_strokes_line_says_when_it_was_delayed_on_the_way() -> None:
+    # Held by the broker 3.4 s (a sleeve restarting): said, as the page and up say it; a stroke
+    # that came in time is not.
+    from feelmysign.cli.send import _answer_line
+
+    sent_ms = TIMING["first_command_at_ms"] - 3400.0
+    outcome = outcome_of(2, played(0), played(1, sent_at_ms=sent_ms))
+    lines = [
+        _answer_line(i, 2, s, s.played, json_lines=False)  # type: ignore[arg-type]
+        for i, s in enumerate(outcome.strokes)
+    ]
+    assert "delayed" not in lines[0]
+    assert lines[1].endswith(", delayed on the way by 3.4 s"), lines[1]

@@ -52,7 +52,14 @@ from feelmysign.cli.options.parser import Subcommands, add_command
 from feelmysign.cli.options.values import number, stdin_lines, topic
 from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
-from feelmysign.events import Event, Status, StatusControls, StatusFloor
+from feelmysign.events import (
+    Event,
+    Status,
+    StatusControls,
+    StatusFloor,
+    delivery_delay_ms,
+    is_delayed,
+)
 from feelmysign.fates import caught_up_ms, waited_ms
 from feelmysign.input_files import loads_json
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
@@ -458,6 +465,9 @@ def _answer_line(
     shorter_ms = caught_up_ms(played)
     if shorter_ms:  # played faster to catch up with the strokes before it
         line += f", {shorter_ms:.0f} ms shorter to catch up"
+    if is_delayed(played):  # held on the way: the broker kept it, or the network was slow
+        delay_s = (delivery_delay_ms(played) or 0.0) / 1000
+        line += f", delayed on the way by {delay_s:.1f} s"
     return line
 
 
