@@ -4,6 +4,7 @@ least the floor, it is the least-squares one among all such polylines through dr
 
 from __future__ import annotations
 
+import csv
 import itertools
 import math
 from pathlib import Path
@@ -141,6 +142,14 @@ def test_evaluate_reports_the_best_at_the_floor_beside_the_drawings(
         (30.0, 0.05),
     }
     assert all(s["max_deviation_max"] <= 0.05 + 1e-9 for s in document["best_at_floor"])
+    # Each drawing's own figures, per reference: which ones it loses.
+    with (tmp_path / "o" / "best_at_floor.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 2 * document["recordings"]
+    assert {r["lookahead_ms"] for r in rows} == {"", "30.0"}
+    assert all(float(r["max_deviation"]) <= 0.05 + 1e-9 for r in rows)
+    assert all(int(r["brief_strokes"]) <= int(r["strokes"]) for r in rows)
+    assert {r["recognised_drawn"] for r in rows} == {"1"}
     assert main(["evaluate", *argv, "--best-at-floor", "--lookahead-ms", "30"]) == 0
     out = capsys.readouterr().out
     assert "Best at a floor of 73.701 ms" in out and "offline" in out and "online, 30 ms" in out

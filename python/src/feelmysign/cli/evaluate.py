@@ -37,7 +37,8 @@ apart.
 Written to --out (default: evaluations/<date>-<time>/ under the current folder):
 results.csv (one row per recording x algorithm x parameter set), frontier.csv
 (Douglas-Peucker over a range of errors), summary.json, and the plots
-error_vs_strokes.png, lag.png and per_shape.png. --json prints the summary.
+error_vs_strokes.png, lag.png and per_shape.png (with --best-at-floor, also
+best_at_floor.csv: the references per drawing). --json prints the summary.
 """
 
 from __future__ import annotations
@@ -227,7 +228,10 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     if args.best_at_floor is not None:
         from feelmysign.research.floor_reference import summarize_at_floor
 
-        at_floor = summarize_at_floor(sources, recogniser, args.best_at_floor, max_error=args.bound)
+        drawings: list[dict[str, Any]] = []
+        at_floor = summarize_at_floor(
+            sources, recogniser, args.best_at_floor, max_error=args.bound, drawings=drawings
+        )
         if args.lookahead_ms is not None:
             at_floor += summarize_at_floor(
                 sources,
@@ -236,8 +240,10 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
                 lookahead_ms=args.lookahead_ms,
                 cap_ms=DEFAULT_CAP_MS,
                 max_error=args.bound,
+                drawings=drawings,
             )
         document["best_at_floor"] = at_floor
+        _write_drawings_csv(drawings, out / "best_at_floor.csv")
     (out / "summary.json").write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
     plots.error_vs_strokes(summary, dp, out / "error_vs_strokes.png")
     plots.lag_distribution(rows, out / "lag.png")
@@ -432,6 +438,19 @@ def _table(
     return "\n".join(lines)
 
 
+def _write_drawings_csv(drawings: list[dict[str, Any]], path: Path) -> None:
+    """--best-at-floor's figures per drawing and reference: which drawings it loses."""
+    import csv
+
+    from feelmysign.research.floor_reference import DRAWING_COLUMNS
+
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=DRAWING_COLUMNS)
+        writer.writeheader()
+        for row in drawings:
+            writer.writerow({k: "" if row[k] is None else row[k] for k in DRAWING_COLUMNS})
+
+
 def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
     floor_ms = at_floor[0]["floor_ms"] if at_floor else DEFAULT_FLOOR_MS
     lines = [
@@ -465,6 +484,7 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
             f"{s['max_deviation_max']:>6.3f} "
             + ("-" if drawn is None else f"{drawn:.1f}/{best:.1f}/{felt:.1f}").rjust(18)
         )
+    lines += ["", "Each drawing's figures: best_at_floor.csv, beside results.csv."]
     return "\n".join(lines)
 
 

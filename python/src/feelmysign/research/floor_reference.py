@@ -110,9 +110,6 @@ def best_at_floor(
 # Far more than a distance's rounding error on a grid, far less than any bound (as the window
 # simplifier's ROUNDING_SLACK): a sample at the bound, to within rounding, keeps it.
 ROUNDING_SLACK = 1e-9
-# What a piece briefer than the floor costs in the bounded search: more than any sum of squared
-# distances on a grid (at most 63 units a side) over any path, so the fewest such pieces win.
-BRIEF_PIECE_COST = 1e12
 # The most samples a piece of the bounded search holds: the window simplifier's default work
 # cap (max_window), which keeps the search's cost (samples x this squared) within reach.
 MAX_PIECE_SAMPLES = 256
@@ -175,6 +172,9 @@ def _best(
     n = last - first + 1
     best = np.full(n, np.inf)
     best[0] = 0.0
+    # With a bound: how many pieces briefer than the floor, compared before the error (a
+    # count kept apart: a large cost added to the error would swamp its last digits).
+    brief = np.zeros(n, dtype=np.float64)
     before = np.full(n, -1, dtype=np.int64)
     for k in range(1, n):
         j = first + k
@@ -188,19 +188,25 @@ def _best(
             stop = min(stop, k)
             if stop <= 0:
                 continue
-            low = 0
             starts = np.arange(first, first + stop, dtype=np.int64)
             totals = best[:stop] + sums.errors(starts, j)
-        else:
-            # At most MAX_PIECE_SAMPLES samples a piece, as the window's work cap (max_window).
-            low = max(0, k - MAX_PIECE_SAMPLES)
-            starts = np.arange(first + low, j, dtype=np.int64)
-            totals = best[low:k] + sums.errors(starts, j)
-            if not (open_end and j == last):
-                totals += BRIEF_PIECE_COST * (times[j] - times[starts] < floor_ms)
-            totals = np.where(bound.keeps(starts, j), totals, np.inf)
+            i = int(np.argmin(totals))
+            best[k], before[k] = totals[i], i
+            continue
+        # At most MAX_PIECE_SAMPLES samples a piece, as the window's work cap (max_window).
+        low = max(0, k - MAX_PIECE_SAMPLES)
+        starts = np.arange(first + low, j, dtype=np.int64)
+        totals = best[low:k] + sums.errors(starts, j)
+        counts = brief[low:k].copy()
+        if not (open_end and j == last):
+            counts += times[j] - times[starts] < floor_ms
+        counts = np.where(bound.keeps(starts, j), counts, np.inf)
+        fewest = counts.min()
+        if not np.isfinite(fewest):
+            continue
+        totals = np.where(counts == fewest, totals, np.inf)
         i = int(np.argmin(totals))
-        best[k], before[k] = totals[i], low + i
+        best[k], brief[k], before[k] = totals[i], fewest, low + i
     if not np.isfinite(best[n - 1]):
         return [first, last]
     chosen = [n - 1]
@@ -322,6 +328,7 @@ def summarize_at_floor(
     lookahead_ms: float | None = None,
     cap_ms: float = math.inf,
     max_error: float | None = None,
+    drawings: list[dict[str, Any]] | None = None,
 ) -> list[dict[str, Any]]:
     """Per set, in first-seen order, of the best polyline at the floor of each drawing
     (offline, or online with ``lookahead_ms``): its strokes (mean; and in all, and how many
@@ -330,7 +337,8 @@ def summarize_at_floor(
     None without a shape to recognise), the felt end (release to the end of the last stroke
     felt, p95) and time on the skin over drawing time (mean, p95), and the farthest drawn
     sample from its stroke (grid units). Drawings are mapped to the grid as the window
-    simplifier maps them."""
+    simplifier maps them. ``drawings``, when given, gets each drawing's own figures
+    (``DRAWING_COLUMNS``)."""
     from feelmysign.research.evaluate import grid_points, layout_for
     from feelmysign.research.felt import felt_path
     from feelmysign.research.playback import simulate
@@ -353,25 +361,46 @@ def summarize_at_floor(
             felt = recogniser.names(source, felt_path(playback.schedules))
             named = recogniser.names(source, found.polyline)
             drawn_named = recogniser.drawn(source, drawn)
-        sets.setdefault(source.set, []).append(
-            {
-                "strokes": found.strokes,
-                "brief": sum(
-                    item.segment.end_ms - item.segment.start_ms < floor_ms
-                    for item in found.segments
-                ),
-                "drawn": drawn_named,
-                "named": named,
-                "felt": felt,
-                "felt_end_ms": playback.release_to_felt_end_ms,
-                "skin": playback.skin_ratio if playback.drawing_ms > 0 else None,
-                "deviation": max(found.deviations, default=0.0),
-            }
+        skin = playback.skin_ratio if playback.drawing_ms > 0 else None
+        deviation = max(found.deviations, default=0.0)
+        brief = sum(
+            item.segment.end_ms - item.segment.start_ms < floor_ms for item in found.segments
         )
+        figures: dict[str, Any] = {
+            "strokes": found.strokes,
+            "brief": brief,
+            "drawn": drawn_named,
+            "named": named,
+            "felt": felt,
+            "felt_end_ms": playback.release_to_felt_end_ms,
+            "skin": skin,
+            "deviation": deviation,
+        }
+        sets.setdefault(source.set, []).append(figures)
+        if drawings is not None:
+            drawings.append(
+                {
+                    "recording": source.name,
+                    "group": source.group,
+                    "set": source.set,
+                    "lookahead_ms": lookahead_ms,
+                    "max_error": max_error,
+                    "strokes": figures["strokes"],
+                    "brief_strokes": brief,
+                    "recognised_drawn": _flag(drawn_named),
+                    "recognised": _flag(named),
+                    "recognised_felt": _flag(felt),
+                    "release_to_felt_end_ms": round(max(playback.release_to_felt_end_ms), 1)
+                    if playback.release_to_felt_end_ms
+                    else "",
+                    "skin_ratio": "" if skin is None else round(skin, 3),
+                    "max_deviation": round(deviation, 6),
+                }
+            )
     summary = []
     for name, members in sets.items():
         felt_end = [v for m in members for v in m["felt_end_ms"]]
-        skin = [m["skin"] for m in members if m["skin"] is not None]
+        skins = [m["skin"] for m in members if m["skin"] is not None]
         summary.append(
             {
                 "set": name,
@@ -386,12 +415,34 @@ def summarize_at_floor(
                 "recognised_pct": _percent([m["named"] for m in members]),
                 "recognised_felt_pct": _percent([m["felt"] for m in members]),
                 "release_to_felt_end_p95_ms": _rounded(felt_end, 95),
-                "skin_ratio_mean": round(float(np.mean(skin)), 3) if skin else None,
-                "skin_ratio_p95": _rounded(skin, 95, 3),
+                "skin_ratio_mean": round(float(np.mean(skins)), 3) if skins else None,
+                "skin_ratio_p95": _rounded(skins, 95, 3),
                 "max_deviation_max": round(max(m["deviation"] for m in members), 6),
             }
         )
     return summary
+
+
+# The columns of best_at_floor.csv, one row per drawing and reference (``drawings``).
+DRAWING_COLUMNS = (
+    "recording",
+    "group",
+    "set",
+    "lookahead_ms",
+    "max_error",
+    "strokes",
+    "brief_strokes",
+    "recognised_drawn",
+    "recognised",
+    "recognised_felt",
+    "release_to_felt_end_ms",
+    "skin_ratio",
+    "max_deviation",
+)
+
+
+def _flag(value: bool | None) -> int | str:
+    return "" if value is None else int(value)
 
 
 def _rounded(values: Sequence[float], q: float, digits: int = 1) -> float | None:
