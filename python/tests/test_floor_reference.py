@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from test_cli_evaluate import evaluate_json, gesture_folder
 
 from feelmysign.cli import main
+from feelmysign.research import metrics
 from feelmysign.research.floor_reference import (
     best_at_floor,
     online_at_floor,
@@ -219,15 +220,8 @@ def test_online_with_a_lookahead_past_the_path_is_the_offline_polyline(
 
 
 def farthest(points: np.ndarray, a: int, b: int) -> float:
-    start, end = points[a], points[b]
-    d = end - start
-    length_sq = float(d @ d)
-    worst = 0.0
-    for k in range(a, b + 1):
-        q = points[k] - start
-        t = min(max(float(q @ d) / length_sq, 0.0), 1.0) if length_sq > 0 else 0.0
-        worst = max(worst, math.hypot(*(q - t * d)))
-    return worst
+    """The farthest of points[a..b] from the segment points[a] -> points[b]."""
+    return float(np.max(metrics.segment_distances(points[a : b + 1], points[a], points[b])))
 
 
 @settings(max_examples=150, deadline=None)
