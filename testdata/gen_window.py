@@ -22,26 +22,56 @@ from typing import Any
 
 from feelmysign.simplify import Sample, WindowParams
 from feelmysign.simplify.window import WINDOW_PARAMS, WindowSimplifier
-from gen_angle import H, Path, W, _line, simplifier_case, simplifier_cases
+from gen_angle import SHAPES, H, Path, W, _line, simplifier_case, simplifier_cases
 
 VARIATIONS: dict[str, dict[str, Any]] = {
     "defaults": {},
-    "max-error-0.02": {"max_error": 0.02},
-    "max-error-0.05": {"max_error": 0.05},
-    "max-error-0.2": {"max_error": 0.2},
-    "max-window-1": {"max_window": 1},
-    "max-window-8": {"max_window": 8},
-    "max-window-1000": {"max_window": 1000},
-    "max-stroke-ms-100": {"max_stroke_ms": 100.0},
-    "max-stroke-ms-300": {"max_stroke_ms": 300.0},
-    "min-duration-200": {"min_duration_ms": 200.0},
-    "min-length-0.5": {"min_length": 0.5},
-    "stretch": {"stretch": True, "canvas_width_px": 1600.0},
-    "sleeve-4x6": {"rows": 4, "columns": 6},
-    "rest-off": {"rest_ms": 0.0},
-    "rest-300": {"rest_ms": 300.0},
-    "strict-minimums": {"strict_minimums": True, "min_length": 0.5, "min_duration_ms": 120.0},
+    "chord": {"least_squares": False},
+    "max-error-0.02": {"least_squares": False, "max_error": 0.02},
+    "max-error-0.05": {"least_squares": False, "max_error": 0.05},
+    "max-error-0.2": {"least_squares": False, "max_error": 0.2},
+    "max-window-1": {"least_squares": False, "max_window": 1},
+    "max-window-8": {"least_squares": False, "max_window": 8},
+    "max-window-1000": {"least_squares": False, "max_window": 1000},
+    "max-stroke-ms-100": {"least_squares": False, "max_stroke_ms": 100.0},
+    "max-stroke-ms-300": {"least_squares": False, "max_stroke_ms": 300.0},
+    "min-duration-200": {"least_squares": False, "min_duration_ms": 200.0},
+    "min-length-0.5": {"least_squares": False, "min_length": 0.5},
+    "stretch": {"least_squares": False, "stretch": True, "canvas_width_px": 1600.0},
+    "sleeve-4x6": {"least_squares": False, "rows": 4, "columns": 6},
+    "rest-off": {"least_squares": False, "rest_ms": 0.0},
+    "rest-300": {"least_squares": False, "rest_ms": 300.0},
+    "strict-minimums": {
+        "least_squares": False,
+        "strict_minimums": True,
+        "min_length": 0.5,
+        "min_duration_ms": 120.0,
+    },
 }
+# The least-squares core (``least_squares``; ``simplify/fit.py``) over the same shapes.
+FIT = {"least_squares": True}
+FIT_VARIATIONS: dict[str, dict[str, Any]] = {
+    "least-squares": FIT,
+    "least-squares-max-error-0.05": {**FIT, "max_error": 0.05},
+    "least-squares-max-error-0.15": {**FIT, "max_error": 0.15},
+    "least-squares-lookahead-0": {**FIT, "lookahead_ms": 0.0},
+    "least-squares-lookahead-100": {**FIT, "lookahead_ms": 100.0},
+    "least-squares-max-stroke-ms-100": {**FIT, "max_stroke_ms": 100.0},
+    "least-squares-no-cap": {**FIT, "max_stroke_ms": 0.0},
+    "least-squares-max-window-8": {**FIT, "max_window": 8},
+    "least-squares-floor-40": {**FIT, "floor_ms": 40.0},
+    "least-squares-min-duration-200": {**FIT, "min_duration_ms": 200.0},
+    "least-squares-rest-off": {**FIT, "rest_ms": 0.0},
+    "least-squares-rest-300": {**FIT, "rest_ms": 300.0},
+    "least-squares-strict-minimums": {
+        **FIT,
+        "strict_minimums": True,
+        "min_length": 0.5,
+        "min_duration_ms": 120.0,
+    },
+    "least-squares-stretch": {**FIT, "stretch": True, "canvas_width_px": 1600.0},
+}
+VARIATIONS.update(FIT_VARIATIONS)
 
 
 def _edge_u(seed: int = 3) -> Path:
@@ -109,6 +139,11 @@ def _tail() -> list[Path]:
 EDGE_SHAPES = {"edge-u": lambda: [_edge_u()], "crawl": lambda: [_crawl()], "tail": _tail}
 EDGE_VARIATIONS = (
     "defaults",
+    "chord",
+    "least-squares",
+    "least-squares-max-stroke-ms-100",
+    "least-squares-rest-300",
+    "least-squares-strict-minimums",
     "max-stroke-ms-100",
     "max-error-0.05",
     "rest-off",
@@ -143,6 +178,10 @@ def cases() -> dict[str, dict[str, Any]]:
         VARIATIONS,
         "the window simplifier's parameters: defaults and allowed ranges",
     )
+    for shape in SHAPES:
+        result[f"{shape}/least-squares.json"] = simplifier_case(
+            WindowParams, FIT, f"{shape} path, least-squares", SHAPES[shape]()
+        )
     for shape in EDGE_SHAPES:
         for variation in EDGE_VARIATIONS:
             result[f"{shape}/{variation}.json"] = _edge_case(shape, variation)

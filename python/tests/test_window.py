@@ -389,6 +389,8 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
         floor_ms=draw(st.sampled_from([0.0, 73.7, 200.0])),
         rest_ms=draw(st.sampled_from([0.0, 30.0, 100.0])),
         stretch=draw(st.booleans()),
+        least_squares=draw(st.booleans()),
+        lookahead_ms=draw(st.sampled_from([0.0, 30.0, 100.0])),
         canvas_width_px=800,
         canvas_height_px=600,
     )

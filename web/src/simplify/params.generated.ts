@@ -39,6 +39,8 @@ export interface WindowParams extends SharedParams {
   readonly rest_ms: number;
   readonly strict_minimums: boolean;
   readonly floor_ms: number;
+  readonly least_squares: boolean;
+  readonly lookahead_ms: number;
 }
 
 /** Every parameter a person sets in the settings panel, of every simplifier. */
@@ -51,6 +53,8 @@ export interface PanelParams {
   readonly rest_ms: number;
   readonly strict_minimums: boolean;
   readonly floor_ms: number;
+  readonly least_squares: boolean;
+  readonly lookahead_ms: number;
   readonly check_frames: number;
   readonly max_angle_deg: number;
   readonly frame_max: number;
@@ -96,6 +100,8 @@ export const WINDOW_PARAM_NAMES = [
   "rest_ms",
   "strict_minimums",
   "floor_ms",
+  "least_squares",
+  "lookahead_ms",
   ...SHARED_PARAM_NAMES,
 ] as const;
 
@@ -217,6 +223,36 @@ export const PARAMETERS: readonly ParamSpec[] = [
     unit: "ms",
     label: "Sleeve floor",
     help: "shortest stroke the sleeve plays without slowing it, in ms (its status says); a briefer piece merges into a neighbour where the error bound allows",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "least_squares",
+    algorithms: ["window"],
+    paper: null,
+    type: "boolean",
+    default: false,
+    minimum: null,
+    maximum: null,
+    unit: null,
+    label: "Least squares",
+    help: "place strokes where the drawn samples lie nearest them (least squares over several strokes, each lasting the sleeve's floor) instead of at the sample farthest from the chord where the bound breaks",
+    panel: "simplifier",
+    detail_levels: null,
+    short: null,
+  },
+  {
+    name: "lookahead_ms",
+    algorithms: ["window"],
+    paper: null,
+    type: "number",
+    default: 30,
+    minimum: 0,
+    maximum: 1000,
+    unit: "ms",
+    label: "Lookahead",
+    help: "with least_squares: how long the pen draws past a stroke's end before the stroke is sent, in ms",
     panel: "simplifier",
     detail_levels: null,
     short: null,

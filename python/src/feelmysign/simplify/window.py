@@ -99,6 +99,7 @@ import bisect
 import math
 from dataclasses import dataclass, field, replace
 
+from feelmysign.simplify.fit import FitCore
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import ParamSpec, SharedParams, param, specs_of
 from feelmysign.simplify.segment import (
@@ -223,6 +224,22 @@ class _WindowOwn:
         help="shortest stroke the sleeve plays without slowing it, in ms (its status says); "
         "a briefer piece merges into a neighbour where the error bound allows",
         label="Sleeve floor",
+        unit="ms",
+    )
+    least_squares: bool = param(
+        False,
+        help="place strokes where the drawn samples lie nearest them (least squares over "
+        "several strokes, each lasting the sleeve's floor) instead of at the sample farthest "
+        "from the chord where the bound breaks",
+        label="Least squares",
+    )
+    lookahead_ms: float = param(
+        30.0,
+        0,
+        1000,
+        help="with least_squares: how long the pen draws past a stroke's end before the "
+        "stroke is sent, in ms",
+        label="Lookahead",
         unit="ms",
     )
 
@@ -697,6 +714,12 @@ class Merger:
     min_duration_ms: float
     floor_ms: float
     strict: bool = False
+    # Whether a piece too short or too brief waits to merge (the window's pieces). The least
+    # squares' pieces do not, unless strict: they are briefer than the floor only where no piece
+    # lasting it keeps the bound, and one that lasts the floor yet is shorter than min_length was
+    # drawn by a nearly still pen; each is sent as it is, a brief one to last the floor (holding
+    # them made the felt end later and lost shapes drawn fast: docs/research.md).
+    hold_short: bool = True
     # The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first.
     _points: list[Point] = field(default_factory=list)
     _times: list[float] = field(default_factory=list)
@@ -716,8 +739,9 @@ class Merger:
         self._times.append(t_ms)
 
     def _short(self, segment: Segment) -> bool:
-        return segment.length < self.min_length or segment.drawn_ms < max(
-            self.min_duration_ms, self.floor_ms
+        return self.hold_short and (
+            segment.length < self.min_length
+            or segment.drawn_ms < max(self.min_duration_ms, self.floor_ms)
         )
 
     def _below_minimums(self, segment: Segment) -> bool:
@@ -860,18 +884,19 @@ class WindowSimplifier:
     """The window simplifier: the window's pieces, the too-short ones merged (``Merger``)."""
 
     params: WindowParams = field(default_factory=WindowParams)
-    _core: WindowCore = field(init=False)
+    _core: WindowCore | FitCore = field(init=False)
     _merger: Merger = field(init=False)
 
     def __post_init__(self) -> None:
         params = self.params
-        self._core = WindowCore(params)
+        self._core = FitCore(params) if params.least_squares else WindowCore(params)
         self._merger = Merger(
             params.max_error,
             params.min_length,
             params.min_duration_ms,
             params.floor_ms,
             params.strict_minimums,
+            hold_short=not params.least_squares or params.strict_minimums,
         )
 
     @property

@@ -68,8 +68,8 @@ public final class ParamTable {
               "window",
               names(
                   "max_error max_window max_stroke_ms max_bend bend_floor rest_ms strict_minimums "
-                      + "floor_ms clear_on_press min_duration_ms min_length rows columns "
-                      + "canvas_width_px canvas_height_px stretch")));
+                      + "floor_ms least_squares lookahead_ms clear_on_press min_duration_ms "
+                      + "min_length rows columns canvas_width_px canvas_height_px stretch")));
 
   /** Every parameter once. */
   public static final List<Row> PARAMETERS =
@@ -196,6 +196,39 @@ public final class ParamTable {
               "Sleeve floor",
               "shortest stroke the sleeve plays without slowing it, in ms (its status says); a "
                   + "briefer piece merges into a neighbour where the error bound allows",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "least_squares",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.BOOLEAN,
+              false,
+              null,
+              null,
+              null,
+              "Least squares",
+              "place strokes where the drawn samples lie nearest them (least squares over several "
+                  + "strokes, each lasting the sleeve's floor) instead of at the sample farthest "
+                  + "from the chord where the bound breaks",
+              "simplifier",
+              null,
+              null),
+          new Row(
+              "lookahead_ms",
+              List.of("window"),
+              null,
+              0,
+              ParamSpec.Kind.NUMBER,
+              30.0,
+              0.0,
+              1000.0,
+              "ms",
+              "Lookahead",
+              "with least_squares: how long the pen draws past a stroke's end before the stroke is "
+                  + "sent, in ms",
               "simplifier",
               null,
               null),

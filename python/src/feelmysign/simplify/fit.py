@@ -1,0 +1,401 @@
+"""Least-squares placement at the sleeve's floor: the window simplifier's core with
+``least_squares`` on.
+
+The window (``window.WindowCore``) grows a stroke until a sample breaks the error bound, then
+cuts at the sample farthest from the chord. This core places the strokes' ends where the drawn
+samples lie nearest them instead: at each sample it keeps, over the samples since the last
+stroke it let go (the anchor), the polyline through drawn samples with the least integral square
+error (the sum of each sample's squared distance to the line of its stroke) among those whose
+strokes all keep every sample within ``max_error`` (distance to the segment) and last at least
+the sleeve's floor (``floor_ms``, or ``min_duration_ms`` if longer); where no stroke lasting the
+floor keeps the bound, the fewest briefer ones (each sent to last the floor). It is the dynamic
+program of Perez and Vidal ("Optimum polygonal approximation of digitized curves", Pattern
+Recognition Letters 15, 1994) with the floor and the bound as constraints on each piece instead
+of a count of pieces, solved one sample at a time: each sample's best polyline from the anchor
+is found once, from those of the samples before it, and each piece's error comes from running
+sums in O(1). The last stroke of the polyline to the newest sample may be briefer than the floor
+(the path goes on).
+
+A stroke is let go, its first vertex after the anchor final, once the pen has drawn
+``lookahead_ms`` past that vertex, or once that stroke lasts more than ``max_stroke_ms`` (the
+latency cap). With no vertex yet and the stroke from the anchor longer than the cap, the stroke
+to the sample before is let go as one (a line the cap cuts). At release the polyline to the last
+sample is let go whole, every stroke at the floor. The samples after a stroke let go are taken
+again from its end. So each stroke but the last waits ``lookahead_ms`` for what is drawn after
+it, and no stroke lasts the floor only because the bound broke.
+
+Measured on people's gestures and LASA (docs/research.md, "What the floor leaves of
+recognition"), this keeps the drawings' shape better than the chord's farthest sample at the
+same error bound: its vertices sit where the drawing turns, found over several strokes at once.
+
+Kept from the window: the mapping, times that never run backwards, the rest rule (a pen resting
+``rest_ms`` lets the polyline to the rest's start go; the rest is not played) and the work cap
+(no piece holds more than ``max_window`` samples after its start). Not taken: the chord's reach,
+the bend rule, the crawling pen's later start and the line a cap cut goes on along (the least
+squares place a line's vertices on it). The float operations are written out, in this order, in
+the TypeScript and Java ports, which reproduce the shared vectors exactly.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from feelmysign.simplify.segment import Sample, Segment, finish_segment
+from feelmysign.stroke import Point
+
+if TYPE_CHECKING:
+    from feelmysign.simplify.window import WindowParams
+
+
+def segment_distance_sq(px: float, py: float, ax: float, ay: float, ex: float, ey: float) -> float:
+    """Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey): the projection clamped
+    onto it (``window.segment_distance_sq``'s operations)."""
+    dx = ex - ax
+    dy = ey - ay
+    qx = px - ax
+    qy = py - ay
+    length_sq = dx * dx + dy * dy
+    if length_sq > 0.0:
+        t = (qx * dx + qy * dy) / length_sq
+        if t >= 1.0:
+            qx = qx - dx
+            qy = qy - dy
+        elif not t <= 0.0:
+            qx = qx - t * dx
+            qy = qy - t * dy
+    return qx * qx + qy * qy
+
+
+@dataclass
+class FitCore:
+    """The least-squares core: the pieces to merge (``WindowSimplifier`` merges them), as
+    ``WindowCore`` gives its own."""
+
+    params: WindowParams
+    # The samples since the anchor, the anchor first: grid points, times, samples.
+    _xs: list[float] = field(default_factory=list)
+    _ys: list[float] = field(default_factory=list)
+    _ts: list[float] = field(default_factory=list)
+    _samples: list[Sample] = field(default_factory=list)
+    # Running sums of x, y, x^2, y^2 and xy over the samples, relative to the anchor's point.
+    _sums: list[list[float]] = field(default_factory=lambda: [[0.0] for _ in range(5)])
+    # Each sample's best polyline from the anchor (every piece at the floor, where the bound lets
+    # it be): its squared error, its count of pieces briefer than the floor and its last vertex.
+    _best: list[float] = field(default_factory=list)
+    _brief: list[int] = field(default_factory=list)
+    _before: list[int] = field(default_factory=list)
+    # A piece's error per start, for the sample being placed (reused).
+    _errors: list[float] = field(default_factory=list)
+    _errors_end: int = -1
+    _pointer: Sample | None = None
+    _emitted_in_path: bool = False
+    # While the pen rests (``rest_ms``): the point it rests at; each sample near it retimes the
+    # anchor, none is taken.
+    _resting: bool = False
+    _rest_x: float = 0.0
+    _rest_y: float = 0.0
+    rested: bool = False
+    _taken: tuple[float, Point] = (0.0, (0.0, 0.0))
+
+    def __post_init__(self) -> None:
+        from feelmysign.simplify.window import rest_radius
+
+        params = self.params
+        self._max_error_sq = params.max_error * params.max_error
+        self._floor_ms = max(params.floor_ms, params.min_duration_ms)
+        rest = rest_radius(params)
+        self._rest_sq = rest * rest
+        self._mapping = params.mapping
+
+    @property
+    def drawing(self) -> bool:
+        return bool(self._xs)
+
+    @property
+    def line_start(self) -> Sample | None:
+        return self._samples[0] if self._samples else None
+
+    def last_sample(self) -> tuple[float, Point]:
+        return self._taken
+
+    def pointer_ms(self) -> float:
+        return self._pointer.t_ms if self._pointer else 0.0
+
+    def push(self, sample: Sample) -> list[Segment]:
+        """One pointer sample while the pointer is down; the first of a path is the press."""
+        ts = self._ts
+        if ts and sample.t_ms < ts[-1]:
+            sample = Sample(ts[-1], sample.x, sample.y, sample.pressure)
+        self._pointer = sample
+        x, y = point = self._mapping.to_grid(sample.x, sample.y)
+        self._taken = (sample.t_ms, point)
+        self.rested = False
+        t = sample.t_ms
+        if not ts:
+            self._emitted_in_path = False
+            self._resting = False
+            self._restart_at([x], [y], [t], [sample])
+            return []
+        if self._resting:
+            dx = x - self._rest_x
+            dy = y - self._rest_y
+            if len(ts) == 1 and dx * dx + dy * dy <= self._rest_sq:
+                self._retime(t)
+                return []
+            self._resting = False
+        out: list[Segment] = []
+        self._append(x, y, t, sample)
+        if self._rests(out):
+            return out
+        self._let_go(out)
+        return out
+
+    def end(self) -> list[Segment]:
+        """Release: the best polyline to the last sample, every stroke at the floor (a tap gives
+        one stroke, dropped, of length 0)."""
+        out: list[Segment] = []
+        count = len(self._xs)
+        self._resting = False
+        if count == 0:
+            return out
+        if count == 1:
+            if not self._emitted_in_path:
+                out.append(self._piece(0, 0))
+        else:
+            self._polyline(count - 1, out)
+        self._xs, self._ys, self._ts, self._samples = [], [], [], []
+        return out
+
+    # --- the polyline -------------------------------------------------------------------------
+
+    def _restart_at(
+        self, xs: list[float], ys: list[float], ts: list[float], samples: list[Sample]
+    ) -> None:
+        """The samples since a new anchor (xs[0]): running sums and best polylines again."""
+        self._xs, self._ys, self._ts, self._samples = xs, ys, ts, samples
+        self._sums = [[0.0] for _ in range(5)]
+        self._best, self._brief, self._before = [0.0], [0], [-1]
+        self._errors_end = -1
+        ax, ay = xs[0], ys[0]
+        self._add_sums(0.0, 0.0)
+        for k in range(1, len(xs)):
+            self._add_sums(xs[k] - ax, ys[k] - ay)
+            self._place(k)
+
+    def _add_sums(self, rx: float, ry: float) -> None:
+        sx, sy, sxx, syy, sxy = self._sums
+        sx.append(sx[-1] + rx)
+        sy.append(sy[-1] + ry)
+        sxx.append(sxx[-1] + rx * rx)
+        syy.append(syy[-1] + ry * ry)
+        sxy.append(sxy[-1] + rx * ry)
+
+    def _append(self, x: float, y: float, t: float, sample: Sample) -> None:
+        self._xs.append(x)
+        self._ys.append(y)
+        self._ts.append(t)
+        self._samples.append(sample)
+        self._add_sums(x - self._xs[0], y - self._ys[0])
+        self._place(len(self._xs) - 1)
+
+    def _errors_to(self, k: int) -> int:
+        """Each piece's error to sample k, from every start it may have (into ``_errors``, kept
+        for the sample until the next): the first start."""
+        low = max(0, k - self.params.max_window)
+        if self._errors_end == k:
+            return low
+        xs, ys = self._xs, self._ys
+        ax, ay = xs[0], ys[0]
+        errors = self._errors
+        errors.clear()
+        sums = self._sums
+        for i in range(low, k):
+            errors.append(piece_error(xs, ys, ax, ay, sums, i, k))
+        self._errors_end = k
+        return low
+
+    def _choose(self, k: int, low: int, closed: bool) -> int:
+        """The best start of the last piece to sample k: the fewest pieces briefer than the
+        floor (the last counted only when ``closed``), then the least squared error, then the
+        earliest start; among the pieces that keep the bound (the piece from k - 1 always
+        does)."""
+        best, brief, errors, ts = self._best, self._brief, self._errors, self._ts
+        floor_ms = self._floor_ms
+        t_k = ts[k]
+        rejected: list[int] = []
+        while True:
+            chosen = -1
+            chosen_count = 0
+            chosen_total = 0.0
+            for i in range(low, k):
+                if i in rejected:
+                    continue
+                total = best[i] + errors[i - low]
+                count = brief[i]
+                if closed and t_k - ts[i] < floor_ms:
+                    count += 1
+                if (
+                    chosen < 0
+                    or count < chosen_count
+                    or (count == chosen_count and total < chosen_total)
+                ):
+                    chosen, chosen_count, chosen_total = i, count, total
+            if chosen == k - 1 or self._keeps(chosen, k):
+                return chosen
+            rejected.append(chosen)
+
+    def _place(self, k: int) -> None:
+        """Sample k's best polyline from the anchor, every piece closed (at the floor)."""
+        low = self._errors_to(k)
+        i = self._choose(k, low, closed=True)
+        total = self._best[i] + self._errors[i - low]
+        count = self._brief[i] + (1 if self._ts[k] - self._ts[i] < self._floor_ms else 0)
+        self._best.append(total)
+        self._brief.append(count)
+        self._before.append(i)
+
+    def _keeps(self, start: int, end: int) -> bool:
+        """Whether every sample between xs[start] and xs[end] lies within max_error of the
+        segment between them."""
+        xs, ys = self._xs, self._ys
+        ax, ay, ex, ey = xs[start], ys[start], xs[end], ys[end]
+        limit_sq = self._max_error_sq
+        for m in range(start + 1, end):
+            if segment_distance_sq(xs[m], ys[m], ax, ay, ex, ey) > limit_sq:
+                return False
+        return True
+
+    def _polyline(self, last: int, out: list[Segment]) -> None:
+        """Lets go the best polyline (every piece closed) to sample ``last``."""
+        vertices = [last]
+        while vertices[-1] != 0:
+            vertices.append(self._before[vertices[-1]])
+        vertices.reverse()
+        for a, b in itertools.pairwise(vertices):
+            out.append(self._piece(a, b))
+
+    def _piece(self, a: int, b: int) -> Segment:
+        self._emitted_in_path = True
+        xs, ys, ts = self._xs, self._ys, self._ts
+        return finish_segment(
+            (xs[a], ys[a]),
+            (xs[b], ys[b]),
+            ts[a],
+            ts[b],
+            self._pointer.t_ms if self._pointer else ts[b],
+            min_length=self.params.min_length,
+            min_duration_ms=self.params.min_duration_ms,
+        )
+
+    def _from(self, k: int) -> None:
+        """Sample k anchors the next stroke; the samples after it are taken again."""
+        self._restart_at(self._xs[k:], self._ys[k:], self._ts[k:], self._samples[k:])
+
+    def _let_go(self, out: list[Segment]) -> None:
+        """Lets go each stroke that is final: its end drawn ``lookahead_ms`` ago, or the stroke
+        longer than the latency cap."""
+        cap_ms = self.params.max_stroke_ms
+        lookahead_ms = self.params.lookahead_ms
+        floor_ms = self._floor_ms
+        while True:
+            ts = self._ts
+            j = len(ts) - 1
+            if ts[j] - ts[0] < floor_ms:
+                return
+            low = self._errors_to(j)
+            last = self._choose(j, low, closed=False)
+            if last == 0:
+                # One stroke from the anchor: cut by the latency cap at the sample before.
+                if (
+                    cap_ms > 0.0
+                    and ts[j] - ts[0] > cap_ms
+                    and j >= 2
+                    and ts[j - 1] - ts[0] >= floor_ms
+                    and self._keeps(0, j - 1)
+                ):
+                    out.append(self._piece(0, j - 1))
+                    self._from(j - 1)
+                    continue
+                return
+            vertex = last
+            while self._before[vertex] != 0:
+                vertex = self._before[vertex]
+            if ts[j] - ts[vertex] < lookahead_ms and not (
+                cap_ms > 0.0 and ts[vertex] - ts[0] > cap_ms
+            ):
+                return
+            out.append(self._piece(0, vertex))
+            self._from(vertex)
+
+    # --- rests --------------------------------------------------------------------------------
+
+    def _retime(self, t_ms: float) -> None:
+        self._ts[0] = t_ms
+        anchor = self._samples[0]
+        self._samples[0] = Sample(t_ms, anchor.x, anchor.y, anchor.pressure)
+
+    def _rests(self, out: list[Segment]) -> bool:
+        """Whether the pen has rested ``rest_ms`` at the newest sample: its samples of the last
+        ``rest_ms`` or more all lie within the rest radius of it (as the window finds). The best
+        polyline to the rest's first sample is let go; the rest is not played; the anchor waits
+        at that sample for the pen to move on."""
+        rest_ms = self.params.rest_ms
+        xs, ys, ts = self._xs, self._ys, self._ts
+        j = len(ts) - 1
+        t = ts[j]
+        if rest_ms <= 0.0 or t - ts[0] < rest_ms:
+            return False
+        x, y = xs[j], ys[j]
+        rest_sq = self._rest_sq
+        start = j
+        while start > 0:
+            dx = xs[start - 1] - x
+            dy = ys[start - 1] - y
+            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN ends the rest too)
+                break
+            start -= 1
+        if start == j or t - ts[start] < rest_ms:
+            return False
+        if start > 0:
+            self._polyline(start, out)
+        self._restart_at([xs[start]], [ys[start]], [ts[start]], [self._samples[start]])
+        self._retime(t)
+        self._rest_x, self._rest_y = x, y
+        self._resting = True
+        self.rested = True
+        return True
+
+
+def piece_error(
+    xs: list[float],
+    ys: list[float],
+    ax: float,
+    ay: float,
+    sums: list[list[float]],
+    start: int,
+    end: int,
+) -> float:
+    """The integral square error of the piece xs[start] -> xs[end]: the sum of the squared
+    distances of samples start..end to the line through its ends (to its start where they
+    coincide), from the running sums ``sums`` = [x, y, xx, yy, xy] (each of length n + 1, of the
+    coordinates relative to the anchor (ax, ay)). Never below 0 (rounding); a NaN gives 0."""
+    sx_, sy_, sxx_, syy_, sxy_ = sums
+    count = float(end + 1 - start)
+    px = xs[start] - ax
+    py = ys[start] - ay
+    dx = (xs[end] - ax) - px
+    dy = (ys[end] - ay) - py
+    sx = sx_[end + 1] - sx_[start]
+    sy = sy_[end + 1] - sy_[start]
+    # Sums of (x - px)^2, (y - py)^2 and (x - px)(y - py) over the piece's samples.
+    cxx = sxx_[end + 1] - sxx_[start] - 2.0 * px * sx + count * px * px
+    cyy = syy_[end + 1] - syy_[start] - 2.0 * py * sy + count * py * py
+    cxy = sxy_[end + 1] - sxy_[start] - px * sy - py * sx + count * px * py
+    length_sq = dx * dx + dy * dy
+    if length_sq > 0.0:
+        error = (dx * dx * cyy + dy * dy * cxx - 2.0 * dx * dy * cxy) / length_sq
+    else:
+        error = cxx + cyy
+    return error if error > 0.0 else 0.0
