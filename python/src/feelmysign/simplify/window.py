@@ -715,7 +715,8 @@ class Merger:
     floor_ms: float
     strict: bool = False
     # Whether a piece too short or too brief waits to merge (the window's pieces). The least
-    # squares' pieces do not, unless strict: they are briefer than the floor only where no piece
+    # squares' pieces do not once the path has sent one (a path's first piece still waits, so
+    # that a tap is dropped), unless strict: they are briefer than the floor only where no piece
     # lasting it keeps the bound, and one that lasts the floor yet is shorter than min_length was
     # drawn by a nearly still pen; each is sent as it is, a brief one to last the floor (holding
     # them made the felt end later and lost shapes drawn fast: docs/research.md).
@@ -739,7 +740,7 @@ class Merger:
         self._times.append(t_ms)
 
     def _short(self, segment: Segment) -> bool:
-        return self.hold_short and (
+        return (self.hold_short or not self._sent_in_path) and (
             segment.length < self.min_length
             or segment.drawn_ms < max(self.min_duration_ms, self.floor_ms)
         )
