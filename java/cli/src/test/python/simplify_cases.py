@@ -57,6 +57,11 @@ def random_flags(rng: random.Random) -> list[str]:
         maybe("--max-error", str(round(rng.uniform(0.001, 1.5), rng.choice([1, 3, 6]))))
         maybe("--max-window", str(rng.choice([1, 2, 3, 8, 40, 256, 10000])))
         maybe("--max-stroke-ms", str(rng.choice([0, 50, 100.5, 300, 1000, 60000])))
+        # The least-squares core (simplify/fit.py), half the time, with its lookahead and floor.
+        if rng.random() < 0.5:
+            flags.append("--least-squares")
+            maybe("--lookahead-ms", str(rng.choice([0, 10, 30, 100.5, 1000])))
+            maybe("--floor-ms", str(rng.choice([0, 20, 73.701, 150])))
     elif kind in ("angle", "paper"):
         maybe("--check-frames", str(rng.randint(2, 30)))
         maybe("--max-angle-deg", str(rng.choice([1, 5, 12.5, 20, 45, 90, 179])))
@@ -228,6 +233,9 @@ def main_(outdir: Path) -> None:
         turn = 2 if name.startswith("random") else index % 3
         flags = [[], ["--paper"], random_flags(rng)][turn]
         case(name, [str(path), *flags, "--json"])
+    # The least-squares core on drawn shapes too (LASA, people's gestures), at its defaults.
+    for name, path in recordings[::12]:
+        case(name + " least squares", [str(path), "--least-squares", "--json"])
     first = str(recordings[0][1])
     case("text output", [first])
     case("text output, angle", [first, "--paper", "--stretch"])

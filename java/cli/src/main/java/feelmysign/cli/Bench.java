@@ -9,6 +9,7 @@ import java.io.IOException;
 import java.nio.file.Files;
 import java.nio.file.Path;
 import java.util.ArrayList;
+import java.util.HashMap;
 import java.util.List;
 import java.util.Map;
 import java.util.function.LongSupplier;
@@ -52,6 +53,10 @@ public final class Bench {
     double baseline = rate("baseline: one distance per frame", () -> baseline(demos), 0);
     rate("angle simplifier (paper's defaults)", () -> run(Algorithm.ANGLE, demos), baseline);
     rate("window simplifier (max_error 0.25)", () -> run(Algorithm.WINDOW, demos), baseline);
+    rate(
+        "window simplifier, least squares",
+        () -> run(Algorithm.WINDOW, demos, Map.of("least_squares", true)),
+        baseline);
   }
 
   private static double number(Object value) {
@@ -76,13 +81,18 @@ public final class Bench {
   }
 
   private static long run(Algorithm algorithm, List<Demo> demos) {
+    return run(algorithm, demos, Map.of());
+  }
+
+  /** The simplifier at its defaults on each demonstration's canvas, with {@code given} over them. */
+  private static long run(Algorithm algorithm, List<Demo> demos, Map<String, Object> given) {
     long count = 0;
     int segments = 0;
     for (Demo demo : demos) {
-      Params params =
-          Params.of(
-              algorithm,
-              Map.of("canvas_width_px", demo.widthPx(), "canvas_height_px", demo.heightPx()));
+      Map<String, Object> values = new HashMap<>(given);
+      values.put("canvas_width_px", demo.widthPx());
+      values.put("canvas_height_px", demo.heightPx());
+      Params params = Params.of(algorithm, values);
       Simplifier simplifier = algorithm.make(params);
       for (Sample frame : demo.frames()) {
         segments += simplifier.push(frame).size();

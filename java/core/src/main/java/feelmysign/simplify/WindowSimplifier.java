@@ -27,20 +27,31 @@ import java.util.List;
  * covered lies within {@code max_error} of that stroke (nothing more is sent; {@link
  * #mergedBack} counts them); only a tap is dropped with its reason. The float operations follow
  * the reference's order, so every value is the same to the last bit.
+ *
+ * <p>With {@code least_squares} the pieces come from the least-squares core instead ({@code
+ * FitCore}, the reference's {@code simplify/fit.py}): strokes placed where the drawn samples lie
+ * nearest them, each lasting the sleeve's floor where the bound allows, let go {@code
+ * lookahead_ms} after their end or at the latency cap. Its pieces do not wait to merge (unless
+ * {@code strict_minimums}): each is sent as it is, one briefer than the floor to last the floor.
  */
 public final class WindowSimplifier implements Simplifier {
-  private final WindowCore core;
+  private final PieceCore core;
   private final Merger merger;
 
   public WindowSimplifier(Params params) {
-    this.core = new WindowCore(params);
+    boolean leastSquares = params.flag("least_squares");
+    boolean strict = params.flag("strict_minimums");
+    // The least squares' pieces are briefer than the floor only where no piece lasting it keeps
+    // the bound: they do not wait to merge, unless strict (the reference's hold_short).
+    this.core = leastSquares ? new FitCore(params) : new WindowCore(params);
     this.merger =
         new Merger(
             params.number("max_error"),
             params.number("min_length"),
             params.number("min_duration_ms"),
             params.number("floor_ms"),
-            params.flag("strict_minimums"));
+            strict,
+            !leastSquares || strict);
   }
 
   public Params params() {
@@ -91,10 +102,33 @@ public final class WindowSimplifier implements Simplifier {
 }
 
 /**
+ * What {@link WindowSimplifier} needs of its core ({@link WindowCore}, or {@link FitCore} with
+ * {@code least_squares}): the pieces to merge, and each sample as the core took it, for the
+ * merger.
+ */
+interface PieceCore extends Simplifier {
+  Params params();
+
+  /** Whether the last push found the pen resting (the stroke before the rest is final). */
+  boolean rested();
+
+  /** The time of the last sample taken, as taken (never before the one before). */
+  double lastMs();
+
+  /** The grid point of the last sample taken. */
+  double lastX();
+
+  double lastY();
+
+  /** The time of the last sample pushed, as taken (0 before any). */
+  double pointerMs();
+}
+
+/**
  * The window itself: strokes cut by the error bound, the bend rule and the caps, before
  * too-short pieces are merged ({@link WindowSimplifier} merges them).
  */
-final class WindowCore implements Simplifier {
+final class WindowCore implements PieceCore {
   /** The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
    * stroke's start, so that the stroke it ends is not too brief to be felt in its drawn time. */
   static final double CAP_FEATURE_SHARE = 0.5;
@@ -190,18 +224,25 @@ final class WindowCore implements Simplifier {
     this.restMs = params.number("rest_ms");
     // The least of a share of min_length, half of max_error and what a pen at the rest speed
     // covers in rest_ms, at the canvas's tighter scale (as Python's and the page's rest radius).
-    double rest =
-        Math.min(
-            Math.min(REST_SHARE * minLength, 0.5 * maxError),
-            REST_SPEED_PX_PER_MS * restMs * mapping.scale());
+    double rest = restRadius(minLength, maxError, restMs, mapping.scale());
     this.restSq = rest * rest;
   }
 
+  /** How near one point a resting pen stays, in grid units: the least of a share of min_length,
+   * half of max_error and what a pen at the rest speed covers in rest_ms, at the canvas's tighter
+   * scale (as Python's and the page's rest radius). */
+  static double restRadius(double minLength, double maxError, double restMs, double scale) {
+    return Math.min(
+        Math.min(REST_SHARE * minLength, 0.5 * maxError), REST_SPEED_PX_PER_MS * restMs * scale);
+  }
+
   /** Whether the last push found the pen resting. */
-  boolean rested() {
+  @Override
+  public boolean rested() {
     return rested;
   }
 
+  @Override
   public Params params() {
     return params;
   }
@@ -217,20 +258,24 @@ final class WindowCore implements Simplifier {
   }
 
   /** The time of the last sample taken, as taken (never before the one before). */
-  double lastMs() {
+  @Override
+  public double lastMs() {
     return takenMs;
   }
 
-  double lastX() {
+  @Override
+  public double lastX() {
     return takenX;
   }
 
-  double lastY() {
+  @Override
+  public double lastY() {
     return takenY;
   }
 
   /** The time of the last sample pushed, as taken (0 before any). */
-  double pointerMs() {
+  @Override
+  public double pointerMs() {
     return pointer != null ? pointer.tMs() : 0.0;
   }
 
@@ -755,6 +800,10 @@ final class Merger {
   private final double minDurationMs;
   private final double shortMs;
   private final boolean strict;
+  /** Whether a piece too short or too brief waits to merge (the window's pieces). The least
+   * squares' pieces do not, unless strict: each is sent as it is, a brief one to last the
+   * floor. */
+  private final boolean holdShort;
   // The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first:
   // [first, size).
   private double[] xs = new double[64];
@@ -771,12 +820,23 @@ final class Merger {
   // Pieces merged at release into a stroke already sent (nothing more is sent for them), in all.
   private int mergedBack;
 
-  Merger(double maxError, double minLength, double minDurationMs, double floorMs, boolean strict) {
+  Merger(
+      double maxError,
+      double minLength,
+      double minDurationMs,
+      double floorMs,
+      boolean strict,
+      boolean holdShort) {
     this.maxError = maxError;
     this.minLength = minLength;
     this.minDurationMs = minDurationMs;
     this.shortMs = Math.max(minDurationMs, floorMs);
     this.strict = strict;
+    this.holdShort = holdShort;
+  }
+
+  Merger(double maxError, double minLength, double minDurationMs, double floorMs, boolean strict) {
+    this(maxError, minLength, minDurationMs, floorMs, strict, true);
   }
 
   Merger(double maxError, double minLength, double minDurationMs, double floorMs) {
@@ -807,7 +867,7 @@ final class Merger {
   }
 
   private boolean isShort(Segment segment) {
-    return segment.length() < minLength || segment.drawnMs() < shortMs;
+    return holdShort && (segment.length() < minLength || segment.drawnMs() < shortMs);
   }
 
   private boolean belowMinimums(Segment segment) {
