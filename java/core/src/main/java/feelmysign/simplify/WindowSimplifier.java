@@ -867,7 +867,9 @@ final class Merger {
   }
 
   private boolean isShort(Segment segment) {
-    return holdShort && (segment.length() < minLength || segment.drawnMs() < shortMs);
+    // A path's first piece waits even where the least squares send pieces as they are:
+    // a tap is dropped.
+    return (holdShort || !sentInPath) && (segment.length() < minLength || segment.drawnMs() < shortMs);
   }
 
   private boolean belowMinimums(Segment segment) {
