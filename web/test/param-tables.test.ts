@@ -95,6 +95,8 @@ describe("parameter tables", () => {
       rest_ms: "window",
       strict_minimums: "window",
       floor_ms: "window",
+      least_squares: "window",
+      lookahead_ms: "window",
     });
   });
 

@@ -35,6 +35,9 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   floor_ms: fc.constant(73.7),
   rest_ms: fc.constantFrom(0, 30, 100),
   strict_minimums: fc.boolean(),
+  // The window's own core (the least-squares one is tested in fit.properties.test.ts).
+  least_squares: fc.constant(false),
+  lookahead_ms: fc.constant(30),
   rows: fc.integer({ min: 1, max: 8 }),
   columns: fc.integer({ min: 1, max: 8 }),
   canvas_width_px: fc.constant(WIDTH_PX),

@@ -45,6 +45,9 @@ const paramsArb: fc.Arbitrary<WindowParams> = fc.record({
   rest_ms: fc.constantFrom(0, 30, 100, 300),
   // Strict minimums let the bound yield to a wearer's limits: not this property's.
   strict_minimums: fc.constant(false),
+  // The window's own core (the least-squares one: fit.properties.test.ts).
+  least_squares: fc.constant(false),
+  lookahead_ms: fc.constant(30),
   ...SHARED_PARAM_ARBS,
 });
 
@@ -303,6 +306,8 @@ const edgeDrawingArb = fc
       floor_ms: 73.7,
       rest_ms: 100,
       strict_minimums: false,
+      least_squares: false,
+      lookahead_ms: 30,
       clear_on_press: true,
       min_duration_ms: d.minDurationMs,
       min_length: d.minLength,

@@ -25,9 +25,12 @@
  * merges at release into the stroke already sent before it where every drawn sample it has not
  * covered lies within max_error of that stroke (nothing more is sent: `mergedBack` counts them);
  * only a tap is dropped with its reason (with `strict_minimums`, also a path's last piece below
- * the minimums that the stroke before cannot cover). The float operations follow the reference's
- * order.
+ * the minimums that the stroke before cannot cover). With `least_squares` on, the pieces are the
+ * least-squares core's instead (`FitCore`, `fit.ts`), which the merger sends as they are, a brief
+ * one to last the floor, unless strict minimums hold them (`Merger`'s `holdShort`). The float
+ * operations follow the reference's order.
  */
+import { FitCore } from "./fit";
 import { CanvasMapping } from "./mapping";
 import {
   finishSegment,
@@ -39,7 +42,10 @@ import {
   type Sample,
   type Segment,
 } from "./segment";
+import { restRadius } from "./rest";
 import { checkWindowParams, type WindowParams } from "./window-params";
+
+export { REST_SHARE, REST_SPEED_PX_PER_MS, restRadius } from "./rest";
 
 /**
  * The latency cap cuts at a feature drawn at least this share of max_stroke_ms after the
@@ -67,33 +73,6 @@ export const LINE_SHARE = 0.25;
 const ROUNDING_SLACK = 1e-9;
 
 /** What `push` gives when no stroke is finished (most samples): one frozen array, none made. */
-/**
- * A pen rests while its samples stay within this share of min_length of one point (never farther
- * than half of max_error, so the point that ends or starts a stroke covers the rest): well below a
- * stroke the sleeve renders, well above a still hand's jitter.
- */
-export const REST_SHARE = 0.25;
-/**
- * ... and never farther than a pen this slow (canvas pixels per ms) covers in rest_ms: a quarter of
- * a pixel a frame at 60 fps. A pen that stays near one point for all of rest_ms rests; a slow, steady
- * pen does not, as the distance it covers over the whole window tells: at twice this speed (half a
- * pixel a frame) or more, in any direction, it leaves the radius well within rest_ms, even with its
- * samples rounded to whole pixels. In pixels, not grid units: a hand's speed on the screen does not
- * depend on how the canvas maps onto the sleeve (at the default canvas a quarter of min_length is 16
- * pixels, which a pen at 2 pixels a frame took 100 ms to leave).
- */
-export const REST_SPEED_PX_PER_MS = 0.015;
-
-/**
- * How near one point a resting pen stays, in grid units: the least of `REST_SHARE` x min_length,
- * half of max_error and the distance a pen at `REST_SPEED_PX_PER_MS` covers in rest_ms, mapped at
- * the canvas's tighter scale (so no more pixels on either axis).
- */
-export function restRadius(params: WindowParams, mapping: CanvasMapping): number {
-  const px = REST_SPEED_PX_PER_MS * params.rest_ms;
-  return Math.min(REST_SHARE * params.min_length, 0.5 * params.max_error, px * mapping.scale);
-}
-
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
 /**
@@ -966,6 +945,13 @@ export class Merger {
   readonly #shortMs: number;
   readonly #strict: boolean;
   /**
+   * Whether a piece too short or too brief waits to merge (the window's pieces). The least
+   * squares' pieces do not, unless strict: they are briefer than the floor only where no piece
+   * lasting it keeps the bound, and one that lasts the floor yet is shorter than min_length was
+   * drawn by a nearly still pen; each is sent as it is, a brief one to last the floor.
+   */
+  readonly #holdShort: boolean;
+  /**
    * The drawn samples (ms, grid units), oldest first: those not yet covered by a sent stroke are
    * [first, count) (`Drawn`). The window's own store when the merger takes its pieces (each
    * sample stored once), else one of its own that `sample` fills. Not a typed array: its buffer
@@ -990,6 +976,7 @@ export class Merger {
     minDurationMs: number,
     floorMs: number,
     strict = false,
+    holdShort = true,
     drawn: Drawn = new Drawn(),
   ) {
     this.#drawn = drawn;
@@ -999,6 +986,7 @@ export class Merger {
     this.#minDurationMs = minDurationMs;
     this.#shortMs = Math.max(minDurationMs, floorMs);
     this.#strict = strict;
+    this.#holdShort = holdShort;
   }
 
   /** A drawn sample, in order (its time as the window took it). */
@@ -1012,7 +1000,9 @@ export class Merger {
   }
 
   #short(segment: Segment): boolean {
-    return segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs;
+    return (
+      this.#holdShort && (segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs)
+    );
   }
 
   #belowMinimums(segment: Segment): boolean {
@@ -1202,40 +1192,67 @@ export class Merger {
   }
 }
 
-/** The window simplifier: the window's pieces, the too-short ones merged (`Merger`). */
+/**
+ * The window simplifier: the window's pieces, the too-short ones merged (`Merger`). With
+ * `least_squares` on, the pieces are the least-squares core's (`FitCore`), which the merger sends
+ * as they are (a brief one to last the floor) unless strict minimums hold them.
+ */
 export class WindowSimplifier {
   readonly params: WindowParams;
-  readonly #core: WindowCore;
+  /** The window (null with `least_squares` on). */
+  readonly #core: WindowCore | null;
+  /** The least-squares core (null with `least_squares` off). */
+  readonly #fit: FitCore | null;
   readonly #merger: Merger;
 
   constructor(params: WindowParams) {
+    this.params = params;
+    if (params.least_squares) {
+      // The core keeps its samples apart; the merger is given each one taken (`#pushFit`).
+      this.#core = null;
+      this.#fit = new FitCore(params);
+      this.#merger = new Merger(
+        params.max_error,
+        params.min_length,
+        params.min_duration_ms,
+        params.floor_ms,
+        params.strict_minimums,
+        params.strict_minimums,
+      );
+      return;
+    }
     // One store of the drawn samples, which the window fills and the merger reads too.
     const drawn = new Drawn();
     this.#core = new WindowCore(params, drawn);
-    this.params = params;
+    this.#fit = null;
     this.#merger = new Merger(
       params.max_error,
       params.min_length,
       params.min_duration_ms,
       params.floor_ms,
       params.strict_minimums,
+      true,
       drawn,
     );
   }
 
   /** True between the first sample of a path and `end`. */
   get drawing(): boolean {
-    return this.#core.drawing;
+    const fit = this.#fit;
+    return fit !== null ? fit.drawing : this.#core!.drawing;
   }
 
   /** Where the stroke being drawn starts (canvas pixels), for showing it; null between paths. */
   get lineStart(): Sample | null {
-    return this.#core.lineStart;
+    const fit = this.#fit;
+    return fit !== null ? fit.lineStart : this.#core!.lineStart;
   }
 
   /** One pointer sample while the pointer is down; the first of a path is the press. */
   push(input: Sample): readonly Segment[] {
-    const core = this.#core;
+    const fit = this.#fit;
+    if (fit !== null) return this.#pushFit(fit, input);
+    const core = this.#core!;
     const pieces = core.push(input);
     const merger = this.#merger;
     const takenMs = core.takenMs;
@@ -1251,6 +1268,19 @@ export class WindowSimplifier {
     return out.length > 0 ? out : NO_SEGMENTS;
   }
 
+  /** `push` with the least-squares core: the merger is given the sample taken, then its pieces. */
+  #pushFit(fit: FitCore, input: Sample): readonly Segment[] {
+    const pieces = fit.push(input);
+    const merger = this.#merger;
+    const takenMs = fit.takenMs;
+    merger.sample(takenMs, fit.takenX, fit.takenY);
+    if (pieces.length === 0 && !fit.rested) return NO_SEGMENTS;
+    const out: Segment[] = [];
+    for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
+    if (fit.rested) merger.rest(takenMs, out);
+    return out.length > 0 ? out : NO_SEGMENTS;
+  }
+
   /** Pieces merged at release into a stroke already sent (`Merger.end`), over every path so far. */
   get mergedBack(): number {
     return this.#merger.mergedBack;
@@ -1258,7 +1288,8 @@ export class WindowSimplifier {
 
   /** Release: the rest of the path, the held piece first (a tap gives one, dropped). */
   end(): Segment[] {
-    const core = this.#core;
+    const fit = this.#fit;
+    const core = fit !== null ? fit : this.#core!;
     const nowMs = core.pointerMs();
     const out: Segment[] = [];
     const pieces = core.end();
