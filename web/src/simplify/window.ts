@@ -1000,8 +1000,11 @@ export class Merger {
   }
 
   #short(segment: Segment): boolean {
+    // A path's first piece waits even where the least squares send pieces as they are: a tap is
+    // dropped.
     return (
-      this.#holdShort && (segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs)
+      (this.#holdShort || !this.#sentInPath) &&
+      (segmentLength(segment) < this.#minLength || segment.duration_ms < this.#shortMs)
     );
   }
 
