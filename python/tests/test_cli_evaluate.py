@@ -12,7 +12,8 @@ import pytest
 from test_cli_replay import browser_recording
 
 from feelmysign.cli import main
-from feelmysign.research.sweep import SweepError, parse_sweep
+from feelmysign.research.sweep import SweepError, parameter_sets, parse_sweep
+from feelmysign.simplify import ALGORITHMS
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 OUTPUTS = ("results.csv", "frontier.csv", "summary.json")
@@ -135,6 +136,19 @@ def test_sweep_values() -> None:
     for bad in ("max_error", "max_error=a:b:c", "max_error=1:0:1", "max_error=0:1:0"):
         with pytest.raises(SweepError):
             parse_sweep(bad)
+
+
+def test_a_true_false_parameter_is_fixed_or_run_both_ways() -> None:
+    window = ALGORITHMS["window"]
+    assert parameter_sets(window, [parse_sweep("least_squares=0:1:1")]) == [
+        {"least_squares": False},
+        {"least_squares": True},
+    ]
+    assert parameter_sets(window, [parse_sweep("least-squares=false")]) == [
+        {"least_squares": False}
+    ]
+    with pytest.raises(SweepError, match="takes 0 or 1"):
+        parameter_sets(window, [parse_sweep("least_squares=0:2:1")])
 
 
 def test_lasa_at_three_speeds_gives_timing_and_recognition(

@@ -6,11 +6,14 @@
     feelmysign evaluate --lasa --limit 14 --sweep max_error=0.05:0.5:0.05 --out /tmp/e
     feelmysign evaluate --lasa --speeds --defaults           # the figures behind the defaults
     feelmysign evaluate research/gestures --defaults         # recorded gestures at three speeds
+    feelmysign evaluate research/gestures --sweep least_squares=0:1:1   # both window cores
 
 Every recording (RECORDING files, folders of them, or the LASA handwriting data
 set with --lasa) is run through every chosen algorithm at every point of its parameter
 grid: the product of the --sweep values of its own parameters (NAME=FROM:TO:STEP,
-TO included; NAME=VALUE fixes one), its defaults otherwise. Without --sweep:
+TO included; NAME=VALUE fixes one; a true/false one takes 0 and 1, or false and
+true: least_squares=0:1:1 runs the window with its chord core and its least-squares
+one), its defaults otherwise. Without --sweep:
 {default_sweeps}.
 --speeds adds LASA re-timed to three drawing speeds (slow 2.4 s, normal 1.2 s,
 fast 0.6 s a shape, sampled at 125 Hz); --defaults runs each algorithm once, at

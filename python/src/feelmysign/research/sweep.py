@@ -44,7 +44,8 @@ def parse_sweep(text: str) -> Sweep:
         raise SweepError(
             f"--sweep {text!r}: write NAME=FROM:TO:STEP, e.g. {DEFAULT_SWEEPS[PAPER_ALGORITHM][0]}"
         )
-    parts = spec.split(":")
+    words = {"true": "1", "false": "0"}  # a true/false parameter: NAME=true, or 0:1:1 for both
+    parts = [words.get(p.strip().lower(), p) for p in spec.split(":")]
     try:
         numbers = [float(p) for p in parts]
     except ValueError:
@@ -65,11 +66,17 @@ def parse_sweep(text: str) -> Sweep:
 def parameter_sets(algorithm: Algorithm, sweeps: Sequence[Sweep]) -> list[dict[str, Any]]:
     """The overrides of every point of ``algorithm``'s grid, in sweep order (one: {})."""
     own = [s for s in sweeps if s.name in algorithm.specs]
-    axes = []
+    axes: list[list[tuple[str, Any]]] = []
     for sweep in own:
         kind = algorithm.specs[sweep.name].kind
         if kind is bool:
-            raise SweepError(f"--sweep {sweep.name}: a true/false parameter cannot be swept")
+            if not all(v in (0.0, 1.0) for v in sweep.values):
+                raise SweepError(
+                    f"--sweep {sweep.name}: a true/false parameter takes 0 or 1 (false or true),"
+                    f" got {sweep.values}; e.g. {sweep.name}=0:1:1 for both"
+                )
+            axes.append([(sweep.name, v == 1.0) for v in sweep.values])
+            continue
         if kind is int and not all(float(v).is_integer() for v in sweep.values):
             raise SweepError(f"--sweep {sweep.name}: whole numbers only, got {sweep.values}")
         axes.append([(sweep.name, int(v) if kind is int else v) for v in sweep.values])
