@@ -179,9 +179,10 @@ def cases() -> dict[str, dict[str, Any]]:
         "the window simplifier's parameters: defaults and allowed ranges",
     )
     for shape in SHAPES:
-        result[f"{shape}/least-squares.json"] = simplifier_case(
-            WindowParams, FIT, f"{shape} path, least-squares", SHAPES[shape]()
-        )
+        for name in ("chord", "least-squares"):
+            result[f"{shape}/{name}.json"] = simplifier_case(
+                WindowParams, VARIATIONS[name], f"{shape} path, {name}", SHAPES[shape]()
+            )
     for shape in EDGE_SHAPES:
         for variation in EDGE_VARIATIONS:
             result[f"{shape}/{variation}.json"] = _edge_case(shape, variation)

@@ -65,7 +65,7 @@ def test_a_stroke_sent_at_the_floor_is_noted(
 ) -> None:
     # The window vector of a line ending in a quick flick back: its last piece, drawn briefer
     # than the sleeve's floor, is sent lasting the floor; the table says so, and JSON gives both.
-    case = dict(load("window"))["flick-back/defaults"]
+    case = dict(load("window"))["flick-back/chord"]
     recording = write_recording(case, tmp_path / "flick.json")
     params = {**case["params"], "algorithm": "window"}
     recording.write_text(

@@ -106,7 +106,9 @@ def test_a_circle_keeps_its_round_shape_with_strokes_at_the_floor() -> None:
     # Drawn in 1.2 s, a circle of radius 2 grid units: the chord's farthest sample cuts it where
     # the bound breaks, into few strokes; the least squares into as many as the floor allows.
     circle = _circle(radius_px=128, step_ms=10.0)
-    chord = WindowSimplifier(WindowParams(canvas_width_px=800, canvas_height_px=600))
+    chord = WindowSimplifier(
+        WindowParams(least_squares=False, canvas_width_px=800, canvas_height_px=600)
+    )
     fit = WindowSimplifier(
         WindowParams(least_squares=True, canvas_width_px=800, canvas_height_px=600)
     )

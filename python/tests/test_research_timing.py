@@ -19,7 +19,7 @@ from feelmysign.research.evaluate import Row, Run, Source, evaluate_one, grid_po
 from feelmysign.research.lasa import load_lasa
 from feelmysign.research.playback import simulate
 from feelmysign.research.speeds import retimed
-from feelmysign.simplify import ALGORITHMS, PathSegment, Sample, Segment
+from feelmysign.simplify import ALGORITHMS, PathSegment, Sample, Segment, WindowParams
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import params_for
 
@@ -140,7 +140,13 @@ def test_douglas_peucker_runs_above_a_tie_with_the_rows_deviation() -> None:
         recording = Recording(1200.0, 800.0, (samples,), 3, 4)
         run = Run(
             ALGORITHMS["window"],
-            {"max_error": 0.6, "min_duration_ms": 0.0, "max_stroke_ms": 0.0, "max_bend": 0.0},
+            {
+                "least_squares": False,
+                "max_error": 0.6,
+                "min_duration_ms": 0.0,
+                "max_stroke_ms": 0.0,
+                "max_bend": 0.0,
+            },
         )
         row = evaluate_one(Source("bump", "bump", recording), run)
         assert row.strokes == 1 and row.dp_strokes == 1
@@ -184,8 +190,12 @@ def test_simplify_json_gives_each_stroke_its_drawn_times(
     assert strokes and every[0]["start_ms"] == 0.0 and every[-1]["end_ms"] == 590.0
     for before, after in itertools.pairwise(every):
         assert after["start_ms"] == before["end_ms"]
+    # Played as drawn, but a stroke drawn briefer than the sleeve's floor (here the jump, which
+    # no longer stroke keeps within max_error), which is sent to last the floor.
+    floor_ms = WindowParams().floor_ms
     for stroke in every:
-        assert stroke["duration_ms"] == pytest.approx(stroke["end_ms"] - stroke["start_ms"])
+        drawn = stroke["end_ms"] - stroke["start_ms"]
+        assert stroke["duration_ms"] == pytest.approx(drawn if drawn >= floor_ms else floor_ms)
 
 
 def test_lasa_drawings_are_recognised_leaving_their_own_out() -> None:

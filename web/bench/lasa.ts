@@ -47,6 +47,8 @@ interface Demo {
   tolerancePx: number;
   angle: AngleParams;
   window: WindowParams;
+  /** The same with the chord core (`least_squares` off). */
+  chord: WindowParams;
 }
 
 export interface LasaRate {
@@ -85,6 +87,13 @@ function load(path: string): { file: FramesJson; demos: Demo[] } {
       tolerancePx: demo.tolerance_px,
       angle: { ...DEFAULT_ANGLE_PARAMS, ...canvas, fps: file.fps },
       window: { ...DEFAULT_WINDOW_PARAMS, ...canvas, fps: file.fps, max_error: file.max_error },
+      chord: {
+        ...DEFAULT_WINDOW_PARAMS,
+        ...canvas,
+        fps: file.fps,
+        max_error: file.max_error,
+        least_squares: false,
+      },
     };
   });
   return { file, demos };
@@ -132,18 +141,23 @@ export function benchLasa(path: string = LASA_FRAMES_PATH): LasaFigures | null {
         return strokes;
       },
     },
-    {
-      name: `window simplifier (max_error ${file.max_error})`,
+    ...(
+      [
+        ["least squares: the defaults", (demo: Demo) => demo.window],
+        ["chord", (demo: Demo) => demo.chord],
+      ] as const
+    ).map(([core, params]) => ({
+      name: `window simplifier (max_error ${file.max_error}, ${core})`,
       run: () => {
         let strokes = 0;
         for (const demo of demos) {
-          const simplifier = new WindowSimplifier(demo.window);
+          const simplifier = new WindowSimplifier(params(demo));
           for (const frame of demo.frames) strokes += simplifier.push(frame).length;
           strokes += simplifier.end().length;
         }
         return strokes;
       },
-    },
+    })),
     ...[true, false].map((highQuality) => ({
       name: `simplify-js (highQuality ${highQuality})`,
       run: () => {
@@ -170,7 +184,8 @@ export function benchLasa(path: string = LASA_FRAMES_PATH): LasaFigures | null {
     pointsPerSecond: points / (median(times[index]!) / 1000),
     strokes: made[index]!,
   }));
-  const [baseline, angle, window, highQuality, fast] = rates as [
+  const [baseline, angle, window, chord, highQuality, fast] = rates as [
+    LasaRate,
     LasaRate,
     LasaRate,
     LasaRate,
@@ -184,7 +199,7 @@ export function benchLasa(path: string = LASA_FRAMES_PATH): LasaFigures | null {
     fps: file.fps,
     maxError: file.max_error,
     baseline,
-    rates: [baseline, angle, window],
+    rates: [baseline, angle, window, chord],
     simplifyJs: { highQuality, fast },
   };
 }

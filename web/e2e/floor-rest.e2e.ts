@@ -1,6 +1,6 @@
 /**
  * A pen that rests mid-path, on real processes (`feelmysign up` with the simulated sleeve, the page
- * in Chromium): a piece briefer than the sleeve's floor, held to merge when the pen stops, is sent
+ * in Chromium, its window simplifier with the chord core): a piece briefer than the sleeve's floor, held to merge when the pen stops, is sent
  * at the rest lent the time it needs from it (window.ts `Merger.rest`). It must last the floor to
  * the last bit: `start + floor - start` rounds below the floor for about half the start times of a
  * page open 5 to 20 s (73.70099999999911 ms from 15000.1 ms), and the sleeve slowed such a stroke
@@ -10,7 +10,7 @@
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import type { EventWatcher } from "./harness";
-import { drawingArea, moveByClock, nextFrame, type Area } from "./page";
+import { drawingArea, moveByClock, nextFrame, setLeastSquares, type Area } from "./page";
 import { Processes } from "./processes";
 
 type Point = readonly [number, number];
@@ -32,6 +32,9 @@ describe("a pen resting mid-path", () => {
     const up = await processes.up("floor-rest");
     watcher = await processes.watch(up.credentials);
     page = await processes.onlinePage(up.url);
+    // The chord core's merger holds a brief piece until the rest (the least squares send theirs
+    // as they are, lasting the floor: their own tests).
+    await setLeastSquares(page, false);
     area = await drawingArea(page);
   });
 

@@ -259,6 +259,15 @@ export async function openAdvanced(page: Page): Promise<void> {
   });
 }
 
+/** Settings → Advanced → Least squares on or off (the window simplifier's core), saved. */
+export async function setLeastSquares(page: Page, on: boolean): Promise<void> {
+  await page.locator('[data-testid="settings-button"]').click();
+  await openAdvanced(page);
+  await page.locator('[data-testid="setting-least_squares"]').setChecked(on);
+  await page.locator('[data-testid="settings-save"]').click();
+  await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
+}
+
 /** Settings → Advanced → Longest stroke (ms of drawing; 0 = no limit), saved. */
 export async function setLongestStroke(page: Page, ms: string): Promise<void> {
   await page.locator('[data-testid="settings-button"]').click();

@@ -472,6 +472,7 @@ const restArb = fc
     const rests = r.capMs > 0 ? [50, 100] : [50, 100, 300];
     const params: WindowParams = {
       ...DEFAULT_WINDOW_PARAMS,
+      least_squares: false,
       max_stroke_ms: r.capMs,
       rest_ms: rests[r.restPick % rests.length]!,
       canvas_width_px: 1200,

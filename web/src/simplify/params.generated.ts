@@ -232,7 +232,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     algorithms: ["window"],
     paper: null,
     type: "boolean",
-    default: false,
+    default: true,
     minimum: null,
     maximum: null,
     unit: null,

@@ -100,7 +100,8 @@ def write(path: Path = DEFAULT_PATH) -> int:
 
 
 def simplifier_rates(demos: Sequence[LasaFrames]) -> list[Rate]:
-    """The baseline, then angle and window (defaults, each demo's canvas) per frame."""
+    """The baseline, then angle and window (defaults, each demo's canvas; the window also with
+    its chord core, ``least_squares`` off) per frame."""
     params: dict[str, list[AngleParams | WindowParams]] = {
         "angle": [
             AngleParams(canvas_width_px=d.width_px, canvas_height_px=d.height_px) for d in demos
@@ -108,13 +109,19 @@ def simplifier_rates(demos: Sequence[LasaFrames]) -> list[Rate]:
         "window": [
             WindowParams(canvas_width_px=d.width_px, canvas_height_px=d.height_px) for d in demos
         ],
+        "chord": [
+            WindowParams(
+                canvas_width_px=d.width_px, canvas_height_px=d.height_px, least_squares=False
+            )
+            for d in demos
+        ],
     }
 
     def baseline() -> int:
         return sum(one_distance_per_frame(d.frames) for d in demos)
 
     def run(name: str) -> int:
-        make = ALGORITHMS[name].make
+        make = ALGORITHMS["window" if name == "chord" else name].make
         count = 0
         for demo, demo_params in zip(demos, params[name], strict=True):
             simplifier = make(demo_params)
@@ -127,7 +134,11 @@ def simplifier_rates(demos: Sequence[LasaFrames]) -> list[Rate]:
     return [
         best_rate("baseline: one distance per frame", baseline),
         best_rate("angle simplifier (paper's defaults)", lambda: run("angle")),
-        best_rate(f"window simplifier (max_error {MAX_ERROR})", lambda: run("window")),
+        best_rate(
+            f"window simplifier (max_error {MAX_ERROR}, least squares: the defaults)",
+            lambda: run("window"),
+        ),
+        best_rate(f"window simplifier (max_error {MAX_ERROR}, chord)", lambda: run("chord")),
     ]
 
 

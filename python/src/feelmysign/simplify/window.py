@@ -227,7 +227,7 @@ class _WindowOwn:
         unit="ms",
     )
     least_squares: bool = param(
-        False,
+        True,
         help="place strokes where the drawn samples lie nearest them (least squares over "
         "several strokes, each lasting the sleeve's floor) instead of at the sample farthest "
         "from the chord where the bound breaks",

@@ -205,7 +205,7 @@ public final class ParamTable {
               null,
               0,
               ParamSpec.Kind.BOOLEAN,
-              false,
+              true,
               null,
               null,
               null,
