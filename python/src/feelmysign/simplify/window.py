@@ -222,7 +222,8 @@ class _WindowOwn:
         0,
         10_000,
         help="shortest stroke the sleeve plays without slowing it, in ms (its status says); "
-        "a briefer piece merges into a neighbour where the error bound allows",
+        "a piece drawn briefer merges into a neighbour where the error bound allows, else is "
+        "sent to last it",
         label="Sleeve floor",
         unit="ms",
     )
@@ -237,7 +238,7 @@ class _WindowOwn:
         30.0,
         0,
         1000,
-        help="with least_squares: how long the pen draws past a stroke's end before the "
+        help="with least squares on: how long the pen draws past a stroke's end before the "
         "stroke is sent, in ms",
         label="Lookahead",
         unit="ms",

@@ -195,7 +195,8 @@ public final class ParamTable {
               "ms",
               "Sleeve floor",
               "shortest stroke the sleeve plays without slowing it, in ms (its status says); a "
-                  + "briefer piece merges into a neighbour where the error bound allows",
+                  + "piece drawn briefer merges into a neighbour where the error bound allows, "
+                  + "else is sent to last it",
               "simplifier",
               null,
               null),
@@ -227,8 +228,8 @@ public final class ParamTable {
               1000.0,
               "ms",
               "Lookahead",
-              "with least_squares: how long the pen draws past a stroke's end before the stroke is "
-                  + "sent, in ms",
+              "with least squares on: how long the pen draws past a stroke's end before the stroke "
+                  + "is sent, in ms",
               "simplifier",
               null,
               null),
