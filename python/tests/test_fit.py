@@ -44,8 +44,10 @@ def test_the_strokes_are_the_research_references_online_polyline(
     case: tuple[WindowParams, list[Sample]],
 ) -> None:
     # floor_reference.online_at_floor solves the whole problem again at every sample with numpy;
-    # the core solves it one sample at a time. Same pieces, let go by the same samples.
+    # the core solves it one sample at a time. Same pieces, let go by the same samples. (Without
+    # the latency cap: the core's pieces keep it, the reference's only let go by it.)
     params, samples = case
+    params = WindowParams(**{**params.__dict__, "max_stroke_ms": 0.0})
     core = FitCore(params)
     pieces = [piece for sample in samples for piece in core.push(sample)] + core.end()
     mapping = params.mapping
@@ -87,6 +89,11 @@ def test_every_sample_lies_within_max_error_of_the_stroke_drawn_through_it(
     for stroke in strokes:
         if stroke.dropped is None and stroke.end_ms - stroke.start_ms < params.floor_ms:
             assert stroke.duration_ms >= params.floor_ms, stroke
+    # None outlasts the latency cap, but one from a sample to the next drawn further apart.
+    cap = params.max_stroke_ms
+    for stroke in strokes:
+        between = [s for s in samples if stroke.start_ms < s.t_ms < stroke.end_ms]
+        assert cap == 0 or stroke.end_ms - stroke.start_ms <= cap or not between, stroke
     assert all(s.dropped is None for s in strokes) or len(strokes) == 1
 
 

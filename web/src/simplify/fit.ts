@@ -288,7 +288,14 @@ export class FitCore {
    * sample until the next): the first start.
    */
   #errorsTo(k: number): number {
-    const low = Math.max(0, k - this.params.max_window);
+    let low = Math.max(0, k - this.params.max_window);
+    // No piece outlasts the latency cap, but one between two samples drawn further apart.
+    const capMs = this.params.max_stroke_ms;
+    if (capMs > 0) {
+      const ts = this.#ts;
+      const tK = ts[k]!;
+      while (low < k - 1 && tK - ts[low]! > capMs) low++;
+    }
     if (this.#errorsEnd === k) return low;
     const xs = this.#xs;
     const ys = this.#ys;

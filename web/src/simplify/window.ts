@@ -952,6 +952,11 @@ export class Merger {
    */
   readonly #holdShort: boolean;
   /**
+   * With holdShort off (the least squares' pieces): no merge makes a stroke outlast this (the
+   * latency cap, ms; 0: no limit). The window's own merges keep it by their pieces.
+   */
+  readonly #capMs: number;
+  /**
    * The drawn samples (ms, grid units), oldest first: those not yet covered by a sent stroke are
    * [first, count) (`Drawn`). The window's own store when the merger takes its pieces (each
    * sample stored once), else one of its own that `sample` fills. Not a typed array: its buffer
@@ -977,6 +982,7 @@ export class Merger {
     floorMs: number,
     strict = false,
     holdShort = true,
+    capMs = 0,
     drawn: Drawn = new Drawn(),
   ) {
     this.#drawn = drawn;
@@ -987,6 +993,7 @@ export class Merger {
     this.#shortMs = Math.max(minDurationMs, floorMs);
     this.#strict = strict;
     this.#holdShort = holdShort;
+    this.#capMs = capMs;
   }
 
   /** A drawn sample, in order (its time as the window took it). */
@@ -1093,7 +1100,11 @@ export class Merger {
     const held = this.#held;
     if (held !== null) {
       this.#held = null;
-      if (this.#fits(held.start, piece.end, piece.end_ms) || (this.#strict && this.#belowMinimums(held))) {
+      const withinCap = this.#holdShort || this.#capMs <= 0 || piece.end_ms - held.start_ms <= this.#capMs;
+      if (
+        (withinCap && this.#fits(held.start, piece.end, piece.end_ms)) ||
+        (this.#strict && this.#belowMinimums(held))
+      ) {
         piece = {
           start: held.start,
           end: piece.end,
@@ -1221,6 +1232,7 @@ export class WindowSimplifier {
         params.floor_ms,
         params.strict_minimums,
         params.strict_minimums,
+        params.max_stroke_ms,
       );
       return;
     }
@@ -1235,6 +1247,7 @@ export class WindowSimplifier {
       params.floor_ms,
       params.strict_minimums,
       true,
+      0,
       drawn,
     );
   }

@@ -14,7 +14,8 @@ Recognition Letters 15, 1994) with the floor and the bound as constraints on eac
 of a count of pieces, solved one sample at a time: each sample's best polyline from the anchor
 is found once, from those of the samples before it, and each piece's error comes from running
 sums in O(1). The last stroke of the polyline to the newest sample may be briefer than the floor
-(the path goes on).
+(the path goes on). No stroke lasts longer than the latency cap (``max_stroke_ms``), but one
+between two samples drawn further apart than it.
 
 A stroke is let go, its first vertex after the anchor final, once the pen has drawn
 ``lookahead_ms`` past that vertex, or once that stroke lasts more than ``max_stroke_ms`` (the
@@ -204,6 +205,13 @@ class FitCore:
         """Each piece's error to sample k, from every start it may have (into ``_errors``, kept
         for the sample until the next): the first start."""
         low = max(0, k - self.params.max_window)
+        # No piece outlasts the latency cap, but one between two samples drawn further apart.
+        cap_ms = self.params.max_stroke_ms
+        if cap_ms > 0.0:
+            ts = self._ts
+            t_k = ts[k]
+            while low < k - 1 and t_k - ts[low] > cap_ms:
+                low += 1
         if self._errors_end == k:
             return low
         xs, ys = self._xs, self._ys

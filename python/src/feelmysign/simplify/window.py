@@ -722,6 +722,9 @@ class Merger:
     # drawn by a nearly still pen; each is sent as it is, a brief one to last the floor (holding
     # them made the felt end later and lost shapes drawn fast: docs/research.md).
     hold_short: bool = True
+    # With hold_short off (the least squares' pieces): no merge makes a stroke outlast this (the
+    # latency cap, ms; 0: no limit). The window's own merges keep it by their pieces.
+    cap_ms: float = 0.0
     # The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first.
     _points: list[Point] = field(default_factory=list)
     _times: list[float] = field(default_factory=list)
@@ -797,7 +800,10 @@ class Merger:
         held = self._held
         if held is not None:
             self._held = None
-            if self._fits(held.start, piece.end, piece.end_ms) or (
+            within_cap = (
+                self.hold_short or self.cap_ms <= 0.0 or piece.end_ms - held.start_ms <= self.cap_ms
+            )
+            if (within_cap and self._fits(held.start, piece.end, piece.end_ms)) or (
                 self.strict and self._below_minimums(held)
             ):
                 piece = Segment(
@@ -899,6 +905,7 @@ class WindowSimplifier:
             params.floor_ms,
             params.strict_minimums,
             hold_short=not params.least_squares or params.strict_minimums,
+            cap_ms=params.max_stroke_ms,
         )
 
     @property

@@ -283,6 +283,13 @@ final class FitCore implements PieceCore {
    * sample until the next): the first start. */
   private int errorsTo(int k) {
     int low = Math.max(0, k - maxWindow);
+    // No piece outlasts the latency cap, but one between two samples drawn further apart.
+    if (maxStrokeMs > 0.0) {
+      double tK = ts[k];
+      while (low < k - 1 && tK - ts[low] > maxStrokeMs) {
+        low++;
+      }
+    }
     if (errorsEnd == k) {
       return low;
     }

@@ -51,7 +51,8 @@ public final class WindowSimplifier implements Simplifier {
             params.number("min_duration_ms"),
             params.number("floor_ms"),
             strict,
-            !leastSquares || strict);
+            !leastSquares || strict,
+            params.number("max_stroke_ms"));
   }
 
   public Params params() {
@@ -804,6 +805,9 @@ final class Merger {
    * squares' pieces do not, unless strict: each is sent as it is, a brief one to last the
    * floor. */
   private final boolean holdShort;
+  // With holdShort off (the least squares' pieces): no merge makes a stroke outlast this (the
+  // latency cap, ms; 0: no limit). The window's own merges keep it by their pieces.
+  private final double capMs;
   // The drawn samples not yet covered by a sent stroke (grid units, ms), oldest first:
   // [first, size).
   private double[] xs = new double[64];
@@ -826,17 +830,19 @@ final class Merger {
       double minDurationMs,
       double floorMs,
       boolean strict,
-      boolean holdShort) {
+      boolean holdShort,
+      double capMs) {
     this.maxError = maxError;
     this.minLength = minLength;
     this.minDurationMs = minDurationMs;
     this.shortMs = Math.max(minDurationMs, floorMs);
     this.strict = strict;
     this.holdShort = holdShort;
+    this.capMs = capMs;
   }
 
   Merger(double maxError, double minLength, double minDurationMs, double floorMs, boolean strict) {
-    this(maxError, minLength, minDurationMs, floorMs, strict, true);
+    this(maxError, minLength, minDurationMs, floorMs, strict, true, 0.0);
   }
 
   Merger(double maxError, double minLength, double minDurationMs, double floorMs) {
@@ -943,7 +949,8 @@ final class Merger {
     Segment before = held;
     if (before != null) {
       held = null;
-      if (fits(before, piece) || (strict && belowMinimums(before))) {
+      boolean withinCap = holdShort || capMs <= 0.0 || piece.endMs() - before.startMs() <= capMs;
+      if ((withinCap && fits(before, piece)) || (strict && belowMinimums(before))) {
         piece =
             new Segment(
                 before.startX(),
