@@ -372,7 +372,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     maximum: 100,
     unit: "grid units",
     label: "Min length",
-    help: "shortest stroke to send, in grid units",
+    help: "shortest stroke to send, in grid units (the window's least-squares core holds only a path's first piece to it, unless strict_minimums)",
     panel: "simplifier",
     detail_levels: null,
     short: null,

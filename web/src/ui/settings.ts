@@ -426,8 +426,9 @@ export function detailLimit(candidate: { algorithm?: unknown; max_stroke_ms?: un
   const capMs = candidate.max_stroke_ms;
   if (candidate.algorithm !== "window" || typeof capMs !== "number" || !(capMs > 0)) return "";
   return (
-    `The longest stroke (${capMs} ms of drawing, under Advanced) cuts too: at any detail no stroke ` +
-    "lasts longer, so for a drawing slower than that, coarse sends about as many strokes as fine. " +
+    `The longest stroke (${capMs} ms of drawing, under Advanced) cuts too: at any detail a stroke ` +
+    "lasts longer only where it must (a path's first, one across a pause), so for a drawing slower " +
+    "than that, coarse sends about as many strokes as fine. " +
     "Set it to 0 for the fewest, longest strokes."
   );
 }

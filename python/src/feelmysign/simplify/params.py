@@ -225,7 +225,8 @@ class SharedParams:
         0.1,
         0,
         100,
-        help="shortest stroke to send, in grid units",
+        help="shortest stroke to send, in grid units (the window's least-squares core holds "
+        "only a path's first piece to it, unless strict_minimums)",
         label="Min length",
         unit="grid units",
         paper="minimumSize",

@@ -349,7 +349,8 @@ public final class ParamTable {
               100.0,
               "grid units",
               "Min length",
-              "shortest stroke to send, in grid units",
+              "shortest stroke to send, in grid units (the window's least-squares core holds only "
+                  + "a path's first piece to it, unless strict_minimums)",
               "simplifier",
               null,
               null),
