@@ -22,16 +22,40 @@ function kindOf(event: PointerEvent): PointerKind {
   return event.pointerType === "pen" || event.pointerType === "touch" ? event.pointerType : "mouse";
 }
 
+/**
+ * A pointer held still sends no events. After this long without one (ms, two frames) the page
+ * samples it where it is, and again as often while it stays: the simplifier's rest rule then
+ * sees the rest, and a stop mid-path is not played as a stroke as long as the stop.
+ */
+export const STILL_SAMPLE_MS = 32;
+
 export function attachPointer(view: DrawingView, handlers: PointerHandlers): () => void {
   const surface = view.surface;
   let activeId: number | null = null;
   let lastPressure = 0.5;
+  /** The last sample of the pointer down (real or sampled still), and the timer that samples it. */
+  let last: Sample | null = null;
+  let still: ReturnType<typeof setInterval> | null = null;
 
   const sample = (event: PointerEvent): Sample => {
     const [x, y] = view.toDrawing(event.clientX, event.clientY);
     const pressure = Number.isFinite(event.pressure) ? Math.min(Math.max(event.pressure, 0), 1) : 0.5;
     lastPressure = pressure;
-    return { t_ms: event.timeStamp, x, y, pressure };
+    last = { t_ms: event.timeStamp, x, y, pressure };
+    return last;
+  };
+
+  // Event times and performance.now() share one clock (the page's time origin).
+  const sampleStill = (): void => {
+    const now = performance.now();
+    if (activeId === null || last === null || now - last.t_ms < STILL_SAMPLE_MS) return;
+    last = { t_ms: now, x: last.x, y: last.y, pressure: last.pressure };
+    handlers.move([last]);
+  };
+  const stopStill = (): void => {
+    if (still !== null) clearInterval(still);
+    still = null;
+    last = null;
   };
 
   const onDown = (event: PointerEvent): void => {
@@ -45,6 +69,8 @@ export function attachPointer(view: DrawingView, handlers: PointerHandlers): () 
     }
     view.beginPointer();
     handlers.press(() => sample(event), kindOf(event));
+    stopStill();
+    still = setInterval(sampleStill, STILL_SAMPLE_MS / 2);
   };
 
   const onMove = (event: PointerEvent): void => {
@@ -56,6 +82,7 @@ export function attachPointer(view: DrawingView, handlers: PointerHandlers): () 
   const onUp = (event: PointerEvent): void => {
     if (event.pointerId !== activeId) return;
     activeId = null;
+    stopStill();
     // A lifted pointer reports pressure 0; the release point was drawn with the last pressure.
     const pressure = lastPressure;
     handlers.release({ ...sample(event), pressure });
@@ -73,6 +100,7 @@ export function attachPointer(view: DrawingView, handlers: PointerHandlers): () 
   const noMenu = (event: Event) => event.preventDefault();
   surface.addEventListener("contextmenu", noMenu);
   return () => {
+    stopStill();
     for (const [type, listener] of listeners) surface.removeEventListener(type, listener as EventListener);
     surface.removeEventListener("contextmenu", noMenu);
   };
