@@ -427,7 +427,7 @@ export function detailLimit(candidate: { algorithm?: unknown; max_stroke_ms?: un
   if (candidate.algorithm !== "window" || typeof capMs !== "number" || !(capMs > 0)) return "";
   return (
     `The longest stroke (${capMs} ms of drawing, under Advanced) cuts too: at any detail a stroke ` +
-    "lasts longer only where it must (a path's first, one across a pause), so for a drawing slower " +
+    "lasts longer only between two samples drawn further apart, so for a drawing slower " +
     "than that, coarse sends about as many strokes as fine. " +
     "Set it to 0 for the fewest, longest strokes."
   );
