@@ -128,3 +128,16 @@ def test_missing_file_and_bad_parameter(tmp_path: Path, capsys: pytest.CaptureFi
     assert caught.value.code == 2
     err = capsys.readouterr().err
     assert "--check-frames: 1 is out of range; give a whole number from" in err, err
+
+
+def test_a_gesture_log_given_to_simplify_is_named_and_pointed_to_evaluate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = tmp_path / "arrow01.xml"
+    log.write_text(
+        '<?xml version="1.0"?>\n<Gesture Name="arrow01"><Point X="1" Y="2" T="3"/></Gesture>\n'
+    )
+    assert main(["simplify", str(log)]) == 1
+    err = capsys.readouterr().err
+    assert "XML, not a recording" in err and "feelmysign evaluate reads $1 gesture logs" in err
+    assert "Traceback" not in err

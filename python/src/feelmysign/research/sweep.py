@@ -49,7 +49,10 @@ def parse_sweep(text: str) -> Sweep:
     try:
         numbers = [float(p) for p in parts]
     except ValueError:
-        raise SweepError(f"--sweep {text!r}: FROM, TO and STEP must be numbers") from None
+        raise SweepError(
+            f"--sweep {text!r}: FROM, TO and STEP must be numbers (a true/false parameter takes"
+            " true, false or 0:1:1)"
+        ) from None
     if len(numbers) == 1:
         return Sweep(name, (numbers[0],))
     if len(numbers) != 3:

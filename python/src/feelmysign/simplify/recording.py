@@ -75,6 +75,11 @@ def parse_recording(text: str, *, source: str = "<recording>") -> Recording:
     try:
         data = loads_json(text, parse_constant=_reject_constant)
     except ValueError as error:
+        if text.lstrip().startswith("<"):
+            raise RecordingError(
+                f"{source}: XML, not a recording; simplify and replay read recording JSON (the"
+                " page's Save), and feelmysign evaluate reads $1 gesture logs (.xml)"
+            ) from None
         raise RecordingError(f"{source}: not valid JSON ({error})") from error
     if not isinstance(data, dict):
         raise RecordingError(f"{source}: the recording must be a JSON object with canvas and paths")

@@ -64,6 +64,12 @@ public record Recording(
       throw new RecordingException(
           source + ": not valid JSON (" + error.literal() + " is not a number)");
     } catch (JsonDecodeException error) {
+      if (text.stripLeading().startsWith("<")) {
+        throw new RecordingException(
+            source
+                + ": XML, not a recording; simplify and replay read recording JSON (the page's"
+                + " Save), and feelmysign evaluate reads $1 gesture logs (.xml)");
+      }
       String detail = error.tooDeep() ? "nested too deeply to read" : error.getMessage();
       throw new RecordingException(source + ": not valid JSON (" + detail + ")");
     }
