@@ -218,9 +218,30 @@ class FitCore:
         ax, ay = xs[0], ys[0]
         errors = self._errors
         errors.clear()
-        sums = self._sums
+        # ``piece_error`` for every start, written out with the end's terms taken once (the
+        # same operations in the same order: each start's error to the last bit).
+        sx_, sy_, sxx_, syy_, sxy_ = self._sums
+        ex = xs[k] - ax
+        ey = ys[k] - ay
+        sx_end, sy_end = sx_[k + 1], sy_[k + 1]
+        sxx_end, syy_end, sxy_end = sxx_[k + 1], syy_[k + 1], sxy_[k + 1]
         for i in range(low, k):
-            errors.append(piece_error(xs, ys, ax, ay, sums, i, k))
+            count = float(k + 1 - i)
+            px = xs[i] - ax
+            py = ys[i] - ay
+            dx = ex - px
+            dy = ey - py
+            sx = sx_end - sx_[i]
+            sy = sy_end - sy_[i]
+            cxx = sxx_end - sxx_[i] - 2.0 * px * sx + count * px * px
+            cyy = syy_end - syy_[i] - 2.0 * py * sy + count * py * py
+            cxy = sxy_end - sxy_[i] - px * sy - py * sx + count * px * py
+            length_sq = dx * dx + dy * dy
+            if length_sq > 0.0:
+                error = (dx * dx * cyy + dy * dy * cxx - 2.0 * dx * dy * cxy) / length_sq
+            else:
+                error = cxx + cyy
+            errors.append(error if error > 0.0 else 0.0)
         self._errors_end = k
         return low
 
@@ -268,10 +289,24 @@ class FitCore:
         """Whether every sample between xs[start] and xs[end] lies within max_error of the
         segment between them."""
         xs, ys = self._xs, self._ys
-        ax, ay, ex, ey = xs[start], ys[start], xs[end], ys[end]
+        ax, ay = xs[start], ys[start]
         limit_sq = self._max_error_sq
+        # ``segment_distance_sq`` written out, the segment's terms taken once.
+        dx = xs[end] - ax
+        dy = ys[end] - ay
+        length_sq = dx * dx + dy * dy
         for m in range(start + 1, end):
-            if segment_distance_sq(xs[m], ys[m], ax, ay, ex, ey) > limit_sq:
+            qx = xs[m] - ax
+            qy = ys[m] - ay
+            if length_sq > 0.0:
+                t = (qx * dx + qy * dy) / length_sq
+                if t >= 1.0:
+                    qx = qx - dx
+                    qy = qy - dy
+                elif not t <= 0.0:
+                    qx = qx - t * dx
+                    qy = qy - t * dy
+            if qx * qx + qy * qy > limit_sq:
                 return False
         return True
 
