@@ -7,13 +7,14 @@ import itertools
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from simplifier_checks import random_walk
 
 from feelmysign.research.floor_reference import online_at_floor
 from feelmysign.simplify import Sample, WindowParams, WindowSimplifier
-from feelmysign.simplify.fit import FitCore, segment_distance_sq
+from feelmysign.simplify.fit import FitCore, piece_error, segment_distance_sq
 
 
 @st.composite
@@ -150,3 +151,34 @@ def test_a_resting_pen_ends_the_polyline_and_the_rest_is_not_played() -> None:
     # No stroke plays the rest: the one after it starts when the pen moves on.
     after = [s for s in strokes if s.start_ms > line[-1].t_ms]
     assert after and min(s.start_ms for s in after) >= 690.0
+
+
+@settings(max_examples=200, deadline=None)
+@given(fitted())
+def test_each_piece_s_error_is_its_samples_squared_distances_to_its_line(
+    case: tuple[WindowParams, list[Sample]],
+) -> None:
+    # The core's errors (written out in its loop) are piece_error's to the bit, and piece_error
+    # is the sum of each sample's squared distance to the piece's line, to rounding.
+    params, samples = case
+    params = WindowParams(**{**params.__dict__, "max_stroke_ms": 0.0, "lookahead_ms": 1000.0})
+    core = FitCore(params)
+    for sample in samples[:40]:
+        core.push(sample)
+    xs, ys, sums = core._xs, core._ys, core._sums
+    k = len(xs) - 1
+    if k < 1:
+        return
+    low = core._errors_to(k)
+    for i in range(low, k):
+        error = piece_error(xs, ys, xs[0], ys[0], sums, i, k)
+        assert core._errors[i - low] == error
+        ax, ay, dx, dy = xs[i], ys[i], xs[k] - xs[i], ys[k] - ys[i]
+        length = math.hypot(dx, dy)
+        direct = sum(
+            ((xs[m] - ax) * dy - (ys[m] - ay) * dx) ** 2 / length**2
+            if length > 0
+            else (xs[m] - ax) ** 2 + (ys[m] - ay) ** 2
+            for m in range(i, k + 1)
+        )
+        assert error == pytest.approx(direct, rel=1e-6, abs=1e-9)
