@@ -409,6 +409,9 @@ def _references(runs: list[Run]) -> dict[str, str]:
 def _table(
     summary: list[dict[str, Any]], recordings: int, out: Path, against: str | None = None
 ) -> str:
+    # Columns as wide as the longest set name and parameter set (a folder's own sets).
+    set_w = max([6, *(len(str(s["set"])) for s in summary)])
+    setting_w = max([30, *(len(str(s["setting"])) for s in summary)])
     lines = [
         f"{recordings} recording(s); means per recording; deviation and Fréchet in grid units;",
         "strokes: sent per recording; DP: offline Douglas-Peucker's at the same deviation; max",
@@ -421,14 +424,15 @@ def _table(
         "recognised: $1 on the drawings / strokes sent / felt path"
         + (f", against {against}" if against else ""),
         "",
-        f"{'set':<6} {'algorithm':<9} {'parameters':<30} {'strokes':>7} {'DP':>6} "
+        f"{'set':<{set_w}} {'algorithm':<9} {'parameters':<{setting_w}} {'strokes':>7} {'DP':>6} "
         f"{'max dev':>8} {'worst':>6} {'Fréchet':>7} {'skin':>5} {'p95':>5} "
         f"{'felt end p95':>12} {'pen p95':>8} {'faster':>6} {'skipped':>7} {'slowed':>6} "
         f"{'dropped':>7} {'recognised':>17}",
     ]
     for s in summary:
         lines.append(
-            f"{s['set']:<6} {s['algorithm']:<9} {s['setting']:<30} {s['strokes_mean']:>7.2f} "
+            f"{s['set']:<{set_w}} {s['algorithm']:<9} {s['setting']:<{setting_w}} "
+            f"{s['strokes_mean']:>7.2f} "
             f"{s['dp_strokes_mean']:>6.2f} {s['max_deviation_mean']:>8.3f} "
             f"{s['max_deviation_max']:>6.3f} {s['frechet_mean']:>7.3f} "
             f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
@@ -456,6 +460,7 @@ def _write_drawings_csv(drawings: list[dict[str, Any]], path: Path) -> None:
 
 def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
     floor_ms = at_floor[0]["floor_ms"] if at_floor else DEFAULT_FLOOR_MS
+    set_w = max([6, *(len(str(s["set"])) for s in at_floor)])
     lines = [
         "",
         f"Best at a floor of {floor_ms:g} ms (research.floor_reference): per drawing, the",
@@ -471,7 +476,7 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
         "worst: the farthest drawn sample from its stroke (grid units); recognised: $1 on the",
         "drawings / the polyline / its felt path",
         "",
-        f"{'set':<6} {'found':<18} {'strokes':>7} {'brief':>9} {'skin':>5} {'p95':>5} "
+        f"{'set':<{set_w}} {'found':<18} {'strokes':>7} {'brief':>9} {'skin':>5} {'p95':>5} "
         f"{'felt end p95':>12} {'worst':>6} {'recognised':>18}",
     ]
     for s in at_floor:
@@ -481,7 +486,7 @@ def _at_floor_table(at_floor: list[dict[str, Any]]) -> str:
         found = "offline" if s["lookahead_ms"] is None else f"online, {s['lookahead_ms']:g} ms"
         brief = f"{s['brief_strokes_total']}/{s['strokes_total']}"
         lines.append(
-            f"{s['set']:<6} {found:<18} {s['strokes_mean']:>7.2f} {brief:>9} "
+            f"{s['set']:<{set_w}} {found:<18} {s['strokes_mean']:>7.2f} {brief:>9} "
             f"{_num(s['skin_ratio_mean'], '.2f'):>5} {_num(s['skin_ratio_p95'], '.2f'):>5} "
             f"{_num(s['release_to_felt_end_p95_ms'], '.0f', ' ms'):>12} "
             f"{s['max_deviation_max']:>6.3f} "
