@@ -15,6 +15,7 @@ from simplifier_checks import random_walk
 from feelmysign.research.floor_reference import online_at_floor
 from feelmysign.simplify import Sample, WindowParams, WindowSimplifier
 from feelmysign.simplify.fit import FitCore, piece_error, segment_distance_sq
+from feelmysign.simplify.segment import Segment
 
 
 @st.composite
@@ -182,3 +183,34 @@ def test_each_piece_s_error_is_its_samples_squared_distances_to_its_line(
             for m in range(i, k + 1)
         )
         assert error == pytest.approx(direct, rel=1e-6, abs=1e-9)
+
+
+def test_a_sample_costs_at_most_a_few_bound_tests_per_sample_held() -> None:
+    # The widest settings the page offers (window 10000, no latency cap, lookahead 1000 ms, floor
+    # 10000 ms) and a slow arc at 1000 Hz: every piece is briefer than the floor, and at sample
+    # 1793 the fewest-pieces starts break the bound one after another (about 1000 of them). Each
+    # rejected start once cost a pass over every start and a test of every sample of its piece
+    # from the first (205698 distance tests and 4.6 s in one push); the starts are now taken
+    # from a heap in the same order and a piece's samples tested coarse to fine.
+    params = WindowParams(
+        least_squares=True,
+        max_window=10000,
+        max_stroke_ms=0.0,
+        lookahead_ms=1000.0,
+        floor_ms=10000.0,
+        rest_ms=0.0,
+        canvas_width_px=800,
+        canvas_height_px=600,
+    )
+    core = FitCore(params)
+    worst = 0
+    pieces: list[Segment] = []
+    for k in range(1800):
+        before = core.distance_tests
+        pieces += core.push(
+            Sample(float(k), 400 + 200 * math.cos(k * 0.002), 300 + 200 * math.sin(k * 0.002))
+        )
+        worst = max(worst, core.distance_tests - before)
+    pieces += core.end()
+    assert worst <= 2 * 1800
+    assert len(pieces) >= 2 and all(a.end == b.start for a, b in itertools.pairwise(pieces))

@@ -39,6 +39,7 @@ the TypeScript and Java ports, which reproduce the shared vectors exactly.
 
 from __future__ import annotations
 
+import heapq
 import itertools
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -90,6 +91,11 @@ class FitCore:
     # A piece's error per start, for the sample being placed (reused).
     _errors: list[float] = field(default_factory=list)
     _errors_end: int = -1
+    # Per sample, the sample that last broke the bound of a piece from it (-1: none yet): tested
+    # first, as it often breaks the next piece from there too.
+    _broke: list[int] = field(default_factory=list)
+    # How many sample distances the bound's tests have taken, in all (what a sample costs).
+    distance_tests: int = 0
     _pointer: Sample | None = None
     _emitted_in_path: bool = False
     # While the pen rests (``rest_ms``): the point it rests at; each sample near it retimes the
@@ -172,10 +178,16 @@ class FitCore:
     # --- the polyline -------------------------------------------------------------------------
 
     def _restart_at(
-        self, xs: list[float], ys: list[float], ts: list[float], samples: list[Sample]
+        self,
+        xs: list[float],
+        ys: list[float],
+        ts: list[float],
+        samples: list[Sample],
+        broke: list[int] | None = None,
     ) -> None:
         """The samples since a new anchor (xs[0]): running sums and best polylines again."""
         self._xs, self._ys, self._ts, self._samples = xs, ys, ts, samples
+        self._broke = broke if broke is not None else [-1] * len(xs)
         self._sums = [[0.0] for _ in range(5)]
         self._best, self._brief, self._before = [0.0], [0], [-1]
         self._errors_end = -1
@@ -198,6 +210,7 @@ class FitCore:
         self._ys.append(y)
         self._ts.append(t)
         self._samples.append(sample)
+        self._broke.append(-1)
         self._add_sums(x - self._xs[0], y - self._ys[0])
         self._place(len(self._xs) - 1)
 
@@ -249,31 +262,46 @@ class FitCore:
         """The best start of the last piece to sample k: the fewest pieces briefer than the
         floor (the last counted only when ``closed``), then the least squared error, then the
         earliest start; among the pieces that keep the bound (the piece from k - 1 always
-        does)."""
+        does).
+
+        The first choice is found in one pass; where its bound breaks, the other starts are
+        tested in the same order, from a heap of (count, error, start) built once: the totals
+        are never NaN (``piece_error`` gives none, and sums of numbers at or above 0 give
+        none), so that order is the pass's own and each sample costs O(max_window log
+        max_window) choices, not a pass per start rejected."""
         best, brief, errors, ts = self._best, self._brief, self._errors, self._ts
         floor_ms = self._floor_ms
         t_k = ts[k]
-        rejected: list[int] = []
+        chosen = -1
+        chosen_count = 0
+        chosen_total = 0.0
+        for i in range(low, k):
+            total = best[i] + errors[i - low]
+            count = brief[i]
+            if closed and t_k - ts[i] < floor_ms:
+                count += 1
+            if (
+                chosen < 0
+                or count < chosen_count
+                or (count == chosen_count and total < chosen_total)
+            ):
+                chosen, chosen_count, chosen_total = i, count, total
+        if chosen == k - 1 or self._keeps(chosen, k):
+            return chosen
+        heap = [
+            (
+                brief[i] + (1 if closed and t_k - ts[i] < floor_ms else 0),
+                best[i] + errors[i - low],
+                i,
+            )
+            for i in range(low, k)
+            if i != chosen
+        ]
+        heapq.heapify(heap)
         while True:
-            chosen = -1
-            chosen_count = 0
-            chosen_total = 0.0
-            for i in range(low, k):
-                if i in rejected:
-                    continue
-                total = best[i] + errors[i - low]
-                count = brief[i]
-                if closed and t_k - ts[i] < floor_ms:
-                    count += 1
-                if (
-                    chosen < 0
-                    or count < chosen_count
-                    or (count == chosen_count and total < chosen_total)
-                ):
-                    chosen, chosen_count, chosen_total = i, count, total
+            chosen = heapq.heappop(heap)[2]
             if chosen == k - 1 or self._keeps(chosen, k):
                 return chosen
-            rejected.append(chosen)
 
     def _place(self, k: int) -> None:
         """Sample k's best polyline from the anchor, every piece closed (at the floor)."""
@@ -287,27 +315,45 @@ class FitCore:
 
     def _keeps(self, start: int, end: int) -> bool:
         """Whether every sample between xs[start] and xs[end] lies within max_error of the
-        segment between them."""
+        segment between them. The answer is the same in any order of tests, so a rejected
+        start is made to cost few: the sample that broke the last piece tested from ``start``
+        is tested first, then the samples coarse to fine (the middle, the quarters, the
+        eighths, ...: a bulge the piece cuts off is met early)."""
         xs, ys = self._xs, self._ys
         ax, ay = xs[start], ys[start]
         limit_sq = self._max_error_sq
-        # ``segment_distance_sq`` written out, the segment's terms taken once.
-        dx = xs[end] - ax
-        dy = ys[end] - ay
-        length_sq = dx * dx + dy * dy
-        for m in range(start + 1, end):
-            qx = xs[m] - ax
-            qy = ys[m] - ay
-            if length_sq > 0.0:
-                t = (qx * dx + qy * dy) / length_sq
-                if t >= 1.0:
-                    qx = qx - dx
-                    qy = qy - dy
-                elif not t <= 0.0:
-                    qx = qx - t * dx
-                    qy = qy - t * dy
-            if qx * qx + qy * qy > limit_sq:
+        ex, ey = xs[end], ys[end]
+        m = self._broke[start]
+        if start < m < end:
+            self.distance_tests += 1
+            if segment_distance_sq(xs[m], ys[m], ax, ay, ex, ey) > limit_sq:
                 return False
+        # ``segment_distance_sq`` written out, the segment's terms taken once.
+        dx = ex - ax
+        dy = ey - ay
+        length_sq = dx * dx + dy * dy
+        span = end - start
+        step = 1
+        while step * 2 < span:
+            step *= 2
+        while step > 0:
+            for m in range(start + step, end, 2 * step):
+                qx = xs[m] - ax
+                qy = ys[m] - ay
+                if length_sq > 0.0:
+                    t = (qx * dx + qy * dy) / length_sq
+                    if t >= 1.0:
+                        qx = qx - dx
+                        qy = qy - dy
+                    elif not t <= 0.0:
+                        qx = qx - t * dx
+                        qy = qy - t * dy
+                if qx * qx + qy * qy > limit_sq:
+                    self._broke[start] = m
+                    self.distance_tests += (m - start - step) // (2 * step) + 1
+                    return False
+            self.distance_tests += len(range(start + step, end, 2 * step))
+            step //= 2
         return True
 
     def _polyline(self, last: int, out: list[Segment]) -> None:
@@ -334,7 +380,8 @@ class FitCore:
 
     def _from(self, k: int) -> None:
         """Sample k anchors the next stroke; the samples after it are taken again."""
-        self._restart_at(self._xs[k:], self._ys[k:], self._ts[k:], self._samples[k:])
+        broke = [m - k if m > k else -1 for m in self._broke[k:]]
+        self._restart_at(self._xs[k:], self._ys[k:], self._ts[k:], self._samples[k:], broke)
 
     def _let_go(self, out: list[Segment]) -> None:
         """Lets go each stroke that is final: its end drawn ``lookahead_ms`` ago, or the stroke
