@@ -128,9 +128,8 @@ export class FitCore {
   /** A piece's error per start, for the sample being placed (reused), and that sample. */
   readonly #errors: number[] = [];
   #errorsEnd = -1;
-  /** The starts `#choose` has rejected (their bound broken): those marked with `#round`. */
-  readonly #rejected: number[] = [];
-  #round = 0;
+  /** Per sample, the sample that last broke the bound of a piece from it (-1: none yet). */
+  #broke: number[] = [];
   #emittedInPath = false;
   /** While the pen rests (`rest_ms`): the point it rests at; each sample near it retimes the anchor. */
   #resting = false;
@@ -236,7 +235,8 @@ export class FitCore {
   // --- the polyline ----------------------------------------------------------------------------
 
   /** The samples since a new anchor (xs[0]): running sums and best polylines again. */
-  #restartAt(xs: number[], ys: number[], ts: number[], samples: Sample[]): void {
+  #restartAt(xs: number[], ys: number[], ts: number[], samples: Sample[], broke?: number[]): void {
+    this.#broke = broke ?? xs.map(() => -1);
     this.#xs = xs;
     this.#ys = ys;
     this.#ts = ts;
@@ -279,6 +279,7 @@ export class FitCore {
     ys.push(y);
     this.#ts.push(t);
     this.#samples.push(sample);
+    this.#broke.push(-1);
     this.#addSums(x - xs[0]!, y - ys[0]!);
     this.#place(xs.length - 1);
   }
@@ -312,7 +313,9 @@ export class FitCore {
   /**
    * The best start of the last piece to sample k: the fewest pieces briefer than the floor (the
    * last counted only when `closed`), then the least squared error, then the earliest start; among
-   * the pieces that keep the bound (the piece from k - 1 always does).
+   * the pieces that keep the bound (the piece from k - 1 always does). Where the first choice's
+   * bound breaks, the other starts are tested in the same order, sorted once (the totals are never
+   * NaN). Python `FitCore._choose`.
    */
   #choose(k: number, low: number, closed: boolean): number {
     const best = this.#best;
@@ -321,27 +324,42 @@ export class FitCore {
     const ts = this.#ts;
     const floorMs = this.#floorMs;
     const tK = ts[k]!;
-    const rejected = this.#rejected;
-    // A mark of this call's own: the starts rejected before it are not.
-    const round = ++this.#round;
-    for (;;) {
-      let chosen = -1;
-      let chosenCount = 0;
-      let chosenTotal = 0;
-      for (let i = low; i < k; i++) {
-        if (rejected[i] === round) continue;
-        const total = best[i]! + errors[i - low]!;
-        let count = brief[i]!;
-        if (closed && tK - ts[i]! < floorMs) count += 1;
-        if (chosen < 0 || count < chosenCount || (count === chosenCount && total < chosenTotal)) {
-          chosen = i;
-          chosenCount = count;
-          chosenTotal = total;
-        }
+    let chosen = -1;
+    let chosenCount = 0;
+    let chosenTotal = 0;
+    for (let i = low; i < k; i++) {
+      const total = best[i]! + errors[i - low]!;
+      let count = brief[i]!;
+      if (closed && tK - ts[i]! < floorMs) count += 1;
+      if (chosen < 0 || count < chosenCount || (count === chosenCount && total < chosenTotal)) {
+        chosen = i;
+        chosenCount = count;
+        chosenTotal = total;
       }
-      if (chosen === k - 1 || this.#keeps(chosen, k)) return chosen;
-      rejected[chosen] = round;
     }
+    if (chosen === k - 1 || this.#keeps(chosen, k)) return chosen;
+    const starts: number[] = [];
+    const counts: number[] = [];
+    const totals: number[] = [];
+    for (let i = low; i < k; i++) {
+      counts.push(brief[i]! + (closed && tK - ts[i]! < floorMs ? 1 : 0));
+      totals.push(best[i]! + errors[i - low]!);
+      if (i !== chosen) starts.push(i);
+    }
+    starts.sort((a, b) => {
+      const ca = counts[a - low]!;
+      const cb = counts[b - low]!;
+      if (ca !== cb) return ca - cb;
+      const ta = totals[a - low]!;
+      const tb = totals[b - low]!;
+      if (ta < tb) return -1;
+      if (tb < ta) return 1;
+      return a - b;
+    });
+    for (const start of starts) {
+      if (start === k - 1 || this.#keeps(start, k)) return start;
+    }
+    return k - 1; // (never: the piece from k - 1 is among the starts)
   }
 
   /** Sample k's best polyline from the anchor, every piece closed (at the floor). */
@@ -355,7 +373,11 @@ export class FitCore {
     this.#before.push(i);
   }
 
-  /** Whether every sample between xs[start] and xs[end] lies within max_error of the segment between them. */
+  /**
+   * Whether every sample between xs[start] and xs[end] lies within max_error of the segment between
+   * them: the sample that broke the last piece tested from `start` first, then the samples coarse
+   * to fine (the answer is the same in any order). Python `FitCore._keeps`.
+   */
   #keeps(start: number, end: number): boolean {
     const xs = this.#xs;
     const ys = this.#ys;
@@ -364,8 +386,20 @@ export class FitCore {
     const ex = xs[end]!;
     const ey = ys[end]!;
     const limitSq = this.#maxErrorSq;
-    for (let m = start + 1; m < end; m++) {
-      if (segmentDistanceSq(xs[m]!, ys[m]!, ax, ay, ex, ey) > limitSq) return false;
+    const broke = this.#broke[start]!;
+    if (start < broke && broke < end && segmentDistanceSq(xs[broke]!, ys[broke]!, ax, ay, ex, ey) > limitSq) {
+      return false;
+    }
+    const span = end - start;
+    let step = 1;
+    while (step * 2 < span) step *= 2;
+    for (; step > 0; step = Math.floor(step / 2)) {
+      for (let m = start + step; m < end; m += 2 * step) {
+        if (segmentDistanceSq(xs[m]!, ys[m]!, ax, ay, ex, ey) > limitSq) {
+          this.#broke[start] = m;
+          return false;
+        }
+      }
     }
     return true;
   }
@@ -389,7 +423,8 @@ export class FitCore {
 
   /** Sample k anchors the next stroke; the samples after it are taken again. */
   #from(k: number): void {
-    this.#restartAt(this.#xs.slice(k), this.#ys.slice(k), this.#ts.slice(k), this.#samples.slice(k));
+    const broke = this.#broke.slice(k).map((m) => (m > k ? m - k : -1));
+    this.#restartAt(this.#xs.slice(k), this.#ys.slice(k), this.#ts.slice(k), this.#samples.slice(k), broke);
   }
 
   /**
