@@ -63,9 +63,12 @@ final class FitCore implements PieceCore {
   // A piece's error per start (from the first start), for the sample errorsEnd (reused).
   private double[] errors = new double[64];
   private int errorsEnd = -1;
-  // The starts a choice has found breaking the bound: those marked with the choice's number.
-  private int[] rejected = new int[64];
-  private int choice;
+  // Per sample, the sample that last broke the bound of a piece from it (-1: none yet).
+  private int[] broke = new int[64];
+  // The starts of a choice after its first one broke the bound, and their counts and totals.
+  private Integer[] starts = new Integer[0];
+  private int[] startCounts = new int[64];
+  private double[] startTotals = new double[64];
 
   private Sample pointer;
   private boolean emittedInPath;
@@ -221,7 +224,9 @@ final class FitCore implements PieceCore {
     brief = Arrays.copyOf(brief, capacity);
     before = Arrays.copyOf(before, capacity);
     errors = Arrays.copyOf(errors, capacity);
-    rejected = Arrays.copyOf(rejected, capacity);
+    broke = Arrays.copyOf(broke, capacity);
+    startCounts = Arrays.copyOf(startCounts, capacity);
+    startTotals = Arrays.copyOf(startTotals, capacity);
   }
 
   private void put(int index, double x, double y, double t, Sample sample) {
@@ -242,6 +247,12 @@ final class FitCore implements PieceCore {
       System.arraycopy(ys, from, ys, 0, n);
       System.arraycopy(ts, from, ts, 0, n);
       System.arraycopy(samples, from, samples, 0, n);
+      for (int m = 0; m < n; m++) {
+        int at = broke[from + m];
+        broke[m] = at > from ? at - from : -1;
+      }
+    } else {
+      Arrays.fill(broke, 0, n, -1);
     }
     count = n;
     sumX[0] = 0.0;
@@ -274,6 +285,7 @@ final class FitCore implements PieceCore {
   private void append(double x, double y, double t, Sample sample) {
     int k = count;
     put(k, x, y, t, sample);
+    broke[k] = -1;
     count = k + 1;
     addSums(k + 1, x - xs[0], y - ys[0]);
     place(k);
@@ -303,41 +315,69 @@ final class FitCore implements PieceCore {
   /**
    * The best start of the last piece to sample k: the fewest pieces briefer than the floor (the
    * last counted only when closed), then the least squared error, then the earliest start; among
-   * the pieces that keep the bound (the piece from k - 1 always does), tested lazily in that
-   * order.
+   * the pieces that keep the bound (the piece from k - 1 always does). Where the first choice's
+   * bound breaks, the other starts are tested in the same order, sorted once (the totals are never
+   * NaN). The reference's {@code _choose}.
    */
   private int choose(int k, int low, boolean closed) {
     double tK = ts[k];
-    int mark = ++choice;
-    if (mark == 0) {
-      // The marks wrapped around: none of the old ones may count.
-      Arrays.fill(rejected, 0);
-      mark = choice = 1;
-    }
-    while (true) {
-      int chosen = -1;
-      int chosenCount = 0;
-      double chosenTotal = 0.0;
-      for (int i = low; i < k; i++) {
-        if (rejected[i] == mark) {
-          continue;
-        }
-        double total = best[i] + errors[i - low];
-        int n = brief[i];
-        if (closed && tK - ts[i] < floorMs) {
-          n += 1;
-        }
-        if (chosen < 0 || n < chosenCount || (n == chosenCount && total < chosenTotal)) {
-          chosen = i;
-          chosenCount = n;
-          chosenTotal = total;
-        }
+    int chosen = -1;
+    int chosenCount = 0;
+    double chosenTotal = 0.0;
+    for (int i = low; i < k; i++) {
+      double total = best[i] + errors[i - low];
+      int n = brief[i];
+      if (closed && tK - ts[i] < floorMs) {
+        n += 1;
       }
-      if (chosen == k - 1 || keeps(chosen, k)) {
-        return chosen;
+      if (chosen < 0 || n < chosenCount || (n == chosenCount && total < chosenTotal)) {
+        chosen = i;
+        chosenCount = n;
+        chosenTotal = total;
       }
-      rejected[chosen] = mark;
     }
+    if (chosen == k - 1 || keeps(chosen, k)) {
+      return chosen;
+    }
+    if (starts.length < k - low) {
+      starts = new Integer[Math.max(k - low, starts.length * 2)];
+    }
+    int size = 0;
+    for (int i = low; i < k; i++) {
+      startCounts[i - low] = brief[i] + (closed && tK - ts[i] < floorMs ? 1 : 0);
+      startTotals[i - low] = best[i] + errors[i - low];
+      if (i != chosen) {
+        starts[size++] = i;
+      }
+    }
+    final int first = low;
+    Arrays.sort(
+        starts,
+        0,
+        size,
+        (a, b) -> {
+          int ca = startCounts[a - first];
+          int cb = startCounts[b - first];
+          if (ca != cb) {
+            return ca < cb ? -1 : 1;
+          }
+          double ta = startTotals[a - first];
+          double tb = startTotals[b - first];
+          if (ta < tb) {
+            return -1;
+          }
+          if (tb < ta) {
+            return 1;
+          }
+          return Integer.compare(a, b);
+        });
+    for (int s = 0; s < size; s++) {
+      int start = starts[s];
+      if (start == k - 1 || keeps(start, k)) {
+        return start;
+      }
+    }
+    return k - 1; // (never: the piece from k - 1 is among the starts)
   }
 
   /** Sample k's best polyline from the anchor, every piece closed (at the floor). */
@@ -351,17 +391,34 @@ final class FitCore implements PieceCore {
     before[k] = i;
   }
 
-  /** Whether every sample between xs[start] and xs[end] lies within max_error of the segment
-   * between them. */
+  /**
+   * Whether every sample between xs[start] and xs[end] lies within max_error of the segment between
+   * them: the sample that broke the last piece tested from start first, then the samples coarse to
+   * fine (the answer is the same in any order). The reference's {@code _keeps}.
+   */
   private boolean keeps(int start, int end) {
     double ax = xs[start];
     double ay = ys[start];
     double ex = xs[end];
     double ey = ys[end];
     double limitSq = maxErrorSq;
-    for (int m = start + 1; m < end; m++) {
-      if (segmentDistanceSq(xs[m], ys[m], ax, ay, ex, ey) > limitSq) {
-        return false;
+    int last = broke[start];
+    if (start < last
+        && last < end
+        && segmentDistanceSq(xs[last], ys[last], ax, ay, ex, ey) > limitSq) {
+      return false;
+    }
+    int span = end - start;
+    int step = 1;
+    while (step * 2 < span) {
+      step *= 2;
+    }
+    for (; step > 0; step /= 2) {
+      for (int m = start + step; m < end; m += 2 * step) {
+        if (segmentDistanceSq(xs[m], ys[m], ax, ay, ex, ey) > limitSq) {
+          broke[start] = m;
+          return false;
+        }
       }
     }
     return true;
