@@ -5,11 +5,12 @@
  * rest rule sees the stop: the stroke before it is sent at once, and the stop is not played as a
  * stroke as long as itself.
  */
+import { execFileSync } from "node:child_process";
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
-import { RESULTS_DIR } from "./harness";
+import { FEELMYSIGN, RESULTS_DIR } from "./harness";
 import { drawingArea, moveByClock, waitForPlayed, type Area } from "./page";
 import { Processes } from "./processes";
 
@@ -56,6 +57,15 @@ describe("a pen held still mid-path, no event sent", () => {
     // The stop was sampled: samples at one place, no gap of more than a few frames among them.
     const gaps = samples.slice(1).map((s, i) => s.t_ms - samples[i]!.t_ms);
     expect(Math.max(...gaps), JSON.stringify(gaps)).toBeLessThan(STOP_MS / 4);
+    // ... and never back in time (an event handled after a still sample may be older than it).
+    expect(Math.min(...gaps), JSON.stringify(gaps)).toBeGreaterThanOrEqual(0);
+    // The reference reads the recording (it refuses samples out of order) and sends the same.
+    const replay = JSON.parse(
+      execFileSync(FEELMYSIGN, ["simplify", file, "--json"], { encoding: "utf8" }),
+    ) as {
+      strokes: unknown[];
+    };
+    expect(replay.strokes).toHaveLength(recording.strokes.length);
     const stillSamples = samples.filter(
       (s, i) => i > 0 && s.x === samples[i - 1]!.x && s.y === samples[i - 1]!.y,
     );

@@ -41,7 +41,9 @@ export function attachPointer(view: DrawingView, handlers: PointerHandlers): () 
     const [x, y] = view.toDrawing(event.clientX, event.clientY);
     const pressure = Number.isFinite(event.pressure) ? Math.min(Math.max(event.pressure, 0), 1) : 0.5;
     lastPressure = pressure;
-    last = { t_ms: event.timeStamp, x, y, pressure };
+    // An event handled after a still sample may be older than it: never back in time.
+    const t = last !== null && event.timeStamp < last.t_ms ? last.t_ms : event.timeStamp;
+    last = { t_ms: t, x, y, pressure };
     return last;
   };
 
@@ -67,9 +69,9 @@ export function attachPointer(view: DrawingView, handlers: PointerHandlers): () 
     } catch {
       // A pointer that is already gone cannot be captured; the path still works inside the canvas.
     }
+    stopStill();
     view.beginPointer();
     handlers.press(() => sample(event), kindOf(event));
-    stopStill();
     still = setInterval(sampleStill, STILL_SAMPLE_MS / 2);
   };
 
