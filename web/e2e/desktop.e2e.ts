@@ -138,8 +138,12 @@ describe("drawing with a mouse on a desktop", () => {
     await waitForData(page, '[data-testid="played-summary"]', "played", "3");
     const log = page.locator('[data-testid="event-log"] li').first();
     await expect(log.innerText()).resolves.toContain("Stroke 3 refused: duration_ms is 12000");
-    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toBe(
-      `3 of ${sentCount} strokes played, 1 refused.`,
+    // (With a note of the strokes drawn faster than the sleeve plays, sent at its floor, when the
+    // drawing by the clock of a loaded machine made some.)
+    await expect(page.locator('[data-testid="played-summary"]').innerText()).resolves.toMatch(
+      new RegExp(
+        `^3 of ${sentCount} strokes played( \\(\\d+ drawn faster than the sleeve can play, sent at its floor\\))?, 1 refused\\.$`,
+      ),
     );
     await screenshot(page, "desktop-after");
   });
