@@ -18,42 +18,13 @@
  * same to the last bit; ties break as there (the fewest pieces briefer than the floor, then the
  * least error, then the earliest start).
  */
+import { distanceSq } from "./distance";
 import { CanvasMapping } from "./mapping";
 import { finishSegment, type Point, type Sample, type Segment } from "./segment";
 import { restRadius } from "./rest";
 import { checkWindowParams, type WindowParams } from "./window-params";
 
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
-
-/**
- * Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey): the projection clamped onto
- * it. Python `fit.segment_distance_sq`.
- */
-export function segmentDistanceSq(
-  px: number,
-  py: number,
-  ax: number,
-  ay: number,
-  ex: number,
-  ey: number,
-): number {
-  const dx = ex - ax;
-  const dy = ey - ay;
-  let qx = px - ax;
-  let qy = py - ay;
-  const lengthSq = dx * dx + dy * dy;
-  if (lengthSq > 0) {
-    const t = (qx * dx + qy * dy) / lengthSq;
-    if (t >= 1) {
-      qx = qx - dx;
-      qy = qy - dy;
-    } else if (!(t <= 0)) {
-      qx = qx - t * dx;
-      qy = qy - t * dy;
-    }
-  }
-  return qx * qx + qy * qy;
-}
 
 /** Running sums of x, y, x^2, y^2 and xy over samples (each of length n + 1, from 0). */
 export interface RunningSums {
@@ -387,7 +358,7 @@ export class FitCore {
     const ey = ys[end]!;
     const limitSq = this.#maxErrorSq;
     const broke = this.#broke[start]!;
-    if (start < broke && broke < end && segmentDistanceSq(xs[broke]!, ys[broke]!, ax, ay, ex, ey) > limitSq) {
+    if (start < broke && broke < end && distanceSq(xs[broke]!, ys[broke]!, ax, ay, ex, ey) > limitSq) {
       return false;
     }
     const span = end - start;
@@ -395,7 +366,7 @@ export class FitCore {
     while (step * 2 < span) step *= 2;
     for (; step > 0; step = Math.floor(step / 2)) {
       for (let m = start + step; m < end; m += 2 * step) {
-        if (segmentDistanceSq(xs[m]!, ys[m]!, ax, ay, ex, ey) > limitSq) {
+        if (distanceSq(xs[m]!, ys[m]!, ax, ay, ex, ey) > limitSq) {
           this.#broke[start] = m;
           return false;
         }

@@ -405,7 +405,7 @@ final class FitCore implements PieceCore {
     int last = broke[start];
     if (start < last
         && last < end
-        && segmentDistanceSq(xs[last], ys[last], ax, ay, ex, ey) > limitSq) {
+        && WindowCore.distanceSq(xs[last], ys[last], ax, ay, ex, ey) > limitSq) {
       return false;
     }
     int span = end - start;
@@ -415,7 +415,7 @@ final class FitCore implements PieceCore {
     }
     for (; step > 0; step /= 2) {
       for (int m = start + step; m < end; m += 2 * step) {
-        if (segmentDistanceSq(xs[m], ys[m], ax, ay, ex, ey) > limitSq) {
+        if (WindowCore.distanceSq(xs[m], ys[m], ax, ay, ex, ey) > limitSq) {
           broke[start] = m;
           return false;
         }
@@ -564,27 +564,5 @@ final class FitCore implements PieceCore {
       error = cxx + cyy;
     }
     return error > 0.0 ? error : 0.0;
-  }
-
-  /** Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey): the projection clamped
-   * onto it (the reference's {@code fit.segment_distance_sq}, its operations in its order). */
-  static double segmentDistanceSq(
-      double px, double py, double ax, double ay, double ex, double ey) {
-    double dx = ex - ax;
-    double dy = ey - ay;
-    double qx = px - ax;
-    double qy = py - ay;
-    double lengthSq = dx * dx + dy * dy;
-    if (lengthSq > 0.0) {
-      double t = (qx * dx + qy * dy) / lengthSq;
-      if (t >= 1.0) {
-        qx = qx - dx;
-        qy = qy - dy;
-      } else if (!(t <= 0.0)) {
-        qx = qx - t * dx;
-        qy = qy - t * dy;
-      }
-    }
-    return qx * qx + qy * qy;
   }
 }

@@ -111,7 +111,7 @@ class FitPropertyTest {
           for (Segment s : strokes) {
             if (s.sent()) {
               double d =
-                  FitCore.segmentDistanceSq(x, y, s.startX(), s.startY(), s.endX(), s.endY());
+                  WindowCore.distanceSq(x, y, s.startX(), s.startY(), s.endX(), s.endY());
               nearest = Math.min(nearest, Math.sqrt(d));
             }
           }
