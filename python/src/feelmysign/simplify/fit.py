@@ -50,6 +50,10 @@ from feelmysign.stroke import Point
 if TYPE_CHECKING:
     from feelmysign.simplify.window import WindowParams
 
+# The running sums at a sample: of x, y, x^2, y^2 and xy over the samples before it, each
+# relative to the anchor.
+Sums = tuple[float, float, float, float, float]
+
 
 def segment_distance_sq(px: float, py: float, ax: float, ay: float, ex: float, ey: float) -> float:
     """Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey): the projection clamped
@@ -82,7 +86,7 @@ class FitCore:
     _ts: list[float] = field(default_factory=list)
     _samples: list[Sample] = field(default_factory=list)
     # Running sums of x, y, x^2, y^2 and xy over the samples, relative to the anchor's point.
-    _sums: list[list[float]] = field(default_factory=lambda: [[0.0] for _ in range(5)])
+    _sums: list[Sums] = field(default_factory=lambda: [(0.0, 0.0, 0.0, 0.0, 0.0)])
     # Each sample's best polyline from the anchor (every piece at the floor, where the bound lets
     # it be): its squared error, its count of pieces briefer than the floor and its last vertex.
     _best: list[float] = field(default_factory=list)
@@ -91,6 +95,14 @@ class FitCore:
     # A piece's error per start, for the sample being placed (reused).
     _errors: list[float] = field(default_factory=list)
     _errors_end: int = -1
+    # For that sample: its first start (``_errors[0]`` is the piece from it) and the best start
+    # of an open last piece before its bound is tested (``_choose``'s first choice).
+    _errors_low: int = 0
+    _open_first: int = -1
+    # The last piece found to keep the bound (its start and end), not tested twice: the closed
+    # and the open choice for the newest sample are often the same piece.
+    _kept_start: int = -1
+    _kept_end: int = -1
     # Per sample, the sample that last broke the bound of a piece from it (-1: none yet): tested
     # first, as it often breaks the next piece from there too.
     _broke: list[int] = field(default_factory=list)
@@ -112,6 +124,8 @@ class FitCore:
         params = self.params
         self._max_error_sq = params.max_error * params.max_error
         self._floor_ms = max(params.floor_ms, params.min_duration_ms)
+        self._max_window = params.max_window
+        self._cap_ms = params.max_stroke_ms
         rest = rest_radius(params)
         self._rest_sq = rest * rest
         self._mapping = params.mapping
@@ -188,9 +202,10 @@ class FitCore:
         """The samples since a new anchor (xs[0]): running sums and best polylines again."""
         self._xs, self._ys, self._ts, self._samples = xs, ys, ts, samples
         self._broke = broke if broke is not None else [-1] * len(xs)
-        self._sums = [[0.0] for _ in range(5)]
+        self._sums = [(0.0, 0.0, 0.0, 0.0, 0.0)]
         self._best, self._brief, self._before = [0.0], [0], [-1]
         self._errors_end = -1
+        self._kept_start = self._kept_end = -1
         ax, ay = xs[0], ys[0]
         self._add_sums(0.0, 0.0)
         for k in range(1, len(xs)):
@@ -198,12 +213,9 @@ class FitCore:
             self._place(k)
 
     def _add_sums(self, rx: float, ry: float) -> None:
-        sx, sy, sxx, syy, sxy = self._sums
-        sx.append(sx[-1] + rx)
-        sy.append(sy[-1] + ry)
-        sxx.append(sxx[-1] + rx * rx)
-        syy.append(syy[-1] + ry * ry)
-        sxy.append(sxy[-1] + rx * ry)
+        sums = self._sums
+        sx, sy, sxx, syy, sxy = sums[-1]
+        sums.append((sx + rx, sy + ry, sxx + rx * rx, syy + ry * ry, sxy + rx * ry))
 
     def _append(self, x: float, y: float, t: float, sample: Sample) -> None:
         self._xs.append(x)
@@ -211,83 +223,101 @@ class FitCore:
         self._ts.append(t)
         self._samples.append(sample)
         self._broke.append(-1)
-        self._add_sums(x - self._xs[0], y - self._ys[0])
+        # ``_add_sums``, written out.
+        rx = x - self._xs[0]
+        ry = y - self._ys[0]
+        sums = self._sums
+        sx, sy, sxx, syy, sxy = sums[-1]
+        sums.append((sx + rx, sy + ry, sxx + rx * rx, syy + ry * ry, sxy + rx * ry))
         self._place(len(self._xs) - 1)
 
-    def _errors_to(self, k: int) -> int:
-        """Each piece's error to sample k, from every start it may have (into ``_errors``, kept
-        for the sample until the next): the first start."""
-        low = max(0, k - self.params.max_window)
+    def _scan(self, k: int) -> tuple[int, int]:
+        """Each piece's error to sample k, from every start it may have (into ``_errors``), and
+        the first choice of ``_choose`` for its last piece closed and open, in one pass (kept
+        for the sample until the next): the first start and the closed first choice."""
+        low = k - self._max_window
+        if low < 0:
+            low = 0
+        ts = self._ts
+        t_k = ts[k]
         # No piece outlasts the latency cap, but one between two samples drawn further apart.
-        cap_ms = self.params.max_stroke_ms
+        cap_ms = self._cap_ms
         if cap_ms > 0.0:
-            ts = self._ts
-            t_k = ts[k]
             while low < k - 1 and t_k - ts[low] > cap_ms:
                 low += 1
-        if self._errors_end == k:
-            return low
         xs, ys = self._xs, self._ys
         ax, ay = xs[0], ys[0]
         errors = self._errors
         errors.clear()
+        append = errors.append
+        best, brief = self._best, self._brief
+        floor_ms = self._floor_ms
         # ``piece_error`` for every start, written out with the end's terms taken once (the
         # same operations in the same order: each start's error to the last bit).
-        sx_, sy_, sxx_, syy_, sxy_ = self._sums
+        sums = self._sums
         ex = xs[k] - ax
         ey = ys[k] - ay
-        sx_end, sy_end = sx_[k + 1], sy_[k + 1]
-        sxx_end, syy_end, sxy_end = sxx_[k + 1], syy_[k + 1], sxy_[k + 1]
+        sx_end, sy_end, sxx_end, syy_end, sxy_end = sums[k + 1]
+        # The first choices: the fewest pieces briefer than the floor, then the least squared
+        # error, then the earliest start (the last piece counted only when closed).
+        closed_start = open_start = -1
+        closed_count = open_count = 0
+        closed_total = open_total = 0.0
+        count = float(k + 1 - low)  # the piece's samples, k + 1 - i: whole numbers, exact
         for i in range(low, k):
-            count = float(k + 1 - i)
             px = xs[i] - ax
             py = ys[i] - ay
             dx = ex - px
             dy = ey - py
-            sx = sx_end - sx_[i]
-            sy = sy_end - sy_[i]
-            cxx = sxx_end - sxx_[i] - 2.0 * px * sx + count * px * px
-            cyy = syy_end - syy_[i] - 2.0 * py * sy + count * py * py
-            cxy = sxy_end - sxy_[i] - px * sy - py * sx + count * px * py
+            sx_i, sy_i, sxx_i, syy_i, sxy_i = sums[i]
+            sx = sx_end - sx_i
+            sy = sy_end - sy_i
+            cxx = sxx_end - sxx_i - 2.0 * px * sx + count * px * px
+            cyy = syy_end - syy_i - 2.0 * py * sy + count * py * py
+            cxy = sxy_end - sxy_i - px * sy - py * sx + count * px * py
+            count -= 1.0
             length_sq = dx * dx + dy * dy
             if length_sq > 0.0:
                 error = (dx * dx * cyy + dy * dy * cxx - 2.0 * dx * dy * cxy) / length_sq
             else:
                 error = cxx + cyy
-            errors.append(error if error > 0.0 else 0.0)
+            if not error > 0.0:
+                error = 0.0
+            append(error)
+            total = best[i] + error
+            pieces = brief[i]
+            if (
+                open_start < 0
+                or pieces < open_count
+                or (pieces == open_count and total < open_total)
+            ):
+                open_start, open_count, open_total = i, pieces, total
+            if t_k - ts[i] < floor_ms:
+                pieces += 1
+            if (
+                closed_start < 0
+                or pieces < closed_count
+                or (pieces == closed_count and total < closed_total)
+            ):
+                closed_start, closed_count, closed_total = i, pieces, total
         self._errors_end = k
-        return low
+        self._errors_low = low
+        self._open_first = open_start
+        return low, closed_start
 
-    def _choose(self, k: int, low: int, closed: bool) -> int:
+    def _choose(self, k: int, low: int, closed: bool, chosen: int) -> int:
         """The best start of the last piece to sample k: the fewest pieces briefer than the
         floor (the last counted only when ``closed``), then the least squared error, then the
         earliest start; among the pieces that keep the bound (the piece from k - 1 always
-        does).
+        does). ``chosen`` is the first choice (``_scan``'s), whose bound the caller found broken.
 
-        The first choice is found in one pass; where its bound breaks, the other starts are
-        tested in the same order, from a heap of (count, error, start) built once: the totals
-        are never NaN (``piece_error`` gives none, and sums of numbers at or above 0 give
-        none), so that order is the pass's own and each sample costs O(max_window log
-        max_window) choices, not a pass per start rejected."""
+        The other starts are tested in the same order, from a heap of
+        (count, error, start) built once: the totals are never NaN (``piece_error`` gives none,
+        and sums of numbers at or above 0 give none), so that order is the pass's own and each
+        sample costs O(max_window log max_window) choices, not a pass per start rejected."""
         best, brief, errors, ts = self._best, self._brief, self._errors, self._ts
         floor_ms = self._floor_ms
         t_k = ts[k]
-        chosen = -1
-        chosen_count = 0
-        chosen_total = 0.0
-        for i in range(low, k):
-            total = best[i] + errors[i - low]
-            count = brief[i]
-            if closed and t_k - ts[i] < floor_ms:
-                count += 1
-            if (
-                chosen < 0
-                or count < chosen_count
-                or (count == chosen_count and total < chosen_total)
-            ):
-                chosen, chosen_count, chosen_total = i, count, total
-        if chosen == k - 1 or self._keeps(chosen, k):
-            return chosen
         heap = [
             (
                 brief[i] + (1 if closed and t_k - ts[i] < floor_ms else 0),
@@ -305,12 +335,12 @@ class FitCore:
 
     def _place(self, k: int) -> None:
         """Sample k's best polyline from the anchor, every piece closed (at the floor)."""
-        low = self._errors_to(k)
-        i = self._choose(k, low, closed=True)
-        total = self._best[i] + self._errors[i - low]
-        count = self._brief[i] + (1 if self._ts[k] - self._ts[i] < self._floor_ms else 0)
-        self._best.append(total)
-        self._brief.append(count)
+        low, i = self._scan(k)
+        if i != k - 1 and not self._keeps(i, k):
+            i = self._choose(k, low, True, i)
+        ts = self._ts
+        self._best.append(self._best[i] + self._errors[i - low])
+        self._brief.append(self._brief[i] + (1 if ts[k] - ts[i] < self._floor_ms else 0))
         self._before.append(i)
 
     def _keeps(self, start: int, end: int) -> bool:
@@ -319,6 +349,8 @@ class FitCore:
         start is made to cost few: the sample that broke the last piece tested from ``start``
         is tested first, then the samples coarse to fine (the middle, the quarters, the
         eighths, ...: a bulge the piece cuts off is met early)."""
+        if start == self._kept_start and end == self._kept_end:
+            return True
         xs, ys = self._xs, self._ys
         ax, ay = xs[start], ys[start]
         limit_sq = self._max_error_sq
@@ -354,6 +386,7 @@ class FitCore:
                     return False
             self.distance_tests += len(range(start + step, end, 2 * step))
             step //= 2
+        self._kept_start, self._kept_end = start, end
         return True
 
     def _polyline(self, last: int, out: list[Segment]) -> None:
@@ -394,8 +427,11 @@ class FitCore:
             j = len(ts) - 1
             if ts[j] - ts[0] < floor_ms:
                 return
-            low = self._errors_to(j)
-            last = self._choose(j, low, closed=False)
+            if self._errors_end != j:
+                self._scan(j)
+            last = self._open_first
+            if last != j - 1 and not self._keeps(last, j):
+                last = self._choose(j, self._errors_low, False, last)
             if last == 0:
                 # One stroke from the anchor: cut by the latency cap at the sample before.
                 if (
@@ -463,26 +499,27 @@ def piece_error(
     ys: list[float],
     ax: float,
     ay: float,
-    sums: list[list[float]],
+    sums: list[Sums],
     start: int,
     end: int,
 ) -> float:
     """The integral square error of the piece xs[start] -> xs[end]: the sum of the squared
     distances of samples start..end to the line through its ends (to its start where they
-    coincide), from the running sums ``sums`` = [x, y, xx, yy, xy] (each of length n + 1, of the
-    coordinates relative to the anchor (ax, ay)). Never below 0 (rounding); a NaN gives 0."""
-    sx_, sy_, sxx_, syy_, sxy_ = sums
+    coincide), from the running sums ``sums`` (n + 1 of them, from 0, of the coordinates
+    relative to the anchor (ax, ay)). Never below 0 (rounding); a NaN gives 0."""
+    sx_end, sy_end, sxx_end, syy_end, sxy_end = sums[end + 1]
+    sx_start, sy_start, sxx_start, syy_start, sxy_start = sums[start]
     count = float(end + 1 - start)
     px = xs[start] - ax
     py = ys[start] - ay
     dx = (xs[end] - ax) - px
     dy = (ys[end] - ay) - py
-    sx = sx_[end + 1] - sx_[start]
-    sy = sy_[end + 1] - sy_[start]
+    sx = sx_end - sx_start
+    sy = sy_end - sy_start
     # Sums of (x - px)^2, (y - py)^2 and (x - px)(y - py) over the piece's samples.
-    cxx = sxx_[end + 1] - sxx_[start] - 2.0 * px * sx + count * px * px
-    cyy = syy_[end + 1] - syy_[start] - 2.0 * py * sy + count * py * py
-    cxy = sxy_[end + 1] - sxy_[start] - px * sy - py * sx + count * px * py
+    cxx = sxx_end - sxx_start - 2.0 * px * sx + count * px * px
+    cyy = syy_end - syy_start - 2.0 * py * sy + count * py * py
+    cxy = sxy_end - sxy_start - px * sy - py * sx + count * px * py
     length_sq = dx * dx + dy * dy
     if length_sq > 0.0:
         error = (dx * dx * cyy + dy * dy * cxx - 2.0 * dx * dy * cxy) / length_sq
