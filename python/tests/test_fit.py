@@ -14,7 +14,8 @@ from simplifier_checks import random_walk
 
 from feelmysign.research.floor_reference import online_at_floor
 from feelmysign.simplify import Sample, WindowParams, WindowSimplifier
-from feelmysign.simplify.fit import FitCore, piece_error, segment_distance_sq
+from feelmysign.simplify.distance import segment_distance_sq
+from feelmysign.simplify.fit import FitCore, piece_error
 from feelmysign.simplify.segment import Segment
 
 

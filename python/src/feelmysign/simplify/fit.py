@@ -41,9 +41,11 @@ from __future__ import annotations
 
 import heapq
 import itertools
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from feelmysign.simplify.distance import ROUNDING_SLACK, segment_distance_sq
 from feelmysign.simplify.segment import Sample, Segment, finish_segment
 from feelmysign.stroke import Point
 
@@ -53,25 +55,6 @@ if TYPE_CHECKING:
 # The running sums at a sample: of x, y, x^2, y^2 and xy over the samples before it, each
 # relative to the anchor.
 Sums = tuple[float, float, float, float, float]
-
-
-def segment_distance_sq(px: float, py: float, ax: float, ay: float, ex: float, ey: float) -> float:
-    """Squared distance from (px, py) to the segment (ax, ay) -> (ex, ey): the projection clamped
-    onto it (``window.segment_distance_sq``'s operations)."""
-    dx = ex - ax
-    dy = ey - ay
-    qx = px - ax
-    qy = py - ay
-    length_sq = dx * dx + dy * dy
-    if length_sq > 0.0:
-        t = (qx * dx + qy * dy) / length_sq
-        if t >= 1.0:
-            qx = qx - dx
-            qy = qy - dy
-        elif not t <= 0.0:
-            qx = qx - t * dx
-            qy = qy - t * dy
-    return qx * qx + qy * qy
 
 
 @dataclass
@@ -99,10 +82,10 @@ class FitCore:
     # of an open last piece before its bound is tested (``_choose``'s first choice).
     _errors_low: int = 0
     _open_first: int = -1
-    # The last piece found to keep the bound (its start and end), not tested twice: the closed
-    # and the open choice for the newest sample are often the same piece.
-    _kept_start: int = -1
-    _kept_end: int = -1
+    # Per sample, the end of the last piece from it found to keep the bound (-1: none) and that
+    # piece's reach: no sample between lies farther from it, rounding allowed for (``_keeps``).
+    _reach_end: list[int] = field(default_factory=list)
+    _reach_of: list[float] = field(default_factory=list)
     # Per sample, the sample that last broke the bound of a piece from it (-1: none yet): tested
     # first, as it often breaks the next piece from there too.
     _broke: list[int] = field(default_factory=list)
@@ -123,6 +106,7 @@ class FitCore:
 
         params = self.params
         self._max_error_sq = params.max_error * params.max_error
+        self._reach_limit = params.max_error - ROUNDING_SLACK
         self._floor_ms = max(params.floor_ms, params.min_duration_ms)
         self._max_window = params.max_window
         self._cap_ms = params.max_stroke_ms
@@ -197,15 +181,18 @@ class FitCore:
         ys: list[float],
         ts: list[float],
         samples: list[Sample],
-        broke: list[int] | None = None,
+        held: tuple[list[int], list[int], list[float]] | None = None,
     ) -> None:
-        """The samples since a new anchor (xs[0]): running sums and best polylines again."""
+        """The samples since a new anchor (xs[0]): running sums and best polylines again.
+        ``held``: what ``_keeps`` found of the pieces between them (``_broke``, ``_reach_end``,
+        ``_reach_of``), as indices from the anchor."""
         self._xs, self._ys, self._ts, self._samples = xs, ys, ts, samples
-        self._broke = broke if broke is not None else [-1] * len(xs)
+        if held is None:
+            held = ([-1] * len(xs), [-1] * len(xs), [0.0] * len(xs))
+        self._broke, self._reach_end, self._reach_of = held
         self._sums = [(0.0, 0.0, 0.0, 0.0, 0.0)]
         self._best, self._brief, self._before = [0.0], [0], [-1]
         self._errors_end = -1
-        self._kept_start = self._kept_end = -1
         ax, ay = xs[0], ys[0]
         self._add_sums(0.0, 0.0)
         for k in range(1, len(xs)):
@@ -223,6 +210,8 @@ class FitCore:
         self._ts.append(t)
         self._samples.append(sample)
         self._broke.append(-1)
+        self._reach_end.append(-1)
+        self._reach_of.append(0.0)
         # ``_add_sums``, written out.
         rx = x - self._xs[0]
         ry = y - self._ys[0]
@@ -348,13 +337,28 @@ class FitCore:
         segment between them. The answer is the same in any order of tests, so a rejected
         start is made to cost few: the sample that broke the last piece tested from ``start``
         is tested first, then the samples coarse to fine (the middle, the quarters, the
-        eighths, ...: a bulge the piece cuts off is met early)."""
-        if start == self._kept_start and end == self._kept_end:
-            return True
+        eighths, ...: a bulge the piece cuts off is met early).
+
+        Where the piece from ``start`` to the sample before ``end`` kept the bound, its reach
+        plus how far the sample before ``end`` lies from the piece to ``end`` bounds every
+        distance to it (the distance to a segment is convex along the old piece, 0 at its
+        start): under ``max_error`` by ``ROUNDING_SLACK``, the piece keeps the bound, as
+        testing each sample would find, without testing each."""
+        reach_end = self._reach_end[start]
+        if reach_end == end:
+            return True  # (found a moment ago: the closed and the open choice share pieces)
         xs, ys = self._xs, self._ys
         ax, ay = xs[start], ys[start]
         limit_sq = self._max_error_sq
         ex, ey = xs[end], ys[end]
+        if reach_end == end - 1:
+            self.distance_tests += 1
+            step_sq = segment_distance_sq(xs[end - 1], ys[end - 1], ax, ay, ex, ey)
+            reach = self._reach_of[start] + math.sqrt(step_sq) + ROUNDING_SLACK
+            if reach <= self._reach_limit:
+                self._reach_of[start] = reach
+                self._reach_end[start] = end
+                return True
         m = self._broke[start]
         if start < m < end:
             self.distance_tests += 1
@@ -364,6 +368,7 @@ class FitCore:
         dx = ex - ax
         dy = ey - ay
         length_sq = dx * dx + dy * dy
+        farthest = 0.0  # (a NaN counts as none: it breaks no bound)
         span = end - start
         step = 1
         while step * 2 < span:
@@ -380,13 +385,17 @@ class FitCore:
                     elif not t <= 0.0:
                         qx = qx - t * dx
                         qy = qy - t * dy
-                if qx * qx + qy * qy > limit_sq:
+                distance_sq = qx * qx + qy * qy
+                if distance_sq > limit_sq:
                     self._broke[start] = m
                     self.distance_tests += (m - start - step) // (2 * step) + 1
                     return False
+                if distance_sq > farthest:
+                    farthest = distance_sq
             self.distance_tests += len(range(start + step, end, 2 * step))
             step //= 2
-        self._kept_start, self._kept_end = start, end
+        self._reach_of[start] = math.sqrt(farthest) + ROUNDING_SLACK
+        self._reach_end[start] = end
         return True
 
     def _polyline(self, last: int, out: list[Segment]) -> None:
@@ -413,8 +422,12 @@ class FitCore:
 
     def _from(self, k: int) -> None:
         """Sample k anchors the next stroke; the samples after it are taken again."""
-        broke = [m - k if m > k else -1 for m in self._broke[k:]]
-        self._restart_at(self._xs[k:], self._ys[k:], self._ts[k:], self._samples[k:], broke)
+        held = (
+            [m - k if m > k else -1 for m in self._broke[k:]],
+            [end - k if end > k else -1 for end in self._reach_end[k:]],
+            self._reach_of[k:],
+        )
+        self._restart_at(self._xs[k:], self._ys[k:], self._ts[k:], self._samples[k:], held)
 
     def _let_go(self, out: list[Segment]) -> None:
         """Lets go each stroke that is final: its end drawn ``lookahead_ms`` ago, or the stroke

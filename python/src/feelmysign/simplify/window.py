@@ -99,6 +99,7 @@ import bisect
 import math
 from dataclasses import dataclass, field, replace
 
+from feelmysign.simplify.distance import ROUNDING_SLACK
 from feelmysign.simplify.fit import FitCore
 from feelmysign.simplify.mapping import CanvasMapping
 from feelmysign.simplify.params import ParamSpec, SharedParams, param, specs_of
@@ -121,12 +122,6 @@ STRAIGHT = 1e-6
 # max_error of it; the stroke after it then goes on along that line where the bound allows, by
 # moving its end at most this share of max_error off its drawn sample (no drift along a bend).
 LINE_SHARE = 0.25
-# Far more than any rounding error of a distance computed here (grid coordinates are at most 63,
-# so under 1e-12 grid units), far less than the least max_error (0.001): what the reach of a
-# stroke (``WindowSimplifier._reach``) adds for rounding, so that it never understates a true
-# distance, and the room it keeps below max_error, so that no distance it lets through could
-# compute above it.
-ROUNDING_SLACK = 1e-9
 # A pen rests while its samples stay within this share of min_length of one point (never
 # farther than half of max_error, so the point that ends or starts a stroke covers the rest):
 # well below a stroke the sleeve renders, well above a still hand's jitter.
