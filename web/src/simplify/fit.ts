@@ -120,6 +120,8 @@ export class FitCore {
   #errorsEnd = -1;
   #errorsLow = 0;
   #openChosen = -1;
+  /** Whether the piece from `#openChosen` to `#errorsEnd` is known to keep the bound. */
+  #openKeeps = false;
   // Scratch for the starts tried after the best one (`#chooseAgain`): counts and totals per start.
   readonly #counts: number[] = [];
   readonly #totals: number[] = [];
@@ -331,44 +333,41 @@ export class FitCore {
 
   /**
    * Each piece's error to sample k, from every start it may have (into `#errors`, kept for the
-   * sample until the next): the first start. `pieceError`, its terms of the end computed once.
+   * sample until the next): the first start.
    */
   #errorsTo(k: number): number {
+    // The same first start while the errors are kept (no time before the sample's changes).
+    if (this.#errorsEnd === k) return this.#errorsLow;
     const low = this.#lowTo(k);
-    if (this.#errorsEnd === k) return low;
     const errors = this.#errors;
+    for (let i = low; i < k; i++) errors[i - low] = this.#errorOf(i, k);
+    this.#errorsEnd = k;
+    this.#errorsLow = low;
+    return low;
+  }
+
+  /**
+   * The error of the piece from sample i to sample k: `pieceError`, from the coordinates relative
+   * to the anchor as the sums took them (the same values).
+   */
+  #errorOf(i: number, k: number): number {
     const rxs = this.#rxs;
     const rys = this.#rys;
     const sx = this.#sx;
     const sy = this.#sy;
-    const sxx = this.#sxx;
-    const syy = this.#syy;
-    const sxy = this.#sxy;
-    const ex = rxs[k]!;
-    const ey = rys[k]!;
-    const sxEnd = sx[k + 1]!;
-    const syEnd = sy[k + 1]!;
-    const sxxEnd = sxx[k + 1]!;
-    const syyEnd = syy[k + 1]!;
-    const sxyEnd = sxy[k + 1]!;
-    for (let i = low; i < k; i++) {
-      const count = k + 1 - i;
-      const px = rxs[i]!;
-      const py = rys[i]!;
-      const dx = ex - px;
-      const dy = ey - py;
-      const sxI = sxEnd - sx[i]!;
-      const syI = syEnd - sy[i]!;
-      const cxx = sxxEnd - sxx[i]! - 2 * px * sxI + count * px * px;
-      const cyy = syyEnd - syy[i]! - 2 * py * syI + count * py * py;
-      const cxy = sxyEnd - sxy[i]! - px * syI - py * sxI + count * px * py;
-      const lengthSq = dx * dx + dy * dy;
-      const error = lengthSq > 0 ? (dx * dx * cyy + dy * dy * cxx - 2 * dx * dy * cxy) / lengthSq : cxx + cyy;
-      errors[i - low] = error > 0 ? error : 0;
-    }
-    this.#errorsEnd = k;
-    this.#errorsLow = low;
-    return low;
+    const count = k + 1 - i;
+    const px = rxs[i]!;
+    const py = rys[i]!;
+    const dx = rxs[k]! - px;
+    const dy = rys[k]! - py;
+    const sxI = sx[k + 1]! - sx[i]!;
+    const syI = sy[k + 1]! - sy[i]!;
+    const cxx = this.#sxx[k + 1]! - this.#sxx[i]! - 2 * px * sxI + count * px * px;
+    const cyy = this.#syy[k + 1]! - this.#syy[i]! - 2 * py * syI + count * py * py;
+    const cxy = this.#sxy[k + 1]! - this.#sxy[i]! - px * syI - py * sxI + count * px * py;
+    const lengthSq = dx * dx + dy * dy;
+    const error = lengthSq > 0 ? (dx * dx * cyy + dy * dy * cxx - 2 * dx * dy * cxy) / lengthSq : cxx + cyy;
+    return error > 0 ? error : 0;
   }
 
   /**
@@ -414,6 +413,8 @@ export class FitCore {
     const counts = this.#counts;
     const totals = this.#totals;
     for (let i = low; i < k; i++) {
+      // A piece's error `#place` left out (-1: its start could not be the first choice).
+      if (errors[i - low]! < 0) errors[i - low] = this.#errorOf(i, k);
       counts[i - low] = brief[i]! + (closed && tK - ts[i]! < floorMs ? 1 : 0);
       totals[i - low] = best[i]! + errors[i - low]!;
     }
@@ -442,38 +443,83 @@ export class FitCore {
   /**
    * Sample k's best polyline from the anchor, every piece closed (at the floor): `#errorsTo` and
    * `#choose` in one pass, which also finds the best start with the last piece open, for `#letGo`.
+   * Only the starts with the fewest brief pieces, closed or open, can be either first choice: the
+   * others' errors are left out (-1), computed only if a first choice breaks the bound.
    */
   #place(k: number): void {
-    const low = this.#errorsTo(k);
+    const low = this.#lowTo(k);
     const best = this.#best;
     const brief = this.#brief;
     const errors = this.#errors;
     const ts = this.#ts;
     const floorMs = this.#floorMs;
     const tK = ts[k]!;
+    let closedFewest = Infinity;
+    let openFewest = Infinity;
+    for (let i = low; i < k; i++) {
+      const count = brief[i]!;
+      if (count < openFewest) openFewest = count;
+      const closedI = tK - ts[i]! < floorMs ? count + 1 : count;
+      if (closedI < closedFewest) closedFewest = closedI;
+    }
+    // `#errorOf`, its terms of the end read once.
+    const rxs = this.#rxs;
+    const rys = this.#rys;
+    const sx = this.#sx;
+    const sy = this.#sy;
+    const sxx = this.#sxx;
+    const syy = this.#syy;
+    const sxy = this.#sxy;
+    const ex = rxs[k]!;
+    const ey = rys[k]!;
+    const sxEnd = sx[k + 1]!;
+    const syEnd = sy[k + 1]!;
+    const sxxEnd = sxx[k + 1]!;
+    const syyEnd = syy[k + 1]!;
+    const sxyEnd = sxy[k + 1]!;
     let closed = -1;
-    let closedCount = 0;
     let closedTotal = 0;
     let open = -1;
-    let openCount = 0;
     let openTotal = 0;
     for (let i = low; i < k; i++) {
-      const total = best[i]! + errors[i - low]!;
       const count = brief[i]!;
-      if (open < 0 || count < openCount || (count === openCount && total < openTotal)) {
+      const isOpen = count === openFewest;
+      const isClosed = (tK - ts[i]! < floorMs ? count + 1 : count) === closedFewest;
+      if (!isOpen && !isClosed) {
+        errors[i - low] = -1;
+        continue;
+      }
+      const pieceCount = k + 1 - i;
+      const px = rxs[i]!;
+      const py = rys[i]!;
+      const dx = ex - px;
+      const dy = ey - py;
+      const sxI = sxEnd - sx[i]!;
+      const syI = syEnd - sy[i]!;
+      const cxx = sxxEnd - sxx[i]! - 2 * px * sxI + pieceCount * px * px;
+      const cyy = syyEnd - syy[i]! - 2 * py * syI + pieceCount * py * py;
+      const cxy = sxyEnd - sxy[i]! - px * syI - py * sxI + pieceCount * px * py;
+      const lengthSq = dx * dx + dy * dy;
+      const raw = lengthSq > 0 ? (dx * dx * cyy + dy * dy * cxx - 2 * dx * dy * cxy) / lengthSq : cxx + cyy;
+      const error = raw > 0 ? raw : 0;
+      errors[i - low] = error;
+      const total = best[i]! + error;
+      // The first of the fewest with the least total (earliest at equal totals), as `#choose`.
+      if (isOpen && (open < 0 || total < openTotal)) {
         open = i;
-        openCount = count;
         openTotal = total;
       }
-      const closedI = tK - ts[i]! < floorMs ? count + 1 : count;
-      if (closed < 0 || closedI < closedCount || (closedI === closedCount && total < closedTotal)) {
+      if (isClosed && (closed < 0 || total < closedTotal)) {
         closed = i;
-        closedCount = closedI;
         closedTotal = total;
       }
     }
-    this.#openChosen = open;
+    this.#errorsEnd = k;
+    this.#errorsLow = low;
     const i = closed === k - 1 || this.#keeps(closed, k) ? closed : this.#chooseAgain(k, low, true, closed);
+    // Most often the open choice is the closed one, whose piece keeps the bound: not tested again.
+    this.#openChosen = open;
+    this.#openKeeps = open === i;
     best[k] = best[i]! + errors[i - low]!;
     brief[k] = brief[i]! + (tK - ts[i]! < floorMs ? 1 : 0);
     this.#before[k] = i;
@@ -483,7 +529,9 @@ export class FitCore {
   #chooseOpen(k: number, low: number): number {
     if (this.#errorsEnd !== k || this.#errorsLow !== low) return this.#choose(k, low, false);
     const open = this.#openChosen;
-    return open === k - 1 || this.#keeps(open, k) ? open : this.#chooseAgain(k, low, false, open);
+    return open === k - 1 || this.#openKeeps || this.#keeps(open, k)
+      ? open
+      : this.#chooseAgain(k, low, false, open);
   }
 
   /**
