@@ -26,6 +26,13 @@ import { checkWindowParams, type WindowParams } from "./window-params";
 
 const NO_SEGMENTS: readonly Segment[] = Object.freeze([]);
 
+/**
+ * What a reach (`FitCore`'s `#keeps`, as `WindowCore`'s) adds for rounding, and the room it keeps
+ * below max_error: far more than any rounding error of a distance on the grid, far less than the
+ * least max_error.
+ */
+const ROUNDING_SLACK = 1e-9;
+
 /** Running sums of x, y, x^2, y^2 and xy over samples (each of length n + 1, from 0). */
 export interface RunningSums {
   readonly sx: readonly number[];
@@ -127,6 +134,14 @@ export class FitCore {
   readonly #totals: number[] = [];
   /** Per sample, the sample that last broke the bound of a piece from it (-1: none yet). */
   readonly #broke: number[] = [];
+  /**
+   * Per sample, the last end to which a piece from it kept the bound (-1: none yet), and that
+   * piece's reach (`#keeps`).
+   */
+  readonly #reachEnd: number[] = [];
+  readonly #reachOf: number[] = [];
+  /** Reach + what a step adds at most this: every sample keeps the bound (`#keeps`). */
+  readonly #reachLimit: number;
   /** The vertices of a polyline let go, last first (`#polyline`, reused). */
   readonly #vertices: number[] = [];
   #emittedInPath = false;
@@ -147,6 +162,7 @@ export class FitCore {
     checkWindowParams(params);
     this.params = params;
     this.#maxErrorSq = params.max_error * params.max_error;
+    this.#reachLimit = params.max_error - ROUNDING_SLACK;
     this.#floorMs = Math.max(params.floor_ms, params.min_duration_ms);
     this.#mapping = CanvasMapping.fromParams(params);
     const rest = restRadius(params, this.#mapping);
@@ -254,6 +270,7 @@ export class FitCore {
     this.#ts[0] = t;
     this.#samples[0] = sample;
     this.#broke[0] = -1;
+    this.#reachEnd[0] = -1;
     this.#count = 1;
     this.#restart();
   }
@@ -308,6 +325,7 @@ export class FitCore {
     this.#ts[k] = t;
     this.#samples[k] = sample;
     this.#broke[k] = -1;
+    this.#reachEnd[k] = -1;
     this.#count = k + 1;
     const rx = x - xs[0]!;
     const ry = y - ys[0]!;
@@ -539,6 +557,12 @@ export class FitCore {
    * them: the sample that broke the last piece tested from `start` first, then the samples coarse
    * to fine (the answer is the same in any order). Python `FitCore._keeps`. `distanceSq` with the
    * segment's terms computed once (the same operations).
+   *
+   * Where the piece from `start` to the sample before `end` kept the bound, its reach (as
+   * `WindowCore`'s: no sample between lies farther from it, rounding allowed for) plus how far the
+   * sample before `end` lies from the piece to `end` bounds every distance to it (the distance to
+   * a segment is convex along it, 0 at its start): under max_error by ROUNDING_SLACK, the piece
+   * keeps the bound without testing each sample, as testing each would find.
    */
   #keeps(start: number, end: number): boolean {
     const xs = this.#xs;
@@ -549,6 +573,19 @@ export class FitCore {
     const dy = ys[end]! - ay;
     const lengthSq = dx * dx + dy * dy;
     const limitSq = this.#maxErrorSq;
+    const reachEnd = this.#reachEnd;
+    const reachOf = this.#reachOf;
+    if (reachEnd[start] === end - 1) {
+      const qx = xs[end - 1]! - ax;
+      const qy = ys[end - 1]! - ay;
+      const step = lengthSq > 0 ? chordDistanceSq(qx, qy, dx, dy, lengthSq) : qx * qx + qy * qy;
+      const reach = reachOf[start]! + Math.sqrt(step) + ROUNDING_SLACK;
+      if (reach <= this.#reachLimit) {
+        reachOf[start] = reach;
+        reachEnd[start] = end;
+        return true;
+      }
+    }
     const broke = this.#broke[start]!;
     if (start < broke && broke < end) {
       const qx = xs[broke]! - ax;
@@ -559,6 +596,8 @@ export class FitCore {
     const span = end - start;
     let step = 1;
     while (step * 2 < span) step *= 2;
+    // The farthest distance found (a NaN counts as none: it breaks no bound).
+    let farthest = 0;
     for (; step > 0; step = Math.floor(step / 2)) {
       for (let m = start + step; m < end; m += 2 * step) {
         const qx = xs[m]! - ax;
@@ -568,8 +607,11 @@ export class FitCore {
           this.#broke[start] = m;
           return false;
         }
+        if (d > farthest) farthest = d;
       }
     }
+    reachOf[start] = Math.sqrt(farthest) + ROUNDING_SLACK;
+    reachEnd[start] = end;
     return true;
   }
 
@@ -604,6 +646,8 @@ export class FitCore {
     const ts = this.#ts;
     const samples = this.#samples;
     const broke = this.#broke;
+    const reachEnd = this.#reachEnd;
+    const reachOf = this.#reachOf;
     const count = this.#count;
     for (let from = k, to = 0; from < count; from++, to++) {
       xs[to] = xs[from]!;
@@ -612,6 +656,10 @@ export class FitCore {
       samples[to] = samples[from]!;
       const m = broke[from]!;
       broke[to] = m > k ? m - k : -1;
+      // A piece's reach is its samples', wherever they are held.
+      const end = reachEnd[from]!;
+      reachEnd[to] = end >= 0 ? end - k : -1;
+      reachOf[to] = reachOf[from]!;
     }
     this.#count = count - k;
     this.#restart();
