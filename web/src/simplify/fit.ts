@@ -142,6 +142,9 @@ export class FitCore {
   readonly #reachOf: number[] = [];
   /** Reach + what a step adds at most this: every sample keeps the bound (`#keeps`). */
   readonly #reachLimit: number;
+  /** The end of the last piece let go, and the sample it is (-1: none held now). */
+  #end: Point | null = null;
+  #endAt = -1;
   /** The vertices of a polyline let go, last first (`#polyline`, reused). */
   readonly #vertices: number[] = [];
   #emittedInPath = false;
@@ -271,6 +274,7 @@ export class FitCore {
     this.#samples[0] = sample;
     this.#broke[0] = -1;
     this.#reachEnd[0] = -1;
+    this.#endAt = -1;
     this.#count = 1;
     this.#restart();
   }
@@ -635,8 +639,13 @@ export class FitCore {
     const xs = this.#xs;
     const ys = this.#ys;
     const ts = this.#ts;
+    // A piece starting where the one before ended starts at that same point, a readonly pair.
+    const start: Point = this.#endAt === a ? this.#end! : [xs[a]!, ys[a]!];
+    const end: Point = [xs[b]!, ys[b]!];
+    this.#end = end;
+    this.#endAt = b;
     // The pointer's time: the last sample taken (the reference's `_pointer`, always set here).
-    return finishSegment([xs[a]!, ys[a]!], [xs[b]!, ys[b]!], ts[a]!, ts[b]!, this.takenMs, this.#limits);
+    return finishSegment(start, end, ts[a]!, ts[b]!, this.takenMs, this.#limits);
   }
 
   /** Sample k anchors the next stroke; the samples after it are taken again, moved to the front. */
@@ -662,6 +671,7 @@ export class FitCore {
       reachOf[to] = reachOf[from]!;
     }
     this.#count = count - k;
+    this.#endAt = this.#endAt === k ? 0 : -1;
     this.#restart();
   }
 
