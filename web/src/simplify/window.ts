@@ -1292,8 +1292,6 @@ export class WindowSimplifier {
     const takenMs = fit.takenMs;
     merger.sample(takenMs, fit.takenX, fit.takenY);
     if (pieces.length === 0 && !fit.rested) return NO_SEGMENTS;
-    // One piece (the core's array, made for it): what the merger sends goes in that array.
-    if (pieces.length === 1 && !fit.rested) return merger.takeAlone(pieces as Segment[], takenMs);
     const out: Segment[] = [];
     for (let i = 0; i < pieces.length; i++) merger.take(pieces[i]!, takenMs, out);
     if (fit.rested) merger.rest(takenMs, out);
