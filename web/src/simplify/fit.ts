@@ -136,7 +136,8 @@ export class FitCore {
   readonly #broke: number[] = [];
   /**
    * Per sample, the last end to which a piece from it kept the bound (-1: none yet), and that
-   * piece's reach (`#keeps`).
+   * piece's reach (`#keeps`). Both written for every sample taken, so that they hold no hole (a
+   * hole read and copied would make every number stored there an object).
    */
   readonly #reachEnd: number[] = [];
   readonly #reachOf: number[] = [];
@@ -274,6 +275,7 @@ export class FitCore {
     this.#samples[0] = sample;
     this.#broke[0] = -1;
     this.#reachEnd[0] = -1;
+    this.#reachOf[0] = 0;
     this.#endAt = -1;
     this.#count = 1;
     this.#restart();
@@ -330,6 +332,7 @@ export class FitCore {
     this.#samples[k] = sample;
     this.#broke[k] = -1;
     this.#reachEnd[k] = -1;
+    this.#reachOf[k] = 0;
     this.#count = k + 1;
     const rx = x - xs[0]!;
     const ry = y - ys[0]!;
