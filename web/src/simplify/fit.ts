@@ -468,8 +468,9 @@ export class FitCore {
   /**
    * Sample k's best polyline from the anchor, every piece closed (at the floor): `#errorsTo` and
    * `#choose` in one pass, which also finds the best start with the last piece open, for `#letGo`.
-   * Only the starts with the fewest brief pieces, closed or open, can be either first choice: the
-   * others' errors are left out (-1), computed only if a first choice breaks the bound.
+   * A start with more brief pieces than the one chosen so far (closed and open) cannot be chosen
+   * in its place, whatever its error: its error is left out (-1), computed only if a first choice
+   * breaks the bound.
    */
   #place(k: number): void {
     const low = this.#lowTo(k);
@@ -479,14 +480,6 @@ export class FitCore {
     const ts = this.#ts;
     const floorMs = this.#floorMs;
     const tK = ts[k]!;
-    let closedFewest = Infinity;
-    let openFewest = Infinity;
-    for (let i = low; i < k; i++) {
-      const count = brief[i]!;
-      if (count < openFewest) openFewest = count;
-      const closedI = tK - ts[i]! < floorMs ? count + 1 : count;
-      if (closedI < closedFewest) closedFewest = closedI;
-    }
     // `#errorOf`, its terms of the end read once.
     const rxs = this.#rxs;
     const rys = this.#rys;
@@ -502,15 +495,17 @@ export class FitCore {
     const sxxEnd = sxx[k + 1]!;
     const syyEnd = syy[k + 1]!;
     const sxyEnd = sxy[k + 1]!;
+    // `#choose`'s scan, closed and open at once (no count is infinite: the first start is chosen).
     let closed = -1;
+    let closedCount = Infinity;
     let closedTotal = 0;
     let open = -1;
+    let openCount = Infinity;
     let openTotal = 0;
     for (let i = low; i < k; i++) {
       const count = brief[i]!;
-      const isOpen = count === openFewest;
-      const isClosed = (tK - ts[i]! < floorMs ? count + 1 : count) === closedFewest;
-      if (!isOpen && !isClosed) {
+      const closedI = tK - ts[i]! < floorMs ? count + 1 : count;
+      if (count > openCount && closedI > closedCount) {
         errors[i - low] = -1;
         continue;
       }
@@ -529,13 +524,14 @@ export class FitCore {
       const error = raw > 0 ? raw : 0;
       errors[i - low] = error;
       const total = best[i]! + error;
-      // The first of the fewest with the least total (earliest at equal totals), as `#choose`.
-      if (isOpen && (open < 0 || total < openTotal)) {
+      if (count < openCount || (count === openCount && total < openTotal)) {
         open = i;
+        openCount = count;
         openTotal = total;
       }
-      if (isClosed && (closed < 0 || total < closedTotal)) {
+      if (closedI < closedCount || (closedI === closedCount && total < closedTotal)) {
         closed = i;
+        closedCount = closedI;
         closedTotal = total;
       }
     }
