@@ -368,6 +368,8 @@ export class FitCore {
     for (let i = low; i < k; i++) errors[i - low] = this.#errorOf(i, k);
     this.#errorsEnd = k;
     this.#errorsLow = low;
+    // No open choice found for k (`#place` finds it).
+    this.#openChosen = -1;
     return low;
   }
 
@@ -411,6 +413,8 @@ export class FitCore {
     let chosenCount = 0;
     let chosenTotal = 0;
     for (let i = low; i < k; i++) {
+      // A piece's error `#place` left out (-1).
+      if (errors[i - low]! < 0) errors[i - low] = this.#errorOf(i, k);
       const total = best[i]! + errors[i - low]!;
       let count = brief[i]!;
       if (closed && tK - ts[i]! < floorMs) count += 1;
@@ -548,8 +552,8 @@ export class FitCore {
 
   /** `#choose(k, low, false)` for the newest sample, its first choice found by `#place`. */
   #chooseOpen(k: number, low: number): number {
-    if (this.#errorsEnd !== k || this.#errorsLow !== low) return this.#choose(k, low, false);
     const open = this.#openChosen;
+    if (this.#errorsEnd !== k || this.#errorsLow !== low || open < 0) return this.#choose(k, low, false);
     return open === k - 1 || this.#openKeeps || this.#keeps(open, k)
       ? open
       : this.#chooseAgain(k, low, false, open);
