@@ -52,9 +52,10 @@ import processing.event.MouseEvent;
  * <p>The library registers its own {@code mouseEvent}, {@code draw} and {@code dispose} hooks:
  * a press starts a drawing, each drag goes through the simplifier, each stroke it lets go is
  * sent. A pen held still sends no drag: while it is down and no mouse event has come for {@link
- * #STILL_SAMPLE_MS}, each {@code draw()} samples it where it is, at the events' clock now, so
- * a stroke drawn up to a stop is sent while the pen rests (as the page does). The sleeve's events and the broker's news are queued by the network thread and handed
- * to the sketch on its own thread, at the end of each {@code draw()}: to {@code void
+ * #STILL_SAMPLE_MS}, each {@code draw()} samples it where it is, at the events' clock now, so a
+ * stroke drawn up to a stop is sent while the pen rests (as the page does). The sleeve's events
+ * and the broker's news are queued by the network thread and handed to the sketch on its own
+ * thread, at the end of each {@code draw()}: to {@code void
  * sleeveEvent(SleeveEvent event)}, {@code void sleeveStatus(String sentence)} and {@code void
  * sleeveWearer(WearerState wearer)} (the wearer paused the sleeve, set a ceiling, or asked not to
  * be disturbed; also said to {@code sleeveStatus}) when the sketch has them. Nothing the network does throws into {@code draw()}: a broker out of reach, a wrong
@@ -142,9 +143,9 @@ public class FeelMySign {
   /**
    * The least of (this JVM's monotonic clock at an event's arrival, ms) minus (the event's {@code
    * getMillis()}) over the line being drawn: the clock of the mouse events now is the monotonic
-   * clock less it. Renderers stamp events with clocks of their own (AWT the wall clock, NEWT one
-   * of its own), so the library reads the clock of the events themselves. The least is the event
-   * handed over soonest, so the time it gives is never ahead of the events' clock.
+   * clock less it. Renderers stamp events with their toolkit's time (Java2D AWT's, the OpenGL
+   * renderers NEWT's), so the library reads the clock of the events themselves. The least is the
+   * event handed over soonest, so the time it gives is never ahead of the events' clock.
    */
   private double eventClockLagMs = Double.POSITIVE_INFINITY;
   private int tooShort;
@@ -539,7 +540,7 @@ public class FeelMySign {
 
   private void press(Sample sample) {
     if (simplifier.drawing()) {
-      release(line.isEmpty() ? sample : line.get(line.size() - 1));
+      release(last != null ? last : sample); // where the pen was last, never back in time
     }
     if (params.flag("clear_on_press")) {
       synchronized (sent) {
