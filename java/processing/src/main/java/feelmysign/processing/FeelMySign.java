@@ -51,8 +51,11 @@ import processing.event.MouseEvent;
  *
  * <p>The library registers its own {@code mouseEvent}, {@code draw} and {@code dispose} hooks:
  * a press starts a drawing, each drag goes through the simplifier, each stroke it lets go is
- * sent. The sleeve's events and the broker's news are queued by the network thread and handed
- * to the sketch on its own thread, at the end of each {@code draw()}: to {@code void
+ * sent. A pen held still sends no drag: while it is down and no mouse event has come for {@link
+ * #STILL_SAMPLE_MS}, each {@code draw()} samples it where it is, at the events' clock now, so a
+ * stroke drawn up to a stop is sent while the pen rests (as the page does). The sleeve's events
+ * and the broker's news are queued by the network thread and handed to the sketch on its own
+ * thread, at the end of each {@code draw()}: to {@code void
  * sleeveEvent(SleeveEvent event)}, {@code void sleeveStatus(String sentence)} and {@code void
  * sleeveWearer(WearerState wearer)} (the wearer paused the sleeve, set a ceiling, or asked not to
  * be disturbed; also said to {@code sleeveStatus}) when the sketch has them. Nothing the network does throws into {@code draw()}: a broker out of reach, a wrong
@@ -86,6 +89,14 @@ public class FeelMySign {
    * oldest after the press go first, so the line keeps its start and its latest stretch.
    */
   public static final int LINE_SAMPLES = 10_000;
+  /**
+   * A pen held still on the canvas sends no mouse event. After this long without one (ms, two
+   * frames) the library's {@code draw()} hook samples it where it is, and again as often while it
+   * stays, as the page does ({@code STILL_SAMPLE_MS}, web/src/ui/pointer.ts): the simplifier sees
+   * time pass, so a stroke drawn up to the stop is sent while the pen rests, and the rest is not
+   * played as a stroke as long as itself.
+   */
+  public static final int STILL_SAMPLE_MS = 32;
 
   private final PApplet parent;
   private String brokerUrl = "mqtt://127.0.0.1:1883";
@@ -124,6 +135,19 @@ public class FeelMySign {
   private final Deque<Stroke> sent = new ArrayDeque<>();
   private final Deque<SleeveEvent> events = new ArrayDeque<>();
   private final List<Sample> line = new ArrayList<>();
+  /**
+   * The last sample of the pen down (a mouse event's, or one sampled still), in the mouse events'
+   * clock; null while the pen is up (sketch thread).
+   */
+  private Sample last;
+  /**
+   * The least of (this JVM's monotonic clock at an event's arrival, ms) minus (the event's {@code
+   * getMillis()}) over the line being drawn: the clock of the mouse events now is the monotonic
+   * clock less it. Renderers stamp events with their toolkit's time (Java2D AWT's, the OpenGL
+   * renderers NEWT's), so the library reads the clock of the events themselves. The least is the
+   * event handed over soonest, so the time it gives is never ahead of the events' clock.
+   */
+  private double eventClockLagMs = Double.POSITIVE_INFINITY;
   private int tooShort;
   private int tooBrief;
   private final Method eventMethod;
@@ -464,15 +488,50 @@ public class FeelMySign {
 
   /** Processing's hook: mouse presses, drags and releases go through the simplifier. */
   public void mouseEvent(MouseEvent event) {
+    int action = event.getAction();
+    if (action != MouseEvent.PRESS && action != MouseEvent.DRAG && action != MouseEvent.RELEASE) {
+      return;
+    }
     double x = clamp(event.getX(), params.number("canvas_width_px"));
     double y = clamp(event.getY(), params.number("canvas_height_px"));
-    Sample sample = new Sample(event.getMillis(), x, y);
-    switch (event.getAction()) {
+    double millis = event.getMillis();
+    if (action == MouseEvent.PRESS) {
+      eventClockLagMs = Double.POSITIVE_INFINITY; // a new line: the clock is read afresh
+    }
+    eventClockLagMs = Math.min(eventClockLagMs, monotonicMs() - millis);
+    // An event handled after a still sample may be older than it: never back in time.
+    double t = action != MouseEvent.PRESS && last != null ? Math.max(millis, last.tMs()) : millis;
+    Sample sample = new Sample(t, x, y);
+    switch (action) {
       case MouseEvent.PRESS -> press(sample);
       case MouseEvent.DRAG -> move(sample);
-      case MouseEvent.RELEASE -> release(sample);
-      default -> {}
+      default -> release(sample);
     }
+  }
+
+  private static double monotonicMs() {
+    return System.nanoTime() / 1e6;
+  }
+
+  /**
+   * The pen down and no mouse event for {@link #STILL_SAMPLE_MS}: a sample where it is, at the
+   * mouse events' clock now (whole ms, as theirs), as the page's still pointer. Fed to the
+   * simplifier as a drag is, through the frames for the angle simplifier: the frames of a pause
+   * are then taken as it lasts, not when the pen moves again (the page's animation frames do
+   * the same), and they are the frames of the same path without the still samples, since each
+   * holds the position the pen rests at.
+   */
+  private void sampleStill() {
+    if (!started || last == null || !simplifier.drawing()) {
+      return;
+    }
+    double now = Math.floor(monotonicMs() - eventClockLagMs);
+    if (now - last.tMs() < STILL_SAMPLE_MS) {
+      return;
+    }
+    last = new Sample(now, last.x(), last.y(), last.pressure());
+    // Not added to the on-screen line: it does not change it.
+    feed(inUse.algorithm().takesFrames() ? frames.move(last) : List.of(last));
   }
 
   private static double clamp(double v, double max) {
@@ -481,7 +540,7 @@ public class FeelMySign {
 
   private void press(Sample sample) {
     if (simplifier.drawing()) {
-      release(line.isEmpty() ? sample : line.get(line.size() - 1));
+      release(last != null ? last : sample); // where the pen was last, never back in time
     }
     if (params.flag("clear_on_press")) {
       synchronized (sent) {
@@ -495,6 +554,7 @@ public class FeelMySign {
     client.newDrawing();
     line.clear();
     line.add(sample);
+    last = sample;
     if (inUse.algorithm().takesFrames()) {
       frames = new LiveFrames(inUse.fps());
       feed(frames.press(sample));
@@ -511,6 +571,7 @@ public class FeelMySign {
       line.remove(1); // bounded: the on-screen line of a path drawn for minutes
     }
     line.add(sample);
+    last = sample;
     feed(inUse.algorithm().takesFrames() ? frames.move(sample) : List.of(sample));
   }
 
@@ -526,6 +587,7 @@ public class FeelMySign {
       emit(s);
     }
     line.clear();
+    last = null;
     tellDropped();
     keepToFloor(); // a floor that came during this line applies from the next
   }
@@ -584,8 +646,13 @@ public class FeelMySign {
     }
   }
 
-  /** Processing's hook, after the sketch's draw(): the network's news, on the sketch's thread. */
+  /**
+   * Processing's hook, after the sketch's draw() and the frame's mouse events: a pen held still
+   * is sampled where it is ({@link #STILL_SAMPLE_MS}), and the network's news is handed to the
+   * sketch, on its own thread.
+   */
   public void draw() {
+    sampleStill();
     for (Object item; (item = inbox.poll()) != null; ) {
       if (item instanceof SleeveEvent event) {
         synchronized (events) {

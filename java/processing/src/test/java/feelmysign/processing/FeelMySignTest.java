@@ -348,4 +348,42 @@ class FeelMySignTest {
           "trial " + trial + " at " + fps + " fps: " + samples);
     }
   }
+
+  @Test
+  void aStillPensSamplesLeaveTheFramesOfThePathAsTheyWere() {
+    // The samples a still pen is given (its last position, later) go through the frames too:
+    // each frame holds where the pen is either way, so the frames are those of the path without
+    // them, taken as the rest lasts instead of at the next event.
+    java.util.Random random = new java.util.Random(11);
+    for (int trial = 0; trial < 200; trial++) {
+      List<feelmysign.simplify.Sample> drawn = new ArrayList<>();
+      List<feelmysign.simplify.Sample> withStill = new ArrayList<>();
+      double t = random.nextInt(1000);
+      int n = 2 + random.nextInt(30);
+      for (int i = 0; i < n; i++) {
+        feelmysign.simplify.Sample sample =
+            new feelmysign.simplify.Sample(t, random.nextInt(500), random.nextInt(500));
+        drawn.add(sample);
+        withStill.add(sample);
+        double gap = random.nextInt(3) == 0 ? 100 + random.nextInt(400) : random.nextInt(20);
+        if (i < n - 1) {
+          // A rest: a still sample every STILL_SAMPLE_MS while no event comes.
+          for (double s = t + FeelMySign.STILL_SAMPLE_MS; s < t + gap;
+              s += FeelMySign.STILL_SAMPLE_MS) {
+            withStill.add(new feelmysign.simplify.Sample(s, sample.x(), sample.y()));
+          }
+        }
+        t += gap;
+      }
+      double fps = new double[] {60, 30, 24, 7.5}[random.nextInt(4)];
+      LiveFrames live = new LiveFrames(fps);
+      List<feelmysign.simplify.Sample> got = new ArrayList<>(live.press(withStill.get(0)));
+      for (int i = 1; i < withStill.size(); i++) {
+        got.addAll(live.move(withStill.get(i)));
+      }
+      got.addAll(live.release());
+      assertEquals(feelmysign.simplify.Frames.fromSamples(drawn, fps), got,
+          "trial " + trial + " at " + fps + " fps: " + withStill);
+    }
+  }
 }
