@@ -9,7 +9,8 @@
  * simplify-js gets the window simplifier's `max_error` (grid units) as a
  * tolerance in each canvas's pixels (the mapping keeps the aspect ratio: one
  * scale), with highQuality on (Douglas-Peucker alone) and off (a radial
- * distance pass first). Figures, not a test: nothing is asserted.
+ * distance pass first). Each case's rate is the median of its runs after the JIT's warm-up.
+ * Figures, not a test: nothing is asserted.
  */
 import { existsSync, readFileSync } from "node:fs";
 import { fileURLToPath } from "node:url";
@@ -20,7 +21,14 @@ import type { Sample } from "../src/simplify/segment";
 import { WindowSimplifier } from "../src/simplify/window";
 import { DEFAULT_WINDOW_PARAMS, type WindowParams } from "../src/simplify/window-params";
 
-const REPEATS = 7;
+/**
+ * Runs of every case, interleaved; the first WARM_UP of each are not counted: the JIT compiles
+ * the simplifiers over the first runs (the least-squares core's rate rises for about ten), and a
+ * page that has drawn for a few seconds runs the compiled code. The figure is the median of the
+ * rest. About 1 s in all.
+ */
+const REPEATS = 25;
+const WARM_UP = 8;
 
 /** The frames file: FEELMYSIGN_LASA_FRAMES, else the one the Makefile writes beside this file. */
 export const LASA_FRAMES_PATH =
@@ -175,7 +183,7 @@ export function benchLasa(path: string = LASA_FRAMES_PATH): LasaFigures | null {
     cases.forEach((item, index) => {
       const started = performance.now();
       made[index] = item.run();
-      times[index]!.push(performance.now() - started);
+      if (repeat >= WARM_UP) times[index]!.push(performance.now() - started);
     });
   }
   if (Number.isNaN(sink)) throw new Error("unreachable: keeps the baseline loop from being optimised away");
