@@ -61,14 +61,16 @@ STEP_MS = 100.0
 DOWN_S = 2.5  # how long the sleeve stays down while the drawing goes on: above max_lag_ms (1 s)
 
 
+@pytest.mark.parametrize("stop", ["kill", "clean"])
 def test_a_restarted_sleeve_catches_up_with_a_drawing_that_went_on(
-    start_broker: StartBroker, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    start_broker: StartBroker, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, stop: str
 ) -> None:
     """The strokes the broker held while the sleeve was down are measured against the time line
     the sleeve kept (feelmysign.sleeve.pace_memory): late by how long they were held, skipped
     until it has caught up, and the strokes drawn after the restart play in real time. Without
     the kept time line the first held stroke set a new one, the backlog played seconds late,
-    and the strokes drawn after the restart waited behind it."""
+    and the strokes drawn after the restart waited behind it. The same after kill -9 and after
+    a clean stop (SIGTERM: a service restarted in the middle of a drawing)."""
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "sleeve-state"))  # the processes' own
 
     def draw(seqs: range) -> None:
@@ -84,7 +86,7 @@ def test_a_restarted_sleeve_catches_up_with_a_drawing_that_went_on(
         draw(before)
         wait_for(lambda: set(before) <= set(by_seq(watcher.snapshot(), sender.drawing)), "5 events")
         time.sleep(0.2)  # the played events out, and the time line kept
-        first.kill()
+        first.kill() if stop == "kill" else first.stop()
         held = range(5, 5 + round(DOWN_S * 1000 / STEP_MS))
         draw(held)
         wait_for(lambda: set(held) <= sender.acked_seqs(), "the broker holding the strokes")

@@ -137,14 +137,3 @@ def test_a_state_folder_that_cannot_be_written_is_said_once(
         memory.played(played("a", 5.0))
         memory.played(played("b", 5.0))
     assert caplog.text.count("could not be kept") == 1
-
-
-def test_a_clean_stop_forgets(tmp_path: Path) -> None:
-    path = tmp_path / "s.json"
-    memory = PaceMemory(str(path))
-    memory.played(played("a", 5.0))
-    assert path.exists()
-    memory.forget()
-    assert not path.exists()
-    memory.forget()  # nothing to remove: nothing said
-    assert PaceMemory(str(path)).load(max_age_ms=10_000) == []

@@ -325,10 +325,9 @@ class Sleeve:
                 self._telemetry.stop()
             self._outbox.put(None)  # the events still queued go out before the goodbye
             publisher.join(timeout=5.0)
-            if self._fatal is None:
-                self._pace_memory.forget()  # a clean stop: this run's drawings are over
-            else:
-                self._pace_memory.save()  # to restart after a bug as after a crash
+            # Kept after a clean stop too: a service restarted in the middle of a drawing takes
+            # its time line back, as after a crash, and skips what the broker held too long.
+            self._pace_memory.save()
             self._write_journal(every_drawing=True)
             self._say_goodbye()
 

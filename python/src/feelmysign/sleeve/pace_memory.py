@@ -21,7 +21,9 @@ the drawing goes on in real time.
 The file is written by the sleeve's publishing thread, off the path from a stroke to its
 first command: when the sleeve is quiet (no event to publish for a quarter second), and at
 most every ``SAVE_EVERY_MS`` while strokes play; written whole to a temporary file and
-renamed over the old one. A clean stop removes it: the drawings of that run are over. Best effort:
+renamed over the old one, and at every stop, a clean one too (a service restarted in the middle
+of a drawing takes its time line back, as after a crash; entries older than ``max_age_ms`` are
+left out at the next start, and at most ``REMEMBERED_DRAWINGS`` are kept). Best effort:
 a file that cannot be read or written is said in one log line and the sleeve goes on as if
 it had none (the pace rules then work as they did without it).
 """
@@ -132,17 +134,6 @@ class PaceMemory:
                     error.strerror or error,
                 )
             self._failed = True
-
-    def forget(self) -> None:
-        """A clean stop: the file removed (the drawings of this run are over)."""
-        self._drawings.clear()
-        self._unsaved = False
-        try:
-            os.remove(self._path)
-        except FileNotFoundError:
-            pass
-        except OSError as error:
-            log.warning("could not remove %s: %s", self._path, error.strerror or error)
 
     def _say_unusable(self, problem: str) -> None:
         log.warning(
