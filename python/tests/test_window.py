@@ -360,7 +360,12 @@ def test_cli_reproduces_the_vectors(
 def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     recording = write_recording(WINDOW["right-angle/defaults"], tmp_path / "r.json")
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0.05"]) == 0
-    assert "window: max error 0.05 grid units" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "(window, least squares: max error 0.05 grid units, strokes of 73.701 ms or more" in out
+    assert "sent 30 ms after their end is drawn, longest stroke 200 ms; " in out
+    assert main(["simplify", str(recording), "--no-least-squares", "--max-stroke-ms", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "(window, chord: max error 0.25 grid units, every sample, longest stroke no limit" in out
     with pytest.raises(SystemExit) as exit_:
         main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"])
     assert exit_.value.code == 2

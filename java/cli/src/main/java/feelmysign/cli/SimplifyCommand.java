@@ -567,7 +567,18 @@ final class SimplifyCommand {
     if (params.algorithm() == Algorithm.WINDOW) {
       double cap = params.number("max_stroke_ms");
       String capText = cap != 0 ? Numbers.pythonG(cap) + " ms" : "no limit";
-      return "window: max error "
+      if (params.flag("least_squares")) {
+        double floorMs = Math.max(params.number("floor_ms"), params.number("min_duration_ms"));
+        return "window, least squares: max error "
+            + Numbers.pythonG(params.number("max_error"))
+            + " grid units, strokes of "
+            + Numbers.pythonG(floorMs)
+            + " ms or more (the sleeve's floor), sent "
+            + Numbers.pythonG(params.number("lookahead_ms"))
+            + " ms after their end is drawn, longest stroke "
+            + capText;
+      }
+      return "window, chord: max error "
           + Numbers.pythonG(params.number("max_error"))
           + " grid units, every sample, longest stroke "
           + capText;
