@@ -155,6 +155,33 @@ def test_a_resting_pen_ends_the_polyline_and_the_rest_is_not_played() -> None:
     assert after and min(s.start_ms for s in after) >= 690.0
 
 
+@pytest.mark.parametrize("rest_ms", [100.0, 150.0, 300.0, 600.0])
+@pytest.mark.parametrize("lookahead_ms", [0.0, 30.0, 120.0])
+def test_a_stop_longer_than_a_stroke_at_the_floor_is_not_played(
+    rest_ms: float, lookahead_ms: float
+) -> None:
+    # A pen held still for a second, a sample every 16 ms (the page samples a still pointer): no
+    # stroke of the stop is sent, whatever rest_ms (longer than a stroke at the floor and its
+    # lookahead, too) and however long the lookahead; the line before it and after it are felt.
+    down = [Sample(k * 16.0, 150, 60 + 6.0 * k) for k in range(40)]
+    still = [Sample(640 + k * 16.0, 150, 300) for k in range(62)]
+    on = [Sample(1632 + k * 16.0, 150, 300 + 8.0 * k) for k in range(1, 30)]
+    simplifier = WindowSimplifier(
+        WindowParams(
+            canvas_width_px=900, canvas_height_px=600, rest_ms=rest_ms, lookahead_ms=lookahead_ms
+        )
+    )
+    strokes = [s for sample in down + still + on for s in simplifier.push(sample)]
+    strokes += simplifier.end()
+    sent = [s for s in strokes if s.dropped is None]
+    stop_start, stop_end = still[0].t_ms, still[-1].t_ms
+    assert [s for s in sent if s.start_ms >= stop_start and s.end_ms <= stop_end] == []
+    assert [s for s in sent if s.start == s.end] == []
+    assert any(s.end_ms <= stop_start + 16 for s in sent) and any(
+        s.start_ms >= stop_end for s in sent
+    )
+
+
 @settings(max_examples=200, deadline=None)
 @given(fitted())
 def test_each_piece_s_error_is_its_samples_squared_distances_to_its_line(

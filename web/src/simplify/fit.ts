@@ -690,7 +690,7 @@ export class FitCore {
     const before = this.#before;
     for (;;) {
       const j = this.#count - 1;
-      if (ts[j]! - ts[0]! < floorMs) return;
+      if (ts[j]! - ts[0]! < floorMs || this.#still(j)) return;
       const low = this.#errorsTo(j);
       const last = this.#chooseOpen(j, low);
       if (last === 0) {
@@ -717,6 +717,28 @@ export class FitCore {
   }
 
   // --- rests -----------------------------------------------------------------------------------
+
+  /**
+   * Whether the pen may be resting since the anchor: every sample since it lies within the rest
+   * radius of sample j (with `rest_ms` on). Nothing is let go then: a stroke of a still pen would
+   * play the stop (strokes of length 0, one per floor, where `rest_ms` is longer than a stroke at
+   * the floor and its lookahead); the rest rule ends it once it has lasted `rest_ms`, or the pen
+   * moves on. Python `FitCore._still`.
+   */
+  #still(j: number): boolean {
+    if (this.#restMs <= 0) return false;
+    const xs = this.#xs;
+    const ys = this.#ys;
+    const x = xs[j]!;
+    const y = ys[j]!;
+    const restSq = this.#restSq;
+    for (let k = 0; k < j; k++) {
+      const dx = xs[k]! - x;
+      const dy = ys[k]! - y;
+      if (!(dx * dx + dy * dy <= restSq)) return false; // (not ">": a NaN is a move)
+    }
+    return true;
+  }
 
   #retime(tMs: number): void {
     this.#ts[0] = tMs;

@@ -438,7 +438,7 @@ class FitCore:
         while True:
             ts = self._ts
             j = len(ts) - 1
-            if ts[j] - ts[0] < floor_ms:
+            if ts[j] - ts[0] < floor_ms or self._still(j):
                 return
             if self._errors_end != j:
                 self._scan(j)
@@ -469,6 +469,24 @@ class FitCore:
             self._from(vertex)
 
     # --- rests --------------------------------------------------------------------------------
+
+    def _still(self, j: int) -> bool:
+        """Whether the pen may be resting since the anchor: every sample since it lies within
+        the rest radius of sample j (with ``rest_ms`` on). Nothing is let go then: a stroke
+        of a still pen would play the stop (strokes of length 0, one per floor, where
+        ``rest_ms`` is longer than a stroke at the floor and its lookahead); the rest rule ends
+        it once it has lasted ``rest_ms``, or the pen moves on."""
+        if self.params.rest_ms <= 0.0:
+            return False
+        xs, ys = self._xs, self._ys
+        x, y = xs[j], ys[j]
+        rest_sq = self._rest_sq
+        for k in range(j):
+            dx = xs[k] - x
+            dy = ys[k] - y
+            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN is a move)
+                return False
+        return True
 
     def _retime(self, t_ms: float) -> None:
         self._ts[0] = t_ms

@@ -459,7 +459,7 @@ final class FitCore implements PieceCore {
     double capMs = maxStrokeMs;
     while (true) {
       int j = count - 1;
-      if (ts[j] - ts[0] < floorMs) {
+      if (ts[j] - ts[0] < floorMs || still(j)) {
         return;
       }
       int low = errorsTo(j);
@@ -490,6 +490,29 @@ final class FitCore implements PieceCore {
   }
 
   // --- rests -----------------------------------------------------------------------------------
+
+  /**
+   * Whether the pen may be resting since the anchor: every sample since it lies within the rest
+   * radius of sample j (with rest_ms on). Nothing is let go then: a stroke of a still pen would
+   * play the stop (strokes of length 0, one per floor, where rest_ms is longer than a stroke at
+   * the floor and its lookahead); the rest rule ends it once it has lasted rest_ms, or the pen
+   * moves on. Python {@code FitCore._still}.
+   */
+  private boolean still(int j) {
+    if (restMs <= 0.0) {
+      return false;
+    }
+    double x = xs[j];
+    double y = ys[j];
+    for (int k = 0; k < j; k++) {
+      double dx = xs[k] - x;
+      double dy = ys[k] - y;
+      if (!(dx * dx + dy * dy <= restSq)) { // (not ">": a NaN is a move)
+        return false;
+      }
+    }
+    return true;
+  }
 
   private void retime(double t) {
     ts[0] = t;
