@@ -51,7 +51,9 @@ def table() -> dict[str, Any]:
             "default; minimum and maximum (null: unbounded; both included); unit; label and "
             "help, as people read them; panel: the section of the page's settings panel that "
             "shows it (null: set from the drawing area); detail_levels: the values of the "
-            "page's detail control, coarse to fine; short: its name in plot legends. "
+            "page's detail control, coarse to fine; short: its name in plot legends; "
+            "only_when: {name, value}, the simplifier reads it only while the boolean "
+            "parameter name has that value (its other core ignores it; null: always). "
             f"algorithms: each simplifier's parameters in the order of its vectors; "
             f"default_algorithm: the one a client starts with ({DEFAULT_ALGORITHM})."
         ),
@@ -164,9 +166,12 @@ class _Spread:
 
 
 def _literal(value: Any) -> str:
-    """A JSON value as a TypeScript literal; a whole number without its ``.0`` (as JS prints it)."""
+    """A JSON value as a TypeScript literal; a whole number without its ``.0`` (as JS prints it);
+    an object of plain values on one line, as prettier prints a short one."""
     if isinstance(value, _Spread):
         return f"...{value.name}"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k}: {_literal(v)}" for k, v in value.items()) + " }"
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return json.dumps(value, ensure_ascii=False)
@@ -213,6 +218,8 @@ def java() -> str:
         "   * @param panel the section of the page's settings panel that shows it, or null",
         "   * @param detailLevels the values of the page's detail control, coarse to fine, or null",
         "   * @param shortName its name in plot legends, or null",
+        "   * @param onlyWhen the value of another (boolean) parameter the simplifier reads it",
+        "   *     under (its other core ignores it), or null: always read",
         "   */",
         "  public record Row(",
         "      String name,",
@@ -228,7 +235,16 @@ def java() -> str:
         "      String help,",
         "      String panel,",
         "      List<Double> detailLevels,",
-        "      String shortName) {}",
+        "      String shortName,",
+        "      Condition onlyWhen) {}",
+        "",
+        "  /**",
+        "   * A parameter's value under which another parameter is read.",
+        "   *",
+        "   * @param name the boolean parameter's name",
+        "   * @param value the value it must have",
+        "   */",
+        "  public record Condition(String name, boolean value) {}",
         "",
         "  /** The simplifier a client starts with. */",
         f"  public static final String DEFAULT_ALGORITHM = {_java(DEFAULT_ALGORITHM)};",
@@ -352,6 +368,11 @@ def _java_row(name: str, spec: ParamSpec) -> _Call:
             _java(spec.panel),
             levels if spec.detail_levels else "null",
             _java(spec.short),
+            (
+                "null"
+                if spec.only_when is None
+                else _Call("new Condition", [_java(spec.only_when[0]), _java(spec.only_when[1])])
+            ),
         ],
     )
 

@@ -151,6 +151,22 @@ def test_a_true_false_parameter_is_fixed_or_run_both_ways() -> None:
         parameter_sets(window, [parse_sweep("least_squares=0:2:1")])
 
 
+def test_a_parameter_no_run_reads_is_refused() -> None:
+    """The bend rule is the chord core's and the lookahead the least-squares core's: swept where
+    no run uses that core, every value would give the same strokes."""
+    window = ALGORITHMS["window"]
+    with pytest.raises(SweepError, match="only read with least_squares false, which no run has"):
+        parameter_sets(window, [parse_sweep("max_bend=0:0.2:0.1")])
+    with pytest.raises(SweepError, match="--sweep lookahead_ms: only read with least_squares true"):
+        parameter_sets(window, [parse_sweep("least_squares=false"), parse_sweep("lookahead_ms=30")])
+    both = parameter_sets(window, [parse_sweep("least_squares=0:1:1"), parse_sweep("max_bend=0.1")])
+    assert both == [
+        {"least_squares": False, "max_bend": 0.1},
+        {"least_squares": True, "max_bend": 0.1},
+    ]
+    assert len(parameter_sets(window, [parse_sweep("lookahead_ms=0:60:30")])) == 3
+
+
 def test_lasa_at_three_speeds_gives_timing_and_recognition(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -69,6 +69,47 @@ def test_a_default_of_another_type_than_its_field_is_refused() -> None:
         specs_of(Wrong)
 
 
+def test_a_condition_on_a_parameter_that_is_not_a_switch_of_its_class_is_refused() -> None:
+    @dataclass(frozen=True)
+    class NoSwitch:
+        limit_ms: float = param(3.0, 0, 10, help="a limit", label="Limit", only_when=("on", True))
+
+    @dataclass(frozen=True)
+    class NumberSwitch:
+        on: float = param(1.0, 0, 1, help="a number", label="On")
+        limit_ms: float = param(3.0, 0, 10, help="a limit", label="Limit", only_when=("on", True))
+
+    for wrong in (NoSwitch, NumberSwitch):
+        with pytest.raises(TypeError, match=rf"{wrong.__name__}\.limit_ms: only_when names 'on'"):
+            specs_of(wrong)
+
+
+def test_a_conditional_parameter_applies_only_under_its_condition() -> None:
+    @dataclass(frozen=True)
+    class Cores:
+        fast: bool = param(True, help="the fast core", label="Fast")
+        slow_limit: float = param(1.0, 0, 2, help="a", label="A", only_when=("fast", False))
+
+    spec = specs_of(Cores)["slow_limit"]
+    assert spec.only_when == ("fast", False)
+    assert spec.applies({"fast": False}) and not spec.applies({"fast": True})
+    assert specs_of(Cores)["fast"].applies({"fast": True})  # no condition: always read
+    row = spec.to_table(["x"])
+    assert row["only_when"] == {"name": "fast", "value": False}
+    assert specs_of(Cores)["fast"].to_table(["x"])["only_when"] is None
+
+
+def test_the_table_carries_each_condition() -> None:
+    table = json.loads((Path(__file__).parents[2] / "testdata/params/params.json").read_text())
+    conditions = {row["name"]: row["only_when"] for row in table["parameters"] if row["only_when"]}
+    assert conditions == {
+        name: {"name": spec.only_when[0], "value": spec.only_when[1]}
+        for name, spec in PARAMETERS.items()
+        if spec.only_when is not None
+    }
+    assert set(conditions) == {"max_bend", "bend_floor", "lookahead_ms"}
+
+
 def _simplify_parser() -> argparse.ArgumentParser:
     parser = build_parser()
     subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
@@ -88,7 +129,12 @@ def test_every_parameter_that_shapes_the_strokes_is_an_option_with_its_help_and_
                 f"({spec.minimum:g} to {spec.maximum:g}; default: {spec.default:g})" in action.help
             )
         if name in ONLY_FOR:
-            assert action.help.startswith(f"{ONLY_FOR[name]}: ")
+            # Read by one core only: "window with --least-squares: ..."
+            condition = ""
+            if spec.only_when is not None:
+                switch, value = spec.only_when
+                condition = f" with --{'' if value else 'no-'}{switch.replace('_', '-')}"
+            assert action.help.startswith(f"{ONLY_FOR[name]}{condition}: ")
 
 
 def _recording(path: Path) -> Path:

@@ -34,7 +34,7 @@ from feelmysign.simplify import (
     WindowSimplifier,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE
-from feelmysign.simplify.window import LINE_SHARE, WindowCore, rest_radius
+from feelmysign.simplify.window import LINE_SHARE, WINDOW_PARAMS, WindowCore, rest_radius
 from feelmysign.stroke import Point
 
 WINDOW = dict(load("window"))
@@ -328,10 +328,11 @@ def _flags(params: dict[str, Any]) -> list[str]:
         "max_stroke_ms",
         "min_duration_ms",
         "min_length",
-        "lookahead_ms",
     )
-    placement = "--least-squares" if params["least_squares"] else "--no-least-squares"
-    return [*simplify_flags("window", params, numbers), placement]
+    # The lookahead only with the core that reads it (else the CLI refuses it).
+    if params["least_squares"]:
+        return [*simplify_flags("window", params, (*numbers, "lookahead_ms")), "--least-squares"]
+    return [*simplify_flags("window", params, numbers), "--no-least-squares"]
 
 
 @pytest.mark.parametrize(
@@ -387,6 +388,107 @@ def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixt
     assert main(["simplify", str(recording), "--paper", "--json"]) == 0
     paper = json.loads(capsys.readouterr().out)
     assert paper["algorithm"] == "angle" and paper["params"]["max_angle_deg"] == 20.0
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (
+            ["--max-bend", "0.2"],
+            "--max-bend only applies with --no-least-squares; drop it, or add "
+            "--no-least-squares (least squares is on by default)",
+        ),
+        (
+            ["--least-squares", "--bend-floor", "0.2"],
+            "--bend-floor only applies with --no-least-squares; drop it, or give "
+            "--no-least-squares instead of --least-squares",
+        ),
+        (
+            ["--no-least-squares", "--lookahead-ms", "80"],
+            "--lookahead-ms only applies with --least-squares; drop it, or give "
+            "--least-squares instead of --no-least-squares",
+        ),
+    ],
+)
+@pytest.mark.parametrize("command", ["simplify", "replay"])
+def test_cli_refuses_an_option_of_the_core_not_run(
+    command: str,
+    flags: list[str],
+    message: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    recording = write_recording(WINDOW["circle/defaults"], tmp_path / "r.json")
+    with pytest.raises(SystemExit) as exit_:
+        main([command, str(recording), *flags])
+    assert exit_.value.code == 2
+    assert f"Error: {message}." in capsys.readouterr().err
+
+
+def test_cli_takes_an_option_of_the_core_the_recording_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The check is on the settings in effect: a recording made with the chord core takes the
+    bend rule and refuses the lookahead, unless --least-squares is given too."""
+    path = write_recording(WINDOW["circle/defaults"], tmp_path / "r.json")
+    document = json.loads(path.read_text())
+    chord = {"algorithm": "window", "params": {"least_squares": False, "max_error": 0.5}}
+    path.write_text(json.dumps({**document, "simplifier": chord}))
+    runs = {}
+    for bend in ("0", "0.05"):
+        assert main(["simplify", str(path), "--max-bend", bend, "--bend-floor", "0", "--json"]) == 0
+        runs[bend] = json.loads(capsys.readouterr().out)
+        assert runs[bend]["params"]["least_squares"] is False
+    # Taken and read: the bend rule cuts this circle elsewhere.
+    assert runs["0.05"]["strokes"] != runs["0"]["strokes"]
+    with pytest.raises(SystemExit) as exit_:
+        main(["simplify", str(path), "--lookahead-ms", "80"])
+    assert exit_.value.code == 2
+    assert (
+        "--lookahead-ms only applies with --least-squares; drop it, or add --least-squares "
+        "(the recording's settings have least squares off)" in capsys.readouterr().err
+    )
+    assert main(["simplify", str(path), "--least-squares", "--lookahead-ms", "80", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["params"]["lookahead_ms"] == 80
+
+
+# The parameters one core of the window reads and the other ignores, as declared.
+ONE_CORE = {n: s.only_when for n, s in WINDOW_PARAMS.items() if s.only_when is not None}
+# Values to try for each: the default and others across its range.
+ONE_CORE_VALUES = {"lookahead_ms": [0.0, 80.0, 1000.0], "max_bend": [0.05, 0.3, 1.0]}
+
+
+def test_the_parameters_of_one_core_are_declared() -> None:
+    assert ONE_CORE == {
+        "max_bend": ("least_squares", False),
+        "bend_floor": ("least_squares", False),
+        "lookahead_ms": ("least_squares", True),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(ONE_CORE))
+def test_a_parameter_of_one_core_changes_nothing_under_the_other(name: str) -> None:
+    """What ``only_when`` declares is what the cores do: under the other core no value of the
+    parameter changes a stroke; under its own some value does."""
+    switch, needed = ONE_CORE[name]
+    values = ONE_CORE_VALUES.get(name, [0.0, 0.5, 5.0])
+    paths = [
+        [Sample(*s) for s in path]
+        for vector in ("circle/defaults", "zigzag/defaults", "two-paths/defaults", "slow/defaults")
+        for path in WINDOW[vector]["paths"]
+    ]
+    # The bend floor acts only while the bend rule is on.
+    base: dict[str, Any] = {"max_bend": 0.1} if name == "bend_floor" else {}
+
+    def strokes(value: float, on: bool) -> list[tuple[int, Segment]]:
+        return run(WindowParams(**{**base, switch: on, name: value}), paths)
+
+    default = WINDOW_PARAMS[name].default
+    assert isinstance(default, float)
+    ignored, read = strokes(default, not needed), strokes(default, needed)
+    for value in values:
+        assert strokes(value, not needed) == ignored, (name, value)
+    assert any(strokes(value, needed) != read for value in values), name
 
 
 def test_cli_uses_the_recordings_algorithm_and_parameters(

@@ -66,6 +66,8 @@ export interface FieldSpec {
   readonly maximum?: number;
   readonly unit?: string;
   readonly choices?: readonly { readonly value: string; readonly label: string }[];
+  /** Read only while the switch `key` is `value` (the other core ignores it): locked otherwise. */
+  readonly onlyWhen?: { readonly key: SettingKey; readonly value: boolean };
   /** Why the value is not allowed (a sentence fragment after the label), or null. */
   problem(value: unknown): string | null;
 }
@@ -101,6 +103,9 @@ function specField(spec: ParamSpec<PanelParamName> & { panel: PanelSection }): F
     ...(spec.minimum !== null ? { minimum: spec.minimum } : {}),
     ...(spec.maximum !== null ? { maximum: spec.maximum } : {}),
     ...(spec.unit !== null ? { unit: spec.unit } : {}),
+    ...(spec.only_when !== null
+      ? { onlyWhen: { key: spec.only_when.name as SettingKey, value: spec.only_when.value } }
+      : {}),
     problem: (value) => paramProblem(spec, value),
   };
 }
@@ -281,6 +286,20 @@ export function fieldSpec(key: SettingKey): FieldSpec {
   const field = FIELDS_BY_KEY.get(key);
   if (field === undefined) throw new Error(`no settings field '${key}'`);
   return field;
+}
+
+/** Whether a field is read with these values: not while its switch (`onlyWhen`) is the other way. */
+export function conditionMet(field: FieldSpec, values: Partial<Record<SettingKey, unknown>>): boolean {
+  return field.onlyWhen === undefined || values[field.onlyWhen.key] === field.onlyWhen.value;
+}
+
+/** What a field read by one core only says while locked: "Lookahead: least squares only". */
+export function conditionNote(field: FieldSpec): string | null {
+  if (field.onlyWhen === undefined) return null;
+  const switchLabel = fieldSpec(field.onlyWhen.key).label.toLowerCase();
+  return field.onlyWhen.value
+    ? `${field.label}: ${switchLabel} only`
+    : `${field.label}: only with ${switchLabel} off`;
 }
 
 /** The reference's defaults of the parameters a person sets. */

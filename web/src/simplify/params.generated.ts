@@ -121,6 +121,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: [0.4, 0.25, 0.15, 0.1, 0.05],
     short: "err",
+    only_when: null,
   },
   {
     name: "max_window",
@@ -136,6 +137,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "max_stroke_ms",
@@ -151,6 +153,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "max_bend",
@@ -166,6 +169,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: { name: "least_squares", value: false },
   },
   {
     name: "bend_floor",
@@ -181,6 +185,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: { name: "least_squares", value: false },
   },
   {
     name: "rest_ms",
@@ -196,6 +201,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "strict_minimums",
@@ -211,6 +217,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "floor_ms",
@@ -226,6 +233,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "least_squares",
@@ -241,6 +249,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "lookahead_ms",
@@ -252,10 +261,11 @@ export const PARAMETERS: readonly ParamSpec[] = [
     maximum: 1000,
     unit: "ms",
     label: "Lookahead",
-    help: "with least squares on: how long the pen draws past a stroke's end before the stroke is sent, in ms",
+    help: "how long the pen draws past a stroke's end before the stroke is sent, in ms",
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: { name: "least_squares", value: true },
   },
   {
     name: "check_frames",
@@ -271,6 +281,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: "chk",
+    only_when: null,
   },
   {
     name: "max_angle_deg",
@@ -286,6 +297,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: [60, 45, 30, 20, 12],
     short: "deg",
+    only_when: null,
   },
   {
     name: "frame_max",
@@ -301,6 +313,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: "fmax",
+    only_when: null,
   },
   {
     name: "fps",
@@ -316,6 +329,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "recover",
@@ -331,6 +345,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "clear_on_press",
@@ -346,6 +361,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "drawing",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "min_duration_ms",
@@ -361,6 +377,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "min_length",
@@ -376,6 +393,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "rows",
@@ -391,6 +409,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "sleeve",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "columns",
@@ -406,6 +425,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "sleeve",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "canvas_width_px",
@@ -421,6 +441,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: null,
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "canvas_height_px",
@@ -436,6 +457,7 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: null,
     detail_levels: null,
     short: null,
+    only_when: null,
   },
   {
     name: "stretch",
@@ -451,5 +473,6 @@ export const PARAMETERS: readonly ParamSpec[] = [
     panel: "simplifier",
     detail_levels: null,
     short: null,
+    only_when: null,
   },
 ];

@@ -46,6 +46,17 @@ export interface ParamSpec<N extends string = ParamName> {
   readonly detail_levels: readonly number[] | null;
   /** Its name in plot legends. */
   readonly short: string | null;
+  /**
+   * Read only while the boolean parameter `name` has `value` (the one core of its simplifier that
+   * reads it; the other ignores it), or null: always read.
+   */
+  readonly only_when: ParamCondition | null;
+}
+
+/** A boolean parameter's value under which another parameter is read. */
+export interface ParamCondition {
+  readonly name: ParamName;
+  readonly value: boolean;
 }
 
 const SPECS_BY_NAME = new Map<string, ParamSpec>(PARAMETERS.map((spec) => [spec.name, spec]));

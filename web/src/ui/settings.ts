@@ -10,7 +10,10 @@ import { floorNote, type Minimums } from "../sleeve-floor";
 import { ceilingNote } from "../wearer-status";
 import {
   FIELDS,
+  conditionMet,
+  conditionNote,
   defaultSettings,
+  fieldSpec,
   validateSettings,
   type FieldSpec,
   type SettingKey,
@@ -63,6 +66,8 @@ export class SettingsPanel {
   readonly #inputs = new Map<SettingKey, HTMLInputElement[]>();
   readonly #errors = new Map<SettingKey, HTMLElement>();
   readonly #rows = new Map<SettingKey, HTMLElement>();
+  /** The note a field read by one core only shows while locked. */
+  readonly #conditionNotes = new Map<SettingKey, HTMLElement>();
   #context: SettingsPanelContext = { config: null, sleeveGrid: null };
   /** The settings in force when the panel opened. */
   #current: Settings = defaultSettings(null);
@@ -271,6 +276,14 @@ export class SettingsPanel {
       input.addEventListener("change", () => this.#validate());
     }
     row.append(label, control, help, error);
+    const note = conditionNote(field);
+    if (note !== null) {
+      const element = paragraph("field-note", note, "span");
+      element.dataset["testid"] = `setting-${field.key}-note`;
+      element.hidden = true;
+      row.insertBefore(element, help);
+      this.#conditionNotes.set(field.key, element);
+    }
     this.#inputs.set(field.key, inputs);
     this.#errors.set(field.key, error);
     this.#rows.set(field.key, row);
@@ -339,7 +352,9 @@ export class SettingsPanel {
     if (key === "legacy_topic") return candidate.protocol !== "legacy";
     // Fields only one simplifier has: locked while the other is chosen.
     const owner = ONLY_FOR[key];
-    return owner !== undefined && candidate.algorithm !== owner;
+    if (owner !== undefined && candidate.algorithm !== owner) return true;
+    // Fields only one core of the simplifier reads: locked while its switch chooses the other.
+    return !conditionMet(fieldSpec(key), candidate);
   }
 
   #applyDependencies(candidate: Candidate): void {
@@ -356,6 +371,12 @@ export class SettingsPanel {
       const disabled = this.#isDisabled(key, candidate);
       this.#rows.get(key)!.dataset["disabled"] = String(disabled);
       for (const input of this.#inputs.get(key) ?? []) input.disabled = disabled;
+    }
+    // Its note only when the switch is why (not when the other simplifier is chosen).
+    for (const [key, note] of this.#conditionNotes) {
+      const owner = ONLY_FOR[key];
+      note.hidden =
+        (owner !== undefined && candidate.algorithm !== owner) || conditionMet(fieldSpec(key), candidate);
     }
     const { config, sleeveGrid, spacingCm, floor, ceiling } = this.#context;
     if (this.#ceilingNote) {

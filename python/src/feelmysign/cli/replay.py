@@ -99,8 +99,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     _check_usage(args, parser)
     recording = simplify.load(args.recording)
     algorithm = simplify.chosen_algorithm(args, recording)
-    simplify._check_usage(args, algorithm, parser)  # another algorithm's option: exit 2
-    params = simplify.params_from_args(args, recording)
+    # An option of another algorithm, or of the core not run: exit 2.
+    params = simplify.checked_params(args, recording, parser)
     client = _connect(args) if args.send else None
     try:
         if client is not None:

@@ -84,6 +84,8 @@ def _option(parser: argparse.ArgumentParser, spec: ParamSpec) -> None:
     so the recording's value or the default applies."""
     owners = OWNERS[spec.name]
     prefix = f"{owners[0]}: " if len(owners) == 1 else ""
+    if spec.only_when is not None:  # read by one of its simplifier's cores only
+        prefix = f"{prefix[:-2]} with {_switch_flag(*spec.only_when)}: "
     flag = option_flag(spec.name)
     if spec.kind is bool:
         default = "on" if spec.default else "off"
@@ -131,6 +133,12 @@ def _value_of(spec: ParamSpec) -> Any:
 
     parse.__name__ = "whole number" if whole else "number"
     return parse
+
+
+def _switch_flag(name: str, value: bool) -> str:
+    """The flag that sets a boolean parameter to ``value``: ``--least-squares`` or
+    ``--no-least-squares``."""
+    return option_flag(name if value else f"no_{name}")
 
 
 def _bound(value: float | None) -> str:
@@ -188,10 +196,20 @@ def load(path: str) -> Recording:
     return load_recording(path)
 
 
-def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser | None = None) -> int:
-    recording = load(args.recording)
+def checked_params(
+    args: argparse.Namespace, recording: Recording, parser: argparse.ArgumentParser | None
+) -> Params:
+    """``params_from_args``, after refusing (exit 2) an option the strokes would ignore: one of
+    the other algorithm's, or one of the core the effective settings do not run."""
     _check_usage(args, chosen_algorithm(args, recording), parser)
     params = params_from_args(args, recording)
+    _check_conditions(args, params, parser)
+    return params
+
+
+def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser | None = None) -> int:
+    recording = load(args.recording)
+    params = checked_params(args, recording, parser)
     result = simplify_paths(params, recording.paths)
     if args.json:
         print(json.dumps(to_json(result, params)))
@@ -214,6 +232,32 @@ def _check_usage(
         if owner != algorithm and value is not None and parser:
             flag = option_flag(name if value is not False else f"no_{name}")
             parser.error(f"{flag} only applies to --algorithm {owner}")
+
+
+def _check_conditions(
+    args: argparse.Namespace, params: Params, parser: argparse.ArgumentParser | None
+) -> None:
+    """Usage error (exit 2): an option its simplifier reads only under a setting (``only_when``)
+    that is off here, the recording's settings included, so it would change nothing."""
+    for name, spec in algorithm_of(params).specs.items():
+        value = getattr(args, name, None)
+        if spec.only_when is None or value is None or spec.applies(asdict(params)) or not parser:
+            continue
+        switch, needed = spec.only_when
+        flag = option_flag(name if value is not False else f"no_{name}")
+        wanted = _switch_flag(switch, needed)
+        if getattr(args, switch, None) is not None:
+            fix = f"drop it, or give {wanted} instead of {_switch_flag(switch, not needed)}"
+        else:
+            state = "on" if not needed else "off"
+            label = PARAMETERS[switch].label.lower()
+            why = (
+                f"{label} is {state} by default"
+                if getattr(params, switch) == PARAMETERS[switch].default
+                else f"the recording's settings have {label} {state}"
+            )
+            fix = f"drop it, or add {wanted} ({why})"
+        parser.error(f"{flag} only applies with {wanted}; {fix}")
 
 
 def to_json(result: list[PathSegment], params: Params) -> dict[str, Any]:

@@ -83,7 +83,28 @@ def parameter_sets(algorithm: Algorithm, sweeps: Sequence[Sweep]) -> list[dict[s
         if kind is int and not all(float(v).is_integer() for v in sweep.values):
             raise SweepError(f"--sweep {sweep.name}: whole numbers only, got {sweep.values}")
         axes.append([(sweep.name, int(v) if kind is int else v) for v in sweep.values])
-    return [dict(point) for point in itertools.product(*axes)]
+    points = [dict(point) for point in itertools.product(*axes)]
+    _check_read(algorithm, own, points)
+    return points
+
+
+def _check_read(
+    algorithm: Algorithm, sweeps: Sequence[Sweep], points: Sequence[dict[str, Any]]
+) -> None:
+    """SweepError for a swept parameter that one core reads (``only_when``) and no point of the
+    grid runs: its values would all give the same strokes."""
+    defaults = {name: spec.default for name, spec in algorithm.specs.items()}
+    for sweep in sweeps:
+        spec = algorithm.specs[sweep.name]
+        if spec.only_when is None:
+            continue
+        if not any(spec.applies({**defaults, **point}) for point in points):
+            switch, value = spec.only_when
+            word = "true" if value else "false"
+            raise SweepError(
+                f"--sweep {sweep.name}: only read with {switch} {word}, which no run has; "
+                f"sweep it too: {switch}={word}, or {switch}=0:1:1 for both"
+            )
 
 
 def check_names(sweeps: Sequence[Sweep], algorithms: Sequence[Algorithm]) -> None:

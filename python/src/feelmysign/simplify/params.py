@@ -2,14 +2,17 @@
 
 A parameter is a field of its simplifier's parameter dataclass, declared with
 ``param`` (its default, range, unit, help, the paper's name for it, and where
-the page's settings panel shows it). The parameters every simplifier has (the
+the page's settings panel shows it, and, for a parameter only one core of its simplifier
+reads, the switch and value that choose that core: ``only_when``). The parameters every
+simplifier has (the
 canvas, the sleeve's grid, the shortest stroke to send) are the fields of
 ``SharedParams``, declared here once; each simplifier declares its own beside
 its code (``angle.py``, ``window.py``). ``specs_of`` reads the declarations
 back as ``ParamSpec`` rows, and everything else is derived from them:
 
 - every parameter dataclass checks its values against them (``check_all``);
-- ``feelmysign simplify`` builds its options, help and ranges from them;
+- ``feelmysign simplify`` builds its options, help and ranges from them, and refuses an
+  option its simplifier or core would ignore;
 - ``testdata/generate.py`` writes them as the language-neutral table
   ``testdata/params/params.json`` (the clients in other languages read it), as
   each simplifier's ``testdata/<algorithm>/params.json``, and as the page's
@@ -57,6 +60,10 @@ class ParamSpec:
     detail_levels: tuple[float, ...] = ()
     # A few letters for plot legends (``feelmysign evaluate``), where the name is too long.
     short: str | None = None
+    # Read only when another (boolean) parameter of the same simplifier has this value, e.g.
+    # ("least_squares", True): the one core that reads it. Otherwise it changes nothing, so the
+    # CLI refuses it and the page's settings panel locks it. None: always read.
+    only_when: tuple[str, bool] | None = None
 
     def check(self, value: Any) -> None:
         if self.kind is bool:
@@ -110,7 +117,19 @@ class ParamSpec:
             "panel": self.panel,
             "detail_levels": list(self.detail_levels) or None,
             "short": self.short,
+            "only_when": (
+                None
+                if self.only_when is None
+                else {"name": self.only_when[0], "value": self.only_when[1]}
+            ),
         }
+
+    def applies(self, values: dict[str, Any]) -> bool:
+        """Whether a simplifier with these values (by name) reads this parameter."""
+        if self.only_when is None:
+            return True
+        name, value = self.only_when
+        return bool(values[name] == value)
 
 
 def _fmt(bound: float | None) -> str:
@@ -130,6 +149,7 @@ class _Declaration:
     panel: Panel | None
     detail_levels: tuple[float, ...]
     short: str | None
+    only_when: tuple[str, bool] | None
 
 
 def param(
@@ -144,10 +164,11 @@ def param(
     panel: Panel | None = "simplifier",
     detail_levels: tuple[float, ...] = (),
     short: str | None = None,
+    only_when: tuple[str, bool] | None = None,
 ) -> T:
     """A parameter field with its default and its declaration (read back by ``specs_of``)."""
     declaration = _Declaration(
-        minimum, maximum, help, label, unit, paper, panel, detail_levels, short
+        minimum, maximum, help, label, unit, paper, panel, detail_levels, short, only_when
     )
     # field() is typed as the default's type, so the dataclass field keeps its own type.
     return field(default=default, metadata={_DECLARATION: declaration})
@@ -185,7 +206,18 @@ def _read_specs(params_class: type) -> dict[str, ParamSpec]:
             declared.panel,
             declared.detail_levels,
             declared.short,
+            declared.only_when,
         )
+    for spec in specs.values():
+        if spec.only_when is None:
+            continue
+        name, value = spec.only_when
+        condition = specs.get(name)
+        if condition is None or condition.kind is not bool or not isinstance(value, bool):
+            raise TypeError(
+                f"{params_class.__name__}.{spec.name}: only_when names {name!r}, "
+                "not a boolean parameter of the same class"
+            )
     return specs
 
 

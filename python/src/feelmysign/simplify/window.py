@@ -188,6 +188,7 @@ class _WindowOwn:
         "(never under bend_floor), so round shapes stay round; 0 = no limit",
         label="Max bend",
         unit="of the stroke's length",
+        only_when=("least_squares", False),
     )
     bend_floor: float = param(
         0.1,
@@ -196,6 +197,7 @@ class _WindowOwn:
         help="least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
         label="Bend floor",
         unit="grid units",
+        only_when=("least_squares", False),
     )
     rest_ms: float = param(
         100.0,
@@ -233,10 +235,10 @@ class _WindowOwn:
         30.0,
         0,
         1000,
-        help="with least squares on: how long the pen draws past a stroke's end before the "
-        "stroke is sent, in ms",
+        help="how long the pen draws past a stroke's end before the stroke is sent, in ms",
         label="Lookahead",
         unit="ms",
+        only_when=("least_squares", True),
     )
 
 

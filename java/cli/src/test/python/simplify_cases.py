@@ -62,6 +62,10 @@ def random_flags(rng: random.Random) -> list[str]:
             flags.append("--least-squares")
             maybe("--lookahead-ms", str(rng.choice([0, 10, 30, 100.5, 1000])))
             maybe("--floor-ms", str(rng.choice([0, 20, 73.701, 150])))
+        elif rng.random() < 0.5:  # the chord core, with its bend rule
+            flags.append("--no-least-squares")
+            maybe("--max-bend", str(rng.choice([0, 0.05, 0.2, 1])))
+            maybe("--bend-floor", str(rng.choice([0, 0.1, 0.5])))
     elif kind in ("angle", "paper"):
         maybe("--check-frames", str(rng.randint(2, 30)))
         maybe("--max-angle-deg", str(rng.choice([1, 5, 12.5, 20, 45, 90, 179])))
@@ -169,6 +173,10 @@ USAGE_ERRORS = [
     ["--stretch=yes"],
     ["--max-e=abc"],
     ["--max-window", "2.5"],
+    # An option of the window core not run (the least-squares core is the default).
+    ["--max-bend", "0.2"],
+    ["--least-squares", "--bend-floor", "0.2"],
+    ["--algorithm", "window", "--no-least-squares", "--lookahead-ms", "80"],
 ]
 
 
@@ -236,6 +244,15 @@ def main_(outdir: Path) -> None:
     # The least-squares core on drawn shapes too (LASA, people's gestures), at its defaults.
     for name, path in recordings[::12]:
         case(name + " least squares", [str(path), "--least-squares", "--json"])
+    # A recording made with the chord core: its bend rule is taken, the lookahead refused
+    # unless --least-squares is given too (the check is on the settings in effect).
+    chord = json.loads(recordings[0][1].read_text())
+    chord["simplifier"] = {"algorithm": "window", "params": {"least_squares": False}}
+    chord_path = str(save("chord-core.json", chord))
+    bend = ["--max-bend", "0.1", "--bend-floor", "0.05"]
+    case("chord core, bend rule", [chord_path, *bend, "--json"])
+    case("chord core, lookahead", [chord_path, "--lookahead-ms", "80", "--json"])
+    case("chord core, least squares", [chord_path, "--least-squares", "--lookahead-ms", "80"])
     first = str(recordings[0][1])
     case("text output", [first])
     case("text output, angle", [first, "--paper", "--stretch"])

@@ -27,6 +27,7 @@ import java.util.ArrayList;
 import java.util.LinkedHashMap;
 import java.util.LinkedHashSet;
 import java.util.List;
+import java.util.Locale;
 import java.util.Map;
 import java.util.Set;
 
@@ -104,6 +105,13 @@ final class SimplifyCommand {
   /** The option of one parameter, its help and range from the table, as the reference's. */
   private static void parameter(ParamTable.Row row) {
     String prefix = row.algorithms().size() == 1 ? row.algorithms().get(0) + ": " : "";
+    if (row.onlyWhen() != null) { // read by one of its simplifier's cores only
+      prefix =
+          prefix.substring(0, prefix.length() - 2)
+              + " with "
+              + switchFlag(row.onlyWhen().name(), row.onlyWhen().value())
+              + ": ";
+    }
     String flag = "--" + row.name().replace('_', '-');
     if (row.kind() == ParamSpec.Kind.BOOLEAN) {
       String onOff = Boolean.TRUE.equals(row.defaultValue()) ? "on" : "off";
@@ -161,6 +169,7 @@ final class SimplifyCommand {
     Algorithm algorithm = chosenAlgorithm(given, recording, path);
     checkUsage(given, algorithm);
     Params params = params(given, recording, algorithm);
+    checkConditions(given, params);
     List<PathSegment> result = Simplify.paths(params, recording.paths());
     if (given.containsKey("json")) {
       out.println(PyDumps.dumps(toJson(result, params)));
@@ -454,6 +463,58 @@ final class SimplifyCommand {
         throw usage(flag + " only applies to --algorithm " + only.getValue().wireName());
       }
     }
+  }
+
+  /** The flag that sets a boolean parameter: --least-squares or --no-least-squares. */
+  private static String switchFlag(String name, boolean value) {
+    return (value ? "--" : "--no-") + name.replace('_', '-');
+  }
+
+  /**
+   * Usage error (exit 2): an option its simplifier reads only under a setting (the table's
+   * onlyWhen) that is off here, the recording's settings included, so it would change nothing.
+   */
+  private static void checkConditions(Map<String, Object> given, Params params) {
+    for (ParamTable.Row row : ParamTable.PARAMETERS) {
+      ParamTable.Condition condition = row.onlyWhen();
+      String name = row.name();
+      if (condition == null
+          || !given.containsKey(name)
+          || !params.algorithm().defaults().containsKey(name)
+          || params.flag(condition.name()) == condition.value()) {
+        continue;
+      }
+      String flag = (Boolean.FALSE.equals(given.get(name)) ? "--no-" : "--") + name.replace('_', '-');
+      String wanted = switchFlag(condition.name(), condition.value());
+      String fix;
+      if (given.containsKey(condition.name())) {
+        fix =
+            "drop it, or give "
+                + wanted
+                + " instead of "
+                + switchFlag(condition.name(), !condition.value());
+      } else {
+        ParamTable.Row switchRow = row(condition.name());
+        String state = condition.value() ? "off" : "on";
+        String label = switchRow.label().toLowerCase(Locale.ROOT);
+        boolean byDefault = switchRow.defaultValue().equals(params.flag(condition.name()));
+        String why =
+            byDefault
+                ? label + " is " + state + " by default"
+                : "the recording's settings have " + label + " " + state;
+        fix = "drop it, or add " + wanted + " (" + why + ")";
+      }
+      throw usage(flag + " only applies with " + wanted + "; " + fix);
+    }
+  }
+
+  private static ParamTable.Row row(String name) {
+    for (ParamTable.Row row : ParamTable.PARAMETERS) {
+      if (row.name().equals(name)) {
+        return row;
+      }
+    }
+    throw new IllegalArgumentException("no parameter " + name);
   }
 
   /** The recording's own settings, then the command line's, over the algorithm's defaults. */

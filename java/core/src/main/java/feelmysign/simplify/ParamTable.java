@@ -36,6 +36,8 @@ public final class ParamTable {
    * @param panel the section of the page's settings panel that shows it, or null
    * @param detailLevels the values of the page's detail control, coarse to fine, or null
    * @param shortName its name in plot legends, or null
+   * @param onlyWhen the value of another (boolean) parameter the simplifier reads it
+   *     under (its other core ignores it), or null: always read
    */
   public record Row(
       String name,
@@ -51,7 +53,16 @@ public final class ParamTable {
       String help,
       String panel,
       List<Double> detailLevels,
-      String shortName) {}
+      String shortName,
+      Condition onlyWhen) {}
+
+  /**
+   * A parameter's value under which another parameter is read.
+   *
+   * @param name the boolean parameter's name
+   * @param value the value it must have
+   */
+  public record Condition(String name, boolean value) {}
 
   /** The simplifier a client starts with. */
   public static final String DEFAULT_ALGORITHM = "window";
@@ -88,7 +99,8 @@ public final class ParamTable {
               "farthest a drawn point may lie from its stroke, in grid units",
               "simplifier",
               List.of(0.4, 0.25, 0.15, 0.1, 0.05),
-              "err"),
+              "err",
+              null),
           new Row(
               "max_window",
               List.of("window"),
@@ -102,6 +114,7 @@ public final class ParamTable {
               "Window cap",
               "longest stroke in samples after its start (bounds the work per sample)",
               "simplifier",
+              null,
               null,
               null),
           new Row(
@@ -119,6 +132,7 @@ public final class ParamTable {
                   + "limit",
               "simplifier",
               null,
+              null,
               null),
           new Row(
               "max_bend",
@@ -135,7 +149,8 @@ public final class ParamTable {
                   + "(never under bend_floor), so round shapes stay round; 0 = no limit",
               "simplifier",
               null,
-              null),
+              null,
+              new Condition("least_squares", false)),
           new Row(
               "bend_floor",
               List.of("window"),
@@ -150,7 +165,8 @@ public final class ParamTable {
               "least bound the bend rule sets, in grid units, so noise does not cut a short stroke",
               "simplifier",
               null,
-              null),
+              null,
+              new Condition("least_squares", false)),
           new Row(
               "rest_ms",
               List.of("window"),
@@ -165,6 +181,7 @@ public final class ParamTable {
               "a pen resting this long ends the stroke so far, in ms (the rest is not played); 0 = "
                   + "never",
               "simplifier",
+              null,
               null,
               null),
           new Row(
@@ -181,6 +198,7 @@ public final class ParamTable {
               "never send a stroke below min_length or min_duration_ms, even where max_error must "
                   + "yield (a wearer's measured limits: senders set it from the sleeve's status)",
               "simplifier",
+              null,
               null,
               null),
           new Row(
@@ -199,6 +217,7 @@ public final class ParamTable {
                   + "else is sent to last it",
               "simplifier",
               null,
+              null,
               null),
           new Row(
               "least_squares",
@@ -216,6 +235,7 @@ public final class ParamTable {
                   + "from the chord where the bound breaks",
               "simplifier",
               null,
+              null,
               null),
           new Row(
               "lookahead_ms",
@@ -228,11 +248,11 @@ public final class ParamTable {
               1000.0,
               "ms",
               "Lookahead",
-              "with least squares on: how long the pen draws past a stroke's end before the stroke "
-                  + "is sent, in ms",
+              "how long the pen draws past a stroke's end before the stroke is sent, in ms",
               "simplifier",
               null,
-              null),
+              null,
+              new Condition("least_squares", true)),
           new Row(
               "check_frames",
               List.of("angle"),
@@ -247,7 +267,8 @@ public final class ParamTable {
               "frames between two checks (the paper's checkFrame)",
               "simplifier",
               null,
-              "chk"),
+              "chk",
+              null),
           new Row(
               "max_angle_deg",
               List.of("angle"),
@@ -262,7 +283,8 @@ public final class ParamTable {
               "largest turn, in degrees, that continues a line",
               "simplifier",
               List.of(60.0, 45.0, 30.0, 20.0, 12.0),
-              "deg"),
+              "deg",
+              null),
           new Row(
               "frame_max",
               List.of("angle"),
@@ -277,7 +299,8 @@ public final class ParamTable {
               "longest line in frames; 0 = no limit",
               "simplifier",
               null,
-              "fmax"),
+              "fmax",
+              null),
           new Row(
               "fps",
               List.of("angle"),
@@ -291,6 +314,7 @@ public final class ParamTable {
               "Frames per second",
               "frames per second of the drawing loop",
               "simplifier",
+              null,
               null,
               null),
           new Row(
@@ -307,6 +331,7 @@ public final class ParamTable {
               "start a new line at the last check (no gaps)",
               "simplifier",
               null,
+              null,
               null),
           new Row(
               "clear_on_press",
@@ -322,6 +347,7 @@ public final class ParamTable {
               "a new press clears the drawing",
               "drawing",
               null,
+              null,
               null),
           new Row(
               "min_duration_ms",
@@ -336,6 +362,7 @@ public final class ParamTable {
               "Min duration",
               "shortest stroke to send, in ms",
               "simplifier",
+              null,
               null,
               null),
           new Row(
@@ -353,6 +380,7 @@ public final class ParamTable {
                   + "a path's first piece to it, unless strict_minimums)",
               "simplifier",
               null,
+              null,
               null),
           new Row(
               "rows",
@@ -367,6 +395,7 @@ public final class ParamTable {
               "Rows",
               "actuator rows of the sleeve",
               "sleeve",
+              null,
               null,
               null),
           new Row(
@@ -383,6 +412,7 @@ public final class ParamTable {
               "actuator columns of the sleeve",
               "sleeve",
               null,
+              null,
               null),
           new Row(
               "canvas_width_px",
@@ -396,6 +426,7 @@ public final class ParamTable {
               "px",
               "Canvas width",
               "drawing area width in pixels",
+              null,
               null,
               null,
               null),
@@ -413,6 +444,7 @@ public final class ParamTable {
               "drawing area height in pixels",
               null,
               null,
+              null,
               null),
           new Row(
               "stretch",
@@ -427,6 +459,7 @@ public final class ParamTable {
               "Stretch to the grid",
               "stretch the canvas onto the grid (the paper's)",
               "simplifier",
+              null,
               null,
               null));
 

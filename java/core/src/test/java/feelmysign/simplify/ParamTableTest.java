@@ -65,7 +65,7 @@ class ParamTableTest {
     Set<String> columns =
         Set.of(
             "name", "algorithms", "paper", "type", "default", "minimum", "maximum", "unit",
-            "label", "help", "panel", "detail_levels", "short");
+            "label", "help", "panel", "detail_levels", "short", "only_when");
     for (int i = 0; i < rows.size(); i++) {
       JsonNode json = rows.get(i);
       ParamTable.Row row = ParamTable.PARAMETERS.get(i);
@@ -92,6 +92,17 @@ class ParamTableTest {
       }
       assertEquals(levels, row.detailLevels(), name + " detail levels");
       assertEquals(textOrNull(json.get("short")), row.shortName(), name + " short");
+      JsonNode condition = json.get("only_when");
+      assertEquals(
+          condition.isNull()
+              ? null
+              : new ParamTable.Condition(
+                  condition.get("name").asText(), condition.get("value").asBoolean()),
+          row.onlyWhen(),
+          name + " only when");
+      if (!condition.isNull()) {
+        assertTrue(condition.get("value").isBoolean(), name + ": a condition is on a switch");
+      }
     }
   }
 
