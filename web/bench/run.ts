@@ -76,6 +76,20 @@ if (lasa !== null) {
   partTime();
 }
 
+const { benchWidest } = await import("./widest");
+const widest = benchWidest();
+console.log(
+  `web: window simplifier at the widest settings (window 10,000, no latency cap, lookahead 1,000 ms,` +
+    ` floor 10,000 ms; a slow arc, ${widest.samples.toLocaleString("en")} samples at 1,000 Hz; least of 3 runs)`,
+);
+for (const core of widest.cores) {
+  console.log(
+    `  ${core.name.padEnd(28)} mean ${core.meanUs.toFixed(1).padStart(7)} us a sample` +
+      `   worst push ${core.worstMs.toFixed(1).padStart(6)} ms`,
+  );
+}
+partTime();
+
 /** Budget of the two growth ratios below: the page's cost must not grow with the drawing. */
 const GROWTH_BUDGET = 1.2;
 
