@@ -268,6 +268,15 @@ export async function setLeastSquares(page: Page, on: boolean): Promise<void> {
   await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
 }
 
+/** Settings → Advanced → Rest (ms a pen rests before the stroke so far ends; 0 = never), saved. */
+export async function setRest(page: Page, ms: string): Promise<void> {
+  await page.locator('[data-testid="settings-button"]').click();
+  await openAdvanced(page);
+  await page.locator('[data-testid="setting-rest_ms"]').fill(ms);
+  await page.locator('[data-testid="settings-save"]').click();
+  await page.locator('[data-testid="settings-panel"]').waitFor({ state: "hidden" });
+}
+
 /** Settings → Advanced → Longest stroke (ms of drawing; 0 = no limit), saved. */
 export async function setLongestStroke(page: Page, ms: string): Promise<void> {
   await page.locator('[data-testid="settings-button"]').click();

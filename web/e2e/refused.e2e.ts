@@ -9,7 +9,15 @@ import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { REPO_DIR, type EventWatcher } from "./harness";
-import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
+import {
+  drawingArea,
+  drawWithMouse,
+  screenshot,
+  setLongestStroke,
+  setRest,
+  waitForData,
+  type Area,
+} from "./page";
 import { Processes } from "./processes";
 
 type Point = readonly [number, number];
@@ -46,7 +54,10 @@ describe("a stroke the sleeve refuses", () => {
 
   it("marks it refused, counts it, and leaves it out of the felt timeline", async () => {
     // One stroke a leg (no cap on a stroke's length): each lasts as long as its leg took to draw.
+    // No rest rule either: on a loaded machine the mouse's events can stall for longer than
+    // rest_ms, and the page's samples of the still pointer would end the slow leg's stroke there.
     await setLongestStroke(page, "0");
+    await setRest(page, "0");
     await drawWithMouse(page, [at(0.1, 0.8), at(0.3, 0.2), at(0.5, 0.8), at(0.7, 0.2)], {
       legMs: FAST_LEG_MS,
     });
