@@ -216,6 +216,11 @@ final class SendCommand {
       }
 
       @Override
+      public void noSleeve(String sentence) {
+        // Not said: the command says what the Python CLI's says, and that one does not.
+      }
+
+      @Override
       public void floorIgnored(String sentence) {
         err.println(Character.toUpperCase(sentence.charAt(0)) + sentence.substring(1));
       }
