@@ -217,7 +217,7 @@ final class SendCommand {
 
       @Override
       public void noSleeve(String sentence) {
-        // Not said: the command says what the Python CLI's says, and that one does not.
+        // Not said: the command's output stays the Python CLI's, which has no such line.
       }
 
       @Override
