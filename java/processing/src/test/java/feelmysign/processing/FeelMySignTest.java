@@ -90,6 +90,18 @@ class FeelMySignTest {
   }
 
   @Test
+  void aFloatLiteralIsTheNumberWritten() {
+    // In a .pde, 0.1 is a float; set() takes it as written, not as the float's exact value.
+    FeelMySign library = new FeelMySign(new Sketch()).set("max_error", 0.1f).set("rest_ms", 150f);
+    assertEquals(0.1, library.params().get("max_error"));
+    assertEquals(150.0, library.params().get("rest_ms"));
+    assertTrue(library.params().values().toString().contains("max_error=0.1,"),
+        library.params().values().toString());
+    FeelMySign paper = new FeelMySign(new Sketch()).angle().set("minimumSize", 0.3f);
+    assertEquals(0.3, paper.params().get("min_length"));
+  }
+
+  @Test
   void theSketchIsToldWhenTheSleeveGoesOfflineAndComesBack() throws Exception {
     Sketch sketch = new Sketch();
     FeelMySign library = new FeelMySign(sketch);
