@@ -187,7 +187,11 @@ public class FeelMySign {
     return this;
   }
 
-  /** The sleeve's id (default sleeve1): strokes go to feelmysign/&lt;id&gt;/strokes. */
+  /**
+   * The sleeve's id (default sleeve1): strokes go to feelmysign/&lt;id&gt;/strokes. An id no
+   * sleeve has reported on is said to sleeveStatus a few seconds after connecting, and once
+   * more when strokes are sent there ({@link SleeveClient.Listener#noSleeve}).
+   */
   public FeelMySign sleeve(String id) {
     this.sleeveId = id;
     return this;
