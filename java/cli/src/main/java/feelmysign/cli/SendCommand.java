@@ -216,6 +216,11 @@ final class SendCommand {
       }
 
       @Override
+      public void noSleeve(String sentence) {
+        // Not said: the command's output stays the Python CLI's, which has no such line.
+      }
+
+      @Override
       public void floorIgnored(String sentence) {
         err.println(Character.toUpperCase(sentence.charAt(0)) + sentence.substring(1));
       }

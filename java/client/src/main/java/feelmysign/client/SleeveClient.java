@@ -69,6 +69,12 @@ public final class SleeveClient implements AutoCloseable {
   public static final long RECONNECT_PERIOD_MS = 2000;
   /** The broker notices a vanished sender after 1.5 x this. */
   public static final int KEEPALIVE_S = 20;
+  /**
+   * A sleeve that ever reported has its retained status at the broker, sent right after the
+   * subscription: none within this, none listens (the page's STATUS_WAIT_MS, the Python CLI's
+   * STATUS_WAIT_S).
+   */
+  public static final long STATUS_WAIT_MS = 2500;
 
   /** The connection to the broker. */
   public enum State {
@@ -84,6 +90,18 @@ public final class SleeveClient implements AutoCloseable {
 
     /** The sleeve's retained status (JSON; "" when it was cleared). */
     default void status(String payload) {}
+
+    /**
+     * No sleeve listens on the id ({@link #noSleeveSentence}): the broker holds no status of it,
+     * none having come within {@link #STATUS_WAIT_MS} of subscribing, or it was cleared. Said
+     * once per connection, and once more when strokes are sent after it was said (not per
+     * stroke; strokes sent while it was found out are covered by the first). Not with the legacy
+     * format, whose topic any sleeve may read. From the network thread, a timer's, or the thread
+     * that sent the stroke. By default the sentence is printed on the console (System.err).
+     */
+    default void noSleeve(String sentence) {
+      System.err.println("feelmysign: " + sentence);
+    }
 
     /**
      * The wearer's choice (paused, ceiling, "do not disturb"), typed, right after each online
@@ -154,6 +172,14 @@ public final class SleeveClient implements AutoCloseable {
   private volatile SleeveFloor floor;
   /** The last floor not understood, told once (network thread only). */
   private String floorIgnoredTold;
+  /** Counts connections and losses: a status wait of an earlier connection does nothing. */
+  private long connection;
+  /** Whether a sleeve listens: null while its retained status is awaited, or not connected. */
+  private Boolean sleeveListens;
+  /** Whether strokes sent to the id no sleeve listens on have been told (once, not per stroke). */
+  private boolean absenceToldForStrokes;
+  /** Whether strokes were sent while it was not known whether a sleeve listens. */
+  private boolean sentWhileUnknown;
 
   private SleeveClient(Builder b) {
     this.url = b.url;
@@ -323,11 +349,15 @@ public final class SleeveClient implements AutoCloseable {
 
   private void onConnected() {
     Mqtt3AsyncClient current;
+    long thisConnection;
     synchronized (lock) {
       current = client;
       connected = true;
       lastCertificateProblem = null;
       outageTold = false;
+      thisConnection = ++connection;
+      sleeveListens = null;
+      absenceToldForStrokes = false;
     }
     listener.broker(
         State.CONNECTED,
@@ -344,6 +374,12 @@ public final class SleeveClient implements AutoCloseable {
                   listener.broker(
                       State.CONNECTED,
                       "Connected, but cannot read the sleeve's " + name + ": " + error.getMessage());
+                } else if (name.equals(Topics.STATUS)) {
+                  // The retained status, if the broker holds one, follows the SUBACK at once.
+                  java.util.concurrent.CompletableFuture.runAsync(
+                      () -> statusAwaited(thisConnection),
+                      java.util.concurrent.CompletableFuture.delayedExecutor(
+                          STATUS_WAIT_MS, TimeUnit.MILLISECONDS));
                 }
               });
     }
@@ -357,6 +393,8 @@ public final class SleeveClient implements AutoCloseable {
       wasConnected = connected;
       connected = false;
       outbox.requeueInFlight();
+      connection++;
+      sleeveListens = null;
     }
     if (context.getSource() == MqttDisconnectSource.USER) {
       context.getReconnector().reconnect(false);
@@ -441,7 +479,18 @@ public final class SleeveClient implements AutoCloseable {
     String text = new String(publish.getPayloadAsBytes(), StandardCharsets.UTF_8);
     if (topic.equals(Topics.telemetryTopic(sleeveId, Topics.STATUS))) {
       boolean floorChanged = readFloor(text);
+      boolean absent = text.isBlank();
+      boolean tell;
+      synchronized (lock) {
+        tell = absent && !Boolean.FALSE.equals(sleeveListens) && format != WireFormat.LEGACY;
+        sleeveListens = !absent;
+        absenceToldForStrokes = false;
+        sentWhileUnknown = false;
+      }
       listener.status(text);
+      if (tell) {
+        listener.noSleeve(noSleeveSentence(sleeveId));
+      }
       if (floorChanged) {
         listener.floor(floor);
       }
@@ -455,6 +504,35 @@ public final class SleeveClient implements AutoCloseable {
         listener.event(event);
       }
     }
+  }
+
+  /**
+   * The wait for the retained status of connection {@code which} is over: with none, no sleeve
+   * listens, and that is said (the strokes sent so far are covered by it).
+   */
+  private void statusAwaited(long which) {
+    synchronized (lock) {
+      if (which != connection || !connected || sleeveListens != null) {
+        return;
+      }
+      sleeveListens = false;
+      absenceToldForStrokes = sentWhileUnknown;
+      sentWhileUnknown = false;
+    }
+    if (format != WireFormat.LEGACY) {
+      listener.noSleeve(noSleeveSentence(sleeveId));
+    }
+  }
+
+  /**
+   * What {@link Listener#noSleeve} says: the page's words (web/src/sleeve-state.ts), for a sender
+   * without its settings.
+   */
+  public static String noSleeveSentence(String sleeveId) {
+    return "no sleeve listens on id '"
+        + sleeveId
+        + "': nothing has ever reported there, so strokes sent now are not felt; check the"
+        + " sleeve id (a sleeve prints its id when it starts)";
   }
 
   /**
@@ -553,6 +631,7 @@ public final class SleeveClient implements AutoCloseable {
    */
   public Stroke send(Stroke stroke) {
     Stroke addressed;
+    boolean tellAbsence;
     synchronized (lock) {
       if (stroke.drawing() == null) {
         if (drawing == null) {
@@ -567,6 +646,16 @@ public final class SleeveClient implements AutoCloseable {
         addressed = addressed.withSentAt((double) System.currentTimeMillis());
       }
       outbox.add(addressed, nowMs());
+      tellAbsence = Boolean.FALSE.equals(sleeveListens) && !absenceToldForStrokes;
+      if (tellAbsence) {
+        absenceToldForStrokes = true;
+      }
+      if (sleeveListens == null) {
+        sentWhileUnknown = true;
+      }
+    }
+    if (tellAbsence && format != WireFormat.LEGACY) {
+      listener.noSleeve(noSleeveSentence(sleeveId));
     }
     flush();
     return addressed;

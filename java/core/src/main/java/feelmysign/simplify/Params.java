@@ -139,7 +139,9 @@ public final class Params {
       return ((Number) value).longValue();
     }
     if (value instanceof Float f) {
-      return f.doubleValue();
+      // The double that prints as the float does: 0.1f is 0.1, not 0.10000000149011612 (its
+      // exact value). A float is what Processing's literals are; what was written is meant.
+      return Double.parseDouble(Float.toString(f));
     }
     return value;
   }

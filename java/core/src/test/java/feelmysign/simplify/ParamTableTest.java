@@ -250,6 +250,24 @@ class ParamTableTest {
   }
 
   @Test
+  void aFloatIsTakenAsTheDecimalItPrintsAs() {
+    // Processing's literals are floats: 0.1f is meant as 0.1, not its exact 0.10000000149011612.
+    assertEquals(0.10000000149011612, (double) 0.1f);
+    Params window = Params.window().with("max_error", 0.1f).with("rest_ms", 150.5f);
+    assertEquals(0.1, window.get("max_error"));
+    assertEquals(150.5, window.get("rest_ms"));
+    assertEquals("0.1", String.valueOf(window.values().get("max_error")));
+    // The same parameters as from a double, so the same strokes.
+    assertEquals(Params.window().with("max_error", 0.1).with("rest_ms", 150.5), window);
+    assertEquals(1.0E-3, Params.window().with("max_error", 1e-3f).get("max_error"));
+    assertEquals(1800.0, Params.angle().with("screenX", 1800f).get("canvas_width_px"));
+    // Still checked against the range, and said as it was written (in Python's repr).
+    ParameterException out =
+        assertThrows(ParameterException.class, () -> Params.window().with("max_error", 0.0001f));
+    assertEquals("max_error = 0.0001 is not allowed; it must be in [0.001, 100]", out.getMessage());
+  }
+
+  @Test
   void theParametersOfTheOtherAlgorithmAreRefused() {
     IllegalArgumentException paper =
         assertThrows(IllegalArgumentException.class, () -> Params.window().with("checkFrame", 5));

@@ -187,7 +187,11 @@ public class FeelMySign {
     return this;
   }
 
-  /** The sleeve's id (default sleeve1): strokes go to feelmysign/&lt;id&gt;/strokes. */
+  /**
+   * The sleeve's id (default sleeve1): strokes go to feelmysign/&lt;id&gt;/strokes. An id no
+   * sleeve has reported on is said to sleeveStatus a few seconds after connecting, and once
+   * more when strokes are sent there ({@link SleeveClient.Listener#noSleeve}).
+   */
   public FeelMySign sleeve(String id) {
     this.sleeveId = id;
     return this;
@@ -833,10 +837,11 @@ public class FeelMySign {
     }
   }
 
-  /** Runs on the network thread: only queues, never blocks, never throws. */
+  /** Runs on the network thread (noSleeve may not): only queues, never blocks, never throws. */
   private final class Relay implements SleeveClient.Listener {
     // The sleeve as its last status understood says (null before any): a change is said.
-    private SleeveSeen sleeve;
+    // Written by the network thread, and by noSleeve from a timer's or the sending thread.
+    private volatile SleeveSeen sleeve;
 
     private void offer(Object item) {
       if (!inbox.offer(item)) {
@@ -861,18 +866,23 @@ public class FeelMySign {
                     + " play if it is back within its age limit (10 s unless set; older ones are"
                     + " refused as stale); if it crashed, a motor it was driving may run until it"
                     + " restarts");
-        case NONE ->
-            offer(
-                "no sleeve listens on id '"
-                    + sleeveId
-                    + "': nothing has ever reported there, so strokes sent now are not felt; check"
-                    + " the sleeve id (a sleeve prints its id when it starts)");
+        case NONE -> {
+          // Said by the client (noSleeve), which also says it when no status comes at all.
+        }
         case ONLINE -> {
-          if (before != null) {
+          if (before == SleeveSeen.OFFLINE) {
             offer("sleeve " + sleeveId + " is online again");
+          } else if (before == SleeveSeen.NONE) {
+            offer("sleeve " + sleeveId + " is online: strokes sent from now on are felt");
           }
         }
       }
+    }
+
+    @Override
+    public void noSleeve(String sentence) {
+      sleeve = SleeveSeen.NONE;
+      offer(sentence);
     }
 
     @Override

@@ -7,6 +7,7 @@ import static org.junit.jupiter.api.Assertions.assertThrows;
 import static org.junit.jupiter.api.Assertions.assertTrue;
 import static org.junit.jupiter.api.Assertions.fail;
 
+import feelmysign.client.SleeveClient;
 import feelmysign.client.SleeveEvent;
 import feelmysign.client.WearerState;
 import java.io.IOException;
@@ -89,6 +90,18 @@ class FeelMySignTest {
   }
 
   @Test
+  void aFloatLiteralIsTheNumberWritten() {
+    // In a .pde, 0.1 is a float; set() takes it as written, not as the float's exact value.
+    FeelMySign library = new FeelMySign(new Sketch()).set("max_error", 0.1f).set("rest_ms", 150f);
+    assertEquals(0.1, library.params().get("max_error"));
+    assertEquals(150.0, library.params().get("rest_ms"));
+    assertTrue(library.params().values().toString().contains("max_error=0.1,"),
+        library.params().values().toString());
+    FeelMySign paper = new FeelMySign(new Sketch()).angle().set("minimumSize", 0.3f);
+    assertEquals(0.3, paper.params().get("min_length"));
+  }
+
+  @Test
   void theSketchIsToldWhenTheSleeveGoesOfflineAndComesBack() throws Exception {
     Sketch sketch = new Sketch();
     FeelMySign library = new FeelMySign(sketch);
@@ -103,7 +116,9 @@ class FeelMySignTest {
               library.relay().status(offline);
               library.relay().status("{not json"); // not understood: nothing said, nothing kept
               library.relay().status(online);
-              library.relay().status(""); // cleared: nothing listens there
+              library.relay().status(""); // cleared: the client says it (noSleeve), not this
+              library.relay().noSleeve(SleeveClient.noSleeveSentence("sleeve1"));
+              library.relay().status(online); // a sleeve starts on the id
             });
     network.start();
     network.join();
@@ -116,7 +131,8 @@ class FeelMySignTest {
                 + " restarts",
             "sleeve sleeve1 is online again",
             "no sleeve listens on id 'sleeve1': nothing has ever reported there, so strokes sent"
-                + " now are not felt; check the sleeve id (a sleeve prints its id when it starts)"),
+                + " now are not felt; check the sleeve id (a sleeve prints its id when it starts)",
+            "sleeve sleeve1 is online: strokes sent from now on are felt"),
         sketch.statuses);
     for (Thread thread : sketch.threads) {
       assertSame(Thread.currentThread(), thread, "a callback ran off the sketch's thread");
