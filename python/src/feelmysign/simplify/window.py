@@ -964,8 +964,9 @@ class WindowSimplifier:
 
     @property
     def merged_back(self) -> int:
-        """Pieces merged at release into a stroke already sent (``Merger.end``: nothing more was
-        sent for them), over every path so far."""
+        """Pieces merged at release (or, strict, at a rest) into a stroke already sent
+        (``Merger.end``, ``Merger.rest``: nothing more was sent for them), over every path so
+        far."""
         return self._merger.merged_back
 
     def end(self) -> list[Segment]:
