@@ -11,8 +11,8 @@ per path, the pieces merged at release into the stroke already sent before them 
 sent for them; ``WindowSimplifier.merged_back``). ``params.json`` is the
 parameter table (defaults and allowed ranges). Besides gen_angle's shapes, a window-only
 ones (``EDGE_SHAPES``): a drawing along the canvas edges, whose strokes must stay on the grid,
-a crawl, and lines released just after a cut of the latency cap (a last piece merged at release,
-and one sent).
+a crawl, lines released just after a cut of the latency cap (a last piece merged at release,
+and one sent), and "L"s with a stop half-way down the stem (``stop``).
 """
 
 from __future__ import annotations
@@ -47,6 +47,14 @@ VARIATIONS: dict[str, dict[str, Any]] = {
         "min_length": 0.5,
         "min_duration_ms": 120.0,
     },
+    # A wearer's limits as a sender takes them from the sleeve's floor (a wearer file's
+    # min_length 0.5 and min_duration_ms 150): strict minimums above the floor.
+    "wearer": {
+        "least_squares": False,
+        "strict_minimums": True,
+        "min_length": 0.5,
+        "min_duration_ms": 150.0,
+    },
 }
 # The least-squares core (``least_squares``; ``simplify/fit.py``) over the same shapes.
 FIT = {"least_squares": True}
@@ -70,6 +78,12 @@ FIT_VARIATIONS: dict[str, dict[str, Any]] = {
         "min_duration_ms": 120.0,
     },
     "least-squares-stretch": {**FIT, "stretch": True, "canvas_width_px": 1600.0},
+    "least-squares-wearer": {
+        **FIT,
+        "strict_minimums": True,
+        "min_length": 0.5,
+        "min_duration_ms": 150.0,
+    },
 }
 VARIATIONS.update(FIT_VARIATIONS)
 
@@ -134,9 +148,51 @@ def _tail() -> list[Path]:
     return [line, hooked]
 
 
+def _stop_l(stop_y: float) -> Path:
+    """An "L" drawn as a mouse draws it (a sample a frame at 60 Hz, 800 px/s: 2 grid units a
+    second), down from (200, 80) to (200, ``stop_y``), held still there for a second with the
+    button down (a sample every 32 ms, as the page and the Processing library sample a still
+    pen), on down to (200, 720) and across to (1000, 720)."""
+    frame_ms = 1000.0 / 60.0
+    samples = [Sample(0.0, 200.0, 80.0)]
+
+    def to(x: float, y: float) -> None:
+        last = samples[-1]
+        steps = max(1, round(max(abs(x - last.x), abs(y - last.y)) / (0.8 * frame_ms)))
+        for k in range(1, steps + 1):
+            samples.append(
+                Sample(
+                    round(last.t_ms + frame_ms * k, 3),
+                    last.x + (x - last.x) * k / steps,
+                    last.y + (y - last.y) * k / steps,
+                )
+            )
+
+    to(200.0, stop_y)
+    last = samples[-1]
+    samples += [Sample(round(last.t_ms + 32.0 * k, 3), last.x, last.y) for k in range(1, 32)]
+    to(200.0, 720.0)
+    to(1000.0, 720.0)
+    return samples
+
+
+def _stops() -> list[Path]:
+    """Two "L"s with a stop half-way down the stem, where the piece drawn since the last stroke
+    is shorter than a wearer's min_length: at grid y 1.0 (a new user's trial: within max_error
+    of the stroke before, with the least squares) and 1.1 (too far from it: dropped at the
+    rest). With strict minimums the piece is never merged across the stop (the stop would be
+    played)."""
+    return [_stop_l(400.0), _stop_l(440.0)]
+
+
 # Window-only shapes, each with the defaults and the latency cap's variations (W x H fills the
 # default 3 x 4 grid, so the canvas edges are the grid's).
-EDGE_SHAPES = {"edge-u": lambda: [_edge_u()], "crawl": lambda: [_crawl()], "tail": _tail}
+EDGE_SHAPES = {
+    "edge-u": lambda: [_edge_u()],
+    "crawl": lambda: [_crawl()],
+    "tail": _tail,
+    "stop": _stops,
+}
 EDGE_VARIATIONS = (
     "defaults",
     "chord",
@@ -149,6 +205,8 @@ EDGE_VARIATIONS = (
     "rest-off",
     "rest-300",
     "strict-minimums",
+    "least-squares-wearer",
+    "wearer",
 )
 
 

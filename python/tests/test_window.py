@@ -681,14 +681,18 @@ def test_a_short_piece_is_merged_or_else_could_not_be(
 def test_a_last_piece_merges_at_release_where_the_stroke_before_covers_it_or_else_could_not(
     case: tuple[WindowParams, list[Sample]], max_error: float, strict: bool
 ) -> None:
-    # Merged at release: nothing dropped, the path's last sent stroke ends before the release and
-    # every sample drawn from its end on lies within max_error of it. Not merged, the last sent
-    # stroke briefer than the floor has a stroke before it that leaves a sample drawn from its
-    # end on farther than max_error (without rests, which send a held piece before the release).
+    # Merged at release: nothing dropped then, the path's last sent stroke ends before the
+    # release and every sample drawn from its end on lies within max_error of it. Not merged, the
+    # last sent stroke briefer than the floor has a stroke before it that leaves a sample drawn
+    # from its end on farther than max_error (without rests, which send a held piece before the
+    # release; with strict minimums, one still below them merges back or is dropped there).
     params, samples = case
     params = replace(params, max_error=max_error, strict_minimums=strict)
     simplifier = WindowSimplifier(params)
-    segments = [out for sample in samples for out in simplifier.push(sample)] + simplifier.end()
+    segments = [out for sample in samples for out in simplifier.push(sample)]
+    at_rests = simplifier.merged_back
+    released = simplifier.end()
+    segments += released
     sent = [s for s in segments if s.dropped is None]
     mapping = params.mapping
     points = [(sample.t_ms, mapping.to_grid(sample.x, sample.y)) for sample in samples]
@@ -696,8 +700,8 @@ def test_a_last_piece_merges_at_release_where_the_stroke_before_covers_it_or_els
     def farthest_from(stroke: Segment) -> float:
         return max(_distance(p, stroke.start, stroke.end) for t, p in points if t >= stroke.end_ms)
 
-    if simplifier.merged_back:
-        assert simplifier.merged_back >= 1 and sent and len(sent) == len(segments)
+    if simplifier.merged_back > at_rests:
+        assert sent and all(s.dropped is None for s in released)
         assert sent[-1].end_ms <= samples[-1].t_ms
         assert farthest_from(sent[-1]) <= params.max_error + FLOAT_TOLERANCE
         return
@@ -1026,6 +1030,73 @@ def test_a_rest_ends_the_stroke_before_it_and_is_not_played(
     assert after, "the leg after the rest was not sent"
     told_ms = params.rest_ms if params.max_stroke_ms else 0.0
     assert after[0].start_ms >= samples[leave].t_ms - told_ms
+
+
+@st.composite
+def stops(draw: st.DrawFn) -> tuple[WindowParams, list[Sample], list[tuple[float, float]]]:
+    """Legs between points of the canvas at a steady pen's speed, with the pen held still
+    between some of them (a sample every 32 ms, as the page and the Processing library sample a
+    still pen) for longer than rest_ms; either core, strict minimums or not (a wearer's limits
+    up to a piece of half a grid unit and 150 ms). With each stop's first and last times."""
+    least_squares = draw(st.booleans())
+    cap_ms = draw(st.sampled_from([0.0, 200.0]))
+    params = WindowParams(
+        least_squares=least_squares,
+        strict_minimums=draw(st.booleans()),
+        min_length=draw(st.sampled_from([0.1, 0.3, 0.5])),
+        min_duration_ms=draw(st.sampled_from([6.1, 120.0, 150.0])),
+        # The chord core's crawl rule moves a stroke's start on before a rest longer than the
+        # latency cap is seen (the stroke after it starts at most the cap before the pen moves).
+        rest_ms=draw(
+            st.sampled_from([50.0, 100.0] if cap_ms and not least_squares else [50.0, 100.0, 300.0])
+        ),
+        max_stroke_ms=cap_ms,
+        canvas_width_px=900.0,
+        canvas_height_px=600.0,
+    )
+    step_ms = draw(st.sampled_from([1000 / 60, 8.0]))
+    speed = draw(st.floats(0.2, 1.5))  # px/ms: 12 to 90 px a frame at 60 Hz
+    x, y = draw(st.floats(0, 900)), draw(st.floats(0, 600))
+    t_ms = 0.0
+    samples = [Sample(t_ms, x, y)]
+    held: list[tuple[float, float]] = []
+    for _ in range(draw(st.integers(2, 5))):
+        tx, ty = draw(st.floats(0, 900)), draw(st.floats(0, 600))
+        steps = max(2, math.ceil(math.hypot(tx - x, ty - y) / (speed * step_ms)))
+        for k in range(1, steps + 1):
+            t_ms += step_ms
+            samples.append(Sample(t_ms, x + (tx - x) * k / steps, y + (ty - y) * k / steps))
+        x, y = tx, ty
+        if draw(st.booleans()):
+            first = t_ms
+            for _ in range(math.ceil((params.rest_ms + draw(st.floats(64, 1000))) / 32.0)):
+                t_ms += 32.0
+                samples.append(Sample(t_ms, x, y))
+            held.append((first, t_ms))
+    return params, samples, held
+
+
+@settings(max_examples=300, deadline=None)
+@given(stops())
+def test_no_sent_stroke_spans_a_rest(
+    case: tuple[WindowParams, list[Sample], list[tuple[float, float]]],
+) -> None:
+    """A rest is not played (the rest rule): no sent stroke starts before a stop longer than
+    rest_ms and ends after it, with strict minimums too (a piece held below them is not merged
+    across the stop into the stroke after it). What is not sent is said: every piece is sent,
+    dropped with its reason, or merged back into the stroke before it."""
+    params, samples, held = case
+    simplifier = WindowSimplifier(params)
+    segments = [out for sample in samples for out in simplifier.push(sample)] + simplifier.end()
+    sent = [s for s in segments if s.dropped is None]
+    assert sent or segments, "a path gave nothing, not even a dropped piece"
+    for first, last in held:
+        for stroke in sent:
+            assert not (stroke.start_ms <= first and stroke.end_ms >= last), (first, last, stroke)
+    if params.strict_minimums:
+        for stroke in sent:
+            assert stroke.length >= params.min_length - FLOAT_TOLERANCE, stroke
+            assert stroke.drawn_ms >= params.min_duration_ms - FLOAT_TOLERANCE, stroke
 
 
 @pytest.mark.parametrize("start_ms", [100.3, 2000.7, 15000.1, 612345.6])

@@ -156,9 +156,13 @@ export class ReferenceMerger {
             };
     out.push(sent);
     // The samples before its end are covered now (those at its end may start the next).
+    this.#cover(segment.end_ms);
+  }
+
+  /** The samples drawn before endMs are covered. */
+  #cover(endMs: number): void {
     const drawn = this.#drawn;
     const count = this.#count;
-    const endMs = segment.end_ms;
     let keep = this.#first;
     while (keep < count && drawn[DRAWN * keep]! < endMs) keep++;
     this.#first = keep;
@@ -201,7 +205,8 @@ export class ReferenceMerger {
    * The pen rests (since the held piece's end, until `nowMs`): the held piece is sent now, into
    * `out`, rather than merged with what comes after the rest, which would play the rest. If it is
    * briefer than the sleeve's floor, it takes the time it needs from the rest: the pen was at its
-   * end then. With strict minimums, a piece still below them waits.
+   * end then. With strict minimums, a piece still below them is not sent: it merges back into
+   * the path's last sent stroke where the bound allows, else is dropped with its reason.
    */
   rest(nowMs: number, out: Segment[]): void {
     let held = this.#held;
@@ -210,11 +215,17 @@ export class ReferenceMerger {
       const endMs = Math.min(floorEndMs(held.start_ms, this.#shortMs), nowMs);
       held = { ...held, end_ms: endMs, duration_ms: endMs - held.start_ms };
     }
+    this.#held = null;
     if (this.#strict && this.#belowMinimums(held)) {
-      this.#held = held;
+      // Never sent, nor merged across the rest: merged back where the bound allows, else dropped.
+      if (this.#mergesBack(held)) this.mergedBack += (held.merged ?? 0) + 1;
+      else {
+        const reason = segmentLength(held) < this.#minLength ? NOT_ENOUGH_DISTANCE : NOT_ENOUGH_DURATION;
+        out.push({ ...held, emitted_at_ms: nowMs, dropped: reason });
+      }
+      this.#cover(held.end_ms);
       return;
     }
-    this.#held = null;
     this.#send(held, nowMs, out);
   }
 

@@ -937,7 +937,9 @@ export class WindowCore {
  * a path, if short, is sent short, unless at release it is briefer than the floor and lies, with
  * every drawn sample not yet covered, within `max_error` of the stroke already sent before it:
  * then it merges into that stroke and nothing more is sent (`mergedBack`). Only a path's one and
- * only piece, too short, is dropped.
+ * only piece, too short, is dropped. With strict minimums (a wearer's), a piece below them merges
+ * into the next whatever the bound, but never across a rest (`rest`), and one left at release or
+ * at a rest merges back where the bound allows, else is dropped with its reason.
  */
 export class Merger {
   readonly #maxError: number;
@@ -973,7 +975,10 @@ export class Merger {
    * max_error of it (`end`).
    */
   #last: Segment | null = null;
-  /** Pieces merged at release into a stroke already sent (nothing more is sent for them), in all. */
+  /**
+   * Pieces merged at release (or, strict, at a rest) into a stroke already sent (nothing more is
+   * sent for them), in all.
+   */
   mergedBack = 0;
 
   constructor(
@@ -1145,10 +1150,12 @@ export class Merger {
   }
 
   /**
-   * The pen rests (since the held piece's end, until `nowMs`): the held piece is sent now, into
+   * The pen rests (since the held piece's end, until `nowMs`): the held piece is let go now, into
    * `out`, rather than merged with what comes after the rest, which would play the rest. If it is
    * briefer than the sleeve's floor, it takes the time it needs from the rest: the pen was at its
-   * end then. With strict minimums, a piece still below them waits.
+   * end then, and it is sent. With strict minimums, a piece still below them is not sent: as at
+   * release, it merges into the path's last sent stroke where that keeps the bound
+   * (`#mergesBack`), else it is dropped with its reason.
    */
   rest(nowMs: number, out: Segment[]): void {
     let held = this.#held;
@@ -1157,12 +1164,27 @@ export class Merger {
       const endMs = Math.min(floorEndMs(held.start_ms, this.#shortMs), nowMs);
       held = { ...held, end_ms: endMs, duration_ms: endMs - held.start_ms };
     }
+    this.#held = null;
     if (this.#strict && this.#belowMinimums(held)) {
-      this.#held = held;
+      if (this.#mergesBack(held)) this.mergedBack += (held.merged ?? 0) + 1;
+      else out.push({ ...held, emitted_at_ms: nowMs, dropped: this.#reason(held) });
+      // Its samples are let go with it (those at its end may start the next).
+      const drawn = this.#drawn;
+      const { ts, count } = drawn;
+      let keep = drawn.first;
+      while (keep < count && ts[keep]! < held.end_ms) keep++;
+      drawn.first = keep;
+      drawn.compact();
       return;
     }
-    this.#held = null;
     this.#send(held, nowMs, out);
+  }
+
+  /** Why `segment` is too short to send (null if it is not). */
+  #reason(segment: Segment): DropReason | null {
+    if (segmentLength(segment) < this.#minLength) return NOT_ENOUGH_DISTANCE;
+    if (segment.duration_ms < this.#minDurationMs) return NOT_ENOUGH_DURATION;
+    return null;
   }
 
   /**
@@ -1191,11 +1213,7 @@ export class Merger {
       held = null;
     }
     if (held !== null) {
-      let reason: DropReason | null = null;
-      if (!this.#sentInPath || this.#strict) {
-        if (segmentLength(held) < this.#minLength) reason = NOT_ENOUGH_DISTANCE;
-        else if (held.duration_ms < this.#minDurationMs) reason = NOT_ENOUGH_DURATION;
-      }
+      const reason = !this.#sentInPath || this.#strict ? this.#reason(held) : null;
       if (reason !== null) out.push({ ...held, emitted_at_ms: nowMs, dropped: reason });
       else this.#send(held, nowMs, out);
     }
@@ -1298,7 +1316,10 @@ export class WindowSimplifier {
     return out.length > 0 ? out : NO_SEGMENTS;
   }
 
-  /** Pieces merged at release into a stroke already sent (`Merger.end`), over every path so far. */
+  /**
+   * Pieces merged at release (or, strict, at a rest) into a stroke already sent (`Merger.end`,
+   * `Merger.rest`), over every path so far.
+   */
   get mergedBack(): number {
     return this.#merger.mergedBack;
   }

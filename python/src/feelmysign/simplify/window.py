@@ -81,12 +81,16 @@ corners land on the drawing's features. Here:
   newest, the stroke so far ends there, at the time the rest
   began, and is sent now; while the pen stays, the next stroke's start moves
   on with it, so the rest is not played. A held short piece is sent at the
-  rest (briefer than the floor, it takes the time it needs from the rest).
+  rest (briefer than the floor, it takes the time it needs from the rest);
+  nothing is merged across a rest.
 - A crawling pen: a stroke still too short to send after ``max_stroke_ms``
   starts later rather than lasting longer, so the latency cap holds for it.
 - Strict minimums (``strict_minimums``, a wearer's limits): a piece below
   ``min_length`` or ``min_duration_ms`` merges into the next even where
-  ``max_error`` must yield, and a path's last such piece is dropped.
+  ``max_error`` must yield, but never across a rest: a path's last such piece,
+  and one still below them at a rest (after taking time from it), merges back
+  into the stroke sent before it where the bound allows, else is dropped with
+  its reason.
 
 Pure and streaming: ``push`` one sample at a time, ``end`` on release. A
 sample earlier than the one before it (clocks of two event sources) is taken
@@ -715,6 +719,9 @@ class Merger:
     lies within ``max_error`` of that stroke (nothing more is sent; ``merged_back`` counts
     them). Only a path's one and only piece, too short, is dropped with its reason (a tap:
     nothing to merge with). Every other drawn sample lies within ``max_error`` of a sent stroke.
+    With ``strict`` (a wearer's minimums), a piece below them merges into the next whatever the
+    bound, but never across a rest (``rest``), and one left at release or at a rest merges back
+    where the bound allows, else is dropped with its reason.
     """
 
     max_error: float
@@ -742,7 +749,8 @@ class Merger:
     # covered lies within max_error of it (``end``).
     _last_start: Point | None = None
     _last_end: Point = (0.0, 0.0)
-    # Pieces merged at release into a stroke already sent (nothing more is sent for them), in all.
+    # Pieces merged at release (or, strict, at a rest) into a stroke already sent (nothing more
+    # is sent for them), in all.
     merged_back: int = 0
 
     def sample(self, t_ms: float, point: Point) -> None:
@@ -830,25 +838,42 @@ class Merger:
         return out
 
     def rest(self, now_ms: float) -> list[Segment]:
-        """The pen rests (since the held piece's end, until ``now_ms``): the held piece is sent
+        """The pen rests (since the held piece's end, until ``now_ms``): the held piece is let go
         now rather than merged with what comes after the rest, which would play the rest.
 
         If it is briefer than the sleeve's floor, it takes the time it needs from the rest: the
-        pen was at its end then (``floor_end_ms``). With strict minimums, a piece still below
-        them waits."""
+        pen was at its end then (``floor_end_ms``), and it is sent. With strict minimums, a
+        piece still below them is not sent: as at release, it merges into the path's last sent
+        stroke where that keeps the bound (``_merges_back``), else it is dropped with its
+        reason."""
         held = self._held
         if held is None:
             return []
         short_ms = max(self.min_duration_ms, self.floor_ms)
         if held.drawn_ms < short_ms and now_ms > held.end_ms:
             held = replace(held, end_ms=min(floor_end_ms(held.start_ms, short_ms), now_ms))
-        if self.strict and self._below_minimums(held):
-            self._held = held
-            return []
         self._held = None
         out: list[Segment] = []
+        if self.strict and self._below_minimums(held):
+            if self._merges_back(held):
+                self.merged_back += held.merged + 1
+            else:
+                out.append(replace(held, emitted_at_ms=now_ms, dropped=self._reason(held)))
+            # Its samples are let go with it (those at its end may start the next).
+            keep = bisect.bisect_left(self._times, held.end_ms)
+            del self._points[:keep]
+            del self._times[:keep]
+            return out
         self._send(held, now_ms, out)
         return out
+
+    def _reason(self, segment: Segment) -> str | None:
+        """Why ``segment`` is too short to send (None if it is not)."""
+        if segment.length < self.min_length:
+            return NOT_ENOUGH_DISTANCE
+        if segment.drawn_ms < self.min_duration_ms:
+            return NOT_ENOUGH_DURATION
+        return None
 
     def _merges_back(self, held: Segment) -> bool:
         """Whether the piece held at release merges into the path's last sent stroke.
@@ -877,12 +902,7 @@ class Merger:
             self.merged_back += held.merged + 1
             held = None
         if held is not None:
-            reason = None
-            if not self._sent_in_path or self.strict:
-                if held.length < self.min_length:
-                    reason = NOT_ENOUGH_DISTANCE
-                elif held.drawn_ms < self.min_duration_ms:
-                    reason = NOT_ENOUGH_DURATION
+            reason = self._reason(held) if not self._sent_in_path or self.strict else None
             if reason is not None:
                 out.append(replace(held, emitted_at_ms=now_ms, dropped=reason))
             else:
@@ -944,8 +964,9 @@ class WindowSimplifier:
 
     @property
     def merged_back(self) -> int:
-        """Pieces merged at release into a stroke already sent (``Merger.end``: nothing more was
-        sent for them), over every path so far."""
+        """Pieces merged at release (or, strict, at a rest) into a stroke already sent
+        (``Merger.end``, ``Merger.rest``: nothing more was sent for them), over every path so
+        far."""
         return self._merger.merged_back
 
     def end(self) -> list[Segment]:

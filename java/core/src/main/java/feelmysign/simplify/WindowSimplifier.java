@@ -84,8 +84,9 @@ public final class WindowSimplifier implements Simplifier {
     return out == null ? List.of() : out;
   }
 
-  /** Pieces merged at release into a stroke already sent, over every path so far: nothing more
-   * was sent for them (each lies within max_error of the stroke before it). */
+  /** Pieces merged at release (or, with strict minimums, at a rest) into a stroke already sent,
+   * over every path so far: nothing more was sent for them (each lies within max_error of the
+   * stroke before it). */
   public int mergedBack() {
     return merger.mergedBack();
   }
@@ -793,7 +794,10 @@ final class WindowCore implements PieceCore {
  * last piece, if short, is sent short, unless at release it is briefer than the floor and lies,
  * with every drawn sample not yet covered, within max_error of the stroke already sent before
  * it: then it merges into that stroke and nothing more is sent. Only a path's one and only
- * piece, too short, is dropped with its reason.
+ * piece, too short, is dropped with its reason. With strict minimums (a wearer's), a piece below
+ * them merges into the next whatever the bound, but never across a rest ({@link #rest}), and one
+ * left at release or at a rest merges back where the bound allows, else is dropped with its
+ * reason.
  */
 final class Merger {
   private final double maxError;
@@ -821,7 +825,8 @@ final class Merger {
   // left at release merges into it when every drawn sample it has not covered lies within
   // max_error of it (end).
   private Segment last;
-  // Pieces merged at release into a stroke already sent (nothing more is sent for them), in all.
+  // Pieces merged at release (or, strict, at a rest) into a stroke already sent (nothing more is
+  // sent for them), in all.
   private int mergedBack;
 
   Merger(
@@ -905,7 +910,8 @@ final class Merger {
     return true;
   }
 
-  /** Pieces merged at release into a stroke already sent ({@link #end}), over every path so far. */
+  /** Pieces merged at release (or, strict, at a rest) into a stroke already sent ({@link #end},
+   * {@link #rest}), over every path so far. */
   int mergedBack() {
     return mergedBack;
   }
@@ -984,10 +990,12 @@ final class Merger {
     return endMs;
   }
 
-  /** The pen rests (since the held piece's end, until nowMs): the held piece is sent now rather
-   * than merged with what comes after the rest, which would play the rest. If it is briefer than
-   * the sleeve's floor, it takes the time it needs from the rest: the pen was at its end then.
-   * With strict minimums, a piece still below them waits. */
+  /** The pen rests (since the held piece's end, until nowMs): the held piece is let go now
+   * rather than merged with what comes after the rest, which would play the rest. If it is
+   * briefer than the sleeve's floor, it takes the time it needs from the rest: the pen was at its
+   * end then, and it is sent. With strict minimums, a piece still below them is not sent: as at
+   * release, it merges into the path's last sent stroke where that keeps the bound
+   * ({@link #mergesBack}), else it is dropped with its reason. */
   List<Segment> rest(double nowMs, List<Segment> out) {
     Segment piece = held;
     if (piece == null) {
@@ -1006,12 +1014,46 @@ final class Merger {
               piece.dropped(),
               piece.merged());
     }
-    if (strict && belowMinimums(piece)) {
-      held = piece;
-      return out;
-    }
     held = null;
+    if (strict && belowMinimums(piece)) {
+      List<Segment> result = out;
+      if (mergesBack(piece)) {
+        mergedBack += piece.merged() + 1;
+      } else {
+        result = add(result, dropped(piece, nowMs, reason(piece)));
+      }
+      // Its samples are let go with it (those at its end may start the next).
+      while (first < size && ts[first] < piece.endMs()) {
+        first++;
+      }
+      return result;
+    }
     return send(piece, nowMs, out);
+  }
+
+  /** Why segment is too short to send (null if it is not). */
+  private String reason(Segment segment) {
+    if (segment.length() < minLength) {
+      return Segment.NOT_ENOUGH_DISTANCE;
+    }
+    if (segment.drawnMs() < minDurationMs) {
+      return Segment.NOT_ENOUGH_DURATION;
+    }
+    return null;
+  }
+
+  /** segment, dropped for reason at nowMs. */
+  private static Segment dropped(Segment segment, double nowMs, String reason) {
+    return new Segment(
+        segment.startX(),
+        segment.startY(),
+        segment.endX(),
+        segment.endY(),
+        segment.startMs(),
+        segment.endMs(),
+        nowMs,
+        reason,
+        segment.merged());
   }
 
   /** Whether the piece held at release merges into the path's last sent stroke: it is briefer
@@ -1037,29 +1079,8 @@ final class Merger {
       held = null;
     }
     if (held != null) {
-      String reason = null;
-      if (!sentInPath || strict) {
-        if (held.length() < minLength) {
-          reason = Segment.NOT_ENOUGH_DISTANCE;
-        } else if (held.drawnMs() < minDurationMs) {
-          reason = Segment.NOT_ENOUGH_DURATION;
-        }
-      }
-      result =
-          reason != null
-              ? add(
-                  result,
-                  new Segment(
-                      held.startX(),
-                      held.startY(),
-                      held.endX(),
-                      held.endY(),
-                      held.startMs(),
-                      held.endMs(),
-                      nowMs,
-                      reason,
-                      held.merged()))
-              : send(held, nowMs, result);
+      String reason = !sentInPath || strict ? reason(held) : null;
+      result = reason != null ? add(result, dropped(held, nowMs, reason)) : send(held, nowMs, result);
     }
     held = null;
     sentInPath = false;

@@ -242,4 +242,61 @@ class SleeveFloorTest {
     library.draw();
     assertEquals(1, sketch.statuses.size());
   }
+
+  /**
+   * A new user's "L" on a 900 x 600 canvas at 600 px/s under wearer T01's limits (0.5 grid units,
+   * 150 ms), the pen held still for a second half-way down the stem (a drag at the same point
+   * every 32 ms, as the library's still sampler gives): the stop is not played, no stroke lasting
+   * across it; the piece drawn just before it, 0.3 grid units (below min_length, too far from the
+   * stroke before to merge back into it), is dropped and said in the line's gaps.
+   */
+  @Test
+  void aPieceBelowTheWearersLimitsHeldAtAStopIsNotPlayedAcrossItButSaidAsAGap() throws Exception {
+    FeelMySignTest.Sketch sketch = new FeelMySignTest.Sketch();
+    sketch.width = 900;
+    sketch.height = 600;
+    FeelMySign library = new FeelMySign(sketch).broker("mqtt://127.0.0.1:9").start();
+    try {
+      library.relay().floor(new SleeveFloor(150.0, 0.5, "T01"));
+      library.draw();
+      assertTrue(library.params().flag("strict_minimums"));
+      long t = 1000;
+      post(library, MouseEvent.PRESS, t, 150, 60);
+      int[][] legs = {{150, 330}, {150, 540}, {750, 540}};
+      int x = 150;
+      int y = 60;
+      for (int[] leg : legs) {
+        int steps = Math.max(Math.abs(leg[0] - x), Math.abs(leg[1] - y)) / 10;
+        for (int k = 1; k <= steps; k++) {
+          t += k % 3 == 0 ? 16 : 17; // a frame at 60 Hz, 10 px a frame
+          post(library, MouseEvent.DRAG, t, x + (leg[0] - x) * k / steps,
+              y + (leg[1] - y) * k / steps);
+        }
+        x = leg[0];
+        y = leg[1];
+        if (y == 330) {
+          for (int k = 0; k < 31; k++) { // held still for a second
+            t += 32;
+            post(library, MouseEvent.DRAG, t, x, y);
+          }
+        }
+      }
+      post(library, MouseEvent.RELEASE, t, x, y);
+      library.draw();
+      List<Stroke> sent = library.sent();
+      assertFalse(sent.isEmpty());
+      for (Stroke s : sent) {
+        assertTrue(s.durationMs() < 1000, "a stroke plays the stop: " + sent);
+        assertFalse(belowLimits(s, 150.0, 0.5), "a stroke below the wearer's limits: " + s);
+      }
+      assertTrue(sketch.statuses.stream().anyMatch(s -> s.startsWith("this line has 1 gap(s): 1"
+          + " piece(s) shorter than minimumSize (0.5 grid units)")), sketch.statuses.toString());
+    } finally {
+      library.dispose();
+    }
+  }
+
+  private static boolean belowLimits(Stroke s, double ms, double gridUnits) {
+    return s.durationMs() < ms || length(s) < gridUnits - 1e-9;
+  }
 }
