@@ -10,7 +10,16 @@ import { join } from "node:path";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { RESULTS_DIR, type EventWatcher } from "./harness";
-import { drawingArea, drawWithMouse, screenshot, setLongestStroke, waitForData, type Area } from "./page";
+import {
+  drawingArea,
+  drawWithMouse,
+  screenshot,
+  setLeastSquares,
+  setLongestStroke,
+  setRest,
+  waitForData,
+  type Area,
+} from "./page";
 import { Processes } from "./processes";
 
 type Point = readonly [number, number];
@@ -110,8 +119,13 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
     await waitForData(page, '[data-testid="sleeve-preview"]', "lit", "0", 30_000);
     const before = readRecord(recordPath).length;
     // One stroke a leg (no cap on a stroke's length), so the last one plays as long as its
-    // leg took to draw: seconds, however slowly this machine answers the Esc.
+    // leg took to draw: seconds, however slowly this machine answers the Esc. The chord core
+    // cuts a straight leg nowhere (the least squares place strokes at the sleeve's floor where
+    // the mouse's pixels leave a leg not quite straight), and no rest rule: on a loaded machine
+    // the mouse's events can stall for longer than rest_ms, which would end a stroke there.
     await setLongestStroke(page, "0");
+    await setLeastSquares(page, false);
+    await setRest(page, "0");
     await page.locator('[data-testid="new-button"]').click();
     // A slow zigzag: each leg takes seconds to draw, so its stroke plays that long. Timed by
     // the clock, not by pointer steps: a loaded machine took 8 to 10 s a leg at 4 px a step,
@@ -204,7 +218,10 @@ describe("the felt drawing, served by feelmysign up with the simulated sleeve", 
       "1 cut short by Stop",
     );
     await screenshot(page, "felt-stopped");
-    await setLongestStroke(page, "300"); // the default again, for what follows
+    // The defaults again, for what follows.
+    await setLongestStroke(page, "200");
+    await setLeastSquares(page, true);
+    await setRest(page, "100");
   });
 
   it("loads a saved recording back, shows what would be felt, and plays it again", async () => {
