@@ -165,10 +165,27 @@ def test_a_server_with_a_certificate_from_another_ca_cannot_join_the_cluster(
     a, b = cluster.nodes[0], cluster.nodes[1]
 
     def server(name: str, tls: TlsFiles) -> tuple[subprocess.Popen[bytes], int]:
-        node = NatsNode(name, free("127.0.0.1"), free("127.0.0.1"), 0, 0, tls=True)
-        node = replace(node, mqtt_port=free("127.0.0.1"), ws_port=free("127.0.0.1"))
-        monitor = free("127.0.0.1")
-        return cluster.spawn(executable, node, [a, b], tls, "-m", str(monitor)), monitor
+        # Its five ports are picked free, but another test running beside this one may take
+        # one before the server binds it: then it stops at once ("address already in use"),
+        # and is started again on other ports, rather than never trying to join at all.
+        log = cluster.state_dir / f"{name}.log"
+        for _ in range(5):
+            node = NatsNode(name, free("127.0.0.1"), free("127.0.0.1"), 0, 0, tls=True)
+            node = replace(node, mqtt_port=free("127.0.0.1"), ws_port=free("127.0.0.1"))
+            monitor = free("127.0.0.1")
+            process = cluster.spawn(executable, node, [a, b], tls, "-m", str(monitor))
+
+            def settled(started: subprocess.Popen[bytes] = process) -> bool:
+                return started.poll() is not None or "Server is ready" in log.read_text(
+                    errors="replace"
+                )
+
+            _until(settled, f"{name} neither started nor stopped")
+            if process.poll() is None or "address already in use" not in log.read_text(
+                errors="replace"
+            ):
+                break
+        return process, monitor
 
     def refused_by(node: NatsNode) -> bool:
         log = (cluster.state_dir / f"{node.name}.log").read_text(errors="replace")
