@@ -119,15 +119,14 @@ export class FitCore {
   readonly #brief: number[] = [];
   readonly #before: number[] = [];
   /**
-   * A piece's error per start (from `#errorsLow`), for the sample `#errorsEnd` (reused), and the
+   * A piece's error per start (from `#errorsLow`), for the sample placed last (reused), and the
    * best start of its last piece when that piece is open (not counted as briefer than the floor:
    * `#letGo` asks for the newest sample's), found with the closed one.
    */
   readonly #errors: number[] = [];
-  #errorsEnd = -1;
   #errorsLow = 0;
   #openChosen = -1;
-  /** Whether the piece from `#openChosen` to `#errorsEnd` is known to keep the bound. */
+  /** Whether the piece from `#openChosen` to the sample placed last is known to keep the bound. */
   #openKeeps = false;
   // Scratch for the starts tried after the best one (`#chooseAgain`): counts and totals per start.
   readonly #counts: number[] = [];
@@ -294,7 +293,6 @@ export class FitCore {
     this.#best[0] = 0;
     this.#brief[0] = 0;
     this.#before[0] = -1;
-    this.#errorsEnd = -1;
     const ax = xs[0]!;
     const ay = ys[0]!;
     this.#rxs[0] = ax - ax;
@@ -344,7 +342,7 @@ export class FitCore {
     this.#place(k);
   }
 
-  /** The first start a piece to sample k may have: none outlasts the caps (`#errorsTo`). */
+  /** The first start a piece to sample k may have: none outlasts the caps. */
   #lowTo(k: number): number {
     let low = k - this.#maxWindow;
     if (low < 0) low = 0;
@@ -355,23 +353,6 @@ export class FitCore {
       const tK = ts[k]!;
       while (low < k - 1 && tK - ts[low]! > capMs) low++;
     }
-    return low;
-  }
-
-  /**
-   * Each piece's error to sample k, from every start it may have (into `#errors`, kept for the
-   * sample until the next): the first start.
-   */
-  #errorsTo(k: number): number {
-    // The same first start while the errors are kept (no time before the sample's changes).
-    if (this.#errorsEnd === k) return this.#errorsLow;
-    const low = this.#lowTo(k);
-    const errors = this.#errors;
-    for (let i = low; i < k; i++) errors[i - low] = this.#errorOf(i, k);
-    this.#errorsEnd = k;
-    this.#errorsLow = low;
-    // No open choice found for k (`#place` finds it).
-    this.#openChosen = -1;
     return low;
   }
 
@@ -400,37 +381,9 @@ export class FitCore {
   }
 
   /**
-   * The best start of the last piece to sample k: the fewest pieces briefer than the floor (the
-   * last counted only when `closed`), then the least squared error, then the earliest start; among
-   * the pieces that keep the bound (the piece from k - 1 always does). Python `FitCore._choose`.
-   */
-  #choose(k: number, low: number, closed: boolean): number {
-    const best = this.#best;
-    const brief = this.#brief;
-    const errors = this.#errors;
-    const ts = this.#ts;
-    const floorMs = this.#floorMs;
-    const tK = ts[k]!;
-    let chosen = -1;
-    let chosenCount = 0;
-    let chosenTotal = 0;
-    for (let i = low; i < k; i++) {
-      // A piece's error `#place` left out (-1).
-      if (errors[i - low]! < 0) errors[i - low] = this.#errorOf(i, k);
-      const total = best[i]! + errors[i - low]!;
-      let count = brief[i]!;
-      if (closed && tK - ts[i]! < floorMs) count += 1;
-      if (chosen < 0 || count < chosenCount || (count === chosenCount && total < chosenTotal)) {
-        chosen = i;
-        chosenCount = count;
-        chosenTotal = total;
-      }
-    }
-    return chosen === k - 1 || this.#keeps(chosen, k) ? chosen : this.#chooseAgain(k, low, closed, chosen);
-  }
-
-  /**
-   * `#choose` where the first choice's bound breaks: the other starts tested in the order of a sort
+   * The best start of the last piece to sample k where the first choice's bound breaks (the fewest
+   * pieces briefer than the floor, the last counted only when `closed`, then the least squared
+   * error, then the earliest start; Python `FitCore._choose`): the other starts tested in the order of a sort
    * by the same keys (the reference takes them from a heap; the totals are never NaN, so the order
    * is total and the same), the first that keeps the bound.
    */
@@ -472,8 +425,9 @@ export class FitCore {
   }
 
   /**
-   * Sample k's best polyline from the anchor, every piece closed (at the floor): `#errorsTo` and
-   * `#choose` in one pass, which also finds the best start with the last piece open, for `#letGo`.
+   * Sample k's best polyline from the anchor, every piece closed (at the floor): each piece's error
+   * and the first choice in one pass, which also finds the best start with the last piece open,
+   * for `#letGo`.
    * A start with more brief pieces than the one chosen so far (closed and open) cannot be chosen
    * in its place, whatever its error: its error is left out (-1), computed only if a first choice
    * breaks the bound.
@@ -501,7 +455,8 @@ export class FitCore {
     const sxxEnd = sxx[k + 1]!;
     const syyEnd = syy[k + 1]!;
     const sxyEnd = sxy[k + 1]!;
-    // `#choose`'s scan, closed and open at once (no count is infinite: the first start is chosen).
+    // The first choice's scan, closed and open at once (no count is infinite: the first start is
+    // chosen).
     let closed = -1;
     let closedCount = Infinity;
     let closedTotal = 0;
@@ -541,7 +496,6 @@ export class FitCore {
         closedTotal = total;
       }
     }
-    this.#errorsEnd = k;
     this.#errorsLow = low;
     const i = closed === k - 1 || this.#keeps(closed, k) ? closed : this.#chooseAgain(k, low, true, closed);
     // Most often the open choice is the closed one, whose piece keeps the bound: not tested again.
@@ -552,13 +506,15 @@ export class FitCore {
     this.#before[k] = i;
   }
 
-  /** `#choose(k, low, false)` for the newest sample, its first choice found by `#place`. */
-  #chooseOpen(k: number, low: number): number {
+  /**
+   * The best start of the last piece, open, to the newest sample k: its first choice found by
+   * `#place` (which placed k last: `#letGo` runs after it), else the next that keeps the bound.
+   */
+  #chooseOpen(k: number): number {
     const open = this.#openChosen;
-    if (this.#errorsEnd !== k || this.#errorsLow !== low || open < 0) return this.#choose(k, low, false);
     return open === k - 1 || this.#openKeeps || this.#keeps(open, k)
       ? open
-      : this.#chooseAgain(k, low, false, open);
+      : this.#chooseAgain(k, this.#errorsLow, false, open);
   }
 
   /**
@@ -693,8 +649,7 @@ export class FitCore {
     for (;;) {
       const j = this.#count - 1;
       if (ts[j]! - ts[0]! < floorMs || this.#still(j)) return;
-      const low = this.#errorsTo(j);
-      const last = this.#chooseOpen(j, low);
+      const last = this.#chooseOpen(j);
       if (last === 0) {
         // One stroke from the anchor: cut by the latency cap at the sample before.
         if (
