@@ -105,6 +105,10 @@ NOT_ACKNOWLEDGED = frozenset({"stopped", "player_stopped"})
 # Marks the log records that say the sleeve lost or cannot reach its broker: a program
 # that reports these itself in its own words (``feelmysign up``) filters them out.
 CONNECTION_STATE = {"connection_state": True}
+# While the broker stays out of reach, how often the sleeve says so again: once when it
+# begins, then a line a minute (paho retries every RECONNECT_MAX_S at most, and a line per
+# attempt would bury the wearer's log).
+UNREACHABLE_REMINDER_S = 60.0
 CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
 # Safety events after which the status's ``hardware`` changed: published again with them.
 HARDWARE_EVENTS = frozenset({"chip_lost", "chip_back"})
@@ -251,6 +255,10 @@ class Sleeve:
         self._stopped = threading.Event()
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
+        # Since when the broker is out of reach (monotonic s; None: it is not), and when
+        # that was last said.
+        self._unreachable_since: float | None = None
+        self._unreachable_said_at = 0.0
         self.counts: Counter[str] = Counter()
         self._counts_lock = threading.Lock()  # counted from the network and player threads
         # One log line per drawing once it is over (strokes played, refused, start delay):
@@ -397,6 +405,7 @@ class Sleeve:
             log.error(message)
             return
         self._connection += 1
+        self._unreachable_since = None
         subscriptions = [(strokes_topic(self._id), 1), (control_topic(self._id), 1)]
         if self._options.legacy_topic:
             subscriptions.append((self._options.legacy_topic, 1))
@@ -411,14 +420,30 @@ class Sleeve:
         log.info("sleeve %s: connected to %s (%s session)", self._id, server.url, session)
 
     def _on_connect_fail(self, client: mqtt.Client, userdata: Any) -> None:
-        log.warning(
-            "sleeve %s: cannot reach the broker at %s (nothing answers, or the host is unknown); "
-            "retrying every %g s at most. Start one with 'feelmysign broker' or check --broker.",
-            self._id,
-            self._settings.url,
-            RECONNECT_MAX_S,
-            extra=CONNECTION_STATE,
-        )
+        now = time.monotonic()
+        since = self._unreachable_since
+        if since is None:
+            self._unreachable_since = self._unreachable_said_at = now
+            log.warning(
+                "sleeve %s: cannot reach the broker at %s (nothing answers, or the host is "
+                "unknown); retrying every %g s at most. Start one with 'feelmysign broker' or "
+                "check --broker.",
+                self._id,
+                self._settings.url,
+                RECONNECT_MAX_S,
+                extra=CONNECTION_STATE,
+            )
+        elif now - self._unreachable_said_at >= UNREACHABLE_REMINDER_S:
+            self._unreachable_said_at = now
+            log.warning(
+                "sleeve %s: still cannot reach the broker at %s after %.0f s; retrying every "
+                "%g s at most",
+                self._id,
+                self._settings.url,
+                now - since,
+                RECONNECT_MAX_S,
+                extra=CONNECTION_STATE,
+            )
 
     def _on_subscribe(
         self, client: mqtt.Client, userdata: Any, mid: int, reasons: Any, properties: Any
@@ -447,6 +472,8 @@ class Sleeve:
     ) -> None:
         self._connected.clear()
         if not self._stopped.is_set():
+            # The loss is said here; attempts that fail after it are said once a minute.
+            self._unreachable_since = self._unreachable_said_at = time.monotonic()
             log.warning(
                 "sleeve %s: lost the broker (%s); reconnecting",
                 self._id,
