@@ -173,3 +173,17 @@ def test_controls_read_from_bytes_or_text_alike_and_a_whole_float_is_a_time() ->
     read = Status.from_json(text).controls
     assert read == Status.from_json(text.encode()).controls
     assert read is not None and read.do_not_disturb_until_ms == 1795330000000
+
+
+@pytest.mark.parametrize(("name", "case"), FATES, ids=[n for n, _ in FATES])
+def test_a_study_send_summary_says_how_the_sleeve_caught_up(
+    name: str, case: dict[str, Any]
+) -> None:
+    """The study's record of a send (its page and trials.csv) counts by the same rule."""
+    from feelmysign.study.runner import events_summary
+
+    summary = events_summary(case["wire"], len(case["fates"]))
+    assert summary["played"] == case["counts"]["played"]
+    assert summary["late"] == case["catch_up"]["late"] == case["refusals"].get("late", 0)
+    assert summary["compressed"] == case["catch_up"]["compressed"]
+    assert summary["compressed_ms"] == round(case["catch_up"]["compressed_ms"], 1)

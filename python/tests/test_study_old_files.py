@@ -3,6 +3,8 @@ every trial given the speed it was played at, and its export the same as the old
 
 from __future__ import annotations
 
+import csv
+import json
 import shutil
 import sqlite3
 from pathlib import Path
@@ -16,6 +18,8 @@ from feelmysign.study.export import export_study
 # simulate --participants 2 --seed 5, study export), before trials had a speed: the file and
 # the export that version wrote from it.
 OLD = Path(__file__).parent / "study_files" / "schema-2"
+# The trials' columns added since that version, and their values for its file.
+ADDED = {"late": "0", "compressed": "0", "compressed_ms": "0.0"}
 
 
 def test_a_file_of_schema_2_is_migrated_after_a_backup_and_exports_as_before(
@@ -31,12 +35,22 @@ def test_a_file_of_schema_2_is_migrated_after_a_backup_and_exports_as_before(
     assert len(trials) == 10 and {t["speed_cm_s"] for t in trials} == {8.0}
     export = export_study(store, tmp_path / "export")
     names = {path.name: path for path in export}
-    for name in ("trials.csv", "design.json", "sub-01_task-shapes_beh.tsv"):
-        assert names[name].read_bytes() == (OLD / name).read_bytes(), name
-    assert (
-        names["sub-01_task-shapes_beh.json"].read_bytes()
-        == (OLD / "sub-01_task-shapes_beh.json").read_bytes()
-    )
+    assert names["design.json"].read_bytes() == (OLD / "design.json").read_bytes()
+    # The same columns with the same values, and the columns added since: the sleeve's
+    # catching up (all 0: a study's shape is sent at once and plays at its own pace).
+    for name, delimiter in (("trials.csv", ","), ("sub-01_task-shapes_beh.tsv", "\t")):
+        rows, old_rows = (
+            list(csv.DictReader(path.read_text().splitlines(), delimiter=delimiter))
+            for path in (names[name], OLD / name)
+        )
+        assert len(rows) == len(old_rows) > 0
+        for row, old_row in zip(rows, old_rows, strict=True):
+            assert {k: row[k] for k in old_row} == old_row, name
+            assert {k: row[k] for k in row.keys() - old_row.keys()} == ADDED, name
+    sidecar = json.loads(names["sub-01_task-shapes_beh.json"].read_text())
+    old_sidecar = json.loads((OLD / "sub-01_task-shapes_beh.json").read_text())
+    assert {k: sidecar[k] for k in old_sidecar} == old_sidecar
+    assert sidecar.keys() - old_sidecar.keys() == ADDED.keys()
     store.close()
     old = sqlite3.connect(backup)  # the backup is the file as the old version left it
     assert old.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone() == ("2",)

@@ -25,6 +25,25 @@ describe("the study page's counts", () => {
       "played 1 of 4 strokes · 1 cut short · 2 cancelled",
     );
   });
+
+  it("says how many strokes the sleeve played faster to catch up, and skipped as late", () => {
+    const sent = {
+      strokes: 5,
+      played: 4,
+      adjusted: 0,
+      rejected: ["late"],
+      compressed: 2,
+      compressed_ms: 210.4,
+      latency_ms_max: null,
+      felt_duration_ms: 1,
+    };
+    expect(sentText(sent)).toBe(
+      "played 4 of 5 strokes · 2 faster to catch up (210 ms shorter in all) · rejected: late",
+    );
+    expect(sentText({ ...sent, compressed: 0, compressed_ms: 0 })).toBe(
+      "played 4 of 5 strokes · rejected: late",
+    );
+  });
 });
 
 describe("the trial's line on the study page", () => {

@@ -35,6 +35,13 @@ export interface SendSummary {
   cancelled?: number;
   adjusted: number;
   rejected: string[];
+  /**
+   * Played faster to catch up with the drawing, and how much shorter in all (fates.py
+   * `CatchUp`); absent from a record made before they were counted. Skipped ones are among
+   * `rejected` as "late".
+   */
+  compressed?: number;
+  compressed_ms?: number;
   latency_ms_max: number | null;
   felt_duration_ms: number;
   error?: string | null;

@@ -19,6 +19,11 @@ export function sentText(sent: SendSummary): string {
   if ((sent.cut_short ?? 0) > 0) parts.push(`${sent.cut_short} cut short`);
   if ((sent.cancelled ?? 0) > 0) parts.push(`${sent.cancelled} cancelled`);
   if (sent.adjusted > 0) parts.push(`${sent.adjusted} slowed to be felt`);
+  if ((sent.compressed ?? 0) > 0) {
+    parts.push(
+      `${sent.compressed} faster to catch up (${Math.round(sent.compressed_ms ?? 0)} ms shorter in all)`,
+    );
+  }
   if (sent.rejected.length > 0) parts.push(`rejected: ${sent.rejected.join(", ")}`);
   if (sent.latency_ms_max !== null) parts.push(`latency at most ${sent.latency_ms_max.toFixed(1)} ms`);
   if (sent.error) parts.push(`error: ${sent.error}`);

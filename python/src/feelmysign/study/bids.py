@@ -75,6 +75,24 @@ COLUMNS: dict[str, dict[str, Any]] = {
         "Units": "strokes",
     },
     "rejected": {"Description": "Strokes the sleeve refused, last send.", "Units": "strokes"},
+    "late": {
+        "Description": (
+            "Strokes the sleeve skipped as too late to catch up with the drawing (counted "
+            "under rejected too), last send."
+        ),
+        "Units": "strokes",
+    },
+    "compressed": {
+        "Description": (
+            "Strokes the sleeve played faster than sent, to catch up with the drawing after a "
+            "queue (by 5 % of their duration or more), last send."
+        ),
+        "Units": "strokes",
+    },
+    "compressed_ms": {
+        "Description": "How much shorter those strokes played, in all, last send.",
+        "Units": "ms",
+    },
     "latency_ms_max": {
         "Description": (
             "Longest time of a stroke from its arrival at the sleeve to its first motor "

@@ -42,6 +42,9 @@ TRIAL_COLUMNS = (
     "played",
     "adjusted",
     "rejected",
+    "late",
+    "compressed",
+    "compressed_ms",
     "latency_ms_max",
     "felt_duration_ms",
     "response_time_s",
@@ -121,6 +124,9 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                     "played": summary["played"],
                     "adjusted": summary["adjusted"],
                     "rejected": len(summary["rejected"]),
+                    "late": summary["late"],
+                    "compressed": summary["compressed"],
+                    "compressed_ms": summary["compressed_ms"],
                     "latency_ms_max": ""
                     if summary["latency_ms_max"] is None
                     else summary["latency_ms_max"],

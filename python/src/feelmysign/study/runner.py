@@ -65,6 +65,7 @@ def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]
     for event in typed:
         fates.add(event)
     counts = fates.counts()
+    catch_up = fates.catch_up()
     return {
         "strokes": strokes,
         "played": counts["played"],
@@ -72,6 +73,11 @@ def events_summary(events: list[dict[str, Any]], strokes: int) -> dict[str, Any]
         "cancelled": counts["cancelled"],
         "adjusted": sum(1 for e in typed if isinstance(e, Adjusted)),
         "rejected": list(fates.refusals().elements()),
+        # How the sleeve kept the send in time (docs/protocol.md, "Catching up"): strokes
+        # skipped as late (also among the rejected), and played faster to catch up.
+        "late": catch_up.late,
+        "compressed": catch_up.compressed,
+        "compressed_ms": round(catch_up.compressed_ms, 1),
         "latency_ms_max": round(max(e.latency_ms for e in played), 3) if played else None,
         "felt_duration_ms": round(sum(float(e.duration_ms) for e in played), 1),
     }
