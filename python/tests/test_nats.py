@@ -361,3 +361,36 @@ def test_a_stroke_redelivered_after_later_ones_plays_once(cluster: NatsCluster) 
     assert all(len(payloads) == 1 for payloads in events.played.values()), "played twice"
     if back_within_ack_wait:  # else NATS may send stroke 0 again before the others
         assert events.order(drawing) == [1, 2, 3, 0], said
+
+
+def test_a_port_taken_before_a_node_binds_it_starts_the_cluster_on_other_ports(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A port picked free can be taken by another program before nats-server binds it: the
+    node stops at once ("address already in use"), and the cluster starts on other ports."""
+    import socket
+
+    from feelmysign.broker import _process as process_
+
+    taken = socket.socket()
+    taken.bind(("127.0.0.1", 0))
+    taken.listen()
+    port = taken.getsockname()[1]
+    picked_free = process_.free_port
+    picks = iter([port])  # the first port picked is the one another program holds
+
+    def free_port(host: str) -> int:
+        return next(picks, None) or picked_free(host)
+
+    monkeypatch.setattr(process_, "free_port", free_port)
+    credentials = reuse_or_create(
+        tmp_path / "credentials.json", sleeve_id=SLEEVE, mqtt_url="mqtt://x:1", ws_url="ws://x:2"
+    )
+    try:
+        with NatsCluster(tmp_path / "nats", credentials) as running:
+            assert port not in {p for n in running.nodes for p in (n.client_port, n.mqtt_port)}
+            logs = (tmp_path / "nats" / "a.log").read_text(errors="replace")
+            assert "address already in use" in logs  # the first start met the taken port
+            stop_loop(client(running.nodes[0].mqtt_url, credentials.sender))
+    finally:
+        taken.close()

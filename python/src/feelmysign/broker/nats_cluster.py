@@ -74,6 +74,10 @@ READY_POLL_S = 0.2
 PROBE_TIMEOUT_S = 10.0
 MONITOR_TIMEOUT_S = 5.0
 STOP_TIMEOUT_S = 10.0
+# Each node's ports are picked free, but another program may take one before the node binds
+# it (the node then stops at once, "address already in use"): the cluster is started again
+# on other ports, this many times in all.
+PORT_ATTEMPTS = 3
 
 
 @dataclass(frozen=True)
@@ -137,8 +141,23 @@ class NatsCluster(Started):
             shutil.copyfile(conf, self.state_dir / conf.name)
         accounts = render_nats_accounts(self.credentials, self._others, legacy_topic=LEGACY_TOPIC)
         write_private_file(self.state_dir / "accounts.conf", accounts)
+        for attempt in range(1, PORT_ATTEMPTS + 1):
+            self.nodes = self._free_nodes()
+            try:
+                self._processes = [self._spawn(executable, node) for node in self.nodes]
+                self._wait_ready()
+                return
+            except BrokerError as error:
+                self.stop()
+                if attempt == PORT_ATTEMPTS or "address already in use" not in str(error):
+                    raise
+            except BaseException:
+                self.stop()
+                raise
+
+    def _free_nodes(self) -> list[NatsNode]:
         free = process_.free_port
-        self.nodes = [
+        return [
             NatsNode(
                 name,
                 free("127.0.0.1"),
@@ -150,12 +169,6 @@ class NatsCluster(Started):
             )
             for name in NODE_NAMES
         ]
-        try:
-            self._processes = [self._spawn(executable, node) for node in self.nodes]
-            self._wait_ready()
-        except BaseException:
-            self.stop()
-            raise
 
     def _spawn(self, executable: Path, node: NatsNode) -> subprocess.Popen[bytes]:
         others = [n for n in self.nodes if n is not node]
