@@ -200,6 +200,30 @@ def test_send_says_a_wearers_floor_is_kept_by_senders_not_by_the_sleeve(
     assert "(the sleeve slows a briefer one; " in capsys.readouterr().err
 
 
+def test_replay_says_a_wearers_limits_leave_nothing_and_not_to_lower_the_options(
+    tmp_path: Path,
+) -> None:
+    from dataclasses import replace
+
+    from feelmysign.cli.replay import strokes_to_send
+    from feelmysign.cli.simplify import load
+    from feelmysign.errors import StrokeError
+    from feelmysign.research.rerun import rerun
+    from feelmysign.simplify.window import WindowParams
+
+    recording = load(str(varied_recording(tmp_path / "zigzag.json")))
+    # Longer than any stroke of the 3 x 4 grid: nothing is left of the drawing.
+    params = replace(WindowParams(), min_length=10.0, strict_minimums=True)
+    result = rerun(recording, params)
+    with pytest.raises(StrokeError) as raised:
+        strokes_to_send(result, params, "P01")
+    said = str(raised.value)
+    assert "wearer P01's limits" in said and "10 grid units" in said, said
+    assert "draw it larger or slower" in said and "try a lower" not in said
+    with pytest.raises(StrokeError, match="try a lower --min-length"):
+        strokes_to_send(result, params)  # a sender's own minimums: lowering them helps
+
+
 # ---- the loop ----------------------------------------------------------------------------
 
 
