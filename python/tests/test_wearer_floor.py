@@ -22,8 +22,10 @@ from feelmysign.apparent_motion import shortest_planned_ms
 from feelmysign.bench.sleeve import sleeve_command
 from feelmysign.broker import Broker
 from feelmysign.cli import main
+from feelmysign.cli.send import _say_floor
 from feelmysign.events import StatusFloor
 from feelmysign.layout import Layout
+from feelmysign.stroke import Stroke
 from feelmysign.study.store import StudyStore
 from feelmysign.wearer import (
     SLEEVE_MIN_LENGTH,
@@ -78,6 +80,16 @@ def test_save_keeps_the_other_dimension_and_reads_back(tmp_path: Path) -> None:
 def test_save_says_when_it_cannot_write(tmp_path: Path) -> None:
     with pytest.raises(WearerError, match=r"cannot write the wearer file .*give a writable path"):
         save_wearer(tmp_path / "missing-folder" / "wearer.json", "P01", "length", 0.62)
+
+
+def test_the_file_to_write_by_hand_is_given_as_a_wearer_file_reads_it(tmp_path: Path) -> None:
+    with pytest.raises(WearerError) as raised:
+        save_wearer(tmp_path / "missing-folder" / "wearer.json", "P01", "length", 0.62)
+    said = str(raised.value)
+    by_hand = said[said.index("or write ") + len("or write ") : said.index(" into a file by hand")]
+    path = tmp_path / "by-hand.json"
+    path.write_text(by_hand)  # what the researcher would copy
+    assert read_wearer(path) == Wearer("P01", 0.62, None)
 
 
 def test_save_refuses_another_wearers_file(tmp_path: Path) -> None:
@@ -175,6 +187,43 @@ def test_a_dry_run_is_not_saved_as_a_real_participants_limit(
     assert not wearer.exists()
 
 
+def test_send_says_a_wearers_floor_is_kept_by_senders_not_by_the_sleeve(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    below_wearer = [Stroke((0.0, 1.0), (2.0, 1.0), 150.0)]  # played as sent: above 73.7 ms
+    _say_floor(StatusFloor(min_duration_ms=283.5, min_length=0.63, wearer="P01"), below_wearer)
+    err = capsys.readouterr().err
+    assert "the stroke is below it (sent as given: the wearer may not feel" in err, err
+    assert "slows" not in err
+    too_brief = [Stroke((0.0, 1.0), (2.0, 1.0), 50.0)]
+    _say_floor(StatusFloor(min_duration_ms=73.701, min_length=0.05, wearer=None), too_brief)
+    assert "(the sleeve slows a briefer one; " in capsys.readouterr().err
+
+
+def test_replay_says_a_wearers_limits_leave_nothing_and_not_to_lower_the_options(
+    tmp_path: Path,
+) -> None:
+    from dataclasses import replace
+
+    from feelmysign.cli.replay import strokes_to_send
+    from feelmysign.cli.simplify import load
+    from feelmysign.errors import StrokeError
+    from feelmysign.research.rerun import rerun
+    from feelmysign.simplify.window import WindowParams
+
+    recording = load(str(varied_recording(tmp_path / "zigzag.json")))
+    # Longer than any stroke of the 3 x 4 grid: nothing is left of the drawing.
+    params = replace(WindowParams(), min_length=10.0, strict_minimums=True)
+    result = rerun(recording, params)
+    with pytest.raises(StrokeError) as raised:
+        strokes_to_send(result, params, "P01")
+    said = str(raised.value)
+    assert "wearer P01's limits" in said and "10 grid units" in said, said
+    assert "draw it larger or slower" in said and "try a lower" not in said
+    with pytest.raises(StrokeError, match="try a lower --min-length"):
+        strokes_to_send(result, params)  # a sender's own minimums: lowering them helps
+
+
 # ---- the loop ----------------------------------------------------------------------------
 
 
@@ -203,6 +252,9 @@ def test_the_calibration_loop_closes(
             ]
         )
         assert code == 0
+        # The line names what was written, as JSON (the file's own text, to copy by hand).
+        said = capsys.readouterr().out.split(f"Saved to {wearer}: ", 1)[1]
+        assert json.loads(said.split("; run the sleeve", 1)[0]) == json.loads(wearer.read_text())
     measured = read_wearer(wearer)
     assert measured.min_length is not None and measured.min_duration_ms is not None
     recording = varied_recording(tmp_path / "drawing.json")

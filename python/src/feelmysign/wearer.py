@@ -156,8 +156,8 @@ def save_wearer(path: str | os.PathLike[str], name: str, dimension: str, value: 
     except OSError as error:
         raise WearerError(
             f"cannot write the wearer file {os.fspath(path)} ({error.strerror or error}); the "
-            f"threshold is in the study file: give a writable path, or write {wearer.to_json()} "
-            "into a file by hand"
+            "threshold is in the study file: give a writable path, or write "
+            f"{json.dumps(wearer.to_json())} into a file by hand"
         ) from None
     return wearer
 

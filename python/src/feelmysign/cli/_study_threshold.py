@@ -9,6 +9,7 @@ participant: the sleeve would take it as that wearer's measured floor.
 from __future__ import annotations
 
 import argparse
+import json
 import random
 import sqlite3
 from pathlib import Path
@@ -127,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
 
         wearer = save_wearer(args.save, args.participant, args.dimension, estimate.threshold)
         print(
-            f"Saved to {args.save}: {wearer.to_json()}; run the sleeve with "
+            f"Saved to {args.save}: {json.dumps(wearer.to_json())}; run the sleeve with "
             f"'feelmysign sleeve --wearer {args.save}' (or 'feelmysign up --wearer {args.save}')."
         )
     return 0

@@ -103,13 +103,16 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     params = simplify.checked_params(args, recording, parser)
     client = _connect(args) if args.send else None
     try:
+        wearer = None
         if client is not None:
-            params = _respect_floor(client, broker_settings_from_args(args, "sender"), params)
+            params, wearer = _respect_floor(
+                client, broker_settings_from_args(args, "sender"), params
+            )
         result = rerun(recording, params)
         compared = recording.strokes is not None and algorithm == _recorded_algorithm(recording)
         difference = mismatch(result.segments, recording.strokes or ()) if compared else None
         if client is not None:
-            _send(args, client, result, params)
+            _send(args, client, result, params, wearer)
     finally:
         if client is not None:
             client.disconnect()
@@ -161,10 +164,14 @@ def _document(
     return document
 
 
-def strokes_to_send(result: Rerun, params: Params) -> tuple[list[Stroke], list[float]]:
+def strokes_to_send(
+    result: Rerun, params: Params, wearer: str | None = None
+) -> tuple[list[Stroke], list[float]]:
     """The sent segments as strokes of one new drawing, and when to send each (ms from the press).
 
-    Each is checked by the sleeve's own rules first: StrokeError, nothing sent.
+    Each is checked by the sleeve's own rules first: StrokeError, nothing sent. ``wearer``: whose
+    limits (from the sleeve's status) the minimums were raised to, for the message when none is
+    left.
     """
     layout = grid_layout(
         params.rows,
@@ -184,11 +191,18 @@ def strokes_to_send(result: Rerun, params: Params) -> tuple[list[Stroke], list[f
         strokes.append(checked)
         at_ms.append(segment.emitted_at_ms - origin_ms)
     if not strokes:
-        raise StrokeError(
-            "empty",
+        dropped = (
             f"The replay gave no stroke to send ({len(result.segments)} segment(s), all "
-            "dropped as too short or too brief); try a lower --min-length or --min-duration-ms.",
+            "dropped as too short or too brief)"
         )
+        if wearer is not None:  # lower options would be raised to the wearer's limits again
+            raise StrokeError(
+                "empty",
+                f"{dropped}: wearer {wearer}'s limits (at least {params.min_duration_ms:g} ms "
+                f"and {params.min_length:g} grid units a stroke) leave nothing of this drawing; "
+                "draw it larger or slower.",
+            )
+        raise StrokeError("empty", f"{dropped}; try a lower --min-length or --min-duration-ms.")
     return strokes, at_ms
 
 
@@ -199,9 +213,11 @@ def _connect(args: argparse.Namespace) -> mqtt.Client:
     )
 
 
-def _respect_floor(client: mqtt.Client, settings: BrokerSettings, params: Params) -> Params:
+def _respect_floor(
+    client: mqtt.Client, settings: BrokerSettings, params: Params
+) -> tuple[Params, str | None]:
     """The simplifier's minimums raised to the floor the sleeve advertises (never lowered), said
-    on stderr (stdout may be JSON for a program)."""
+    on stderr (stdout may be JSON for a program); and whose limits are in that floor, if any."""
     from feelmysign.simplify.window import WindowParams
     from feelmysign.wearer import respect_floor  # the planner's constants: not by --help
 
@@ -218,11 +234,17 @@ def _respect_floor(client: mqtt.Client, settings: BrokerSettings, params: Params
         params = replace(
             params, floor_ms=floor.min_duration_ms, strict_minimums=floor.wearer is not None
         )
-    return params
+    return params, None if floor is None else floor.wearer
 
 
-def _send(args: argparse.Namespace, client: mqtt.Client, result: Rerun, params: Params) -> None:
-    strokes, at_ms = strokes_to_send(result, params)
+def _send(
+    args: argparse.Namespace,
+    client: mqtt.Client,
+    result: Rerun,
+    params: Params,
+    wearer: str | None,
+) -> None:
+    strokes, at_ms = strokes_to_send(result, params, wearer)
     settings: BrokerSettings = broker_settings_from_args(args, "sender")
     speed = args.speed or 1.0
     messages = [

@@ -573,10 +573,16 @@ def _say_floor(floor: StatusFloor | None, strokes: list[Stroke]) -> None:
     if not below and not floor.wearer:
         return
     whose = f" with wearer {floor.wearer}'s limits" if floor.wearer else ""
+    # The sleeve slows only what its motors cannot play; a wearer's limits are kept by senders,
+    # so below them a stroke is played as sent, and may not be felt.
+    why = (
+        "sent as given: the wearer may not feel a briefer or shorter one"
+        if floor.wearer
+        else "the sleeve slows a briefer one; a shorter one may not be felt"
+    )
     verdict = (
         f"{'the stroke is' if len(strokes) == 1 else f'{below} of the {len(strokes)} strokes are'}"
-        " below it (the sleeve slows a briefer one; "
-        "a shorter one may not be felt)"
+        f" below it ({why})"
         if below
         else "every stroke is at or above it"
     )

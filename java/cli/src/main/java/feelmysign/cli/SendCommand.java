@@ -431,9 +431,13 @@ final class SendCommand {
       return;
     }
     String whose = floor.hasWearer() ? " with wearer " + floor.wearer() + "'s limits" : "";
+    // The sleeve slows only what its motors cannot play; a wearer's limits are kept by senders,
+    // so below them a stroke is played as sent, and may not be felt.
+    String why = floor.hasWearer()
+        ? "sent as given: the wearer may not feel a briefer or shorter one"
+        : "the sleeve slows a briefer one; a shorter one may not be felt";
     String verdict = below > 0
-        ? below + " of the " + strokes.size() + " strokes are below it (the sleeve slows a"
-            + " briefer one; a shorter one may not be felt)"
+        ? below + " of the " + strokes.size() + " strokes are below it (" + why + ")"
         : "every stroke is at or above it";
     err.println("The sleeve's floor" + whose + ": strokes of at least "
         + Numbers.pythonG(floor.minDurationMs()) + " ms and " + Numbers.pythonG(floor.minLength())

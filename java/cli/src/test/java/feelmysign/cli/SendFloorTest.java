@@ -162,6 +162,13 @@ class SendFloorTest {
     List<Stroke> strokes = arrived(count(kept));
     assertFalse(strokes.isEmpty());
     assertTrue(strokes.stream().noneMatch(SendFloorTest::belowP01), strokes.toString());
+    // Strokes given below a wearer's limits go as given: the sleeve does not slow them to it.
+    Result given = send("0,0,2,0,100", "2,0,2,2,300");
+    assertEquals(0, given.code(), given.err());
+    assertEquals("The sleeve's floor with wearer P01's limits: strokes of at least 118.4 ms and"
+        + " 0.62 grid units; 1 of the 2 strokes are below it (sent as given: the wearer may not"
+        + " feel a briefer or shorter one).\n", given.err());
+    assertEquals(100.0, arrived(2).get(0).durationMs(), "sent as given");
   }
 
   @Test
