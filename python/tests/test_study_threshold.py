@@ -17,6 +17,7 @@ from feelmysign.errors import StudyError
 from feelmysign.layout import grid_layout
 from feelmysign.study import StudyStore, load_design
 from feelmysign.study.api import StudyApi
+from feelmysign.study.choices import DIRECTIONS
 from feelmysign.study.runner import Session
 from feelmysign.study.simulated_sleeve import offline_player
 from feelmysign.study.threshold import Procedure, SimulatedObserver, check_fits
@@ -161,3 +162,55 @@ def _status_lines(path: Path) -> str:
     with contextlib.redirect_stdout(out):
         assert cli_main(["study", "status", str(path)]) == 0
     return out.getvalue()
+
+
+def _run(design_threshold: Any, dimension: str, answer: Any, seed: int) -> Any:
+    procedure = Procedure(design_threshold, dimension)  # type: ignore[arg-type]
+    rng = random.Random(seed)
+    while procedure.stop_reason() is None:
+        value, direction = procedure.next_value(), rng.choice(["up", "down", "left", "right"])
+        procedure.update(value, answer(direction, value, rng) == direction)
+    return procedure.estimate()
+
+
+@pytest.mark.parametrize("dimension", ["length", "duration"])
+def test_a_run_at_an_end_of_the_tested_range_is_a_bound_not_a_measurement(dimension: str) -> None:
+    """A wearer who tells no direction (answers by chance) is not measured: the interval
+    reaches the top of the range; one who tells every direction gives a bound at its bottom;
+    a threshold inside the range is measured."""
+    threshold = load_design(PAPER_DESIGN).threshold
+    grid = threshold.length if dimension == "length" else threshold.duration
+    for seed in range(5):
+        guess = _run(threshold, dimension, lambda d, v, rng: rng.choice(sorted(DIRECTIONS)), seed)
+        assert guess.censored == "above", guess
+        words = guess.words(dimension, grid)
+        assert words.startswith("not measured") and "run again" in words
+        always = _run(threshold, dimension, lambda d, v, rng: d, seed)
+        assert always.censored == "below", always
+        assert always.words(dimension, grid).startswith("at most ")
+        middle = (grid.minimum * grid.maximum) ** 0.5
+        observer = SimulatedObserver(middle)
+        inside = _run(threshold, dimension, observer.respond, seed)
+        assert inside.censored is None and grid.minimum < inside.low < inside.high < grid.maximum
+        assert "e+" not in inside.words(dimension, grid)
+
+
+def test_a_run_that_measured_nothing_is_not_saved_as_the_wearers_limit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    store = new_study(tmp_path)
+    code = store.add_participant(simulated=True)
+    store.set_consent(code, True)
+    path = str(store.path)
+    store.close()
+    wearer = tmp_path / "wearer.json"
+    argv = ["study", "threshold", path, "--participant", code, "--dimension", "duration"]
+    # A threshold far above the longest stroke tested: the wearer tells almost nothing.
+    assert cli_main([*argv, "--simulated-observer", "100000", "--save", str(wearer)]) == 1
+    out, err = capsys.readouterr()
+    assert "Simulated duration threshold (a dry run, stored as one): not measured" in out, out
+    assert f"nothing saved to {wearer}" in err and "Traceback" not in err, err
+    assert not wearer.exists()
+    # The run is kept, and the report says what it is.
+    (run,) = StudyStore(tmp_path / "study.sqlite").threshold_runs(code)
+    assert run["threshold"] is not None

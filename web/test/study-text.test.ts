@@ -73,3 +73,18 @@ describe("the trial's line on the study page", () => {
     expect(trialDetail({ ...trial, speed_cm_s: null }, true)).toBe(" · coarse, 4 strokes");
   });
 });
+
+describe("a threshold run's estimate on the study page", () => {
+  it("gives a measured threshold with its interval, and a bound where the interval reaches an end", async () => {
+    const { estimateWords } = await import("../src/study/threshold-view");
+    const estimate = { threshold: 0.6234, low: 0.45, high: 0.8 };
+    expect(estimateWords(estimate, "grid units")).toBe("0.623 grid units, 95% interval 0.45 to 0.8");
+    expect(estimateWords(estimate, "grid units", true)).toBe("0.623 grid units (95% interval 0.45 to 0.8)");
+    expect(estimateWords({ ...estimate, censored: "above" }, "grid units")).toMatch(
+      /^not measured: the 95% interval 0.45 to 0.8 reaches the top of the tested range/,
+    );
+    expect(estimateWords({ ...estimate, censored: "below" }, "grid units")).toMatch(
+      /^at most 0.623 grid units: the 95% interval 0.45 to 0.8 reaches the bottom/,
+    );
+  });
+});

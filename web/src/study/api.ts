@@ -164,6 +164,11 @@ export interface ThresholdEstimate {
   threshold: number;
   low: number;
   high: number;
+  /**
+   * Where the 95% interval reaches an end of the tested range (study/threshold.py `censored`):
+   * "above", not measured; "below", a bound. Absent from a server before it was said.
+   */
+  censored?: "above" | "below" | null;
 }
 
 export interface ThresholdTrial {

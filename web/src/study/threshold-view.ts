@@ -11,6 +11,7 @@ import {
   type Dimension,
   type Direction,
   type ThresholdDimension,
+  type ThresholdEstimate,
   type ThresholdRun,
   type ThresholdState,
 } from "./api";
@@ -26,6 +27,23 @@ const ARROWS: Record<string, Direction> = {
 const SYMBOL: Record<Direction, string> = { up: "↑", down: "↓", left: "←", right: "→" };
 
 const number = (value: number) => String(Number(value.toPrecision(3)));
+
+/**
+ * A run's estimate in words: the threshold and its 95% interval, or, where the interval reaches
+ * an end of the tested range, what the run says instead (Python `Estimate.words`).
+ */
+export function estimateWords(estimate: ThresholdEstimate, unit: string, bracketed = false): string {
+  const interval = `95% interval ${number(estimate.low)} to ${number(estimate.high)}`;
+  if (estimate.censored === "above") {
+    return `not measured: the ${interval} reaches the top of the tested range, so the threshold may lie above it (the wearer told the direction hardly better than by chance)`;
+  }
+  if (estimate.censored === "below") {
+    return `at most ${number(estimate.threshold)} ${unit}: the ${interval} reaches the bottom of the tested range (a bound, not a measurement)`;
+  }
+  return bracketed
+    ? `${number(estimate.threshold)} ${unit} (${interval})`
+    : `${number(estimate.threshold)} ${unit}, ${interval}`;
+}
 
 export class ThresholdView {
   readonly #root: HTMLElement;
@@ -227,9 +245,7 @@ export class ThresholdView {
           }
         }
       : null;
-    const estimate = run.estimate
-      ? `${number(run.estimate.threshold)} ${dimension.unit} (95% interval ${number(run.estimate.low)} to ${number(run.estimate.high)})`
-      : "none yet";
+    const estimate = run.estimate ? estimateWords(run.estimate, dimension.unit, true) : "none yet";
     const card = h(
       "div",
       { class: "card trial", "data-testid": "threshold-run", "data-position": next.position },
@@ -324,7 +340,7 @@ export class ThresholdView {
           h(
             "li",
             { "data-run": r.run },
-            `${number(r.threshold)} ${dimension.unit}, 95% interval ${number(r.low)} to ${number(r.high)}, after ${plural(r.trials, "trial")}${r.stop_reason === `${r.trials} trials` ? "" : ` (stopped: ${r.stop_reason})`}`,
+            `${estimateWords(r, dimension.unit)}, after ${plural(r.trials, "trial")}${r.stop_reason === `${r.trials} trials` ? "" : ` (stopped: ${r.stop_reason})`}`,
           ),
         ),
       ),

@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     from feelmysign.study.sleeve_link import SleeveLink
     from feelmysign.study.stimulus import stimulus_layout
     from feelmysign.study.store import StudyStore
-    from feelmysign.study.threshold import SimulatedObserver
+    from feelmysign.study.threshold import SimulatedObserver, dimension_settings, value_words
     from feelmysign.study.threshold_run import run_threshold
 
     if args.save is not None:
@@ -88,11 +88,11 @@ def run(args: argparse.Namespace) -> int:
     if args.save is not None and args.simulated_observer is not None:
         _refuse_a_dry_run_for_a_real_wearer(participant, args.save)
     layout = stimulus_layout(store.design.stimulus, store.base_dir)
-    unit = "grid units" if args.dimension == "length" else "ms"
 
     def progress(n: int, value: float, sent: str, said: str) -> None:
         mark = "right" if sent == said else "wrong"
-        print(f"  trial {n}: {value:.3g} {unit} {sent}, answered {said} ({mark})", flush=True)
+        shown = value_words(args.dimension, value)
+        print(f"  trial {n}: {shown} {sent}, answered {said} ({mark})", flush=True)
 
     if args.simulated_observer is not None:
         if not args.simulated_observer > 0:
@@ -119,13 +119,17 @@ def run(args: argparse.Namespace) -> int:
         if args.simulated_observer
         else f"Threshold ({args.dimension})"
     )
-    print(
-        f"{kind}: {estimate.threshold:.3g} {unit}, 95% interval "
-        f"{estimate.low:.3g} to {estimate.high:.3g}, after {estimate.trials} trials."
-    )
+    grid = dimension_settings(store.design.threshold, args.dimension)
+    print(f"{kind}: {estimate.words(args.dimension, grid)}.")
     if args.save is not None:
         from feelmysign.wearer import save_wearer
 
+        if estimate.censored == "above":
+            raise StudyError(
+                f"nothing saved to {args.save}: this run did not measure a {args.dimension} "
+                "threshold (above), and the sleeve would keep to the top of the tested range "
+                "as the wearer's limit; the run stays in the study file"
+            )
         wearer = save_wearer(args.save, args.participant, args.dimension, estimate.threshold)
         print(
             f"Saved to {args.save}: {json.dumps(wearer.to_json())}; run the sleeve with "

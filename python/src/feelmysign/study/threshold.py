@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import random
 from dataclasses import dataclass
+from typing import Literal
 
 from feelmysign.errors import StudyError
 from feelmysign.layout import Layout
@@ -40,12 +41,67 @@ MIN_TRIALS = 10  # before the interval can stop a run early
 CREDIBLE = 0.95
 
 
+# Where a run's 95% interval reaches an end of the tested range: the threshold was not
+# measured there, only bounded ("above": it may lie beyond the longest or slowest stroke
+# tested, as for a wearer who tells no direction; "below": the wearer told the direction
+# even of the shortest or briefest).
+Censored = Literal["above", "below"]
+
+
+def censored(grid: ThresholdDimension, low: float, high: float) -> Censored | None:
+    """Whether the 95% interval [low, high] reaches an end of ``grid``'s range: within the
+    last step of the posterior's threshold grid (2.5% of the posterior or more lies there)."""
+    steps = (grid.steps - 1) * THRESHOLD_GRID_FACTOR
+    ratio = (grid.maximum / grid.minimum) ** (1 / steps)
+    slack = 1e-9  # the grid's own rounding
+    if high >= grid.maximum / ratio * (1 - slack):
+        return "above"
+    if low <= grid.minimum * ratio * (1 + slack):
+        return "below"
+    return None
+
+
+def value_words(dimension: Dimension, value: float) -> str:
+    """A length or a duration as the study's lines write it: 0.62 grid units, 118 ms,
+    1454 ms (never 1.45e+03)."""
+    if dimension == "length":
+        return f"{value:.3g} grid units"
+    return f"{value:.0f} ms" if value >= 100 else f"{value:.3g} ms"
+
+
 @dataclass(frozen=True)
 class Estimate:
     threshold: float
     low: float
     high: float
     trials: int
+    censored: Censored | None = None
+
+    def words(self, dimension: Dimension, grid: ThresholdDimension) -> str:
+        """The result in a sentence: the threshold and its interval, or, where the interval
+        reaches an end of the tested range, the bound the run gives and what to do."""
+        interval = (
+            f"95% interval {value_words(dimension, self.low)} to "
+            f"{value_words(dimension, self.high)}, after {self.trials} trials"
+        )
+        if self.censored == "above":
+            top = value_words(dimension, grid.maximum)
+            return (
+                f"not measured: the 95% interval reaches the top of the tested range ({top}; "
+                f"{interval}), so the threshold may lie above it: the wearer told the "
+                "direction hardly better than by chance. Check that the sleeve sits well and "
+                "that the wearer knows the task, and run again (with a larger "
+                f"threshold.{dimension}.maximum in the design if the sleeve allows it)"
+            )
+        if self.censored == "below":
+            bottom = value_words(dimension, grid.minimum)
+            return (
+                f"at most {value_words(dimension, self.threshold)}: the wearer told the "
+                f"direction even at the bottom of the tested range ({bottom}; {interval}), "
+                "so the threshold lies at or below it (a bound, not a measurement; a limit "
+                "the wearer feels)"
+            )
+        return f"{value_words(dimension, self.threshold)}, {interval}"
 
 
 def dimension_settings(threshold: Threshold, dimension: Dimension) -> ThresholdDimension:
@@ -123,7 +179,8 @@ class Procedure:
         low = math.exp(float(np.interp(tail, cumulative, logs)))
         high = math.exp(float(np.interp(1 - tail, cumulative, logs)))
         mean = float(np.sum(marginal * self.thresholds) / marginal.sum())
-        return Estimate(mean, low, high, self.trials)
+        grid = dimension_settings(self.settings, self.dimension)
+        return Estimate(mean, low, high, self.trials, censored(grid, low, high))
 
     def stop_reason(self) -> str | None:
         """Why the run is over, or None to go on."""

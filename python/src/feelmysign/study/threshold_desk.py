@@ -29,6 +29,7 @@ from feelmysign.study.threshold import (
     MIN_TRIALS,
     Procedure,
     SimulatedObserver,
+    censored,
     check_fits,
     dimension_settings,
 )
@@ -164,6 +165,7 @@ class ThresholdDesk:
                     "threshold": r["threshold"],
                     "low": r["low"],
                     "high": r["high"],
+                    "censored": censored(grid, r["low"], r["high"]),
                     "stop_reason": r["stop_reason"],
                     "trials": len(self.store.threshold_trials(r["id"])),
                 }
@@ -200,7 +202,12 @@ class ThresholdDesk:
             ],
             "estimate": None
             if not trials
-            else {"threshold": estimate.threshold, "low": estimate.low, "high": estimate.high},
+            else {
+                "threshold": estimate.threshold,
+                "low": estimate.low,
+                "high": estimate.high,
+                "censored": estimate.censored,
+            },
             # The direction stays hidden until the answer is in.
             "next": {"position": coming.position, "value": coming.value, "sent": waiting},
             "last_send": events_summary(sent.events, 1) if waiting and sent else None,

@@ -220,9 +220,13 @@ def participant_table(
 
 
 def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
-    """Every threshold run (SQ2.2), anonymised, with its result when it has finished, and
-    whether it is a dry run (``simulated``: the report keeps those apart)."""
+    """Every threshold run (SQ2.2), anonymised, with its result when it has finished, whether
+    its interval reaches an end of the tested range (``censored``), and whether it is a dry
+    run (``simulated``: the report keeps those apart)."""
+    from feelmysign.study.threshold import censored, dimension_settings
+
     labels = anonymous_labels(store)
+    design = store.design.threshold
     return [
         {
             "participant": labels[run["participant"]],
@@ -231,6 +235,11 @@ def threshold_summaries(store: StudyStore) -> list[dict[str, Any]]:
             "threshold": run["threshold"],
             "low": run["low"],
             "high": run["high"],
+            # Where the interval reaches an end of the tested range: "above" (not measured),
+            # "below" (a bound); None: measured, or not finished.
+            "censored": None
+            if run["threshold"] is None
+            else censored(dimension_settings(design, run["dimension"]), run["low"], run["high"]),
             "trials": len(store.threshold_trials(run["id"])),
             "stop_reason": run["stop_reason"],
         }

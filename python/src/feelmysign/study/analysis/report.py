@@ -434,7 +434,8 @@ def _threshold_section(analysis: Analysis) -> list[str]:
         "## Shortest and briefest stroke whose direction is felt (SQ2.2)",
         "",
         "QUEST+ on a Weibull function, four directions (25% by chance); threshold = posterior "
-        "mean (about 71% correct), interval = 95% credible interval.",
+        "mean (about 71% correct), interval = 95% credible interval. Where the interval reaches "
+        "an end of the tested range, the run gives a bound, not a measurement.",
         "",
     ]
     lines += _runs_table(measured) if measured else ["No measured run."]
@@ -463,8 +464,13 @@ def _runs_table(runs: list[dict[str, Any]]) -> list[str]:
                 f"| {run['participant']} | {run['dimension']} | {what} | | {run['trials']} | |"
             )
             continue
+        threshold = f"{run['threshold']:.3g} {unit}"
+        if run.get("censored") == "above":
+            threshold = "not measured: may lie above the tested range"
+        elif run.get("censored") == "below":
+            threshold = f"at most {threshold} (the bottom of the tested range)"
         lines.append(
-            f"| {run['participant']} | {run['dimension']} | {run['threshold']:.3g} {unit} | "
+            f"| {run['participant']} | {run['dimension']} | {threshold} | "
             f"{run['low']:.3g} - {run['high']:.3g} | {run['trials']} | {run['stop_reason']} |"
         )
     return lines
