@@ -24,13 +24,14 @@ from feelmysign.broker import Broker
 from feelmysign.cli import main
 from feelmysign.cli.send import _say_floor
 from feelmysign.events import StatusFloor
-from feelmysign.layout import Layout
+from feelmysign.layout import Layout, load_layout
 from feelmysign.stroke import Stroke
 from feelmysign.study.store import StudyStore
 from feelmysign.wearer import (
     SLEEVE_MIN_LENGTH,
     Wearer,
     WearerError,
+    check_wearer_fits,
     read_wearer,
     respect_floor,
     save_wearer,
@@ -131,6 +132,32 @@ def test_the_sleeve_will_not_start_with_a_bad_wearer_file(
     assert main(["sleeve", "--wearer", str(path), "--broker", "mqtt://127.0.0.1:1"]) == 1
     err = capsys.readouterr().err
     assert "min_length = -1 must be a number above 0" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("content", "says"),
+    [
+        ('{"wearer": "P01", "min_length": 10}', "the longest stroke on this 3 x 4 sleeve"),
+        ('{"wearer": "P01", "min_duration_ms": 4000}', "no stroke longer than 3000 ms"),
+    ],
+)
+def test_the_sleeve_will_not_start_with_limits_no_stroke_on_it_can_keep(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: str, says: str
+) -> None:
+    layout = tmp_path / "layout.toml"
+    layout.write_text(
+        "rows = 3\ncolumns = 4\nspacing_cm = 3.0\n\n[safety]\nmax_stroke_duration_ms = 3000\n"
+    )
+    path = tmp_path / "wearer.json"
+    path.write_text(content)
+    argv = ["sleeve", "--layout", str(layout), "--wearer", str(path)]
+    assert main([*argv, "--broker", "mqtt://127.0.0.1:1"]) == 1
+    err = capsys.readouterr().err
+    assert says in err and "senders would send nothing" in err and "Traceback" not in err, err
+    # Limits the grid can keep start it (up to the broker it cannot reach).
+    path.write_text('{"wearer": "P01", "min_length": 3.6, "min_duration_ms": 2999}')
+    wearer = read_wearer(path)
+    check_wearer_fits(wearer, load_layout(layout), str(path))
 
 
 # ---- the floor ---------------------------------------------------------------------------

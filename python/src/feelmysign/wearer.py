@@ -19,6 +19,7 @@ simplifier's minimums to it (``respect_floor``), never lowering a higher setting
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass
 from typing import Any
@@ -89,6 +90,32 @@ def wearer_from_json(data: Any, source: str) -> Wearer:
 
 
 _EXAMPLE = '{"wearer": "P01", "min_length": 0.6, "min_duration_ms": 120}'
+
+
+def check_wearer_fits(wearer: Wearer, layout: Layout, source: str) -> None:
+    """WearerError where no stroke on ``layout`` could keep to ``wearer``'s limits: a
+    ``min_length`` beyond the grid's diagonal, or a ``min_duration_ms`` beyond the longest
+    stroke the sleeve accepts. With either, every sender would send nothing at all."""
+    problems = []
+    longest = math.hypot(layout.rows - 1, layout.columns - 1)
+    if wearer.min_length is not None and wearer.min_length > longest:
+        problems.append(
+            f"min_length = {wearer.min_length:g} grid units, but the longest stroke on this "
+            f"{layout.rows} x {layout.columns} sleeve (its diagonal) is {longest:.3g}"
+        )
+    slowest = layout.max_stroke_duration_ms
+    if wearer.min_duration_ms is not None and wearer.min_duration_ms > slowest:
+        problems.append(
+            f"min_duration_ms = {wearer.min_duration_ms:g}, but the sleeve plays no stroke "
+            f"longer than {slowest:g} ms (the layout's safety.max_stroke_duration_ms)"
+        )
+    if problems:
+        lines = "\n".join(f"  - {p}" for p in problems)
+        raise WearerError(
+            f"{source}: no stroke on this sleeve can keep to the wearer's limits, so senders "
+            f"would send nothing:\n{lines}\ncheck that the file is this wearer's and this "
+            "sleeve's, or measure the limits again on it ('feelmysign study threshold --save')"
+        )
 
 
 def _limit(

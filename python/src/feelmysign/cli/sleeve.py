@@ -152,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
     if args.record is not None:
         output_file(args.record, option="--record")
     layout = layout_from_args(args)
-    wearer = wearer_from_args(args)
+    wearer = wearer_from_args(args, layout)
     settings = broker_settings_from_args(args, "sleeve")
     options = SleeveOptions(
         sleeve_id=settings.sleeve_id,

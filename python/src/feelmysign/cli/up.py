@@ -121,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
     if args.record is not None:
         output_file(args.record, option="--record")
     layout = layout_from_args(args)
-    wearer = wearer_from_args(args)
+    wearer = wearer_from_args(args, layout)
     lan = lan_from_args(args)
     check_built(args.web_dir)
     state_dir = args.state_dir if args.state_dir is not None else default_state_dir()

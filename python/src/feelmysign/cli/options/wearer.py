@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the planner's constants: not imported by 'feelmysign --help'
+    from feelmysign.layout import Layout
     from feelmysign.wearer import Wearer
 
 
@@ -18,8 +19,13 @@ def add_wearer_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def wearer_from_args(args: argparse.Namespace) -> Wearer | None:
-    """The wearer file's limits, checked before the sleeve starts; None without --wearer."""
-    from feelmysign.wearer import read_wearer
+def wearer_from_args(args: argparse.Namespace, layout: Layout) -> Wearer | None:
+    """The wearer file's limits, checked before the sleeve starts (against its ``layout``
+    too: limits no stroke on it can keep are refused); None without --wearer."""
+    from feelmysign.wearer import check_wearer_fits, read_wearer
 
-    return None if args.wearer is None else read_wearer(args.wearer)
+    if args.wearer is None:
+        return None
+    wearer = read_wearer(args.wearer)
+    check_wearer_fits(wearer, layout, args.wearer)
+    return wearer
