@@ -185,6 +185,26 @@ def test_a_missing_multiplexer_is_named() -> None:
         Drv2605Backend(layout, bus=bus).open()
 
 
+def test_a_missing_multiplexer_says_the_others_were_switched_off_and_its_motors_may_run() -> None:
+    # As for a chip that does not answer: the motors behind it got no "off", so the
+    # message must say so (cut the power), and that every motor that answered is off.
+    layout = paper_layout()
+    bus = EmulatedI2CBus.for_layout(layout)
+    left_running(bus)
+    bus.multiplexer(0x71).connected = False
+    with pytest.raises(HardwareError) as error:
+        Drv2605Backend(layout, bus=bus).open()
+    message = str(error.value)
+    assert message.startswith("TCA9548A multiplexer 0x71 did not answer")
+    assert message.endswith(
+        " (every chip that answered was switched off first; a motor on a chip that did not"
+        " answer may still run: if one keeps vibrating, cut the sleeve's power)"
+    )
+    behind = {key for key, chip in bus.chips.items() if key[0] == 0x71}
+    assert behind and all(bus.chips[key].output > 0.5 for key in behind)  # unreachable: on
+    assert all(chip.output == 0.0 for key, chip in bus.chips.items() if key not in behind)
+
+
 def test_the_layout_is_checked_completely_before_any_i2c_traffic() -> None:
     layout = paper_layout()
     broken = dataclasses.replace(

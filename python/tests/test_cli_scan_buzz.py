@@ -360,6 +360,32 @@ def test_the_documented_wiring_table_is_the_paper_layout_s(paper: Layout) -> Non
     assert documented == layout_wiring
 
 
+def test_every_status_scan_gives_a_fault_is_explained_in_troubleshooting(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], paper: Layout
+) -> None:
+    # One chip of each fault; the builder looks the status up in the doc's Troubleshooting.
+    bus = EmulatedI2CBus.for_layout(paper)
+    bus.detach_chip(0x70, 3)  # MISSING
+    bus.chip(mux=0x71, channel=2).device_id = DRV2604_DEVICE_ID  # WRONG CHIP
+    bus.attach_chip(0x71, 6)  # UNEXPECTED
+    left_on = bus.chip(mux=0x70, channel=4)  # DRIVING: as a killed sleeve leaves it
+    left_on.registers[RTP_INPUT] = 0x66
+    left_on.registers[MODE] = 0x05
+    code, out = _scan_with(monkeypatch, bus)(capsys)
+    assert code == 1
+    faults = {status for status in _statuses(out).values() if status not in ("ok", "free")}
+    assert faults == {"MISSING", "WRONG CHIP", "UNEXPECTED", "DRIVING"}
+    doc = HARDWARE_DOC.read_text(encoding="utf-8")
+    troubleshooting = doc[doc.index("## Troubleshooting") :]
+    for status in faults:
+        assert f"(`{status}`" in troubleshooting or f"`{status}` in `scan`" in troubleshooting, (
+            status
+        )
+    bring_up = doc[doc.index("## Bring-up, step by step") : doc.index("## Motors off")]
+    for status in faults:
+        assert f"`{status}`" in bring_up, status  # step 4 lists what Troubleshooting explains
+
+
 def test_scan_names_a_motor_left_driving_and_fails(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], paper: Layout
 ) -> None:

@@ -533,7 +533,10 @@ class Drv2605Backend(GridBackend):
     def _check_chips(self, *, readback: bool = False) -> None:
         """Every chip answers and is a DRV2605L (with ``readback``, also reads back "off":
         before an enable line goes high); HardwareError listing every one that is not."""
-        problems = list(self._chip_problems(readback=readback).values())
+        try:
+            problems = list(self._chip_problems(readback=readback).values())
+        except HardwareError as error:  # a multiplexer did not answer: no chip can be checked
+            problems = [str(error)]
         for key in self.missing:  # left out (leave_out_missing): the rest are driven
             self._actuators.pop(key, None)
         others_off = _OTHERS_OFF

@@ -10,7 +10,8 @@ standby), trying each one even when another does not answer, and checks
 nothing first. Meant for after a crash: the sleeve's service runs it as soon
 as the sleeve process has ended, however it ended (``ExecStopPost``), so a
 motor left on by a ``kill -9`` or a crash is not left on until the restart.
-Exit 0 when every chip took the "off", 1 (naming the chips) otherwise.
+Exit 0 when every chip took the "off", 1 (naming the chips) otherwise; with an
+enable line, 0 naming them (the line, left low, holds every motor off).
 """
 
 from __future__ import annotations
