@@ -260,18 +260,21 @@ SWEEPS = ("max_error=0.05:0.3:0.05",)
 
 def describe(params: WindowParams) -> str:
     """The settings that shape the strokes, in a few words."""
-    cap = f"{params.max_stroke_ms:g} ms" if params.max_stroke_ms else "no limit"
+    # The latency cap cuts a stroke after so much drawing; a stroke merged with a brief
+    # neighbour, or drawn between two samples further apart, can still last longer.
+    cap = (
+        f"cut after {params.max_stroke_ms:g} ms of drawing"
+        if params.max_stroke_ms
+        else "not cut by time"
+    )
     if params.least_squares:
         floor_ms = max(params.floor_ms, params.min_duration_ms)
         return (
             f"window, least squares: max error {params.max_error:g} grid units, strokes of "
             f"{floor_ms:g} ms or more (the sleeve's floor), sent {params.lookahead_ms:g} ms "
-            f"after their end is drawn, longest stroke {cap}"
+            f"after their end is drawn, {cap}"
         )
-    return (
-        f"window, chord: max error {params.max_error:g} grid units, every sample, "
-        f"longest stroke {cap}"
-    )
+    return f"window, chord: max error {params.max_error:g} grid units, every sample, {cap}"
 
 
 @dataclass

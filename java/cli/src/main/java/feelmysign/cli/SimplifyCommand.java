@@ -627,7 +627,9 @@ final class SimplifyCommand {
   private static String settings(Params params) {
     if (params.algorithm() == Algorithm.WINDOW) {
       double cap = params.number("max_stroke_ms");
-      String capText = cap != 0 ? Numbers.pythonG(cap) + " ms" : "no limit";
+      // As Python's describe: a stroke merged with a brief neighbour can last longer.
+      String capText =
+          cap != 0 ? "cut after " + Numbers.pythonG(cap) + " ms of drawing" : "not cut by time";
       if (params.flag("least_squares")) {
         double floorMs = Math.max(params.number("floor_ms"), params.number("min_duration_ms"));
         return "window, least squares: max error "
@@ -636,12 +638,12 @@ final class SimplifyCommand {
             + Numbers.pythonG(floorMs)
             + " ms or more (the sleeve's floor), sent "
             + Numbers.pythonG(params.number("lookahead_ms"))
-            + " ms after their end is drawn, longest stroke "
+            + " ms after their end is drawn, "
             + capText;
       }
       return "window, chord: max error "
           + Numbers.pythonG(params.number("max_error"))
-          + " grid units, every sample, longest stroke "
+          + " grid units, every sample, "
           + capText;
     }
     return "angle: check every "
