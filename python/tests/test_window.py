@@ -363,10 +363,10 @@ def test_cli_summary_and_usage_errors(tmp_path: Path, capsys: pytest.CaptureFixt
     assert main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0.05"]) == 0
     out = capsys.readouterr().out
     assert "(window, least squares: max error 0.05 grid units, strokes of 73.701 ms or more" in out
-    assert "sent 30 ms after their end is drawn, longest stroke 200 ms; " in out
+    assert "sent 30 ms after their end is drawn, cut after 200 ms of drawing; " in out
     assert main(["simplify", str(recording), "--no-least-squares", "--max-stroke-ms", "0"]) == 0
     out = capsys.readouterr().out
-    assert "(window, chord: max error 0.25 grid units, every sample, longest stroke no limit" in out
+    assert "(window, chord: max error 0.25 grid units, every sample, not cut by time" in out
     with pytest.raises(SystemExit) as exit_:
         main(["simplify", str(recording), "--algorithm", "window", "--max-error", "0"])
     assert exit_.value.code == 2
@@ -1097,6 +1097,48 @@ def test_no_sent_stroke_spans_a_rest(
         for stroke in sent:
             assert stroke.length >= params.min_length - FLOAT_TOLERANCE, stroke
             assert stroke.drawn_ms >= params.min_duration_ms - FLOAT_TOLERANCE, stroke
+
+
+@pytest.mark.parametrize("strict", [False, True])
+@pytest.mark.parametrize("cap_ms", [0.0, 200.0])
+def test_a_stop_after_a_strokes_vertex_is_not_played(strict: bool, cap_ms: float) -> None:
+    """Out along a line, a stop longer than rest_ms, and back (least squares): the stroke up to
+    the stop is not let go through part of it (the stop began after its vertex, so the pen was
+    not still since the anchor), and no stroke spans the stop, with a wearer's strict minimums
+    too (a piece held before it merges back or is dropped, never across it)."""
+    params = WindowParams(
+        max_stroke_ms=cap_ms,
+        rest_ms=300.0,
+        strict_minimums=strict,
+        min_duration_ms=150.0 if strict else 0.0,
+        canvas_width_px=900.0,
+        canvas_height_px=600.0,
+    )
+    frame_ms = 1000 / 60
+    # A small step first, then the line: the stroke's first vertex lies near the press.
+    out = [Sample(k * frame_ms, 0.9375 * k, 0.0, 0.5) for k in range(3)] + [
+        Sample(k * frame_ms, 1.875 + 7.2824 * (k - 2), 14.4444 * (k - 2), 0.5) for k in range(3, 30)
+    ]
+    stop_from, stop_to = out[-1].t_ms, out[-1].t_ms + 384.0
+    last = out[-1]
+    stop = [Sample(last.t_ms + 32.0 * k, last.x, last.y, 0.5) for k in range(1, 13)]
+    back = [
+        Sample(stop_to + k * frame_ms, last.x - 7.3 * k, last.y - 14.4 * k, 0.5)
+        for k in range(1, 27)
+    ]
+    simplifier = WindowSimplifier(params)
+    segments = [
+        s for sample in out + stop + back for s in simplifier.push(sample)
+    ] + simplifier.end()
+    sent = [s for s in segments if s.dropped is None]
+    assert sent
+    for stroke in sent:
+        # Nothing of the stop is played but the time a piece briefer than the floor borrows
+        # from it (the pen was at its end then): the rest starts at the stop's first sample,
+        # the strokes after it at its last.
+        played_of_stop = min(stroke.end_ms, stop_to) - max(stroke.start_ms, stop_from)
+        lent_ms = max(params.floor_ms, params.min_duration_ms) - (stop_from - stroke.start_ms)
+        assert played_of_stop <= max(lent_ms, 0.0) + 1e-6, (stroke, stop_from, stop_to)
 
 
 @pytest.mark.parametrize("start_ms", [100.3, 2000.7, 15000.1, 612345.6])

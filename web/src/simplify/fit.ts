@@ -648,7 +648,8 @@ export class FitCore {
     const before = this.#before;
     for (;;) {
       const j = this.#count - 1;
-      if (ts[j]! - ts[0]! < floorMs || this.#still(j)) return;
+      const still = this.#stillFrom(j);
+      if (ts[j]! - ts[0]! < floorMs || still === 0) return;
       const last = this.#chooseOpen(j);
       if (last === 0) {
         // One stroke from the anchor: cut by the latency cap at the sample before.
@@ -657,6 +658,7 @@ export class FitCore {
           ts[j]! - ts[0]! > capMs &&
           j >= 2 &&
           ts[j - 1]! - ts[0]! >= floorMs &&
+          j - 1 <= still &&
           this.#keeps(0, j - 1)
         ) {
           this.#emit(this.#piece(0, j - 1));
@@ -667,7 +669,12 @@ export class FitCore {
       }
       let vertex = last;
       while (before[vertex] !== 0) vertex = before[vertex]!;
-      if (ts[j]! - ts[vertex]! < lookaheadMs && !(capMs > 0 && ts[vertex]! - ts[0]! > capMs)) return;
+      if (
+        vertex > still ||
+        (ts[j]! - ts[vertex]! < lookaheadMs && !(capMs > 0 && ts[vertex]! - ts[0]! > capMs))
+      ) {
+        return;
+      }
       this.#emit(this.#piece(0, vertex));
       this.#from(vertex);
     }
@@ -676,25 +683,27 @@ export class FitCore {
   // --- rests -----------------------------------------------------------------------------------
 
   /**
-   * Whether the pen may be resting since the anchor: every sample since it lies within the rest
-   * radius of sample j (with `rest_ms` on). Nothing is let go then: a stroke of a still pen would
-   * play the stop (strokes of length 0, one per floor, where `rest_ms` is longer than a stroke at
-   * the floor and its lookahead); the rest rule ends it once it has lasted `rest_ms`, or the pen
-   * moves on. Python `FitCore._still`.
+   * Where the pen may have been resting since: the first of the samples up to j that all lie
+   * within the rest radius of sample j (with `rest_ms` on; j + 1 without). No stroke is let go
+   * that ends after it: its end would lie inside a stop that may yet turn out a rest, and the
+   * stroke would play the stop. The rest rule ends the stop once it has lasted `rest_ms`, or the
+   * pen moves on. Python `FitCore._still_from`.
    */
-  #still(j: number): boolean {
-    if (this.#restMs <= 0) return false;
+  #stillFrom(j: number): number {
+    if (this.#restMs <= 0) return j + 1;
     const xs = this.#xs;
     const ys = this.#ys;
     const x = xs[j]!;
     const y = ys[j]!;
     const restSq = this.#restSq;
-    for (let k = 0; k < j; k++) {
-      const dx = xs[k]! - x;
-      const dy = ys[k]! - y;
-      if (!(dx * dx + dy * dy <= restSq)) return false; // (not ">": a NaN is a move)
+    let k = j;
+    while (k > 0) {
+      const dx = xs[k - 1]! - x;
+      const dy = ys[k - 1]! - y;
+      if (!(dx * dx + dy * dy <= restSq)) break; // (not ">": a NaN is a move)
+      k -= 1;
     }
-    return true;
+    return k;
   }
 
   #retime(tMs: number): void {

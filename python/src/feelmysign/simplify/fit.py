@@ -438,7 +438,8 @@ class FitCore:
         while True:
             ts = self._ts
             j = len(ts) - 1
-            if ts[j] - ts[0] < floor_ms or self._still(j):
+            still = self._still_from(j)
+            if ts[j] - ts[0] < floor_ms or still == 0:
                 return
             if self._errors_end != j:
                 self._scan(j)
@@ -452,6 +453,7 @@ class FitCore:
                     and ts[j] - ts[0] > cap_ms
                     and j >= 2
                     and ts[j - 1] - ts[0] >= floor_ms
+                    and j - 1 <= still
                     and self._keeps(0, j - 1)
                 ):
                     out.append(self._piece(0, j - 1))
@@ -461,8 +463,9 @@ class FitCore:
             vertex = last
             while self._before[vertex] != 0:
                 vertex = self._before[vertex]
-            if ts[j] - ts[vertex] < lookahead_ms and not (
-                cap_ms > 0.0 and ts[vertex] - ts[0] > cap_ms
+            if vertex > still or (
+                ts[j] - ts[vertex] < lookahead_ms
+                and not (cap_ms > 0.0 and ts[vertex] - ts[0] > cap_ms)
             ):
                 return
             out.append(self._piece(0, vertex))
@@ -470,23 +473,28 @@ class FitCore:
 
     # --- rests --------------------------------------------------------------------------------
 
-    def _still(self, j: int) -> bool:
-        """Whether the pen may be resting since the anchor: every sample since it lies within
-        the rest radius of sample j (with ``rest_ms`` on). Nothing is let go then: a stroke
-        of a still pen would play the stop (strokes of length 0, one per floor, where
-        ``rest_ms`` is longer than a stroke at the floor and its lookahead); the rest rule ends
-        it once it has lasted ``rest_ms``, or the pen moves on."""
+    def _still_from(self, j: int) -> int:
+        """Where the pen may have been resting since: the first of the samples up to j that all
+        lie within the rest radius of sample j (with ``rest_ms`` on; j + 1 without).
+
+        No stroke is let go that ends after it: its end would lie inside a stop that may yet
+        turn out a rest, and the stroke would play the stop (strokes of length 0, one per
+        floor, where the pen rests at the anchor; a stroke through part of the stop where it
+        rests after a stroke's vertex). The rest rule ends the stop once it has lasted
+        ``rest_ms``, or the pen moves on."""
         if self.params.rest_ms <= 0.0:
-            return False
+            return j + 1
         xs, ys = self._xs, self._ys
         x, y = xs[j], ys[j]
         rest_sq = self._rest_sq
-        for k in range(j):
-            dx = xs[k] - x
-            dy = ys[k] - y
+        k = j
+        while k > 0:
+            dx = xs[k - 1] - x
+            dy = ys[k - 1] - y
             if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN is a move)
-                return False
-        return True
+                break
+            k -= 1
+        return k
 
     def _retime(self, t_ms: float) -> None:
         self._ts[0] = t_ms

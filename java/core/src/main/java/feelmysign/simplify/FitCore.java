@@ -459,7 +459,8 @@ final class FitCore implements PieceCore {
     double capMs = maxStrokeMs;
     while (true) {
       int j = count - 1;
-      if (ts[j] - ts[0] < floorMs || still(j)) {
+      int still = stillFrom(j);
+      if (ts[j] - ts[0] < floorMs || still == 0) {
         return;
       }
       int low = errorsTo(j);
@@ -470,6 +471,7 @@ final class FitCore implements PieceCore {
             && ts[j] - ts[0] > capMs
             && j >= 2
             && ts[j - 1] - ts[0] >= floorMs
+            && j - 1 <= still
             && keeps(0, j - 1)) {
           out.add(piece(0, j - 1));
           from(j - 1);
@@ -481,7 +483,9 @@ final class FitCore implements PieceCore {
       while (before[vertex] != 0) {
         vertex = before[vertex];
       }
-      if (ts[j] - ts[vertex] < lookaheadMs && !(capMs > 0.0 && ts[vertex] - ts[0] > capMs)) {
+      if (vertex > still
+          || (ts[j] - ts[vertex] < lookaheadMs
+              && !(capMs > 0.0 && ts[vertex] - ts[0] > capMs))) {
         return;
       }
       out.add(piece(0, vertex));
@@ -492,26 +496,28 @@ final class FitCore implements PieceCore {
   // --- rests -----------------------------------------------------------------------------------
 
   /**
-   * Whether the pen may be resting since the anchor: every sample since it lies within the rest
-   * radius of sample j (with rest_ms on). Nothing is let go then: a stroke of a still pen would
-   * play the stop (strokes of length 0, one per floor, where rest_ms is longer than a stroke at
-   * the floor and its lookahead); the rest rule ends it once it has lasted rest_ms, or the pen
-   * moves on. Python {@code FitCore._still}.
+   * Where the pen may have been resting since: the first of the samples up to j that all lie
+   * within the rest radius of sample j (with rest_ms on; j + 1 without). No stroke is let go that
+   * ends after it: its end would lie inside a stop that may yet turn out a rest, and the stroke
+   * would play the stop. The rest rule ends the stop once it has lasted rest_ms, or the pen moves
+   * on. Python {@code FitCore._still_from}.
    */
-  private boolean still(int j) {
+  private int stillFrom(int j) {
     if (restMs <= 0.0) {
-      return false;
+      return j + 1;
     }
     double x = xs[j];
     double y = ys[j];
-    for (int k = 0; k < j; k++) {
-      double dx = xs[k] - x;
-      double dy = ys[k] - y;
+    int k = j;
+    while (k > 0) {
+      double dx = xs[k - 1] - x;
+      double dy = ys[k - 1] - y;
       if (!(dx * dx + dy * dy <= restSq)) { // (not ">": a NaN is a move)
-        return false;
+        break;
       }
+      k--;
     }
-    return true;
+    return k;
   }
 
   private void retime(double t) {
