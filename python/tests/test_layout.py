@@ -16,6 +16,7 @@ from feelmysign.layout import (
     MUX_CHANNELS,
     PAPER_SLEEVE,
     TOP_KEYS,
+    EnableLine,
     Layout,
     Wire,
     check_layout,
@@ -444,3 +445,21 @@ def test_a_button_line_given_by_its_name_is_refused_with_the_offset_to_use() -> 
     )
     with pytest.raises(LayoutError, match=r"controls\.pause_button\.line: must be a whole number"):
         parse_layout(text)
+
+
+@pytest.mark.parametrize(("line", "pin"), [(2, "SDA"), (3, "SCL")])
+def test_an_enable_line_or_button_on_the_pis_i2c_pins_is_refused(line: int, pin: str) -> None:
+    wired = wiring_toml(paper_wires())
+    enable = f'enable = {{ chip = "gpiochip0", line = {line} }}\n'
+    button = f'\n[controls]\npause_button = {{ chip = "gpiochip0", line = {line} }}\n'
+    (problem,) = problems_of(wired.replace("[i2c]\n", "[i2c]\nbus = 1\n" + enable))
+    assert problem.startswith(
+        f"i2c.enable.line: {line} is GPIO{line}, the Raspberry Pi's I2C1 {pin}"
+    )
+    assert "GPIO17" in problem
+    (problem,) = problems_of(wired + button)  # bus 1 is the default
+    assert problem.startswith(f"controls.pause_button.line: {line} is GPIO{line}")
+    # On another bus (or another chip) those pins are free.
+    other_bus = wired.replace("[i2c]\n", "[i2c]\nbus = 3\n" + enable)
+    assert parse_layout(other_bus).enable == EnableLine("gpiochip0", line)
+    assert parse_layout(wired.replace("[i2c]\n", "[i2c]\n" + enable.replace("chip0", "chip4")))

@@ -471,7 +471,8 @@ class Sleeve:
         self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
     ) -> None:
         self._connected.clear()
-        if not self._stopped.is_set():
+        # paho can report one loss twice (a keep-alive timeout): said once.
+        if not self._stopped.is_set() and self._unreachable_since is None:
             # The loss is said here; attempts that fail after it are said once a minute.
             self._unreachable_since = self._unreachable_said_at = time.monotonic()
             log.warning(

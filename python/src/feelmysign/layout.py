@@ -384,9 +384,36 @@ def _build(data: dict[str, Any], source: str) -> Layout:
     caps = _read_caps(problems, data)
     hardware = _read_i2c(problems, data.get("i2c", {}), geometry["rows"], geometry["columns"])
     buttons = _read_controls(problems, data.get("controls", {}), hardware["enable"])
+    _check_not_on_i2c_pins(problems, hardware, buttons)
     if problems.items:
         raise LayoutError(source, problems.items)
     return Layout(**geometry, **caps, **hardware, **buttons)
+
+
+# A Raspberry Pi's I2C bus 1 (the one its header gives the chips) runs on GPIO2 (SDA) and
+# GPIO3 (SCL) of its first GPIO chip.
+PI_I2C1_LINES = {2: "SDA", 3: "SCL"}
+
+
+def _check_not_on_i2c_pins(
+    problems: _Problems, hardware: dict[str, Any], buttons: dict[str, Any]
+) -> None:
+    """No enable line or button on the pins of the I2C bus the chips use (bus 1 on a Pi)."""
+    if hardware["i2c_bus"] != 1:
+        return
+    lines = {"i2c.enable": hardware["enable"]}
+    lines |= {f"controls.{key}": line for key, line in buttons.items()}
+    for key, found in lines.items():
+        if found is None or found.chip.removeprefix("/dev/") != "gpiochip0":
+            continue
+        pin = PI_I2C1_LINES.get(found.line)
+        if pin is not None:
+            problems.add(
+                f"{key}.line",
+                f"{found.line} is GPIO{found.line}, the Raspberry Pi's I2C1 {pin}, which "
+                "i2c.bus = 1 uses to reach the chips; wire it to a free line (GPIO17, 27 or "
+                "22, see docs/sleeve-hardware.md)",
+            )
 
 
 def _read_geometry(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
