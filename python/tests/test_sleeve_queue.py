@@ -3,6 +3,7 @@ the player that plays on the sleeve."""
 
 from __future__ import annotations
 
+import math
 import threading
 from typing import Any
 
@@ -186,7 +187,8 @@ def test_the_player_plays_a_stroke_behind_its_drawing_faster_and_says_so() -> No
     now_ms = [0.0]
     backend = SimBackend(PAPER)
     events = Events()
-    player = Player(backend, PAPER, clock=lambda: now_ms[0], on_event=events)
+    # The clock jumps ahead to let every stroke play: no stall (which would refuse them).
+    player = Player(backend, PAPER, clock=lambda: now_ms[0], on_event=events, stall_ms=math.inf)
     floor_ms = shortest_planned_ms(PAPER.shortest_burst_ms)
     # A long diagonal: many crossings, which must be thinned to fit the shorter time.
     stroke = Stroke((0.0, 0.0), (3.0, 2.0), 600.0)

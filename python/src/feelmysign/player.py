@@ -64,7 +64,14 @@ from feelmysign.events import (
 )
 from feelmysign.layout import Layout
 from feelmysign.planner import Outline, outline
-from feelmysign.protocol import CANCELLED, DUPLICATE, PLAYER_STOPPED, QUEUE_FULL, SILENCED
+from feelmysign.protocol import (
+    CANCELLED,
+    DUPLICATE,
+    LATE,
+    PLAYER_STOPPED,
+    QUEUE_FULL,
+    SILENCED,
+)
 from feelmysign.schedule import Schedule
 from feelmysign.sleeve.admission import MAX_BACKLOG_MS, MAX_PENDING, duplicate_message, queue_full
 from feelmysign.sleeve.queue import REMEMBERED_CANCELS, Queue
@@ -88,6 +95,11 @@ RETRY_LOST_S = 0.2
 CHECK_DRIVEN_S = 0.005
 WEARER = "wearer"  # the ``by`` of the events of strokes the wearer stopped or paused
 STOPPED_MESSAGE = "the wearer stopped this drawing; a new drawing plays"
+# The player wakes within a few ms of what is due (a loaded Pi: tens); woken this much later,
+# its process did not run meanwhile (stopped, swapped out, starved): a stroke whose whole time
+# passed then is not played at all (every command of it written at once is felt as nothing)
+# but refused as late, and not called played.
+STALL_MS = 250.0
 
 
 @dataclass
@@ -156,8 +168,12 @@ class Player:
         max_backlog_ms: float = MAX_BACKLOG_MS,
         spin_ms: float = SPIN_MS,
         floor_ms: float | None = None,
+        stall_ms: float = STALL_MS,
     ) -> None:
         self._backend = backend
+        # How late the player may wake before the strokes whose time passed are refused
+        # (a test whose clock jumps ahead to let every stroke play gives math.inf).
+        self._stall_ms = stall_ms
         self._timeline = Timeline(layout)
         self._on_event = on_event
         self._clock = clock
@@ -200,6 +216,7 @@ class Player:
         self.timing_errors_ms: deque[float] = deque(maxlen=TIMING_SAMPLES)
         self.played = 0
         self.capped = 0
+        self.stalled = 0  # strokes refused as late because the player did not run in their time
         self.cut = 0  # strokes cut for a chip that stopped answering
         self._retry_at_s = 0.0  # when the lost chips are tried again next
         self._check_at_s = 0.0  # when the driven chips are read again next
@@ -565,7 +582,9 @@ class Player:
         if self._silenced():
             self._refuse_all_silenced()
             return
-        due = self._timeline.pop_due(self._clock())
+        now_ms = self._clock()
+        self._skip_stalled(now_ms)
+        due = self._timeline.pop_due(now_ms)
         written_at_ms = self._clock()  # the first command of a stroke goes out now
         lost = self._write(due.changes)
         self._timeline.complete()  # the rest of a stroke just started, while it plays
@@ -576,6 +595,55 @@ class Player:
                 self._started(tag, written_at_ms)
         for capped in due.capped:
             self._capped(capped)
+
+    def _skip_stalled(self, now_ms: float) -> None:
+        """Refuse as ``late`` the strokes not yet started whose whole time passed while the
+        player did not run (``STALL_MS`` or more late): written now, each would switch its
+        motors on and off at once, felt as nothing, and be called played."""
+        next_ms = self._timeline.next_ms()
+        if next_ms is None or now_ms - next_ms < self._stall_ms:
+            return
+        missed = {
+            id(tag)
+            for tag in self._timeline.unstarted()
+            if isinstance(tag, PlannedStroke) and tag.start_ms + tag.schedule.duration_ms < now_ms
+        }
+        if not missed:
+            return
+        cut = self._timeline.cancel(lambda tag: id(tag) in missed, now_ms)
+        self._write(cut.changes)  # (none: they had not started)
+        with self._lock:
+            self._pending -= len(cut.unstarted)
+            acknowledgements = [
+                (tag, self._done(tag)) for tag in cut.unstarted if isinstance(tag, PlannedStroke)
+            ]
+            self._queue.replan(
+                (tag.start_ms + tag.schedule.duration_ms, tag.ref.drawing)
+                for tag in [*self._timeline.tags(), *self._inbox]
+                if isinstance(tag, PlannedStroke)
+            )
+        stalled_ms = now_ms - next_ms
+        for tag, acknowledge in acknowledgements:
+            self.stalled += 1
+            self._on_event(
+                Rejected(
+                    reason=LATE,
+                    message=(
+                        f"not played: the sleeve's player did not run for {stalled_ms:.0f} ms "
+                        "(its process was stopped or starved), and the stroke's whole time "
+                        "passed meanwhile"
+                    ),
+                    stroke=tag.ref,
+                )
+            )
+            if acknowledge is not None:
+                acknowledge()  # refused, and said so: the broker must not send it again
+        log.warning(
+            "the player ran %.0f ms late (its process did not run): %d stroke(s) whose time "
+            "passed meanwhile refused as late",
+            stalled_ms,
+            len(acknowledgements),
+        )
 
     def _write(self, changes: list[Change]) -> tuple[Change, str, list[PlannedStroke]] | None:
         """Output ``changes``; a stroke's motor that could not be switched on is a lost chip:

@@ -1,0 +1,81 @@
+"""A sleeve whose process does not run for a while (stopped, starved) does not call played
+the strokes whose whole time passed meanwhile: each would have had every command written at
+once, felt as nothing. They are refused as late, and every stroke still gets one outcome."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import time
+import uuid
+from typing import Any
+
+from sleeve_watch import SleeveWatch, online
+
+from feelmysign.bench.sleeve import sleeve_command
+from feelmysign.broker import Broker
+from feelmysign.player import STALL_MS
+from feelmysign.stroke import Stroke
+
+WAIT_S = 60.0
+STROKES, DURATION_MS = 10, 300.0
+STALL_S = 1.5
+
+
+def test_strokes_whose_time_passed_while_the_sleeve_was_stopped_are_late_not_played(
+    broker: Broker,
+) -> None:
+    assert STALL_S * 1000 > 2 * DURATION_MS + STALL_MS  # whole strokes fall inside the stall
+    drawing = str(uuid.uuid4())
+    with SleeveWatch(broker.credentials, "status", "events") as watch:
+        sleeve = subprocess.Popen(
+            sleeve_command(broker.credentials_path, "--no-legacy"),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            watch.next(online, "the sleeve online")
+            for seq in range(STROKES):
+                watch.send(Stroke((0, 1), (3, 1), DURATION_MS, 0.8, drawing, seq))
+
+            def mine(name: str, body: dict[str, Any]) -> bool:
+                return name == "events" and body.get("drawing") == drawing
+
+            first = watch.next(mine, "the first stroke's event")
+            assert first["type"] == "played" and first["seq"] == 0, first
+            stopped_wall_ms = time.time() * 1000
+            sleeve.send_signal(signal.SIGSTOP)
+            time.sleep(STALL_S)
+            resumed_wall_ms = time.time() * 1000
+            sleeve.send_signal(signal.SIGCONT)
+
+            def answered() -> bool:
+                seqs = {body.get("seq") for name, body in watch.history if mine(name, body)}
+                return seqs >= set(range(STROKES))
+
+            watch.wait_until(answered, "an event for every stroke")
+            sleeve.send_signal(signal.SIGTERM)
+            _, errors = sleeve.communicate(timeout=WAIT_S)
+        finally:
+            sleeve.kill()
+        assert sleeve.returncode == 0, errors
+    events = [body for name, body in watch.history if mine(name, body)]
+    by_seq: dict[int, list[dict[str, Any]]] = {}
+    for event in events:
+        by_seq.setdefault(event["seq"], []).append(event)
+    assert all(len(group) == 1 for group in by_seq.values()), by_seq  # one outcome each
+    late = [seq for seq, (event,) in by_seq.items() if event.get("reason") == "late"]
+    assert late, by_seq
+    for seq in late:
+        assert "did not run for" in by_seq[seq][0]["message"], by_seq[seq]
+    # No stroke whose whole planned time passed during the stall is called played: each
+    # played stroke started before it, or was still due when the sleeve ran again.
+    for seq, (event,) in by_seq.items():
+        if (
+            event["type"] in ("played", "adjusted")
+            and event["first_command_at_ms"] > stopped_wall_ms
+        ):
+            planned_end_ms = event["start_at_ms"] + event["duration_ms"]
+            assert planned_end_ms >= resumed_wall_ms - STALL_MS - 50.0, (seq, event)
+    assert "ran" in errors and "late" in errors, errors
