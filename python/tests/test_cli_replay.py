@@ -178,3 +178,51 @@ def test_send_publishes_the_strokes_in_order_at_their_pace(
         assert sent_ms >= drawn_ms / 20 - 2, (payload["seq"], sent_ms, drawn_ms / 20)
     out = capsys.readouterr().out
     assert "feelmysign/sleeve1/strokes {" in out and "matches the" in out
+
+
+def _line_across(path: Path, *, grid: tuple[int, int] | None = None) -> Path:
+    """A slow line from the canvas's left edge to its right, for any grid (or the one given)."""
+    samples = [{"t_ms": 20.0 * k, "x": 10.0 + 39.0 * k, "y": 300.0} for k in range(31)]
+    data: dict[str, Any] = {"canvas": {"width_px": 1200, "height_px": 600}, "paths": [samples]}
+    if grid is not None:
+        data["sleeve"] = {"rows": grid[0], "columns": grid[1]}
+    path.write_text(json.dumps(data))
+    return path
+
+
+def test_send_cuts_the_strokes_for_the_grid_the_sleeve_advertises(
+    broker: Broker, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A recording with no grid of its own is cut for the sleeve's (its retained status); one
+    whose grid differs is sent as it is, and the difference is said."""
+    import subprocess
+
+    from sleeve_watch import SleeveWatch, online
+
+    from feelmysign.bench.sleeve import sleeve_command
+
+    layout = tmp_path / "wide.toml"
+    layout.write_text("rows = 3\ncolumns = 5\nspacing_cm = 2.2\n")
+    argv = ["--send", "--speed", "20", "--credentials", str(broker.credentials_path), "--json"]
+    with SleeveWatch(broker.credentials, "status") as watch:
+        sleeve = subprocess.Popen(
+            sleeve_command(broker.credentials_path, "--no-legacy", "--layout", str(layout)),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            watch.next(online, "the sleeve online")
+            capsys.readouterr()
+            assert main(["replay", str(_line_across(tmp_path / "any.json")), *argv]) == 0
+            out, err = capsys.readouterr()
+            assert "Cut for sleeve 'sleeve1''s 3 x 5 grid (its status)." in err, err
+            ends = [s["end"][0] for s in json.loads(out.splitlines()[-1])["strokes"]]
+            assert max(ends) > 3.5  # the line reaches the fifth column
+            fixed = _line_across(tmp_path / "fixed.json", grid=(3, 4))
+            assert main(["replay", str(fixed), *argv]) == 0
+            out, err = capsys.readouterr()
+            assert "Cut for a 3 x 4 grid (the recording), but sleeve 'sleeve1' is 3 x 5" in err
+            assert "--rows 3 --columns 5" in err
+        finally:
+            sleeve.terminate()
+            sleeve.wait(timeout=60)

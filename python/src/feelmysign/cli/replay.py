@@ -19,7 +19,9 @@ emitted_at_ms from the first frame, divided by --speed; durations unchanged),
 and each is acknowledged by the broker before the next (QoS 1). Every stroke
 is checked against the sleeve's rules before connecting. The sleeve's retained
 status is read first (up to 2.5 s): its floor raises the simplifier's
-min_duration_ms and min_length (never lowers them), said on stderr.
+min_duration_ms and min_length (never lowers them), and a recording with no grid
+of its own (nor --rows/--columns) is cut for the sleeve's grid; each said on
+stderr, as is a grid that differs from the sleeve's.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
-from feelmysign.sending import OutgoingStroke, StrokeSender, printer, sleeve_floor_from_status
+from feelmysign.sending import OutgoingStroke, StrokeSender, printer, sleeve_status
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import DEFAULT_ALGORITHM, Params
 from feelmysign.stroke import Stroke
@@ -52,6 +54,7 @@ from feelmysign.stroke import Stroke
 if TYPE_CHECKING:
     import paho.mqtt.client as mqtt
 
+    from feelmysign.events import Status, StatusFloor
     from feelmysign.research.rerun import Rerun
 
 MAX_SPEED = 1000.0  # a minute of drawing in 60 ms: faster is a burst, not a pace
@@ -105,8 +108,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
     try:
         wearer = None
         if client is not None:
-            params, wearer = _respect_floor(
-                client, broker_settings_from_args(args, "sender"), params
+            params, wearer = _respect_status(
+                client, broker_settings_from_args(args, "sender"), params, args, recording
             )
         result = rerun(recording, params)
         compared = recording.strokes is not None and algorithm == _recorded_algorithm(recording)
@@ -213,15 +216,60 @@ def _connect(args: argparse.Namespace) -> mqtt.Client:
     )
 
 
-def _respect_floor(
-    client: mqtt.Client, settings: BrokerSettings, params: Params
+def _respect_status(
+    client: mqtt.Client,
+    settings: BrokerSettings,
+    params: Params,
+    args: argparse.Namespace,
+    recording: Recording,
 ) -> tuple[Params, str | None]:
+    """What the sleeve's retained status asks of the strokes: its grid (``_sleeves_grid``) and
+    its floor (``_respect_floor``); whose limits are in that floor, if any."""
+    status = sleeve_status(client, settings)
+    params = _sleeves_grid(status, settings, params, args, recording)
+    return _respect_floor(None if status is None else status.floor, params)
+
+
+def _sleeves_grid(
+    status: Status | None,
+    settings: BrokerSettings,
+    params: Params,
+    args: argparse.Namespace,
+    recording: Recording,
+) -> Params:
+    """The strokes cut for the grid the sleeve advertises, said on stderr, where neither the
+    recording nor --rows/--columns gives one; where they do and it differs, said so (the
+    sleeve refuses a stroke off its grid as ``outside_grid``)."""
+    grid = None if status is None else status.layout
+    if grid is None or (grid.rows, grid.columns) == (params.rows, params.columns):
+        return params
+    sid = settings.sleeve_id
+    chosen = getattr(args, "rows", None) is not None or getattr(args, "columns", None) is not None
+    if not chosen and recording.rows is None and recording.columns is None:
+        print(
+            f"Cut for sleeve {sid!r}'s {grid.rows} x {grid.columns} grid (its status).",
+            file=sys.stderr,
+            flush=True,
+        )
+        return replace(params, rows=grid.rows, columns=grid.columns)
+    source = "--rows/--columns" if chosen else "the recording"
+    print(
+        f"Cut for a {params.rows} x {params.columns} grid ({source}), but sleeve {sid!r} is "
+        f"{grid.rows} x {grid.columns} (its status): the drawing is felt at another size, and "
+        f"a stroke off its grid is refused; give --rows {grid.rows} --columns {grid.columns} to "
+        "cut it for the sleeve.",
+        file=sys.stderr,
+        flush=True,
+    )
+    return params
+
+
+def _respect_floor(floor: StatusFloor | None, params: Params) -> tuple[Params, str | None]:
     """The simplifier's minimums raised to the floor the sleeve advertises (never lowered), said
     on stderr (stdout may be JSON for a program); and whose limits are in that floor, if any."""
     from feelmysign.simplify.window import WindowParams
     from feelmysign.wearer import respect_floor  # the planner's constants: not by --help
 
-    floor = sleeve_floor_from_status(client, settings)
     min_duration_ms, min_length, note = respect_floor(
         params.min_duration_ms, params.min_length, floor
     )
