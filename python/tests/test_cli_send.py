@@ -478,3 +478,43 @@ def test_an_answer_heard_before_its_stroke_is_said_sent_is_printed_after_it() ->
     assert said == ["[1/3] sent", "[1/3] played", "[2/3] sent", "[2/3] played"]
     lines.flush()
     assert said[-1] == "[3/3] refused"
+
+
+def test_a_stroke_held_up_on_the_way_keeps_the_time_the_drawing_gave_it(
+    broker: Broker, sleeve: Sleeve
+) -> None:
+    """A paced drawing whose sending is held up (here between two strokes; a broker away, whose
+    acknowledgement comes late, holds it up the same way): each stroke after it is stamped with
+    the time it was due, not the moment it left, so the sleeve sees how late it is."""
+    import time
+
+    from feelmysign.connection import connect_client
+    from feelmysign.sending import OutgoingStroke, StrokeSender
+    from feelmysign.stroke import Stroke
+
+    credentials = broker.credentials
+    settings = credentials.settings("sender")
+    client = connect_client(settings, "held-up-sender")
+    count, step_ms, held_s = 6, 100.0, 1.0
+    topic = f"feelmysign/{credentials.sleeve_id}/strokes"
+    messages = [
+        OutgoingStroke(k, topic, Stroke((0, 1), (1, 1), step_ms, drawing="held", seq=k))
+        for k in range(count)
+    ]
+    asked = [0]
+
+    def hold_the_third() -> bool:
+        asked[0] += 1
+        if asked[0] == 3:
+            time.sleep(held_s)
+        return False
+
+    try:
+        sender = StrokeSender(client, settings, timeout_s=WAIT_S)
+        assert sender.send_at(messages, [k * step_ms for k in range(count)], until=hold_the_third)
+    finally:
+        client.disconnect()
+        client.loop_stop()
+    stamps = [json.loads(payload)["sent_at_ms"] for _, payload in sleeve.receive(count)]
+    for k, stamp in enumerate(stamps):
+        assert abs(stamp - stamps[0] - k * step_ms) <= 1.0, (k, stamps)

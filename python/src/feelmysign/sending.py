@@ -38,11 +38,13 @@ class OutgoingStroke:
     stroke: Stroke
     legacy: bool = False
 
-    def payload(self) -> str:
+    def payload(self, sent_at_ms: float | None = None) -> str:
+        """The message; stamped ``sent_at_ms`` (a wall-clock ms), else the wall clock now: the
+        sleeve measures its latency, and how late the stroke is, from it."""
         if self.legacy:
             return format_legacy(self.stroke)
-        # The wall clock at the moment of sending: the sleeve measures latency from it.
-        return format_json(replace(self.stroke, sent_at_ms=round(time.time() * 1000)))
+        stamp = time.time() * 1000 if sent_at_ms is None else sent_at_ms
+        return format_json(replace(self.stroke, sent_at_ms=round(stamp)))
 
 
 class _Acks:
@@ -137,23 +139,35 @@ class StrokeSender:
         stamped with its ``sent_at_ms`` rather than from this call: whatever held the first
         one up (a busy machine) holds the rest up as much, so no two strokes leave closer
         together than their offsets say, and their ``sent_at_ms`` show it.
+
+        Each later message is stamped with the moment it was due, not the moment it leaves:
+        one held up on the way (a broker away, whose acknowledgement of the one before came
+        late) keeps the time the drawing gave it (docs/protocol.md, "a stroke a sender held
+        keeps its stamp"), so the sleeve sees how late it is and catches up or skips it,
+        rather than taking a burst of them for new strokes.
         """
         start_s = time.monotonic()
-        first: tuple[float, float] | None = None  # (monotonic s after its stamp, its offset)
+        # The first message: monotonic s after its stamp, its offset, and its stamp (wall ms).
+        first: tuple[float, float, float] | None = None
         for count, (message, offset_ms) in enumerate(zip(messages, offsets_ms, strict=True)):
+            stamp_ms: float | None = None
             if first is None:
                 due_s = start_s + offset_ms / 1000
             else:
-                first_s, first_offset_ms = first
+                first_s, first_offset_ms, first_stamp_ms = first
                 due_s = first_s + (offset_ms - first_offset_ms) / 1000
+                stamp_ms = first_stamp_ms + (offset_ms - first_offset_ms)
             # Drawing time, not a wait for an event: the pace is the point.
             time.sleep(max(0.0, due_s - time.monotonic()))
             if until():
                 return count
-            payload = message.payload()
             if first is None:
+                stamp_ms = time.time() * 1000
+                payload = message.payload(stamp_ms)
                 # Read after the stamp: the moment it counts from is never before it.
-                first = (time.monotonic(), offset_ms)
+                first = (time.monotonic(), offset_ms, stamp_ms)
+            else:
+                payload = message.payload(stamp_ms)
             payload, mid = self._publish(message, payload)
             self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
         return len(messages)
