@@ -47,13 +47,8 @@ def connect_failure_message(settings: BrokerSettings, failure: BaseException | R
             f"No answer from {url}: check the host and port, the network and any firewall; "
             f"or {_START_HINT}."
         )
-    if isinstance(failure, ssl.SSLCertVerificationError) and settings.ca_file is None:
-        return (
-            f"The TLS handshake with {url} failed ({failure.reason or failure}): this machine "
-            "does not trust the broker's certificate. For a 'feelmysign broker --lan' broker, "
-            "send with the token of 'feelmysign broker add-sender' (--join TOKEN), or copy its "
-            "ca.pem here and give --ca FILE."
-        )
+    if isinstance(failure, ssl.SSLCertVerificationError):
+        return _certificate_message(settings, failure)
     if isinstance(failure, ssl.SSLError):
         return (
             f"The TLS handshake with {url} failed ({failure.reason or failure}): mqtts:// and "
@@ -68,6 +63,37 @@ def connect_failure_message(settings: BrokerSettings, failure: BaseException | R
         )
     detail = getattr(failure, "strerror", None) or str(failure) or type(failure).__name__
     return f"Cannot connect to {url} ({detail}): check --broker, or {_START_HINT}."
+
+
+def _certificate_message(settings: BrokerSettings, failure: ssl.SSLCertVerificationError) -> str:
+    """Why the broker's certificate was not accepted (OpenSSL's verify message), and what to
+    do: an expired certificate and one for another host are the broker's to fix, not a reason
+    to leave TLS."""
+    url = settings.url
+    why = failure.verify_message or failure.reason or str(failure)
+    start = f"The TLS handshake with {url} failed: the broker's certificate was refused ({why})"
+    if "expired" in why or "not yet valid" in why:
+        return (
+            f"{start}. Renew the certificate on the broker (for Let's Encrypt: certbot renew, "
+            "then reload Mosquitto), and check that this machine's clock is right "
+            "('timedatectl' must say 'System clock synchronized: yes')."
+        )
+    if "mismatch" in why:
+        return (
+            f"{start}: it is not made out for {settings.host!r}. Give --broker the host name "
+            "the certificate names (for a 'feelmysign broker --lan' broker, the address its "
+            "join tokens carry)."
+        )
+    if settings.ca_file is not None:
+        return (
+            f"{start}: the CA given with --ca ({settings.ca_file}) did not sign it. Give the "
+            "ca.pem of that broker (or of the CA that signed its certificate)."
+        )
+    return (
+        f"{start}: this machine does not trust it. For a 'feelmysign broker --lan' broker, send "
+        "with the token of 'feelmysign broker add-sender' (--join TOKEN), or copy its ca.pem "
+        "here and give --ca FILE."
+    )
 
 
 def _login_refused_message(settings: BrokerSettings, code: ReasonCode) -> str:
