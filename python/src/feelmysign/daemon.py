@@ -109,6 +109,10 @@ CONNECTION_STATE = {"connection_state": True}
 # begins, then a line a minute (paho retries every RECONNECT_MAX_S at most, and a line per
 # attempt would bury the wearer's log).
 UNREACHABLE_REMINDER_S = 60.0
+# A broker that closes the connection within this long of each login, this many times in a row,
+# refuses something the sleeve sends there (its retained status, a message's size): said once.
+SHORT_CONNECTION_S = 5.0
+SHORT_CONNECTIONS = 3
 CLIENT_ID_DIGEST_HEX = 32  # 128 bits of the HMAC: not guessable
 # Safety events after which the status's ``hardware`` changed: published again with them.
 HARDWARE_EVENTS = frozenset({"chip_lost", "chip_back"})
@@ -255,6 +259,11 @@ class Sleeve:
         self._stopped = threading.Event()
         self._connected = threading.Event()
         self._fatal: FeelMySignError | None = None
+        # When the last login was taken (monotonic s), how many connections in a row the
+        # broker closed within SHORT_CONNECTION_S of it, and whether that was said.
+        self._connected_at: float | None = None  # None: no login since the last loss
+        self._short_connections = 0
+        self._short_said = False
         # Since when the broker is out of reach (monotonic s; None: it is not), and when
         # that was last said.
         self._unreachable_since: float | None = None
@@ -406,6 +415,7 @@ class Sleeve:
             return
         self._connection += 1
         self._unreachable_since = None
+        self._connected_at = time.monotonic()
         subscriptions = [(strokes_topic(self._id), 1), (control_topic(self._id), 1)]
         if self._options.legacy_topic:
             subscriptions.append((self._options.legacy_topic, 1))
@@ -471,6 +481,8 @@ class Sleeve:
         self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
     ) -> None:
         self._connected.clear()
+        if not self._stopped.is_set():
+            self._count_short_connection()
         # paho can report one loss twice (a keep-alive timeout): said once.
         if not self._stopped.is_set() and self._unreachable_since is None:
             # The loss is said here; attempts that fail after it are said once a minute.
@@ -481,6 +493,32 @@ class Sleeve:
                 reason,
                 extra=CONNECTION_STATE,
             )
+
+    def _count_short_connection(self) -> None:
+        """A loss soon after a login, again and again: the broker closes the connection for
+        something the sleeve publishes there at once. Said once, with the usual causes."""
+        connected_at, self._connected_at = self._connected_at, None
+        if connected_at is not None and time.monotonic() - connected_at >= SHORT_CONNECTION_S:
+            self._short_connections = 0
+            return
+        self._short_connections += 1  # closed soon after its login, or before any
+        if self._short_connections < SHORT_CONNECTIONS or self._short_said:
+            return
+        self._short_said = True
+        log.error(
+            "sleeve %s: the broker at %s closed the connection within %g s of each of the last "
+            "%d logins (or before their answer): it refuses something the sleeve sends as it "
+            "connects. Usually the broker takes no retained messages (Mosquitto: "
+            "retain_available false; the sleeve's status and its last will are retained), or "
+            "none as large as the sleeve's status and events (up to about 1 KiB; Mosquitto: "
+            "max_packet_size), or its access list denies this user a topic of sleeve %s; see "
+            "docs/deploy.md, 'Topics and ACL', and the broker's log",
+            self._id,
+            self._settings.url,
+            SHORT_CONNECTION_S,
+            self._short_connections,
+            self._id,
+        )
 
     def _on_message(self, client: mqtt.Client, userdata: Any, message: mqtt.MQTTMessage) -> None:
         received_at_ms, received_wall_ms = both_ms()
