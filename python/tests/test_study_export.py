@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import pytest
 from study_helpers import pilot_study
 
 from feelmysign.study.export import export_study
@@ -112,3 +113,55 @@ def test_latency_ms_max_is_what_its_description_says(tmp_path: Path) -> None:
             assert float(row["latency_ms_max"]) == round(max(latencies), 3)
             checked += 1
     assert checked > 0
+
+
+def test_threshold_trials_say_what_the_sleeve_played_and_each_run_its_result(
+    tmp_path: Path,
+) -> None:
+    """threshold.csv says per trial whether its stroke was played, and slowed to the sleeve's
+    floor (then not at the value asked: a duration below the floor); threshold-runs.csv gives
+    each run's result as the report does."""
+    import random
+
+    from study_helpers import new_study
+
+    from feelmysign.apparent_motion import shortest_planned_ms
+    from feelmysign.study.runner import Session
+    from feelmysign.study.simulated_sleeve import offline_player
+    from feelmysign.study.threshold import SimulatedObserver
+    from feelmysign.study.threshold_run import run_threshold
+
+    store = new_study(tmp_path)
+    code = store.add_participant(simulated=True)
+    store.set_consent(code, True)
+    layout = Session(store, None).layout
+    observer, rng = SimulatedObserver(90.0), random.Random(3)  # near the floor: some below
+    estimate = run_threshold(
+        store,
+        code,
+        "duration",
+        layout,
+        offline_player(layout),
+        lambda direction, value: observer.respond(direction, value, rng),
+        simulated=True,
+    )
+    export_study(store, tmp_path / "out")
+    with (tmp_path / "out" / "threshold.csv").open() as file:
+        rows = list(csv.DictReader(file))
+    floor_ms = shortest_planned_ms(layout.shortest_burst_ms)
+    assert rows and all(row["played"] == "1" and row["refused"] == "" for row in rows)
+    below = [row for row in rows if float(row["value"]) < floor_ms]
+    assert below, [row["value"] for row in rows]  # the grid reaches below the floor
+    for row in rows:
+        slowed = float(row["value"]) < floor_ms
+        assert row["slowed"] == str(int(slowed)), row
+        played_ms = float(row["played_ms"])
+        assert played_ms == (
+            pytest.approx(floor_ms, abs=0.01) if slowed else pytest.approx(float(row["value"]))
+        ), row
+    with (tmp_path / "out" / "threshold-runs.csv").open() as file:
+        (run,) = list(csv.DictReader(file))
+    assert run["participant"] == "P01" and run["dimension"] == "duration"
+    assert int(run["trials"]) == len(rows) == estimate.trials
+    assert float(run["threshold"]) == pytest.approx(estimate.threshold)
+    assert run["censored"] == (estimate.censored or "") and run["stop_reason"]

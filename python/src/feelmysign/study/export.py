@@ -179,7 +179,60 @@ def comfort_rows(store: StudyStore) -> list[dict[str, Any]]:
     return out
 
 
+THRESHOLD_COLUMNS = (
+    "participant",
+    "run",
+    "simulated",
+    "dimension",
+    "trial",
+    "value",
+    "direction",
+    "response",
+    "correct",
+    "played",
+    "slowed",
+    "played_ms",
+    "refused",
+)
+THRESHOLD_RUN_COLUMNS = (
+    "participant",
+    "run",
+    "simulated",
+    "dimension",
+    "trials",
+    "threshold",
+    "low",
+    "high",
+    "censored",
+    "stop_reason",
+)
+
+
+def _stroke_outcome(events_json: str) -> dict[str, Any]:
+    """What the sleeve did with a threshold trial's one stroke: played (1/0), slowed to its
+    floor (1/0: the stroke was not felt at the value asked), the duration it played, and a
+    refusal's reason."""
+    events = json.loads(events_json)
+    played = [e for e in events if e.get("type") in ("played", "adjusted")]
+    refused = [e for e in events if e.get("type") == "rejected"]
+    if played:
+        event = played[0]
+        return {
+            "played": 1,
+            "slowed": int(event.get("type") == "adjusted"),
+            "played_ms": event.get("duration_ms", ""),
+            "refused": "",
+        }
+    return {
+        "played": 0,
+        "slowed": 0,
+        "played_ms": "",
+        "refused": refused[0].get("reason", "") if refused else "",
+    }
+
+
 def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
+    """threshold.csv: every trial of every run, with what the sleeve did with its stroke."""
     labels = anonymous_labels(store)
     out = []
     for run in store.threshold_runs():
@@ -195,9 +248,33 @@ def threshold_rows(store: StudyStore) -> list[dict[str, Any]]:
                     "direction": trial["direction"],
                     "response": trial["response"],
                     "correct": trial["correct"],
+                    **_stroke_outcome(trial["events_json"]),
                 }
             )
     return out
+
+
+def threshold_run_rows(store: StudyStore) -> list[dict[str, Any]]:
+    """threshold-runs.csv: one row per run, its result (as the report and results.json give
+    it: empty while unfinished or discarded)."""
+    from feelmysign.study.analysis.analyse import threshold_summaries
+
+    runs = store.threshold_runs()
+    return [
+        {
+            "participant": summary["participant"],
+            "run": run["id"],
+            "simulated": int(summary["simulated"]),
+            "dimension": summary["dimension"],
+            "trials": summary["trials"],
+            "threshold": "" if summary["threshold"] is None else summary["threshold"],
+            "low": "" if summary["low"] is None else summary["low"],
+            "high": "" if summary["high"] is None else summary["high"],
+            "censored": summary["censored"] or "",
+            "stop_reason": summary["stop_reason"] or "",
+        }
+        for run, summary in zip(runs, threshold_summaries(store), strict=True)
+    ]
 
 
 def _write_csv(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...]) -> None:
@@ -208,27 +285,15 @@ def _write_csv(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...])
 
 
 def export_study(store: StudyStore, out_dir: Path) -> list[Path]:
-    """Write trials.csv, questionnaire.csv, comfort.csv, threshold.csv and design.json into
-    ``out_dir``."""
+    """Write trials.csv, questionnaire.csv, comfort.csv, threshold.csv, threshold-runs.csv and
+    design.json into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {
         "trials.csv": (trial_rows(store), trial_columns(store.design)),
         "questionnaire.csv": (questionnaire_rows(store), ("participant", "item", "text", "value")),
         "comfort.csv": (comfort_rows(store), COMFORT_COLUMNS),
-        "threshold.csv": (
-            threshold_rows(store),
-            (
-                "participant",
-                "run",
-                "simulated",
-                "dimension",
-                "trial",
-                "value",
-                "direction",
-                "response",
-                "correct",
-            ),
-        ),
+        "threshold.csv": (threshold_rows(store), THRESHOLD_COLUMNS),
+        "threshold-runs.csv": (threshold_run_rows(store), THRESHOLD_RUN_COLUMNS),
     }
     written = []
     trials = files["trials.csv"][0]

@@ -310,6 +310,7 @@ def write_report(path: Path, store: StudyStore, analysis: Analysis) -> Path:
     lines += [
         "",
         "Files: trials.csv (one row per trial, anonymised), questionnaire.csv, threshold.csv, "
+        "threshold-runs.csv, "
         "design.json, results.json.",
         "",
     ]
