@@ -518,3 +518,31 @@ def test_a_stroke_held_up_on_the_way_keeps_the_time_the_drawing_gave_it(
     stamps = [json.loads(payload)["sent_at_ms"] for _, payload in sleeve.receive(count)]
     for k, stamp in enumerate(stamps):
         assert abs(stamp - stamps[0] - k * step_ms) <= 1.0, (k, stamps)
+
+
+def test_a_grid_given_that_is_not_the_sleeves_is_said(
+    broker: Broker, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import subprocess
+
+    from sleeve_watch import SleeveWatch, online
+
+    from feelmysign.bench.sleeve import sleeve_command
+
+    with SleeveWatch(broker.credentials, "status") as watch:
+        sleeve = subprocess.Popen(
+            sleeve_command(broker.credentials_path, "--no-legacy"),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            watch.next(online, "the sleeve online")
+            capsys.readouterr()
+            assert send(broker, "--rows", "5", "--columns", "6", "--no-wait", "0,0,1,0,300") == 0
+            err = capsys.readouterr().err
+            assert "checked against a 5 x 6 grid" in err and "sleeve 'sleeve1' is 3 x 4" in err
+            assert send(broker, "--rows", "3", "--columns", "4", "--no-wait", "0,0,1,0,300") == 0
+            assert "checked against" not in capsys.readouterr().err  # the sleeve's own grid
+        finally:
+            sleeve.terminate()
+            sleeve.wait(timeout=60)

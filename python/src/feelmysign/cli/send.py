@@ -223,6 +223,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         if layout is None:
             layout = _layout_of_sleeve(status, settings)
             strokes = _strokes(args, layout, texts)
+        else:
+            _say_other_grid(status, settings, layout)
         _say_offline(status, settings, wait=wait)
         controls = _wearer_controls(status, payload)
         hold = wearer_hold(controls)
@@ -323,6 +325,22 @@ def _layout_of_sleeve(status: Status | None, settings: BrokerSettings) -> Layout
         raise LayoutError(
             error.source, [*error.problems, "give --layout FILE with the sleeve's layout"]
         ) from None
+
+
+def _say_other_grid(status: Status | None, settings: BrokerSettings, layout: Layout) -> None:
+    """A grid given (--layout, --rows/--columns) that is not the one the sleeve advertises:
+    said, since the sleeve refuses a stroke off its own grid (``outside_grid``)."""
+    grid = None if status is None else status.layout
+    if grid is None or (grid.rows, grid.columns) == (layout.rows, layout.columns):
+        return
+    print(
+        f"The strokes are checked against a {layout.rows} x {layout.columns} grid (--layout, "
+        f"--rows/--columns), but sleeve {settings.sleeve_id!r} is {grid.rows} x {grid.columns} "
+        "(its status): it refuses a stroke off its own grid. Leave the grid options out to use "
+        "the sleeve's.",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def _say_offline(status: Status | None, settings: BrokerSettings, *, wait: bool) -> None:
