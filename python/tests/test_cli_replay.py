@@ -215,7 +215,7 @@ def test_send_cuts_the_strokes_for_the_grid_the_sleeve_advertises(
             capsys.readouterr()
             assert main(["replay", str(_line_across(tmp_path / "any.json")), *argv]) == 0
             out, err = capsys.readouterr()
-            assert "Cut for sleeve 'sleeve1''s 3 x 5 grid (its status)." in err, err
+            assert "Cut for the 3 x 5 grid of sleeve 'sleeve1' (its status)." in err, err
             ends = [s["end"][0] for s in json.loads(out.splitlines()[-1])["strokes"]]
             assert max(ends) > 3.5  # the line reaches the fifth column
             fixed = _line_across(tmp_path / "fixed.json", grid=(3, 4))

@@ -126,3 +126,15 @@ def test_a_refused_certificate_says_why_and_never_to_leave_tls(
     err = capsys.readouterr().err
     assert "the broker's certificate was refused" in err and says in err, err
     assert "mqtt://" not in err.replace(f"mqtts://127.0.0.1:{port}", "") and "Traceback" not in err
+
+
+def test_a_ca_file_with_no_certificate_in_it_is_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, cert, key = _certificates(tmp_path / "broker", "127.0.0.1")
+    with _tls_server(cert, key) as port:
+        argv = ["send", "--broker", f"mqtts://127.0.0.1:{port}", "--ca", str(key), "0,0,1,0,300"]
+        assert main(argv) == 1  # the key given for the CA: no certificate in it
+    err = capsys.readouterr().err
+    assert f"The CA file {key} holds no certificate" in err and "ca.pem" in err, err
+    assert "bug" not in err and "Traceback" not in err

@@ -46,7 +46,13 @@ from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import StrokeError
 from feelmysign.layout import PAPER_SLEEVE, grid_layout
 from feelmysign.protocol import Rejected, validate_stroke
-from feelmysign.sending import OutgoingStroke, StrokeSender, printer, sleeve_status
+from feelmysign.sending import (
+    STATUS_WAIT_S,
+    OutgoingStroke,
+    StrokeSender,
+    printer,
+    sleeve_status,
+)
 from feelmysign.simplify.recording import Recording
 from feelmysign.simplify.registry import DEFAULT_ALGORITHM, Params
 from feelmysign.stroke import Stroke
@@ -241,13 +247,22 @@ def _sleeves_grid(
     recording nor --rows/--columns gives one; where they do and it differs, said so (the
     sleeve refuses a stroke off its grid as ``outside_grid``)."""
     grid = None if status is None else status.layout
-    if grid is None or (grid.rows, grid.columns) == (params.rows, params.columns):
-        return params
     sid = settings.sleeve_id
+    if grid is None:
+        print(
+            f"No status from sleeve {sid!r} at {settings.url} within {STATUS_WAIT_S:g} s (it has "
+            "never connected to this broker, or is an older sleeve): the strokes are cut for a "
+            f"{params.rows} x {params.columns} grid; give --rows/--columns for another.",
+            file=sys.stderr,
+            flush=True,
+        )
+        return params
+    if (grid.rows, grid.columns) == (params.rows, params.columns):
+        return params
     chosen = getattr(args, "rows", None) is not None or getattr(args, "columns", None) is not None
     if not chosen and recording.rows is None and recording.columns is None:
         print(
-            f"Cut for sleeve {sid!r}'s {grid.rows} x {grid.columns} grid (its status).",
+            f"Cut for the {grid.rows} x {grid.columns} grid of sleeve {sid!r} (its status).",
             file=sys.stderr,
             flush=True,
         )

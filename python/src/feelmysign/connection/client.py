@@ -82,7 +82,16 @@ def new_client(
     if settings.transport == "websockets":
         client.ws_set_options(path=settings.path)
     if settings.tls:
-        client.tls_set(ca_certs=settings.ca_file, cert_reqs=ssl.CERT_REQUIRED)
+        try:
+            client.tls_set(ca_certs=settings.ca_file, cert_reqs=ssl.CERT_REQUIRED)
+        except ssl.SSLError as error:  # a file that is there but holds no certificate
+            raise BrokerConnectionError(
+                "bad-option",
+                f"The CA file {settings.ca_file} holds no certificate OpenSSL can read "
+                f"({error.reason or error}): give the broker's ca.pem (a PEM file that begins "
+                "'-----BEGIN CERTIFICATE-----'), not its key or another file.",
+                url=settings.url,
+            ) from None
     if settings.username is not None:
         client.username_pw_set(settings.username, settings.password)
     client.on_socket_open = send_at_once
