@@ -71,6 +71,7 @@ def _refuse_a_dry_run_for_a_real_wearer(participant: sqlite3.Row, path: Path) ->
 
 
 def run(args: argparse.Namespace) -> int:
+    from feelmysign.apparent_motion import shortest_planned_ms
     from feelmysign.study.simulated_sleeve import offline_player
     from feelmysign.study.sleeve_link import SleeveLink
     from feelmysign.study.stimulus import stimulus_layout
@@ -121,6 +122,13 @@ def run(args: argparse.Namespace) -> int:
     )
     grid = dimension_settings(store.design.threshold, args.dimension)
     print(f"{kind}: {estimate.words(args.dimension, grid)}.")
+    floor_ms = shortest_planned_ms(layout.shortest_burst_ms)
+    if args.dimension == "duration" and estimate.threshold < floor_ms:
+        print(
+            f"The sleeve played every stroke briefer than its floor ({floor_ms:g} ms) at the "
+            "floor: how this wearer does below it is not known, and senders keep to the floor "
+            "anyway."
+        )
     if args.save is not None:
         from feelmysign.wearer import save_wearer
 
