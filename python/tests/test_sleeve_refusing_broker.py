@@ -55,6 +55,9 @@ def test_a_broker_refusing_retained_messages_is_named(tmp_path: Path) -> None:
             said = log.read_text()
             assert SAID in said and "retain_available false" in said, said
             assert said.count(SAID) == 1
+            # Never logged in: no broker was "lost".
+            assert "closed the connection before taking the login" in said, said
+            assert "lost the broker" not in said, said
             sleeve.send_signal(signal.SIGTERM)
             sleeve.wait(timeout=WAIT_S)
         finally:

@@ -49,6 +49,7 @@ def test_an_unreachable_broker_is_said_once_and_the_sleeve_connects_when_it_come
         time.sleep(retries_s)
         said = log.read_text()
         assert said.count(UNREACHABLE) == 1, said
+        assert "publishes no clock" not in said  # no broker reached: nothing was checked
         start_broker(state_dir=tmp_path / "state", port=c.mqtt_port, ws_port=c.ws_port)
         said = _wait_for(log, "connected to")
         assert said.count(UNREACHABLE) == 1, said

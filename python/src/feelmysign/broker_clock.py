@@ -74,7 +74,8 @@ def broker_time_ms(payload: bytes, remaining_s: int | None) -> float | None:
 
 def read_broker_time_ms(settings: BrokerSettings, *, wait_s: float = CLOCK_WAIT_S) -> float | None:
     """The broker machine's time, read once over a connection of its own; None when the
-    broker has no clock, or it could not be read within ``wait_s``."""
+    broker has no clock, or it could not be read within ``wait_s``; FeelMySignError when no
+    broker could be reached."""
     from feelmysign.connection import connect_client
     from feelmysign.errors import FeelMySignError
 
@@ -91,7 +92,7 @@ def read_broker_time_ms(settings: BrokerSettings, *, wait_s: float = CLOCK_WAIT_
         client = connect_client(settings, client_id, timeout_s=wait_s, note=lambda _: None)
     except FeelMySignError as error:
         log.debug("the broker's clock could not be read: %s", error)
-        return None
+        raise
     try:
         client.on_message = on_message
         client.subscribe(CLOCK_TOPIC, qos=1)
@@ -106,7 +107,12 @@ def check_clock(settings: BrokerSettings, *, max_age_ms: float, sleeve_id: str) 
     """Compare this machine's clock with the broker's and log what was found: a warning when
     they differ by more than ``max_age_ms`` (every stroke would be ``stale``, or stay fresh
     too long). Returns the difference in ms (this machine minus the broker), or None."""
-    broker_ms = read_broker_time_ms(settings)
+    from feelmysign.errors import FeelMySignError
+
+    try:
+        broker_ms = read_broker_time_ms(settings)
+    except FeelMySignError:
+        return None  # no broker reached: the sleeve says so itself, and nothing was checked
     if broker_ms is None:
         log.info(
             "sleeve %s: the broker publishes no clock (feelmysign/clock): this machine's clock "

@@ -481,18 +481,29 @@ class Sleeve:
         self, client: mqtt.Client, userdata: Any, flags: Any, reason: Any, properties: Any
     ) -> None:
         self._connected.clear()
+        logged_in = self._connected_at is not None
         if not self._stopped.is_set():
             self._count_short_connection()
         # paho can report one loss twice (a keep-alive timeout): said once.
         if not self._stopped.is_set() and self._unreachable_since is None:
             # The loss is said here; attempts that fail after it are said once a minute.
             self._unreachable_since = self._unreachable_said_at = time.monotonic()
-            log.warning(
-                "sleeve %s: lost the broker (%s); reconnecting",
-                self._id,
-                reason,
-                extra=CONNECTION_STATE,
-            )
+            if logged_in:
+                log.warning(
+                    "sleeve %s: lost the broker (%s); reconnecting",
+                    self._id,
+                    reason,
+                    extra=CONNECTION_STATE,
+                )
+            else:
+                log.warning(
+                    "sleeve %s: the broker at %s closed the connection before taking the "
+                    "login (%s); retrying",
+                    self._id,
+                    self._settings.url,
+                    reason,
+                    extra=CONNECTION_STATE,
+                )
 
     def _count_short_connection(self) -> None:
         """A loss soon after a login, again and again: the broker closes the connection for
