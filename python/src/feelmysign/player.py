@@ -544,17 +544,7 @@ class Player:
             if cancel.everything:
                 self._all_off_quietly("cancel everything")  # nothing may run on after it
             with self._lock:
-                self._pending -= len(cut.unstarted)
-                acknowledgements = {
-                    id(tag): self._done(tag)
-                    for tag in cut.unstarted
-                    if isinstance(tag, PlannedStroke)
-                }
-                self._queue.replan(
-                    (tag.start_ms + tag.schedule.duration_ms, tag.ref.drawing)
-                    for tag in [*self._timeline.tags(), *self._inbox]
-                    if isinstance(tag, PlannedStroke)
-                )
+                acknowledgements = self._forget_unstarted(cut.unstarted)
             for tags, started in ((cut.started, True), (cut.unstarted, False)):
                 for tag in tags:
                     if isinstance(tag, PlannedStroke):
@@ -613,17 +603,10 @@ class Player:
         cut = self._timeline.cancel(lambda tag: id(tag) in missed, now_ms)
         self._write(cut.changes)  # (none: they had not started)
         with self._lock:
-            self._pending -= len(cut.unstarted)
-            acknowledgements = [
-                (tag, self._done(tag)) for tag in cut.unstarted if isinstance(tag, PlannedStroke)
-            ]
-            self._queue.replan(
-                (tag.start_ms + tag.schedule.duration_ms, tag.ref.drawing)
-                for tag in [*self._timeline.tags(), *self._inbox]
-                if isinstance(tag, PlannedStroke)
-            )
+            acknowledgements = self._forget_unstarted(cut.unstarted)
         stalled_ms = now_ms - next_ms
-        for tag, acknowledge in acknowledgements:
+        refused = [tag for tag in cut.unstarted if isinstance(tag, PlannedStroke)]
+        for tag in refused:
             self.stalled += 1
             self._on_event(
                 Rejected(
@@ -636,14 +619,30 @@ class Player:
                     stroke=tag.ref,
                 )
             )
+            acknowledge = acknowledgements[id(tag)]
             if acknowledge is not None:
                 acknowledge()  # refused, and said so: the broker must not send it again
         log.warning(
             "the player ran %.0f ms late (its process did not run): %d stroke(s) whose time "
             "passed meanwhile refused as late",
             stalled_ms,
-            len(acknowledgements),
+            len(refused),
         )
+
+    def _forget_unstarted(self, unstarted: list[object]) -> dict[int, Callable[[], None] | None]:
+        """Under the lock: strokes taken off the timeline before they started leave the pending
+        and unplayed ones, and the queue is planned again without them. Their acknowledgements
+        (by the tag's id), to call once their event is out."""
+        self._pending -= len(unstarted)
+        acknowledgements = {
+            id(tag): self._done(tag) for tag in unstarted if isinstance(tag, PlannedStroke)
+        }
+        self._queue.replan(
+            (tag.start_ms + tag.schedule.duration_ms, tag.ref.drawing)
+            for tag in [*self._timeline.tags(), *self._inbox]
+            if isinstance(tag, PlannedStroke)
+        )
+        return acknowledgements
 
     def _write(self, changes: list[Change]) -> tuple[Change, str, list[PlannedStroke]] | None:
         """Output ``changes``; a stroke's motor that could not be switched on is a lost chip:

@@ -161,13 +161,12 @@ class StrokeSender:
             time.sleep(max(0.0, due_s - time.monotonic()))
             if until():
                 return count
-            if first is None:
+            if stamp_ms is None:  # the first: stamped now
                 stamp_ms = time.time() * 1000
-                payload = message.payload(stamp_ms)
+            payload = message.payload(stamp_ms)
+            if first is None:
                 # Read after the stamp: the moment it counts from is never before it.
                 first = (time.monotonic(), offset_ms, stamp_ms)
-            else:
-                payload = message.payload(stamp_ms)
             payload, mid = self._publish(message, payload)
             self._confirm(message, payload, mid, time.monotonic() + self._timeout_s, len(messages))
         return len(messages)

@@ -700,7 +700,7 @@ export class FitCore {
     while (k > 0) {
       const dx = xs[k - 1]! - x;
       const dy = ys[k - 1]! - y;
-      if (!(dx * dx + dy * dy <= restSq)) break; // (not ">": a NaN is a move)
+      if (!(dx * dx + dy * dy <= restSq)) break; // (not ">": a NaN is a move, and ends a rest)
       k -= 1;
     }
     return k;
@@ -727,14 +727,7 @@ export class FitCore {
     if (restMs <= 0 || t - ts[0]! < restMs) return false;
     const x = xs[j]!;
     const y = ys[j]!;
-    const restSq = this.#restSq;
-    let start = j;
-    while (start > 0) {
-      const dx = xs[start - 1]! - x;
-      const dy = ys[start - 1]! - y;
-      if (!(dx * dx + dy * dy <= restSq)) break; // (not ">": a NaN ends the rest too)
-      start -= 1;
-    }
+    const start = this.#stillFrom(j);
     if (start === j || t - ts[start]! < restMs) return false;
     if (start > 0) this.#polyline(start);
     this.#restartWith(xs[start]!, ys[start]!, ts[start]!, this.#samples[start]!);

@@ -491,7 +491,7 @@ class FitCore:
         while k > 0:
             dx = xs[k - 1] - x
             dy = ys[k - 1] - y
-            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN is a move)
+            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN is a move, and ends a rest)
                 break
             k -= 1
         return k
@@ -512,22 +512,14 @@ class FitCore:
         t = ts[j]
         if rest_ms <= 0.0 or t - ts[0] < rest_ms:
             return False
-        x, y = xs[j], ys[j]
-        rest_sq = self._rest_sq
-        start = j
-        while start > 0:
-            dx = xs[start - 1] - x
-            dy = ys[start - 1] - y
-            if not dx * dx + dy * dy <= rest_sq:  # (not ">": a NaN ends the rest too)
-                break
-            start -= 1
+        start = self._still_from(j)
         if start == j or t - ts[start] < rest_ms:
             return False
         if start > 0:
             self._polyline(start, out)
         self._restart_at([xs[start]], [ys[start]], [ts[start]], [self._samples[start]])
         self._retime(t)
-        self._rest_x, self._rest_y = x, y
+        self._rest_x, self._rest_y = xs[j], ys[j]
         self._resting = True
         self.rested = True
         return True

@@ -512,7 +512,7 @@ final class FitCore implements PieceCore {
     while (k > 0) {
       double dx = xs[k - 1] - x;
       double dy = ys[k - 1] - y;
-      if (!(dx * dx + dy * dy <= restSq)) { // (not ">": a NaN is a move)
+      if (!(dx * dx + dy * dy <= restSq)) { // (not ">": a NaN is a move, and ends a rest)
         break;
       }
       k--;
@@ -539,15 +539,7 @@ final class FitCore implements PieceCore {
     }
     double x = xs[j];
     double y = ys[j];
-    int start = j;
-    while (start > 0) {
-      double dx = xs[start - 1] - x;
-      double dy = ys[start - 1] - y;
-      if (!(dx * dx + dy * dy <= restSq)) { // (not ">": a NaN ends the rest too)
-        break;
-      }
-      start--;
-    }
+    int start = stillFrom(j);
     if (start == j || t - ts[start] < restMs) {
       return false;
     }
