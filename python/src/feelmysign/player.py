@@ -95,11 +95,12 @@ RETRY_LOST_S = 0.2
 CHECK_DRIVEN_S = 0.005
 WEARER = "wearer"  # the ``by`` of the events of strokes the wearer stopped or paused
 STOPPED_MESSAGE = "the wearer stopped this drawing; a new drawing plays"
-# The player wakes within a few ms of what is due (a loaded Pi: tens); woken this much later,
-# its process did not run meanwhile (stopped, swapped out, starved): a stroke whose whole time
-# passed then is not played at all (every command of it written at once is felt as nothing)
-# but refused as late, and not called played.
-STALL_MS = 250.0
+# The player wakes within a few ms of what is due; on a loaded machine its process can wait
+# for a core for half a second. Woken a second or more late, it did not run meanwhile
+# (stopped, swapped out): a stroke whose whole time passed then is not played at all (every
+# command of it written at once is felt as nothing) but refused as late, and not called
+# played. A shorter wait is caught up as before.
+STALL_MS = 1000.0
 
 
 @dataclass
