@@ -6,6 +6,7 @@ test kills that Mosquitto with SIGKILL, by its process id.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import queue
@@ -259,3 +260,37 @@ def test_up_prints_one_line_for_a_drawing_whose_pen_rested(tmp_path: Path) -> No
     (line,) = [line for line in seen if line.startswith(f"Drawing {resting[:8]}")]
     # (strokes that queued on a loaded machine are said in brackets: played faster)
     assert re.match(rf"Drawing {resting[:8]}: 2 strokes played( \([^)]*\))?;", line), line
+
+
+def test_up_restarts_a_broker_that_runs_but_answers_nothing(tmp_path: Path) -> None:
+    """A Mosquitto stopped with SIGSTOP keeps its process and its ports (the kernel still
+    takes connections) but answers nothing: up says so, and starts it again."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    mosquitto = 0
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        (mosquitto,) = _mosquitto_children(process.pid)
+        before = len(seen)
+        os.kill(mosquitto, signal.SIGSTOP)
+        _wait_for(lines, "Back: the broker is running again on", seen)
+        assert _mosquitto_children(process.pid) not in ([], [mosquitto])
+        with pytest.raises(ProcessLookupError):  # the stopped one is gone, not left behind
+            os.kill(mosquitto, 0)
+        sent = _send_line(tmp_path)  # the new broker takes a drawing, and the sleeve plays it
+        _wait_for(lines, f"Drawing {sent[:8]}: ", seen)
+    finally:
+        if mosquitto:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(mosquitto, signal.SIGCONT)
+        code = _interrupt(process)
+    assert code == 0, "".join(seen)
+    outage = seen[before:]
+    hung, back = outage[0], outage[1]
+    assert hung.startswith(f"The broker (pid {mosquitto}) is running but answers nothing"), hung
+    assert "starting it again on the same ports" in hung, hung
+    assert "The broker stopped" not in "".join(outage), "".join(outage)
+    assert back.startswith("Back: the broker is running again on"), back
+    (line,) = [line for line in seen if line.startswith(f"Drawing {sent[:8]}: ")]
+    assert " played" in line and "rejected" not in line, line

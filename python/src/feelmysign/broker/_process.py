@@ -7,6 +7,7 @@ started it dies (Linux ``PR_SET_PDEATHSIG``), and stopped by ``Broker.stop``,
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import errno
 import os
@@ -153,9 +154,15 @@ def spawn(executable: str, config: Path, log: IO[bytes]) -> subprocess.Popen[byt
 
 
 def stop(process: subprocess.Popen[bytes], *, timeout_s: float) -> None:
-    """SIGTERM (Mosquitto saves its database and exits), then SIGKILL after ``timeout_s``."""
+    """SIGTERM (Mosquitto saves its database and exits), then SIGKILL after ``timeout_s``.
+
+    SIGCONT after the SIGTERM: a stopped process (SIGSTOP, a debugger's pause) takes no
+    signal but SIGKILL until continued, and continued it saves its database as it exits.
+    """
     if process.poll() is None:
         process.terminate()
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(process.pid, signal.SIGCONT)
         try:
             process.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
