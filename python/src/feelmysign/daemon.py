@@ -424,10 +424,23 @@ class Sleeve:
             telemetry_topic(self._id, "status"), self._status(online=True), qos=1, retain=True
         )
         self._count("connections")  # `up` tells the terminal when the sleeve is back
-        session = "resumed" if getattr(flags, "session_present", False) else "new"
+        resumed = bool(getattr(flags, "session_present", False))
+        session = "resumed" if resumed else "new"
         # With several servers, the one reached (failover moves it between attempts).
         server = replace(self._settings, host=client.host, port=client.port, fallbacks=())
         log.info("sleeve %s: connected to %s (%s session)", self._id, server.url, session)
+        if not resumed and self._connection > 1:
+            # This process had a session there: the broker forgot it, and with it every
+            # stroke it held for the sleeve, acknowledged to its sender or not.
+            log.warning(
+                "sleeve %s: the broker at %s no longer had the sleeve's session: strokes it "
+                "held for the sleeve while it was away are lost (their senders get no answer "
+                "for them). A broker restarted without 'persistence true', or one that "
+                "expires sessions sooner than the sleeve can be away, does this "
+                "(docs/deploy.md, Topics and ACL).",
+                self._id,
+                server.url,
+            )
 
     def _on_connect_fail(self, client: mqtt.Client, userdata: Any) -> None:
         now = time.monotonic()
