@@ -76,7 +76,7 @@ from feelmysign.sending import (
 )
 from feelmysign.shapes import DRAWING_SPEED_CM_S, SHAPE_NAMES, SHAPES, shape_strokes
 from feelmysign.stroke import Stroke
-from feelmysign.topics import LEGACY_TOPIC, telemetry_topic
+from feelmysign.topics import LEGACY_TOPIC, strokes_topic, telemetry_topic
 from feelmysign.wearer_status import (
     WEARER_REASONS,
     ceiling_sentence,
@@ -246,7 +246,8 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
             print(_summary(args, settings, strokes, sent, stopped=stopped), flush=True)
         if outcome is None:
             return 0
-        return _await_sleeve(outcome, settings, args, strokes)
+        online = status is not None and status.online
+        return _await_sleeve(outcome, settings, args, strokes, online=online)
     finally:
         client.disconnect()
         client.loop_stop()
@@ -500,7 +501,10 @@ def _await_sleeve(
     settings: BrokerSettings,
     args: argparse.Namespace,
     strokes: list[Stroke],
+    *,
+    online: bool,
 ) -> int:
+    """``online``: the sleeve's retained status said it was online when the drawing began."""
     burst = (args.pace or "realtime") == "burst"
     drawing_s = (
         sum(s.duration_ms for s in strokes) / 1000 if burst else strokes[-1].duration_ms / 1000
@@ -516,11 +520,24 @@ def _await_sleeve(
     line = summary.text()
     if summary.unheard:
         unheard = ", ".join(str(seq + 1) for seq in summary.unheard)
-        line += (
-            f"; no answer for stroke(s) {unheard} within {args.timeout_s:g} s after the "
-            f"drawing: is sleeve {settings.sleeve_id!r} running and connected to "
-            f"{settings.url}? (--timeout-s waits longer; --no-wait does not wait)"
-        )
+        line += f"; no answer for stroke(s) {unheard} within {args.timeout_s:g} s after the drawing"
+        if online and len(summary.unheard) == len(strokes):
+            # Online, yet not one answer: most often the broker's access rules, which drop
+            # what they refuse without a word (MQTT 3.1.1 has no way to say it).
+            sleeve = settings.sleeve_id
+            line += (
+                f": sleeve {sleeve!r} is online (its status), yet none of its answers reached "
+                f"this sender. The broker's access rules (ACL) may keep the sleeve from reading "
+                f"{strokes_topic(sleeve)} or writing {telemetry_topic(sleeve, 'events')}, or "
+                "this account from reading the events (docs/deploy.md, Topics and ACL); a "
+                "sleeve stopped a moment ago may also still show online (--timeout-s waits "
+                "longer; --no-wait does not wait)"
+            )
+        else:
+            line += (
+                f": is sleeve {settings.sleeve_id!r} running and connected to "
+                f"{settings.url}? (--timeout-s waits longer; --no-wait does not wait)"
+            )
     if summary.all_played and not summary.unheard:
         if not args.json:
             print(f"{line}.", flush=True)
