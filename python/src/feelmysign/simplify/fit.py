@@ -75,7 +75,7 @@ class FitCore:
     _best: list[float] = field(default_factory=list)
     _brief: list[int] = field(default_factory=list)
     _before: list[int] = field(default_factory=list)
-    # A piece's error per start, for the sample being placed (reused).
+    # A piece's error per start, for the sample being placed (reused; -1: left out by ``_scan``).
     _errors: list[float] = field(default_factory=list)
     _errors_end: int = -1
     # For that sample: its first start (``_errors[0]`` is the piece from it) and the best start
@@ -221,9 +221,10 @@ class FitCore:
         self._place(len(self._xs) - 1)
 
     def _scan(self, k: int) -> tuple[int, int]:
-        """Each piece's error to sample k, from every start it may have (into ``_errors``), and
-        the first choice of ``_choose`` for its last piece closed and open, in one pass (kept
-        for the sample until the next): the first start and the closed first choice."""
+        """Each piece's error to sample k, from every start it may have (into ``_errors``; -1
+        for a start that cannot be a first choice), and the first choice of ``_choose`` for
+        its last piece closed and open, in one pass (kept for the sample until the next): the
+        first start and the closed first choice."""
         low = k - self._max_window
         if low < 0:
             low = 0
@@ -254,6 +255,15 @@ class FitCore:
         closed_total = open_total = 0.0
         count = float(k + 1 - low)  # the piece's samples, k + 1 - i: whole numbers, exact
         for i in range(low, k):
+            pieces = brief[i]
+            closed_pieces = pieces + 1 if t_k - ts[i] < floor_ms else pieces
+            if open_start >= 0 and pieces > open_count and closed_pieces > closed_count:
+                # More pieces briefer than the floor than both first choices so far: this
+                # start can be neither, whatever its error, which is left out (-1: no error
+                # is below 0) and computed only if a first choice breaks the bound (``_choose``).
+                append(-1.0)
+                count -= 1.0
+                continue
             px = xs[i] - ax
             py = ys[i] - ay
             dx = ex - px
@@ -274,21 +284,18 @@ class FitCore:
                 error = 0.0
             append(error)
             total = best[i] + error
-            pieces = brief[i]
             if (
                 open_start < 0
                 or pieces < open_count
                 or (pieces == open_count and total < open_total)
             ):
                 open_start, open_count, open_total = i, pieces, total
-            if t_k - ts[i] < floor_ms:
-                pieces += 1
             if (
                 closed_start < 0
-                or pieces < closed_count
-                or (pieces == closed_count and total < closed_total)
+                or closed_pieces < closed_count
+                or (closed_pieces == closed_count and total < closed_total)
             ):
-                closed_start, closed_count, closed_total = i, pieces, total
+                closed_start, closed_count, closed_total = i, closed_pieces, total
         self._errors_end = k
         self._errors_low = low
         self._open_first = open_start
@@ -307,6 +314,10 @@ class FitCore:
         best, brief, errors, ts = self._best, self._brief, self._errors, self._ts
         floor_ms = self._floor_ms
         t_k = ts[k]
+        xs, ys = self._xs, self._ys
+        for i in range(low, k):
+            if errors[i - low] < 0.0:  # left out by ``_scan``: its start could not be first
+                errors[i - low] = piece_error(xs, ys, xs[0], ys[0], self._sums, i, k)
         heap = [
             (
                 brief[i] + (1 if closed and t_k - ts[i] < floor_ms else 0),
