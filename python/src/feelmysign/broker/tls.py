@@ -18,6 +18,8 @@ from __future__ import annotations
 import datetime
 import hashlib
 import ipaddress
+import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -62,7 +64,7 @@ class LanOptions:
         if (self.cert is None) != (self.key is None):
             raise BrokerError("bad-option", "Give --tls-cert and --tls-key together.")
         if self.cert is not None and self.key is not None:
-            return user_certificate(self.cert, self.key)
+            return user_certificate(self.cert, self.key, [self.host, *self.names])
         return ensure_local_ca(tls_dir, [self.host, *self.names])
 
 
@@ -106,8 +108,13 @@ def ensure_local_ca(tls_dir: Path, hosts: list[str]) -> TlsFiles:
     )
 
 
-def user_certificate(cert: Path, key: Path) -> TlsFiles:
-    """The user's own certificate (e.g. Let's Encrypt's fullchain.pem and privkey.pem)."""
+def user_certificate(cert: Path, key: Path, hosts: Sequence[str] = ()) -> TlsFiles:
+    """The user's own certificate (e.g. Let's Encrypt's fullchain.pem and privkey.pem).
+
+    Refused (BrokerError ``bad-option``) when every client would refuse it or the listener
+    could not use it: expired or not yet valid, or ``key`` not its private key. One that names
+    none of ``hosts`` (the address up listens on and prints, and further names) is said on
+    stderr: clients that use a name it holds still connect (a port forwarded under a DNS name)."""
     pem: dict[str, bytes] = {}
     for path, option in ((cert, "--tls-cert"), (key, "--tls-key")):
         try:
@@ -119,15 +126,99 @@ def user_certificate(cert: Path, key: Path) -> TlsFiles:
                 "bad-option", f"{option} {path} cannot be read: {error.strerror or error}."
             ) from None
     try:
-        x509.load_pem_x509_certificates(pem["--tls-cert"])
-        serialization.load_pem_private_key(pem["--tls-key"], password=None)
+        leaf = x509.load_pem_x509_certificates(pem["--tls-cert"])[0]
+        private = serialization.load_pem_private_key(pem["--tls-key"], password=None)
     except (ValueError, TypeError) as error:
         raise BrokerError(
             "bad-option",
             f"--tls-cert {cert} / --tls-key {key} is not a PEM certificate and an unencrypted "
             f"PEM private key ({error}).",
         ) from None
+    _check_user_certificate(leaf, private, cert, key, hosts)
     return TlsFiles(cert=cert.absolute(), key=key.absolute(), ca=None, ca_fingerprint=None)
+
+
+def _check_user_certificate(
+    leaf: x509.Certificate, private: object, cert: Path, key: Path, hosts: Sequence[str]
+) -> None:
+    now = _now()
+    if leaf.not_valid_after_utc < now:
+        raise BrokerError(
+            "bad-option",
+            f"--tls-cert {cert} expired on {leaf.not_valid_after_utc:%Y-%m-%d %H:%M} UTC: every "
+            "phone, page and sleeve would refuse it. Renew it (certbot renew), or leave out "
+            "--tls-cert and --tls-key to use the local CA's; if it should still be valid, "
+            f"check this machine's clock (it says {now:%Y-%m-%d %H:%M} UTC).",
+        )
+    if leaf.not_valid_before_utc > now:
+        raise BrokerError(
+            "bad-option",
+            f"--tls-cert {cert} is valid only from {leaf.not_valid_before_utc:%Y-%m-%d %H:%M} "
+            f"UTC, and this machine's clock says {now:%Y-%m-%d %H:%M} UTC: set the clock "
+            "('timedatectl' must say 'System clock synchronized: yes'), or wait.",
+        )
+    public = getattr(private, "public_key", None)
+    if public is None or public().public_bytes(
+        serialization.Encoding.DER, serialization.PublicFormat.SubjectPublicKeyInfo
+    ) != leaf.public_key().public_bytes(
+        serialization.Encoding.DER, serialization.PublicFormat.SubjectPublicKeyInfo
+    ):
+        raise BrokerError(
+            "bad-option",
+            f"--tls-key {key} is not the private key of the certificate in --tls-cert {cert}: "
+            "give the key made with it (Let's Encrypt: privkey.pem beside fullchain.pem).",
+        )
+    names = _certificate_names(leaf)
+    wanted = [host for host in hosts if host not in WILDCARD_ADDRESSES]
+    if wanted and not any(_names_host(names, host) for host in wanted):
+        print(
+            f"Warning: --tls-cert {cert} is for {', '.join(names) or 'no host name'}, not "
+            f"{' or '.join(wanted)}: a client that connects by {wanted[0]} (the addresses "
+            "printed below) will refuse it. Give --host a name the certificate holds, or a "
+            f"certificate for {wanted[0]}.",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+# Addresses to listen on that no client connects by.
+WILDCARD_ADDRESSES = frozenset({"0.0.0.0", "::"})
+
+
+def _certificate_names(cert: x509.Certificate) -> list[str]:
+    """The host names and addresses a certificate is for: its subject alternative names (the
+    common name only without them, as clients do)."""
+    try:
+        alternatives = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+    except x509.ExtensionNotFound:
+        common = cert.subject.get_attributes_for_oid(NameOID.COMMON_NAME)
+        return [str(attribute.value) for attribute in common]
+    names: list[str] = list(alternatives.get_values_for_type(x509.DNSName))
+    names += [str(address) for address in alternatives.get_values_for_type(x509.IPAddress)]
+    return names
+
+
+def _names_host(names: list[str], host: str) -> bool:
+    """Whether a client connecting by ``host`` finds it among ``names`` (RFC 6125: an address
+    only as an address, a wildcard for one leftmost label)."""
+    try:
+        address = ipaddress.ip_address(host)
+    except ValueError:
+        address = None
+    for name in names:
+        if address is not None:
+            try:
+                if ipaddress.ip_address(name) == address:
+                    return True
+            except ValueError:
+                continue
+            continue
+        wanted, given = host.lower().rstrip("."), name.lower().rstrip(".")
+        if given == wanted:
+            return True
+        if given.startswith("*.") and "." in wanted and wanted.split(".", 1)[1] == given[2:]:
+            return True
+    return False
 
 
 def _now() -> datetime.datetime:
