@@ -13,7 +13,10 @@ file, laid out as ``s01/fast/arrow01.xml``)::
 A gesture log becomes a one-path recording: screen pixels as drawn (y down),
 times in ms from the first point (a time earlier than the one before is taken
 at the one before), the canvas the bounding box plus a margin on every side (as
-for LASA, ``lasa.recording_in_box``).
+for LASA, ``lasa.recording_in_box``). A log holds pointer events alone, and a
+pointer held still sends none: where ``STILL_SAMPLE_MS`` or more pass between
+two points, the pointer is sampled still at the first every ``STILL_SAMPLE_MS``,
+as the page does (``with_still_samples``), so that a stop is a rest.
 
 Each recording is named by its path; its gesture (what the recogniser must
 name) is the gesture's ``Name`` (else the file name) without trailing digits
@@ -49,6 +52,9 @@ MAX_GESTURE_BYTES = 10_000_000
 # The least a gesture log's points may span: its canvas (its box plus a twentieth of the larger
 # side on every side, lasa.recording_in_box) is then at least a pixel on each side.
 MIN_GESTURE_EXTENT_PX = 10.0
+# How often the page samples a pointer held still, which sends no events (web/src/ui/pointer.ts,
+# STILL_SAMPLE_MS): a gesture log has the events alone.
+STILL_SAMPLE_MS = 32.0
 
 
 @dataclass(frozen=True)
@@ -135,10 +141,29 @@ def load_gesture_log(path: Path, folder: str | None = None) -> Gesture:
             "plus a margin of a twentieth of its larger side)"
         )
     times = np.maximum.accumulate(xyt[:, 2]) - xyt[0, 2]
-    recording = recording_in_box(xyt[:, 0], xyt[:, 1], times, px_per_unit=1.0)
+    x, y, times = with_still_samples(xyt[:, 0], xyt[:, 1], times)
+    recording = recording_in_box(x, y, times, px_per_unit=1.0)
     name = root.attrib.get("Name") or path.stem
     speed = root.attrib.get("Speed") or folder or FILES_SET
     return Gesture(str(path), gesture_name(name), speed, recording)
+
+
+def with_still_samples(
+    x: np.ndarray, y: np.ndarray, t: np.ndarray, every_ms: float = STILL_SAMPLE_MS
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The points the page would give the simplifier for these pointer events: a pointer held
+    still sends no events, so where ``every_ms`` or more pass without one the page samples it
+    where it is, every ``every_ms`` (web/src/ui/pointer.ts), and the rest rule sees a stop."""
+    gaps = np.diff(t)
+    counts = np.zeros(len(t), dtype=int)  # still samples after each point
+    counts[:-1] = np.ceil(gaps / every_ms).astype(int) - 1
+    counts[counts < 0] = 0
+    if not counts.any():
+        return x, y, t
+    index = np.repeat(np.arange(len(t)), counts + 1)
+    # Each point, then its still samples k * every_ms after it (k = 1, 2, ...).
+    within = np.arange(len(index)) - np.repeat(np.cumsum(counts + 1) - (counts + 1), counts + 1)
+    return x[index], y[index], t[index] + within * every_ms
 
 
 def load_all(
