@@ -12,7 +12,8 @@ sent for them; ``WindowSimplifier.merged_back``). ``params.json`` is the
 parameter table (defaults and allowed ranges). Besides gen_angle's shapes, a window-only
 ones (``EDGE_SHAPES``): a drawing along the canvas edges, whose strokes must stay on the grid,
 a crawl, lines released just after a cut of the latency cap (a last piece merged at release,
-and one sent), and "L"s with a stop half-way down the stem (``stop``).
+and one sent), and "L"s with a stop half-way down the stem (``stop``), one without samples
+during the stop (``gap``).
 """
 
 from __future__ import annotations
@@ -148,11 +149,12 @@ def _tail() -> list[Path]:
     return [line, hooked]
 
 
-def _stop_l(stop_y: float) -> Path:
+def _stop_l(stop_y: float, still_samples: bool = True) -> Path:
     """An "L" drawn as a mouse draws it (a sample a frame at 60 Hz, 800 px/s: 2 grid units a
     second), down from (200, 80) to (200, ``stop_y``), held still there for a second with the
     button down (a sample every 32 ms, as the page and the Processing library sample a still
-    pen), on down to (200, 720) and across to (1000, 720)."""
+    pen; with ``still_samples`` off, none, as a source of pointer events alone gives it), on
+    down to (200, 720) and across to (1000, 720)."""
     frame_ms = 1000.0 / 60.0
     samples = [Sample(0.0, 200.0, 80.0)]
 
@@ -171,6 +173,9 @@ def _stop_l(stop_y: float) -> Path:
     to(200.0, stop_y)
     last = samples[-1]
     samples += [Sample(round(last.t_ms + 32.0 * k, 3), last.x, last.y) for k in range(1, 32)]
+    if not still_samples:
+        # Nothing during the stop; the first move after it, 3 px on, when the stop ends.
+        samples = [*samples[:-31], Sample(samples[-1].t_ms, last.x, last.y + 3.0)]
     to(200.0, 720.0)
     to(1000.0, 720.0)
     return samples
@@ -185,6 +190,13 @@ def _stops() -> list[Path]:
     return [_stop_l(400.0), _stop_l(440.0)]
 
 
+def _gap() -> list[Path]:
+    """The first "L" of ``_stops`` from a source of pointer events alone: no sample during the
+    stop, and the first after it 3 px on (a pen moves off a little as it sets off again). The
+    simplifier takes the pen to have stood still through the gap: the stop is a rest."""
+    return [_stop_l(400.0, still_samples=False)]
+
+
 # Window-only shapes, each with the defaults and the latency cap's variations (W x H fills the
 # default 3 x 4 grid, so the canvas edges are the grid's).
 EDGE_SHAPES = {
@@ -192,6 +204,7 @@ EDGE_SHAPES = {
     "crawl": lambda: [_crawl()],
     "tail": _tail,
     "stop": _stops,
+    "gap": _gap,
 }
 EDGE_VARIATIONS = (
     "defaults",

@@ -34,7 +34,13 @@ from feelmysign.simplify import (
     WindowSimplifier,
 )
 from feelmysign.simplify.segment import NOT_ENOUGH_DISTANCE
-from feelmysign.simplify.window import LINE_SHARE, WINDOW_PARAMS, WindowCore, rest_radius
+from feelmysign.simplify.window import (
+    LINE_SHARE,
+    WINDOW_PARAMS,
+    WindowCore,
+    rest_radius,
+    taken_samples,
+)
 from feelmysign.stroke import Point
 
 WINDOW = dict(load("window"))
@@ -538,9 +544,43 @@ def paths(draw: st.DrawFn, min_step_ms: float = 0.0) -> tuple[WindowParams, list
         canvas_width_px=800,
         canvas_height_px=600,
     )
-    # Starting and stepping past the canvas exercises the clamping onto the grid.
-    samples = random_walk(draw, margin_px=50, min_step_ms=min_step_ms)
+    # Starting and stepping past the canvas exercises the clamping onto the grid. The samples
+    # the simplifier takes: with the pen standing through a stop's gap (see
+    # test_a_gap_is_taken_as_the_pen_standing), so that the properties below hold for each.
+    samples = taken_samples(
+        random_walk(draw, margin_px=50, min_step_ms=min_step_ms), params.rest_ms
+    )
     return params, samples
+
+
+@st.composite
+def _stopping_walks(draw: st.DrawFn) -> list[Sample]:
+    """A random walk with up to four stops: gaps of up to 900 ms with no sample."""
+    samples = random_walk(draw, margin_px=50)
+    stops = draw(st.lists(st.tuples(st.integers(1, 150), st.floats(0, 900)), max_size=4))
+    shifts = [sum(gap for at, gap in stops if at <= j) for j in range(len(samples))]
+    return [
+        Sample(s.t_ms + shift, s.x, s.y, s.pressure)
+        for s, shift in zip(samples, shifts, strict=True)
+    ]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.sampled_from([0.0, 30.0, 100.0, 300.0]), st.booleans(), _stopping_walks())
+def test_a_gap_is_taken_as_the_pen_standing(
+    rest_ms: float, least_squares: bool, samples: list[Sample]
+) -> None:
+    """A sample rest_ms or more after the one before gives the strokes of the pen standing at
+    the one before until it (as the page samples a still pen), and only such a sample."""
+    params = WindowParams(rest_ms=rest_ms, least_squares=least_squares)
+    expected = samples[:1]
+    for a, b in itertools.pairwise(samples):  # (the walk's times never run backwards)
+        if 0 < rest_ms <= b.t_ms - a.t_ms:
+            expected.append(Sample(b.t_ms, a.x, a.y, a.pressure))
+        expected.append(b)
+    taken = taken_samples(samples, rest_ms)
+    assert taken == expected
+    assert run(params, [samples]) == run(params, [taken])
 
 
 def _rest_radius(params: WindowParams) -> float:

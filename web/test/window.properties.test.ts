@@ -20,6 +20,7 @@ import {
   WindowCore,
   WindowSimplifier,
   restRadius as windowRestRadius,
+  takenSamples,
 } from "../src/simplify/window";
 import { DEFAULT_WINDOW_PARAMS, type WindowParams } from "../src/simplify/window-params";
 
@@ -146,7 +147,8 @@ describe("window simplifier invariants", () => {
     "strokes join end to start from the press to the release",
     () => {
       fc.assert(
-        fc.property(paramsArb, pathArb, (params, samples) => {
+        fc.property(paramsArb, pathArb, (params, drawn) => {
+          const samples = takenSamples(drawn, params.rest_ms);
           const { segments, map, mergedBack } = covered(params, samples);
           const first = samples[0]!;
           const last = samples[samples.length - 1]!;
@@ -190,8 +192,9 @@ describe("window simplifier invariants", () => {
       // sent; only a path that is one short piece in all (a tap) is dropped, with its reason.
       const errorArb = fc.constantFrom(0.001, 0.05, 0.1, 0.15, 0.25, 1);
       fc.assert(
-        fc.property(paramsArb, errorArb, pathArb, (drawn, maxError, samples) => {
+        fc.property(paramsArb, errorArb, pathArb, (drawn, maxError, path) => {
           const params = { ...drawn, max_error: maxError };
+          const samples = takenSamples(path, params.rest_ms);
           const { segments, map } = covered(params, samples);
           if (segments.some((segment) => segment.dropped !== null)) {
             expect(segments.length).toBe(1);
@@ -223,8 +226,9 @@ describe("window simplifier invariants", () => {
       // with strict minimums, one still below them merges back or is dropped there).
       const errorArb = fc.constantFrom(0.05, 0.1, 0.15, 0.25);
       fc.assert(
-        fc.property(paramsArb, errorArb, fc.boolean(), pathArb, (drawn, maxError, strict, samples) => {
+        fc.property(paramsArb, errorArb, fc.boolean(), pathArb, (drawn, maxError, strict, path) => {
           const params = { ...drawn, max_error: maxError, strict_minimums: strict };
+          const samples = takenSamples(path, params.rest_ms);
           const simplifier = new WindowSimplifier(params);
           const segments: Segment[] = samples.flatMap((sample) => simplifier.push(sample));
           const atRests = simplifier.mergedBack;

@@ -1237,9 +1237,13 @@ export class WindowSimplifier {
   /** The least-squares core (null with `least_squares` off). */
   readonly #fit: FitCore | null;
   readonly #merger: Merger;
+  readonly #restMs: number;
+  /** The last sample pushed in the path being drawn (null between paths). */
+  #last: Sample | null = null;
 
   constructor(params: WindowParams) {
     this.params = params;
+    this.#restMs = params.rest_ms;
     if (params.least_squares) {
       // The core keeps its samples apart; the merger is given each one taken (`#pushFit`).
       this.#core = null;
@@ -1283,8 +1287,33 @@ export class WindowSimplifier {
     return fit !== null ? fit.lineStart : this.#core!.lineStart;
   }
 
-  /** One pointer sample while the pointer is down; the first of a path is the press. */
+  /**
+   * One pointer sample while the pointer is down; the first of a path is the press.
+   *
+   * A sample `rest_ms` or more after the one before (with the rest rule on) comes after a stop: a
+   * pointer held still sends no event, and a source that does not sample it where it is (the page
+   * does, every 32 ms: `ui/pointer.ts`) leaves a gap. The pen is taken to have stood at the sample
+   * before until this one, as if sampled there at this one's time: the rest rule sees the rest,
+   * and the stop is not played as a stroke as long as the stop. Python `WindowSimplifier.push`.
+   */
   push(input: Sample): readonly Segment[] {
+    const last = this.#last;
+    this.#last = input;
+    const still = last === null ? null : stillBefore(last, input, this.#pointerMs(), this.#restMs);
+    if (still !== null) {
+      const before = this.#pushOne(still);
+      const after = this.#pushOne(input);
+      return before.length === 0 ? after : after.length === 0 ? before : [...before, ...after];
+    }
+    return this.#pushOne(input);
+  }
+
+  #pointerMs(): number {
+    const fit = this.#fit;
+    return fit !== null ? fit.pointerMs() : this.#core!.pointerMs();
+  }
+
+  #pushOne(input: Sample): readonly Segment[] {
     const fit = this.#fit;
     if (fit !== null) return this.#pushFit(fit, input);
     const core = this.#core!;
@@ -1326,6 +1355,7 @@ export class WindowSimplifier {
 
   /** Release: the rest of the path, the held piece first (a tap gives one, dropped). */
   end(): Segment[] {
+    this.#last = null;
     const fit = this.#fit;
     const core = fit !== null ? fit : this.#core!;
     const nowMs = core.pointerMs();
@@ -1335,6 +1365,35 @@ export class WindowSimplifier {
     this.#merger.end(nowMs, out);
     return out;
   }
+}
+
+/**
+ * The pen standing at `last` at `sample`'s time, where `sample` comes `restMs` or more after the
+ * last time taken (`takenMs`: times never run backwards) with the rest rule on; else null
+ * (`WindowSimplifier.push`). Python `still_before`.
+ */
+export function stillBefore(last: Sample, sample: Sample, takenMs: number, restMs: number): Sample | null {
+  if (restMs > 0 && sample.t_ms - takenMs >= restMs) {
+    return { t_ms: sample.t_ms, x: last.x, y: last.y, pressure: last.pressure };
+  }
+  return null;
+}
+
+/**
+ * The samples `WindowSimplifier` takes for one path's `samples`: each, after the pen standing at
+ * the one before where a stop left a gap (`stillBefore`). What its strokes cover, for tests and
+ * tools that check them against the samples. Python `taken_samples`.
+ */
+export function takenSamples(samples: readonly Sample[], restMs: number): Sample[] {
+  const taken: Sample[] = [];
+  let takenMs = -Infinity;
+  for (const sample of samples) {
+    const still = taken.length > 0 ? stillBefore(taken[taken.length - 1]!, sample, takenMs, restMs) : null;
+    if (still !== null) taken.push(still);
+    taken.push(sample);
+    takenMs = Math.max(takenMs, sample.t_ms);
+  }
+  return taken;
 }
 
 /**

@@ -924,6 +924,8 @@ class WindowSimplifier:
     params: WindowParams = field(default_factory=WindowParams)
     _core: WindowCore | FitCore = field(init=False)
     _merger: Merger = field(init=False)
+    # The last sample pushed in the path being drawn (None between paths).
+    _last: Sample | None = field(init=False, default=None)
 
     def __post_init__(self) -> None:
         params = self.params
@@ -949,7 +951,22 @@ class WindowSimplifier:
         return self._core.line_start
 
     def push(self, sample: Sample) -> list[Segment]:
-        """One pointer sample while the pointer is down; the first of a path is the press."""
+        """One pointer sample while the pointer is down; the first of a path is the press.
+
+        A sample ``rest_ms`` or more after the one before (with the rest rule on) comes after a
+        stop: a pointer held still sends no event, and a source that does not sample it where
+        it is (the page does, every 32 ms) leaves a gap. The pen is taken to have stood at the
+        sample before until this one, as if sampled there at this one's time: the rest rule
+        sees the rest, and the stop is not played as a stroke as long as the stop."""
+        last = self._last
+        self._last = sample
+        if last is not None:
+            still = still_before(last, sample, self._core.pointer_ms(), self.params.rest_ms)
+            if still is not None:
+                return self._push(still) + self._push(sample)
+        return self._push(sample)
+
+    def _push(self, sample: Sample) -> list[Segment]:
         core = self._core
         pieces = core.push(sample)
         merger = self._merger
@@ -975,12 +992,38 @@ class WindowSimplifier:
     def end(self) -> list[Segment]:
         """Release: the rest of the path, the held piece first (a tap gives one, dropped)."""
         core = self._core
+        self._last = None
         now_ms = core.pointer_ms()
         out: list[Segment] = []
         for piece in core.end():
             out.extend(self._merger.take(piece, now_ms))
         out.extend(self._merger.end(now_ms))
         return out
+
+
+def still_before(last: Sample, sample: Sample, taken_ms: float, rest_ms: float) -> Sample | None:
+    """The pen standing at ``last`` at ``sample``'s time, where ``sample`` comes ``rest_ms`` or
+    more after the last time taken (``taken_ms``: times never run backwards) with the rest rule
+    on; else None (``WindowSimplifier.push``)."""
+    if rest_ms > 0.0 and sample.t_ms - taken_ms >= rest_ms:
+        return Sample(sample.t_ms, last.x, last.y, last.pressure)
+    return None
+
+
+def taken_samples(samples: list[Sample], rest_ms: float) -> list[Sample]:
+    """The samples ``WindowSimplifier`` takes for one path's ``samples``: each, after the pen
+    standing at the one before where a stop left a gap (``still_before``). What its strokes
+    cover, for tests and tools that check them against the samples."""
+    taken: list[Sample] = []
+    taken_ms = -math.inf
+    for sample in samples:
+        if taken:
+            still = still_before(taken[-1], sample, taken_ms, rest_ms)
+            if still is not None:
+                taken.append(still)
+        taken.append(sample)
+        taken_ms = max(taken_ms, sample.t_ms)
+    return taken
 
 
 def floor_end_ms(start_ms: float, floor_ms: float) -> float:

@@ -37,8 +37,12 @@ import java.util.List;
 public final class WindowSimplifier implements Simplifier {
   private final PieceCore core;
   private final Merger merger;
+  private final double restMs;
+  /** The last sample pushed in the path being drawn (null between paths). */
+  private Sample last;
 
   public WindowSimplifier(Params params) {
+    this.restMs = params.number("rest_ms");
     boolean leastSquares = params.flag("least_squares");
     boolean strict = params.flag("strict_minimums");
     // The least squares' pieces are briefer than the floor only where no piece lasting it keeps
@@ -69,8 +73,70 @@ public final class WindowSimplifier implements Simplifier {
     return core.lineStart();
   }
 
+  /**
+   * One pointer sample while the pointer is down; the first of a path is the press.
+   *
+   * <p>A sample {@code rest_ms} or more after the one before (with the rest rule on) comes after a
+   * stop: a pointer held still sends no event, and a source that does not sample it where it is
+   * (the page does, every 32 ms; the Processing library at every frame) leaves a gap. The pen is
+   * taken to have stood at the sample before until this one, as if sampled there at this one's
+   * time: the rest rule sees the rest, and the stop is not played as a stroke as long as the
+   * stop. The reference's {@code WindowSimplifier.push}.
+   */
   @Override
   public List<Segment> push(Sample input) {
+    Sample before = last;
+    last = input;
+    Sample still = before == null ? null : stillBefore(before, input, core.pointerMs(), restMs);
+    if (still == null) {
+      return pushOne(input);
+    }
+    List<Segment> first = pushOne(still);
+    List<Segment> second = pushOne(input);
+    if (first.isEmpty()) {
+      return second;
+    }
+    if (second.isEmpty()) {
+      return first;
+    }
+    List<Segment> both = new ArrayList<>(first);
+    both.addAll(second);
+    return both;
+  }
+
+  /**
+   * The pen standing at {@code last} at {@code sample}'s time, where {@code sample} comes {@code
+   * restMs} or more after the last time taken ({@code takenMs}: times never run backwards) with
+   * the rest rule on; else null. The reference's {@code still_before}.
+   */
+  public static Sample stillBefore(Sample last, Sample sample, double takenMs, double restMs) {
+    if (restMs > 0 && sample.tMs() - takenMs >= restMs) {
+      return new Sample(sample.tMs(), last.x(), last.y(), last.pressure());
+    }
+    return null;
+  }
+
+  /**
+   * The samples the simplifier takes for one path's {@code samples}: each, after the pen standing
+   * at the one before where a stop left a gap ({@link #stillBefore}). What its strokes cover, for
+   * tests and tools that check them against the samples. The reference's {@code taken_samples}.
+   */
+  public static List<Sample> takenSamples(List<Sample> samples, double restMs) {
+    List<Sample> taken = new ArrayList<>(samples.size());
+    double takenMs = Double.NEGATIVE_INFINITY;
+    for (Sample sample : samples) {
+      Sample still =
+          taken.isEmpty() ? null : stillBefore(taken.get(taken.size() - 1), sample, takenMs, restMs);
+      if (still != null) {
+        taken.add(still);
+      }
+      taken.add(sample);
+      takenMs = Math.max(takenMs, sample.tMs());
+    }
+    return taken;
+  }
+
+  private List<Segment> pushOne(Sample input) {
     List<Segment> pieces = core.push(input);
     double takenMs = core.lastMs();
     merger.sample(takenMs, core.lastX(), core.lastY());
@@ -93,6 +159,7 @@ public final class WindowSimplifier implements Simplifier {
 
   @Override
   public List<Segment> end() {
+    last = null;
     double nowMs = core.pointerMs();
     List<Segment> out = null;
     for (Segment piece : core.end()) {
