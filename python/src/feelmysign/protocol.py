@@ -145,8 +145,13 @@ class Rejected:
         )
 
 
-def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accepted | Rejected:
+def parse(
+    payload: object, layout: Layout | None, *, format: Format = "auto"
+) -> Accepted | Rejected:
     """Parse and validate one stroke message against ``layout``'s grid and duration cap.
+
+    ``layout`` None: the message's form only, for a sender that does not know the sleeve
+    yet: no grid and no duration cap (any sleeve's), and the stroke is not clamped.
 
     ``format="auto"`` reads JSON when the text starts with ``{`` or ``[`` (after
     whitespace), the legacy CSV otherwise. Never raises on any payload.
@@ -172,10 +177,12 @@ def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accept
         stroke = _parse_legacy(body)
     if isinstance(stroke, Rejected):
         return stroke
-    checked = validate_stroke(stroke, layout)
+    checked = (
+        validate_stroke(stroke, layout) if layout is not None else _first_problem(stroke, None)
+    )
     if isinstance(checked, Rejected):
         return _named(checked, stroke)
-    return Accepted(checked, chosen)
+    return Accepted(stroke if checked is None else checked, chosen)
 
 
 def _named(problem: Rejected, stroke: Stroke) -> Rejected:
