@@ -457,6 +457,10 @@ class _InOrder:
             self._waiting.clear()
 
 
+# How the sleeve begins the message of a stroke a lost chip cut after it began (player.py).
+CUT_PART_WAY = "cut part-way, after its played event: "
+
+
 def _answer_line(
     seq: int, total: int, stroke: StrokeOutcome, event: Event, *, json_lines: bool
 ) -> str:
@@ -465,7 +469,10 @@ def _answer_line(
     width = len(str(total))
     where = f"[{seq + 1:>{width}}/{total}]"
     if stroke.cut_reason is not None:
-        return f"{where} cut part-way ({stroke.cut_reason}): {getattr(event, 'message', '')}"
+        # The sleeve's own sentence may begin with what the line says ("cut part-way, after
+        # its played event: The DRV2605L ..."): said once.
+        message = str(getattr(event, "message", "") or "").removeprefix(CUT_PART_WAY)
+        return f"{where} cut part-way ({stroke.cut_reason}): {message}".rstrip(": ")
     if stroke.refused_reason == LATE:  # said as the summary, up's line and the page say it
         return f"{where} skipped as late: {stroke.refused_message or ''}".rstrip()
     if stroke.refused_reason is not None:
