@@ -67,6 +67,8 @@ def test_an_answer_is_never_overwritten_and_needs_consent(tmp_path: Path) -> Non
     with pytest.raises(StudyError, match="send the shape"):
         session.answer(code, trial["id"], answer="line", felt_nothing=False, confidence=None)
     session.send(code)
+    with pytest.raises(StudyError, match="'felt nothing' takes no confidence"):
+        session.answer(code, trial["id"], answer="", felt_nothing=True, confidence=2)
     session.answer(code, trial["id"], answer="line", felt_nothing=False, confidence=4)
     with pytest.raises(StudyError, match="not the current one"):
         session.answer(code, trial["id"], answer="circle", felt_nothing=False, confidence=None)

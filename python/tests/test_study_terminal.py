@@ -114,3 +114,20 @@ def test_conditions_below_the_wearers_limits_are_said_once_before_the_first_tria
     assert "practice trial 1" not in warning  # the line's one stroke lasts long enough
     assert "may not feel them" in warning and "fewer segments or a slower speed" in warning
     assert out.index("P-LIMIT") < out.index("Trial 1/")  # up front, before the first trial
+
+
+def test_felt_nothing_is_recorded_without_asking_a_confidence(
+    tmp_path: Path, broker: Broker, sleeve: Sleeve
+) -> None:
+    study = tmp_path / "study.sqlite"
+    StudyStore.create(study, QUICK_DESIGN, load_design(QUICK_DESIGN)).close()
+    # Consent, comfort; trial 1: Enter to send, an empty answer (felt nothing); trial 2:
+    # Enter to send, "line", confidence 3; then the input ends.
+    result = _study_run(study, broker, "y\ny\nn\n\n\n\nline\n3\n")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert result.stdout.count("Confidence 1-5") == 1, result.stdout  # for trial 2 only
+    store = StudyStore(study)
+    (participant,) = store.participants()
+    first, second = store.trials(participant["code"])[:2]
+    assert (first["felt_nothing"], first["confidence"], first["answer"]) == (1, None, "")
+    assert (second["felt_nothing"], second["confidence"], second["answer"]) == (0, 3, "line")

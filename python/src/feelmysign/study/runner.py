@@ -261,6 +261,11 @@ class Session:
             raise StudyError(f"an answer is at most {MAX_ANSWER_CHARS} characters")
         if not text and not felt_nothing:
             raise StudyError("type the answer, or choose 'felt nothing'")
+        if felt_nothing and confidence is not None:
+            raise StudyError(
+                "'felt nothing' takes no confidence: record it without one, or record the "
+                "answer the participant gave with its confidence"
+            )
         if confidence is not None and not 1 <= confidence <= CONFIDENCE_POINTS:
             raise StudyError(f"confidence is 1 to {CONFIDENCE_POINTS}, or none")
         synonyms = [(s.name, s.synonyms) for s in self.store.design.shapes]

@@ -63,7 +63,8 @@ def _session(store: StudyStore, settings: BrokerSettings, participant: str | Non
             answer = input("  Answer (empty = felt nothing, 'r' = send again): ").strip()
             if answer == "r":
                 continue
-            confidence = input("  Confidence 1-5 (empty = none): ").strip()
+            # Felt nothing: there is nothing to be confident of, and none is asked.
+            confidence = input("  Confidence 1-5 (empty = none): ").strip() if answer else ""
             coding = session.answer(
                 code,
                 trial["id"],
