@@ -175,20 +175,23 @@ def test_a_response_time_never_holds_the_time_no_runner_ran(
     code = store.add_participant()
     first.consent(code, True)
     first.comfort(code, [True, True], adjusted=False)
-    answers = {"answer": "line", "felt_nothing": False, "confidence": None}
     first.send(code)
     now[0] += 1_500
-    first.answer(code, None, **answers)  # 1.5 s after its send, the runner running
+    first.answer(
+        code, None, answer="line", felt_nothing=False, confidence=None
+    )  # 1.5 s after its send, the runner running
     now[0] += 1_000
     first.send(code)
     now[0] += 600_000  # the runner dies here; another starts ten minutes later
     second = Session(store, player)
     now[0] += 2_000
-    second.answer(code, None, **answers)  # the page showed the stored send: not sent again
+    second.answer(
+        code, None, answer="line", felt_nothing=False, confidence=None
+    )  # the page showed the stored send: not sent again
     now[0] += 1_000
     second.send(code)
     now[0] += 2_500
-    second.answer(code, None, **answers)
+    second.answer(code, None, answer="line", felt_nothing=False, confidence=None)
     store.close()
     out = tmp_path / "export"
     assert main(["study", "export", str(tmp_path / "study.sqlite"), "--out", str(out)]) == 0
