@@ -126,6 +126,11 @@ def valid_cases() -> list[Case]:
             ACCEPTED,
             ("json-full", "every field of JSON v1", full),
             ("json-minimal", "only the required fields", minimal()),
+            (
+                "json-sent-at-latest",
+                "sent_at_ms exactly 1e13 (the year 2286), the latest",
+                minimal('"sent_at_ms":10000000000000'),
+            ),
             ("json-pretty", "indented over several lines", pretty),
             ("json-unknown-keys", "unknown keys are ignored", unknown),
             ("json-null-optionals", "null optional fields = absent", nulls),
@@ -370,6 +375,12 @@ def json_value_cases() -> list[Case]:
         *expect(
             "sent_at_out_of_range",
             ("sent-at-negative", "sent_at_ms -1", minimal('"sent_at_ms":-1')),
+            ("sent-at-far-future", "sent_at_ms 1e300", minimal('"sent_at_ms":1e300')),
+            (
+                "sent-at-after-2286",
+                "sent_at_ms 1 ms above 1e13",
+                minimal('"sent_at_ms":10000000000001'),
+            ),
         ),
     ]
 
@@ -502,8 +513,13 @@ def format_strokes() -> list[tuple[str, str, Stroke]]:
                 (3.0, 2.0),
                 1.2345678901234568e20,
                 intensity=5e-324,
-                sent_at_ms=1e21,
+                sent_at_ms=9999999999999.5,
             ),
+        ),
+        (
+            "exponent-duration",
+            "1e21 and above written with an exponent",
+            Stroke((0, 0), (3.0, 2.0), 1e21),
         ),
         (
             "escaped-drawing",

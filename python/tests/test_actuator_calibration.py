@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 from pathlib import Path
@@ -121,6 +122,17 @@ def test_a_sleeve_programs_its_motors_calibrates_once_and_restores_it_after_a_po
     ) as first:
         watcher.next(online, "the sleeve online")
         assert exit_code_after(first, signal.SIGTERM) == 0
+    # The log says each chip's results in a sentence, the registers as scan shows them.
+    logged = (tmp_path / "sleeve.log").read_text()
+    assert "Calibration(" not in logged
+    said = re.findall(
+        r"calibrated the DRV2605L on (multiplexer 0x7[01] channel \d).*?: its results "
+        r"are A_CAL_COMP 0x[0-9A-F]{2}, A_CAL_BEMF 0x[0-9A-F]{2} and BEMF_GAIN (\d)$",
+        logged,
+        flags=re.MULTILINE,
+    )
+    assert len(said) == len(load_layout(layout).wiring), logged
+    assert {gain for _, gain in said} == {str(expected["bemf_gain"])}
     calibrated = chips(state)
     assert len(calibrated) == len(load_layout(layout).wiring)
     results = {}

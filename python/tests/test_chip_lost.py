@@ -121,3 +121,45 @@ def test_a_chip_lost_mid_stroke_cuts_the_stroke_says_which_chip_and_switches_all
         e.get("drawing") == "d" and e.get("type") in ("played", "adjusted") for e in events
     ), events
     assert set(drive_levels(state).values()) == {0.0}
+
+
+def test_send_says_a_stroke_a_lost_chip_cut_part_way_once(broker: Broker, tmp_path: Path) -> None:
+    """``send --wait``'s line for the stroke: 'cut part-way' once, then the sleeve's reason."""
+    state = tmp_path / "bus.json"
+    wire = next(
+        w for w in load_layout(restart_off.PAPER).wiring if (w.row, w.column) == (ROW, LOST_COLUMN)
+    )
+    key = chip_key(wire.multiplexer, wire.channel)
+    with SleeveWatch(broker.credentials, "status", "events") as watcher:
+        sleeve = subprocess.Popen(
+            restart_off.sleeve_command(broker.credentials_path, state),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            watcher.next(online, "the sleeve online")
+            send = subprocess.Popen(
+                [
+                    *restart_off.feelmysign_command(),
+                    "send",
+                    "--credentials",
+                    str(broker.credentials_path),
+                    "--wait",
+                    "0,1,3,1,8000",
+                ],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            watcher.next(lambda n, b: b.get("type") == "played", "the stroke played")
+            wait_until(lambda: drive_levels(state)[key] == 0.0, "the lost chip was never off")
+            unplug(state, key)
+            out, err = send.communicate(timeout=WAIT_S)
+        finally:
+            sleeve.kill()
+            sleeve.wait(WAIT_S)
+    line = next((li for li in out.splitlines() if li.startswith("[1/1] cut")), None)
+    assert line is not None, out + err
+    assert line.startswith("[1/1] cut part-way (chip_lost): The DRV2605L"), line
+    assert line.count("part-way") == 1, line
+    assert f"channel {wire.channel}" in line, line

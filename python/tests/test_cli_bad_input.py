@@ -237,6 +237,18 @@ def test_a_layout_from_the_environment_is_checked_too(tmp_path: Path) -> None:
     assert_one_error(done, "layout file '/dev/zero' is a device")
 
 
+def test_a_stroke_of_no_duration_is_told_the_range_a_sleeve_allows(tmp_path: Path) -> None:
+    """Judged before connecting, when the sleeve's longest stroke is not known yet: the range
+    names it as the sleeve's (not the 600000 ms any sleeve is checked against) and what to
+    type."""
+    done = run(["send", "--broker", "mqtt://127.0.0.1:1", "0,0,2,0,0"], tmp_path)
+    line = assert_one_error(done, "(duration_not_positive)", "Nothing was sent.")
+    assert "600000" not in line
+    assert "more than 0 ms and at most the sleeve's longest stroke" in line
+    assert "10000 ms on the paper's sleeve" in line and "e.g. 0,0,2,0,500" in line
+    assert done.returncode == 1
+
+
 def test_a_negative_stroke_is_judged_not_taken_for_an_option(tmp_path: Path) -> None:
     done = run(["validate", "-1,0,1,0,500", "--json"], tmp_path)
     assert done.returncode == 1, done.stderr

@@ -193,6 +193,15 @@ def test_a_bad_stroke_sends_nothing(
     assert sleeve.receive(1) == [(LEGACY_TOPIC, "2,2,3,2,100")]
 
 
+def test_a_stroke_too_long_for_the_sleeve_is_told_the_sleeves_own_limit(
+    broker: Broker, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert send(broker, "0,0,1,1,700000") == 1
+    error = capsys.readouterr().err
+    assert "(duration_too_long)" in error and "at most 10000 ms" in error
+    assert "600000" not in error
+
+
 def test_a_bad_stroke_on_standard_input_names_its_line(
     broker: Broker, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

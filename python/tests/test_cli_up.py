@@ -452,6 +452,42 @@ def test_up_with_a_sleeve_builder_s_layout_emulates_its_buttons_and_says_how_to_
     assert not any("Error" in line for line in seen), seen
 
 
+@pytest.mark.broker
+def test_up_with_a_wearer_file_names_it_and_its_limits_in_the_banner(tmp_path: Path) -> None:
+    wearer = tmp_path / "wearer.json"
+    wearer.write_text('{"wearer": "P-LIMITS", "min_length": 0.62, "min_duration_ms": 118.4}')
+    web = tmp_path / "web"
+    web.mkdir()
+    (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    env["XDG_STATE_HOME"] = str(tmp_path / "xdg")
+    argv = [*RUN_ONLY, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
+    ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
+    up = subprocess.Popen(
+        [*argv, *ports, "--wearer", str(wearer)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env=env,
+    )
+    seen: list[str] = []
+    try:
+        _wait_for(_lines(up.stdout), "Press Ctrl-C to stop.", seen)
+    finally:
+        up.send_signal(signal.SIGINT)
+        try:
+            up.wait(timeout=WAIT_S)
+        finally:
+            if up.poll() is None:
+                up.kill()
+    banner = seen[next(i for i, line in enumerate(seen) if line == "feelmysign is up.") :]
+    said = [line for line in banner if line.startswith("  Wearer:")]
+    assert said == [
+        f"  Wearer:      P-LIMITS's limits from {wearer}: the sleeve asks senders for strokes "
+        "of at least 118.4 ms and 0.62 grid units"
+    ], seen
+
+
 @pytest.mark.skipif(shutil.which("make") is None, reason="needs make")
 def test_make_up_passes_args_on() -> None:
     done = subprocess.run(

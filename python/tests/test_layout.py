@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from feelmysign.cli import main
 from feelmysign.errors import LayoutError
 from feelmysign.layout import (
     MIN_BURST_MS,
@@ -225,12 +226,53 @@ def test_wiring_problems() -> None:
         "i2c.wiring[4].multiplexer: 0x72 is not declared in i2c.multiplexers "
         "(declared: 0x70, 0x71)",
         "i2c.wiring[5].channel: must be a whole number from 0 to 7; got 8",
-        "i2c.wiring: 4 of 12 actuators are not wired: (row 0, column 1), (row 0, column 2), "
-        "(row 0, column 3), (row 1, column 1)",
+        # Entries 1 and 5 name (0, 1) and (1, 1): wrong in another field, said above.
+        "i2c.wiring: 2 of 12 actuators are not wired: (row 0, column 2), (row 0, column 3);",
     ]
     for text in expected:
         assert any(problem.startswith(text) for problem in problems), (text, problems)
     assert len(problems) == len(expected)
+
+
+PAPER_TEXT = (LAYOUTS / "paper-sleeve.toml").read_text()
+
+
+@pytest.mark.parametrize(
+    ("change", "only"),
+    [
+        # An LRA's key with actuator_type mistyped: not blamed on an ERM as well.
+        (
+            ('actuator_type = "ERM"', 'actuator_type = "lra"\nresonant_frequency_hz = 175'),
+            'actuator_type: must be "ERM" or "LRA"; got "lra" (a string); write it in capitals',
+        ),
+        # A bad channel: its actuator is not called unwired as well.
+        (
+            ("multiplexer = 0x71, channel = 3 }", "multiplexer = 0x71, channel = 8 }"),
+            "i2c.wiring[11].channel: must be a whole number from 0 to 7; got 8",
+        ),
+        # A bad address in the list: the wires naming the one meant are not each said again.
+        (
+            ("multiplexers = [0x70, 0x71]", "multiplexers = [0x70, 0x80]"),
+            "i2c.multiplexers[1]: must be a TCA9548A address from 0x70 to 0x77; got 0x80",
+        ),
+        # An address left out of the list: one line for its four wires.
+        (
+            ("multiplexers = [0x70, 0x71]", "multiplexers = [0x70]"),
+            "i2c.wiring[8], [9], [10], [11].multiplexer: 0x71 is not declared in "
+            "i2c.multiplexers (declared: 0x70)",
+        ),
+    ],
+)
+def test_one_mistake_is_said_once_without_follow_on_lines(
+    change: tuple[str, str], only: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    old, new = change
+    assert PAPER_TEXT.count(old) == 1
+    layout = tmp_path / "sleeve.toml"
+    layout.write_text(PAPER_TEXT.replace(old, new))
+    assert main(["validate", "--layout", str(layout), "0,0,1,1,500"]) != 0
+    problems = [line for line in capsys.readouterr().err.splitlines() if line.startswith("  - ")]
+    assert len(problems) == 1 and problems[0].startswith(f"  - {only}"), problems
 
 
 def test_every_problem_is_reported_at_once() -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import signal
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -58,3 +59,37 @@ def test_an_unreachable_broker_is_said_once_and_the_sleeve_connects_when_it_come
     finally:
         sleeve.kill()
     assert sleeve.returncode == 0, log.read_text()
+
+
+def test_a_refused_login_is_said_alone_without_the_clock_line(
+    start_broker: StartBroker, tmp_path: Path
+) -> None:
+    """A wrong password: the refusal and the error, nothing on a clock that was not read."""
+    broker = start_broker(state_dir=tmp_path / "state")
+    c = broker.credentials
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "feelmysign",
+            "sleeve",
+            "--backend",
+            "sim",
+            "--no-legacy",
+            "--broker",
+            c.mqtt_url,
+            "--id",
+            c.sleeve_id,
+            "--username",
+            c.sleeve.username,
+            "--password",
+            "not-the-password",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    said = done.stdout + done.stderr
+    assert done.returncode == 1, said
+    assert "refused the sleeve: Not authorized" in said, said
+    assert "clock" not in said, said

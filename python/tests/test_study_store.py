@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import random
@@ -15,6 +16,7 @@ from pathlib import Path
 import pytest
 from study_helpers import PAPER_DESIGN, ZIGZAG_SHAPE, new_study, zigzag_recording
 
+from feelmysign.cli import main
 from feelmysign.errors import StudyError
 from feelmysign.study import StudyStore
 from feelmysign.study.dry_run import dry_run, run_simulated_participant
@@ -67,6 +69,8 @@ def test_an_answer_is_never_overwritten_and_needs_consent(tmp_path: Path) -> Non
     with pytest.raises(StudyError, match="send the shape"):
         session.answer(code, trial["id"], answer="line", felt_nothing=False, confidence=None)
     session.send(code)
+    with pytest.raises(StudyError, match="'felt nothing' takes no confidence"):
+        session.answer(code, trial["id"], answer="", felt_nothing=True, confidence=2)
     session.answer(code, trial["id"], answer="line", felt_nothing=False, confidence=4)
     with pytest.raises(StudyError, match="not the current one"):
         session.answer(code, trial["id"], answer="circle", felt_nothing=False, confidence=None)
@@ -154,3 +158,44 @@ def test_a_dry_run_sends_and_answers_a_recorded_drawing_too(tmp_path: Path) -> N
         "WHERE t.shape = 'zigzag'"
     )
     assert {len(json.loads(r[0])) for r in strokes} == {t["segments"] for t in rows}
+
+
+def test_a_response_time_never_holds_the_time_no_runner_ran(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A runner stopped (a crash) after a shape was felt and before its answer: the answer
+    recorded after the restart, without sending again, has no response time (how long the
+    participant took is not known, and the time between is none of it); answers within one
+    run keep theirs."""
+    store = new_study(tmp_path)
+    now = [1_800_000_000_000]
+    store.clock = lambda: now[0]
+    player = offline_player(Session(store, None).layout)
+    first = Session(store, player)
+    code = store.add_participant()
+    first.consent(code, True)
+    first.comfort(code, [True, True], adjusted=False)
+    first.send(code)
+    now[0] += 1_500
+    first.answer(
+        code, None, answer="line", felt_nothing=False, confidence=None
+    )  # 1.5 s after its send, the runner running
+    now[0] += 1_000
+    first.send(code)
+    now[0] += 600_000  # the runner dies here; another starts ten minutes later
+    second = Session(store, player)
+    now[0] += 2_000
+    second.answer(
+        code, None, answer="line", felt_nothing=False, confidence=None
+    )  # the page showed the stored send: not sent again
+    now[0] += 1_000
+    second.send(code)
+    now[0] += 2_500
+    second.answer(code, None, answer="line", felt_nothing=False, confidence=None)
+    store.close()
+    out = tmp_path / "export"
+    assert main(["study", "export", str(tmp_path / "study.sqlite"), "--out", str(out)]) == 0
+    capsys.readouterr()
+    with (out / "trials.csv").open(newline="") as handle:
+        times = [row["response_time_s"] for row in csv.DictReader(handle)]
+    assert times == ["1.5", "", "2.5"], times

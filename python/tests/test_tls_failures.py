@@ -6,10 +6,15 @@ from __future__ import annotations
 
 import contextlib
 import datetime
+import hashlib
 import ipaddress
+import os
 import socket
 import ssl
+import subprocess
+import sys
 import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -21,6 +26,7 @@ from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import NameOID
 
 from feelmysign.cli import main
+from feelmysign.connection.join_token import JoinToken
 
 
 def _name(text: str) -> x509.Name:
@@ -138,3 +144,48 @@ def test_a_ca_file_with_no_certificate_in_it_is_said(
     err = capsys.readouterr().err
     assert f"The CA file {key} holds no certificate" in err and "ca.pem" in err, err
     assert "bug" not in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("host", "expired", "says"),
+    [
+        ("127.0.0.1", True, "certificate has expired"),
+        ("192.0.2.7", False, "it is not made out for '127.0.0.1'"),
+    ],
+)
+def test_the_sleeve_says_why_the_certificate_was_refused_not_that_nothing_answers(
+    tmp_path: Path, host: str, expired: bool, says: str
+) -> None:
+    """The sleeve's own line for a refused certificate says the TLS problem and what to do,
+    as the senders do; it goes on retrying (the certificate may be renewed)."""
+    ca, cert, key = _certificates(tmp_path / "broker", host, expired=expired)
+    # The sleeve joins with a token pinning that CA, kept where a first join keeps it.
+    fingerprint = hashlib.sha256(ssl.PEM_cert_to_DER_cert(ca.read_text())).hexdigest()
+    trusted = tmp_path / "state" / "feelmysign" / "trusted"
+    trusted.mkdir(parents=True)
+    (trusted / f"ca-{fingerprint[:16]}.pem").write_text(ca.read_text())
+    log = tmp_path / "sleeve.log"
+    with _tls_server(cert, key) as port, log.open("w") as stderr:
+        token = JoinToken(f"mqtts://127.0.0.1:{port}", "s1", "sleeve", "pw", fingerprint)
+        sleeve = subprocess.Popen(
+            [sys.executable, "-m", "feelmysign", "sleeve", "--backend", "sim"],
+            stdout=subprocess.DEVNULL,
+            stderr=stderr,
+            env={
+                **{k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")},
+                "XDG_STATE_HOME": str(tmp_path / "state"),
+                "FEELMYSIGN_JOIN": token.encode(),
+            },
+        )
+        try:
+            deadline = time.monotonic() + 60
+            while "cannot connect to the broker" not in log.read_text():
+                assert sleeve.poll() is None, log.read_text()
+                assert time.monotonic() < deadline, log.read_text()
+                time.sleep(0.1)
+        finally:
+            sleeve.terminate()
+            sleeve.wait(timeout=60)
+    said = log.read_text()
+    assert "the broker's certificate was refused" in said and says in said, said
+    assert "nothing answers" not in said, said

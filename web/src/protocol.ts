@@ -23,6 +23,8 @@ export const JSON_VERSION = 1;
 export const LEGACY_DECIMALS = 4;
 /** The largest integer a JavaScript sender holds exactly. */
 export const MAX_SEQ = Number.MAX_SAFE_INTEGER;
+/** The latest sent_at_ms a sender's clock can give (1e13 ms: 20 November 2286), as the sleeve checks. */
+export const MAX_SENT_AT_MS = 1e13;
 /** Printable ASCII without spaces, 1 to 64 characters (a UUID is 36). */
 export const DRAWING_ID = /^[!-~]{1,64}$/;
 /** Number.prototype.toFixed switches to exponent notation from here on. */
@@ -133,6 +135,12 @@ export function strokeProblem(stroke: Stroke): StrokeError | null {
     }
     if (sent_at_ms < 0) {
       return new StrokeError("sent_at_out_of_range", `sent_at_ms is ${sent_at_ms}; it must be 0 or more.`);
+    }
+    if (sent_at_ms > MAX_SENT_AT_MS) {
+      return new StrokeError(
+        "sent_at_out_of_range",
+        `sent_at_ms is ${sent_at_ms}; it must be at most ${MAX_SENT_AT_MS} (the year 2286): check this machine's clock.`,
+      );
     }
   }
   return null;

@@ -33,6 +33,7 @@ describe("invalid strokes are refused before they reach the wire", () => {
     ["negative seq", { seq: -1 }, "seq_out_of_range"],
     ["spaces in drawing id", { drawing: "a b" }, "bad_drawing_id"],
     ["negative sent_at_ms", { sent_at_ms: -5 }, "sent_at_out_of_range"],
+    ["sent_at_ms beyond 2286", { sent_at_ms: 1e300 }, "sent_at_out_of_range"],
   ])("%s", (_what, change, reason) => {
     const stroke = { ...base, ...change };
     expect(strokeProblem(stroke)?.reason).toBe(reason);

@@ -35,6 +35,8 @@ import hmac
 import json
 import logging
 import queue
+import ssl
+import sys
 import threading
 import time
 from collections import Counter, OrderedDict, deque
@@ -45,7 +47,12 @@ from feelmysign import __version__
 from feelmysign.backends.base import Backend
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.clock import both_ms, wall_ms
-from feelmysign.connection import RECONNECT_MAX_S, BrokerSettings, new_client
+from feelmysign.connection import (
+    RECONNECT_MAX_S,
+    BrokerSettings,
+    connect_failure_message,
+    new_client,
+)
 from feelmysign.control import Cancel, parse_control
 from feelmysign.errors import FeelMySignError
 from feelmysign.events import (
@@ -445,7 +452,19 @@ class Sleeve:
     def _on_connect_fail(self, client: mqtt.Client, userdata: Any) -> None:
         now = time.monotonic()
         since = self._unreachable_since
-        if since is None:
+        # paho calls this in the handler of the attempt's OSError: a TLS failure is said as
+        # such (the certificate's own reason and what to do), as the senders say it.
+        error = sys.exc_info()[1]
+        if since is None and isinstance(error, ssl.SSLError):
+            self._unreachable_since = self._unreachable_said_at = now
+            log.warning(
+                "sleeve %s: cannot connect to the broker: %s Retrying every %g s at most.",
+                self._id,
+                connect_failure_message(self._settings, error),
+                RECONNECT_MAX_S,
+                extra=CONNECTION_STATE,
+            )
+        elif since is None:
             self._unreachable_since = self._unreachable_said_at = now
             log.warning(
                 "sleeve %s: cannot reach the broker at %s (nothing answers, or the host is "

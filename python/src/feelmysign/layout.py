@@ -470,7 +470,8 @@ def _read_motor(problems: _Problems, data: dict[str, Any]) -> dict[str, Any]:
     frequency = data.get("resonant_frequency_hz")
     read["resonant_frequency_hz"] = None
     if frequency is not None:
-        if kind != "LRA":
+        # A kind that is neither (a typo, said on its own) is not taken for an ERM here.
+        if kind == "ERM":
             problems.add(
                 "resonant_frequency_hz",
                 'is for an LRA only (actuator_type = "LRA"); an ERM has no resonance to '
@@ -542,8 +543,12 @@ def _read_i2c(
 ) -> dict[str, Any]:
     i2c = problems.table("i2c", value, _I2C_KEYS)
     bus = problems.integer("i2c.bus", i2c.get("bus", _DEFAULTS.i2c_bus), 0, MAX_I2C_BUS)
+    said = len(problems.items)
     multiplexers = _read_multiplexers(problems, i2c.get("multiplexers", []))
-    wiring = _read_wiring(problems, i2c.get("wiring", []), rows, columns, multiplexers)
+    # A bad entry in the list is said there: the wires naming the address it was meant to be
+    # are not said again as "not declared".
+    declared = None if len(problems.items) > said else multiplexers
+    wiring = _read_wiring(problems, i2c.get("wiring", []), rows, columns, declared)
     enable = None
     if "enable" in i2c:
         enable = _read_enable(problems, i2c["enable"], bool(i2c.get("wiring")))
@@ -653,8 +658,10 @@ def _read_wiring(
     value: Any,
     rows: int | None,
     columns: int | None,
-    declared: tuple[int, ...],
+    declared: tuple[int, ...] | None,
 ) -> tuple[Wire, ...]:
+    """The wires of ``i2c.wiring``; ``declared`` None: the multiplexer list had a bad entry,
+    and no wire's multiplexer is checked against it."""
     if not isinstance(value, list):
         problems.add(
             "i2c.wiring",
@@ -664,9 +671,15 @@ def _read_wiring(
     by_channel: dict[tuple[int, int], str] = {}
     by_actuator: dict[tuple[int, int], str] = {}
     wires: list[Wire] = []
+    # The actuators entries name, even entries with another field wrong (said on their own:
+    # not "not wired" again), and the entries naming each multiplexer not declared.
+    named: set[tuple[int, int]] = set()
+    undeclared: dict[int, list[int]] = {}
     for index, entry in enumerate(value):
         key = f"i2c.wiring[{index}]"
-        wire = _read_wire(problems, key, entry, rows, columns, declared)
+        wire = _read_wire(problems, key, entry, rows, columns, named)
+        if wire is not None and declared is not None and wire.multiplexer not in declared:
+            undeclared.setdefault(wire.multiplexer, []).append(index)
         if wire is None:
             continue
         channel, actuator = (wire.multiplexer, wire.channel), (wire.row, wire.column)
@@ -686,8 +699,16 @@ def _read_wiring(
             by_channel[channel] = f"{key} (row {wire.row}, column {wire.column})"
             by_actuator[actuator] = key
             wires.append(wire)
+    for multiplexer, indices in undeclared.items():
+        listed = ", ".join(_hex(a) for a in declared or ()) or "none"
+        entries = "i2c.wiring[" + "], [".join(map(str, indices)) + "]"
+        problems.add(
+            f"{entries}.multiplexer",
+            f"{_hex(multiplexer)} is not declared in i2c.multiplexers (declared: {listed}); "
+            "add it there or fix the address",
+        )
     if value and rows and columns:
-        _check_all_wired(problems, rows, columns, set(by_actuator))
+        _check_all_wired(problems, rows, columns, set(by_actuator) | named)
     return tuple(sorted(wires, key=lambda w: (w.row, w.column)))
 
 
@@ -697,8 +718,10 @@ def _read_wire(
     entry: Any,
     rows: int | None,
     columns: int | None,
-    declared: tuple[int, ...],
+    named: set[tuple[int, int]],
 ) -> Wire | None:
+    """The entry's wire, None when a field is bad; the actuator it names goes into ``named``
+    when its row and column are good."""
     table = problems.table(key, entry, _WIRE_KEYS)
     if not table:
         return None
@@ -711,13 +734,8 @@ def _read_wire(
     channel = problems.integer(
         f"{key}.channel", table.get("channel", _MISSING), 0, MUX_CHANNELS - 1
     )
-    if multiplexer is not None and multiplexer not in declared:
-        listed = ", ".join(_hex(a) for a in declared) or "none"
-        problems.add(
-            f"{key}.multiplexer",
-            f"{_hex(multiplexer)} is not declared in i2c.multiplexers (declared: {listed}); "
-            "add it there or fix the address",
-        )
+    if row is not None and column is not None:
+        named.add((row, column))
     if row is None or column is None or multiplexer is None or channel is None:
         return None
     return Wire(row=row, column=column, multiplexer=multiplexer, channel=channel)

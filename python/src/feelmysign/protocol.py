@@ -37,6 +37,9 @@ LEGACY_DECIMALS = 4  # 1e-4 grid units is ~3 micrometres on a 3 cm grid: far bel
 GRID_TOLERANCE = 1e-9  # a sender's float maths may land 2.9999999999 for 3; accepted, then clamped
 MAX_DRAWING_ID_CHARS = 64  # a UUID is 36; room for a prefix, small enough for logs and topics
 MAX_SEQ = 2**53 - 1  # the largest integer a JavaScript sender holds exactly
+# The latest sent_at_ms a sender's clock can give: 1e13 ms since 1970 is 20 November 2286.
+# Beyond it the clock is broken (or the field holds something else), and its pace is nonsense.
+MAX_SENT_AT_MS = 1e13
 JSON_VERSION = 1
 SHOWN_VALUE_CHARS = 40  # bad values are quoted in messages up to this many characters
 
@@ -93,7 +96,7 @@ REASONS: dict[str, str] = {
     DURATION_NOT_POSITIVE: "duration_ms is 0 or negative",
     DURATION_TOO_LONG: "duration_ms is above the sleeve's max_stroke_duration_ms",
     INTENSITY_OUT_OF_RANGE: "intensity is outside 0..1",
-    SENT_AT_OUT_OF_RANGE: "sent_at_ms is negative",
+    SENT_AT_OUT_OF_RANGE: "sent_at_ms is negative or above 1e13 (the year 2286)",
 }
 
 # JSON's whitespace (RFC 8259), also stripped around the legacy payload and each field.
@@ -145,8 +148,13 @@ class Rejected:
         )
 
 
-def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accepted | Rejected:
+def parse(
+    payload: object, layout: Layout | None, *, format: Format = "auto"
+) -> Accepted | Rejected:
     """Parse and validate one stroke message against ``layout``'s grid and duration cap.
+
+    ``layout`` None: the message's form only, for a sender that does not know the sleeve
+    yet: no grid and no duration cap (any sleeve's), and the stroke is not clamped.
 
     ``format="auto"`` reads JSON when the text starts with ``{`` or ``[`` (after
     whitespace), the legacy CSV otherwise. Never raises on any payload.
@@ -172,10 +180,12 @@ def parse(payload: object, layout: Layout, *, format: Format = "auto") -> Accept
         stroke = _parse_legacy(body)
     if isinstance(stroke, Rejected):
         return stroke
-    checked = validate_stroke(stroke, layout)
+    checked = (
+        validate_stroke(stroke, layout) if layout is not None else _first_problem(stroke, None)
+    )
     if isinstance(checked, Rejected):
         return _named(checked, stroke)
-    return Accepted(checked, chosen)
+    return Accepted(stroke if checked is None else checked, chosen)
 
 
 def _named(problem: Rejected, stroke: Stroke) -> Rejected:
@@ -502,7 +512,7 @@ def _plain_json(document: dict[str, Any], layout: Layout) -> Stroke | None:
         intensity = float(intensity)
     sent_at_ms = get("sent_at_ms")
     if sent_at_ms is not None:
-        if type(sent_at_ms) not in numbers or not 0 <= sent_at_ms <= _PLAIN_SENT_AT_MAX_MS:
+        if type(sent_at_ms) not in numbers or not 0 <= sent_at_ms <= MAX_SENT_AT_MS:
             return None
         sent_at_ms = float(sent_at_ms)
     # As _clamp leaves a point inside the grid: a float, -0.0 made 0.0.
@@ -515,11 +525,6 @@ def _plain_json(document: dict[str, Any], layout: Layout) -> Stroke | None:
         seq,
         sent_at_ms,
     )
-
-
-# sent_at_ms beyond this (the year 33,000 and on) is read the long way, where an integer too
-# large for a float becomes infinite and is refused.
-_PLAIN_SENT_AT_MAX_MS = 1e15
 
 
 def _json_error_text(error: Exception) -> str:
@@ -781,8 +786,16 @@ def _check_sent_at(sent_at_ms: float | None) -> Rejected | None:
             f"sent_at_ms is {_number(sent_at_ms)}; it must be a finite time in milliseconds.",
             "sent_at_ms",
         )
-    if sent_at_ms >= 0:
+    if 0 <= sent_at_ms <= MAX_SENT_AT_MS:
         return None
+    if sent_at_ms > MAX_SENT_AT_MS:
+        return Rejected(
+            SENT_AT_OUT_OF_RANGE,
+            f"sent_at_ms is {_number(sent_at_ms)}; it must be the sender's clock in "
+            f"milliseconds since 1970-01-01 UTC, from 0 to {_number(MAX_SENT_AT_MS)} (the year "
+            "2286): check the sender's clock, or leave it out.",
+            "sent_at_ms",
+        )
     return Rejected(
         SENT_AT_OUT_OF_RANGE,
         f"sent_at_ms is {_number(sent_at_ms)}; it must be the sender's clock in milliseconds "

@@ -253,7 +253,8 @@ export class SessionView {
       "Felt nothing",
     );
     const submit = (feltNothing: boolean) => {
-      const value = confidence.value === "" ? null : Number(confidence.value);
+      // Felt nothing: there is nothing to be confident of, whatever the list shows.
+      const value = feltNothing || confidence.value === "" ? null : Number(confidence.value);
       this.#run(() => api.answer(code, trial.id, feltNothing ? "" : answer.value, feltNothing, value));
     };
     send.addEventListener("click", () => {

@@ -159,6 +159,13 @@ class Calibration:
     a_cal_bemf: int
     bemf_gain: int
 
+    def __str__(self) -> str:
+        """The results as a log or a person reads them, the registers as scan shows them."""
+        return (
+            f"A_CAL_COMP 0x{self.a_cal_comp:02X}, A_CAL_BEMF 0x{self.a_cal_bemf:02X} and "
+            f"BEMF_GAIN {self.bemf_gain}"
+        )
+
 
 def calibration_path(name: str) -> str:
     """``$XDG_STATE_HOME/feelmysign/calibration/NAME.json`` (``/var/lib/...`` under systemd)."""

@@ -517,7 +517,9 @@ class Drv2605Backend(GridBackend):
                 measured[self._chip_name(key)] = outcome
                 self._guard(actuator, "after calibrating", self._start_rtp, key, actuator)
                 self._playing.add(key)
-                log.info("calibrated the DRV2605L on %s: %s", actuator.where, outcome)
+                log.info(
+                    "calibrated the DRV2605L on %s: its results are %s", actuator.where, outcome
+                )
         finally:
             if measured and self._store is not None:
                 try:

@@ -65,7 +65,7 @@ from feelmysign.input_files import loads_json
 from feelmysign.layout import MAX_DURATION_MS, MAX_GRID_SIDE, PAPER_SLEEVE, Layout, check_layout
 from feelmysign.outcome import DrawingOutcome, StrokeOutcome
 from feelmysign.plural import plural
-from feelmysign.protocol import LATE, Accepted, parse
+from feelmysign.protocol import DURATION_NOT_POSITIVE, LATE, Accepted, parse
 from feelmysign.sending import (
     STATUS_WAIT_S,
     OutgoingStroke,
@@ -458,6 +458,10 @@ class _InOrder:
             self._waiting.clear()
 
 
+# How the sleeve begins the message of a stroke a lost chip cut after it began (player.py).
+CUT_PART_WAY = "cut part-way, after its played event: "
+
+
 def _answer_line(
     seq: int, total: int, stroke: StrokeOutcome, event: Event, *, json_lines: bool
 ) -> str:
@@ -466,7 +470,10 @@ def _answer_line(
     width = len(str(total))
     where = f"[{seq + 1:>{width}}/{total}]"
     if stroke.cut_reason is not None:
-        return f"{where} cut part-way ({stroke.cut_reason}): {getattr(event, 'message', '')}"
+        # The sleeve's own sentence may begin with what the line says ("cut part-way, after
+        # its played event: The DRV2605L ..."): said once.
+        message = str(getattr(event, "message", "") or "").removeprefix(CUT_PART_WAY)
+        return f"{where} cut part-way ({stroke.cut_reason}): {message}".rstrip(": ")
     if stroke.refused_reason == LATE:  # said as the summary, up's line and the page say it
         return f"{where} skipped as late: {stroke.refused_message or ''}".rstrip()
     if stroke.refused_reason is not None:
@@ -684,9 +691,21 @@ def _strokes(
         )
     drawing = str(uuid.uuid4())
     strokes = []
+    # Before the sleeve's grid is known its form only: its grid and its longest stroke are the
+    # sleeve's, checked once its status is read (ANY_GRID's would be quoted as the sleeve's).
+    known = layout is not ANY_GRID
     for seq, (where, text) in enumerate(texts):
-        result = parse(text, layout, format="legacy")
+        result = parse(text, layout if known else None, format="legacy")
         if not isinstance(result, Accepted):
+            if not known and result.reason == DURATION_NOT_POSITIVE:
+                result = replace(
+                    result,
+                    message=f"{result.message.removesuffix('.')} and at most the sleeve's "
+                    "longest stroke (its layout's max_stroke_duration_ms, "
+                    f"{PAPER_SLEEVE.max_stroke_duration_ms:g} ms on the paper's sleeve): give "
+                    "the duration in milliseconds as the stroke's fifth number, e.g. "
+                    "0,0,2,0,500.",
+                )
             raise result.as_error(f"{where} {text!r}", then=" Nothing was sent.")
         strokes.append(replace(result.stroke, intensity=args.intensity, drawing=drawing, seq=seq))
     if not strokes:

@@ -181,6 +181,7 @@ def _run(
             )
 
             log = DrawingLog(c.settings("sender"), c.sleeve_id)  # a line per drawing
+            limits = _wearer_limits(wearer, layout, args.wearer)
 
             def started(sleeve: Sleeve) -> None:
                 running.append(sleeve)
@@ -188,7 +189,7 @@ def _run(
                 watchdog.watch(sleeve, log.listening)
                 threading.Thread(
                     target=_announce,
-                    args=(sleeve, page_url, broker, api is not None, wearer_url),
+                    args=(sleeve, page_url, broker, api is not None, wearer_url, limits),
                     daemon=True,
                 ).start()
 
@@ -240,8 +241,27 @@ def _port_or_free(asked: int | None, default: int, name: str) -> int:
     return default
 
 
+def _wearer_limits(wearer: Wearer | None, layout: Layout, path: str | None) -> str:
+    """The banner's line for ``--wearer FILE``: whose limits, from which file, and the floor
+    the sleeve's status then asks senders to keep ("" without a wearer)."""
+    if wearer is None:
+        return ""
+    from feelmysign.wearer import sleeve_floor
+
+    floor = sleeve_floor(layout, wearer)
+    return (
+        f"  Wearer:      {wearer.name}'s limits from {path}: the sleeve asks senders for strokes "
+        f"of at least {floor.min_duration_ms:g} ms and {floor.min_length:g} grid units\n"
+    )
+
+
 def _announce(
-    sleeve: Sleeve, url: str, broker: Broker, study: bool = False, wearer_url: str | None = None
+    sleeve: Sleeve,
+    url: str,
+    broker: Broker,
+    study: bool = False,
+    wearer_url: str | None = None,
+    limits: str = "",
 ) -> None:
     if not sleeve.connected.wait(15):
         print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
@@ -263,7 +283,8 @@ def _announce(
         + lan
         + _for_the_wearer(wearer_url, lan=bool(lan))
         + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
-        f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
+        + limits
+        + f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"
         f"One line per drawing follows here once it has been played.\n"
         f"Press Ctrl-C to stop.",

@@ -104,7 +104,11 @@ def dry_run(
         raise StudyError(f"unknown simulated wearer {wearer!r}; one of {', '.join(WEARERS)}")
     session = Session(store, None, simulation_seed=seed)
     session = Session(
-        store, play or offline_player(session.layout), simulation_seed=seed, wearer=wearer
+        store,
+        play or offline_player(session.layout),
+        simulation_seed=seed,
+        wearer=wearer,
+        dry_run=True,
     )
     clock = SimulatedClock(now_ms()) if play is None else None
     codes = []

@@ -79,6 +79,7 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
         for r in store.query("SELECT trial, COUNT(*) AS n FROM codings GROUP BY trial")
     }
     design = store.design
+    starts = store.runner_starts()
     out = []
     for participant in store.participants():
         for trial in store.trials(participant["code"]):
@@ -99,6 +100,12 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
             # From the send the answer follows (a repeat send restarts the clock; so does a
             # restart of the session, which sends again).
             last_sent = sends[-1]["sent_at_ms"] if sends else trial["answered_at_ms"]
+            answered = trial["answered_at_ms"]
+            # A runner started between the send and the answer: it crashed or was stopped
+            # with the shape felt and not answered. The time no runner ran is no response
+            # time, and how long the participant took is not known: left out.
+            resumed = any(last_sent < at <= answered for at in starts)
+            response_s = "" if resumed else round((answered - last_sent) / 1000, 3)
             speed = {} if not design.speed_is_factor else {SPEED_COLUMN: trial["speed_cm_s"]}
             out.append(
                 {
@@ -131,7 +138,7 @@ def trial_rows(store: StudyStore) -> list[dict[str, Any]]:
                     if summary["latency_ms_max"] is None
                     else summary["latency_ms_max"],
                     "felt_duration_ms": summary["felt_duration_ms"],
-                    "response_time_s": round((trial["answered_at_ms"] - last_sent) / 1000, 3),
+                    "response_time_s": response_s,
                 }
             )
     return out

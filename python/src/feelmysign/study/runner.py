@@ -93,6 +93,7 @@ class Session:
         *,
         simulation_seed: int = 0,
         wearer: str = "template",
+        dry_run: bool = False,
     ) -> None:
         self.store = store
         self._play = play
@@ -104,6 +105,10 @@ class Session:
         # plays, and the trial is sent again.
         self._playing: set[int] = set()
         self._playing_lock = threading.Lock()
+        # A runner that sends to a sleeve (the page's server, the terminal): its start is
+        # kept, so that an answer's time is counted within one run of it (export.trial_rows).
+        if play is not None and not dry_run:
+            store.note_runner_start()
 
     @functools.cached_property
     def _templates(self) -> dict[str, list[Point]]:
@@ -261,6 +266,11 @@ class Session:
             raise StudyError(f"an answer is at most {MAX_ANSWER_CHARS} characters")
         if not text and not felt_nothing:
             raise StudyError("type the answer, or choose 'felt nothing'")
+        if felt_nothing and confidence is not None:
+            raise StudyError(
+                "'felt nothing' takes no confidence: record it without one, or record the "
+                "answer the participant gave with its confidence"
+            )
         if confidence is not None and not 1 <= confidence <= CONFIDENCE_POINTS:
             raise StudyError(f"confidence is 1 to {CONFIDENCE_POINTS}, or none")
         synonyms = [(s.name, s.synonyms) for s in self.store.design.shapes]

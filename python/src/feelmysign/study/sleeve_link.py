@@ -18,8 +18,8 @@ from typing import Any
 import paho.mqtt.client as mqtt
 
 from feelmysign.connection import BrokerSettings, connect_client
-from feelmysign.events import Event, EventError, Played, Rejected, event_from_json
-from feelmysign.sending import OutgoingStroke, StrokeSender
+from feelmysign.events import Event, EventError, Played, Rejected, StatusFloor, event_from_json
+from feelmysign.sending import OutgoingStroke, StrokeSender, sleeve_floor_from_status
 from feelmysign.stroke import Stroke
 from feelmysign.topics import telemetry_topic
 
@@ -94,6 +94,12 @@ class SleeveLink:
         if self._client is not None:
             self._client.disconnect()
             self._client.loop_stop()
+
+    def floor(self) -> StatusFloor | None:
+        """The floor the sleeve advertises in its retained status (with its wearer's limits,
+        when it was started with them); None when the broker holds no status with one."""
+        assert self._client is not None, "use SleeveLink in a with block"
+        return sleeve_floor_from_status(self._client, self._settings)
 
     def play(self, strokes: list[Stroke]) -> list[dict[str, Any]]:
         """Publish ``strokes`` (one drawing) at their pace; the sleeve's events for them."""

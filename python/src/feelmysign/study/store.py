@@ -34,6 +34,7 @@ CODE_ALPHABET = "23456789ABCDEFGHJKMNPQRSTUVWXYZ"
 CODE_LENGTH = 5
 
 
+RUNNER_STARTS = "runner_starts_json"  # meta: when each runner started (note_runner_start)
 DISCARDED = "discarded"  # a threshold run's stop_reason when the researcher discarded it
 
 
@@ -180,6 +181,23 @@ class StudyStore:
     def set_meta(self, key: str, value: str) -> None:
         with self._transaction() as db:
             db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", (key, value))
+
+    def note_runner_start(self) -> None:
+        """A runner (the page's server or the terminal, one that sends) starts on this file:
+        its time is kept, so that an answer recorded after a restart, to a shape sent before
+        it, is known to have waited through the time no runner ran."""
+        with self._transaction() as db:
+            row = db.execute("SELECT value FROM meta WHERE key = ?", (RUNNER_STARTS,)).fetchone()
+            starts = [*json.loads(row[0]), self.clock()] if row else [self.clock()]
+            db.execute(
+                "INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)",
+                (RUNNER_STARTS, json.dumps(starts)),
+            )
+
+    def runner_starts(self) -> list[int]:
+        """When a runner started on this file, oldest first (none kept before this was)."""
+        stored = self.meta(RUNNER_STARTS)
+        return [int(at) for at in json.loads(stored)] if stored else []
 
     # ---- participants ------------------------------------------------------------------
 

@@ -7,7 +7,9 @@ stops with every answer given so far stored, and the same command resumes.
 from __future__ import annotations
 
 from feelmysign.connection import BrokerSettings
+from feelmysign.events import StatusFloor
 from feelmysign.plural import plural
+from feelmysign.study.below_floor import below_floor, below_floor_message
 from feelmysign.study.runner import Session
 from feelmysign.study.sleeve_link import SleeveLink
 from feelmysign.study.store import StudyStore
@@ -31,6 +33,7 @@ def run_in_terminal(store: StudyStore, settings: BrokerSettings, participant: st
 def _session(store: StudyStore, settings: BrokerSettings, participant: str | None) -> int:
     with SleeveLink(settings) as link:
         session = Session(store, link.play)
+        _say_below_floor(store, link.floor(), settings.sleeve_id)
         code = participant or store.add_participant()
         print(f"Participant {code} ({store.design.name}). Ctrl-C stops; the same command resumes.")
         design = store.design
@@ -60,7 +63,8 @@ def _session(store: StudyStore, settings: BrokerSettings, participant: str | Non
             answer = input("  Answer (empty = felt nothing, 'r' = send again): ").strip()
             if answer == "r":
                 continue
-            confidence = input("  Confidence 1-5 (empty = none): ").strip()
+            # Felt nothing: there is nothing to be confident of, and none is asked.
+            confidence = input("  Confidence 1-5 (empty = none): ").strip() if answer else ""
             coding = session.answer(
                 code,
                 trial["id"],
@@ -82,6 +86,17 @@ def _session(store: StudyStore, settings: BrokerSettings, participant: str | Non
             session.questionnaire(code, values)
         print(f"Session of {code}: {session.step(code)}.")
     return 0
+
+
+def _say_below_floor(store: StudyStore, floor: StatusFloor | None, sleeve_id: str) -> None:
+    """Once, before the first trial: the conditions whose strokes are below the wearer's
+    limits the sleeve advertises (none said without a wearer's limits: the sleeve's own floor
+    is what ``study check`` warns about)."""
+    if floor is None or not floor.wearer:
+        return
+    found = below_floor(store.design, store.base_dir, floor)
+    if found:
+        print(below_floor_message(found, floor, sleeve_id), flush=True)
 
 
 def review_in_terminal(store: StudyStore) -> int:

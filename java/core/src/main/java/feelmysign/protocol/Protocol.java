@@ -47,6 +47,12 @@ public final class Protocol {
   public static final int MAX_DRAWING_ID_CHARS = 64;
   /** The largest integer a JavaScript sender holds exactly. */
   public static final long MAX_SEQ = (1L << 53) - 1;
+
+  /**
+   * The latest {@code sent_at_ms} a sender's clock can give: 1e13 ms since 1970 is 20 November
+   * 2286. Beyond it the clock is broken, and the stroke's pace would be nonsense.
+   */
+  public static final double MAX_SENT_AT_MS = 1e13;
   public static final int JSON_VERSION = 1;
 
   static final String LEGACY_EXAMPLE = "'0,0,2,0,1000'";
@@ -781,8 +787,18 @@ public final class Protocol {
           "sent_at_ms is " + number(sentAtMs) + "; it must be a finite time in milliseconds.",
           "sent_at_ms");
     }
-    if (sentAtMs >= 0) {
+    if (sentAtMs >= 0 && sentAtMs <= MAX_SENT_AT_MS) {
       return null;
+    }
+    if (sentAtMs > MAX_SENT_AT_MS) {
+      return new Rejected(
+          SENT_AT_OUT_OF_RANGE,
+          "sent_at_ms is "
+              + number(sentAtMs)
+              + "; it must be the sender's clock in milliseconds since 1970-01-01 UTC, from 0 to "
+              + number(MAX_SENT_AT_MS)
+              + " (the year 2286): check the sender's clock, or leave it out.",
+          "sent_at_ms");
     }
     return new Rejected(
         SENT_AT_OUT_OF_RANGE,

@@ -53,7 +53,7 @@ public final class Reasons {
     all.put(DURATION_NOT_POSITIVE, "duration_ms is 0 or negative");
     all.put(DURATION_TOO_LONG, "duration_ms is above the sleeve's max_stroke_duration_ms");
     all.put(INTENSITY_OUT_OF_RANGE, "intensity is outside 0..1");
-    all.put(SENT_AT_OUT_OF_RANGE, "sent_at_ms is negative");
+    all.put(SENT_AT_OUT_OF_RANGE, "sent_at_ms is negative or above 1e13 (the year 2286)");
     ALL = java.util.Collections.unmodifiableMap(all);
   }
 }
