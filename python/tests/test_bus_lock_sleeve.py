@@ -11,6 +11,7 @@ same and says that the sleeve drives the motors again; a second sleeve is refuse
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import threading
@@ -20,9 +21,12 @@ from pathlib import Path
 import pytest
 from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
 
-from feelmysign.backends.emulated_state import drive_levels
+from feelmysign.backends.bus_lock import lock_for
+from feelmysign.backends.drv2605 import Drv2605Backend
+from feelmysign.backends.emulated_state import drive_levels, open_state_bus
 from feelmysign.bench import restart_off
 from feelmysign.broker import Broker
+from feelmysign.layout import load_layout
 from feelmysign.stroke import Stroke
 
 WAIT_S = 60.0  # generous: a loaded 2-core machine starts Python slowly
@@ -176,3 +180,31 @@ def test_kill_9_of_the_sleeve_lets_go_of_the_bus_at_once(
     off = feelmysign("off", "--layout", PAPER, "--emulate-state", str(state))
     assert (off.returncode, off.stderr) == (0, "")
     assert off.stdout.startswith("Every motor is off (12 DRV2605L")
+
+
+def test_a_sleeve_starting_on_a_held_bus_switches_every_motor_off_first_then_refuses(
+    broker: Broker, tmp_path: Path
+) -> None:
+    state = tmp_path / "bus.json"
+    layout = load_layout(PAPER)
+    backend = Drv2605Backend(layout, bus=open_state_bus(state, layout))
+    backend.open()
+    backend.set_intensity(1, 1, 1.0)  # left on by a sleeve that died
+    holder = lock_for(layout.i2c_bus, state)  # and a process that holds the bus now
+    assert holder.try_acquire("sleeve") is None
+    try:
+        started = subprocess.run(
+            restart_off.sleeve_command(broker.credentials_path, state),
+            capture_output=True,
+            text=True,
+            timeout=WAIT_S,
+        )
+    finally:
+        holder.release()
+    assert started.returncode == 1, started
+    assert started.stderr.startswith("Error: The emulated I2C bus in ")
+    assert f"in use by a running sleeve, process {os.getpid()} " in started.stderr
+    assert "This sleeve does not start: one bus drives one sleeve." in started.stderr
+    assert "Traceback" not in started.stderr
+    # The restart's all-off came first, whatever holds the bus (make bench's restart path).
+    assert not driving(state)
