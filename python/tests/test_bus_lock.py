@@ -252,3 +252,31 @@ def test_off_beside_a_buzz_switches_off_and_says_it_may_switch_a_motor_on_again(
         "(feelmysign buzz 2 2): it may switch a motor on again until it ends."
     ), err
     assert "wait for it to end" in err
+
+
+def test_the_command_a_lock_file_names_leaves_out_passwords_and_logins(
+    state: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(
+        sys,
+        "argv",
+        [
+            "/opt/feelmysign/bin/feelmysign",
+            "sleeve",
+            "--password",
+            "hunter2",
+            "--join=fms1.secret",
+            "--broker",
+            "mqtts://arm:hunter3@broker.lan:8883",
+        ],
+    )
+    lock = lock_for(1, state)
+    assert lock.try_acquire("sleeve") is None
+    try:
+        text = Path(lock.path).read_text()
+    finally:
+        lock.release()
+    assert "hunter" not in text and "secret" not in text, text
+    assert (
+        "command feelmysign sleeve --password *** --join=*** --broker mqtts://***@broker.lan:8883\n"
+    ) in text

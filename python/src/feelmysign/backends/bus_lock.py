@@ -41,7 +41,8 @@ from feelmysign.errors import HardwareError
 LOCK_DIRS = ("/run/lock", "/var/lock")  # then the temporary directory
 LOCK_SUFFIX = ".lock"
 MAX_HOLDER_BYTES = 4096  # a few lines; more is not a holder's record
-SERVICE = "feelmysign-sleeve"  # deploy/feelmysign-sleeve.service
+# Options whose value is a secret: left out of the command the lock file names.
+SECRET_OPTIONS = ("--password", "--join")
 
 
 def bus_lock_path(bus_number: int, dirs: tuple[str, ...] = LOCK_DIRS) -> str:
@@ -305,8 +306,22 @@ def _read_holder(fd: int) -> Holder:
 
 
 def _this_command() -> str:
-    """This process's command line, as a person would type it: ``feelmysign sleeve ...``."""
-    return " ".join(["feelmysign", *sys.argv[1:]])[:500]
+    """This process's command line, as a person would type it: ``feelmysign sleeve ...``,
+    without its secrets (the file is for everyone to read)."""
+    words: list[str] = []
+    hide_next = False
+    for word in sys.argv[1:]:
+        name, equals, _value = word.partition("=")
+        if hide_next:
+            word = "***"
+        elif name in SECRET_OPTIONS and equals:
+            word = f"{name}=***"
+        elif "://" in word and "@" in word:  # a URL with a login in it
+            scheme, _, rest = word.partition("://")
+            word = f"{scheme}://***@{rest.rpartition('@')[2]}"
+        hide_next = word in SECRET_OPTIONS
+        words.append(word)
+    return " ".join(["feelmysign", *words])[:500]
 
 
 def _this_unit() -> str:
