@@ -25,6 +25,7 @@ from feelmysign.backends.bus_lock import (
     holder_of,
     lock_for,
     state_lock_path,
+    unit_of,
 )
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_state import drive_levels, open_state_bus
@@ -280,3 +281,13 @@ def test_the_command_a_lock_file_names_leaves_out_passwords_and_logins(
     assert (
         "command feelmysign sleeve --password *** --join=*** --broker mqtts://***@broker.lan:8883\n"
     ) in text
+
+
+def test_the_systemd_service_a_holder_runs_in_is_read_from_its_cgroup() -> None:
+    assert unit_of("0::/system.slice/feelmysign-sleeve.service\n") == "feelmysign-sleeve.service"
+    assert unit_of("1:name=systemd:/system.slice/feelmysign-sleeve.service\n0::/\n") == (
+        "feelmysign-sleeve.service"
+    )
+    # A person's shell: a session scope, or a terminal's scope under the user's manager.
+    assert unit_of("0::/user.slice/user-1000.slice/session-3.scope\n") == ""
+    assert unit_of("0::/user.slice/user-1000.slice/user@1000.service/app.slice/vte.scope\n") == ""

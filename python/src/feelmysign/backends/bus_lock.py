@@ -325,13 +325,18 @@ def _this_command() -> str:
 
 
 def _this_unit() -> str:
-    """The systemd service this process runs in (the last part of its cgroup), or ""."""
+    """The systemd service this process runs in, or ""."""
     try:
         with open("/proc/self/cgroup", encoding="utf-8", errors="replace") as cgroup:
-            text = cgroup.read(MAX_HOLDER_BYTES)
+            return unit_of(cgroup.read(MAX_HOLDER_BYTES))
     except OSError:
         return ""
-    for line in text.splitlines():
+
+
+def unit_of(cgroup: str) -> str:
+    """The systemd service a process runs in, from its /proc/PID/cgroup: the last part of its
+    cgroup's path when that is a ``.service`` (``""`` for a login session's ``.scope``)."""
+    for line in cgroup.splitlines():
         last = line.rpartition("/")[2]
         if last.endswith(".service"):
             return last
