@@ -18,15 +18,16 @@ left behind holds nothing. Which file:
   is writable by everyone on Debian and Raspberry Pi OS, and shared by every
   user, so the service's sleeve and a builder's ``buzz`` meet there; the systemd
   unit lists it in ``ReadWritePaths``). Where ``/run/lock`` cannot be written,
-  ``/var/lock``, then the temporary directory (``/tmp``), the same for every process;
+  ``/var/lock``, then ``/tmp`` (not ``$TMPDIR``: the same for every user);
 - the emulated bus kept in a file (``--emulate-state FILE``): ``FILE.lock``
   beside it, so that it behaves as the hardware does (``--emulate`` alone is a
   bus of the process's own: nothing to share, no lock).
 
-The holder writes who it is into the file (PID, start time, command, systemd
-unit), for the message of whoever finds the bus held. Nothing here but ``os``
-and (when a lock is taken) ``fcntl``: the early all-off of ``buzz`` looks at the
-lock before any other import (:mod:`feelmysign.early_off`).
+The holder writes who it is into the file (PID, what it does, its command
+without secrets, its systemd service, since when), for the message of whoever
+finds the bus held. Nothing here but ``os`` and (when a lock is taken)
+``fcntl``: the early all-off of ``buzz`` looks at the lock before any other
+import (:mod:`feelmysign.early_off`).
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ import sys
 
 from feelmysign.errors import HardwareError
 
-LOCK_DIRS = ("/run/lock", "/var/lock")  # then the temporary directory
+LOCK_DIRS = ("/run/lock", "/var/lock")
+FALLBACK_DIR = "/tmp"  # where none of LOCK_DIRS can be written
 LOCK_SUFFIX = ".lock"
 MAX_HOLDER_BYTES = 4096  # a few lines; more is not a holder's record
 # Options whose value is a secret: left out of the command the lock file names.
@@ -52,8 +54,8 @@ def bus_lock_path(bus_number: int, dirs: tuple[str, ...] = LOCK_DIRS) -> str:
     for folder in dirs:
         if os.path.isdir(folder) and os.access(folder, os.W_OK | os.X_OK):
             return os.path.join(folder, name)
-    # Not tempfile.gettempdir(): it imports much, and the early all-off of buzz reads this.
-    return os.path.join(os.environ.get("TMPDIR") or "/tmp", name)
+    # Not tempfile.gettempdir() nor $TMPDIR: one place for every user and every process.
+    return os.path.join(FALLBACK_DIR, name)
 
 
 def state_lock_path(state_path: str | os.PathLike[str]) -> str:
