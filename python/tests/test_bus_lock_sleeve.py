@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
 
-from feelmysign.backends.bus_lock import lock_for
+from feelmysign.backends.bus_lock import holder_of, lock_for
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_state import drive_levels, open_state_bus
 from feelmysign.bench import restart_off
@@ -98,7 +98,7 @@ def refused_naming(result: subprocess.CompletedProcess[str], sleeve: subprocess.
 
 
 def test_buzz_and_scan_refuse_while_a_sleeve_plays_naming_it_and_touch_nothing(
-    playing: tuple[subprocess.Popen[str], Path],
+    playing: tuple[subprocess.Popen[str], Path], watcher: SleeveWatch
 ) -> None:
     sleeve, state = playing
     buzz = feelmysign(
@@ -112,9 +112,12 @@ def test_buzz_and_scan_refuse_while_a_sleeve_plays_naming_it_and_touch_nothing(
     assert scan.stdout == ""
     assert scan_state.exists()
 
-    # Neither took anything from the sleeve: it plays on.
+    # Neither took anything from the sleeve: it plays its stroke to the end, and runs on.
+    watcher.next(
+        lambda name, body: body.get("type") == "played" and body.get("drawing") == "bench-kill",
+        "the long stroke played to its end",
+    )
     assert sleeve.poll() is None
-    assert driving(state)
 
 
 def test_off_is_never_refused_it_switches_off_and_says_the_sleeve_drives_again(
@@ -163,12 +166,14 @@ def test_kill_9_of_the_sleeve_lets_go_of_the_bus_at_once(
     playing: tuple[subprocess.Popen[str], Path],
 ) -> None:
     sleeve, state = playing
-    refused = feelmysign("scan", "--layout", PAPER, "--emulate-state", str(state))
-    refused_naming(refused, sleeve)
+    lock_file = f"{state}.lock"
+    held = holder_of(lock_file)
+    assert held is not None and (held.pid, held.role) == (sleeve.pid, "sleeve")
 
     assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+    assert holder_of(lock_file) is None
     assert driving(state)  # nothing ran after the kill: the chips drive what they drove
-    assert Path(f"{state}.lock").exists()  # the file stays; the lock went with the process
+    assert Path(lock_file).exists()  # the file stays; the lock went with the process
 
     buzz = feelmysign(
         "buzz", "0", "0", "--layout", PAPER, "--emulate-state", str(state), "--duration-ms", "50"
