@@ -136,6 +136,8 @@ def test_the_real_bus_lock_is_in_the_first_writable_lock_folder_else_the_tempora
     writable.mkdir()
     missing = str(tmp_path / "no-such-folder")
     name = "feelmysign-i2c-3.lock"
+    assert bus_lock_path(3) == os.path.join(os.environ["FEELMYSIGN_LOCK_DIR"], name)
+    monkeypatch.delenv("FEELMYSIGN_LOCK_DIR")
     assert bus_lock_path(3, (missing, str(writable))) == str(writable / name)
     monkeypatch.setenv("TMPDIR", str(tmp_path))  # a user's own: not shared, not used
     assert bus_lock_path(3, (missing,)) == f"/tmp/{name}"

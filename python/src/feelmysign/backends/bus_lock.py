@@ -19,6 +19,7 @@ left behind holds nothing. Which file:
   user, so the service's sleeve and a builder's ``buzz`` meet there; the systemd
   unit lists it in ``ReadWritePaths``). Where ``/run/lock`` cannot be written,
   ``/var/lock``, then ``/tmp`` (not ``$TMPDIR``: the same for every user);
+  ``$FEELMYSIGN_LOCK_DIR`` instead, when set (the tests set it);
 - the emulated bus kept in a file (``--emulate-state FILE``): ``FILE.lock``
   beside it, so that it behaves as the hardware does (``--emulate`` alone is a
   bus of the process's own: nothing to share, no lock).
@@ -41,6 +42,10 @@ from feelmysign.errors import HardwareError
 
 LOCK_DIRS = ("/run/lock", "/var/lock")
 FALLBACK_DIR = "/tmp"  # where none of LOCK_DIRS can be written
+# Another folder for the real buses' lock files: for the tests (which must not meet the
+# machine's own sleeve, or each other), or a system without /run/lock. Every process on a
+# bus must then see the same value, or they do not see each other's lock.
+LOCK_DIR_ENV = "FEELMYSIGN_LOCK_DIR"
 LOCK_SUFFIX = ".lock"
 MAX_HOLDER_BYTES = 4096  # a few lines; more is not a holder's record
 # Options whose value is a secret: left out of the command the lock file names.
@@ -48,9 +53,12 @@ SECRET_OPTIONS = ("--password", "--join")
 
 
 def bus_lock_path(bus_number: int, dirs: tuple[str, ...] = LOCK_DIRS) -> str:
-    """The lock file of ``/dev/i2c-<bus_number>``: in the first of ``dirs`` this process can
-    write, else in the temporary directory."""
+    """The lock file of ``/dev/i2c-<bus_number>``: in ``$FEELMYSIGN_LOCK_DIR`` when set, else
+    in the first of ``dirs`` this process can write, else in ``/tmp``."""
     name = f"feelmysign-i2c-{bus_number}{LOCK_SUFFIX}"
+    chosen = os.environ.get(LOCK_DIR_ENV)
+    if chosen:
+        return os.path.join(chosen, name)
     for folder in dirs:
         if os.path.isdir(folder) and os.access(folder, os.W_OK | os.X_OK):
             return os.path.join(folder, name)
