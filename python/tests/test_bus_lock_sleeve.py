@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+from lost_chip import paper_with_enable
 from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
 
 from feelmysign.backends.bus_lock import holder_of, lock_for
@@ -213,3 +214,27 @@ def test_a_sleeve_starting_on_a_held_bus_switches_every_motor_off_first_then_ref
     assert "Traceback" not in started.stderr
     # The restart's all-off came first, whatever holds the bus (make bench's restart path).
     assert not driving(state)
+
+
+def test_off_beside_a_sleeve_holding_the_enable_line_names_the_sleeve_as_without_one(
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path
+) -> None:
+    """The enable line guarded part of this before the lock (off could not take the line);
+    now the words are the lock's, with the line's own problem listed."""
+    state, layout = tmp_path / "bus.json", paper_with_enable(tmp_path)
+    command = restart_off.sleeve_command(broker.credentials_path, state)
+    command[command.index("--layout") + 1] = str(layout)
+    with reaped(
+        subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    ) as sleeve:
+        watcher.next(online, "the sleeve online")
+        off = feelmysign("off", "--layout", str(layout), "--emulate-state", str(state))
+        buzz = feelmysign("buzz", "0", "0", "--layout", str(layout), "--emulate-state", str(state))
+        assert sleeve.poll() is None
+    print(off.stdout, off.stderr, sep="\n")
+    assert off.returncode == 1, off
+    assert off.stdout.startswith("The off went out to every chip that answered (12 DRV2605L on ")
+    assert f"in use by process {sleeve.pid}" in off.stdout  # the line: the sleeve holds it
+    assert off.stderr.startswith(f"Error: A sleeve runs on this bus, process {sleeve.pid} (")
+    assert "Traceback" not in off.stderr
+    assert "Nothing was buzzed." in refused_naming(buzz, sleeve)

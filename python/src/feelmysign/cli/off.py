@@ -104,7 +104,7 @@ def _held_by(holder: Holder, problems: list[str], chips: str) -> int:
     will drive the motors again and how to stop it (HardwareError: exit 1)."""
     if problems:
         listed = "\n".join(f"  - {p}" for p in problems)
-        print(f"Every chip that answered took the off ({chips}), except:\n{listed}", flush=True)
+        print(f"The off went out to every chip that answered ({chips}), but:\n{listed}", flush=True)
     else:
         print(f"Every motor is off for now ({chips}).", flush=True)
     if holder.is_sleeve:
