@@ -9,7 +9,9 @@ import pytest
 
 
 def clean_cli_environment(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    """No FEELMYSIGN_* from the developer's shell, and no local broker's credentials file."""
-    for name in [name for name in os.environ if name.startswith("FEELMYSIGN_")]:
+    """No FEELMYSIGN_* from the developer's shell, and no local broker's credentials file
+    (the session's lock folder kept: conftest.py)."""
+    kept = ("FEELMYSIGN_LOCK_DIR",)
+    for name in [n for n in os.environ if n.startswith("FEELMYSIGN_") and n not in kept]:
         monkeypatch.delenv(name)
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))

@@ -63,6 +63,16 @@ def _state_home(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
         yield state_home
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _lock_dir(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """The real buses' lock files (feelmysign.backends.bus_lock) in a folder of this session's
+    own: a test on /dev/i2c-1 meets neither this machine's sleeve nor another test run."""
+    folder = tmp_path_factory.mktemp("locks")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("FEELMYSIGN_LOCK_DIR", str(folder))
+        yield folder
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         if BROKER_FIXTURES.intersection(getattr(item, "fixturenames", ())):

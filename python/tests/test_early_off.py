@@ -302,7 +302,7 @@ def test_a_bug_in_the_early_pass_does_not_keep_the_start_up_from_its_own_all_off
 ) -> None:
     import feelmysign.early_off as early
 
-    def broken(layout_path: str, state_path: str | None) -> list[str]:
+    def broken(layout_path: str, state_path: str | None, *, skip_held: bool) -> list[str]:
         raise RuntimeError("a bug")
 
     monkeypatch.setattr(early, "_switch_off", broken)

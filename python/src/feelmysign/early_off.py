@@ -21,6 +21,10 @@ ours (``feelmysign.input_files``, ``feelmysign.backends.all_off``):
    the previous memo names is switched off: the chips the edit moved may be
    the ones the killed sleeve left on. Then the memo is written for next time.
 
+``buzz`` leaves alone a bus that another process holds (a running sleeve:
+:mod:`feelmysign.backends.bus_lock`), as it then refuses; the sleeve and ``off``
+switch off first whoever holds the bus, and only then look at its lock.
+
 It is best effort and quiet on purpose: whatever goes wrong here (no layout,
 no bus, a missing chip, no place to keep the memo) the command's own start-up
 switches everything off again and then reports the problem with the usual error.
@@ -69,7 +73,7 @@ def switch_off_early(command: str | None, arguments: Sequence[str]) -> list[str]
         return []
     layout_path, state_path = options
     try:
-        return _switch_off(layout_path, state_path)
+        return _switch_off(layout_path, state_path, skip_held=command == "buzz")
     except Exception as error:  # a bug here must not keep the start-up from its own all-off
         if os.environ.get(DEBUG_ENV):
             import traceback
@@ -114,7 +118,7 @@ def _scan_options(command: str | None, arguments: Sequence[str]) -> tuple[str, s
     return layout, state
 
 
-def _switch_off(layout_path: str, state_path: str | None) -> list[str]:
+def _switch_off(layout_path: str, state_path: str | None, *, skip_held: bool) -> list[str]:
     if state_path is not None and not os.path.exists(state_path):
         return []  # a fresh emulated bus starts with every motor off
     try:
@@ -126,7 +130,7 @@ def _switch_off(layout_path: str, state_path: str | None) -> list[str]:
     memo_path = _memo_path(source)
     memo = _read_memo(memo_path, source)
     if memo is not None and memo[0] == text:
-        return _off(memo[1], state_path)  # exactly what this layout wires
+        return _off(memo[1], state_path, skip_held)  # exactly what this layout wires
     targets: Targets = {}
     if memo is not None:  # the layout was edited: what the old one wired may be on
         _add_every_channel(targets, memo[1])
@@ -134,14 +138,19 @@ def _switch_off(layout_path: str, state_path: str | None) -> list[str]:
     if wiring is not None:
         _add_every_channel(targets, wiring)
         _write_memo(memo_path, source, text, wiring)
-    return _off(targets, state_path)
+    return _off(targets, state_path, skip_held)
 
 
-def _off(targets: Targets, state_path: str | None) -> list[str]:
+def _off(targets: Targets, state_path: str | None, skip_held: bool) -> list[str]:
     problems: list[str] = []
     for bus_number, channels in sorted(targets.items()):
         if not channels:
             continue  # a layout without wiring: no chip on this bus to reach
+        if skip_held and _held(bus_number, state_path):
+            # buzz beside a running sleeve: it refuses, and must not touch the sleeve's bus
+            # first (the sleeve and off switch off whatever holds the bus).
+            problems.append(f"I2C bus {bus_number}: in use by another process, left alone")
+            continue
         try:
             bus = _open_bus(bus_number, state_path)
         except OSError as error:
@@ -152,6 +161,12 @@ def _off(targets: Targets, state_path: str | None) -> list[str]:
         finally:
             bus.close()
     return problems
+
+
+def _held(bus_number: int, state_path: str | None) -> bool:
+    from feelmysign.backends.bus_lock import holder_of, lock_for
+
+    return holder_of(lock_for(bus_number, state_path).path) is not None
 
 
 def _open_bus(bus_number: int, state_path: str | None) -> WriteBus:

@@ -36,6 +36,7 @@ from feelmysign.backends.actuator_config import (
 from feelmysign.backends.all_off import DRV2605_ADDRESS as DRV2605_ADDRESS  # re-exported
 from feelmysign.backends.all_off import MODE_STANDBY, REG_MODE, REG_RTP_INPUT
 from feelmysign.backends.base import GridBackend
+from feelmysign.backends.bus_lock import BusLock
 from feelmysign.backends.enable import Line
 from feelmysign.backends.i2c import I2CBus, is_no_answer, open_smbus
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES, Multiplexers
@@ -308,9 +309,13 @@ class Drv2605Backend(GridBackend):
         calibration: CalibrationStore | None = None,
         calibrate: bool = False,
         leave_out_missing: bool = False,
+        bus_lock: BusLock | None = None,
     ) -> None:
         super().__init__(layout, telemetry=telemetry)
         self._leave_out_missing = leave_out_missing
+        # The bus's lock (feelmysign.backends.bus_lock), taken by the opener: let go on close,
+        # after every motor is off.
+        self._bus_lock = bus_lock
         self.missing: dict[tuple[int, int], str] = {}  # left out at open: actuator -> where
         self._bus = bus
         # Auto-calibration results: restored from ``calibration`` at every open; a chip without
@@ -630,7 +635,11 @@ class Drv2605Backend(GridBackend):
 
     def close(self) -> None:
         self.hold_low()
-        super().close()
+        try:
+            super().close()
+        finally:
+            if self._bus_lock is not None:
+                self._bus_lock.release()
 
     def hold_low(self) -> None:
         """The sleeve is stopping: the enable line low now, and it stays low through the

@@ -17,6 +17,7 @@ from feelmysign.backends.actuator_config import (
     store_name_for_state_file,
 )
 from feelmysign.backends.base import Backend
+from feelmysign.backends.bus_lock import lock_for
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_i2c import EmulatedI2CBus
 from feelmysign.backends.emulated_state import open_state_bus
@@ -32,6 +33,12 @@ if TYPE_CHECKING:
 
 BackendName = Literal["sim", "drv2605"]
 BACKEND_NAMES: tuple[BackendName, ...] = ("sim", "drv2605")
+# What opens a backend on a shared bus; what it does not do when another process holds it.
+BusRole = Literal["sleeve", "buzz"]
+REFUSED: dict[BusRole, str] = {
+    "sleeve": "This sleeve does not start: one bus drives one sleeve.",
+    "buzz": "Nothing was buzzed.",
+}
 
 
 def open_backend(
@@ -43,6 +50,7 @@ def open_backend(
     emulate: bool = False,
     emulate_state: str | os.PathLike[str] | None = None,
     leave_out_missing: bool = False,
+    role: BusRole = "sleeve",
 ) -> Backend:
     """An open backend for ``layout``, every actuator silent; close it (or use ``with``).
 
@@ -51,9 +59,14 @@ def open_backend(
     with ``emulate``, on an emulated bus wired as the layout says (to try the
     hardware path without hardware); ``emulate_state`` keeps that bus's registers
     in a file across processes (see :mod:`feelmysign.backends.emulated_state`)
-    and implies ``emulate``; ``leave_out_missing``: see ``Drv2605Backend``. Raises
-    ParameterError for a bad choice, LayoutError for a layout without wiring,
-    HardwareError when the chips do not answer (see :meth:`Drv2605Backend.open`).
+    and implies ``emulate``; ``leave_out_missing``: see ``Drv2605Backend``.
+
+    A bus shared with other processes (the real one, or one kept in a file) is locked
+    for ``role`` (``sleeve``, ``buzz``: see :mod:`feelmysign.backends.bus_lock`) before
+    any I2C traffic, until the backend is closed. Raises ParameterError for a bad choice,
+    LayoutError for a layout without wiring, BusBusyError (a HardwareError) when another
+    process holds the bus, HardwareError when the chips do not answer (see
+    :meth:`Drv2605Backend.open`).
     """
     if name not in BACKEND_NAMES:
         raise ParameterError(
@@ -70,22 +83,32 @@ def open_backend(
             "left out with the drv2605 backend: only the simulator records (--backend sim)",
         )
     check_wired(layout)
-    bus: I2CBus | None = None
-    if emulate_state is not None:
-        bus = open_state_bus(emulate_state, layout)
-    elif emulate:
-        bus = EmulatedI2CBus.for_layout(layout)
-    backend = Drv2605Backend(
-        layout,
-        bus=bus,
-        telemetry=telemetry,
-        enable=enable_line_for(layout, bus),
-        calibration=calibration_store_for(layout, emulate_state),
-        # An emulated bus without a file starts from reset values every time: a fresh sleeve.
-        calibrate=emulate and emulate_state is None,
-        leave_out_missing=leave_out_missing,
-    )
-    backend.open()
+    # An emulated bus without a file is this process's own: nobody to share it with.
+    lock = None if emulate and emulate_state is None else lock_for(layout.i2c_bus, emulate_state)
+    if lock is not None:
+        lock.acquire(role, refused=REFUSED[role])
+    try:
+        bus: I2CBus | None = None
+        if emulate_state is not None:
+            bus = open_state_bus(emulate_state, layout)
+        elif emulate:
+            bus = EmulatedI2CBus.for_layout(layout)
+        backend = Drv2605Backend(
+            layout,
+            bus=bus,
+            telemetry=telemetry,
+            enable=enable_line_for(layout, bus),
+            calibration=calibration_store_for(layout, emulate_state),
+            # An emulated bus without a file starts from reset values every time: a fresh sleeve.
+            calibrate=emulate and emulate_state is None,
+            leave_out_missing=leave_out_missing,
+            bus_lock=lock,
+        )
+        backend.open()
+    except BaseException:
+        if lock is not None:
+            lock.release()  # open() failed with every motor it reached off
+        raise
     return backend
 
 

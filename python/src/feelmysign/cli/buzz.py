@@ -14,6 +14,11 @@ checked, and low again before the "off" goes out over I2C.
 A DRV2605L that does not answer does not keep the others from being tried: it is
 named on stderr and left out, and buzzing its own motor is the error (with an
 enable line, which switches every chip, a missing chip keeps every motor off).
+
+While a sleeve runs on the same bus (or another buzz or scan), buzz refuses
+before any I2C traffic, naming that process (PID, command), exit 1: two
+processes must not drive one bus. Stop the sleeve first (``sudo systemctl stop
+feelmysign-sleeve`` for the service, Ctrl-C where it runs otherwise).
 """
 
 from __future__ import annotations
@@ -87,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
         emulate=args.emulate,
         emulate_state=args.emulate_state,
         leave_out_missing=True,
+        role="buzz",
     )
     try:
         _check_not_missing(backend, args.row, args.column)

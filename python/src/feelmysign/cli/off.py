@@ -12,6 +12,13 @@ as the sleeve process has ended, however it ended (``ExecStopPost``), so a
 motor left on by a ``kill -9`` or a crash is not left on until the restart.
 Exit 0 when every chip took the "off", 1 (naming the chips) otherwise; with an
 enable line, 0 naming them (the line, left low, holds every motor off).
+
+Never refused, not even while a sleeve runs on the same bus: the "off" goes out
+all the same. But that sleeve drives the motors again with its next stroke (and
+holds the enable line, which off cannot drop then), so off then names it (PID,
+command), says how to stop it (``sudo systemctl stop feelmysign-sleeve`` for
+the service, Ctrl-C where it runs otherwise; it switches every motor off as it
+stops) and exits 1. Likewise, naming it, beside a running buzz or scan.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from __future__ import annotations
 import argparse
 import os
 
+from feelmysign.backends.bus_lock import Holder, holder_of, lock_for
 from feelmysign.backends.drv2605 import Drv2605Backend
 from feelmysign.backends.emulated_state import open_state_bus
 from feelmysign.backends.factory import enable_line_for
@@ -61,6 +69,8 @@ def run(args: argparse.Namespace) -> int:
         )
     bus: I2CBus | None = None
     where = f"/dev/i2c-{layout.i2c_bus}"
+    # Who else drives this bus, if anyone: looked at, never waited for.
+    holder = holder_of(lock_for(layout.i2c_bus, args.emulate_state or None).path)
     if args.emulate_state:
         bus, where = (
             open_state_bus(args.emulate_state, layout),
@@ -68,6 +78,8 @@ def run(args: argparse.Namespace) -> int:
         )
     enable = enable_line_for(layout, bus)
     problems = Drv2605Backend(layout, bus=bus, enable=enable).switch_off_unchecked()
+    if holder is not None:
+        return _held_by(holder, problems, f"{len(layout.wiring)} DRV2605L on {where}")
     if problems and enable is not None and not any("enable line" in p for p in problems):
         listed = "\n".join(f"  - {p}" for p in problems)
         print(
@@ -85,3 +97,24 @@ def run(args: argparse.Namespace) -> int:
     line = "" if enable is None else f", and the {enable.description} is low"
     print(f"Every motor is off ({len(layout.wiring)} DRV2605L on {where}{line}).", flush=True)
     return 0
+
+
+def _held_by(holder: Holder, problems: list[str], chips: str) -> int:
+    """The "off" went out while another process holds the bus: say what was done, then who
+    will drive the motors again and how to stop it (HardwareError: exit 1)."""
+    if problems:
+        listed = "\n".join(f"  - {p}" for p in problems)
+        print(f"The off went out to every chip that answered ({chips}), but:\n{listed}", flush=True)
+    else:
+        print(f"Every motor is off for now ({chips}).", flush=True)
+    if holder.is_sleeve:
+        again = (
+            f"A sleeve runs on this bus, {holder.describe()}: it drives the motors again "
+            "with its next stroke"
+        )
+    else:
+        again = (
+            f"Another feelmysign command uses this bus, {holder.describe()}: it may switch "
+            "a motor on again until it ends"
+        )
+    raise HardwareError(f"{again}. To keep every motor off, {holder.how_to_stop()}.")

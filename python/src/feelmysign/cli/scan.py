@@ -17,13 +17,18 @@ what the layout's motor asks for, its auto-calibration results (A_CAL_COMP, A_CA
 BEMF_GAIN) and whether they are kept for the next start. ``--calibrate`` first runs the
 chips' auto-calibration again (each motor buzzes for about a second, one after another)
 and keeps the results: do it after changing a motor; the sleeve calibrates by itself a
-chip that has no result kept. Stop the sleeve first (``sudo systemctl stop
-feelmysign-sleeve``): two processes must not drive one bus.
+chip that has no result kept.
+
+While a sleeve runs on the same bus (or a buzz), scan refuses before any I2C
+traffic, naming that process (PID, command), exit 1: two processes must not
+drive one bus. Stop the sleeve first (``sudo systemctl stop feelmysign-sleeve``
+for the service, Ctrl-C where it runs otherwise).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 from dataclasses import dataclass
@@ -36,6 +41,7 @@ from feelmysign.backends.actuator_config import (
     chip_settings,
     motor_description,
 )
+from feelmysign.backends.bus_lock import lock_for
 from feelmysign.backends.drv2605 import (
     DRV2605_ADDRESS,
     SUPPORTED_DEVICE_IDS,
@@ -139,6 +145,17 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("--bus", bus_number, f"a bus number from 0 to {MAX_I2C_BUS}")
     # Without wiring there is nothing to expect: probe every address a TCA9548A can have.
     addresses = layout.multiplexers or tuple(MULTIPLEXER_ADDRESSES)
+    # An emulated bus without a file is this process's own; any other one may be shared.
+    with contextlib.ExitStack() as held:
+        if args.emulate_state or not args.emulate:
+            lock = held.enter_context(lock_for(bus_number, args.emulate_state or None))
+            lock.acquire("scan", refused="Nothing was scanned.")
+        return _scan(args, layout, bus_number, addresses)
+
+
+def _scan(
+    args: argparse.Namespace, layout: Layout, bus_number: int, addresses: tuple[int, ...]
+) -> int:
     bus: I2CBus
     if args.emulate_state:
         bus = open_state_bus(args.emulate_state, layout)

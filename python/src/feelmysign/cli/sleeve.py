@@ -51,7 +51,10 @@ def register(subparsers: Subcommands) -> None:
             "legacy topic, plan each stroke with Tactile Brush and play it on the motors "
             "(--backend drv2605) or the simulator (--backend sim), publishing status, "
             "actuator telemetry and one event per stroke. Ctrl-C or SIGTERM stops it with "
-            "every motor off."
+            "every motor off. On the motors it holds their I2C bus while it runs (a lock, "
+            "/run/lock/feelmysign-i2c-N.lock, or FILE.lock beside --emulate-state FILE): a "
+            "second sleeve, 'feelmysign buzz' and 'feelmysign scan' on that bus are refused, "
+            "naming it, and 'feelmysign off' says it drives the motors again."
         ),
     )
     add_broker_options(parser, role="sleeve")
