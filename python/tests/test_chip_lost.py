@@ -21,7 +21,7 @@ from sleeve_watch import SleeveWatch, online
 from feelmysign.backends.emulated_state import chip_key, drive_levels, read_state
 from feelmysign.bench import restart_off
 from feelmysign.broker import Broker
-from feelmysign.layout import load_layout
+from feelmysign.layout import Wire, load_layout
 from feelmysign.stroke import Stroke
 
 WAIT_S = 60.0  # generous: a loaded 2-core machine starts Python slowly
@@ -48,6 +48,14 @@ def unplug(state: Path, key: str) -> None:
         time.sleep(0.05)
 
 
+def _lost_wire() -> tuple[Wire, str]:
+    """The wire of the actuator the tests unplug (ROW, LOST_COLUMN), and its chip's key."""
+    wire = next(
+        w for w in load_layout(restart_off.PAPER).wiring if (w.row, w.column) == (ROW, LOST_COLUMN)
+    )
+    return wire, chip_key(wire.multiplexer, wire.channel)
+
+
 def _connected(state: Path, key: str) -> bool:
     multiplexer, _, channel = key.partition("/")
     return read_state(state).chips[(int(multiplexer, 16), int(channel))].connected
@@ -57,10 +65,7 @@ def test_a_chip_lost_mid_stroke_cuts_the_stroke_says_which_chip_and_switches_all
     broker: Broker, tmp_path: Path
 ) -> None:
     state = tmp_path / "bus.json"
-    wire = next(
-        w for w in load_layout(restart_off.PAPER).wiring if (w.row, w.column) == (ROW, LOST_COLUMN)
-    )
-    key = chip_key(wire.multiplexer, wire.channel)
+    wire, key = _lost_wire()
     with SleeveWatch(broker.credentials, "status", "events") as watcher:
         sleeve = subprocess.Popen(
             restart_off.sleeve_command(broker.credentials_path, state),
@@ -126,10 +131,7 @@ def test_a_chip_lost_mid_stroke_cuts_the_stroke_says_which_chip_and_switches_all
 def test_send_says_a_stroke_a_lost_chip_cut_part_way_once(broker: Broker, tmp_path: Path) -> None:
     """``send --wait``'s line for the stroke: 'cut part-way' once, then the sleeve's reason."""
     state = tmp_path / "bus.json"
-    wire = next(
-        w for w in load_layout(restart_off.PAPER).wiring if (w.row, w.column) == (ROW, LOST_COLUMN)
-    )
-    key = chip_key(wire.multiplexer, wire.channel)
+    wire, key = _lost_wire()
     with SleeveWatch(broker.credentials, "status", "events") as watcher:
         sleeve = subprocess.Popen(
             restart_off.sleeve_command(broker.credentials_path, state),

@@ -413,20 +413,7 @@ def test_up_with_a_sleeve_builder_s_layout_emulates_its_buttons_and_says_how_to_
         paper.replace("[i2c]\n", '[i2c]\nenable = { chip = "gpiochip0", line = 17 }\n', 1)
         + '\n[controls]\npause_button = { chip = "gpiochip0", line = 27 }\n'
     )
-    web = tmp_path / "web"
-    web.mkdir()
-    (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
-    env["XDG_STATE_HOME"] = str(tmp_path / "xdg")
-    argv = [*RUN_ONLY, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
-    ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
-    up = subprocess.Popen(
-        [*argv, *ports, "--layout", str(layout)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        env=env,
-    )
+    up = _start_up(tmp_path, "--layout", str(layout))
     seen: list[str] = []
     try:
         out = _lines(up.stdout)
@@ -442,20 +429,16 @@ def test_up_with_a_sleeve_builder_s_layout_emulates_its_buttons_and_says_how_to_
             time.sleep(0.05)
         assert json.loads(controls.read_text())["paused_by"] == "button"
     finally:
-        up.send_signal(signal.SIGINT)
-        try:
-            up.wait(timeout=WAIT_S)
-        finally:
-            if up.poll() is None:
-                up.kill()
+        _interrupt(up)
     assert up.returncode == 0, seen
     assert not any("Error" in line for line in seen), seen
 
 
-@pytest.mark.broker
-def test_up_with_a_wearer_file_names_it_and_its_limits_in_the_banner(tmp_path: Path) -> None:
-    wearer = tmp_path / "wearer.json"
-    wearer.write_text('{"wearer": "P-LIMITS", "min_length": 0.62, "min_duration_ms": 118.4}')
+def _start_up(
+    tmp_path: Path, *options: str, stderr: int = subprocess.STDOUT
+) -> subprocess.Popen[str]:
+    """``feelmysign up`` with ``options``, on free ports, a stand-in page and state of its own
+    (XDG_STATE_HOME under ``tmp_path``); its output in a pipe."""
     web = tmp_path / "web"
     web.mkdir()
     (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
@@ -463,23 +446,31 @@ def test_up_with_a_wearer_file_names_it_and_its_limits_in_the_banner(tmp_path: P
     env["XDG_STATE_HOME"] = str(tmp_path / "xdg")
     argv = [*RUN_ONLY, "up", "--state-dir", str(tmp_path / "state"), "--web-dir", str(web)]
     ports = ["--port", "0", "--ws-port", "0", "--http-port", "0"]
-    up = subprocess.Popen(
-        [*argv, *ports, "--wearer", str(wearer)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        text=True,
-        env=env,
+    return subprocess.Popen(
+        [*argv, *ports, *options], stdout=subprocess.PIPE, stderr=stderr, text=True, env=env
     )
+
+
+def _interrupt(up: subprocess.Popen[str]) -> None:
+    """Ctrl-C to up, and wait for it to end (killed if it does not)."""
+    up.send_signal(signal.SIGINT)
+    try:
+        up.wait(timeout=WAIT_S)
+    finally:
+        if up.poll() is None:
+            up.kill()
+
+
+@pytest.mark.broker
+def test_up_with_a_wearer_file_names_it_and_its_limits_in_the_banner(tmp_path: Path) -> None:
+    wearer = tmp_path / "wearer.json"
+    wearer.write_text('{"wearer": "P-LIMITS", "min_length": 0.62, "min_duration_ms": 118.4}')
+    up = _start_up(tmp_path, "--wearer", str(wearer), stderr=subprocess.DEVNULL)
     seen: list[str] = []
     try:
         _wait_for(_lines(up.stdout), "Press Ctrl-C to stop.", seen)
     finally:
-        up.send_signal(signal.SIGINT)
-        try:
-            up.wait(timeout=WAIT_S)
-        finally:
-            if up.poll() is None:
-                up.kill()
+        _interrupt(up)
     banner = seen[next(i for i, line in enumerate(seen) if line == "feelmysign is up.") :]
     said = [line for line in banner if line.startswith("  Wearer:")]
     assert said == [
