@@ -118,6 +118,7 @@ class PlannedStroke:
     acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
     compressed_ms: float | None = None  # how much shorter it plays to catch up, if it does
+    started: bool = False  # its first command went out and its played event with it
 
     @property
     def received_wall_ms(self) -> float:
@@ -473,11 +474,12 @@ class Player:
             unstarted = [
                 tag for tag in self._timeline.unstarted() if isinstance(tag, PlannedStroke)
             ]
+            # (Not one the duty-cycle cap refused at its start: it never played.)
             self.cut_by_stop = [
                 tag
                 for tag in self._timeline.tags()
                 if isinstance(tag, PlannedStroke)
-                and not any(tag is other for other in unstarted)
+                and tag.started
                 and tag.start_ms + tag.schedule.duration_ms > stopped_ms
             ]
             unplayed = list(self._inbox) + unstarted
@@ -936,6 +938,7 @@ class Player:
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:
+            stroke.started = True
             self._pending -= 1
             acknowledge = self._done(stroke)
             self._queue.mark_started(stroke.ref.drawing, stroke.ref.seq)
