@@ -966,8 +966,9 @@ def crashed_event(interrupted: Interrupted) -> Safety:
         row=0,
         column=0,
         message=(
-            "cut short, after its played event: the sleeve's process ended while it played "
-            f"(killed, crashed or its power cut) and was started again; {played_words(interrupted)}"
+            "cut short, after its played event: the sleeve's process ended while it played (it "
+            "was killed, crashed or lost its power) and was started again; "
+            f"{played_words(interrupted)}"
         ),
         stroke=interrupted.playing.ref(),
     )

@@ -59,7 +59,7 @@ import math
 import os
 from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 from feelmysign.clock import wall_ms
@@ -139,6 +139,7 @@ class PaceMemory:
         self._saved_ms = -float("inf")
         self._unsaved = False
         self._failed = False
+        self._saved_once = False  # the folder is made before the first write only
         # The strokes playing, by (drawing, seq, received_at_ms), as last noted.
         self._playing: dict[tuple[str | None, int | None, float], Playing] = {}
         # Noted by the process before this one and still playing when it ended (see load).
@@ -257,16 +258,19 @@ class PaceMemory:
         for key in [key for key, note in self._playing.items() if note.ends_at_ms <= now_ms]:
             del self._playing[key]  # ended while the process ran: not cut by its end
         if self._playing:
-            document["playing"] = [asdict(note) for note in self._playing.values()]
+            document["playing"] = [note.__dict__ for note in self._playing.values()]
         document["alive_at_ms"] = now_ms
         text = json.dumps(document) + "\n"
         temporary = f"{self._path}.{os.getpid()}.tmp"
         try:
-            os.makedirs(os.path.dirname(self._path), mode=0o700, exist_ok=True)
+            if not self._saved_once:
+                os.makedirs(os.path.dirname(self._path), mode=0o700, exist_ok=True)
             with open(temporary, "w", encoding="utf-8") as file:
                 file.write(text)
             os.replace(temporary, self._path)
+            self._saved_once = True
         except OSError as error:
+            self._saved_once = False  # the folder may have gone: made again at the next write
             if not self._failed:  # once: the next writes would fail the same way
                 log.warning(
                     "the sleeve's time lines could not be kept in %s (%s): after a restart, "
