@@ -23,8 +23,10 @@ A test that uses any of them is marked ``broker`` automatically (``pytest -m "no
 skips it); a missing Mosquitto fails it with the command that installs it.
 
 Every test, and every process it starts, keeps its state (``$XDG_STATE_HOME``: a broker's
-default state directory, the sleeve's wiring memos) in a temporary directory of the test
-session, never in the home directory of whoever runs the tests.
+default state directory, the sleeve's wiring memos, its pace memory and the note of the stroke
+it plays) in a temporary directory of its own, never in the home directory of whoever runs the
+tests: a sleeve killed in the middle of a stroke by one test leaves a note that a sleeve of the
+same id started by another would report (a ``safety`` event ``crashed``).
 """
 
 from __future__ import annotations
@@ -71,6 +73,18 @@ def _lock_dir(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("FEELMYSIGN_LOCK_DIR", str(folder))
         yield folder
+
+
+@pytest.fixture(autouse=True)
+def _state_home_of_each_test(
+    _state_home: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[Path]:
+    """``$XDG_STATE_HOME`` of one test (a test may still set its own): what its sleeves
+    keep across a restart is its own."""
+    state_home = tmp_path_factory.mktemp("xdg-state-test")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("XDG_STATE_HOME", str(state_home))
+        yield state_home
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -79,10 +79,14 @@ class SleeveProcess(Closing):
 
     def started(self) -> int:
         """How many strokes the stopped sleeve started, by its own count (the line it prints as
-        it stops): one per start, however many copies of each event a watcher received."""
-        found = re.findall(r"stopped, every motor off \((\d+) played", self.log.read_text())
+        it stops): one per start, however many copies of each event a watcher received. Those
+        played whole and those cut short (by the stop itself, one still playing then)."""
+        found = re.findall(
+            r"stopped, every motor off \((\d+) played(?:, (\d+) cut short)?", self.log.read_text()
+        )
         assert found, f"the sleeve did not say what it played as it stopped: see {self.log}"
-        return int(found[-1])
+        played, cut = found[-1]
+        return int(played) + int(cut or 0)
 
     def changes(self) -> list[dict[str, Any]]:
         if not self.record.exists():

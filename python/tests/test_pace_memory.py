@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from pathlib import Path
 
 import pytest
 
 from feelmysign.events import Played, StrokeRef
 from feelmysign.pace import LATE, PacePolicy
-from feelmysign.sleeve.pace_memory import PACE_FORMAT, SAVE_EVERY_MS, PaceMemory
+from feelmysign.sleeve.pace_memory import END_NOTE_MS, PACE_FORMAT, SAVE_EVERY_MS, PaceMemory
 from feelmysign.sleeve.queue import REMEMBERED_DRAWINGS
 
 
@@ -137,3 +138,104 @@ def test_a_state_folder_that_cannot_be_written_is_said_once(
         memory.played(played("a", 5.0))
         memory.played(played("b", 5.0))
     assert caplog.text.count("could not be kept") == 1
+
+
+# --- the strokes playing, noted for the process started after a crash ------------------------
+
+
+def started(clock: Clock, duration_ms: float, seq: int = 0, drawing: str | None = "a") -> Played:
+    """The played event of a stroke whose first command went out now, by ``clock``."""
+    now_ms = clock.now_ms
+    return Played(
+        stroke=StrokeRef("feelmysign/s/strokes", drawing, seq, now_ms - 9.0, 4.0, 0.0, now_ms - 5),
+        start_at_ms=now_ms - 0.2,
+        first_command_at_ms=now_ms,
+        latency_ms=5.0,
+        start_error_ms=0.2,
+        queued_ms=0.0,
+        duration_ms=duration_ms,
+        commands=4,
+    )
+
+
+def test_a_stroke_playing_when_the_process_ends_is_reported_once(tmp_path: Path) -> None:
+    path = str(tmp_path / "s.json")
+    clock = Clock()
+    memory = PaceMemory(path, clock_ms=clock)
+    event = started(clock, 3000.0, seq=4)
+    memory.playing(event)  # written at once: its played event goes out after this
+    [note] = json.loads(Path(path).read_text())["playing"]
+    assert (note["drawing"], note["seq"], note["received_at_ms"]) == ("a", 4, event.received_at_ms)
+    # A heartbeat while it plays: the process ran a second into it.
+    clock.now_ms += 400.0
+    assert memory.keep_up() == pytest.approx(0.6)
+    clock.now_ms += 600.0
+    memory.keep_up()
+    clock.now_ms += 700.0  # ... and died here, 1.7 s into the stroke
+    restarted = PaceMemory(path, clock_ms=clock)
+    restarted.load(max_age_ms=10_000)
+    [interrupted] = restarted.interrupted()
+    assert interrupted.playing.ref() == StrokeRef(
+        "feelmysign/s/strokes", "a", 4, event.sent_at_ms, received_at_ms=event.received_at_ms
+    )
+    assert interrupted.played_at_least_ms == pytest.approx(1000.0)
+    assert interrupted.duration_ms == pytest.approx(3000.0 - 0.2)
+    # Reported by this process: its next write leaves the note out.
+    restarted.save()
+    again = PaceMemory(path, clock_ms=clock)
+    again.load(max_age_ms=10_000)
+    assert again.interrupted() == []
+
+
+def test_a_stroke_that_ended_before_the_process_ended_is_not_reported(tmp_path: Path) -> None:
+    path = str(tmp_path / "s.json")
+    clock = Clock()
+    memory = PaceMemory(path, clock_ms=clock)
+    memory.playing(started(clock, 500.0))
+    assert memory.keep_up() == pytest.approx((500.0 - 0.2 + END_NOTE_MS) / 1000)
+    clock.now_ms += 500.0 - 0.2 + END_NOTE_MS  # the publishing thread wakes after its end
+    assert memory.keep_up() == math.inf  # written: nothing plays now
+    assert "playing" not in json.loads(Path(path).read_text())
+    clock.now_ms += 3000.0  # the process dies later
+    restarted = PaceMemory(path, clock_ms=clock)
+    restarted.load(max_age_ms=10_000)
+    assert restarted.interrupted() == []
+    # Back to back: the next stroke's note drops the one that ended as it started.
+    memory.playing(started(clock, 500.0, seq=1))
+    clock.now_ms += 500.0 - 0.2
+    memory.playing(started(clock, 500.0, seq=2))
+    restarted = PaceMemory(path, clock_ms=clock)
+    restarted.load(max_age_ms=10_000)
+    assert [i.playing.seq for i in restarted.interrupted()] == [2]
+
+
+def test_a_stroke_said_cut_while_the_process_ran_is_not_reported_again(tmp_path: Path) -> None:
+    path = str(tmp_path / "s.json")
+    clock = Clock()
+    memory = PaceMemory(path, clock_ms=clock)
+    event = started(clock, 3000.0, drawing=None)  # a legacy stroke: named by its receipt
+    memory.playing(event)
+    clock.now_ms += 100.0
+    memory.settled(event.stroke)  # cancelled, or a chip lost: its event says cut already
+    memory.save()  # a clean stop writes the file
+    restarted = PaceMemory(path, clock_ms=clock)
+    restarted.load(max_age_ms=10_000)
+    assert restarted.interrupted() == []
+
+
+@pytest.mark.parametrize(
+    "playing",
+    [
+        "not a list",
+        [{"drawing": "a"}],
+        [{"received_at_ms": 1.0, "started_at_ms": 1.0, "ends_at_ms": "later"}],
+        [{"received_at_ms": 1.0, "started_at_ms": 1.0, "ends_at_ms": 9e9, "seq": -1}],
+    ],
+)
+def test_a_note_that_is_not_one_is_left_out(tmp_path: Path, playing: object) -> None:
+    path = tmp_path / "s.json"
+    document = {"format": PACE_FORMAT, "drawings": [], "playing": playing, "alive_at_ms": 0.0}
+    path.write_text(json.dumps(document))
+    memory = PaceMemory(str(path))
+    assert memory.load(max_age_ms=10_000) == []
+    assert memory.interrupted() == []

@@ -56,6 +56,7 @@ def test_strokes_whose_time_passed_while_the_sleeve_was_stopped_are_late_not_pla
                 return seqs >= set(range(STROKES))
 
             watch.wait_until(answered, "an event for every stroke")
+            answered_wall_ms = time.time() * 1000
             sleeve.send_signal(signal.SIGTERM)
             _, errors = sleeve.communicate(timeout=WAIT_S)
         finally:
@@ -77,7 +78,12 @@ def test_strokes_whose_time_passed_while_the_sleeve_was_stopped_are_late_not_pla
     late = [seq for seq in queued if by_seq[seq][0].get("reason") == "late"]
     assert late, (stopped_wall_ms, resumed_wall_ms, by_seq)
     for seq in late:
-        assert "did not run for" in by_seq[seq][0]["message"], by_seq[seq]
+        refused = by_seq[seq][0]
+        assert "did not run for" in refused["message"], refused
+        # How late it was when refused, as any late refusal says: its planned start came
+        # while the sleeve was stopped (else it would have started), and its whole time
+        # passed before it was refused (at least the shortest stroke the sleeve plays).
+        assert 73.0 < refused.get("lag_ms", 0.0) <= answered_wall_ms - stopped_wall_ms, refused
     for seq, (event,) in by_seq.items():
         if (
             event["type"] in ("played", "adjusted")
@@ -85,4 +91,9 @@ def test_strokes_whose_time_passed_while_the_sleeve_was_stopped_are_late_not_pla
         ):
             planned_end_ms = event["start_at_ms"] + event["duration_ms"]
             assert planned_end_ms >= resumed_wall_ms - STALL_MS - 50.0, (seq, event)
-    assert "ran" in errors and "late" in errors, errors
+    # Said in the sleeve's log as its other lines are: naming the sleeve.
+    said = [line for line in errors.splitlines() if "the player ran" in line]
+    assert said and all(
+        f"sleeve {broker.credentials.sleeve_id}: the player ran" in line for line in said
+    ), errors
+    assert "late" in said[0], said

@@ -80,7 +80,9 @@ export interface CancelledEvent extends StrokeRef {
  * A motor was protected: `duty_cycle`, a stroke the duty-cycle cap kept from playing (with
  * the stroke's fields, the motor's would-be duty cycle and the limit); `chip_lost` or
  * `chip_back`, a DRV2605L that stopped answering or answers again; `silenced`, a stroke cut
- * while the sleeve's enable line is held low (docs/protocol.md).
+ * while the sleeve's enable line is held low; `stopped` and `crashed`, a stroke cut short after its
+ * `played` because the sleeve stopped, or its process ended (said by the sleeve started next),
+ * while it played (docs/protocol.md).
  */
 export interface SafetyEvent extends StrokeRef {
   readonly type: "safety";

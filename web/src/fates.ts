@@ -5,7 +5,9 @@
  *
  * - played: its `played` (or `adjusted`) event: felt whole;
  * - cut: cut short by Stop (or the wearer's pause or stop, `by` "wearer") while it played
- *   (`cancelled`, started): felt in part, counted here only;
+ *   (`cancelled`, started), or by a fault on the sleeve after its `played` (a `safety` event:
+ *   `chip_lost`, the sleeve `stopped`, or its process ended, `crashed`): felt in part, counted
+ *   here only;
  * - cancelled: dropped by Stop before it started (`cancelled` not started, or refused as
  *   `cancelled` on arrival);
  * - refused: refused for any other reason (the wearer's `paused` and `do_not_disturb` too: never
@@ -226,7 +228,8 @@ export class DrawingFates {
 
 /**
  * The card's and the caption's words for `cut` strokes cut short while playing: by Stop, by the
- * wearer (their pause or stop), or by a fault on the sleeve (a chip lost mid-stroke).
+ * wearer (their pause or stop), or by a fault on the sleeve (a chip lost mid-stroke, the sleeve
+ * stopped or its process ended mid-stroke: `safety` `chip_lost`, `stopped`, `crashed`).
  */
 export function cutShortWords(cut: number, causes: Partial<CutCauses> = {}): string[] {
   const byWearer = Math.min(cut, causes.byWearer ?? 0);

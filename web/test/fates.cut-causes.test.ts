@@ -1,6 +1,7 @@
 /**
  * A stroke cut short while playing is said with what cut it: the sender's Stop, the wearer's
- * pause or stop, or a fault on the sleeve (a chip lost mid-stroke), never a fault as "Stop".
+ * pause or stop, or a fault on the sleeve (a chip lost mid-stroke, the sleeve stopped or its process
+ * ended mid-stroke), never a fault as "Stop".
  */
 import { describe, expect, it } from "vitest";
 import { parseEvent, type SleeveEvent } from "../src/events";
@@ -47,6 +48,18 @@ const chipLost = (seq: number): SleeveEvent =>
     seq,
   });
 
+// What the sleeve started after a kill -9 says of the stroke the killed one was playing.
+const crashed = (seq: number): SleeveEvent =>
+  event({
+    type: "safety",
+    reason: "crashed",
+    row: 0,
+    column: 0,
+    message: "cut short, after its played event: the sleeve's process ended while it played",
+    ...stroke,
+    seq,
+  });
+
 describe("what cut a stroke short", () => {
   it("tells Stop, the wearer and a fault apart, each stroke once", () => {
     const fates = new DrawingFates();
@@ -63,6 +76,17 @@ describe("what cut a stroke short", () => {
       "1 cut short by the wearer",
       "1 cut short by a fault on the sleeve",
     ]);
+  });
+
+  it("counts a stroke the sleeve's end cut short as cut by a fault, once", () => {
+    const fates = new DrawingFates();
+    fates.add(played(0));
+    fates.add(played(1));
+    fates.add(crashed(1)); // from the restarted sleeve, after the killed one's played event
+    fates.add(crashed(1)); // delivered again
+    expect(fates.counts()).toEqual({ played: 1, cut: 1, cancelled: 0, refused: 0 });
+    expect(fates.fate(1)).toBe("cut");
+    expect(cutShortWords(1, fates.cutCauses())).toEqual(["1 cut short by a fault on the sleeve"]);
   });
 
   it("says Stop only for what no one else cut, and never more causes than cuts", () => {

@@ -73,7 +73,15 @@ from feelmysign.fates import Fate
 from feelmysign.layout import Layout
 from feelmysign.pace import MAX_AGE_MS, MAX_LAG_MS
 from feelmysign.player import SPIN_MS, WEARER, PlannedStroke, Player, cancelled
-from feelmysign.protocol import CANCELLED, DO_NOT_DISTURB, DUPLICATE, HELD, PAUSED
+from feelmysign.protocol import (
+    CANCELLED,
+    CRASHED,
+    DO_NOT_DISTURB,
+    DUPLICATE,
+    HELD,
+    PAUSED,
+    STOPPED,
+)
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 from feelmysign.services.drawing_log import DrawingSummaries
 from feelmysign.sleeve.admission import BURST, RATE_PER_S, Admission, Refused, duplicate_message
@@ -85,7 +93,7 @@ from feelmysign.sleeve.controls import (
     describe,
     refusal_for,
 )
-from feelmysign.sleeve.pace_memory import PaceMemory, pace_path
+from feelmysign.sleeve.pace_memory import Interrupted, PaceMemory, pace_path
 from feelmysign.topics import LEGACY_TOPIC, control_topic, strokes_topic, telemetry_topic
 from feelmysign.wearer import Wearer, sleeve_floor
 
@@ -108,7 +116,7 @@ NETWORK_STOP_S = 5.0  # a network thread ends within its 1 s select after a disc
 LOGIN_REFUSED_CODES = (134, 135)
 # Rejections after which the broker must deliver the stroke again: the sleeve did not play it
 # and is going away, not refusing it.
-NOT_ACKNOWLEDGED = frozenset({"stopped", "player_stopped"})
+NOT_ACKNOWLEDGED = frozenset({STOPPED, "player_stopped"})
 # Marks the log records that say the sleeve lost or cannot reach its broker: a program
 # that reports these itself in its own words (``feelmysign up``) filters them out.
 CONNECTION_STATE = {"connection_state": True}
@@ -224,6 +232,7 @@ class Sleeve:
             on_event=self._event,
             spin_ms=options.spin_ms,
             floor_ms=sleeve_floor(layout, options.wearer).min_duration_ms,
+            sleeve_id=options.sleeve_id,
         )
         self._admission = Admission(
             layout,
@@ -237,6 +246,9 @@ class Sleeve:
         # while the sleeve was down are late by how long they were held, not a new time line.
         self._pace_memory = PaceMemory(pace_path(self._id))
         self._admission.remember(self._pace_memory.load(options.max_age_ms))
+        # The strokes the sleeve's last process was playing when it ended: cut short by that,
+        # said once the publishing thread runs (see _report_interrupted).
+        self._interrupted = self._pace_memory.interrupted()
         # For the wearer's stop: the drawings lately seen (drawing -> the monotonic ms of its
         # last stroke's arrival), the strokes refused during the present pause, and the
         # drawings stopped (drawing -> when, wall clock: the admission's cancel of it).
@@ -307,6 +319,7 @@ class Sleeve:
         )
         publisher.start()
         self._player.start()  # every motor off (the backend's open), then the player's thread
+        self._report_interrupted()
         manager = ServiceManager.from_environment()
         feeder = WatchdogFeeder(manager, self._player.alive) if manager is not None else None
         if feeder is not None:
@@ -339,9 +352,22 @@ class Sleeve:
         self.controls.close()
         try:
             unplayed = self._player.stop()  # motors off first, whatever happens to the network
+            for stroke in self._player.cut_by_stop:
+                self._event(
+                    Safety(
+                        reason=STOPPED,
+                        row=0,
+                        column=0,
+                        message=(
+                            "cut short, after its played event: the sleeve stopped while it "
+                            "played (every motor off)"
+                        ),
+                        stroke=stroke.ref,
+                    )
+                )
             for stroke in unplayed:
                 message = "the sleeve stopped before this stroke could play"
-                self._reject("stopped", message, stroke.ref)
+                self._reject(STOPPED, message, stroke.ref)
         finally:
             if self._telemetry is not None:
                 # Every motor is off: that frame goes out (after any older one) before the
@@ -808,6 +834,25 @@ class Sleeve:
         if ack is not None:
             self._outbox.put(ack)
 
+    def _report_interrupted(self) -> None:
+        """The strokes the sleeve's last process was playing when it ended (``kill -9``, a
+        crash, a power cut): each reported cut short (``safety`` ``crashed``, after the
+        ``played`` event that process published), once the broker is reached. Not in this
+        process's journal: it never played them."""
+        for interrupted in self._interrupted:
+            event = crashed_event(interrupted)
+            self._count("crashed")
+            log.warning(
+                "sleeve %s: stroke %s of drawing %s was cut short when the sleeve's last "
+                "process ended (%s)",
+                self._id,
+                "?" if event.seq is None else event.seq + 1,
+                event.drawing,
+                played_words(interrupted),
+            )
+            self._outbox.put(_Publish(telemetry_topic(self._id, "events"), event.dumps(), 1, False))
+        self._interrupted = []
+
     def _say_if_delayed(self, event: Played) -> None:
         """A stroke felt long after it was sent (held by the broker, a slow network): logged, with
         its delay. Not ``late``, the refusal of a stroke the sleeve is too far behind for."""
@@ -852,8 +897,11 @@ class Sleeve:
 
     def _publish_loop(self) -> None:
         while True:
+            # While a stroke plays, the note of it is brought up to date at its end and now
+            # and then (feelmysign.sleeve.pace_memory): the sleeve's sign of life.
+            wait_s = min(JOURNAL_CHECK_S, self._pace_memory.keep_up())
             try:
-                item = self._outbox.get(timeout=JOURNAL_CHECK_S)
+                item = self._outbox.get(timeout=wait_s)
             except queue.Empty:
                 self._write_journal()  # quiet: a good moment to look
                 self._pace_memory.save()  # and to keep the time lines
@@ -865,15 +913,21 @@ class Sleeve:
             if isinstance(item, _Ack):
                 self._acknowledge(item)
                 continue
+            event = item.event
+            if isinstance(event, Played):
+                # Noted as playing before its played event leaves (and before its
+                # acknowledgement, which follows it): a process that dies mid-stroke leaves the
+                # note, and the next one says the stroke was cut short.
+                self._pace_memory.playing(event)
+            elif isinstance(event, Cancelled | Safety):
+                self._pace_memory.settled(event.stroke)  # said cut: not for the next process
             try:
                 self._client.publish(item.topic, item.payload, qos=item.qos, retain=item.retain)
             except (RuntimeError, ValueError, OSError) as error:
                 log.warning("sleeve %s: could not publish on %s: %s", self._id, item.topic, error)
-            if item.event is not None:
+            if event is not None:
                 with self._journal_lock:
-                    self._journal.add(item.event, time.monotonic())
-                if isinstance(item.event, Played):
-                    self._pace_memory.played(item.event)
+                    self._journal.add(event, time.monotonic())
 
     def _acknowledge(self, ack: _Ack) -> None:
         # Once only: a message id is reused by the broker as soon as it is acknowledged. And
@@ -924,3 +978,29 @@ class Sleeve:
             lost=tuple(chips),
             enable=None if enable is None else "high" if enable.high else "low",
         )
+
+
+def played_words(interrupted: Interrupted) -> str:
+    """How much of an interrupted stroke was played, as far as the note tells."""
+    at_least_s = interrupted.played_at_least_ms / 1000
+    return (
+        f"it had played at least {at_least_s:.1f} s of its "
+        f"{interrupted.duration_ms / 1000:.1f} s, and at most until the process ended"
+    )
+
+
+def crashed_event(interrupted: Interrupted) -> Safety:
+    """The ``safety`` event ``crashed`` of a stroke cut short by the end of the sleeve's last
+    process (the stroke's fields as its ``played`` event had them; row and column 0: it names
+    no motor)."""
+    return Safety(
+        reason=CRASHED,
+        row=0,
+        column=0,
+        message=(
+            "cut short, after its played event: the sleeve's process ended while it played (it "
+            "was killed, crashed or lost its power) and was started again; "
+            f"{played_words(interrupted)}"
+        ),
+        stroke=interrupted.playing.ref(),
+    )

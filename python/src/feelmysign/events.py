@@ -316,8 +316,10 @@ class Safety(_AboutAStroke, _Event):
     """A motor was protected: a stroke the duty-cycle cap kept from playing (``duty_cycle``:
     the stroke's fields, the motor's would-be duty cycle and the limit); a chip that stopped
     answering (``chip_lost``, one per stroke cut, or one without a stroke) or answers again
-    (``chip_back``); a stroke cut while the sleeve is silent (``silenced``). Sleeves before
-    these sent ``off_failed`` for an off that failed twice."""
+    (``chip_back``); a stroke cut while the sleeve is silent (``silenced``); a stroke cut short
+    after its ``played`` because the sleeve stopped (``stopped``) or its process ended
+    (``crashed``, said by the sleeve started next) while it played. Sleeves before these sent
+    ``off_failed`` for an off that failed twice."""
 
     kind: ClassVar[EventType] = "safety"
     reason: str

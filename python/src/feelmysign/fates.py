@@ -6,8 +6,10 @@ Each stroke has one fate, read from the sleeve's events about it (docs/protocol.
 
 - ``played``: its ``played`` (or ``adjusted``) event: felt whole;
 - ``cut``: cut short by a cancel while it played (a ``cancelled`` event with
-  ``started``; the sender's, or the wearer's pause or stop, ``by: "wearer"``): felt in
-  part, counted once, here and not under played;
+  ``started``; the sender's, or the wearer's pause or stop, ``by: "wearer"``), or by a
+  fault after its ``played`` (a ``safety`` event: ``chip_lost``; ``stopped`` or
+  ``crashed``, the sleeve stopped or its process ended while it played): felt in part,
+  counted once, here and not under played;
 - ``cancelled``: dropped by a cancel before it started (a ``cancelled`` event
   without ``started``, or refused as ``cancelled`` on arrival: a stroke of a
   drawing stopped before it came);

@@ -4,9 +4,9 @@
 waits, with a bound, until each stroke of its drawing has a final answer from
 the sleeve: played (``played`` or ``adjusted``), or refused (``rejected``, a
 ``safety`` event that kept it from playing, a ``cancelled`` one before it
-started). A stroke played and later cut (``safety`` ``chip_lost``, ``cancelled``
-while playing) is reported as cut. Copies of an event (QoS 1 delivers at least
-once) are counted once (``EventCopies``). Its summary says too, in the words of
+started). A stroke played and later cut (``safety`` ``chip_lost``, ``stopped`` or
+``crashed``, ``cancelled`` while playing) is reported as cut. Copies of an event (QoS 1
+delivers at least once) are counted once (``EventCopies``). Its summary says too, in the words of
 ``feelmysign.fates.CatchUp`` (as the page's card and ``up``'s line), how many strokes
 the sleeve played faster to catch up with the drawing and by how much in all, how many
 it slowed to its floor, and how many it skipped as ``late``.

@@ -118,6 +118,7 @@ class PlannedStroke:
     acknowledge: Callable[[], None] | None = None
     number: int = -1  # the order it was accepted in: a cancel covers those accepted before it
     compressed_ms: float | None = None  # how much shorter it plays to catch up, if it does
+    started: bool = False  # its first command went out and its played event with it
 
     @property
     def received_wall_ms(self) -> float:
@@ -170,8 +171,11 @@ class Player:
         spin_ms: float = SPIN_MS,
         floor_ms: float | None = None,
         stall_ms: float = STALL_MS,
+        sleeve_id: str | None = None,
     ) -> None:
         self._backend = backend
+        # Its log lines name the sleeve, as the daemon's do ("sleeve <id>: ...").
+        self._log_prefix = "" if sleeve_id is None else f"sleeve {sleeve_id}: "
         # How late the player may wake before the strokes whose time passed are refused
         # (a test whose clock jumps ahead to let every stroke play gives math.inf).
         self._stall_ms = stall_ms
@@ -219,6 +223,8 @@ class Player:
         self.capped = 0
         self.stalled = 0  # strokes refused as late because the player did not run in their time
         self.cut = 0  # strokes cut for a chip that stopped answering
+        # Set by stop: the strokes playing when it switched every motor off (cut short by it).
+        self.cut_by_stop: list[PlannedStroke] = []
         self._retry_at_s = 0.0  # when the lost chips are tried again next
         self._check_at_s = 0.0  # when the driven chips are read again next
 
@@ -311,13 +317,15 @@ class Player:
             if next_ms is not None and next_ms <= self._clock():
                 self._play()
         except Exception:  # as in the player's thread: every motor off, and the player stops
-            log.exception("player stopped by an unexpected error; all motors off")
+            log.exception(
+                "%splayer stopped by an unexpected error; all motors off", self._log_prefix
+            )
             self._running = False
             self._on_event(ErrorEvent(reason="player_crashed"))
             try:
                 self._backend.all_off()
             except Exception as error:  # a lost chip: stop() tries again and says so
-                log.warning("all motors off as the player stops: %s", error)
+                log.warning("%sall motors off as the player stops: %s", self._log_prefix, error)
         finally:
             self._play_lock.release()
 
@@ -444,7 +452,8 @@ class Player:
     def stop(self) -> list[PlannedStroke]:
         """Stop playing and switch every motor off (also when the thread died).
 
-        Returns the strokes accepted but not started, which will never play.
+        Returns the strokes accepted but not started, which will never play; those that had
+        started and not ended, cut short by the stop, are in ``cut_by_stop`` then.
         """
         self._running = False
         self._hold_low()  # an enable line low at once, before the wait and any I2C "off"
@@ -457,13 +466,23 @@ class Player:
         locked = self._play_lock.acquire(timeout=STOP_WAIT_S)
         try:
             self._backend.all_off()
+            stopped_ms = self._clock()
         finally:
             if locked:
                 self._play_lock.release()
         with self._lock:
-            unplayed = list(self._inbox) + [
+            unstarted = [
                 tag for tag in self._timeline.unstarted() if isinstance(tag, PlannedStroke)
             ]
+            # (Not one the duty-cycle cap refused at its start: it never played.)
+            self.cut_by_stop = [
+                tag
+                for tag in self._timeline.tags()
+                if isinstance(tag, PlannedStroke)
+                and tag.started
+                and tag.start_ms + tag.schedule.duration_ms > stopped_ms
+            ]
+            unplayed = list(self._inbox) + unstarted
             self._inbox.clear()
             self._unplayed.clear()  # never acknowledged: the broker sends them again
         return unplayed
@@ -499,7 +518,9 @@ class Player:
                 if wait_s is not None:
                     self._wake.wait(wait_s)
         except Exception:  # the thread must never die with motors on
-            log.exception("player stopped by an unexpected error; all motors off")
+            log.exception(
+                "%splayer stopped by an unexpected error; all motors off", self._log_prefix
+            )
             self._on_event(ErrorEvent(reason="player_crashed"))
         finally:
             self._running = False
@@ -509,7 +530,7 @@ class Player:
             try:
                 self._backend.all_off()
             except Exception as error:  # a lost chip: stop() tries again and says so
-                log.warning("all motors off as the player stops: %s", error)
+                log.warning("%sall motors off as the player stops: %s", self._log_prefix, error)
             finally:
                 if locked:
                     self._play_lock.release()
@@ -617,15 +638,16 @@ class Player:
                         "(its process was stopped or starved), and the stroke's whole time "
                         "passed meanwhile"
                     ),
-                    stroke=tag.ref,
+                    stroke=stalled_ref(tag, now_ms),
                 )
             )
             acknowledge = acknowledgements[id(tag)]
             if acknowledge is not None:
                 acknowledge()  # refused, and said so: the broker must not send it again
         log.warning(
-            "the player ran %.0f ms late (its process did not run): %d stroke(s) whose time "
+            "%sthe player ran %.0f ms late (its process did not run): %d stroke(s) whose time "
             "passed meanwhile refused as late",
+            self._log_prefix,
             stalled_ms,
             len(refused),
         )
@@ -680,7 +702,9 @@ class Player:
                     note(ref.drawing, ref.seq)
                 self._backend.set_intensity(change.row, change.column, change.intensity)
             except Exception as error:  # a motor that fails must not stop the others
-                log.warning("actuator (%d, %d): %s", change.row, change.column, error)
+                log.warning(
+                    "%sactuator (%d, %d): %s", self._log_prefix, change.row, change.column, error
+                )
                 self._on_event(
                     ErrorEvent(
                         reason="backend", message=str(error), row=change.row, column=change.column
@@ -711,7 +735,7 @@ class Player:
         try:
             self._backend.all_off()
         except Exception as error:
-            log.warning("all motors off %s: %s", when, error)
+            log.warning("%sall motors off %s: %s", self._log_prefix, when, error)
 
     # --- chips that stopped answering ---------------------------------------------
 
@@ -753,7 +777,12 @@ class Player:
         )
         back = [] if retry is None else retry()
         for row, column in back:
-            log.warning("actuator (%d, %d): its chip answers again and is off", row, column)
+            log.warning(
+                "%sactuator (%d, %d): its chip answers again and is off",
+                self._log_prefix,
+                row,
+                column,
+            )
             self._on_event(
                 Safety(
                     reason="chip_back",
@@ -785,7 +814,7 @@ class Player:
             failed = check()
             if failed is not None:
                 (row, column), error = failed
-                log.warning("actuator (%d, %d): %s", row, column, error)
+                log.warning("%sactuator (%d, %d): %s", self._log_prefix, row, column, error)
                 self._on_event(ErrorEvent(reason="backend", message=error, row=row, column=column))
                 cut = self._cut_playing()
                 self._chip_lost(
@@ -870,7 +899,10 @@ class Player:
             self._backend.set_intensity(change.row, change.column, 0.0)
         except Exception:
             log.warning(
-                "actuator (%d, %d) still not off: its chip is lost", change.row, change.column
+                "%sactuator (%d, %d) still not off: its chip is lost",
+                self._log_prefix,
+                change.row,
+                change.column,
             )
             return False
         return True
@@ -906,6 +938,7 @@ class Player:
 
     def _started(self, stroke: PlannedStroke, now: float) -> None:
         with self._lock:
+            stroke.started = True
             self._pending -= 1
             acknowledge = self._done(stroke)
             self._queue.mark_started(stroke.ref.drawing, stroke.ref.seq)
@@ -951,6 +984,16 @@ def played_event(stroke: PlannedStroke, written_at_ms: float) -> Played:
             requested_duration_ms=schedule.adjusted.requested_duration_ms,
         )
     return Played(**timing)
+
+
+def stalled_ref(stroke: PlannedStroke, now_ms: float) -> StrokeRef:
+    """What names a stroke refused at ``now_ms`` (the player's clock) because its whole time
+    passed while the player did not run: its ``lag_ms`` is how late it was then, as another
+    ``late`` refusal's: the lag it was admitted with (behind its sender's time line; 0 without
+    ``sent_at_ms``) plus how long after its planned start it was refused."""
+    ref = stroke.ref
+    lag_ms = (ref.lag_ms or 0.0) + max(0.0, now_ms - stroke.start_ms)
+    return replace(ref, lag_ms=round(lag_ms, 1))
 
 
 def _both(first: Callable[[], None] | None, second: Callable[[], None]) -> Callable[[], None]:

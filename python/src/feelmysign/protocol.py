@@ -74,6 +74,13 @@ LATE = "late"
 QUEUE_FULL = "queue_full"
 PLAYER_STOPPED = "player_stopped"
 SILENCED = "silenced"  # the enable line is held low for a chip that does not answer
+# The sleeve stopped: a stroke not started is rejected so (never acknowledged: the broker
+# delivers it again), one playing is cut short so (a ``safety`` event after its ``played``).
+STOPPED = "stopped"
+# The sleeve's process ended (kill -9, a crash, a power cut) while the stroke played: a
+# ``safety`` event after its ``played``, from the sleeve started next
+# (feelmysign.sleeve.pace_memory).
+CRASHED = "crashed"
 # The wearer's (feelmysign.sleeve.controls): the sleeve paused, or "do not disturb" running.
 PAUSED = "paused"
 DO_NOT_DISTURB = "do_not_disturb"
