@@ -97,6 +97,27 @@ def test_strokes_older_than_the_maximum_age_are_stale() -> None:
     assert "clock" in verdict.message and "10 s" in verdict.message
 
 
+@pytest.mark.parametrize(
+    ("ahead_ms", "stale"), [(10_001.0, True), (3_600_000.0, True), (9_999.0, False)]
+)
+def test_strokes_stamped_further_ahead_than_the_maximum_age_are_stale(
+    ahead_ms: float, stale: bool
+) -> None:
+    """A stroke stamped ahead of the sleeve's clock cannot be told old: one held in the broker
+    all night, by a sender whose clock runs an hour fast, would play when the sleeve comes on."""
+    verdict = PacePolicy(max_age_ms=10_000.0).check(
+        drawing="d",
+        sent_at_ms=1e12 + ahead_ms,
+        received_wall_ms=1e12,
+        start_wall_ms=1e12,
+        duration_ms=DURATION_MS,
+    )
+    assert (verdict.reason == STALE) is stale, verdict
+    assert verdict.age_ms == pytest.approx(-ahead_ms)
+    if stale:
+        assert "ahead of the sleeve's clock" in verdict.message and "NTP" in verdict.message
+
+
 def test_strokes_without_a_send_time_are_never_refused() -> None:
     verdict = PacePolicy(max_age_ms=100.0, max_lag_ms=10.0).check(
         drawing="d", sent_at_ms=None, received_wall_ms=1e9, start_wall_ms=2e9, duration_ms=1.0

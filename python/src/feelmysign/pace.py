@@ -8,8 +8,9 @@ format) is never refused by them:
 - **stale**: a stroke received more than ``max_age_ms`` after it was sent is
   refused. This catches strokes the broker kept while the sleeve was away. It
   compares two clocks, the sender's and the sleeve's, so it needs them to agree
-  to well within ``max_age_ms`` (NTP does; a sender whose clock is behind by more
-  gets every stroke refused, and the message says to check its clock).
+  to well within ``max_age_ms`` (NTP does; a sender whose clock is behind or
+  ahead by more gets every stroke refused, and the message says to check its
+  clock: a stroke stamped further ahead cannot be told from one held all night).
 - **late**: a stroke that would start more than ``max_lag_ms`` after it was due
   is skipped. When a stroke is due is the sender's own time line: its
   ``sent_at_ms``, but never before the stroke before it in the same drawing has
@@ -131,6 +132,18 @@ class PacePolicy:
                 f"sleeve plays strokes at most {self.max_age_ms / 1000:g} s old. It was held on "
                 "the way (the sleeve or its broker was away), or, if it was just sent, the "
                 "sender's clock is behind the sleeve's: set both by NTP",
+                age_ms=age_ms,
+            )
+        if age_ms < -self.max_age_ms:
+            # Its age cannot be told: a stroke the broker held all night, stamped ahead by a
+            # clock that runs fast (or on purpose), would otherwise play when the sleeve
+            # comes on.
+            return Verdict(
+                STALE,
+                f"the stroke is stamped {-age_ms / 1000:.1f} s ahead of the sleeve's clock (by "
+                "the sender's clock), so how old it is cannot be told; the sleeve plays strokes "
+                f"stamped at most {self.max_age_ms / 1000:g} s either side of its own time. The "
+                "sender's clock is ahead of the sleeve's: set both by NTP",
                 age_ms=age_ms,
             )
         line.smallest_delay_ms = min(line.smallest_delay_ms, age_ms)
