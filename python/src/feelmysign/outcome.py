@@ -5,7 +5,9 @@ waits, with a bound, until each stroke of its drawing has a final answer from
 the sleeve: played (``played`` or ``adjusted``), or refused (``rejected``, a
 ``safety`` event that kept it from playing, a ``cancelled`` one before it
 started). A stroke played and later cut (``safety`` ``chip_lost``, ``stopped`` or
-``crashed``, ``cancelled`` while playing) is reported as cut. Copies of an event (QoS 1
+``crashed``, ``cancelled`` while playing) is reported as cut; one playing when the sleeve's
+status turned offline (its process died: the broker's will) is not counted played, and is
+said as not known unless an answer about it comes after. Copies of an event (QoS 1
 delivers at least once) are counted once (``EventCopies``). Its summary says too, in the words of
 ``feelmysign.fates.CatchUp`` (as the page's card and ``up``'s line), how many strokes
 the sleeve played faster to catch up with the drawing and by how much in all, how many
@@ -55,6 +57,9 @@ class StrokeOutcome:
 
     # Never sent: the sender stopped once the sleeve refused a stroke as its wearer paused it.
     held: bool = False
+    # Playing when the sleeve went offline (its status, the broker's will when its process
+    # died): how much was felt is not known here until the sleeve, restarted, says (``crashed``).
+    offline: bool = False
 
     @property
     def final(self) -> bool:
@@ -122,6 +127,22 @@ class DrawingOutcome:
             return True
         return False
 
+    def went_offline(self) -> None:
+        """The sleeve's status said offline: a stroke it was playing then (its played event
+        seen, its time on the skin not over, no cut told) may have been cut; it is not counted
+        played, unless an answer about it comes after all."""
+        now = time.monotonic()
+        with self._condition:
+            for stroke in self.strokes:
+                if (
+                    stroke.played is not None
+                    and stroke.played_seen_s is not None
+                    and stroke.cut_reason is None
+                    and now < stroke.played_seen_s + stroke.played.duration_ms / 1000
+                ):
+                    stroke.offline = True
+            self._condition.notify_all()
+
     def held_by_wearer(self) -> bool:
         """Whether the sleeve refused a stroke as its wearer paused it (or asked not to be
         disturbed), or the wearer's pause or stop cut or dropped one: what is not sent yet
@@ -166,13 +187,20 @@ class DrawingOutcome:
     def summary(self) -> DrawingSummary:
         with self._condition:
             # One fate a stroke, as feelmysign.fates counts them: one cut part-way is not played.
-            played = [s.played for s in self.strokes if s.played is not None and not s.cut_reason]
+            played = [
+                s.played
+                for s in self.strokes
+                if s.played is not None and not s.cut_reason and not s.offline
+            ]
             refused = Counter(s.refused_reason for s in self.strokes if s.refused_reason)
             cut = Counter(s.cut_reason for s in self.strokes if s.cut_reason)
             unheard = [i for i, s in enumerate(self.strokes) if not s.final]
             held = [i for i, s in enumerate(self.strokes) if s.held]
+            offline = [i for i, s in enumerate(self.strokes) if s.offline and not s.cut_reason]
         catch_up = CatchUp.of(played, refused[LATE])
-        return DrawingSummary(self.count, len(played), refused, cut, unheard, held, catch_up)
+        return DrawingSummary(
+            self.count, len(played), refused, cut, unheard, held, catch_up, offline
+        )
 
 
 @dataclass(frozen=True)
@@ -185,10 +213,12 @@ class DrawingSummary:
     held: list[int] = field(default_factory=list)  # seqs not sent: the wearer's hold
     # Played faster to catch up, slowed to the floor, skipped as late (refused[LATE] too).
     catch_up: CatchUp = field(default_factory=CatchUp)
+    # seqs playing when the sleeve went offline, with no answer since (``went_offline``)
+    offline: list[int] = field(default_factory=list)
 
     @property
     def all_played(self) -> bool:
-        return self.played == self.count and not self.cut
+        return self.played == self.count and not self.cut and not self.offline
 
     def text(self) -> str:
         parts = [f"played {self.played} of {self.count} strokes"]
@@ -201,6 +231,12 @@ class DrawingSummary:
             parts.append(f"refused {sum(refused.values())} ({_reasons(refused)})")
         if self.cut:
             parts.append(f"cut {sum(self.cut.values())} part-way ({_reasons(self.cut)})")
+        if self.offline:
+            numbers = ", ".join(str(seq + 1) for seq in self.offline)
+            parts.append(
+                f"went offline while it played stroke(s) {numbers}: how much of them was felt "
+                "is not known (the sleeve says when it is back: see its log)"
+            )
         text = "The sleeve " + ", ".join(parts)
         if self.held:
             text += f"; {len(self.held)} not sent (from stroke {self.held[0] + 1} on)"

@@ -54,6 +54,7 @@ from feelmysign.connection import BrokerSettings, connect_client
 from feelmysign.errors import BrokerConnectionError, LayoutError, ParameterError, StrokeError
 from feelmysign.events import (
     Event,
+    EventError,
     Status,
     StatusControls,
     StatusFloor,
@@ -410,11 +411,14 @@ def _watch_events(
     outcome = DrawingOutcome(strokes[0].drawing or "", total, tell)
     topic = telemetry_topic(settings.sleeve_id, "events")
     client.message_callback_add(topic, outcome.on_message)
+    # The sleeve's status too: offline (its will, when its process dies) while a stroke plays.
+    status_topic = telemetry_topic(settings.sleeve_id, "status")
+    client.message_callback_add(status_topic, lambda *m: _on_status(outcome, m[2]))
     subscribed = threading.Event()
     client.on_subscribe = lambda *_: subscribed.set()
     # Subscribed again on a reconnection: a clean session forgets subscriptions.
-    client.on_connect = lambda c, *_: c.subscribe(topic, qos=1)
-    client.subscribe(topic, qos=1)
+    client.on_connect = lambda c, *_: c.subscribe([(topic, 1), (status_topic, 1)])
+    client.subscribe([(topic, 1), (status_topic, 1)])
     if not subscribed.wait(args.timeout_s):
         raise BrokerConnectionError(
             "timeout",
@@ -423,6 +427,16 @@ def _watch_events(
             url=settings.url,
         )
     return outcome
+
+
+def _on_status(outcome: DrawingOutcome, message: mqtt.MQTTMessage) -> None:
+    """A status that says offline: the sleeve's process ended (or it left the broker)."""
+    try:
+        status = Status.from_json(bytes(message.payload))
+    except EventError:
+        return  # one this sender cannot read: not a word on whether it is online
+    if not status.online:
+        outcome.went_offline()
 
 
 class _InOrder:
