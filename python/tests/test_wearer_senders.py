@@ -19,6 +19,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 import urllib.error
 import urllib.request
 from collections.abc import Iterator
@@ -69,12 +70,12 @@ def free_port() -> int:
 
 
 @contextmanager
-def running_up(state_dir: Path, mqtt_port: int) -> Iterator[Up]:
+def running_up(state_dir: Path, mqtt_port: int, *more: str) -> Iterator[Up]:
     # The same MQTT port at each start: a join token holds the broker's URL.
     process = subprocess.Popen(
         [
             *(FEELMYSIGN, "up", "--state-dir", str(state_dir)),
-            *("--http-port", "0", "--port", str(mqtt_port), "--ws-port", "0"),
+            *("--http-port", "0", "--port", str(mqtt_port), "--ws-port", "0", *more),
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
@@ -166,6 +167,63 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
         sent = send(token, tmp_path)
         assert sent.returncode == 0, sent.stdout + sent.stderr
         assert "The sleeve played" in sent.stdout, sent.stdout
+
+
+def _driven(record: Path) -> list[tuple[float, float]]:
+    """The simulated sleeve's record: (wall ms, intensity) of every motor change."""
+    if not record.exists():
+        return []
+    rows = [json.loads(line) for line in record.read_text().splitlines() if line.strip()]
+    return [(row["wall_ms"], row["intensity"]) for row in rows]
+
+
+def _on_at(changes: list[tuple[float, float]], wall_ms: float) -> bool:
+    return any(at > wall_ms and level > 0 for at, level in changes)
+
+
+def test_blocking_a_sender_stops_what_it_already_sent(tmp_path: Path) -> None:
+    """A wearer blocks a sender to make it stop: its stroke playing is cut at once, its
+    strokes waiting dropped, and its own ``send`` says it was cut off by the block."""
+    state_dir = tmp_path / "up"
+    record = tmp_path / "felt.jsonl"
+    with running_up(state_dir, free_port(), "--record", str(record)) as up:
+        token = add_sender(state_dir, "alice")
+        env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+        env["XDG_STATE_HOME"] = str(tmp_path / "sender-state")
+        # Two long strokes, sent at their pace: the second still to come at the block.
+        sending = subprocess.Popen(
+            [FEELMYSIGN, "send", "--join", token, "0,1,3,1,6000", "0,2,3,2,6000"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        try:
+            deadline = time.monotonic() + WAIT_S
+            while not _on_at(_driven(record), 0):
+                assert time.monotonic() < deadline, "the sender's stroke never played"
+                assert sending.poll() is None, sending.communicate()
+                time.sleep(0.05)
+            time.sleep(1.0)  # well into the 6 s stroke
+            up.call("block", {"sender": "alice"})
+            blocked_ms = time.time() * 1000
+            out, err = sending.communicate(timeout=WAIT_S)
+        finally:
+            if sending.poll() is None:
+                sending.kill()
+        time.sleep(2.0)  # the rest of the first stroke, the start of the second
+        changes = _driven(record)
+        off = [at for at, _ in changes if at >= blocked_ms - 500]
+        levels: dict[tuple[int, int], float] = {}
+        rows = [json.loads(line) for line in record.read_text().splitlines() if line.strip()]
+        for row in rows:
+            levels[(row["row"], row["column"])] = row["intensity"]
+        assert all(level == 0 for level in levels.values()), levels
+        assert not _on_at(changes, blocked_ms + 200), "a motor was driven after the block"
+        assert off, "no motor change around the block"
+        assert sending.returncode != 0, out + err
+        assert "The wearer blocked this sender" in err, err
+        assert "closed the connection" not in err, err
 
 
 @pytest.mark.parametrize("name", ["page", "a/b", "", "x" * 65])

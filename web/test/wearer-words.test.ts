@@ -6,6 +6,7 @@ import {
   ceilingChoices,
   ceilingLine,
   doNotDisturbLine,
+  sendersLine,
   summary,
   untilHint,
   untilTime,
@@ -124,5 +125,17 @@ describe("do not disturb until a time", () => {
       // An hour earlier is within the 24 hours.
       expect(untilTime("21:00", evening).ok).toBe(true);
     });
+  });
+});
+
+describe("the wearer's senders", () => {
+  it("says that a block also stops what is playing and waiting, from every sender", () => {
+    expect(sendersLine(true)).toContain("Blocking also stops what is playing and waiting now");
+    expect(sendersLine(true)).toContain("cannot tell whose strokes are whose");
+  });
+
+  it("without the broker's files, says where to block rather than that the broker is another", () => {
+    expect(sendersLine(false)).not.toContain("uses another one");
+    expect(sendersLine(false)).toContain("wearer's page of 'feelmysign up'");
   });
 });

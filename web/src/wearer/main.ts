@@ -11,6 +11,7 @@ import {
   ceilingChoices,
   ceilingLine,
   doNotDisturbLine,
+  sendersLine,
   summary,
   untilHint,
   untilTime,
@@ -38,7 +39,7 @@ const dndUntil = byId<HTMLFormElement>("dnd-until");
 const dndTime = byId<HTMLInputElement>("dnd-time");
 const dndTimeHint = byId<HTMLParagraphElement>("dnd-time-hint");
 const dndEnd = byId<HTMLButtonElement>("dnd-end");
-const sendersLine = byId<HTMLParagraphElement>("senders-line");
+const sendersLineElement = byId<HTMLParagraphElement>("senders-line");
 const sendersList = byId<HTMLUListElement>("senders");
 
 let state: WearerState | null = null;
@@ -166,9 +167,7 @@ function render(s: WearerState): void {
     button.disabled = !ready;
   }
 
-  sendersLine.textContent = s.blocking
-    ? "Block a sender to stop them drawing on you until you unblock them."
-    : "Blocking a sender needs the broker feelmysign runs; this sleeve uses another one.";
+  sendersLineElement.textContent = sendersLine(s.blocking);
   renderSenders(s.senders);
 
   const said = summary(s, nowMs);

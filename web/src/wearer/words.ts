@@ -57,6 +57,20 @@ export function doNotDisturbLine(untilMs: number | null, nowMs: number): string 
     : `On until ${untilClock(untilMs, nowMs)}: nothing reaches you.`;
 }
 
+/**
+ * The line above the senders. A block also stops what plays and what waits (every sender's: the
+ * sleeve cannot tell whose stroke is whose), so what the blocked sender already sent ends too.
+ */
+export function sendersLine(blocking: boolean): string {
+  return blocking
+    ? "Block a sender to stop them drawing on you until you unblock them. Blocking also stops " +
+        "what is playing and waiting now, from every sender: the sleeve cannot tell whose " +
+        "strokes are whose."
+    : "Blocking is not offered here: this page does not find the broker's files on this " +
+        "computer (its usual state directory). Block senders on the wearer's page of " +
+        "'feelmysign up', where the broker runs.";
+}
+
 /** The words a screen reader says when they change (pause, ceiling, do not disturb, online). */
 export function summary(state: WearerState, nowMs: number): string {
   const c = state.controls;
