@@ -6,6 +6,7 @@ import {
   ceilingChoices,
   ceilingLine,
   doNotDisturbLine,
+  playLine,
   sendersLine,
   summary,
   untilHint,
@@ -83,7 +84,7 @@ describe("do not disturb until a time", () => {
     );
     expect(
       summary(state({ do_not_disturb_until_ms: new Date(2026, 10, 27, 22, 0).getTime() }), now),
-    ).toContain("Do not disturb until tomorrow at 22:00.");
+    ).toContain("Do not disturb until tomorrow at 22:00: nothing plays.");
   });
 
   it("takes the current minute as tomorrow's, within the 24 h the sleeve allows", () => {
@@ -137,5 +138,32 @@ describe("the wearer's senders", () => {
   it("without the broker's files, says where to block rather than that the broker is another", () => {
     expect(sendersLine(false)).not.toContain("uses another one");
     expect(sendersLine(false)).toContain("wearer's page of 'feelmysign up'");
+  });
+});
+
+describe("what the wearer's page says plays", () => {
+  const now = new Date(2026, 10, 26, 23, 24).getTime();
+  const until = new Date(2026, 10, 26, 23, 39).getTime();
+
+  it("says nothing plays under do not disturb, not that it plays what senders draw", () => {
+    const dnd = state({ do_not_disturb_until_ms: until }).controls!;
+    expect(playLine(dnd, now)).toBe("Do not disturb until 23:39: nothing plays.");
+    expect(summary(state({ do_not_disturb_until_ms: until }), now)).toBe(
+      "Do not disturb until 23:39: nothing plays.",
+    );
+    // Once its time has passed, it plays again.
+    expect(playLine(dnd, until + 1)).toBe("Playing: what senders draw, you feel.");
+  });
+
+  it("says why the sleeve started paused at the lowest strength by itself", () => {
+    const safe = state({ paused: true, paused_by: "sleeve", ceiling: 0.05 }).controls!;
+    expect(playLine(safe, now)).toContain("could not read your last choices");
+    expect(playLine(safe, now)).toContain("at the lowest strength, 5 %");
+    expect(summary(state({ paused: true, paused_by: "sleeve", ceiling: 0.05 }), now)).toBe(
+      "Paused by the sleeve itself: it could not read your last choices. Strongest vibration 5 %.",
+    );
+    expect(playLine(state({ paused: true, paused_by: "page" }).controls!, now)).toBe(
+      "Paused: nothing plays until you resume.",
+    );
   });
 });

@@ -580,12 +580,22 @@ def _wearer_line(outcome: DrawingOutcome) -> str | None:
             f"{_numbers(refused['do_not_disturb'])} refused"
         )
     if cut:
-        parts.append(f"the wearer's pause or stop cut or dropped stroke(s) {_numbers(cut)}")
+        parts.append(
+            f"the wearer (a pause, stop or block) cut or dropped stroke(s) {_numbers(cut)}"
+        )
     held = [i + 1 for i, s in enumerate(outcome.strokes) if s.held]
     if held:
         parts.append(f"stroke(s) {_numbers(held)} not sent, since the sleeve would refuse them")
     text = "; ".join(parts)
-    return f" {text[0].upper()}{text[1:]}. Send again once the wearer has resumed."
+    # What to do depends on what the wearer chose: a pause ends with a resume, do not disturb
+    # at its time, and a stop (no refusal for a hold) means the wearer did not want it now.
+    if refused["paused"] or (held and not refused["do_not_disturb"]):
+        advice = "Send again once the wearer has resumed."
+    elif refused["do_not_disturb"]:
+        advice = "Send again once do not disturb has ended."
+    else:
+        advice = "The wearer stopped it (or paused the sleeve): send again only when they want it."
+    return f" {text[0].upper()}{text[1:]}. {advice}"
 
 
 def _numbers(numbers: list[int]) -> str:
