@@ -235,7 +235,9 @@ def _answers_as_a_stop_mid_drawing(stroke: dict[str, Any]) -> list[dict[str, Any
     if stroke["seq"] < 2:
         return answers
     (refused,) = answers
-    ref = {k: refused[k] for k in ("topic", "drawing", "seq", "received_at_ms") if k in refused}
+    ref: dict[str, Any] = {
+        k: refused[k] for k in ("topic", "drawing", "seq", "received_at_ms") if k in refused
+    }
     return [
         {
             "type": "cancelled",
