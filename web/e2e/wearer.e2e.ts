@@ -321,6 +321,21 @@ describe("the wearer's page served by feelmysign up", () => {
     await waitForData(page, '[data-testid="dnd-line"]', "until", "");
   });
 
+  it("takes the time 24-hour in an en-US browser, as typed, with no AM/PM", async () => {
+    // The page is en-US (PHONE): a native time field would show 10:30 PM and want AM/PM typed.
+    expect(await page.evaluate(() => navigator.language)).toBe("en-US");
+    const field = page.locator('[data-testid="dnd-time"]');
+    await field.fill("");
+    await field.pressSequentially("22:30");
+    expect(await field.inputValue()).toBe("22:30");
+    await expect(page.locator('[data-testid="dnd-time-hint"]').textContent()).resolves.toMatch(
+      /^Set makes it until (tomorrow at )?22:30/,
+    );
+    expect(await field.evaluate((input) => (input as HTMLInputElement).type)).toBe("text");
+    await screenshot(page, "wearer-phone-dnd-24-hour");
+    await field.fill("");
+  });
+
   it("says what to enter when Set is pressed without a time", async () => {
     const field = page.locator('[data-testid="dnd-time"]');
     await field.fill("");

@@ -100,9 +100,21 @@ describe("do not disturb until a time", () => {
     });
     expect(untilTime("late", now)).toEqual({
       ok: false,
-      problem: "late is not a time of day: enter one such as 22:30, then press Set.",
+      problem: "late is not a time of day: enter one such as 22:30 (24-hour), then press Set.",
     });
     expect(untilHint("", now)).toBe("");
+    for (const wrong of ["24:00", "22:60", "10:30 PM", "12345"]) expect(untilTime(wrong, now).ok).toBe(false);
+  });
+
+  it("takes 24-hour times as the wearer types them", () => {
+    const at = (h: number, m: number, day = 26) => new Date(2026, 10, day, h, m).getTime();
+    expect(untilTime("23:05", now)).toMatchObject({ ok: true, untilMs: at(23, 5) });
+    expect(untilTime("2305", now)).toMatchObject({ ok: true, untilMs: at(23, 5) });
+    expect(untilTime("7:05", now)).toMatchObject({
+      ok: true,
+      untilMs: at(7, 5, 27),
+      words: "until tomorrow at 07:05",
+    });
   });
 
   describe("on the night the clocks go back", () => {

@@ -136,19 +136,20 @@ export type UntilTime =
   | { readonly ok: false; readonly problem: string };
 
 /**
- * The next time `hhmm` ("22:30", as an `<input type="time">` gives it) comes: today, or tomorrow
- * when it has passed (said so: "until tomorrow at 07:00"). Refused in words when empty, or when
- * it is more than 24 h away (the sleeve's limit; only on the day the clocks go back).
+ * The next time `hhmm` comes: today, or tomorrow when it has passed (said so: "until tomorrow at
+ * 07:00"). 24-hour, as the wearer types it: "22:30", "7:05", "2230" (and "22:30:00"). Refused in
+ * words when empty, not a time of day, or more than 24 h away (the sleeve's limit; only on the
+ * day the clocks go back).
  */
 export function untilTime(hhmm: string, nowMs: number): UntilTime {
-  const match = /^(\d{2}):(\d{2})(?::\d{2}(?:\.\d+)?)?$/.exec(hhmm.trim());
-  if (match === null) {
+  const match = /^(\d{1,2})[:.h]?(\d{2})(?::\d{2}(?:\.\d+)?)?$/.exec(hhmm.trim());
+  if (match === null || Number(match[1]) > 23 || Number(match[2]) > 59) {
     return {
       ok: false,
       problem:
         hhmm.trim() === ""
           ? "Enter the time do not disturb ends, such as 22:30, then press Set."
-          : `${hhmm} is not a time of day: enter one such as 22:30, then press Set.`,
+          : `${hhmm.trim()} is not a time of day: enter one such as 22:30 (24-hour), then press Set.`,
     };
   }
   const at = new Date(nowMs);
