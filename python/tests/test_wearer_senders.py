@@ -43,10 +43,11 @@ pytestmark = pytest.mark.broker
 class Up:
     """A running ``feelmysign up`` and its wearer's API."""
 
-    def __init__(self, process: subprocess.Popen[str], base: str, key: str) -> None:
+    def __init__(self, process: subprocess.Popen[str], base: str, key: str, banner: str) -> None:
         self.process = process
         self.base = base
         self.key = key
+        self.banner = banner
 
     def call(self, action: str, body: dict[str, object] | None = None) -> dict[str, object]:
         request = urllib.request.Request(
@@ -96,7 +97,7 @@ def running_up(state_dir: Path, mqtt_port: int, *more: str) -> Iterator[Up]:
             seen.append(lines.get(timeout=WAIT_S))
         found = WEARER_URL.search("".join(seen))
         assert found is not None, "".join(seen)
-        yield Up(process, found[1], found[2])
+        yield Up(process, found[1], found[2], "".join(seen))
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(WAIT_S)
@@ -129,6 +130,8 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
     state_dir = tmp_path / "up"
     mqtt_port = free_port()
     with running_up(state_dir, mqtt_port) as up:
+        # The banner names what the wearer's page does, blocking included.
+        assert "do not disturb, block a sender" in up.banner, up.banner
         token = add_sender(state_dir, "alice")
         assert add_sender(state_dir, "alice") == token  # the same name: the same account
         login = decode_join_token(token)

@@ -298,7 +298,8 @@ def _for_the_wearer(url: str | None, *, lan: bool) -> str:
         return ""
     code = f"{qr_text(url)}" if lan else ""
     return (
-        f"  For the wearer's phone (pause, stop, a ceiling; keep this key from senders):\n"
+        "  For the wearer's phone (pause, stop, a ceiling, do not disturb, block a sender;\n"
+        "               keep this key from senders):\n"
         f"               {url}\n{code}"
     )
 
