@@ -78,6 +78,8 @@ def running_up(state_dir: Path, mqtt_port: int, *more: str) -> Iterator[Up]:
             *(FEELMYSIGN, "up", "--state-dir", str(state_dir)),
             *("--http-port", "0", "--port", str(mqtt_port), "--ws-port", "0", *more),
         ],
+        # The sleeve's controls (a pause) of this test's own: not another test's sleeve1.
+        env={**os.environ, "XDG_STATE_HOME": str(state_dir.parent / "up-xdg")},
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -160,9 +162,12 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
         assert refused.returncode != 0, refused.stdout + refused.stderr
         assert "The wearer blocked this sender" in refused.stderr, refused.stderr
         assert "Traceback" not in refused.stderr
+        up.call("pause", {})
 
-    # A restart of up keeps the block.
+    # A restart of up keeps the block, and says the wearer's pause it kept.
     with running_up(state_dir, mqtt_port) as up:
+        assert "The wearer's choices kept from before: paused (by page)" in up.banner, up.banner
+        up.call("resume", {})
         assert {"name": "alice", "blocked": True, "blockable": True} in up.call("state")["senders"]  # type: ignore[operator]
         refused = send(token, tmp_path)
         assert "The wearer blocked this sender" in refused.stderr, refused.stderr

@@ -283,12 +283,27 @@ def _announce(
         + lan
         + _for_the_wearer(wearer_url, lan=bool(lan))
         + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
+        + _controls_at_start(sleeve)
         + limits
         + f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"
         f"One line per drawing follows here once it has been played.\n"
         f"Press Ctrl-C to stop.",
         flush=True,
+    )
+
+
+def _controls_at_start(sleeve: Sleeve) -> str:
+    """The wearer's choices kept from before (a pause, a ceiling, do not disturb): said, so
+    that whoever runs up knows why the sleeve plays nothing, or less; "" when none."""
+    from feelmysign.sleeve.controls import NOT_PAUSED, describe
+
+    state = sleeve.controls.state()
+    if state == NOT_PAUSED:
+        return ""
+    return (
+        f"  The wearer's choices kept from before: {describe(state)} (the wearer's page "
+        "changes them)\n"
     )
 
 
