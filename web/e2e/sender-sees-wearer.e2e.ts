@@ -310,6 +310,10 @@ describe("the sender sees the wearer's choice", () => {
       SUMMARY,
     );
     expect(await page.locator(SUMMARY).innerText()).not.toContain("cancelled by Stop");
+    // The strokes with no answer yet are not "as they would" be felt: the sleeve refuses them.
+    await page.waitForFunction(
+      () => !document.querySelector('[data-testid="timeline-caption"]')?.textContent?.includes("as it would"),
+    );
     expect(await logText(page)).toContain("cancelled by the wearer before it played.");
     await screenshot(page, "wearer-stopped-desktop");
     // A new drawing is not stopped: the notice goes.

@@ -385,6 +385,8 @@ describe("the wearer's page served by feelmysign up", () => {
     for (const id of ["pause", "stop", "dnd-15", "sender-alice"]) {
       expect(await page.locator(`[data-testid="${id}"]`).isDisabled(), id).toBe(true);
     }
+    expect(await page.locator('[data-testid="dnd-line"]').textContent()).toContain("Unknown");
+    await page.evaluate(() => window.scrollTo(0, 0));
     await screenshot(page, "wearer-sleeve-gone");
   });
 });

@@ -554,6 +554,8 @@ export class App {
       if (this.#session.drawing?.id !== drawing || this.#wearerStopped === drawing) return;
       if (this.#wearer.hold(Date.now()) !== null) return;
       this.#wearerStopped = drawing;
+      // As after the sender's Stop: what has no answer yet will not be felt.
+      this.#felt.stopCursor();
       this.#says.add("info", `${wearerStoppedHeadline} ${wearerStoppedDetail}`);
       this.#showWearer();
     };

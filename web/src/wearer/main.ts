@@ -16,6 +16,7 @@ import {
   STOPPED_SAID,
   summary,
   UNREACHABLE_LINE,
+  UNREACHABLE_SAID,
   untilHint,
   untilTime,
 } from "./words";
@@ -184,12 +185,15 @@ function render(s: WearerState): void {
 function showUnreachable(): void {
   sleeveLine.dataset["state"] = "unreachable";
   sleeveLine.textContent = UNREACHABLE_LINE;
-  pauseLine.textContent = "Unknown: the sleeve does not answer.";
+  // Its last state may no longer hold: not shown as if it did.
+  for (const line of [pauseLine, ceilingLineElement, dndLine])
+    line.textContent = "Unknown: the sleeve does not answer.";
+  dndEnd.hidden = true;
   for (const button of document.querySelectorAll<HTMLButtonElement>("main button")) button.disabled = true;
   problem.hidden = true;
-  if (lastSaid !== UNREACHABLE_LINE) {
-    lastSaid = UNREACHABLE_LINE;
-    live.textContent = UNREACHABLE_LINE;
+  if (lastSaid !== UNREACHABLE_SAID) {
+    lastSaid = UNREACHABLE_SAID;
+    live.textContent = UNREACHABLE_SAID;
   }
 }
 

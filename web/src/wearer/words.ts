@@ -127,6 +127,9 @@ export const UNREACHABLE_LINE =
   "The sleeve does not answer: it may not be running, or this phone is not on its network. " +
   "Nothing here reaches it. If a motor keeps buzzing, switch the sleeve off or unplug it.";
 
+/** What the live region says of it (the line above says the rest). */
+export const UNREACHABLE_SAID = "The sleeve does not answer: your controls are off until it does.";
+
 /** What the page says after Stop: the API does not tell whether anything was playing. */
 export const STOPPED_SAID = "Stopped: anything playing or waiting was dropped.";
 
