@@ -358,6 +358,9 @@ describe("the wearer's page served by feelmysign up", () => {
     await page.locator('[data-testid="sender-alice"]').click();
     await waitForData(page, '[data-sender="alice"]', "blocked", "true");
     expect(JSON.parse(readFileSync(sendersFile, "utf8")).alice.blocked).toBe(true);
+    expect(await page.locator('[data-testid="live"]').textContent()).toBe(
+      "Blocked alice. What was playing or waiting was stopped too.",
+    );
     expect(readFileSync(join(stateDir, "passwd"), "utf8")).not.toContain("sender-alice:");
     expect(await page.locator('[data-testid="sender-alice"]').getAttribute("aria-label")).toBe(
       "Unblock alice",

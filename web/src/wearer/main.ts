@@ -11,6 +11,7 @@ import {
   ceilingChoices,
   ceilingLine,
   doNotDisturbLine,
+  blockedSaid,
   playLine,
   sendersLine,
   STOPPED_SAID,
@@ -231,6 +232,7 @@ async function apply(action: Action, body: object): Promise<boolean> {
     pending--;
     render(next);
     if (action === "stop") live.textContent = STOPPED_SAID;
+    if (action === "block") live.textContent = blockedSaid(String((body as { sender?: unknown }).sender));
     return true;
   } catch (error) {
     pending--;

@@ -130,6 +130,11 @@ export const UNREACHABLE_LINE =
 /** What the live region says of it (the line above says the rest). */
 export const UNREACHABLE_SAID = "The sleeve does not answer: your controls are off until it does.";
 
+/** What the page says after a block: the stop that came with it too. */
+export function blockedSaid(sender: string): string {
+  return `Blocked ${sender}. What was playing or waiting was stopped too.`;
+}
+
 /** What the page says after Stop: the API does not tell whether anything was playing. */
 export const STOPPED_SAID = "Stopped: anything playing or waiting was dropped.";
 
