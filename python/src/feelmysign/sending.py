@@ -130,6 +130,12 @@ class StrokeSender:
 
         client.on_connect = on_connect
 
+    def login_refused(self) -> str | None:
+        """Why the broker cut this sender off, when a reconnection's login was refused (the
+        wearer blocked it); None otherwise. Said as ``send`` says a refused login."""
+        code = self._acks.refused
+        return None if code is None else connect_failure_message(self._settings, code)
+
     def send(
         self, messages: list[OutgoingStroke], *, pace: Pace, until: Callable[[], bool] = _never
     ) -> int:
