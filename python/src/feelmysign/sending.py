@@ -92,6 +92,8 @@ class _Acks:
             )
             if mid in self._codes:
                 return self._codes.pop(mid)
+            if self.refused is not None:
+                return "refused"
             return self._lost if self._lost is not None else "timeout"
 
 
@@ -117,8 +119,11 @@ class StrokeSender:
         self._acks = _Acks()
         client.on_publish = self._acks.on_publish
         client.on_disconnect = self._acks.on_disconnect
-        # Kept: whoever set it (the events' subscription) still hears each connection.
+        # Kept: whoever set it (the events' subscription) still hears each connection. An
+        # earlier sender's wrapper on the same client (the study's, one per trial) is
+        # replaced, not wrapped again.
         earlier: Any = client.on_connect
+        earlier = getattr(earlier, "wrapped", earlier)
 
         def on_connect(
             c: mqtt.Client, userdata: Any, flags: Any, code: ReasonCode, props: Any
@@ -128,6 +133,7 @@ class StrokeSender:
             if earlier is not None:
                 earlier(c, userdata, flags, code, props)
 
+        on_connect.wrapped = earlier  # type: ignore[attr-defined]
         client.on_connect = on_connect
 
     def login_refused(self) -> str | None:
