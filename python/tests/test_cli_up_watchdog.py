@@ -110,6 +110,43 @@ def test_up_restarts_a_killed_broker_and_says_so_once(tmp_path: Path) -> None:
     assert "the sleeve is connected to it" in back, back
 
 
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead but not reaped by its new parent, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def test_a_restarted_broker_dies_with_up_killed_with_sigkill(tmp_path: Path) -> None:
+    """The broker up started again (from its watchdog's thread) must not outlive a ``kill -9``
+    of up: no handler runs then, only the kernel's parent-death signal."""
+    process = _start_up(tmp_path)
+    seen: list[str] = []
+    restarted: list[int] = []
+    try:
+        lines = _lines(process)
+        _wait_for(lines, "Press Ctrl-C", seen)
+        (mosquitto,) = _mosquitto_children(process.pid)
+        os.kill(mosquitto, signal.SIGKILL)
+        _wait_for(lines, "Back: the broker is running again on", seen)
+        restarted = _mosquitto_children(process.pid)
+        assert len(restarted) == 1 and restarted != [mosquitto], restarted
+        process.kill()
+        process.wait(timeout=WAIT_S)
+        deadline = time.monotonic() + 10
+        while _alive(restarted[0]) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not _alive(restarted[0]), "the restarted broker outlived up's kill -9"
+    finally:
+        if process.poll() is None:
+            process.kill()
+        for pid in restarted:  # left behind by a failure: not for the next test to find
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+
+
 def test_up_says_it_is_stopping_on_ctrl_c_and_reports_no_fault(tmp_path: Path) -> None:
     process = _start_up(tmp_path)
     seen: list[str] = []

@@ -225,8 +225,44 @@ def test_a_pause_during_a_send_names_the_strokes_it_kept_from_the_skin(
         "Error: The sleeve played 1 of 4 strokes, refused 2 (paused x2), cut 1 part-way (cancelled)"
     )
     assert "The wearer paused the sleeve: stroke(s) 3, 4 refused" in error
-    assert "the wearer's pause or stop cut or dropped stroke(s) 2" in error
+    assert "the wearer (a pause, stop or block) cut or dropped stroke(s) 2" in error
     assert error.endswith("Send again once the wearer has resumed.")
+
+
+def _answers_as_a_stop_mid_drawing(stroke: dict[str, Any]) -> list[dict[str, Any]]:
+    """Stroke 2 cut by the wearer's stop, the rest dropped by it: no pause anywhere."""
+    answers = _answers_as_a_pause_mid_drawing(stroke)
+    if stroke["seq"] < 2:
+        return answers
+    (refused,) = answers
+    ref: dict[str, Any] = {
+        k: refused[k] for k in ("topic", "drawing", "seq", "received_at_ms") if k in refused
+    }
+    return [
+        {
+            "type": "cancelled",
+            "reason": "cancelled",
+            "message": "dropped by the wearer before it played",
+            **ref,
+            "cancelled_at_ms": ref["received_at_ms"],
+            "started": False,
+            "by": "wearer",
+        }
+    ]
+
+
+def test_a_stop_by_the_wearer_is_not_said_as_a_pause_to_resume(
+    broker: Broker, sleeve: StandInSleeve
+) -> None:
+    sleeve.status(NOT_PAUSED)
+    sleeve.answer = _answers_as_a_stop_mid_drawing
+    strokes = ["0,0,1,0,100", "1,0,2,0,100", "2,0,3,0,100", "3,0,3,1,100"]
+    result = send(broker, *strokes, "--wait", "--pace", "burst", "--timeout-s", "20")
+    assert result.returncode == WEARER_HOLD_EXIT, result.stdout + result.stderr
+    error = result.stderr.strip().splitlines()[-1]
+    assert "The wearer (a pause, stop or block) cut or dropped stroke(s) 2 to 4" in error, error
+    assert "resumed" not in error, error
+    assert error.endswith("send again only when they want it."), error
 
 
 def test_a_refusal_of_the_sender_s_own_making_keeps_exit_1(

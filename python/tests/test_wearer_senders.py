@@ -19,6 +19,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 import urllib.error
 import urllib.request
 from collections.abc import Iterator
@@ -42,10 +43,11 @@ pytestmark = pytest.mark.broker
 class Up:
     """A running ``feelmysign up`` and its wearer's API."""
 
-    def __init__(self, process: subprocess.Popen[str], base: str, key: str) -> None:
+    def __init__(self, process: subprocess.Popen[str], base: str, key: str, banner: str) -> None:
         self.process = process
         self.base = base
         self.key = key
+        self.banner = banner
 
     def call(self, action: str, body: dict[str, object] | None = None) -> dict[str, object]:
         request = urllib.request.Request(
@@ -69,13 +71,15 @@ def free_port() -> int:
 
 
 @contextmanager
-def running_up(state_dir: Path, mqtt_port: int) -> Iterator[Up]:
+def running_up(state_dir: Path, mqtt_port: int, *more: str) -> Iterator[Up]:
     # The same MQTT port at each start: a join token holds the broker's URL.
     process = subprocess.Popen(
         [
             *(FEELMYSIGN, "up", "--state-dir", str(state_dir)),
-            *("--http-port", "0", "--port", str(mqtt_port), "--ws-port", "0"),
+            *("--http-port", "0", "--port", str(mqtt_port), "--ws-port", "0", *more),
         ],
+        # The sleeve's controls (a pause) of this test's own: not another test's sleeve1.
+        env={**os.environ, "XDG_STATE_HOME": str(state_dir.parent / "up-xdg")},
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -95,7 +99,7 @@ def running_up(state_dir: Path, mqtt_port: int) -> Iterator[Up]:
             seen.append(lines.get(timeout=WAIT_S))
         found = WEARER_URL.search("".join(seen))
         assert found is not None, "".join(seen)
-        yield Up(process, found[1], found[2])
+        yield Up(process, found[1], found[2], "".join(seen))
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(WAIT_S)
@@ -128,6 +132,8 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
     state_dir = tmp_path / "up"
     mqtt_port = free_port()
     with running_up(state_dir, mqtt_port) as up:
+        # The banner names what the wearer's page does, blocking included.
+        assert "do not disturb, block a sender" in up.banner, up.banner
         token = add_sender(state_dir, "alice")
         assert add_sender(state_dir, "alice") == token  # the same name: the same account
         login = decode_join_token(token)
@@ -156,9 +162,12 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
         assert refused.returncode != 0, refused.stdout + refused.stderr
         assert "The wearer blocked this sender" in refused.stderr, refused.stderr
         assert "Traceback" not in refused.stderr
+        up.call("pause", {})
 
-    # A restart of up keeps the block.
+    # A restart of up keeps the block, and says the wearer's pause it kept.
     with running_up(state_dir, mqtt_port) as up:
+        assert "The wearer's choices kept from before: paused (by page)" in up.banner, up.banner
+        up.call("resume", {})
         assert {"name": "alice", "blocked": True, "blockable": True} in up.call("state")["senders"]  # type: ignore[operator]
         refused = send(token, tmp_path)
         assert "The wearer blocked this sender" in refused.stderr, refused.stderr
@@ -166,6 +175,78 @@ def test_a_blocked_sender_is_cut_off_refused_in_words_and_unblocked(tmp_path: Pa
         sent = send(token, tmp_path)
         assert sent.returncode == 0, sent.stdout + sent.stderr
         assert "The sleeve played" in sent.stdout, sent.stdout
+
+
+def _driven(record: Path) -> list[tuple[float, float]]:
+    """The simulated sleeve's record: (wall ms, intensity) of every motor change."""
+    if not record.exists():
+        return []
+    rows = [json.loads(line) for line in record.read_text().splitlines() if line.strip()]
+    return [(row["wall_ms"], row["intensity"]) for row in rows]
+
+
+def _on_at(changes: list[tuple[float, float]], wall_ms: float) -> bool:
+    return any(at > wall_ms and level > 0 for at, level in changes)
+
+
+@pytest.mark.parametrize(
+    "how",
+    [
+        # Two long strokes, sent at their pace: the second still to come at the block.
+        ["0,1,3,1,6000", "0,2,3,2,6000"],
+        # One, every stroke out already: send waits for the sleeve's answers, none can come.
+        ["0,1,3,1,6000", "--wait"],
+    ],
+    ids=["sending", "waiting"],
+)
+def test_blocking_a_sender_stops_what_it_already_sent(tmp_path: Path, how: list[str]) -> None:
+    """A wearer blocks a sender to make it stop: its stroke playing is cut at once, its
+    strokes waiting dropped, and its own ``send`` says it was cut off by the block."""
+    state_dir = tmp_path / "up"
+    record = tmp_path / "felt.jsonl"
+    with running_up(state_dir, free_port(), "--record", str(record)) as up:
+        token = add_sender(state_dir, "alice")
+        env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+        env["XDG_STATE_HOME"] = str(tmp_path / "sender-state")
+        sending = subprocess.Popen(
+            [FEELMYSIGN, "send", "--join", token, *how],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        try:
+            deadline = time.monotonic() + WAIT_S
+            while not _on_at(_driven(record), 0):
+                assert time.monotonic() < deadline, "the sender's stroke never played"
+                assert sending.poll() is None, sending.communicate()
+                time.sleep(0.05)
+            time.sleep(1.0)  # well into the 6 s stroke
+            up.call("block", {"sender": "alice"})
+            blocked_ms = time.time() * 1000
+            out, err = sending.communicate(timeout=WAIT_S)
+        finally:
+            if sending.poll() is None:
+                sending.kill()
+        time.sleep(2.0)  # the rest of the first stroke, the start of the second
+        changes = _driven(record)
+        off = [at for at, _ in changes if at >= blocked_ms - 500]
+        levels: dict[tuple[int, int], float] = {}
+        rows = [json.loads(line) for line in record.read_text().splitlines() if line.strip()]
+        for row in rows:
+            levels[(row["row"], row["column"])] = row["intensity"]
+        assert all(level == 0 for level in levels.values()), levels
+        assert not _on_at(changes, blocked_ms + 200), "a motor was driven after the block"
+        assert off, "no motor change around the block"
+        assert sending.returncode != 0, out + err
+        # Cut off before the wearer's stop reached it: told by the broker's refusal; else
+        # (waiting, the stop's answer can come before the broker's reload cuts it off) by
+        # the sleeve's answer, which names the block too.
+        blocked = "The wearer blocked this sender" in err
+        assert blocked or (
+            "--wait" in how and "The wearer (a pause, stop or block) cut or dropped" in err
+        ), err
+        assert "closed the connection" not in err, err
 
 
 @pytest.mark.parametrize("name", ["page", "a/b", "", "x" * 65])

@@ -277,6 +277,50 @@ describe("the sender sees the wearer's choice", () => {
     await screenshot(phone, "wearer-resumed-phone");
   });
 
+  it("says the wearer stopped the drawing, and counts its strokes as cancelled by the wearer", async () => {
+    await publishControls(sleeve, NOT_PAUSED);
+    await page.locator('[data-testid="new-button"]').click();
+    const before = sleeve.strokes().length;
+    await drawWithMouse(page, [at(0.1, 0.4), at(0.5, 0.6), at(0.9, 0.4)], { legMs: 400 });
+    const sent = (await sleeve.waitForStrokes(before + 2)).slice(before);
+    // The wearer's stop, as the sleeve tells it: the waiting strokes dropped, by the wearer.
+    for (const stroke of sent) {
+      await sleeve.publish("events", {
+        type: "cancelled",
+        reason: "cancelled",
+        message: "dropped by the wearer before it played",
+        topic: `feelmysign/${sleeve.sleeveId}/strokes`,
+        received_at_ms: Date.now(),
+        cancelled_at_ms: Date.now(),
+        started: false,
+        by: "wearer",
+        drawing: stroke["drawing"],
+        seq: stroke["seq"],
+      });
+    }
+    await waitForData(page, NOTICE, "state", "stopped");
+    expect(await page.locator('[data-testid="wearer-headline"]').innerText()).toBe(
+      "The wearer stopped this drawing.",
+    );
+    expect(await page.locator('[data-testid="wearer-detail"]').innerText()).toContain(
+      "Press New drawing to draw again.",
+    );
+    await page.waitForFunction(
+      (selector) => document.querySelector(selector)!.textContent!.includes("cancelled by the wearer"),
+      SUMMARY,
+    );
+    expect(await page.locator(SUMMARY).innerText()).not.toContain("cancelled by Stop");
+    // The strokes with no answer yet are not "as they would" be felt: the sleeve refuses them.
+    await page.waitForFunction(
+      () => !document.querySelector('[data-testid="timeline-caption"]')?.textContent?.includes("as it would"),
+    );
+    expect(await logText(page)).toContain("cancelled by the wearer before it played.");
+    await screenshot(page, "wearer-stopped-desktop");
+    // A new drawing is not stopped: the notice goes.
+    await page.locator('[data-testid="new-button"]').click();
+    await waitForData(page, NOTICE, "state", "none");
+  });
+
   it("shows the sleeve's own grid in the felt timeline before the first drawing", async () => {
     const twoByFive = { rows: 2, columns: 5, spacing_cm: 3, max_intensity: 1 };
     await publishControls(sleeve, NOT_PAUSED, twoByFive);

@@ -7,7 +7,7 @@
  * en-US (whose own clock says "10:11 PM"): the wearer's page and the sender's page, side by
  * side, say the same ceiling and the same time.
  */
-import { spawnSync } from "node:child_process";
+import { spawnSync, type ChildProcess } from "node:child_process";
 import { readFileSync, writeFileSync } from "node:fs";
 import { createRequire } from "node:module";
 import { join } from "node:path";
@@ -68,6 +68,7 @@ describe("the wearer's page served by feelmysign up", () => {
   let page: Page;
   let stateDir: string;
   let senderUrl: string;
+  let up: ChildProcess;
 
   beforeAll(async () => {
     checkPrerequisites();
@@ -80,6 +81,7 @@ describe("the wearer's page served by feelmysign up", () => {
       url: /Draw here:\s+(http:\/\/127\.0\.0\.1:\d+\/\S*)[\s\S]*?(http:\/\/127\.0\.0\.1:\d+\/wearer\?key=[\w-]+)/,
     });
     processes.add(() => stopChild(child));
+    up = child;
     senderUrl = match[1]!;
     const url = match[2]!;
     const added = spawnSync(
@@ -219,6 +221,12 @@ describe("the wearer's page served by feelmysign up", () => {
     const until = (await apiState(page)).controls.do_not_disturb_until_ms!;
     expect(until).toBeGreaterThan(before + 14 * 60_000);
     expect(until).toBeLessThan(Date.now() + 16 * 60_000);
+    // Nothing plays: said so under Vibration and to a screen reader, not "Playing".
+    await page.waitForFunction(() =>
+      document.querySelector('[data-testid="pause-line"]')!.textContent!.startsWith("Do not disturb until"),
+    );
+    expect(await page.locator('[data-testid="pause-line"]').textContent()).toContain("nothing plays");
+    expect(await page.locator('[data-testid="live"]').textContent()).not.toContain("Playing");
     await page.locator('[data-testid="dnd-end"]').click();
     await waitForData(page, '[data-testid="dnd-line"]', "until", "");
     expect((await apiState(page)).controls.do_not_disturb_until_ms).toBeNull();
@@ -313,6 +321,21 @@ describe("the wearer's page served by feelmysign up", () => {
     await waitForData(page, '[data-testid="dnd-line"]', "until", "");
   });
 
+  it("takes the time 24-hour in an en-US browser, as typed, with no AM/PM", async () => {
+    // The page is en-US (PHONE): a native time field would show 10:30 PM and want AM/PM typed.
+    expect(await page.evaluate(() => navigator.language)).toBe("en-US");
+    const field = page.locator('[data-testid="dnd-time"]');
+    await field.fill("");
+    await field.pressSequentially("22:30");
+    expect(await field.inputValue()).toBe("22:30");
+    await expect(page.locator('[data-testid="dnd-time-hint"]').textContent()).resolves.toMatch(
+      /^Set makes it until (tomorrow at )?22:30/,
+    );
+    expect(await field.evaluate((input) => (input as HTMLInputElement).type)).toBe("text");
+    await screenshot(page, "wearer-phone-dnd-24-hour");
+    await field.fill("");
+  });
+
   it("says what to enter when Set is pressed without a time", async () => {
     const field = page.locator('[data-testid="dnd-time"]');
     await field.fill("");
@@ -335,6 +358,9 @@ describe("the wearer's page served by feelmysign up", () => {
     await page.locator('[data-testid="sender-alice"]').click();
     await waitForData(page, '[data-sender="alice"]', "blocked", "true");
     expect(JSON.parse(readFileSync(sendersFile, "utf8")).alice.blocked).toBe(true);
+    expect(await page.locator('[data-testid="live"]').textContent()).toBe(
+      "Blocked alice. What was playing or waiting was stopped too.",
+    );
     expect(readFileSync(join(stateDir, "passwd"), "utf8")).not.toContain("sender-alice:");
     expect(await page.locator('[data-testid="sender-alice"]').getAttribute("aria-label")).toBe(
       "Unblock alice",
@@ -350,5 +376,20 @@ describe("the wearer's page served by feelmysign up", () => {
     await other.goto(page.url()); // /wearer without ?key=
     await waitForData(other, '[data-testid="sleeve-line"]', "state", "no-key");
     expect(await other.locator('[data-testid="problem"]').textContent()).toContain("wearer's key");
+  });
+
+  it("says the sleeve does not answer once its server is gone, and disables every control", async () => {
+    await stopChild(up);
+    await waitForData(page, '[data-testid="sleeve-line"]', "state", "unreachable");
+    expect(await page.locator('[data-testid="sleeve-line"]').textContent()).toContain(
+      "The sleeve does not answer",
+    );
+    expect(await page.locator('[data-testid="sleeve-line"]').textContent()).not.toContain("broker");
+    for (const id of ["pause", "stop", "dnd-15", "sender-alice"]) {
+      expect(await page.locator(`[data-testid="${id}"]`).isDisabled(), id).toBe(true);
+    }
+    expect(await page.locator('[data-testid="dnd-line"]').textContent()).toContain("Unknown");
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await screenshot(page, "wearer-sleeve-gone");
   });
 });

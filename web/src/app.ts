@@ -8,7 +8,7 @@ import { CANCEL_ALL } from "./control";
 import type { ServerConfig } from "./config";
 import type { Drawing } from "./drawing";
 import { newDrawingId } from "./drawing-id";
-import { EventCopies, interpretEvent, parseEvent, parseStatus, strokeLabel } from "./events";
+import { BY_WEARER, EventCopies, interpretEvent, parseEvent, parseStatus, strokeLabel } from "./events";
 import { StrokeSender, type BrokerState } from "./mqtt/sender";
 import type { Stroke } from "./protocol";
 import { buildRecording, recordingFileName } from "./recording";
@@ -41,7 +41,12 @@ import {
   isWearerRefusal,
   NO_CONTROLS,
   wearerRefusalNote,
+  wearerStoppedDetail,
+  wearerStoppedHeadline,
 } from "./wearer-status";
+
+/** A cut by the wearer is said as their stop once this passed without a pause in their status. */
+const WEARER_STOP_SETTLE_MS = 1000;
 
 export interface AppOptions {
   readonly config: ServerConfig | null;
@@ -75,6 +80,8 @@ export class App {
   readonly #wearerNotice: WearerNotice;
   /** Wakes the page when a "do not disturb" runs out. */
   #wearerTimer: ReturnType<typeof setTimeout> | null = null;
+  /** The drawing the wearer stopped (their stop or block): the sleeve refuses the rest of it. */
+  #wearerStopped: string | null = null;
   #settings: Settings;
   #refitPending = false;
   #arrival: Arrival = "as-drawn";
@@ -241,7 +248,10 @@ export class App {
     const another = (drawing?.id ?? null) !== this.#says.drawingId;
     this.#says.reset(drawing?.id ?? null);
     this.#says.setSent(drawing?.strokeCount ?? 0, drawing?.lengthenedCount ?? 0);
-    if (another) this.#newDrawingHeld();
+    if (another) {
+      this.#wearerStopped = null;
+      this.#newDrawingHeld();
+    }
     this.#hint.hidden = drawing !== null;
     const hasPaths = drawing !== null && drawing.paths.length > 0;
     this.#buttons.undo.disabled = !hasPaths;
@@ -503,6 +513,7 @@ export class App {
     const seq = "seq" in event ? event.seq : null;
     const ours = seq !== null && drawingId !== null && "drawing" in event && event.drawing === drawingId;
     const fate = ours ? this.#says.fate(event) : null;
+    if (ours && event.type === "cancelled" && event.by === BY_WEARER) this.#cancelledByWearer(event.started);
     // A copy's refusal (after a broker restart, or after Stop) of a stroke that was felt.
     const feltCopy = event.type === "rejected" && (fate === "played" || fate === "cut");
     if (reading.played !== null) this.#felt.played(reading.played);
@@ -529,6 +540,28 @@ export class App {
   }
 
   // ---- the wearer's choice -----------------------------------------------------------------
+
+  /**
+   * The wearer cancelled a stroke of this drawing. One dropped before it played means their stop
+   * (or block): the sleeve refuses the rest of the drawing, so the page says so. One cut while it
+   * played may also be their pause: said as a stop only if, a moment later (the sleeve tells the
+   * cut before its new status), the wearer holds nothing.
+   */
+  #cancelledByWearer(started: boolean): void {
+    const drawing = this.#session.drawing?.id ?? null;
+    if (drawing === null || this.#wearerStopped === drawing) return;
+    const stopped = () => {
+      if (this.#session.drawing?.id !== drawing || this.#wearerStopped === drawing) return;
+      if (this.#wearer.hold(Date.now()) !== null) return;
+      this.#wearerStopped = drawing;
+      // As after the sender's Stop: what has no answer yet will not be felt.
+      this.#felt.stopCursor();
+      this.#says.add("info", `${wearerStoppedHeadline} ${wearerStoppedDetail}`);
+      this.#showWearer();
+    };
+    if (started) setTimeout(stopped, WEARER_STOP_SETTLE_MS);
+    else stopped();
+  }
 
   /** A stroke drawn (or played again): sent, or held on the page while the wearer paused. */
   #send(stroke: Stroke): void {
@@ -628,6 +661,7 @@ export class App {
       this.#wearer.view(nowMs),
       ceilingNote(this.#wearer.ceiling, this.#settings.intensity),
       nowMs,
+      this.#wearerStopped !== null && this.#wearerStopped === (this.#session.drawing?.id ?? null),
     );
     if (this.#wearerTimer !== null) clearTimeout(this.#wearerTimer);
     this.#wearerTimer = null;

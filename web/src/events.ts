@@ -560,7 +560,7 @@ export function interpretEvent(event: SleeveEvent, drawingId: string | null): Ev
         notes: [
           {
             kind: "info",
-            text: `${label} cancelled${event.started ? " while playing" : " before it played"}.`,
+            text: `${label} cancelled${event.by === BY_WEARER ? " by the wearer" : ""}${event.started ? " while playing" : " before it played"}.`,
           },
         ],
         cancelled: event,

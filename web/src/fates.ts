@@ -124,7 +124,7 @@ export function verdict(event: SleeveEvent, playedBefore: boolean): Verdict | nu
     case "cancelled":
       return event.started
         ? { rank: CUT, fate: "cut", reason: event.by === WEARER ? WEARER : null }
-        : { rank: OWN, fate: "cancelled", reason: null };
+        : { rank: OWN, fate: "cancelled", reason: event.by === WEARER ? WEARER : null };
     case "safety":
       if (event.received_at_ms === null) return null;
       if (event.reason !== DUTY_CYCLE && playedBefore)
@@ -204,6 +204,15 @@ export class DrawingFates {
     return { byWearer, byFault };
   }
 
+  /** Of the strokes cancelled before they played: those the wearer cancelled (their stop or block). */
+  cancelledByWearer(): number {
+    let count = 0;
+    for (const { fate, reason } of [...this.#bySeq.values(), ...this.#unnamed]) {
+      if (fate === "cancelled" && reason === WEARER) count++;
+    }
+    return count;
+  }
+
   /**
    * Of the strokes played (by their own played event), those played faster to catch up and those
    * slowed; of the refused, those skipped as `late`.
@@ -239,5 +248,20 @@ export function cutShortWords(cut: number, causes: Partial<CutCauses> = {}): str
   if (byStop > 0) words.push(`${byStop} cut short by Stop`);
   if (byWearer > 0) words.push(`${byWearer} cut short by the wearer`);
   if (byFault > 0) words.push(`${byFault} cut short by a fault on the sleeve`);
+  return words;
+}
+
+/**
+ * The words for `cancelled` strokes dropped before they played: by the sender's Stop, or by the
+ * wearer (`byWearer`: their stop, or a block, on the wearer's page or button). `after`: what
+ * follows each ("before they played"), or "".
+ */
+export function cancelledWords(cancelled: number, byWearer = 0, after = ""): string[] {
+  const wearer = Math.min(cancelled, byWearer);
+  const stop = cancelled - wearer;
+  const tail = (n: number) => (after === "" ? "" : ` ${after.replace("{it}", n === 1 ? "it" : "they")}`);
+  const words: string[] = [];
+  if (stop > 0) words.push(`${stop} cancelled by Stop${tail(stop)}`);
+  if (wearer > 0) words.push(`${wearer} cancelled by the wearer${tail(wearer)}`);
   return words;
 }

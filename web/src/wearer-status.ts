@@ -162,3 +162,8 @@ export function ceilingNote(ceiling: number | null, intensity: number): string |
 export function playedIntensity(intensity: number, ceiling: number | null): number {
   return ceiling === null ? intensity : Math.min(intensity, ceiling);
 }
+
+/** The notice once the wearer stopped the drawing (their stop or block): not the sender's Stop. */
+export const wearerStoppedHeadline = "The wearer stopped this drawing.";
+export const wearerStoppedDetail =
+  "The sleeve refuses the rest of it, so what you add to it is not felt. Press New drawing to draw again.";

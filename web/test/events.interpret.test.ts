@@ -161,6 +161,11 @@ describe.skipIf(!present)("events of the drawing on the page", () => {
     const queued = interpretEvent(vector("cancelled-queued"), DRAWING);
     expect(queued.counts).toEqual(["cancelled"]);
     expect(queued.notes).toEqual([{ kind: "info", text: "Stroke 4 cancelled before it played." }]);
+    // The wearer's stop is said as the wearer's, not as the sender's Stop.
+    const byWearer = interpretEvent({ ...vector("cancelled-queued"), by: "wearer" } as SleeveEvent, DRAWING);
+    expect(byWearer.notes).toEqual([
+      { kind: "info", text: "Stroke 4 cancelled by the wearer before it played." },
+    ]);
   });
 
   it("reports safety and errors whatever the drawing", () => {

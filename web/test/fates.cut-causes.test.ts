@@ -5,7 +5,7 @@
  */
 import { describe, expect, it } from "vitest";
 import { parseEvent, type SleeveEvent } from "../src/events";
-import { cutShortWords, DrawingFates } from "../src/fates";
+import { cancelledWords, cutShortWords, DrawingFates } from "../src/fates";
 
 const event = (fields: Record<string, unknown>): SleeveEvent => {
   const parsed = parseEvent(JSON.stringify(fields));
@@ -93,5 +93,38 @@ describe("what cut a stroke short", () => {
     expect(cutShortWords(2)).toEqual(["2 cut short by Stop"]);
     expect(cutShortWords(0, { byWearer: 0, byFault: 0 })).toEqual([]);
     expect(cutShortWords(1, { byWearer: 3, byFault: 2 })).toEqual(["1 cut short by the wearer"]);
+  });
+});
+
+const dropped = (seq: number, by?: string): SleeveEvent =>
+  event({
+    type: "cancelled",
+    reason: "cancelled",
+    message: "dropped before it played",
+    ...stroke,
+    seq,
+    cancelled_at_ms: 1795326268000.5,
+    started: false,
+    ...(by === undefined ? {} : { by }),
+  });
+
+describe("who cancelled a stroke before it played", () => {
+  it("tells the wearer's stop from the sender's Stop, in the card's and the caption's words", () => {
+    const fates = new DrawingFates();
+    fates.add(dropped(0));
+    fates.add(dropped(1, "wearer"));
+    fates.add(dropped(2, "wearer"));
+    fates.add(dropped(2, "wearer")); // delivered again
+    expect(fates.counts()).toEqual({ played: 0, cut: 0, cancelled: 3, refused: 0 });
+    expect(fates.cancelledByWearer()).toBe(2);
+    expect(fates.reason(1)).toBe("wearer");
+    expect(cancelledWords(3, fates.cancelledByWearer())).toEqual([
+      "1 cancelled by Stop",
+      "2 cancelled by the wearer",
+    ]);
+    expect(cancelledWords(1, 1, "before {it} played")).toEqual([
+      "1 cancelled by the wearer before it played",
+    ]);
+    expect(cancelledWords(2, 0, "before {it} played")).toEqual(["2 cancelled by Stop before they played"]);
   });
 });

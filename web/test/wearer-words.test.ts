@@ -6,6 +6,8 @@ import {
   ceilingChoices,
   ceilingLine,
   doNotDisturbLine,
+  playLine,
+  sendersLine,
   summary,
   untilHint,
   untilTime,
@@ -82,7 +84,7 @@ describe("do not disturb until a time", () => {
     );
     expect(
       summary(state({ do_not_disturb_until_ms: new Date(2026, 10, 27, 22, 0).getTime() }), now),
-    ).toContain("Do not disturb until tomorrow at 22:00.");
+    ).toContain("Do not disturb until tomorrow at 22:00: nothing plays.");
   });
 
   it("takes the current minute as tomorrow's, within the 24 h the sleeve allows", () => {
@@ -98,9 +100,21 @@ describe("do not disturb until a time", () => {
     });
     expect(untilTime("late", now)).toEqual({
       ok: false,
-      problem: "late is not a time of day: enter one such as 22:30, then press Set.",
+      problem: "late is not a time of day: enter one such as 22:30 (24-hour), then press Set.",
     });
     expect(untilHint("", now)).toBe("");
+    for (const wrong of ["24:00", "22:60", "10:30 PM", "12345"]) expect(untilTime(wrong, now).ok).toBe(false);
+  });
+
+  it("takes 24-hour times as the wearer types them", () => {
+    const at = (h: number, m: number, day = 26) => new Date(2026, 10, day, h, m).getTime();
+    expect(untilTime("23:05", now)).toMatchObject({ ok: true, untilMs: at(23, 5) });
+    expect(untilTime("2305", now)).toMatchObject({ ok: true, untilMs: at(23, 5) });
+    expect(untilTime("7:05", now)).toMatchObject({
+      ok: true,
+      untilMs: at(7, 5, 27),
+      words: "until tomorrow at 07:05",
+    });
   });
 
   describe("on the night the clocks go back", () => {
@@ -124,5 +138,44 @@ describe("do not disturb until a time", () => {
       // An hour earlier is within the 24 hours.
       expect(untilTime("21:00", evening).ok).toBe(true);
     });
+  });
+});
+
+describe("the wearer's senders", () => {
+  it("says that a block also stops what is playing and waiting, from every sender", () => {
+    expect(sendersLine(true)).toContain("Blocking also stops what is playing and waiting now");
+    expect(sendersLine(true)).toContain("cannot tell whose strokes are whose");
+  });
+
+  it("without the broker's files, says where to block rather than that the broker is another", () => {
+    expect(sendersLine(false)).not.toContain("uses another one");
+    expect(sendersLine(false)).toContain("wearer's page of 'feelmysign up'");
+  });
+});
+
+describe("what the wearer's page says plays", () => {
+  const now = new Date(2026, 10, 26, 23, 24).getTime();
+  const until = new Date(2026, 10, 26, 23, 39).getTime();
+
+  it("says nothing plays under do not disturb, not that it plays what senders draw", () => {
+    const dnd = state({ do_not_disturb_until_ms: until }).controls!;
+    expect(playLine(dnd, now)).toBe("Do not disturb until 23:39: nothing plays.");
+    expect(summary(state({ do_not_disturb_until_ms: until }), now)).toBe(
+      "Do not disturb until 23:39: nothing plays.",
+    );
+    // Once its time has passed, it plays again.
+    expect(playLine(dnd, until + 1)).toBe("Playing: what senders draw, you feel.");
+  });
+
+  it("says why the sleeve started paused at the lowest strength by itself", () => {
+    const safe = state({ paused: true, paused_by: "sleeve", ceiling: 0.05 }).controls!;
+    expect(playLine(safe, now)).toContain("could not read your last choices");
+    expect(playLine(safe, now)).toContain("at the lowest strength, 5 %");
+    expect(summary(state({ paused: true, paused_by: "sleeve", ceiling: 0.05 }), now)).toBe(
+      "Paused by the sleeve itself: it could not read your last choices. Strongest vibration 5 %.",
+    );
+    expect(playLine(state({ paused: true, paused_by: "page" }).controls!, now)).toBe(
+      "Paused: nothing plays until you resume.",
+    );
   });
 });

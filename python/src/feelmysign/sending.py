@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Literal
 
 from feelmysign.connection import BrokerSettings
+from feelmysign.connection.failures import LOGIN_REFUSED, connect_failure_message
 from feelmysign.errors import BrokerConnectionError
 from feelmysign.events import Status, StatusFloor
 from feelmysign.protocol import format_json, format_legacy
@@ -60,6 +61,8 @@ class _Acks:
         self._condition = threading.Condition()
         self._codes: dict[int, ReasonCode] = {}
         self._lost: str | None = None
+        # A login refused on a reconnection (the wearer blocked this sender): no use waiting.
+        self.refused: ReasonCode | None = None
 
     def on_publish(
         self, _client: mqtt.Client, _userdata: Any, mid: int, code: ReasonCode, _props: Any
@@ -75,12 +78,22 @@ class _Acks:
             self._lost = str(code)
             self._condition.notify_all()
 
-    def wait(self, mid: int, timeout_s: float) -> ReasonCode | str:
-        """The PUBACK's reason code, or why none came: 'timeout', or the last disconnect."""
+    def on_refused(self, code: ReasonCode) -> None:
         with self._condition:
-            self._condition.wait_for(lambda: mid in self._codes, max(timeout_s, 0.0))
+            self.refused = code
+            self._condition.notify_all()
+
+    def wait(self, mid: int, timeout_s: float) -> ReasonCode | str:
+        """The PUBACK's reason code, or why none came: 'timeout', or the last disconnect (at
+        once when a reconnection's login was refused: ``refused``)."""
+        with self._condition:
+            self._condition.wait_for(
+                lambda: mid in self._codes or self.refused is not None, max(timeout_s, 0.0)
+            )
             if mid in self._codes:
                 return self._codes.pop(mid)
+            if self.refused is not None:
+                return "refused"
             return self._lost if self._lost is not None else "timeout"
 
 
@@ -106,6 +119,28 @@ class StrokeSender:
         self._acks = _Acks()
         client.on_publish = self._acks.on_publish
         client.on_disconnect = self._acks.on_disconnect
+        # Kept: whoever set it (the events' subscription) still hears each connection. An
+        # earlier sender's wrapper on the same client (the study's, one per trial) is
+        # replaced, not wrapped again.
+        earlier: Any = client.on_connect
+        earlier = getattr(earlier, "wrapped", earlier)
+
+        def on_connect(
+            c: mqtt.Client, userdata: Any, flags: Any, code: ReasonCode, props: Any
+        ) -> None:
+            if code.is_failure and code.value in LOGIN_REFUSED:
+                self._acks.on_refused(code)
+            if earlier is not None:
+                earlier(c, userdata, flags, code, props)
+
+        on_connect.wrapped = earlier  # type: ignore[attr-defined]
+        client.on_connect = on_connect
+
+    def login_refused(self) -> str | None:
+        """Why the broker cut this sender off, when a reconnection's login was refused (the
+        wearer blocked it); None otherwise. Said as ``send`` says a refused login."""
+        code = self._acks.refused
+        return None if code is None else connect_failure_message(self._settings, code)
 
     def send(
         self, messages: list[OutgoingStroke], *, pace: Pace, until: Callable[[], bool] = _never
@@ -196,6 +231,13 @@ class StrokeSender:
                 "timeout",
                 f"{url} did not acknowledge {number} within {self._timeout_s:g} s: the broker "
                 "may be overloaded or the network slow; try again, or raise --timeout-s.",
+                url=url,
+            )
+        if isinstance(answer, str) and self._acks.refused is not None:
+            raise BrokerConnectionError(
+                "login-refused",
+                f"The broker did not acknowledge {number}: it cut this sender off. "
+                + connect_failure_message(self._settings, self._acks.refused),
                 url=url,
             )
         if isinstance(answer, str):

@@ -18,7 +18,9 @@ between, so the wearer can pause even when the broker is down.
 Blocking needs the broker feelmysign runs (its state directory: ``broker_files``): the
 sender's account is left out of the password file and the ACL and the broker is reloaded,
 which disconnects it (Mosquitto 2.0 checks every connected client again on SIGHUP) and
-refuses its next login. Without that directory ``blocking`` is false.
+refuses its next login. Without that directory ``blocking`` is false. A block also stops
+what plays and drops what waits, as ``stop`` does: the blocked sender's strokes already at
+the sleeve must not go on, and the sleeve cannot tell one sender's strokes from another's.
 """
 
 from __future__ import annotations
@@ -149,7 +151,12 @@ class WearerApi:
         elif action == "do-not-disturb":
             controls.set_do_not_disturb(_until_ms(fields), BY)
         else:
-            self._block(_sender(fields), blocked=action == "block")
+            blocked = action == "block"
+            self._block(_sender(fields), blocked=blocked)
+            if blocked:
+                # What the sender already sent is at the sleeve (playing, waiting), and a
+                # stroke does not say which account sent it: all of it is stopped, as by Stop.
+                controls.stop(BY)
         return self.state()
 
     def _block(self, name: str, *, blocked: bool) -> None:

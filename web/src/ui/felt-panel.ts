@@ -12,7 +12,7 @@
  */
 import type { Drawing, DrawnSegment } from "../drawing";
 import type { CancelledEvent, AdjustedEvent, PlayedEvent, Unplayed } from "../events";
-import { cutShortWords, type Fate } from "../fates";
+import { cancelledWords, cutShortWords, type Fate } from "../fates";
 import { brushAt, placeStrokes, type FeltStroke, type Grid, type PlacedStroke } from "../felt";
 import { FeltPlacement } from "../felt-placement";
 import { simplifyPaths, type SimplifierParams } from "../simplify/registry";
@@ -33,6 +33,8 @@ export interface Tally {
   readonly cutByWearer?: number;
   readonly cutByFault?: number;
   readonly cancelled: number;
+  /** Of the cancelled: by the wearer (their stop or block; the rest by Stop). */
+  readonly cancelledByWearer?: number;
   /** Refused on arrival, or kept from playing by the duty-cycle cap. */
   readonly refused: number;
   /** Of the refused: skipped as late (the sleeve too far behind its sender), said apart. Absent: none. */
@@ -375,8 +377,7 @@ export function timelineCaption(
       `${capped} not felt (the sleeve's duty-cycle cap kept ${capped === 1 ? "it" : "them"} from playing)`,
     );
   }
-  if (cancelled > 0)
-    said.push(`${cancelled} cancelled by Stop before ${cancelled === 1 ? "it" : "they"} played`);
+  said.push(...cancelledWords(cancelled, tally.cancelledByWearer ?? 0, "before {it} played"));
   const refusedOff = refused - capped;
   // Skipped as late, as the card says them: refused on arrival too, apart from the others.
   const late = Math.min(tally.late ?? 0, refusedOff);
@@ -398,11 +399,14 @@ export function standingTally(tally: Tally, undone: readonly UndoneStroke[]): Ta
   let late = tally.late ?? 0;
   let cutByWearer = tally.cutByWearer ?? 0;
   let cutByFault = tally.cutByFault ?? 0;
+  let cancelledByWearer = tally.cancelledByWearer ?? 0;
   for (const { fate, reason, unsent } of undone) {
     sent--;
     if (fate === "played") played--;
-    else if (fate === "cancelled") cancelled--;
-    else if (fate === "cut") {
+    else if (fate === "cancelled") {
+      cancelled--;
+      if (reason === "wearer") cancelledByWearer--;
+    } else if (fate === "cut") {
       cut--;
       if (reason === "wearer") cutByWearer--;
       else if (reason !== null) cutByFault--;
@@ -423,6 +427,7 @@ export function standingTally(tally: Tally, undone: readonly UndoneStroke[]): Ta
     late: atLeast0(late),
     cutByWearer: atLeast0(cutByWearer),
     cutByFault: atLeast0(cutByFault),
+    cancelledByWearer: atLeast0(cancelledByWearer),
   };
 }
 
@@ -433,7 +438,8 @@ export function undoneWords(undone: readonly UndoneStroke[]): string | null {
   const parts: [number, string][] = [
     [by((s) => s.fate === "played"), "played"],
     [by((s) => s.fate === "cut"), "cut short"],
-    [by((s) => s.fate === "cancelled"), "cancelled by Stop"],
+    [by((s) => s.fate === "cancelled" && s.reason !== "wearer"), "cancelled by Stop"],
+    [by((s) => s.fate === "cancelled" && s.reason === "wearer"), "cancelled by the wearer"],
     [by((s) => s.fate === "refused" && s.reason === "late"), "skipped as late"],
     [by((s) => s.fate === "refused" && s.reason !== "late"), "not felt (refused by the sleeve)"],
     [by((s) => s.fate === null && s.unsent !== null), "never sent"],

@@ -15,7 +15,14 @@
  * Reset with every new drawing, so nothing of an old drawing lingers.
  */
 import { seconds, type SleeveEvent } from "../events";
-import { catchUpWords, cutShortWords, durationWords, DrawingFates, type Fate } from "../fates";
+import {
+  cancelledWords,
+  catchUpWords,
+  cutShortWords,
+  durationWords,
+  DrawingFates,
+  type Fate,
+} from "../fates";
 import { EventLog, type LogKind } from "./event-log";
 
 export interface Counts {
@@ -35,6 +42,8 @@ export interface Counts {
   late: number;
   /** Dropped by Stop before they started (on the sleeve). */
   cancelled: number;
+  /** Of the cancelled: by the wearer (their stop or block), not the sender's Stop. */
+  cancelledByWearer: number;
   /** Cut short while playing (by Stop, the wearer or a fault): felt in part, not under played. */
   cut: number;
   /** Of the cut: by the wearer, and by a fault on the sleeve (fates.ts `cutCauses`). */
@@ -107,6 +116,7 @@ export class SleeveSays {
       late: catchUp.late,
       cutByWearer: causes.byWearer,
       cutByFault: causes.byFault,
+      cancelledByWearer: this.#fates.cancelledByWearer(),
       dropped: this.#dropped,
       held: this.#held,
       heldWhy: this.#heldWhy,
@@ -285,7 +295,7 @@ export function summaryText(
     `${played} of ${plural(sent - notSent, "stroke")} played${playedWords === "" ? "" : ` (${playedWords})`}`,
   ];
   parts.push(...cutShortWords(cut, { byWearer: counts.cutByWearer, byFault: counts.cutByFault }));
-  if (cancelled > 0) parts.push(`${cancelled} cancelled by Stop`);
+  parts.push(...cancelledWords(cancelled, counts.cancelledByWearer));
   if (late > 0) parts.push(`${late} skipped as late`);
   const otherwise = refused - late;
   if (otherwise > 0) {

@@ -4,7 +4,14 @@
  * ceiling. The words come from wearer-status.ts; this only puts them on the page.
  */
 import type { WearerView } from "../wearer-hold";
-import { endedHeadline, holdDetail, holdHeadline, holdReason } from "../wearer-status";
+import {
+  endedHeadline,
+  holdDetail,
+  holdHeadline,
+  holdReason,
+  wearerStoppedDetail,
+  wearerStoppedHeadline,
+} from "../wearer-status";
 import { byId } from "./status";
 
 export interface WearerNoticeActions {
@@ -33,9 +40,13 @@ export class WearerNotice {
     byId(doc, "drop-held-button").addEventListener("click", () => actions.dropHeld());
   }
 
-  /** `ceiling`: the line about the wearer's ceiling (ceilingNote), or null; `nowMs`: for the day of a time. */
-  show(view: WearerView, ceiling: string | null, nowMs: number): void {
-    const state = view.state === "none" ? (ceiling === null ? "none" : "ceiling") : view.state;
+  /**
+   * `ceiling`: the line about the wearer's ceiling (ceilingNote), or null; `nowMs`: for the day of
+   * a time; `stopped`: the wearer stopped this drawing (said unless a pause or its end is).
+   */
+  show(view: WearerView, ceiling: string | null, nowMs: number, stopped = false): void {
+    const state =
+      view.state !== "none" ? view.state : stopped ? "stopped" : ceiling === null ? "none" : "ceiling";
     this.#box.dataset["state"] = state;
     this.#box.dataset["held"] = String(view.state === "none" ? 0 : view.held);
     this.#box.hidden = state === "none";
@@ -51,6 +62,8 @@ export class WearerNotice {
           : `${plural(view.held, "stroke")} drawn meanwhile ${view.held === 1 ? "is" : "are"} held here. ` +
             "Send them to play them now, back to back, or drop them; what you draw now is sent.";
       this.#set(endedHeadline(view.ended, nowMs), detail, ceiling);
+    } else if (stopped) {
+      this.#set(wearerStoppedHeadline, wearerStoppedDetail, ceiling);
     } else if (ceiling !== null) {
       this.#set(ceiling, null, null);
     }

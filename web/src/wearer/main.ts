@@ -11,7 +11,13 @@ import {
   ceilingChoices,
   ceilingLine,
   doNotDisturbLine,
+  blockedSaid,
+  playLine,
+  sendersLine,
+  STOPPED_SAID,
   summary,
+  UNREACHABLE_LINE,
+  UNREACHABLE_SAID,
   untilHint,
   untilTime,
 } from "./words";
@@ -38,7 +44,7 @@ const dndUntil = byId<HTMLFormElement>("dnd-until");
 const dndTime = byId<HTMLInputElement>("dnd-time");
 const dndTimeHint = byId<HTMLParagraphElement>("dnd-time-hint");
 const dndEnd = byId<HTMLButtonElement>("dnd-end");
-const sendersLine = byId<HTMLParagraphElement>("senders-line");
+const sendersLineElement = byId<HTMLParagraphElement>("senders-line");
 const sendersList = byId<HTMLUListElement>("senders");
 
 let state: WearerState | null = null;
@@ -103,6 +109,7 @@ function renderSenders(senders: readonly Sender[]): void {
     const who = sender.name === "page" ? "The drawing page on the sleeve's computer" : sender.name;
     name.textContent = sender.blocked ? `${who}: blocked` : who;
     button.hidden = !sender.blockable;
+    button.disabled = false; // again, after the sleeve did not answer
     button.textContent = sender.blocked ? "Unblock" : "Block";
     button.setAttribute("aria-label", `${sender.blocked ? "Unblock" : "Block"} ${who}`);
     return item;
@@ -127,16 +134,11 @@ function render(s: WearerState): void {
       ? `Sleeve ${s.sleeve_id} is starting…`
       : s.online
         ? `Sleeve ${s.sleeve_id} is on.`
-        : `Sleeve ${s.sleeve_id} is offline: it cannot reach the broker. Your choices here still hold.`;
+        : `Sleeve ${s.sleeve_id} is running but cannot reach the broker: senders' drawings do not reach it. Your choices here still hold.`;
 
   pauseButton.dataset["paused"] = String(c?.paused ?? false);
   pauseButton.textContent = c?.paused ? "Resume the sleeve" : "Pause the sleeve";
-  pauseLine.textContent =
-    c === null
-      ? ""
-      : c.paused
-        ? `Paused${c.paused_by === "button" ? " with the sleeve's button" : ""}: nothing plays until you resume.`
-        : "Playing: what senders draw, you feel.";
+  pauseLine.textContent = c === null ? "" : playLine(c, Date.now());
   pauseButton.disabled = !ready;
   stopButton.disabled = !ready;
 
@@ -166,9 +168,7 @@ function render(s: WearerState): void {
     button.disabled = !ready;
   }
 
-  sendersLine.textContent = s.blocking
-    ? "Block a sender to stop them drawing on you until you unblock them."
-    : "Blocking a sender needs the broker feelmysign runs; this sleeve uses another one.";
+  sendersLineElement.textContent = sendersLine(s.blocking);
   renderSenders(s.senders);
 
   const said = summary(s, nowMs);
@@ -178,13 +178,34 @@ function render(s: WearerState): void {
   }
 }
 
+/**
+ * The page's own server does not answer (the sleeve's page: the sleeve itself is gone). Its last
+ * state is not shown as if it held: the line says so and every control is disabled, as a press
+ * would reach nothing. The next answer (render) enables them again.
+ */
+function showUnreachable(): void {
+  sleeveLine.dataset["state"] = "unreachable";
+  sleeveLine.textContent = UNREACHABLE_LINE;
+  // Its last state may no longer hold: not shown as if it did.
+  for (const line of [pauseLine, ceilingLineElement, dndLine])
+    line.textContent = "Unknown: the sleeve does not answer.";
+  dndEnd.hidden = true;
+  for (const button of document.querySelectorAll<HTMLButtonElement>("main button")) button.disabled = true;
+  problem.hidden = true;
+  if (lastSaid !== UNREACHABLE_SAID) {
+    lastSaid = UNREACHABLE_SAID;
+    live.textContent = UNREACHABLE_SAID;
+  }
+}
+
 function showProblem(error: unknown): void {
-  problem.textContent =
-    error instanceof WearerApiError
-      ? error.message
-      : "The sleeve's server does not answer: check that the phone is on the same network, then reload.";
+  if (!(error instanceof WearerApiError)) {
+    showUnreachable();
+    return;
+  }
+  problem.textContent = error.message;
   problem.hidden = false;
-  if (error instanceof WearerApiError && error.status === 403) sleeveLine.dataset["state"] = "no-key";
+  if (error.status === 403) sleeveLine.dataset["state"] = "no-key";
 }
 
 /** Actions that stop what the wearer feels: sent at once, never queued behind another change. */
@@ -210,12 +231,13 @@ async function apply(action: Action, body: object): Promise<boolean> {
     changeRefused = false;
     pending--;
     render(next);
-    if (action === "stop") live.textContent = "Stopped what was playing.";
+    if (action === "stop") live.textContent = STOPPED_SAID;
+    if (action === "block") live.textContent = blockedSaid(String((body as { sender?: unknown }).sender));
     return true;
   } catch (error) {
     pending--;
-    if (state !== null) render(state);
-    changeRefused = true;
+    if (state !== null && error instanceof WearerApiError) render(state);
+    changeRefused = error instanceof WearerApiError;
     showProblem(error);
     return false;
   }

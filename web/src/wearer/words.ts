@@ -6,7 +6,7 @@
  */
 import { untilClock } from "../clock";
 import { drivePercent } from "../drive-level";
-import type { WearerState } from "./api";
+import type { Controls, WearerState } from "./api";
 
 /** The sleeve's lowest ceiling (feelmysign.sleeve.controls MIN_CEILING). */
 export const MIN_CEILING = 0.05;
@@ -57,20 +57,86 @@ export function doNotDisturbLine(untilMs: number | null, nowMs: number): string 
     : `On until ${untilClock(untilMs, nowMs)}: nothing reaches you.`;
 }
 
+/**
+ * The line above the senders. A block also stops what plays and what waits (every sender's: the
+ * sleeve cannot tell whose stroke is whose), so what the blocked sender already sent ends too.
+ */
+export function sendersLine(blocking: boolean): string {
+  return blocking
+    ? "Block a sender to stop them drawing on you until you unblock them. Blocking also stops " +
+        "what is playing and waiting now, from every sender: the sleeve cannot tell whose " +
+        "strokes are whose."
+    : "Blocking is not offered here: this page does not find the broker's files on this " +
+        "computer (its usual state directory). Block senders on the wearer's page of " +
+        "'feelmysign up', where the broker runs.";
+}
+
+/** The sleeve's paused_by when it started paused by itself: the wearer's last choices unreadable. */
+export const PAUSED_BY_SLEEVE = "sleeve";
+
+/** A "do not disturb" still running at `nowMs`, or null. */
+function dndRunning(c: Controls, nowMs: number): number | null {
+  const until = c.do_not_disturb_until_ms;
+  return until !== null && until > nowMs ? until : null;
+}
+
+/**
+ * The line under "Vibration": paused (by whom), do not disturb, or playing. A sleeve that started
+ * paused by itself says why: it could not read the wearer's last choices, so it took the safe side
+ * of both (paused, and the lowest ceiling).
+ */
+export function playLine(c: Controls, nowMs: number): string {
+  if (c.paused) {
+    if (c.paused_by === PAUSED_BY_SLEEVE) {
+      return (
+        "Paused by the sleeve itself: it could not read your last choices (its settings file), so " +
+        `it started paused and at the lowest strength${c.ceiling === null ? "" : `, ${drivePercent(c.ceiling)}`}. ` +
+        "Resume when you want, and choose the strongest vibration again."
+      );
+    }
+    return `Paused${c.paused_by === "button" ? " with the sleeve's button" : ""}: nothing plays until you resume.`;
+  }
+  const until = dndRunning(c, nowMs);
+  if (until !== null) return `Do not disturb until ${untilClock(until, nowMs)}: nothing plays.`;
+  return "Playing: what senders draw, you feel.";
+}
+
 /** The words a screen reader says when they change (pause, ceiling, do not disturb, online). */
 export function summary(state: WearerState, nowMs: number): string {
   const c = state.controls;
   if (c === null) return "The sleeve is starting.";
+  const until = dndRunning(c, nowMs);
   const parts = [
-    state.online ? "" : "The sleeve is offline.",
-    c.paused ? "Paused: nothing plays." : "Playing what senders draw.",
+    state.online ? "" : "The sleeve cannot reach the broker.",
+    c.paused
+      ? c.paused_by === PAUSED_BY_SLEEVE
+        ? "Paused by the sleeve itself: it could not read your last choices."
+        : "Paused: nothing plays."
+      : until === null
+        ? "Playing what senders draw."
+        : `Do not disturb until ${untilClock(until, nowMs)}: nothing plays.`,
     c.ceiling === null ? "" : `Strongest vibration ${drivePercent(c.ceiling)}.`,
-    c.do_not_disturb_until_ms === null
-      ? ""
-      : `Do not disturb until ${untilClock(c.do_not_disturb_until_ms, nowMs)}.`,
+    // Under a pause, a do not disturb still running is said too: it outlasts a resume.
+    c.paused && until !== null ? `Do not disturb until ${untilClock(until, nowMs)}.` : "",
   ];
   return parts.filter(Boolean).join(" ");
 }
+
+/** The line at the top when the page's own server does not answer: the sleeve itself may be gone. */
+export const UNREACHABLE_LINE =
+  "The sleeve does not answer: it may not be running, or this phone is not on its network. " +
+  "Nothing here reaches it. If a motor keeps buzzing, switch the sleeve off or unplug it.";
+
+/** What the live region says of it (the line above says the rest). */
+export const UNREACHABLE_SAID = "The sleeve does not answer: your controls are off until it does.";
+
+/** What the page says after a block: the stop that came with it too. */
+export function blockedSaid(sender: string): string {
+  return `Blocked ${sender}. What was playing or waiting was stopped too.`;
+}
+
+/** What the page says after Stop: the API does not tell whether anything was playing. */
+export const STOPPED_SAID = "Stopped: anything playing or waiting was dropped.";
 
 /** A time of day the wearer typed, as "do not disturb" would take it. */
 export type UntilTime =
@@ -78,19 +144,20 @@ export type UntilTime =
   | { readonly ok: false; readonly problem: string };
 
 /**
- * The next time `hhmm` ("22:30", as an `<input type="time">` gives it) comes: today, or tomorrow
- * when it has passed (said so: "until tomorrow at 07:00"). Refused in words when empty, or when
- * it is more than 24 h away (the sleeve's limit; only on the day the clocks go back).
+ * The next time `hhmm` comes: today, or tomorrow when it has passed (said so: "until tomorrow at
+ * 07:00"). 24-hour, as the wearer types it: "22:30", "7:05", "2230" (and "22:30:00"). Refused in
+ * words when empty, not a time of day, or more than 24 h away (the sleeve's limit; only on the
+ * day the clocks go back).
  */
 export function untilTime(hhmm: string, nowMs: number): UntilTime {
-  const match = /^(\d{2}):(\d{2})(?::\d{2}(?:\.\d+)?)?$/.exec(hhmm.trim());
-  if (match === null) {
+  const match = /^(\d{1,2})[:.h]?(\d{2})(?::\d{2}(?:\.\d+)?)?$/.exec(hhmm.trim());
+  if (match === null || Number(match[1]) > 23 || Number(match[2]) > 59) {
     return {
       ok: false,
       problem:
         hhmm.trim() === ""
           ? "Enter the time do not disturb ends, such as 22:30, then press Set."
-          : `${hhmm} is not a time of day: enter one such as 22:30, then press Set.`,
+          : `${hhmm.trim()} is not a time of day: enter one such as 22:30 (24-hour), then press Set.`,
     };
   }
   const at = new Date(nowMs);

@@ -2,7 +2,10 @@
 
 The child never outlives us: it is killed by the kernel when the thread that
 started it dies (Linux ``PR_SET_PDEATHSIG``), and stopped by ``Broker.stop``,
-``atexit`` and the CLI's signal handlers otherwise.
+``atexit`` and the CLI's signal handlers otherwise. That thread is the main one, or,
+for a broker started again from another thread (``up``'s watchdog), one kept for
+that which never ends before the process does: so a ``kill -9`` of the process
+takes a restarted broker with it too.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import subprocess
 import sys
 import threading
 from collections.abc import Callable, Sequence
+from concurrent.futures import Future
 from pathlib import Path
 from typing import IO
 
@@ -115,16 +119,55 @@ def port_in_use_error(
     )
 
 
+class _Spawner:
+    """A thread that forks the children other threads ask for, and lives as long as the
+    process (it never returns): the kernel's parent-death signal watches the *thread* that
+    forks, so a child forked by a passing thread would die with it, and one forked without
+    the signal would outlive a ``kill -9`` of the process."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._requests: list[
+            tuple[Callable[[], subprocess.Popen[bytes]], Future[subprocess.Popen[bytes]]]
+        ] = []
+        self._wake = threading.Condition(self._lock)
+        self.thread: threading.Thread | None = None
+
+    def run(self, start: Callable[[], subprocess.Popen[bytes]]) -> subprocess.Popen[bytes]:
+        future: Future[subprocess.Popen[bytes]] = Future()
+        with self._lock:
+            if self.thread is None:
+                self.thread = threading.Thread(
+                    target=self._serve, name="feelmysign-spawner", daemon=True
+                )
+                self.thread.start()
+            self._requests.append((start, future))
+            self._wake.notify()
+        return future.result()
+
+    def _serve(self) -> None:
+        while True:
+            with self._lock:
+                self._wake.wait_for(lambda: bool(self._requests))
+                start, future = self._requests.pop(0)
+            try:
+                future.set_result(start())
+            except BaseException as error:  # handed to the thread that asked
+                future.set_exception(error)
+
+
+_SPAWNER = _Spawner()
+
+
 def _parent_death_signal(parent_pid: int) -> Callable[[], None] | None:
     """A pre-exec hook asking the kernel to SIGTERM the child when its parent dies (Linux only).
 
-    The kernel watches the *thread* that forks, not the process: from any other thread
-    than the main one, Mosquitto would die with that thread, so there we rely on
-    ``stop()`` and ``atexit`` alone.
+    The kernel watches the *thread* that forks, not the process: only the main thread and
+    the spawner's (``_Spawner``), which end with the process, may set it.
     """
-    if (
-        not sys.platform.startswith("linux")
-        or threading.current_thread() is not threading.main_thread()
+    current = threading.current_thread()
+    if not sys.platform.startswith("linux") or (
+        current is not threading.main_thread() and current is not _SPAWNER.thread
     ):
         return None
     prctl = ctypes.CDLL(None, use_errno=True).prctl  # resolved before fork: nothing to load after
@@ -141,16 +184,27 @@ def spawn(executable: str, config: Path, log: IO[bytes]) -> subprocess.Popen[byt
     """Start ``mosquitto -c config`` in its own session, its stdout and stderr into ``log``.
 
     Its own session: a Ctrl-C in the terminal reaches only us, and we stop the broker in
-    order (SIGTERM, so it saves its database) instead of racing it.
+    order (SIGTERM, so it saves its database) instead of racing it. From a thread other
+    than the main one (a restart), forked by the spawner's thread (``_Spawner``), so that
+    it still dies with this process.
     """
-    return subprocess.Popen(
-        [executable, "-c", str(config)],
-        stdin=subprocess.DEVNULL,
-        stdout=log,
-        stderr=log,
-        start_new_session=True,
-        preexec_fn=_parent_death_signal(os.getpid()),  # only prctl runs there: fork-safe
-    )
+
+    def start() -> subprocess.Popen[bytes]:
+        return subprocess.Popen(
+            [executable, "-c", str(config)],
+            stdin=subprocess.DEVNULL,
+            stdout=log,
+            stderr=log,
+            start_new_session=True,
+            preexec_fn=_parent_death_signal(os.getpid()),  # only prctl runs there: fork-safe
+        )
+
+    if (
+        sys.platform.startswith("linux")
+        and threading.current_thread() is not threading.main_thread()
+    ):
+        return _SPAWNER.run(start)
+    return start()
 
 
 def stop(process: subprocess.Popen[bytes], *, timeout_s: float) -> None:

@@ -75,8 +75,8 @@ class Broker(Started):
     Options are checked when the object is made; ``start()`` (or ``with``) writes the
     files, starts Mosquitto and returns once it accepts the sender's login. ``port`` or
     ``ws_port`` 0 picks a free port. ``mosquitto`` is the executable (default: found on
-    PATH, then in /usr/sbin). Mosquitto is stopped by ``stop()``, at exit, and, when
-    started from the main thread on Linux, by the kernel if this process dies.
+    PATH, then in /usr/sbin). Mosquitto is stopped by ``stop()``, at exit, and, on Linux,
+    by the kernel if this process dies (from whichever thread it was started).
     ``save_every_change`` (default) has Mosquitto save its state after every change, so
     that a SIGKILL loses no stroke it acknowledged; False saves every 60 s (for benchmarks).
     ``lock``: the state directory's lock when the caller holds it already (``feelmysign up``

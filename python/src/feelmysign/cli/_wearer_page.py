@@ -107,7 +107,8 @@ def wearer_page_server(
     )
     code = "" if tls is None else qr_text(url)
     return server, (
-        f"For the wearer's phone (pause, stop, a ceiling; keep this key from senders{accept}):\n"
+        "For the wearer's phone (pause, stop, a ceiling, do not disturb; keep this key from "
+        f"senders{accept}):\n"
         f"  {url}\n{code}"
     )
 

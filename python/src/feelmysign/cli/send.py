@@ -238,7 +238,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         messages = [OutgoingStroke(i, topic, s, args.legacy) for i, s in enumerate(strokes)]
         lines = _InOrder()
         outcome = _watch_events(client, settings, strokes, args, lines) if wait else None
-        sent = _send(client, settings, messages, args, outcome, lines)
+        sent, cut_off = _send(client, settings, messages, args, outcome, lines)
         lines.flush()
         if outcome is not None and sent < len(messages):
             outcome.hold(range(sent, len(messages)))
@@ -248,7 +248,7 @@ def run(args: argparse.Namespace, *, parser: argparse.ArgumentParser) -> int:
         if outcome is None:
             return 0
         online = status is not None and status.online
-        return _await_sleeve(outcome, settings, args, strokes, online=online)
+        return _await_sleeve(outcome, settings, args, strokes, online=online, cut_off=cut_off)
     finally:
         client.disconnect()
         client.loop_stop()
@@ -261,10 +261,12 @@ def _send(
     args: argparse.Namespace,
     outcome: DrawingOutcome | None,
     lines: _InOrder,
-) -> int:
-    """Publishes the strokes; how many went out. Waiting for the sleeve's answers, it stops
-    once the sleeve refuses one as its wearer paused it (the rest would be refused too), or
-    once the drawing is cancelled (``feelmysign stop``, or the wearer's stop): it is over."""
+) -> tuple[int, Callable[[], str | None]]:
+    """Publishes the strokes; how many went out, and a call saying why the broker cut this
+    sender off since (its login refused on reconnecting: blocked), or None. Waiting for the
+    sleeve's answers, it stops once the sleeve refuses one as its wearer paused it (the rest
+    would be refused too), or once the drawing is cancelled (``feelmysign stop``, or the
+    wearer's stop): it is over."""
     pace: Pace = args.pace or "realtime"
     say = printer(json_lines=args.json, total=len(messages))
 
@@ -273,10 +275,11 @@ def _send(
 
     sender = StrokeSender(client, settings, timeout_s=args.timeout_s, on_sent=report)
     if outcome is None:
-        return sender.send(messages, pace=pace)
-    return sender.send(
+        return sender.send(messages, pace=pace), sender.login_refused
+    sent = sender.send(
         messages, pace=pace, until=lambda: outcome.held_by_wearer() or outcome.stopped()
     )
+    return sent, sender.login_refused
 
 
 def _wait_asked(args: argparse.Namespace, parser: argparse.ArgumentParser) -> bool:
@@ -515,6 +518,8 @@ def _answer_line(
 # answer may take is --timeout-s; a stroke played is then awaited until it has been felt,
 # at most this long (the sleeve's own cap on queued strokes).
 MAX_FELT_WAIT_S = 30.0
+# While waiting for the answers: how often to look whether the broker cut this sender off.
+CUT_OFF_CHECK_S = 0.25
 
 
 def _await_sleeve(
@@ -524,14 +529,28 @@ def _await_sleeve(
     strokes: list[Stroke],
     *,
     online: bool,
+    cut_off: Callable[[], str | None] = lambda: None,
 ) -> int:
-    """``online``: the sleeve's retained status said it was online when the drawing began."""
+    """``online``: the sleeve's retained status said it was online when the drawing began.
+    ``cut_off``: why the broker cut this sender off meanwhile (blocked), or None: then no
+    answer can come, and that is said instead of waiting for them."""
     burst = (args.pace or "realtime") == "burst"
     drawing_s = (
         sum(s.duration_ms for s in strokes) / 1000 if burst else strokes[-1].duration_ms / 1000
     )
     answered_by_s = time.monotonic() + drawing_s + args.timeout_s
-    outcome.wait_answered(answered_by_s)
+    while time.monotonic() < answered_by_s and cut_off() is None:
+        outcome.wait_answered(min(answered_by_s, time.monotonic() + CUT_OFF_CHECK_S))
+        if outcome.summary().unheard == []:
+            break
+    why = cut_off()
+    if why is not None:
+        print(
+            f"Error: {outcome.summary().text()}; no more answers can come. {why}",
+            file=sys.stderr,
+            flush=True,
+        )
+        return 1
     # Return once the last stroke has been felt, not when it started: a second send right
     # after this one then starts on a sleeve with nothing left of this drawing.
     felt_by_s = outcome.felt_by_s()
@@ -594,12 +613,22 @@ def _wearer_line(outcome: DrawingOutcome) -> str | None:
             f"{_numbers(refused['do_not_disturb'])} refused"
         )
     if cut:
-        parts.append(f"the wearer's pause or stop cut or dropped stroke(s) {_numbers(cut)}")
+        parts.append(
+            f"the wearer (a pause, stop or block) cut or dropped stroke(s) {_numbers(cut)}"
+        )
     held = [i + 1 for i, s in enumerate(outcome.strokes) if s.held]
     if held:
         parts.append(f"stroke(s) {_numbers(held)} not sent, since the sleeve would refuse them")
     text = "; ".join(parts)
-    return f" {text[0].upper()}{text[1:]}. Send again once the wearer has resumed."
+    # What to do depends on what the wearer chose: a pause ends with a resume, do not disturb
+    # at its time, and a stop (no refusal for a hold) means the wearer did not want it now.
+    if refused["paused"] or (held and not refused["do_not_disturb"]):
+        advice = "Send again once the wearer has resumed."
+    elif refused["do_not_disturb"]:
+        advice = "Send again once do not disturb has ended."
+    else:
+        advice = "The wearer stopped it (or paused the sleeve): send again only when they want it."
+    return f" {text[0].upper()}{text[1:]}. {advice}"
 
 
 def _numbers(numbers: list[int]) -> str:

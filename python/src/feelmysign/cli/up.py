@@ -283,6 +283,7 @@ def _announce(
         + lan
         + _for_the_wearer(wearer_url, lan=bool(lan))
         + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
+        + _controls_at_start(sleeve)
         + limits
         + f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
         f"  Credentials: {broker.credentials_path}\n"
@@ -292,13 +293,28 @@ def _announce(
     )
 
 
+def _controls_at_start(sleeve: Sleeve) -> str:
+    """The wearer's choices kept from before (a pause, a ceiling, do not disturb): said, so
+    that whoever runs up knows why the sleeve plays nothing, or less; "" when none."""
+    from feelmysign.sleeve.controls import NOT_PAUSED, describe
+
+    state = sleeve.controls.state()
+    if state == NOT_PAUSED:
+        return ""
+    return (
+        f"  The wearer's choices kept from before: {describe(state)} (the wearer's page "
+        "changes them)\n"
+    )
+
+
 def _for_the_wearer(url: str | None, *, lan: bool) -> str:
     """The wearer's page: their own URL and key (pause, stop, a ceiling, block a sender)."""
     if url is None:
         return ""
     code = f"{qr_text(url)}" if lan else ""
     return (
-        f"  For the wearer's phone (pause, stop, a ceiling; keep this key from senders):\n"
+        "  For the wearer's phone (pause, stop, a ceiling, do not disturb, block a sender;\n"
+        "               keep this key from senders):\n"
         f"               {url}\n{code}"
     )
 

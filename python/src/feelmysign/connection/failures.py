@@ -13,7 +13,7 @@ if TYPE_CHECKING:  # paho is imported where a client is made, not by 'feelmysign
 
 # MQTT 5 CONNACK reason codes that mean "these credentials": Bad user name or
 # password, Not authorized.
-_LOGIN_REFUSED = (134, 135)
+LOGIN_REFUSED = (134, 135)
 _START_HINT = "start one with 'feelmysign broker' or 'make up', or give the right --broker URL"
 
 
@@ -97,7 +97,7 @@ def _certificate_message(settings: BrokerSettings, failure: ssl.SSLCertVerificat
 
 
 def _login_refused_message(settings: BrokerSettings, code: ReasonCode) -> str:
-    if code.value not in _LOGIN_REFUSED:
+    if code.value not in LOGIN_REFUSED:
         return f"The broker at {settings.url} refused the connection ({code}, code {code.value})."
     who = f"user {settings.username!r}" if settings.username else "an anonymous login"
     if settings.username and settings.username.startswith(SENDER_USERNAME_PREFIX):

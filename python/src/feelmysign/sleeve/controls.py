@@ -232,10 +232,14 @@ class WearerControls:
             )
         until = round(value)
         if not now_ms < until <= now_ms + MAX_DO_NOT_DISTURB_MS:
+            instead = (
+                "a later time, up to 24 hours ahead"
+                if until <= now_ms
+                else "an earlier time, at most 24 hours ahead"
+            )
             raise ControlsError(
                 f'"do not disturb" until {_clock_time(until)} is not within the next 24 hours '
-                f"(now {_clock_time(now_ms)}); give a later time up to 24 hours ahead, or none "
-                "to end it now"
+                f"(now {_clock_time(now_ms)}); give {instead}, or none to end it now"
             )
         return int(until)
 
