@@ -1,0 +1,169 @@
+"""The sleeve's guardian (feelmysign.guard): a sleeve killed or stopped mid-stroke, and no
+restart, no systemd: every motor it drove goes off within a second all the same.
+
+Each sleeve is a process of its own (``feelmysign sleeve --backend drv2605 --emulate-state
+FILE``) against a real Mosquitto; the state file is the chips' registers, which outlive the
+sleeve as real chips' do. Without the guardian every one of these tests fails: the motors
+run on after ``kill -9`` and through a stop, and no guardian process is found.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+from sleeve_watch import SleeveWatch, online, reaped
+
+from feelmysign.backends.emulated_state import drive_levels
+from feelmysign.bench import restart_off
+from feelmysign.broker import Broker
+from feelmysign.guard import STOPPED_S, guardian_pids, process_state
+from feelmysign.stroke import Stroke
+
+WAIT_S = 60.0  # generous: a loaded 2-core machine starts Python slowly
+OFF_WITHIN_S = 1.0  # after a kill, or a stop: every motor off within this, or the test fails
+GUARDIAN_MARK = "feelmysign.guard"
+
+
+def guardians_anywhere(sleeve: int) -> list[int]:
+    """Every guardian process on this machine that watches ``sleeve`` (as ps would list them)."""
+    listed = subprocess.run(
+        ["ps", "-eo", "pid=,stat=,args="], capture_output=True, text=True, check=True
+    ).stdout
+    found = []
+    for line in listed.splitlines():
+        pid, stat, *args = line.split()
+        if stat.startswith("Z"):
+            continue  # ended, not yet reaped: it runs nothing
+        if GUARDIAN_MARK in line and str(sleeve) in args:
+            found.append(int(pid))
+    return found
+
+
+def wait_until(condition: Callable[[], bool], what: str, within_s: float = WAIT_S) -> float:
+    """Seconds until ``condition`` held; AssertionError naming ``what`` past ``within_s``."""
+    started = time.monotonic()
+    while not condition():
+        if time.monotonic() - started > within_s:
+            raise AssertionError(f"{what}: not within {within_s} s")
+        time.sleep(0.005)
+    return time.monotonic() - started
+
+
+def driving(state: Path) -> bool:
+    return any(level > 0 for level in drive_levels(state).values())
+
+
+def start_sleeve(broker: Broker, state: Path) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        restart_off.sleeve_command(broker.credentials_path, state),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+@pytest.fixture
+def watcher(broker: Broker) -> Iterator[SleeveWatch]:
+    with SleeveWatch(broker.credentials, "status", "events") as watching:
+        yield watching
+
+
+def playing(watcher: SleeveWatch, state: Path, stroke: Stroke) -> None:
+    watcher.next(online, "the sleeve online")
+    watcher.send(stroke)
+    wait_until(lambda: driving(state), "a motor on")
+
+
+def its_guardian(sleeve: subprocess.Popen[str]) -> int:
+    found: list[int] = []
+
+    def started() -> bool:
+        found[:] = guardian_pids(sleeve.pid)
+        return bool(found)
+
+    wait_until(started, "the sleeve's guardian started", 10.0)
+    assert len(found) == 1, found
+    return found[0]
+
+
+def test_a_sleeve_killed_mid_stroke_has_every_motor_switched_off_by_its_guardian(
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path
+) -> None:
+    state = tmp_path / "bus.json"
+    with reaped(start_sleeve(broker, state)) as sleeve:
+        playing(watcher, state, restart_off.LONG_STROKE)  # 8 s
+        guardian = its_guardian(sleeve)
+        # Its own session: a Ctrl-C to the terminal's process group does not reach it.
+        assert os.getsid(guardian) == guardian != os.getsid(sleeve.pid)
+        sleeve.send_signal(signal.SIGKILL)
+        took = wait_until(lambda: not driving(state), "every motor off", OFF_WITHIN_S)
+        _, errors = sleeve.communicate(timeout=WAIT_S)  # EOF: the guardian has ended too
+    assert set(drive_levels(state).values()) == {0.0}, took
+    assert f"the sleeve (process {sleeve.pid}) ended without switching" in errors, errors
+    wait_until(lambda: not guardians_anywhere(sleeve.pid), "the guardian ended", 5.0)
+
+
+def test_a_stopped_sleeve_has_its_motors_switched_off_and_plays_on_once_continued(
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path
+) -> None:
+    state = tmp_path / "bus.json"
+    with reaped(start_sleeve(broker, state)) as sleeve:
+        playing(watcher, state, Stroke((0.0, 1.0), (3.0, 1.0), 4000.0, 0.9, "long", 0))
+        guardian = its_guardian(sleeve)
+        os.kill(sleeve.pid, signal.SIGSTOP)
+        took = wait_until(lambda: not driving(state), "every motor off", OFF_WITHIN_S)
+        assert took >= STOPPED_S * 0.9  # not before the stop lasted STOPPED_S
+        time.sleep(0.5)
+        assert process_state(sleeve.pid) == "T"  # still stopped, and the motors stay off
+        assert not driving(state)
+        assert guardian_pids(sleeve.pid) == [guardian]  # it stays while its sleeve lives
+        os.kill(sleeve.pid, signal.SIGCONT)
+        # The sleeve goes on: a stroke sent now plays.
+        watcher.send(Stroke((0.0, 0.0), (3.0, 0.0), 300.0, 0.9, "after", 0))
+        played = watcher.next(
+            lambda name, body: body.get("drawing") == "after", "the stroke after the stop"
+        )
+        assert played["type"] == "played", played
+        sleeve.send_signal(signal.SIGTERM)
+        _, errors = sleeve.communicate(timeout=WAIT_S)
+        assert sleeve.returncode == 0, errors
+    assert f"the sleeve (process {sleeve.pid}) stopped for" in errors, errors
+    assert "Traceback" not in errors, errors
+    assert set(drive_levels(state).values()) == {0.0}
+    assert guardians_anywhere(sleeve.pid) == []
+
+
+def test_a_sleeve_stopped_cleanly_dismisses_its_guardian_which_leaves_the_bus_alone(
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path
+) -> None:
+    state = tmp_path / "bus.json"
+    with reaped(start_sleeve(broker, state)) as sleeve:
+        playing(watcher, state, restart_off.LONG_STROKE)
+        guardian = its_guardian(sleeve)
+        sleeve.send_signal(signal.SIGTERM)
+        _, errors = sleeve.communicate(timeout=WAIT_S)
+        assert sleeve.returncode == 0, errors
+    # The sleeve switched every motor off itself, then dismissed the guardian (and reaped it):
+    # the guardian wrote nothing.
+    assert set(drive_levels(state).values()) == {0.0}
+    assert "feelmysign guardian" not in errors, errors
+    assert process_state(guardian) is None  # gone, reaped by the sleeve
+    assert guardians_anywhere(sleeve.pid) == []
+
+
+def test_a_sleeve_of_the_simulator_starts_no_guardian(broker: Broker, watcher: SleeveWatch) -> None:
+    command = restart_off.sleeve_command(broker.credentials_path, Path("unused"))
+    at = command.index("--backend")
+    del command[at : at + 4]  # --backend drv2605 --emulate-state FILE: the default, sim
+    with reaped(
+        subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, text=True)
+    ) as sleeve:
+        watcher.next(online, "the sleeve online")
+        time.sleep(0.5)
+        assert guardian_pids(sleeve.pid) == []
