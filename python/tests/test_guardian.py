@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import threading
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -21,7 +22,7 @@ from sleeve_watch import SleeveWatch, online, reaped
 
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
-from feelmysign.broker import Broker
+from feelmysign.broker import Broker, load_credentials
 from feelmysign.guard import STOPPED_S, guardian_pids, process_state
 from feelmysign.stroke import Stroke
 
@@ -167,3 +168,53 @@ def test_a_sleeve_of_the_simulator_starts_no_guardian(broker: Broker, watcher: S
         watcher.next(online, "the sleeve online")
         time.sleep(0.5)
         assert guardian_pids(sleeve.pid) == []
+
+
+@pytest.mark.broker
+def test_the_sleeve_of_up_on_an_emulated_bus_is_guarded_too(tmp_path: Path) -> None:
+    """``feelmysign up --sleeve-backend drv2605``: its sleeve runs in up's process, which a
+    Ctrl-Z stops whole; the guardian switches its motors off, and goes at Ctrl-C."""
+    state = tmp_path / "bus.json"
+    web = tmp_path / "web"
+    web.mkdir()
+    (web / "index.html").write_text("<!doctype html><title>feelmysign</title>\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FEELMYSIGN_")}
+    env["XDG_STATE_HOME"] = str(tmp_path / "xdg")
+    command = [
+        *restart_off.feelmysign_command(),
+        "up",
+        *("--state-dir", str(tmp_path / "state"), "--web-dir", str(web)),
+        *("--port", "0", "--ws-port", "0", "--http-port", "0"),
+        *("--sleeve-backend", "drv2605", "--emulate-state", str(state)),
+        *("--layout", str(restart_off.PAPER)),
+    ]
+    up = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env
+    )
+    output: list[str] = []
+    try:
+        assert up.stdout is not None
+        for line in up.stdout:
+            output.append(line)
+            if line.startswith("Press Ctrl-C to stop."):
+                break
+        else:
+            raise AssertionError("".join(output))
+        threading.Thread(target=lambda: output.extend(up.stdout or ()), daemon=True).start()
+        credentials = load_credentials(tmp_path / "state" / "credentials.json")
+        with SleeveWatch(credentials, "status", "events") as watcher:
+            watcher.send(restart_off.LONG_STROKE)
+            wait_until(lambda: driving(state), "a motor on")
+        guardian = its_guardian(up)
+        os.kill(up.pid, signal.SIGSTOP)
+        wait_until(lambda: not driving(state), "every motor off", OFF_WITHIN_S)
+        os.kill(up.pid, signal.SIGCONT)
+        up.send_signal(signal.SIGINT)
+        assert up.wait(WAIT_S) == 0, "".join(output)
+    finally:
+        if up.poll() is None:
+            up.kill()
+            up.wait(WAIT_S)
+    assert set(drive_levels(state).values()) == {0.0}
+    assert process_state(guardian) is None
+    assert guardians_anywhere(up.pid) == []
