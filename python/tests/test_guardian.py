@@ -9,9 +9,11 @@ run on after ``kill -9`` and through a stop, and no guardian process is found.
 
 from __future__ import annotations
 
+import ast
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -104,6 +106,7 @@ def test_a_sleeve_killed_mid_stroke_has_every_motor_switched_off_by_its_guardian
         assert os.getsid(guardian) == guardian != os.getsid(sleeve.pid)
         sleeve.send_signal(signal.SIGKILL)
         took = wait_until(lambda: not driving(state), "every motor off", OFF_WITHIN_S)
+        print(f"kill -9 -> every motor off: {took * 1000:.0f} ms")
         _, errors = sleeve.communicate(timeout=WAIT_S)  # EOF: the guardian has ended too
     assert set(drive_levels(state).values()) == {0.0}, took
     assert f"the sleeve (process {sleeve.pid}) ended without switching" in errors, errors
@@ -119,6 +122,7 @@ def test_a_stopped_sleeve_has_its_motors_switched_off_and_plays_on_once_continue
         guardian = its_guardian(sleeve)
         os.kill(sleeve.pid, signal.SIGSTOP)
         took = wait_until(lambda: not driving(state), "every motor off", OFF_WITHIN_S)
+        print(f"SIGSTOP -> every motor off: {took * 1000:.0f} ms")
         assert took >= STOPPED_S * 0.9  # not before the stop lasted STOPPED_S
         time.sleep(0.5)
         assert process_state(sleeve.pid) == "T"  # still stopped, and the motors stay off
@@ -218,3 +222,52 @@ def test_the_sleeve_of_up_on_an_emulated_bus_is_guarded_too(tmp_path: Path) -> N
     assert set(drive_levels(state).values()) == {0.0}
     assert process_state(guardian) is None
     assert guardians_anywhere(up.pid) == []
+
+
+GUARDIAN_PROBE = """
+import os, sys
+sys.path.insert(0, {root!r})
+import feelmysign.early_off as early
+
+seen = []
+real_off = early.off
+
+def spy_off(*args, **kwargs):
+    seen.append(sorted(sys.modules))
+    return real_off(*args, **kwargs)
+
+early.off = spy_off
+read_end, write_end = os.pipe()
+os.close(write_end)  # the "sleeve" is gone at once: end of file
+from feelmysign.guard import main
+
+main([str(os.getpid()), str(read_end), "", "mux 99 0x70 0 1 2 3 4 5 6 7"])
+print(repr(seen))
+"""
+
+
+def test_the_guardian_imports_no_more_than_the_early_all_off_before_it_writes() -> None:
+    """What the guardian has loaded when it switches off: none of what the early all-off
+    must not load either (test_cli_imports), and no JSON on a real bus."""
+    from test_cli_imports import NOT_BEFORE_ALL_OFF, NOT_BEFORE_REAL_BUS
+
+    import feelmysign
+
+    root = str(Path(feelmysign.__file__).resolve().parents[1])
+    done = subprocess.run(
+        [sys.executable, "-I", "-S", "-c", GUARDIAN_PROBE.format(root=root)],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+    )
+    assert done.returncode == 0, done.stderr
+    # No /dev/i2c-99 here: the off says so, and it is what the sleeve's stderr would show.
+    assert "ended without switching its motors off" in done.stderr, done.stderr
+    (modules,) = ast.literal_eval(done.stdout.strip().splitlines()[-1])
+    loaded = [
+        name
+        for name in modules
+        for banned in (*NOT_BEFORE_ALL_OFF, *NOT_BEFORE_REAL_BUS)
+        if name == banned or name.startswith(banned + ".")
+    ]
+    assert not loaded, loaded
