@@ -15,8 +15,9 @@ off the path of the first motor command. The guardian:
   and exits. A sleeve that stops cleanly switches its motors off itself, then writes one byte
   (:meth:`Guardian.dismiss`): the guardian exits without touching the bus. A sleeve whose own
   all-off failed closes the pipe without the byte: the guardian tries once more.
-- reads the sleeve's state in ``/proc/PID/stat`` every POLL_S. A sleeve *stopped* (``T``,
-  SIGSTOP or Ctrl-Z; ``t``, a debugger) for more than STOPPED_S gets every motor switched off,
+- reads the state of each of the sleeve's threads in ``/proc/PID/task/TID/stat`` every
+  POLL_S. A sleeve *stopped* (every thread ``T``, SIGSTOP or Ctrl-Z; or ``t``, a debugger)
+  for more than STOPPED_S gets every motor switched off,
   once per stop. A stopped process cannot be half-way through an I2C transaction, so the
   guardian's writes cannot interleave with its own. It may have been stopped between a
   multiplexer select and its chip write: the off ends with every multiplexer channel disabled
@@ -30,7 +31,8 @@ off the path of the first motor command. The guardian:
 
 It never dies with the sleeve by a signal: no parent-death signal, and a session of its own,
 so that a Ctrl-C to the terminal's process group reaches the sleeve (which then stops cleanly
-and dismisses it) but not the guardian. It exits by itself once its work is done.
+and dismisses it) but not the guardian; it ignores SIGINT, SIGHUP and SIGTERM (systemd's
+stop sends SIGTERM to every process of the unit). It exits by itself once its work is done.
 
 What it cannot cover: a guardian itself killed (``kill -9`` of both, a cgroup killed whole),
 a SIGCONT that lands during the few milliseconds of its off (the two writers may then
@@ -166,7 +168,11 @@ def main(arguments: list[str]) -> int:
     """The guardian: PARENT_PID PIPE_FD STATE_FILE_OR_EMPTY WIRING_LINE..."""
     import signal
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C is the sleeve's to act on
+    # Its end is the sleeve's: a Ctrl-C, a hang-up or a SIGTERM (systemd's stop reaches every
+    # process of the unit) is the sleeve's to act on, and the sleeve dismisses it once every
+    # motor is off, or dies, and then it acts. Only SIGKILL ends it before that.
+    for ignored in (signal.SIGINT, signal.SIGHUP, signal.SIGTERM):
+        signal.signal(ignored, signal.SIG_IGN)
     from feelmysign.early_off import targets_from_lines
 
     parent, read_end = int(arguments[0]), int(arguments[1])
@@ -196,7 +202,7 @@ def watch(parent: int, read_end: int, switch_off: Callable[[str], None]) -> int:
                 return 0  # a clean stop: the sleeve switched its motors off itself
             switch_off("ended without switching its motors off")
             return 0
-        if process_state(parent) in STOPPED_STATES:
+        if stopped(parent):
             now = time.monotonic()
             if stopped_since is None:
                 stopped_since = now
@@ -207,10 +213,23 @@ def watch(parent: int, read_end: int, switch_off: Callable[[str], None]) -> int:
             stopped_since, acted_on_stop = None, False
 
 
-def process_state(pid: int) -> str | None:
-    """The state letter of ``pid`` in /proc/PID/stat (``R``, ``S``, ``T``...); None if gone."""
+def stopped(pid: int) -> bool:
+    """Every thread of ``pid`` stopped (``T``, ``t``). One thread stopped alone (a debugger
+    may stop only the one it traces) is not enough: another may be writing to the bus."""
     try:
-        with open(f"/proc/{pid}/stat", "rb") as stat:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return False
+    states = [process_state(pid, task) for task in tasks]
+    return bool(states) and all(state in STOPPED_STATES for state in states)
+
+
+def process_state(pid: int, thread: str | None = None) -> str | None:
+    """The state letter of ``pid`` (or of its ``thread``) in /proc/PID/stat (``R``, ``S``,
+    ``T``...); None if gone."""
+    path = f"/proc/{pid}/stat" if thread is None else f"/proc/{pid}/task/{thread}/stat"
+    try:
+        with open(path, "rb") as stat:
             text = stat.read()
     except OSError:
         return None
