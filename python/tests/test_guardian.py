@@ -271,3 +271,47 @@ def test_the_guardian_imports_no_more_than_the_early_all_off_before_it_writes() 
         if name == banned or name.startswith(banned + ".")
     ]
     assert not loaded, loaded
+
+
+@pytest.mark.parametrize("busy", [False, True])
+def test_the_guardian_leaves_a_running_or_sleeping_process_alone_and_acts_once_per_stop(
+    busy: bool,
+) -> None:
+    """``watch`` on a stand-in for the sleeve (a process that sleeps, or one that spins): never
+    while it runs or sleeps, however long; once when it has been stopped STOPPED_S, not again
+    during that stop, and again at the next stop."""
+    from feelmysign.guard import watch
+
+    spin = "while True: pass" if busy else "import time; time.sleep(60)"
+    stand_in = subprocess.Popen([sys.executable, "-c", spin])
+    read_end, write_end = os.pipe()
+    calls: list[tuple[float, str]] = []
+    watcher = threading.Thread(
+        target=watch,
+        args=(stand_in.pid, read_end, lambda why: calls.append((time.monotonic(), why))),
+    )
+    try:
+        watcher.start()
+        time.sleep(STOPPED_S * 4)
+        assert calls == []  # running (R) or sleeping (S): never acted on
+        for _ in range(2):
+            stopped_at = time.monotonic()
+            os.kill(stand_in.pid, signal.SIGSTOP)
+            wait_until(lambda: len(calls) == 1, "the off for the stop", OFF_WITHIN_S * 3)
+            assert calls[0][0] - stopped_at >= STOPPED_S
+            assert calls[0][1].startswith("stopped for"), calls
+            time.sleep(STOPPED_S * 2)
+            assert len(calls) == 1  # once per stop
+            os.kill(stand_in.pid, signal.SIGCONT)
+            time.sleep(STOPPED_S * 2)
+            assert len(calls) == 1
+            calls.clear()
+        os.write(write_end, b"\x00")  # dismissed: it returns without an off
+        watcher.join(WAIT_S)
+        assert not watcher.is_alive() and calls == []
+    finally:
+        os.close(write_end)
+        watcher.join(WAIT_S)
+        os.close(read_end)
+        stand_in.kill()
+        stand_in.wait(WAIT_S)
