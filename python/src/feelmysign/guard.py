@@ -28,6 +28,9 @@ off the path of the first motor command. The guardian:
   off. A sleeve that is merely slow or busy (``R``, ``S``, ``D``) is never acted on: two
   writers on one bus can send a write to the wrong chip (:mod:`feelmysign.backends.bus_lock`).
   The guardian takes no bus lock: its off is an emergency off, like ``feelmysign off``.
+  On the emulated bus kept in a file the continued sleeve writes its whole model of the
+  chips back at its next write (one process at a time should drive a state file), so the
+  file may show the stroke's motors on again where real chips, left in standby, would not.
 
 It never dies with the sleeve by a signal: no parent-death signal, and a session of its own,
 so that a Ctrl-C to the terminal's process group reaches the sleeve (which then stops cleanly
