@@ -62,12 +62,14 @@ def driving(state: Path) -> bool:
     return any(level > 0 for level in drive_levels(state).values())
 
 
-def start_sleeve(broker: Broker, state: Path) -> subprocess.Popen[str]:
+def start_sleeve(broker: Broker, state: Path, *, own_group: bool = False) -> subprocess.Popen[str]:
+    """The sleeve; ``own_group``: leading a process group of its own, as a shell's job."""
     return subprocess.Popen(
         restart_off.sleeve_command(broker.credentials_path, state),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
+        process_group=0 if own_group else None,
     )
 
 
@@ -144,14 +146,18 @@ def test_a_stopped_sleeve_has_its_motors_switched_off_and_plays_on_once_continue
     assert guardians_anywhere(sleeve.pid) == []
 
 
+@pytest.mark.parametrize("how", ["SIGTERM", "Ctrl-C to its process group"])
 def test_a_sleeve_stopped_cleanly_dismisses_its_guardian_which_leaves_the_bus_alone(
-    broker: Broker, watcher: SleeveWatch, tmp_path: Path
+    broker: Broker, watcher: SleeveWatch, tmp_path: Path, how: str
 ) -> None:
     state = tmp_path / "bus.json"
-    with reaped(start_sleeve(broker, state)) as sleeve:
+    with reaped(start_sleeve(broker, state, own_group=True)) as sleeve:
         playing(watcher, state, restart_off.LONG_STROKE)
         guardian = its_guardian(sleeve)
-        sleeve.send_signal(signal.SIGTERM)
+        if how == "SIGTERM":
+            sleeve.send_signal(signal.SIGTERM)
+        else:  # as a terminal's Ctrl-C: SIGINT to every process of the foreground group
+            os.killpg(sleeve.pid, signal.SIGINT)
         _, errors = sleeve.communicate(timeout=WAIT_S)
         assert sleeve.returncode == 0, errors
     # The sleeve switched every motor off itself, then dismissed the guardian (and reaped it):
