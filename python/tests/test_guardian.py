@@ -63,13 +63,13 @@ def driving(state: Path) -> bool:
 
 
 def start_sleeve(broker: Broker, state: Path, *, own_group: bool = False) -> subprocess.Popen[str]:
-    """The sleeve; ``own_group``: leading a process group of its own, as a shell's job."""
+    """The sleeve; ``own_group``: leading a process group (and session) of its own, as a job."""
     return subprocess.Popen(
         restart_off.sleeve_command(broker.credentials_path, state),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
-        process_group=0 if own_group else None,
+        start_new_session=own_group,  # (process_group= needs Python 3.11)
     )
 
 
