@@ -4,6 +4,7 @@ arrive from a real broker, and a way to wait for one of them."""
 from __future__ import annotations
 
 import json
+import os
 import queue
 import signal
 import subprocess
@@ -17,6 +18,7 @@ import paho.mqtt.client as mqtt
 
 from feelmysign.broker import Credentials
 from feelmysign.connection import BrokerSettings, new_client
+from feelmysign.guard import guardian_pids
 from feelmysign.lifecycle import Closing
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
@@ -99,6 +101,15 @@ def exit_code_after(process: subprocess.Popen[str], sent: signal.Signals) -> int
     # full pipe would never end.
     process.communicate(timeout=WAIT_S)
     return process.returncode
+
+
+def killed_with_its_guardian(process: subprocess.Popen[str]) -> int:
+    """``kill -9`` of a sleeve and of its guardian (feelmysign.guard), the guardian first:
+    what only the restart's early all-off (or an enable line) then puts right. Its exit code
+    (minus SIGKILL)."""
+    for guardian in guardian_pids(process.pid):
+        os.kill(guardian, signal.SIGKILL)
+    return exit_code_after(process, signal.SIGKILL)
 
 
 def online(name: str, body: dict[str, Any]) -> bool:

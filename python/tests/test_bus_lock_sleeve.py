@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 from lost_chip import paper_with_enable
-from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
+from sleeve_watch import SleeveWatch, killed_with_its_guardian, online, reaped
 
 from feelmysign.backends.bus_lock import holder_of, lock_for
 from feelmysign.backends.drv2605 import Drv2605Backend
@@ -171,7 +171,7 @@ def test_kill_9_of_the_sleeve_lets_go_of_the_bus_at_once(
     held = holder_of(lock_file)
     assert held is not None and (held.pid, held.role) == (sleeve.pid, "sleeve")
 
-    assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+    assert killed_with_its_guardian(sleeve) == -signal.SIGKILL
     assert holder_of(lock_file) is None
     assert driving(state)  # nothing ran after the kill: the chips drive what they drove
     assert Path(lock_file).exists()  # the file stays; the lock went with the process

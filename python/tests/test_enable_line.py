@@ -31,7 +31,7 @@ from lost_chip import (
     set_connected,
     wait_until,
 )
-from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
+from sleeve_watch import SleeveWatch, exit_code_after, killed_with_its_guardian, online, reaped
 
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
@@ -72,7 +72,7 @@ def test_a_chip_lost_while_on_then_kill_9_leaves_every_motor_off(
         key = a_motor_on(state)
         print("before the fault:", excerpt(state, key))
         set_connected(state, key, False)
-        assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+        assert killed_with_its_guardian(sleeve) == -signal.SIGKILL
     print("after kill -9:", excerpt(state, key))
     # Nobody switched the lost chip off over I2C: its registers still say "on"...
     assert register_drive(state, key) > 0
@@ -93,7 +93,7 @@ def test_kill_9_while_the_line_is_high_leaves_every_motor_off_with_no_process_le
         watcher.next(online, "the sleeve online")
         watcher.send(restart_off.LONG_STROKE)
         key = a_motor_on(state)
-        assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+        assert killed_with_its_guardian(sleeve) == -signal.SIGKILL
     print("after kill -9 with the line high:", excerpt(state, key))
     line = saved(state)["enable"]
     assert (line["level"], line["holder"]["pid"]) == (1, sleeve.pid)  # left high by the dead
@@ -189,7 +189,7 @@ def test_a_restart_with_a_chip_missing_keeps_the_line_low_and_says_which(
         watcher.next(online, "the sleeve online")
         watcher.send(restart_off.LONG_STROKE)
         key = a_motor_on(state)
-        assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+        assert killed_with_its_guardian(sleeve) == -signal.SIGKILL
     set_connected(state, key, False)  # and its wire came loose meanwhile
     before = saved(state)["enable"]
     print("before the restart:", excerpt(state, key))

@@ -19,7 +19,14 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
-from sleeve_watch import SleeveWatch, exit_code_after, online, reaped, settings
+from sleeve_watch import (
+    SleeveWatch,
+    exit_code_after,
+    killed_with_its_guardian,
+    online,
+    reaped,
+    settings,
+)
 
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
@@ -65,7 +72,7 @@ def kill_mid_stroke(broker: Broker, watcher: SleeveWatch, state: Path) -> dict[s
         watcher.next(online, "the sleeve online")
         watcher.send(restart_off.LONG_STROKE)  # row 1, 8 s
         wait_until(lambda: any(level > 0 for level in drive_levels(state).values()))
-        assert exit_code_after(sleeve, signal.SIGKILL) == -signal.SIGKILL
+        assert killed_with_its_guardian(sleeve) == -signal.SIGKILL
     left = drive_levels(state)
     # Nothing ran after SIGKILL: the chips still drive what they drove. Without
     # this the rest of the test would prove nothing.

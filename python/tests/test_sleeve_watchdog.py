@@ -30,6 +30,7 @@ from sleeve_watch import SleeveWatch, exit_code_after, online, reaped
 from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import restart_off
 from feelmysign.broker import Broker
+from feelmysign.guard import guardian_pids
 from feelmysign.service_manager import ServiceManager, WatchdogFeeder
 
 WAIT_S = 60.0  # generous: a loaded 2-core machine starts Python slowly
@@ -105,6 +106,10 @@ def test_a_stopped_sleeve_stops_pinging_and_the_watchdog_restart_switches_every_
                 time.sleep(0.01)
             notify.expect("WATCHDOG=1")  # still pinging while it plays
 
+            # The watchdog alone: the sleeve's guardian (feelmysign.guard), which would switch
+            # the motors of a stopped sleeve off first, is gone (killed, as systemd may).
+            for guardian in guardian_pids(sleeve.pid):
+                os.kill(guardian, signal.SIGKILL)
             sleeve.send_signal(signal.SIGSTOP)
             # systemd's rule: no ping for a whole period, and the watchdog fires. Pings sent
             # before the stop may still be queued; after them, silence.

@@ -44,6 +44,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from feelmysign.backends.all_off import WriteBus
+    from feelmysign.layout import Layout
 
 # The commands that drive motors, and their --backend default ("scan" only reads).
 # "off" has no --backend: it always drives the chips.
@@ -130,7 +131,7 @@ def _switch_off(layout_path: str, state_path: str | None, *, skip_held: bool) ->
     memo_path = _memo_path(source)
     memo = _read_memo(memo_path, source)
     if memo is not None and memo[0] == text:
-        return _off(memo[1], state_path, skip_held)  # exactly what this layout wires
+        return off(memo[1], state_path, skip_held=skip_held)  # exactly what this layout wires
     targets: Targets = {}
     if memo is not None:  # the layout was edited: what the old one wired may be on
         _add_every_channel(targets, memo[1])
@@ -138,10 +139,12 @@ def _switch_off(layout_path: str, state_path: str | None, *, skip_held: bool) ->
     if wiring is not None:
         _add_every_channel(targets, wiring)
         _write_memo(memo_path, source, text, wiring)
-    return _off(targets, state_path, skip_held)
+    return off(targets, state_path, skip_held=skip_held)
 
 
-def _off(targets: Targets, state_path: str | None, skip_held: bool) -> list[str]:
+def off(targets: Targets, state_path: str | None, *, skip_held: bool = False) -> list[str]:
+    """Every DRV2605L of ``targets`` off (on the emulated bus in ``state_path``, if given);
+    what failed, in words. Also the sleeve's guardian's off (:mod:`feelmysign.guard`)."""
     problems: list[str] = []
     for bus_number, channels in sorted(targets.items()):
         if not channels:
@@ -196,10 +199,40 @@ def _parse_wiring(text: bytes, source: str) -> Targets | None:
         layout = parse_layout(text.decode("utf-8"), source)
     except (LayoutError, UnicodeDecodeError):
         return None  # the command's own start-up says what is wrong with it
+    return targets_of(layout)
+
+
+def targets_of(layout: Layout) -> Targets:
+    """The chips ``layout`` wires: its bus -> multiplexer -> channels."""
     channels: dict[int, set[int]] = {}
     for wire in layout.wiring:
         channels.setdefault(wire.multiplexer, set()).add(wire.channel)
     return {layout.i2c_bus: channels}
+
+
+def wiring_lines(targets: Targets) -> list[str]:
+    """``targets`` as the memo writes them, one ``mux BUS 0xADDRESS CHANNEL...`` line per
+    multiplexer (also the guardian's command line: :mod:`feelmysign.guard`)."""
+    lines = []
+    for bus_number, multiplexers in sorted(targets.items()):
+        for multiplexer, channels in sorted(multiplexers.items()):
+            listed = " ".join(str(channel) for channel in sorted(channels))
+            lines.append(f"mux {bus_number} 0x{multiplexer:02X} {listed}")
+    return lines
+
+
+def targets_from_lines(lines: Sequence[str | bytes]) -> Targets | None:
+    """What :func:`wiring_lines` wrote; None for a line it did not write."""
+    targets: Targets = {}
+    try:
+        for line in lines:
+            kind, bus, multiplexer, *channels = line.split()
+            if kind not in ("mux", b"mux"):
+                return None
+            targets.setdefault(int(bus), {})[int(multiplexer, 16)] = {int(c) for c in channels}
+    except ValueError:
+        return None
+    return targets
 
 
 # --- the memo ------------------------------------------------------------------------------
@@ -232,18 +265,13 @@ def _read_memo(path: str, source: str) -> tuple[bytes, Targets] | None:
     lines = header.split(b"\n")
     if not (separator and newline) or lines[:2] != [MEMO_FORMAT, b"source " + os.fsencode(source)]:
         return None
-    targets: Targets = {}
     try:
         if int(size) != len(text):
             return None  # cut short: a memo is replaced whole, but a disk may fill up
-        for line in lines[2:]:
-            kind, bus, multiplexer, *channels = line.split()
-            if kind != b"mux":
-                return None
-            targets.setdefault(int(bus), {})[int(multiplexer, 16)] = {int(c) for c in channels}
     except ValueError:
         return None
-    return text, targets
+    targets = targets_from_lines(lines[2:])
+    return None if targets is None else (text, targets)
 
 
 def _write_memo(path: str, source: str, text: bytes, wiring: Targets) -> None:
@@ -251,10 +279,7 @@ def _write_memo(path: str, source: str, text: bytes, wiring: Targets) -> None:
     if "\n" in source:
         return  # the memo is one path per line
     lines = [MEMO_FORMAT, b"source " + os.fsencode(source)]
-    for bus_number, multiplexers in sorted(wiring.items()):
-        for multiplexer, channels in sorted(multiplexers.items()):
-            listed = " ".join(str(channel) for channel in sorted(channels))
-            lines.append(f"mux {bus_number} 0x{multiplexer:02X} {listed}".encode())
+    lines.extend(line.encode() for line in wiring_lines(wiring))
     lines.append(b"layout %d" % len(text))
     temporary = f"{path}.{os.getpid()}.tmp"
     try:

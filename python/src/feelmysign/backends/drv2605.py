@@ -42,6 +42,7 @@ from feelmysign.backends.i2c import I2CBus, is_no_answer, open_smbus
 from feelmysign.backends.tca9548a import CHANNELS, MULTIPLEXER_ADDRESSES, Multiplexers
 from feelmysign.backends.telemetry import ActuatorTelemetry
 from feelmysign.errors import HardwareError, LayoutError, ParameterError
+from feelmysign.guard import Guardian
 from feelmysign.layout import Layout, Wire
 
 # Register map (datasheet names); the ones the all-off writes come from all_off.
@@ -316,6 +317,7 @@ class Drv2605Backend(GridBackend):
         # The bus's lock (feelmysign.backends.bus_lock), taken by the opener: let go on close,
         # after every motor is off.
         self._bus_lock = bus_lock
+        self._guardian: Guardian | None = None
         self.missing: dict[tuple[int, int], str] = {}  # left out at open: actuator -> where
         self._bus = bus
         # Auto-calibration results: restored from ``calibration`` at every open; a chip without
@@ -635,11 +637,22 @@ class Drv2605Backend(GridBackend):
 
     def close(self) -> None:
         self.hold_low()
+        switched_off = False
         try:
             super().close()
+            switched_off = True
         finally:
+            guardian, self._guardian = self._guardian, None
+            if guardian is not None:  # before the bus is let go: then another may drive it
+                guardian.dismiss(switched_off=switched_off and not self._lost)
             if self._bus_lock is not None:
                 self._bus_lock.release()
+
+    def guard(self, guardian: Guardian) -> None:
+        """``guardian`` switches every motor off should this process die or be stopped
+        (:mod:`feelmysign.guard`); dismissed on ``close``, once every motor is off."""
+        self._guardian = guardian
+        guardian.start()
 
     def hold_low(self) -> None:
         """The sleeve is stopping: the enable line low now, and it stays low through the

@@ -25,7 +25,9 @@ from feelmysign.backends.enable import GpiodLine, Line
 from feelmysign.backends.i2c import I2CBus
 from feelmysign.backends.sim import SimBackend
 from feelmysign.backends.telemetry import ActuatorTelemetry
+from feelmysign.early_off import targets_of
 from feelmysign.errors import LayoutError, ParameterError
+from feelmysign.guard import Guardian
 from feelmysign.layout import ButtonLine, Layout
 
 if TYPE_CHECKING:
@@ -105,11 +107,18 @@ def open_backend(
             bus_lock=lock,
         )
         backend.open()
+        if lock is not None and role == "sleeve":
+            # After the first all-off, in the background: off the first command's path.
+            backend.guard(Guardian(targets_of(layout), _fspath(emulate_state)))
     except BaseException:
         if lock is not None:
             lock.release()  # open() failed with every motor it reached off
         raise
     return backend
+
+
+def _fspath(path: str | os.PathLike[str] | None) -> str | None:
+    return None if path is None else os.path.abspath(os.fspath(path))
 
 
 def calibration_store_for(

@@ -52,6 +52,7 @@ from feelmysign.backends.emulated_state import drive_levels
 from feelmysign.bench import _mqtt
 from feelmysign.broker import Broker, Credentials
 from feelmysign.connection import new_client
+from feelmysign.guard import guardian_pids
 from feelmysign.protocol import format_json
 from feelmysign.stroke import Stroke
 from feelmysign.topics import strokes_topic, telemetry_topic
@@ -141,6 +142,10 @@ def _kill_mid_stroke(command: list[str], state: Path, online: _Online, env: dict
         ).wait_for_publish(WAIT_S)
         _wait(lambda: not _all_off(state), "no motor came on")
     finally:
+        # The guardian first (feelmysign.guard): it would switch every motor off itself, and
+        # what is measured here is the restart's own all-off, the last line when both died.
+        for guardian in guardian_pids(process.pid):
+            os.kill(guardian, signal.SIGKILL)
         process.send_signal(signal.SIGKILL)
         process.wait(WAIT_S)
 

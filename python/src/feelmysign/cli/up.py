@@ -21,6 +21,7 @@ from feelmysign.broker import (
 from feelmysign.broker.instance import InstanceLock
 from feelmysign.broker.tls import LanOptions
 from feelmysign.cli._page_server import page_server, qr_text
+from feelmysign.cli.options.emulation import add_emulate_state_option
 from feelmysign.cli.options.lan import add_lan_options, lan_from_args
 from feelmysign.cli.options.layout import add_layout_options, layout_from_args
 from feelmysign.cli.options.parser import Subcommands
@@ -111,6 +112,7 @@ def register(subparsers: Subcommands) -> None:
         help="serve this study file's researcher page at /study (make one with "
         "'feelmysign study new DESIGN.toml --out FILE')",
     )
+    add_emulate_state_option(parser)
     add_layout_options(parser)
     add_wearer_option(parser)
     add_lan_options(parser)
@@ -200,6 +202,7 @@ def _run(
                     options,
                     backend=args.sleeve_backend,
                     record=args.record,
+                    emulate_state=args.emulate_state,
                     on_start=started,
                     # The simulated sleeve has no GPIO: a layout's buttons are emulated.
                     sim_buttons=True,

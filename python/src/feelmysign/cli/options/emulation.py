@@ -1,4 +1,4 @@
-"""``--emulate-state FILE``, for the commands that drive or probe chips: sleeve, scan, buzz."""
+"""``--emulate-state FILE``, for the commands that drive or probe chips: sleeve, up, scan, buzz."""
 
 from __future__ import annotations
 
