@@ -926,9 +926,11 @@ class WindowSimplifier:
     _merger: Merger = field(init=False)
     # The last sample pushed in the path being drawn (None between paths).
     _last: Sample | None = field(init=False, default=None)
+    _rest_ms: float = field(init=False)
 
     def __post_init__(self) -> None:
         params = self.params
+        self._rest_ms = params.rest_ms
         self._core = FitCore(params) if params.least_squares else WindowCore(params)
         self._merger = Merger(
             params.max_error,
@@ -958,16 +960,14 @@ class WindowSimplifier:
         it is (the page does, every 32 ms) leaves a gap. The pen is taken to have stood at the
         sample before until this one, as if sampled there at this one's time: the rest rule
         sees the rest, and the stop is not played as a stroke as long as the stop."""
+        core = self._core
         last = self._last
         self._last = sample
-        if last is not None:
-            still = still_before(last, sample, self._core.pointer_ms(), self.params.rest_ms)
-            if still is not None:
-                return self._push(still) + self._push(sample)
-        return self._push(sample)
-
-    def _push(self, sample: Sample) -> list[Segment]:
-        core = self._core
+        # ``after_stop`` written out (it runs at every sample), from the last time taken
+        # (``core.pointer_ms()``: times never run backwards).
+        if last is not None and 0.0 < self._rest_ms <= sample.t_ms - core._taken[0]:
+            self._last = None
+            return self.push(still_before(last, sample)) + self.push(sample)
         pieces = core.push(sample)
         merger = self._merger
         taken, point = core._taken  # core.last_sample() and merger.sample, inlined: per sample
@@ -1001,26 +1001,27 @@ class WindowSimplifier:
         return out
 
 
-def still_before(last: Sample, sample: Sample, taken_ms: float, rest_ms: float) -> Sample | None:
-    """The pen standing at ``last`` at ``sample``'s time, where ``sample`` comes ``rest_ms`` or
-    more after the last time taken (``taken_ms``: times never run backwards) with the rest rule
-    on; else None (``WindowSimplifier.push``)."""
-    if rest_ms > 0.0 and sample.t_ms - taken_ms >= rest_ms:
-        return Sample(sample.t_ms, last.x, last.y, last.pressure)
-    return None
+def after_stop(gap_ms: float, rest_ms: float) -> bool:
+    """Whether a sample ``gap_ms`` after the last time taken comes after a stop: ``rest_ms``
+    or more, with the rest rule on (``WindowSimplifier.push``, which writes this test out)."""
+    return 0.0 < rest_ms <= gap_ms
+
+
+def still_before(last: Sample, sample: Sample) -> Sample:
+    """The pen standing at ``last`` at ``sample``'s time: what a stop before ``sample`` gives
+    (``after_stop``)."""
+    return Sample(sample.t_ms, last.x, last.y, last.pressure)
 
 
 def taken_samples(samples: list[Sample], rest_ms: float) -> list[Sample]:
     """The samples ``WindowSimplifier`` takes for one path's ``samples``: each, after the pen
-    standing at the one before where a stop left a gap (``still_before``). What its strokes
+    standing at the one before where a stop left a gap (``after_stop``). What its strokes
     cover, for tests and tools that check them against the samples."""
     taken: list[Sample] = []
     taken_ms = -math.inf
     for sample in samples:
-        if taken:
-            still = still_before(taken[-1], sample, taken_ms, rest_ms)
-            if still is not None:
-                taken.append(still)
+        if taken and after_stop(sample.t_ms - taken_ms, rest_ms):
+            taken.append(still_before(taken[-1], sample))
         taken.append(sample)
         taken_ms = max(taken_ms, sample.t_ms)
     return taken
