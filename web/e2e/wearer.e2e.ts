@@ -333,6 +333,14 @@ describe("the wearer's page served by feelmysign up", () => {
     );
     expect(await field.evaluate((input) => (input as HTMLInputElement).type)).toBe("text");
     await screenshot(page, "wearer-phone-dnd-24-hour");
+    // A 12-hour time typed whole reaches the check, which refuses it: not cut to "10:30" (12
+    // hours early).
+    await field.fill("");
+    await field.pressSequentially("10:30 PM");
+    expect(await field.inputValue()).toBe("10:30 PM");
+    await page.locator('[data-testid="dnd-set"]').click();
+    await waitForData(page, '[data-testid="dnd-time-hint"]', "state", "problem");
+    expect((await apiState(page)).controls.do_not_disturb_until_ms).toBeNull();
     await field.fill("");
   });
 
