@@ -124,6 +124,21 @@ def test_a_paused_sleeve_gets_nothing_and_send_says_so_in_one_line(
     _marker_comes_first(broker, sleeve)
 
 
+def test_a_sleeve_that_paused_itself_is_not_said_as_the_wearer_s_pause(
+    broker: Broker, sleeve: StandInSleeve
+) -> None:
+    """Started paused because its settings file could not be read (``paused_by: "sleeve"``):
+    the sender is not told that the wearer paused it."""
+    sleeve.status({**PAUSED, "paused_by": "sleeve"})
+    result = send(broker, "0,0,3,2,500")
+    assert result.returncode == WEARER_HOLD_EXIT, result.stdout + result.stderr
+    errors = [line for line in result.stderr.splitlines() if line.startswith("Error:")]
+    assert len(errors) == 1, result.stderr
+    assert errors[0].startswith("Error: Sleeve 'sleeve1' paused itself: it could not read"), errors
+    assert "The wearer paused" not in result.stderr
+    _marker_comes_first(broker, sleeve)
+
+
 def test_do_not_disturb_names_its_end_and_sends_nothing(
     broker: Broker, sleeve: StandInSleeve
 ) -> None:

@@ -24,8 +24,24 @@ export const NO_CONTROLS: SleeveControls = {
  * a pause's `untilMs`: a "do not disturb" that runs under the pause and still holds after a resume.
  */
 export type WearerHold =
-  | { readonly reason: "paused"; readonly sinceMs: number | null; readonly untilMs: number | null }
+  | {
+      readonly reason: "paused";
+      readonly sinceMs: number | null;
+      readonly untilMs: number | null;
+      /** Paused by the sleeve itself: it could not read its wearer's last choices at start. */
+      readonly bySleeve?: true;
+    }
   | { readonly reason: "do_not_disturb"; readonly untilMs: number };
+
+/** A status's `paused_by` when the sleeve paused itself (Python `wearer_status.PAUSED_BY_SLEEVE`). */
+export const PAUSED_BY_SLEEVE = "sleeve";
+
+/** Who paused, as the notices say it. */
+function pausedWho(hold: { readonly bySleeve?: true }): string {
+  return hold.bySleeve
+    ? "The sleeve paused itself (it could not read its wearer's last choices)"
+    : "The wearer paused the sleeve";
+}
 
 /**
  * What holds the drawing at `nowMs`, or null. Pausing wins over "do not disturb" (it has no end),
@@ -38,7 +54,11 @@ export function wearerHold(
 ): WearerHold | null {
   const dndUntilMs = controls.do_not_disturb_until_ms;
   const untilMs = dndUntilMs !== null && dndUntilMs > nowMs ? dndUntilMs : null;
-  if (controls.paused) return { reason: "paused", sinceMs, untilMs };
+  if (controls.paused) {
+    return controls.paused_by === PAUSED_BY_SLEEVE
+      ? { reason: "paused", sinceMs, untilMs, bySleeve: true }
+      : { reason: "paused", sinceMs, untilMs };
+  }
   if (untilMs !== null) return { reason: "do_not_disturb", untilMs };
   return null;
 }
@@ -52,8 +72,8 @@ export function isWearerRefusal(reason: string): reason is "paused" | "do_not_di
 export function holdHeadline(hold: WearerHold, nowMs: number): string {
   if (hold.reason === "paused") {
     return hold.sinceMs === null
-      ? "The wearer paused the sleeve."
-      : `The wearer paused the sleeve ${atClock(hold.sinceMs, nowMs)}.`;
+      ? `${pausedWho(hold)}.`
+      : `${pausedWho(hold)} ${atClock(hold.sinceMs, nowMs)}.`;
   }
   return `The wearer asked not to be disturbed until ${untilClock(hold.untilMs, nowMs)}.`;
 }
@@ -80,7 +100,8 @@ export function holdDetail(hold: WearerHold, heldStrokes: number, nowMs: number)
 
 /** Why strokes are held, in a few words (the legend, the counts). */
 export function holdReason(hold: WearerHold): string {
-  return hold.reason === "paused" ? "the wearer paused" : "the wearer asked not to be disturbed";
+  if (hold.reason === "paused") return hold.bySleeve ? "the sleeve paused itself" : "the wearer paused";
+  return "the wearer asked not to be disturbed";
 }
 
 /** A hold that ended: `ranOut` when a "do not disturb" reached its time (not ended by the wearer). */
@@ -119,8 +140,8 @@ export function holdChangeNote(
   if (after.reason === "paused") {
     if (before?.reason === "paused") return null;
     return after.untilMs === null
-      ? "The wearer paused the sleeve: what you draw is held here until the wearer resumes."
-      : "The wearer paused the sleeve: what you draw is held here until the wearer resumes and " +
+      ? `${pausedWho(after)}: what you draw is held here until the wearer resumes.`
+      : `${pausedWho(after)}: what you draw is held here until the wearer resumes and ` +
           `do not disturb has ended (it runs until ${untilClock(after.untilMs, nowMs)}).`;
   }
   const until = untilClock(after.untilMs, nowMs);

@@ -7,6 +7,7 @@ import {
   holdChangeNote,
   holdDetail,
   holdHeadline,
+  holdReason,
   NO_CONTROLS,
   playedIntensity,
   wearerHold,
@@ -134,5 +135,21 @@ describe("the page's words", () => {
     expect(playedIntensity(0.8, 0.6)).toBe(0.6);
     expect(playedIntensity(0.5, 0.6)).toBe(0.5);
     expect(playedIntensity(0.8, null)).toBe(0.8);
+  });
+});
+
+describe("a sleeve that paused itself", () => {
+  it("is not said as the wearer's pause", () => {
+    // Started paused because its settings file could not be read (`paused_by: "sleeve"`).
+    const controls = { paused: true, paused_by: "sleeve", ceiling: 0.05, do_not_disturb_until_ms: null };
+    const hold = wearerHold(controls, 1_000);
+    expect(hold).toEqual({ reason: "paused", sinceMs: null, untilMs: null, bySleeve: true });
+    expect(holdHeadline(hold!, 1_000)).toBe(
+      "The sleeve paused itself (it could not read its wearer's last choices).",
+    );
+    expect(holdChangeNote(null, hold, false, 1_000)).toMatch(/^The sleeve paused itself \(/);
+    expect(holdReason(hold!)).toBe("the sleeve paused itself");
+    const byWearer = wearerHold({ ...controls, paused_by: "page" }, 1_000);
+    expect(holdHeadline(byWearer!, 1_000)).toBe("The wearer paused the sleeve.");
   });
 });

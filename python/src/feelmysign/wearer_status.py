@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 
 # Refusals that are the wearer's choice, not the sender's fault: waiting is what to do.
 WEARER_REASONS = frozenset({PAUSED, DO_NOT_DISTURB})
+# A status's ``paused_by`` when the sleeve paused itself (feelmysign.sleeve.controls.BY_SLEEVE).
+PAUSED_BY_SLEEVE = "sleeve"
 
 
 @dataclass(frozen=True)
@@ -30,6 +32,9 @@ class WearerHold:
 
     reason: Literal["paused", "do_not_disturb"]
     until_ms: int | None = None
+    # Paused by the sleeve itself (``paused_by: "sleeve"``): it could not read its wearer's
+    # last choices at start, so it started paused and at the least strength.
+    by_sleeve: bool = False
 
 
 def wearer_hold(controls: StatusControls | None, now_ms: int | None = None) -> WearerHold | None:
@@ -39,7 +44,7 @@ def wearer_hold(controls: StatusControls | None, now_ms: int | None = None) -> W
     if controls is None:
         return None
     if controls.paused:
-        return WearerHold("paused")
+        return WearerHold("paused", by_sleeve=controls.paused_by == PAUSED_BY_SLEEVE)
     until_ms = controls.do_not_disturb_until_ms
     now = int(time.time() * 1000) if now_ms is None else now_ms
     if until_ms is not None and until_ms > now:
@@ -54,6 +59,13 @@ def clock_time(ms: int) -> str:
 
 def hold_sentence(hold: WearerHold, sleeve_id: str) -> str:
     """What holds the sleeve and what to do, in one sentence (for ``send``)."""
+    if hold.reason == "paused" and hold.by_sleeve:
+        return (
+            f"Sleeve {sleeve_id!r} paused itself: it could not read its wearer's last choices "
+            "(its settings file), so it started paused and at the least strength, and refuses "
+            "every stroke until the wearer resumes it (their button or the wearer's page). "
+            "Nothing was sent; send again once the wearer has resumed."
+        )
     if hold.reason == "paused":
         return (
             f"The wearer paused sleeve {sleeve_id!r}: it plays nothing and refuses every stroke "

@@ -299,11 +299,17 @@ def _announce(
 def _controls_at_start(sleeve: Sleeve) -> str:
     """The wearer's choices kept from before (a pause, a ceiling, do not disturb): said, so
     that whoever runs up knows why the sleeve plays nothing, or less; "" when none."""
-    from feelmysign.sleeve.controls import NOT_PAUSED, describe
+    from feelmysign.sleeve.controls import BY_SLEEVE, NOT_PAUSED, describe
 
     state = sleeve.controls.state()
     if state == NOT_PAUSED:
         return ""
+    if state.paused and state.paused_by == BY_SLEEVE:
+        return (
+            "  The sleeve started paused at the least strength: it could not read the wearer's "
+            "last choices (its settings file); the wearer's page resumes it and sets the "
+            "strength again\n"
+        )
     return (
         f"  The wearer's choices kept from before: {describe(state)} (the wearer's page "
         "changes them)\n"

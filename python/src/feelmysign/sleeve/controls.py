@@ -45,6 +45,7 @@ from feelmysign.input_files import loads_json, read_text
 from feelmysign.player import Refusal
 from feelmysign.protocol import DO_NOT_DISTURB, PAUSED
 from feelmysign.state_home import state_path
+from feelmysign.wearer_status import PAUSED_BY_SLEEVE
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +63,7 @@ MAX_DO_NOT_DISTURB_MS = 24 * 3600 * 1000  # one night and day: longer is a mista
 # Who changed the controls: the sleeve's button, the wearer's page, ``feelmysign wearer``.
 # ``sleeve``: the sleeve paused itself at start, its controls file unreadable.
 BY = ("button", "page", "cli")
-BY_SLEEVE = "sleeve"
+BY_SLEEVE = PAUSED_BY_SLEEVE
 
 NOT_PAUSED = ControlsState(paused=False)
 
