@@ -472,6 +472,9 @@ def test_up_with_a_wearer_file_names_it_and_its_limits_in_the_banner(tmp_path: P
     finally:
         _interrupt(up)
     banner = seen[next(i for i, line in enumerate(seen) if line == "feelmysign is up.") :]
+    assert "  Sleeve:      sleeve1 (simulated: no motors; --sleeve-backend drv2605 drives" in (
+        "".join(banner)
+    ), banner
     said = [line for line in banner if line.startswith("  Wearer:")]
     assert said == [
         f"  Wearer:      P-LIMITS's limits from {wearer}: the sleeve asks senders for strokes "

@@ -228,6 +228,8 @@ def test_the_sleeve_of_up_on_an_emulated_bus_is_guarded_too(tmp_path: Path) -> N
     assert set(drive_levels(state).values()) == {0.0}
     assert process_state(guardian) is None
     assert guardians_anywhere(up.pid) == []
+    # The banner says what drives the motors: not "simulated".
+    assert "  Sleeve:      sleeve1 (DRV2605L chips over I2C)\n" in output, "".join(output)
 
 
 GUARDIAN_PROBE = """

@@ -192,6 +192,7 @@ def _run(
                 threading.Thread(
                     target=_announce,
                     args=(sleeve, page_url, broker, api is not None, wearer_url, limits),
+                    kwargs={"backend": args.sleeve_backend},
                     daemon=True,
                 ).start()
 
@@ -265,6 +266,8 @@ def _announce(
     study: bool = False,
     wearer_url: str | None = None,
     limits: str = "",
+    *,
+    backend: str = "sim",
 ) -> None:
     if not sleeve.connected.wait(15):
         print("The sleeve has not reached the broker after 15 s; see the log above.", flush=True)
@@ -285,7 +288,7 @@ def _announce(
         + (f"  Study:       {url.split('?')[0]}study\n" if study else "")
         + lan
         + _for_the_wearer(wearer_url, lan=bool(lan))
-        + f"  Sleeve:      {c.sleeve_id} (simulated unless --sleeve-backend drv2605)\n"
+        + f"  Sleeve:      {c.sleeve_id} ({_sleeve_kind(backend)})\n"
         + _controls_at_start(sleeve)
         + limits
         + f"  Broker:      {c.mqtt_url} and {c.ws_url}\n"
@@ -294,6 +297,15 @@ def _announce(
         f"Press Ctrl-C to stop.",
         flush=True,
     )
+
+
+def _sleeve_kind(backend: str) -> str:
+    """What drives the motors, for the banner."""
+    if backend == "sim":
+        return "simulated: no motors; --sleeve-backend drv2605 drives DRV2605L chips"
+    if backend == "drv2605":
+        return "DRV2605L chips over I2C"
+    return f"the {backend} backend"
 
 
 def _controls_at_start(sleeve: Sleeve) -> str:
