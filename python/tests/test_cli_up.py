@@ -383,12 +383,7 @@ def test_up_prints_one_line_per_drawing_and_records_whose_each_change_is(
         assert f"The sleeve played 4 of 4 strokes ({caught_up[1]})" in sent.stdout, sent.stdout
         assert sent.stdout.count(" ms shorter to catch up\n") == 3, sent.stdout  # per stroke
     finally:
-        up.send_signal(signal.SIGINT)
-        try:
-            up.wait(timeout=WAIT_S)
-        finally:
-            if up.poll() is None:
-                up.kill()
+        _interrupt(up)
     assert up.returncode == 0, seen
     changes = [json.loads(line) for line in record.read_text(encoding="utf-8").splitlines()]
     played = [c for c in changes if c["drawing"] is not None]
