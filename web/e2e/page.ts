@@ -154,12 +154,14 @@ export async function drawWithTouch(
 export async function screenshot(page: Page, name: string): Promise<string> {
   mkdirSync(RESULTS_DIR, { recursive: true });
   // A sheet sliding in would be caught half transparent: wait for running animations to end.
+  // One cancelled meanwhile (the page replaced it) rejects its `finished` with an AbortError:
+  // it has ended too.
   await page.evaluate(() =>
     Promise.all(
       document
         .getAnimations()
         .filter((animation) => animation.effect?.getComputedTiming().iterations !== Infinity)
-        .map((animation) => animation.finished),
+        .map((animation) => animation.finished.catch(() => animation)),
     ),
   );
   const path = join(RESULTS_DIR, `${name}.png`);
