@@ -543,6 +543,14 @@ def _await_sleeve(
         outcome.wait_answered(min(answered_by_s, time.monotonic() + CUT_OFF_CHECK_S))
         if outcome.summary().unheard == []:
             break
+    # Return once the last stroke has been felt, not when it started: a second send right
+    # after this one then starts on a sleeve with nothing left of this drawing. A cut-off
+    # meanwhile (a block during the last stroke) ends the wait: a cut of it could not reach us.
+    felt_by_s = outcome.felt_by_s()
+    if felt_by_s is not None:
+        until_s = time.monotonic() + min(MAX_FELT_WAIT_S, max(0.0, felt_by_s - time.monotonic()))
+        while cut_off() is None and time.monotonic() < until_s:
+            time.sleep(min(CUT_OFF_CHECK_S, max(0.0, until_s - time.monotonic())))
     why = cut_off()
     if why is not None:
         print(
@@ -551,11 +559,6 @@ def _await_sleeve(
             flush=True,
         )
         return 1
-    # Return once the last stroke has been felt, not when it started: a second send right
-    # after this one then starts on a sleeve with nothing left of this drawing.
-    felt_by_s = outcome.felt_by_s()
-    if felt_by_s is not None:
-        time.sleep(min(MAX_FELT_WAIT_S, max(0.0, felt_by_s - time.monotonic())))
     summary = outcome.summary()
     line = summary.text()
     if summary.unheard:
